@@ -1,0 +1,29 @@
+// CPU reference decoder: reconstructs a conventional frame from a CoNUS image. A view is a
+// rectangle of the undistorted image plane rendered at width x height; each output pixel at (u,v)
+// takes the CoNUS image at SM(u,v) (Equation 1), bilinearly. Where the output is coarser than the
+// CoNUS image there (zoomed out), several taps over the pixel's footprint are averaged.
+#pragma once
+
+#include "conus/codec/sampling_map.h"
+#include "conus/format/error.h"
+#include "conus/format/image.h"
+
+namespace conus::codec {
+
+struct View {
+    double u0 = 0, v0 = 0, u1 = 1, v1 = 1;  // undistorted rectangle; may extend past [0,1]^2 (edge clamp)
+};
+
+struct DecodeOptions {
+    View view;
+    int width = 0, height = 0;  // output size
+    int threads = 0;
+    ProgressFn progress;
+};
+
+format::Image decodeImage(const format::Image& conus, const SamplingMap& map, const DecodeOptions& options);
+
+// The plain baseline: the same view of a uniform image by bilinear resampling.
+format::Image resizeBilinear(const format::Image& image, const View& view, int width, int height, int threads = 0);
+
+}  // namespace conus::codec

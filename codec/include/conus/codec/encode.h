@@ -1,0 +1,27 @@
+// CPU reference encoder: renders a CoNUS image from a conventional image through a sampling map.
+// A CoNUS pixel centred at distorted p_d takes the source at undistorted SM^-1(p_d), filtered over
+// the pixel's footprint in the source: the footprint follows the local Jacobian of the map, so
+// there is no aliasing where the map compresses and no blur where it magnifies.
+//
+// Shared rules: sources are float images with any channels (alpha and Z preserved as channels);
+// threads = 0 uses every core; sizes are checked (conus::Error InvalidArgument / LimitExceeded).
+#pragma once
+
+#include "conus/codec/sampling_map.h"
+#include "conus/format/error.h"
+#include "conus/format/image.h"
+
+namespace conus::codec {
+
+struct EncodeOptions {
+    int width = 0, height = 0;  // CoNUS image size
+    int threads = 0;
+    ProgressFn progress;
+};
+
+format::Image encodeImage(const format::Image& source, const SamplingMap& map, const EncodeOptions& options);
+
+// The plain baseline: box-filter area downsample to width x height (exact area weights).
+format::Image areaDownsample(const format::Image& source, int width, int height, int threads = 0);
+
+}  // namespace conus::codec

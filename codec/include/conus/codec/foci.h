@@ -1,0 +1,42 @@
+// Circular focus maps (spec/ "foci"): a focus u,v,r,k magnifies a disc of radius r (a fraction of
+// the image width, circular in pixels) so that the linear sampling rate at its centre is k times
+// the rate far from every focus. Density inside the disc is k^2 times the context density and
+// falls smoothly to it between r and 2r.
+//
+// Two ways to build several foci:
+// - Density (default): one map from the joint density of all foci (density_map.h); the region
+//   between foci is squeezed least.
+// - Add: the paper's composition: each focus's own map, displacement vectors added; if the sum
+//   folds, displacements are scaled down until every cell is valid.
+#pragma once
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "conus/codec/sampling_map.h"
+
+namespace conus::codec {
+
+struct Focus {
+    double u = 0.5, v = 0.5, r = 0.1, k = 2;
+};
+
+enum class FociComposition { Density, Add };
+
+struct FociOptions {
+    int columns = 65, rows = 65;  // grid of the built map
+    double aspect = 1.0;          // image width / height: makes a focus circular in pixels
+    FociComposition composition = FociComposition::Density;
+};
+
+// Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r <= 0 or k < 1 or k > 64.
+SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options = {});
+
+// The target density (before normalization) of a set of foci at undistorted p.
+double fociDensity(std::span<const Focus> foci, double aspect, double u, double v);
+
+// "u,v,r,k" -> Focus; throws conus::Error(InvalidArgument) with the reason.
+Focus parseFocus(const std::string& text);
+
+}  // namespace conus::codec

@@ -1,0 +1,46 @@
+// Private: split rows across threads. Work is handed out in small chunks so that rows of uneven
+// cost (a focus in the middle of the image) keep both cores busy.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace conus::codec::detail {
+
+inline int threadCount(int requested) {
+    if (requested > 0) return requested;
+    return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// Calls fn(y0, y1) for disjoint row ranges covering [0, rows). Rethrows the first exception.
+template <typename Fn>
+void parallelRows(int rows, int threads, Fn&& fn, int chunk = 8) {
+    const int n = std::min(threadCount(threads), std::max(1, (rows + chunk - 1) / chunk));
+    if (n <= 1) {
+        fn(0, rows);
+        return;
+    }
+    std::atomic<int> next{0};
+    std::exception_ptr error;
+    std::mutex errorMutex;
+    auto worker = [&] {
+        try {
+            for (int y0; (y0 = next.fetch_add(chunk)) < rows;) fn(y0, std::min(rows, y0 + chunk));
+        } catch (...) {
+            std::lock_guard lock(errorMutex);
+            if (!error) error = std::current_exception();
+            next = rows;
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < n; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+}
+
+}  // namespace conus::codec::detail

@@ -1,0 +1,105 @@
+// The CoNUS container, version 1 (spec/conus-format.md): an OpenEXR multipart file with a `conus`
+// part (the CoNUS image, an ordinary EXR image to any tool) and a `samplingmap` part (the grid of
+// distorted node positions), plus attributes for analytic map parameters, camera, source size and
+// data kind. This header is the whole model; no OpenEXR type appears here.
+//
+// Rules shared by the functions below:
+// - writeConusFile validates first and writes nothing for an invalid file; it writes to a
+//   temporary file in the destination's folder and renames it, so no half-written file is left.
+// - readConusFile checks every size against ReadLimits before allocating, and throws conus::Error:
+//   NotConus for an EXR without a `conus` part, Corrupt for a damaged file or a broken V-rule,
+//   LimitExceeded for sizes beyond the limits, Io when the file cannot be opened.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "conus/format/image.h"
+#include "conus/format/validation.h"
+
+namespace conus::format {
+
+inline constexpr int kFormatVersion = 1;
+inline constexpr const char* kConusPartName = "conus";
+inline constexpr const char* kMapPartName = "samplingmap";
+
+enum class PixelType { Half, Float };         // storage type of the image channels (Z is always float)
+enum class Compression { None, Zip, Piz, Dwaa };
+enum class DataKind { Image, HeightField, DepthImage };
+enum class DepthKind { None, CameraDepth, Height };  // what a `Z` channel holds
+
+// The sampling map's nodes: node (i,j), i the column, j the row, sits at undistorted
+// (i/(columns-1), j/(rows-1)) and stores its distorted location (xy[2k], xy[2k+1]), k = j*columns+i.
+struct GridNodes {
+    int columns = 0;
+    int rows = 0;
+    std::vector<float> xy;
+};
+
+struct FocusParams {
+    double u = 0, v = 0;  // centre, normalized image-plane coordinates
+    double r = 0;         // radius as a fraction of the image width (circular in pixels)
+    double k = 1;         // linear magnification at the centre relative to far context
+};
+
+// How a map was built, kept so the same map can be rebuilt and shown (focus outlines, ground
+// plane). The grid in `samplingmap` is always the authority for decoding.
+struct AnalyticMap {
+    std::string kind;                       // "foci" or "ground" (spec/ lists the kinds)
+    std::vector<FocusParams> foci;          // kind "foci"
+    std::string composition;                // kind "foci": "density" or "add"
+    std::map<std::string, double> scalars;  // other kinds' named parameters
+};
+
+struct Camera {
+    std::string projection = "perspective";  // "perspective" or "orthographic"
+    std::array<float, 16> worldToCamera{};    // row-major, as EXR's standard attribute (M44f)
+    std::array<float, 16> worldToNDC{};
+};
+
+struct DepthInfo {
+    DepthKind kind = DepthKind::None;
+    std::string units = "";  // e.g. "m"
+    float near = 0, far = 0;  // range of valid depths/heights
+};
+
+struct ConusFile {
+    Image image;                         // the CoNUS image (channels incl. optional Z)
+    PixelType pixelType = PixelType::Half;
+    Compression compression = Compression::Zip;
+    int sourceWidth = 0, sourceHeight = 0;  // size of the conventional frame it encodes
+    DataKind dataKind = DataKind::Image;
+    GridNodes map;
+    std::optional<AnalyticMap> analytic;
+    std::optional<Camera> camera;
+    DepthInfo depth;
+    std::string software;  // free text; the writer fills "conus <version>" when empty
+};
+
+struct ReadLimits {
+    std::int64_t maxPixels = kMaxImagePixels;  // CoNUS image pixels
+    int maxMapSide = 4097;                     // sampling-map nodes per side
+    int maxChannels = 64;
+};
+
+void writeConusFile(const std::string& path, const ConusFile& file);
+ConusFile readConusFile(const std::string& path, const ReadLimits& limits = {});
+
+// Every violated rule of the file at `path` (never throws for bad content).
+ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits = {});
+// Every violated rule of an in-memory file (structure, attributes, map geometry).
+ValidationReport validateConusFile(const ConusFile& file);
+// The sampling-map rules alone (node count, finite values, boundary, strictly convex cells with
+// the identity's orientation). Used by codec::SamplingMap so the rules live in one place.
+ValidationReport validateGrid(const GridNodes& grid);
+
+const char* toString(PixelType);
+const char* toString(Compression);
+const char* toString(DataKind);
+const char* toString(DepthKind);
+
+}  // namespace conus::format

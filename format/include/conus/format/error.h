@@ -1,0 +1,33 @@
+// The one error type of the CoNUS libraries. Libraries never print and never exit: they throw
+// conus::Error (with a code a caller can branch on) or return a ValidationReport (validation.h).
+#pragma once
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+namespace conus {
+
+enum class ErrorCode {
+    InvalidArgument,  // a caller passed a value outside the documented range
+    Io,               // a file could not be opened, read, written or renamed
+    NotConus,         // a readable EXR file that is not a CoNUS file (no `conus` part)
+    Corrupt,          // a file that breaks the format: damaged EXR, or a CoNUS rule (spec V-rules)
+    LimitExceeded,    // a size beyond the reader's limits (checked before anything is allocated)
+    InvalidMap,       // a sampling map that is folded, degenerate, NaN or off its boundary
+    Unsupported,      // a valid request this build cannot serve
+};
+
+class Error : public std::runtime_error {
+public:
+    Error(ErrorCode code, const std::string& message) : std::runtime_error(message), m_code(code) {}
+    ErrorCode code() const noexcept { return m_code; }
+
+private:
+    ErrorCode m_code;
+};
+
+// Long operations report progress in [0,1] through this callback; an empty one is allowed.
+using ProgressFn = std::function<void(double fraction)>;
+
+}  // namespace conus
