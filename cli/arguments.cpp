@@ -1,0 +1,59 @@
+#include "arguments.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <vector>
+
+#include "conus/format/error.h"
+
+namespace conus::cli {
+namespace {
+
+[[noreturn]] void invalid(const std::string& what) { throw Error(ErrorCode::InvalidArgument, what); }
+
+std::vector<double> parseNumbers(const std::string& text, char separator) {
+    std::vector<double> values;
+    std::stringstream stream(text);
+    std::string item;
+    while (std::getline(stream, item, separator)) {
+        char* end = nullptr;
+        const double value = std::strtod(item.c_str(), &end);
+        if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(value))
+            invalid("'" + text + "': '" + item + "' is not a number");
+        values.push_back(value);
+    }
+    return values;
+}
+
+}  // namespace
+
+Size parseSize(const std::string& text) {
+    const auto values = parseNumbers(text, 'x');
+    if (values.size() != 2 || text.back() == 'x') invalid("size '" + text + "' is not of the form WxH");
+    for (double v : values)
+        if (v != std::floor(v) || v < 1 || v > format::kMaxImageSide)
+            invalid("size '" + text + "': each side must be a whole number in [1, 65536]");
+    return {static_cast<int>(values[0]), static_cast<int>(values[1])};
+}
+
+codec::View parseView(const std::string& text) {
+    const auto values = parseNumbers(text, ',');
+    if (values.size() != 4) invalid("view '" + text + "' is not of the form u0,v0,u1,v1");
+    codec::View view{values[0], values[1], values[2], values[3]};
+    if (!(view.u0 < view.u1) || !(view.v0 < view.v1))
+        invalid("view '" + text + "' is empty: it needs u0 < u1 and v0 < v1");
+    if (std::abs(view.u0) > 1e3 || std::abs(view.u1) > 1e3 || std::abs(view.v0) > 1e3 || std::abs(view.v1) > 1e3)
+        invalid("view '" + text + "' is absurdly far from the image ([0,1] is the whole image)");
+    return view;
+}
+
+format::Compression parseCompression(const std::string& text) {
+    if (text == "zip") return format::Compression::Zip;
+    if (text == "piz") return format::Compression::Piz;
+    if (text == "dwaa") return format::Compression::Dwaa;
+    if (text == "none") return format::Compression::None;
+    invalid("compression '" + text + "' is not one of zip, piz, dwaa, none");
+}
+
+}  // namespace conus::cli

@@ -1,0 +1,20 @@
+// Parsing of the values the subcommands share: sizes "WxH", views "u0,v0,u1,v1", enumerations.
+// Each parser throws conus::Error(InvalidArgument) with a reason that names the bad text.
+#pragma once
+
+#include <string>
+
+#include "conus/codec/decode.h"
+#include "conus/format/container.h"
+
+namespace conus::cli {
+
+struct Size {
+    int width = 0, height = 0;
+};
+
+Size parseSize(const std::string& text);        // "1024x768"; each side in [1, 65536]
+codec::View parseView(const std::string& text);  // "u0,v0,u1,v1" with u0 < u1, v0 < v1, all finite
+format::Compression parseCompression(const std::string& text);  // zip | piz | dwaa | none
+
+}  // namespace conus::cli

@@ -1,0 +1,60 @@
+// conus decode: reconstruct a conventional frame (any view rectangle, any size) from a CoNUS file.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "arguments.h"
+#include "commands.h"
+#include "conus/codec/decode.h"
+#include "conus/format/error.h"
+#include "image_io.h"
+#include "progress.h"
+
+namespace conus::cli {
+
+Command addDecodeCommand(CLI::App& root) {
+    struct Options {
+        std::string input, output, viewText, sizeText;
+    };
+    auto options = std::make_shared<Options>();
+    CLI::App* command = root.add_subcommand(
+        "decode", "Reconstruct a conventional frame from a CoNUS file: zoom and pan anywhere");
+    command->add_option("input", options->input, "CoNUS file (.exr)")->required();
+    command->add_option("-o,--output", options->output, "output image (.png, .exr, .tif, .jpg)")->required();
+    command->add_option("--view", options->viewText,
+                        "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image)");
+    command->add_option("--size", options->sizeText,
+                        "output size WxH (default: the view at the source's resolution)");
+    return {command, [options] {
+                const format::ConusFile file = format::readConusFile(options->input);
+                const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
+                codec::DecodeOptions decode;
+                if (!options->viewText.empty()) decode.view = parseView(options->viewText);
+                if (!options->sizeText.empty()) {
+                    const Size size = parseSize(options->sizeText);
+                    decode.width = size.width;
+                    decode.height = size.height;
+                } else {
+                    const double w = std::round((decode.view.u1 - decode.view.u0) * file.sourceWidth);
+                    const double h = std::round((decode.view.v1 - decode.view.v0) * file.sourceHeight);
+                    if (w > format::kMaxImageSide || h > format::kMaxImageSide)
+                        throw Error(ErrorCode::InvalidArgument,
+                                    "the view at source resolution would be " + std::to_string(long(w)) + "x" +
+                                        std::to_string(long(h)) + " pixels; give --size");
+                    decode.width = std::max(1, static_cast<int>(w));
+                    decode.height = std::max(1, static_cast<int>(h));
+                }
+                Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
+                decode.progress = progress.callback();
+                const format::Image frame = codec::decodeImage(file.image, map, decode);
+                progress.done();
+                writeImage(options->output, frame);
+                std::printf("wrote %s: %dx%d view [%g,%g]-[%g,%g]\n", options->output.c_str(), frame.width,
+                            frame.height, decode.view.u0, decode.view.v0, decode.view.u1, decode.view.v1);
+                return 0;
+            }};
+}
+
+}  // namespace conus::cli

@@ -1,0 +1,141 @@
+// conus demo: the main job on a built-in input. Encodes a 4096^2 picture with two foci at 1/16 of
+// its pixels, decodes zoomed views of each focus and the whole frame, writes PNGs side by side with
+// the uniform image of the same pixel count, and prints the PSNR of every view for both.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "commands.h"
+#include "conus/codec/decode.h"
+#include "conus/codec/encode.h"
+#include "conus/codec/foci.h"
+#include "conus/codec/metrics.h"
+#include "demo_picture.h"
+#include "encoding.h"
+#include "image_io.h"
+#include "pictures.h"
+#include "progress.h"
+
+namespace conus::cli {
+namespace {
+
+// The source pixels under a view whose edges fall on pixel edges.
+format::Image crop(const format::Image& source, int x0, int y0, int width, int height) {
+    format::Image out = format::makeImage(width, height, source.channels);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            for (int c = 0; c < source.channelCount(); ++c) out.at(x, y, c) = source.at(x0 + x, y0 + y, c);
+    return out;
+}
+
+}  // namespace
+
+Command addDemoCommand(CLI::App& root) {
+    struct Options {
+        std::string out = "demo-out", input;
+        std::vector<std::string> foci;
+        int size = 4096;
+        double k = 4;
+    };
+    auto options = std::make_shared<Options>();
+    CLI::App* command = root.add_subcommand(
+        "demo", "The main job on a built-in picture: CoNUS vs uniform at 1/16 of the pixels, with PSNR");
+    command->add_option("--out", options->out, "folder for the pictures and files (default demo-out)");
+    command->add_option("--size", options->size, "side of the built-in picture (default 4096)")
+        ->check(CLI::Range(256, 8192));
+    command->add_option("--k", options->k, "magnification of both foci (default 4)")->check(CLI::Range(1.0, 8.0));
+    command->add_option("--input", options->input,
+                        "run the same comparison on your own picture instead of the built-in one");
+    command->add_option("--focus", options->foci, "with --input: focus u,v,r,k (repeatable; default: the centre)");
+    return {command, [options] {
+                namespace fs = std::filesystem;
+                fs::create_directories(options->out);
+                const fs::path out(options->out);
+                format::Image source;
+                std::vector<codec::Focus> foci;
+                if (options->input.empty()) {
+                    Progress picture("build the " + std::to_string(options->size) + "x" +
+                                     std::to_string(options->size) + " demo picture");
+                    source = makeDemoPicture(options->size);
+                    picture.done();
+                    foci = {{0.28, 0.30, 0.07, options->k}, {0.70, 0.66, 0.07, options->k}};
+                } else {
+                    source = readImage(options->input);
+                    for (const auto& text : options->foci) foci.push_back(codec::parseFocus(text));
+                    if (foci.empty()) foci.push_back({0.5, 0.5, 0.1, options->k});
+                }
+                const int w = source.width, h = source.height;
+                Progress building("build the sampling map");
+                codec::FociOptions fociOptions;
+                fociOptions.aspect = double(w) / h;
+                const codec::SamplingMap map = codec::buildFociMap(foci, fociOptions);
+                building.done();
+                format::AnalyticMap analytic{"foci", {}, "density", {}};
+                for (const auto& f : foci) analytic.foci.push_back({f.u, f.v, f.r, f.k});
+
+                const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
+                format::ConusFile conus = encodeToConus(source, map, size, analytic);
+                format::ConusFile uniform =
+                    encodeToConus(source, codec::SamplingMap::identity(2, 2), size, std::nullopt);
+                format::writeConusFile((out / "conus.exr").string(), conus);
+                format::writeConusFile((out / "uniform.exr").string(), uniform);
+                writeImage((out / "conus.png").string(), conus.image);
+                writeImage((out / "uniform.png").string(), uniform.image);
+                const double shrink = std::min(1.0, 1024.0 / std::max(w, h));
+                const int pw = std::max(16, int(w * shrink)), ph = std::max(16, int(h * shrink));
+                writeImage((out / "density.png").string(), densityPicture(map, pw, ph, 64, &analytic));
+                const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
+
+                struct ViewCase {
+                    std::string name, label;
+                    int x0, y0, width, height;  // source pixels
+                    int outWidth, outHeight;    // size of the picture written
+                };
+                std::vector<ViewCase> views;
+                for (std::size_t i = 0; i < foci.size(); ++i) {
+                    // The focus disc's bounding square (r is a fraction of the width), kept inside the image.
+                    const int half = std::max(1, static_cast<int>(std::lround(foci[i].r * w)));
+                    const int x0 = std::clamp(static_cast<int>(std::lround(foci[i].u * w)) - half, 0, std::max(0, w - 2 * half));
+                    const int y0 = std::clamp(static_cast<int>(std::lround(foci[i].v * h)) - half, 0, std::max(0, h - 2 * half));
+                    const int vw = std::min(w, 2 * half), vh = std::min(h, 2 * half);
+                    std::string label = "focus " + std::to_string(i + 1);
+                    if (options->input.empty()) label += i == 0 ? " (fine print)" : " (zone plate)";
+                    views.push_back({"focus" + std::to_string(i + 1), label, x0, y0, vw, vh, vw, vh});
+                }
+                views.push_back({"frame", "whole frame", 0, 0, w, h, std::max(1, int(w * shrink)), std::max(1, int(h * shrink))});
+
+                std::printf("\nCoNUS demo: %dx%d %s -> %dx%d (1/16 of the pixels), %zu foci:", w, h,
+                            options->input.empty() ? "built-in picture" : options->input.c_str(), size.width,
+                            size.height, foci.size());
+                for (const auto& f : foci) std::printf(" (%g,%g,r=%g,k=%g)", f.u, f.v, f.r, f.k);
+                std::printf("\n");
+                std::printf("%-22s %12s %14s %8s\n", "view", "CoNUS PSNR", "uniform PSNR", "gain");
+                for (const auto& v : views) {
+                    codec::DecodeOptions decode;
+                    decode.view = {double(v.x0) / w, double(v.y0) / h, double(v.x0 + v.width) / w,
+                                   double(v.y0 + v.height) / h};
+                    decode.width = v.width;
+                    decode.height = v.height;
+                    const format::Image reference = crop(source, v.x0, v.y0, v.width, v.height);
+                    const format::Image fromConus = codec::decodeImage(conus.image, map, decode);
+                    const format::Image fromUniform = codec::decodeImage(uniform.image, identity, decode);
+                    const double a = codec::psnr(reference, fromConus), b = codec::psnr(reference, fromUniform);
+                    std::printf("%-22s %9.2f dB %11.2f dB %+7.2f\n", v.label.c_str(), a, b, a - b);
+                    std::vector<format::Image> strip{reference, fromConus, fromUniform};
+                    if (v.outWidth != v.width)
+                        for (auto& image : strip) image = codec::areaDownsample(image, v.outWidth, v.outHeight);
+                    writeImage((out / ("view-" + v.name + ".png")).string(), sideBySide(strip));
+                }
+                std::printf("\nwrote %s/: conus.exr, uniform.exr, conus.png, uniform.png, density.png,\n"
+                            "  view-focus1.png, view-focus2.png, view-frame.png (each: source | CoNUS | uniform)\n",
+                            options->out.c_str());
+                return 0;
+            }};
+}
+
+}  // namespace conus::cli

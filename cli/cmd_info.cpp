@@ -1,0 +1,117 @@
+// conus info: what a CoNUS file holds, as text or JSON, and a picture of its sampling density.
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <memory>
+
+#include "commands.h"
+#include "conus/codec/sampling_map.h"
+#include "conus/format/container.h"
+#include "image_io.h"
+#include "pictures.h"
+
+namespace conus::cli {
+
+Command addInfoCommand(CLI::App& root) {
+    struct Options {
+        std::string input, densityPng;
+        bool json = false;
+    };
+    auto options = std::make_shared<Options>();
+    CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth");
+    command->add_option("input", options->input, "CoNUS file (.exr)")->required();
+    command->add_flag("--json", options->json, "print JSON instead of text");
+    command->add_option("--density", options->densityPng,
+                        "write the sampling density as a heat map with the sampling pattern over it (.png)");
+    return {command, [options] {
+                const format::ConusFile file = format::readConusFile(options->input);
+                const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
+                const DensityStats stats = densityStats(map);
+
+                nlohmann::ordered_json j;
+                j["file"] = options->input;
+                j["formatVersion"] = format::kFormatVersion;
+                j["dataKind"] = format::toString(file.dataKind);
+                j["image"] = {{"width", file.image.width},
+                              {"height", file.image.height},
+                              {"channels", file.image.channels},
+                              {"pixelType", format::toString(file.pixelType)},
+                              {"compression", format::toString(file.compression)}};
+                j["source"] = {{"width", file.sourceWidth}, {"height", file.sourceHeight}};
+                const double pixelRatio = double(file.image.width) * file.image.height /
+                                          (double(file.sourceWidth) * file.sourceHeight);
+                j["pixelRatio"] = pixelRatio;
+                j["samplingMap"] = {{"columns", map.columns()},
+                                    {"rows", map.rows()},
+                                    {"densityMin", stats.min},
+                                    {"densityMax", stats.max},
+                                    {"densityMean", stats.mean}};
+                if (file.analytic) {
+                    nlohmann::ordered_json a{{"kind", file.analytic->kind}};
+                    if (file.analytic->kind == "foci") {
+                        a["composition"] = file.analytic->composition;
+                        for (const auto& f : file.analytic->foci)
+                            a["foci"].push_back({{"u", f.u}, {"v", f.v}, {"r", f.r}, {"k", f.k}});
+                    }
+                    for (const auto& [name, value] : file.analytic->scalars) a["params"][name] = value;
+                    j["analyticMap"] = a;
+                }
+                if (file.camera) j["camera"] = {{"projection", file.camera->projection},
+                                                {"worldToCamera", file.camera->worldToCamera},
+                                                {"worldToNDC", file.camera->worldToNDC}};
+                if (file.depth.kind != format::DepthKind::None)
+                    j["depth"] = {{"kind", format::toString(file.depth.kind)},
+                                  {"units", file.depth.units},
+                                  {"near", file.depth.near},
+                                  {"far", file.depth.far}};
+                if (!file.software.empty()) j["software"] = file.software;
+
+                if (!options->densityPng.empty()) {
+                    // The picture covers the conventional frame, at most 1024 px on its long side.
+                    const double scale = 1024.0 / std::max(file.sourceWidth, file.sourceHeight);
+                    const int w = std::max(16, static_cast<int>(file.sourceWidth * std::min(1.0, scale)));
+                    const int h = std::max(16, static_cast<int>(file.sourceHeight * std::min(1.0, scale)));
+                    const int lines = std::max(8, std::min(64, file.image.width / 8));
+                    writeImage(options->densityPng,
+                               densityPicture(map, w, h, lines, file.analytic ? &*file.analytic : nullptr));
+                    j["densityPicture"] = options->densityPng;
+                }
+
+                if (options->json) {
+                    std::printf("%s\n", j.dump(2).c_str());
+                    return 0;
+                }
+                std::printf("%s: CoNUS file, format version %d, data kind %s\n", options->input.c_str(),
+                            format::kFormatVersion, format::toString(file.dataKind));
+                std::string channels;
+                for (const auto& c : file.image.channels) channels += (channels.empty() ? "" : ",") + c;
+                std::printf("  CoNUS image   %d x %d, channels %s, %s, %s compression\n", file.image.width,
+                            file.image.height, channels.c_str(), format::toString(file.pixelType),
+                            format::toString(file.compression));
+                std::printf("  source        %d x %d (CoNUS image holds %.2f%% of its pixels)\n", file.sourceWidth,
+                            file.sourceHeight, 100.0 * pixelRatio);
+                std::printf("  sampling map  %d x %d nodes; density min %.3f, max %.3f, mean %.3f\n", map.columns(),
+                            map.rows(), stats.min, stats.max, stats.mean);
+                if (file.analytic) {
+                    std::printf("  analytic map  %s", file.analytic->kind.c_str());
+                    if (file.analytic->kind == "foci") {
+                        std::printf(" (%s composition)", file.analytic->composition.c_str());
+                        for (const auto& f : file.analytic->foci)
+                            std::printf("\n    focus u=%g v=%g r=%g k=%g", f.u, f.v, f.r, f.k);
+                    }
+                    for (const auto& [name, value] : file.analytic->scalars)
+                        std::printf("\n    %s = %g", name.c_str(), value);
+                    std::printf("\n");
+                }
+                if (file.camera) std::printf("  camera        %s\n", file.camera->projection.c_str());
+                if (file.depth.kind != format::DepthKind::None)
+                    std::printf("  depth         %s in [%g, %g] %s\n", format::toString(file.depth.kind),
+                                file.depth.near, file.depth.far, file.depth.units.c_str());
+                if (!options->densityPng.empty())
+                    std::printf("  density       written to %s\n", options->densityPng.c_str());
+                return 0;
+            }};
+}
+
+}  // namespace conus::cli

@@ -1,0 +1,31 @@
+// conus validate: every violated rule of spec/conus-format.md, exit 0 only for a valid file.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <memory>
+
+#include "commands.h"
+#include "conus/format/container.h"
+
+namespace conus::cli {
+
+Command addValidateCommand(CLI::App& root) {
+    auto input = std::make_shared<std::string>();
+    CLI::App* command = root.add_subcommand(
+        "validate", "Check a file against every rule of the CoNUS spec; exit 0 only if valid");
+    command->add_option("input", *input, "file to check")->required();
+    return {command, [input] {
+                const format::ValidationReport report = format::validateConusFile(*input);
+                if (report.ok()) {
+                    std::printf("%s: valid CoNUS file (format version %d)\n", input->c_str(), format::kFormatVersion);
+                    return 0;
+                }
+                for (const auto& issue : report.issues)
+                    std::printf("%s: V%d: %s\n", input->c_str(), issue.rule, issue.message.c_str());
+                std::fprintf(stderr, "conus validate: %s: not a valid CoNUS file (%zu problem%s)\n", input->c_str(),
+                             report.issues.size(), report.issues.size() == 1 ? "" : "s");
+                return 1;
+            }};
+}
+
+}  // namespace conus::cli

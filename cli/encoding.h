@@ -1,0 +1,36 @@
+// What `encode`, `uniform` and `demo` share: options for how a CoNUS file is stored, and the one
+// path from a source image and a map to a ConusFile.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "arguments.h"
+#include "conus/codec/sampling_map.h"
+#include "conus/format/container.h"
+
+namespace CLI {
+class App;
+}
+
+namespace conus::cli {
+
+struct StorageOptions {
+    std::string sizeText;  // "WxH"; empty: a quarter of each source side (1/16 of the pixels)
+    bool half = false, full = false;
+    std::string compression = "zip";
+};
+
+void addStorageOptions(CLI::App& command, StorageOptions& options);
+
+// Resolves the CoNUS image size (checking it against the source) and the storage settings.
+Size conusSize(const StorageOptions& options, const format::Image& source);
+
+// Encodes `source` through `map` at `size` (with progress) into a file model ready to write.
+format::ConusFile encodeToConus(const format::Image& source, const codec::SamplingMap& map, Size size,
+                                std::optional<format::AnalyticMap> analytic, bool quiet = false);
+
+// Applies the storage options to a file model.
+void applyStorage(const StorageOptions& options, format::ConusFile& file);
+
+}  // namespace conus::cli

@@ -1,0 +1,49 @@
+// conus: encode, decode, inspect and validate CoNUS files. See `conus --help`.
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.h"
+#include "conus/format/error.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"conus: coherent non-uniform sampling images (flexible pinhole camera)", "conus"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "conus 1.0.0 (CoNUS file format version 1)");
+
+    std::vector<conus::cli::Command> commands{
+        conus::cli::addEncodeCommand(app),   conus::cli::addUniformCommand(app),
+        conus::cli::addDecodeCommand(app),   conus::cli::addInfoCommand(app),
+        conus::cli::addValidateCommand(app), conus::cli::addDemoCommand(app),
+    };
+
+    std::string name;
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        for (CLI::App* sub : app.get_subcommands()) name = sub->get_name();
+        std::fprintf(stderr, "conus%s%s: %s (see --help)\n", name.empty() ? "" : " ", name.c_str(), e.what());
+        return 2;
+    }
+
+    for (auto& command : commands) {
+        if (!command.app->parsed()) continue;
+        name = command.app->get_name();
+        try {
+            return command.run();
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "conus %s: %s\n", name.c_str(), e.what());
+            return 1;
+        }
+    }
+    return 2;
+}

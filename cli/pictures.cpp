@@ -1,0 +1,126 @@
+#include "pictures.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+namespace conus::cli {
+namespace {
+
+// A perceptually ordered dark-to-bright ramp (after matplotlib's "inferno"), sampled at 6 points.
+glm::vec3 heat(double t) {
+    static const std::array<glm::vec3, 6> kRamp{{{0.001f, 0.000f, 0.014f},
+                                                 {0.258f, 0.039f, 0.406f},
+                                                 {0.578f, 0.148f, 0.404f},
+                                                 {0.865f, 0.317f, 0.226f},
+                                                 {0.988f, 0.645f, 0.040f},
+                                                 {0.988f, 0.998f, 0.645f}}};
+    t = std::clamp(t, 0.0, 1.0) * (kRamp.size() - 1);
+    const int i = std::min(static_cast<int>(t), static_cast<int>(kRamp.size()) - 2);
+    const float f = static_cast<float>(t - i);
+    return kRamp[i] * (1 - f) + kRamp[i + 1] * f;
+}
+
+void blend(format::Image& image, int x, int y, glm::vec3 color, float alpha) {
+    if (x < 0 || y < 0 || x >= image.width || y >= image.height) return;
+    for (int c = 0; c < 3; ++c) image.at(x, y, c) = image.at(x, y, c) * (1 - alpha) + color[c] * alpha;
+}
+
+}  // namespace
+
+DensityStats densityStats(const codec::SamplingMap& map, int samples) {
+    DensityStats stats{1e300, 0, 0};
+    for (int j = 0; j < samples; ++j)
+        for (int i = 0; i < samples; ++i) {
+            const double d = map.density({(i + 0.5) / samples, (j + 0.5) / samples});
+            stats.min = std::min(stats.min, d);
+            stats.max = std::max(stats.max, d);
+            stats.mean += d;
+        }
+    stats.mean /= double(samples) * samples;
+    return stats;
+}
+
+format::Image densityPicture(const codec::SamplingMap& map, int width, int height, int lines,
+                             const format::AnalyticMap* analytic) {
+    format::Image picture = format::makeImage(width, height, {"R", "G", "B"});
+    std::vector<glm::dvec2> distorted(static_cast<std::size_t>(width) * height);
+    std::vector<double> logDensity(distorted.size());
+    double lo = 1e300, hi = -1e300;
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const glm::dvec2 p{(x + 0.5) / width, (y + 0.5) / height};
+            const std::size_t k = static_cast<std::size_t>(y) * width + x;
+            distorted[k] = map.distort(p);
+            logDensity[k] = std::log(std::max(map.density(p), 1e-12));
+            lo = std::min(lo, logDensity[k]);
+            hi = std::max(hi, logDensity[k]);
+        }
+    // A uniform map gets a mid-scale colour rather than a division by zero.
+    const double range = hi - lo > 1e-9 ? hi - lo : 1.0;
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const std::size_t k = static_cast<std::size_t>(y) * width + x;
+            const glm::vec3 c = heat(hi - lo > 1e-9 ? (logDensity[k] - lo) / range : 0.5);
+            for (int ch = 0; ch < 3; ++ch) picture.at(x, y, ch) = c[ch];
+        }
+    // Lines of the CoNUS pixel grid: where floor(u_d * lines) or floor(v_d * lines) changes.
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const std::size_t k = static_cast<std::size_t>(y) * width + x;
+            const glm::dvec2 d = distorted[k] * double(lines);
+            bool edge = false;
+            if (x + 1 < width) edge |= std::floor(d.x) != std::floor(distorted[k + 1].x * lines);
+            if (y + 1 < height) edge |= std::floor(d.y) != std::floor(distorted[k + width].y * lines);
+            if (edge) blend(picture, x, y, glm::vec3(1.0f), 0.55f);
+        }
+    if (analytic && analytic->kind == "foci") {
+        for (const auto& f : analytic->foci) {
+            // r is a fraction of the image width, circular in pixels.
+            const double radius = f.r * width;
+            const int steps = std::max(64, static_cast<int>(radius * 8));
+            for (int s = 0; s < steps; ++s) {
+                const double a = 2 * std::numbers::pi * s / steps;
+                blend(picture, static_cast<int>(f.u * width + radius * std::cos(a)),
+                      static_cast<int>(f.v * height + radius * std::sin(a)), {0.2f, 1.0f, 0.4f}, 1.0f);
+            }
+        }
+    }
+    return picture;
+}
+
+format::Image toRgb(const format::Image& image) {
+    format::Image rgb = format::makeImage(image.width, image.height, {"R", "G", "B"});
+    int source[3] = {image.channelIndex("R"), image.channelIndex("G"), image.channelIndex("B")};
+    if (source[0] < 0 || source[1] < 0 || source[2] < 0) {
+        int grey = image.channelIndex("Y");
+        if (grey < 0) grey = 0;
+        source[0] = source[1] = source[2] = grey;
+    }
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x)
+            for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = image.at(x, y, source[c]);
+    return rgb;
+}
+
+format::Image sideBySide(std::span<const format::Image> images, int gap) {
+    int width = gap, height = 0;
+    for (const auto& image : images) {
+        width += image.width + gap;
+        height = std::max(height, image.height);
+    }
+    format::Image strip = format::makeImage(width, height + 2 * gap, {"R", "G", "B"});
+    std::fill(strip.pixels.begin(), strip.pixels.end(), 0.12f);
+    int x0 = gap;
+    for (const auto& image : images) {
+        const format::Image rgb = toRgb(image);
+        for (int y = 0; y < rgb.height; ++y)
+            for (int x = 0; x < rgb.width; ++x)
+                for (int c = 0; c < 3; ++c) strip.at(x0 + x, gap + y, c) = rgb.at(x, y, c);
+        x0 += image.width + gap;
+    }
+    return strip;
+}
+
+}  // namespace conus::cli

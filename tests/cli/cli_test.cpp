@@ -1,0 +1,270 @@
+// The `conus` command as a user runs it: exit codes, messages and outputs, through the real binary.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
+
+#include "conus/codec/sampling_map.h"
+#include "conus/format/container.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+    int exitCode = -1;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+class Cli : public ::testing::Test {
+protected:
+    void SetUp() override {
+        m_dir = fs::temp_directory_path() /
+                ("conus-cli-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
+                 std::to_string(::getpid()));
+        fs::remove_all(m_dir);
+        fs::create_directories(m_dir);
+    }
+    void TearDown() override { fs::remove_all(m_dir); }
+
+    Result run(const std::string& args) {
+        const fs::path out = m_dir / "stdout.txt", err = m_dir / "stderr.txt";
+        const std::string command = std::string(CONUS_BIN_DIR) + "/conus " + args + " >" + out.string() + " 2>" +
+                                    err.string() + " </dev/null";
+        const int status = std::system(command.c_str());
+        Result r;
+        r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        r.out = slurp(out);
+        r.err = slurp(err);
+        return r;
+    }
+
+    // A detailed RGB test picture (diagonal stripes of varying period plus a gradient), as PNG.
+    std::string makePicture(int width, int height, const std::string& name = "in.png") {
+        std::vector<unsigned char> pixels(static_cast<std::size_t>(width) * height * 3);
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x) {
+                const double s = 0.5 + 0.5 * std::sin((x + y) * (0.05 + 0.4 * x / width));
+                pixels[(y * width + x) * 3 + 0] = static_cast<unsigned char>(255 * s);
+                pixels[(y * width + x) * 3 + 1] = static_cast<unsigned char>(255.0 * y / height);
+                pixels[(y * width + x) * 3 + 2] = static_cast<unsigned char>(255 * (1 - s));
+            }
+        const std::string path = (m_dir / name).string();
+        auto output = OIIO::ImageOutput::create(path);
+        OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+        EXPECT_TRUE(output->open(path, spec));
+        EXPECT_TRUE(output->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+        output->close();
+        return path;
+    }
+
+    std::string path(const std::string& name) const { return (m_dir / name).string(); }
+
+    // Nothing but the expected files: no temporaries left behind.
+    std::vector<std::string> leftovers() const {
+        std::vector<std::string> names;
+        for (const auto& e : fs::directory_iterator(m_dir)) {
+            const std::string n = e.path().filename().string();
+            if (n.find("tmp") != std::string::npos) names.push_back(n);
+        }
+        return names;
+    }
+
+    fs::path m_dir;
+};
+
+std::pair<int, int> imageSize(const std::string& path) {
+    auto input = OIIO::ImageInput::open(path);
+    if (!input) return {0, 0};
+    return {input->spec().width, input->spec().height};
+}
+
+TEST_F(Cli, NoArgumentsIsAnErrorWithUsage) {
+    const Result r = run("");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find("conus"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, HelpListsEverySubcommand) {
+    const Result r = run("--help");
+    EXPECT_EQ(r.exitCode, 0);
+    for (const char* name : {"encode", "decode", "uniform", "info", "validate", "demo"})
+        EXPECT_NE(r.out.find(name), std::string::npos) << name;
+}
+
+TEST_F(Cli, EncodeWithFociThenValidateInfoDecode) {
+    const std::string in = makePicture(400, 300);
+    Result r = run("encode " + in + " -o " + path("a.exr") + " --size 100x75 --focus 0.3,0.4,0.1,4 --focus 0.7,0.6,0.08,3");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("100x75"), std::string::npos) << r.out;
+
+    r = run("validate " + path("a.exr"));
+    EXPECT_EQ(r.exitCode, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("valid CoNUS file"), std::string::npos);
+
+    r = run("info " + path("a.exr") + " --json --density " + path("density.png"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["image"]["width"], 100);
+    EXPECT_EQ(j["image"]["height"], 75);
+    EXPECT_EQ(j["source"]["width"], 400);
+    EXPECT_EQ(j["analyticMap"]["kind"], "foci");
+    ASSERT_EQ(j["analyticMap"]["foci"].size(), 2u);
+    EXPECT_NEAR(j["analyticMap"]["foci"][0]["k"].get<double>(), 4.0, 1e-6);
+    // Two foci magnify: the map is not uniform.
+    EXPECT_GT(j["samplingMap"]["densityMax"].get<double>(), 2.0 * j["samplingMap"]["densityMin"].get<double>());
+    EXPECT_EQ(imageSize(path("density.png")).first, 400);
+
+    r = run("decode " + path("a.exr") + " -o " + path("frame.png"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(imageSize(path("frame.png")), std::make_pair(400, 300));
+
+    r = run("decode " + path("a.exr") + " -o " + path("zoom.png") + " --view 0.2,0.3,0.4,0.5 --size 320x240");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(imageSize(path("zoom.png")), std::make_pair(320, 240));
+
+    r = run("decode " + path("a.exr") + " -o " + path("zoom2.exr") + " --view 0.2,0.3,0.4,0.5");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(imageSize(path("zoom2.exr")), std::make_pair(80, 60));  // the view at source resolution
+    EXPECT_TRUE(leftovers().empty());
+}
+
+TEST_F(Cli, UniformIsTheIdentityMap) {
+    const std::string in = makePicture(256, 256);
+    const Result r = run("uniform " + in + " -o " + path("u.exr") + " --size 64x64 --float");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto file = conus::format::readConusFile(path("u.exr"));
+    EXPECT_EQ(file.pixelType, conus::format::PixelType::Float);
+    const auto map = conus::codec::SamplingMap::fromGrid(file.map);
+    EXPECT_NEAR(map.density({0.3, 0.7}), 1.0, 1e-9);
+    EXPECT_EQ(file.image.width, 64);
+}
+
+TEST_F(Cli, EncodeTakesTheMapOfAnotherFile) {
+    const std::string in = makePicture(200, 200);
+    ASSERT_EQ(run("encode " + in + " -o " + path("a.exr") + " --size 50x50 --focus 0.5,0.5,0.1,3").exitCode, 0);
+    const Result r = run("encode " + in + " -o " + path("b.exr") + " --size 60x60 --map " + path("a.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto a = conus::format::readConusFile(path("a.exr"));
+    const auto b = conus::format::readConusFile(path("b.exr"));
+    EXPECT_EQ(a.map.xy, b.map.xy);
+    EXPECT_EQ(b.image.width, 60);
+}
+
+TEST_F(Cli, BadArgumentsGiveOneLineReasons) {
+    const std::string in = makePicture(64, 64);
+    struct Case {
+        std::string args, expected;
+    };
+    const Case cases[] = {
+        {"encode " + in + " -o " + path("x.exr") + " --size 0x5", "size"},
+        {"encode " + in + " -o " + path("x.exr") + " --size 12", "WxH"},
+        {"encode " + in + " -o " + path("x.exr") + " --focus 0.5,0.5,0.1", "focus"},
+        {"encode " + in + " -o " + path("x.exr") + " --focus 1.5,0.5,0.1,4", "focus"},
+        {"encode " + in + " -o " + path("x.exr") + " --focus 0.5,0.5,0.1,nan", "focus"},
+        {"encode " + path("missing.png") + " -o " + path("x.exr"), "missing.png"},
+        {"encode " + in + " -o " + path("x.exr") + " --compression lzma", "compression"},
+        {"decode " + path("missing.exr") + " -o " + path("x.png"), "missing.exr"},
+        {"decode " + in + " -o " + path("x.png"), "in.png"},
+        {"encode " + in, "output"},
+        {"frobnicate", "frobnicate"},
+    };
+    for (const auto& c : cases) {
+        const Result r = run(c.args);
+        EXPECT_NE(r.exitCode, 0) << c.args;
+        EXPECT_EQ(r.err.rfind("conus", 0), 0u) << c.args << "\n" << r.err;
+        EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.args << "\n" << r.err;
+        EXPECT_FALSE(fs::exists(path("x.exr"))) << c.args;
+        EXPECT_FALSE(fs::exists(path("x.png"))) << c.args;
+    }
+    EXPECT_TRUE(leftovers().empty());
+}
+
+TEST_F(Cli, DecodeViewMustNotBeEmpty) {
+    const std::string in = makePicture(64, 64);
+    ASSERT_EQ(run("uniform " + in + " -o " + path("u.exr") + " --size 16x16").exitCode, 0);
+    const Result r = run("decode " + path("u.exr") + " -o " + path("v.png") + " --view 0.5,0.5,0.4,0.6");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find("view"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("v.png")));
+}
+
+TEST_F(Cli, FailedWriteLeavesNoFile) {
+    const std::string in = makePicture(64, 64);
+    const Result r = run("encode " + in + " -o " + path("no/such/dir/x.exr") + " --size 16x16");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_FALSE(fs::exists(path("no")));
+    EXPECT_TRUE(leftovers().empty());
+}
+
+TEST_F(Cli, ExistingOutputIsUntouchedOnFailure) {
+    const std::string in = makePicture(64, 64);
+    ASSERT_EQ(run("uniform " + in + " -o " + path("keep.exr") + " --size 16x16").exitCode, 0);
+    const std::string before = slurp(path("keep.exr"));
+    EXPECT_NE(run("encode " + path("missing.png") + " -o " + path("keep.exr")).exitCode, 0);
+    EXPECT_EQ(slurp(path("keep.exr")), before);
+}
+
+TEST_F(Cli, ValidateRejectsWhatIsNotCoNUS) {
+    const std::string in = makePicture(32, 32);
+    Result r = run("validate " + in);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("not a valid CoNUS file"), std::string::npos) << r.err;
+
+    const fs::path beachball = fs::path(CONUS_SHARED_DATA) / "exr/Beachball_multipart.0001.exr";
+    if (!fs::exists(beachball)) GTEST_SKIP() << "shared data not found at " << CONUS_SHARED_DATA;
+    r = run("validate " + beachball.string());
+    EXPECT_EQ(r.exitCode, 1);
+    r = run("decode " + beachball.string() + " -o " + path("b.png"));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("not a CoNUS file"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("b.png")));
+}
+
+TEST_F(Cli, InfoListsTheFoci) {
+    const std::string in = makePicture(64, 64);
+    ASSERT_EQ(run("encode " + in + " -o " + path("a.exr") + " --size 16x16 --focus 0.5,0.5,0.2,3").exitCode, 0);
+    const Result r = run("info " + path("a.exr"));
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("focus u=0.5 v=0.5 r=0.2 k=3"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, ValidateNamesTheRuleOfADamagedFile) {
+    const fs::path damaged = fs::path(CONUS_SHARED_DATA) / "exr/damaged";
+    if (!fs::exists(damaged)) GTEST_SKIP() << "shared data not found at " << CONUS_SHARED_DATA;
+    int checked = 0;
+    for (const auto& entry : fs::directory_iterator(damaged)) {
+        if (entry.path().extension() == ".rst" || ++checked > 5) continue;
+        const Result r = run("validate '" + entry.path().string() + "'");
+        EXPECT_EQ(r.exitCode, 1) << entry.path();
+        EXPECT_NE(r.out.find(": V"), std::string::npos) << entry.path() << "\n" << r.out;
+    }
+}
+
+TEST_F(Cli, DemoRunsSmallAndPrintsPsnr) {
+    const Result r = run("demo --size 512 --out " + path("demo"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (const char* name : {"conus.exr", "uniform.exr", "conus.png", "uniform.png", "density.png",
+                             "view-focus1.png", "view-focus2.png", "view-frame.png"})
+        EXPECT_TRUE(fs::exists(path("demo") + "/" + name)) << name;
+    EXPECT_NE(r.out.find("focus 1"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("dB"), std::string::npos) << r.out;
+    EXPECT_EQ(run("validate " + path("demo") + "/conus.exr").exitCode, 0);
+}
+
+}  // namespace
