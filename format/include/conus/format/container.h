@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "conus/format/error.h"
 #include "conus/format/image.h"
 #include "conus/format/validation.h"
 

@@ -1,0 +1,425 @@
+// All OpenEXR calls of conus_format. OpenEXR's exceptions (Iex::BaseExc derives from
+// std::exception) are caught right where OpenEXR is called and turned into report issues or
+// conus::Error, so nothing from OpenEXR escapes this file.
+#include "exr_io.h"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFloatAttribute.h>
+#include <ImfFloatVectorAttribute.h>
+#include <ImfIntAttribute.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfStandardAttributes.h>
+#include <ImfStringAttribute.h>
+#include <ImfVecAttribute.h>
+#include <ImfTiledInputPart.h>
+#include <openexr.h>
+#include <half.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <system_error>
+
+#include "header_model.h"
+
+namespace conus::format::detail {
+namespace {
+
+// ---- Core pre-check ----------------------------------------------------------------------------
+// OpenEXR's C core parses headers defensively (its validation.c checks every window, channel and
+// attribute) without allocating chunk tables, so hostile headers are refused here before the C++
+// library, which trusts more, ever sees them. The C++ library then reads the offset table of each
+// part: a part needing more 8-byte offsets than the file has bytes is truncated or lying.
+
+void silentCoreError(exr_const_context_t ctx, exr_result_t code, const char* msg) {
+    void* user = nullptr;
+    if (exr_get_user_data(ctx, &user) == EXR_ERR_SUCCESS && user != nullptr) {
+        auto* last = static_cast<std::string*>(user);
+        if (last->empty()) *last = msg ? msg : exr_get_default_error_message(code);
+    }
+}
+
+// Empty on success, else what is wrong.
+std::string coreCheck(const std::string& path, std::uintmax_t fileSize) {
+    std::string message;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = &silentCoreError;
+    init.user_data = &message;
+    init.flags = EXR_CONTEXT_FLAG_SILENT_HEADER_PARSE;
+    exr_context_t ctx = nullptr;
+    exr_result_t rv = exr_start_read(&ctx, path.c_str(), &init);
+    if (rv != EXR_ERR_SUCCESS) {
+        if (ctx) exr_finish(&ctx);
+        return message.empty() ? exr_get_default_error_message(rv) : message;
+    }
+    int parts = 0;
+    rv = exr_get_count(ctx, &parts);
+    std::string result;
+    if (rv != EXR_ERR_SUCCESS || parts < 1) result = "no parts";
+    exr_attr_box2i_t firstDisplay{};
+    for (int p = 0; p < parts && result.empty(); ++p) {
+        exr_attr_box2i_t display{};
+        if (exr_get_display_window(ctx, p, &display) == EXR_ERR_SUCCESS) {
+            if (p == 0) firstDisplay = display;
+            if (std::memcmp(&display, &firstDisplay, sizeof display) != 0) {
+                // OpenEXR's C++ library refuses such a file with a vague message; name the rule.
+                result = "V15: part " + std::to_string(p) + " displayWindow (" + std::to_string(display.min.x) + ", " +
+                         std::to_string(display.min.y) + ") - (" + std::to_string(display.max.x) + ", " +
+                         std::to_string(display.max.y) + ") differs from part 0's (" + std::to_string(firstDisplay.min.x) +
+                         ", " + std::to_string(firstDisplay.min.y) + ") - (" + std::to_string(firstDisplay.max.x) + ", " +
+                         std::to_string(firstDisplay.max.y) + ")";
+                break;
+            }
+        }
+        int32_t chunks = 0;
+        exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
+        if (exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS) {
+            result = "part " + std::to_string(p) + ": unknown storage";
+        } else if (exr_get_chunk_count(ctx, p, &chunks) != EXR_ERR_SUCCESS || chunks < 0) {
+            result = "part " + std::to_string(p) + ": invalid chunk count";
+        } else if (std::uintmax_t(chunks) * 8 > fileSize) {
+            result = "part " + std::to_string(p) + " needs " + std::to_string(chunks) + " chunk offsets, more than a " +
+                     std::to_string(fileSize) + "-byte file can hold";
+        }
+    }
+    exr_finish(&ctx);
+    return result;
+}
+
+// ---- headers -> HeaderModel ------------------------------------------------------------------
+
+Box boxOf(const Imath::Box2i& b) { return Box{b.min.x, b.min.y, b.max.x, b.max.y}; }
+
+template <class ExrAttr, class T, class Convert>
+Attr<T> readAttr(const Imf::Header& h, const char* name, Convert convert) {
+    Attr<T> a;
+    auto it = h.find(name);
+    if (it == h.end()) return a;
+    a.present = true;
+    a.typeName = it.attribute().typeName();
+    if (const auto* typed = dynamic_cast<const ExrAttr*>(&it.attribute())) {
+        a.typeOk = true;
+        a.value = convert(typed->value());
+    }
+    return a;
+}
+
+template <class ExrAttr, class T>
+Attr<T> readAttr(const Imf::Header& h, const char* name) {
+    return readAttr<ExrAttr, T>(h, name, [](const auto& v) { return T(v); });
+}
+
+std::array<float, 16> toArray(const Imath::M44f& m) {
+    std::array<float, 16> a{};
+    for (int r = 0; r < 4; ++r) {
+        for (int c = 0; c < 4; ++c) a[r * 4 + c] = m[r][c];
+    }
+    return a;
+}
+
+PartModel partOf(const Imf::Header& h) {
+    PartModel p;
+    p.name = h.hasName() ? h.name() : std::string();
+    p.type = h.hasType() ? h.type() : (h.hasTileDescription() ? Imf::TILEDIMAGE : Imf::SCANLINEIMAGE);
+    for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+        const Imf::Channel& c = it.channel();
+        ChannelType t = c.type == Imf::HALF ? ChannelType::Half : c.type == Imf::FLOAT ? ChannelType::Float : ChannelType::Uint;
+        p.channels.push_back({it.name(), t, c.xSampling, c.ySampling});
+    }
+    p.dataWindow = boxOf(h.dataWindow());
+    p.displayWindow = boxOf(h.displayWindow());
+    if (h.hasTileDescription()) {
+        p.tileWidth = h.tileDescription().xSize;
+        p.tileHeight = h.tileDescription().ySize;
+    }
+    return p;
+}
+
+HeaderModel modelOf(const Imf::MultiPartInputFile& file) {
+    HeaderModel m;
+    for (int i = 0; i < file.parts(); ++i) {
+        m.parts.push_back(partOf(file.header(i)));
+        if (m.parts.back().name == kConusPartName && m.conusPartCount++ == 0) m.conusPart = i;
+        if (m.parts.back().name == kMapPartName && m.mapPartCount++ == 0) m.mapPart = i;
+    }
+    if (m.conusPart < 0) return m;
+    const Imf::Header& h = file.header(m.conusPart);
+    m.version = readAttr<Imf::IntAttribute, int>(h, kAttrVersion);
+    m.sourceSize = readAttr<Imf::V2iAttribute, std::array<int, 2>>(h, kAttrSourceSize,
+                                                                    [](const Imath::V2i& v) { return std::array<int, 2>{v.x, v.y}; });
+    m.dataKind = readAttr<Imf::StringAttribute, std::string>(h, kAttrDataKind);
+    m.mapKind = readAttr<Imf::StringAttribute, std::string>(h, kAttrMapKind);
+    m.foci = readAttr<Imf::FloatVectorAttribute, std::vector<float>>(h, kAttrFoci);
+    m.composition = readAttr<Imf::StringAttribute, std::string>(h, kAttrComposition);
+    const std::size_t prefixLen = std::strlen(kAttrParamPrefix);
+    for (auto it = h.begin(); it != h.end(); ++it) {
+        if (std::strncmp(it.name(), kAttrParamPrefix, prefixLen) != 0) continue;
+        Attr<double>& a = m.params[it.name() + prefixLen];
+        a.present = true;
+        a.typeName = it.attribute().typeName();
+        if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&it.attribute())) {
+            a.typeOk = true;
+            a.value = d->value();
+        } else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&it.attribute())) {
+            a.typeOk = true;
+            a.value = f->value();
+        }
+    }
+    m.worldToCamera = readAttr<Imf::M44fAttribute, std::array<float, 16>>(h, kAttrWorldToCamera, toArray);
+    m.worldToNDC = readAttr<Imf::M44fAttribute, std::array<float, 16>>(h, kAttrWorldToNDC, toArray);
+    m.projection = readAttr<Imf::StringAttribute, std::string>(h, kAttrProjection);
+    m.depthKind = readAttr<Imf::StringAttribute, std::string>(h, kAttrDepthKind);
+    m.depthRange = readAttr<Imf::V2fAttribute, std::array<float, 2>>(h, kAttrDepthRange,
+                                                                      [](const Imath::V2f& v) { return std::array<float, 2>{v.x, v.y}; });
+    m.depthUnits = readAttr<Imf::StringAttribute, std::string>(h, kAttrDepthUnits);
+    return m;
+}
+
+// ---- HeaderModel -> ConusFile fields ----------------------------------------------------------
+
+Compression compressionOf(Imf::Compression c) {
+    switch (c) {
+        case Imf::NO_COMPRESSION: return Compression::None;
+        case Imf::PIZ_COMPRESSION: return Compression::Piz;
+        case Imf::DWAA_COMPRESSION:
+        case Imf::DWAB_COMPRESSION: return Compression::Dwaa;
+        default: return Compression::Zip;  // other codecs (RLE, ZIPS, PXR24, B44) are read as-is
+    }
+}
+
+void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
+    const PartModel& part = m.parts[m.conusPart];
+    out.pixelType = PixelType::Half;
+    for (const ChannelModel& c : part.channels) {
+        if (c.name != "Z" && c.type == ChannelType::Float) out.pixelType = PixelType::Float;
+    }
+    out.compression = compressionOf(h.compression());
+    out.sourceWidth = m.sourceSize.value[0];
+    out.sourceHeight = m.sourceSize.value[1];
+    const std::string& kind = m.dataKind.value;
+    out.dataKind = kind == "heightfield" ? DataKind::HeightField : kind == "depthimage" ? DataKind::DepthImage : DataKind::Image;
+    if (m.mapKind.ok()) {
+        AnalyticMap a;
+        a.kind = m.mapKind.value;
+        const std::vector<float>& f = m.foci.value;
+        for (std::size_t i = 0; i + 3 < f.size(); i += 4) a.foci.push_back({f[i], f[i + 1], f[i + 2], f[i + 3]});
+        a.composition = m.composition.value;
+        for (const auto& [name, attr] : m.params) a.scalars[name] = attr.value;
+        out.analytic = std::move(a);
+    }
+    if (m.projection.ok()) out.camera = Camera{m.projection.value, m.worldToCamera.value, m.worldToNDC.value};
+    const std::string depth = m.depthKind.ok() ? m.depthKind.value : "none";
+    out.depth.kind = depth == "cameraDepth" ? DepthKind::CameraDepth : depth == "height" ? DepthKind::Height : DepthKind::None;
+    if (out.depth.kind != DepthKind::None) {
+        out.depth.near = m.depthRange.value[0];
+        out.depth.far = m.depthRange.value[1];
+    }
+    out.depth.units = m.depthUnits.value;
+    if (const auto* sw = h.findTypedAttribute<Imf::StringAttribute>(kAttrSoftware)) out.software = sw->value();
+}
+
+// ---- pixels ---------------------------------------------------------------------------------
+
+void readImage(Imf::MultiPartInputFile& file, const HeaderModel& m, Image& image) {
+    const PartModel& part = m.parts[m.conusPart];
+    std::vector<std::string> names;
+    for (const ChannelModel& c : part.channels) names.push_back(c.name);
+    image = makeImage(int(part.dataWindow.width()), int(part.dataWindow.height()), std::move(names));
+    const std::size_t nc = image.channels.size();
+    const std::size_t xStride = nc * sizeof(float);
+    const std::size_t yStride = xStride * image.width;
+    Imf::FrameBuffer fb;
+    for (std::size_t c = 0; c < nc; ++c) {
+        // Fill 0 for nothing: every channel exists, so OpenEXR writes every value.
+        fb.insert(image.channels[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(image.pixels.data() + c), xStride, yStride));
+    }
+    if (part.type == Imf::TILEDIMAGE) {
+        Imf::TiledInputPart in(file, m.conusPart);
+        in.setFrameBuffer(fb);
+        in.readTiles(0, in.numXTiles(0) - 1, 0, in.numYTiles(0) - 1, 0, 0);
+    } else {
+        Imf::InputPart in(file, m.conusPart);
+        in.setFrameBuffer(fb);
+        in.readPixels(0, image.height - 1);
+    }
+}
+
+void readMap(Imf::MultiPartInputFile& file, const HeaderModel& m, GridNodes& grid) {
+    const PartModel& part = m.parts[m.mapPart];
+    grid.columns = int(part.dataWindow.width());
+    grid.rows = int(part.dataWindow.height());
+    grid.xy.assign(std::size_t{2} * grid.columns * grid.rows, 0.0f);
+    Imf::FrameBuffer fb;
+    char* base = reinterpret_cast<char*>(grid.xy.data());
+    const std::size_t xStride = 2 * sizeof(float);
+    fb.insert(kMapChannelU, Imf::Slice(Imf::FLOAT, base, xStride, xStride * grid.columns));
+    fb.insert(kMapChannelV, Imf::Slice(Imf::FLOAT, base + sizeof(float), xStride, xStride * grid.columns));
+    Imf::InputPart in(file, m.mapPart);
+    in.setFrameBuffer(fb);
+    in.readPixels(0, grid.rows - 1);
+}
+
+Imf::Compression exrCompression(Compression c) {
+    switch (c) {
+        case Compression::None: return Imf::NO_COMPRESSION;
+        case Compression::Zip: return Imf::ZIP_COMPRESSION;
+        case Compression::Piz: return Imf::PIZ_COMPRESSION;
+        case Compression::Dwaa: return Imf::DWAA_COMPRESSION;
+    }
+    return Imf::ZIP_COMPRESSION;
+}
+
+Imath::M44f toM44(const std::array<float, 16>& a) {
+    Imath::M44f m;
+    for (int r = 0; r < 4; ++r) {
+        for (int c = 0; c < 4; ++c) m[r][c] = a[r * 4 + c];
+    }
+    return m;
+}
+
+}  // namespace
+
+LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, ConusFile& out) {
+    LoadResult result;
+    ValidationReport& r = result.report;
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec || !std::ifstream(path, std::ios::binary)) {
+        r.add(1, "cannot open " + path + (ec ? ": " + ec.message() : std::string()));
+        result.code = ErrorCode::Io;
+        return result;
+    }
+    if (const std::string problem = coreCheck(path, size); !problem.empty()) {
+        if (problem.rfind("V15: ", 0) == 0) {
+            r.add(15, problem.substr(5));
+        } else {
+            r.add(1, "not a readable OpenEXR file: " + problem);
+        }
+        return result;
+    }
+    try {
+        Imf::MultiPartInputFile file(path.c_str());
+        const HeaderModel model = modelOf(file);
+        const HeaderCheck hc = checkHeaderRules(model, limits, r);
+        if (!r.ok()) {
+            result.code = hc.notConus ? ErrorCode::NotConus : hc.limitExceeded ? ErrorCode::LimitExceeded : ErrorCode::Corrupt;
+            return result;
+        }
+        // Headers passed every rule, so every size below is within limits.
+        ConusFile loaded;
+        fillMetadata(model, file.header(model.conusPart), loaded);
+        readImage(file, model, loaded.image);
+        readMap(file, model, loaded.map);
+        const ValidationReport grid = validateGrid(loaded.map);
+        r.issues.insert(r.issues.end(), grid.issues.begin(), grid.issues.end());
+        if (!r.ok()) {
+            result.code = ErrorCode::InvalidMap;
+            return result;
+        }
+        out = std::move(loaded);
+    } catch (const std::exception& e) {
+        r.add(1, std::string("damaged OpenEXR data: ") + e.what());
+        result.code = ErrorCode::Corrupt;
+    }
+    return result;
+}
+
+void writeExrFile(const std::string& path, const ConusFile& file) {
+    const Image& im = file.image;
+    try {
+        Imf::Header conus(im.width, im.height);
+        conus.setName(kConusPartName);
+        conus.setType(Imf::SCANLINEIMAGE);
+        conus.compression() = exrCompression(file.compression);
+        for (const std::string& name : im.channels) {
+            const bool asFloat = name == "Z" || file.pixelType == PixelType::Float;
+            conus.channels().insert(name, Imf::Channel(asFloat ? Imf::FLOAT : Imf::HALF));
+        }
+        conus.insert(kAttrVersion, Imf::IntAttribute(kFormatVersion));
+        conus.insert(kAttrSourceSize, Imf::V2iAttribute(Imath::V2i(file.sourceWidth, file.sourceHeight)));
+        conus.insert(kAttrDataKind, Imf::StringAttribute(toString(file.dataKind)));
+        conus.insert(kAttrSoftware,
+                     Imf::StringAttribute(file.software.empty() ? "conus " + std::to_string(kFormatVersion) : file.software));
+        if (file.analytic) {
+            const AnalyticMap& a = *file.analytic;
+            conus.insert(kAttrMapKind, Imf::StringAttribute(a.kind));
+            if (!a.foci.empty()) {
+                std::vector<float> f;
+                for (const FocusParams& p : a.foci) f.insert(f.end(), {float(p.u), float(p.v), float(p.r), float(p.k)});
+                conus.insert(kAttrFoci, Imf::FloatVectorAttribute(f));
+            }
+            if (!a.composition.empty()) conus.insert(kAttrComposition, Imf::StringAttribute(a.composition));
+            for (const auto& [name, value] : a.scalars) {
+                conus.insert(kAttrParamPrefix + name, Imf::DoubleAttribute(value));
+            }
+        }
+        if (file.camera) {
+            Imf::addWorldToCamera(conus, toM44(file.camera->worldToCamera));
+            Imf::addWorldToNDC(conus, toM44(file.camera->worldToNDC));
+            conus.insert(kAttrProjection, Imf::StringAttribute(file.camera->projection));
+        }
+        conus.insert(kAttrDepthKind, Imf::StringAttribute(toString(file.depth.kind)));
+        if (file.depth.kind != DepthKind::None) {
+            conus.insert(kAttrDepthRange, Imf::V2fAttribute(Imath::V2f(file.depth.near, file.depth.far)));
+        }
+        if (!file.depth.units.empty()) conus.insert(kAttrDepthUnits, Imf::StringAttribute(file.depth.units));
+
+        // OpenEXR requires every part to share displayWindow: the map part gets the image's and its
+        // own dataWindow. It is always stored losslessly (DWAA would quantize the node positions).
+        Imf::Header map(conus.displayWindow(),
+                        Imath::Box2i(Imath::V2i(0, 0), Imath::V2i(file.map.columns - 1, file.map.rows - 1)));
+        map.setName(kMapPartName);
+        map.setType(Imf::SCANLINEIMAGE);
+        map.compression() = file.compression == Compression::None ? Imf::NO_COMPRESSION : Imf::ZIP_COMPRESSION;
+        map.channels().insert(kMapChannelU, Imf::Channel(Imf::FLOAT));
+        map.channels().insert(kMapChannelV, Imf::Channel(Imf::FLOAT));
+
+        const Imf::Header headers[2] = {conus, map};
+        Imf::MultiPartOutputFile exr(path.c_str(), headers, 2);
+        {
+            // OpenEXR converts types when reading but not when writing: HALF channels get their own
+            // planar half buffers (rounded to nearest), FLOAT ones are written from the image.
+            const std::size_t nc = im.channels.size();
+            const std::size_t count = std::size_t(im.width) * im.height;
+            std::vector<std::vector<Imath::half>> halves;
+            Imf::FrameBuffer fb;
+            for (std::size_t c = 0; c < nc; ++c) {
+                if (im.channels[c] != "Z" && file.pixelType == PixelType::Half) {
+                    std::vector<Imath::half>& h = halves.emplace_back(count);
+                    for (std::size_t i = 0; i < count; ++i) h[i] = Imath::half(im.pixels[i * nc + c]);
+                    fb.insert(im.channels[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(h.data()), sizeof(Imath::half),
+                                                         sizeof(Imath::half) * im.width));
+                } else {
+                    fb.insert(im.channels[c], Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(im.pixels.data() + c)),
+                                                         nc * sizeof(float), nc * sizeof(float) * im.width));
+                }
+            }
+            Imf::OutputPart part(exr, 0);
+            part.setFrameBuffer(fb);
+            part.writePixels(im.height);
+        }
+        {
+            Imf::FrameBuffer fb;
+            char* base = const_cast<char*>(reinterpret_cast<const char*>(file.map.xy.data()));
+            const std::size_t xStride = 2 * sizeof(float);
+            fb.insert(kMapChannelU, Imf::Slice(Imf::FLOAT, base, xStride, xStride * file.map.columns));
+            fb.insert(kMapChannelV, Imf::Slice(Imf::FLOAT, base + sizeof(float), xStride, xStride * file.map.columns));
+            Imf::OutputPart part(exr, 1);
+            part.setFrameBuffer(fb);
+            part.writePixels(file.map.rows);
+        }
+    } catch (const std::exception& e) {
+        throw Error(ErrorCode::Io, "cannot write " + path + ": " + e.what());
+    }
+}
+
+}  // namespace conus::format::detail

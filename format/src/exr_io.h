@@ -1,0 +1,24 @@
+// Private to format/: the one place that talks to OpenEXR (exr_io.cpp).
+#pragma once
+
+#include <string>
+
+#include "conus/format/container.h"
+
+namespace conus::format::detail {
+
+struct LoadResult {
+    ValidationReport report;
+    ErrorCode code = ErrorCode::Corrupt;  // how readConusFile throws when the report is not ok
+};
+
+// Opens `path`, checks the header rules, then (only if they pass) reads pixels and map and checks
+// the map rules. Never throws for bad content: every problem lands in the report. `out` is filled
+// only when the report is ok.
+LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, ConusFile& out);
+
+// Writes an already validated file to `path` as it is (no temporary, no rename): throws
+// conus::Error(Io) with OpenEXR's message on failure.
+void writeExrFile(const std::string& path, const ConusFile& file);
+
+}  // namespace conus::format::detail

@@ -1,0 +1,39 @@
+// The plain float image: channel lookup and checked allocation.
+#include <string>
+
+#include "conus/format/error.h"
+#include "conus/format/image.h"
+
+namespace conus::format {
+
+int Image::channelIndex(const std::string& name) const {
+    for (std::size_t c = 0; c < channels.size(); ++c) {
+        if (channels[c] == name) return static_cast<int>(c);
+    }
+    return -1;
+}
+
+Image makeImage(int width, int height, std::vector<std::string> channels) {
+    if (width < 1 || height < 1 || channels.empty()) {
+        throw Error(ErrorCode::InvalidArgument,
+                    "makeImage: need width, height and channel count >= 1, got " + std::to_string(width) +
+                        "x" + std::to_string(height) + " with " + std::to_string(channels.size()) +
+                        " channels");
+    }
+    // Sizes in 64-bit before allocating, so absurd requests fail cleanly instead of overflowing.
+    const std::int64_t pixels = std::int64_t{width} * height;
+    if (width > kMaxImageSide || height > kMaxImageSide || pixels > kMaxImagePixels) {
+        throw Error(ErrorCode::LimitExceeded, "makeImage: " + std::to_string(width) + "x" +
+                                                  std::to_string(height) + " exceeds the limit of " +
+                                                  std::to_string(kMaxImageSide) + " a side, " +
+                                                  std::to_string(kMaxImagePixels) + " pixels");
+    }
+    Image image;
+    image.width = width;
+    image.height = height;
+    image.channels = std::move(channels);
+    image.pixels.assign(static_cast<std::size_t>(pixels) * image.channels.size(), 0.0f);
+    return image;
+}
+
+}  // namespace conus::format

@@ -1,0 +1,345 @@
+// The header rules of spec/conus-format.md (V2..V7, V12..V15) on a HeaderModel, and the
+// in-memory validator that runs them on the header a ConusFile would be written with.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <string>
+
+#include "header_model.h"
+
+namespace conus::format {
+namespace detail {
+namespace {
+
+constexpr int kMaxChannels = 64;
+constexpr std::int64_t kMaxTileArea = std::int64_t{1} << 24;
+
+std::string num(double value) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%.9g", value);
+    return buf;
+}
+
+std::string boxStr(const Box& b) {
+    std::string s(1, '(');
+    s += std::to_string(b.minX) + ", " + std::to_string(b.minY) + ") - (" + std::to_string(b.maxX) + ", " +
+         std::to_string(b.maxY) + ")";
+    return s;
+}
+
+const char* typeName(ChannelType t) {
+    switch (t) {
+        case ChannelType::Uint: return "UINT";
+        case ChannelType::Half: return "HALF";
+        case ChannelType::Float: return "FLOAT";
+    }
+    return "?";
+}
+
+// "present with the right type" or a message for `rule`; returns whether the value can be used.
+template <class T>
+bool need(const Attr<T>& a, const char* name, const char* expected, int rule, ValidationReport& r) {
+    if (!a.present) {
+        r.add(rule, std::string("missing attribute ") + name + " (" + expected + ")");
+        return false;
+    }
+    if (!a.typeOk) {
+        r.add(rule, std::string("attribute ") + name + " has type " + a.typeName + ", expected " + expected);
+        return false;
+    }
+    return true;
+}
+
+template <class T>
+bool optional(const Attr<T>& a, const char* name, const char* expected, int rule, ValidationReport& r) {
+    return a.present && need(a, name, expected, rule, r);
+}
+
+bool oneOf(const std::string& s, std::initializer_list<const char*> allowed) {
+    return std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return s == a; });
+}
+
+void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport& r) {
+    if (m.conusPartCount > 1) r.add(2, std::to_string(m.conusPartCount) + " parts are named `conus`; exactly one is allowed");
+    if (part.type != "scanlineimage" && part.type != "tiledimage") {
+        r.add(2, "part `conus` has type `" + part.type + "`, expected scanlineimage or tiledimage");
+    }
+    if (part.type == "tiledimage" &&
+        (part.tileWidth < 1 || part.tileHeight < 1 || part.tileWidth * part.tileHeight > kMaxTileArea)) {
+        r.add(2, "part `conus` has tiles of " + std::to_string(part.tileWidth) + "x" + std::to_string(part.tileHeight) +
+                     " pixels; at most " + std::to_string(kMaxTileArea) + " pixels a tile are read");
+    }
+    if (!need(m.version, kAttrVersion, "int", 2, r)) return;
+    if (m.version.value > kFormatVersion) {
+        r.add(2, "written by a newer CoNUS (version " + std::to_string(m.version.value) + "); this reader knows version " +
+                     std::to_string(kFormatVersion));
+    } else if (m.version.value < 1) {
+        r.add(2, "invalid " + std::string(kAttrVersion) + " " + std::to_string(m.version.value));
+    }
+}
+
+void checkChannels(const PartModel& part, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
+    const auto n = static_cast<std::int64_t>(part.channels.size());
+    if (n < 1 || n > kMaxChannels) {
+        r.add(3, "part `conus` has " + std::to_string(n) + " channels; 1 to " + std::to_string(kMaxChannels) + " allowed");
+    } else if (n > limits.maxChannels) {
+        r.add(3, "part `conus` has " + std::to_string(n) + " channels, beyond the reader's limit of " +
+                     std::to_string(limits.maxChannels));
+        hc.limitExceeded = true;
+    }
+    std::set<std::string> seen;
+    for (const ChannelModel& c : part.channels) {
+        if (c.name.empty() || !seen.insert(c.name).second) r.add(3, "channel name `" + c.name + "` is empty or repeated");
+        if (c.type == ChannelType::Uint) r.add(3, "channel `" + c.name + "` is UINT; HALF or FLOAT expected");
+        if (c.xSampling != 1 || c.ySampling != 1) {
+            r.add(3, "channel `" + c.name + "` has sampling " + std::to_string(c.xSampling) + "x" +
+                         std::to_string(c.ySampling) + "; 1x1 expected");
+        }
+        if (c.name == "Z" && c.type != ChannelType::Float) r.add(3, std::string("channel `Z` is ") + typeName(c.type) + "; FLOAT expected");
+    }
+}
+
+void checkWindows(const PartModel& part, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
+    const Box& dw = part.dataWindow;
+    if (!(dw == part.displayWindow) || dw.minX != 0 || dw.minY != 0) {
+        r.add(4, "part `conus` dataWindow " + boxStr(dw) + " must equal displayWindow " + boxStr(part.displayWindow) +
+                     " with origin (0, 0)");
+    }
+    const std::int64_t w = dw.width(), h = dw.height();
+    if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide) {
+        r.add(4, "image size " + std::to_string(w) + "x" + std::to_string(h) + " outside [1, " + std::to_string(kMaxImageSide) + "]");
+    } else if (w * h > limits.maxPixels) {
+        r.add(4, "image of " + std::to_string(w) + "x" + std::to_string(h) + " = " + std::to_string(w * h) +
+                     " pixels exceeds the reader's limit of " + std::to_string(limits.maxPixels));
+        hc.limitExceeded = true;
+    }
+}
+
+void checkSourceAndKind(const HeaderModel& m, ValidationReport& r) {
+    if (need(m.sourceSize, kAttrSourceSize, "v2i", 5, r)) {
+        const auto [sw, sh] = m.sourceSize.value;
+        if (sw < 1 || sh < 1 || sw > kMaxImageSide || sh > kMaxImageSide) {
+            r.add(5, "source size " + std::to_string(sw) + "x" + std::to_string(sh) + " outside [1, " +
+                         std::to_string(kMaxImageSide) + "]");
+        }
+    }
+    if (need(m.dataKind, kAttrDataKind, "string", 6, r) && !oneOf(m.dataKind.value, {"image", "heightfield", "depthimage"})) {
+        r.add(6, "data kind `" + m.dataKind.value + "` is not one of image, heightfield, depthimage");
+    }
+}
+
+void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
+    if (m.mapPartCount != 1) {
+        r.add(7, std::to_string(m.mapPartCount) + " parts are named `samplingmap`; exactly one is required");
+        if (m.mapPart < 0) return;
+    }
+    const PartModel& p = m.parts[m.mapPart];
+    if (p.type != "scanlineimage") r.add(7, "part `samplingmap` has type `" + p.type + "`, expected scanlineimage");
+    const bool channelsOk = p.channels.size() == 2 && p.channels[0].name == kMapChannelU && p.channels[1].name == kMapChannelV &&
+                            std::all_of(p.channels.begin(), p.channels.end(), [](const ChannelModel& c) {
+                                return c.type == ChannelType::Float && c.xSampling == 1 && c.ySampling == 1;
+                            });
+    if (!channelsOk) {
+        std::string list;
+        for (const ChannelModel& c : p.channels) list += (list.empty() ? "" : ", ") + c.name + ":" + typeName(c.type);
+        r.add(7, "part `samplingmap` has channels {" + list + "}; exactly FLOAT `ud` and `vd` expected");
+    }
+    const Box& dw = p.dataWindow;
+    const std::int64_t n = dw.width(), rows = dw.height();
+    if (dw.minX != 0 || dw.minY != 0 || n < 2 || rows < 2 || n > 4097 || rows > 4097) {
+        r.add(7, "part `samplingmap` dataWindow " + boxStr(dw) + " must be (0, 0) - (columns-1, rows-1) with columns and rows in [2, 4097]");
+    } else if (n > limits.maxMapSide || rows > limits.maxMapSide) {
+        r.add(7, "sampling map of " + std::to_string(n) + "x" + std::to_string(rows) + " nodes exceeds the reader's limit of " +
+                     std::to_string(limits.maxMapSide) + " a side");
+        hc.limitExceeded = true;
+    }
+}
+
+void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
+    if (!m.mapKind.present) {
+        if (m.foci.present || m.composition.present || !m.params.empty()) {
+            r.add(12, std::string("analytic map parameters without ") + kAttrMapKind);
+        }
+        return;
+    }
+    if (!need(m.mapKind, kAttrMapKind, "string", 12, r)) return;
+    const std::string& kind = m.mapKind.value;
+    if (kind == "foci") {
+        if (need(m.foci, kAttrFoci, "floatvector", 12, r)) {
+            const std::vector<float>& f = m.foci.value;
+            if (f.empty() || f.size() % 4 != 0) {
+                r.add(12, std::string(kAttrFoci) + " has " + std::to_string(f.size()) + " values; 4 per focus (u,v,r,k), at least one focus");
+            } else {
+                for (std::size_t i = 0; i < f.size() / 4; ++i) {
+                    const float u = f[4 * i], v = f[4 * i + 1], rad = f[4 * i + 2], k = f[4 * i + 3];
+                    // Written as negations so NaN fails every test.
+                    if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1 && rad > 0 && std::isfinite(rad) && k >= 1 && k <= 64)) {
+                        r.add(12, "focus " + std::to_string(i) + " (u,v,r,k) = (" + num(u) + ", " + num(v) + ", " + num(rad) + ", " +
+                                      num(k) + "): need u,v in [0,1], r > 0 finite, k in [1,64]");
+                    }
+                }
+            }
+        }
+        if (need(m.composition, kAttrComposition, "string", 12, r) && !oneOf(m.composition.value, {"density", "add"})) {
+            r.add(12, "composition `" + m.composition.value + "` is not density or add");
+        }
+    } else if (kind != "ground") {
+        r.add(12, "map kind `" + kind + "` is not foci or ground");
+    }
+    for (const auto& [name, a] : m.params) {
+        const std::string full = kAttrParamPrefix + name;
+        if (need(a, full.c_str(), "double or float", 12, r) && !std::isfinite(a.value)) {
+            r.add(12, full + " = " + num(a.value) + " is not finite");
+        }
+    }
+}
+
+void checkCamera(const HeaderModel& m, ValidationReport& r) {
+    if (!m.worldToCamera.present && !m.worldToNDC.present && !m.projection.present) return;
+    for (const auto* a : {&m.worldToCamera, &m.worldToNDC}) {
+        const char* name = a == &m.worldToCamera ? kAttrWorldToCamera : kAttrWorldToNDC;
+        if (need(*a, name, "m44f", 13, r) &&
+            !std::all_of(a->value.begin(), a->value.end(), [](float x) { return std::isfinite(x); })) {
+            r.add(13, std::string(name) + " has a non-finite element");
+        }
+    }
+    if (need(m.projection, kAttrProjection, "string", 13, r) && !oneOf(m.projection.value, {"perspective", "orthographic"})) {
+        r.add(13, "projection `" + m.projection.value + "` is not perspective or orthographic");
+    }
+}
+
+void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r) {
+    std::string kind = "none";  // absent means no depth
+    if (optional(m.depthKind, kAttrDepthKind, "string", 14, r)) {
+        kind = m.depthKind.value;
+        if (!oneOf(kind, {"none", "cameraDepth", "height"})) {
+            r.add(14, "depth kind `" + kind + "` is not none, cameraDepth or height");
+            return;
+        }
+    }
+    const bool hasZ = std::any_of(part.channels.begin(), part.channels.end(), [](const ChannelModel& c) { return c.name == "Z"; });
+    if (hasZ && kind == "none") r.add(14, "a `Z` channel needs conus:depthKind cameraDepth or height, not none");
+    if (!hasZ && kind != "none") r.add(14, "conus:depthKind is " + kind + " but there is no `Z` channel");
+    if (kind != "none" && need(m.depthRange, kAttrDepthRange, "v2f", 14, r)) {
+        const auto [nearV, farV] = m.depthRange.value;
+        if (!(std::isfinite(nearV) && std::isfinite(farV) && nearV < farV)) {
+            r.add(14, "depth range (" + num(nearV) + ", " + num(farV) + ") must be finite with near < far");
+        }
+    }
+    optional(m.depthUnits, kAttrDepthUnits, "string", 14, r);
+}
+
+void checkDisplayWindows(const HeaderModel& m, ValidationReport& r) {
+    for (std::size_t i = 1; i < m.parts.size(); ++i) {
+        if (!(m.parts[i].displayWindow == m.parts[0].displayWindow)) {
+            r.add(15, "part " + std::to_string(i) + " (`" + m.parts[i].name + "`) displayWindow " + boxStr(m.parts[i].displayWindow) +
+                          " differs from part 0's " + boxStr(m.parts[0].displayWindow));
+        }
+    }
+}
+
+}  // namespace
+
+HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r) {
+    HeaderCheck hc;
+    if (m.conusPart < 0) {
+        r.add(2, "not a CoNUS file: no part named `conus` among " + std::to_string(m.parts.size()) + " part(s)");
+        hc.notConus = true;
+        return hc;
+    }
+    const PartModel& part = m.parts[m.conusPart];
+    checkVersion(m, part, r);
+    checkChannels(part, limits, r, hc);
+    checkWindows(part, limits, r, hc);
+    checkSourceAndKind(m, r);
+    checkMapPart(m, limits, r, hc);
+    checkAnalytic(m, r);
+    checkCamera(m, r);
+    checkDepth(m, part, r);
+    checkDisplayWindows(m, r);
+    return hc;
+}
+
+namespace {
+template <class T>
+Attr<T> attr(T value) {
+    Attr<T> a;
+    a.present = a.typeOk = true;
+    a.value = std::move(value);
+    return a;
+}
+}  // namespace
+
+HeaderModel modelOf(const ConusFile& file) {
+    HeaderModel m;
+    const Image& im = file.image;
+    PartModel conus;
+    conus.name = kConusPartName;
+    conus.type = "scanlineimage";
+    for (const std::string& name : im.channels) {
+        conus.channels.push_back({name, name == "Z" || file.pixelType == PixelType::Float ? ChannelType::Float : ChannelType::Half, 1, 1});
+    }
+    // OpenEXR stores channels sorted by name; so does the model, so checks read the same.
+    std::sort(conus.channels.begin(), conus.channels.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+    conus.dataWindow = conus.displayWindow = Box{0, 0, std::int64_t{im.width} - 1, std::int64_t{im.height} - 1};
+    PartModel map;
+    map.name = kMapPartName;
+    map.type = "scanlineimage";
+    map.channels = {{kMapChannelU, ChannelType::Float, 1, 1}, {kMapChannelV, ChannelType::Float, 1, 1}};
+    map.displayWindow = conus.displayWindow;
+    map.dataWindow = Box{0, 0, std::int64_t{file.map.columns} - 1, std::int64_t{file.map.rows} - 1};
+    m.parts = {conus, map};
+    m.conusPart = 0;
+    m.mapPart = 1;
+    m.conusPartCount = m.mapPartCount = 1;
+
+    m.version = attr(kFormatVersion);
+    m.sourceSize = attr(std::array<int, 2>{file.sourceWidth, file.sourceHeight});
+    m.dataKind = attr(std::string(toString(file.dataKind)));
+    if (file.analytic) {
+        const AnalyticMap& a = *file.analytic;
+        m.mapKind = attr(a.kind);
+        if (a.kind == "foci" || !a.foci.empty()) {
+            std::vector<float> f;
+            for (const FocusParams& p : a.foci) {
+                f.insert(f.end(), {float(p.u), float(p.v), float(p.r), float(p.k)});
+            }
+            m.foci = attr(std::move(f));
+        }
+        if (a.kind == "foci" || !a.composition.empty()) m.composition = attr(a.composition);
+        for (const auto& [name, value] : a.scalars) m.params[name] = attr(value);
+    }
+    if (file.camera) {
+        m.worldToCamera = attr(file.camera->worldToCamera);
+        m.worldToNDC = attr(file.camera->worldToNDC);
+        m.projection = attr(file.camera->projection);
+    }
+    m.depthKind = attr(std::string(toString(file.depth.kind)));
+    if (file.depth.kind != DepthKind::None) m.depthRange = attr(std::array<float, 2>{file.depth.near, file.depth.far});
+    if (!file.depth.units.empty()) m.depthUnits = attr(file.depth.units);
+    return m;
+}
+
+}  // namespace detail
+
+ValidationReport validateConusFile(const ConusFile& file) {
+    ValidationReport report;
+    const detail::HeaderModel model = detail::modelOf(file);
+    detail::checkHeaderRules(model, ReadLimits{}, report);
+    // The in-memory image must hold what its header promises (V4 covers the pixel array).
+    const Image& im = file.image;
+    if (im.width >= 1 && im.height >= 1 &&
+        im.pixels.size() != std::size_t(im.width) * std::size_t(im.height) * im.channels.size()) {
+        report.add(4, "image holds " + std::to_string(im.pixels.size()) + " values; " + std::to_string(im.width) + "x" +
+                          std::to_string(im.height) + "x" + std::to_string(im.channels.size()) + " expected");
+    }
+    const ValidationReport grid = validateGrid(file.map);
+    // V7's shape was already reported from the header model; keep the grid's own messages otherwise.
+    for (const Issue& issue : grid.issues) {
+        if (issue.rule != 7 || !report.violates(7)) report.issues.push_back(issue);
+    }
+    return report;
+}
+
+}  // namespace conus::format

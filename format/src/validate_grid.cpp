@@ -1,0 +1,130 @@
+// The sampling-map rules V7..V11 (spec/conus-format.md), shared by the container and by
+// codec::SamplingMap so they live in one place.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "conus/format/container.h"
+
+namespace conus::format {
+namespace {
+
+constexpr int kMinMapSide = 2;
+constexpr int kMaxMapSide = 4097;
+// Each rule reports at most this many problems, then one summary line, so that a 4097² broken
+// grid yields a readable report instead of megabytes.
+constexpr int kMaxMessagesPerRule = 20;
+constexpr double kMinCornerCross = 1e-12;
+
+std::string fmt(double value) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%.9g", value);
+    return buf;
+}
+
+// Adds messages for one rule up to the cap, and the "... and N more" line at the end.
+class CappedRule {
+public:
+    CappedRule(ValidationReport& report, int rule, const char* what)
+        : m_report(report), m_rule(rule), m_what(what) {}
+    ~CappedRule() {
+        if (m_count > kMaxMessagesPerRule) {
+            m_report.add(m_rule, "... and " + std::to_string(m_count - kMaxMessagesPerRule) + " more " + m_what);
+        }
+    }
+    void add(std::string message) {
+        if (++m_count <= kMaxMessagesPerRule) m_report.add(m_rule, std::move(message));
+    }
+
+private:
+    ValidationReport& m_report;
+    int m_rule;
+    const char* m_what;
+    long long m_count = 0;
+};
+
+std::string node(int i, int j) {
+    // Built by appending: g++ 12 gives a false -Wrestrict warning for "literal" + std::string&&.
+    std::string s(1, '(');
+    s.append(std::to_string(i)).append(1, ',').append(std::to_string(j)).append(1, ')');
+    return s;
+}
+
+}  // namespace
+
+ValidationReport validateGrid(const GridNodes& grid) {
+    ValidationReport report;
+    const int n = grid.columns;
+    const int m = grid.rows;
+    if (n < kMinMapSide || n > kMaxMapSide || m < kMinMapSide || m > kMaxMapSide) {
+        report.add(7, "map grid is " + std::to_string(n) + "x" + std::to_string(m) + " nodes; columns and rows must be in [" +
+                          std::to_string(kMinMapSide) + ", " + std::to_string(kMaxMapSide) + "]");
+        return report;  // nothing below can be indexed safely
+    }
+    const std::size_t expected = std::size_t{2} * n * m;
+    if (grid.xy.size() != expected) {
+        report.add(7, "map grid " + std::to_string(n) + "x" + std::to_string(m) + " needs " + std::to_string(expected) +
+                          " values, has " + std::to_string(grid.xy.size()));
+        return report;
+    }
+    auto U = [&](int i, int j) { return static_cast<double>(grid.xy[2 * (std::size_t(j) * n + i)]); };
+    auto V = [&](int i, int j) { return static_cast<double>(grid.xy[2 * (std::size_t(j) * n + i) + 1]); };
+
+    bool allFinite = true;
+    {
+        CappedRule v8(report, 8, "nodes");
+        CappedRule v9(report, 9, "nodes");
+        CappedRule v10(report, 10, "nodes");
+        for (int j = 0; j < m; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const double u = U(i, j), v = V(i, j);
+                if (!std::isfinite(u) || !std::isfinite(v)) {
+                    v8.add("node " + node(i, j) + " is not finite: (" + fmt(u) + ", " + fmt(v) + ")");
+                    allFinite = false;
+                    continue;
+                }
+                if (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) {
+                    v9.add("node " + node(i, j) + " = (" + fmt(u) + ", " + fmt(v) + ") is outside [0,1]^2");
+                }
+                // Exact comparisons: boundary nodes must sit on their edge so the CoNUS image covers
+                // exactly the conventional field of view.
+                if (i == 0 && u != 0.0) v10.add("left-column node " + node(i, j) + " has u = " + fmt(u) + ", must be 0");
+                if (i == n - 1 && u != 1.0) v10.add("right-column node " + node(i, j) + " has u = " + fmt(u) + ", must be 1");
+                if (j == 0 && v != 0.0) v10.add("top-row node " + node(i, j) + " has v = " + fmt(v) + ", must be 0");
+                if (j == m - 1 && v != 1.0) v10.add("bottom-row node " + node(i, j) + " has v = " + fmt(v) + ", must be 1");
+            }
+        }
+    }
+    if (!allFinite) return report;  // cross products of NaN say nothing useful
+
+    // V11: at every corner of every cell (cyclic order (i,j),(i+1,j),(i+1,j+1),(i,j+1)) the cross
+    // product of the incoming and outgoing edge is positive, as for the identity. A bilinear patch
+    // has a positive Jacobian everywhere iff it does at its four corners, so this is exactly
+    // injectivity of the piecewise-bilinear map.
+    CappedRule v11(report, 11, "cells");
+    static constexpr int kDi[4] = {0, 1, 1, 0};
+    static constexpr int kDj[4] = {0, 0, 1, 1};
+    for (int j = 0; j + 1 < m; ++j) {
+        for (int i = 0; i + 1 < n; ++i) {
+            double px[4], py[4];
+            for (int c = 0; c < 4; ++c) {
+                px[c] = U(i + kDi[c], j + kDj[c]);
+                py[c] = V(i + kDi[c], j + kDj[c]);
+            }
+            for (int c = 0; c < 4; ++c) {
+                const int prev = (c + 3) % 4, next = (c + 1) % 4;
+                const double ax = px[c] - px[prev], ay = py[c] - py[prev];
+                const double bx = px[next] - px[c], by = py[next] - py[c];
+                const double cross = ax * by - ay * bx;
+                if (!(cross > kMinCornerCross)) {
+                    v11.add("cell " + node(i, j) + " is not strictly convex: corner " +
+                            node(i + kDi[c], j + kDj[c]) + " cross = " + fmt(cross));
+                    break;  // one message per cell
+                }
+            }
+        }
+    }
+    return report;
+}
+
+}  // namespace conus::format

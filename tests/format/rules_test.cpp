@@ -1,0 +1,306 @@
+// Every rule V1..V15 of spec/conus-format.md, each broken once: in memory where a ConusFile can
+// express the fault, else as a malformed file written with OpenEXR directly.
+#include <gtest/gtest.h>
+
+#include <ImfChannelList.h>
+#include <ImfFloatVectorAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIntAttribute.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
+#include <ImfStringAttribute.h>
+#include <ImfVecAttribute.h>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+
+#include "test_files.h"
+
+namespace conus::format {
+namespace {
+
+using testing::TempDir;
+using testing::validFile;
+using Mutate = std::function<void(Imf::Header& conus, Imf::Header& map)>;
+
+// The report is not ok and names only `rule`.
+::testing::AssertionResult onlyRule(const ValidationReport& r, int rule) {
+    if (r.ok()) return ::testing::AssertionFailure() << "report is ok, expected V" << rule;
+    for (const Issue& i : r.issues) {
+        if (i.rule != rule) return ::testing::AssertionFailure() << "expected only V" << rule << ", got:\n" << r.str();
+    }
+    return ::testing::AssertionSuccess();
+}
+
+// Writes what writeConusFile would, without validation, after `mutate` edits the headers; every
+// channel of each header gets pixel data, so any channel layout can be written.
+void writeRaw(const std::string& path, const ConusFile& f, const Mutate& mutate, bool withMap = true) {
+    Imf::Header conus(f.image.width, f.image.height);
+    conus.setName("conus");
+    conus.setType(Imf::SCANLINEIMAGE);
+    for (const std::string& c : f.image.channels) conus.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    conus.insert("conus:version", Imf::IntAttribute(1));
+    conus.insert("conus:sourceSize", Imf::V2iAttribute(Imath::V2i(f.sourceWidth, f.sourceHeight)));
+    conus.insert("conus:dataKind", Imf::StringAttribute("image"));
+    conus.insert("conus:depthKind", Imf::StringAttribute("none"));
+    Imf::Header map(conus.displayWindow(), Imath::Box2i({0, 0}, {f.map.columns - 1, f.map.rows - 1}));
+    map.setName("samplingmap");
+    map.setType(Imf::SCANLINEIMAGE);
+    map.channels().insert("ud", Imf::Channel(Imf::FLOAT));
+    map.channels().insert("vd", Imf::Channel(Imf::FLOAT));
+    mutate(conus, map);
+
+    std::vector<Imf::Header> headers{conus};
+    if (withMap) headers.push_back(map);
+    Imf::MultiPartOutputFile out(path.c_str(), headers.data(), int(headers.size()));
+    std::vector<std::vector<float>> store;
+    for (int p = 0; p < int(headers.size()); ++p) {
+        const Imf::Header& h = headers[p];
+        const Imath::Box2i dw = h.dataWindow();
+        const int w = dw.max.x - dw.min.x + 1, rows = dw.max.y - dw.min.y + 1;
+        Imf::FrameBuffer fb;
+        for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+            // OpenEXR writes only from slices of the channel's own type; 0.5f has the bits of a
+            // plausible UINT too, and HALF channels get a half's worth of each float.
+            std::vector<float>& buf = store.emplace_back(std::size_t(w) * rows, 0.5f);
+            const Imf::PixelType type = it.channel().type;
+            if (p == 1 && (std::string(it.name()) == "ud" || std::string(it.name()) == "vd")) {
+                const int off = std::string(it.name()) == "ud" ? 0 : 1;
+                for (std::size_t k = 0; k < buf.size() && 2 * k + 1 < f.map.xy.size(); ++k) buf[k] = f.map.xy[2 * k + off];
+            }
+            char* base = reinterpret_cast<char*>(buf.data()) - (std::ptrdiff_t(dw.min.x) + std::ptrdiff_t(dw.min.y) * w) * 4;
+            const std::size_t size = type == Imf::HALF ? 2 : 4;
+            if (type == Imf::HALF) base = reinterpret_cast<char*>(buf.data());  // zero-origin windows only
+            fb.insert(it.name(), Imf::Slice(type, base, size, size * w, it.channel().xSampling, it.channel().ySampling));
+        }
+        Imf::OutputPart part(out, p);
+        part.setFrameBuffer(fb);
+        part.writePixels(rows);
+    }
+}
+
+class RuleTest : public ::testing::Test {
+protected:
+    ValidationReport raw(const Mutate& mutate, bool withMap = true) {
+        writeRaw(m_dir.file("raw.exr"), validFile(), mutate, withMap);
+        return validateConusFile(m_dir.file("raw.exr"));
+    }
+    TempDir m_dir;
+};
+
+TEST_F(RuleTest, RawWriterMakesValidFiles) {
+    const ValidationReport r = raw([](Imf::Header&, Imf::Header&) {});
+    EXPECT_TRUE(r.ok()) << r.str();
+    EXPECT_TRUE(validateConusFile(validFile()).ok()) << validateConusFile(validFile()).str();
+}
+
+TEST_F(RuleTest, UnknownConusAttributesAreIgnored) {
+    EXPECT_TRUE(raw([](Imf::Header& c, Imf::Header&) { c.insert("conus:futureThing", Imf::IntAttribute(7)); }).ok());
+}
+
+TEST_F(RuleTest, V1NotAnExrFile) {
+    std::ofstream(m_dir.file("junk.exr")) << "this is not an EXR file at all";
+    const ValidationReport r = validateConusFile(m_dir.file("junk.exr"));
+    EXPECT_TRUE(onlyRule(r, 1));
+    std::ofstream(m_dir.file("empty.exr")).close();
+    EXPECT_TRUE(onlyRule(validateConusFile(m_dir.file("empty.exr")), 1));
+    try {
+        readConusFile(m_dir.file("junk.exr"));
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::Corrupt);
+    }
+}
+
+TEST_F(RuleTest, V2NoConusPartIsNotConus) {
+    const ValidationReport r = raw([](Imf::Header& c, Imf::Header&) { c.setName("other"); });
+    EXPECT_TRUE(onlyRule(r, 2));
+    try {
+        readConusFile(m_dir.file("raw.exr"));
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::NotConus);
+        EXPECT_NE(std::string(e.what()).find("not a CoNUS file"), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(RuleTest, V2NewerVersionIsRefused) {
+    const ValidationReport r = raw([](Imf::Header& c, Imf::Header&) { c.insert("conus:version", Imf::IntAttribute(2)); });
+    EXPECT_TRUE(onlyRule(r, 2));
+    EXPECT_NE(r.str().find("written by a newer CoNUS (version 2)"), std::string::npos) << r.str();
+}
+
+TEST_F(RuleTest, V2VersionMissingOrMistyped) {
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.erase("conus:version"); }), 2));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) {
+                             c.erase("conus:version");
+                             c.insert("conus:version", Imf::StringAttribute("1"));
+                         }),
+                         2));
+}
+
+TEST_F(RuleTest, V3Channels) {
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.channels().insert("Q", Imf::Channel(Imf::UINT)); }), 3));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.channels().insert("S", Imf::Channel(Imf::HALF, 2, 2)); }), 3));
+    // A HALF Z breaks V3 (Z is FLOAT); depthKind must then say what Z is, so set it too.
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) {
+                             c.channels().insert("Z", Imf::Channel(Imf::HALF));
+                             c.insert("conus:depthKind", Imf::StringAttribute("height"));
+                             c.insert("conus:depthRange", Imf::V2fAttribute(Imath::V2f(0, 1)));
+                         }),
+                         3));
+    ConusFile f = validFile();
+    f.image = makeImage(2, 2, std::vector<std::string>(65, "C"));
+    for (int i = 0; i < 65; ++i) f.image.channels[i] = std::to_string(100 + i).insert(0, 1, 'C');
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 3));
+    f = validFile();
+    f.image.channels[1] = f.image.channels[0];
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 3));
+}
+
+TEST_F(RuleTest, V4Windows) {
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.dataWindow() = Imath::Box2i({0, 0}, {6, 5}); }), 4));
+    ConusFile f = validFile();
+    f.image.width = 0;
+    f.image.pixels.clear();
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 4));
+    f = validFile();
+    f.image.pixels.pop_back();
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 4));
+}
+
+TEST_F(RuleTest, V5SourceSize) {
+    ConusFile f = validFile();
+    f.sourceHeight = 70000;
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 5));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.erase("conus:sourceSize"); }), 5));
+}
+
+TEST_F(RuleTest, V6DataKind) {
+    ConusFile f = validFile();
+    f.dataKind = static_cast<DataKind>(42);
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 6));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.insert("conus:dataKind", Imf::StringAttribute("photo")); }), 6));
+}
+
+TEST_F(RuleTest, V7MapPart) {
+    ConusFile f = validFile();
+    f.map = testing::identityGrid(1, 4);
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 7));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header&, Imf::Header&) {}, false), 7));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header&, Imf::Header& m) { m.channels().insert("wd", Imf::Channel(Imf::FLOAT)); }), 7));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header&, Imf::Header& m) {
+                             m.channels() = Imf::ChannelList();
+                             m.channels().insert("ud", Imf::Channel(Imf::HALF));
+                             m.channels().insert("vd", Imf::Channel(Imf::FLOAT));
+                         }),
+                         7));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header&, Imf::Header& m) { m.dataWindow() = Imath::Box2i({1, 0}, {5, 3}); }), 7));
+}
+
+TEST_F(RuleTest, V8ToV11MapGeometry) {
+    ConusFile f = validFile();
+    f.map.xy[2 * 6] = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 8));
+    f = validFile();
+    f.map.xy[2 * 6 + 1] = -0.5f;  // node (1,1) above the top edge: outside and folded
+    EXPECT_TRUE(validateConusFile(f).violates(9));
+    f = validFile();
+    f.map.xy[1] = 0.01f;  // top-left corner off its edge
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 10));
+    f = validFile();
+    f.map.xy[2 * 6] = 0.6f;  // node (1,1) past (2,1): folded
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 11));
+}
+
+TEST_F(RuleTest, MapRulesAreCheckedInFiles) {
+    ConusFile f = validFile();
+    f.map.xy[2 * 6] = 0.6f;
+    writeRaw(m_dir.file("fold.exr"), f, [](Imf::Header&, Imf::Header&) {});
+    EXPECT_TRUE(onlyRule(validateConusFile(m_dir.file("fold.exr")), 11));
+    try {
+        readConusFile(m_dir.file("fold.exr"));
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::InvalidMap);
+    }
+}
+
+TEST_F(RuleTest, V12AnalyticMap) {
+    ConusFile f = validFile();
+    f.analytic = AnalyticMap{"foci", {{0.5, 0.5, 0.1, 100}}, "density", {}};
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 12));
+    f.analytic = AnalyticMap{"foci", {{0.5, 0.5, 0.1, 2}}, "multiply", {}};
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 12));
+    f.analytic = AnalyticMap{"foci", {}, "add", {}};
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 12));
+    f.analytic = AnalyticMap{"spiral", {}, "", {}};
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 12));
+    f.analytic = AnalyticMap{"ground", {}, "", {{"tilt", std::numeric_limits<double>::infinity()}}};
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 12));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) {
+                             c.insert("conus:mapKind", Imf::StringAttribute("foci"));
+                             c.insert("conus:foci", Imf::FloatVectorAttribute({0.5f, 0.5f, 0.1f, 2.0f, 0.3f}));
+                             c.insert("conus:composition", Imf::StringAttribute("add"));
+                         }),
+                         12));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) {
+                             c.insert("conus:mapKind", Imf::StringAttribute("ground"));
+                             c.insert("conus:param:tilt", Imf::StringAttribute("steep"));
+                         }),
+                         12));
+}
+
+TEST_F(RuleTest, V13Camera) {
+    ConusFile f = validFile();
+    f.camera = Camera{};
+    f.camera->worldToNDC[5] = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 13));
+    f.camera = Camera{"fisheye", {}, {}};
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 13));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) {
+                             c.insert("worldToCamera", Imf::M44fAttribute(Imath::M44f()));
+                             c.insert("conus:projection", Imf::StringAttribute("perspective"));
+                         }),
+                         13));
+}
+
+TEST_F(RuleTest, V14Depth) {
+    ConusFile f = validFile();
+    f.image = makeImage(8, 6, {"Y", "Z"});
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 14));  // Z without depthKind
+    f.depth = {DepthKind::CameraDepth, "m", 5.0f, 1.0f};
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 14));  // near > far
+    f = validFile();
+    f.depth = {DepthKind::Height, "m", 0.0f, 1.0f};
+    EXPECT_TRUE(onlyRule(validateConusFile(f), 14));  // depthKind without Z
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.insert("conus:depthKind", Imf::StringAttribute("altitude")); }), 14));
+}
+
+TEST_F(RuleTest, V15DisplayWindows) {
+    // OpenEXR refuses to write parts with different displayWindows, so patch the second part's
+    // in the bytes: name, type, size 16, then min.x min.y max.x max.y as little-endian int32.
+    writeRaw(m_dir.file("raw.exr"), validFile(), [](Imf::Header&, Imf::Header&) {});
+    std::string bytes;
+    {
+        std::ifstream in(m_dir.file("raw.exr"), std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const std::string key("displayWindow\0box2i\0", 20);
+    const std::size_t first = bytes.find(key);
+    const std::size_t second = bytes.find(key, first + 1);
+    ASSERT_NE(second, std::string::npos);
+    bytes[second + key.size() + 4 + 8] = 99;  // max.x of part 1
+    std::ofstream(m_dir.file("patched.exr"), std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    const ValidationReport r = validateConusFile(m_dir.file("patched.exr"));
+    EXPECT_TRUE(onlyRule(r, 15));
+    EXPECT_NE(r.str().find("(0, 0) - (99, 5)"), std::string::npos) << r.str();
+}
+
+}  // namespace
+}  // namespace conus::format

@@ -1,0 +1,168 @@
+// The sampling-map rules V7..V11 on in-memory grids.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "conus/format/container.h"
+
+namespace conus::format {
+namespace {
+
+GridNodes identityGrid(int columns, int rows) {
+    GridNodes g;
+    g.columns = columns;
+    g.rows = rows;
+    g.xy.resize(std::size_t{2} * columns * rows);
+    for (int j = 0; j < rows; ++j) {
+        for (int i = 0; i < columns; ++i) {
+            const std::size_t k = std::size_t(j) * columns + i;
+            g.xy[2 * k] = float(i) / float(columns - 1);
+            g.xy[2 * k + 1] = float(j) / float(rows - 1);
+        }
+    }
+    return g;
+}
+
+float& u(GridNodes& g, int i, int j) { return g.xy[2 * (std::size_t(j) * g.columns + i)]; }
+float& v(GridNodes& g, int i, int j) { return g.xy[2 * (std::size_t(j) * g.columns + i) + 1]; }
+
+// The report breaks exactly `rule` and nothing else.
+void expectOnly(const ValidationReport& r, int rule) {
+    ASSERT_FALSE(r.ok());
+    for (const Issue& issue : r.issues) EXPECT_EQ(issue.rule, rule) << r.str();
+}
+
+TEST(ValidateGrid, IdentityIsValid) {
+    EXPECT_TRUE(validateGrid(identityGrid(2, 2)).ok());
+    EXPECT_TRUE(validateGrid(identityGrid(17, 9)).ok()) << validateGrid(identityGrid(17, 9)).str();
+}
+
+TEST(ValidateGrid, SmoothDistortionIsValid) {
+    GridNodes g = identityGrid(33, 33);
+    for (int j = 1; j < 32; ++j) {
+        for (int i = 1; i < 32; ++i) {
+            const float x = u(g, i, j), y = v(g, i, j);
+            u(g, i, j) = x + 0.05f * std::sin(3.14159265f * x) * std::sin(3.14159265f * y);
+        }
+    }
+    EXPECT_TRUE(validateGrid(g).ok()) << validateGrid(g).str();
+}
+
+TEST(ValidateGrid, V7Shape) {
+    expectOnly(validateGrid(identityGrid(1, 5)), 7);
+    GridNodes big;
+    big.columns = 4098;
+    big.rows = 2;
+    expectOnly(validateGrid(big), 7);
+    GridNodes g = identityGrid(4, 4);
+    g.xy.pop_back();
+    expectOnly(validateGrid(g), 7);
+    EXPECT_NE(validateGrid(g).str().find("V7: "), std::string::npos);
+}
+
+TEST(ValidateGrid, V8NotFinite) {
+    GridNodes g = identityGrid(5, 5);
+    u(g, 2, 2) = std::numeric_limits<float>::quiet_NaN();
+    expectOnly(validateGrid(g), 8);
+    g = identityGrid(5, 5);
+    v(g, 1, 3) = std::numeric_limits<float>::infinity();
+    expectOnly(validateGrid(g), 8);
+}
+
+TEST(ValidateGrid, V9OutsideUnitSquare) {
+    // An interior node out of [0,1]^2 can only get there by folding too, so accept V11 alongside.
+    GridNodes g = identityGrid(3, 3);
+    u(g, 1, 1) = 1.5f;
+    const ValidationReport r = validateGrid(g);
+    EXPECT_TRUE(r.violates(9)) << r.str();
+    EXPECT_FALSE(r.violates(10));
+    EXPECT_NE(r.str().find("(1,1)"), std::string::npos) << r.str();
+}
+
+TEST(ValidateGrid, V10BoundaryOffEdge) {
+    GridNodes g = identityGrid(5, 5);
+    u(g, 0, 2) = 0.01f;  // left column slides inward: still convex, still inside
+    expectOnly(validateGrid(g), 10);
+    g = identityGrid(5, 5);
+    v(g, 4, 4) = 0.999f;  // a corner
+    expectOnly(validateGrid(g), 10);
+}
+
+TEST(ValidateGrid, V11FoldedCell) {
+    GridNodes g = identityGrid(5, 5);
+    u(g, 2, 2) = 0.8f;  // past its right neighbour at 0.75: cells fold
+    const ValidationReport r = validateGrid(g);
+    expectOnly(r, 11);
+    EXPECT_NE(r.str().find("is not strictly convex"), std::string::npos) << r.str();
+}
+
+TEST(ValidateGrid, V11DegenerateCell) {
+    GridNodes g = identityGrid(5, 5);
+    u(g, 2, 2) = 0.75f;  // onto its right neighbour: zero-area corner
+    expectOnly(validateGrid(g), 11);
+}
+
+TEST(ValidateGrid, V11MirroredGridHasWrongOrientation) {
+    // A grid mirrored in u has every cell convex but clockwise; the boundary rule breaks too.
+    GridNodes g = identityGrid(4, 4);
+    for (int j = 0; j < 4; ++j) {
+        for (int i = 0; i < 4; ++i) u(g, i, j) = 1.0f - u(g, i, j);
+    }
+    const ValidationReport r = validateGrid(g);
+    EXPECT_TRUE(r.violates(11));
+    EXPECT_TRUE(r.violates(10));
+}
+
+TEST(ValidateGrid, MessagesAreCapped) {
+    GridNodes g = identityGrid(200, 200);
+    for (float& x : g.xy) x = std::numeric_limits<float>::quiet_NaN();
+    const ValidationReport r = validateGrid(g);
+    EXPECT_EQ(r.issues.size(), 21u);
+    EXPECT_NE(r.issues.back().message.find("... and 39980 more"), std::string::npos) << r.issues.back().message;
+
+    GridNodes flat = identityGrid(100, 100);
+    for (int j = 1; j < 99; ++j) {
+        for (int i = 1; i < 99; ++i) v(flat, i, j) = 0.5f;  // interior rows collapse
+    }
+    const ValidationReport rf = validateGrid(flat);
+    EXPECT_EQ(rf.issues.size(), 21u) << rf.str();
+    EXPECT_NE(rf.issues.back().message.find("more cells"), std::string::npos);
+}
+
+TEST(ValidationReport, StrAndViolates) {
+    ValidationReport r;
+    EXPECT_TRUE(r.ok());
+    r.add(3, "bad channel");
+    r.add(0, "unreadable");
+    EXPECT_TRUE(r.violates(3));
+    EXPECT_FALSE(r.violates(4));
+    EXPECT_EQ(r.str(), "V3: bad channel\nerror: unreadable\n");
+}
+
+TEST(Image, MakeImageAndChannelIndex) {
+    Image im = makeImage(3, 2, {"R", "G", "B"});
+    EXPECT_EQ(im.pixels.size(), 18u);
+    EXPECT_EQ(im.channelIndex("G"), 1);
+    EXPECT_EQ(im.channelIndex("Z"), -1);
+    im.at(2, 1, 2) = 5.0f;
+    EXPECT_EQ(im.pixels.back(), 5.0f);
+    EXPECT_THROW(makeImage(0, 2, {"R"}), Error);
+    EXPECT_THROW(makeImage(2, 2, {}), Error);
+    try {
+        makeImage(65536, 65536, {"R"});
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::LimitExceeded);
+    }
+}
+
+TEST(ToString, Names) {
+    EXPECT_STREQ(toString(PixelType::Half), "half");
+    EXPECT_STREQ(toString(Compression::Dwaa), "dwaa");
+    EXPECT_STREQ(toString(DataKind::HeightField), "heightfield");
+    EXPECT_STREQ(toString(DepthKind::CameraDepth), "cameraDepth");
+}
+
+}  // namespace
+}  // namespace conus::format
