@@ -88,7 +88,7 @@ Command addDemoCommand(CLI::App& root) {
                 writeImage((out / "uniform.png").string(), uniform.image);
                 const double shrink = std::min(1.0, 1024.0 / std::max(w, h));
                 const int pw = std::max(16, int(w * shrink)), ph = std::max(16, int(h * shrink));
-                writeImage((out / "density.png").string(), densityPicture(map, pw, ph, 64, &analytic));
+                writeImage((out / "density.png").string(), densityPicture(map, pw, ph, 32, &analytic));
                 const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
 
                 struct ViewCase {

@@ -21,6 +21,17 @@ int main(int argc, char** argv) {
     };
 
     std::string name;
+    // CLI11 would only say "a subcommand is required"; name the word it did not know instead.
+    std::string known;
+    bool isKnown = false;
+    for (const auto& command : commands) {
+        known += (known.empty() ? "" : ", ") + command.app->get_name();
+        isKnown |= argc > 1 && command.app->get_name() == argv[1];
+    }
+    if (argc > 1 && argv[1][0] != '-' && !isKnown) {
+        std::fprintf(stderr, "conus: unknown command '%s' (commands: %s; see --help)\n", argv[1], known.c_str());
+        return 2;
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
