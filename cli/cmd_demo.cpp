@@ -8,16 +8,19 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "commands.h"
 #include "conus/codec/decode.h"
 #include "conus/codec/encode.h"
+#include "conus/codec/auto_map.h"
 #include "conus/codec/foci.h"
 #include "conus/codec/metrics.h"
 #include "demo_picture.h"
 #include "encoding.h"
 #include "image_io.h"
+#include "importance.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -33,11 +36,31 @@ format::Image crop(const format::Image& source, int x0, int y0, int width, int h
     return out;
 }
 
+// The view around the most important region: the bounding square of the importance above half its
+// peak, as a focus-shaped rectangle (centre, half side as a fraction of the width).
+codec::Focus hottestRegion(const format::Image& importance, int width, int height) {
+    float peak = 0;
+    for (int y = 0; y < importance.height; ++y)
+        for (int x = 0; x < importance.width; ++x) peak = std::max(peak, importance.at(x, y));
+    double u0 = 1, v0 = 1, u1 = 0, v1 = 0;
+    for (int y = 0; y < importance.height; ++y)
+        for (int x = 0; x < importance.width; ++x)
+            if (peak > 0 && importance.at(x, y) >= 0.5f * peak) {
+                u0 = std::min(u0, double(x) / importance.width);
+                u1 = std::max(u1, double(x + 1) / importance.width);
+                v0 = std::min(v0, double(y) / importance.height);
+                v1 = std::max(v1, double(y + 1) / importance.height);
+            }
+    if (u1 <= u0) return {0.5, 0.5, 0.1, 1};
+    const double half = 0.5 * std::max((u1 - u0) * width, (v1 - v0) * height) / width;
+    return {0.5 * (u0 + u1), 0.5 * (v0 + v1), std::max(half, 8.0 / width), 1};
+}
+
 }  // namespace
 
 Command addDemoCommand(CLI::App& root) {
     struct Options {
-        std::string out = "demo-out", input;
+        std::string out = "demo-out", input, importance;
         std::vector<std::string> foci;
         int size = 4096;
         double k = 4;
@@ -52,6 +75,9 @@ Command addDemoCommand(CLI::App& root) {
     command->add_option("--input", options->input,
                         "run the same comparison on your own picture instead of the built-in one");
     command->add_option("--focus", options->foci, "with --input: focus u,v,r,k (repeatable; default: the centre)");
+    command->add_option("--importance", options->importance,
+                        "with --input: build the map automatically from importance (a file, 'detail' or 'faces') "
+                        "instead of foci; --focus then only names the views to compare");
     return {command, [options] {
                 namespace fs = std::filesystem;
                 fs::create_directories(options->out);
@@ -71,12 +97,21 @@ Command addDemoCommand(CLI::App& root) {
                 }
                 const int w = source.width, h = source.height;
                 Progress building("build the sampling map");
-                codec::FociOptions fociOptions;
-                fociOptions.aspect = double(w) / h;
-                const codec::SamplingMap map = codec::buildFociMap(foci, fociOptions);
+                std::optional<format::AnalyticMap> analytic;
+                std::optional<codec::SamplingMap> built;
+                if (!options->importance.empty()) {
+                    const format::Image importance = importanceFrom(options->importance, source);
+                    built = codec::buildAutoMap(importance, {});
+                    if (options->foci.empty()) foci = {hottestRegion(importance, w, h)};
+                } else {
+                    codec::FociOptions fociOptions;
+                    fociOptions.aspect = double(w) / h;
+                    built = codec::buildFociMap(foci, fociOptions);
+                    analytic = format::AnalyticMap{"foci", {}, "density", {}};
+                    for (const auto& f : foci) analytic->foci.push_back({f.u, f.v, f.r, f.k});
+                }
+                const codec::SamplingMap& map = *built;
                 building.done();
-                format::AnalyticMap analytic{"foci", {}, "density", {}};
-                for (const auto& f : foci) analytic.foci.push_back({f.u, f.v, f.r, f.k});
 
                 const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
                 format::ConusFile conus = encodeToConus(source, map, size, analytic);
@@ -88,7 +123,7 @@ Command addDemoCommand(CLI::App& root) {
                 writeImage((out / "uniform.png").string(), uniform.image);
                 const double shrink = std::min(1.0, 1024.0 / std::max(w, h));
                 const int pw = std::max(16, int(w * shrink)), ph = std::max(16, int(h * shrink));
-                writeImage((out / "density.png").string(), densityPicture(map, pw, ph, 32, &analytic));
+                writeImage((out / "density.png").string(), densityPicture(map, pw, ph, 32, analytic ? &*analytic : nullptr));
                 const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
 
                 struct ViewCase {
@@ -109,9 +144,13 @@ Command addDemoCommand(CLI::App& root) {
                 }
                 views.push_back({"frame", "whole frame", 0, 0, w, h, std::max(1, int(w * shrink)), std::max(1, int(h * shrink))});
 
-                std::printf("\nCoNUS demo: %dx%d %s -> %dx%d (1/16 of the pixels), %zu foci:", w, h,
+                std::printf("\nCoNUS demo: %dx%d %s -> %dx%d (1/16 of the pixels), ", w, h,
                             options->input.empty() ? "built-in picture" : options->input.c_str(), size.width,
-                            size.height, foci.size());
+                            size.height);
+                if (!options->importance.empty())
+                    std::printf("map from '%s' importance", options->importance.c_str());
+                else
+                    std::printf("%zu foci", foci.size());
                 for (const auto& f : foci) std::printf(" (%g,%g,r=%g,k=%g)", f.u, f.v, f.r, f.k);
                 std::printf("\n");
                 std::printf("%-22s %12s %14s %8s\n", "view", "CoNUS PSNR", "uniform PSNR", "gain");
@@ -131,9 +170,11 @@ Command addDemoCommand(CLI::App& root) {
                         for (auto& image : strip) image = codec::areaDownsample(image, v.outWidth, v.outHeight);
                     writeImage((out / ("view-" + v.name + ".png")).string(), sideBySide(strip));
                 }
-                std::printf("\nwrote %s/: conus.exr, uniform.exr, conus.png, uniform.png, density.png,\n"
-                            "  view-focus1.png, view-focus2.png, view-frame.png (each: source | CoNUS | uniform)\n",
-                            options->out.c_str());
+                std::string written;
+                for (const auto& v : views) written += ", view-" + v.name + ".png";
+                std::printf("\nwrote %s/: conus.exr, uniform.exr, conus.png, uniform.png, density.png%s\n"
+                            "  (each view-*.png: source | CoNUS | uniform)\n",
+                            options->out.c_str(), written.c_str());
                 return 0;
             }};
 }

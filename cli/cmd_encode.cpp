@@ -5,16 +5,19 @@
 #include <memory>
 
 #include "commands.h"
+#include "conus/codec/auto_map.h"
 #include "conus/codec/foci.h"
 #include "encoding.h"
 #include "image_io.h"
+#include "importance.h"
 #include "progress.h"
 
 namespace conus::cli {
 
 Command addEncodeCommand(CLI::App& root) {
     struct Options {
-        std::string input, output, mapFile, compose = "density";
+        std::string input, output, mapFile, compose = "density", importance, method = "flow";
+        double minDensity = 0.25, maxDensity = 16;
         std::vector<std::string> foci;
         int grid = 65;
         StorageOptions storage;
@@ -28,9 +31,22 @@ Command addEncodeCommand(CLI::App& root) {
                         "focus u,v,r,k: centre (u,v) in [0,1], radius r as a fraction of the width, linear "
                         "magnification k (repeat for several foci)");
     command->add_option("--map", options->mapFile, "take the sampling map from this CoNUS file")->excludes("--focus");
+    command->add_option("--importance,--auto", options->importance,
+                        "build the map automatically from importance: an image file (higher = more samples), "
+                        "'detail' (the image's own edges) or 'faces' (faces found in it)")
+        ->excludes("--focus")
+        ->excludes("--map");
+    command->add_option("--min-density", options->minDensity,
+                        "with --importance: sampling density kept everywhere (0..1, default 0.25)")
+        ->check(CLI::Range(0.001, 0.999));
+    command->add_option("--max-density", options->maxDensity,
+                        "with --importance: cap on the density (default 16, i.e. 4x the linear rate)")
+        ->check(CLI::Range(1.001, 4096.0));
+    command->add_option("--method", options->method, "with --importance: flow (default) | separable")
+        ->check(CLI::IsMember({"flow", "separable"}));
     command->add_option("--compose", options->compose, "how several foci combine: density (default) | add")
         ->check(CLI::IsMember({"density", "add"}));
-    command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus (default 65)")
+    command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus and --importance (default 65)")
         ->check(CLI::Range(2, 1025));
     addStorageOptions(*command, options->storage);
 
@@ -43,6 +59,17 @@ Command addEncodeCommand(CLI::App& root) {
                     const format::ConusFile mapSource = format::readConusFile(options->mapFile);
                     map = std::make_unique<codec::SamplingMap>(codec::SamplingMap::fromGrid(mapSource.map));
                     analytic = mapSource.analytic;
+                } else if (!options->importance.empty()) {
+                    Progress progress("build sampling map from " + options->importance + " importance");
+                    codec::AutoMapOptions autoOptions;
+                    autoOptions.columns = autoOptions.rows = options->grid;
+                    autoOptions.minDensity = options->minDensity;
+                    autoOptions.maxDensity = options->maxDensity;
+                    autoOptions.method =
+                        options->method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
+                    map = std::make_unique<codec::SamplingMap>(
+                        codec::buildAutoMap(importanceFrom(options->importance, source), autoOptions));
+                    progress.done();
                 } else if (!options->foci.empty()) {
                     std::vector<codec::Focus> foci;
                     format::AnalyticMap params{"foci", {}, options->compose, {}};

@@ -23,5 +23,6 @@ Command addDecodeCommand(CLI::App& root);
 Command addInfoCommand(CLI::App& root);
 Command addValidateCommand(CLI::App& root);
 Command addDemoCommand(CLI::App& root);
+Command addMapCommand(CLI::App& root);
 
 }  // namespace conus::cli

@@ -73,6 +73,20 @@ protected:
         return path;
     }
 
+    // A grey PNG that is bright in a disc around (0.3, 0.6) and dark elsewhere.
+    std::string makeImportance(int width, int height) {
+        std::vector<unsigned char> pixels(static_cast<std::size_t>(width) * height);
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x)
+                pixels[y * width + x] = std::hypot((x + 0.5) / width - 0.3, (y + 0.5) / height - 0.6) < 0.15 ? 255 : 0;
+        const std::string file = (m_dir / "importance.png").string();
+        auto output = OIIO::ImageOutput::create(file);
+        EXPECT_TRUE(output->open(file, OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::UINT8)));
+        EXPECT_TRUE(output->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+        output->close();
+        return file;
+    }
+
     std::string path(const std::string& name) const { return (m_dir / name).string(); }
 
     // Nothing but the expected files: no temporaries left behind.
@@ -254,6 +268,80 @@ TEST_F(Cli, ValidateNamesTheRuleOfADamagedFile) {
         EXPECT_EQ(r.exitCode, 1) << entry.path();
         EXPECT_NE(r.out.find(": V"), std::string::npos) << entry.path() << "\n" << r.out;
     }
+}
+
+TEST_F(Cli, MapSubcommandsWriteValidMapsThatEncodeUses) {
+    const std::string in = makePicture(200, 150);
+    {
+        std::ofstream strokes(path("strokes.json"));
+        strokes << R"([{"u":0.4,"v":0.5,"radius":0.15,"strength":1.0,"duration":0.3}])";
+    }
+    const std::string maps[][2] = {
+        {"foci", "map foci --focus 0.3,0.4,0.1,3 --focus 0.7,0.6,0.1,2 --aspect 1.333"},
+        {"ground", "map ground --eye-height 1 --near 1 --far 20 --fov 60 --grid 33"},
+        {"springs", "map springs --strokes " + path("strokes.json") + " --grid 33 --out-grid 17"},
+        {"auto", "map auto --importance " + makeImportance(64, 48) + " --grid 33"},
+    };
+    for (const auto& [name, args] : maps) {
+        const Result r = run(args + " -o " + path(name + ".exr") + " --preview " + path(name + ".png"));
+        ASSERT_EQ(r.exitCode, 0) << args << "\n" << r.err;
+        EXPECT_EQ(run("validate " + path(name + ".exr")).exitCode, 0) << name;
+        EXPECT_GT(imageSize(path(name + ".png")).first, 0) << name;
+        const Result e = run("encode " + in + " --map " + path(name + ".exr") + " -o " + path(name + "-enc.exr") +
+                             " --size 50x40");
+        ASSERT_EQ(e.exitCode, 0) << name << "\n" << e.err;
+        const auto map = conus::codec::SamplingMap::fromGrid(conus::format::readConusFile(path(name + "-enc.exr")).map);
+        // Every builder made a map that is not the identity somewhere.
+        double spread = 0;
+        for (double v = 0.05; v < 1; v += 0.1)
+            for (double u = 0.05; u < 1; u += 0.1) spread = std::max(spread, std::abs(map.density({u, v}) - 1.0));
+        EXPECT_GT(spread, 0.2) << name;
+    }
+    const Result c = run("map compose " + path("foci.exr") + " " + path("ground.exr") + " --translate 0.05,0 -o " +
+                         path("sum.exr"));
+    ASSERT_EQ(c.exitCode, 0) << c.err;
+    EXPECT_EQ(run("validate " + path("sum.exr")).exitCode, 0);
+    EXPECT_TRUE(leftovers().empty());
+}
+
+TEST_F(Cli, MapErrorsAreOneLine) {
+    {
+        std::ofstream strokes(path("bad.json"));
+        strokes << R"([{"u":0.4,"radius":0.15,"strength":1.0,"duration":0.3}])";
+    }
+    Result r = run("map springs --strokes " + path("bad.json") + " -o " + path("x.exr"));
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find("conus map: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"v\""), std::string::npos) << r.err;
+    r = run("map auto --importance detail -o " + path("x.exr"));
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find("needs an input image"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("x.exr")));
+}
+
+TEST_F(Cli, FacesImportanceFindsTheAstronautsFace) {
+    const std::string photo = "/usr/lib/python3/dist-packages/skimage/data/astronaut.png";
+    if (!fs::exists(photo)) GTEST_SKIP() << "python3-skimage's photographs not installed (" << photo << ")";
+    const Result r = run("encode " + photo + " --importance faces -o " + path("a.exr") + " --size 128x128");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto map = conus::codec::SamplingMap::fromGrid(conus::format::readConusFile(path("a.exr")).map);
+    // The face is around (0.44, 0.23); the flag at the left edge and the suit are context.
+    EXPECT_GT(map.density({0.44, 0.23}), 3.0);
+    EXPECT_LT(map.density({0.1, 0.6}), 0.5);
+    EXPECT_LT(map.density({0.8, 0.85}), 0.5);
+}
+
+TEST_F(Cli, FocusViewOfARealPhotoBeatsTheUniformImage) {
+    const std::string photo = "/usr/lib/python3/dist-packages/skimage/data/astronaut.png";
+    if (!fs::exists(photo)) GTEST_SKIP() << "python3-skimage's photographs not installed (" << photo << ")";
+    const Result r = run("demo --input " + photo + " --focus 0.44,0.23,0.08,4 --out " + path("q"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    // "focus 1   31.30 dB   24.31 dB   +6.99"
+    const auto line = r.out.find("focus 1");
+    ASSERT_NE(line, std::string::npos) << r.out;
+    double conusDb = 0, uniformDb = 0;
+    ASSERT_EQ(std::sscanf(r.out.c_str() + line, "focus 1 %lf dB %lf dB", &conusDb, &uniformDb), 2) << r.out;
+    EXPECT_GT(conusDb, uniformDb + 3.0) << r.out;
 }
 
 TEST_F(Cli, DemoRunsSmallAndPrintsPsnr) {

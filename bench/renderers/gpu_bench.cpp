@@ -1,0 +1,148 @@
+// GPU encode and decode against the CPU reference, in one binary so ratios come from one run.
+// CONUS_BACKEND picks the GL backend (auto, egl, osmesa; default auto: the EGL hardware device on a
+// GPU machine, llvmpipe elsewhere). GPU rows report upload, draw and readback per call.
+//
+//   encode: a 4096^2 RGB source -> 1024^2 CoNUS image through a two-focus map
+//   decode: a 1920x1080 view of a 2048^2 RGB CoNUS image
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "conus/codec/decode.h"
+#include "conus/codec/encode.h"
+#include "conus/codec/foci.h"
+#include "conus/renderers/context.h"
+#include "conus/renderers/gpu_image.h"
+
+namespace {
+
+using namespace conus;
+
+format::Image smoothSource(int size) {
+    format::Image im = format::makeImage(size, size, {"R", "G", "B"});
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const double u = (x + 0.5) / size, v = (y + 0.5) / size;
+            for (int c = 0; c < 3; ++c)
+                im.at(x, y, c) = static_cast<float>(0.5 + 0.3 * std::sin(40.0 * u + c) * std::cos(31.0 * v - c) +
+                                                    0.1 * std::sin(400.0 * u * v));
+        }
+    return im;
+}
+
+const codec::SamplingMap& focusMap() {
+    static const codec::SamplingMap map =
+        codec::buildFociMap(std::vector<codec::Focus>{{0.35, 0.4, 0.08, 4}, {0.7, 0.65, 0.06, 3}});
+    return map;
+}
+
+const format::Image& encodeSource() {
+    static const format::Image image = smoothSource(4096);
+    return image;
+}
+
+const format::Image& decodeSource() {
+    static const format::Image image = smoothSource(2048);
+    return image;
+}
+
+// Null when no GL backend works (the GPU rows then report the error and skip).
+gl::Context* context() {
+    static std::unique_ptr<gl::Context> ctx;
+    static std::string error;
+    static bool tried = false;
+    if (!tried) {
+        tried = true;
+        const char* env = std::getenv("CONUS_BACKEND");
+        try {
+            ctx = gl::Context::create(gl::parseBackend(env ? env : "auto"));
+        } catch (const Error& e) {
+            error = e.what();
+        }
+    }
+    return ctx.get();
+}
+
+void reportTimings(benchmark::State& state, const gl::GpuTimings& sum) {
+    const auto avg = benchmark::Counter::kAvgIterations;
+    state.counters["upload_ms"] = benchmark::Counter(sum.uploadMs, avg);
+    state.counters["draw_ms"] = benchmark::Counter(sum.drawMs, avg);
+    state.counters["readback_ms"] = benchmark::Counter(sum.readbackMs, avg);
+    state.SetLabel(context()->renderer());
+}
+
+codec::EncodeOptions encodeOptions() {
+    codec::EncodeOptions o;
+    o.width = 1024;
+    o.height = 1024;
+    return o;
+}
+
+codec::DecodeOptions decodeOptions() {
+    codec::DecodeOptions o;
+    o.view = {0.2, 0.25, 0.2 + 0.6, 0.25 + 0.6 * 1080.0 / 1920.0};
+    o.width = 1920;
+    o.height = 1080;
+    return o;
+}
+
+void BM_EncodeCpu(benchmark::State& state) {
+    const format::Image& source = encodeSource();
+    for (auto _ : state) benchmark::DoNotOptimize(codec::encodeImage(source, focusMap(), encodeOptions()));
+}
+
+void BM_EncodeGpu(benchmark::State& state) {
+    if (!context()) return state.SkipWithError("no GL backend");
+    const format::Image& source = encodeSource();
+    gl::encodeImageGpu(*context(), source, focusMap(), encodeOptions());  // compile shaders outside the timing
+    gl::GpuTimings sum, t;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(gl::encodeImageGpu(*context(), source, focusMap(), encodeOptions(), &t));
+        sum.uploadMs += t.uploadMs;
+        sum.drawMs += t.drawMs;
+        sum.readbackMs += t.readbackMs;
+    }
+    reportTimings(state, sum);
+}
+
+format::Image decodeInput() {
+    codec::EncodeOptions o;
+    o.width = 2048;
+    o.height = 2048;
+    return codec::encodeImage(decodeSource(), focusMap(), o);
+}
+
+const format::Image& conusImage() {
+    static const format::Image image = decodeInput();
+    return image;
+}
+
+void BM_DecodeCpu(benchmark::State& state) {
+    const format::Image& conus = conusImage();
+    for (auto _ : state) benchmark::DoNotOptimize(codec::decodeImage(conus, focusMap(), decodeOptions()));
+}
+
+void BM_DecodeGpu(benchmark::State& state) {
+    if (!context()) return state.SkipWithError("no GL backend");
+    const format::Image& conus = conusImage();
+    gl::decodeImageGpu(*context(), conus, focusMap(), decodeOptions());
+    gl::GpuTimings sum, t;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(gl::decodeImageGpu(*context(), conus, focusMap(), decodeOptions(), &t));
+        sum.uploadMs += t.uploadMs;
+        sum.drawMs += t.drawMs;
+        sum.readbackMs += t.readbackMs;
+    }
+    reportTimings(state, sum);
+}
+
+BENCHMARK(BM_EncodeCpu)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodeGpu)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeCpu)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeGpu)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,261 @@
+// conus map: build a sampling map (mass-spring strokes, composition of map files, the perspective
+// ground plane, foci, importance) and write it as a CoNUS map file that `conus encode --map` reads.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "conus/codec/auto_map.h"
+#include "conus/codec/compose.h"
+#include "conus/codec/foci.h"
+#include "conus/codec/ground_map.h"
+#include "conus/codec/springs.h"
+#include "conus/format/container.h"
+#include "conus/format/error.h"
+#include "image_io.h"
+#include "importance.h"
+#include "pictures.h"
+#include "progress.h"
+
+namespace conus::cli {
+namespace {
+
+constexpr int kPreviewSide = 512;
+
+struct OutputOptions {
+    std::string output, preview;
+};
+
+void addOutputOptions(CLI::App& command, OutputOptions& options) {
+    command.add_option("-o,--output", options.output, "output map file (.exr, a CoNUS file)")->required();
+    command.add_option("--preview", options.preview,
+                       "also write a picture of the map (PNG, ...): density heat map with the distorted grid");
+}
+
+// "a,b" -> two finite numbers.
+std::pair<double, double> parsePair(const std::string& text, const char* what) {
+    std::istringstream in(text);
+    double a = 0, b = 0;
+    char comma = 0;
+    if (!(in >> a >> comma >> b) || comma != ',' || !in.eof() || !std::isfinite(a) || !std::isfinite(b)) {
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + " \"" + text + "\" is not two numbers \"a,b\"");
+    }
+    return {a, b};
+}
+
+// A map file: the map in `samplingmap`, and as the CoNUS image the map's own density at each
+// node (columns x rows pixels, channel Y), so any EXR viewer shows where the samples go.
+void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticMap> analytic, const OutputOptions& out) {
+    format::ConusFile file;
+    file.image = format::makeImage(map.columns(), map.rows(), {"Y"});
+    for (int j = 0; j < map.rows(); ++j)
+        for (int i = 0; i < map.columns(); ++i)
+            file.image.at(i, j) = float(map.density({double(i) / (map.columns() - 1), double(j) / (map.rows() - 1)}));
+    file.pixelType = format::PixelType::Float;
+    file.sourceWidth = map.columns();
+    file.sourceHeight = map.rows();
+    file.dataKind = format::DataKind::Image;
+    file.map = map.toGrid();
+    file.analytic = std::move(analytic);
+    format::writeConusFile(out.output, file);
+    const DensityStats stats = densityStats(map);
+    std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g\n", out.output.c_str(), map.columns(), map.rows(),
+                stats.min, stats.max);
+    if (!out.preview.empty()) {
+        writeImage(out.preview, densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr));
+        std::printf("wrote %s\n", out.preview.c_str());
+    }
+}
+
+std::string readText(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(ErrorCode::Io, "cannot open " + path);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+}  // namespace
+
+Command addMapCommand(CLI::App& root) {
+    struct Options {
+        OutputOptions springsOut, composeOut, groundOut, fociOut, autoOut;
+        // auto
+        std::string importance, image, method = "flow";
+        double minDensity = 0.25, maxDensity = 16;
+        int autoGrid = 65;
+        // springs
+        std::string strokes;
+        int particles = 256, springsGrid = 33, maxSteps = 20000;
+        // compose
+        std::vector<std::string> inputs, translate, scale;
+        std::vector<double> weights;
+        int composeGrid = 0;
+        // ground
+        codec::GroundParams ground;
+        int groundGrid = 65;
+        // foci
+        std::vector<std::string> foci;
+        std::string composition = "density";
+        int fociGrid = 65;
+        double aspect = 1.0;
+    };
+    auto o = std::make_shared<Options>();
+    CLI::App* command = root.add_subcommand("map", "Build a sampling map and write it as a map file for `conus encode --map`");
+    command->require_subcommand(1);
+
+    CLI::App* springs = command->add_subcommand(
+        "springs", "Mass-spring brush system (paper 3.1): paint strokes from a JSON list, solve until stable");
+    springs->add_option("--strokes", o->strokes,
+                        "JSON list of strokes: [{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1.0,\"duration\":0.5}, ...]")
+        ->required();
+    springs->add_option("--grid", o->particles, "particles per side (default 256)")->check(CLI::Range(2, 1025));
+    springs->add_option("--out-grid", o->springsGrid, "nodes per side of the written map (default 33)")->check(CLI::Range(2, 1025));
+    springs->add_option("--max-steps", o->maxSteps, "give up waiting for the stable state after this many steps (default 20000)")
+        ->check(CLI::Range(1, 10000000));
+    addOutputOptions(*springs, o->springsOut);
+
+    CLI::App* compose = command->add_subcommand(
+        "compose", "Add the displacement fields of map files (paper Fig. 9), each optionally translated and scaled");
+    compose->add_option("inputs", o->inputs, "map files (any CoNUS file)")->required()->expected(1, -1);
+    compose->add_option("--translate", o->translate, "dx,dy: move the k-th input's pattern (k-th use, k-th input)");
+    compose->add_option("--scale", o->scale, "s or s,cu,cv: scale the k-th input's pattern by s about (cu,cv), default centre 0.5,0.5");
+    compose->add_option("--weight", o->weights, "weight of the k-th input's displacement (default 1)");
+    compose->add_option("--grid", o->composeGrid, "nodes per side of the result (default: the largest input's)")->check(CLI::Range(2, 4097));
+    addOutputOptions(*compose, o->composeOut);
+
+    CLI::App* ground = command->add_subcommand(
+        "ground", "Perspective ground-plane map of a height field (paper section 4), viewer at the bottom edge's middle");
+    ground->add_option("--eye-height", o->ground.eyeHeight, "eye height above the ground (ground units)")->required();
+    ground->add_option("--near", o->ground.near, "ground distance of the bottom edge (v = 1)")->required();
+    ground->add_option("--far", o->ground.far, "ground distance of the top edge (v = 0)")->required();
+    ground->add_option("--fov", o->ground.fovDegrees, "horizontal field of view in degrees at the far edge (default 60)");
+    ground->add_option("--grid", o->groundGrid, "nodes per side (default 65)")->check(CLI::Range(2, 4097));
+    addOutputOptions(*ground, o->groundOut);
+
+    CLI::App* foci = command->add_subcommand("foci", "Circular foci u,v,r,k");
+    foci->add_option("--focus", o->foci, "focus u,v,r,k (repeat for several)")->required();
+    foci->add_option("--compose", o->composition, "how several foci combine: density (default) | add")
+        ->check(CLI::IsMember({"density", "add"}));
+    foci->add_option("--grid", o->fociGrid, "nodes per side (default 65)")->check(CLI::Range(2, 1025));
+    foci->add_option("--aspect", o->aspect, "image width / height, so foci are circular in pixels (default 1)");
+    addOutputOptions(*foci, o->fociOut);
+
+    CLI::App* automatic = command->add_subcommand(
+        "auto", "Automatic map from importance: density follows the importance, with a floor for context");
+    automatic->add_option("--importance", o->importance,
+                          "importance image (one channel or RGB; higher = more samples), or 'detail' / 'faces' "
+                          "computed from --image")
+        ->required();
+    automatic->add_option("--image", o->image, "the picture that 'detail' and 'faces' look at");
+    automatic->add_option("--min-density", o->minDensity, "density kept everywhere (0..1, default 0.25)")
+        ->check(CLI::Range(0.001, 0.999));
+    automatic->add_option("--max-density", o->maxDensity, "cap on the density (default 16: 4x the linear rate)")
+        ->check(CLI::Range(1.001, 4096.0));
+    automatic->add_option("--method", o->method, "flow (2-D, default) | separable (baseline)")
+        ->check(CLI::IsMember({"flow", "separable"}));
+    automatic->add_option("--grid", o->autoGrid, "nodes per side (default 65)")->check(CLI::Range(2, 1025));
+    addOutputOptions(*automatic, o->autoOut);
+
+    return {command, [o, springs, compose, ground, foci, automatic] {
+                if (springs->parsed()) {
+                    const std::vector<codec::Stroke> strokes = codec::parseStrokes(readText(o->strokes));
+                    codec::SpringSystem system(o->particles, o->particles);
+                    for (const codec::Stroke& s : strokes) system.addStroke(s);
+                    Progress progress("solve " + std::to_string(o->particles) + "x" + std::to_string(o->particles) +
+                                      " springs, " + std::to_string(strokes.size()) + " strokes");
+                    const int steps = system.runUntilStable(o->maxSteps, progress.callback());
+                    progress.done();
+                    if (system.stable()) {
+                        std::printf("stable after %d steps (%.2f simulated s)\n", steps, system.time());
+                    } else {
+                        std::printf("not stable after %d steps; writing the current state\n", steps);
+                    }
+                    double scale = 1.0;
+                    const codec::SamplingMap map = system.toMap(o->springsGrid, o->springsGrid, &scale);
+                    if (scale < 1.0) std::printf("the %d-node grid folded; displacements scaled by %.4f\n", o->springsGrid, scale);
+                    writeMapFile(map, std::nullopt, o->springsOut);
+                } else if (compose->parsed()) {
+                    if (o->translate.size() > o->inputs.size() || o->scale.size() > o->inputs.size() ||
+                        o->weights.size() > o->inputs.size()) {
+                        throw Error(ErrorCode::InvalidArgument, "more --translate, --scale or --weight values than inputs");
+                    }
+                    std::vector<codec::SamplingMap> maps;
+                    int grid = o->composeGrid;
+                    for (std::size_t k = 0; k < o->inputs.size(); ++k) {
+                        const format::ConusFile file = format::readConusFile(o->inputs[k]);
+                        codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
+                        if (o->composeGrid == 0) grid = std::max({grid, map.columns(), map.rows()});
+                        if (k < o->translate.size()) {
+                            const auto [dx, dy] = parsePair(o->translate[k], "--translate");
+                            codec::ComposeResult r = codec::translateMap(map, {dx, dy});
+                            if (r.scale < 1.0) std::printf("%s: translated pattern scaled by %.4f to stay valid\n", o->inputs[k].c_str(), r.scale);
+                            map = std::move(r.map);
+                        }
+                        if (k < o->scale.size()) {
+                            double s = 0, cu = 0.5, cv = 0.5;
+                            std::istringstream in(o->scale[k]);
+                            char c1 = 0, c2 = 0;
+                            const bool ok = (in >> s) && (in.eof() || ((in >> c1 >> cu >> c2 >> cv) && c1 == ',' && c2 == ',' && in.eof()));
+                            if (!ok) throw Error(ErrorCode::InvalidArgument, "--scale \"" + o->scale[k] + "\" is not s or s,cu,cv");
+                            codec::ComposeResult r = codec::scaleMap(map, s, {cu, cv});
+                            if (r.scale < 1.0) std::printf("%s: scaled pattern's displacement scaled by %.4f to stay valid\n", o->inputs[k].c_str(), r.scale);
+                            map = std::move(r.map);
+                        }
+                        maps.push_back(std::move(map));
+                    }
+                    std::vector<double> weights;
+                    if (!o->weights.empty()) {
+                        weights.assign(maps.size(), 1.0);
+                        std::copy(o->weights.begin(), o->weights.end(), weights.begin());
+                    }
+                    const codec::ComposeResult sum = codec::addMaps(maps, grid, grid, weights);
+                    std::printf("added %zu maps; displacement scale %.4f%s\n", maps.size(), sum.scale,
+                                sum.scale < 1.0 ? " (the plain sum folds)" : "");
+                    writeMapFile(sum.map, std::nullopt, o->composeOut);
+                } else if (ground->parsed()) {
+                    const codec::SamplingMap map = codec::buildGroundMap(o->ground, o->groundGrid, o->groundGrid);
+                    writeMapFile(map, codec::toAnalytic(o->ground), o->groundOut);
+                } else if (automatic->parsed()) {
+                    const format::Image picture = o->image.empty() ? format::Image{} : readImage(o->image);
+                    const format::Image importance = importanceFrom(o->importance, picture);
+                    codec::AutoMapOptions options;
+                    options.columns = options.rows = o->autoGrid;
+                    options.minDensity = o->minDensity;
+                    options.maxDensity = o->maxDensity;
+                    options.method = o->method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
+                    Progress progress("build sampling map from importance");
+                    const codec::SamplingMap map = codec::buildAutoMap(importance, options);
+                    progress.done();
+                    std::printf("achieved density follows the target with correlation %.3f\n",
+                                codec::densityCorrelation(map, codec::importanceToDensity(importance, options)));
+                    writeMapFile(map, std::nullopt, o->autoOut);
+                } else if (foci->parsed()) {
+                    std::vector<codec::Focus> list;
+                    format::AnalyticMap params{"foci", {}, o->composition, {}};
+                    for (const auto& text : o->foci) {
+                        list.push_back(codec::parseFocus(text));
+                        params.foci.push_back({list.back().u, list.back().v, list.back().r, list.back().k});
+                    }
+                    codec::FociOptions fo;
+                    fo.columns = fo.rows = o->fociGrid;
+                    fo.aspect = o->aspect;
+                    fo.composition = o->composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+                    Progress progress("build sampling map (" + std::to_string(list.size()) + " foci)");
+                    const codec::SamplingMap map = codec::buildFociMap(list, fo);
+                    progress.done();
+                    writeMapFile(map, params, o->fociOut);
+                }
+                return 0;
+            }};
+}
+
+}  // namespace conus::cli

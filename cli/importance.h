@@ -1,0 +1,20 @@
+// Importance sources for automatic maps: an importance image file, the image's own detail, or the
+// faces found in it. `encode --importance` and `map auto` share this.
+#pragma once
+
+#include <string>
+
+#include "conus/format/image.h"
+
+namespace conus::cli {
+
+// `source` is "detail", "faces", or the path of a single-channel (or RGB) importance image.
+// `image` is the picture being encoded (detail and faces are computed from it; may be empty for a
+// file source).
+format::Image importanceFrom(const std::string& source, const format::Image& image);
+
+// Importance that is high on each face found in `image` (a soft disc over every detection), zero
+// elsewhere; throws conus::Error(InvalidArgument) when no face is found.
+format::Image faceImportance(const format::Image& image);
+
+}  // namespace conus::cli
