@@ -21,7 +21,8 @@ struct EncodeOptions {
 
 format::Image encodeImage(const format::Image& source, const SamplingMap& map, const EncodeOptions& options);
 
-// The plain baseline: box-filter area downsample to width x height (exact area weights).
+// The plain baseline: box-filter area downsample to width x height (exact area weights). It only
+// shrinks: a width or height above the source's throws conus::Error(InvalidArgument).
 format::Image areaDownsample(const format::Image& source, int width, int height, int threads = 0);
 
 }  // namespace conus::codec
