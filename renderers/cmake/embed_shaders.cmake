@@ -1,0 +1,23 @@
+# cmake -DOUTPUT=header.h -DSHADERS="a.glsl;b.glsl" -P embed_shaders.cmake
+# Writes one header with `inline constexpr const char kShader<Name>[]` per shader, the file's text
+# as a raw string literal; <Name> is the file name in PascalCase (encode.frag.glsl -> EncodeFrag).
+set(_text "// Generated from renderers/shaders/*.glsl by embed_shaders.cmake; do not edit.\n#pragma once\n\nnamespace conus::gl::shaders {\n")
+foreach(_path IN LISTS SHADERS)
+  get_filename_component(_file "${_path}" NAME)
+  string(REGEX REPLACE "\\.glsl$" "" _stem "${_file}")
+  string(REGEX REPLACE "[._-]" ";" _parts "${_stem}")
+  set(_name "")
+  foreach(_part IN LISTS _parts)
+    string(SUBSTRING "${_part}" 0 1 _first)
+    string(SUBSTRING "${_part}" 1 -1 _rest)
+    string(TOUPPER "${_first}" _first)
+    string(APPEND _name "${_first}${_rest}")
+  endforeach()
+  file(READ "${_path}" _source)
+  if(_source MATCHES "\\)glsl\"")
+    message(FATAL_ERROR "${_path} contains the raw string delimiter )glsl\"")
+  endif()
+  string(APPEND _text "\n// ${_file}\ninline constexpr const char kShader${_name}[] = R\"glsl(${_source})glsl\";\n")
+endforeach()
+string(APPEND _text "\n}  // namespace conus::gl::shaders\n")
+file(WRITE "${OUTPUT}" "${_text}")

@@ -1,0 +1,43 @@
+// GPU image encode and decode (paper section 3.2 and section 4), the GL counterparts of
+// codec::encodeImage and codec::decodeImage, and meant to agree with them (the tests hold them to
+// PSNR >= 45 dB for encode and >= 50 dB for decode).
+//
+// Encode rasterizes the mesh of distorted map nodes carrying undistorted texture coordinates, each
+// map cell subdivided so the piecewise-linear mesh follows the bilinear cells to a small fraction
+// of a pixel; the fragment shader averages bilinear taps over the pixel's footprint in the source
+// (from the screen-space derivatives of the texture coordinates) on a pyramid level chosen like
+// the CPU reference's, in a pyramid built on the GPU at the CPU's level sizes with exact area
+// weights (GL's own mipmaps differ for odd sizes). Decode is one full-screen pass that evaluates
+// Equation 1 per pixel from the map's nodes and samples the CoNUS image bilinearly (several taps
+// where zoomed out).
+//
+// Shared rules: images are float with any number of channels, processed four per pass (32-bit
+// float textures, an RGBA32F target); the options' threads and progress are ignored (the GPU runs
+// the whole image at once); sizes are checked like the CPU paths (conus::Error InvalidArgument /
+// LimitExceeded); an image wider or taller than the context's GL_MAX_TEXTURE_SIZE throws
+// conus::Error(LimitExceeded) (no tiling yet). The context is made current on the calling thread;
+// a GL failure throws conus::Error(Unsupported), a GL out-of-memory LimitExceeded.
+#pragma once
+
+#include "conus/codec/decode.h"
+#include "conus/codec/encode.h"
+#include "conus/codec/sampling_map.h"
+#include "conus/format/image.h"
+#include "conus/renderers/context.h"
+
+namespace conus::gl {
+
+// Where the time of one call went, in milliseconds; each phase ends with glFinish, so the phases
+// add up to the call (minus CPU-side argument checks). Upload includes building the source pyramid
+// and the mesh or map upload; readback includes the copy into the returned image.
+struct GpuTimings {
+    double uploadMs = 0, drawMs = 0, readbackMs = 0;
+};
+
+format::Image encodeImageGpu(Context& context, const format::Image& source, const codec::SamplingMap& map,
+                             const codec::EncodeOptions& options, GpuTimings* timings = nullptr);
+
+format::Image decodeImageGpu(Context& context, const format::Image& conus, const codec::SamplingMap& map,
+                             const codec::DecodeOptions& options, GpuTimings* timings = nullptr);
+
+}  // namespace conus::gl

@@ -1,0 +1,203 @@
+// The ordered backend list and what every Context shares: loading GL through glad (one function
+// table per context) and the cache of compiled programs.
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <sstream>
+
+#include "context_pvt.h"
+#include "conus/format/error.h"
+
+namespace conus::gl {
+namespace {
+
+// Platforms differ in dispatch; the one bound last on this thread is released before another.
+thread_local Platform* tCurrent = nullptr;
+
+void bind(Platform* platform) {
+    if (tCurrent && tCurrent != platform) tCurrent->release();
+    platform->makeCurrent();
+    tCurrent = platform;
+}
+
+std::string glString(const GladGLContext& gl, GLenum name) {
+    const GLubyte* s = gl.GetString(name);
+    return s ? reinterpret_cast<const char*>(s) : "";
+}
+
+// One backend: a current context with GL 4.5 loaded, or nullptr and the reason.
+std::unique_ptr<Context::Impl> tryBackend(Backend backend, std::string& reason) {
+    if (disabledByEnvironment(backendName(backend))) {
+        reason = "disabled by CONUS_GL_DISABLE";
+        return nullptr;
+    }
+    auto impl = std::make_unique<Context::Impl>();
+    impl->backend = backend;
+    if (tCurrent) {
+        tCurrent->release();  // creating a context may bind it before we know it works
+        tCurrent = nullptr;
+    }
+    impl->platform = backend == Backend::Egl ? createEglPlatform(reason) : createOsMesaPlatform(reason);
+    if (!impl->platform) return nullptr;
+    tCurrent = impl->platform.get();
+    const int version = gladLoadGLContext(&impl->gl, impl->platform->loader());
+    if (version == 0 || GLAD_VERSION_MAJOR(version) * 10 + GLAD_VERSION_MINOR(version) < 45) {
+        reason += std::string(reason.empty() ? "" : "; ") + impl->platform->description() +
+                  ": could not load OpenGL 4.5 core entry points (glad reports " + std::to_string(GLAD_VERSION_MAJOR(version)) +
+                  "." + std::to_string(GLAD_VERSION_MINOR(version)) + ")";
+        return nullptr;
+    }
+    impl->renderer = glString(impl->gl, GL_RENDERER);
+    impl->version = glString(impl->gl, GL_VERSION);
+    impl->gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &impl->maxTextureSize);
+    impl->gl.GenVertexArrays(1, &impl->emptyVertexArray);
+    impl->reason = impl->platform->description() + (reason.empty() ? "" : " (after: " + reason + ")");
+    return impl;
+}
+
+}  // namespace
+
+bool disabledByEnvironment(const std::string& name) {
+    const char* env = std::getenv("CONUS_GL_DISABLE");
+    if (!env) return false;
+    std::string list(env);
+    std::transform(list.begin(), list.end(), list.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::stringstream ss(list);
+    for (std::string item; std::getline(ss, item, ',');)
+        if (item == name) return true;
+    return false;
+}
+
+Context::Impl::~Impl() {
+    if (!platform) return;
+    bind(platform.get());
+    for (const auto& [key, program] : programs) gl.DeleteProgram(program);
+    if (emptyVertexArray) gl.DeleteVertexArrays(1, &emptyVertexArray);
+    platform->release();
+    if (tCurrent == platform.get()) tCurrent = nullptr;
+}
+
+Backend parseBackend(const std::string& name) {
+    std::string lower(name);
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+    for (Backend b : {Backend::Auto, Backend::Egl, Backend::OsMesa, Backend::Cpu})
+        if (lower == backendName(b)) return b;
+    throw Error(ErrorCode::InvalidArgument, "unknown backend '" + name + "' (expected auto, egl, osmesa or cpu)");
+}
+
+std::string backendName(Backend backend) {
+    switch (backend) {
+    case Backend::Auto: return "auto";
+    case Backend::Egl: return "egl";
+    case Backend::OsMesa: return "osmesa";
+    case Backend::Cpu: return "cpu";
+    }
+    return "unknown";
+}
+
+std::vector<BackendStatus> probeBackends() {
+    std::vector<BackendStatus> out;
+    for (Backend b : {Backend::Egl, Backend::OsMesa}) {
+        BackendStatus status;
+        status.backend = b;
+        std::string reason;
+        if (auto impl = tryBackend(b, reason)) {
+            status.works = true;
+            status.renderer = impl->renderer;
+            status.version = impl->version;
+            status.reason = impl->reason;
+        } else {
+            status.reason = reason;
+        }
+        out.push_back(status);
+    }
+    out.push_back({Backend::Cpu, true, "CPU reference (conus::codec)", "", "always available"});
+    return out;
+}
+
+std::unique_ptr<Context> Context::create(Backend backend) {
+    if (backend == Backend::Cpu)
+        throw Error(ErrorCode::InvalidArgument,
+                    "Context::create: the cpu backend has no GL context (use codec::encodeImage / decodeImage)");
+    // EGL first: it reaches hardware devices and is what GPU machines offer headless; OSMesa is
+    // Mesa-only software rendering, kept as the fallback.
+    const std::vector<Backend> order =
+        backend == Backend::Auto ? std::vector<Backend>{Backend::Egl, Backend::OsMesa} : std::vector<Backend>{backend};
+    std::string reasons;
+    for (Backend b : order) {
+        std::string reason;
+        if (auto impl = tryBackend(b, reason)) return std::make_unique<Context>(std::move(impl));
+        reasons += std::string(reasons.empty() ? "" : "; ") + backendName(b) + ": " + reason;
+    }
+    throw Error(ErrorCode::Unsupported, "no OpenGL 4.5 context (" + reasons + ")");
+}
+
+Context::Context(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+Context::~Context() = default;
+
+Backend Context::backend() const { return m_impl->backend; }
+std::string Context::renderer() const { return m_impl->renderer; }
+std::string Context::version() const { return m_impl->version; }
+std::string Context::description() const { return m_impl->reason; }
+int Context::maxTextureSize() const { return m_impl->maxTextureSize; }
+void Context::makeCurrent() { bind(m_impl->platform.get()); }
+
+const GladGLContext& makeCurrentGl(Context& context) {
+    context.makeCurrent();
+    return context.impl().gl;
+}
+
+namespace {
+
+GLuint compileShader(const GladGLContext& gl, GLenum type, const char* source, const std::string& key) {
+    const GLuint shader = gl.CreateShader(type);
+    gl.ShaderSource(shader, 1, &source, nullptr);
+    gl.CompileShader(shader);
+    GLint ok = 0;
+    gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        GLint length = 0;
+        gl.GetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+        std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+        gl.GetShaderInfoLog(shader, length, nullptr, log.data());
+        gl.DeleteShader(shader);
+        throw Error(ErrorCode::Unsupported, "GLSL compile failed (" + key + "): " + log);
+    }
+    return shader;
+}
+
+}  // namespace
+
+GLuint cachedProgram(Context& context, const std::string& key, const char* vertex, const char* fragment) {
+    Context::Impl& impl = context.impl();
+    if (auto it = impl.programs.find(key); it != impl.programs.end()) return it->second;
+    const GladGLContext& gl = impl.gl;
+    const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, vertex, key);
+    GLuint fs = 0;
+    try {
+        fs = compileShader(gl, GL_FRAGMENT_SHADER, fragment, key);
+    } catch (...) {
+        gl.DeleteShader(vs);
+        throw;
+    }
+    const GLuint program = gl.CreateProgram();
+    gl.AttachShader(program, vs);
+    gl.AttachShader(program, fs);
+    gl.LinkProgram(program);
+    gl.DeleteShader(vs);
+    gl.DeleteShader(fs);
+    GLint ok = 0;
+    gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        GLint length = 0;
+        gl.GetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
+        std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+        gl.GetProgramInfoLog(program, length, nullptr, log.data());
+        gl.DeleteProgram(program);
+        throw Error(ErrorCode::Unsupported, "GLSL link failed (" + key + "): " + log);
+    }
+    impl.programs.emplace(key, program);
+    return program;
+}
+
+}  // namespace conus::gl

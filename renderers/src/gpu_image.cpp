@@ -1,0 +1,410 @@
+// GPU image encode (paper section 3.2) and decode (section 4) on a Context.
+//
+// Images travel to and from GL in memory order, top row first, so texture row 0 and window row 0
+// are the image's top row: GL's y axis is the spec's v (downward) and no flip is needed anywhere;
+// the only place one would appear, NDC, is written y = 2v - 1 (encode.vert.glsl).
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "context_pvt.h"
+#include "conus/renderers/gpu_image.h"
+#include "embedded_shaders.h"
+#include "gl_objects.h"
+
+namespace conus::gl {
+namespace {
+
+// Each map cell is split into sub-quads so the piecewise-linear mesh follows the bilinear cell:
+// a cell of twist t = N00 - N10 - N01 + N11 (in CoNUS pixels) split s ways departs from its
+// bilinear patch by at most |t| / (4 s^2), kept under kMaxBendPixels; and no sub-quad is longer
+// than kMaxSubQuadPixels, so the per-triangle derivatives that size the filter follow the local
+// Jacobian. Finer meshes cost llvmpipe dearly (tiny triangles shade whole 2x2 quads).
+constexpr double kMaxBendPixels = 0.05;
+constexpr double kMaxSubQuadPixels = 8.0;
+// Bounds the mesh (memory and vertex work) for extreme maps; finer subdivision stops here.
+constexpr double kMaxMeshVertices = 4.0e6;
+constexpr int kChannelsPerPass = 4;
+
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point& start) {
+    const Clock::time_point now = Clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - start).count();
+    start = now;
+    return ms;
+}
+
+void checkImage(const format::Image& image, const char* what) {
+    if (image.empty())
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": empty image (" + std::to_string(image.width) +
+                                                    "x" + std::to_string(image.height) + ", " +
+                                                    std::to_string(image.channelCount()) + " channels)");
+    const std::size_t expected = static_cast<std::size_t>(image.width) * image.height * image.channels.size();
+    if (image.pixels.size() != expected)
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": image holds " +
+                                                    std::to_string(image.pixels.size()) + " values, expected " +
+                                                    std::to_string(expected));
+}
+
+void checkTextureSize(const Context& context, int width, int height, const char* what, const char* role) {
+    const int limit = context.maxTextureSize();
+    if (width > limit || height > limit)
+        throw Error(ErrorCode::LimitExceeded, std::string(what) + ": " + role + " " + std::to_string(width) + "x" +
+                                                  std::to_string(height) + " exceeds GL_MAX_TEXTURE_SIZE " +
+                                                  std::to_string(limit) + " of " + context.renderer() +
+                                                  " (tiling is not implemented; use the CPU path)");
+}
+
+GLenum internalFormat(int channels) {
+    static constexpr GLenum kFormats[] = {GL_R32F, GL_RG32F, GL_RGB32F, GL_RGBA32F};
+    return kFormats[channels - 1];
+}
+GLenum pixelFormat(int channels) {
+    static constexpr GLenum kFormats[] = {GL_RED, GL_RG, GL_RGB, GL_RGBA};
+    return kFormats[channels - 1];
+}
+
+// Channels [first, first + count) of an image, interleaved; the image's own array when it is all.
+// Uploads keep the image's channel count (R32F .. RGBA32F): measured on llvmpipe, padding RGB to
+// RGBA on the CPU made the upload slower, not faster.
+class PassPixels {
+public:
+    PassPixels(const format::Image& image, int first, int count) {
+        const int channels = image.channelCount();
+        if (first == 0 && count == channels) {
+            m_data = image.pixels.data();
+            return;
+        }
+        const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
+        m_copy.resize(pixels * count);
+        for (std::size_t i = 0; i < pixels; ++i)
+            for (int c = 0; c < count; ++c) m_copy[i * count + c] = image.pixels[i * channels + first + c];
+        m_data = m_copy.data();
+    }
+    const float* data() const { return m_data; }
+
+private:
+    std::vector<float> m_copy;
+    const float* m_data = nullptr;
+};
+
+// Reads the bound framebuffer's first `count` channels into channels [first, first + count).
+void readBack(const GladGLContext& gl, format::Image& out, int first, int count) {
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    const int channels = out.channelCount();
+    if (first == 0 && count == channels) {
+        gl.ReadPixels(0, 0, out.width, out.height, pixelFormat(count), GL_FLOAT, out.pixels.data());
+        return;
+    }
+    const std::size_t pixels = static_cast<std::size_t>(out.width) * out.height;
+    std::vector<float> buffer(pixels * count);
+    gl.ReadPixels(0, 0, out.width, out.height, pixelFormat(count), GL_FLOAT, buffer.data());
+    for (std::size_t i = 0; i < pixels; ++i)
+        for (int c = 0; c < count; ++c) out.pixels[i * channels + first + c] = buffer[i * count + c];
+}
+
+// An RGBA32F colour attachment of width x height, bound for drawing.
+struct Target {
+    GlHandle texture, framebuffer;
+    Target(const GladGLContext& gl, int width, int height, const char* what)
+        : texture(makeTexture(gl)), framebuffer(makeFramebuffer(gl)) {
+        gl.BindTexture(GL_TEXTURE_2D, texture.id());
+        gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
+        gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.id(), 0);
+        checkGl(gl, what);
+        if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            throw Error(ErrorCode::Unsupported, std::string(what) + ": the driver cannot render to a " +
+                                                    std::to_string(width) + "x" + std::to_string(height) +
+                                                    " RGBA32F framebuffer");
+        gl.Viewport(0, 0, width, height);
+    }
+};
+
+// Positions along one axis of the map at which the mesh has vertices: every node, plus `splits[i]`
+// equal steps across cell column (or row) i. One count per whole column or row of cells keeps
+// neighbouring cells' vertices shared, so the mesh has no cracks.
+std::vector<double> meshAxis(const std::vector<int>& splits) {
+    const int cells = static_cast<int>(splits.size());
+    std::vector<double> out;
+    for (int i = 0; i < cells; ++i)
+        for (int k = 0; k < splits[i]; ++k) out.push_back((i + static_cast<double>(k) / splits[i]) / cells);
+    out.push_back(1.0);
+    return out;
+}
+
+struct Mesh {
+    std::vector<float> vertices;  // distorted x, y, undistorted u, v
+    std::vector<GLuint> indices;
+};
+
+Mesh buildMesh(const codec::SamplingMap& map, int width, int height) {
+    const int n = map.columns(), m = map.rows();
+    const auto pixels = [&](glm::vec2 d) { return std::hypot(double(d.x) * width, double(d.y) * height); };
+    // Most splits per cell that keep the whole mesh under kMaxMeshVertices.
+    const int maxSplits = static_cast<int>(std::max(1.0, std::sqrt(kMaxMeshVertices / (double(n - 1) * (m - 1)))));
+    std::vector<int> columnSplits(n - 1, 1), rowSplits(m - 1, 1);
+    for (int j = 0; j + 1 < m; ++j)
+        for (int i = 0; i + 1 < n; ++i) {
+            const glm::vec2 n00 = map.node(i, j), n10 = map.node(i + 1, j), n01 = map.node(i, j + 1);
+            const double twist = pixels(n00 - n10 - n01 + map.node(i + 1, j + 1));
+            const double bend = std::ceil(std::sqrt(twist / (4.0 * kMaxBendPixels)));
+            const auto splits = [&](double extent) {
+                return std::clamp(static_cast<int>(std::max(bend, std::ceil(extent / kMaxSubQuadPixels))), 1, maxSplits);
+            };
+            columnSplits[i] = std::max(columnSplits[i], splits(std::max(pixels(n10 - n00), pixels(map.node(i + 1, j + 1) - n01))));
+            rowSplits[j] = std::max(rowSplits[j], splits(std::max(pixels(n01 - n00), pixels(map.node(i + 1, j + 1) - n10))));
+        }
+    const std::vector<double> us = meshAxis(columnSplits), vs = meshAxis(rowSplits);
+
+    Mesh mesh;
+    const std::size_t nu = us.size(), nv = vs.size();
+    mesh.vertices.reserve(nu * nv * 4);
+    for (double v : vs)
+        for (double u : us) {
+            const glm::dvec2 d = map.distort({u, v});
+            mesh.vertices.insert(mesh.vertices.end(), {float(d.x), float(d.y), float(u), float(v)});
+        }
+    mesh.indices.reserve((nu - 1) * (nv - 1) * 6);
+    for (std::size_t j = 0; j + 1 < nv; ++j)
+        for (std::size_t i = 0; i + 1 < nu; ++i) {
+            const auto k = static_cast<GLuint>(j * nu + i), right = k + 1, below = static_cast<GLuint>(k + nu);
+            mesh.indices.insert(mesh.indices.end(), {k, right, below + 1, k, below + 1, below});
+        }
+    return mesh;
+}
+
+// The encoder's source pyramid at the CPU reference's level sizes ((w + 1) / 2 each way, down to
+// 1 x 1): level 0 is the source texture itself, levels 1.. are stacked in one RGBA32F atlas.
+constexpr int kMaxPyramidLevels = 32;  // uLevelRect in encode.frag.glsl
+
+struct Pyramid {
+    std::vector<std::array<int, 4>> rects;  // per level: x, y in the atlas, width, height
+    int atlasWidth = 0, atlasHeight = 0;
+};
+
+Pyramid pyramidLayout(int width, int height) {
+    Pyramid p;
+    p.rects.push_back({0, 0, width, height});
+    int y = 0;
+    while ((width > 1 || height > 1) && static_cast<int>(p.rects.size()) < kMaxPyramidLevels) {
+        width = std::max(1, (width + 1) / 2);
+        height = std::max(1, (height + 1) / 2);
+        p.rects.push_back({0, y, width, height});
+        p.atlasWidth = std::max(p.atlasWidth, width);
+        y += height;
+    }
+    p.atlasHeight = y;
+    return p;
+}
+
+void setLinearClamp(const GladGLContext& gl) {
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+// Fills the atlas level by level, each from the one above (level 0 is `source`). Reading the atlas
+// while drawing into another region of it is defined after glTextureBarrier.
+void buildPyramid(Context& context, const GladGLContext& gl, const Pyramid& pyramid, GLuint source, GLuint atlas) {
+    if (pyramid.rects.size() < 2) return;
+    const GLuint program =
+        cachedProgram(context, "pyramid", shaders::kShaderFullscreenVert, shaders::kShaderPyramidFrag);
+    GlHandle framebuffer = makeFramebuffer(gl);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, atlas, 0);
+    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        throw Error(ErrorCode::Unsupported, "encodeImageGpu: the driver cannot render into the RGBA32F pyramid");
+    gl.UseProgram(program);
+    gl.Uniform1i(gl.GetUniformLocation(program, "uSource"), 0);
+    const GLint sourceRect = gl.GetUniformLocation(program, "uSourceRect");
+    const GLint targetRect = gl.GetUniformLocation(program, "uTargetRect");
+    gl.BindVertexArray(context.impl().emptyVertexArray);
+    gl.ActiveTexture(GL_TEXTURE0);
+    for (std::size_t level = 1; level < pyramid.rects.size(); ++level) {
+        const auto& from = pyramid.rects[level - 1];
+        const auto& to = pyramid.rects[level];
+        gl.BindTexture(GL_TEXTURE_2D, level == 1 ? source : atlas);
+        gl.Uniform4i(sourceRect, from[0], from[1], from[2], from[3]);
+        gl.Uniform4i(targetRect, to[0], to[1], to[2], to[3]);
+        gl.Viewport(to[0], to[1], to[2], to[3]);
+        gl.TextureBarrier();
+        gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+}
+
+}  // namespace
+
+format::Image encodeImageGpu(Context& context, const format::Image& source, const codec::SamplingMap& map,
+                             const codec::EncodeOptions& options, GpuTimings* timings) {
+    constexpr const char* kWhat = "encodeImageGpu";
+    checkImage(source, kWhat);
+    format::Image out = format::makeImage(options.width, options.height, source.channels);
+    checkTextureSize(context, source.width, source.height, kWhat, "source");
+    checkTextureSize(context, out.width, out.height, kWhat, "output");
+
+    GpuTimings t;
+    Clock::time_point start = Clock::now();
+    const GladGLContext& gl = makeCurrentGl(context);
+    const GLuint program = cachedProgram(context, "encode", shaders::kShaderEncodeVert, shaders::kShaderEncodeFrag);
+
+    // The mesh, once for every pass.
+    const Mesh mesh = buildMesh(map, out.width, out.height);
+    GlHandle vertexArray = makeVertexArray(gl), vertexBuffer = makeBuffer(gl), indexBuffer = makeBuffer(gl);
+    gl.BindVertexArray(vertexArray.id());
+    gl.BindBuffer(GL_ARRAY_BUFFER, vertexBuffer.id());
+    gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vertices.size() * sizeof(float)), mesh.vertices.data(),
+                  GL_STATIC_DRAW);
+    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer.id());
+    gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(GLuint)),
+                  mesh.indices.data(), GL_STATIC_DRAW);
+    gl.EnableVertexAttribArray(0);
+    gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), nullptr);
+    gl.EnableVertexAttribArray(1);
+    gl.VertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), reinterpret_cast<const void*>(2 * sizeof(float)));
+    Target target(gl, out.width, out.height, kWhat);
+    checkGl(gl, kWhat);
+
+    const Pyramid pyramid = pyramidLayout(source.width, source.height);
+    if (pyramid.atlasWidth > context.maxTextureSize() || pyramid.atlasHeight > context.maxTextureSize())
+        throw Error(ErrorCode::LimitExceeded, std::string(kWhat) + ": the source pyramid (" +
+                                                  std::to_string(pyramid.atlasWidth) + "x" +
+                                                  std::to_string(pyramid.atlasHeight) +
+                                                  ") exceeds GL_MAX_TEXTURE_SIZE " +
+                                                  std::to_string(context.maxTextureSize()));
+    for (int first = 0; first < source.channelCount(); first += kChannelsPerPass) {
+        const int count = std::min(kChannelsPerPass, source.channelCount() - first);
+        // Upload: the source as a float texture, and its area-averaged pyramid built on the GPU.
+        GlHandle texture = makeTexture(gl), atlas = makeTexture(gl);
+        {
+            const PassPixels pixels(source, first, count);
+            gl.ActiveTexture(GL_TEXTURE0);
+            gl.BindTexture(GL_TEXTURE_2D, texture.id());
+            gl.TexStorage2D(GL_TEXTURE_2D, 1, internalFormat(count), source.width, source.height);
+            gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+            gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, source.width, source.height, pixelFormat(count), GL_FLOAT,
+                             pixels.data());
+            setLinearClamp(gl);
+            gl.BindTexture(GL_TEXTURE_2D, atlas.id());
+            gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, std::max(1, pyramid.atlasWidth),
+                            std::max(1, pyramid.atlasHeight));
+            setLinearClamp(gl);
+            buildPyramid(context, gl, pyramid, texture.id(), atlas.id());
+            checkGl(gl, kWhat);
+            gl.Finish();
+        }
+        t.uploadMs += millisecondsSince(start);
+
+        // Draw: rasterize the mesh at the CoNUS resolution.
+        gl.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer.id());
+        gl.Viewport(0, 0, out.width, out.height);
+        gl.ClearColor(0, 0, 0, 0);
+        gl.Clear(GL_COLOR_BUFFER_BIT);
+        gl.ActiveTexture(GL_TEXTURE0);
+        gl.BindTexture(GL_TEXTURE_2D, texture.id());
+        gl.ActiveTexture(GL_TEXTURE1);
+        gl.BindTexture(GL_TEXTURE_2D, atlas.id());
+        gl.UseProgram(program);
+        gl.Uniform1i(gl.GetUniformLocation(program, "uLevel0"), 0);
+        gl.Uniform1i(gl.GetUniformLocation(program, "uPyramid"), 1);
+        gl.Uniform1i(gl.GetUniformLocation(program, "uLevels"), static_cast<GLint>(pyramid.rects.size()));
+        gl.Uniform4iv(gl.GetUniformLocation(program, "uLevelRect"), static_cast<GLsizei>(pyramid.rects.size()),
+                      pyramid.rects[0].data());
+        gl.BindVertexArray(vertexArray.id());
+        gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.indices.size()), GL_UNSIGNED_INT, nullptr);
+        checkGl(gl, kWhat);
+        gl.Finish();
+        t.drawMs += millisecondsSince(start);
+
+        readBack(gl, out, first, count);
+        checkGl(gl, kWhat);
+        t.readbackMs += millisecondsSince(start);
+    }
+    gl.BindVertexArray(0);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (timings) *timings = t;
+    return out;
+}
+
+format::Image decodeImageGpu(Context& context, const format::Image& conus, const codec::SamplingMap& map,
+                             const codec::DecodeOptions& options, GpuTimings* timings) {
+    constexpr const char* kWhat = "decodeImageGpu";
+    checkImage(conus, kWhat);
+    const codec::View& view = options.view;
+    if (!std::isfinite(view.u0) || !std::isfinite(view.u1) || !std::isfinite(view.v0) || !std::isfinite(view.v1) ||
+        view.u0 == view.u1 || view.v0 == view.v1 || std::abs(view.u1 - view.u0) > 1e6 ||
+        std::abs(view.v1 - view.v0) > 1e6)
+        throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": view (" + std::to_string(view.u0) + ", " +
+                                                    std::to_string(view.v0) + ") - (" + std::to_string(view.u1) +
+                                                    ", " + std::to_string(view.v1) + ") is empty or not finite");
+    format::Image out = format::makeImage(options.width, options.height, conus.channels);
+    checkTextureSize(context, conus.width, conus.height, kWhat, "CoNUS image");
+    checkTextureSize(context, out.width, out.height, kWhat, "output");
+
+    GpuTimings t;
+    Clock::time_point start = Clock::now();
+    const GladGLContext& gl = makeCurrentGl(context);
+    const GLuint program = cachedProgram(context, "decode", shaders::kShaderFullscreenVert, shaders::kShaderDecodeFrag);
+
+    // The map's nodes, fetched exactly (texelFetch) by the shader.
+    GlHandle mapTexture = makeTexture(gl);
+    gl.ActiveTexture(GL_TEXTURE1);
+    gl.BindTexture(GL_TEXTURE_2D, mapTexture.id());
+    gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, map.columns(), map.rows());
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, map.columns(), map.rows(), GL_RG, GL_FLOAT, map.nodes().data());
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    Target target(gl, out.width, out.height, kWhat);
+    checkGl(gl, kWhat);
+
+    for (int first = 0; first < conus.channelCount(); first += kChannelsPerPass) {
+        const int count = std::min(kChannelsPerPass, conus.channelCount() - first);
+        GlHandle texture = makeTexture(gl);
+        {
+            const PassPixels pixels(conus, first, count);
+            gl.ActiveTexture(GL_TEXTURE0);
+            gl.BindTexture(GL_TEXTURE_2D, texture.id());
+            gl.TexStorage2D(GL_TEXTURE_2D, 1, internalFormat(count), conus.width, conus.height);
+            gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, conus.width, conus.height, pixelFormat(count), GL_FLOAT,
+                             pixels.data());
+            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            checkGl(gl, kWhat);
+            gl.Finish();
+        }
+        t.uploadMs += millisecondsSince(start);
+
+        gl.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer.id());
+        gl.ActiveTexture(GL_TEXTURE1);
+        gl.BindTexture(GL_TEXTURE_2D, mapTexture.id());
+        gl.UseProgram(program);
+        gl.Uniform1i(gl.GetUniformLocation(program, "uConus"), 0);
+        gl.Uniform1i(gl.GetUniformLocation(program, "uMap"), 1);
+        gl.Uniform4f(gl.GetUniformLocation(program, "uView"), float(view.u0), float(view.v0), float(view.u1),
+                     float(view.v1));
+        gl.Uniform2f(gl.GetUniformLocation(program, "uOutputSize"), float(out.width), float(out.height));
+        gl.BindVertexArray(context.impl().emptyVertexArray);
+        gl.DrawArrays(GL_TRIANGLES, 0, 3);
+        checkGl(gl, kWhat);
+        gl.Finish();
+        t.drawMs += millisecondsSince(start);
+
+        readBack(gl, out, first, count);
+        checkGl(gl, kWhat);
+        t.readbackMs += millisecondsSince(start);
+    }
+    gl.BindVertexArray(0);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (timings) *timings = t;
+    return out;
+}
+
+}  // namespace conus::gl

@@ -1,0 +1,86 @@
+// Shared by the renderers tests: one context per backend for the whole run, and test images.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "conus/codec/foci.h"
+#include "conus/codec/sampling_map.h"
+#include "conus/format/image.h"
+#include "conus/renderers/context.h"
+
+namespace conus::gl::test {
+
+// Both backends must work on CI machines (Mesa's EGL and OSMesa): a missing one fails, never skips.
+inline Context& contextFor(Backend backend) {
+    // Never destroyed: Mesa's own exit handlers may run before static destructors.
+    static auto* contexts = new std::map<Backend, std::unique_ptr<Context>>;
+    auto& slot = (*contexts)[backend];
+    if (!slot) slot = Context::create(backend);
+    return *slot;
+}
+
+inline std::string paramName(const ::testing::TestParamInfo<Backend>& info) { return backendName(info.param); }
+
+inline format::Image blank(int w, int h, std::vector<std::string> channels) {
+    format::Image im;
+    im.width = w;
+    im.height = h;
+    im.channels = std::move(channels);
+    im.pixels.assign(static_cast<std::size_t>(w) * h * im.channels.size(), 0.0f);
+    return im;
+}
+
+// Photo-like: smooth shading, hard-edged shapes, fine texture and a little noise, per channel
+// slightly different.
+inline format::Image photoLike(int w, int h, std::vector<std::string> channels = {"R", "G", "B"}, unsigned seed = 7) {
+    format::Image im = blank(w, h, std::move(channels));
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> noise(-0.03f, 0.03f);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const double u = (x + 0.5) / w, v = (y + 0.5) / h;
+            for (int c = 0; c < im.channelCount(); ++c) {
+                double value = 0.35 + 0.25 * std::sin(3.0 * u + 2.0 * v + c) * std::cos(2.5 * v - c);
+                const double dx = u - 0.3 - 0.1 * c, dy = v - 0.55;
+                if (dx * dx + dy * dy < 0.04) value += 0.3;
+                if (u > 0.6 && u < 0.85 && v > 0.15 && v < 0.4) value -= 0.2;
+                value += 0.08 * std::sin(140.0 * u * (1 + v)) * std::sin(90.0 * v);
+                im.at(x, y, c) = static_cast<float>(value) + noise(rng);
+            }
+        }
+    return im;
+}
+
+// A valid random map: a coarse grid with interior nodes jittered by up to `amplitude` of a cell.
+inline codec::SamplingMap jitteredMap(int columns, int rows, double amplitude, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> d(-amplitude, amplitude);
+    std::vector<glm::vec2> nodes;
+    for (int j = 0; j < rows; ++j)
+        for (int i = 0; i < columns; ++i) {
+            double u = double(i) / (columns - 1), v = double(j) / (rows - 1);
+            if (i > 0 && i < columns - 1) u += d(rng) / (columns - 1);
+            if (j > 0 && j < rows - 1) v += d(rng) / (rows - 1);
+            nodes.emplace_back(float(u), float(v));
+        }
+    return codec::SamplingMap(columns, rows, std::move(nodes));
+}
+
+// buildFociMap with 1-3 random foci.
+inline codec::SamplingMap randomFociMap(unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> pos(0.15, 0.85), radius(0.04, 0.12), gain(1.5, 5.0);
+    std::vector<codec::Focus> foci(1 + seed % 3);
+    for (auto& f : foci) f = {pos(rng), pos(rng), radius(rng), gain(rng)};
+    codec::FociOptions options;
+    options.composition = seed % 2 ? codec::FociComposition::Density : codec::FociComposition::Add;
+    return codec::buildFociMap(foci, options);
+}
+
+}  // namespace conus::gl::test

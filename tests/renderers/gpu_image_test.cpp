@@ -1,0 +1,272 @@
+#include "conus/renderers/gpu_image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include "conus/codec/decode.h"
+#include "conus/codec/encode.h"
+#include "conus/codec/foci.h"
+#include "conus/codec/metrics.h"
+#include "conus/format/error.h"
+#include "gl_test_util.h"
+
+namespace conus::gl {
+namespace {
+
+using test::contextFor;
+
+constexpr double kEncodePsnr = 45.0;
+constexpr double kDecodePsnr = 50.0;
+
+codec::EncodeOptions encodeSize(int w, int h) {
+    codec::EncodeOptions o;
+    o.width = w;
+    o.height = h;
+    return o;
+}
+
+codec::DecodeOptions decodeView(codec::View view, int w, int h) {
+    codec::DecodeOptions o;
+    o.view = view;
+    o.width = w;
+    o.height = h;
+    return o;
+}
+
+codec::SamplingMap twoFoci() {
+    const std::vector<codec::Focus> foci = {{0.3, 0.35, 0.08, 4}, {0.7, 0.6, 0.06, 3}};
+    return codec::buildFociMap(foci);
+}
+
+// The skimage sample photos when installed (OpenImageIO reads them), as float RGB; empty if not.
+format::Image readPhoto(const std::string& name) {
+    const std::string path = "/usr/lib/python3/dist-packages/skimage/data/" + name;
+    if (!std::filesystem::exists(path)) return {};
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) return {};
+    const OIIO::ImageSpec& spec = in->spec();
+    std::vector<float> all(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) return {};
+    format::Image im = test::blank(spec.width, spec.height, {"R", "G", "B"});
+    for (std::size_t i = 0; i < static_cast<std::size_t>(spec.width) * spec.height; ++i)
+        for (int c = 0; c < 3; ++c) im.pixels[i * 3 + c] = all[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
+    return im;
+}
+
+class GpuImage : public ::testing::TestWithParam<Backend> {
+protected:
+    Context& context() { return contextFor(GetParam()); }
+
+    double encodePsnr(const format::Image& source, const codec::SamplingMap& map, int w, int h) {
+        const format::Image cpu = codec::encodeImage(source, map, encodeSize(w, h));
+        const format::Image gpu = encodeImageGpu(context(), source, map, encodeSize(w, h));
+        EXPECT_EQ(gpu.channels, source.channels);
+        const double psnr = codec::psnr(cpu, gpu);
+        std::printf("    encode %dx%d -> %dx%d, map %dx%d, %s: PSNR %.2f dB\n", source.width, source.height, w, h,
+                    map.columns(), map.rows(), backendName(GetParam()).c_str(), psnr);
+        return psnr;
+    }
+
+    double decodePsnr(const format::Image& conus, const codec::SamplingMap& map, codec::View view, int w, int h) {
+        const format::Image cpu = codec::decodeImage(conus, map, decodeView(view, w, h));
+        const format::Image gpu = decodeImageGpu(context(), conus, map, decodeView(view, w, h));
+        EXPECT_EQ(gpu.channels, conus.channels);
+        const double psnr = codec::psnr(cpu, gpu);
+        std::printf("    decode %dx%d view (%.2f,%.2f)-(%.2f,%.2f) -> %dx%d, %s: PSNR %.2f dB\n", conus.width,
+                    conus.height, view.u0, view.v0, view.u1, view.v1, w, h, backendName(GetParam()).c_str(), psnr);
+        return psnr;
+    }
+};
+
+TEST_P(GpuImage, RunsOnTheBackendAskedFor) {
+    EXPECT_EQ(context().backend(), GetParam());
+    EXPECT_FALSE(context().renderer().empty());
+}
+
+TEST_P(GpuImage, EncodeMatchesCpuWithIdentityMap) {
+    const format::Image source = test::photoLike(512, 512);
+    // Integer ratios (exact box filters on the CPU), a non-integer ratio, and magnification.
+    EXPECT_GE(encodePsnr(source, codec::SamplingMap::identity(65, 65), 256, 256), kEncodePsnr);
+    EXPECT_GE(encodePsnr(source, codec::SamplingMap::identity(2, 2), 128, 128), kEncodePsnr);
+    EXPECT_GE(encodePsnr(source, codec::SamplingMap::identity(17, 9), 300, 200), kEncodePsnr);
+    EXPECT_GE(encodePsnr(source, codec::SamplingMap::identity(9, 9), 640, 600), kEncodePsnr);
+}
+
+TEST_P(GpuImage, EncodeMatchesCpuWithFocusMap) {
+    const format::Image source = test::photoLike(512, 512);
+    EXPECT_GE(encodePsnr(source, twoFoci(), 256, 256), kEncodePsnr);
+    EXPECT_GE(encodePsnr(source, twoFoci(), 128, 160), kEncodePsnr);
+}
+
+TEST_P(GpuImage, EncodeMatchesCpuWithRandomMaps) {
+    const format::Image source = test::photoLike(384, 320, {"R", "G", "B"}, 3);
+    for (unsigned seed = 1; seed <= 4; ++seed) {
+        SCOPED_TRACE(seed);
+        EXPECT_GE(encodePsnr(source, test::randomFociMap(seed), 192, 160), kEncodePsnr);
+        EXPECT_GE(encodePsnr(source, test::jitteredMap(5 + seed, 4 + seed, 0.3, seed), 200, 180), kEncodePsnr);
+    }
+}
+
+TEST_P(GpuImage, EncodeMatchesCpuOnPhotos) {
+    for (const char* name : {"astronaut.png", "motorcycle_left.png"}) {
+        SCOPED_TRACE(name);
+        format::Image photo = readPhoto(name);
+        if (photo.empty()) {
+            std::printf("    %s not installed: a procedural image stands in\n", name);
+            photo = test::photoLike(512, 384, {"R", "G", "B"}, 11);
+        }
+        const codec::SamplingMap map = codec::buildFociMap(std::vector<codec::Focus>{{0.45, 0.3, 0.1, 3}});
+        EXPECT_GE(encodePsnr(photo, map, photo.width / 2, photo.height / 2), kEncodePsnr);
+        EXPECT_GE(encodePsnr(photo, test::randomFociMap(5), photo.width / 3, photo.height / 3), kEncodePsnr);
+        EXPECT_GE(encodePsnr(photo, codec::SamplingMap::identity(33, 33), photo.width / 2, photo.height / 2),
+                  kEncodePsnr);
+    }
+}
+
+TEST_P(GpuImage, EncodeHandlesAnyChannelCount) {
+    const format::Image full = test::photoLike(256, 192, {"R", "G", "B", "A", "Z", "N"}, 5);
+    for (int count : {1, 2, 3, 4, 5, 6}) {
+        SCOPED_TRACE(count);
+        format::Image source = test::blank(full.width, full.height, {});
+        source.channels.assign(full.channels.begin(), full.channels.begin() + count);
+        source.pixels.resize(static_cast<std::size_t>(source.width) * source.height * count);
+        for (std::size_t i = 0; i < static_cast<std::size_t>(source.width) * source.height; ++i)
+            for (int c = 0; c < count; ++c) source.pixels[i * count + c] = full.pixels[i * 6 + c];
+        const codec::SamplingMap map = twoFoci();
+        const format::Image cpu = codec::encodeImage(source, map, encodeSize(128, 96));
+        const format::Image gpu = encodeImageGpu(context(), source, map, encodeSize(128, 96));
+        ASSERT_EQ(gpu.channels, source.channels);
+        // Per channel: each pass must land in its own channels.
+        for (int c = 0; c < count; ++c) {
+            format::Image a = test::blank(128, 96, {"Y"}), b = test::blank(128, 96, {"Y"});
+            for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+                a.pixels[i] = cpu.pixels[i * count + c];
+                b.pixels[i] = gpu.pixels[i * count + c];
+            }
+            EXPECT_GE(codec::psnr(a, b), kEncodePsnr) << "channel " << c;
+        }
+    }
+}
+
+// The edges of a checkerboard land where Equation 1 puts them: a vertical source edge at u = e
+// crosses CoNUS row y where distort(e, v).y is that row's centre, at x = distort(e, v).x.
+TEST_P(GpuImage, CheckerboardEdgesFollowEquation1) {
+    constexpr int kSource = 512, kSquare = 64, kW = 256, kH = 256;
+    format::Image board = test::blank(kSource, kSource, {"Y"});
+    for (int y = 0; y < kSource; ++y)
+        for (int x = 0; x < kSource; ++x) board.at(x, y) = float(((x / kSquare) + (y / kSquare)) % 2);
+    const codec::SamplingMap map = codec::buildFociMap(std::vector<codec::Focus>{{0.4, 0.45, 0.1, 4}});
+    const format::Image conus = encodeImageGpu(context(), board, map, encodeSize(kW, kH));
+
+    int checked = 0;
+    double worst = 0;
+    for (int edge = 1; edge < kSource / kSquare; ++edge) {
+        const double e = double(edge * kSquare) / kSource;
+        for (int square = 0; square < kSource / kSquare; ++square) {
+            // Mid-square in v, away from the horizontal edges; find the CoNUS row there.
+            const double vMid = (square + 0.5) * kSquare / kSource;
+            const int row = std::clamp(int(map.distort({e, vMid}).y * kH), 0, kH - 1);
+            const double rowV = (row + 0.5) / kH;
+            double lo = 0, hi = 1;  // v with distort(e, v).y == rowV: y grows with v along the edge
+            for (int k = 0; k < 60; ++k) {
+                const double mid = 0.5 * (lo + hi);
+                (map.distort({e, mid}).y < rowV ? lo : hi) = mid;
+            }
+            const double expected = map.distort({e, lo}).x * kW - 0.5;  // in pixel-centre units
+            // The 0.5 crossing of the row nearest the expected position.
+            double best = 1e9;
+            for (int x = std::max(0, int(expected) - 4); x < std::min(kW - 1, int(expected) + 5); ++x) {
+                const double a = conus.at(x, row) - 0.5, b = conus.at(x + 1, row) - 0.5;
+                if (a * b > 0 || a == b) continue;
+                const double crossing = x + a / (a - b);
+                if (std::abs(crossing - expected) < std::abs(best - expected)) best = crossing;
+            }
+            ASSERT_LT(best, 1e8) << "no edge near x = " << expected << " on row " << row;
+            worst = std::max(worst, std::abs(best - expected));
+            EXPECT_LE(std::abs(best - expected), 1.0) << "edge u = " << e << ", row " << row;
+            ++checked;
+        }
+    }
+    std::printf("    %d edge crossings, worst %.3f CoNUS pixels from Eq. 1\n", checked, worst);
+    EXPECT_EQ(checked, 7 * 8);
+}
+
+TEST_P(GpuImage, DecodeMatchesCpu) {
+    const format::Image source = test::photoLike(512, 512);
+    for (unsigned seed = 0; seed < 3; ++seed) {
+        SCOPED_TRACE(seed);
+        const codec::SamplingMap map = seed == 0 ? twoFoci() : test::randomFociMap(seed);
+        const format::Image conus = codec::encodeImage(source, map, encodeSize(256, 256));
+        EXPECT_GE(decodePsnr(conus, map, {}, 512, 512), kDecodePsnr);                      // full frame
+        EXPECT_GE(decodePsnr(conus, map, {0.25, 0.3, 0.45, 0.5}, 320, 240), kDecodePsnr);  // zoomed in
+        EXPECT_GE(decodePsnr(conus, map, {0, 0, 1, 1}, 96, 80), kDecodePsnr);              // zoomed out: taps
+        EXPECT_GE(decodePsnr(conus, map, {-0.2, -0.1, 1.1, 1.3}, 300, 280), kDecodePsnr);  // past the edges
+        EXPECT_GE(decodePsnr(conus, map, {1, 1, 0, 0}, 200, 200), kDecodePsnr);            // mirrored
+    }
+    const codec::SamplingMap jittered = test::jitteredMap(7, 6, 0.3, 9);
+    const format::Image conus = codec::encodeImage(source, jittered, encodeSize(200, 220));
+    EXPECT_GE(decodePsnr(conus, jittered, {}, 400, 300), kDecodePsnr);
+}
+
+TEST_P(GpuImage, DecodeHandlesAnyChannelCount) {
+    const format::Image conus = test::photoLike(128, 128, {"R", "G", "B", "A", "Z"}, 4);
+    const codec::SamplingMap map = twoFoci();
+    const format::Image cpu = codec::decodeImage(conus, map, decodeView({}, 160, 120));
+    const format::Image gpu = decodeImageGpu(context(), conus, map, decodeView({}, 160, 120));
+    ASSERT_EQ(gpu.channels, conus.channels);
+    EXPECT_GE(codec::psnr(cpu, gpu), kDecodePsnr);
+    // Z is left out of psnr(); compare it directly.
+    float worst = 0;
+    for (std::size_t i = 4; i < cpu.pixels.size(); i += 5) worst = std::max(worst, std::abs(cpu.pixels[i] - gpu.pixels[i]));
+    EXPECT_LT(worst, 1e-3f);
+}
+
+TEST_P(GpuImage, ReportsTimings) {
+    const format::Image source = test::photoLike(256, 256);
+    GpuTimings t;
+    t.uploadMs = t.drawMs = t.readbackMs = -1;
+    const format::Image conus = encodeImageGpu(context(), source, twoFoci(), encodeSize(128, 128), &t);
+    EXPECT_GT(t.uploadMs, 0);
+    EXPECT_GT(t.drawMs, 0);
+    EXPECT_GE(t.readbackMs, 0);
+    t = {-1, -1, -1};
+    decodeImageGpu(context(), conus, twoFoci(), decodeView({}, 200, 100), &t);
+    EXPECT_GT(t.uploadMs, 0);
+    EXPECT_GT(t.drawMs, 0);
+    EXPECT_GE(t.readbackMs, 0);
+}
+
+TEST_P(GpuImage, RejectsBadArguments) {
+    const format::Image source = test::photoLike(64, 64);
+    const codec::SamplingMap map = codec::SamplingMap::identity(2, 2);
+    const auto code = [](auto&& fn) {
+        try {
+            fn();
+        } catch (const Error& e) {
+            return e.code();
+        }
+        return ErrorCode::Io;  // "did not throw"
+    };
+    EXPECT_EQ(code([&] { encodeImageGpu(context(), format::Image{}, map, encodeSize(8, 8)); }),
+              ErrorCode::InvalidArgument);
+    EXPECT_EQ(code([&] { encodeImageGpu(context(), source, map, encodeSize(0, 8)); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(code([&] { decodeImageGpu(context(), source, map, decodeView({0.5, 0, 0.5, 1}, 8, 8)); }),
+              ErrorCode::InvalidArgument);
+    format::Image broken = source;
+    broken.pixels.pop_back();
+    EXPECT_EQ(code([&] { decodeImageGpu(context(), broken, map, decodeView({}, 8, 8)); }), ErrorCode::InvalidArgument);
+    // Wider than any texture the context can hold: refused clearly, not tiled.
+    const format::Image wide = test::blank(context().maxTextureSize() + 1, 1, {"Y"});
+    EXPECT_EQ(code([&] { encodeImageGpu(context(), wide, map, encodeSize(8, 8)); }), ErrorCode::LimitExceeded);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, GpuImage, ::testing::Values(Backend::Egl, Backend::OsMesa), test::paramName);
+
+}  // namespace
+}  // namespace conus::gl
