@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "arguments.h"
+#include "backend.h"
 #include "commands.h"
 #include "conus/codec/decode.h"
 #include "conus/format/error.h"
@@ -16,7 +17,7 @@ namespace conus::cli {
 
 Command addDecodeCommand(CLI::App& root) {
     struct Options {
-        std::string input, output, viewText, sizeText;
+        std::string input, output, viewText, sizeText, backend = "auto";
     };
     auto options = std::make_shared<Options>();
     CLI::App* command = root.add_subcommand(
@@ -27,6 +28,7 @@ Command addDecodeCommand(CLI::App& root) {
                         "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image)");
     command->add_option("--size", options->sizeText,
                         "output size WxH (default: the view at the source's resolution)");
+    addBackendOption(*command, options->backend);
     return {command, [options] {
                 const format::ConusFile file = format::readConusFile(options->input);
                 const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
@@ -48,7 +50,8 @@ Command addDecodeCommand(CLI::App& root) {
                 }
                 Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
                 decode.progress = progress.callback();
-                const format::Image frame = codec::decodeImage(file.image, map, decode);
+                Renderer renderer(options->backend);
+                const format::Image frame = renderer.decode(file.image, map, decode);
                 progress.done();
                 writeImage(options->output, frame);
                 std::printf("wrote %s: %dx%d view [%g,%g]-[%g,%g]\n", options->output.c_str(), frame.width,

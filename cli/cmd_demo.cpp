@@ -60,7 +60,7 @@ codec::Focus hottestRegion(const format::Image& importance, int width, int heigh
 
 Command addDemoCommand(CLI::App& root) {
     struct Options {
-        std::string out = "demo-out", input, importance;
+        std::string out = "demo-out", input, importance, backend = "auto";
         std::vector<std::string> foci;
         int size = 4096;
         double k = 4;
@@ -78,6 +78,7 @@ Command addDemoCommand(CLI::App& root) {
     command->add_option("--importance", options->importance,
                         "with --input: build the map automatically from importance (a file, 'detail' or 'faces') "
                         "instead of foci; --focus then only names the views to compare");
+    addBackendOption(*command, options->backend);
     return {command, [options] {
                 namespace fs = std::filesystem;
                 fs::create_directories(options->out);
@@ -114,9 +115,10 @@ Command addDemoCommand(CLI::App& root) {
                 building.done();
 
                 const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
-                format::ConusFile conus = encodeToConus(source, map, size, analytic);
+                Renderer renderer(options->backend);
+                format::ConusFile conus = encodeToConus(renderer, source, map, size, analytic);
                 format::ConusFile uniform =
-                    encodeToConus(source, codec::SamplingMap::identity(2, 2), size, std::nullopt);
+                    encodeToConus(renderer, source, codec::SamplingMap::identity(2, 2), size, std::nullopt);
                 format::writeConusFile((out / "conus.exr").string(), conus);
                 format::writeConusFile((out / "uniform.exr").string(), uniform);
                 writeImage((out / "conus.png").string(), conus.image);
@@ -152,7 +154,7 @@ Command addDemoCommand(CLI::App& root) {
                 else
                     std::printf("%zu foci", foci.size());
                 for (const auto& f : foci) std::printf(" (%g,%g,r=%g,k=%g)", f.u, f.v, f.r, f.k);
-                std::printf("\n");
+                std::printf("\nrenderer: %s\n", renderer.describe().c_str());
                 std::printf("%-22s %12s %14s %8s\n", "view", "CoNUS PSNR", "uniform PSNR", "gain");
                 for (const auto& v : views) {
                     codec::DecodeOptions decode;
@@ -161,8 +163,8 @@ Command addDemoCommand(CLI::App& root) {
                     decode.width = v.width;
                     decode.height = v.height;
                     const format::Image reference = crop(source, v.x0, v.y0, v.width, v.height);
-                    const format::Image fromConus = codec::decodeImage(conus.image, map, decode);
-                    const format::Image fromUniform = codec::decodeImage(uniform.image, identity, decode);
+                    const format::Image fromConus = renderer.decode(conus.image, map, decode);
+                    const format::Image fromUniform = renderer.decode(uniform.image, identity, decode);
                     const double a = codec::psnr(reference, fromConus), b = codec::psnr(reference, fromUniform);
                     std::printf("%-22s %9.2f dB %11.2f dB %+7.2f\n", v.label.c_str(), a, b, a - b);
                     std::vector<format::Image> strip{reference, fromConus, fromUniform};

@@ -89,7 +89,8 @@ Command addEncodeCommand(CLI::App& root) {
                 } else {
                     map = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
                 }
-                format::ConusFile file = encodeToConus(source, *map, size, analytic);
+                Renderer renderer(options->storage.backend);
+                format::ConusFile file = encodeToConus(renderer, source, *map, size, analytic);
                 applyStorage(options->storage, file);
                 format::writeConusFile(options->output, file);
                 std::printf("wrote %s: %dx%d CoNUS image of a %dx%d source, %dx%d sampling map\n",

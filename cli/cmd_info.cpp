@@ -8,23 +8,54 @@
 #include "commands.h"
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
+#include "conus/format/error.h"
+#include "conus/renderers/context.h"
 #include "image_io.h"
 #include "pictures.h"
 
 namespace conus::cli {
 
+namespace {
+
+int printBackends(bool json) {
+    const std::vector<gl::BackendStatus> statuses = gl::probeBackends();
+    if (json) {
+        nlohmann::ordered_json j = nlohmann::ordered_json::array();
+        for (const auto& s : statuses)
+            j.push_back({{"backend", gl::backendName(s.backend)},
+                         {"works", s.works},
+                         {"renderer", s.renderer},
+                         {"version", s.version},
+                         {"reason", s.reason}});
+        std::printf("%s\n", j.dump(2).c_str());
+        return 0;
+    }
+    for (const auto& s : statuses) {
+        std::printf("%-7s %-10s %s\n", gl::backendName(s.backend).c_str(), s.works ? "works" : "unavailable",
+                    s.works ? (s.renderer + (s.version.empty() ? "" : " (" + s.version + ")")).c_str() : "");
+        if (!s.reason.empty()) std::printf("        %s\n", s.reason.c_str());
+    }
+    return 0;
+}
+
+}  // namespace
+
 Command addInfoCommand(CLI::App& root) {
     struct Options {
         std::string input, densityPng;
-        bool json = false;
+        bool json = false, backends = false;
     };
     auto options = std::make_shared<Options>();
     CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth");
-    command->add_option("input", options->input, "CoNUS file (.exr)")->required();
+    command->add_option("input", options->input, "CoNUS file (.exr)");
+    command->add_flag("--backends", options->backends,
+                      "list the rendering backends (EGL, OSMesa, CPU): whether each works, its GL_RENDERER, why not");
     command->add_flag("--json", options->json, "print JSON instead of text");
     command->add_option("--density", options->densityPng,
                         "write the sampling density as a heat map with the sampling pattern over it (.png)");
     return {command, [options] {
+                if (options->backends) return printBackends(options->json);
+                if (options->input.empty()) throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends)");
                 const format::ConusFile file = format::readConusFile(options->input);
                 const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
                 const DensityStats stats = densityStats(map);

@@ -25,8 +25,9 @@ Command addUniformCommand(CLI::App& root) {
     return {command, [options] {
                 const format::Image source = readImage(options->input);
                 const Size size = conusSize(options->storage, source);
+                Renderer renderer(options->storage.backend);
                 format::ConusFile file =
-                    encodeToConus(source, codec::SamplingMap::identity(2, 2), size, std::nullopt);
+                    encodeToConus(renderer, source, codec::SamplingMap::identity(2, 2), size, std::nullopt);
                 applyStorage(options->storage, file);
                 format::writeConusFile(options->output, file);
                 std::printf("wrote %s: %dx%d uniform image of a %dx%d source\n", options->output.c_str(),

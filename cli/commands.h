@@ -24,5 +24,6 @@ Command addInfoCommand(CLI::App& root);
 Command addValidateCommand(CLI::App& root);
 Command addDemoCommand(CLI::App& root);
 Command addMapCommand(CLI::App& root);
+Command addHeightFieldCommand(CLI::App& root);
 
 }  // namespace conus::cli

@@ -16,6 +16,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
     command.add_option("--compression", options.compression, "zip | piz | dwaa | none")
         ->default_val("zip")
         ->check(CLI::IsMember({"zip", "piz", "dwaa", "none"}));
+    addBackendOption(command, options.backend);
 }
 
 Size conusSize(const StorageOptions& options, const format::Image& source) {
@@ -28,13 +29,13 @@ void applyStorage(const StorageOptions& options, format::ConusFile& file) {
     file.compression = parseCompression(options.compression);
 }
 
-format::ConusFile encodeToConus(const format::Image& source, const codec::SamplingMap& map, Size size,
-                                std::optional<format::AnalyticMap> analytic, bool quiet) {
+format::ConusFile encodeToConus(Renderer& renderer, const format::Image& source, const codec::SamplingMap& map,
+                                Size size, std::optional<format::AnalyticMap> analytic, bool quiet) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                           std::to_string(size.width) + "x" + std::to_string(size.height),
                       quiet);
     format::ConusFile file;
-    file.image = codec::encodeImage(source, map, {size.width, size.height, 0, progress.callback()});
+    file.image = renderer.encode(source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
     file.sourceWidth = source.width;
     file.sourceHeight = source.height;

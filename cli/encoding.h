@@ -6,6 +6,7 @@
 #include <string>
 
 #include "arguments.h"
+#include "backend.h"
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
 
@@ -19,6 +20,7 @@ struct StorageOptions {
     std::string sizeText;  // "WxH"; empty: a quarter of each source side (1/16 of the pixels)
     bool half = false, full = false;
     std::string compression = "zip";
+    std::string backend = "auto";
 };
 
 void addStorageOptions(CLI::App& command, StorageOptions& options);
@@ -27,8 +29,8 @@ void addStorageOptions(CLI::App& command, StorageOptions& options);
 Size conusSize(const StorageOptions& options, const format::Image& source);
 
 // Encodes `source` through `map` at `size` (with progress) into a file model ready to write.
-format::ConusFile encodeToConus(const format::Image& source, const codec::SamplingMap& map, Size size,
-                                std::optional<format::AnalyticMap> analytic, bool quiet = false);
+format::ConusFile encodeToConus(Renderer& renderer, const format::Image& source, const codec::SamplingMap& map,
+                                Size size, std::optional<format::AnalyticMap> analytic, bool quiet = false);
 
 // Applies the storage options to a file model.
 void applyStorage(const StorageOptions& options, format::ConusFile& file);

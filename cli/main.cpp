@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
         conus::cli::addEncodeCommand(app),   conus::cli::addUniformCommand(app),
         conus::cli::addDecodeCommand(app),   conus::cli::addInfoCommand(app),
         conus::cli::addValidateCommand(app), conus::cli::addDemoCommand(app),
-        conus::cli::addMapCommand(app),
+        conus::cli::addMapCommand(app),  conus::cli::addHeightFieldCommand(app),
     };
 
     std::string name;

@@ -1,0 +1,213 @@
+// conus heightfield encode|render: CoNUS height fields (paper section 4, Figure 5). encode samples
+// a DEM through the perspective ground map (the server); render undistorts the file into a mesh
+// and renders a frame near the viewer (the client), optionally next to the full-resolution DEM and
+// a uniform height field of the same sample count, with their PSNRs.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <regex>
+#include <sstream>
+
+#include "arguments.h"
+#include "commands.h"
+#include "conus/codec/encode.h"
+#include "conus/codec/heightfield.h"
+#include "conus/codec/metrics.h"
+#include "conus/format/container.h"
+#include "conus/format/error.h"
+#include "conus/renderers/terrain.h"
+#include "dem_io.h"
+#include "image_io.h"
+#include "progress.h"
+
+namespace conus::cli {
+namespace {
+
+// The DEM's colour: a texture (resized down to the DEM when larger), else the height/slope ramp.
+format::Image demColour(const Dem& dem, const std::string& texture, glm::dvec2 extent) {
+    if (texture.empty()) return codec::terrainColours(dem.heights, extent);
+    format::Image image = readImage(texture);
+    if (image.width == dem.heights.width && image.height == dem.heights.height) return image;
+    if (image.width < dem.heights.width || image.height < dem.heights.height)
+        throw Error(ErrorCode::InvalidArgument, "colour texture " + texture + " (" + std::to_string(image.width) + "x" +
+                                                    std::to_string(image.height) + ") is smaller than the DEM (" +
+                                                    std::to_string(dem.heights.width) + "x" +
+                                                    std::to_string(dem.heights.height) + ")");
+    return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
+}
+
+gl::TerrainCamera parseCamera(const std::string& text) {
+    std::vector<double> v;
+    std::stringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        try {
+            std::size_t used = 0;
+            v.push_back(std::stod(item, &used));
+            if (used != item.size()) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+            throw Error(ErrorCode::InvalidArgument, "camera '" + text + "': '" + item + "' is not a number");
+        }
+    }
+    if (v.size() != 7)
+        throw Error(ErrorCode::InvalidArgument, "camera '" + text + "' needs 7 values x,y,z,lx,ly,lz,fovDeg");
+    gl::TerrainCamera camera;
+    camera.eye = {v[0], v[1], v[2]};
+    camera.target = {v[3], v[4], v[5]};
+    camera.fovYDegrees = v[6];
+    return camera;
+}
+
+void printCamera(const gl::TerrainCamera& c) {
+    std::printf("camera %.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f\n", c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y,
+                c.target.z, c.fovYDegrees);
+}
+
+}  // namespace
+
+Command addHeightFieldCommand(CLI::App& root) {
+    struct Options {
+        std::string dem, output, sizeText = "512x512", colour, compression = "zip";
+        double eyeHeight = 150, near = 200, far = 0, fov = 0, heightScale = 1;
+        int grid = 129;
+        std::string input, frame, cameraText, frameSize = "960x540", compare, backend = "auto";
+    };
+    auto o = std::make_shared<Options>();
+    CLI::App* command = root.add_subcommand(
+        "heightfield", "CoNUS height fields: sample a DEM densely near a viewer (encode), render it (render)");
+    command->require_subcommand(1);
+
+    CLI::App* encode = command->add_subcommand("encode", "Sample a DEM through the perspective ground map");
+    encode->add_option("dem", o->dem,
+                       "DEM: 16-bit PNG/TIFF (read as [0,1]: give --height-scale), float EXR, .npy, .npz "
+                       "(e.g. matplotlib's jacksboro_fault_dem.npz) or procedural[:SIZE[:SEED]]")
+        ->required();
+    encode->add_option("-o,--output", o->output, "CoNUS file (.exr)")->required();
+    encode->add_option("--size", o->sizeText, "CoNUS image size WxH")->capture_default_str();
+    encode->add_option("--eye-height", o->eyeHeight, "viewer's eye above the base plane, metres")->capture_default_str();
+    encode->add_option("--near", o->near, "distance from the viewer to the field's near edge, metres")
+        ->capture_default_str();
+    encode->add_option("--far", o->far,
+                       "distance to the far edge, metres (default: near + the DEM's depth when the file gives its "
+                       "spacing, else 6000)");
+    encode->add_option("--fov", o->fov,
+                       "horizontal field of view at the far edge, degrees; sets the field's width (default: the "
+                       "DEM's own width when known, else 60)");
+    encode->add_option("--grid", o->grid, "sampling-map nodes per side stored in the file")->capture_default_str();
+    encode->add_option("--height-scale", o->heightScale, "multiplies the DEM's values (to metres)")
+        ->capture_default_str();
+    encode->add_option("--colour,--color", o->colour, "colour texture (default: a ramp by height and slope)");
+    encode->add_option("--compression", o->compression, "zip | piz | dwaa | none")->capture_default_str();
+
+    CLI::App* render = command->add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
+    render->add_option("input", o->input, "CoNUS height field (.exr)")->required();
+    render->add_option("-o,--output", o->frame, "frame (.png, .exr, ...)")->required();
+    render->add_option("--camera", o->cameraText,
+                       "x,y,z,lx,ly,lz,fovDeg: eye, look-at point (world metres: x right, y up, z toward the "
+                       "viewer) and vertical fov (default: the ground map's viewer)");
+    render->add_option("--size", o->frameSize, "frame size WxH")->capture_default_str();
+    render->add_option("--compare", o->compare,
+                       "the DEM the file was made from: also render it at full resolution and a uniform height "
+                       "field of the same sample count, side by side (full | CoNUS | uniform), with PSNRs");
+    render->add_option("--height-scale", o->heightScale, "as given to encode (for --compare)")->capture_default_str();
+    render->add_option("--colour,--color", o->colour, "as given to encode (for --compare)");
+    render->add_option("--backend", o->backend, "auto | egl | osmesa (GL is needed)")->capture_default_str();
+
+    return {command, [o, encode, render] {
+                if (encode->parsed()) {
+                    Progress loading("read " + o->dem);
+                    const Dem dem = readDem(o->dem, o->heightScale);
+                    loading.done();
+                    const glm::dvec2 demMetres(dem.cellMetres.x * dem.heights.width,
+                                               dem.cellMetres.y * dem.heights.height);
+                    codec::HeightFieldOptions options;
+                    options.ground.eyeHeight = o->eyeHeight;
+                    options.ground.near = o->near;
+                    options.ground.far = o->far > 0 ? o->far : demMetres.y > 0 ? o->near + demMetres.y : 6000.0;
+                    options.ground.fovDegrees =
+                        o->fov > 0 ? o->fov
+                        : demMetres.x > 0
+                            ? codec::fovForFieldWidth(o->eyeHeight, o->near, options.ground.far, demMetres.x)
+                            : 60.0;
+                    const Size size = parseSize(o->sizeText);
+                    options.width = size.width;
+                    options.height = size.height;
+                    options.mapGrid = o->grid;
+                    const glm::dvec2 extent = codec::fieldExtent(options.ground);
+                    const format::Image colour = demColour(dem, o->colour, extent);
+                    Progress progress("encode height field " + o->sizeText);
+                    options.progress = progress.callback();
+                    format::ConusFile file = codec::encodeHeightField(dem.heights, colour, options);
+                    progress.done();
+                    file.compression = parseCompression(o->compression);
+                    format::writeConusFile(o->output, file);
+                    std::printf("wrote %s: %dx%d CoNUS height field of %s; field %.0f x %.0f m (eye %g m, near %g m, "
+                                "far %g m, fov %.2f deg); heights %.1f..%.1f m\n",
+                                o->output.c_str(), file.image.width, file.image.height, dem.description.c_str(),
+                                extent.x, extent.y, options.ground.eyeHeight, options.ground.near, options.ground.far,
+                                options.ground.fovDegrees, file.depth.near, file.depth.far);
+                    return 0;
+                }
+                const format::ConusFile file = format::readConusFile(o->input);
+                if (file.dataKind != format::DataKind::HeightField || !file.analytic || file.analytic->kind != "ground")
+                    throw Error(ErrorCode::InvalidArgument,
+                                o->input + " is not a CoNUS height field with ground-map parameters");
+                const codec::GroundParams ground = codec::groundFromAnalytic(*file.analytic);
+                const glm::dvec2 extent = codec::fieldExtent(ground);
+                const Size size = parseSize(o->frameSize);
+                gl::TerrainCamera camera = gl::viewerCamera(ground, codec::heightAt(file, {0.5, 1.0}));
+                if (!o->cameraText.empty()) {
+                    const gl::TerrainCamera given = parseCamera(o->cameraText);
+                    camera.eye = given.eye;
+                    camera.target = given.target;
+                    camera.fovYDegrees = given.fovYDegrees;
+                }
+                const gl::Backend backend = gl::parseBackend(o->backend);
+                if (backend == gl::Backend::Cpu)
+                    throw Error(ErrorCode::InvalidArgument, "terrain rendering needs GL: use --backend auto|egl|osmesa");
+                const auto context = gl::Context::create(backend);
+
+                Progress progress("undistort and render");
+                const format::Image frame =
+                    gl::renderTerrain(*context, codec::undistortHeightField(file, extent), camera, size.width, size.height);
+                progress.done();
+                printCamera(camera);
+                if (o->compare.empty()) {
+                    writeImage(o->frame, frame);
+                    std::printf("wrote %s: %dx%d frame (%s)\n", o->frame.c_str(), frame.width, frame.height,
+                                context->renderer().c_str());
+                    return 0;
+                }
+                Progress comparing("render full resolution and uniform");
+                const Dem dem = readDem(o->compare, o->heightScale);
+                const format::Image colour = demColour(dem, o->colour, extent);
+                const format::Image full = gl::renderTerrain(
+                    *context,
+                    codec::undistortHeightField(
+                        codec::uniformHeightField(dem.heights, colour, dem.heights.width, dem.heights.height), extent),
+                    camera, size.width, size.height);
+                const format::Image uniform = gl::renderTerrain(
+                    *context,
+                    codec::undistortHeightField(
+                        codec::uniformHeightField(dem.heights, colour, file.image.width, file.image.height), extent),
+                    camera, size.width, size.height);
+                comparing.done();
+                format::Image sideBySide = format::makeImage(3 * size.width, size.height, {"R", "G", "B"});
+                const format::Image* panels[] = {&full, &frame, &uniform};
+                for (int p = 0; p < 3; ++p)
+                    for (int y = 0; y < size.height; ++y)
+                        for (int x = 0; x < size.width; ++x)
+                            for (int c = 0; c < 3; ++c) sideBySide.at(p * size.width + x, y, c) = panels[p]->at(x, y, c);
+                writeImage(o->frame, sideBySide);
+                std::printf("wrote %s: full resolution %dx%d | CoNUS %dx%d | uniform %dx%d (%s)\n", o->frame.c_str(),
+                            dem.heights.width, dem.heights.height, file.image.width, file.image.height,
+                            file.image.width, file.image.height, context->renderer().c_str());
+                std::printf("PSNR vs full resolution: CoNUS %.2f dB, uniform %.2f dB\n", codec::psnr(frame, full),
+                            codec::psnr(uniform, full));
+                return 0;
+            }};
+}
+
+}  // namespace conus::cli
