@@ -7,12 +7,14 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "conus/format/container.h"
 #include "conus/format/error.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"conus: coherent non-uniform sampling images (flexible pinhole camera)", "conus"};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "conus 1.0.0 (CoNUS file format version 1)");
+    app.set_version_flag("--version", std::string(conus::format::kSoftwareName) + " (CoNUS file format version " +
+                                           std::to_string(conus::format::kFormatVersion) + ")");
 
     std::vector<conus::cli::Command> commands{
         conus::cli::addEncodeCommand(app),   conus::cli::addUniformCommand(app),

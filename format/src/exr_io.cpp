@@ -348,7 +348,7 @@ void writeExrFile(const std::string& path, const ConusFile& file) {
         conus.insert(kAttrSourceSize, Imf::V2iAttribute(Imath::V2i(file.sourceWidth, file.sourceHeight)));
         conus.insert(kAttrDataKind, Imf::StringAttribute(toString(file.dataKind)));
         conus.insert(kAttrSoftware,
-                     Imf::StringAttribute(file.software.empty() ? "conus " + std::to_string(kFormatVersion) : file.software));
+                     Imf::StringAttribute(file.software.empty() ? std::string(kSoftwareName) : file.software));
         if (file.analytic) {
             const AnalyticMap& a = *file.analytic;
             conus.insert(kAttrMapKind, Imf::StringAttribute(a.kind));

@@ -25,6 +25,7 @@
 namespace conus::format {
 
 inline constexpr int kFormatVersion = 1;
+inline constexpr const char* kSoftwareName = "conus 1.0.0";  // the `software` attribute written by default
 inline constexpr const char* kConusPartName = "conus";
 inline constexpr const char* kMapPartName = "samplingmap";
 
