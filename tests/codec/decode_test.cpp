@@ -12,55 +12,17 @@
 #include "conus/codec/foci.h"
 #include "conus/codec/metrics.h"
 #include "conus/format/error.h"
+#include "test_images.h"
 
 namespace conus::codec {
 namespace {
 
-format::Image blank(int w, int h, std::vector<std::string> channels) {
-    format::Image im;
-    im.width = w;
-    im.height = h;
-    im.channels = std::move(channels);
-    im.pixels.assign(static_cast<std::size_t>(w) * h * im.channels.size(), 0.0f);
-    return im;
-}
-
-format::Image noise(int w, int h, std::vector<std::string> channels, unsigned seed = 1) {
-    format::Image im = blank(w, h, std::move(channels));
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> d(0.0f, 1.0f);
-    for (float& v : im.pixels) v = d(rng);
-    return im;
-}
-
-// Noise box-blurred over 3x3: a detailed texture with little energy at the very top frequencies.
-format::Image texture(int size, unsigned seed) {
-    const format::Image n = noise(size, size, {"Y"}, seed);
-    format::Image t = blank(size, size, {"Y"});
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) {
-            float sum = 0;
-            for (int j = -1; j <= 1; ++j)
-                for (int i = -1; i <= 1; ++i)
-                    sum += n.at(std::clamp(x + i, 0, size - 1), std::clamp(y + j, 0, size - 1));
-            t.at(x, y) = sum / 9;
-        }
-    return t;
-}
-
-format::Image zonePlate(int size, double edgeFrequency) {
-    format::Image im = blank(size, size, {"Y"});
-    const double half = size / 2.0, k = edgeFrequency / half;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) {
-            const double dx = x + 0.5 - half, dy = y + 0.5 - half;
-            im.at(x, y) = static_cast<float>(0.5 + 0.5 * std::cos(M_PI * k * (dx * dx + dy * dy)));
-        }
-    return im;
-}
+using test::noise;
+using test::texture;
+using test::zonePlate;
 
 format::Image crop(const format::Image& im, int x0, int y0, int w, int h) {
-    format::Image out = blank(w, h, im.channels);
+    format::Image out = format::makeImage(w, h, im.channels);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
             for (int c = 0; c < im.channelCount(); ++c) out.at(x, y, c) = im.at(x0 + x, y0 + y, c);
@@ -187,7 +149,7 @@ TEST(Decode, FocusRegionBeatsUniformImageOfTheSameSize) {
 
 TEST(Decode, ZoomedOutViewAveragesInsteadOfAliasing) {
     // A one-pixel checkerboard: any honest view coarser than the image is flat grey.
-    format::Image conus = blank(512, 512, {"Y"});
+    format::Image conus = format::makeImage(512, 512, {"Y"});
     for (int y = 0; y < 512; ++y)
         for (int x = 0; x < 512; ++x) conus.at(x, y) = static_cast<float>((x + y) % 2);
     for (const SamplingMap& map : {SamplingMap::identity(5, 5), twoFoci()}) {

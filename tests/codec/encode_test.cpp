@@ -11,39 +11,14 @@
 #include "conus/codec/foci.h"
 #include "conus/codec/metrics.h"
 #include "conus/format/error.h"
+#include "test_images.h"
 
 namespace conus::codec {
 namespace {
 
-format::Image blank(int w, int h, std::vector<std::string> channels) {
-    format::Image im;
-    im.width = w;
-    im.height = h;
-    im.channels = std::move(channels);
-    im.pixels.assign(static_cast<std::size_t>(w) * h * im.channels.size(), 0.0f);
-    return im;
-}
-
-format::Image noise(int w, int h, std::vector<std::string> channels, unsigned seed = 1) {
-    format::Image im = blank(w, h, std::move(channels));
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> d(0.0f, 1.0f);
-    for (float& v : im.pixels) v = d(rng);
-    return im;
-}
-
-// cos(pi * k * r^2) with r in pixels from the centre: the local frequency grows linearly with r
-// and reaches `edgeFrequency` cycles per pixel at the middle of the sides.
-format::Image zonePlate(int size, double edgeFrequency) {
-    format::Image im = blank(size, size, {"Y"});
-    const double half = size / 2.0, k = edgeFrequency / half;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) {
-            const double dx = x + 0.5 - half, dy = y + 0.5 - half;
-            im.at(x, y) = static_cast<float>(0.5 + 0.5 * std::cos(M_PI * k * (dx * dx + dy * dy)));
-        }
-    return im;
-}
+using test::noise;
+using test::texture;
+using test::zonePlate;
 
 float maxAbsDifference(const format::Image& a, const format::Image& b) {
     EXPECT_EQ(a.pixels.size(), b.pixels.size());
@@ -148,7 +123,7 @@ TEST(Encode, FootprintsBeyondTheTapCapUseThePyramid) {
 }
 
 TEST(Encode, ConstantImageStaysConstantUnderAnyMapAndKeepsAlpha) {
-    format::Image src = blank(256, 192, {"R", "G", "B", "A"});
+    format::Image src = format::makeImage(256, 192, {"R", "G", "B", "A"});
     for (std::size_t i = 0; i < src.pixels.size(); i += 4) {
         src.pixels[i] = 0.25f;
         src.pixels[i + 1] = 0.5f;
@@ -189,7 +164,7 @@ TEST(Encode, AlphaIsCarriedThroughTheMap) {
 // R edges must sit where Eq. 1 sends the source edges (and likewise G along columns).
 TEST(Encode, EdgesLandWhereEquationOnePutsThem) {
     const int S = 1024, C = 256, period = 64;
-    format::Image src = blank(S, S, {"R", "G"});
+    format::Image src = format::makeImage(S, S, {"R", "G"});
     for (int y = 0; y < S; ++y)
         for (int x = 0; x < S; ++x) {
             src.at(x, y, 0) = (x / period) % 2 ? 1.0f : 0.0f;
@@ -237,7 +212,7 @@ TEST(Encode, FootprintFilterPreventsAliasing) {
     const SamplingMap map = buildFociMap(foci);
     const format::Image enc = encodeImage(src, map, sized(C, C));
 
-    format::Image reference = blank(C, C, {"Y"}), pointSampled = blank(C, C, {"Y"});
+    format::Image reference = format::makeImage(C, C, {"Y"}), pointSampled = format::makeImage(C, C, {"Y"});
     const int kSuper = 12;  // sub-pixels per axis per CoNUS pixel, each undistorted exactly
     for (int y = 0; y < C; ++y)
         for (int x = 0; x < C; ++x) {

@@ -46,7 +46,7 @@ TEST(Container, FloatRoundTripIsBitExact) {
     EXPECT_FALSE(g.analytic.has_value());
     EXPECT_FALSE(g.camera.has_value());
     EXPECT_EQ(g.depth.kind, DepthKind::None);
-    EXPECT_EQ(g.software, "conus 1");
+    EXPECT_EQ(g.software, format::kSoftwareName);
     EXPECT_TRUE(validateConusFile(dir.file("a.exr")).ok());
 }
 

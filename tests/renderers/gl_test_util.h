@@ -27,19 +27,11 @@ inline Context& contextFor(Backend backend) {
 
 inline std::string paramName(const ::testing::TestParamInfo<Backend>& info) { return backendName(info.param); }
 
-inline format::Image blank(int w, int h, std::vector<std::string> channels) {
-    format::Image im;
-    im.width = w;
-    im.height = h;
-    im.channels = std::move(channels);
-    im.pixels.assign(static_cast<std::size_t>(w) * h * im.channels.size(), 0.0f);
-    return im;
-}
 
 // Photo-like: smooth shading, hard-edged shapes, fine texture and a little noise, per channel
 // slightly different.
 inline format::Image photoLike(int w, int h, std::vector<std::string> channels = {"R", "G", "B"}, unsigned seed = 7) {
-    format::Image im = blank(w, h, std::move(channels));
+    format::Image im = format::makeImage(w, h, std::move(channels));
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> noise(-0.03f, 0.03f);
     for (int y = 0; y < h; ++y)

@@ -53,7 +53,7 @@ format::Image readPhoto(const std::string& name) {
     const OIIO::ImageSpec& spec = in->spec();
     std::vector<float> all(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) return {};
-    format::Image im = test::blank(spec.width, spec.height, {"R", "G", "B"});
+    format::Image im = format::makeImage(spec.width, spec.height, {"R", "G", "B"});
     for (std::size_t i = 0; i < static_cast<std::size_t>(spec.width) * spec.height; ++i)
         for (int c = 0; c < 3; ++c) im.pixels[i * 3 + c] = all[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
     return im;
@@ -133,9 +133,8 @@ TEST_P(GpuImage, EncodeHandlesAnyChannelCount) {
     const format::Image full = test::photoLike(256, 192, {"R", "G", "B", "A", "Z", "N"}, 5);
     for (int count : {1, 2, 3, 4, 5, 6}) {
         SCOPED_TRACE(count);
-        format::Image source = test::blank(full.width, full.height, {});
-        source.channels.assign(full.channels.begin(), full.channels.begin() + count);
-        source.pixels.resize(static_cast<std::size_t>(source.width) * source.height * count);
+        format::Image source = format::makeImage(
+            full.width, full.height, std::vector<std::string>(full.channels.begin(), full.channels.begin() + count));
         for (std::size_t i = 0; i < static_cast<std::size_t>(source.width) * source.height; ++i)
             for (int c = 0; c < count; ++c) source.pixels[i * count + c] = full.pixels[i * 6 + c];
         const codec::SamplingMap map = twoFoci();
@@ -144,7 +143,7 @@ TEST_P(GpuImage, EncodeHandlesAnyChannelCount) {
         ASSERT_EQ(gpu.channels, source.channels);
         // Per channel: each pass must land in its own channels.
         for (int c = 0; c < count; ++c) {
-            format::Image a = test::blank(128, 96, {"Y"}), b = test::blank(128, 96, {"Y"});
+            format::Image a = format::makeImage(128, 96, {"Y"}), b = format::makeImage(128, 96, {"Y"});
             for (std::size_t i = 0; i < a.pixels.size(); ++i) {
                 a.pixels[i] = cpu.pixels[i * count + c];
                 b.pixels[i] = gpu.pixels[i * count + c];
@@ -158,7 +157,7 @@ TEST_P(GpuImage, EncodeHandlesAnyChannelCount) {
 // crosses CoNUS row y where distort(e, v).y is that row's centre, at x = distort(e, v).x.
 TEST_P(GpuImage, CheckerboardEdgesFollowEquation1) {
     constexpr int kSource = 512, kSquare = 64, kW = 256, kH = 256;
-    format::Image board = test::blank(kSource, kSource, {"Y"});
+    format::Image board = format::makeImage(kSource, kSource, {"Y"});
     for (int y = 0; y < kSource; ++y)
         for (int x = 0; x < kSource; ++x) board.at(x, y) = float(((x / kSquare) + (y / kSquare)) % 2);
     const codec::SamplingMap map = codec::buildFociMap(std::vector<codec::Focus>{{0.4, 0.45, 0.1, 4}});
@@ -262,7 +261,7 @@ TEST_P(GpuImage, RejectsBadArguments) {
     broken.pixels.pop_back();
     EXPECT_EQ(code([&] { decodeImageGpu(context(), broken, map, decodeView({}, 8, 8)); }), ErrorCode::InvalidArgument);
     // Wider than any texture the context can hold: refused clearly, not tiled.
-    const format::Image wide = test::blank(context().maxTextureSize() + 1, 1, {"Y"});
+    const format::Image wide = format::makeImage(context().maxTextureSize() + 1, 1, {"Y"});
     EXPECT_EQ(code([&] { encodeImageGpu(context(), wide, map, encodeSize(8, 8)); }), ErrorCode::LimitExceeded);
 }
 

@@ -1,0 +1,52 @@
+// Procedural test images shared by the suites: varied content (noise, textures, zone plates), never
+// constants, so a resampler that is wrong cannot pass by accident.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "conus/format/image.h"
+
+namespace conus::test {
+
+// Uniform noise in [0,1) in every channel.
+inline format::Image noise(int w, int h, std::vector<std::string> channels, unsigned seed = 1) {
+    format::Image im = format::makeImage(w, h, std::move(channels));
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> d(0.0f, 1.0f);
+    for (float& v : im.pixels) v = d(rng);
+    return im;
+}
+
+// Noise box-blurred over 3x3: a detailed texture with little energy at the very top frequencies.
+inline format::Image texture(int size, unsigned seed) {
+    const format::Image n = noise(size, size, {"Y"}, seed);
+    format::Image t = format::makeImage(size, size, {"Y"});
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            float sum = 0;
+            for (int j = -1; j <= 1; ++j)
+                for (int i = -1; i <= 1; ++i)
+                    sum += n.at(std::clamp(x + i, 0, size - 1), std::clamp(y + j, 0, size - 1));
+            t.at(x, y) = sum / 9;
+        }
+    return t;
+}
+
+// cos(pi * k * r^2) with r in pixels from the centre: the local frequency grows linearly with r
+// and reaches `edgeFrequency` cycles per pixel at the middle of the sides.
+inline format::Image zonePlate(int size, double edgeFrequency) {
+    format::Image im = format::makeImage(size, size, {"Y"});
+    const double half = size / 2.0, k = edgeFrequency / half;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const double dx = x + 0.5 - half, dy = y + 0.5 - half;
+            im.at(x, y) = static_cast<float>(0.5 + 0.5 * std::cos(M_PI * k * (dx * dx + dy * dy)));
+        }
+    return im;
+}
+
+}  // namespace conus::test
