@@ -1,0 +1,91 @@
+// Drawing a CoNUS file for a viewer: the conventional frame reconstructed from the CoNUS data
+// (Equation 1 evaluated per pixel in the shader, never an upscaled cached frame) into the
+// framebuffer bound in the current GL context, with the views a CoNUS viewer wants (raw image,
+// the uniform image of the same pixel count, a wipe between the two, the sampling density) and
+// overlays (the CoNUS pixel grid, focus outlines), exposure and gamma for HDR data.
+//
+// Shared rules: a ViewRenderer lives on one Context and is destroyed before it; every call makes
+// that context current (a no-op for an adopted one, whose owner keeps it current). Image-plane
+// coordinates follow spec/ (v down); the only flip is ViewOptions::bottomUp for a window's default
+// framebuffer. GL failures throw conus::Error (Unsupported, LimitExceeded) as in gpu_image.h.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "conus/codec/decode.h"
+#include "conus/codec/sampling_map.h"
+#include "conus/format/container.h"
+#include "conus/format/image.h"
+#include "conus/renderers/context.h"
+
+namespace conus::gl {
+
+// A GL loader: glfwGetProcAddress and friends have this shape.
+using ProcAddress = void (*)();
+using GetProcFn = ProcAddress (*)(const char* name);
+
+// A Context on the GL context current on the calling thread (a GLFW window's, say), loaded through
+// `getProc`. It neither owns nor destroys that GL context and never makes it current: the caller
+// keeps it current while using the Context and destroys the Context first. Throws
+// conus::Error(Unsupported) when GL 4.5 core cannot be loaded.
+std::unique_ptr<Context> adoptCurrentContext(GetProcFn getProc);
+
+enum class ViewMode {
+    Reconstructed,  // the conventional frame decoded from the CoNUS image (default)
+    Raw,            // the CoNUS image itself, stretched over the view's undistorted rectangle
+    Uniform,        // the uniform image of the CoNUS image's pixel count, decoded the same way
+    Wipe,           // Reconstructed left of ViewOptions::wipeX, Uniform right of it
+    Density,        // heat map of log det J of the map (the sampling density), from the nodes
+};
+
+struct ViewOptions {
+    ViewMode mode = ViewMode::Reconstructed;
+    bool grid = false;       // lines of the CoNUS pixel grid (where floor(u_d * W) changes)
+    int gridEvery = 0;       // every n-th grid line; 0: automatic, lines at least ~6 pixels apart
+    bool outlines = false;   // analytic focus circles (radius r and 2r)
+    double exposure = 0.0;   // colour * 2^exposure
+    double gamma = 2.2;      // display gamma (1 = linear values straight to the framebuffer)
+    double wipeX = 0.5;      // Wipe: split position, a fraction of the viewport width
+    bool bottomUp = true;    // the target's row 0 is the bottom (a window); false: top (readback)
+};
+
+class ViewRenderer {
+public:
+    explicit ViewRenderer(Context& context);
+    ~ViewRenderer();
+    ViewRenderer(const ViewRenderer&) = delete;
+    ViewRenderer& operator=(const ViewRenderer&) = delete;
+
+    // Uploads the CoNUS image (display channels: R,G,B[,A], or Y, or the first), the map's nodes,
+    // and computes the uniform image: a GPU decode of the whole frame at the CoNUS image's size,
+    // whose footprint filter is an area downsample of the reconstructed frame. Throws
+    // conus::Error(InvalidMap) for a bad map, LimitExceeded beyond GL_MAX_TEXTURE_SIZE.
+    void setImage(const format::ConusFile& file);
+    // Replaces the map alone (the map editor's live grid); the uniform image is not recomputed.
+    void setMap(const codec::SamplingMap& map);
+    bool hasImage() const;
+
+    // Draws into the currently bound framebuffer, viewport (0,0,width,height).
+    void draw(const codec::View& view, int viewportWidth, int viewportHeight, const ViewOptions& options);
+
+    // Draws into an offscreen RGBA32F target and reads it back: RGBA, top row first, display
+    // values (after exposure and gamma). options.bottomUp is ignored.
+    format::Image renderToImage(const codec::View& view, int width, int height, ViewOptions options);
+    // Reads the currently bound read framebuffer (a window's back buffer before the swap) as
+    // 8-bit-range RGBA floats in [0,1], top row first.
+    format::Image readFramebuffer(int width, int height, bool bottomUp = true);
+    // Clears the bound framebuffer to one colour (the viewer's "this file could not be opened").
+    void clear(int width, int height, float red, float green, float blue);
+    // Waits for the GPU (for timing).
+    void finish();
+
+    // The uniform image computed by setImage (for tests and the inspector).
+    const format::Image& uniformImage() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace conus::gl

@@ -1,0 +1,138 @@
+#version 450 core
+// One window pixel of conus-view: the undistorted (u,v) of the pixel, then by mode the CoNUS image
+// decoded there (Equation 1 from the nodes, bilinear taps over the pixel's footprint exactly as
+// decode.frag.glsl does), the raw CoNUS image, the uniform image, a wipe of the two, or the
+// sampling density det J; then the CoNUS pixel grid and focus outlines over it.
+// uBottomUp flips rows for a window's default framebuffer (row 0 at the bottom); offscreen targets
+// are read back top row first and need no flip.
+// VIEW_MODE, VIEW_GRID and VIEW_OUTLINES are compile-time: the renderer compiles one program per
+// combination, because llvmpipe runs both sides of every branch under a mask, so a run-time mode
+// switch would pay for every mode's taps on every pixel (measured: 2.5 -> see view_renderer.cpp).
+#ifndef VIEW_MODE
+#define VIEW_MODE 0
+#endif
+#ifndef VIEW_GRID
+#define VIEW_GRID 0
+#endif
+#ifndef VIEW_OUTLINES
+#define VIEW_OUTLINES 0
+#endif
+const int kMode = VIEW_MODE;  // 0 reconstructed, 1 raw, 2 uniform, 3 wipe, 4 density
+const bool kGrid = VIEW_GRID != 0;
+const bool kOutlines = VIEW_OUTLINES != 0;
+layout(location = 0) out vec4 fragColor;
+uniform sampler2D uConus;    // display channels as RGBA, bilinear, clamp to edge
+uniform sampler2D uMap;      // columns x rows texels, RG32F: the distorted node positions
+uniform sampler2D uUniform;  // the uniform image of the same pixel count, RGBA
+uniform vec4 uView;          // u0, v0, u1, v1
+uniform vec2 uOutputSize;
+uniform bool uBottomUp;
+uniform vec2 uGridLines;     // CoNUS pixels (or every n-th) across u and v; 0: no grid
+uniform vec2 uSourceSize;    // conventional frame in pixels (focus radii are fractions of its width)
+uniform int uFocusCount;
+uniform vec3 uFoci[16];      // u, v, r
+uniform float uExposure;     // 2^ev, applied before gamma
+uniform float uInvGamma;
+uniform float uWipeX;        // pixels
+uniform vec2 uLogDensity;    // log density range for the heat map
+
+const float kMultiTap = 1.5;
+const int kMaxTaps = 8;
+const vec3 kBackground = vec3(0.11);
+
+int taps(float len) { return len <= kMultiTap ? 1 : min(kMaxTaps, int(ceil(len))); }
+
+// Equation 1 at uv with its partial derivatives (d/du, d/dv), as decode.frag.glsl evaluates it.
+struct MapPoint { vec2 pd; vec2 du; vec2 dv; };
+MapPoint evalMap(vec2 uv) {
+    const ivec2 nodes = textureSize(uMap, 0);
+    const vec2 cells = vec2(nodes - 1);
+    const vec2 g = clamp(uv, 0.0, 1.0) * cells;
+    const ivec2 c = clamp(ivec2(g), ivec2(0), nodes - 2);
+    const vec2 st = g - vec2(c);
+    const vec2 n00 = texelFetch(uMap, c, 0).xy;
+    const vec2 n10 = texelFetch(uMap, c + ivec2(1, 0), 0).xy;
+    const vec2 n01 = texelFetch(uMap, c + ivec2(0, 1), 0).xy;
+    const vec2 n11 = texelFetch(uMap, c + ivec2(1, 1), 0).xy;
+    const vec2 left = mix(n00, n01, st.y), right = mix(n10, n11, st.y);
+    MapPoint p;
+    p.pd = mix(left, right, st.x);
+    p.du = (right - left) * cells.x;
+    p.dv = mix(n01 - n00, n11 - n10, st.x) * cells.y;
+    return p;
+}
+
+// Bilinear taps over the footprint (edges a, b in normalized texture units) centred at q.
+vec4 filtered(sampler2D tex, vec2 q, vec2 a, vec2 b) {
+    const vec2 size = vec2(textureSize(tex, 0));
+    const int na = taps(length(a * size)), nb = taps(length(b * size));
+    if (na == 1 && nb == 1) return textureLod(tex, q, 0.0);
+    vec4 sum = vec4(0.0);
+    for (int j = 0; j < nb; ++j) {
+        const vec2 r = q + b * ((float(j) + 0.5) / float(nb) - 0.5);
+        for (int i = 0; i < na; ++i)
+            sum += textureLod(tex, clamp(r + a * ((float(i) + 0.5) / float(na) - 0.5), 0.0, 1.0), 0.0);
+    }
+    return sum / float(na * nb);
+}
+
+vec3 heat(float t) {  // after matplotlib's "inferno", as cli/pictures.cpp
+    const vec3 ramp[6] = vec3[6](vec3(0.001, 0.000, 0.014), vec3(0.258, 0.039, 0.406), vec3(0.578, 0.148, 0.404),
+                                 vec3(0.865, 0.317, 0.226), vec3(0.988, 0.645, 0.040), vec3(0.988, 0.998, 0.645));
+    t = clamp(t, 0.0, 1.0) * 5.0;
+    const int i = min(int(t), 4);
+    return mix(ramp[i], ramp[i + 1], t - float(i));
+}
+
+vec3 display(vec4 c) { return pow(max(c.rgb * uExposure, vec3(0.0)), vec3(uInvGamma)); }
+
+void main() {
+    const float row = uBottomUp ? uOutputSize.y - gl_FragCoord.y : gl_FragCoord.y;
+    const vec2 pixel = vec2(gl_FragCoord.x, row);
+    const vec2 extent = uView.zw - uView.xy;
+    const vec2 step = extent / uOutputSize;  // signed: one pixel right / one row down
+    const vec2 uv = uView.xy + pixel * step;
+    const bool inside = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
+    const vec2 insideAxes = vec2(uv.x >= 0.0 && uv.x <= 1.0 ? 1.0 : 0.0, uv.y >= 0.0 && uv.y <= 1.0 ? 1.0 : 0.0);
+    const vec2 astep = abs(step) * insideAxes;
+    const MapPoint m = evalMap(uv);
+
+    int mode = kMode;
+    if (mode == 3) mode = gl_FragCoord.x < uWipeX ? 0 : 2;
+    vec3 color;
+    if (!inside && mode != 4) {
+        color = kBackground;
+    } else if (mode == 0) {
+        color = display(filtered(uConus, m.pd, m.du * astep.x, m.dv * astep.y));
+    } else if (mode == 1) {
+        color = display(filtered(uConus, clamp(uv, 0.0, 1.0), vec2(astep.x, 0.0), vec2(0.0, astep.y)));
+    } else if (mode == 2) {
+        color = display(filtered(uUniform, clamp(uv, 0.0, 1.0), vec2(astep.x, 0.0), vec2(0.0, astep.y)));
+    } else {
+        const float det = m.du.x * m.dv.y - m.du.y * m.dv.x;
+        const float range = uLogDensity.y - uLogDensity.x;
+        color = heat(range > 1e-6 ? (log(max(det, 1e-12)) - uLogDensity.x) / range : 0.5);
+        if (!inside) color *= 0.35;
+    }
+
+    // The CoNUS pixel grid: this pixel is on a line where the distorted column (row) index changes
+    // between it and its right (lower) neighbour, as cli/pictures.cpp draws it.
+    if (kGrid && inside) {
+        const vec2 right = evalMap(uv + vec2(step.x, 0.0)).pd;
+        const vec2 below = evalMap(uv + vec2(0.0, step.y)).pd;
+        const vec2 lines = uGridLines;
+        const bool edge = floor(m.pd.x * lines.x) != floor(right.x * lines.x) ||
+                          floor(m.pd.y * lines.y) != floor(below.y * lines.y);
+        if (edge) color = mix(color, vec3(1.0), 0.55);
+    }
+    // Focus circles at r (solid) and 2r (where the density has fallen back to the context's).
+    for (int k = 0; kOutlines && k < uFocusCount; ++k) {
+        const vec2 d = (uv - uFoci[k].xy) * uSourceSize;
+        const float radius = uFoci[k].z * uSourceSize.x, dist = length(d);
+        const float pixelSize = abs(step.x) * uSourceSize.x;
+        if (abs(dist - radius) < 0.75 * pixelSize) color = vec3(0.2, 1.0, 0.4);
+        else if (abs(dist - 2.0 * radius) < 0.6 * pixelSize) color = mix(color, vec3(0.2, 1.0, 0.4), 0.5);
+    }
+    if (kMode == 3 && abs(gl_FragCoord.x - uWipeX) < 1.0) color = vec3(1.0);
+    fragColor = vec4(color, 1.0);
+}

@@ -1,0 +1,292 @@
+// conus-view's drawing: one full-screen pass of view_frame.frag.glsl into the bound framebuffer,
+// and the Context that adopts a window's GL context (context_pvt.h's Platform, doing nothing).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "context_pvt.h"
+#include "conus/renderers/gpu_image.h"
+#include "conus/renderers/view_renderer.h"
+#include "embedded_shaders.h"
+#include "gl_objects.h"
+
+namespace conus::gl {
+namespace {
+
+constexpr int kMaxFoci = 16;             // uFoci in view_frame.frag.glsl
+constexpr int kDensitySamples = 128;     // per side, for the heat map's log-density range
+constexpr double kMinGridSpacing = 6.0;  // pixels between automatic grid lines (at density 1)
+
+// The caller's context: binding and unbinding it are the caller's business (GLFW's, say).
+class AdoptedPlatform final : public Platform {
+public:
+    explicit AdoptedPlatform(GetProcFn getProc) : m_getProc(getProc) {}
+    void makeCurrent() override {}
+    void release() override {}
+    GLADloadfunc loader() const override { return reinterpret_cast<GLADloadfunc>(m_getProc); }
+    std::string description() const override { return "adopted GL context (owned by the caller)"; }
+
+private:
+    GetProcFn m_getProc;
+};
+
+std::string glString(const GladGLContext& gl, GLenum name) {
+    const GLubyte* s = gl.GetString(name);
+    return s ? reinterpret_cast<const char*>(s) : "";
+}
+
+// The display channels of a CoNUS image as RGBA: R,G,B(,A) when present, else Y (or the first
+// channel) as grey. A depth-only image shows its Z as grey too, which is what one wants to see.
+format::Image displayRgba(const format::Image& image) {
+    format::Image out = format::makeImage(image.width, image.height, {"R", "G", "B", "A"});
+    int source[4] = {image.channelIndex("R"), image.channelIndex("G"), image.channelIndex("B"), image.channelIndex("A")};
+    if (source[0] < 0 || source[1] < 0 || source[2] < 0) {
+        int grey = image.channelIndex("Y");
+        if (grey < 0) grey = 0;
+        source[0] = source[1] = source[2] = grey;
+    }
+    const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
+    const std::size_t channels = image.channels.size();
+    for (std::size_t i = 0; i < pixels; ++i) {
+        for (int c = 0; c < 3; ++c) out.pixels[i * 4 + c] = image.pixels[i * channels + source[c]];
+        out.pixels[i * 4 + 3] = source[3] >= 0 ? image.pixels[i * channels + source[3]] : 1.0f;
+    }
+    return out;
+}
+
+void uploadRgba(const GladGLContext& gl, GLuint& texture, const format::Image& image) {
+    if (texture) gl.DeleteTextures(1, &texture);
+    gl.GenTextures(1, &texture);
+    gl.ActiveTexture(GL_TEXTURE0);
+    gl.BindTexture(GL_TEXTURE_2D, texture);
+    gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, image.width, image.height);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, image.width, image.height, GL_RGBA, GL_FLOAT, image.pixels.data());
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+}  // namespace
+
+std::unique_ptr<Context> adoptCurrentContext(GetProcFn getProc) {
+    if (!getProc) throw Error(ErrorCode::InvalidArgument, "adoptCurrentContext: no GL loader given");
+    auto impl = std::make_unique<Context::Impl>();
+    impl->backend = Backend::Auto;
+    impl->platform = std::make_unique<AdoptedPlatform>(getProc);
+    const int version = gladLoadGLContext(&impl->gl, impl->platform->loader());
+    if (version == 0 || GLAD_VERSION_MAJOR(version) * 10 + GLAD_VERSION_MINOR(version) < 45) {
+        impl->platform.reset();  // nothing was created in the caller's context
+        throw Error(ErrorCode::Unsupported, "adoptCurrentContext: the current GL context does not offer OpenGL 4.5 core "
+                                            "(glad reports " + std::to_string(GLAD_VERSION_MAJOR(version)) + "." +
+                                                std::to_string(GLAD_VERSION_MINOR(version)) + ")");
+    }
+    impl->renderer = glString(impl->gl, GL_RENDERER);
+    impl->version = glString(impl->gl, GL_VERSION);
+    impl->gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &impl->maxTextureSize);
+    impl->gl.GenVertexArrays(1, &impl->emptyVertexArray);
+    impl->reason = impl->platform->description();
+    return std::make_unique<Context>(std::move(impl));
+}
+
+struct ViewRenderer::Impl {
+    Context& context;
+    GLuint conus = 0, map = 0, uniform = 0;
+    int conusWidth = 0, conusHeight = 0;
+    double sourceWidth = 1, sourceHeight = 1;
+    std::vector<float> foci;  // u, v, r per focus
+    float logDensityLo = 0, logDensityHi = 0;
+    format::Image uniformImage;
+
+    explicit Impl(Context& c) : context(c) {}
+    ~Impl() {
+        const GladGLContext& gl = makeCurrentGl(context);
+        for (GLuint* t : {&conus, &map, &uniform})
+            if (*t) gl.DeleteTextures(1, t);
+    }
+
+    // The program for a mode and overlays: view_frame.frag.glsl with its VIEW_* switches defined
+    // after the #version line (compiled once per combination, cached by the context).
+    GLuint program(const ViewOptions& options) {
+        const int mode = static_cast<int>(options.mode);
+        const std::string key = "view_frame/" + std::to_string(mode) + (options.grid ? "g" : "") + (options.outlines ? "o" : "");
+        std::string source = shaders::kShaderViewFrameFrag;
+        const std::size_t eol = source.find('\n') + 1;
+        source.insert(eol, "#define VIEW_MODE " + std::to_string(mode) + "\n#define VIEW_GRID " + (options.grid ? "1" : "0") +
+                               "\n#define VIEW_OUTLINES " + (options.outlines ? "1" : "0") + "\n");
+        return cachedProgram(context, key, shaders::kShaderFullscreenVert, source.c_str());
+    }
+
+    void uploadMap(const codec::SamplingMap& m) {
+        const GladGLContext& gl = makeCurrentGl(context);
+        if (map) gl.DeleteTextures(1, &map);
+        gl.GenTextures(1, &map);
+        gl.ActiveTexture(GL_TEXTURE1);
+        gl.BindTexture(GL_TEXTURE_2D, map);
+        gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, m.columns(), m.rows());
+        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, m.columns(), m.rows(), GL_RG, GL_FLOAT, m.nodes().data());
+        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        checkGl(gl, "ViewRenderer: map upload");
+        double lo = 1e300, hi = -1e300;
+        for (int j = 0; j < kDensitySamples; ++j)
+            for (int i = 0; i < kDensitySamples; ++i) {
+                const double d = std::log(std::max(
+                    m.density({(i + 0.5) / kDensitySamples, (j + 0.5) / kDensitySamples}), 1e-12));
+                lo = std::min(lo, d);
+                hi = std::max(hi, d);
+            }
+        logDensityLo = static_cast<float>(lo);
+        logDensityHi = static_cast<float>(hi);
+    }
+};
+
+ViewRenderer::ViewRenderer(Context& context) : m_impl(std::make_unique<Impl>(context)) {
+    // Compile now, so a broken driver fails at start-up rather than at the first frame.
+    makeCurrentGl(context);
+    m_impl->program(ViewOptions{});
+}
+
+ViewRenderer::~ViewRenderer() = default;
+
+bool ViewRenderer::hasImage() const { return m_impl->conus != 0; }
+const format::Image& ViewRenderer::uniformImage() const { return m_impl->uniformImage; }
+
+void ViewRenderer::setImage(const format::ConusFile& file) {
+    Impl& d = *m_impl;
+    const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
+    const format::Image rgba = displayRgba(file.image);
+    const int limit = d.context.maxTextureSize();
+    if (rgba.width > limit || rgba.height > limit)
+        throw Error(ErrorCode::LimitExceeded, "ViewRenderer: CoNUS image " + std::to_string(rgba.width) + "x" +
+                                                  std::to_string(rgba.height) + " exceeds GL_MAX_TEXTURE_SIZE " +
+                                                  std::to_string(limit));
+    // The uniform image of the same pixel count: the whole frame decoded at the CoNUS image's size
+    // on the GPU. The decoder averages taps over each output pixel's footprint, so this is the area
+    // downsample of the reconstructed full frame in one pass (a CPU decode at source size plus
+    // codec::areaDownsample takes seconds for a 2048^2 image; this takes a frame).
+    codec::DecodeOptions options;
+    options.width = rgba.width;
+    options.height = rgba.height;
+    d.uniformImage = decodeImageGpu(d.context, rgba, map, options);
+
+    const GladGLContext& gl = makeCurrentGl(d.context);
+    uploadRgba(gl, d.conus, rgba);
+    uploadRgba(gl, d.uniform, d.uniformImage);
+    checkGl(gl, "ViewRenderer: image upload");
+    d.uploadMap(map);
+    d.conusWidth = rgba.width;
+    d.conusHeight = rgba.height;
+    d.sourceWidth = file.sourceWidth > 0 ? file.sourceWidth : rgba.width;
+    d.sourceHeight = file.sourceHeight > 0 ? file.sourceHeight : rgba.height;
+    d.foci.clear();
+    if (file.analytic && file.analytic->kind == "foci")
+        for (const auto& f : file.analytic->foci) {
+            if (static_cast<int>(d.foci.size()) / 3 >= kMaxFoci) break;
+            d.foci.insert(d.foci.end(), {float(f.u), float(f.v), float(f.r)});
+        }
+}
+
+void ViewRenderer::setMap(const codec::SamplingMap& map) { m_impl->uploadMap(map); }
+
+void ViewRenderer::draw(const codec::View& view, int width, int height, const ViewOptions& options) {
+    Impl& d = *m_impl;
+    const GladGLContext& gl = makeCurrentGl(d.context);
+    if (!hasImage()) {
+        gl.Viewport(0, 0, width, height);
+        gl.ClearColor(0.11f, 0.11f, 0.11f, 1.0f);
+        gl.Clear(GL_COLOR_BUFFER_BIT);
+        return;
+    }
+    const GLuint program = d.program(options);
+    gl.Viewport(0, 0, width, height);
+    gl.Disable(GL_DEPTH_TEST);
+    gl.Disable(GL_BLEND);
+    gl.UseProgram(program);
+    const GLuint textures[3] = {d.conus, d.map, d.uniform};
+    for (int unit = 0; unit < 3; ++unit) {
+        gl.ActiveTexture(GL_TEXTURE0 + unit);
+        gl.BindTexture(GL_TEXTURE_2D, textures[unit]);
+    }
+    const auto at = [&](const char* name) { return gl.GetUniformLocation(program, name); };
+    gl.Uniform1i(at("uConus"), 0);
+    gl.Uniform1i(at("uMap"), 1);
+    gl.Uniform1i(at("uUniform"), 2);
+    gl.Uniform4f(at("uView"), float(view.u0), float(view.v0), float(view.u1), float(view.v1));
+    gl.Uniform2f(at("uOutputSize"), float(width), float(height));
+    gl.Uniform1i(at("uBottomUp"), options.bottomUp ? 1 : 0);
+    int every = options.gridEvery;
+    if (every <= 0) {
+        // Window pixels per CoNUS pixel where the density is 1; coarser lines until they are legible.
+        const double perPixel = width / (std::abs(view.u1 - view.u0) * d.conusWidth);
+        every = 1;
+        while (every * perPixel < kMinGridSpacing && every < d.conusWidth) every *= 2;
+    }
+    gl.Uniform2f(at("uGridLines"), options.grid ? float(d.conusWidth) / every : 0.0f,
+                 options.grid ? float(d.conusHeight) / every : 0.0f);
+    gl.Uniform2f(at("uSourceSize"), float(d.sourceWidth), float(d.sourceHeight));
+    const int foci = options.outlines ? static_cast<int>(d.foci.size() / 3) : 0;
+    gl.Uniform1i(at("uFocusCount"), foci);
+    if (foci > 0) gl.Uniform3fv(at("uFoci"), foci, d.foci.data());
+    gl.Uniform1f(at("uExposure"), static_cast<float>(std::exp2(options.exposure)));
+    gl.Uniform1f(at("uInvGamma"), static_cast<float>(1.0 / std::max(options.gamma, 0.05)));
+    gl.Uniform1f(at("uWipeX"), static_cast<float>(options.wipeX * width));
+    gl.Uniform2f(at("uLogDensity"), d.logDensityLo, d.logDensityHi);
+    gl.BindVertexArray(d.context.impl().emptyVertexArray);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl.BindVertexArray(0);
+    checkGl(gl, "ViewRenderer::draw");
+}
+
+format::Image ViewRenderer::renderToImage(const codec::View& view, int width, int height, ViewOptions options) {
+    constexpr const char* kWhat = "ViewRenderer::renderToImage";
+    format::Image out = format::makeImage(width, height, {"R", "G", "B", "A"});
+    const GladGLContext& gl = makeCurrentGl(m_impl->context);
+    GlHandle texture = makeTexture(gl), framebuffer = makeFramebuffer(gl);
+    gl.BindTexture(GL_TEXTURE_2D, texture.id());
+    gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.id(), 0);
+    checkGl(gl, kWhat);
+    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        throw Error(ErrorCode::Unsupported, std::string(kWhat) + ": cannot render to a " + std::to_string(width) + "x" +
+                                                std::to_string(height) + " RGBA32F framebuffer");
+    options.bottomUp = false;  // read back top row first: no flip
+    draw(view, width, height, options);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, out.pixels.data());
+    checkGl(gl, kWhat);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    return out;
+}
+
+format::Image ViewRenderer::readFramebuffer(int width, int height, bool bottomUp) {
+    const GladGLContext& gl = makeCurrentGl(m_impl->context);
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(width) * height * 4);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
+    checkGl(gl, "ViewRenderer::readFramebuffer");
+    format::Image out = format::makeImage(width, height, {"R", "G", "B", "A"});
+    for (int y = 0; y < height; ++y) {
+        const int row = bottomUp ? height - 1 - y : y;
+        for (int x = 0; x < width * 4; ++x)
+            out.pixels[static_cast<std::size_t>(y) * width * 4 + x] =
+                bytes[static_cast<std::size_t>(row) * width * 4 + x] / 255.0f;
+    }
+    return out;
+}
+
+void ViewRenderer::clear(int width, int height, float red, float green, float blue) {
+    const GladGLContext& gl = makeCurrentGl(m_impl->context);
+    gl.Viewport(0, 0, width, height);
+    gl.ClearColor(red, green, blue, 1.0f);
+    gl.Clear(GL_COLOR_BUFFER_BIT);
+}
+
+void ViewRenderer::finish() { makeCurrentGl(m_impl->context).Finish(); }
+
+}  // namespace conus::gl

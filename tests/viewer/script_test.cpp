@@ -1,0 +1,76 @@
+#include "actions.h"
+#include "script.h"
+
+#include <gtest/gtest.h>
+
+#include "conus/format/error.h"
+
+namespace conus::viewer {
+namespace {
+
+TEST(Actions, ChordsParse) {
+    const auto g = parseChord("g");
+    ASSERT_TRUE(g);
+    EXPECT_EQ(g->key, "G");
+    const auto se = parseChord("Shift+E");
+    ASSERT_TRUE(se);
+    EXPECT_TRUE(se->shift);
+    EXPECT_EQ(se->key, "E");
+    const auto plus = parseChord("+");
+    ASSERT_TRUE(plus);
+    EXPECT_EQ(plus->key, "+");
+    const auto tab = parseChord("ctrl+shift+tab");
+    ASSERT_TRUE(tab);
+    EXPECT_TRUE(tab->ctrl && tab->shift);
+    EXPECT_EQ(tab->key, "Tab");
+    EXPECT_FALSE(parseChord("alt+G"));
+    EXPECT_FALSE(parseChord("Gee"));
+}
+
+TEST(Actions, TheKeysTheIssueAsksFor) {
+    const auto act = [](const char* chord, bool editing = false) { return actionFor(*parseChord(chord), editing); };
+    EXPECT_EQ(act("1"), Action::SourceResolution);  // 1 is 1:1, not a file number
+    EXPECT_EQ(act("F"), Action::Fit);
+    EXPECT_EQ(act("R"), Action::ModeRaw);
+    EXPECT_EQ(act("ctrl+R"), Action::Reload);
+    EXPECT_EQ(act("F5"), Action::Reload);
+    EXPECT_EQ(act("E"), Action::ExposureUp);
+    EXPECT_EQ(act("shift+E"), Action::ExposureDown);
+    EXPECT_EQ(act("E", true), Action::EncodeImage);
+    EXPECT_EQ(act("ctrl+S", true), Action::EncodeImage);
+    EXPECT_EQ(act("S", true), Action::SaveMap);
+    EXPECT_EQ(act("S"), Action::None);
+    EXPECT_EQ(act("Tab"), Action::NextFile);
+    EXPECT_EQ(act("shift+Tab"), Action::PreviousFile);
+    for (const char* key : {"C", "U", "W", "D", "G", "O", "H", "I", "+", "-", "Left"}) EXPECT_NE(act(key), Action::None) << key;
+    EXPECT_NE(helpText(false).find("G "), std::string::npos);
+    EXPECT_NE(helpText(true).find("Ctrl-S"), std::string::npos);
+}
+
+TEST(Script, ParsesCommands) {
+    const auto s = parseScript("# a comment\n\nzoom 2 at 400 300\nzoom 0.5\npan 10 -4\nkey shift+E\nwheel -2 at 5 6\n"
+                               "drag 1 2 3 4\nscreenshot /tmp/a.png\nwait 3\ninspect 7 8\nquit\n");
+    ASSERT_EQ(s.size(), 10u);
+    EXPECT_EQ(s[0].name, "zoom");
+    EXPECT_EQ(s[0].numbers, (std::vector<double>{2, 400, 300}));
+    EXPECT_EQ(s[0].line, 3);
+    EXPECT_EQ(s[1].numbers.size(), 1u);
+    EXPECT_EQ(s[3].text, "shift+E");
+    EXPECT_EQ(s[4].numbers, (std::vector<double>{-2, 5, 6}));
+    EXPECT_EQ(s[6].text, "/tmp/a.png");
+}
+
+TEST(Script, RejectsBadLinesWithTheLineNumber) {
+    for (const char* bad : {"zoom", "zoom -1", "pan 1", "pan 1 x", "key Hyper+Q", "fly 1 2", "screenshot", "wait -3"}) {
+        try {
+            parseScript(std::string("wait 1\n") + bad + "\n");
+            ADD_FAILURE() << bad;
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+            EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
+        }
+    }
+}
+
+}  // namespace
+}  // namespace conus::viewer

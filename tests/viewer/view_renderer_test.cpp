@@ -1,0 +1,183 @@
+// The viewer's GPU drawing on the headless context (EGL or OSMesa): what --screenshot renders.
+#include "conus/renderers/view_renderer.h"
+
+#include <gtest/gtest.h>
+
+#include "conus/codec/decode.h"
+#include "conus/codec/encode.h"
+#include "viewer_test_util.h"
+
+namespace conus::viewer {
+namespace {
+
+using gl::ViewMode;
+using gl::ViewOptions;
+
+struct Fixture {
+    format::ConusFile file = test::conusFile();
+    codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
+    gl::ViewRenderer renderer{test::context()};
+    Fixture() { renderer.setImage(file); }
+};
+
+Fixture& fixture() {
+    static Fixture* f = new Fixture;
+    return *f;
+}
+
+ViewOptions linear(ViewMode mode = ViewMode::Reconstructed) {
+    ViewOptions o;
+    o.mode = mode;
+    o.gamma = 1.0;
+    return o;
+}
+
+float channelDiff(const format::Image& a, const format::Image& b, int x, int y, int c) {
+    return std::abs(a.at(x, y, c) - b.at(x, y, c));
+}
+
+double psnrRgb(const format::Image& a, const format::Image& b) {
+    double se = 0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x)
+            for (int c = 0; c < 3; ++c) se += std::pow(double(a.at(x, y, c)) - b.at(x, y, c), 2);
+    const double mse = se / (3.0 * a.width * a.height);
+    return 10 * std::log10(1.0 / std::max(mse, 1e-20));
+}
+
+TEST(ViewRenderer, ReconstructedMatchesTheCpuDecoder) {
+    Fixture& f = fixture();
+    const codec::View view{0.1, 0.15, 0.9, 0.8};
+    const format::Image gpu = f.renderer.renderToImage(view, 256, 208, linear());
+    codec::DecodeOptions options;
+    options.view = view;
+    options.width = 256;
+    options.height = 208;
+    const format::Image cpu = codec::decodeImage(f.file.image, f.map, options);
+    EXPECT_GT(psnrRgb(gpu, cpu), 50.0);
+    // Zoomed far in: still decoded from the CoNUS data (a zoom on the focus).
+    const codec::View close{0.6, 0.5, 0.7, 0.6};
+    options.view = close;
+    EXPECT_GT(psnrRgb(f.renderer.renderToImage(close, 256, 208, linear()), codec::decodeImage(f.file.image, f.map, options)), 50.0);
+}
+
+TEST(ViewRenderer, RawShowsTheCoNUSImageItself) {
+    Fixture& f = fixture();
+    const format::Image raw = f.renderer.renderToImage({}, test::kConusWidth, test::kConusHeight, linear(ViewMode::Raw));
+    for (int y = 0; y < raw.height; y += 7)
+        for (int x = 0; x < raw.width; x += 5)
+            for (int c = 0; c < 3; ++c) ASSERT_LT(channelDiff(raw, f.file.image, x, y, c), 1e-4) << x << "," << y;
+}
+
+TEST(ViewRenderer, UniformImageHasTheSamePixelCountAndLooksLikeTheSource) {
+    Fixture& f = fixture();
+    const format::Image& uniform = f.renderer.uniformImage();
+    EXPECT_EQ(uniform.width, test::kConusWidth);
+    EXPECT_EQ(uniform.height, test::kConusHeight);
+    const format::Image reference = codec::areaDownsample(test::sourceImage(), test::kConusWidth, test::kConusHeight);
+    EXPECT_GT(psnrRgb(uniform, reference), 28.0);
+    // Uniform mode at the uniform image's own size shows it pixel for pixel.
+    const format::Image shown = f.renderer.renderToImage({}, uniform.width, uniform.height, linear(ViewMode::Uniform));
+    EXPECT_GT(psnrRgb(shown, uniform), 60.0);
+}
+
+TEST(ViewRenderer, WipeSplitsReconstructedAndUniform) {
+    Fixture& f = fixture();
+    ViewOptions wipe = linear(ViewMode::Wipe);
+    wipe.wipeX = 0.5;
+    const format::Image w = f.renderer.renderToImage({}, 200, 150, wipe);
+    const format::Image r = f.renderer.renderToImage({}, 200, 150, linear());
+    const format::Image u = f.renderer.renderToImage({}, 200, 150, linear(ViewMode::Uniform));
+    for (int y = 0; y < 150; y += 3) {
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(w.at(40, y, c), r.at(40, y, c));
+            EXPECT_EQ(w.at(160, y, c), u.at(160, y, c));
+            EXPECT_EQ(w.at(100, y, c), 1.0f);  // the split line
+        }
+    }
+}
+
+TEST(ViewRenderer, GridLinesAreWhereEquationOnePutsThem) {
+    Fixture& f = fixture();
+    const int width = 400, height = 300, every = 5;
+    const codec::View view{0.0, 0.0, 1.0, 1.0};
+    ViewOptions options = linear();
+    const format::Image plain = f.renderer.renderToImage(view, width, height, options);
+    options.grid = true;
+    options.gridEvery = every;
+    const format::Image grid = f.renderer.renderToImage(view, width, height, options);
+    const double lx = double(test::kConusWidth) / every, ly = double(test::kConusHeight) / every;
+    const auto distorted = [&](int x, int y) {
+        return f.map.distort({(x + 0.5) / width, (y + 0.5) / height});
+    };
+    int predicted = 0, brighter = 0, quiet = 0, unchanged = 0;
+    for (int y = 1; y + 2 < height; ++y)
+        for (int x = 1; x + 2 < width; ++x) {
+            const glm::dvec2 d = distorted(x, y), r = distorted(x + 1, y), b = distorted(x, y + 1);
+            const bool edge = std::floor(d.x * lx) != std::floor(r.x * lx) || std::floor(d.y * ly) != std::floor(b.y * ly);
+            // Far from any line (its neighbours are not on one either): the overlay leaves it alone.
+            const glm::dvec2 l = distorted(x - 1, y), a = distorted(x, y - 1), rr = distorted(x + 2, y), bb = distorted(x, y + 2);
+            const bool nearEdge = std::floor(l.x * lx) != std::floor(rr.x * lx) || std::floor(a.y * ly) != std::floor(bb.y * ly);
+            const float gain = grid.at(x, y, 1) - plain.at(x, y, 1);
+            if (edge) {
+                ++predicted;
+                brighter += gain > 0.2f;
+            } else if (!nearEdge) {
+                ++quiet;
+                unchanged += gain == 0.0f;
+            }
+        }
+    ASSERT_GT(predicted, 3000);
+    EXPECT_GT(brighter, 0.97 * predicted) << brighter << " of " << predicted;
+    EXPECT_GT(unchanged, 0.999 * quiet) << unchanged << " of " << quiet;
+}
+
+TEST(ViewRenderer, DensityIsBrightAtTheFocus) {
+    Fixture& f = fixture();
+    const format::Image d = f.renderer.renderToImage({}, 160, 120, linear(ViewMode::Density));
+    const auto brightness = [&](double u, double v) {
+        const int x = int(u * 160), y = int(v * 120);
+        return d.at(x, y, 0) + d.at(x, y, 1) + d.at(x, y, 2);
+    };
+    EXPECT_GT(brightness(test::kFocusU, test::kFocusV), 2.0f);
+    EXPECT_LT(brightness(0.05, 0.05), 1.0f);
+    EXPECT_GT(brightness(test::kFocusU, test::kFocusV), brightness(0.05, 0.05) + 1.0f);
+}
+
+TEST(ViewRenderer, OutlinesCircleTheFocus) {
+    Fixture& f = fixture();
+    ViewOptions o = linear();
+    o.outlines = true;
+    const int width = test::kSourceWidth, height = test::kSourceHeight;
+    const format::Image im = f.renderer.renderToImage({}, width, height, o);
+    // r = 0.1 of the width: 32 pixels right of the centre.
+    const int x = int(test::kFocusU * width + 0.1 * width), y = int(test::kFocusV * height);
+    EXPECT_FLOAT_EQ(im.at(x, y, 1), 1.0f);
+    EXPECT_FLOAT_EQ(im.at(x, y, 0), 0.2f);
+    EXPECT_NE(im.at(int(test::kFocusU * width), y, 1), 1.0f);
+}
+
+TEST(ViewRenderer, ExposureAndGamma) {
+    Fixture& f = fixture();
+    ViewOptions o = linear();
+    const format::Image base = f.renderer.renderToImage({}, 64, 48, o);
+    o.exposure = 1.0;
+    const format::Image brighter = f.renderer.renderToImage({}, 64, 48, o);
+    o.exposure = 0.0;
+    o.gamma = 2.0;
+    const format::Image gamma = f.renderer.renderToImage({}, 64, 48, o);
+    for (int x = 0; x < 64; x += 9) {
+        EXPECT_NEAR(brighter.at(x, 20, 0), 2 * base.at(x, 20, 0), 1e-5);
+        EXPECT_NEAR(gamma.at(x, 20, 0), std::sqrt(base.at(x, 20, 0)), 1e-5);
+    }
+}
+
+TEST(ViewRenderer, OutsideTheImageIsBackground) {
+    Fixture& f = fixture();
+    const format::Image im = f.renderer.renderToImage({-1.0, -1.0, 2.0, 2.0}, 90, 90, linear());
+    EXPECT_NEAR(im.at(5, 5, 0), 0.11f, 1e-6);
+    EXPECT_NE(im.at(45, 45, 0), 0.11f);
+}
+
+}  // namespace
+}  // namespace conus::viewer

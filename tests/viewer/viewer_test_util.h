@@ -1,0 +1,104 @@
+// Shared by the viewer tests: a small CoNUS file with a focus and one bright marker, the headless
+// context, and running conus-view (under xvfb-run for window tests).
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "conus/codec/encode.h"
+#include "conus/codec/foci.h"
+#include "conus/format/container.h"
+#include "conus/renderers/context.h"
+
+namespace conus::viewer::test {
+
+inline constexpr int kSourceWidth = 320, kSourceHeight = 240;
+inline constexpr int kConusWidth = 200, kConusHeight = 150;
+inline constexpr double kMarkerU = 0.3, kMarkerV = 0.4;   // a white disc on a dark picture
+inline constexpr double kFocusU = 0.65, kFocusV = 0.55;
+
+inline std::filesystem::path tempDir() {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("conus_viewer_tests_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+// Dark smooth colours, a white disc of radius 5 source pixels at the marker.
+inline format::Image sourceImage() {
+    format::Image im = format::makeImage(kSourceWidth, kSourceHeight, {"R", "G", "B"});
+    for (int y = 0; y < kSourceHeight; ++y)
+        for (int x = 0; x < kSourceWidth; ++x) {
+            const double u = (x + 0.5) / kSourceWidth, v = (y + 0.5) / kSourceHeight;
+            const bool marker = std::hypot((u - kMarkerU) * kSourceWidth, (v - kMarkerV) * kSourceHeight) < 5.0;
+            for (int c = 0; c < 3; ++c)
+                im.at(x, y, c) = marker ? 1.0f : float(0.2 + 0.15 * std::sin(6 * u + 2 * c) * std::cos(5 * v));
+        }
+    return im;
+}
+
+inline format::ConusFile conusFile() {
+    const codec::Focus focus{kFocusU, kFocusV, 0.1, 3.0};
+    codec::FociOptions fo;
+    fo.aspect = double(kSourceWidth) / kSourceHeight;
+    const codec::SamplingMap map = codec::buildFociMap(std::span<const codec::Focus>(&focus, 1), fo);
+    codec::EncodeOptions eo;
+    eo.width = kConusWidth;
+    eo.height = kConusHeight;
+    format::ConusFile file;
+    file.image = codec::encodeImage(sourceImage(), map, eo);
+    file.pixelType = format::PixelType::Float;
+    file.sourceWidth = kSourceWidth;
+    file.sourceHeight = kSourceHeight;
+    file.map = map.toGrid();
+    format::AnalyticMap analytic;
+    analytic.kind = "foci";
+    analytic.composition = "density";
+    analytic.foci.push_back({focus.u, focus.v, focus.r, focus.k});
+    file.analytic = analytic;
+    return file;
+}
+
+// Written once per process.
+inline const std::string& conusPath() {
+    static const std::string path = [] {
+        const std::string p = (tempDir() / "test.exr").string();
+        format::writeConusFile(p, conusFile());
+        return p;
+    }();
+    return path;
+}
+
+inline gl::Context& context() {
+    // Never destroyed: Mesa's exit handlers may run before static destructors.
+    static gl::Context* c = gl::Context::create().release();
+    return *c;
+}
+
+inline std::string viewerBinary() { return std::string(CONUS_BIN_DIR) + "/conus-view"; }
+
+inline bool haveXvfb() { return std::system("command -v xvfb-run > /dev/null 2>&1") == 0; }
+
+// Runs a shell command, its output into `log`; returns the exit status.
+inline int run(const std::string& command, std::string* log = nullptr) {
+    const std::string logPath = (tempDir() / "run.log").string();
+    const int status = std::system((command + " > " + logPath + " 2>&1").c_str());
+    if (log) {
+        std::ifstream in(logPath);
+        log->assign(std::istreambuf_iterator<char>(in), {});
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+inline void writeText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+}  // namespace conus::viewer::test

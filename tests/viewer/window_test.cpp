@@ -1,0 +1,175 @@
+// conus-view as a user runs it: --screenshot headless, and the real window under Xvfb driven by
+// --script (xvfb-run must be installed: package xvfb; these tests fail, not skip, without it, as
+// CI installs it).
+#include <OpenImageIO/imageio.h>
+
+#include <gtest/gtest.h>
+
+#include "conus/codec/decode.h"
+#include "conus/format/container.h"
+#include "view_state.h"
+#include "viewer_test_util.h"
+
+namespace conus::viewer {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The files every test of this process wrote go when the process ends.
+class RemoveTempDir : public ::testing::Environment {
+public:
+    void TearDown() override {
+        std::error_code ignored;
+        fs::remove_all(test::tempDir(), ignored);
+    }
+};
+[[maybe_unused]] ::testing::Environment* const kRemoveTempDir = ::testing::AddGlobalTestEnvironment(new RemoveTempDir);
+
+format::Image readPng(const fs::path& path) {
+    auto in = OIIO::ImageInput::open(path.string());
+    if (!in) return {};
+    const OIIO::ImageSpec spec = in->spec();
+    format::Image im = format::makeImage(spec.width, spec.height, std::vector<std::string>(spec.nchannels, "C"));
+    in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, im.pixels.data());
+    return im;
+}
+
+void writePng(const fs::path& path, const format::Image& im) {
+    auto out = OIIO::ImageOutput::create(path.string());
+    OIIO::ImageSpec spec(im.width, im.height, im.channelCount(), OIIO::TypeDesc::UINT8);
+    out->open(path.string(), spec);
+    out->write_image(OIIO::TypeDesc::FLOAT, im.pixels.data());
+    out->close();
+}
+
+// Centroid and count of the pixels bright in every channel (the white marker).
+glm::dvec3 marker(const format::Image& im) {
+    glm::dvec3 sum{0.0};
+    for (int y = 0; y < im.height; ++y)
+        for (int x = 0; x < im.width; ++x)
+            if (im.at(x, y, 0) > 0.85f && im.at(x, y, 1) > 0.85f && im.at(x, y, 2) > 0.85f) sum += glm::dvec3(x + 0.5, y + 0.5, 1);
+    return sum.z > 0 ? glm::dvec3(sum.x / sum.z, sum.y / sum.z, sum.z) : sum;
+}
+
+std::string xvfb(const std::string& args) {
+    return "xvfb-run -a -s '-screen 0 1024x768x24' " + test::viewerBinary() + " " + args;
+}
+
+TEST(ConusView, ScreenshotIsTheDecodedFrameWithoutADisplay) {
+    const fs::path out = test::tempDir() / "shot.png";
+    std::string log;
+    ASSERT_EQ(test::run("env -u DISPLAY " + test::viewerBinary() + " " + test::conusPath() + " --screenshot " + out.string() +
+                            " --view 0.1,0.2,0.9,0.8 --size 240x180 --gamma 1", &log), 0) << log;
+    const format::Image shot = readPng(out);
+    ASSERT_EQ(shot.width, 240);
+    const format::ConusFile file = format::readConusFile(test::conusPath());
+    codec::DecodeOptions options;
+    options.view = {0.1, 0.2, 0.9, 0.8};
+    options.width = 240;
+    options.height = 180;
+    const format::Image cpu = codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
+    // EXR stores channels sorted by name (B,G,R); the PNG is R,G,B.
+    const int channel[3] = {cpu.channelIndex("R"), cpu.channelIndex("G"), cpu.channelIndex("B")};
+    double worst = 0;
+    for (int y = 0; y < 180; ++y)
+        for (int x = 0; x < 240; ++x)
+            for (int c = 0; c < 3; ++c)
+                worst = std::max(worst, double(std::abs(shot.at(x, y, c) - std::clamp(cpu.at(x, y, channel[c]), 0.0f, 1.0f))));
+    EXPECT_LT(worst, 3.0 / 255) << "8-bit rounding plus float differences";
+}
+
+TEST(ConusView, ScreenshotModesAndGrid) {
+    const fs::path dir = test::tempDir();
+    for (const char* mode : {"raw", "uniform", "wipe", "density"}) {
+        const fs::path out = dir / (std::string(mode) + ".png");
+        std::string log;
+        EXPECT_EQ(test::run(test::viewerBinary() + " " + test::conusPath() + " --screenshot " + out.string() + " --mode " +
+                                mode + " --grid --outlines", &log), 0) << log;
+        EXPECT_EQ(readPng(out).width, test::kSourceWidth) << mode;
+    }
+}
+
+TEST(ConusView, ScreenshotOfAnInvalidFileFailsWithAReason) {
+    const fs::path bad = test::tempDir() / "not_conus.exr";
+    test::writeText(bad, "not an exr");
+    std::string log;
+    EXPECT_EQ(test::run(test::viewerBinary() + " " + bad.string() + " --screenshot " + (test::tempDir() / "x.png").string(), &log), 1);
+    EXPECT_NE(log.find("not_conus.exr"), std::string::npos) << log;
+    EXPECT_EQ(test::run(test::viewerBinary() + " --mode sideways " + test::conusPath(), &log), 2) << log;
+}
+
+TEST(ConusView, WindowZoomKeepsTheFeatureUnderTheCursor) {
+    ASSERT_TRUE(test::haveXvfb()) << "install xvfb (scripts/packages.txt)";
+    const fs::path dir = test::tempDir();
+    // Where the marker lands in a 400x300 window fitted to the 320x240 image.
+    const ViewState state(400, 300, test::kSourceWidth, test::kSourceHeight);
+    const glm::dvec2 at = state.imageToWindow({test::kMarkerU, test::kMarkerV});
+    test::writeText(dir / "zoom.txt", "screenshot " + (dir / "before.png").string() + "\nzoom 3 at " + std::to_string(at.x) +
+                                          " " + std::to_string(at.y) + "\nscreenshot " + (dir / "after.png").string() +
+                                          "\nkey G\nkey D\nscreenshot " + (dir / "grid.png").string() +
+                                          "\ninspect " + std::to_string(at.x) + " " + std::to_string(at.y) + "\n");
+    std::string log;
+    ASSERT_EQ(test::run(xvfb(test::conusPath() + " --window 400x300 --script " + (dir / "zoom.txt").string()), &log), 0) << log;
+    const format::Image before = readPng(dir / "before.png"), after = readPng(dir / "after.png"), grid = readPng(dir / "grid.png");
+    ASSERT_EQ(before.width, 400);
+    ASSERT_EQ(after.height, 300);
+    const glm::dvec3 a = marker(before), b = marker(after);
+    ASSERT_GT(a.z, 10);
+    EXPECT_NEAR(a.x, at.x, 1.5);
+    EXPECT_NEAR(a.y, at.y, 1.5);
+    EXPECT_NEAR(b.x, at.x, 1.5) << "the marker drifted away from the cursor";
+    EXPECT_NEAR(b.y, at.y, 1.5);
+    EXPECT_GT(b.z, 6 * a.z) << "3x zoom: about 9x the area";
+    EXPECT_EQ(marker(grid).z, 0) << "density mode shows no picture";
+    // The inspector line for the marker: the white disc, undistorted (u,v) at the marker.
+    EXPECT_NE(log.find("u,v=(0.3000,0.4000)"), std::string::npos) << log;
+    EXPECT_NE(log.find("R=0.99"), std::string::npos) << log;
+}
+
+TEST(ConusView, WindowShowsAnInvalidFileAsAnErrorWithoutCrashing) {
+    ASSERT_TRUE(test::haveXvfb());
+    const fs::path dir = test::tempDir();
+    test::writeText(dir / "broken.exr", "garbage");
+    test::writeText(dir / "bad.txt", "screenshot " + (dir / "bad.png").string() + "\nkey Tab\nscreenshot " +
+                                         (dir / "good.png").string() + "\nkey ctrl+R\nkey Tab\ninspect 10 10\n");
+    std::string log;
+    EXPECT_EQ(test::run(xvfb((dir / "broken.exr").string() + " " + test::conusPath() + " --window 320x240 --script " +
+                             (dir / "bad.txt").string()), &log), 1) << log;
+    EXPECT_NE(log.find("broken.exr"), std::string::npos) << log;
+    const format::Image bad = readPng(dir / "bad.png"), good = readPng(dir / "good.png");
+    ASSERT_EQ(bad.width, 320);
+    EXPECT_GT(bad.at(160, 120, 0), 0.3f);  // dark red
+    EXPECT_LT(bad.at(160, 120, 1), 0.1f);
+    ASSERT_EQ(good.width, 320);
+    EXPECT_GT(marker(good).z, 10) << "the second file is shown";
+    EXPECT_NE(log.find("error:"), std::string::npos) << log;
+}
+
+TEST(ConusView, EditorPaintsSavesAndEncodes) {
+    ASSERT_TRUE(test::haveXvfb());
+    const fs::path dir = test::tempDir();
+    writePng(dir / "photo.png", test::sourceImage());
+    // The window fits the 320x240 image exactly: window pixel = source pixel.
+    test::writeText(dir / "edit.txt", "drag 150 120 170 120\nwait 40\nkey S\nkey ctrl+S\nscreenshot " +
+                                          (dir / "edit.png").string() + "\n");
+    std::string log;
+    ASSERT_EQ(test::run(xvfb("--edit " + (dir / "photo.png").string() + " -o " + (dir / "painted").string() +
+                             " --size 160x120 --window 320x240 --script " + (dir / "edit.txt").string()), &log), 0) << log;
+    const format::ConusFile map = format::readConusFile((dir / "painted.map.exr").string());
+    const codec::SamplingMap sm = codec::SamplingMap::fromGrid(map.map);
+    EXPECT_GT(sm.density({0.5, 0.5}), 1.2) << "the brush magnified the centre";
+    const format::ConusFile encoded = format::readConusFile((dir / "painted.conus.exr").string());
+    EXPECT_EQ(encoded.image.width, 160);
+    EXPECT_EQ(encoded.sourceWidth, test::kSourceWidth);
+    EXPECT_EQ(readPng(dir / "edit.png").width, 320);
+}
+
+TEST(ConusView, BenchmarkPrintsFramesPerSecond) {
+    ASSERT_TRUE(test::haveXvfb());
+    std::string log;
+    ASSERT_EQ(test::run(xvfb(test::conusPath() + " --window 320x240 --benchmark-frames 5"), &log), 0) << log;
+    EXPECT_NE(log.find("frames/s"), std::string::npos) << log;
+}
+
+}  // namespace
+}  // namespace conus::viewer

@@ -1,0 +1,120 @@
+#include "actions.h"
+
+#include <algorithm>
+#include <cctype>
+#include <vector>
+
+namespace conus::viewer {
+namespace {
+
+struct Binding {
+    const char* key;
+    bool shift, ctrl;
+    Action action;
+    const char* help;  // empty: not listed (an alias of the line above)
+};
+
+// Shared by the viewer and the editor; the editor's own table is searched first.
+const std::vector<Binding> kViewBindings = {
+    {"H", false, false, Action::Help, "H          this help"},
+    {"F", false, false, Action::Fit, "F          fit the image to the window"},
+    {"1", false, false, Action::SourceResolution, "1          source resolution (1 source pixel = 1 window pixel)"},
+    {"+", false, false, Action::ZoomIn, "+ / -      zoom in / out about the window centre (wheel: about the cursor)"},
+    {"=", false, false, Action::ZoomIn, ""},
+    {"-", false, false, Action::ZoomOut, ""},
+    {"Left", false, false, Action::PanLeft, "arrows     pan (drag with the left button too)"},
+    {"Right", false, false, Action::PanRight, ""},
+    {"Up", false, false, Action::PanUp, ""},
+    {"Down", false, false, Action::PanDown, ""},
+    {"C", false, false, Action::ModeReconstructed, "C          reconstructed frame (decoded from the CoNUS data)"},
+    {"R", false, false, Action::ModeRaw, "R          raw CoNUS image, stretched"},
+    {"U", false, false, Action::ModeUniform, "U          uniform image of the same pixel count"},
+    {"W", false, false, Action::ModeWipe, "W          wipe: CoNUS left, uniform right (Shift-drag moves the split)"},
+    {"D", false, false, Action::ModeDensity, "D          sampling density heat map (det J)"},
+    {"G", false, false, Action::ToggleGrid, "G          CoNUS pixel grid overlay"},
+    {"O", false, false, Action::ToggleOutlines, "O          focus outlines (r and 2r)"},
+    {"E", true, false, Action::ExposureDown, "E / Shift-E exposure +/- 0.5 stop; 0 resets"},
+    {"0", false, false, Action::ResetExposure, ""},
+    {"L", false, false, Action::ToggleGamma, "L          linear output (gamma 1) / display gamma 2.2"},
+    {"Tab", false, false, Action::NextFile, "Tab, PgDn  next file; Shift-Tab, PgUp previous"},
+    {"PageDown", false, false, Action::NextFile, ""},
+    {"Tab", true, false, Action::PreviousFile, ""},
+    {"PageUp", false, false, Action::PreviousFile, ""},
+    {"R", false, true, Action::Reload, "Ctrl-R, F5 reload the file from disk"},
+    {"F5", false, false, Action::Reload, ""},
+    {"I", false, false, Action::Inspect, "I          print the pixel under the cursor (also shown in the title)"},
+    {"Q", false, false, Action::Quit, "Q, Esc     quit"},
+    {"Escape", false, false, Action::Quit, ""},
+};
+
+const std::vector<Binding> kExposureUp = {{"E", false, false, Action::ExposureUp, ""}};
+
+const std::vector<Binding> kEditBindings = {
+    {"S", false, false, Action::SaveMap, "S          save the sampling map (<out>.map.exr)"},
+    {"S", false, true, Action::EncodeImage, "Ctrl-S, E  encode the image through the map (<out>.conus.exr)"},
+    {"E", false, false, Action::EncodeImage, ""},
+    {"[", false, false, Action::StrengthDown, "[ / ]      brush strength down / up; Shift-wheel: brush radius"},
+    {"]", false, false, Action::StrengthUp, ""},
+    {"X", false, false, Action::ResetMap, "X          start again from the identity map"},
+};
+
+const Binding* find(const std::vector<Binding>& table, const KeyChord& chord) {
+    for (const auto& b : table)
+        if (chord.key == b.key && chord.shift == b.shift && chord.ctrl == b.ctrl) return &b;
+    return nullptr;
+}
+
+std::string lower(std::string s) {
+    std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+    return s;
+}
+
+}  // namespace
+
+std::optional<KeyChord> parseChord(const std::string& text) {
+    KeyChord chord;
+    std::string rest = text;
+    for (;;) {
+        const std::size_t plus = rest.find('+');
+        if (plus == std::string::npos || plus + 1 >= rest.size()) break;  // "+" alone is the key
+        const std::string modifier = lower(rest.substr(0, plus));
+        if (modifier == "shift") chord.shift = true;
+        else if (modifier == "ctrl" || modifier == "control") chord.ctrl = true;
+        else return std::nullopt;
+        rest = rest.substr(plus + 1);
+    }
+    static const char* kNamed[] = {"Tab", "F5", "Left", "Right", "Up", "Down", "PageUp", "PageDown", "Escape"};
+    for (const char* name : kNamed)
+        if (lower(rest) == lower(name)) {
+            chord.key = name;
+            return chord;
+        }
+    if (rest.size() != 1) return std::nullopt;
+    const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(rest[0])));
+    if (!std::isalnum(static_cast<unsigned char>(c)) && std::string("+-=[]").find(c) == std::string::npos)
+        return std::nullopt;
+    chord.key = std::string(1, c);
+    return chord;
+}
+
+Action actionFor(const KeyChord& chord, bool editing) {
+    if (editing)
+        if (const Binding* b = find(kEditBindings, chord)) return b->action;
+    if (const Binding* b = find(kViewBindings, chord)) return b->action;
+    if (const Binding* b = find(kExposureUp, chord)) return b->action;
+    return Action::None;
+}
+
+std::string helpText(bool editing) {
+    std::string text = editing ? "conus-view --edit: paint with the left button (mass-spring brush, paper Fig. 8)\n"
+                               : "conus-view keys:\n";
+    const auto add = [&](const std::vector<Binding>& table) {
+        for (const auto& b : table)
+            if (*b.help) text += std::string("  ") + b.help + "\n";
+    };
+    if (editing) add(kEditBindings);
+    add(kViewBindings);
+    return text;
+}
+
+}  // namespace conus::viewer

@@ -1,0 +1,34 @@
+#include "document.h"
+
+#include <exception>
+
+namespace conus::viewer {
+
+int Document::sourceWidth() const {
+    if (!file) return 1;
+    return file->sourceWidth > 0 ? file->sourceWidth : file->image.width;
+}
+
+int Document::sourceHeight() const {
+    if (!file) return 1;
+    return file->sourceHeight > 0 ? file->sourceHeight : file->image.height;
+}
+
+Document loadDocument(const std::string& path) {
+    Document doc;
+    doc.path = path;
+    try {
+        format::ConusFile file = format::readConusFile(path);
+        doc.map.emplace(codec::SamplingMap::fromGrid(file.map));
+        doc.file.emplace(std::move(file));
+    } catch (const std::exception& e) {
+        // Anything from the reader (OpenEXR's own exceptions are translated there) or the map.
+        doc.file.reset();
+        doc.map.reset();
+        doc.error = e.what();
+        if (doc.error.empty()) doc.error = "unknown error";
+    }
+    return doc;
+}
+
+}  // namespace conus::viewer

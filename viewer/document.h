@@ -1,0 +1,27 @@
+// One file open in conus-view: the CoNUS file and its map, or the reason it could not be opened.
+// Loading never throws: a file that is not a valid CoNUS file becomes a Document with an error,
+// which the window shows (title, stderr) instead of crashing.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "conus/codec/sampling_map.h"
+#include "conus/format/container.h"
+
+namespace conus::viewer {
+
+struct Document {
+    std::string path;
+    std::optional<format::ConusFile> file;
+    std::optional<codec::SamplingMap> map;
+    std::string error;  // empty when loaded
+    bool ok() const { return file.has_value() && map.has_value(); }
+    // Source size (the conventional frame), falling back to the CoNUS image's.
+    int sourceWidth() const;
+    int sourceHeight() const;
+};
+
+Document loadDocument(const std::string& path);
+
+}  // namespace conus::viewer

@@ -1,0 +1,77 @@
+#include "editor.h"
+
+#include <algorithm>
+
+#include "conus/codec/encode.h"
+
+namespace conus::viewer {
+
+MapEditor::MapEditor(format::Image source, int gridColumns, int gridRows)
+    : m_source(std::move(source)), m_columns(gridColumns), m_rows(gridRows), m_springs(gridColumns, gridRows) {}
+
+void MapEditor::scaleRadius(double factor) { m_brush.radius = std::clamp(m_brush.radius * factor, 0.01, 1.0); }
+void MapEditor::scaleStrength(double factor) { m_brush.strength = std::clamp(m_brush.strength * factor, 0.02, 20.0); }
+
+void MapEditor::addStroke(glm::dvec2 uv) {
+    codec::Stroke stroke;
+    stroke.u = std::clamp(uv.x, 0.0, 1.0);
+    stroke.v = std::clamp(uv.y, 0.0, 1.0);
+    stroke.radius = m_brush.radius;
+    stroke.strength = m_brush.strength;
+    m_springs.addStroke(stroke);
+    m_last = uv;
+    ++m_strokes;
+}
+
+void MapEditor::press(glm::dvec2 uv) {
+    m_painting = true;
+    addStroke(uv);
+}
+
+void MapEditor::moveTo(glm::dvec2 uv) {
+    // Strokes persist once painted, so spacing them by a fraction of the radius keeps a drag's
+    // strength independent of how often the mouse reports.
+    if (m_painting && glm::length(uv - m_last) >= m_brush.radius / 3) addStroke(uv);
+}
+
+void MapEditor::release() { m_painting = false; }
+
+void MapEditor::step(int n) { m_springs.step(n); }
+
+void MapEditor::reset() {
+    m_springs = codec::SpringSystem(m_columns, m_rows);
+    m_strokes = 0;
+    m_painting = false;
+}
+
+format::ConusFile MapEditor::mapFile() const {
+    const codec::SamplingMap map = this->map();
+    format::ConusFile file;
+    file.image = format::makeImage(map.columns(), map.rows(), {"Y"});
+    for (int j = 0; j < map.rows(); ++j)
+        for (int i = 0; i < map.columns(); ++i)
+            file.image.at(i, j) = float(map.density({double(i) / (map.columns() - 1), double(j) / (map.rows() - 1)}));
+    file.pixelType = format::PixelType::Float;
+    file.sourceWidth = map.columns();
+    file.sourceHeight = map.rows();
+    file.dataKind = format::DataKind::Image;
+    file.map = map.toGrid();
+    return file;
+}
+
+format::ConusFile MapEditor::encode(int width, int height) const {
+    const codec::SamplingMap map = this->map();
+    codec::EncodeOptions options;
+    options.width = width;
+    options.height = height;
+    format::ConusFile file;
+    file.image = codec::encodeImage(m_source, map, options);
+    file.pixelType = format::PixelType::Half;
+    file.sourceWidth = m_source.width;
+    file.sourceHeight = m_source.height;
+    file.dataKind = format::DataKind::Image;
+    file.map = map.toGrid();
+    return file;
+}
+
+}  // namespace conus::viewer

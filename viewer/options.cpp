@@ -1,0 +1,98 @@
+#include "options.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "conus/format/error.h"
+
+namespace conus::viewer {
+namespace {
+
+constexpr const char* kDescription =
+    "conus-view: a small viewer for CoNUS files (coherent non-uniform sampling images).\n"
+    "The frame is reconstructed from the CoNUS data on the GPU at every zoom level.\n"
+    "Press H in the window for the keys. --edit IMAGE opens the mass-spring map editor.";
+
+std::pair<int, int> parseSize(const std::string& text, const char* what) {
+    int w = 0, h = 0;
+    char x = 0;
+    std::istringstream in(text);
+    if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || !in.eof() || w < 1 || h < 1 || w > 16384 || h > 16384)
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + " \"" + text + "\" is not WxH (1 .. 16384)");
+    return {w, h};
+}
+
+codec::View parseView(const std::string& text) {
+    codec::View v;
+    char c1 = 0, c2 = 0, c3 = 0;
+    std::istringstream in(text);
+    if (!(in >> v.u0 >> c1 >> v.v0 >> c2 >> v.u1 >> c3 >> v.v1) || c1 != ',' || c2 != ',' || c3 != ',' || !in.eof() ||
+        v.u0 == v.u1 || v.v0 == v.v1)
+        throw Error(ErrorCode::InvalidArgument, "--view \"" + text + "\" is not u0,v0,u1,v1 with u0 != u1, v0 != v1");
+    return v;
+}
+
+}  // namespace
+
+gl::ViewMode parseMode(const std::string& name) {
+    for (gl::ViewMode m : {gl::ViewMode::Reconstructed, gl::ViewMode::Raw, gl::ViewMode::Uniform, gl::ViewMode::Wipe,
+                           gl::ViewMode::Density})
+        if (name == modeName(m)) return m;
+    throw Error(ErrorCode::InvalidArgument, "--mode \"" + name + "\" is not reconstructed, raw, uniform, wipe or density");
+}
+
+const char* modeName(gl::ViewMode mode) {
+    switch (mode) {
+    case gl::ViewMode::Reconstructed: return "reconstructed";
+    case gl::ViewMode::Raw: return "raw";
+    case gl::ViewMode::Uniform: return "uniform";
+    case gl::ViewMode::Wipe: return "wipe";
+    case gl::ViewMode::Density: return "density";
+    }
+    return "?";
+}
+
+std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
+    Options o;
+    std::string view, size, window = "1280x800", mode = "reconstructed";
+    CLI::App app(kDescription, "conus-view");
+    app.add_option("files", o.files, "CoNUS files (.exr); Tab / PageDown switch between them");
+    app.add_option("--edit", o.edit, "paint a sampling map over IMAGE (PNG, JPEG, EXR, ...)");
+    app.add_option("-o,--output", o.output, "--edit: base path for S (<base>.map.exr) and Ctrl-S (<base>.conus.exr)");
+    app.add_option("--screenshot", o.screenshot, "render the first file offscreen (no display needed) to a PNG and exit");
+    app.add_option("--view", view, "undistorted rectangle u0,v0,u1,v1 to show");
+    app.add_option("--size", size, "WxH of --screenshot, or of the CoNUS image --edit encodes");
+    app.add_option("--window", window, "window size WxH")->capture_default_str();
+    app.add_option("--mode", mode, "reconstructed|raw|uniform|wipe|density")->capture_default_str();
+    app.add_flag("--grid", o.display.grid, "draw the CoNUS pixel grid");
+    app.add_option("--grid-every", o.display.gridEvery, "draw every n-th grid line (0: automatic)");
+    app.add_flag("--outlines", o.display.outlines, "draw the focus outlines");
+    app.add_option("--exposure", o.display.exposure, "exposure in stops");
+    app.add_option("--gamma", o.display.gamma, "display gamma (1: linear)")->capture_default_str();
+    app.add_option("--script", o.script, "run window commands from a file, then exit (see viewer/script.h)");
+    app.add_option("--benchmark-frames", o.benchmarkFrames, "draw N frames, print frames/s and exit");
+    app.add_option("--backend", o.backend, "--screenshot GL backend: auto, egl, osmesa")->capture_default_str();
+    try {
+        app.parse(argc, argv);
+        if (!view.empty()) o.view = parseView(view);
+        if (!size.empty()) std::tie(o.width, o.height) = parseSize(size, "--size");
+        std::tie(o.windowWidth, o.windowHeight) = parseSize(window, "--window");
+        o.display.mode = parseMode(mode);
+        if (o.files.empty() && o.edit.empty()) throw Error(ErrorCode::InvalidArgument, "no file given (conus-view FILE.exr or --edit IMAGE)");
+        if (!o.edit.empty() && !o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--edit takes no CoNUS files");
+        if (!o.screenshot.empty() && o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--screenshot needs a CoNUS file");
+        if (o.benchmarkFrames < 0) throw Error(ErrorCode::InvalidArgument, "--benchmark-frames must be >= 0");
+    } catch (const CLI::ParseError& e) {
+        *exitCode = app.exit(e);
+        return std::nullopt;
+    } catch (const Error& e) {
+        std::fprintf(stderr, "conus-view: %s\n", e.what());
+        *exitCode = 2;
+        return std::nullopt;
+    }
+    return o;
+}
+
+}  // namespace conus::viewer

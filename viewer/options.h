@@ -1,0 +1,34 @@
+// conus-view's command line (CLI11): what to open and how, parsed into plain values.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "conus/codec/decode.h"
+#include "conus/renderers/view_renderer.h"
+
+namespace conus::viewer {
+
+struct Options {
+    std::vector<std::string> files;      // CoNUS files to view
+    std::string edit;                    // --edit IMAGE: the map editor on this image
+    std::string output;                  // --edit: base path of the saved map / CoNUS file
+    std::string screenshot;              // --screenshot OUT.png: render offscreen and exit
+    std::optional<codec::View> view;     // --view u0,v0,u1,v1
+    int width = 0, height = 0;           // --size: screenshot size, or the editor's encode size
+    int windowWidth = 1280, windowHeight = 800;
+    gl::ViewOptions display;             // --mode, --grid, --outlines, --exposure, --gamma
+    std::string script;                  // --script CMDS.txt
+    int benchmarkFrames = 0;             // --benchmark-frames N
+    std::string backend = "auto";        // --backend for --screenshot (egl, osmesa)
+};
+
+// Parses argv. Returns nullopt after printing help (exit 0) or an error (exit 2, in *exitCode).
+std::optional<Options> parseOptions(int argc, char** argv, int* exitCode);
+
+// "reconstructed|raw|uniform|wipe|density" -> ViewMode; conus::Error(InvalidArgument) otherwise.
+gl::ViewMode parseMode(const std::string& name);
+const char* modeName(gl::ViewMode mode);
+
+}  // namespace conus::viewer

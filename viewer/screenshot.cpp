@@ -1,0 +1,47 @@
+#include "screenshot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "conus/renderers/context.h"
+#include "conus/renderers/view_renderer.h"
+#include "document.h"
+#include "image_io.h"
+
+namespace conus::viewer {
+
+constexpr int kDefaultMaxSide = 2048;
+
+int runScreenshot(const Options& options) {
+    const Document doc = loadDocument(options.files.front());
+    if (!doc.ok()) {
+        std::fprintf(stderr, "conus-view: %s: %s\n", doc.path.c_str(), doc.error.c_str());
+        return 1;
+    }
+    try {
+        const codec::View view = options.view.value_or(codec::View{});
+        int width = options.width, height = options.height;
+        if (width == 0) {
+            // The view at source resolution, shrunk to fit kDefaultMaxSide.
+            const double w = std::abs(view.u1 - view.u0) * doc.sourceWidth();
+            const double h = std::abs(view.v1 - view.v0) * doc.sourceHeight();
+            const double scale = std::min(1.0, kDefaultMaxSide / std::max(w, h));
+            width = std::max(1, static_cast<int>(std::lround(w * scale)));
+            height = std::max(1, static_cast<int>(std::lround(h * scale)));
+        }
+        auto context = gl::Context::create(gl::parseBackend(options.backend));
+        gl::ViewRenderer renderer(*context);
+        renderer.setImage(*doc.file);
+        const format::Image frame = renderer.renderToImage(view, width, height, options.display);
+        writeImage(options.screenshot, frame);
+        std::printf("wrote %s: %dx%d, %s view of %s (%s)\n", options.screenshot.c_str(), width, height,
+                    modeName(options.display.mode), doc.path.c_str(), context->renderer().c_str());
+        return 0;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "conus-view: %s\n", e.what());
+        return 1;
+    }
+}
+
+}  // namespace conus::viewer
