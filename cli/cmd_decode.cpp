@@ -17,7 +17,7 @@ namespace conus::cli {
 
 Command addDecodeCommand(CLI::App& root) {
     struct Options {
-        std::string input, output, viewText, sizeText, backend = "auto";
+        std::string input, output, viewText, sizeText, cameraText, backend = "auto";
     };
     auto options = std::make_shared<Options>();
     CLI::App* command = root.add_subcommand(
@@ -28,9 +28,23 @@ Command addDecodeCommand(CLI::App& root) {
                         "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image)");
     command->add_option("--size", options->sizeText,
                         "output size WxH (default: the view at the source's resolution)");
+    command->add_option("--camera", options->cameraText,
+                        "height fields: render a 3-D frame from x,y,z,lx,ly,lz,fovDeg (eye, look-at, vertical fov; "
+                        "world metres) instead of a 2-D view; 'viewer' is the ground map's own viewer");
     addBackendOption(*command, options->backend);
     return {command, [options] {
                 const format::ConusFile file = format::readConusFile(options->input);
+                if (!options->cameraText.empty()) {
+                    // A height field seen from a camera: undistort to a mesh and render it.
+                    const Size size = parseSize(options->sizeText.empty() ? "960x540" : options->sizeText);
+                    const format::Image frame = renderHeightFieldFrame(
+                        file, options->cameraText == "viewer" ? "" : options->cameraText, size.width, size.height,
+                        options->backend);
+                    writeImage(options->output, frame);
+                    std::printf("wrote %s: %dx%d frame of the height field\n", options->output.c_str(), frame.width,
+                                frame.height);
+                    return 0;
+                }
                 const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
                 codec::DecodeOptions decode;
                 if (!options->viewText.empty()) decode.view = parseView(options->viewText);

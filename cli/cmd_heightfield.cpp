@@ -20,6 +20,7 @@
 #include "conus/renderers/terrain.h"
 #include "dem_io.h"
 #include "image_io.h"
+#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -66,6 +67,42 @@ void printCamera(const gl::TerrainCamera& c) {
 }
 
 }  // namespace
+
+codec::GroundParams groundOf(const format::ConusFile& file, const std::string& name) {
+    if (file.dataKind != format::DataKind::HeightField || !file.analytic || file.analytic->kind != "ground")
+        throw Error(ErrorCode::InvalidArgument, name + " is not a CoNUS height field with ground-map parameters");
+    return codec::groundFromAnalytic(*file.analytic);
+}
+
+std::unique_ptr<gl::Context> terrainContext(const std::string& backendName) {
+    const gl::Backend backend = gl::parseBackend(backendName);
+    if (backend == gl::Backend::Cpu)
+        throw Error(ErrorCode::InvalidArgument, "terrain rendering needs GL: use --backend auto|egl|osmesa");
+    return gl::Context::create(backend);
+}
+
+gl::TerrainCamera terrainCamera(const format::ConusFile& file, const std::string& cameraText) {
+    gl::TerrainCamera camera = gl::viewerCamera(groundOf(file, "the file"), codec::heightAt(file, {0.5, 1.0}));
+    if (!cameraText.empty()) {
+        const gl::TerrainCamera given = parseCamera(cameraText);
+        camera.eye = given.eye;
+        camera.target = given.target;
+        camera.fovYDegrees = given.fovYDegrees;
+    }
+    return camera;
+}
+
+format::Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
+                                     int height, const std::string& backendName) {
+    const auto context = terrainContext(backendName);
+    const glm::dvec2 extent = codec::fieldExtent(groundOf(file, "the file"));
+    const gl::TerrainCamera camera = terrainCamera(file, cameraText);
+    Progress progress("undistort the height field and render " + std::to_string(width) + "x" + std::to_string(height));
+    format::Image frame = gl::renderTerrain(*context, codec::undistortHeightField(file, extent), camera, width, height);
+    progress.done();
+    printCamera(camera);
+    return frame;
+}
 
 Command addHeightFieldCommand(CLI::App& root) {
     struct Options {
@@ -151,24 +188,11 @@ Command addHeightFieldCommand(CLI::App& root) {
                     return 0;
                 }
                 const format::ConusFile file = format::readConusFile(o->input);
-                if (file.dataKind != format::DataKind::HeightField || !file.analytic || file.analytic->kind != "ground")
-                    throw Error(ErrorCode::InvalidArgument,
-                                o->input + " is not a CoNUS height field with ground-map parameters");
-                const codec::GroundParams ground = codec::groundFromAnalytic(*file.analytic);
-                const glm::dvec2 extent = codec::fieldExtent(ground);
                 const Size size = parseSize(o->frameSize);
-                gl::TerrainCamera camera = gl::viewerCamera(ground, codec::heightAt(file, {0.5, 1.0}));
-                if (!o->cameraText.empty()) {
-                    const gl::TerrainCamera given = parseCamera(o->cameraText);
-                    camera.eye = given.eye;
-                    camera.target = given.target;
-                    camera.fovYDegrees = given.fovYDegrees;
-                }
-                const gl::Backend backend = gl::parseBackend(o->backend);
-                if (backend == gl::Backend::Cpu)
-                    throw Error(ErrorCode::InvalidArgument, "terrain rendering needs GL: use --backend auto|egl|osmesa");
-                const auto context = gl::Context::create(backend);
-
+                const auto context = terrainContext(o->backend);
+                const codec::GroundParams ground = groundOf(file, o->input);
+                const glm::dvec2 extent = codec::fieldExtent(ground);
+                const gl::TerrainCamera camera = terrainCamera(file, o->cameraText);
                 Progress progress("undistort and render");
                 const format::Image frame =
                     gl::renderTerrain(*context, codec::undistortHeightField(file, extent), camera, size.width, size.height);
@@ -194,13 +218,8 @@ Command addHeightFieldCommand(CLI::App& root) {
                         codec::uniformHeightField(dem.heights, colour, file.image.width, file.image.height), extent),
                     camera, size.width, size.height);
                 comparing.done();
-                format::Image sideBySide = format::makeImage(3 * size.width, size.height, {"R", "G", "B"});
-                const format::Image* panels[] = {&full, &frame, &uniform};
-                for (int p = 0; p < 3; ++p)
-                    for (int y = 0; y < size.height; ++y)
-                        for (int x = 0; x < size.width; ++x)
-                            for (int c = 0; c < 3; ++c) sideBySide.at(p * size.width + x, y, c) = panels[p]->at(x, y, c);
-                writeImage(o->frame, sideBySide);
+                const format::Image panels[] = {full, frame, uniform};
+                writeImage(o->frame, sideBySide(panels));
                 std::printf("wrote %s: full resolution %dx%d | CoNUS %dx%d | uniform %dx%d (%s)\n", o->frame.c_str(),
                             dem.heights.width, dem.heights.height, file.image.width, file.image.height,
                             file.image.width, file.image.height, context->renderer().c_str());

@@ -5,6 +5,9 @@
 #pragma once
 
 #include <functional>
+#include <string>
+
+#include "conus/format/container.h"
 
 namespace CLI {
 class App;
@@ -25,5 +28,10 @@ Command addValidateCommand(CLI::App& root);
 Command addDemoCommand(CLI::App& root);
 Command addMapCommand(CLI::App& root);
 Command addHeightFieldCommand(CLI::App& root);
+
+// A frame of a CoNUS height field from a camera "x,y,z,lx,ly,lz,fovDeg" (empty: the ground map's
+// own viewer), rendered with GL: what `decode` does for height fields and `heightfield render` does.
+format::Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
+                                     int height, const std::string& backendName);
 
 }  // namespace conus::cli

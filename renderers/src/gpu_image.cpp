@@ -7,6 +7,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -50,13 +52,38 @@ void checkImage(const format::Image& image, const char* what) {
                                                     std::to_string(expected));
 }
 
-void checkTextureSize(const Context& context, int width, int height, const char* what, const char* role) {
+// The largest texture side the GPU paths use: the context's GL_MAX_TEXTURE_SIZE, or less where the
+// environment variable CONUS_GL_MAX_TEXTURE asks for less (for tests of the tiled encoder; clamped
+// to [kMinTextureLimit, GL_MAX_TEXTURE_SIZE]).
+constexpr int kMinTextureLimit = 64;
+constexpr const char* kTextureLimitVariable = "CONUS_GL_MAX_TEXTURE";
+
+int textureLimit(const Context& context) {
     const int limit = context.maxTextureSize();
+    const char* env = std::getenv(kTextureLimitVariable);
+    if (!env || !*env) return limit;
+    char* end = nullptr;
+    const long value = std::strtol(env, &end, 10);
+    if (end == env || *end != '\0' || value <= 0)
+        throw Error(ErrorCode::InvalidArgument, std::string(kTextureLimitVariable) + "=\"" + env +
+                                                    "\" is not a positive whole number of texels");
+    return static_cast<int>(std::clamp<long>(value, std::min(kMinTextureLimit, limit), limit));
+}
+
+std::string limitDescription(const Context& context, int limit) {
+    std::string text = "the texture limit " + std::to_string(limit) + " (GL_MAX_TEXTURE_SIZE " +
+                       std::to_string(context.maxTextureSize()) + " of " + context.renderer();
+    if (limit < context.maxTextureSize()) text += std::string(", lowered by ") + kTextureLimitVariable;
+    return text + ")";
+}
+
+void checkTextureSize(const Context& context, int width, int height, const char* what, const char* role) {
+    const int limit = textureLimit(context);
     if (width > limit || height > limit)
         throw Error(ErrorCode::LimitExceeded, std::string(what) + ": " + role + " " + std::to_string(width) + "x" +
-                                                  std::to_string(height) + " exceeds GL_MAX_TEXTURE_SIZE " +
-                                                  std::to_string(limit) + " of " + context.renderer() +
-                                                  " (tiling is not implemented; use the CPU path)");
+                                                  std::to_string(height) + " exceeds " +
+                                                  limitDescription(context, limit) + "; only the encoder's source is "
+                                                  "tiled: use the CPU path");
 }
 
 GLenum internalFormat(int channels) {
@@ -238,6 +265,131 @@ void buildPyramid(Context& context, const GladGLContext& gl, const Pyramid& pyra
     }
 }
 
+// Tiling, for sources (or their pyramids) over the texture limit: the source is cut into tiles,
+// and each tile is drawn from crops of every pyramid level around its core. The levels are the
+// full image's (built once, at the CPU reference's sizes), so a crop's texels are the full
+// pyramid's texels and a tiled pixel reads exactly what an untiled one would.
+//
+// A tap on level L lies within (kMaxTaps / 2) * 2 = 4 texels of the pixel's centre along each
+// footprint edge (the level is the first where the footprint is at most kMaxTaps long, the 1 x 1
+// top level aside, which is always whole), plus one texel for the bilinear filter: kTileMargin
+// texels of each level around the core, with rounding to spare.
+constexpr int kTileMargin = 6;
+
+struct TileLevel {
+    int x = 0, y = 0, width = 0, height = 0;  // the crop, in the full level's texels
+    int atlasX = 0, atlasY = 0;               // where it sits in its texture
+};
+
+struct Tile {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the core, in source texels
+    std::vector<TileLevel> levels;       // level 0 is its own texture; levels 1.. share an atlas
+    int atlasWidth = 1, atlasHeight = 1;
+    std::vector<GLuint> indices;  // the mesh triangles that may reach into the core
+};
+
+// The crops of every level around core [x0, x1) x [y0, y1) of a width x height source: level 1 at
+// the atlas's origin, levels 2.. stacked to its right.
+Tile planTile(const Pyramid& pyramid, int x0, int y0, int x1, int y1) {
+    Tile tile{x0, y0, x1, y1, {}, 1, 1, {}};
+    const double width = pyramid.rects[0][2], height = pyramid.rects[0][3];
+    int stackY = 0, stackWidth = 0;
+    for (std::size_t level = 0; level < pyramid.rects.size(); ++level) {
+        const int w = pyramid.rects[level][2], h = pyramid.rects[level][3];
+        TileLevel crop;
+        crop.x = std::max(0, static_cast<int>(std::floor(x0 * (w / width))) - kTileMargin);
+        crop.y = std::max(0, static_cast<int>(std::floor(y0 * (h / height))) - kTileMargin);
+        crop.width = std::min(w, static_cast<int>(std::ceil(x1 * (w / width))) + kTileMargin) - crop.x;
+        crop.height = std::min(h, static_cast<int>(std::ceil(y1 * (h / height))) + kTileMargin) - crop.y;
+        if (level >= 2) {
+            crop.atlasX = tile.levels[1].width;
+            crop.atlasY = stackY;
+            stackY += crop.height;
+            stackWidth = std::max(stackWidth, crop.width);
+        }
+        tile.levels.push_back(crop);
+    }
+    if (tile.levels.size() > 1) {
+        tile.atlasWidth = tile.levels[1].width + stackWidth;
+        tile.atlasHeight = std::max(tile.levels[1].height, stackY);
+    }
+    return tile;
+}
+
+// Splits [0, size) into `count` near-equal parts.
+std::vector<int> splitAxis(int size, int count) {
+    std::vector<int> cuts;
+    for (int i = 0; i <= count; ++i) cuts.push_back(static_cast<int>((static_cast<long long>(size) * i) / count));
+    return cuts;
+}
+
+// The tiles of the source: the largest near-square cores whose crops fit the limit.
+std::vector<Tile> planTiles(const Pyramid& pyramid, int limit) {
+    const int width = pyramid.rects[0][2], height = pyramid.rects[0][3];
+    for (int core = std::max(1, limit - 2 * kTileMargin - 2);; core = std::max(1, core - std::max(1, core / 16))) {
+        const std::vector<int> xs = splitAxis(width, (width + core - 1) / core);
+        const std::vector<int> ys = splitAxis(height, (height + core - 1) / core);
+        std::vector<Tile> tiles;
+        bool fits = true;
+        for (std::size_t j = 0; j + 1 < ys.size() && fits; ++j)
+            for (std::size_t i = 0; i + 1 < xs.size() && fits; ++i) {
+                tiles.push_back(planTile(pyramid, xs[i], ys[j], xs[i + 1], ys[j + 1]));
+                const Tile& t = tiles.back();
+                fits = t.levels[0].width <= limit && t.levels[0].height <= limit && t.atlasWidth <= limit &&
+                       t.atlasHeight <= limit;
+            }
+        if (fits) return tiles;
+        if (core == 1)
+            throw Error(ErrorCode::LimitExceeded, "encodeImageGpu: no tiling of the " + std::to_string(width) + "x" +
+                                                      std::to_string(height) + " source fits the texture limit " +
+                                                      std::to_string(limit));
+    }
+}
+
+// The tile's core in normalized source coordinates, open-ended at the source's edges (pixels whose
+// undistorted centre falls just outside [0, 1] belong to the edge tiles).
+std::array<float, 4> tileCore(const Tile& tile, int width, int height) {
+    constexpr float kFar = std::numeric_limits<float>::max();
+    return {tile.x0 == 0 ? -kFar : float(double(tile.x0) / width), tile.y0 == 0 ? -kFar : float(double(tile.y0) / height),
+            tile.x1 == width ? kFar : float(double(tile.x1) / width),
+            tile.y1 == height ? kFar : float(double(tile.y1) / height)};
+}
+
+// The mesh's triangles whose undistorted bounding box meets the tile's core (the shader discards
+// the pixels outside it): each pixel is drawn by exactly one tile, the one whose core holds its
+// interpolated undistorted centre.
+std::vector<GLuint> tileIndices(const Mesh& mesh, const std::array<float, 4>& core) {
+    std::vector<GLuint> out;
+    for (std::size_t k = 0; k + 2 < mesh.indices.size(); k += 3) {
+        float u0 = std::numeric_limits<float>::max(), v0 = u0, u1 = -u0, v1 = -u0;
+        for (int c = 0; c < 3; ++c) {
+            const float* vertex = &mesh.vertices[std::size_t(mesh.indices[k + c]) * 4];
+            u0 = std::min(u0, vertex[2]);
+            u1 = std::max(u1, vertex[2]);
+            v0 = std::min(v0, vertex[3]);
+            v1 = std::max(v1, vertex[3]);
+        }
+        constexpr float kSlack = 1e-5f;  // interpolation may stray a rounding error past the vertices
+        if (u1 + kSlack >= core[0] && u0 - kSlack <= core[2] && v1 + kSlack >= core[1] && v0 - kSlack <= core[3])
+            out.insert(out.end(), mesh.indices.begin() + k, mesh.indices.begin() + k + 3);
+    }
+    return out;
+}
+
+// Uploads the crop [x, x + width) x [y, y + height) of `pixels` (an image `rowLength` wide with
+// `count` channels) into the bound texture at (atlasX, atlasY).
+void uploadCrop(const GladGLContext& gl, const float* pixels, int rowLength, int count, const TileLevel& crop) {
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl.PixelStorei(GL_UNPACK_ROW_LENGTH, rowLength);
+    gl.PixelStorei(GL_UNPACK_SKIP_PIXELS, crop.x);
+    gl.PixelStorei(GL_UNPACK_SKIP_ROWS, crop.y);
+    gl.TexSubImage2D(GL_TEXTURE_2D, 0, crop.atlasX, crop.atlasY, crop.width, crop.height, pixelFormat(count), GL_FLOAT,
+                     pixels);
+    gl.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    gl.PixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
+    gl.PixelStorei(GL_UNPACK_SKIP_ROWS, 0);
+}
+
 }  // namespace
 
 format::Image encodeImageGpu(Context& context, const format::Image& source, const codec::SamplingMap& map,
@@ -245,8 +397,11 @@ format::Image encodeImageGpu(Context& context, const format::Image& source, cons
     constexpr const char* kWhat = "encodeImageGpu";
     checkImage(source, kWhat);
     format::Image out = format::makeImage(options.width, options.height, source.channels);
-    checkTextureSize(context, source.width, source.height, kWhat, "source");
     checkTextureSize(context, out.width, out.height, kWhat, "output");
+    const int limit = textureLimit(context);
+    const Pyramid pyramid = pyramidLayout(source.width, source.height);
+    const bool tiled = source.width > limit || source.height > limit || pyramid.atlasWidth > limit ||
+                       pyramid.atlasHeight > limit;
 
     GpuTimings t;
     Clock::time_point start = Clock::now();
@@ -270,19 +425,43 @@ format::Image encodeImageGpu(Context& context, const format::Image& source, cons
     Target target(gl, out.width, out.height, kWhat);
     checkGl(gl, kWhat);
 
-    const Pyramid pyramid = pyramidLayout(source.width, source.height);
-    if (pyramid.atlasWidth > context.maxTextureSize() || pyramid.atlasHeight > context.maxTextureSize())
-        throw Error(ErrorCode::LimitExceeded, std::string(kWhat) + ": the source pyramid (" +
-                                                  std::to_string(pyramid.atlasWidth) + "x" +
-                                                  std::to_string(pyramid.atlasHeight) +
-                                                  ") exceeds GL_MAX_TEXTURE_SIZE " +
-                                                  std::to_string(context.maxTextureSize()));
+    // Tiled: the plan, each tile's share of the mesh, and the pyramid's levels 1.. (built once on the
+    // CPU with the reference's own area filter; the GPU then reads crops of them per tile).
+    std::vector<Tile> tiles;
+    std::vector<format::Image> levels;
+    if (tiled) {
+        tiles = planTiles(pyramid, limit);
+        levels.reserve(pyramid.rects.size());
+        for (Tile& tile : tiles) tile.indices = tileIndices(mesh, tileCore(tile, source.width, source.height));
+        for (std::size_t level = 1; level < pyramid.rects.size(); ++level)
+            levels.push_back(codec::areaDownsample(level == 1 ? source : levels.back(), pyramid.rects[level][2],
+                                                   pyramid.rects[level][3], 0));
+    }
+
+    const auto setDrawState = [&](GLuint level0, GLuint atlas, const std::vector<std::array<int, 4>>& rects,
+                                  const std::array<float, 4>& core) {
+        gl.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer.id());
+        gl.Viewport(0, 0, out.width, out.height);
+        gl.ActiveTexture(GL_TEXTURE0);
+        gl.BindTexture(GL_TEXTURE_2D, level0);
+        gl.ActiveTexture(GL_TEXTURE1);
+        gl.BindTexture(GL_TEXTURE_2D, atlas);
+        gl.UseProgram(program);
+        gl.Uniform1i(gl.GetUniformLocation(program, "uLevel0"), 0);
+        gl.Uniform1i(gl.GetUniformLocation(program, "uPyramid"), 1);
+        gl.Uniform1i(gl.GetUniformLocation(program, "uLevels"), static_cast<GLint>(rects.size()));
+        gl.Uniform4iv(gl.GetUniformLocation(program, "uLevelRect"), static_cast<GLsizei>(rects.size()), rects[0].data());
+        gl.Uniform4f(gl.GetUniformLocation(program, "uCore"), core[0], core[1], core[2], core[3]);
+        gl.BindVertexArray(vertexArray.id());
+    };
+    constexpr float kFar = std::numeric_limits<float>::max();
+
     for (int first = 0; first < source.channelCount(); first += kChannelsPerPass) {
         const int count = std::min(kChannelsPerPass, source.channelCount() - first);
-        // Upload: the source as a float texture, and its area-averaged pyramid built on the GPU.
-        GlHandle texture = makeTexture(gl), atlas = makeTexture(gl);
-        {
-            const PassPixels pixels(source, first, count);
+        const PassPixels pixels(source, first, count);
+        if (!tiled) {
+            // Upload: the source as a float texture, and its area-averaged pyramid built on the GPU.
+            GlHandle texture = makeTexture(gl), atlas = makeTexture(gl);
             gl.ActiveTexture(GL_TEXTURE0);
             gl.BindTexture(GL_TEXTURE_2D, texture.id());
             gl.TexStorage2D(GL_TEXTURE_2D, 1, internalFormat(count), source.width, source.height);
@@ -297,30 +476,61 @@ format::Image encodeImageGpu(Context& context, const format::Image& source, cons
             buildPyramid(context, gl, pyramid, texture.id(), atlas.id());
             checkGl(gl, kWhat);
             gl.Finish();
+            t.uploadMs += millisecondsSince(start);
+
+            // Draw: rasterize the mesh at the CoNUS resolution.
+            setDrawState(texture.id(), atlas.id(), pyramid.rects, {-kFar, -kFar, kFar, kFar});
+            gl.ClearColor(0, 0, 0, 0);
+            gl.Clear(GL_COLOR_BUFFER_BIT);
+            gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.indices.size()), GL_UNSIGNED_INT, nullptr);
+            checkGl(gl, kWhat);
+            gl.Finish();
+            t.drawMs += millisecondsSince(start);
+        } else {
+            gl.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer.id());
+            gl.ClearColor(0, 0, 0, 0);
+            gl.Clear(GL_COLOR_BUFFER_BIT);
+            std::vector<PassPixels> levelPixels;
+            levelPixels.reserve(levels.size());
+            for (const format::Image& level : levels) levelPixels.emplace_back(level, first, count);
+            for (const Tile& tile : tiles) {
+                if (tile.indices.empty()) continue;
+                // Upload: the crops of every level around the tile's core.
+                GlHandle texture = makeTexture(gl), atlas = makeTexture(gl);
+                const TileLevel& crop0 = tile.levels[0];
+                gl.ActiveTexture(GL_TEXTURE0);
+                gl.BindTexture(GL_TEXTURE_2D, texture.id());
+                gl.TexStorage2D(GL_TEXTURE_2D, 1, internalFormat(count), crop0.width, crop0.height);
+                uploadCrop(gl, pixels.data(), source.width, count, crop0);
+                setLinearClamp(gl);
+                gl.BindTexture(GL_TEXTURE_2D, atlas.id());
+                gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, tile.atlasWidth, tile.atlasHeight);
+                for (std::size_t level = 1; level < tile.levels.size(); ++level)
+                    uploadCrop(gl, levelPixels[level - 1].data(), pyramid.rects[level][2], count, tile.levels[level]);
+                setLinearClamp(gl);
+                std::vector<std::array<int, 4>> rects;
+                for (std::size_t level = 0; level < tile.levels.size(); ++level) {
+                    const TileLevel& crop = tile.levels[level];
+                    rects.push_back({crop.atlasX - crop.x, crop.atlasY - crop.y, pyramid.rects[level][2],
+                                     pyramid.rects[level][3]});
+                }
+                gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer.id());
+                gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(tile.indices.size() * sizeof(GLuint)),
+                              tile.indices.data(), GL_STREAM_DRAW);
+                checkGl(gl, kWhat);
+                gl.Finish();
+                t.uploadMs += millisecondsSince(start);
+
+                // Draw: the tile's triangles; the shader keeps the pixels of its core.
+                setDrawState(texture.id(), atlas.id(), rects, tileCore(tile, source.width, source.height));
+                gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(tile.indices.size()), GL_UNSIGNED_INT, nullptr);
+                checkGl(gl, kWhat);
+                gl.Finish();
+                t.drawMs += millisecondsSince(start);
+            }
         }
-        t.uploadMs += millisecondsSince(start);
 
-        // Draw: rasterize the mesh at the CoNUS resolution.
         gl.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer.id());
-        gl.Viewport(0, 0, out.width, out.height);
-        gl.ClearColor(0, 0, 0, 0);
-        gl.Clear(GL_COLOR_BUFFER_BIT);
-        gl.ActiveTexture(GL_TEXTURE0);
-        gl.BindTexture(GL_TEXTURE_2D, texture.id());
-        gl.ActiveTexture(GL_TEXTURE1);
-        gl.BindTexture(GL_TEXTURE_2D, atlas.id());
-        gl.UseProgram(program);
-        gl.Uniform1i(gl.GetUniformLocation(program, "uLevel0"), 0);
-        gl.Uniform1i(gl.GetUniformLocation(program, "uPyramid"), 1);
-        gl.Uniform1i(gl.GetUniformLocation(program, "uLevels"), static_cast<GLint>(pyramid.rects.size()));
-        gl.Uniform4iv(gl.GetUniformLocation(program, "uLevelRect"), static_cast<GLsizei>(pyramid.rects.size()),
-                      pyramid.rects[0].data());
-        gl.BindVertexArray(vertexArray.id());
-        gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.indices.size()), GL_UNSIGNED_INT, nullptr);
-        checkGl(gl, kWhat);
-        gl.Finish();
-        t.drawMs += millisecondsSince(start);
-
         readBack(gl, out, first, count);
         checkGl(gl, kWhat);
         t.readbackMs += millisecondsSince(start);

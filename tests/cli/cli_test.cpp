@@ -373,6 +373,33 @@ TEST_F(Cli, BackendsAgreeAndAreListed) {
     EXPECT_NE(r.err.find("backend"), std::string::npos) << r.err;
 }
 
+TEST_F(Cli, HeightFieldEncodeDecodeAndCompare) {
+    Result r = run("heightfield encode procedural:256:7 -o " + path("t.exr") + " --size 64x64");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(run("validate " + path("t.exr")).exitCode, 0);
+    const auto file = conus::format::readConusFile(path("t.exr"));
+    EXPECT_EQ(file.dataKind, conus::format::DataKind::HeightField);
+    EXPECT_GE(file.image.channelIndex("Z"), 0);
+
+    r = run("decode " + path("t.exr") + " --camera viewer -o " + path("frame.png") + " --size 160x90");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(imageSize(path("frame.png")), std::make_pair(160, 90));
+    r = run("decode " + path("t.exr") + " --camera viewer -o " + path("cpu.png") + " --backend cpu");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find("needs GL"), std::string::npos) << r.err;
+
+    r = run("heightfield render " + path("t.exr") + " -o " + path("cmp.png") + " --size 160x90 --compare procedural:256:7");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("PSNR vs full resolution: CoNUS"), std::string::npos) << r.out;
+
+    // An image is not a height field: asking for a 3-D frame of it says so.
+    const std::string in = makePicture(64, 64);
+    ASSERT_EQ(run("uniform " + in + " -o " + path("u.exr") + " --size 16x16").exitCode, 0);
+    r = run("decode " + path("u.exr") + " --camera viewer -o " + path("x.png"));
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find("not a CoNUS height field"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, DemoRunsSmallAndPrintsPsnr) {
     const Result r = run("demo --size 512 --out " + path("demo"));
     ASSERT_EQ(r.exitCode, 0) << r.err;

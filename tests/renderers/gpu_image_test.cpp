@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 #include <filesystem>
 #include <vector>
 
@@ -58,6 +60,25 @@ format::Image readPhoto(const std::string& name) {
         for (int c = 0; c < 3; ++c) im.pixels[i * 3 + c] = all[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
     return im;
 }
+
+// Lowers the GPU paths' texture limit (CONUS_GL_MAX_TEXTURE) for its lifetime.
+class TextureLimit {
+public:
+    explicit TextureLimit(const std::string& value) {
+        if (const char* old = std::getenv(kVariable)) m_old = old;
+        setenv(kVariable, value.c_str(), 1);
+    }
+    ~TextureLimit() {
+        if (m_old.empty()) unsetenv(kVariable);
+        else setenv(kVariable, m_old.c_str(), 1);
+    }
+    TextureLimit(const TextureLimit&) = delete;
+    TextureLimit& operator=(const TextureLimit&) = delete;
+
+private:
+    static constexpr const char* kVariable = "CONUS_GL_MAX_TEXTURE";
+    std::string m_old;
+};
 
 class GpuImage : public ::testing::TestWithParam<Backend> {
 protected:
@@ -260,9 +281,74 @@ TEST_P(GpuImage, RejectsBadArguments) {
     format::Image broken = source;
     broken.pixels.pop_back();
     EXPECT_EQ(code([&] { decodeImageGpu(context(), broken, map, decodeView({}, 8, 8)); }), ErrorCode::InvalidArgument);
-    // Wider than any texture the context can hold: refused clearly, not tiled.
-    const format::Image wide = format::makeImage(context().maxTextureSize() + 1, 1, {"Y"});
-    EXPECT_EQ(code([&] { encodeImageGpu(context(), wide, map, encodeSize(8, 8)); }), ErrorCode::LimitExceeded);
+    // An output wider than any texture the context can hold: refused clearly (only sources tile).
+    EXPECT_EQ(code([&] { encodeImageGpu(context(), source, map, encodeSize(context().maxTextureSize() + 1, 1)); }),
+              ErrorCode::LimitExceeded);
+    {
+        const TextureLimit limit("lots");
+        EXPECT_EQ(code([&] { encodeImageGpu(context(), source, map, encodeSize(8, 8)); }), ErrorCode::InvalidArgument);
+    }
+}
+
+// Sources over the texture limit are tiled: the limit lowered to 256 texels cuts a 700 x 500
+// source (and its pyramid) into tiles, and the result matches the CPU reference and the untiled GPU.
+TEST_P(GpuImage, EncodeTilesSourcesOverTheLimit) {
+    const format::Image source = test::photoLike(700, 500);
+    struct Case {
+        const char* name;
+        codec::SamplingMap map;
+        int width, height;
+    };
+    const std::vector<Case> cases = {{"two foci", twoFoci(), 256, 184},
+                                     {"identity, ratio 4", codec::SamplingMap::identity(33, 33), 175, 125},
+                                     {"identity, ratio 2.9", codec::SamplingMap::identity(9, 5), 240, 172},
+                                     {"random foci", test::randomFociMap(3), 200, 150}};
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        const format::Image cpu = codec::encodeImage(source, c.map, encodeSize(c.width, c.height));
+        const format::Image untiled = encodeImageGpu(context(), source, c.map, encodeSize(c.width, c.height));
+        format::Image tiled;
+        {
+            const TextureLimit limit("256");
+            tiled = encodeImageGpu(context(), source, c.map, encodeSize(c.width, c.height));
+        }
+        ASSERT_EQ(tiled.channels, source.channels);
+        float worst = 0;
+        for (std::size_t i = 0; i < tiled.pixels.size(); ++i)
+            worst = std::max(worst, std::abs(tiled.pixels[i] - untiled.pixels[i]));
+        const double vsCpu = codec::psnr(cpu, tiled), vsUntiled = codec::psnr(untiled, tiled);
+        std::printf("    tiled encode 700x500 -> %dx%d (%s), limit 256, %s: PSNR %.2f dB vs CPU, %.2f dB vs untiled "
+                    "GPU (largest difference %.2g), untiled vs CPU %.2f dB\n",
+                    c.width, c.height, c.name, backendName(GetParam()).c_str(), vsCpu, vsUntiled, worst,
+                    codec::psnr(cpu, untiled));
+        EXPECT_GE(vsCpu, kEncodePsnr);
+        EXPECT_GE(vsUntiled, 60.0);
+        EXPECT_LT(worst, 0.01f);  // no pixel left out or drawn from the wrong tile
+    }
+    // A source past the real GL_MAX_TEXTURE_SIZE: a 1-texel strip, tiled along its length.
+    const int wide = context().maxTextureSize() + 1;
+    format::Image strip = format::makeImage(wide, 1, {"Y"});
+    for (int x = 0; x < wide; ++x) strip.at(x, 0) = float(x % 97) / 97.0f;
+    const codec::SamplingMap map = codec::SamplingMap::identity(2, 2);
+    const format::Image cpu = codec::encodeImage(strip, map, encodeSize(64, 1));
+    const format::Image gpu = encodeImageGpu(context(), strip, map, encodeSize(64, 1));
+    EXPECT_GE(codec::psnr(cpu, gpu), kEncodePsnr);
+}
+
+// Decode is not tiled: a CoNUS image over the limit is refused with a message naming the limit.
+TEST_P(GpuImage, DecodeRefusesImagesOverTheLimit) {
+    const format::Image conus = test::photoLike(300, 200);
+    const TextureLimit limit("256");
+    try {
+        decodeImageGpu(context(), conus, twoFoci(), decodeView({}, 100, 100));
+        ADD_FAILURE() << "a 300x200 CoNUS image passed the texture limit 256";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::LimitExceeded);
+        EXPECT_NE(std::string(e.what()).find("256"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("CONUS_GL_MAX_TEXTURE"), std::string::npos) << e.what();
+    }
+    // Within the limit it still decodes.
+    EXPECT_NO_THROW(decodeImageGpu(context(), test::photoLike(200, 150), twoFoci(), decodeView({}, 100, 100)));
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, GpuImage, ::testing::Values(Backend::Egl, Backend::OsMesa), test::paramName);

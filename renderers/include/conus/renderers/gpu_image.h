@@ -14,9 +14,21 @@
 // Shared rules: images are float with any number of channels, processed four per pass (32-bit
 // float textures, an RGBA32F target); the options' threads and progress are ignored (the GPU runs
 // the whole image at once); sizes are checked like the CPU paths (conus::Error InvalidArgument /
-// LimitExceeded); an image wider or taller than the context's GL_MAX_TEXTURE_SIZE throws
-// conus::Error(LimitExceeded) (no tiling yet). The context is made current on the calling thread;
-// a GL failure throws conus::Error(Unsupported), a GL out-of-memory LimitExceeded.
+// LimitExceeded). The context is made current on the calling thread; a GL failure throws
+// conus::Error(Unsupported), a GL out-of-memory LimitExceeded.
+//
+// Texture limit: the textures stay within the context's GL_MAX_TEXTURE_SIZE, or within the lower
+// limit that the environment variable CONUS_GL_MAX_TEXTURE asks for (texels, read on every call,
+// clamped to [64, GL_MAX_TEXTURE_SIZE]; not a positive whole number: InvalidArgument), which lets
+// tests exercise tiling on drivers with a large limit. An encoder source wider or taller than the
+// limit (or whose pyramid atlas would be) is tiled: it is cut into tiles whose core plus a margin of
+// 6 texels on every pyramid level fits the limit; the pyramid's levels 1.. are built once for the
+// whole image on the CPU (codec::areaDownsample, the reference's own filter, at its level sizes)
+// and each tile uploads crops of them, so a crop's texels are the full pyramid's; each tile draws
+// the mesh triangles that reach its core, and the shader keeps only the pixels whose interpolated
+// undistorted centre lies in that core, so every CoNUS pixel is drawn once and reads what the
+// untiled encoder would. Not tiled (they throw conus::Error(LimitExceeded) past the limit): the
+// encoder's output, and the decoder's CoNUS image and output.
 #pragma once
 
 #include "conus/codec/decode.h"
