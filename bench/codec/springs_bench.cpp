@@ -46,17 +46,24 @@ void BM_SpringBaselinePass256(benchmark::State& state) {
 }
 BENCHMARK(BM_SpringBaselinePass256)->Unit(benchmark::kMillisecond);
 
-// From the identity to stable(): three strokes, painted in over 0.3 s of simulated time.
+// From the identity to stable() with runUntilStable: three strokes, painted in over 0.3 s of
+// simulated time. steps: 256x256 steps; warm_steps: the coarse-grid warm start's work in 256x256
+// steps. Arg 1: multilevel (the default), 0: plain stepping (the old path).
 void BM_SpringTimeToStable256(benchmark::State& state) {
     int steps = 0;
+    double warm = 0.0;
+    conus::codec::SpringOptions options;
+    options.multilevel = state.range(0) != 0;
     for (auto _ : state) {
-        conus::codec::SpringSystem system(kSide, kSide);
+        conus::codec::SpringSystem system(kSide, kSide, options);
         for (const auto& s : typicalStrokes()) system.addStroke(s);
         steps = system.runUntilStable(100000);
+        warm = system.warmStartWork();
         benchmark::DoNotOptimize(system.time());
     }
     state.counters["steps"] = steps;
+    state.counters["warm_steps"] = warm;
 }
-BENCHMARK(BM_SpringTimeToStable256)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SpringTimeToStable256)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
 }  // namespace

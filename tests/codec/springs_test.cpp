@@ -201,3 +201,68 @@ TEST(Springs, ParseStrokesErrors) {
 
 }  // namespace
 }  // namespace conus::codec
+
+namespace conus::codec {
+namespace {
+
+// runUntilStable's coarse-to-fine warm start and longer relaxation steps reach the equilibrium of
+// plain stepping (within a small fraction of a spacing), in far fewer steps, bit for bit the same
+// every time, and through valid maps only.
+TEST(Springs, MultilevelMatchesPlainStepping) {
+    const std::vector<Stroke> strokes{{0.35, 0.4, 0.15, 1.5, 0.3}, {0.65, 0.6, 0.1, 1.0, 0.3}, {0.5, 0.8, 0.08, 2.0, 0.2}};
+    auto run = [&](bool multilevel, int* steps, double* work) {
+        SpringOptions o;
+        o.multilevel = multilevel;
+        SpringSystem system(129, 129, o);
+        for (const Stroke& s : strokes) system.addStroke(s);
+        *steps = system.runUntilStable(20000);
+        *work = system.warmStartWork();
+        EXPECT_TRUE(system.stable());
+        expectValidPositions(system);
+        return system.positions();
+    };
+    int plainSteps = 0, fastSteps = 0, againSteps = 0;
+    double plainWork = 0, fastWork = 0, againWork = 0;
+    const auto plain = run(false, &plainSteps, &plainWork);
+    const auto fast = run(true, &fastSteps, &fastWork);
+    const auto again = run(true, &againSteps, &againWork);
+    double worst = 0;
+    for (std::size_t k = 0; k < plain.size(); ++k) worst = std::max(worst, double(glm::length(plain[k] - fast[k])));
+    worst *= 128.0;  // in spacings
+    std::printf("129x129 three strokes: plain %d steps, multilevel %d + %.1f (warm start) steps, max difference %.4f spacings\n",
+                plainSteps, fastSteps, fastWork, worst);
+    EXPECT_EQ(plainWork, 0.0);
+    EXPECT_LT(worst, 0.05);
+    EXPECT_LT(fastSteps + fastWork, 0.5 * plainSteps);
+    ASSERT_EQ(fast.size(), again.size());
+    EXPECT_EQ(fastSteps, againSteps);
+    EXPECT_EQ(0, std::memcmp(fast.data(), again.data(), fast.size() * sizeof(glm::vec2)));
+}
+
+// The viewer's use: strokes added between runs and steps; the warm start only happens once per
+// new stroke, and stepping afterwards stays at the equilibrium.
+TEST(Springs, MultilevelAfterSteppingAndNewStrokes) {
+    SpringSystem system(96, 80);
+    system.addStroke({0.4, 0.5, 0.2, 1.0, 0.3});
+    system.step(10);
+    system.runUntilStable(20000);
+    EXPECT_TRUE(system.stable());
+    const double work = system.warmStartWork();
+    EXPECT_GT(work, 0.0);
+    EXPECT_EQ(system.runUntilStable(20000), 0);  // already stable, no new warm start
+    EXPECT_EQ(system.warmStartWork(), work);
+    system.addStroke({0.7, 0.3, 0.1, 2.0, 0.1});
+    system.runUntilStable(20000);
+    EXPECT_TRUE(system.stable());
+    EXPECT_GT(system.warmStartWork(), work);
+    const auto before = system.positions();
+    system.step(20);
+    const auto after = system.positions();
+    double moved = 0;
+    for (std::size_t k = 0; k < before.size(); ++k) moved = std::max(moved, double(glm::length(before[k] - after[k])));
+    EXPECT_LT(moved * 95.0, 0.01);
+    expectValidPositions(system);
+}
+
+}  // namespace
+}  // namespace conus::codec
