@@ -11,9 +11,10 @@ if [ ! -d "$data" ]; then
 fi
 [ -x build/bin/conus ] || scripts/setup.sh
 
-run() {  # name file focus...
+run() {  # name file [--importance SRC] focus...   (with --importance the foci only name the views)
   local name=$1 file=$2; shift 2
   local args=()
+  if [ "${1:-}" = --importance ]; then args+=(--importance "$2"); shift 2; fi
   for f in "$@"; do args+=(--focus "$f"); done
   echo "== $name ($file)"
   build/bin/conus demo --input "$data/$file" "${args[@]}" --out "build/quality/$name" 2>/dev/null |
@@ -23,3 +24,5 @@ run astronaut astronaut.png 0.44,0.23,0.08,4 0.33,0.75,0.06,4
 run chelsea chelsea.png 0.37,0.38,0.07,4 0.71,0.45,0.07,4
 run motorcycle motorcycle_left.png 0.55,0.62,0.08,4 0.72,0.31,0.05,4
 run hubble hubble_deep_field.jpg 0.5,0.5,0.1,4
+run astronaut-faces astronaut.png --importance faces 0.44,0.23,0.08,4
+run chelsea-detail chelsea.png --importance detail 0.37,0.38,0.07,4 0.71,0.45,0.07,4
