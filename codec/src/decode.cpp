@@ -304,7 +304,7 @@ void bilinearRows(const format::Image& src, format::Image& dst, const AxisTaps& 
 }  // namespace
 
 format::Image decodeImage(const format::Image& conus, const SamplingMap& map, const DecodeOptions& options) {
-    detail::checkSourceImage(conus, "decodeImage");
+    format::checkImage(conus, "decodeImage");
     detail::checkOutputSize(options.width, options.height, "decodeImage");
     checkView(options.view, "decodeImage");
     format::Image out = detail::makeOutput(conus, options.width, options.height);
@@ -323,7 +323,7 @@ format::Image decodeImage(const format::Image& conus, const SamplingMap& map, co
 }
 
 format::Image resizeBilinear(const format::Image& image, const View& view, int width, int height, int threads) {
-    detail::checkSourceImage(image, "resizeBilinear");
+    format::checkImage(image, "resizeBilinear");
     detail::checkOutputSize(width, height, "resizeBilinear");
     checkView(view, "resizeBilinear");
     format::Image out = detail::makeOutput(image, width, height);

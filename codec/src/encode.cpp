@@ -198,7 +198,7 @@ void encodeRows(const format::Image& src, const SamplingMap& map, Pyramid& pyram
 }  // namespace
 
 format::Image encodeImage(const format::Image& source, const SamplingMap& map, const EncodeOptions& options) {
-    detail::checkSourceImage(source, "encodeImage");
+    format::checkImage(source, "encodeImage");
     detail::checkOutputSize(options.width, options.height, "encodeImage");
     format::Image out = detail::makeOutput(source, options.width, options.height);
     Pyramid pyramid(source);
@@ -215,7 +215,7 @@ format::Image encodeImage(const format::Image& source, const SamplingMap& map, c
 // Downsample only: growing an axis has no area to average over, and the decoder's bilinear
 // baseline (resizeBilinear) is the tool for that.
 format::Image areaDownsample(const format::Image& source, int width, int height, int threads) {
-    detail::checkSourceImage(source, "areaDownsample");
+    format::checkImage(source, "areaDownsample");
     detail::checkOutputSize(width, height, "areaDownsample");
     if (width > source.width || height > source.height)
         throw Error(ErrorCode::InvalidArgument,

@@ -78,15 +78,8 @@ void checkSize(int w, int h, const char* what) {
                                                     std::to_string(h) + " is outside [1, 65536] per side");
 }
 
-void checkImage(const format::Image& image, const char* what) {
-    if (image.empty() || image.pixels.size() != image.index(0, image.height))
-        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": empty or inconsistent image (" +
-                                                    std::to_string(image.width) + "x" + std::to_string(image.height) +
-                                                    ", " + std::to_string(image.channelCount()) + " channels)");
-}
-
 int heightChannel(const format::Image& heights, const char* what) {
-    checkImage(heights, what);
+    format::checkImage(heights, what);
     const int z = heights.channelIndex("Z");
     if (z >= 0) return z;
     if (heights.channelCount() == 1) return 0;
@@ -98,7 +91,7 @@ int heightChannel(const format::Image& heights, const char* what) {
 // R,G,B,Z at the DEM's size: the one source image the encoder filters.
 format::Image combine(const format::Image& heights, const format::Image& colour, const char* what) {
     const int z = heightChannel(heights, what);
-    checkImage(colour, what);
+    format::checkImage(colour, what);
     if (colour.width != heights.width || colour.height != heights.height)
         throw Error(ErrorCode::InvalidArgument, std::string(what) + ": colour " + std::to_string(colour.width) + "x" +
                                                     std::to_string(colour.height) + " differs from the DEM's " +
@@ -301,7 +294,7 @@ format::ConusFile uniformHeightField(const format::Image& heights, const format:
 Mesh undistortHeightField(const format::ConusFile& file, glm::dvec2 extent) {
     constexpr const char* kWhat = "undistortHeightField";
     const format::Image& image = file.image;
-    checkImage(image, kWhat);
+    format::checkImage(image, kWhat);
     const int z = image.channelIndex("Z");
     if (z < 0) throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": the CoNUS image has no Z channel");
     if (!(extent.x > 0 && extent.y > 0 && std::isfinite(extent.x) && std::isfinite(extent.y)))
@@ -357,7 +350,7 @@ Mesh undistortHeightField(const format::ConusFile& file) {
 
 double heightAt(const format::ConusFile& file, glm::dvec2 p) {
     const format::Image& image = file.image;
-    checkImage(image, "heightAt");
+    format::checkImage(image, "heightAt");
     const int z = image.channelIndex("Z");
     if (z < 0) throw Error(ErrorCode::InvalidArgument, "heightAt: the CoNUS image has no Z channel");
     const glm::dvec2 pd = file.analytic && file.analytic->kind == "ground"

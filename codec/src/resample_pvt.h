@@ -26,18 +26,6 @@ inline void checkOutputSize(int width, int height, const char* what) {
                                                   std::to_string(height) + " exceeds the image limits");
 }
 
-inline void checkSourceImage(const format::Image& image, const char* what) {
-    if (image.empty())
-        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": empty image (" + std::to_string(image.width) +
-                                                    "x" + std::to_string(image.height) + ", " +
-                                                    std::to_string(image.channelCount()) + " channels)");
-    const std::size_t expected = static_cast<std::size_t>(image.width) * image.height * image.channels.size();
-    if (image.pixels.size() != expected)
-        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": image holds " +
-                                                    std::to_string(image.pixels.size()) + " values, expected " +
-                                                    std::to_string(expected));
-}
-
 // Same channels as `like`, zero-filled; sizes already checked.
 inline format::Image makeOutput(const format::Image& like, int width, int height) {
     format::Image out;

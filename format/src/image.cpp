@@ -36,4 +36,16 @@ Image makeImage(int width, int height, std::vector<std::string> channels) {
     return image;
 }
 
+void checkImage(const Image& image, const char* what) {
+    if (image.empty())
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": empty image (" + std::to_string(image.width) +
+                                                    "x" + std::to_string(image.height) + ", " +
+                                                    std::to_string(image.channelCount()) + " channels)");
+    const std::size_t expected = static_cast<std::size_t>(image.width) * image.height * image.channels.size();
+    if (image.pixels.size() != expected)
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": image holds " +
+                                                    std::to_string(image.pixels.size()) + " values, expected " +
+                                                    std::to_string(expected));
+}
+
 }  // namespace conus::format

@@ -40,18 +40,6 @@ double millisecondsSince(Clock::time_point& start) {
     return ms;
 }
 
-void checkImage(const format::Image& image, const char* what) {
-    if (image.empty())
-        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": empty image (" + std::to_string(image.width) +
-                                                    "x" + std::to_string(image.height) + ", " +
-                                                    std::to_string(image.channelCount()) + " channels)");
-    const std::size_t expected = static_cast<std::size_t>(image.width) * image.height * image.channels.size();
-    if (image.pixels.size() != expected)
-        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": image holds " +
-                                                    std::to_string(image.pixels.size()) + " values, expected " +
-                                                    std::to_string(expected));
-}
-
 // The largest texture side the GPU paths use: the context's GL_MAX_TEXTURE_SIZE, or less where the
 // environment variable CONUS_GL_MAX_TEXTURE asks for less (for tests of the tiled encoder; clamped
 // to [kMinTextureLimit, GL_MAX_TEXTURE_SIZE]).
@@ -395,7 +383,7 @@ void uploadCrop(const GladGLContext& gl, const float* pixels, int rowLength, int
 format::Image encodeImageGpu(Context& context, const format::Image& source, const codec::SamplingMap& map,
                              const codec::EncodeOptions& options, GpuTimings* timings) {
     constexpr const char* kWhat = "encodeImageGpu";
-    checkImage(source, kWhat);
+    format::checkImage(source, kWhat);
     format::Image out = format::makeImage(options.width, options.height, source.channels);
     checkTextureSize(context, out.width, out.height, kWhat, "output");
     const int limit = textureLimit(context);
@@ -544,7 +532,7 @@ format::Image encodeImageGpu(Context& context, const format::Image& source, cons
 format::Image decodeImageGpu(Context& context, const format::Image& conus, const codec::SamplingMap& map,
                              const codec::DecodeOptions& options, GpuTimings* timings) {
     constexpr const char* kWhat = "decodeImageGpu";
-    checkImage(conus, kWhat);
+    format::checkImage(conus, kWhat);
     const codec::View& view = options.view;
     if (!std::isfinite(view.u0) || !std::isfinite(view.u1) || !std::isfinite(view.v0) || !std::isfinite(view.v1) ||
         view.u0 == view.u1 || view.v0 == view.v1 || std::abs(view.u1 - view.u0) > 1e6 ||

@@ -226,7 +226,9 @@ TEST(Container, UnwritableFolderLeavesNothing) {
         EXPECT_EQ(e.code(), ErrorCode::Io);
     }
     std::filesystem::permissions(ro, std::filesystem::perms::owner_all);
-    if (threw) EXPECT_TRUE(std::filesystem::is_empty(ro));
+    if (threw) {
+        EXPECT_TRUE(std::filesystem::is_empty(ro));
+    }
 }
 
 TEST(Container, OverwriteReplacesAtomically) {

@@ -5,24 +5,12 @@
 #include <limits>
 
 #include "conus/format/container.h"
+#include "test_files.h"
 
 namespace conus::format {
 namespace {
 
-GridNodes identityGrid(int columns, int rows) {
-    GridNodes g;
-    g.columns = columns;
-    g.rows = rows;
-    g.xy.resize(std::size_t{2} * columns * rows);
-    for (int j = 0; j < rows; ++j) {
-        for (int i = 0; i < columns; ++i) {
-            const std::size_t k = std::size_t(j) * columns + i;
-            g.xy[2 * k] = float(i) / float(columns - 1);
-            g.xy[2 * k + 1] = float(j) / float(rows - 1);
-        }
-    }
-    return g;
-}
+using testing::identityGrid;
 
 float& u(GridNodes& g, int i, int j) { return g.xy[2 * (std::size_t(j) * g.columns + i)]; }
 float& v(GridNodes& g, int i, int j) { return g.xy[2 * (std::size_t(j) * g.columns + i) + 1]; }

@@ -34,4 +34,8 @@ inline constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 30;
 // A zero-filled image; throws conus::Error(InvalidArgument / LimitExceeded) on absurd sizes.
 Image makeImage(int width, int height, std::vector<std::string> channels);
 
+// Throws conus::Error(InvalidArgument), naming `what`, for an empty image or one whose pixel array
+// does not hold width * height * channels values: the check every consumer of an Image starts with.
+void checkImage(const Image& image, const char* what);
+
 }  // namespace conus::format
