@@ -434,6 +434,12 @@ void App::frame() {
 int App::benchmark() {
     int fw = 0, fh = 0;
     glfwGetFramebufferSize(m_window, &fw, &fh);
+    // --script with --benchmark-frames: the commands set up the view (a key, a zoom), then the timing.
+    for (const ScriptCommand& command : m_script) {
+        if (command.name == "quit") break;
+        runScriptCommand(command);
+        frame();
+    }
     for (int k = 0; k < kBenchmarkWarmup; ++k) frame();
     m_renderer->finish();
     const auto start = std::chrono::steady_clock::now();
@@ -455,10 +461,10 @@ int App::benchmark() {
                 1000.0 * drawSeconds / std::max(1, m_options.benchmarkFrames),
                 1000.0 * (seconds - drawSeconds) / std::max(1, m_options.benchmarkFrames));
     const Document* doc = current();
-    std::printf("benchmark: %d frames at %dx%d (%s, %dx%d CoNUS image, %s mode): %.2f frames/s, %.1f ms/frame; %s\n",
+    std::printf("benchmark: %d frames at %dx%d (%s, %dx%d CoNUS image, %s mode, %s decode): %.2f frames/s, %.1f ms/frame; %s\n",
                 m_options.benchmarkFrames, fw, fh, doc ? fileName(doc->path).c_str() : "-",
                 doc && doc->ok() ? doc->file->image.width : 0, doc && doc->ok() ? doc->file->image.height : 0,
-                modeName(m_display.mode), m_options.benchmarkFrames / seconds,
+                modeName(m_display.mode), m_renderer->decodesOnCpu(m_display) ? "CPU" : "GPU", m_options.benchmarkFrames / seconds,
                 1000.0 * seconds / std::max(1, m_options.benchmarkFrames), m_context->renderer().c_str());
     return m_exitCode;
 }

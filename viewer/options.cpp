@@ -12,7 +12,7 @@ namespace {
 
 constexpr const char* kDescription =
     "conus-view: a small viewer for CoNUS files (coherent non-uniform sampling images).\n"
-    "The frame is reconstructed from the CoNUS data on the GPU at every zoom level.\n"
+    "The frame is reconstructed from the CoNUS data at every zoom level (GPU shader, or the CPU decoder on software GL).\n"
     "Press H in the window for the keys. --edit IMAGE opens the mass-spring map editor.";
 
 std::pair<int, int> parseSize(const std::string& text, const char* what) {
@@ -56,7 +56,7 @@ const char* modeName(gl::ViewMode mode) {
 
 std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     Options o;
-    std::string view, size, window = "1280x800", mode = "reconstructed";
+    std::string view, size, window = "1280x800", mode = "reconstructed", decode = "auto";
     CLI::App app(kDescription, "conus-view");
     app.add_option("files", o.files, "CoNUS files (.exr); Tab / PageDown switch between them");
     app.add_option("--edit", o.edit, "paint a sampling map over IMAGE (PNG, JPEG, EXR, ...)");
@@ -71,6 +71,11 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_flag("--outlines", o.display.outlines, "draw the focus outlines");
     app.add_option("--exposure", o.display.exposure, "exposure in stops");
     app.add_option("--gamma", o.display.gamma, "display gamma (1: linear)")->capture_default_str();
+    app.add_option("--decode", decode,
+                   "where the reconstructed frame is decoded: gpu (shader), cpu (codec::decodeImage each frame, "
+                   "uploaded), auto (CONUS_VIEW_DECODE=cpu|gpu, else cpu on llvmpipe/softpipe/swrast)")
+        ->check(CLI::IsMember({"auto", "cpu", "gpu"}))
+        ->capture_default_str();
     app.add_option("--script", o.script, "run window commands from a file, then exit (see viewer/script.h)");
     app.add_option("--benchmark-frames", o.benchmarkFrames, "draw N frames, print frames/s and exit");
     app.add_option("--backend", o.backend, "--screenshot GL backend: auto, egl, osmesa")->capture_default_str();
@@ -80,6 +85,7 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
         if (!size.empty()) std::tie(o.width, o.height) = parseSize(size, "--size");
         std::tie(o.windowWidth, o.windowHeight) = parseSize(window, "--window");
         o.display.mode = parseMode(mode);
+        o.display.decode = decode == "cpu" ? gl::DecodePath::Cpu : decode == "gpu" ? gl::DecodePath::Gpu : gl::DecodePath::Auto;
         if (o.files.empty() && o.edit.empty()) throw Error(ErrorCode::InvalidArgument, "no file given (conus-view FILE.exr or --edit IMAGE)");
         if (!o.edit.empty() && !o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--edit takes no CoNUS files");
         if (!o.screenshot.empty() && o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--screenshot needs a CoNUS file");

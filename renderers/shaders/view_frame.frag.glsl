@@ -17,9 +17,16 @@
 #ifndef VIEW_OUTLINES
 #define VIEW_OUTLINES 0
 #endif
+// VIEW_OVERLAY 1: the overlays alone, premultiplied (rgb, coverage), for blending (GL_ONE,
+// GL_ONE_MINUS_SRC_ALPHA) over a frame already in the target (the CPU-decoded frame on software
+// GL, see view_renderer.cpp): the same result as drawing them over the frame in one pass.
+#ifndef VIEW_OVERLAY
+#define VIEW_OVERLAY 0
+#endif
 const int kMode = VIEW_MODE;  // 0 reconstructed, 1 raw, 2 uniform, 3 wipe, 4 density
 const bool kGrid = VIEW_GRID != 0;
 const bool kOutlines = VIEW_OUTLINES != 0;
+const bool kOverlayOnly = VIEW_OVERLAY != 0;
 layout(location = 0) out vec4 fragColor;
 uniform sampler2D uConus;    // display channels as RGBA, bilinear, clamp to edge
 uniform sampler2D uMap;      // columns x rows texels, RG32F: the distorted node positions
@@ -84,6 +91,12 @@ vec3 heat(float t) {  // after matplotlib's "inferno", as cli/pictures.cpp
     return mix(ramp[i], ramp[i + 1], t - float(i));
 }
 
+// color := mix(color, c, t), and the same step on the premultiplied overlay `over`.
+void paint(inout vec3 color, inout vec4 over, vec3 c, float t) {
+    color = mix(color, c, t);
+    over = mix(over, vec4(c, 1.0), t);
+}
+
 vec3 display(vec4 c) { return pow(max(c.rgb * uExposure, vec3(0.0)), vec3(uInvGamma)); }
 
 void main() {
@@ -99,8 +112,11 @@ void main() {
 
     int mode = kMode;
     if (mode == 3) mode = gl_FragCoord.x < uWipeX ? 0 : 2;
-    vec3 color;
-    if (!inside && mode != 4) {
+    vec3 color = kBackground;
+    vec4 over = vec4(0.0);
+    if (kOverlayOnly) {
+        // the frame is in the target already
+    } else if (!inside && mode != 4) {
         color = kBackground;
     } else if (mode == 0) {
         color = display(filtered(uConus, m.pd, m.du * astep.x, m.dv * astep.y));
@@ -123,16 +139,16 @@ void main() {
         const vec2 lines = uGridLines;
         const bool edge = floor(m.pd.x * lines.x) != floor(right.x * lines.x) ||
                           floor(m.pd.y * lines.y) != floor(below.y * lines.y);
-        if (edge) color = mix(color, vec3(1.0), 0.55);
+        if (edge) paint(color, over, vec3(1.0), 0.55);
     }
     // Focus circles at r (solid) and 2r (where the density has fallen back to the context's).
     for (int k = 0; kOutlines && k < uFocusCount; ++k) {
         const vec2 d = (uv - uFoci[k].xy) * uSourceSize;
         const float radius = uFoci[k].z * uSourceSize.x, dist = length(d);
         const float pixelSize = abs(step.x) * uSourceSize.x;
-        if (abs(dist - radius) < 0.75 * pixelSize) color = vec3(0.2, 1.0, 0.4);
-        else if (abs(dist - 2.0 * radius) < 0.6 * pixelSize) color = mix(color, vec3(0.2, 1.0, 0.4), 0.5);
+        if (abs(dist - radius) < 0.75 * pixelSize) paint(color, over, vec3(0.2, 1.0, 0.4), 1.0);
+        else if (abs(dist - 2.0 * radius) < 0.6 * pixelSize) paint(color, over, vec3(0.2, 1.0, 0.4), 0.5);
     }
     if (kMode == 3 && abs(gl_FragCoord.x - uWipeX) < 1.0) color = vec3(1.0);
-    fragColor = vec4(color, 1.0);
+    fragColor = kOverlayOnly ? over : vec4(color, 1.0);
 }

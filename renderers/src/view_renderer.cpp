@@ -1,10 +1,16 @@
 // conus-view's drawing: one full-screen pass of view_frame.frag.glsl into the bound framebuffer,
 // and the Context that adopts a window's GL context (context_pvt.h's Platform, doing nothing).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include <optional>
 
 #include "context_pvt.h"
 #include "conus/renderers/gpu_image.h"
@@ -18,6 +24,51 @@ namespace {
 constexpr int kMaxFoci = 16;             // uFoci in view_frame.frag.glsl
 constexpr int kDensitySamples = 128;     // per side, for the heat map's log-density range
 constexpr double kMinGridSpacing = 6.0;  // pixels between automatic grid lines (at density 1)
+constexpr float kBackground = 0.11f;     // kBackground in view_frame.frag.glsl
+
+// The 8-bit display table of the CPU path: a display value for every float in [2^-32, 1) by its
+// top 12 mantissa bits (131072 buckets, relative width 2^-12); 0 below, 255 at 1 and above.
+constexpr std::uint32_t kLutLowBits = 0x2f800000u;  // 2^-32
+constexpr int kLutShift = 11;
+constexpr std::size_t kLutSize = (0x3f800000u - kLutLowBits) >> kLutShift;
+
+std::uint32_t floatBits(float f) {
+    std::uint32_t b;
+    std::memcpy(&b, &f, sizeof b);
+    return b;
+}
+
+// The software rasterizers, on which the CPU decoder beats the shader.
+bool softwareRenderer(const std::string& renderer) {
+    std::string lower = renderer;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return lower.find("llvmpipe") != std::string::npos || lower.find("softpipe") != std::string::npos ||
+           lower.find("swrast") != std::string::npos;
+}
+
+// The display channels as R,G,B (the shader writes alpha 1 whatever the image's alpha).
+format::Image displayRgb(const format::Image& rgba) {
+    format::Image out = format::makeImage(rgba.width, rgba.height, {"R", "G", "B"});
+    const std::size_t pixels = static_cast<std::size_t>(rgba.width) * rgba.height;
+    for (std::size_t i = 0; i < pixels; ++i)
+        for (int c = 0; c < 3; ++c) out.pixels[i * 3 + c] = rgba.pixels[i * 4 + c];
+    return out;
+}
+
+// Runs body(y0, y1) over row bands on up to hardware_concurrency threads.
+template <class Body>
+void parallelRows(int height, Body body) {
+    const int threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, std::max(1, height / 16));
+    if (threads <= 1) {
+        body(0, height);
+        return;
+    }
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t)
+        pool.emplace_back([&, t] { body(height * t / threads, height * (t + 1) / threads); });
+    body(0, height / threads);
+    for (std::thread& th : pool) th.join();
+}
 
 // The caller's context: binding and unbinding it are the caller's business (GLFW's, say).
 class AdoptedPlatform final : public Platform {
@@ -95,6 +146,18 @@ std::unique_ptr<Context> adoptCurrentContext(GetProcFn getProc) {
 struct ViewRenderer::Impl {
     Context& context;
     GLuint conus = 0, map = 0, uniform = 0;
+    // The CPU decode path: the display channels and the map on the CPU, the frame texture (RGBA8
+    // for a window, RGBA32F when rendering to a float target) and a framebuffer to blit it from.
+    format::Image rgb;
+    std::optional<codec::SamplingMap> cpuMap;
+    GLuint frameTexture = 0, frameFramebuffer = 0;
+    int frameWidth = 0, frameHeight = 0;
+    GLenum frameFormat = 0;
+    bool floatTarget = false;  // renderToImage: exact float values, no 8-bit rounding
+    std::vector<std::uint8_t> frameBytes;
+    std::vector<float> frameFloats;
+    std::vector<std::uint8_t> lut;
+    float lutExposure = -1, lutInvGamma = -1;
     int conusWidth = 0, conusHeight = 0;
     double sourceWidth = 1, sourceHeight = 1;
     std::vector<float> foci;  // u, v, r per focus
@@ -104,19 +167,150 @@ struct ViewRenderer::Impl {
     explicit Impl(Context& c) : context(c) {}
     ~Impl() {
         const GladGLContext& gl = makeCurrentGl(context);
-        for (GLuint* t : {&conus, &map, &uniform})
+        for (GLuint* t : {&conus, &map, &uniform, &frameTexture})
             if (*t) gl.DeleteTextures(1, t);
+        if (frameFramebuffer) gl.DeleteFramebuffers(1, &frameFramebuffer);
+    }
+
+    bool cpuDecode(const ViewOptions& options) const {
+        if (options.mode != ViewMode::Reconstructed || !cpuMap) return false;
+        switch (options.decode) {
+        case DecodePath::Cpu: return true;
+        case DecodePath::Gpu: return false;
+        case DecodePath::Auto: break;
+        }
+        if (const char* env = std::getenv("CONUS_VIEW_DECODE")) {
+            const std::string value = env;
+            if (value == "cpu") return true;
+            if (value == "gpu") return false;
+        }
+        return softwareRenderer(context.renderer());
+    }
+
+    void buildLut(float exposure, float invGamma) {
+        if (lut.size() == kLutSize && exposure == lutExposure && invGamma == lutInvGamma) return;
+        lut.resize(kLutSize);
+        for (std::size_t i = 0; i < kLutSize; ++i) {
+            const std::uint32_t lo = kLutLowBits + (static_cast<std::uint32_t>(i) << kLutShift);
+            const std::uint32_t mid = lo + (1u << (kLutShift - 1));
+            float x;
+            std::memcpy(&x, &mid, sizeof x);
+            const double v = std::pow(static_cast<double>(x), static_cast<double>(invGamma));
+            lut[i] = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+        }
+        lutExposure = exposure;
+        lutInvGamma = invGamma;
+    }
+
+    // The frame decoded by codec::decodeImage into the frame texture, top row first (or bottom row
+    // first for a window), display values, background outside [0,1]^2 as the shader has it.
+    void decodeFrame(const codec::View& view, int width, int height, const ViewOptions& options) {
+        codec::DecodeOptions decode;
+        decode.view = view;
+        decode.width = width;
+        decode.height = height;
+        const format::Image frame = codec::decodeImage(rgb, *cpuMap, decode);
+        const float exposure = static_cast<float>(std::exp2(options.exposure));
+        const float invGamma = static_cast<float>(1.0 / std::max(options.gamma, 0.05));
+        // Which columns / rows are inside [0,1]^2 at the pixel centres (gl_FragCoord in the shader).
+        std::vector<std::uint8_t> colInside(width), rowInside(height);
+        const double su = (view.u1 - view.u0) / width, sv = (view.v1 - view.v0) / height;
+        for (int x = 0; x < width; ++x) {
+            const double u = view.u0 + (x + 0.5) * su;
+            colInside[x] = u >= 0.0 && u <= 1.0;
+        }
+        for (int y = 0; y < height; ++y) {
+            const double v = view.v0 + (y + 0.5) * sv;
+            rowInside[y] = v >= 0.0 && v <= 1.0;
+        }
+        const bool flip = options.bottomUp;
+        const std::size_t count = static_cast<std::size_t>(width) * height * 4;
+        if (floatTarget) {
+            frameFloats.resize(count);
+            parallelRows(height, [&](int y0, int y1) {
+                for (int y = y0; y < y1; ++y) {
+                    float* out = frameFloats.data() + static_cast<std::size_t>(flip ? height - 1 - y : y) * width * 4;
+                    const float* in = frame.pixels.data() + static_cast<std::size_t>(y) * width * 3;
+                    for (int x = 0; x < width; ++x, out += 4, in += 3) {
+                        for (int c = 0; c < 3; ++c)
+                            out[c] = rowInside[y] && colInside[x] ? std::pow(std::max(in[c] * exposure, 0.0f), invGamma)
+                                                                  : kBackground;
+                        out[3] = 1.0f;
+                    }
+                }
+            });
+        } else {
+            buildLut(exposure, invGamma);
+            frameBytes.resize(count);
+            const std::uint8_t background = static_cast<std::uint8_t>(std::lround(kBackground * 255.0f));
+            const std::uint8_t* table = lut.data();
+            parallelRows(height, [&](int y0, int y1) {
+                for (int y = y0; y < y1; ++y) {
+                    std::uint8_t* out = frameBytes.data() + static_cast<std::size_t>(flip ? height - 1 - y : y) * width * 4;
+                    const float* in = frame.pixels.data() + static_cast<std::size_t>(y) * width * 3;
+                    for (int x = 0; x < width; ++x, out += 4, in += 3) {
+                        if (!rowInside[y] || !colInside[x]) {
+                            out[0] = out[1] = out[2] = background;
+                        } else {
+                            for (int c = 0; c < 3; ++c) {
+                                const float f = in[c] * exposure;
+                                const std::uint32_t b = floatBits(f);
+                                out[c] = !(f >= 0x1p-32f) ? 0 : f >= 1.0f ? 255 : table[(b - kLutLowBits) >> kLutShift];
+                            }
+                        }
+                        out[3] = 255;
+                    }
+                }
+            });
+        }
+
+        const GladGLContext& gl = makeCurrentGl(context);
+        const GLenum format = floatTarget ? GL_RGBA32F : GL_RGBA8;
+        if (!frameTexture || frameWidth != width || frameHeight != height || frameFormat != format) {
+            if (frameTexture) gl.DeleteTextures(1, &frameTexture);
+            gl.GenTextures(1, &frameTexture);
+            gl.ActiveTexture(GL_TEXTURE0);
+            gl.BindTexture(GL_TEXTURE_2D, frameTexture);
+            gl.TexStorage2D(GL_TEXTURE_2D, 1, format, width, height);
+            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+            if (!frameFramebuffer) gl.GenFramebuffers(1, &frameFramebuffer);
+            GLint readBinding = 0;
+            gl.GetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readBinding);
+            gl.BindFramebuffer(GL_READ_FRAMEBUFFER, frameFramebuffer);
+            gl.FramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, frameTexture, 0);
+            gl.BindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readBinding));
+            frameWidth = width;
+            frameHeight = height;
+            frameFormat = format;
+        }
+        gl.ActiveTexture(GL_TEXTURE0);
+        gl.BindTexture(GL_TEXTURE_2D, frameTexture);
+        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        if (floatTarget) gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RGBA, GL_FLOAT, frameFloats.data());
+        else gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, frameBytes.data());
+        // Copied into the bound draw framebuffer; the read binding is left as it was (the viewer
+        // reads its back buffer for screenshots).
+        GLint readBinding = 0;
+        gl.GetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readBinding);
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, frameFramebuffer);
+        gl.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readBinding));
+        checkGl(gl, "ViewRenderer::draw (CPU decode)");
     }
 
     // The program for a mode and overlays: view_frame.frag.glsl with its VIEW_* switches defined
     // after the #version line (compiled once per combination, cached by the context).
-    GLuint program(const ViewOptions& options) {
+    // overlayOnly: the overlays alone, premultiplied, to blend over a frame already drawn.
+    GLuint program(const ViewOptions& options, bool overlayOnly = false) {
         const int mode = static_cast<int>(options.mode);
-        const std::string key = "view_frame/" + std::to_string(mode) + (options.grid ? "g" : "") + (options.outlines ? "o" : "");
+        const std::string key = "view_frame/" + std::to_string(mode) + (options.grid ? "g" : "") + (options.outlines ? "o" : "") +
+                                (overlayOnly ? "v" : "");
         std::string source = shaders::kShaderViewFrameFrag;
         const std::size_t eol = source.find('\n') + 1;
         source.insert(eol, "#define VIEW_MODE " + std::to_string(mode) + "\n#define VIEW_GRID " + (options.grid ? "1" : "0") +
-                               "\n#define VIEW_OUTLINES " + (options.outlines ? "1" : "0") + "\n");
+                               "\n#define VIEW_OUTLINES " + (options.outlines ? "1" : "0") + "\n#define VIEW_OVERLAY " +
+                               (overlayOnly ? "1" : "0") + "\n");
         return cachedProgram(context, key, shaders::kShaderFullscreenVert, source.c_str());
     }
 
@@ -179,6 +373,8 @@ void ViewRenderer::setImage(const format::ConusFile& file) {
     uploadRgba(gl, d.uniform, d.uniformImage);
     checkGl(gl, "ViewRenderer: image upload");
     d.uploadMap(map);
+    d.rgb = displayRgb(rgba);
+    d.cpuMap = map;
     d.conusWidth = rgba.width;
     d.conusHeight = rgba.height;
     d.sourceWidth = file.sourceWidth > 0 ? file.sourceWidth : rgba.width;
@@ -191,7 +387,12 @@ void ViewRenderer::setImage(const format::ConusFile& file) {
         }
 }
 
-void ViewRenderer::setMap(const codec::SamplingMap& map) { m_impl->uploadMap(map); }
+void ViewRenderer::setMap(const codec::SamplingMap& map) {
+    m_impl->uploadMap(map);
+    if (m_impl->cpuMap) m_impl->cpuMap = map;
+}
+
+bool ViewRenderer::decodesOnCpu(const ViewOptions& options) const { return hasImage() && m_impl->cpuDecode(options); }
 
 void ViewRenderer::draw(const codec::View& view, int width, int height, const ViewOptions& options) {
     Impl& d = *m_impl;
@@ -202,10 +403,21 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
         gl.Clear(GL_COLOR_BUFFER_BIT);
         return;
     }
-    const GLuint program = d.program(options);
+    const bool cpu = d.cpuDecode(options);
+    if (cpu) {
+        d.decodeFrame(view, width, height, options);
+        if (!options.grid && !options.outlines) return;
+    }
+    // The whole frame, or (after a CPU decode) the overlays blended over it.
+    const GLuint program = d.program(options, cpu);
     gl.Viewport(0, 0, width, height);
     gl.Disable(GL_DEPTH_TEST);
-    gl.Disable(GL_BLEND);
+    if (cpu) {
+        gl.Enable(GL_BLEND);
+        gl.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    } else {
+        gl.Disable(GL_BLEND);
+    }
     gl.UseProgram(program);
     const GLuint textures[3] = {d.conus, d.map, d.uniform};
     for (int unit = 0; unit < 3; ++unit) {
@@ -239,6 +451,7 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
     gl.BindVertexArray(d.context.impl().emptyVertexArray);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
     gl.BindVertexArray(0);
+    gl.Disable(GL_BLEND);
     checkGl(gl, "ViewRenderer::draw");
 }
 
@@ -256,7 +469,14 @@ format::Image ViewRenderer::renderToImage(const codec::View& view, int width, in
         throw Error(ErrorCode::Unsupported, std::string(kWhat) + ": cannot render to a " + std::to_string(width) + "x" +
                                                 std::to_string(height) + " RGBA32F framebuffer");
     options.bottomUp = false;  // read back top row first: no flip
-    draw(view, width, height, options);
+    m_impl->floatTarget = true;  // a CPU decode keeps float values
+    try {
+        draw(view, width, height, options);
+    } catch (...) {
+        m_impl->floatTarget = false;
+        throw;
+    }
+    m_impl->floatTarget = false;
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
     gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, out.pixels.data());
     checkGl(gl, kWhat);

@@ -61,6 +61,39 @@ TEST(ViewRenderer, ReconstructedMatchesTheCpuDecoder) {
     EXPECT_GT(psnrRgb(f.renderer.renderToImage(close, 256, 208, linear()), codec::decodeImage(f.file.image, f.map, options)), 50.0);
 }
 
+// The software-GL path (codec::decodeImage per frame, uploaded, overlays blended over it) and the
+// shader give the same frame, zoomed out (multi-tap), zoomed in, past the edge, with exposure, gamma
+// and overlays.
+TEST(ViewRenderer, CpuDecodeMatchesTheShader) {
+    Fixture& f = fixture();
+    for (const codec::View& view : {codec::View{0.1, 0.15, 0.9, 0.8}, codec::View{0.6, 0.5, 0.7, 0.6},
+                                    codec::View{-0.2, -0.1, 1.1, 1.2}, codec::View{}}) {
+        for (const bool overlays : {false, true}) {
+            ViewOptions o;
+            o.exposure = 0.5;
+            o.grid = overlays;
+            o.gridEvery = 5;
+            o.outlines = overlays;
+            o.decode = gl::DecodePath::Gpu;
+            EXPECT_FALSE(f.renderer.decodesOnCpu(o));
+            const format::Image gpu = f.renderer.renderToImage(view, 240, 180, o);
+            o.decode = gl::DecodePath::Cpu;
+            EXPECT_TRUE(f.renderer.decodesOnCpu(o));
+            const format::Image cpu = f.renderer.renderToImage(view, 240, 180, o);
+            EXPECT_GT(psnrRgb(gpu, cpu), overlays ? 40.0 : 50.0) << view.u0 << "," << view.v0 << " overlays " << overlays;
+            // Same background outside [0,1]^2, same alpha.
+            EXPECT_EQ(gpu.at(0, 0, 3), cpu.at(0, 0, 3));
+            if (view.u0 < 0) {
+                EXPECT_FLOAT_EQ(cpu.at(1, 1, 0), 0.11f);
+            }
+        }
+    }
+    // Other modes never decode on the CPU.
+    ViewOptions raw = linear(ViewMode::Raw);
+    raw.decode = gl::DecodePath::Cpu;
+    EXPECT_FALSE(f.renderer.decodesOnCpu(raw));
+}
+
 TEST(ViewRenderer, RawShowsTheCoNUSImageItself) {
     Fixture& f = fixture();
     const format::Image raw = f.renderer.renderToImage({}, test::kConusWidth, test::kConusHeight, linear(ViewMode::Raw));
@@ -86,7 +119,9 @@ TEST(ViewRenderer, WipeSplitsReconstructedAndUniform) {
     ViewOptions wipe = linear(ViewMode::Wipe);
     wipe.wipeX = 0.5;
     const format::Image w = f.renderer.renderToImage({}, 200, 150, wipe);
-    const format::Image r = f.renderer.renderToImage({}, 200, 150, linear());
+    ViewOptions shader = linear();
+    shader.decode = gl::DecodePath::Gpu;  // the wipe is drawn by the shader (pixel for pixel; the CPU path is within 50 dB)
+    const format::Image r = f.renderer.renderToImage({}, 200, 150, shader);
     const format::Image u = f.renderer.renderToImage({}, 200, 150, linear(ViewMode::Uniform));
     for (int y = 0; y < 150; y += 3) {
         for (int c = 0; c < 3; ++c) {

@@ -39,6 +39,14 @@ enum class ViewMode {
     Density,        // heat map of log det J of the map (the sampling density), from the nodes
 };
 
+// Where ViewMode::Reconstructed is decoded. Gpu: view_frame.frag.glsl per pixel. Cpu: codec::decodeImage
+// at the target's resolution every frame (still from the CoNUS data at every zoom, no cached frame),
+// uploaded and copied into the target, overlays drawn over it by a second pass; on a software
+// rasterizer (llvmpipe) the multithreaded incremental CPU decoder is several times faster than the
+// shader. Auto: the environment variable CONUS_VIEW_DECODE=cpu|gpu if set, else Cpu when GL_RENDERER
+// names a software rasterizer (llvmpipe, softpipe, swrast), else Gpu. Other modes always use the GPU.
+enum class DecodePath { Auto, Gpu, Cpu };
+
 struct ViewOptions {
     ViewMode mode = ViewMode::Reconstructed;
     bool grid = false;       // lines of the CoNUS pixel grid (where floor(u_d * W) changes)
@@ -48,6 +56,7 @@ struct ViewOptions {
     double gamma = 2.2;      // display gamma (1 = linear values straight to the framebuffer)
     double wipeX = 0.5;      // Wipe: split position, a fraction of the viewport width
     bool bottomUp = true;    // the target's row 0 is the bottom (a window); false: top (readback)
+    DecodePath decode = DecodePath::Auto;
 };
 
 class ViewRenderer {
@@ -79,6 +88,8 @@ public:
     void clear(int width, int height, float red, float green, float blue);
     // Waits for the GPU (for timing).
     void finish();
+    // Whether draw() with these options decodes on the CPU (DecodePath resolved for this context).
+    bool decodesOnCpu(const ViewOptions& options) const;
 
     // The uniform image computed by setImage (for tests and the inspector).
     const format::Image& uniformImage() const;
