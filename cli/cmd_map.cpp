@@ -17,6 +17,7 @@
 #include "conus/codec/compose.h"
 #include "conus/codec/foci.h"
 #include "conus/codec/ground_map.h"
+#include "conus/codec/map_file.h"
 #include "conus/codec/springs.h"
 #include "conus/format/container.h"
 #include "conus/format/error.h"
@@ -51,20 +52,9 @@ std::pair<double, double> parsePair(const std::string& text, const char* what) {
     return {a, b};
 }
 
-// A map file: the map in `samplingmap`, and as the CoNUS image the map's own density at each
-// node (columns x rows pixels, channel Y), so any EXR viewer shows where the samples go.
+// Writes the map file (codec/map_file.h), reports it, and draws its preview.
 void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticMap> analytic, const OutputOptions& out) {
-    format::ConusFile file;
-    file.image = format::makeImage(map.columns(), map.rows(), {"Y"});
-    for (int j = 0; j < map.rows(); ++j)
-        for (int i = 0; i < map.columns(); ++i)
-            file.image.at(i, j) = float(map.density({double(i) / (map.columns() - 1), double(j) / (map.rows() - 1)}));
-    file.pixelType = format::PixelType::Float;
-    file.sourceWidth = map.columns();
-    file.sourceHeight = map.rows();
-    file.dataKind = format::DataKind::Image;
-    file.map = map.toGrid();
-    file.analytic = std::move(analytic);
+    const format::ConusFile file = codec::makeMapFile(map, std::move(analytic));
     format::writeConusFile(out.output, file);
     const DensityStats stats = densityStats(map);
     std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g\n", out.output.c_str(), map.columns(), map.rows(),

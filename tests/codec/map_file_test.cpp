@@ -1,0 +1,24 @@
+#include <gtest/gtest.h>
+
+#include "conus/codec/foci.h"
+#include "conus/codec/map_file.h"
+
+using namespace conus;
+
+TEST(MapFile, HoldsTheMapAndItsDensityAndIsValid) {
+    const std::vector<codec::Focus> foci{{0.3, 0.4, 0.1, 3}};
+    const codec::SamplingMap map = codec::buildFociMap(foci, {});
+    format::AnalyticMap analytic{"foci", {{0.3, 0.4, 0.1, 3}}, "density", {}};
+    const format::ConusFile file = codec::makeMapFile(map, analytic);
+    EXPECT_TRUE(format::validateConusFile(file).ok()) << format::validateConusFile(file).str();
+    EXPECT_EQ(file.image.width, map.columns());
+    EXPECT_EQ(file.image.height, map.rows());
+    const auto back = codec::SamplingMap::fromGrid(file.map);
+    EXPECT_EQ(back.nodes(), map.nodes());
+    // The picture is the density at the nodes: high at the focus, below 1 far from it.
+    const int fi = static_cast<int>(0.3 * (map.columns() - 1) + 0.5), fj = static_cast<int>(0.4 * (map.rows() - 1) + 0.5);
+    EXPECT_GT(file.image.at(fi, fj), 4.0f);
+    EXPECT_LT(file.image.at(map.columns() - 1, map.rows() - 1), 1.0f);
+    ASSERT_TRUE(file.analytic.has_value());
+    EXPECT_EQ(file.analytic->foci.size(), 1u);
+}
