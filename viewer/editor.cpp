@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "conus/codec/encode.h"
+#include "conus/codec/map_file.h"
 
 namespace conus::viewer {
 
@@ -44,20 +45,7 @@ void MapEditor::reset() {
     m_painting = false;
 }
 
-format::ConusFile MapEditor::mapFile() const {
-    const codec::SamplingMap map = this->map();
-    format::ConusFile file;
-    file.image = format::makeImage(map.columns(), map.rows(), {"Y"});
-    for (int j = 0; j < map.rows(); ++j)
-        for (int i = 0; i < map.columns(); ++i)
-            file.image.at(i, j) = float(map.density({double(i) / (map.columns() - 1), double(j) / (map.rows() - 1)}));
-    file.pixelType = format::PixelType::Float;
-    file.sourceWidth = map.columns();
-    file.sourceHeight = map.rows();
-    file.dataKind = format::DataKind::Image;
-    file.map = map.toGrid();
-    return file;
-}
+format::ConusFile MapEditor::mapFile() const { return codec::makeMapFile(map()); }
 
 format::ConusFile MapEditor::encode(int width, int height) const {
     const codec::SamplingMap map = this->map();
