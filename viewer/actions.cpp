@@ -16,7 +16,7 @@ struct Binding {
 
 // Shared by the viewer and the editor; the editor's own table is searched first.
 const std::vector<Binding> kViewBindings = {
-    {"H", false, false, Action::Help, "H          this help"},
+    {"H", false, false, Action::Help, "H          this help (over the view; again to close)"},
     {"F", false, false, Action::Fit, "F          fit the image to the window"},
     {"1", false, false, Action::SourceResolution, "1          source resolution (1 source pixel = 1 window pixel)"},
     {"+", false, false, Action::ZoomIn, "+ / -      zoom in / out about the window centre (wheel: about the cursor)"},
@@ -43,6 +43,7 @@ const std::vector<Binding> kViewBindings = {
     {"R", false, true, Action::Reload, "Ctrl-R, F5 reload the file from disk"},
     {"F5", false, false, Action::Reload, ""},
     {"I", false, false, Action::Inspect, "I          print the pixel under the cursor (also shown in the title)"},
+    {"B", false, false, Action::ToggleStatusBar, "B          status bar: file, mode, zoom, the pixel under the cursor"},
     {"Q", false, false, Action::Quit, "Q, Esc     quit"},
     {"Escape", false, false, Action::Quit, ""},
 };

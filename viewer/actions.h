@@ -13,7 +13,7 @@ namespace conus::viewer {
 
 enum class Action {
     None,
-    Help,               // H: print the key list
+    Help,               // H: the key list over the view (and on stdout)
     Fit,                // F
     SourceResolution,   // 1: one source pixel per window pixel
     ZoomIn, ZoomOut,    // + / -
@@ -30,6 +30,7 @@ enum class Action {
     NextFile, PreviousFile,  // Tab / PageDown, Shift-Tab / PageUp
     Reload,             // Ctrl-R, F5
     Inspect,            // I: print the pixel under the cursor
+    ToggleStatusBar,    // B: one line at the bottom: file, mode, zoom, the pixel under the cursor
     Quit,               // Q, Escape
     // Map editor (--edit)
     SaveMap,            // S

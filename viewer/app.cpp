@@ -19,6 +19,7 @@
 #include "editor.h"
 #include "image_io.h"
 #include "inspector.h"
+#include "overlay.h"
 #include "script.h"
 #include "view_state.h"
 
@@ -60,7 +61,8 @@ std::string fileName(const std::string& path) { return std::filesystem::path(pat
 
 class App {
 public:
-    explicit App(const Options& options) : m_options(options), m_display(options.display) {}
+    explicit App(const Options& options)
+        : m_options(options), m_display(options.display), m_showHelp(options.helpOverlay), m_showStatus(options.statusBar) {}
     ~App() {
         // The renderer and its adopted Context delete GL objects: the window's context must live.
         m_renderer.reset();
@@ -80,6 +82,11 @@ private:
     void frame();
     int benchmark();
     void updateTitle();
+    std::string statusText() const;
+    void drawOverlays(int width, int height);
+    // Uploads `make()`'s panel into `slot` when `key` (what the panel shows) has changed.
+    template <class Make>
+    bool prepareOverlay(int slot, const std::string& key, Make make);
 
     // Input, shared by GLFW's callbacks and the script.
     void onCursor(glm::dvec2 pixel);
@@ -109,6 +116,10 @@ private:
     int m_waitFrames = 0;
     std::string m_pendingScreenshot;
     int m_exitCode = 0;
+    bool m_showHelp = false, m_showStatus = false;
+    std::string m_overlayKey[gl::ViewRenderer::kOverlaySlots];
+    int m_overlayHeight[gl::ViewRenderer::kOverlaySlots] = {};
+    bool m_textBroken = false;  // the font could not be drawn: overlays off, said once on stderr
 };
 
 // GLFW calls back with the window's user pointer; everything forwards to App.
@@ -248,6 +259,65 @@ void App::updateTitle() {
     glfwSetWindowTitle(m_window, title.c_str());
 }
 
+std::string App::statusText() const {
+    std::string text;
+    if (editing()) {
+        char line[160];
+        std::snprintf(line, sizeof line, "[edit] %s | brush r %.3f strength %.2f | %d strokes%s", fileName(m_options.edit).c_str(),
+                      m_editor->brush().radius, m_editor->brush().strength, m_editor->strokes(),
+                      m_editor->stable() ? " | stable" : " | relaxing");
+        text = line;
+        if (!m_editorMessage.empty()) text += " | " + m_editorMessage;
+        return text;
+    }
+    if (m_docs.empty()) return text;
+    const Document& doc = m_docs[m_current];
+    text = fileName(doc.path);
+    if (m_docs.size() > 1) text += " [" + std::to_string(m_current + 1) + "/" + std::to_string(m_docs.size()) + "]";
+    if (!doc.ok()) return text + " | ERROR: " + doc.error;
+    char line[96];
+    std::snprintf(line, sizeof line, " | %s | zoom %.3g%s%s%s%s", modeName(m_display.mode), m_state.zoom(),
+                  m_display.exposure != 0 ? (" | ev " + std::to_string(m_display.exposure).substr(0, 4)).c_str() : "",
+                  m_display.gamma == 1.0 ? " | linear" : "", m_display.grid ? " | grid" : "", m_display.outlines ? " | outlines" : "");
+    text += line;
+    if (!m_probe.empty()) text += " | " + m_probe;
+    return text;
+}
+
+template <class Make>
+bool App::prepareOverlay(int slot, const std::string& key, Make make) {
+    if (m_textBroken) return false;
+    if (m_overlayKey[slot] == key && m_renderer->hasOverlay(slot)) return true;
+    try {
+        const format::Image panel = make();
+        m_renderer->setOverlay(slot, panel);
+        m_overlayKey[slot] = key;
+        m_overlayHeight[slot] = panel.height;
+        return true;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "conus-view: no text in the window: %s\n", e.what());
+        m_textBroken = true;
+        return false;
+    }
+}
+
+void App::drawOverlays(int fw, int fh) {
+    const Document* doc = current();
+    if (!editing() && doc && !doc->ok()) {
+        const std::string name = fileName(doc->path);
+        if (prepareOverlay(kErrorSlot, name + "\n" + doc->error + "\n" + std::to_string(fw),
+                           [&] { return errorPanel(name, doc->error, fw); }))
+            m_renderer->drawOverlay(kErrorSlot, kOverlayMargin, kOverlayMargin, fw, fh);
+    }
+    if (m_showStatus) {
+        const std::string text = statusText();
+        if (prepareOverlay(kStatusSlot, text + "\n" + std::to_string(fw), [&] { return statusPanel(text, fw); }))
+            m_renderer->drawOverlay(kStatusSlot, 0, fh - m_overlayHeight[kStatusSlot], fw, fh);
+    }
+    if (m_showHelp && prepareOverlay(kHelpSlot, editing() ? "edit" : "view", [&] { return helpPanel(editing()); }))
+        m_renderer->drawOverlay(kHelpSlot, kOverlayMargin, kOverlayMargin, fw, fh);
+}
+
 void App::onCursor(glm::dvec2 pixel) {
     const glm::dvec2 delta = pixel - m_cursor;
     m_cursor = pixel;
@@ -289,7 +359,14 @@ void App::doAction(Action action) {
     const glm::dvec2 panStep = kKeyPanFraction * glm::dvec2(m_state.windowWidth(), m_state.windowHeight());
     switch (action) {
     case Action::None: return;
-    case Action::Help: std::fputs(helpText(editing()).c_str(), stdout); std::fflush(stdout); break;
+    case Action::Help:
+        m_showHelp = !m_showHelp;
+        if (m_showHelp) {
+            std::fputs(helpText(editing()).c_str(), stdout);
+            std::fflush(stdout);
+        }
+        break;
+    case Action::ToggleStatusBar: m_showStatus = !m_showStatus; break;
     case Action::Fit: m_state.fit(); break;
     case Action::SourceResolution: m_state.sourceResolution(); break;
     case Action::ZoomIn: m_state.zoomAbout(kKeyZoomStep, centre); break;
@@ -411,11 +488,12 @@ void App::frame() {
     }
     const Document* doc = current();
     if (doc && !doc->ok()) {
-        // No text overlay: the error is in the title and on stderr; the window turns dark red.
+        // The window turns dark red with the error written over it (also in the title and on stderr).
         m_renderer->clear(fw, fh, 0.35f, 0.05f, 0.05f);
     } else {
         m_renderer->draw(m_state.view(), fw, fh, m_display);
     }
+    drawOverlays(fw, fh);
     if (!m_pendingScreenshot.empty()) {
         // The back buffer, before the swap (the front buffer reads as zeros under Xvfb).
         try {

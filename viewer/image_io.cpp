@@ -2,6 +2,11 @@
 
 #include <algorithm>
 
+#include <cmath>
+#include <sstream>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include "conus/format/error.h"
@@ -39,6 +44,80 @@ void writeImage(const std::string& path, const format::Image& image) {
         for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
     if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !out->close())
         throw Error(ErrorCode::Io, "cannot write " + path + ": " + out->geterror());
+}
+
+constexpr const char* kFont = "DejaVuSans";
+
+int textWidth(const std::string& text, int fontSize) {
+    if (text.empty()) return 0;
+    const OIIO::ROI roi = OIIO::ImageBufAlgo::text_size(text, fontSize, kFont);
+    if (!roi.defined()) return static_cast<int>(std::lround(0.6 * fontSize * static_cast<double>(text.size())));
+    return roi.xend;  // from the pen's start (x 0) to the right edge of the last glyph
+}
+
+std::vector<std::string> wrapText(const std::string& text, int maxWidth, int fontSize) {
+    std::vector<std::string> out;
+    std::istringstream paragraphs(text);
+    std::string paragraph;
+    while (std::getline(paragraphs, paragraph)) {
+        std::string line;
+        std::istringstream words(paragraph);
+        std::string word;
+        while (words >> word) {
+            const std::string candidate = line.empty() ? word : line + " " + word;
+            if (textWidth(candidate, fontSize) <= maxWidth) {
+                line = candidate;
+                continue;
+            }
+            if (!line.empty()) out.push_back(line);
+            line = word;
+            // A word wider than a line (a long path): broken wherever it must be.
+            while (line.size() > 1 && textWidth(line, fontSize) > maxWidth) {
+                std::size_t n = line.size() - 1;
+                while (n > 1 && textWidth(line.substr(0, n), fontSize) > maxWidth) --n;
+                out.push_back(line.substr(0, n));
+                line = line.substr(n);
+            }
+        }
+        out.push_back(line);  // an empty paragraph stays an empty line
+    }
+    return out;
+}
+
+format::Image renderTextPanel(const std::vector<std::string>& lines, const TextPanelStyle& style) {
+    const int lineHeight = static_cast<int>(std::lround(style.fontSize * 1.3));
+    int width = 0;
+    // A line "key\tdescription" is two columns, the second at style.tabStop.
+    const auto columns = [&](const std::string& line) {
+        const std::size_t tab = line.find('\t');
+        return tab == std::string::npos ? std::pair<std::string, std::string>{line, ""}
+                                        : std::pair<std::string, std::string>{line.substr(0, tab), line.substr(tab + 1)};
+    };
+    for (const std::string& line : lines) {
+        const auto [left, right] = columns(line);
+        width = std::max(width, right.empty() ? textWidth(left, style.fontSize) : style.tabStop + textWidth(right, style.fontSize));
+    }
+    width = std::clamp(std::max(width + 2 * style.padding, style.minWidth), 1, format::kMaxImageSide);
+    const int height = std::clamp(static_cast<int>(lines.size()) * lineHeight + 2 * style.padding, 1, format::kMaxImageSide);
+    format::Image panel = format::makeImage(width, height, {"R", "G", "B", "A"});
+    for (std::size_t i = 0; i < panel.pixels.size(); ++i) panel.pixels[i] = style.panel[i % 4];
+    OIIO::ImageBuf buffer(OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::FLOAT), panel.pixels.data());
+    // render_text's y is the baseline: the ascent (about 0.8 of the size) below each line's top.
+    const int ascent = static_cast<int>(std::lround(style.fontSize * 1.0));
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+        const int y = style.padding + static_cast<int>(i) * lineHeight + ascent;
+        const auto [left, right] = columns(lines[i]);
+        bool ok = true;
+        if (!left.empty())
+            ok = OIIO::ImageBufAlgo::render_text(buffer, style.padding, y, left, style.fontSize, kFont, OIIO::cspan<float>(style.text, 4));
+        if (ok && !right.empty())
+            ok = OIIO::ImageBufAlgo::render_text(buffer, style.padding + style.tabStop, y, right, style.fontSize, kFont,
+                                                 OIIO::cspan<float>(style.text, 4));
+        if (!ok)
+            throw Error(ErrorCode::Io, std::string("cannot draw text in the font ") + kFont + " (package fonts-dejavu-core): " +
+                                           buffer.geterror());
+    }
+    return panel;
 }
 
 }  // namespace conus::viewer

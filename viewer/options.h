@@ -22,6 +22,8 @@ struct Options {
     std::string script;                  // --script CMDS.txt
     int benchmarkFrames = 0;             // --benchmark-frames N
     std::string backend = "auto";        // --backend for --screenshot (egl, osmesa)
+    bool helpOverlay = false;            // --help-overlay: start with the key list (H) shown
+    bool statusBar = false;              // --status-bar: start with the status bar (B) shown
 };
 
 // Parses argv. Returns nullopt after printing help (exit 0) or an error (exit 2, in *exitCode).

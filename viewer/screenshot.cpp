@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <vector>
 
 #include "conus/renderers/context.h"
 #include "conus/renderers/view_renderer.h"
 #include "document.h"
 #include "image_io.h"
+#include "overlay.h"
 
 namespace conus::viewer {
 
@@ -33,7 +36,20 @@ int runScreenshot(const Options& options) {
         auto context = gl::Context::create(gl::parseBackend(options.backend));
         gl::ViewRenderer renderer(*context);
         renderer.setImage(*doc.file);
-        const format::Image frame = renderer.renderToImage(view, width, height, options.display);
+        std::vector<gl::OverlayPlacement> overlays;
+        if (options.helpOverlay) {
+            renderer.setOverlay(kHelpSlot, helpPanel(false));
+            overlays.push_back({kHelpSlot, kOverlayMargin, kOverlayMargin});
+        }
+        if (options.statusBar) {
+            char text[160];
+            std::snprintf(text, sizeof text, "%s | %s | %dx%d", std::filesystem::path(doc.path).filename().string().c_str(),
+                          modeName(options.display.mode), width, height);
+            const format::Image bar = statusPanel(text, width);
+            renderer.setOverlay(kStatusSlot, bar);
+            overlays.push_back({kStatusSlot, 0, height - bar.height});
+        }
+        const format::Image frame = renderer.renderToImage(view, width, height, options.display, overlays);
         writeImage(options.screenshot, frame);
         std::printf("wrote %s: %dx%d, %s view of %s (%s)\n", options.screenshot.c_str(), width, height,
                     modeName(options.display.mode), doc.path.c_str(), context->renderer().c_str());

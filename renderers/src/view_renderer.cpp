@@ -163,12 +163,16 @@ struct ViewRenderer::Impl {
     std::vector<float> foci;  // u, v, r per focus
     float logDensityLo = 0, logDensityHi = 0;
     format::Image uniformImage;
+    GLuint overlays[ViewRenderer::kOverlaySlots] = {};
+    int overlayWidth[ViewRenderer::kOverlaySlots] = {}, overlayHeight[ViewRenderer::kOverlaySlots] = {};
 
     explicit Impl(Context& c) : context(c) {}
     ~Impl() {
         const GladGLContext& gl = makeCurrentGl(context);
         for (GLuint* t : {&conus, &map, &uniform, &frameTexture})
             if (*t) gl.DeleteTextures(1, t);
+        for (GLuint& t : overlays)
+            if (t) gl.DeleteTextures(1, &t);
         if (frameFramebuffer) gl.DeleteFramebuffers(1, &frameFramebuffer);
     }
 
@@ -455,7 +459,8 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
     checkGl(gl, "ViewRenderer::draw");
 }
 
-format::Image ViewRenderer::renderToImage(const codec::View& view, int width, int height, ViewOptions options) {
+format::Image ViewRenderer::renderToImage(const codec::View& view, int width, int height, ViewOptions options,
+                                          const std::vector<OverlayPlacement>& overlays) {
     constexpr const char* kWhat = "ViewRenderer::renderToImage";
     format::Image out = format::makeImage(width, height, {"R", "G", "B", "A"});
     const GladGLContext& gl = makeCurrentGl(m_impl->context);
@@ -472,6 +477,7 @@ format::Image ViewRenderer::renderToImage(const codec::View& view, int width, in
     m_impl->floatTarget = true;  // a CPU decode keeps float values
     try {
         draw(view, width, height, options);
+        for (const OverlayPlacement& o : overlays) drawOverlay(o.slot, o.x, o.y, width, height, false);
     } catch (...) {
         m_impl->floatTarget = false;
         throw;
@@ -505,6 +511,64 @@ void ViewRenderer::clear(int width, int height, float red, float green, float bl
     gl.Viewport(0, 0, width, height);
     gl.ClearColor(red, green, blue, 1.0f);
     gl.Clear(GL_COLOR_BUFFER_BIT);
+}
+
+void ViewRenderer::setOverlay(int slot, const format::Image& rgba) {
+    if (slot < 0 || slot >= kOverlaySlots)
+        throw Error(ErrorCode::InvalidArgument, "ViewRenderer::setOverlay: slot " + std::to_string(slot) + " out of range");
+    Impl& d = *m_impl;
+    const GladGLContext& gl = makeCurrentGl(d.context);
+    if (d.overlays[slot]) gl.DeleteTextures(1, &d.overlays[slot]);
+    d.overlays[slot] = 0;
+    d.overlayWidth[slot] = d.overlayHeight[slot] = 0;
+    if (rgba.width <= 0 || rgba.height <= 0) return;
+    if (rgba.channelCount() != 4)
+        throw Error(ErrorCode::InvalidArgument, "ViewRenderer::setOverlay: the overlay must be RGBA, not " +
+                                                    std::to_string(rgba.channelCount()) + " channels");
+    const int limit = d.context.maxTextureSize();
+    if (rgba.width > limit || rgba.height > limit)
+        throw Error(ErrorCode::LimitExceeded, "ViewRenderer::setOverlay: " + std::to_string(rgba.width) + "x" +
+                                                  std::to_string(rgba.height) + " exceeds GL_MAX_TEXTURE_SIZE");
+    uploadRgba(gl, d.overlays[slot], rgba);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    checkGl(gl, "ViewRenderer::setOverlay");
+    d.overlayWidth[slot] = rgba.width;
+    d.overlayHeight[slot] = rgba.height;
+}
+
+bool ViewRenderer::hasOverlay(int slot) const {
+    return slot >= 0 && slot < kOverlaySlots && m_impl->overlays[slot] != 0;
+}
+
+void ViewRenderer::drawOverlay(int slot, int x, int y, int width, int height, bool bottomUp) {
+    if (!hasOverlay(slot) || width <= 0 || height <= 0) return;
+    Impl& d = *m_impl;
+    // The overlay's rectangle clipped to the viewport, as a scissor box (GL rows from the bottom).
+    const int x0 = std::max(x, 0), x1 = std::min(x + d.overlayWidth[slot], width);
+    const int y0 = std::max(y, 0), y1 = std::min(y + d.overlayHeight[slot], height);
+    if (x0 >= x1 || y0 >= y1) return;
+    const GladGLContext& gl = makeCurrentGl(d.context);
+    const GLuint program = cachedProgram(d.context, "view_overlay", shaders::kShaderFullscreenVert, shaders::kShaderViewOverlayFrag);
+    gl.Viewport(0, 0, width, height);
+    gl.Disable(GL_DEPTH_TEST);
+    gl.Enable(GL_SCISSOR_TEST);
+    gl.Scissor(x0, bottomUp ? height - y1 : y0, x1 - x0, y1 - y0);
+    gl.Enable(GL_BLEND);
+    gl.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    gl.UseProgram(program);
+    gl.ActiveTexture(GL_TEXTURE0);
+    gl.BindTexture(GL_TEXTURE_2D, d.overlays[slot]);
+    gl.Uniform1i(gl.GetUniformLocation(program, "uOverlay"), 0);
+    gl.Uniform2i(gl.GetUniformLocation(program, "uOrigin"), x, y);
+    gl.Uniform1i(gl.GetUniformLocation(program, "uViewportHeight"), height);
+    gl.Uniform1i(gl.GetUniformLocation(program, "uBottomUp"), bottomUp ? 1 : 0);
+    gl.BindVertexArray(d.context.impl().emptyVertexArray);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl.BindVertexArray(0);
+    gl.Disable(GL_BLEND);
+    gl.Disable(GL_SCISSOR_TEST);
+    checkGl(gl, "ViewRenderer::drawOverlay");
 }
 
 void ViewRenderer::finish() { makeCurrentGl(m_impl->context).Finish(); }

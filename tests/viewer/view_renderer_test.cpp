@@ -214,5 +214,39 @@ TEST(ViewRenderer, OutsideTheImageIsBackground) {
     EXPECT_NE(im.at(45, 45, 0), 0.11f);
 }
 
+TEST(ViewRenderer, OverlayBlendsOverTheFrameInItsRectangleOnly) {
+    Fixture& f = fixture();
+    // A 40x20 overlay: left half opaque white, right half black at alpha 0.5.
+    format::Image overlay = format::makeImage(40, 20, {"R", "G", "B", "A"});
+    for (int y = 0; y < 20; ++y)
+        for (int x = 0; x < 40; ++x) {
+            const float v = x < 20 ? 1.0f : 0.0f;
+            for (int c = 0; c < 3; ++c) overlay.at(x, y, c) = v;
+            overlay.at(x, y, 3) = x < 20 ? 1.0f : 0.5f;
+        }
+    const int slot = 3;
+    f.renderer.setOverlay(slot, overlay);
+    ASSERT_TRUE(f.renderer.hasOverlay(slot));
+    const codec::View view{0.0, 0.0, 1.0, 1.0};
+    const format::Image plain = f.renderer.renderToImage(view, 160, 120, linear());
+    const format::Image over = f.renderer.renderToImage(view, 160, 120, linear(), {{slot, 30, 50}});
+    for (int y = 0; y < 120; ++y)
+        for (int x = 0; x < 160; ++x) {
+            const bool inside = x >= 30 && x < 70 && y >= 50 && y < 70;
+            for (int c = 0; c < 3; ++c) {
+                const float expected = !inside ? plain.at(x, y, c) : x < 50 ? 1.0f : 0.5f * plain.at(x, y, c);
+                ASSERT_NEAR(over.at(x, y, c), expected, 1e-4) << x << "," << y << " c" << c;
+            }
+        }
+    // Clipped at the edges, and an empty image empties the slot.
+    const format::Image corner = f.renderer.renderToImage(view, 160, 120, linear(), {{slot, 150, -10}});
+    EXPECT_NEAR(corner.at(155, 5, 0), 1.0f, 1e-4);
+    EXPECT_NEAR(corner.at(140, 5, 0), plain.at(140, 5, 0), 1e-4);
+    f.renderer.setOverlay(slot, format::Image{});
+    EXPECT_FALSE(f.renderer.hasOverlay(slot));
+    const format::Image none = f.renderer.renderToImage(view, 160, 120, linear(), {{slot, 30, 50}});
+    EXPECT_NEAR(none.at(40, 60, 1), plain.at(40, 60, 1), 1e-6);
+}
+
 }  // namespace
 }  // namespace conus::viewer

@@ -51,6 +51,29 @@ glm::dvec3 marker(const format::Image& im) {
     return sum.z > 0 ? glm::dvec3(sum.x / sum.z, sum.y / sum.z, sum.z) : sum;
 }
 
+// Pixels in [x0,x1)x[y0,y1) bright in every channel (white text).
+int brightPixels(const format::Image& im, int x0, int y0, int x1, int y1) {
+    int n = 0;
+    for (int y = y0; y < std::min(y1, im.height); ++y)
+        for (int x = x0; x < std::min(x1, im.width); ++x)
+            n += im.at(x, y, 0) > 0.9f && im.at(x, y, 1) > 0.9f && im.at(x, y, 2) > 0.9f;
+    return n;
+}
+
+// The rectangle [x0,x1)x[y0,y1) of the pixels that differ between a and b (x0 == x1 == 0: none).
+struct Box { int x0 = 0, y0 = 0, x1 = 0, y1 = 0; };
+Box changed(const format::Image& a, const format::Image& b) {
+    Box box{a.width, a.height, 0, 0};
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x)
+            for (int c = 0; c < 3; ++c)
+                if (std::abs(a.at(x, y, c) - b.at(x, y, c)) > 1.5f / 255) {
+                    box = {std::min(box.x0, x), std::min(box.y0, y), std::max(box.x1, x + 1), std::max(box.y1, y + 1)};
+                    break;
+                }
+    return box.x1 == 0 ? Box{} : box;
+}
+
 std::string xvfb(const std::string& args) {
     return "xvfb-run -a -s '-screen 0 1024x768x24' " + test::viewerBinary() + " " + args;
 }
@@ -98,6 +121,58 @@ TEST(ConusView, ScreenshotOfAnInvalidFileFailsWithAReason) {
     EXPECT_EQ(test::run(test::viewerBinary() + " --mode sideways " + test::conusPath(), &log), 2) << log;
 }
 
+TEST(ConusView, ScreenshotHelpOverlayDrawsTheKeyList) {
+    const fs::path dir = test::tempDir();
+    const std::string common = " " + test::conusPath() + " --size 800x640 --screenshot ";
+    std::string log;
+    ASSERT_EQ(test::run(test::viewerBinary() + common + (dir / "plain.png").string(), &log), 0) << log;
+    ASSERT_EQ(test::run(test::viewerBinary() + common + (dir / "help.png").string() + " --help-overlay", &log), 0) << log;
+    const format::Image plain = readPng(dir / "plain.png"), help = readPng(dir / "help.png");
+    ASSERT_EQ(help.width, 800);
+    ASSERT_EQ(help.height, 640);
+    // The panel starts at the 16-pixel margin; everything outside it is the frame untouched.
+    const Box box = changed(plain, help);
+    EXPECT_EQ(box.x0, 16);
+    EXPECT_EQ(box.y0, 16);
+    EXPECT_GT(box.x1 - box.x0, 200) << "a panel wide enough for the key list";
+    EXPECT_LT(box.x1, 800 - 16);
+    EXPECT_GT(box.y1 - box.y0, 300) << "a line per key";
+    EXPECT_LT(box.y1, 640);
+    // White text inside the panel, on a darkened frame.
+    EXPECT_GT(brightPixels(help, box.x0, box.y0, box.x1, box.y1), 10 * brightPixels(plain, box.x0, box.y0, box.x1, box.y1) + 500);
+    double plainSum = 0, helpSum = 0;
+    for (int y = box.y0; y < box.y1; ++y)
+        for (int x = box.x0; x < box.x1; ++x)
+            if (help.at(x, y, 0) < 0.5f) {
+                plainSum += plain.at(x, y, 1);
+                helpSum += help.at(x, y, 1);
+            }
+    EXPECT_LT(helpSum, 0.6 * plainSum) << "the panel darkens the frame behind the text";
+}
+
+TEST(ConusView, WindowHelpOverlayAndStatusBarToggle) {
+    ASSERT_TRUE(test::haveXvfb());
+    const fs::path dir = test::tempDir();
+    test::writeText(dir / "help.txt", "screenshot " + (dir / "w0.png").string() + "\nkey H\nscreenshot " +
+                                          (dir / "w1.png").string() + "\nkey H\nscreenshot " + (dir / "w2.png").string() +
+                                          "\nkey B\nscreenshot " + (dir / "w3.png").string() + "\n");
+    std::string log;
+    ASSERT_EQ(test::run(xvfb(test::conusPath() + " --window 640x560 --script " + (dir / "help.txt").string()), &log), 0) << log;
+    const format::Image w0 = readPng(dir / "w0.png"), w1 = readPng(dir / "w1.png"), w2 = readPng(dir / "w2.png"),
+                        w3 = readPng(dir / "w3.png");
+    ASSERT_EQ(w1.width, 640);
+    const Box help = changed(w0, w1);
+    EXPECT_EQ(help.x0, 16);
+    EXPECT_EQ(help.y0, 16);
+    EXPECT_GT(brightPixels(w1, help.x0, help.y0, help.x1, help.y1), 500) << "the key list in white";
+    EXPECT_EQ(changed(w0, w2).x1, 0) << "H again closes the help";
+    const Box status = changed(w0, w3);
+    EXPECT_GT(status.y0, 500) << "the status bar is one line at the bottom";
+    EXPECT_EQ(status.y1, 560);
+    EXPECT_GT(brightPixels(w3, 0, status.y0, 640, 560), 50);
+    EXPECT_NE(log.find("conus-view keys:"), std::string::npos) << "H still prints the keys too";
+}
+
 TEST(ConusView, WindowZoomKeepsTheFeatureUnderTheCursor) {
     ASSERT_TRUE(test::haveXvfb()) << "install xvfb (scripts/packages.txt)";
     const fs::path dir = test::tempDir();
@@ -138,8 +213,11 @@ TEST(ConusView, WindowShowsAnInvalidFileAsAnErrorWithoutCrashing) {
     EXPECT_NE(log.find("broken.exr"), std::string::npos) << log;
     const format::Image bad = readPng(dir / "bad.png"), good = readPng(dir / "good.png");
     ASSERT_EQ(bad.width, 320);
-    EXPECT_GT(bad.at(160, 120, 0), 0.3f);  // dark red
-    EXPECT_LT(bad.at(160, 120, 1), 0.1f);
+    EXPECT_GT(bad.at(310, 230, 0), 0.3f);  // dark red (the bottom-right corner, clear of the text)
+    EXPECT_LT(bad.at(310, 230, 1), 0.1f);
+    // The error is written in the window: white text on a darkened panel at the top left.
+    EXPECT_GT(brightPixels(bad, 0, 0, 320, 120), 100) << "no error text in the window";
+    EXPECT_EQ(brightPixels(bad, 0, 0, 16, 240), 0) << "the panel keeps its margin";
     ASSERT_EQ(good.width, 320);
     EXPECT_GT(marker(good).z, 10) << "the second file is shown";
     EXPECT_NE(log.find("error:"), std::string::npos) << log;

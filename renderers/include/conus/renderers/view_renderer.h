@@ -59,8 +59,17 @@ struct ViewOptions {
     DecodePath decode = DecodePath::Auto;
 };
 
+// An overlay (ViewRenderer::setOverlay) drawn over a frame at (x, y): its top-left corner, in
+// target pixels counted from the top-left of the target.
+struct OverlayPlacement {
+    int slot = 0;
+    int x = 0, y = 0;
+};
+
 class ViewRenderer {
 public:
+    static constexpr int kOverlaySlots = 4;
+
     explicit ViewRenderer(Context& context);
     ~ViewRenderer();
     ViewRenderer(const ViewRenderer&) = delete;
@@ -80,12 +89,25 @@ public:
 
     // Draws into an offscreen RGBA32F target and reads it back: RGBA, top row first, display
     // values (after exposure and gamma). options.bottomUp is ignored.
-    format::Image renderToImage(const codec::View& view, int width, int height, ViewOptions options);
+    // `overlays` are drawn over the frame (drawOverlay) before the read-back.
+    format::Image renderToImage(const codec::View& view, int width, int height, ViewOptions options,
+                                const std::vector<OverlayPlacement>& overlays = {});
     // Reads the currently bound read framebuffer (a window's back buffer before the swap) as
     // 8-bit-range RGBA floats in [0,1], top row first.
     format::Image readFramebuffer(int width, int height, bool bottomUp = true);
     // Clears the bound framebuffer to one colour (the viewer's "this file could not be opened").
     void clear(int width, int height, float red, float green, float blue);
+    // Overlays (the viewer's help panel, error text, status bar): straight-alpha RGBA images (R,G,B,A,
+    // top row first) uploaded once per slot (0 <= slot < kOverlaySlots) and drawn over the frame
+    // by drawOverlay every redraw. An image of width or height 0 empties the slot. Throws
+    // conus::Error(InvalidArgument) for a bad slot or an image that is not 4 channels,
+    // LimitExceeded beyond GL_MAX_TEXTURE_SIZE.
+    void setOverlay(int slot, const format::Image& rgba);
+    bool hasOverlay(int slot) const;
+    // Blends the slot's image (premultiplied "over") into the bound framebuffer, one texel per
+    // pixel, its top-left at (x, y) counted from the top-left of the viewport (0,0,width,height);
+    // clipped to the viewport. bottomUp as ViewOptions::bottomUp. Nothing for an empty slot.
+    void drawOverlay(int slot, int x, int y, int viewportWidth, int viewportHeight, bool bottomUp = true);
     // Waits for the GPU (for timing).
     void finish();
     // Whether draw() with these options decodes on the CPU (DecodePath resolved for this context).

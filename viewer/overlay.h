@@ -1,0 +1,22 @@
+// What conus-view draws as text over the frame: the help panel (H), the error of a file that could
+// not be opened, and the status bar (B). Rasterized by image_io's renderTextPanel (OpenImageIO),
+// uploaded once per change into a ViewRenderer overlay slot and drawn over every frame.
+#pragma once
+
+#include <string>
+
+#include "conus/format/image.h"
+
+namespace conus::viewer {
+
+inline constexpr int kHelpSlot = 0, kErrorSlot = 1, kStatusSlot = 2;  // ViewRenderer overlay slots
+inline constexpr int kOverlayMargin = 16;  // window pixels between the panels and the window's edge
+
+// The key list of helpText(editing) on a semi-transparent dark panel, white text.
+format::Image helpPanel(bool editing);
+// "Cannot open <file>" and the reason, wrapped to fit a window `windowWidth` pixels wide.
+format::Image errorPanel(const std::string& fileName, const std::string& error, int windowWidth);
+// One line across the window's width (file, mode, zoom, the pixel under the cursor).
+format::Image statusPanel(const std::string& text, int windowWidth);
+
+}  // namespace conus::viewer
