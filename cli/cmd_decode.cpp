@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "arguments.h"
@@ -33,6 +34,9 @@ Command addDecodeCommand(CLI::App& root) {
                         "world metres) instead of a 2-D view; 'viewer' is the ground map's own viewer");
     addBackendOption(*command, options->backend);
     return {command, [options] {
+                std::error_code same;
+                if (std::filesystem::equivalent(options->input, options->output, same))
+                    throw Error(ErrorCode::InvalidArgument, "the output " + options->output + " is the input file");
                 const format::ConusFile file = format::readConusFile(options->input);
                 if (!options->cameraText.empty()) {
                     // A height field seen from a camera: undistort to a mesh and render it.

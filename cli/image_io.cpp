@@ -63,6 +63,12 @@ void writeImage(const std::string& path, const format::Image& source) {
     if (keep.empty()) keep.push_back(0);
     if (holdsOnlyDisplayChannels(extension) && keep.size() > 4) keep.resize(4);
 
+    // libjpeg ends the process (exit()) on a larger image instead of returning an error.
+    constexpr int kJpegMaxSide = 65500;
+    if ((extension == ".jpg" || extension == ".jpeg") && (source.width > kJpegMaxSide || source.height > kJpegMaxSide))
+        throw Error(ErrorCode::InvalidArgument, path + ": JPEG holds at most 65500 pixels a side, not " +
+                                                    std::to_string(source.width) + "x" + std::to_string(source.height));
+
     OIIO::TypeDesc type = OIIO::TypeDesc::UINT8;
     if (extension == ".exr") type = OIIO::TypeDesc::HALF;
     else if (extension == ".tif" || extension == ".tiff") type = OIIO::TypeDesc::UINT16;

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <exception>
 #include <mutex>
 
 namespace conus::cli {
@@ -17,7 +18,13 @@ Progress::Progress(std::string label, bool quiet)
 }
 
 Progress::~Progress() {
-    if (!m_finished) done();
+    if (m_finished) return;
+    if (std::uncaught_exceptions() > 0) {
+        // Unwinding from an error: the step did not finish; main prints the reason.
+        if (!m_quiet && m_tty) std::fprintf(stderr, "\n");
+        return;
+    }
+    done();
 }
 
 ProgressFn Progress::callback() {

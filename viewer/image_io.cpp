@@ -1,6 +1,9 @@
 #include "image_io.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <filesystem>
 
 #include <cmath>
 #include <sstream>
@@ -42,8 +45,22 @@ void writeImage(const std::string& path, const format::Image& image) {
     OIIO::ImageSpec spec(image.width, image.height, channels, eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
     if (eightBit)
         for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
-    if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !out->close())
-        throw Error(ErrorCode::Io, "cannot write " + path + ": " + out->geterror());
+    // A temporary file beside the destination, renamed into place: never a half-written screenshot.
+    const std::filesystem::path target(path);
+    const std::filesystem::path temp =
+        target.parent_path() / ("." + target.stem().string() + ".tmp-" + std::to_string(::getpid()) + target.extension().string());
+    if (!out->open(temp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !out->close()) {
+        const std::string reason = out->geterror();
+        std::error_code ignored;
+        std::filesystem::remove(temp, ignored);
+        throw Error(ErrorCode::Io, "cannot write " + path + ": " + reason);
+    }
+    std::error_code ec;
+    std::filesystem::rename(temp, target, ec);
+    if (ec) {
+        std::filesystem::remove(temp, ec);
+        throw Error(ErrorCode::Io, "cannot write " + path + ": cannot rename the finished file into place");
+    }
 }
 
 constexpr const char* kFont = "DejaVuSans";

@@ -1,5 +1,7 @@
 #include "options.h"
 
+#include <cmath>
+
 #include <cstdio>
 #include <sstream>
 
@@ -29,8 +31,9 @@ codec::View parseView(const std::string& text) {
     char c1 = 0, c2 = 0, c3 = 0;
     std::istringstream in(text);
     if (!(in >> v.u0 >> c1 >> v.v0 >> c2 >> v.u1 >> c3 >> v.v1) || c1 != ',' || c2 != ',' || c3 != ',' || !in.eof() ||
-        v.u0 == v.u1 || v.v0 == v.v1)
-        throw Error(ErrorCode::InvalidArgument, "--view \"" + text + "\" is not u0,v0,u1,v1 with u0 != u1, v0 != v1");
+        v.u0 == v.u1 || v.v0 == v.v1 || !(std::abs(v.u0) <= 1e3 && std::abs(v.u1) <= 1e3 && std::abs(v.v0) <= 1e3 &&
+                                           std::abs(v.v1) <= 1e3))
+        throw Error(ErrorCode::InvalidArgument, "--view \"" + text + "\" is not u0,v0,u1,v1 with u0 != u1, v0 != v1, each within 1000 of the image");
     return v;
 }
 

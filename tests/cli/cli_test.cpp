@@ -219,6 +219,23 @@ TEST_F(Cli, DecodeViewMustNotBeEmpty) {
     EXPECT_FALSE(fs::exists(path("v.png")));
 }
 
+TEST_F(Cli, DecodeRefusesToOverwriteItsInputAndOversizedJpeg) {
+    const std::string in = makePicture(64, 64);
+    ASSERT_EQ(run("uniform " + in + " -o " + path("u.exr") + " --size 16x16").exitCode, 0);
+    const std::string before = slurp(path("u.exr"));
+    Result r = run("decode " + path("u.exr") + " -o " + path("u.exr"));
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find("is the input file"), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(path("u.exr")), before);
+    // libjpeg would end the process on this size; the writer refuses it first.
+    r = run("decode " + path("u.exr") + " -o " + path("wide.jpg") + " --size 65536x2");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("conus decode: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("65500"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("wide.jpg")));
+    EXPECT_TRUE(leftovers().empty());
+}
+
 TEST_F(Cli, FailedWriteLeavesNoFile) {
     const std::string in = makePicture(64, 64);
     const Result r = run("encode " + in + " -o " + path("no/such/dir/x.exr") + " --size 16x16");
