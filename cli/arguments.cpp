@@ -5,7 +5,7 @@
 #include <sstream>
 #include <vector>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::cli {
 namespace {

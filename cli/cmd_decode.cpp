@@ -10,72 +10,94 @@
 #include "backend.h"
 #include "commands.h"
 #include "conus/codec/decode.h"
-#include "conus/format/error.h"
-#include "image_io.h"
+#include "conus/core/error.h"
+#include "image_files.h"
 #include "progress.h"
 
 namespace conus::cli {
+namespace {
+
+struct DecodeCommandOptions {
+    std::string input, output, viewText, sizeText, cameraText, backend = "auto";
+    PictureOptions picture;
+};
+
+// The view at the source's resolution unless --size says otherwise.
+Size outputSize(const DecodeCommandOptions& o, const codec::View& view, const format::ConusFile& file) {
+    if (!o.sizeText.empty()) return parseSize(o.sizeText);
+    const double w = std::round((view.u1 - view.u0) * file.sourceWidth);
+    const double h = std::round((view.v1 - view.v0) * file.sourceHeight);
+    if (w > format::kMaxImageSide || h > format::kMaxImageSide || w * h > double(format::kMaxImagePixels))
+        throw Error(ErrorCode::InvalidArgument, "the view at source resolution would be " + std::to_string(long(w)) + "x" +
+                                                    std::to_string(long(h)) + " pixels, past the limits (" +
+                                                    std::to_string(format::kMaxImageSide) + " a side, " +
+                                                    std::to_string(format::kMaxImagePixels) + " in all); give --size");
+    return {std::max(1, static_cast<int>(w)), std::max(1, static_cast<int>(h))};
+}
+
+int runDecode(const DecodeCommandOptions& o) {
+    imageio::WriteOptions write = writeOptionsOf(o.picture, nullptr);
+    checkPictureOutput(o.output, write, {o.input});
+    const codec::View view = o.viewText.empty() ? codec::View{} : parseView(o.viewText);
+    Progress reading("read " + o.input);
+    const format::ConusFile file = format::readConusFile(o.input);
+    reading.done();
+    write.source = &file.sourceEncoding;
+    // An EXR keeps the file's own precision: a --float file decodes to float.
+    if (!write.sampleType && std::filesystem::path(o.output).extension() == ".exr")
+        write.sampleType = file.pixelType == format::PixelType::Float ? SampleType::Float : SampleType::Half;
+
+    if (!o.cameraText.empty()) {
+        // A height field seen from a camera: undistort to a mesh and render it.
+        const Size size = parseSize(o.sizeText.empty() ? "960x540" : o.sizeText);
+        const format::Image frame = renderHeightFieldFrame(file, o.cameraText == "viewer" ? "" : o.cameraText, size.width,
+                                                           size.height, o.backend);
+        writePicture(o.output, frame, writeOptionsOf(o.picture, nullptr));
+        std::printf("wrote %s: %dx%d frame of the height field\n", o.output.c_str(), frame.width, frame.height);
+        return 0;
+    }
+    const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
+    const Size size = outputSize(o, view, file);
+    codec::DecodeOptions decode;
+    decode.view = view;
+    decode.width = size.width;
+    decode.height = size.height;
+    Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
+    decode.progress = progress.callback();
+    Renderer renderer(o.backend);
+    const format::Image frame = renderer.decode(file.image, map, decode);
+    progress.done();
+    writePicture(o.output, frame, write);
+    std::printf("wrote %s: %dx%d view [%g,%g]-[%g,%g]\n", o.output.c_str(), frame.width, frame.height, view.u0, view.v0,
+                view.u1, view.v1);
+    return 0;
+}
+
+}  // namespace
 
 Command addDecodeCommand(CLI::App& root) {
-    struct Options {
-        std::string input, output, viewText, sizeText, cameraText, backend = "auto";
-    };
-    auto options = std::make_shared<Options>();
+    auto options = std::make_shared<DecodeCommandOptions>();
     CLI::App* command = root.add_subcommand(
         "decode", "Reconstruct a conventional frame from a CoNUS file: zoom and pan anywhere");
+    command->footer(
+        "Examples:\n"
+        "  conus decode photo.exr -o photo.png                          # the whole frame at source size\n"
+        "  conus decode photo.exr -o face.png --view 0.36,0.15,0.52,0.31  # zoomed on a focus\n"
+        "  conus decode hdr.exr -o hdr.png --exposure -1 --tonemap aces --size 1920x1080");
     command->add_option("input", options->input, "CoNUS file (.exr)")->required();
-    command->add_option("-o,--output", options->output, "output image (.png, .exr, .tif, .jpg)")->required();
+    command->add_option("-o,--output", options->output, "output image (.png, .jpg, .tif, .exr, .bmp, ...)")->required();
     command->add_option("--view", options->viewText,
-                        "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image)");
+                        "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image; "
+                        "outside [0,1] shows the background)");
     command->add_option("--size", options->sizeText,
                         "output size WxH (default: the view at the source's resolution)");
     command->add_option("--camera", options->cameraText,
                         "height fields: render a 3-D frame from x,y,z,lx,ly,lz,fovDeg (eye, look-at, vertical fov; "
                         "world metres) instead of a 2-D view; 'viewer' is the ground map's own viewer");
+    addPictureOptions(*command, options->picture);
     addBackendOption(*command, options->backend);
-    return {command, [options] {
-                std::error_code same;
-                if (std::filesystem::equivalent(options->input, options->output, same))
-                    throw Error(ErrorCode::InvalidArgument, "the output " + options->output + " is the input file");
-                const format::ConusFile file = format::readConusFile(options->input);
-                if (!options->cameraText.empty()) {
-                    // A height field seen from a camera: undistort to a mesh and render it.
-                    const Size size = parseSize(options->sizeText.empty() ? "960x540" : options->sizeText);
-                    const format::Image frame = renderHeightFieldFrame(
-                        file, options->cameraText == "viewer" ? "" : options->cameraText, size.width, size.height,
-                        options->backend);
-                    writeImage(options->output, frame);
-                    std::printf("wrote %s: %dx%d frame of the height field\n", options->output.c_str(), frame.width,
-                                frame.height);
-                    return 0;
-                }
-                const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
-                codec::DecodeOptions decode;
-                if (!options->viewText.empty()) decode.view = parseView(options->viewText);
-                if (!options->sizeText.empty()) {
-                    const Size size = parseSize(options->sizeText);
-                    decode.width = size.width;
-                    decode.height = size.height;
-                } else {
-                    const double w = std::round((decode.view.u1 - decode.view.u0) * file.sourceWidth);
-                    const double h = std::round((decode.view.v1 - decode.view.v0) * file.sourceHeight);
-                    if (w > format::kMaxImageSide || h > format::kMaxImageSide)
-                        throw Error(ErrorCode::InvalidArgument,
-                                    "the view at source resolution would be " + std::to_string(long(w)) + "x" +
-                                        std::to_string(long(h)) + " pixels; give --size");
-                    decode.width = std::max(1, static_cast<int>(w));
-                    decode.height = std::max(1, static_cast<int>(h));
-                }
-                Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
-                decode.progress = progress.callback();
-                Renderer renderer(options->backend);
-                const format::Image frame = renderer.decode(file.image, map, decode);
-                progress.done();
-                writeImage(options->output, frame);
-                std::printf("wrote %s: %dx%d view [%g,%g]-[%g,%g]\n", options->output.c_str(), frame.width,
-                            frame.height, decode.view.u0, decode.view.v0, decode.view.u1, decode.view.v1);
-                return 0;
-            }};
+    addQuietOption(*command);
+    return {command, [options] { return runDecode(*options); }};
 }
 
 }  // namespace conus::cli

@@ -19,7 +19,8 @@
 #include "conus/codec/metrics.h"
 #include "demo_picture.h"
 #include "encoding.h"
-#include "image_io.h"
+#include "conus/imageio/image_file.h"
+#include "image_files.h"
 #include "importance.h"
 #include "pictures.h"
 #include "progress.h"
@@ -68,6 +69,11 @@ Command addDemoCommand(CLI::App& root) {
     auto options = std::make_shared<Options>();
     CLI::App* command = root.add_subcommand(
         "demo", "The main job on a built-in picture: CoNUS vs uniform at 1/16 of the pixels, with PSNR");
+    command->footer(
+        "Examples:\n"
+        "  conus demo                                   # the built-in 4096x4096 picture, two foci\n"
+        "  conus demo --input photo.jpg --focus 0.42,0.31,0.08,4 --out my-demo\n"
+        "  conus demo --input portrait.jpg --importance faces");
     command->add_option("--out", options->out, "folder for the pictures and files (default demo-out)");
     command->add_option("--size", options->size, "side of the built-in picture (default 4096)")
         ->check(CLI::Range(256, 8192));
@@ -79,20 +85,29 @@ Command addDemoCommand(CLI::App& root) {
                         "with --input: build the map automatically from importance (a file, 'detail' or 'faces') "
                         "instead of foci; --focus then only names the views to compare");
     addBackendOption(*command, options->backend);
+    addQuietOption(*command);
     return {command, [options] {
                 namespace fs = std::filesystem;
                 fs::create_directories(options->out);
                 const fs::path out(options->out);
                 format::Image source;
+                SourceEncoding encoding;
                 std::vector<codec::Focus> foci;
                 if (options->input.empty()) {
                     Progress picture("build the " + std::to_string(options->size) + "x" +
                                      std::to_string(options->size) + " demo picture");
                     source = makeDemoPicture(options->size);
+                    // Drawn as an 8-bit sRGB picture would hold it; CoNUS works in linear light.
+                    imageio::linearize(source);
+                    encoding.transfer = Transfer::Srgb;
+                    encoding.sampleType = SampleType::Uint8;
+                    encoding.chromaticities = kRec709Chromaticities;
                     picture.done();
                     foci = {{0.28, 0.30, 0.07, options->k}, {0.70, 0.66, 0.07, options->k}};
                 } else {
-                    source = readImage(options->input);
+                    imageio::ImageFile file = readSource(options->input, {});
+                    source = std::move(file.image);
+                    encoding = file.info.encoding;
                     for (const auto& text : options->foci) foci.push_back(codec::parseFocus(text));
                     if (foci.empty()) foci.push_back({0.5, 0.5, 0.1, options->k});
                 }
@@ -116,16 +131,18 @@ Command addDemoCommand(CLI::App& root) {
 
                 const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
                 Renderer renderer(options->backend);
-                format::ConusFile conus = encodeToConus(renderer, source, map, size, analytic);
+                format::ConusFile conus = encodeToConus(renderer, source, encoding, map, size, analytic);
                 format::ConusFile uniform =
-                    encodeToConus(renderer, source, codec::SamplingMap::identity(2, 2), size, std::nullopt);
+                    encodeToConus(renderer, source, encoding, codec::SamplingMap::identity(2, 2), size, std::nullopt);
                 format::writeConusFile((out / "conus.exr").string(), conus);
                 format::writeConusFile((out / "uniform.exr").string(), uniform);
-                writeImage((out / "conus.png").string(), conus.image);
-                writeImage((out / "uniform.png").string(), uniform.image);
+                imageio::WriteOptions picture;
+                picture.source = &encoding;
+                writePicture((out / "conus.png").string(), conus.image, picture);
+                writePicture((out / "uniform.png").string(), uniform.image, picture);
                 const double shrink = std::min(1.0, 1024.0 / std::max(w, h));
                 const int pw = std::max(16, int(w * shrink)), ph = std::max(16, int(h * shrink));
-                writeImage((out / "density.png").string(), densityPicture(map, pw, ph, 32, analytic ? &*analytic : nullptr));
+                writeDrawing((out / "density.png").string(), densityPicture(map, pw, ph, 32, analytic ? &*analytic : nullptr));
                 const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
 
                 struct ViewCase {
@@ -170,7 +187,7 @@ Command addDemoCommand(CLI::App& root) {
                     std::vector<format::Image> strip{reference, fromConus, fromUniform};
                     if (v.outWidth != v.width)
                         for (auto& image : strip) image = codec::areaDownsample(image, v.outWidth, v.outHeight);
-                    writeImage((out / ("view-" + v.name + ".png")).string(), sideBySide(strip));
+                    writePicture((out / ("view-" + v.name + ".png")).string(), sideBySide(strip), picture);
                 }
                 std::string written;
                 for (const auto& v : views) written += ", view-" + v.name + ".png";

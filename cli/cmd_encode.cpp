@@ -1,4 +1,4 @@
-// conus encode: a conventional image -> a CoNUS file, through foci, a map file, or the identity.
+// conus encode: a conventional image -> a CoNUS file, through foci, a map file, or importance.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -8,24 +8,98 @@
 #include "conus/codec/auto_map.h"
 #include "conus/codec/foci.h"
 #include "encoding.h"
-#include "image_io.h"
+#include "image_files.h"
 #include "importance.h"
 #include "progress.h"
 
 namespace conus::cli {
+namespace {
+
+struct EncodeOptions {
+    std::string input, output, mapFile, compose = "density", importance, method = "flow";
+    double minDensity = 0.25, maxDensity = 16;
+    std::vector<std::string> foci;
+    int grid = 65;
+    SourceOptions source;
+    StorageOptions storage;
+};
+
+struct BuiltMap {
+    std::unique_ptr<codec::SamplingMap> map;
+    std::optional<format::AnalyticMap> analytic;
+};
+
+BuiltMap mapFromFile(const std::string& path) {
+    const format::ConusFile mapSource = format::readConusFile(path);
+    return {std::make_unique<codec::SamplingMap>(codec::SamplingMap::fromGrid(mapSource.map)), mapSource.analytic};
+}
+
+BuiltMap mapFromImportance(const EncodeOptions& o, const format::Image& source) {
+    Progress progress("build sampling map from " + o.importance + " importance");
+    codec::AutoMapOptions autoOptions;
+    autoOptions.columns = autoOptions.rows = o.grid;
+    autoOptions.minDensity = o.minDensity;
+    autoOptions.maxDensity = o.maxDensity;
+    autoOptions.method = o.method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
+    BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildAutoMap(importanceFrom(o.importance, source), autoOptions)),
+                   std::nullopt};
+    progress.done();
+    return built;
+}
+
+BuiltMap mapFromFoci(const EncodeOptions& o, const format::Image& source) {
+    std::vector<codec::Focus> foci;
+    format::AnalyticMap params{"foci", {}, o.compose, {}};
+    for (const auto& text : o.foci) {
+        foci.push_back(codec::parseFocus(text));
+        params.foci.push_back({foci.back().u, foci.back().v, foci.back().r, foci.back().k});
+    }
+    codec::FociOptions fo;
+    fo.columns = fo.rows = o.grid;
+    fo.aspect = double(source.width) / source.height;
+    fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+    Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
+    BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo)), params};
+    progress.done();
+    return built;
+}
+
+int runEncode(const EncodeOptions& o) {
+    checkConusOutput(o.output, o.input);
+    const imageio::ImageFile source = readSource(o.input, o.source);
+    const Size size = conusSize(o.storage, source.image);
+    BuiltMap built;
+    if (!o.mapFile.empty()) built = mapFromFile(o.mapFile);
+    else if (!o.importance.empty()) built = mapFromImportance(o, source.image);
+    else if (!o.foci.empty()) built = mapFromFoci(o, source.image);
+    else {
+        warn("no --focus, --map or --importance: writing the uniform image of the same pixel count (what `conus "
+             "uniform` makes)");
+        built.map = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
+    }
+    Renderer renderer(o.storage.backend);
+    format::ConusFile file = encodeToConus(renderer, source.image, source.info.encoding, *built.map, size, built.analytic);
+    applyStorage(o.storage, file);
+    Progress writing("write " + o.output);
+    format::writeConusFile(o.output, file);
+    writing.done();
+    std::printf("wrote %s: %dx%d CoNUS image of a %dx%d source, %dx%d sampling map\n", o.output.c_str(), size.width,
+                size.height, source.image.width, source.image.height, built.map->columns(), built.map->rows());
+    return 0;
+}
+
+}  // namespace
 
 Command addEncodeCommand(CLI::App& root) {
-    struct Options {
-        std::string input, output, mapFile, compose = "density", importance, method = "flow";
-        double minDensity = 0.25, maxDensity = 16;
-        std::vector<std::string> foci;
-        int grid = 65;
-        StorageOptions storage;
-    };
-    auto options = std::make_shared<Options>();
+    auto options = std::make_shared<EncodeOptions>();
     CLI::App* command = root.add_subcommand(
         "encode", "Encode an image (PNG, JPEG, TIFF, EXR, ...) into a CoNUS file through a sampling map");
-    command->add_option("input", options->input, "source image")->required();
+    command->footer(
+        "Examples:\n"
+        "  conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4\n"
+        "  conus encode photo.jpg -o photo.exr --size 1024x768 --importance faces\n"
+        "  conus encode scan.tif -o scan.exr --map painted.exr --float");
+    command->add_option("input", options->input, "source image ('-' reads standard input)")->required();
     command->add_option("-o,--output", options->output, "output CoNUS file (.exr)")->required();
     command->add_option("--focus", options->foci,
                         "focus u,v,r,k: centre (u,v) in [0,1], radius r as a fraction of the width, linear "
@@ -48,56 +122,10 @@ Command addEncodeCommand(CLI::App& root) {
         ->check(CLI::IsMember({"density", "add"}));
     command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus and --importance (default 65)")
         ->check(CLI::Range(2, 1025));
+    addSourceOptions(*command, options->source);
     addStorageOptions(*command, options->storage);
-
-    return {command, [options] {
-                const format::Image source = readImage(options->input);
-                const Size size = conusSize(options->storage, source);
-                std::optional<format::AnalyticMap> analytic;
-                std::unique_ptr<codec::SamplingMap> map;
-                if (!options->mapFile.empty()) {
-                    const format::ConusFile mapSource = format::readConusFile(options->mapFile);
-                    map = std::make_unique<codec::SamplingMap>(codec::SamplingMap::fromGrid(mapSource.map));
-                    analytic = mapSource.analytic;
-                } else if (!options->importance.empty()) {
-                    Progress progress("build sampling map from " + options->importance + " importance");
-                    codec::AutoMapOptions autoOptions;
-                    autoOptions.columns = autoOptions.rows = options->grid;
-                    autoOptions.minDensity = options->minDensity;
-                    autoOptions.maxDensity = options->maxDensity;
-                    autoOptions.method =
-                        options->method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
-                    map = std::make_unique<codec::SamplingMap>(
-                        codec::buildAutoMap(importanceFrom(options->importance, source), autoOptions));
-                    progress.done();
-                } else if (!options->foci.empty()) {
-                    std::vector<codec::Focus> foci;
-                    format::AnalyticMap params{"foci", {}, options->compose, {}};
-                    for (const auto& text : options->foci) {
-                        foci.push_back(codec::parseFocus(text));
-                        params.foci.push_back({foci.back().u, foci.back().v, foci.back().r, foci.back().k});
-                    }
-                    codec::FociOptions fo;
-                    fo.columns = fo.rows = options->grid;
-                    fo.aspect = double(source.width) / source.height;
-                    fo.composition = options->compose == "add" ? codec::FociComposition::Add
-                                                               : codec::FociComposition::Density;
-                    Progress progress("build sampling map (" + std::to_string(foci.size()) + " foci)");
-                    map = std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo));
-                    progress.done();
-                    analytic = params;
-                } else {
-                    map = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
-                }
-                Renderer renderer(options->storage.backend);
-                format::ConusFile file = encodeToConus(renderer, source, *map, size, analytic);
-                applyStorage(options->storage, file);
-                format::writeConusFile(options->output, file);
-                std::printf("wrote %s: %dx%d CoNUS image of a %dx%d source, %dx%d sampling map\n",
-                            options->output.c_str(), size.width, size.height, source.width, source.height,
-                            map->columns(), map->rows());
-                return 0;
-            }};
+    addQuietOption(*command);
+    return {command, [options] { return runEncode(*options); }};
 }
 
 }  // namespace conus::cli

@@ -16,20 +16,29 @@
 #include "conus/codec/heightfield.h"
 #include "conus/codec/metrics.h"
 #include "conus/format/container.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "conus/renderers/terrain.h"
 #include "dem_io.h"
-#include "image_io.h"
+#include "conus/imageio/image_file.h"
+#include "image_files.h"
 #include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
 namespace {
 
-// The DEM's colour: a texture (resized down to the DEM when larger), else the height/slope ramp.
-format::Image demColour(const Dem& dem, const std::string& texture, glm::dvec2 extent) {
-    if (texture.empty()) return codec::terrainColours(dem.heights, extent);
-    format::Image image = readImage(texture);
+// The DEM's colour in linear light: a texture (resized down to the DEM when larger), else the
+// height/slope ramp (drawn as display colours). `encoding` receives what the colour came from.
+format::Image demColour(const Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding = nullptr) {
+    if (texture.empty()) {
+        format::Image ramp = codec::terrainColours(dem.heights, extent);
+        imageio::linearize(ramp);
+        if (encoding) *encoding = {Transfer::Srgb, SampleType::Uint8, kRec709Chromaticities, {}, {}};
+        return ramp;
+    }
+    imageio::ImageFile file = readSource(texture, {});
+    if (encoding) *encoding = file.info.encoding;
+    format::Image image = std::move(file.image);
     if (image.width == dem.heights.width && image.height == dem.heights.height) return image;
     if (image.width < dem.heights.width || image.height < dem.heights.height)
         throw Error(ErrorCode::InvalidArgument, "colour texture " + texture + " (" + std::to_string(image.width) + "x" +
@@ -136,7 +145,15 @@ Command addHeightFieldCommand(CLI::App& root) {
     encode->add_option("--height-scale", o->heightScale, "multiplies the DEM's values (to metres)")
         ->capture_default_str();
     encode->add_option("--colour,--color", o->colour, "colour texture (default: a ramp by height and slope)");
-    encode->add_option("--compression", o->compression, "zip | piz | dwaa | none")->capture_default_str();
+    encode->add_option("--compression", o->compression, "zip | piz | dwaa | none")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"zip", "piz", "dwaa", "none"}));
+    addQuietOption(*encode);
+    encode->footer(
+        "Examples:\n"
+        "  conus heightfield encode procedural -o terrain.exr\n"
+        "  conus heightfield encode dem.tif --height-scale 800 -o terrain.exr --size 1024x1024 --eye-height 150\n"
+        "  conus heightfield encode jacksboro_fault_dem.npz --colour ortho.png -o terrain.exr");
 
     CLI::App* render = command->add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
     render->add_option("input", o->input, "CoNUS height field (.exr)")->required();
@@ -150,7 +167,15 @@ Command addHeightFieldCommand(CLI::App& root) {
                        "field of the same sample count, side by side (full | CoNUS | uniform), with PSNRs");
     render->add_option("--height-scale", o->heightScale, "as given to encode (for --compare)")->capture_default_str();
     render->add_option("--colour,--color", o->colour, "as given to encode (for --compare)");
-    render->add_option("--backend", o->backend, "auto | egl | osmesa (GL is needed)")->capture_default_str();
+    render->add_option("--backend", o->backend, "auto | egl | osmesa (GL is needed: there is no CPU path)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "egl", "osmesa"}, CLI::ignore_case));
+    addQuietOption(*render);
+    render->footer(
+        "Examples:\n"
+        "  conus heightfield render terrain.exr -o frame.png\n"
+        "  conus heightfield render terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720\n"
+        "  conus heightfield render terrain.exr -o compare.png --compare procedural");
 
     return {command, [o, encode, render] {
                 if (encode->parsed()) {
@@ -173,12 +198,14 @@ Command addHeightFieldCommand(CLI::App& root) {
                     options.height = size.height;
                     options.mapGrid = o->grid;
                     const glm::dvec2 extent = codec::fieldExtent(options.ground);
-                    const format::Image colour = demColour(dem, o->colour, extent);
+                    SourceEncoding encoding;
+                    const format::Image colour = demColour(dem, o->colour, extent, &encoding);
                     Progress progress("encode height field " + o->sizeText);
                     options.progress = progress.callback();
                     format::ConusFile file = codec::encodeHeightField(dem.heights, colour, options);
                     progress.done();
                     file.compression = parseCompression(o->compression);
+                    file.sourceEncoding = encoding;
                     format::writeConusFile(o->output, file);
                     std::printf("wrote %s: %dx%d CoNUS height field of %s; field %.0f x %.0f m (eye %g m, near %g m, "
                                 "far %g m, fov %.2f deg); heights %.1f..%.1f m\n",
@@ -199,7 +226,7 @@ Command addHeightFieldCommand(CLI::App& root) {
                 progress.done();
                 printCamera(camera);
                 if (o->compare.empty()) {
-                    writeImage(o->frame, frame);
+                    writePicture(o->frame, frame);
                     std::printf("wrote %s: %dx%d frame (%s)\n", o->frame.c_str(), frame.width, frame.height,
                                 context->renderer().c_str());
                     return 0;
@@ -219,7 +246,7 @@ Command addHeightFieldCommand(CLI::App& root) {
                     camera, size.width, size.height);
                 comparing.done();
                 const format::Image panels[] = {full, frame, uniform};
-                writeImage(o->frame, sideBySide(panels));
+                writePicture(o->frame, sideBySide(panels));
                 std::printf("wrote %s: full resolution %dx%d | CoNUS %dx%d | uniform %dx%d (%s)\n", o->frame.c_str(),
                             dem.heights.width, dem.heights.height, file.image.width, file.image.height,
                             file.image.width, file.image.height, context->renderer().c_str());

@@ -8,10 +8,11 @@
 #include "commands.h"
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "conus/renderers/context.h"
-#include "image_io.h"
+#include "image_files.h"
 #include "pictures.h"
+#include "progress.h"
 
 namespace conus::cli {
 
@@ -43,7 +44,7 @@ int printBackends(bool json) {
 Command addInfoCommand(CLI::App& root) {
     struct Options {
         std::string input, densityPng;
-        bool json = false, backends = false;
+        bool json = false, backends = false, verbose = false;
     };
     auto options = std::make_shared<Options>();
     CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth");
@@ -51,12 +52,29 @@ Command addInfoCommand(CLI::App& root) {
     command->add_flag("--backends", options->backends,
                       "list the rendering backends (EGL, OSMesa, CPU): whether each works, its GL_RENDERER, why not");
     command->add_flag("--json", options->json, "print JSON instead of text");
+    command->add_flag("-v,--verbose", options->verbose,
+                      "also list the source's metadata; for an invalid file, every broken rule (as `conus validate`)");
+    command->footer(
+        "Examples:\n"
+        "  conus info photo.exr\n"
+        "  conus info photo.exr --json --density density.png\n"
+        "  conus info --backends");
     command->add_option("--density", options->densityPng,
                         "write the sampling density as a heat map with the sampling pattern over it (.png)");
     return {command, [options] {
                 if (options->backends) return printBackends(options->json);
                 if (options->input.empty()) throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends)");
+                if (options->verbose) {
+                    const format::ValidationReport report = format::validateConusFile(options->input);
+                    if (!report.ok()) {
+                        for (const auto& issue : report.issues)
+                            std::printf("%s: V%d: %s\n", options->input.c_str(), issue.rule, issue.message.c_str());
+                        throw Error(ErrorCode::Corrupt, options->input + ": not a valid CoNUS file (" +
+                                                            plural(static_cast<std::size_t>(report.problemCount()), "problem", "problems") + ")");
+                    }
+                }
                 const format::ConusFile file = format::readConusFile(options->input);
+                const std::vector<std::string> channels = format::displayOrder(file.image.channels);
                 const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
                 const DensityStats stats = densityStats(map);
 
@@ -66,7 +84,7 @@ Command addInfoCommand(CLI::App& root) {
                 j["dataKind"] = format::toString(file.dataKind);
                 j["image"] = {{"width", file.image.width},
                               {"height", file.image.height},
-                              {"channels", file.image.channels},
+                              {"channels", channels},
                               {"pixelType", format::toString(file.pixelType)},
                               {"compression", format::toString(file.compression)}};
                 j["source"] = {{"width", file.sourceWidth}, {"height", file.sourceHeight}};
@@ -97,6 +115,14 @@ Command addInfoCommand(CLI::App& root) {
                                   {"near", file.depth.near},
                                   {"far", file.depth.far}};
                 if (!file.software.empty()) j["software"] = file.software;
+                const SourceEncoding& encoding = file.sourceEncoding;
+                nlohmann::ordered_json colour{{"sourceTransfer", toString(encoding.transfer)}};
+                if (encoding.sampleType) colour["sourceSampleType"] = toString(*encoding.sampleType);
+                if (encoding.chromaticities) colour["chromaticities"] = *encoding.chromaticities;
+                colour["iccProfileBytes"] = encoding.iccProfile.size();
+                for (const MetadataItem& item : encoding.metadata)
+                    std::visit([&](const auto& v) { colour["metadata"][item.name] = v; }, item.value);
+                j["colour"] = colour;
 
                 if (!options->densityPng.empty()) {
                     // The picture covers the conventional frame, at most 1024 px on its long side.
@@ -104,7 +130,7 @@ Command addInfoCommand(CLI::App& root) {
                     const int w = std::max(16, static_cast<int>(file.sourceWidth * std::min(1.0, scale)));
                     const int h = std::max(16, static_cast<int>(file.sourceHeight * std::min(1.0, scale)));
                     const int lines = std::max(8, std::min(64, file.image.width / 8));
-                    writeImage(options->densityPng,
+                    writeDrawing(options->densityPng,
                                densityPicture(map, w, h, lines, file.analytic ? &*file.analytic : nullptr));
                     j["densityPicture"] = options->densityPng;
                 }
@@ -115,11 +141,28 @@ Command addInfoCommand(CLI::App& root) {
                 }
                 std::printf("%s: CoNUS file, format version %d, data kind %s\n", options->input.c_str(),
                             format::kFormatVersion, format::toString(file.dataKind));
-                std::string channels;
-                for (const auto& c : file.image.channels) channels += (channels.empty() ? "" : ",") + c;
+                std::string channelList;
+                for (const auto& c : channels) channelList += (channelList.empty() ? "" : ",") + c;
                 std::printf("  CoNUS image   %d x %d, channels %s, %s, %s compression\n", file.image.width,
-                            file.image.height, channels.c_str(), format::toString(file.pixelType),
+                            file.image.height, channelList.c_str(), format::toString(file.pixelType),
                             format::toString(file.compression));
+                std::printf("  colour        %s%s%s\n",
+                            encoding.transfer == Transfer::Raw ? "raw data (never converted)"
+                                                               : "linear light, associated alpha",
+                            encoding.sampleType ? (std::string("; source ") + toString(encoding.transfer) + " " +
+                                                   toString(*encoding.sampleType))
+                                                      .c_str()
+                                                : "",
+                            encoding.iccProfile.empty() ? "" : (", ICC profile of " + std::to_string(encoding.iccProfile.size()) + " bytes").c_str());
+                if (options->verbose)
+                    for (const MetadataItem& item : encoding.metadata) {
+                        std::string value;
+                        std::visit([&](const auto& v) {
+                            if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) value = v;
+                            else value = std::to_string(v);
+                        }, item.value);
+                        std::printf("    %s = %s\n", item.name.c_str(), value.c_str());
+                    }
                 std::printf("  source        %d x %d (CoNUS image holds %.2f%% of its pixels)\n", file.sourceWidth,
                             file.sourceHeight, 100.0 * pixelRatio);
                 std::printf("  sampling map  %d x %d nodes; density min %.3f, max %.3f, mean %.3f\n", map.columns(),

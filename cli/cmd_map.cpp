@@ -20,8 +20,10 @@
 #include "conus/codec/map_file.h"
 #include "conus/codec/springs.h"
 #include "conus/format/container.h"
-#include "conus/format/error.h"
-#include "image_io.h"
+#include "conus/core/atomic_file.h"
+#include "conus/core/error.h"
+#include "conus/imageio/image_file.h"
+#include "image_files.h"
 #include "importance.h"
 #include "pictures.h"
 #include "progress.h"
@@ -36,6 +38,7 @@ struct OutputOptions {
 };
 
 void addOutputOptions(CLI::App& command, OutputOptions& options) {
+    addQuietOption(command);
     command.add_option("-o,--output", options.output, "output map file (.exr, a CoNUS file)")->required();
     command.add_option("--preview", options.preview,
                        "also write a picture of the map (PNG, ...): density heat map with the distorted grid");
@@ -60,12 +63,17 @@ void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticM
     std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g\n", out.output.c_str(), map.columns(), map.rows(),
                 stats.min, stats.max);
     if (!out.preview.empty()) {
-        writeImage(out.preview, densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr));
+        writeDrawing(out.preview, densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr));
         std::printf("wrote %s\n", out.preview.c_str());
     }
 }
 
-std::string readText(const std::string& path) {
+// The strokes as given: inline JSON (it starts with '[' or '{'), or the path of a JSON file.
+std::string strokesText(const std::string& argument) {
+    const auto first = argument.find_first_not_of(" \t\r\n");
+    if (first != std::string::npos && (argument[first] == '[' || argument[first] == '{')) return argument;
+    const std::string& path = argument;
+    checkInputPath(path);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(ErrorCode::Io, "cannot open " + path);
     std::ostringstream text;
@@ -101,11 +109,20 @@ Command addMapCommand(CLI::App& root) {
     auto o = std::make_shared<Options>();
     CLI::App* command = root.add_subcommand("map", "Build a sampling map and write it as a map file for `conus encode --map`");
     command->require_subcommand(1);
+    command->footer(
+        "Examples:\n"
+        "  conus map foci --focus 0.3,0.4,0.08,4 --focus 0.7,0.6,0.05,3 --aspect 1.5 -o m.exr --preview m.png\n"
+        "  conus map springs --strokes '[{\"u\":0.5,\"v\":0.4,\"radius\":0.1}]' -o m.exr\n"
+        "  conus map auto --importance faces --image portrait.jpg -o m.exr");
 
     CLI::App* springs = command->add_subcommand(
         "springs", "Mass-spring brush system (paper 3.1): paint strokes from a JSON list, solve until stable");
+    springs->footer(
+        "Examples:\n"
+        "  conus map springs --strokes '[{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1,\"duration\":0.5}]' -o m.exr\n"
+        "  conus map springs --strokes strokes.json -o m.exr --preview m.png");
     springs->add_option("--strokes", o->strokes,
-                        "JSON list of strokes: [{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1.0,\"duration\":0.5}, ...]")
+                        "strokes as JSON, inline or a file: [{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1.0,\"duration\":0.5}, ...]")
         ->required();
     springs->add_option("--grid", o->particles, "particles per side (default 256)")->check(CLI::Range(2, 1025));
     springs->add_option("--out-grid", o->springsGrid, "nodes per side of the written map (default 33)")->check(CLI::Range(2, 1025));
@@ -157,7 +174,7 @@ Command addMapCommand(CLI::App& root) {
 
     return {command, [o, springs, compose, ground, foci, automatic] {
                 if (springs->parsed()) {
-                    const std::vector<codec::Stroke> strokes = codec::parseStrokes(readText(o->strokes));
+                    const std::vector<codec::Stroke> strokes = codec::parseStrokes(strokesText(o->strokes));
                     codec::SpringSystem system(o->particles, o->particles);
                     for (const codec::Stroke& s : strokes) system.addStroke(s);
                     Progress progress("solve " + std::to_string(o->particles) + "x" + std::to_string(o->particles) +
@@ -215,7 +232,7 @@ Command addMapCommand(CLI::App& root) {
                     const codec::SamplingMap map = codec::buildGroundMap(o->ground, o->groundGrid, o->groundGrid);
                     writeMapFile(map, codec::toAnalytic(o->ground), o->groundOut);
                 } else if (automatic->parsed()) {
-                    const format::Image picture = o->image.empty() ? format::Image{} : readImage(o->image);
+                    const format::Image picture = o->image.empty() ? format::Image{} : imageio::readImageFile(o->image).image;
                     const format::Image importance = importanceFrom(o->importance, picture);
                     codec::AutoMapOptions options;
                     options.columns = options.rows = o->autoGrid;
@@ -239,7 +256,7 @@ Command addMapCommand(CLI::App& root) {
                     fo.columns = fo.rows = o->fociGrid;
                     fo.aspect = o->aspect;
                     fo.composition = o->composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
-                    Progress progress("build sampling map (" + std::to_string(list.size()) + " foci)");
+                    Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
                     const codec::SamplingMap map = codec::buildFociMap(list, fo);
                     progress.done();
                     writeMapFile(map, params, o->fociOut);

@@ -7,33 +7,51 @@
 
 #include "commands.h"
 #include "encoding.h"
-#include "image_io.h"
+#include "image_files.h"
+#include "progress.h"
 
 namespace conus::cli {
+namespace {
+
+struct UniformOptions {
+    std::string input, output;
+    SourceOptions source;
+    StorageOptions storage;
+};
+
+int runUniform(const UniformOptions& o) {
+    checkConusOutput(o.output, o.input);
+    const imageio::ImageFile source = readSource(o.input, o.source);
+    const Size size = conusSize(o.storage, source.image);
+    Renderer renderer(o.storage.backend);
+    format::ConusFile file = encodeToConus(renderer, source.image, source.info.encoding,
+                                           codec::SamplingMap::identity(2, 2), size, std::nullopt);
+    applyStorage(o.storage, file);
+    Progress writing("write " + o.output);
+    format::writeConusFile(o.output, file);
+    writing.done();
+    std::printf("wrote %s: %dx%d uniform image of a %dx%d source\n", o.output.c_str(), size.width, size.height,
+                source.image.width, source.image.height);
+    return 0;
+}
+
+}  // namespace
 
 Command addUniformCommand(CLI::App& root) {
-    struct Options {
-        std::string input, output;
-        StorageOptions storage;
-    };
-    auto options = std::make_shared<Options>();
+    auto options = std::make_shared<UniformOptions>();
     CLI::App* command = root.add_subcommand(
         "uniform", "Encode with the identity map: the uniform image of the same pixel count (the baseline)");
-    command->add_option("input", options->input, "source image")->required();
+    command->footer(
+        "Examples:\n"
+        "  conus uniform photo.jpg -o uniform.exr                 # 1/16 of the pixels, like encode's default\n"
+        "  conus uniform photo.jpg -o uniform.exr --size 512x384\n"
+        "  conus uniform photo.png -o same.exr --size 4000x3000   # at source size: an exact round trip");
+    command->add_option("input", options->input, "source image ('-' reads standard input)")->required();
     command->add_option("-o,--output", options->output, "output CoNUS file (.exr)")->required();
+    addSourceOptions(*command, options->source);
     addStorageOptions(*command, options->storage);
-    return {command, [options] {
-                const format::Image source = readImage(options->input);
-                const Size size = conusSize(options->storage, source);
-                Renderer renderer(options->storage.backend);
-                format::ConusFile file =
-                    encodeToConus(renderer, source, codec::SamplingMap::identity(2, 2), size, std::nullopt);
-                applyStorage(options->storage, file);
-                format::writeConusFile(options->output, file);
-                std::printf("wrote %s: %dx%d uniform image of a %dx%d source\n", options->output.c_str(),
-                            size.width, size.height, source.width, source.height);
-                return 0;
-            }};
+    addQuietOption(*command);
+    return {command, [options] { return runUniform(*options); }};
 }
 
 }  // namespace conus::cli

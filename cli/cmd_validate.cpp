@@ -14,6 +14,10 @@ Command addValidateCommand(CLI::App& root) {
     CLI::App* command = root.add_subcommand(
         "validate", "Check a file against every rule of the CoNUS spec; exit 0 only if valid");
     command->add_option("input", *input, "file to check")->required();
+    command->footer(
+        "Examples:\n"
+        "  conus validate photo.exr            # exit 0: valid; 1: every broken rule listed, one a line\n"
+        "  conus validate photo.exr >/dev/null && echo ok");
     return {command, [input] {
                 const format::ValidationReport report = format::validateConusFile(*input);
                 if (report.ok()) {
@@ -22,8 +26,9 @@ Command addValidateCommand(CLI::App& root) {
                 }
                 for (const auto& issue : report.issues)
                     std::printf("%s: V%d: %s\n", input->c_str(), issue.rule, issue.message.c_str());
-                std::fprintf(stderr, "conus validate: %s: not a valid CoNUS file (%zu problem%s)\n", input->c_str(),
-                             report.issues.size(), report.issues.size() == 1 ? "" : "s");
+                const long long problems = report.problemCount();
+                std::fprintf(stderr, "conus validate: %s: not a valid CoNUS file (%lld problem%s)\n", input->c_str(),
+                             problems, problems == 1 ? "" : "s");
                 return 1;
             }};
 }

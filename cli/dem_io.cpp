@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "conus/codec/heightfield.h"
-#include "conus/format/error.h"
-#include "image_io.h"
+#include "conus/core/error.h"
+#include "image_files.h"
 
 namespace conus::cli {
 namespace {
@@ -196,7 +196,7 @@ Dem readDem(const std::string& source, double heightScale) {
                           " " + a.dtype;
         return dem;
     }
-    const format::Image image = readImage(source);
+    const format::Image image = readData(source);
     int channel = image.channelIndex("Z");
     if (channel < 0) channel = image.channelIndex("Y");
     if (channel < 0) channel = 0;  // a grey or RGB image: its first channel

@@ -6,7 +6,7 @@
 #include <random>
 #include <string>
 
-#include "image_io.h"
+#include "conus/imageio/text.h"
 
 namespace conus::cli {
 namespace {
@@ -103,8 +103,8 @@ format::Image makeDemoPicture(int size) {
         drawFace(img, f[0] * size, f[1] * size, (110 + 60 * uniform(random)) * s, 6.0 * s, uniform(random));
     drawZonePlate(img, 0.33 * size, 0.72 * size, 300 * s, 0.25);
     const float ink[3] = {0.05f, 0.05f, 0.08f}, paper[3] = {0.96f, 0.95f, 0.90f}, white[3] = {1, 1, 1};
-    drawText(img, int(0.40 * size), int(0.05 * size), int(110 * s), "CoNUS demo", white);
-    drawText(img, int(0.62 * size), int(0.40 * size), int(64 * s), "context is sampled sparsely", white);
+    imageio::drawText(img, int(0.40 * size), int(0.05 * size), int(110 * s), "CoNUS demo", white);
+    imageio::drawText(img, int(0.62 * size), int(0.40 * size), int(64 * s), "context is sampled sparsely", white);
 
     // Focus 1 at (0.28, 0.30): fine print on a panel, 15-26 px type.
     const int px = int(0.28 * size), py = int(0.30 * size), half = int(270 * s);
@@ -117,7 +117,7 @@ format::Image makeDemoPicture(int size) {
     int line = 0, baseline = py - half + int(40 * s);
     for (const char* text : lines) {
         const int fontSize = int((26 - (line % 4) * 3) * s);
-        drawText(img, px - half + int(20 * s), baseline, std::max(6, fontSize), text, ink);
+        imageio::drawText(img, px - half + int(20 * s), baseline, std::max(6, fontSize), text, ink);
         baseline += std::max(8, int(fontSize * 1.45));
         ++line;
     }

@@ -3,6 +3,9 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <filesystem>
+
+#include "conus/core/atomic_file.h"
 
 #include "conus/codec/encode.h"
 #include "progress.h"
@@ -11,8 +14,11 @@ namespace conus::cli {
 
 void addStorageOptions(CLI::App& command, StorageOptions& options) {
     command.add_option("--size", options.sizeText, "CoNUS image size WxH (default: a quarter of each source side)");
-    auto* half = command.add_flag("--half", options.half, "store colour channels as 16-bit half (default)");
-    command.add_flag("--float", options.full, "store colour channels as 32-bit float")->excludes(half);
+    auto* half = command.add_flag("--half", options.half,
+                                  "store colour channels as 16-bit half (default for 8-bit sources: exact for them)");
+    command.add_flag("--float", options.full,
+                     "store colour channels as 32-bit float (default for 16-bit and float sources)")
+        ->excludes(half);
     command.add_option("--compression", options.compression, "zip | piz | dwaa | none")
         ->default_val("zip")
         ->check(CLI::IsMember({"zip", "piz", "dwaa", "none"}));
@@ -25,15 +31,29 @@ Size conusSize(const StorageOptions& options, const format::Image& source) {
 }
 
 void applyStorage(const StorageOptions& options, format::ConusFile& file) {
-    file.pixelType = options.full ? format::PixelType::Float : format::PixelType::Half;
+    // Half holds 11 significant bits: every 8-bit sRGB code survives the round trip, 16-bit ones do not.
+    const std::optional<SampleType> source = file.sourceEncoding.sampleType;
+    const bool precise = source && *source != SampleType::Uint8 && *source != SampleType::Half;
+    file.pixelType = options.full || (precise && !options.half) ? format::PixelType::Float : format::PixelType::Half;
     file.compression = parseCompression(options.compression);
 }
 
-format::ConusFile encodeToConus(Renderer& renderer, const format::Image& source, const codec::SamplingMap& map,
-                                Size size, std::optional<format::AnalyticMap> analytic, bool quiet) {
+void checkConusOutput(const std::string& output, const std::string& input) {
+    const std::filesystem::path path(output);
+    std::string extension = path.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
+    if (extension != ".exr")
+        throw Error(ErrorCode::InvalidArgument, "the output " + output +
+                                                    " must end in .exr: a CoNUS file is an OpenEXR file (for a picture of "
+                                                    "it, run `conus decode` on the .exr)");
+    const std::string inputs[] = {input};
+    checkOutputPath(output, inputs);
+}
+
+format::ConusFile encodeToConus(Renderer& renderer, const format::Image& source, const SourceEncoding& encoding,
+                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
-                          std::to_string(size.width) + "x" + std::to_string(size.height),
-                      quiet);
+                      std::to_string(size.width) + "x" + std::to_string(size.height));
     format::ConusFile file;
     file.image = renderer.encode(source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
@@ -41,6 +61,7 @@ format::ConusFile encodeToConus(Renderer& renderer, const format::Image& source,
     file.sourceHeight = source.height;
     file.map = map.toGrid();
     file.analytic = std::move(analytic);
+    file.sourceEncoding = encoding;
     if (file.image.channelIndex("Z") >= 0) {
         file.depth.kind = format::DepthKind::CameraDepth;
         file.depth.near = 0;

@@ -18,7 +18,7 @@ namespace conus::cli {
 
 struct StorageOptions {
     std::string sizeText;  // "WxH"; empty: a quarter of each source side (1/16 of the pixels)
-    bool half = false, full = false;
+    bool half = false, full = false;  // neither: float for 16-bit and float sources, else half
     std::string compression = "zip";
     std::string backend = "auto";
 };
@@ -28,11 +28,17 @@ void addStorageOptions(CLI::App& command, StorageOptions& options);
 // Resolves the CoNUS image size (checking it against the source) and the storage settings.
 Size conusSize(const StorageOptions& options, const format::Image& source);
 
-// Encodes `source` through `map` at `size` (with progress) into a file model ready to write.
-format::ConusFile encodeToConus(Renderer& renderer, const format::Image& source, const codec::SamplingMap& map,
-                                Size size, std::optional<format::AnalyticMap> analytic, bool quiet = false);
+// Encodes `source` through `map` at `size` (with progress) into a file model ready to write,
+// remembering the source's encoding.
+format::ConusFile encodeToConus(Renderer& renderer, const format::Image& source, const SourceEncoding& encoding,
+                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic);
 
-// Applies the storage options to a file model.
+// Applies the storage options to a file model. Without --half or --float, colour is stored as
+// float when the source had more precision than half keeps (16-bit integers, float), else half.
 void applyStorage(const StorageOptions& options, format::ConusFile& file);
+
+// Checks before the work that `output` is a place for a CoNUS file: an .exr name that is not
+// the input. Throws conus::Error(InvalidArgument).
+void checkConusOutput(const std::string& output, const std::string& input);
 
 }  // namespace conus::cli

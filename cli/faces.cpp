@@ -8,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/objdetect.hpp>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "importance.h"
 
 namespace conus::cli {
@@ -22,6 +22,7 @@ constexpr const char* kCascadePaths[] = {
 
 }  // namespace
 
+// `image` is display-encoded (the cascade was trained on ordinary 8-bit photographs).
 format::Image faceImportance(const format::Image& image) {
     if (image.empty()) throw Error(ErrorCode::InvalidArgument, "no image to find faces in");
     // Detection on an 8-bit grey copy at most 1024 px a side: the cascade works on 24 px windows,

@@ -1,21 +1,23 @@
 #include "importance.h"
 
 #include "conus/codec/auto_map.h"
-#include "conus/format/error.h"
-#include "image_io.h"
+#include "conus/core/error.h"
+#include "conus/imageio/image_file.h"
+#include "image_files.h"
 
 namespace conus::cli {
 
 format::Image importanceFrom(const std::string& source, const format::Image& image) {
     if (source == "detail") {
         if (image.empty()) throw Error(ErrorCode::InvalidArgument, "'detail' importance needs an input image");
-        return codec::detailImportance(image);
+        // Detail as people see it: on the display-encoded picture, where NaN cannot reach.
+        return codec::detailImportance(imageio::displayEncoded(image));
     }
     if (source == "faces") {
         if (image.empty()) throw Error(ErrorCode::InvalidArgument, "'faces' importance needs an input image");
-        return faceImportance(image);
+        return faceImportance(imageio::displayEncoded(image));
     }
-    return readImage(source);
+    return readData(source);
 }
 
 }  // namespace conus::cli

@@ -13,7 +13,7 @@ namespace conus::cli {
 // file source).
 format::Image importanceFrom(const std::string& source, const format::Image& image);
 
-// Importance that is high on each face found in `image` (a soft disc over every detection), zero
+// Importance that is high on each face found in `image` (display-encoded: imageio::displayEncoded) (a soft disc over every detection), zero
 // elsewhere; throws conus::Error(InvalidArgument) when no face is found.
 format::Image faceImportance(const format::Image& image);
 

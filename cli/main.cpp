@@ -7,12 +7,19 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "conus/core/atomic_file.h"
+#include "conus/core/error.h"
 #include "conus/format/container.h"
-#include "conus/format/error.h"
+#include "progress.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"conus: coherent non-uniform sampling images (flexible pinhole camera)", "conus"};
     app.require_subcommand(1);
+    app.footer(
+        "Exit codes: 0 success; 1 failure (a file that cannot be read or written, an invalid file); 2 usage\n"
+        "(an unknown option, a value out of range). Errors print one line: conus <command>: <reason>.\n"
+        "`conus <command> --help` shows each command's options and examples.");
+    conus::removeTemporariesOnSignals();
     app.set_version_flag("--version", std::string(conus::format::kSoftwareName) + " (CoNUS file format version " +
                                            std::to_string(conus::format::kFormatVersion) + ")");
 
@@ -52,8 +59,14 @@ int main(int argc, char** argv) {
     for (auto& command : commands) {
         if (!command.app->parsed()) continue;
         name = command.app->get_name();
+        conus::cli::beginCommand(name);
         try {
-            return command.run();
+            const int code = command.run();
+            if (code == 0) conus::cli::printTotal();
+            return code;
+        } catch (const conus::Error& e) {
+            std::fprintf(stderr, "conus %s: %s\n", name.c_str(), e.what());
+            return e.code() == conus::ErrorCode::InvalidArgument ? 2 : 1;
         } catch (const std::exception& e) {
             std::fprintf(stderr, "conus %s: %s\n", name.c_str(), e.what());
             return 1;

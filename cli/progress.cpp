@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
 #include <exception>
 #include <mutex>
@@ -9,32 +11,41 @@
 namespace conus::cli {
 namespace {
 std::mutex g_printMutex;  // progress callbacks arrive from worker threads
+bool g_quiet = false;
+int g_stages = 0;
+std::string g_command;
+const auto g_started = std::chrono::steady_clock::now();
+}  // namespace
+
+void addQuietOption(CLI::App& command) {
+    command.add_flag("-q,--quiet", g_quiet, "print no progress (warnings and errors still print)");
 }
 
-Progress::Progress(std::string label, bool quiet)
-    : m_label(std::move(label)), m_quiet(quiet), m_tty(::isatty(STDERR_FILENO) != 0),
-      m_start(std::chrono::steady_clock::now()) {
-    if (!m_quiet && m_tty) std::fprintf(stderr, "%s ...", m_label.c_str());
+bool quiet() { return g_quiet; }
+
+Progress::Progress(std::string label)
+    : m_label(std::move(label)), m_tty(::isatty(STDERR_FILENO) != 0), m_start(std::chrono::steady_clock::now()) {
+    if (!g_quiet && m_tty) std::fprintf(stderr, "conus %s: %s ...", g_command.c_str(), m_label.c_str());
 }
 
 Progress::~Progress() {
     if (m_finished) return;
     if (std::uncaught_exceptions() > 0) {
-        // Unwinding from an error: the step did not finish; main prints the reason.
-        if (!m_quiet && m_tty) std::fprintf(stderr, "\n");
+        // Unwinding from an error: the stage did not finish; main prints the reason.
+        if (!g_quiet && m_tty) std::fprintf(stderr, "\n");
         return;
     }
     done();
 }
 
 ProgressFn Progress::callback() {
-    if (m_quiet || !m_tty) return {};
+    if (g_quiet || !m_tty) return {};
     return [this](double fraction) {
         const int percent = static_cast<int>(fraction * 100.0);
         std::lock_guard lock(g_printMutex);
         if (percent <= m_lastPercent) return;
         m_lastPercent = percent;
-        std::fprintf(stderr, "\r%s %3d%%", m_label.c_str(), percent);
+        std::fprintf(stderr, "\rconus %s: %s %3d%%", g_command.c_str(), m_label.c_str(), percent);
         std::fflush(stderr);
     };
 }
@@ -42,10 +53,28 @@ ProgressFn Progress::callback() {
 void Progress::done() {
     if (m_finished) return;
     m_finished = true;
-    if (m_quiet) return;
+    ++g_stages;
+    if (g_quiet) return;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
     std::lock_guard lock(g_printMutex);
-    std::fprintf(stderr, "%s%s done (%.2f s)\n", m_tty ? "\r" : "", m_label.c_str(), seconds);
+    std::fprintf(stderr, "%sconus %s: %s done (%.2f s)\n", m_tty ? "\r" : "", g_command.c_str(), m_label.c_str(), seconds);
+}
+
+void beginCommand(const std::string& name) { g_command = name; }
+
+void printTotal() {
+    if (g_quiet || g_stages < 2) return;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - g_started).count();
+    std::fprintf(stderr, "conus %s: done in %.2f s (%d stages)\n", g_command.c_str(), seconds, g_stages);
+}
+
+void warn(const std::string& text) {
+    std::lock_guard lock(g_printMutex);
+    std::fprintf(stderr, "conus %s: warning: %s\n", g_command.c_str(), text.c_str());
+}
+
+std::string plural(std::size_t n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
 }  // namespace conus::cli

@@ -1,28 +1,48 @@
-// Progress on long steps, printed to stderr: a live percentage on a terminal, one line per step
-// with its duration otherwise (logs, CI). Only cli/ prints.
+// Progress on long steps, printed to stderr: a live percentage on a terminal, then one line per
+// stage ("conus encode: read photo.jpg done (0.21 s)"), and one total line when the command ends. `--quiet` (every
+// subcommand has it) silences all of it; warnings and errors still print. Only cli/ prints.
 #pragma once
 
 #include <chrono>
 #include <string>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
+
+namespace CLI {
+class App;
+}
 
 namespace conus::cli {
 
 class Progress {
 public:
-    explicit Progress(std::string label, bool quiet = false);
+    explicit Progress(std::string label);
     ~Progress();  // finishes the line if done() was not called
     ProgressFn callback();
     void done();
 
 private:
     std::string m_label;
-    bool m_quiet;
     bool m_tty;
     bool m_finished = false;
     int m_lastPercent = -1;
     std::chrono::steady_clock::time_point m_start;
 };
+
+// Adds -q/--quiet to a subcommand.
+void addQuietOption(CLI::App& command);
+bool quiet();
+
+// The subcommand that runs, for the lines below (main.cpp sets it).
+void beginCommand(const std::string& name);
+
+// "conus <command>: done in 2.41 s (4 stages)" once a command of several stages succeeded.
+void printTotal();
+
+// "conus <command>: warning: <text>" on stderr, even when quiet.
+void warn(const std::string& text);
+
+// "N focus" / "N foci": counts said right.
+std::string plural(std::size_t n, const char* one, const char* many);
 
 }  // namespace conus::cli

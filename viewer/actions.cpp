@@ -35,7 +35,7 @@ const std::vector<Binding> kViewBindings = {
     {"O", false, false, Action::ToggleOutlines, "O          focus outlines (r and 2r)"},
     {"E", true, false, Action::ExposureDown, "E / Shift-E exposure +/- 0.5 stop; 0 resets"},
     {"0", false, false, Action::ResetExposure, ""},
-    {"L", false, false, Action::ToggleGamma, "L          linear output (gamma 1) / display gamma 2.2"},
+    {"L", false, false, Action::ToggleGamma, "L          linear output (no curve) / the sRGB display curve"},
     {"Tab", false, false, Action::NextFile, "Tab, PgDn  next file; Shift-Tab, PgUp previous"},
     {"PageDown", false, false, Action::NextFile, ""},
     {"Tab", true, false, Action::PreviousFile, ""},

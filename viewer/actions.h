@@ -26,7 +26,7 @@ enum class Action {
     ToggleGrid,         // G
     ToggleOutlines,     // O
     ExposureUp, ExposureDown, ResetExposure,  // E, Shift-E, 0
-    ToggleGamma,        // L: linear (gamma 1) or display gamma 2.2
+    ToggleGamma,        // L: linear (gamma 1) or the sRGB display curve
     NextFile, PreviousFile,  // Tab / PageDown, Shift-Tab / PageUp
     Reload,             // Ctrl-R, F5
     Inspect,            // I: print the pixel under the cursor

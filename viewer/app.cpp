@@ -17,7 +17,7 @@
 #include "conus/renderers/view_renderer.h"
 #include "document.h"
 #include "editor.h"
-#include "image_io.h"
+#include "conus/imageio/image_file.h"
 #include "inspector.h"
 #include "overlay.h"
 #include "script.h"
@@ -27,7 +27,6 @@ namespace conus::viewer {
 namespace {
 
 constexpr double kExposureStep = 0.5;
-constexpr double kDisplayGamma = 2.2;
 constexpr double kStrengthStep = 1.25;
 constexpr int kBenchmarkWarmup = 3;
 
@@ -182,8 +181,8 @@ bool App::openWindow() {
 bool App::loadInputs() {
     if (!m_options.edit.empty()) {
         try {
-            format::Image source = readImage(m_options.edit);
-            m_editor.emplace(std::move(source));
+            imageio::ImageFile source = imageio::readImageFile(m_options.edit);
+            m_editor.emplace(std::move(source.image), source.info.encoding);
             format::ConusFile shown;  // the source, shown raw, with the live map's grid over it
             shown.image = m_editor->source();
             shown.sourceWidth = shown.image.width;
@@ -386,7 +385,7 @@ void App::doAction(Action action) {
     case Action::ExposureUp: m_display.exposure += kExposureStep; break;
     case Action::ExposureDown: m_display.exposure -= kExposureStep; break;
     case Action::ResetExposure: m_display.exposure = 0; break;
-    case Action::ToggleGamma: m_display.gamma = m_display.gamma == 1.0 ? kDisplayGamma : 1.0; break;
+    case Action::ToggleGamma: m_display.gamma = m_display.gamma == 1.0 ? 0.0 : 1.0; break;
     case Action::NextFile:
     case Action::PreviousFile:
         if (m_docs.size() > 1) {
@@ -497,7 +496,9 @@ void App::frame() {
     if (!m_pendingScreenshot.empty()) {
         // The back buffer, before the swap (the front buffer reads as zeros under Xvfb).
         try {
-            writeImage(m_pendingScreenshot, m_renderer->readFramebuffer(fw, fh));
+            imageio::WriteOptions write;
+            write.meaning = imageio::PixelMeaning::Display;  // the framebuffer: already what the screen shows
+            imageio::writeImageFile(m_pendingScreenshot, m_renderer->readFramebuffer(fw, fh), write);
             std::printf("wrote %s\n", m_pendingScreenshot.c_str());
         } catch (const std::exception& e) {
             std::fprintf(stderr, "conus-view: %s\n", e.what());

@@ -7,8 +7,8 @@
 
 namespace conus::viewer {
 
-MapEditor::MapEditor(format::Image source, int gridColumns, int gridRows)
-    : m_source(std::move(source)), m_columns(gridColumns), m_rows(gridRows), m_springs(gridColumns, gridRows) {}
+MapEditor::MapEditor(format::Image source, SourceEncoding encoding, int gridColumns, int gridRows)
+    : m_source(std::move(source)), m_encoding(std::move(encoding)), m_columns(gridColumns), m_rows(gridRows), m_springs(gridColumns, gridRows) {}
 
 void MapEditor::scaleRadius(double factor) { m_brush.radius = std::clamp(m_brush.radius * factor, 0.01, 1.0); }
 void MapEditor::scaleStrength(double factor) { m_brush.strength = std::clamp(m_brush.strength * factor, 0.02, 20.0); }
@@ -58,6 +58,7 @@ format::ConusFile MapEditor::encode(int width, int height) const {
     file.sourceWidth = m_source.width;
     file.sourceHeight = m_source.height;
     file.dataKind = format::DataKind::Image;
+    file.sourceEncoding = m_encoding;
     file.map = map.toGrid();
     return file;
 }

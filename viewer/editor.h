@@ -24,8 +24,10 @@ struct Brush {
 
 class MapEditor {
 public:
-    // `source` is the image painted over; the encode size defaults to the source's.
-    explicit MapEditor(format::Image source, int gridColumns = kEditorGrid, int gridRows = kEditorGrid);
+    // `source` is the image painted over (linear light), `encoding` what its file held; the encode
+    // size defaults to the source's.
+    explicit MapEditor(format::Image source, SourceEncoding encoding = {}, int gridColumns = kEditorGrid,
+                       int gridRows = kEditorGrid);
 
     Brush& brush() { return m_brush; }
     const Brush& brush() const { return m_brush; }
@@ -54,6 +56,7 @@ public:
 private:
     void addStroke(glm::dvec2 uv);
     format::Image m_source;
+    SourceEncoding m_encoding;
     int m_columns, m_rows;
     codec::SpringSystem m_springs;
     Brush m_brush;

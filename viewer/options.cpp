@@ -7,7 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::viewer {
 namespace {
@@ -73,7 +73,9 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("--grid-every", o.display.gridEvery, "draw every n-th grid line (0: automatic)");
     app.add_flag("--outlines", o.display.outlines, "draw the focus outlines");
     app.add_option("--exposure", o.display.exposure, "exposure in stops");
-    app.add_option("--gamma", o.display.gamma, "display gamma (1: linear)")->capture_default_str();
+    app.add_option("--gamma", o.display.gamma,
+                   "display curve: 0 (default) the sRGB curve for linear data, else a display gamma (1: linear)")
+        ->check(CLI::Range(0.0, 10.0));
     app.add_option("--decode", decode,
                    "where the reconstructed frame is decoded: gpu (shader), cpu (codec::decodeImage each frame, "
                    "uploaded), auto (CONUS_VIEW_DECODE=cpu|gpu, else cpu on llvmpipe/softpipe/swrast)")

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "actions.h"
-#include "image_io.h"
+#include "conus/imageio/text.h"
 
 namespace conus::viewer {
 
@@ -26,33 +26,33 @@ format::Image helpPanel(bool editing) {
         }
     }
     lines.push_back("H\tclose this help");
-    TextPanelStyle style;
+    imageio::TextPanelStyle style;
     style.fontSize = 15;
     style.tabStop = 110;
     style.panel[3] = 0.72f;
-    return renderTextPanel(lines, style);
+    return imageio::renderTextPanel(lines, style);
 }
 
 format::Image errorPanel(const std::string& fileName, const std::string& error, int windowWidth) {
-    TextPanelStyle style;
+    imageio::TextPanelStyle style;
     style.fontSize = 16;
     style.panel[3] = 0.55f;
     const int maxWidth = std::max(64, windowWidth - 2 * kOverlayMargin - 2 * style.padding);
-    std::vector<std::string> lines = wrapText("Cannot open " + fileName + ": not a valid CoNUS file", maxWidth, style.fontSize);
-    for (const std::string& line : wrapText(error, maxWidth, style.fontSize)) lines.push_back(line);
+    std::vector<std::string> lines = imageio::wrapText("Cannot open " + fileName + ": not a valid CoNUS file", maxWidth, style.fontSize);
+    for (const std::string& line : imageio::wrapText(error, maxWidth, style.fontSize)) lines.push_back(line);
     lines.push_back("");
-    for (const std::string& line : wrapText("Tab: next file, Ctrl-R: reload, Q: quit", maxWidth, style.fontSize))
+    for (const std::string& line : imageio::wrapText("Tab: next file, Ctrl-R: reload, Q: quit", maxWidth, style.fontSize))
         lines.push_back(line);
-    return renderTextPanel(lines, style);
+    return imageio::renderTextPanel(lines, style);
 }
 
 format::Image statusPanel(const std::string& text, int windowWidth) {
-    TextPanelStyle style;
+    imageio::TextPanelStyle style;
     style.fontSize = 13;
     style.padding = 4;
     style.panel[3] = 0.6f;
     style.minWidth = std::max(1, windowWidth);
-    return renderTextPanel({text}, style);
+    return imageio::renderTextPanel({text}, style);
 }
 
 }  // namespace conus::viewer

@@ -1,5 +1,5 @@
 // What conus-view draws as text over the frame: the help panel (H), the error of a file that could
-// not be opened, and the status bar (B). Rasterized by image_io's renderTextPanel (OpenImageIO),
+// not be opened, and the status bar (B). Rasterized by imageio's renderTextPanel (OpenImageIO),
 // uploaded once per change into a ViewRenderer overlay slot and drawn over every frame.
 #pragma once
 

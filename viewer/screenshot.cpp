@@ -9,7 +9,8 @@
 #include "conus/renderers/context.h"
 #include "conus/renderers/view_renderer.h"
 #include "document.h"
-#include "image_io.h"
+#include "conus/imageio/image_file.h"
+#include "view_state.h"
 #include "overlay.h"
 
 namespace conus::viewer {
@@ -23,9 +24,14 @@ int runScreenshot(const Options& options) {
         return 1;
     }
     try {
-        const codec::View view = options.view.value_or(codec::View{});
+        codec::View view = options.view.value_or(codec::View{});
         int width = options.width, height = options.height;
-        if (width == 0) {
+        if (width > 0) {
+            // The window's way: the view as large as fits, letterboxed, never stretched.
+            ViewState state(width, height, doc.sourceWidth(), doc.sourceHeight());
+            state.showView(view);
+            view = state.view();
+        } else {
             // The view at source resolution, shrunk to fit kDefaultMaxSide.
             const double w = std::abs(view.u1 - view.u0) * doc.sourceWidth();
             const double h = std::abs(view.v1 - view.v0) * doc.sourceHeight();
@@ -50,7 +56,9 @@ int runScreenshot(const Options& options) {
             overlays.push_back({kStatusSlot, 0, height - bar.height});
         }
         const format::Image frame = renderer.renderToImage(view, width, height, options.display, overlays);
-        writeImage(options.screenshot, frame);
+        imageio::WriteOptions write;
+        write.meaning = imageio::PixelMeaning::Display;  // the framebuffer: already what the screen shows
+        imageio::writeImageFile(options.screenshot, frame, write);
         std::printf("wrote %s: %dx%d, %s view of %s (%s)\n", options.screenshot.c_str(), width, height,
                     modeName(options.display.mode), doc.path.c_str(), context->renderer().c_str());
         return 0;

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "actions.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::viewer {
 namespace {

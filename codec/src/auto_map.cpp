@@ -7,7 +7,7 @@
 
 #include "conus/codec/decode.h"
 #include "conus/codec/encode.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <string>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

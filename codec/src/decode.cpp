@@ -301,6 +301,27 @@ void bilinearRows(const format::Image& src, format::Image& dst, const AxisTaps& 
     }
 }
 
+// Pixels whose centre lies outside the image ([0,1]^2 undistorted) show the background, 0 in every
+// channel, instead of the edge pixels smeared outward.
+void clearOutside(format::Image& out, const View& view) {
+    const std::size_t rowValues = static_cast<std::size_t>(out.width) * out.channels.size();
+    std::vector<char> columnOutside(out.width);
+    for (int x = 0; x < out.width; ++x) {
+        const double u = view.u0 + (x + 0.5) / out.width * (view.u1 - view.u0);
+        columnOutside[x] = !(u >= 0.0 && u <= 1.0);
+    }
+    for (int y = 0; y < out.height; ++y) {
+        float* row = out.pixels.data() + y * rowValues;
+        const double v = view.v0 + (y + 0.5) / out.height * (view.v1 - view.v0);
+        if (!(v >= 0.0 && v <= 1.0)) {
+            std::fill(row, row + rowValues, 0.0f);
+            continue;
+        }
+        for (int x = 0; x < out.width; ++x)
+            if (columnOutside[x]) std::fill_n(row + x * out.channels.size(), out.channels.size(), 0.0f);
+    }
+}
+
 }  // namespace
 
 format::Image decodeImage(const format::Image& conus, const SamplingMap& map, const DecodeOptions& options) {
@@ -319,6 +340,7 @@ format::Image decodeImage(const format::Image& conus, const SamplingMap& map, co
             progress.add(y1 - y0);
         },
         16);
+    clearOutside(out, options.view);
     return out;
 }
 
@@ -336,6 +358,7 @@ format::Image resizeBilinear(const format::Image& image, const View& view, int w
                                      [&]<int kC>() { bilinearRows<kC>(image, out, tx, ty, y0, y1); });
         },
         16);
+    clearOutside(out, view);
     return out;
 }
 

@@ -15,7 +15,7 @@
 #include <mutex>
 #include <string>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "parallel.h"
 
 namespace conus::codec {

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "conus/codec/density_map.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

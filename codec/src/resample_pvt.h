@@ -11,7 +11,7 @@
 #include <string>
 #include <utility>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "conus/format/image.h"
 
 namespace conus::codec::detail {

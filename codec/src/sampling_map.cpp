@@ -8,7 +8,7 @@
 #include <limits>
 #include <string>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

@@ -1,9 +1,4 @@
 // The public container entry points: validate, then write atomically; load, then throw or report.
-#include <filesystem>
-#include <system_error>
-
-#include <unistd.h>
-
 #include "conus/format/container.h"
 #include "exr_io.h"
 
@@ -18,39 +13,23 @@ bool onlyMapRules(const ValidationReport& r) {
     return true;
 }
 
-std::string firstLines(const ValidationReport& r) {
-    std::string s = r.str();
-    if (!s.empty() && s.back() == '\n') s.pop_back();
-    return s;
-}
-
 }  // namespace
 
 void writeConusFile(const std::string& path, const ConusFile& file) {
     const ValidationReport report = validateConusFile(file);
     if (!report.ok()) {
         throw Error(onlyMapRules(report) ? ErrorCode::InvalidMap : ErrorCode::Corrupt,
-                    "refusing to write invalid CoNUS file " + path + ":\n" + firstLines(report));
+                    "refusing to write invalid CoNUS file " + path + ": " + report.summary());
     }
-    // Write beside the destination and rename: a reader never sees a half-written file and an
-    // existing destination survives any failure. The pid keeps concurrent writers apart.
-    const std::string temp = path + ".tmp-" + std::to_string(::getpid());
-    try {
-        detail::writeExrFile(temp, file);
-        std::error_code ec;
-        std::filesystem::rename(temp, path, ec);
-        if (ec) throw Error(ErrorCode::Io, "cannot rename " + temp + " to " + path + ": " + ec.message());
-    } catch (...) {
-        std::error_code ignored;
-        std::filesystem::remove(temp, ignored);
-        throw;
-    }
+    AtomicFile out(path);
+    detail::writeExrFile(out, file);
+    out.commit();
 }
 
 ConusFile readConusFile(const std::string& path, const ReadLimits& limits) {
     ConusFile file;
     const detail::LoadResult result = detail::loadConusFile(path, limits, file);
-    if (!result.report.ok()) throw Error(result.code, path + ": " + firstLines(result.report));
+    if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.summary());
     return file;
 }
 

@@ -4,6 +4,8 @@
 #include "exr_io.h"
 
 #include <ImfChannelList.h>
+#include <ImfChromaticitiesAttribute.h>
+#include <ImfIO.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputPart.h>
@@ -181,6 +183,13 @@ HeaderModel modelOf(const Imf::MultiPartInputFile& file) {
     m.depthRange = readAttr<Imf::V2fAttribute, std::array<float, 2>>(h, kAttrDepthRange,
                                                                       [](const Imath::V2f& v) { return std::array<float, 2>{v.x, v.y}; });
     m.depthUnits = readAttr<Imf::StringAttribute, std::string>(h, kAttrDepthUnits);
+    m.sourceTransfer = readAttr<Imf::StringAttribute, std::string>(h, kAttrSourceTransfer);
+    m.sourceSampleType = readAttr<Imf::StringAttribute, std::string>(h, kAttrSourceSampleType);
+    m.iccProfile = readAttr<Imf::StringAttribute, std::string>(h, kAttrIccProfile);
+    m.chromaticities = readAttr<Imf::ChromaticitiesAttribute, std::array<float, 8>>(
+        h, kAttrChromaticities, [](const Imf::Chromaticities& c) {
+            return std::array<float, 8>{c.red.x, c.red.y, c.green.x, c.green.y, c.blue.x, c.blue.y, c.white.x, c.white.y};
+        });
     return m;
 }
 
@@ -224,8 +233,49 @@ void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
         out.depth.far = m.depthRange.value[1];
     }
     out.depth.units = m.depthUnits.value;
+    SourceEncoding& e = out.sourceEncoding;
+    if (m.sourceTransfer.ok()) e.transfer = parseTransfer(m.sourceTransfer.value).value_or(Transfer::Linear);
+    if (m.sourceSampleType.ok()) e.sampleType = parseSampleType(m.sourceSampleType.value);
+    if (m.chromaticities.ok()) e.chromaticities = m.chromaticities.value;
+    if (m.iccProfile.ok()) e.iccProfile = base64Decode(m.iccProfile.value).value_or(std::string());
+    for (auto it = h.begin(); it != h.end(); ++it) {
+        if (!isCarriedMetadata(it.name())) continue;
+        const Imf::Attribute& a = it.attribute();
+        if (const auto* v = dynamic_cast<const Imf::StringAttribute*>(&a)) e.metadata.push_back({it.name(), v->value()});
+        else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&a)) e.metadata.push_back({it.name(), i->value()});
+        else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&a)) e.metadata.push_back({it.name(), f->value()});
+        else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&a)) e.metadata.push_back({it.name(), d->value()});
+    }
     if (const auto* sw = h.findTypedAttribute<Imf::StringAttribute>(kAttrSoftware)) out.software = sw->value();
 }
+
+// ---- writing through an AtomicFile ---------------------------------------------------------------
+
+// OpenEXR writes through this stream into the AtomicFile, so every byte is checked. OpenEXR's
+// destructors write the offset tables and swallow errors; a failure is therefore also remembered
+// here and reported once the file object is gone.
+class AtomicOStream final : public Imf::OStream {
+public:
+    explicit AtomicOStream(AtomicFile& file) : Imf::OStream(file.destination().c_str()), m_file(file) {}
+    void write(const char c[], int n) override {
+        try {
+            if (m_pos == m_file.size()) m_file.write(c, static_cast<std::size_t>(n));
+            else m_file.writeAt(m_pos, c, static_cast<std::size_t>(n));
+        } catch (const Error& e) {
+            if (m_failure.empty()) m_failure = e.what();
+            throw;
+        }
+        m_pos += static_cast<std::uint64_t>(n);
+    }
+    std::uint64_t tellp() override { return m_pos; }
+    void seekp(std::uint64_t pos) override { m_pos = pos; }
+    const std::string& failure() const { return m_failure; }
+
+private:
+    AtomicFile& m_file;
+    std::uint64_t m_pos = 0;
+    std::string m_failure;
+};
 
 // ---- pixels ---------------------------------------------------------------------------------
 
@@ -333,8 +383,10 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, Conu
     return result;
 }
 
-void writeExrFile(const std::string& path, const ConusFile& file) {
+void writeExrFile(AtomicFile& out, const ConusFile& file) {
     const Image& im = file.image;
+    const std::string& path = out.destination();
+    AtomicOStream stream(out);
     try {
         Imf::Header conus(im.width, im.height);
         conus.setName(kConusPartName);
@@ -372,6 +424,22 @@ void writeExrFile(const std::string& path, const ConusFile& file) {
             conus.insert(kAttrDepthRange, Imf::V2fAttribute(Imath::V2f(file.depth.near, file.depth.far)));
         }
         if (!file.depth.units.empty()) conus.insert(kAttrDepthUnits, Imf::StringAttribute(file.depth.units));
+        const SourceEncoding& e = file.sourceEncoding;
+        conus.insert(kAttrSourceTransfer, Imf::StringAttribute(toString(e.transfer)));
+        if (e.sampleType) conus.insert(kAttrSourceSampleType, Imf::StringAttribute(toString(*e.sampleType)));
+        if (e.chromaticities) {
+            const std::array<float, 8>& c = *e.chromaticities;
+            Imf::addChromaticities(conus, Imf::Chromaticities(Imath::V2f(c[0], c[1]), Imath::V2f(c[2], c[3]),
+                                                              Imath::V2f(c[4], c[5]), Imath::V2f(c[6], c[7])));
+        }
+        if (!e.iccProfile.empty()) conus.insert(kAttrIccProfile, Imf::StringAttribute(base64Encode(e.iccProfile)));
+        for (const MetadataItem& item : e.metadata) {
+            if (!isCarriedMetadata(item.name)) continue;  // never let an item overwrite a CoNUS attribute
+            if (const auto* v = std::get_if<std::string>(&item.value)) conus.insert(item.name, Imf::StringAttribute(*v));
+            else if (const auto* i = std::get_if<int>(&item.value)) conus.insert(item.name, Imf::IntAttribute(*i));
+            else if (const auto* f = std::get_if<float>(&item.value)) conus.insert(item.name, Imf::FloatAttribute(*f));
+            else if (const auto* d = std::get_if<double>(&item.value)) conus.insert(item.name, Imf::DoubleAttribute(*d));
+        }
 
         // OpenEXR requires every part to share displayWindow: the map part gets the image's and its
         // own dataWindow. It is always stored losslessly (DWAA would quantize the node positions).
@@ -384,7 +452,7 @@ void writeExrFile(const std::string& path, const ConusFile& file) {
         map.channels().insert(kMapChannelV, Imf::Channel(Imf::FLOAT));
 
         const Imf::Header headers[2] = {conus, map};
-        Imf::MultiPartOutputFile exr(path.c_str(), headers, 2);
+        Imf::MultiPartOutputFile exr(stream, headers, 2);
         {
             // OpenEXR converts types when reading but not when writing: HALF channels get their own
             // planar half buffers (rounded to nearest), FLOAT ones are written from the image.
@@ -418,8 +486,9 @@ void writeExrFile(const std::string& path, const ConusFile& file) {
             part.writePixels(file.map.rows);
         }
     } catch (const std::exception& e) {
-        throw Error(ErrorCode::Io, "cannot write " + path + ": " + e.what());
+        throw Error(ErrorCode::Io, stream.failure().empty() ? "cannot write " + path + ": " + e.what() : stream.failure());
     }
+    if (!stream.failure().empty()) throw Error(ErrorCode::Io, stream.failure());
 }
 
 }  // namespace conus::format::detail

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "conus/core/atomic_file.h"
 #include "conus/format/container.h"
 
 namespace conus::format::detail {
@@ -17,8 +18,8 @@ struct LoadResult {
 // only when the report is ok.
 LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, ConusFile& out);
 
-// Writes an already validated file to `path` as it is (no temporary, no rename): throws
-// conus::Error(Io) with OpenEXR's message on failure.
-void writeExrFile(const std::string& path, const ConusFile& file);
+// Writes an already validated file into `out` (the caller commits it): throws conus::Error(Io)
+// naming out.destination() on failure.
+void writeExrFile(AtomicFile& out, const ConusFile& file);
 
 }  // namespace conus::format::detail

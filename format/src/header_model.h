@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,9 @@ struct HeaderModel {
     Attr<std::string> depthKind;
     Attr<std::array<float, 2>> depthRange;
     Attr<std::string> depthUnits;
+    // Colour (V16).
+    Attr<std::string> sourceTransfer, sourceSampleType, iccProfile;
+    Attr<std::array<float, 8>> chromaticities;
 };
 
 // Which rule a failure maps to is part of the report; this says how readConusFile should throw.
@@ -77,6 +81,11 @@ HeaderCheck checkHeaderRules(const HeaderModel& model, const ReadLimits& limits,
 
 // The header an in-memory file would be written with.
 HeaderModel modelOf(const ConusFile& file);
+
+// Base64 (RFC 4648) for the ICC profile, which OpenEXR 3.1 has no byte-array attribute for.
+std::string base64Encode(const std::string& bytes);
+// Empty optional for text that is not base64.
+std::optional<std::string> base64Decode(const std::string& text);
 
 // Attribute names (spec/conus-format.md).
 inline constexpr const char* kAttrVersion = "conus:version";
@@ -93,6 +102,10 @@ inline constexpr const char* kAttrDepthUnits = "conus:depthUnits";
 inline constexpr const char* kAttrWorldToCamera = "worldToCamera";
 inline constexpr const char* kAttrWorldToNDC = "worldToNDC";
 inline constexpr const char* kAttrSoftware = "software";
+inline constexpr const char* kAttrSourceTransfer = "conus:sourceTransfer";
+inline constexpr const char* kAttrSourceSampleType = "conus:sourceSampleType";
+inline constexpr const char* kAttrIccProfile = "conus:iccProfile";  // base64
+inline constexpr const char* kAttrChromaticities = "chromaticities";
 inline constexpr const char* kMapChannelU = "ud";
 inline constexpr const char* kMapChannelV = "vd";
 

@@ -1,7 +1,8 @@
 // The plain float image: channel lookup and checked allocation.
+#include <algorithm>
 #include <string>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "conus/format/image.h"
 
 namespace conus::format {
@@ -46,6 +47,15 @@ void checkImage(const Image& image, const char* what) {
         throw Error(ErrorCode::InvalidArgument, std::string(what) + ": image holds " +
                                                     std::to_string(image.pixels.size()) + " values, expected " +
                                                     std::to_string(expected));
+}
+
+std::vector<std::string> displayOrder(const std::vector<std::string>& channels) {
+    std::vector<std::string> out;
+    for (const char* name : {"R", "G", "B", "Y", "A", "Z"})
+        if (std::find(channels.begin(), channels.end(), name) != channels.end()) out.push_back(name);
+    for (const std::string& c : channels)
+        if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
+    return out;
 }
 
 }  // namespace conus::format

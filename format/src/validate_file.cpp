@@ -230,6 +230,18 @@ void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r
     optional(m.depthUnits, kAttrDepthUnits, "string", 14, r);
 }
 
+void checkColour(const HeaderModel& m, ValidationReport& r) {
+    if (optional(m.sourceTransfer, kAttrSourceTransfer, "string", 16, r) && !parseTransfer(m.sourceTransfer.value))
+        r.add(16, "source transfer `" + m.sourceTransfer.value + "` is not linear, srgb or raw");
+    if (optional(m.sourceSampleType, kAttrSourceSampleType, "string", 16, r) && !parseSampleType(m.sourceSampleType.value))
+        r.add(16, "source sample type `" + m.sourceSampleType.value + "` is not uint8, uint16, uint32, half or float");
+    if (optional(m.chromaticities, kAttrChromaticities, "chromaticities", 16, r) &&
+        !std::all_of(m.chromaticities.value.begin(), m.chromaticities.value.end(), [](float x) { return std::isfinite(x); }))
+        r.add(16, "chromaticities hold a non-finite value");
+    if (optional(m.iccProfile, kAttrIccProfile, "string", 16, r) && !base64Decode(m.iccProfile.value))
+        r.add(16, std::string(kAttrIccProfile) + " is not base64 text (" + std::to_string(m.iccProfile.value.size()) + " characters)");
+}
+
 void checkDisplayWindows(const HeaderModel& m, ValidationReport& r) {
     for (std::size_t i = 1; i < m.parts.size(); ++i) {
         if (!(m.parts[i].displayWindow == m.parts[0].displayWindow)) {
@@ -257,6 +269,7 @@ HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, Val
     checkAnalytic(m, r);
     checkCamera(m, r);
     checkDepth(m, part, r);
+    checkColour(m, r);
     checkDisplayWindows(m, r);
     return hc;
 }
@@ -318,6 +331,11 @@ HeaderModel modelOf(const ConusFile& file) {
     m.depthKind = attr(std::string(toString(file.depth.kind)));
     if (file.depth.kind != DepthKind::None) m.depthRange = attr(std::array<float, 2>{file.depth.near, file.depth.far});
     if (!file.depth.units.empty()) m.depthUnits = attr(file.depth.units);
+    const SourceEncoding& e = file.sourceEncoding;
+    m.sourceTransfer = attr(std::string(toString(e.transfer)));
+    if (e.sampleType) m.sourceSampleType = attr(std::string(toString(*e.sampleType)));
+    if (e.chromaticities) m.chromaticities = attr(*e.chromaticities);
+    if (!e.iccProfile.empty()) m.iccProfile = attr(base64Encode(e.iccProfile));
     return m;
 }
 

@@ -29,7 +29,8 @@ public:
         : m_report(report), m_rule(rule), m_what(what) {}
     ~CappedRule() {
         if (m_count > kMaxMessagesPerRule) {
-            m_report.add(m_rule, "... and " + std::to_string(m_count - kMaxMessagesPerRule) + " more " + m_what);
+            m_report.add(m_rule, "... and " + std::to_string(m_count - kMaxMessagesPerRule) + " more " + m_what,
+                         m_count - kMaxMessagesPerRule);
         }
     }
     void add(std::string message) {

@@ -26,6 +26,22 @@ std::string ValidationReport::str() const {
     return out;
 }
 
+long long ValidationReport::problemCount() const {
+    long long n = 0;
+    for (const Issue& issue : issues) n += issue.count;
+    return n;
+}
+
+std::string ValidationReport::summary() const {
+    if (issues.empty()) return "valid";
+    const Issue& first = issues.front();
+    std::string out = first.rule == 0 ? std::string() : "V" + std::to_string(first.rule) + ": ";
+    out += first.message;
+    if (const long long more = problemCount() - first.count; more > 0)
+        out += " (and " + std::to_string(more) + " more problem" + (more == 1 ? "" : "s") + "; `conus validate` lists them)";
+    return out;
+}
+
 const char* toString(PixelType t) {
     switch (t) {
         case PixelType::Half: return "half";

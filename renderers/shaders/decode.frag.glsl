@@ -17,6 +17,11 @@ int taps(float len) { return len <= kMultiTap ? 1 : min(kMaxTaps, int(ceil(len))
 
 void main() {
     const vec2 uv = uView.xy + gl_FragCoord.xy / uOutputSize * (uView.zw - uView.xy);
+    // Outside the image: the background, as codec::decodeImage gives it.
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) {
+        fragColor = vec4(0.0);
+        return;
+    }
     // Outside [0,1] Eq. 1 clamps: the point no longer moves with that coordinate.
     const vec2 inside = vec2(uv.x >= 0.0 && uv.x <= 1.0 ? 1.0 : 0.0, uv.y >= 0.0 && uv.y <= 1.0 ? 1.0 : 0.0);
     const ivec2 nodes = textureSize(uMap, 0);

@@ -39,7 +39,7 @@ uniform vec2 uSourceSize;    // conventional frame in pixels (focus radii are fr
 uniform int uFocusCount;
 uniform vec3 uFoci[16];      // u, v, r
 uniform float uExposure;     // 2^ev, applied before gamma
-uniform float uInvGamma;
+uniform float uInvGamma;     // 0: the sRGB curve
 uniform float uWipeX;        // pixels
 uniform vec2 uLogDensity;    // log density range for the heat map
 
@@ -97,7 +97,14 @@ void paint(inout vec3 color, inout vec4 over, vec3 c, float t) {
     over = mix(over, vec4(c, 1.0), t);
 }
 
-vec3 display(vec4 c) { return pow(max(c.rgb * uExposure, vec3(0.0)), vec3(uInvGamma)); }
+// Linear light to the display: exposure, then the sRGB curve (uInvGamma 0) or a plain gamma; the
+// CPU path's twin is conus::linearToSrgbDisplay (core/display.h).
+vec3 display(vec4 c) {
+    const vec3 x = max(c.rgb * uExposure, vec3(0.0));
+    if (uInvGamma != 0.0) return pow(x, vec3(uInvGamma));
+    const vec3 v = clamp(x, 0.0, 1.0);
+    return mix(12.92 * v, 1.055 * pow(v, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), v));
+}
 
 void main() {
     const float row = uBottomUp ? uOutputSize.y - gl_FragCoord.y : gl_FragCoord.y;

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "context_pvt.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::gl {
 namespace {

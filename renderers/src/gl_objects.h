@@ -7,7 +7,7 @@
 
 #include <glad/gl.h>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::gl {
 

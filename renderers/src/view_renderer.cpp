@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "context_pvt.h"
+#include "conus/core/display.h"
 #include "conus/renderers/gpu_image.h"
 #include "conus/renderers/view_renderer.h"
 #include "embedded_shaders.h"
@@ -20,6 +21,11 @@
 
 namespace conus::gl {
 namespace {
+
+// 0 selects the sRGB curve (ViewOptions::gamma 0); a gamma below 0.05 is held there.
+float inverseGamma(const ViewOptions& options) {
+    return options.gamma == 0.0 ? 0.0f : static_cast<float>(1.0 / std::max(options.gamma, 0.05));
+}
 
 constexpr int kMaxFoci = 16;             // uFoci in view_frame.frag.glsl
 constexpr int kDensitySamples = 128;     // per side, for the heat map's log-density range
@@ -199,7 +205,7 @@ struct ViewRenderer::Impl {
             const std::uint32_t mid = lo + (1u << (kLutShift - 1));
             float x;
             std::memcpy(&x, &mid, sizeof x);
-            const double v = std::pow(static_cast<double>(x), static_cast<double>(invGamma));
+            const double v = invGamma == 0.0f ? linearToSrgbDisplay(x) : std::pow(static_cast<double>(x), static_cast<double>(invGamma));
             lut[i] = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
         }
         lutExposure = exposure;
@@ -215,7 +221,7 @@ struct ViewRenderer::Impl {
         decode.height = height;
         const format::Image frame = codec::decodeImage(rgb, *cpuMap, decode);
         const float exposure = static_cast<float>(std::exp2(options.exposure));
-        const float invGamma = static_cast<float>(1.0 / std::max(options.gamma, 0.05));
+        const float invGamma = inverseGamma(options);
         // Which columns / rows are inside [0,1]^2 at the pixel centres (gl_FragCoord in the shader).
         std::vector<std::uint8_t> colInside(width), rowInside(height);
         const double su = (view.u1 - view.u0) / width, sv = (view.v1 - view.v0) / height;
@@ -237,8 +243,10 @@ struct ViewRenderer::Impl {
                     const float* in = frame.pixels.data() + static_cast<std::size_t>(y) * width * 3;
                     for (int x = 0; x < width; ++x, out += 4, in += 3) {
                         for (int c = 0; c < 3; ++c)
-                            out[c] = rowInside[y] && colInside[x] ? std::pow(std::max(in[c] * exposure, 0.0f), invGamma)
-                                                                  : kBackground;
+                            out[c] = rowInside[y] && colInside[x]
+                                         ? (invGamma == 0.0f ? linearToSrgbDisplay(in[c] * exposure)
+                                                             : std::pow(std::max(in[c] * exposure, 0.0f), invGamma))
+                                         : kBackground;
                         out[3] = 1.0f;
                     }
                 }
@@ -449,7 +457,7 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
     gl.Uniform1i(at("uFocusCount"), foci);
     if (foci > 0) gl.Uniform3fv(at("uFoci"), foci, d.foci.data());
     gl.Uniform1f(at("uExposure"), static_cast<float>(std::exp2(options.exposure)));
-    gl.Uniform1f(at("uInvGamma"), static_cast<float>(1.0 / std::max(options.gamma, 0.05)));
+    gl.Uniform1f(at("uInvGamma"), inverseGamma(options));
     gl.Uniform1f(at("uWipeX"), static_cast<float>(options.wipeX * width));
     gl.Uniform2f(at("uLogDensity"), d.logDensityLo, d.logDensityHi);
     gl.BindVertexArray(d.context.impl().emptyVertexArray);

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "conus/codec/auto_map.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 using namespace conus;
 using namespace conus::codec;

@@ -9,7 +9,7 @@
 
 #include "conus/codec/foci.h"
 #include "conus/format/container.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

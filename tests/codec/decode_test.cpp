@@ -11,7 +11,7 @@
 #include "conus/codec/encode.h"
 #include "conus/codec/foci.h"
 #include "conus/codec/metrics.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "test_images.h"
 
 namespace conus::codec {

@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "conus/format/container.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "conus/codec/foci.h"
 #include "conus/codec/metrics.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "test_images.h"
 
 namespace conus::codec {

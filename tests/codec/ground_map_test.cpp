@@ -7,7 +7,7 @@
 #include <random>
 
 #include "conus/format/container.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

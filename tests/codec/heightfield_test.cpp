@@ -8,7 +8,7 @@
 
 #include "conus/codec/ground_map.h"
 #include "conus/format/container.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

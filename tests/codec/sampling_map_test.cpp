@@ -10,7 +10,7 @@
 
 #include "conus/codec/density_map.h"
 #include "conus/codec/foci.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

@@ -12,7 +12,7 @@
 
 #include "conus/codec/compose.h"
 #include "conus/format/container.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "conus/codec/sampling_map.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "conus/renderers/gpu_image.h"
 #include "gl_test_util.h"
 

@@ -15,7 +15,7 @@
 #include "conus/codec/encode.h"
 #include "conus/codec/foci.h"
 #include "conus/codec/metrics.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "gl_test_util.h"
 
 namespace conus::gl {

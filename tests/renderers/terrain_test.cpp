@@ -13,7 +13,7 @@
 
 #include "conus/codec/heightfield.h"
 #include "conus/codec/metrics.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "gl_test_util.h"
 
 namespace conus::gl {

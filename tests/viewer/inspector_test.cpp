@@ -55,7 +55,7 @@ TEST(Document, InvalidFilesBecomeErrorsNotExceptions) {
 }
 
 TEST(MapEditor, StrokesMagnifyTheBrushCentreAndSaveAValidMap) {
-    MapEditor editor(test::sourceImage(), 33, 33);
+    MapEditor editor(test::sourceImage(), {}, 33, 33);
     editor.brush().radius = 0.15;
     editor.brush().strength = 1.0;
     editor.press({0.5, 0.5});

@@ -82,23 +82,54 @@ TEST(ConusView, ScreenshotIsTheDecodedFrameWithoutADisplay) {
     const fs::path out = test::tempDir() / "shot.png";
     std::string log;
     ASSERT_EQ(test::run("env -u DISPLAY " + test::viewerBinary() + " " + test::conusPath() + " --screenshot " + out.string() +
-                            " --view 0.1,0.2,0.9,0.8 --size 240x180 --gamma 1", &log), 0) << log;
+                            " --view 0.1,0.2,0.9,0.8 --size 256x144 --gamma 1", &log), 0) << log;
     const format::Image shot = readPng(out);
-    ASSERT_EQ(shot.width, 240);
+    ASSERT_EQ(shot.width, 256);
     const format::ConusFile file = format::readConusFile(test::conusPath());
     codec::DecodeOptions options;
-    options.view = {0.1, 0.2, 0.9, 0.8};
-    options.width = 240;
-    options.height = 180;
+    options.view = {0.1, 0.2, 0.9, 0.8};  // 256x144 source pixels: the size's aspect, no letterbox
+    options.width = 256;
+    options.height = 144;
     const format::Image cpu = codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
     // EXR stores channels sorted by name (B,G,R); the PNG is R,G,B.
     const int channel[3] = {cpu.channelIndex("R"), cpu.channelIndex("G"), cpu.channelIndex("B")};
     double worst = 0;
-    for (int y = 0; y < 180; ++y)
-        for (int x = 0; x < 240; ++x)
+    for (int y = 0; y < 144; ++y)
+        for (int x = 0; x < 256; ++x)
             for (int c = 0; c < 3; ++c)
                 worst = std::max(worst, double(std::abs(shot.at(x, y, c) - std::clamp(cpu.at(x, y, channel[c]), 0.0f, 1.0f))));
     EXPECT_LT(worst, 3.0 / 255) << "8-bit rounding plus float differences";
+}
+
+TEST(ConusView, ScreenshotLetterboxesLikeTheWindow) {
+    // A 256x144-pixel view asked for at 256x256: shown whole at 256x144, centred, bands above and
+    // below, not stretched to fill.
+    const fs::path out = test::tempDir() / "box.png";
+    std::string log;
+    ASSERT_EQ(test::run("env -u DISPLAY " + test::viewerBinary() + " " + test::conusPath() + " --screenshot " + out.string() +
+                            " --view 0.1,0.2,0.9,0.8 --size 256x256 --gamma 1", &log), 0) << log;
+    const format::Image shot = readPng(out);
+    ASSERT_EQ(shot.width, 256);
+    ASSERT_EQ(shot.height, 256);
+    const format::ConusFile file = format::readConusFile(test::conusPath());
+    codec::DecodeOptions options;
+    options.view = {0.1, 0.2, 0.9, 0.8};
+    options.width = 256;
+    options.height = 144;
+    const format::Image cpu = codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
+    const int channel[3] = {cpu.channelIndex("R"), cpu.channelIndex("G"), cpu.channelIndex("B")};
+    const int top = (256 - 144) / 2;
+    double worst = 0;
+    for (int y = 0; y < 144; ++y)
+        for (int x = 0; x < 256; ++x)
+            for (int c = 0; c < 3; ++c)
+                worst = std::max(worst, double(std::abs(shot.at(x, top + y, c) - std::clamp(cpu.at(x, y, channel[c]), 0.0f, 1.0f))));
+    EXPECT_LT(worst, 3.0 / 255) << "the picture is the view, unstretched";
+    // The bands show the background: one colour, unlike the picture.
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(shot.at(128, 5, c), shot.at(5, 5, c), 1e-6);
+        EXPECT_NEAR(shot.at(128, 250, c), shot.at(5, 5, c), 1e-6);
+    }
 }
 
 TEST(ConusView, ScreenshotModesAndGrid) {

@@ -1,17 +1,18 @@
 // CPU reference decoder: reconstructs a conventional frame from a CoNUS image. A view is a
 // rectangle of the undistorted image plane rendered at width x height; each output pixel at (u,v)
 // takes the CoNUS image at SM(u,v) (Equation 1), bilinearly. Where the output is coarser than the
-// CoNUS image there (zoomed out), several taps over the pixel's footprint are averaged.
+// CoNUS image there (zoomed out), several taps over the pixel's footprint are averaged. Output
+// pixels whose centre lies outside the image show the background (0 in every channel).
 #pragma once
 
 #include "conus/codec/sampling_map.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "conus/format/image.h"
 
 namespace conus::codec {
 
 struct View {
-    double u0 = 0, v0 = 0, u1 = 1, v1 = 1;  // undistorted rectangle; may extend past [0,1]^2 (edge clamp)
+    double u0 = 0, v0 = 0, u1 = 1, v1 = 1;  // undistorted rectangle; may extend past [0,1]^2 (background there)
 };
 
 struct DecodeOptions {

@@ -8,7 +8,7 @@
 #pragma once
 
 #include "conus/codec/sampling_map.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "conus/format/image.h"
 
 namespace conus::codec {

@@ -26,7 +26,7 @@
 #include "conus/codec/ground_map.h"
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 #include "conus/format/image.h"
 
 namespace conus::codec {

@@ -52,7 +52,7 @@
 #include <glm/glm.hpp>
 
 #include "conus/codec/sampling_map.h"
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
 namespace conus::codec {
 

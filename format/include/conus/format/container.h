@@ -4,8 +4,8 @@
 // data kind. This header is the whole model; no OpenEXR type appears here.
 //
 // Rules shared by the functions below:
-// - writeConusFile validates first and writes nothing for an invalid file; it writes to a
-//   temporary file in the destination's folder and renames it, so no half-written file is left.
+// - writeConusFile validates first and writes nothing for an invalid file; it writes through
+//   conus::AtomicFile (core/atomic_file.h), so no half-written file is ever left.
 // - readConusFile checks every size against ReadLimits before allocating, and throws conus::Error:
 //   NotConus for an EXR without a `conus` part, Corrupt for a damaged file or a broken V-rule,
 //   LimitExceeded for sizes beyond the limits, Io when the file cannot be opened.
@@ -18,7 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "conus/format/error.h"
+#include "conus/core/color.h"
+#include "conus/core/error.h"
 #include "conus/format/image.h"
 #include "conus/format/validation.h"
 
@@ -79,6 +80,10 @@ struct ConusFile {
     std::optional<AnalyticMap> analytic;
     std::optional<Camera> camera;
     DepthInfo depth;
+    // What the source picture held (its transfer, sample type, chromaticities, ICC profile, EXIF
+    // and camera metadata), so that decode can give it back as it was. The pixels themselves are
+    // linear light with associated alpha, or raw data when sourceEncoding.transfer is Raw.
+    SourceEncoding sourceEncoding;
     std::string software;  // free text; the writer fills "conus <version>" when empty
 };
 

@@ -31,6 +31,10 @@ struct Image {
 inline constexpr int kMaxImageSide = 1 << 16;
 inline constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 30;
 
+// Channel names in the order people read them: R, G, B, Y, A, Z, then the rest as given (OpenEXR
+// stores them sorted: B, G, R).
+std::vector<std::string> displayOrder(const std::vector<std::string>& channels);
+
 // A zero-filled image; throws conus::Error(InvalidArgument / LimitExceeded) on absurd sizes.
 Image makeImage(int width, int height, std::vector<std::string> channels);
 

@@ -11,6 +11,7 @@ namespace conus::format {
 struct Issue {
     int rule = 0;         // the spec's rule number: 7 means V7; 0 means "not readable at all"
     std::string message;  // what is wrong, with the bad values
+    long long count = 1;  // problems it stands for: N for a "... and N more" line
 };
 
 struct ValidationReport {
@@ -18,7 +19,11 @@ struct ValidationReport {
 
     bool ok() const { return issues.empty(); }
     bool violates(int rule) const;
-    void add(int rule, std::string message) { issues.push_back({rule, std::move(message)}); }
+    void add(int rule, std::string message, long long count = 1) { issues.push_back({rule, std::move(message), count}); }
+    // Every problem, counting the ones a capped rule summed up in "... and N more".
+    long long problemCount() const;
+    // One line: the first issue, then how many more problems there are.
+    std::string summary() const;
     // One line per issue: "V7: <message>".
     std::string str() const;
 };

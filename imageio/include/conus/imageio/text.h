@@ -1,5 +1,6 @@
-// Image files at the viewer's edge (PNG screenshots, the --edit source image) through
-// OpenImageIO; the only file of viewer/ that includes it. CoNUS files go through conus::format.
+// Text drawn into images through OpenImageIO's render_text, in the font "DejaVuSans" (Debian:
+// fonts-dejavu-core): the demo picture's print and the viewer's help, error and status panels.
+// conus::Error(Io) when the font cannot be found or the text cannot be drawn.
 #pragma once
 
 #include <string>
@@ -7,18 +8,12 @@
 
 #include "conus/format/image.h"
 
-namespace conus::viewer {
+namespace conus::imageio {
 
-// Any image OpenImageIO reads, as float (8/16-bit values scaled to [0,1]); conus::Error(Io) when
-// it cannot be read, LimitExceeded beyond the library's image limits.
-format::Image readImage(const std::string& path);
+// Draws `text` in `color` (RGB) with its baseline-left at (x,y), `size` pixels tall, into the
+// image's first channels (at most four: R, G, B and an opaque A).
+void drawText(format::Image& image, int x, int y, int size, const std::string& text, const float color[3]);
 
-// The first three channels (or one grey channel) as an 8-bit PNG/JPEG, or float EXR/TIFF by
-// extension; values are clamped to [0,1] for 8-bit formats. conus::Error(Io) on failure.
-void writeImage(const std::string& path, const format::Image& image);
-
-// Text for the window's overlays, rasterized by OpenImageIO's render_text in the font "DejaVuSans"
-// (Debian: fonts-dejavu-core).
 struct TextPanelStyle {
     int fontSize = 15;                          // pixels
     float text[4] = {1.0f, 1.0f, 1.0f, 1.0f};   // straight RGBA
@@ -29,7 +24,6 @@ struct TextPanelStyle {
 };
 
 // The lines on a panel sized to fit them: RGBA floats, top row first, straight alpha.
-// conus::Error(Io) when the font cannot be found or the text cannot be drawn.
 format::Image renderTextPanel(const std::vector<std::string>& lines, const TextPanelStyle& style);
 
 // Width of `text` in pixels at `fontSize` (0 for empty text; an estimate without the font).
@@ -39,4 +33,4 @@ int textWidth(const std::string& text, int fontSize);
 // than a line) into lines at most maxWidth pixels wide at fontSize.
 std::vector<std::string> wrapText(const std::string& text, int maxWidth, int fontSize);
 
-}  // namespace conus::viewer
+}  // namespace conus::imageio

@@ -1,69 +1,27 @@
-#include "image_io.h"
-
-#include <unistd.h>
+// Text through OpenImageIO's render_text.
+#include "conus/imageio/text.h"
 
 #include <algorithm>
-#include <filesystem>
-
 #include <cmath>
 #include <sstream>
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
 
-#include "conus/format/error.h"
+#include "conus/core/error.h"
 
-namespace conus::viewer {
-
-format::Image readImage(const std::string& path) {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(ErrorCode::Io, "cannot read image " + path + ": " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.width > format::kMaxImageSide ||
-        spec.height > format::kMaxImageSide ||
-        std::int64_t(spec.width) * spec.height > format::kMaxImagePixels)
-        throw Error(ErrorCode::LimitExceeded, path + ": image size " + std::to_string(spec.width) + "x" +
-                                                  std::to_string(spec.height) + " is outside the supported range");
-    std::vector<std::string> names;
-    for (int c = 0; c < spec.nchannels; ++c) names.push_back(spec.channel_name(c));
-    format::Image image = format::makeImage(spec.width, spec.height, names);
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
-        throw Error(ErrorCode::Io, "cannot read image " + path + ": " + in->geterror());
-    return image;
-}
-
-void writeImage(const std::string& path, const format::Image& image) {
-    const int channels = image.channelCount() >= 3 ? 3 : 1;
-    std::vector<float> pixels(static_cast<std::size_t>(image.width) * image.height * channels);
-    for (std::size_t i = 0; i < static_cast<std::size_t>(image.width) * image.height; ++i)
-        for (int c = 0; c < channels; ++c) pixels[i * channels + c] = image.pixels[i * image.channels.size() + c];
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw Error(ErrorCode::Io, "cannot write " + path + ": " + OIIO::geterror());
-    const std::string ext = path.substr(path.find_last_of('.') + 1);
-    const bool eightBit = ext != "exr" && ext != "EXR" && ext != "tif" && ext != "tiff";
-    OIIO::ImageSpec spec(image.width, image.height, channels, eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
-    if (eightBit)
-        for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
-    // A temporary file beside the destination, renamed into place: never a half-written screenshot.
-    const std::filesystem::path target(path);
-    const std::filesystem::path temp =
-        target.parent_path() / ("." + target.stem().string() + ".tmp-" + std::to_string(::getpid()) + target.extension().string());
-    if (!out->open(temp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !out->close()) {
-        const std::string reason = out->geterror();
-        std::error_code ignored;
-        std::filesystem::remove(temp, ignored);
-        throw Error(ErrorCode::Io, "cannot write " + path + ": " + reason);
-    }
-    std::error_code ec;
-    std::filesystem::rename(temp, target, ec);
-    if (ec) {
-        std::filesystem::remove(temp, ec);
-        throw Error(ErrorCode::Io, "cannot write " + path + ": cannot rename the finished file into place");
-    }
-}
+namespace conus::imageio {
 
 constexpr const char* kFont = "DejaVuSans";
+
+void drawText(format::Image& image, int x, int y, int size, const std::string& text, const float color[3]) {
+    OIIO::ImageSpec spec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT);
+    OIIO::ImageBuf buffer(spec, image.pixels.data());  // wraps our pixels: drawn in place
+    const float rgba[4] = {color[0], color[1], color[2], 1.0f};
+    if (!OIIO::ImageBufAlgo::render_text(buffer, x, y, text, size, kFont, OIIO::cspan<float>(rgba, std::min(4, image.channelCount()))))
+        throw Error(ErrorCode::Io, std::string("cannot draw text in the font ") + kFont + " (package fonts-dejavu-core): " +
+                                       buffer.geterror());
+}
 
 int textWidth(const std::string& text, int fontSize) {
     if (text.empty()) return 0;
@@ -137,4 +95,4 @@ format::Image renderTextPanel(const std::vector<std::string>& lines, const TextP
     return panel;
 }
 
-}  // namespace conus::viewer
+}  // namespace conus::imageio

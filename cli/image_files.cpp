@@ -1,0 +1,103 @@
+#include "image_files.h"
+
+#include <CLI/CLI.hpp>
+
+#include "conus/core/atomic_file.h"
+#include "progress.h"
+
+namespace conus::cli {
+
+void addSourceOptions(CLI::App& command, SourceOptions& options) {
+    command.add_option("--input-colorspace", options.colorspace,
+                       "what the input's values are: auto (default: 8/16-bit files sRGB, float files linear), "
+                       "srgb, linear, or raw (data, never converted)")
+        ->check(CLI::IsMember({"auto", "srgb", "linear", "raw"}));
+    command.add_flag("--no-auto-orient", options.noAutoOrient,
+                     "keep the stored frame instead of applying the EXIF orientation");
+    command.add_option("--fix-nonfinite", options.fixNonFinite,
+                       "NaN/Inf in the input: keep (default, with a warning), black (0) or box3 (mean of finite neighbours)")
+        ->check(CLI::IsMember({"keep", "black", "box3"}));
+    command.add_option("--part", options.part, "the part of a multi-part input to read, by name or index (default: the first)");
+}
+
+imageio::ImageFile readSource(const std::string& path, const SourceOptions& options) {
+    imageio::ReadOptions read;
+    if (options.colorspace != "auto") read.colorspace = parseTransfer(options.colorspace);
+    read.autoOrient = !options.noAutoOrient;
+    read.part = options.part;
+    read.repair = options.fixNonFinite == "black"  ? imageio::NonFiniteRepair::Black
+                  : options.fixNonFinite == "box3" ? imageio::NonFiniteRepair::Box3
+                                                   : imageio::NonFiniteRepair::Keep;
+    Progress progress("read " + path);
+    imageio::ImageFile file = imageio::readImageFile(path, read);
+    progress.done();
+    const imageio::ImageFileInfo& info = file.info;
+    if (info.parts > 1)
+        warn(path + " has " + std::to_string(info.parts) + " parts; using part " + std::to_string(info.part) +
+             (info.partName.empty() ? "" : " (" + info.partName + ")") + " (choose with --part NAME|N)");
+    if (info.nonFinite > 0)
+        warn(path + " holds " + plural(static_cast<std::size_t>(info.nonFinite), "NaN or infinite value", "NaN or infinite values") +
+             (read.repair == imageio::NonFiniteRepair::Keep
+                  ? "; filtering spreads them to their neighbours (repair with --fix-nonfinite box3|black)"
+                  : "; repaired (--fix-nonfinite " + options.fixNonFinite + ")"));
+    return file;
+}
+
+format::Image readData(const std::string& path) {
+    imageio::ReadOptions read;
+    read.colorspace = Transfer::Raw;
+    return imageio::readImageFile(path, read).image;
+}
+
+void addPictureOptions(CLI::App& command, PictureOptions& options) {
+    command.add_option("--bits", options.bits,
+                       "sample type of the picture: 8, 16, half or float (default: the source's where the format holds it)")
+        ->check(CLI::IsMember({"8", "16", "half", "float"}));
+    command.add_option("--exposure", options.exposure, "exposure in stops (multiplies colour by 2^EV)")
+        ->check(CLI::Range(-64.0, 64.0));
+    command.add_option("--tonemap", options.toneMap,
+                       "for 8/16-bit pictures of HDR data: none (default: values above 1 clip), reinhard, aces")
+        ->check(CLI::IsMember({"none", "reinhard", "aces"}));
+}
+
+imageio::WriteOptions writeOptionsOf(const PictureOptions& options, const SourceEncoding* source) {
+    imageio::WriteOptions write;
+    write.source = source;
+    write.display.exposure = options.exposure;
+    write.display.toneMap = parseToneMap(options.toneMap).value_or(ToneMap::None);
+    if (options.bits == "8") write.sampleType = SampleType::Uint8;
+    else if (options.bits == "16") write.sampleType = SampleType::Uint16;
+    else if (options.bits == "half") write.sampleType = SampleType::Half;
+    else if (options.bits == "float") write.sampleType = SampleType::Float;
+    return write;
+}
+
+void checkPictureOutput(const std::string& path, const imageio::WriteOptions& options,
+                        std::initializer_list<std::string> inputs) {
+    const std::vector<std::string> list(inputs);
+    checkOutputPath(path, list);
+    imageio::checkImageOutput(path, options);
+    if (options.display.toneMap != ToneMap::None && options.sampleType &&
+        (*options.sampleType == SampleType::Half || *options.sampleType == SampleType::Float))
+        throw Error(ErrorCode::InvalidArgument,
+                    "--tonemap is for 8/16-bit pictures; a " + std::string(toString(*options.sampleType)) +
+                        " picture keeps the linear values (use --exposure alone)");
+}
+
+void writePicture(const std::string& path, const format::Image& image, const imageio::WriteOptions& options) {
+    const std::int64_t nonFinite = imageio::countNonFinite(image);
+    if (nonFinite > 0)
+        warn(path + ": the picture holds " + plural(static_cast<std::size_t>(nonFinite), "NaN or infinite value", "NaN or infinite values") +
+             " (from the input; repair them with --fix-nonfinite when encoding)");
+    Progress progress("write " + path);
+    imageio::writeImageFile(path, image, options);
+    progress.done();
+}
+
+void writeDrawing(const std::string& path, const format::Image& image) {
+    imageio::WriteOptions options;
+    options.meaning = imageio::PixelMeaning::Display;
+    imageio::writeImageFile(path, image, options);
+}
+
+}  // namespace conus::cli

@@ -1,0 +1,76 @@
+// The one way CoNUS writes a file: all or nothing.
+//
+// Rules shared by everything here:
+// - Bytes go to a temporary file beside the destination (dot-prefixed, same extension, named with
+//   the process id and a counter). Every write is checked, and commit() flushes, syncs and closes
+//   the file, checking each step, before it renames the file over the destination. A reader never
+//   sees a half-written file, and an existing destination survives any failure.
+// - A destination that is a symbolic link is written through: the link's target is replaced.
+// - A destination that exists and is not a regular file (directory, device, FIFO, socket) is
+//   refused before anything is written.
+// - Errors are conus::Error(Io) and name the destination the user gave, never the temporary file.
+// - A temporary file that is still open is removed when the process gets SIGINT, SIGTERM or SIGHUP,
+//   once the program has called removeTemporariesOnSignals() (libraries never install handlers).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace conus {
+
+class AtomicFile {
+public:
+    // Creates the temporary file. Throws conus::Error(Io) when the destination cannot be written.
+    explicit AtomicFile(const std::string& destination);
+    ~AtomicFile();  // removes the temporary file unless commit() succeeded
+    AtomicFile(const AtomicFile&) = delete;
+    AtomicFile& operator=(const AtomicFile&) = delete;
+
+    const std::string& destination() const { return m_destination; }
+    // Where a library that only writes by path (OpenEXR's file API) may write instead.
+    const std::string& temporaryPath() const { return m_temporary; }
+
+    // Appends at the current end (sequential writers) or writes at an offset (writers that seek
+    // back to fill in a table). Both throw conus::Error(Io) naming the destination on failure.
+    void write(const void* data, std::size_t size);
+    void writeAt(std::uint64_t offset, const void* data, std::size_t size);
+    std::uint64_t size() const { return m_size; }
+
+    // Flushes, syncs and closes the temporary file, then renames it over the destination.
+    void commit();
+
+private:
+    void flushBuffer();
+    [[noreturn]] void fail(const std::string& what, int error);
+
+    std::string m_destination;  // as the user gave it, for messages
+    std::string m_target;       // the file the rename replaces (a symlink's target)
+    std::string m_temporary;
+    int m_fd = -1;
+    int m_slot = -1;  // in the registry of temporaries removed on signals
+    std::uint64_t m_size = 0;
+    std::vector<unsigned char> m_buffer;  // pending sequential bytes, written at m_size - pending
+    bool m_committed = false;
+};
+
+// Writes `bytes` to `destination` through an AtomicFile.
+void writeFileAtomically(const std::string& destination, std::span<const unsigned char> bytes);
+
+// Checks before any work is done that `output` can be written (its folder exists; it is not a
+// directory, device, FIFO or socket) and that it is none of `inputs` (the same file by any path).
+// Throws conus::Error(InvalidArgument) naming the output.
+void checkOutputPath(const std::string& output, std::span<const std::string> inputs = {});
+
+// Checks that `input` names a regular file that exists (not a directory, device or FIFO, which
+// could be read forever). "-" (standard input) is accepted when allowStdin. Throws conus::Error(Io).
+void checkInputPath(const std::string& input, bool allowStdin = false);
+
+// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove every open temporary file and
+// then end the process as the signal would have. Also ignores SIGXFSZ, so that a write past a
+// file-size limit fails with an error instead of killing the process mid-file.
+void removeTemporariesOnSignals();
+
+}  // namespace conus

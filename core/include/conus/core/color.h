@@ -1,0 +1,63 @@
+// What pixel values mean, shared by image files (imageio/), the container (format/) and the tools.
+//
+// CoNUS works in linear light: every CoNUS image and every EXR it writes holds scene-linear values
+// (OpenEXR's convention) with associated (premultiplied) alpha. Display-referred files (8- and
+// 16-bit PNG, JPEG, TIFF; sRGB or untagged) are converted to linear on read and back to sRGB on
+// write. Data images (importance maps, DEMs, height fields, normal maps) are `raw`: never converted.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+namespace conus {
+
+// The encoding of a file's values.
+enum class Transfer {
+    Linear,  // scene-linear light (EXR, float TIFF, HDR)
+    Srgb,    // the sRGB transfer curve (8/16-bit display formats, unless tagged otherwise)
+    Raw,     // data, not light: values kept exactly as they are
+};
+
+// The sample type a file stored, which a round trip restores.
+enum class SampleType { Uint8, Uint16, Uint32, Half, Float };
+
+// A metadata item carried from a source file into a CoNUS file and back out on decode (EXIF,
+// camera make and model, ...), under the name OpenImageIO gives it ("Make", "Exif:FNumber").
+struct MetadataItem {
+    std::string name;
+    std::variant<std::string, int, float, double> value;
+    bool operator==(const MetadataItem&) const = default;
+};
+
+// What a CoNUS file remembers of its source picture so that decode can give it back as it was.
+struct SourceEncoding {
+    Transfer transfer = Transfer::Linear;  // of the source file's values
+    std::optional<SampleType> sampleType;  // absent when unknown
+    // CIE xy of the red, green and blue primaries and the white point (OpenEXR's chromaticities);
+    // absent for raw data, and when an ICC profile describes the colours instead.
+    std::optional<std::array<float, 8>> chromaticities;
+    std::string iccProfile;  // the source's ICC profile, raw bytes; empty when it had none
+    std::vector<MetadataItem> metadata;
+    bool operator==(const SourceEncoding&) const = default;
+};
+
+// sRGB's primaries and white point (ITU-R BT.709, D65), the chromaticities of sRGB sources.
+inline constexpr std::array<float, 8> kRec709Chromaticities{0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+
+const char* toString(Transfer transfer);      // "linear", "srgb", "raw"
+const char* toString(SampleType sampleType);  // "uint8", "uint16", "uint32", "half", "float"
+std::optional<Transfer> parseTransfer(std::string_view text);
+std::optional<SampleType> parseSampleType(std::string_view text);
+// Bits per sample of a type: 8, 16, 32, 16, 32.
+int bitsOf(SampleType sampleType);
+
+// Whether a metadata item of this name travels from a source file into a CoNUS file and back out:
+// the EXIF, GPS and IPTC blocks (names "Exif:...", "GPS:...", "IPTC:...") and Make, Model,
+// DateTime, Artist, Copyright, ImageDescription and Orientation.
+bool isCarriedMetadata(std::string_view name);
+
+}  // namespace conus

@@ -1,0 +1,579 @@
+// Image files through OpenImageIO: channels by name, colour conversion, metadata, atomic writes.
+// OpenImageIO reports failures through geterror(); they become conus::Error right where it is
+// called, naming the user's path.
+#include "conus/imageio/image_file.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+#include <OpenImageIO/strutil.h>
+
+#include "conus/core/atomic_file.h"
+#include "conus/core/error.h"
+
+namespace conus::imageio {
+namespace {
+
+// ---- what a file format holds ------------------------------------------------------------------
+
+struct FormatTraits {
+    std::vector<SampleType> sampleTypes;  // the first is the natural one
+    bool anyChannels = false;             // TIFF, EXR, DPX: any number of named channels
+    bool alpha = false;
+};
+
+FormatTraits traitsOf(const std::string& formatName, const OIIO::ImageOutput& output) {
+    FormatTraits t;
+    t.anyChannels = output.supports("nchannels") != 0;
+    t.alpha = output.supports("alpha") != 0;
+    using enum SampleType;
+    if (formatName == "png" || formatName == "pnm" || formatName == "jpeg2000" || formatName == "dpx")
+        t.sampleTypes = {Uint8, Uint16};
+    else if (formatName == "tiff")
+        t.sampleTypes = {Uint16, Uint8, Float, Half};
+    else if (formatName == "openexr")
+        t.sampleTypes = {Half, Float};
+    else if (formatName == "hdr")
+        t.sampleTypes = {Float};
+    else
+        t.sampleTypes = {Uint8};
+    return t;
+}
+
+bool isInteger(SampleType t) { return t == SampleType::Uint8 || t == SampleType::Uint16 || t == SampleType::Uint32; }
+
+OIIO::TypeDesc typeDescOf(SampleType t) {
+    switch (t) {
+        case SampleType::Uint8: return OIIO::TypeDesc::UINT8;
+        case SampleType::Uint16: return OIIO::TypeDesc::UINT16;
+        case SampleType::Uint32: return OIIO::TypeDesc::UINT32;
+        case SampleType::Half: return OIIO::TypeDesc::HALF;
+        case SampleType::Float: return OIIO::TypeDesc::FLOAT;
+    }
+    return OIIO::TypeDesc::FLOAT;
+}
+
+std::optional<SampleType> sampleTypeOf(OIIO::TypeDesc type) {
+    switch (type.basetype) {
+        case OIIO::TypeDesc::UINT8:
+        case OIIO::TypeDesc::INT8: return SampleType::Uint8;
+        case OIIO::TypeDesc::UINT16:
+        case OIIO::TypeDesc::INT16: return SampleType::Uint16;
+        case OIIO::TypeDesc::UINT32:
+        case OIIO::TypeDesc::INT32: return SampleType::Uint32;
+        case OIIO::TypeDesc::HALF: return SampleType::Half;
+        case OIIO::TypeDesc::FLOAT:
+        case OIIO::TypeDesc::DOUBLE: return SampleType::Float;
+        default: return std::nullopt;
+    }
+}
+
+std::string joinTypes(const std::vector<SampleType>& types) {
+    std::string s;
+    for (std::size_t i = 0; i < types.size(); ++i)
+        s += std::string(i == 0 ? "" : i + 1 == types.size() ? " or " : ", ") + toString(types[i]);
+    return s;
+}
+
+// ---- channels by name --------------------------------------------------------------------------
+
+// The colour channels of an image in display order: R,G,B when all three are there, else Y, else
+// (an image of other names) its first channel for a grey picture; A separately.
+struct ChannelRoles {
+    std::vector<int> colour;
+    int alpha = -1;
+};
+
+ChannelRoles rolesOf(const format::Image& image) {
+    ChannelRoles roles;
+    const int r = image.channelIndex("R"), g = image.channelIndex("G"), b = image.channelIndex("B");
+    const int y = image.channelIndex("Y");
+    if (r >= 0 && g >= 0 && b >= 0) roles.colour = {r, g, b};
+    else if (y >= 0) roles.colour = {y};
+    roles.alpha = image.channelIndex("A");
+    return roles;
+}
+
+// ---- colour ------------------------------------------------------------------------------------
+
+// Converts the channels `colour` of an interleaved float buffer between OpenImageIO colour spaces
+// ("sRGB", "linear"). OpenImageIO converts the first channels of a buffer (its colorconvert does
+// not honour a channel range that starts past 0), so colour channels that do not lead the pixel
+// are gathered into a buffer of their own first.
+void convertColour(float* pixels, int width, int height, int channels, const std::vector<int>& colour,
+                   const char* from, const char* to, const std::string& path) {
+    if (colour.empty()) return;
+    const auto count = static_cast<std::size_t>(width) * height;
+    const int k = static_cast<int>(colour.size());
+    bool leading = k == 1 || k == 3;
+    for (int i = 0; i < k && leading; ++i) leading = colour[i] == i;
+    auto run = [&](float* data, int nchannels, int chend) {
+        OIIO::ImageBuf buffer(OIIO::ImageSpec(width, height, nchannels, OIIO::TypeDesc::FLOAT), data);
+        OIIO::ROI roi = buffer.roi();
+        roi.chend = chend;
+        if (!OIIO::ImageBufAlgo::colorconvert(buffer, buffer, from, to, false, "", "", nullptr, roi))
+            throw Error(ErrorCode::Io, path + ": colour conversion " + from + " -> " + to + " failed: " + buffer.geterror());
+    };
+    if (leading) {
+        run(pixels, channels, k);
+        return;
+    }
+    for (int c : colour) {  // one channel at a time: each is converted on its own
+        std::vector<float> plane(count);
+        for (std::size_t p = 0; p < count; ++p) plane[p] = pixels[p * channels + c];
+        run(plane.data(), 1, 1);
+        for (std::size_t p = 0; p < count; ++p) pixels[p * channels + c] = plane[p];
+    }
+}
+
+// Multiplies (or divides) the colour channels by alpha, through OpenImageIO.
+void premultiply(float* pixels, int width, int height, int channels, int alpha, bool associate) {
+    OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
+    spec.alpha_channel = alpha;
+    OIIO::ImageBuf buffer(spec, pixels);
+    if (associate) OIIO::ImageBufAlgo::premult(buffer, buffer);
+    else OIIO::ImageBufAlgo::unpremult(buffer, buffer);
+}
+
+// ---- metadata ----------------------------------------------------------------------------------
+
+void collectMetadata(const OIIO::ImageSpec& spec, bool oriented, SourceEncoding& encoding) {
+    for (const OIIO::ParamValue& pv : spec.extra_attribs) {
+        const std::string name = pv.name().string();
+        const OIIO::TypeDesc type = pv.type();
+        if (name == "Orientation") {  // carried only when it was not applied
+            if (!oriented && pv.get_int(1) != 1) encoding.metadata.push_back({name, pv.get_int(1)});
+            continue;
+        }
+        if (!isCarriedMetadata(name) || type.arraylen != 0 || type.aggregate != OIIO::TypeDesc::SCALAR) continue;
+        if (type == OIIO::TypeDesc::STRING) encoding.metadata.push_back({name, pv.get_string()});
+        else if (type.basetype == OIIO::TypeDesc::FLOAT) encoding.metadata.push_back({name, pv.get_float()});
+        else if (type.basetype == OIIO::TypeDesc::DOUBLE) encoding.metadata.push_back({name, double(pv.get_float())});
+        else if (type.is_floating_point() || type == OIIO::TypeRational) encoding.metadata.push_back({name, pv.get_float()});
+        else if (type.basetype >= OIIO::TypeDesc::UINT8 && type.basetype <= OIIO::TypeDesc::INT32)
+            encoding.metadata.push_back({name, pv.get_int()});
+    }
+    if (const OIIO::ParamValue* icc = spec.find_attribute("ICCProfile");
+        icc && icc->type().basetype == OIIO::TypeDesc::UINT8 && icc->datasize() > 0) {
+        const auto* bytes = static_cast<const char*>(icc->data());
+        encoding.iccProfile.assign(bytes, bytes + icc->datasize());
+    }
+}
+
+void applyMetadata(const SourceEncoding& source, bool withIcc, OIIO::ImageSpec& spec) {
+    for (const MetadataItem& item : source.metadata) {
+        if (const auto* s = std::get_if<std::string>(&item.value)) spec.attribute(item.name, *s);
+        else if (const auto* i = std::get_if<int>(&item.value)) spec.attribute(item.name, *i);
+        else if (const auto* f = std::get_if<float>(&item.value)) spec.attribute(item.name, *f);
+        else if (const auto* d = std::get_if<double>(&item.value)) spec.attribute(item.name, OIIO::TypeDesc::DOUBLE, d);
+    }
+    if (withIcc && !source.iccProfile.empty())
+        spec.attribute("ICCProfile", OIIO::TypeDesc(OIIO::TypeDesc::UINT8, static_cast<int>(source.iccProfile.size())),
+                       source.iccProfile.data());
+}
+
+// ---- reading -----------------------------------------------------------------------------------
+
+// Standard input, read whole (bounded), with a name whose extension tells OpenImageIO the format.
+struct StdinImage {
+    std::vector<unsigned char> bytes;
+    std::string name;
+};
+
+StdinImage readStdin() {
+    constexpr std::size_t kMaxStdinBytes = std::size_t{4} << 30;
+    StdinImage in;
+    unsigned char chunk[1 << 16];
+    std::size_t n;
+    while ((n = std::fread(chunk, 1, sizeof chunk, stdin)) > 0) {
+        in.bytes.insert(in.bytes.end(), chunk, chunk + n);
+        if (in.bytes.size() > kMaxStdinBytes)
+            throw Error(ErrorCode::LimitExceeded, "standard input holds more than 4 GiB; give a file instead");
+    }
+    if (in.bytes.empty()) throw Error(ErrorCode::Io, "standard input is empty");
+    const auto starts = [&](const char* magic, std::size_t size) {
+        return in.bytes.size() >= size && std::memcmp(in.bytes.data(), magic, size) == 0;
+    };
+    const char* ext = starts("\x89PNG", 4)               ? "png"
+                      : starts("\xFF\xD8\xFF", 3)          ? "jpg"
+                      : starts("II*\0", 4) || starts("MM\0*", 4) ? "tif"
+                      : starts("\x76\x2f\x31\x01", 4)      ? "exr"
+                      : starts("BM", 2)                    ? "bmp"
+                      : starts("#?", 2)                    ? "hdr"
+                      : starts("P", 1)                     ? "ppm"
+                                                           : "";
+    if (!*ext) throw Error(ErrorCode::Io, "standard input is not an image format CoNUS recognizes (PNG, JPEG, TIFF, EXR, BMP, HDR, PPM)");
+    in.name = std::string("stdin.") + ext;
+    return in;
+}
+
+// Seeks to the part `wanted` (a name or an index; empty: the first) and says which it was.
+void selectPart(OIIO::ImageInput& in, const std::string& path, const std::string& wanted, ImageFileInfo& info) {
+    constexpr int kMaxParts = 10000;
+    std::vector<std::string> names;
+    for (int i = 0; i < kMaxParts && in.seek_subimage(i, 0); ++i)
+        names.push_back(in.spec().get_string_attribute("oiio:subimagename"));
+    info.parts = std::max(1, static_cast<int>(names.size()));
+    int chosen = 0;
+    if (!wanted.empty()) {
+        chosen = -1;
+        for (std::size_t i = 0; i < names.size(); ++i)
+            if (names[i] == wanted) chosen = static_cast<int>(i);
+        char* end = nullptr;
+        const long index = std::strtol(wanted.c_str(), &end, 10);
+        if (chosen < 0 && end && *end == '\0' && index >= 0 && index < static_cast<long>(names.size()))
+            chosen = static_cast<int>(index);
+        if (chosen < 0) {
+            std::string list;
+            for (std::size_t i = 0; i < names.size(); ++i)
+                list += (i ? ", " : "") + std::to_string(i) + (names[i].empty() ? "" : " (" + names[i] + ")");
+            throw Error(ErrorCode::InvalidArgument, path + " has no part '" + wanted + "'; its parts are " + list);
+        }
+    }
+    if (!in.seek_subimage(chosen, 0)) throw Error(ErrorCode::Io, path + ": cannot read part " + std::to_string(chosen));
+    info.part = chosen;
+    info.partName = chosen < static_cast<int>(names.size()) ? names[chosen] : "";
+}
+
+Transfer detectTransfer(const OIIO::ImageSpec& spec) {
+    const OIIO::TypeDesc::BASETYPE base = static_cast<OIIO::TypeDesc::BASETYPE>(spec.format.basetype);
+    if (base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::DOUBLE)
+        return Transfer::Linear;
+    const std::string cs = spec.get_string_attribute("oiio:ColorSpace");
+    if (OIIO::Strutil::iequals(cs, "linear") || OIIO::Strutil::iequals(cs, "scene_linear") ||
+        OIIO::Strutil::iequals(cs, "lin_srgb") || OIIO::Strutil::iequals(cs, "Gamma1.0"))
+        return Transfer::Linear;
+    return Transfer::Srgb;  // sRGB, untagged, or a display gamma: sRGB is what such files hold
+}
+
+}  // namespace
+
+std::int64_t countNonFinite(const format::Image& image) {
+    std::int64_t n = 0;
+    for (float v : image.pixels) n += !std::isfinite(v);
+    return n;
+}
+
+ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
+    checkInputPath(path, /*allowStdin=*/true);
+    StdinImage stdinImage;
+    std::unique_ptr<OIIO::Filesystem::IOMemReader> memory;
+    std::string openName = path;
+    if (path == "-") {
+        stdinImage = readStdin();
+        memory = std::make_unique<OIIO::Filesystem::IOMemReader>(stdinImage.bytes.data(), stdinImage.bytes.size());
+        openName = stdinImage.name;
+    }
+    const std::string shown = path == "-" ? std::string("standard input") : path;
+    // Straight alpha as stored: colour is linearized first, then associated (in linear light).
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(openName, &config, memory.get());
+    if (!in) {
+        std::string reason = OIIO::geterror();
+        if (reason.empty()) reason = "not an image format OpenImageIO reads";
+        throw Error(ErrorCode::Io, shown + ": cannot read image: " + reason);
+    }
+    ImageFile result;
+    ImageFileInfo& info = result.info;
+    info.format = in->format_name();
+    selectPart(*in, shown, options.part, info);
+    const OIIO::ImageSpec spec = in->spec();  // a copy: reading may change the input's
+    const std::int64_t pixels = std::int64_t{spec.width} * spec.height;
+    if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
+        throw Error(ErrorCode::Io, shown + ": the image is empty (" + std::to_string(spec.width) + "x" +
+                                       std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) + " channels)");
+    if (spec.width > format::kMaxImageSide || spec.height > format::kMaxImageSide || pixels > format::kMaxImagePixels ||
+        spec.nchannels > 64)
+        throw Error(ErrorCode::LimitExceeded,
+                    shown + ": image of " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels and " +
+                        std::to_string(spec.nchannels) + " channels is beyond the limits (sides up to " +
+                        std::to_string(format::kMaxImageSide) + ", " + std::to_string(format::kMaxImagePixels) +
+                        " pixels, 64 channels)");
+
+    std::vector<std::string> names;
+    for (int c = 0; c < spec.nchannels; ++c) {
+        char unnamed[16];  // a file without channel names: C0, C1, ...
+        std::snprintf(unnamed, sizeof unnamed, "C%d", c);
+        const std::string n = spec.channel_name(c);
+        names.push_back(n.empty() ? std::string(unnamed) : n);
+    }
+    format::Image& image = result.image;
+    image = format::makeImage(spec.width, spec.height, names);
+    if (!in->read_image(info.part, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
+        std::string reason = in->geterror();
+        if (reason.empty()) reason = "the file ends early or is damaged";
+        throw Error(ErrorCode::Io, shown + ": cannot read pixels: " + reason);
+    }
+
+    SourceEncoding& encoding = info.encoding;
+    encoding.sampleType = sampleTypeOf(spec.format);
+    encoding.transfer = options.colorspace.value_or(detectTransfer(spec));
+    info.orientation = spec.get_int_attribute("Orientation", 1);
+    info.oriented = options.autoOrient && info.orientation >= 2 && info.orientation <= 8;
+    collectMetadata(spec, info.oriented, encoding);
+    if (encoding.transfer != Transfer::Raw) {
+        if (const OIIO::ParamValue* c = spec.find_attribute("chromaticities", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 8))) {
+            std::array<float, 8> xy{};
+            std::memcpy(xy.data(), c->data(), sizeof xy);
+            encoding.chromaticities = xy;
+        } else if (encoding.iccProfile.empty()) {
+            encoding.chromaticities = kRec709Chromaticities;
+        }
+    }
+
+    info.nonFinite = countNonFinite(image);
+    if (info.nonFinite > 0 && options.repair != NonFiniteRepair::Keep) {
+        OIIO::ImageBuf buffer(OIIO::ImageSpec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT),
+                              image.pixels.data());
+        const auto mode = options.repair == NonFiniteRepair::Black ? OIIO::ImageBufAlgo::NONFINITE_BLACK
+                                                                   : OIIO::ImageBufAlgo::NONFINITE_BOX3;
+        if (!OIIO::ImageBufAlgo::fixNonFinite(buffer, buffer, mode))
+            throw Error(ErrorCode::Io, shown + ": cannot repair non-finite values: " + buffer.geterror());
+        // Box3 leaves a value whose 3x3 neighbourhood holds nothing finite; those become 0.
+        for (float& v : image.pixels)
+            if (!std::isfinite(v)) v = 0.0f;
+    }
+
+    // Colour: linear light with associated alpha, as OpenEXR has it.
+    if (encoding.transfer != Transfer::Raw) {
+        const ChannelRoles roles = rolesOf(image);
+        const bool straight = spec.get_int_attribute("oiio:UnassociatedAlpha", 0) != 0;
+        const int c = image.channelCount();
+        if (encoding.transfer == Transfer::Srgb) {
+            if (roles.alpha >= 0 && !straight) premultiply(image.pixels.data(), image.width, image.height, c, roles.alpha, false);
+            convertColour(image.pixels.data(), image.width, image.height, c, roles.colour, "sRGB", "linear", shown);
+        }
+        if (roles.alpha >= 0 && (straight || encoding.transfer == Transfer::Srgb))
+            premultiply(image.pixels.data(), image.width, image.height, c, roles.alpha, true);
+    }
+
+    if (info.oriented) {
+        OIIO::ImageSpec oriented(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT);
+        oriented.attribute("Orientation", info.orientation);
+        OIIO::ImageBuf upright = OIIO::ImageBufAlgo::reorient(OIIO::ImageBuf(oriented, image.pixels.data()));
+        if (upright.has_error()) throw Error(ErrorCode::Io, shown + ": cannot apply the EXIF orientation: " + upright.geterror());
+        const OIIO::ROI roi = upright.roi();
+        format::Image turned = format::makeImage(roi.width(), roi.height(), image.channels);
+        upright.get_pixels(roi, OIIO::TypeDesc::FLOAT, turned.pixels.data());
+        image = std::move(turned);
+    }
+    return result;
+}
+
+void linearize(format::Image& image) {
+    format::checkImage(image, "linearize");
+    const ChannelRoles roles = rolesOf(image);
+    convertColour(image.pixels.data(), image.width, image.height, image.channelCount(), roles.colour, "sRGB", "linear",
+                  "an image");
+    if (roles.alpha >= 0) premultiply(image.pixels.data(), image.width, image.height, image.channelCount(), roles.alpha, true);
+}
+
+format::Image displayEncoded(const format::Image& image) {
+    format::checkImage(image, "displayEncoded");
+    format::Image out = image;
+    for (float& v : out.pixels)
+        if (!std::isfinite(v)) v = 0.0f;
+    const ChannelRoles roles = rolesOf(out);
+    if (roles.alpha >= 0) premultiply(out.pixels.data(), out.width, out.height, out.channelCount(), roles.alpha, false);
+    std::vector<int> colour = roles.colour;
+    if (colour.empty()) colour = {0};
+    convertColour(out.pixels.data(), out.width, out.height, out.channelCount(), colour, "linear", "sRGB", "an image");
+    for (std::size_t p = 0; p < out.pixels.size(); p += out.channels.size())
+        for (int c : colour) out.pixels[p + c] = std::clamp(out.pixels[p + c], 0.0f, 1.0f);
+    return out;
+}
+
+// ---- writing -----------------------------------------------------------------------------------
+
+namespace {
+
+// OpenImageIO's writers write through this proxy into an AtomicFile: every byte checked, and the
+// file renamed into place only after the writer closed without error.
+class AtomicProxy final : public OIIO::Filesystem::IOProxy {
+public:
+    explicit AtomicProxy(AtomicFile& file) : IOProxy(file.destination(), IOProxy::Write), m_file(file) {}
+    const char* proxytype() const override { return "conus-atomic"; }
+    size_t write(const void* buf, size_t size) override {
+        const std::size_t n = pwrite(buf, size, m_pos);
+        m_pos += static_cast<int64_t>(n);
+        return n;
+    }
+    size_t pwrite(const void* buf, size_t size, int64_t offset) override {
+        if (!m_error.empty()) return 0;
+        try {
+            if (static_cast<std::uint64_t>(offset) == m_file.size()) m_file.write(buf, size);
+            else m_file.writeAt(static_cast<std::uint64_t>(offset), buf, size);
+        } catch (const Error& e) {
+            m_error = e.what();
+            return 0;
+        }
+        return size;
+    }
+    bool seek(int64_t offset) override {
+        m_pos = offset;
+        return true;
+    }
+    size_t size() const override { return static_cast<size_t>(m_file.size()); }
+    const std::string& failure() const { return m_error; }
+
+private:
+    AtomicFile& m_file;
+};
+
+struct Target {
+    std::unique_ptr<OIIO::ImageOutput> output;
+    std::string formatName;
+    FormatTraits traits;
+    SampleType sampleType = SampleType::Uint8;
+};
+
+Target targetFor(const std::string& path, const WriteOptions& options) {
+    Target t;
+    t.output = OIIO::ImageOutput::create(path);
+    if (!t.output) {
+        const std::string ext = std::filesystem::path(path).extension().string();
+        (void)OIIO::geterror();
+        throw Error(ErrorCode::InvalidArgument,
+                    path + ": no image writer for " + (ext.empty() ? std::string("a name without an extension") : "'" + ext + "'") +
+                        " (use .png, .jpg, .tif, .exr, .bmp, .hdr, ...)");
+    }
+    t.formatName = t.output->format_name();
+    t.traits = traitsOf(t.formatName, *t.output);
+    const auto holds = [&](SampleType s) {
+        return std::find(t.traits.sampleTypes.begin(), t.traits.sampleTypes.end(), s) != t.traits.sampleTypes.end();
+    };
+    if (options.sampleType) {
+        if (!holds(*options.sampleType))
+            throw Error(ErrorCode::InvalidArgument, path + ": " + t.formatName + " holds " + joinTypes(t.traits.sampleTypes) +
+                                                        " samples, not " + toString(*options.sampleType));
+        t.sampleType = *options.sampleType;
+        return t;
+    }
+    t.sampleType = t.traits.sampleTypes.front();
+    const std::optional<SampleType> source = options.source ? options.source->sampleType : std::nullopt;
+    if (source && holds(*source)) t.sampleType = *source;
+    else if (source && !isInteger(*source) && holds(SampleType::Float)) t.sampleType = SampleType::Float;  // linear stays float
+    return t;
+}
+
+}  // namespace
+
+void checkImageOutput(const std::string& path, const WriteOptions& options) {
+    checkOutputPath(path);
+    (void)targetFor(path, options);
+}
+
+std::string sampleTypesOf(const std::string& path) {
+    auto output = OIIO::ImageOutput::create(path);
+    if (!output) return "no";
+    return joinTypes(traitsOf(output->format_name(), *output).sampleTypes);
+}
+
+void writeImageFile(const std::string& path, const format::Image& image, const WriteOptions& options) {
+    format::checkImage(image, "writeImageFile");
+    Target target = targetFor(path, options);
+    const bool integer = isInteger(target.sampleType);
+
+    // Channels by name: colour first in display order, then alpha, then (formats with named
+    // channels only) the rest in the image's order.
+    ChannelRoles roles = rolesOf(image);
+    if (roles.colour.empty()) {  // no R,G,B or Y: show the first non-alpha channel as grey
+        for (int c = 0; c < image.channelCount() && roles.colour.empty(); ++c)
+            if (c != roles.alpha) roles.colour = {c};
+        if (roles.colour.empty()) roles.colour = {0};
+    }
+    std::vector<int> order = roles.colour;
+    int alpha = -1;
+    if (roles.alpha >= 0 && target.traits.alpha && std::find(order.begin(), order.end(), roles.alpha) == order.end()) {
+        alpha = static_cast<int>(order.size());
+        order.push_back(roles.alpha);
+    }
+    if (target.traits.anyChannels)
+        for (int c = 0; c < image.channelCount(); ++c)
+            if (std::find(order.begin(), order.end(), c) == order.end()) order.push_back(c);
+    const int channels = static_cast<int>(order.size());
+    std::vector<int> colour(roles.colour.size());
+    for (std::size_t i = 0; i < colour.size(); ++i) colour[i] = static_cast<int>(i);
+
+    constexpr int kJpegMaxSide = 65500;  // libjpeg ends the process on larger images
+    if (target.formatName == "jpeg" && (image.width > kJpegMaxSide || image.height > kJpegMaxSide))
+        throw Error(ErrorCode::InvalidArgument, path + ": JPEG holds at most 65500 pixels a side, not " +
+                                                    std::to_string(image.width) + "x" + std::to_string(image.height));
+
+    const auto count = static_cast<std::size_t>(image.width) * image.height;
+    std::vector<float> pixels(count * channels);
+    for (std::size_t p = 0; p < count; ++p)
+        for (int i = 0; i < channels; ++i) pixels[p * channels + i] = image.pixels[p * image.channelCount() + order[i]];
+
+    // What the written values encode.
+    const SourceEncoding* source = options.source;
+    const bool raw = options.meaning == PixelMeaning::Raw || (source && source->transfer == Transfer::Raw);
+    Transfer written = Transfer::Linear;
+    if (raw) written = Transfer::Raw;
+    else if (integer)
+        written = source && source->transfer == Transfer::Linear && source->sampleType && isInteger(*source->sampleType)
+                      ? Transfer::Linear
+                      : Transfer::Srgb;
+
+    if (!raw) {
+        const float gain = static_cast<float>(std::exp2(options.display.exposure));
+        const ToneMap toneMap = integer ? options.display.toneMap : ToneMap::None;
+        if (options.meaning == PixelMeaning::Linear) {
+            // Display formats store straight alpha; the colour is encoded from straight linear values.
+            if (integer && alpha >= 0) premultiply(pixels.data(), image.width, image.height, channels, alpha, false);
+            if (gain != 1.0f || toneMap != ToneMap::None)
+                for (std::size_t p = 0; p < count; ++p)
+                    for (int c : colour) pixels[p * channels + c] = exposeAndToneMap(pixels[p * channels + c], gain, toneMap);
+            if (written == Transfer::Srgb)
+                convertColour(pixels.data(), image.width, image.height, channels, colour, "linear", "sRGB", path);
+        } else if (written != Transfer::Srgb) {  // display artwork into a linear format
+            convertColour(pixels.data(), image.width, image.height, channels, colour, "sRGB", "linear", path);
+        }
+    }
+
+    OIIO::ImageSpec spec(image.width, image.height, channels, typeDescOf(target.sampleType));
+    spec.channelnames.clear();
+    for (int c : order) spec.channelnames.push_back(image.channels[c]);
+    spec.alpha_channel = alpha;
+    spec.z_channel = -1;
+    for (int i = 0; i < channels; ++i)
+        if (spec.channelnames[i] == "Z") spec.z_channel = i;
+    if (written == Transfer::Srgb) spec.attribute("oiio:ColorSpace", "sRGB");
+    else if (written == Transfer::Linear) spec.attribute("oiio:ColorSpace", "Linear");
+    if (integer && alpha >= 0) spec.attribute("oiio:UnassociatedAlpha", 1);
+    if (target.formatName == "openexr") spec.attribute("compression", "zip");
+    if (source) {
+        applyMetadata(*source, written != Transfer::Raw, spec);
+        if (!integer && source->chromaticities && !raw)
+            spec.attribute("chromaticities", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 8), source->chromaticities->data());
+    }
+
+    AtomicFile file(path);
+    AtomicProxy proxy(file);
+    const bool proxied = target.output->supports("ioproxy") && target.output->set_ioproxy(&proxy);
+    const std::string openPath = proxied ? path : file.temporaryPath();
+    bool ok = target.output->open(openPath, spec);
+    ok = ok && target.output->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
+    ok = target.output->close() && ok;
+    if (!ok || !proxy.failure().empty()) {
+        std::string reason = proxy.failure().empty() ? target.output->geterror() : proxy.failure();
+        if (reason.empty()) reason = "the " + target.formatName + " writer failed";
+        // A failure already worded for the destination is passed on as it is.
+        throw Error(ErrorCode::Io, reason.rfind("cannot write " + path, 0) == 0 ? reason : "cannot write " + path + ": " + reason);
+    }
+    file.commit();
+}
+
+}  // namespace conus::imageio
