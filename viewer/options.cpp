@@ -85,7 +85,9 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("--benchmark-frames", o.benchmarkFrames, "draw N frames, print frames/s and exit");
     app.add_flag("--help-overlay", o.helpOverlay, "show the key list (H) over the view, in the window and in --screenshot");
     app.add_flag("--status-bar", o.statusBar, "show the status bar (B): file, mode, zoom, the pixel under the cursor");
-    app.add_option("--backend", o.backend, "--screenshot GL backend: auto, egl, osmesa")->capture_default_str();
+    app.add_option("--backend", o.backend, "--screenshot GL backend: auto, egl, osmesa")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "egl", "osmesa"}, CLI::ignore_case));
     try {
         app.parse(argc, argv);
         if (!view.empty()) o.view = parseView(view);

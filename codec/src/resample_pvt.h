@@ -23,7 +23,9 @@ inline void checkOutputSize(int width, int height, const char* what) {
     if (width > format::kMaxImageSide || height > format::kMaxImageSide ||
         std::int64_t{width} * height > format::kMaxImagePixels)
         throw Error(ErrorCode::LimitExceeded, std::string(what) + ": output size " + std::to_string(width) + "x" +
-                                                  std::to_string(height) + " exceeds the image limits");
+                                                  std::to_string(height) + " exceeds the image limits (" +
+                                                  std::to_string(format::kMaxImageSide) + " a side, " +
+                                                  std::to_string(format::kMaxImagePixels) + " pixels in all)");
 }
 
 // Same channels as `like`, zero-filled; sizes already checked.

@@ -91,7 +91,7 @@ AtomicFile::AtomicFile(const std::string& destination) : m_destination(destinati
                       .string();
     // Registered before it exists, so a signal between open and registration leaves nothing.
     m_slot = registerTemporary(m_temporary);
-    m_fd = ::open(m_temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    m_fd = ::open(m_temporary.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (m_fd < 0) {
         const int error = errno;
         unregisterTemporary(m_slot);
@@ -130,16 +130,15 @@ void AtomicFile::flushBuffer() {
 void AtomicFile::write(const void* data, std::size_t size) {
     if (m_fd < 0) fail("the file is already closed", 0);
     const auto* bytes = static_cast<const unsigned char*>(data);
-    m_size += size;
     if (m_buffer.size() + size > m_buffer.capacity()) {
         flushBuffer();
         if (size >= m_buffer.capacity()) {  // large writes go straight through
-            m_buffer.assign(bytes, bytes + size);
-            flushBuffer();
+            writeAt(m_size, data, size);
             return;
         }
     }
     m_buffer.insert(m_buffer.end(), bytes, bytes + size);
+    m_size += size;
 }
 
 void AtomicFile::writeAt(std::uint64_t offset, const void* data, std::size_t size) {
@@ -155,6 +154,21 @@ void AtomicFile::writeAt(std::uint64_t offset, const void* data, std::size_t siz
         p += n, left -= static_cast<std::size_t>(n), at += n;
     }
     m_size = std::max<std::uint64_t>(m_size, offset + size);
+}
+
+std::size_t AtomicFile::readAt(std::uint64_t offset, void* data, std::size_t size) {
+    if (m_fd < 0) fail("the file is already closed", 0);
+    flushBuffer();
+    auto* p = static_cast<unsigned char*>(data);
+    std::size_t done = 0;
+    while (done < size) {
+        const ssize_t n = ::pread(m_fd, p + done, size - done, static_cast<off_t>(offset + done));
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) fail("cannot read back what was written", errno);
+        if (n == 0) break;
+        done += static_cast<std::size_t>(n);
+    }
+    return done;
 }
 
 void AtomicFile::commit() {

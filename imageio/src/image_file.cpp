@@ -279,6 +279,9 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
     // Straight alpha as stored: colour is linearized first, then associated (in linear light).
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
+    // OpenImageIO 2.4 takes the proxy from the configuration once there is one (its pointer's value).
+    void* proxy = memory.get();
+    if (proxy) config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
     auto in = OIIO::ImageInput::open(openName, &config, memory.get());
     if (!in) {
         std::string reason = OIIO::geterror();
@@ -421,6 +424,20 @@ public:
         }
         return size;
     }
+    size_t read(void* buf, size_t size) override {
+        const std::size_t n = pread(buf, size, m_pos);
+        m_pos += static_cast<int64_t>(n);
+        return n;
+    }
+    size_t pread(void* buf, size_t size, int64_t offset) override {
+        if (!m_error.empty()) return 0;
+        try {
+            return m_file.readAt(static_cast<std::uint64_t>(offset), buf, size);
+        } catch (const Error& e) {
+            m_error = e.what();
+            return 0;
+        }
+    }
     bool seek(int64_t offset) override {
         m_pos = offset;
         return true;
@@ -562,14 +579,26 @@ void writeImageFile(const std::string& path, const format::Image& image, const W
 
     AtomicFile file(path);
     AtomicProxy proxy(file);
-    const bool proxied = target.output->supports("ioproxy") && target.output->set_ioproxy(&proxy);
+    // OpenImageIO 2.4.7 writes an unreadable TIFF through an IOProxy once it adds an EXIF
+    // directory (measured: the header ends up pointing at the EXIF directory), so TIFF is written
+    // by name into the temporary file and read back to check it.
+    const bool proxied = target.formatName != "tiff" && target.output->supports("ioproxy") && target.output->set_ioproxy(&proxy);
     const std::string openPath = proxied ? path : file.temporaryPath();
     bool ok = target.output->open(openPath, spec);
     ok = ok && target.output->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
     ok = target.output->close() && ok;
+    std::string reason = proxy.failure().empty() ? target.output->geterror() : proxy.failure();
+    if (ok && proxy.failure().empty() && !proxied) {
+        auto check = OIIO::ImageInput::open(openPath);
+        if (!check || check->spec().width != spec.width || check->spec().height != spec.height) {
+            ok = false;
+            reason = "the finished file does not read back: " + (check ? std::string("wrong size") : OIIO::geterror());
+        }
+    }
     if (!ok || !proxy.failure().empty()) {
-        std::string reason = proxy.failure().empty() ? target.output->geterror() : proxy.failure();
         if (reason.empty()) reason = "the " + target.formatName + " writer failed";
+        for (std::size_t at; (at = reason.find(file.temporaryPath())) != std::string::npos;)
+            reason.replace(at, file.temporaryPath().size(), path);  // the user's path, never the temporary one
         // A failure already worded for the destination is passed on as it is.
         throw Error(ErrorCode::Io, reason.rfind("cannot write " + path, 0) == 0 ? reason : "cannot write " + path + ": " + reason);
     }

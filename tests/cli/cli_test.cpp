@@ -15,93 +15,13 @@
 #include "conus/codec/metrics.h"
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
+#include "cli_fixture.h"
 
 namespace fs = std::filesystem;
 
+using namespace conus::test;
+
 namespace {
-
-struct Result {
-    int exitCode = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-class Cli : public ::testing::Test {
-protected:
-    void SetUp() override {
-        m_dir = fs::temp_directory_path() /
-                ("conus-cli-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
-                 std::to_string(::getpid()));
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-    }
-    void TearDown() override { fs::remove_all(m_dir); }
-
-    Result run(const std::string& args) {
-        const fs::path out = m_dir / "stdout.txt", err = m_dir / "stderr.txt";
-        const std::string command = std::string(CONUS_BIN_DIR) + "/conus " + args + " >" + out.string() + " 2>" +
-                                    err.string() + " </dev/null";
-        const int status = std::system(command.c_str());
-        Result r;
-        r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        r.out = slurp(out);
-        r.err = slurp(err);
-        return r;
-    }
-
-    // A detailed RGB test picture (diagonal stripes of varying period plus a gradient), as PNG.
-    std::string makePicture(int width, int height, const std::string& name = "in.png") {
-        std::vector<unsigned char> pixels(static_cast<std::size_t>(width) * height * 3);
-        for (int y = 0; y < height; ++y)
-            for (int x = 0; x < width; ++x) {
-                const double s = 0.5 + 0.5 * std::sin((x + y) * (0.05 + 0.4 * x / width));
-                pixels[(y * width + x) * 3 + 0] = static_cast<unsigned char>(255 * s);
-                pixels[(y * width + x) * 3 + 1] = static_cast<unsigned char>(255.0 * y / height);
-                pixels[(y * width + x) * 3 + 2] = static_cast<unsigned char>(255 * (1 - s));
-            }
-        const std::string path = (m_dir / name).string();
-        auto output = OIIO::ImageOutput::create(path);
-        OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-        EXPECT_TRUE(output->open(path, spec));
-        EXPECT_TRUE(output->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
-        output->close();
-        return path;
-    }
-
-    // A grey PNG that is bright in a disc around (0.3, 0.6) and dark elsewhere.
-    std::string makeImportance(int width, int height) {
-        std::vector<unsigned char> pixels(static_cast<std::size_t>(width) * height);
-        for (int y = 0; y < height; ++y)
-            for (int x = 0; x < width; ++x)
-                pixels[y * width + x] = std::hypot((x + 0.5) / width - 0.3, (y + 0.5) / height - 0.6) < 0.15 ? 255 : 0;
-        const std::string file = (m_dir / "importance.png").string();
-        auto output = OIIO::ImageOutput::create(file);
-        EXPECT_TRUE(output->open(file, OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::UINT8)));
-        EXPECT_TRUE(output->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
-        output->close();
-        return file;
-    }
-
-    std::string path(const std::string& name) const { return (m_dir / name).string(); }
-
-    // Nothing but the expected files: no temporaries left behind.
-    std::vector<std::string> leftovers() const {
-        std::vector<std::string> names;
-        for (const auto& e : fs::directory_iterator(m_dir)) {
-            const std::string n = e.path().filename().string();
-            if (n.find("tmp") != std::string::npos) names.push_back(n);
-        }
-        return names;
-    }
-
-    fs::path m_dir;
-};
 
 std::pair<int, int> imageSize(const std::string& path) {
     auto input = OIIO::ImageInput::open(path);

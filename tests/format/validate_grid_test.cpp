@@ -154,3 +154,26 @@ TEST(ToString, Names) {
 
 }  // namespace
 }  // namespace conus::format
+
+TEST(ValidateGrid, CappedRulesStillCountEveryProblem) {
+    // 11x11 nodes with the interior columns in reverse order: most of the 100 cells fold, 20 are
+    // listed, and the count still says how many there are.
+    conus::format::GridNodes grid;
+    grid.columns = grid.rows = 11;
+    for (int j = 0; j < 11; ++j)
+        for (int i = 0; i < 11; ++i) {
+            const float u = i == 0 || i == 10 ? i / 10.0f : (10 - i) / 10.0f;
+            grid.xy.push_back(u);
+            grid.xy.push_back(j / 10.0f);
+        }
+    const conus::format::ValidationReport report = conus::format::validateGrid(grid);
+    ASSERT_FALSE(report.ok());
+    EXPECT_LE(report.issues.size(), 22u) << "listed up to the cap";
+    long long listed = 0;
+    for (const auto& issue : report.issues) listed += issue.count == 1;
+    EXPECT_GT(report.problemCount(), listed) << "past the cap, the summary line carries the rest";
+    EXPECT_GE(report.problemCount(), 70);
+    const std::string summary = report.summary();
+    EXPECT_EQ(summary.find('\n'), std::string::npos) << summary;
+    EXPECT_NE(summary.find("more problems"), std::string::npos) << summary;
+}

@@ -38,6 +38,8 @@ public:
     void write(const void* data, std::size_t size);
     void writeAt(std::uint64_t offset, const void* data, std::size_t size);
     std::uint64_t size() const { return m_size; }
+    // Reads back what was written (writers that patch a header read it first); returns the bytes read.
+    std::size_t readAt(std::uint64_t offset, void* data, std::size_t size);
 
     // Flushes, syncs and closes the temporary file, then renames it over the destination.
     void commit();

@@ -1,0 +1,190 @@
+// What a newcomer reads: one clear line per problem with the right exit code (0 ok, 1 failure,
+// 2 usage), checks made before the work, progress that can be silenced, help with examples.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include <OpenImageIO/imageio.h>
+
+#include "cli_fixture.h"
+
+using namespace conus::test;
+
+namespace {
+
+// Lines of `text` that contain `needle`.
+int countLines(const std::string& text, const std::string& needle) {
+    int n = 0;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) n += line.find(needle) != std::string::npos;
+    return n;
+}
+
+}  // namespace
+
+TEST_F(Cli, EncodeToAPictureNameIsRefusedBeforeAnyWork) {
+    const std::string in = makePicture(64, 48);
+    const Result r = run("encode " + in + " -o " + path("x.png") + " --focus 0.5,0.5,0.1,2");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find(".exr"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("conus decode"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("done"), std::string::npos) << "no stage ran: " << r.err;
+    EXPECT_FALSE(fs::exists(path("x.png")));
+}
+
+TEST_F(Cli, EncodeWithoutAMapSaysItIsTheUniformImage) {
+    const Result r = run("encode " + makePicture(64, 48) + " -o " + path("x.exr"));
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("conus uniform"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, DecodeChecksItsOutputBeforeTheWork) {
+    ASSERT_EQ(run("uniform " + makePicture(64, 48) + " -o " + path("u.exr")).exitCode, 0);
+    for (const std::string& bad : {path("x.xyz"), path("x.png") + " --bits float", path("x.jpg") + " --bits 16",
+                                   path("missing-folder/x.png")}) {
+        const Result r = run("decode " + path("u.exr") + " -o " + bad + " --size 4000x4000");
+        EXPECT_EQ(r.exitCode, 2) << bad << ": " << r.err;
+        EXPECT_EQ(countLines(r.err, "done"), 0) << "nothing decoded first: " << r.err;
+        EXPECT_EQ(countLines(r.err, "conus decode: "), 1) << r.err;
+    }
+}
+
+TEST_F(Cli, ProgressIsOneLinePerStageWithATotalAndQuietSilencesIt) {
+    const std::string in = makePicture(64, 48);
+    Result r = run("encode " + in + " -o " + path("a.exr") + " --focus 0.5,0.5,0.1,2");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(countLines(r.err, "conus encode: read "), 1) << r.err;
+    EXPECT_EQ(countLines(r.err, "build sampling map (1 focus) done"), 1) << "one focus, not '1 foci': " << r.err;
+    EXPECT_EQ(countLines(r.err, "conus encode: write "), 1) << r.err;
+    EXPECT_EQ(countLines(r.err, "conus encode: done in "), 1) << r.err;
+    r = run("encode " + in + " -o " + path("b.exr") + " --focus 0.5,0.5,0.1,2 --quiet");
+    ASSERT_EQ(r.exitCode, 0);
+    EXPECT_TRUE(r.err.empty()) << r.err;
+    r = run("decode " + path("b.exr") + " -o " + path("b.xyz") + " -q");
+    EXPECT_EQ(countLines(r.err, "conus decode: "), 1) << "errors still print: " << r.err;
+}
+
+TEST_F(Cli, InfoOnAnInvalidFileIsOneLineAndVerboseListsEveryProblem) {
+    ASSERT_EQ(run("uniform " + makePicture(64, 48) + " -o " + path("u.exr")).exitCode, 0);
+    // Two broken rules, made by an ordinary EXR tool.
+    ASSERT_EQ(std::system(("oiiotool " + path("u.exr") + " --attrib conus:dataKind bogus --attrib:type=int conus:version -3 -o " +
+                           path("bad.exr") + " >/dev/null 2>&1").c_str()), 0);
+    Result r = run("info " + path("bad.exr"));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(countLines(r.err, ""), 1) << r.err;
+    EXPECT_NE(r.err.find("and 1 more problem"), std::string::npos) << r.err;
+    r = run("info --verbose " + path("bad.exr"));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(countLines(r.out, "V2:") + countLines(r.out, "V6:"), 2) << r.out;
+    EXPECT_NE(r.err.find("(2 problems)"), std::string::npos) << r.err;
+    r = run("validate " + path("bad.exr"));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(countLines(r.out, path("bad.exr") + ": V"), 2) << r.out;
+    EXPECT_NE(r.err.find("(2 problems)"), std::string::npos) << "the count matches the list: " << r.err;
+}
+
+TEST_F(Cli, InfoListsChannelsInDisplayOrderAndTheColour) {
+    ASSERT_EQ(run("uniform " + makePicture(64, 48) + " -o " + path("u.exr")).exitCode, 0);
+    const Result r = run("info " + path("u.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("channels R,G,B,"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("linear light"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("source srgb uint8"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, SpringStrokesInlineOrFromAFile) {
+    const std::string strokes = R"([{"u":0.5,"v":0.4,"radius":0.15,"strength":1,"duration":0.3}])";
+    Result r = run("map springs --grid 33 --out-grid 17 --strokes '" + strokes + "' -o " + path("inline.exr"));
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    { std::ofstream(path("s.json")) << strokes; }
+    r = run("map springs --grid 33 --out-grid 17 --strokes " + path("s.json") + " -o " + path("file.exr"));
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(slurp(path("inline.exr")).size(), slurp(path("file.exr")).size());
+}
+
+TEST_F(Cli, UsageErrorsExitWithTwoBeforeAnyWork) {
+    const std::string cases[] = {
+        "heightfield encode procedural:64 -o " + path("t.exr") + " --compression foo",
+        "heightfield render " + path("t.exr") + " -o " + path("f.png") + " --backend cpu",
+        "decode " + path("t.exr") + " -o " + path("f.png") + " --tonemap sideways",
+        "encode " + path("t.png") + " -o " + path("t.exr") + " --input-colorspace cmyk",
+    };
+    for (const std::string& args : cases) {
+        const Result r = run(args);
+        EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+        EXPECT_EQ(countLines(r.err, ""), 1) << args << "\n" << r.err;
+    }
+    // cpu is not offered where there is no CPU path.
+    const Result help = run("heightfield render --help");
+    EXPECT_EQ(help.out.find("cpu"), std::string::npos) << help.out;
+}
+
+TEST_F(Cli, EveryCommandsHelpHasExamplesAndTheExitCodesAreDocumented) {
+    for (const char* command : {"encode", "uniform", "decode", "info", "validate", "demo", "map", "map springs",
+                                "heightfield encode", "heightfield render"}) {
+        const Result r = run(std::string(command) + " --help");
+        EXPECT_EQ(r.exitCode, 0) << command;
+        EXPECT_NE(r.out.find("Examples:"), std::string::npos) << command << "\n" << r.out;
+    }
+    const Result r = run("--help");
+    EXPECT_NE(r.out.find("Exit codes: 0 success; 1 failure"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, MultiPartInputsSayWhichPartIsUsed) {
+    // Two parts: a red one named "beauty", a blue one named "shadow".
+    const std::string file = path("parts.exr");
+    {
+        auto out = OIIO::ImageOutput::create(file);
+        OIIO::ImageSpec specs[2] = {OIIO::ImageSpec(32, 16, 3, OIIO::TypeDesc::HALF), OIIO::ImageSpec(32, 16, 3, OIIO::TypeDesc::HALF)};
+        specs[0].attribute("oiio:subimagename", "beauty");
+        specs[1].attribute("oiio:subimagename", "shadow");
+        ASSERT_TRUE(out->open(file, 2, specs));
+        std::vector<float> red(32 * 16 * 3, 0.0f), blue(32 * 16 * 3, 0.0f);
+        for (int p = 0; p < 32 * 16; ++p) red[p * 3] = 1.0f, blue[p * 3 + 2] = 1.0f;
+        out->write_image(OIIO::TypeDesc::FLOAT, red.data());
+        out->open(file, specs[1], OIIO::ImageOutput::AppendSubimage);
+        out->write_image(OIIO::TypeDesc::FLOAT, blue.data());
+        out->close();
+    }
+    Result r = run("uniform " + file + " -o " + path("a.exr") + " --size 32x16");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("has 2 parts; using part 0 (beauty)"), std::string::npos) << r.err;
+    r = run("uniform " + file + " -o " + path("b.exr") + " --size 32x16 --part shadow");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    ASSERT_EQ(run("decode " + path("b.exr") + " -o " + path("b.png")).exitCode, 0);
+    auto in = OIIO::ImageInput::open(path("b.png"));
+    ASSERT_TRUE(in);
+    std::vector<float> px(32 * 16 * 3);
+    in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, px.data());
+    EXPECT_GT(px[2], 0.9f) << "the blue part";
+    EXPECT_LT(px[0], 0.1f);
+    r = run("uniform " + file + " -o " + path("c.exr") + " --part nosuch");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("0 (beauty), 1 (shadow)"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, AViewPastTheImageShowsTheBackgroundNotSmearedEdges) {
+    ASSERT_EQ(run("uniform " + makePicture(64, 48) + " -o " + path("u.exr") + " --size 64x48").exitCode, 0);
+    ASSERT_EQ(run("decode " + path("u.exr") + " -o " + path("v.exr") + " --view -0.5,0,0.5,1 --size 64x48").exitCode, 0);
+    auto in = OIIO::ImageInput::open(path("v.exr"));
+    ASSERT_TRUE(in);
+    std::vector<float> px(64 * 48 * 3);
+    in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, px.data());
+    double left = 0, right = 0;
+    for (int y = 0; y < 48; ++y)
+        for (int x = 0; x < 32; ++x) {
+            for (int c = 0; c < 3; ++c) left += px[(y * 64 + x) * 3 + c], right += px[(y * 64 + x + 32) * 3 + c];
+        }
+    EXPECT_EQ(left, 0.0) << "outside the image: background";
+    EXPECT_GT(right, 100.0) << "inside: the picture";
+}
+
+TEST_F(Cli, StandardInputIsAnInput) {
+    const std::string in = makePicture(64, 48);
+    // run() gives the command /dev/null as its input; the shell pipes the picture in instead.
+    const int status = std::system((std::string(CONUS_BIN_DIR) + "/conus uniform - -o " + path("s.exr") + " -q < " + in).c_str());
+    EXPECT_EQ(WEXITSTATUS(status), 0);
+    ASSERT_EQ(run("info " + path("s.exr")).exitCode, 0);
+    EXPECT_NE(run("info " + path("s.exr")).out.find("source        64 x 48"), std::string::npos);
+}

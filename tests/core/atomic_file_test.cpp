@@ -1,0 +1,185 @@
+// AtomicFile: all or nothing, checked to the last byte, and nothing left behind by a failure.
+#include <gtest/gtest.h>
+
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "conus/core/atomic_file.h"
+#include "conus/core/error.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class AtomicFileTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        m_dir = fs::temp_directory_path() /
+                ("conus-atomic-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
+                 std::to_string(::getpid()));
+        fs::remove_all(m_dir);
+        fs::create_directories(m_dir);
+    }
+    void TearDown() override { fs::remove_all(m_dir); }
+    std::string path(const std::string& name) const { return (m_dir / name).string(); }
+    std::vector<std::string> entries() const {
+        std::vector<std::string> names;
+        for (const auto& e : fs::directory_iterator(m_dir)) names.push_back(e.path().filename().string());
+        return names;
+    }
+    fs::path m_dir;
+};
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+}  // namespace
+
+TEST_F(AtomicFileTest, WritesAppendsAndPatchesThenRenames) {
+    conus::AtomicFile file(path("out.bin"));
+    EXPECT_FALSE(fs::exists(path("out.bin"))) << "nothing at the destination before commit";
+    EXPECT_NE(file.temporaryPath().find(".out.tmp-"), std::string::npos);
+    std::string big(3 << 20, 'x');  // past the buffer: written straight through
+    file.write("head", 4);
+    file.write(big.data(), big.size());
+    file.writeAt(0, "HE", 2);  // a writer patching its header
+    char back[4] = {};
+    EXPECT_EQ(file.readAt(0, back, 4), 4u);
+    EXPECT_EQ(std::string(back, 4), "HEad");
+    file.write("tail", 4);
+    file.commit();
+    const std::string got = slurp(path("out.bin"));
+    EXPECT_EQ(got.size(), 4 + big.size() + 4);
+    EXPECT_EQ(got.substr(0, 4), "HEad");
+    EXPECT_EQ(got.substr(got.size() - 4), "tail");
+    EXPECT_EQ(entries(), std::vector<std::string>{"out.bin"});
+}
+
+TEST_F(AtomicFileTest, AnAbandonedFileLeavesTheOldDestinationAndNoTemporary) {
+    { std::ofstream(path("keep.txt")) << "old"; }
+    {
+        conus::AtomicFile file(path("keep.txt"));
+        file.write("new", 3);
+    }  // destroyed without commit: a failed writer
+    EXPECT_EQ(slurp(path("keep.txt")), "old");
+    EXPECT_EQ(entries(), std::vector<std::string>{"keep.txt"});
+}
+
+TEST_F(AtomicFileTest, SymlinksAreWrittenThroughAndKeepTheirTargetsPermissions) {
+    { std::ofstream(path("target.txt")) << "old"; }
+    ::chmod(path("target.txt").c_str(), 0640);
+    fs::create_symlink(path("target.txt"), path("link.txt"));
+    conus::writeFileAtomically(path("link.txt"), std::vector<unsigned char>{'n', 'e', 'w'});
+    EXPECT_TRUE(fs::is_symlink(path("link.txt"))) << "the link stays a link";
+    EXPECT_EQ(slurp(path("target.txt")), "new");
+    struct stat st {};
+    ASSERT_EQ(::stat(path("target.txt").c_str(), &st), 0);
+    EXPECT_EQ(st.st_mode & 0777, 0640u);
+}
+
+TEST_F(AtomicFileTest, DevicesFifosAndDirectoriesAreRefused) {
+    ASSERT_EQ(::mkfifo(path("fifo").c_str(), 0600), 0);
+    fs::create_directory(path("folder"));
+    for (const std::string& target : {std::string("/dev/null"), path("fifo"), path("folder")}) {
+        try {
+            conus::AtomicFile file(target);
+            FAIL() << target << " was accepted";
+        } catch (const conus::Error& e) {
+            EXPECT_EQ(e.code(), conus::ErrorCode::Io);
+            EXPECT_NE(std::string(e.what()).find(target), std::string::npos) << e.what();
+        }
+        EXPECT_THROW(conus::checkOutputPath(target), conus::Error) << target;
+    }
+    struct stat st {};
+    ASSERT_EQ(::stat("/dev/null", &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode)) << "the device is still a device";
+}
+
+TEST_F(AtomicFileTest, OutputThatIsAnInputIsRefusedByAnyPath) {
+    { std::ofstream(path("in.png")) << "source"; }
+    fs::create_symlink(path("in.png"), path("alias.png"));
+    const std::string inputs[] = {path("in.png")};
+    EXPECT_THROW(conus::checkOutputPath(path("alias.png"), inputs), conus::Error);
+    EXPECT_THROW(conus::checkOutputPath(path("./in.png"), inputs), conus::Error);
+    EXPECT_NO_THROW(conus::checkOutputPath(path("out.png"), inputs));
+    EXPECT_THROW(conus::checkOutputPath(path("missing-folder/out.png")), conus::Error);
+}
+
+TEST_F(AtomicFileTest, InputsMustBeRegularFiles) {
+    ASSERT_EQ(::mkfifo(path("fifo").c_str(), 0600), 0);
+    EXPECT_THROW(conus::checkInputPath("/dev/zero"), conus::Error);
+    EXPECT_THROW(conus::checkInputPath(path("fifo")), conus::Error);
+    EXPECT_THROW(conus::checkInputPath(m_dir.string()), conus::Error);
+    EXPECT_THROW(conus::checkInputPath(path("missing")), conus::Error);
+    EXPECT_THROW(conus::checkInputPath("-"), conus::Error);
+    EXPECT_NO_THROW(conus::checkInputPath("-", /*allowStdin=*/true));
+    try {
+        conus::checkInputPath("/dev/zero");
+    } catch (const conus::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(AtomicFileTest, AWritePastTheFileSizeLimitIsAFailureNamingTheDestination) {
+    // In a child: the limit would stay on this process.
+    const pid_t child = ::fork();
+    if (child == 0) {
+        conus::removeTemporariesOnSignals();  // ignores SIGXFSZ: the write fails instead of killing
+        rlimit limit{64 * 1024, 64 * 1024};
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+        int code = 3;
+        try {
+            conus::AtomicFile file(path("big.bin"));
+            const std::vector<char> chunk(1 << 20, 'z');
+            file.write(chunk.data(), chunk.size());
+            file.commit();
+        } catch (const conus::Error& e) {
+            const std::string what = e.what();
+            code = what.find(path("big.bin")) != std::string::npos && what.find(".tmp-") == std::string::npos ? 0 : 4;
+        }
+        std::_Exit(code);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status)) << "the child was killed (signal " << WTERMSIG(status) << ")";
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "3: the write was reported as success; 4: the message named the temporary";
+    EXPECT_TRUE(entries().empty()) << "no destination and no temporary left";
+}
+
+TEST_F(AtomicFileTest, SigtermRemovesTheTemporaryFile) {
+    int ready[2];
+    ASSERT_EQ(::pipe(ready), 0);
+    const pid_t child = ::fork();
+    if (child == 0) {
+        conus::removeTemporariesOnSignals();
+        conus::AtomicFile file(path("slow.bin"));
+        file.write("partial", 7);
+        file.writeAt(0, "P", 1);  // on disk now
+        (void)!::write(ready[1], "r", 1);
+        ::pause();  // killed here, mid-write
+        std::_Exit(0);
+    }
+    char c;
+    ASSERT_EQ(::read(ready[0], &c, 1), 1);
+    bool sawTemporary = false;
+    for (const std::string& name : entries()) sawTemporary |= name.find(".tmp-") != std::string::npos;
+    EXPECT_TRUE(sawTemporary);
+    ::kill(child, SIGTERM);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << "ends as SIGTERM would";
+    EXPECT_TRUE(entries().empty()) << "the temporary was removed";
+}

@@ -1,0 +1,180 @@
+// imageio: channels placed by name in any order, colour converted through OpenImageIO, formats'
+// limits said up front. Files are read back with OpenImageIO directly, never through imageio.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+
+#include "conus/core/error.h"
+#include "conus/imageio/image_file.h"
+
+namespace fs = std::filesystem;
+using conus::format::Image;
+
+namespace {
+
+class ImageFileTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        m_dir = fs::temp_directory_path() /
+                ("conus-imageio-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
+                 std::to_string(::getpid()));
+        fs::remove_all(m_dir);
+        fs::create_directories(m_dir);
+    }
+    void TearDown() override { fs::remove_all(m_dir); }
+    std::string path(const std::string& name) const { return (m_dir / name).string(); }
+    fs::path m_dir;
+};
+
+struct Read {
+    OIIO::ImageSpec spec;
+    std::vector<float> pixels;
+};
+
+Read oiioRead(const std::string& path) {
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
+    Read r;
+    if (!in) return r;
+    r.spec = in->spec();
+    r.pixels.resize(static_cast<std::size_t>(r.spec.width) * r.spec.height * r.spec.nchannels);
+    in->read_image(0, 0, 0, r.spec.nchannels, OIIO::TypeDesc::FLOAT, r.pixels.data());
+    return r;
+}
+
+// A 4x2 image whose channel c at pixel p holds (p + 1) / 16 + c / 64: every value tells where it came from.
+Image tagged(const std::vector<std::string>& channels) {
+    Image im = conus::format::makeImage(4, 2, channels);
+    for (int p = 0; p < 8; ++p)
+        for (int c = 0; c < im.channelCount(); ++c) im.pixels[p * im.channelCount() + c] = (p + 1) / 16.0f + c / 64.0f;
+    return im;
+}
+
+}  // namespace
+
+TEST_F(ImageFileTest, DisplayFormatsGetRgbaByNameWhateverTheOrder) {
+    const std::vector<std::vector<std::string>> orders = {
+        {"B", "G", "R"}, {"A", "B", "G", "R"}, {"Z", "G", "A", "R", "B"}, {"R", "G", "B", "A"}};
+    for (const auto& order : orders) {
+        const Image im = tagged(order);
+        conus::imageio::WriteOptions raw;
+        raw.meaning = conus::imageio::PixelMeaning::Raw;  // values as they are, to trace them
+        conus::imageio::writeImageFile(path("out.png"), im, raw);
+        const Read got = oiioRead(path("out.png"));
+        const bool alpha = im.channelIndex("A") >= 0;
+        ASSERT_EQ(got.spec.nchannels, alpha ? 4 : 3);
+        const char* names[] = {"R", "G", "B", "A"};
+        for (int p = 0; p < 8; ++p)
+            for (int c = 0; c < got.spec.nchannels; ++c) {
+                const float want = im.pixels[p * im.channelCount() + im.channelIndex(names[c])];
+                EXPECT_NEAR(got.pixels[p * got.spec.nchannels + c], want, 1.0 / 255) << names[c] << " of order " << order[0];
+            }
+    }
+}
+
+TEST_F(ImageFileTest, GreyAndGreyAlphaAndNamelessChannels) {
+    conus::imageio::WriteOptions raw;
+    raw.meaning = conus::imageio::PixelMeaning::Raw;
+    conus::imageio::writeImageFile(path("ya.png"), tagged({"A", "Y"}), raw);
+    Read got = oiioRead(path("ya.png"));
+    ASSERT_EQ(got.spec.nchannels, 2);
+    EXPECT_EQ(got.spec.alpha_channel, 1);
+    EXPECT_NEAR(got.pixels[0], 1 / 16.0f + 1 / 64.0f, 0.5 / 255) << "Y first";
+    EXPECT_NEAR(got.pixels[1], 1 / 16.0f, 0.5 / 255) << "then A";
+    // A sampling map's channels have no colour names: the first one is shown as grey.
+    conus::imageio::writeImageFile(path("uv.png"), tagged({"ud", "vd"}), raw);
+    got = oiioRead(path("uv.png"));
+    ASSERT_EQ(got.spec.nchannels, 1);
+    EXPECT_NEAR(got.pixels[0], 1 / 16.0f, 0.5 / 255);
+}
+
+TEST_F(ImageFileTest, SixtyFourChannelsSurviveExrAndTiff) {
+    std::vector<std::string> names;
+    for (int c = 0; c < 64; ++c) names.push_back(std::string(1, 'c').append(std::to_string(c)));
+    const Image im = tagged(names);
+    for (const char* ext : {"exr", "tif"}) {
+        conus::imageio::WriteOptions options;
+        options.meaning = conus::imageio::PixelMeaning::Raw;
+        options.sampleType = conus::SampleType::Float;
+        conus::imageio::writeImageFile(path(std::string("many.") + ext), im, options);
+        const Read got = oiioRead(path(std::string("many.") + ext));
+        ASSERT_EQ(got.spec.nchannels, 64) << ext;
+        const conus::imageio::ImageFile back = conus::imageio::readImageFile(path(std::string("many.") + ext));
+        ASSERT_EQ(back.image.channelCount(), 64);
+        for (int c = 0; c < 64; ++c) {
+            const int k = back.image.channelIndex(got.spec.channel_name(c));
+            ASSERT_GE(k, 0) << got.spec.channel_name(c);
+        }
+    }
+}
+
+TEST_F(ImageFileTest, SrgbIsConvertedThroughOpenImageIoAndRawIsNot) {
+    // An 8-bit file of code 128 everywhere, written by OpenImageIO.
+    {
+        auto out = OIIO::ImageOutput::create(path("mid.png"));
+        OIIO::ImageSpec spec(4, 4, 3, OIIO::TypeDesc::UINT8);
+        std::vector<unsigned char> bytes(48, 128);
+        ASSERT_TRUE(out->open(path("mid.png"), spec));
+        out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+        out->close();
+    }
+    const conus::imageio::ImageFile srgb = conus::imageio::readImageFile(path("mid.png"));
+    EXPECT_EQ(srgb.info.encoding.transfer, conus::Transfer::Srgb);
+    EXPECT_EQ(srgb.info.encoding.sampleType, conus::SampleType::Uint8);
+    EXPECT_NEAR(srgb.image.pixels[0], std::pow((128 / 255.0 + 0.055) / 1.055, 2.4), 1e-6);
+    conus::imageio::ReadOptions raw;
+    raw.colorspace = conus::Transfer::Raw;
+    EXPECT_FLOAT_EQ(conus::imageio::readImageFile(path("mid.png"), raw).image.pixels[0], 128 / 255.0f);
+    // linearize and displayEncoded undo each other.
+    Image drawn = tagged({"R", "G", "B"});
+    const Image before = drawn;
+    conus::imageio::linearize(drawn);
+    EXPECT_LT(drawn.pixels[0], before.pixels[0]);
+    const Image shown = conus::imageio::displayEncoded(drawn);
+    for (std::size_t i = 0; i < before.pixels.size(); ++i) EXPECT_NEAR(shown.pixels[i], before.pixels[i], 1e-5);
+}
+
+TEST_F(ImageFileTest, RequestsAFormatCannotHoldAreRefusedBeforeWriting) {
+    conus::imageio::WriteOptions floatPng;
+    floatPng.sampleType = conus::SampleType::Float;
+    try {
+        conus::imageio::checkImageOutput(path("x.png"), floatPng);
+        FAIL();
+    } catch (const conus::Error& e) {
+        EXPECT_EQ(e.code(), conus::ErrorCode::InvalidArgument);
+        EXPECT_NE(std::string(e.what()).find("uint8 or uint16"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(conus::imageio::checkImageOutput(path("x.xyz")), conus::Error);
+    EXPECT_THROW(conus::imageio::checkImageOutput(path("noextension")), conus::Error);
+    EXPECT_NO_THROW(conus::imageio::checkImageOutput(path("x.exr"), floatPng));
+    EXPECT_TRUE(fs::is_empty(m_dir)) << "checks write nothing";
+}
+
+TEST_F(ImageFileTest, UnreadableFilesSayWhy) {
+    { std::ofstream(path("bad.png")) << "not a png at all"; }
+    try {
+        conus::imageio::readImageFile(path("bad.png"));
+        FAIL();
+    } catch (const conus::Error& e) {
+        EXPECT_NE(std::string(e.what()).find(path("bad.png")), std::string::npos) << e.what();
+    }
+    // A PPM that ends early: the reason is named, not left empty.
+    { std::ofstream(path("short.ppm")) << "P6\n64 64\n255\n" << std::string(100, '\x7f'); }
+    try {
+        conus::imageio::readImageFile(path("short.ppm"));
+        FAIL();
+    } catch (const conus::Error& e) {
+        const std::string what = e.what();
+        EXPECT_GT(what.size(), what.find("cannot read pixels: ") + 20) << what;
+    }
+    EXPECT_THROW(conus::imageio::readImageFile("/dev/zero"), conus::Error);
+}
