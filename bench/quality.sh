@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Quality on real photographs: CoNUS vs the uniform image of the same pixel count (1/16), PSNR of
-# zoomed views of each focus (k = 4) at source resolution and of the whole frame. Photographs come
+# Quality on real photographs: CoNUS vs the uniform image of the same pixel count (1/16), PSNR (in
+# linear light) of zoomed views of each focus (k = 4) at source resolution and of the whole frame. Photographs come
 # from Debian's python3-skimage (installed here if missing). Pictures land in build/quality/<name>/.
 set -euo pipefail
 cd "$(dirname "$0")/.."

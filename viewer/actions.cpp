@@ -36,6 +36,7 @@ const std::vector<Binding> kViewBindings = {
     {"E", true, false, Action::ExposureDown, "E / Shift-E exposure +/- 0.5 stop; 0 resets"},
     {"0", false, false, Action::ResetExposure, ""},
     {"L", false, false, Action::ToggleGamma, "L          linear output (no curve) / the sRGB display curve"},
+    {"T", false, false, Action::NextToneMap, "T          tone map for HDR values: none, reinhard, aces"},
     {"Tab", false, false, Action::NextFile, "Tab, PgDn  next file; Shift-Tab, PgUp previous"},
     {"PageDown", false, false, Action::NextFile, ""},
     {"Tab", true, false, Action::PreviousFile, ""},

@@ -27,6 +27,7 @@ enum class Action {
     ToggleOutlines,     // O
     ExposureUp, ExposureDown, ResetExposure,  // E, Shift-E, 0
     ToggleGamma,        // L: linear (gamma 1) or the sRGB display curve
+    NextToneMap,        // T: none -> reinhard -> aces (values above 1 on the display)
     NextFile, PreviousFile,  // Tab / PageDown, Shift-Tab / PageUp
     Reload,             // Ctrl-R, F5
     Inspect,            // I: print the pixel under the cursor

@@ -386,6 +386,11 @@ void App::doAction(Action action) {
     case Action::ExposureDown: m_display.exposure -= kExposureStep; break;
     case Action::ResetExposure: m_display.exposure = 0; break;
     case Action::ToggleGamma: m_display.gamma = m_display.gamma == 1.0 ? 0.0 : 1.0; break;
+    case Action::NextToneMap:
+        m_display.toneMap = m_display.toneMap == ToneMap::None       ? ToneMap::Reinhard
+                            : m_display.toneMap == ToneMap::Reinhard ? ToneMap::Aces
+                                                                     : ToneMap::None;
+        break;
     case Action::NextFile:
     case Action::PreviousFile:
         if (m_docs.size() > 1) {

@@ -59,7 +59,7 @@ const char* modeName(gl::ViewMode mode) {
 
 std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     Options o;
-    std::string view, size, window = "1280x800", mode = "reconstructed", decode = "auto";
+    std::string view, size, window = "1280x800", mode = "reconstructed", decode = "auto", toneMap = "none";
     CLI::App app(kDescription, "conus-view");
     app.add_option("files", o.files, "CoNUS files (.exr); Tab / PageDown switch between them");
     app.add_option("--edit", o.edit, "paint a sampling map over IMAGE (PNG, JPEG, EXR, ...)");
@@ -73,6 +73,8 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("--grid-every", o.display.gridEvery, "draw every n-th grid line (0: automatic)");
     app.add_flag("--outlines", o.display.outlines, "draw the focus outlines");
     app.add_option("--exposure", o.display.exposure, "exposure in stops");
+    app.add_option("--tonemap", toneMap, "tone map for HDR values: none (default), reinhard, aces")
+        ->check(CLI::IsMember({"none", "reinhard", "aces"}));
     app.add_option("--gamma", o.display.gamma,
                    "display curve: 0 (default) the sRGB curve for linear data, else a display gamma (1: linear)")
         ->check(CLI::Range(0.0, 10.0));
@@ -94,6 +96,7 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
         if (!size.empty()) std::tie(o.width, o.height) = parseSize(size, "--size");
         std::tie(o.windowWidth, o.windowHeight) = parseSize(window, "--window");
         o.display.mode = parseMode(mode);
+        o.display.toneMap = parseToneMap(toneMap).value_or(ToneMap::None);
         o.display.decode = decode == "cpu" ? gl::DecodePath::Cpu : decode == "gpu" ? gl::DecodePath::Gpu : gl::DecodePath::Auto;
         if (o.files.empty() && o.edit.empty()) throw Error(ErrorCode::InvalidArgument, "no file given (conus-view FILE.exr or --edit IMAGE)");
         if (!o.edit.empty() && !o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--edit takes no CoNUS files");

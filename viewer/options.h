@@ -18,7 +18,7 @@ struct Options {
     std::optional<codec::View> view;     // --view u0,v0,u1,v1
     int width = 0, height = 0;           // --size: screenshot size, or the editor's encode size
     int windowWidth = 1280, windowHeight = 800;
-    gl::ViewOptions display;             // --mode, --grid, --outlines, --exposure, --gamma
+    gl::ViewOptions display;             // --mode, --grid, --outlines, --exposure, --tonemap, --gamma
     std::string script;                  // --script CMDS.txt
     int benchmarkFrames = 0;             // --benchmark-frames N
     std::string backend = "auto";        // --backend for --screenshot (egl, osmesa)

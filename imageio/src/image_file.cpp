@@ -331,7 +331,8 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
             std::array<float, 8> xy{};
             std::memcpy(xy.data(), c->data(), sizeof xy);
             encoding.chromaticities = xy;
-        } else if (encoding.iccProfile.empty()) {
+        } else if (encoding.iccProfile.empty() || encoding.iccProfile.find("sRGB") != std::string::npos) {
+            // Untagged, or a profile that names itself sRGB (its description tag): sRGB's primaries.
             encoding.chromaticities = kRec709Chromaticities;
         }
     }

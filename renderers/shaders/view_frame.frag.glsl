@@ -40,6 +40,7 @@ uniform int uFocusCount;
 uniform vec3 uFoci[16];      // u, v, r
 uniform float uExposure;     // 2^ev, applied before gamma
 uniform float uInvGamma;     // 0: the sRGB curve
+uniform int uToneMap;        // conus::ToneMap: 0 none, 1 reinhard, 2 aces
 uniform float uWipeX;        // pixels
 uniform vec2 uLogDensity;    // log density range for the heat map
 
@@ -97,10 +98,12 @@ void paint(inout vec3 color, inout vec4 over, vec3 c, float t) {
     over = mix(over, vec4(c, 1.0), t);
 }
 
-// Linear light to the display: exposure, then the sRGB curve (uInvGamma 0) or a plain gamma; the
-// CPU path's twin is conus::linearToSrgbDisplay (core/display.h).
+// Linear light to the display: exposure, tone map, then the sRGB curve (uInvGamma 0) or a plain
+// gamma; the CPU path's twins are conus::exposeAndToneMap and linearToSrgbDisplay (core/display.h).
 vec3 display(vec4 c) {
-    const vec3 x = max(c.rgb * uExposure, vec3(0.0));
+    vec3 x = max(c.rgb * uExposure, vec3(0.0));
+    if (uToneMap == 1) x = x / (1.0 + x);
+    if (uToneMap == 2) x = min((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), vec3(1.0));
     if (uInvGamma != 0.0) return pow(x, vec3(uInvGamma));
     const vec3 v = clamp(x, 0.0, 1.0);
     return mix(12.92 * v, 1.055 * pow(v, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), v));

@@ -22,6 +22,13 @@
 namespace conus::gl {
 namespace {
 
+// An exposed linear value on the display, 0..255: tone map, then the sRGB curve or a gamma.
+std::uint8_t displayByte(float exposed, float invGamma, ToneMap toneMap) {
+    const float x = exposeAndToneMap(exposed, 1.0f, toneMap);
+    const double v = invGamma == 0.0f ? linearToSrgbDisplay(x) : std::pow(static_cast<double>(std::max(x, 0.0f)), static_cast<double>(invGamma));
+    return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+}
+
 // 0 selects the sRGB curve (ViewOptions::gamma 0); a gamma below 0.05 is held there.
 float inverseGamma(const ViewOptions& options) {
     return options.gamma == 0.0 ? 0.0f : static_cast<float>(1.0 / std::max(options.gamma, 0.05));
@@ -164,6 +171,7 @@ struct ViewRenderer::Impl {
     std::vector<float> frameFloats;
     std::vector<std::uint8_t> lut;
     float lutExposure = -1, lutInvGamma = -1;
+    ToneMap lutToneMap = ToneMap::None;
     int conusWidth = 0, conusHeight = 0;
     double sourceWidth = 1, sourceHeight = 1;
     std::vector<float> foci;  // u, v, r per focus
@@ -197,19 +205,19 @@ struct ViewRenderer::Impl {
         return softwareRenderer(context.renderer());
     }
 
-    void buildLut(float exposure, float invGamma) {
-        if (lut.size() == kLutSize && exposure == lutExposure && invGamma == lutInvGamma) return;
+    void buildLut(float exposure, float invGamma, ToneMap toneMap) {
+        if (lut.size() == kLutSize && exposure == lutExposure && invGamma == lutInvGamma && toneMap == lutToneMap) return;
         lut.resize(kLutSize);
         for (std::size_t i = 0; i < kLutSize; ++i) {
             const std::uint32_t lo = kLutLowBits + (static_cast<std::uint32_t>(i) << kLutShift);
             const std::uint32_t mid = lo + (1u << (kLutShift - 1));
             float x;
             std::memcpy(&x, &mid, sizeof x);
-            const double v = invGamma == 0.0f ? linearToSrgbDisplay(x) : std::pow(static_cast<double>(x), static_cast<double>(invGamma));
-            lut[i] = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+            lut[i] = displayByte(x, invGamma, toneMap);  // indexed by the exposed value
         }
         lutExposure = exposure;
         lutInvGamma = invGamma;
+        lutToneMap = toneMap;
     }
 
     // The frame decoded by codec::decodeImage into the frame texture, top row first (or bottom row
@@ -242,17 +250,18 @@ struct ViewRenderer::Impl {
                     float* out = frameFloats.data() + static_cast<std::size_t>(flip ? height - 1 - y : y) * width * 4;
                     const float* in = frame.pixels.data() + static_cast<std::size_t>(y) * width * 3;
                     for (int x = 0; x < width; ++x, out += 4, in += 3) {
-                        for (int c = 0; c < 3; ++c)
+                        for (int c = 0; c < 3; ++c) {
+                            const float t = exposeAndToneMap(in[c], exposure, options.toneMap);
                             out[c] = rowInside[y] && colInside[x]
-                                         ? (invGamma == 0.0f ? linearToSrgbDisplay(in[c] * exposure)
-                                                             : std::pow(std::max(in[c] * exposure, 0.0f), invGamma))
+                                         ? (invGamma == 0.0f ? linearToSrgbDisplay(t) : std::pow(std::max(t, 0.0f), invGamma))
                                          : kBackground;
+                        }
                         out[3] = 1.0f;
                     }
                 }
             });
         } else {
-            buildLut(exposure, invGamma);
+            buildLut(exposure, invGamma, options.toneMap);
             frameBytes.resize(count);
             const std::uint8_t background = static_cast<std::uint8_t>(std::lround(kBackground * 255.0f));
             const std::uint8_t* table = lut.data();
@@ -267,7 +276,11 @@ struct ViewRenderer::Impl {
                             for (int c = 0; c < 3; ++c) {
                                 const float f = in[c] * exposure;
                                 const std::uint32_t b = floatBits(f);
-                                out[c] = !(f >= 0x1p-32f) ? 0 : f >= 1.0f ? 255 : table[(b - kLutLowBits) >> kLutShift];
+                                // The table spans [2^-32, 1); above 1 only a tone map keeps values apart.
+                                out[c] = !(f >= 0x1p-32f)                      ? 0
+                                         : f < 1.0f                            ? table[(b - kLutLowBits) >> kLutShift]
+                                         : options.toneMap == ToneMap::None    ? 255
+                                                                               : displayByte(f, invGamma, options.toneMap);
                             }
                         }
                         out[3] = 255;
@@ -458,6 +471,7 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
     if (foci > 0) gl.Uniform3fv(at("uFoci"), foci, d.foci.data());
     gl.Uniform1f(at("uExposure"), static_cast<float>(std::exp2(options.exposure)));
     gl.Uniform1f(at("uInvGamma"), inverseGamma(options));
+    gl.Uniform1i(at("uToneMap"), static_cast<int>(options.toneMap));
     gl.Uniform1f(at("uWipeX"), static_cast<float>(options.wipeX * width));
     gl.Uniform2f(at("uLogDensity"), d.logDensityLo, d.logDensityHi);
     gl.BindVertexArray(d.context.impl().emptyVertexArray);

@@ -207,6 +207,25 @@ TEST(ViewRenderer, ExposureAndGamma) {
     }
 }
 
+TEST(ViewRenderer, SrgbCurveAndToneMapsAgreeWithCoreOnBothPaths) {
+    Fixture& f = fixture();
+    const format::Image base = f.renderer.renderToImage({}, 64, 48, linear());
+    for (ToneMap toneMap : {ToneMap::None, ToneMap::Reinhard, ToneMap::Aces}) {
+        ViewOptions o;  // gamma 0: the sRGB curve
+        o.exposure = 2.0;  // pushes the bright parts above 1
+        o.toneMap = toneMap;
+        for (gl::DecodePath path : {gl::DecodePath::Gpu, gl::DecodePath::Cpu}) {
+            o.decode = path;
+            const format::Image shown = f.renderer.renderToImage({}, 64, 48, o);
+            for (int x = 0; x < 64; x += 7)
+                for (int c = 0; c < 3; ++c) {
+                    const float want = linearToSrgbDisplay(exposeAndToneMap(base.at(x, 20, c), 4.0f, toneMap));
+                    EXPECT_NEAR(shown.at(x, 20, c), want, 2e-3) << toString(toneMap) << (path == gl::DecodePath::Cpu ? " cpu" : " gpu");
+                }
+        }
+    }
+}
+
 TEST(ViewRenderer, OutsideTheImageIsBackground) {
     Fixture& f = fixture();
     const format::Image im = f.renderer.renderToImage({-1.0, -1.0, 2.0, 2.0}, 90, 90, linear());

@@ -10,6 +10,8 @@
 // framebuffer. GL failures throw conus::Error (Unsupported, LimitExceeded) as in gpu_image.h.
 #pragma once
 
+#include "conus/core/display.h"
+
 #include <memory>
 #include <vector>
 
@@ -53,6 +55,7 @@ struct ViewOptions {
     int gridEvery = 0;       // every n-th grid line; 0: automatic, lines at least ~6 pixels apart
     bool outlines = false;   // analytic focus circles (radius r and 2r)
     double exposure = 0.0;   // colour * 2^exposure
+    ToneMap toneMap = ToneMap::None;  // after exposure, before the display curve (core/display.h)
     double gamma = 0.0;      // 0: the sRGB curve (data is linear light); else a display gamma (1: linear values)
     double wipeX = 0.5;      // Wipe: split position, a fraction of the viewport width
     bool bottomUp = true;    // the target's row 0 is the bottom (a window); false: top (readback)
