@@ -16,6 +16,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "test_dir.h"
+
 namespace conus::test {
 namespace fs = std::filesystem;
 
@@ -33,15 +35,6 @@ inline std::string slurp(const fs::path& path) {
 
 class Cli : public ::testing::Test {
 protected:
-    void SetUp() override {
-        m_dir = fs::temp_directory_path() /
-                ("conus-cli-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
-                 std::to_string(::getpid()));
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-    }
-    void TearDown() override { fs::remove_all(m_dir); }
-
     Result run(const std::string& args) {
         const fs::path out = m_dir / "stdout.txt", err = m_dir / "stderr.txt";
         const std::string command = std::string(CONUS_BIN_DIR) + "/conus " + args + " >" + out.string() + " 2>" +
@@ -99,7 +92,8 @@ protected:
         return names;
     }
 
-    fs::path m_dir;
+    TestDir m_folder{"conus-cli"};
+    const fs::path& m_dir = m_folder.path();
 };
 
 }  // namespace conus::test

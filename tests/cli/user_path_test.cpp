@@ -19,6 +19,8 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include "test_dir.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -51,16 +53,7 @@ float srgbToLinear(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 
 
 class UserPath : public ::testing::Test {
 protected:
-    void SetUp() override {
-        m_dir = fs::temp_directory_path() /
-                ("conus-user-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
-                 std::to_string(::getpid()));
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-    }
-    void TearDown() override { fs::remove_all(m_dir); }
-
-    std::string path(const std::string& name) const { return (m_dir / name).string(); }
+    std::string path(const std::string& name) const { return m_dir.file(name); }
 
     // Runs the real binary; returns its exit code, stderr in `err`.
     int conus(const std::string& args, std::string* err = nullptr) {
@@ -138,7 +131,7 @@ protected:
         ASSERT_EQ(conus("decode " + path("u.exr") + " -o " + output + " " + decodeArgs, &err), 0) << err;
     }
 
-    fs::path m_dir;
+    conus::test::TestDir m_dir{"conus-user"};
 };
 
 // Expects `got` (read back) to hold `expected` (0..1 values, `channels` each) to within `codes`

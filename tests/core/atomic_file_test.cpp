@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "test_dir.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 
@@ -22,21 +23,10 @@ namespace {
 
 class AtomicFileTest : public ::testing::Test {
 protected:
-    void SetUp() override {
-        m_dir = fs::temp_directory_path() /
-                ("conus-atomic-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
-                 std::to_string(::getpid()));
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-    }
-    void TearDown() override { fs::remove_all(m_dir); }
-    std::string path(const std::string& name) const { return (m_dir / name).string(); }
-    std::vector<std::string> entries() const {
-        std::vector<std::string> names;
-        for (const auto& e : fs::directory_iterator(m_dir)) names.push_back(e.path().filename().string());
-        return names;
-    }
-    fs::path m_dir;
+    std::string path(const std::string& name) const { return m_folder.file(name); }
+    std::vector<std::string> entries() const { return m_folder.entries(); }
+    conus::test::TestDir m_folder{"conus-atomic"};
+    const fs::path& m_dir = m_folder.path();
 };
 
 std::string slurp(const std::string& path) {

@@ -12,6 +12,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "test_dir.h"
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
 
@@ -22,16 +23,9 @@ namespace {
 
 class ImageFileTest : public ::testing::Test {
 protected:
-    void SetUp() override {
-        m_dir = fs::temp_directory_path() /
-                ("conus-imageio-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
-                 std::to_string(::getpid()));
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-    }
-    void TearDown() override { fs::remove_all(m_dir); }
-    std::string path(const std::string& name) const { return (m_dir / name).string(); }
-    fs::path m_dir;
+    std::string path(const std::string& name) const { return m_folder.file(name); }
+    conus::test::TestDir m_folder{"conus-imageio"};
+    const fs::path& m_dir = m_folder.path();
 };
 
 struct Read {
