@@ -1,14 +1,10 @@
-// `--backend auto|egl|osmesa|cpu` for every command that renders. auto takes the fastest that
-// works: a hardware GL device when there is one, else the CPU reference (on Mesa's software
-// rasterizer the CPU path measures several times faster, bench/README.md).
+// `--backend auto|egl|osmesa|cpu` on every command that renders. The choice itself is made in one
+// place, conus::gl::Device::choose (renderers/backend.h); this file only parses the option.
 #pragma once
 
-#include <memory>
 #include <string>
 
-#include "conus/codec/decode.h"
-#include "conus/codec/encode.h"
-#include "conus/renderers/context.h"
+#include "conus/renderers/backend.h"
 
 namespace CLI {
 class App;
@@ -16,18 +12,10 @@ class App;
 
 namespace conus::cli {
 
-class Renderer {
-public:
-    explicit Renderer(const std::string& backendName);
-    format::Image encode(const format::Image& source, const codec::SamplingMap& map, const codec::EncodeOptions& options);
-    format::Image decode(const format::Image& conus, const codec::SamplingMap& map, const codec::DecodeOptions& options);
-    // "cpu", or "egl: <GL_RENDERER>" / "osmesa: <GL_RENDERER>".
-    std::string describe() const;
+// Work without a CPU path offers auto, egl and osmesa only.
+void addBackendOption(CLI::App& command, std::string& backend, gl::CpuPath cpuPath = gl::CpuPath::Available);
 
-private:
-    std::unique_ptr<gl::Context> m_context;  // null: the CPU reference
-};
-
-void addBackendOption(CLI::App& command, std::string& backend);
+// The device for `work` from the option's value.
+gl::Device deviceFor(const std::string& backend, gl::CpuPath cpuPath, const std::string& work);
 
 }  // namespace conus::cli

@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "conus/codec/decode.h"
 #include "conus/core/error.h"
+#include "conus/renderers/gpu_image.h"
 #include "image_files.h"
 #include "progress.h"
 
@@ -64,8 +65,8 @@ int runDecode(const DecodeCommandOptions& o) {
     decode.height = size.height;
     Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
     decode.progress = progress.callback();
-    Renderer renderer(o.backend);
-    const format::Image frame = renderer.decode(file.image, map, decode);
+    const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "decoding");
+    const format::Image frame = gl::decodeImage(device, file.image, map, decode);
     progress.done();
     writePicture(o.output, frame, write);
     std::printf("wrote %s: %dx%d view [%g,%g]-[%g,%g]\n", o.output.c_str(), frame.width, frame.height, view.u0, view.v0,

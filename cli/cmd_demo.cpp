@@ -17,6 +17,7 @@
 #include "conus/codec/auto_map.h"
 #include "conus/codec/foci.h"
 #include "conus/codec/metrics.h"
+#include "conus/renderers/gpu_image.h"
 #include "demo_picture.h"
 #include "encoding.h"
 #include "conus/imageio/image_file.h"
@@ -130,10 +131,10 @@ Command addDemoCommand(CLI::App& root) {
                 building.done();
 
                 const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
-                Renderer renderer(options->backend);
-                format::ConusFile conus = encodeToConus(renderer, source, encoding, map, size, analytic);
+                const gl::Device device = deviceFor(options->backend, gl::CpuPath::Available, "the demo");
+                format::ConusFile conus = encodeToConus(device, source, encoding, map, size, analytic);
                 format::ConusFile uniform =
-                    encodeToConus(renderer, source, encoding, codec::SamplingMap::identity(2, 2), size, std::nullopt);
+                    encodeToConus(device, source, encoding, codec::SamplingMap::identity(2, 2), size, std::nullopt);
                 format::writeConusFile((out / "conus.exr").string(), conus);
                 format::writeConusFile((out / "uniform.exr").string(), uniform);
                 imageio::WriteOptions picture;
@@ -171,7 +172,7 @@ Command addDemoCommand(CLI::App& root) {
                 else
                     std::printf("%zu foci", foci.size());
                 for (const auto& f : foci) std::printf(" (%g,%g,r=%g,k=%g)", f.u, f.v, f.r, f.k);
-                std::printf("\nrenderer: %s\n", renderer.describe().c_str());
+                std::printf("\nrenderer: %s\n", device.describe().c_str());
                 std::printf("%-22s %12s %14s %8s\n", "view", "CoNUS PSNR", "uniform PSNR", "gain");
                 for (const auto& v : views) {
                     codec::DecodeOptions decode;
@@ -180,8 +181,8 @@ Command addDemoCommand(CLI::App& root) {
                     decode.width = v.width;
                     decode.height = v.height;
                     const format::Image reference = crop(source, v.x0, v.y0, v.width, v.height);
-                    const format::Image fromConus = renderer.decode(conus.image, map, decode);
-                    const format::Image fromUniform = renderer.decode(uniform.image, identity, decode);
+                    const format::Image fromConus = gl::decodeImage(device, conus.image, map, decode);
+                    const format::Image fromUniform = gl::decodeImage(device, uniform.image, identity, decode);
                     const double a = codec::psnr(reference, fromConus), b = codec::psnr(reference, fromUniform);
                     std::printf("%-22s %9.2f dB %11.2f dB %+7.2f\n", v.label.c_str(), a, b, a - b);
                     std::vector<format::Image> strip{reference, fromConus, fromUniform};

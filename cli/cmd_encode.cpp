@@ -77,8 +77,8 @@ int runEncode(const EncodeOptions& o) {
              "uniform` makes)");
         built.map = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
     }
-    Renderer renderer(o.storage.backend);
-    format::ConusFile file = encodeToConus(renderer, source.image, source.info.encoding, *built.map, size, built.analytic);
+    const gl::Device device = deviceFor(o.storage.backend, gl::CpuPath::Available, "encoding");
+    format::ConusFile file = encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic);
     applyStorage(o.storage, file);
     Progress writing("write " + o.output);
     format::writeConusFile(o.output, file);

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "arguments.h"
+#include "backend.h"
 #include "commands.h"
 #include "conus/codec/encode.h"
 #include "conus/codec/heightfield.h"
@@ -83,13 +84,6 @@ codec::GroundParams groundOf(const format::ConusFile& file, const std::string& n
     return codec::groundFromAnalytic(*file.analytic);
 }
 
-std::unique_ptr<gl::Context> terrainContext(const std::string& backendName) {
-    const gl::Backend backend = gl::parseBackend(backendName);
-    if (backend == gl::Backend::Cpu)
-        throw Error(ErrorCode::InvalidArgument, "terrain rendering needs GL: use --backend auto|egl|osmesa");
-    return gl::Context::create(backend);
-}
-
 gl::TerrainCamera terrainCamera(const format::ConusFile& file, const std::string& cameraText) {
     gl::TerrainCamera camera = gl::viewerCamera(groundOf(file, "the file"), codec::heightAt(file, {0.5, 1.0}));
     if (!cameraText.empty()) {
@@ -103,11 +97,11 @@ gl::TerrainCamera terrainCamera(const format::ConusFile& file, const std::string
 
 format::Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
                                      int height, const std::string& backendName) {
-    const auto context = terrainContext(backendName);
+    const gl::Device device = deviceFor(backendName, gl::CpuPath::None, "terrain rendering");
     const glm::dvec2 extent = codec::fieldExtent(groundOf(file, "the file"));
     const gl::TerrainCamera camera = terrainCamera(file, cameraText);
     Progress progress("undistort the height field and render " + std::to_string(width) + "x" + std::to_string(height));
-    format::Image frame = gl::renderTerrain(*context, codec::undistortHeightField(file, extent), camera, width, height);
+    format::Image frame = gl::renderTerrain(device.context(), codec::undistortHeightField(file, extent), camera, width, height);
     progress.done();
     printCamera(camera);
     return frame;
@@ -167,9 +161,7 @@ Command addHeightFieldCommand(CLI::App& root) {
                        "field of the same sample count, side by side (full | CoNUS | uniform), with PSNRs");
     render->add_option("--height-scale", o->heightScale, "as given to encode (for --compare)")->capture_default_str();
     render->add_option("--colour,--color", o->colour, "as given to encode (for --compare)");
-    render->add_option("--backend", o->backend, "auto | egl | osmesa (GL is needed: there is no CPU path)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"auto", "egl", "osmesa"}, CLI::ignore_case));
+    addBackendOption(*render, o->backend, gl::CpuPath::None);
     addQuietOption(*render);
     render->footer(
         "Examples:\n"
@@ -216,7 +208,8 @@ Command addHeightFieldCommand(CLI::App& root) {
                 }
                 const format::ConusFile file = format::readConusFile(o->input);
                 const Size size = parseSize(o->frameSize);
-                const auto context = terrainContext(o->backend);
+                const gl::Device device = deviceFor(o->backend, gl::CpuPath::None, "terrain rendering");
+                gl::Context* context = &device.context();
                 const codec::GroundParams ground = groundOf(file, o->input);
                 const glm::dvec2 extent = codec::fieldExtent(ground);
                 const gl::TerrainCamera camera = terrainCamera(file, o->cameraText);

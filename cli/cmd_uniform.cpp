@@ -23,8 +23,8 @@ int runUniform(const UniformOptions& o) {
     checkConusOutput(o.output, o.input);
     const imageio::ImageFile source = readSource(o.input, o.source);
     const Size size = conusSize(o.storage, source.image);
-    Renderer renderer(o.storage.backend);
-    format::ConusFile file = encodeToConus(renderer, source.image, source.info.encoding,
+    const gl::Device device = deviceFor(o.storage.backend, gl::CpuPath::Available, "encoding");
+    format::ConusFile file = encodeToConus(device, source.image, source.info.encoding,
                                            codec::SamplingMap::identity(2, 2), size, std::nullopt);
     applyStorage(o.storage, file);
     Progress writing("write " + o.output);

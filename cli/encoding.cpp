@@ -8,6 +8,7 @@
 #include "conus/core/atomic_file.h"
 
 #include "conus/codec/encode.h"
+#include "conus/renderers/gpu_image.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -50,12 +51,12 @@ void checkConusOutput(const std::string& output, const std::string& input) {
     checkOutputPath(output, inputs);
 }
 
-format::ConusFile encodeToConus(Renderer& renderer, const format::Image& source, const SourceEncoding& encoding,
+format::ConusFile encodeToConus(const gl::Device& device, const format::Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                       std::to_string(size.width) + "x" + std::to_string(size.height));
     format::ConusFile file;
-    file.image = renderer.encode(source, map, {size.width, size.height, 0, progress.callback()});
+    file.image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
     file.sourceWidth = source.width;
     file.sourceHeight = source.height;

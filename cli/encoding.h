@@ -30,7 +30,7 @@ Size conusSize(const StorageOptions& options, const format::Image& source);
 
 // Encodes `source` through `map` at `size` (with progress) into a file model ready to write,
 // remembering the source's encoding.
-format::ConusFile encodeToConus(Renderer& renderer, const format::Image& source, const SourceEncoding& encoding,
+format::ConusFile encodeToConus(const gl::Device& device, const format::Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic);
 
 // Applies the storage options to a file model. Without --half or --float, colour is stored as

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "conus/renderers/context.h"
+#include "conus/renderers/backend.h"
 #include "conus/renderers/view_renderer.h"
 #include "document.h"
 #include "conus/imageio/image_file.h"
@@ -39,8 +39,9 @@ int runScreenshot(const Options& options) {
             width = std::max(1, static_cast<int>(std::lround(w * scale)));
             height = std::max(1, static_cast<int>(std::lround(h * scale)));
         }
-        auto context = gl::Context::create(gl::parseBackend(options.backend));
-        gl::ViewRenderer renderer(*context);
+        const gl::Device device = gl::Device::choose(gl::parseBackend(options.backend), gl::CpuPath::None, "the viewer's screenshot");
+        gl::Context& context = device.context();
+        gl::ViewRenderer renderer(context);
         renderer.setImage(*doc.file);
         std::vector<gl::OverlayPlacement> overlays;
         if (options.helpOverlay) {
@@ -60,7 +61,7 @@ int runScreenshot(const Options& options) {
         write.meaning = imageio::PixelMeaning::Display;  // the framebuffer: already what the screen shows
         imageio::writeImageFile(options.screenshot, frame, write);
         std::printf("wrote %s: %dx%d, %s view of %s (%s)\n", options.screenshot.c_str(), width, height,
-                    modeName(options.display.mode), doc.path.c_str(), context->renderer().c_str());
+                    modeName(options.display.mode), doc.path.c_str(), context.renderer().c_str());
         return 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "conus-view: %s\n", e.what());

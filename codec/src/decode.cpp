@@ -13,7 +13,7 @@
 
 #include "conus/codec/decode.h"
 #include "decode_pvt.h"
-#include "parallel.h"
+#include "conus/core/parallel.h"
 #include "resample_pvt.h"
 
 namespace conus::codec {
@@ -331,7 +331,7 @@ format::Image decodeImage(const format::Image& conus, const SamplingMap& map, co
     format::Image out = detail::makeOutput(conus, options.width, options.height);
     const detail::ViewColumns cols = detail::viewColumns(map.columns(), options.view.u0, options.view.u1, out.width);
     detail::RowProgress progress(options.progress, out.height);
-    detail::parallelRows(
+    parallelRows(
         out.height, options.threads,
         [&](int y0, int y1) {
             detail::dispatchChannels(conus.channelCount(), [&]<int kC>() {
@@ -351,7 +351,7 @@ format::Image resizeBilinear(const format::Image& image, const View& view, int w
     format::Image out = detail::makeOutput(image, width, height);
     const AxisTaps tx = axisTaps(image.width, view.u0, view.u1, width);
     const AxisTaps ty = axisTaps(image.height, view.v0, view.v1, height);
-    detail::parallelRows(
+    parallelRows(
         height, threads,
         [&](int y0, int y1) {
             detail::dispatchChannels(image.channelCount(),

@@ -16,7 +16,7 @@
 #include <string>
 
 #include "conus/core/error.h"
-#include "parallel.h"
+#include "conus/core/parallel.h"
 
 namespace conus::codec {
 namespace {
@@ -147,7 +147,7 @@ format::GridNodes integrateNodes(const FlowField& field, const DensityMapOptions
     grid.rows = m;
     grid.xy.assign(std::size_t(2) * n * m, 0.0f);
     const double dt = 1.0 / steps;
-    detail::parallelRows(m, 0, [&](int j0, int j1) {
+    parallelRows(m, 0, [&](int j0, int j1) {
         // A whole row advances stage by stage: the nodes' RK4 chains are independent, so their
         // lookups and divisions overlap instead of waiting on one another.
         std::vector<glm::dvec2> p(n), k(n), sum(n);

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "conus/codec/encode.h"
-#include "parallel.h"
+#include "conus/core/parallel.h"
 #include "resample_pvt.h"
 
 namespace conus::codec {
@@ -93,7 +93,7 @@ void areaRows(Plane src, float* dst, int dstWidth, int c, const AxisWeights& wx,
 void areaDownsamplePlane(Plane src, float* dst, int width, int height, int channels, int threads) {
     const AxisWeights wx = areaWeights(src.width, width);
     const AxisWeights wy = areaWeights(src.height, height);
-    detail::parallelRows(height, threads, [&](int y0, int y1) {
+    parallelRows(height, threads, [&](int y0, int y1) {
         detail::dispatchChannels(channels, [&]<int kC>() { areaRows<kC>(src, dst, width, channels, wx, wy, y0, y1); });
     });
 }
@@ -203,7 +203,7 @@ format::Image encodeImage(const format::Image& source, const SamplingMap& map, c
     format::Image out = detail::makeOutput(source, options.width, options.height);
     Pyramid pyramid(source);
     detail::RowProgress progress(options.progress, out.height);
-    detail::parallelRows(out.height, options.threads, [&](int y0, int y1) {
+    parallelRows(out.height, options.threads, [&](int y0, int y1) {
         detail::dispatchChannels(source.channelCount(), [&]<int kC>() {
             encodeRows<kC>(source, map, pyramid, out, options.threads, y0, y1);
         });

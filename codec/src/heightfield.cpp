@@ -8,7 +8,7 @@
 #include <string>
 
 #include "conus/codec/encode.h"
-#include "parallel.h"
+#include "conus/core/parallel.h"
 
 namespace conus::codec {
 namespace {
@@ -166,7 +166,7 @@ format::Image generateTerrain(const TerrainOptions& o) {
                         std::to_string(o.ridges) + ": want relief in [0,1e6), features in (0,1e4), octaves in "
                         "[1,24], ridges in [0,1]");
     format::Image out = format::makeImage(o.width, o.height, {"Z"});
-    detail::parallelRows(o.height, 0, [&](int y0, int y1) {
+    parallelRows(o.height, 0, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < o.width; ++x)
                 out.at(x, y) = static_cast<float>(
@@ -199,7 +199,7 @@ format::Image terrainColours(const format::Image& heights, glm::dvec2 extent) {
                                      {0.90, {0.93, 0.94, 0.97}}, {1.00, {1.00, 1.00, 1.00}}};
     const glm::dvec3 rock(0.42, 0.40, 0.38);
     format::Image out = format::makeImage(w, h, {"R", "G", "B"});
-    detail::parallelRows(h, 0, [&](int y0, int y1) {
+    parallelRows(h, 0, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < w; ++x) {
                 const auto at = [&](int xx, int yy) {
@@ -316,7 +316,7 @@ Mesh undistortHeightField(const format::ConusFile& file, glm::dvec2 extent) {
     const std::size_t count = static_cast<std::size_t>(nx) * ny;
     mesh.positions.resize(count);
     mesh.colours.resize(count);
-    detail::parallelRows(ny, 0, [&](int j0, int j1) {
+    parallelRows(ny, 0, [&](int j0, int j1) {
         for (int j = j0; j < j1; ++j) {
             const int py = std::clamp(j - 1, 0, h - 1);
             for (int i = 0; i < nx; ++i) {

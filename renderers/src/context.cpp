@@ -25,6 +25,20 @@ std::string glString(const GladGLContext& gl, GLenum name) {
     return s ? reinterpret_cast<const char*>(s) : "";
 }
 
+// Loads GL 4.5 core into a context whose platform is current and reads what every Context
+// knows of itself. Empty on success, else why not.
+std::string loadGl(Context::Impl& impl) {
+    const int version = gladLoadGLContext(&impl.gl, impl.platform->loader());
+    if (version == 0 || GLAD_VERSION_MAJOR(version) * 10 + GLAD_VERSION_MINOR(version) < 45)
+        return impl.platform->description() + ": could not load OpenGL 4.5 core entry points (glad reports " +
+               std::to_string(GLAD_VERSION_MAJOR(version)) + "." + std::to_string(GLAD_VERSION_MINOR(version)) + ")";
+    impl.renderer = glString(impl.gl, GL_RENDERER);
+    impl.version = glString(impl.gl, GL_VERSION);
+    impl.gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &impl.maxTextureSize);
+    impl.gl.GenVertexArrays(1, &impl.emptyVertexArray);
+    return {};
+}
+
 // One backend: a current context with GL 4.5 loaded, or nullptr and the reason.
 std::unique_ptr<Context::Impl> tryBackend(Backend backend, std::string& reason) {
     if (disabledByEnvironment(backendName(backend))) {
@@ -40,20 +54,28 @@ std::unique_ptr<Context::Impl> tryBackend(Backend backend, std::string& reason) 
     impl->platform = backend == Backend::Egl ? createEglPlatform(reason) : createOsMesaPlatform(reason);
     if (!impl->platform) return nullptr;
     tCurrent = impl->platform.get();
-    const int version = gladLoadGLContext(&impl->gl, impl->platform->loader());
-    if (version == 0 || GLAD_VERSION_MAJOR(version) * 10 + GLAD_VERSION_MINOR(version) < 45) {
-        reason += std::string(reason.empty() ? "" : "; ") + impl->platform->description() +
-                  ": could not load OpenGL 4.5 core entry points (glad reports " + std::to_string(GLAD_VERSION_MAJOR(version)) +
-                  "." + std::to_string(GLAD_VERSION_MINOR(version)) + ")";
+    if (const std::string failure = loadGl(*impl); !failure.empty()) {
+        reason += std::string(reason.empty() ? "" : "; ") + failure;
         return nullptr;
     }
-    impl->renderer = glString(impl->gl, GL_RENDERER);
-    impl->version = glString(impl->gl, GL_VERSION);
-    impl->gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &impl->maxTextureSize);
-    impl->gl.GenVertexArrays(1, &impl->emptyVertexArray);
     impl->reason = impl->platform->description() + (reason.empty() ? "" : " (after: " + reason + ")");
     return impl;
 }
+
+// The caller's context: binding and unbinding it are the caller's business (GLFW's, say).
+class AdoptedPlatform final : public Platform {
+public:
+    explicit AdoptedPlatform(GetProcFn getProc) : m_getProc(getProc) {}
+    void makeCurrent() override {}
+    void release() override {}
+    GLADloadfunc loader() const override { return reinterpret_cast<GLADloadfunc>(m_getProc); }
+    std::string description() const override { return "adopted GL context (owned by the caller)"; }
+
+private:
+    GetProcFn m_getProc;
+};
+
+constexpr int kMinTextureLimit = 64;
 
 }  // namespace
 
@@ -130,6 +152,31 @@ std::unique_ptr<Context> Context::create(Backend backend) {
         reasons += std::string(reasons.empty() ? "" : "; ") + backendName(b) + ": " + reason;
     }
     throw Error(ErrorCode::Unsupported, "no OpenGL 4.5 context (" + reasons + ")");
+}
+
+std::unique_ptr<Context> adoptCurrentContext(GetProcFn getProc) {
+    if (!getProc) throw Error(ErrorCode::InvalidArgument, "adoptCurrentContext: no GL loader given");
+    auto impl = std::make_unique<Context::Impl>();
+    impl->backend = Backend::Auto;
+    impl->platform = std::make_unique<AdoptedPlatform>(getProc);
+    if (const std::string failure = loadGl(*impl); !failure.empty()) {
+        impl->platform.reset();  // nothing was created in the caller's context
+        throw Error(ErrorCode::Unsupported, "adoptCurrentContext: " + failure);
+    }
+    impl->reason = impl->platform->description();
+    return std::make_unique<Context>(std::move(impl));
+}
+
+int Context::textureLimit() const {
+    const int limit = m_impl->maxTextureSize;
+    const char* env = std::getenv(kTextureLimitVariable);
+    if (!env || !*env) return limit;
+    char* end = nullptr;
+    const long value = std::strtol(env, &end, 10);
+    if (end == env || *end != '\0' || value <= 0)
+        throw Error(ErrorCode::InvalidArgument, std::string(kTextureLimitVariable) + "=\"" + env +
+                                                    "\" is not a positive whole number of texels");
+    return static_cast<int>(std::clamp<long>(value, std::min(kMinTextureLimit, limit), limit));
 }
 
 Context::Context(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}

@@ -11,21 +11,37 @@
 
 namespace conus::gl {
 
-// The Gen/Delete pair of glGen*/glDelete* share one signature; the handle keeps its Delete.
+// The Gen/Delete pair of glGen*/glDelete* share one signature; the handle keeps its Delete. An
+// empty handle (default) holds nothing; moving hands the object over, assigning deletes the old one.
+// The context must be current wherever a handle is destroyed or assigned.
 class GlHandle {
 public:
     using Gen = PFNGLGENTEXTURESPROC;
     using Del = PFNGLDELETETEXTURESPROC;
+    GlHandle() = default;
     GlHandle(Gen gen, Del del) : m_del(del) { gen(1, &m_id); }
-    ~GlHandle() {
-        if (m_id) m_del(1, &m_id);
-    }
+    ~GlHandle() { reset(); }
     GlHandle(const GlHandle&) = delete;
     GlHandle& operator=(const GlHandle&) = delete;
+    GlHandle(GlHandle&& other) noexcept : m_del(other.m_del), m_id(other.m_id) { other.m_id = 0; }
+    GlHandle& operator=(GlHandle&& other) noexcept {
+        if (this != &other) {
+            reset();
+            m_del = other.m_del;
+            m_id = other.m_id;
+            other.m_id = 0;
+        }
+        return *this;
+    }
+    void reset() {
+        if (m_id && m_del) m_del(1, &m_id);
+        m_id = 0;
+    }
     GLuint id() const { return m_id; }
+    explicit operator bool() const { return m_id != 0; }
 
 private:
-    Del m_del;
+    Del m_del = nullptr;
     GLuint m_id = 0;
 };
 

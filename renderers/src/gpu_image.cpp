@@ -40,24 +40,6 @@ double millisecondsSince(Clock::time_point& start) {
     return ms;
 }
 
-// The largest texture side the GPU paths use: the context's GL_MAX_TEXTURE_SIZE, or less where the
-// environment variable CONUS_GL_MAX_TEXTURE asks for less (for tests of the tiled encoder; clamped
-// to [kMinTextureLimit, GL_MAX_TEXTURE_SIZE]).
-constexpr int kMinTextureLimit = 64;
-constexpr const char* kTextureLimitVariable = "CONUS_GL_MAX_TEXTURE";
-
-int textureLimit(const Context& context) {
-    const int limit = context.maxTextureSize();
-    const char* env = std::getenv(kTextureLimitVariable);
-    if (!env || !*env) return limit;
-    char* end = nullptr;
-    const long value = std::strtol(env, &end, 10);
-    if (end == env || *end != '\0' || value <= 0)
-        throw Error(ErrorCode::InvalidArgument, std::string(kTextureLimitVariable) + "=\"" + env +
-                                                    "\" is not a positive whole number of texels");
-    return static_cast<int>(std::clamp<long>(value, std::min(kMinTextureLimit, limit), limit));
-}
-
 std::string limitDescription(const Context& context, int limit) {
     std::string text = "the texture limit " + std::to_string(limit) + " (GL_MAX_TEXTURE_SIZE " +
                        std::to_string(context.maxTextureSize()) + " of " + context.renderer();
@@ -66,7 +48,7 @@ std::string limitDescription(const Context& context, int limit) {
 }
 
 void checkTextureSize(const Context& context, int width, int height, const char* what, const char* role) {
-    const int limit = textureLimit(context);
+    const int limit = context.textureLimit();
     if (width > limit || height > limit)
         throw Error(ErrorCode::LimitExceeded, std::string(what) + ": " + role + " " + std::to_string(width) + "x" +
                                                   std::to_string(height) + " exceeds " +
@@ -386,7 +368,7 @@ format::Image encodeImageGpu(Context& context, const format::Image& source, cons
     format::checkImage(source, kWhat);
     format::Image out = format::makeImage(options.width, options.height, source.channels);
     checkTextureSize(context, out.width, out.height, kWhat, "output");
-    const int limit = textureLimit(context);
+    const int limit = context.textureLimit();
     const Pyramid pyramid = pyramidLayout(source.width, source.height);
     const bool tiled = source.width > limit || source.height > limit || pyramid.atlasWidth > limit ||
                        pyramid.atlasHeight > limit;
@@ -603,6 +585,18 @@ format::Image decodeImageGpu(Context& context, const format::Image& conus, const
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     if (timings) *timings = t;
     return out;
+}
+
+format::Image encodeImage(const Device& device, const format::Image& source, const codec::SamplingMap& map,
+                          const codec::EncodeOptions& options) {
+    return device.run([&] { return codec::encodeImage(source, map, options); },
+                      [&](Context& context) { return encodeImageGpu(context, source, map, options); });
+}
+
+format::Image decodeImage(const Device& device, const format::Image& conus, const codec::SamplingMap& map,
+                          const codec::DecodeOptions& options) {
+    return device.run([&] { return codec::decodeImage(conus, map, options); },
+                      [&](Context& context) { return decodeImageGpu(context, conus, map, options); });
 }
 
 }  // namespace conus::gl

@@ -1,5 +1,5 @@
 // conus-view's drawing: one full-screen pass of view_frame.frag.glsl into the bound framebuffer,
-// and the Context that adopts a window's GL context (context_pvt.h's Platform, doing nothing).
+// or (where the backend rule prefers the CPU) codec's decoder per frame, uploaded and blitted.
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -14,6 +14,8 @@
 
 #include "context_pvt.h"
 #include "conus/core/display.h"
+#include "conus/core/parallel.h"
+#include "conus/renderers/backend.h"
 #include "conus/renderers/gpu_image.h"
 #include "conus/renderers/view_renderer.h"
 #include "embedded_shaders.h"
@@ -51,14 +53,6 @@ std::uint32_t floatBits(float f) {
     return b;
 }
 
-// The software rasterizers, on which the CPU decoder beats the shader.
-bool softwareRenderer(const std::string& renderer) {
-    std::string lower = renderer;
-    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return lower.find("llvmpipe") != std::string::npos || lower.find("softpipe") != std::string::npos ||
-           lower.find("swrast") != std::string::npos;
-}
-
 // The display channels as R,G,B (the shader writes alpha 1 whatever the image's alpha).
 format::Image displayRgb(const format::Image& rgba) {
     format::Image out = format::makeImage(rgba.width, rgba.height, {"R", "G", "B"});
@@ -66,39 +60,6 @@ format::Image displayRgb(const format::Image& rgba) {
     for (std::size_t i = 0; i < pixels; ++i)
         for (int c = 0; c < 3; ++c) out.pixels[i * 3 + c] = rgba.pixels[i * 4 + c];
     return out;
-}
-
-// Runs body(y0, y1) over row bands on up to hardware_concurrency threads.
-template <class Body>
-void parallelRows(int height, Body body) {
-    const int threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, std::max(1, height / 16));
-    if (threads <= 1) {
-        body(0, height);
-        return;
-    }
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t)
-        pool.emplace_back([&, t] { body(height * t / threads, height * (t + 1) / threads); });
-    body(0, height / threads);
-    for (std::thread& th : pool) th.join();
-}
-
-// The caller's context: binding and unbinding it are the caller's business (GLFW's, say).
-class AdoptedPlatform final : public Platform {
-public:
-    explicit AdoptedPlatform(GetProcFn getProc) : m_getProc(getProc) {}
-    void makeCurrent() override {}
-    void release() override {}
-    GLADloadfunc loader() const override { return reinterpret_cast<GLADloadfunc>(m_getProc); }
-    std::string description() const override { return "adopted GL context (owned by the caller)"; }
-
-private:
-    GetProcFn m_getProc;
-};
-
-std::string glString(const GladGLContext& gl, GLenum name) {
-    const GLubyte* s = gl.GetString(name);
-    return s ? reinterpret_cast<const char*>(s) : "";
 }
 
 // The display channels of a CoNUS image as RGBA: R,G,B(,A) when present, else Y (or the first
@@ -120,11 +81,10 @@ format::Image displayRgba(const format::Image& image) {
     return out;
 }
 
-void uploadRgba(const GladGLContext& gl, GLuint& texture, const format::Image& image) {
-    if (texture) gl.DeleteTextures(1, &texture);
-    gl.GenTextures(1, &texture);
+GlHandle uploadRgba(const GladGLContext& gl, const format::Image& image) {
+    GlHandle texture = makeTexture(gl);
     gl.ActiveTexture(GL_TEXTURE0);
-    gl.BindTexture(GL_TEXTURE_2D, texture);
+    gl.BindTexture(GL_TEXTURE_2D, texture.id());
     gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, image.width, image.height);
     gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
     gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, image.width, image.height, GL_RGBA, GL_FLOAT, image.pixels.data());
@@ -132,38 +92,19 @@ void uploadRgba(const GladGLContext& gl, GLuint& texture, const format::Image& i
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return texture;
 }
 
 }  // namespace
 
-std::unique_ptr<Context> adoptCurrentContext(GetProcFn getProc) {
-    if (!getProc) throw Error(ErrorCode::InvalidArgument, "adoptCurrentContext: no GL loader given");
-    auto impl = std::make_unique<Context::Impl>();
-    impl->backend = Backend::Auto;
-    impl->platform = std::make_unique<AdoptedPlatform>(getProc);
-    const int version = gladLoadGLContext(&impl->gl, impl->platform->loader());
-    if (version == 0 || GLAD_VERSION_MAJOR(version) * 10 + GLAD_VERSION_MINOR(version) < 45) {
-        impl->platform.reset();  // nothing was created in the caller's context
-        throw Error(ErrorCode::Unsupported, "adoptCurrentContext: the current GL context does not offer OpenGL 4.5 core "
-                                            "(glad reports " + std::to_string(GLAD_VERSION_MAJOR(version)) + "." +
-                                                std::to_string(GLAD_VERSION_MINOR(version)) + ")");
-    }
-    impl->renderer = glString(impl->gl, GL_RENDERER);
-    impl->version = glString(impl->gl, GL_VERSION);
-    impl->gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &impl->maxTextureSize);
-    impl->gl.GenVertexArrays(1, &impl->emptyVertexArray);
-    impl->reason = impl->platform->description();
-    return std::make_unique<Context>(std::move(impl));
-}
-
 struct ViewRenderer::Impl {
     Context& context;
-    GLuint conus = 0, map = 0, uniform = 0;
+    GlHandle conus, map, uniform;
     // The CPU decode path: the display channels and the map on the CPU, the frame texture (RGBA8
     // for a window, RGBA32F when rendering to a float target) and a framebuffer to blit it from.
     format::Image rgb;
     std::optional<codec::SamplingMap> cpuMap;
-    GLuint frameTexture = 0, frameFramebuffer = 0;
+    GlHandle frameTexture, frameFramebuffer;
     int frameWidth = 0, frameHeight = 0;
     GLenum frameFormat = 0;
     bool floatTarget = false;  // renderToImage: exact float values, no 8-bit rounding
@@ -177,18 +118,12 @@ struct ViewRenderer::Impl {
     std::vector<float> foci;  // u, v, r per focus
     float logDensityLo = 0, logDensityHi = 0;
     format::Image uniformImage;
-    GLuint overlays[ViewRenderer::kOverlaySlots] = {};
+    GlHandle overlays[ViewRenderer::kOverlaySlots];
     int overlayWidth[ViewRenderer::kOverlaySlots] = {}, overlayHeight[ViewRenderer::kOverlaySlots] = {};
 
     explicit Impl(Context& c) : context(c) {}
-    ~Impl() {
-        const GladGLContext& gl = makeCurrentGl(context);
-        for (GLuint* t : {&conus, &map, &uniform, &frameTexture})
-            if (*t) gl.DeleteTextures(1, t);
-        for (GLuint& t : overlays)
-            if (t) gl.DeleteTextures(1, &t);
-        if (frameFramebuffer) gl.DeleteFramebuffers(1, &frameFramebuffer);
-    }
+    // The handles delete their objects after this body, with the context current.
+    ~Impl() { makeCurrentGl(context); }
 
     bool cpuDecode(const ViewOptions& options) const {
         if (options.mode != ViewMode::Reconstructed || !cpuMap) return false;
@@ -197,12 +132,7 @@ struct ViewRenderer::Impl {
         case DecodePath::Gpu: return false;
         case DecodePath::Auto: break;
         }
-        if (const char* env = std::getenv("CONUS_VIEW_DECODE")) {
-            const std::string value = env;
-            if (value == "cpu") return true;
-            if (value == "gpu") return false;
-        }
-        return softwareRenderer(context.renderer());
+        return prefersCpu(context);
     }
 
     void buildLut(float exposure, float invGamma, ToneMap toneMap) {
@@ -245,7 +175,7 @@ struct ViewRenderer::Impl {
         const std::size_t count = static_cast<std::size_t>(width) * height * 4;
         if (floatTarget) {
             frameFloats.resize(count);
-            parallelRows(height, [&](int y0, int y1) {
+            parallelRows(height, 0, [&](int y0, int y1) {
                 for (int y = y0; y < y1; ++y) {
                     float* out = frameFloats.data() + static_cast<std::size_t>(flip ? height - 1 - y : y) * width * 4;
                     const float* in = frame.pixels.data() + static_cast<std::size_t>(y) * width * 3;
@@ -265,7 +195,7 @@ struct ViewRenderer::Impl {
             frameBytes.resize(count);
             const std::uint8_t background = static_cast<std::uint8_t>(std::lround(kBackground * 255.0f));
             const std::uint8_t* table = lut.data();
-            parallelRows(height, [&](int y0, int y1) {
+            parallelRows(height, 0, [&](int y0, int y1) {
                 for (int y = y0; y < y1; ++y) {
                     std::uint8_t* out = frameBytes.data() + static_cast<std::size_t>(flip ? height - 1 - y : y) * width * 4;
                     const float* in = frame.pixels.data() + static_cast<std::size_t>(y) * width * 3;
@@ -292,25 +222,24 @@ struct ViewRenderer::Impl {
         const GladGLContext& gl = makeCurrentGl(context);
         const GLenum format = floatTarget ? GL_RGBA32F : GL_RGBA8;
         if (!frameTexture || frameWidth != width || frameHeight != height || frameFormat != format) {
-            if (frameTexture) gl.DeleteTextures(1, &frameTexture);
-            gl.GenTextures(1, &frameTexture);
+            frameTexture = makeTexture(gl);
             gl.ActiveTexture(GL_TEXTURE0);
-            gl.BindTexture(GL_TEXTURE_2D, frameTexture);
+            gl.BindTexture(GL_TEXTURE_2D, frameTexture.id());
             gl.TexStorage2D(GL_TEXTURE_2D, 1, format, width, height);
             gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
             gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-            if (!frameFramebuffer) gl.GenFramebuffers(1, &frameFramebuffer);
+            if (!frameFramebuffer) frameFramebuffer = makeFramebuffer(gl);
             GLint readBinding = 0;
             gl.GetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readBinding);
-            gl.BindFramebuffer(GL_READ_FRAMEBUFFER, frameFramebuffer);
-            gl.FramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, frameTexture, 0);
+            gl.BindFramebuffer(GL_READ_FRAMEBUFFER, frameFramebuffer.id());
+            gl.FramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, frameTexture.id(), 0);
             gl.BindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readBinding));
             frameWidth = width;
             frameHeight = height;
             frameFormat = format;
         }
         gl.ActiveTexture(GL_TEXTURE0);
-        gl.BindTexture(GL_TEXTURE_2D, frameTexture);
+        gl.BindTexture(GL_TEXTURE_2D, frameTexture.id());
         gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
         if (floatTarget) gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RGBA, GL_FLOAT, frameFloats.data());
         else gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, frameBytes.data());
@@ -318,7 +247,7 @@ struct ViewRenderer::Impl {
         // reads its back buffer for screenshots).
         GLint readBinding = 0;
         gl.GetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readBinding);
-        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, frameFramebuffer);
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, frameFramebuffer.id());
         gl.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
         gl.BindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readBinding));
         checkGl(gl, "ViewRenderer::draw (CPU decode)");
@@ -341,10 +270,9 @@ struct ViewRenderer::Impl {
 
     void uploadMap(const codec::SamplingMap& m) {
         const GladGLContext& gl = makeCurrentGl(context);
-        if (map) gl.DeleteTextures(1, &map);
-        gl.GenTextures(1, &map);
+        map = makeTexture(gl);
         gl.ActiveTexture(GL_TEXTURE1);
-        gl.BindTexture(GL_TEXTURE_2D, map);
+        gl.BindTexture(GL_TEXTURE_2D, map.id());
         gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, m.columns(), m.rows());
         gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
         gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, m.columns(), m.rows(), GL_RG, GL_FLOAT, m.nodes().data());
@@ -372,17 +300,17 @@ ViewRenderer::ViewRenderer(Context& context) : m_impl(std::make_unique<Impl>(con
 
 ViewRenderer::~ViewRenderer() = default;
 
-bool ViewRenderer::hasImage() const { return m_impl->conus != 0; }
+bool ViewRenderer::hasImage() const { return static_cast<bool>(m_impl->conus); }
 const format::Image& ViewRenderer::uniformImage() const { return m_impl->uniformImage; }
 
 void ViewRenderer::setImage(const format::ConusFile& file) {
     Impl& d = *m_impl;
     const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
     const format::Image rgba = displayRgba(file.image);
-    const int limit = d.context.maxTextureSize();
+    const int limit = d.context.textureLimit();
     if (rgba.width > limit || rgba.height > limit)
         throw Error(ErrorCode::LimitExceeded, "ViewRenderer: CoNUS image " + std::to_string(rgba.width) + "x" +
-                                                  std::to_string(rgba.height) + " exceeds GL_MAX_TEXTURE_SIZE " +
+                                                  std::to_string(rgba.height) + " exceeds the texture limit " +
                                                   std::to_string(limit));
     // The uniform image of the same pixel count: the whole frame decoded at the CoNUS image's size
     // on the GPU. The decoder averages taps over each output pixel's footprint, so this is the area
@@ -394,8 +322,8 @@ void ViewRenderer::setImage(const format::ConusFile& file) {
     d.uniformImage = decodeImageGpu(d.context, rgba, map, options);
 
     const GladGLContext& gl = makeCurrentGl(d.context);
-    uploadRgba(gl, d.conus, rgba);
-    uploadRgba(gl, d.uniform, d.uniformImage);
+    d.conus = uploadRgba(gl, rgba);
+    d.uniform = uploadRgba(gl, d.uniformImage);
     checkGl(gl, "ViewRenderer: image upload");
     d.uploadMap(map);
     d.rgb = displayRgb(rgba);
@@ -444,7 +372,7 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
         gl.Disable(GL_BLEND);
     }
     gl.UseProgram(program);
-    const GLuint textures[3] = {d.conus, d.map, d.uniform};
+    const GLuint textures[3] = {d.conus.id(), d.map.id(), d.uniform.id()};
     for (int unit = 0; unit < 3; ++unit) {
         gl.ActiveTexture(GL_TEXTURE0 + unit);
         gl.BindTexture(GL_TEXTURE_2D, textures[unit]);
@@ -540,8 +468,7 @@ void ViewRenderer::setOverlay(int slot, const format::Image& rgba) {
         throw Error(ErrorCode::InvalidArgument, "ViewRenderer::setOverlay: slot " + std::to_string(slot) + " out of range");
     Impl& d = *m_impl;
     const GladGLContext& gl = makeCurrentGl(d.context);
-    if (d.overlays[slot]) gl.DeleteTextures(1, &d.overlays[slot]);
-    d.overlays[slot] = 0;
+    d.overlays[slot].reset();
     d.overlayWidth[slot] = d.overlayHeight[slot] = 0;
     if (rgba.width <= 0 || rgba.height <= 0) return;
     if (rgba.channelCount() != 4)
@@ -551,7 +478,7 @@ void ViewRenderer::setOverlay(int slot, const format::Image& rgba) {
     if (rgba.width > limit || rgba.height > limit)
         throw Error(ErrorCode::LimitExceeded, "ViewRenderer::setOverlay: " + std::to_string(rgba.width) + "x" +
                                                   std::to_string(rgba.height) + " exceeds GL_MAX_TEXTURE_SIZE");
-    uploadRgba(gl, d.overlays[slot], rgba);
+    d.overlays[slot] = uploadRgba(gl, rgba);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     checkGl(gl, "ViewRenderer::setOverlay");
@@ -560,7 +487,7 @@ void ViewRenderer::setOverlay(int slot, const format::Image& rgba) {
 }
 
 bool ViewRenderer::hasOverlay(int slot) const {
-    return slot >= 0 && slot < kOverlaySlots && m_impl->overlays[slot] != 0;
+    return slot >= 0 && slot < kOverlaySlots && static_cast<bool>(m_impl->overlays[slot]);
 }
 
 void ViewRenderer::drawOverlay(int slot, int x, int y, int width, int height, bool bottomUp) {
@@ -580,7 +507,7 @@ void ViewRenderer::drawOverlay(int slot, int x, int y, int width, int height, bo
     gl.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     gl.UseProgram(program);
     gl.ActiveTexture(GL_TEXTURE0);
-    gl.BindTexture(GL_TEXTURE_2D, d.overlays[slot]);
+    gl.BindTexture(GL_TEXTURE_2D, d.overlays[slot].id());
     gl.Uniform1i(gl.GetUniformLocation(program, "uOverlay"), 0);
     gl.Uniform2i(gl.GetUniformLocation(program, "uOrigin"), x, y);
     gl.Uniform1i(gl.GetUniformLocation(program, "uViewportHeight"), height);

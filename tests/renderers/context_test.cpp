@@ -7,6 +7,7 @@
 
 #include "conus/codec/sampling_map.h"
 #include "conus/core/error.h"
+#include "conus/renderers/backend.h"
 #include "conus/renderers/gpu_image.h"
 #include "gl_test_util.h"
 
@@ -177,4 +178,37 @@ TEST(Context, BackendsInterleaveInOneProcess) {
 }
 
 }  // namespace
+TEST(Device, TheOneDispatchChoosesByTheOrderedListAndTheSoftwareRule) {
+    EXPECT_TRUE(isSoftwareRasterizer("llvmpipe (LLVM 15.0.6, 256 bits)"));
+    EXPECT_TRUE(isSoftwareRasterizer("softpipe"));
+    EXPECT_FALSE(isSoftwareRasterizer("NVIDIA H100 80GB HBM3/PCIe/SSE2"));
+    // The CPU by name, where there is a CPU path; refused, naming the work, where there is none.
+    EXPECT_FALSE(Device::choose(Backend::Cpu, CpuPath::Available, "encoding").onGpu());
+    std::string message;
+    EXPECT_EQ(codeOf([&] { Device::choose(Backend::Cpu, CpuPath::None, "terrain rendering"); }, &message),
+              ErrorCode::InvalidArgument);
+    EXPECT_NE(message.find("terrain rendering has no CPU path"), std::string::npos) << message;
+    // GL by name is GL; auto without a CPU path is GL on any rasterizer.
+    EXPECT_EQ(Device::choose(Backend::OsMesa, CpuPath::Available, "encoding").backend(), Backend::OsMesa);
+    const Device needsGl = Device::choose(Backend::Auto, CpuPath::None, "terrain rendering");
+    ASSERT_TRUE(needsGl.onGpu());
+    // auto with a CPU path: the CPU on a software rasterizer, the GPU on hardware.
+    const Device automatic = Device::choose(Backend::Auto, CpuPath::Available, "encoding");
+    EXPECT_EQ(automatic.onGpu(), !prefersCpu(needsGl.context()));
+    EXPECT_EQ(automatic.describe() == "cpu", !automatic.onGpu());
+    // No GL at all: auto falls back to the CPU where it can, and says why where it cannot.
+    ScopedEnv off("CONUS_GL_DISABLE", "egl,osmesa");
+    EXPECT_FALSE(Device::choose(Backend::Auto, CpuPath::Available, "encoding").onGpu());
+    EXPECT_EQ(codeOf([&] { Device::choose(Backend::Auto, CpuPath::None, "terrain rendering"); }, &message),
+              ErrorCode::Unsupported);
+}
+
+TEST(Device, RunTakesThePathOfTheDevice) {
+    const Device cpu = Device::cpu();
+    EXPECT_EQ(cpu.run([] { return 1; }, [](Context&) { return 2; }), 1);
+    const Device gpu = Device::on(Context::create(Backend::OsMesa));
+    EXPECT_EQ(gpu.run([] { return 1; }, [](Context& c) { return c.backend() == Backend::OsMesa ? 2 : 3; }), 2);
+    EXPECT_EQ(codeOf([&] { cpu.context(); }), ErrorCode::InvalidArgument);
+}
+
 }  // namespace conus::gl

@@ -20,6 +20,9 @@
 
 namespace conus::gl {
 
+// The environment variable that lowers Context::textureLimit.
+inline constexpr const char* kTextureLimitVariable = "CONUS_GL_MAX_TEXTURE";
+
 enum class Backend {
     Auto,    // the first that works of Egl, OsMesa (never Cpu: a GL context is asked for)
     Egl,     // EGL device platform, then surfaceless
@@ -61,6 +64,11 @@ public:
     std::string version() const;      // GL_VERSION
     std::string description() const;  // which platform/device, e.g. "EGL device 0 (software)"
     int maxTextureSize() const;       // GL_MAX_TEXTURE_SIZE
+    // The largest texture side the GPU paths use: GL_MAX_TEXTURE_SIZE, or less where the
+    // environment variable CONUS_GL_MAX_TEXTURE asks for less (texels, read on every call, clamped
+    // to [64, GL_MAX_TEXTURE_SIZE]; tests use it to exercise tiling). A value that is not a
+    // positive whole number throws conus::Error(InvalidArgument).
+    int textureLimit() const;
     // Binds the context to the calling thread (GPU functions do this themselves).
     void makeCurrent();
 
@@ -71,5 +79,15 @@ public:
 private:
     std::unique_ptr<Impl> m_impl;
 };
+
+// A GL loader: glfwGetProcAddress and friends have this shape.
+using ProcAddress = void (*)();
+using GetProcFn = ProcAddress (*)(const char* name);
+
+// A Context on the GL context current on the calling thread (a GLFW window's, say), loaded through
+// `getProc`. It neither owns nor destroys that GL context and never makes it current: the caller
+// keeps it current while using the Context and destroys the Context first. Throws
+// conus::Error(Unsupported) when GL 4.5 core cannot be loaded.
+std::unique_ptr<Context> adoptCurrentContext(GetProcFn getProc);
 
 }  // namespace conus::gl

@@ -35,6 +35,7 @@
 #include "conus/codec/encode.h"
 #include "conus/codec/sampling_map.h"
 #include "conus/format/image.h"
+#include "conus/renderers/backend.h"
 #include "conus/renderers/context.h"
 
 namespace conus::gl {
@@ -51,5 +52,11 @@ format::Image encodeImageGpu(Context& context, const format::Image& source, cons
 
 format::Image decodeImageGpu(Context& context, const format::Image& conus, const codec::SamplingMap& map,
                              const codec::DecodeOptions& options, GpuTimings* timings = nullptr);
+
+// Encode and decode on a device: the GPU paths above, or codec's CPU reference.
+format::Image encodeImage(const Device& device, const format::Image& source, const codec::SamplingMap& map,
+                          const codec::EncodeOptions& options);
+format::Image decodeImage(const Device& device, const format::Image& conus, const codec::SamplingMap& map,
+                          const codec::DecodeOptions& options);
 
 }  // namespace conus::gl

@@ -23,16 +23,6 @@
 
 namespace conus::gl {
 
-// A GL loader: glfwGetProcAddress and friends have this shape.
-using ProcAddress = void (*)();
-using GetProcFn = ProcAddress (*)(const char* name);
-
-// A Context on the GL context current on the calling thread (a GLFW window's, say), loaded through
-// `getProc`. It neither owns nor destroys that GL context and never makes it current: the caller
-// keeps it current while using the Context and destroys the Context first. Throws
-// conus::Error(Unsupported) when GL 4.5 core cannot be loaded.
-std::unique_ptr<Context> adoptCurrentContext(GetProcFn getProc);
-
 enum class ViewMode {
     Reconstructed,  // the conventional frame decoded from the CoNUS image (default)
     Raw,            // the CoNUS image itself, stretched over the view's undistorted rectangle
@@ -45,8 +35,8 @@ enum class ViewMode {
 // at the target's resolution every frame (still from the CoNUS data at every zoom, no cached frame),
 // uploaded and copied into the target, overlays drawn over it by a second pass; on a software
 // rasterizer (llvmpipe) the multithreaded incremental CPU decoder is several times faster than the
-// shader. Auto: the environment variable CONUS_VIEW_DECODE=cpu|gpu if set, else Cpu when GL_RENDERER
-// names a software rasterizer (llvmpipe, softpipe, swrast), else Gpu. Other modes always use the GPU.
+// shader. Auto: the backend rule of backend.h (gl::prefersCpu: Cpu when GL_RENDERER names a
+// software rasterizer), else Gpu. Other modes always use the GPU.
 enum class DecodePath { Auto, Gpu, Cpu };
 
 struct ViewOptions {

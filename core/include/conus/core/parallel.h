@@ -1,5 +1,7 @@
-// Private: split rows across threads. Work is handed out in small chunks so that rows of uneven
-// cost (a focus in the middle of the image) keep both cores busy.
+// Rows split across threads, for every per-pixel loop of CoNUS (codec's encode and decode, the
+// viewer's CPU frames). Work is handed out in small chunks so that rows of uneven cost (a focus in
+// the middle of the image) keep every core busy; the first exception thrown by any band is
+// rethrown on the calling thread once all have stopped.
 #pragma once
 
 #include <algorithm>
@@ -9,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-namespace conus::codec::detail {
+namespace conus {
 
 inline int threadCount(int requested) {
     if (requested > 0) return requested;
@@ -43,4 +45,4 @@ void parallelRows(int rows, int threads, Fn&& fn, int chunk = 8) {
     if (error) std::rethrow_exception(error);
 }
 
-}  // namespace conus::codec::detail
+}  // namespace conus

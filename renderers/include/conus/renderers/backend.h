@@ -1,0 +1,54 @@
+// Where work runs, decided in one place.
+//
+// The ordered list: EGL (hardware devices first, then Mesa's software device, then surfaceless),
+// then OSMesa, then the CPU reference in conus::codec. `auto` takes the first that works, with one
+// rule: on a software rasterizer (llvmpipe, softpipe, swrast), work that has a CPU path runs there
+// instead, since the CPU reference measured several times faster (bench/README.md). Work without
+// a CPU path (terrain rendering) needs GL on any rasterizer, and asking for the CPU is refused.
+//
+// A GPU path and its CPU reference are registered once, where the work is declared, through
+// Device::run (gpu_image.h's encodeImage / decodeImage are the pattern to follow).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "conus/renderers/context.h"
+
+namespace conus::gl {
+
+enum class CpuPath { Available, None };
+
+class Device {
+public:
+    // Chooses by the rule above. `work` names the work in messages ("terrain rendering"). Throws
+    // conus::Error: InvalidArgument for Backend::Cpu when there is no CPU path; Unsupported when
+    // the GL backend asked for by name does not work, or no GL works for work that needs it.
+    static Device choose(Backend requested, CpuPath cpuPath, const std::string& work);
+    // The CPU reference (no GL), and a device on a context someone else made.
+    static Device cpu();
+    static Device on(std::shared_ptr<Context> context);
+
+    bool onGpu() const { return m_context != nullptr; }
+    Context& context() const;  // throws conus::Error(InvalidArgument) on the CPU
+    Backend backend() const { return m_context ? m_context->backend() : Backend::Cpu; }
+    // "cpu", or "egl: <GL_RENDERER>" / "osmesa: <GL_RENDERER>".
+    std::string describe() const;
+
+    // The one place a piece of work names its two paths: gpu(Context&) on a GL device, else cpu().
+    template <class CpuFn, class GpuFn>
+    auto run(CpuFn&& cpu, GpuFn&& gpu) const {
+        return m_context ? std::forward<GpuFn>(gpu)(*m_context) : std::forward<CpuFn>(cpu)();
+    }
+
+private:
+    std::shared_ptr<Context> m_context;  // null: the CPU
+};
+
+// Whether GL_RENDERER names a software rasterizer (llvmpipe, softpipe, swrast).
+bool isSoftwareRasterizer(const std::string& renderer);
+// Whether work that has a CPU path should take it rather than run on this context: the rule above.
+bool prefersCpu(const Context& context);
+
+}  // namespace conus::gl

@@ -1,0 +1,51 @@
+// The backend dispatch: the ordered list and the software-rasterizer rule, written once.
+#include "conus/renderers/backend.h"
+
+#include "conus/core/error.h"
+
+namespace conus::gl {
+
+bool isSoftwareRasterizer(const std::string& renderer) {
+    for (const char* name : {"llvmpipe", "softpipe", "swrast"})
+        if (renderer.find(name) != std::string::npos) return true;
+    return false;
+}
+
+bool prefersCpu(const Context& context) { return isSoftwareRasterizer(context.renderer()); }
+
+Device Device::choose(Backend requested, CpuPath cpuPath, const std::string& work) {
+    if (requested == Backend::Cpu) {
+        if (cpuPath == CpuPath::None)
+            throw Error(ErrorCode::InvalidArgument, work + " has no CPU path: use --backend auto, egl or osmesa");
+        return cpu();
+    }
+    if (requested != Backend::Auto || cpuPath == CpuPath::None)
+        return on(Context::create(requested));  // asked for by name, or GL is the only way: its failure is an error
+    try {
+        std::shared_ptr<Context> context = Context::create(Backend::Auto);
+        if (!prefersCpu(*context)) return on(std::move(context));
+    } catch (const Error&) {
+        // No GL at all: the CPU reference serves.
+    }
+    return cpu();
+}
+
+Device Device::cpu() { return Device(); }
+
+Device Device::on(std::shared_ptr<Context> context) {
+    Device device;
+    device.m_context = std::move(context);
+    return device;
+}
+
+Context& Device::context() const {
+    if (!m_context) throw Error(ErrorCode::InvalidArgument, "this work runs on the CPU: there is no GL context");
+    return *m_context;
+}
+
+std::string Device::describe() const {
+    if (!m_context) return "cpu";
+    return backendName(m_context->backend()) + ": " + m_context->renderer();
+}
+
+}  // namespace conus::gl
