@@ -16,7 +16,7 @@ bool prefersCpu(const Context& context) { return isSoftwareRasterizer(context.re
 Device Device::choose(Backend requested, CpuPath cpuPath, const std::string& work) {
     if (requested == Backend::Cpu) {
         if (cpuPath == CpuPath::None)
-            throw Error(ErrorCode::InvalidArgument, work + " has no CPU path: use --backend auto, egl or osmesa");
+            throw Error(ErrorCode::InvalidArgument, work + " needs GL (it has no CPU path): use --backend auto, egl or osmesa");
         return cpu();
     }
     if (requested != Backend::Auto || cpuPath == CpuPath::None)
