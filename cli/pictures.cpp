@@ -5,21 +5,20 @@
 #include <cmath>
 #include <numbers>
 
+#include "conus/core/display.h"
+
 namespace conus::cli {
 namespace {
 
-// A perceptually ordered dark-to-bright ramp (after matplotlib's "inferno"), sampled at 6 points.
+// The density ramp (core/display.h), interpolated.
 glm::vec3 heat(double t) {
-    static const std::array<glm::vec3, 6> kRamp{{{0.001f, 0.000f, 0.014f},
-                                                 {0.258f, 0.039f, 0.406f},
-                                                 {0.578f, 0.148f, 0.404f},
-                                                 {0.865f, 0.317f, 0.226f},
-                                                 {0.988f, 0.645f, 0.040f},
-                                                 {0.988f, 0.998f, 0.645f}}};
-    t = std::clamp(t, 0.0, 1.0) * (kRamp.size() - 1);
-    const int i = std::min(static_cast<int>(t), static_cast<int>(kRamp.size()) - 2);
-    const float f = static_cast<float>(t - i);
-    return kRamp[i] * (1 - f) + kRamp[i + 1] * f;
+    constexpr std::size_t n = kInfernoRamp.size();
+    t = std::clamp(t, 0.0, 1.0) * (n - 1);
+    const std::size_t i = std::min(static_cast<std::size_t>(t), n - 2);
+    const float f = static_cast<float>(t - static_cast<double>(i));
+    const glm::vec3 a(kInfernoRamp[i][0], kInfernoRamp[i][1], kInfernoRamp[i][2]);
+    const glm::vec3 b(kInfernoRamp[i + 1][0], kInfernoRamp[i + 1][1], kInfernoRamp[i + 1][2]);
+    return a * (1 - f) + b * f;
 }
 
 void blend(format::Image& image, int x, int y, glm::vec3 color, float alpha) {

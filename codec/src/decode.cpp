@@ -100,8 +100,8 @@ std::vector<glm::dvec2> distortViewRow(const SamplingMap& map, const View& view,
 namespace {
 
 // A footprint longer than this (in CoNUS pixels) on either axis gets several taps.
-constexpr double kMultiTapThreshold = 1.5;
-constexpr int kMaxTapsPerAxis = 8;
+constexpr double kMultiTapThreshold = kDecodeMultiTap;
+constexpr int kMaxTapsPerAxis = kDecodeMaxTaps;
 
 void checkView(const View& v, const char* what) {
     if (!std::isfinite(v.u0) || !std::isfinite(v.u1) || !std::isfinite(v.v0) || !std::isfinite(v.v1) ||

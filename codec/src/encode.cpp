@@ -17,13 +17,8 @@
 namespace conus::codec {
 namespace {
 
-// Most sub-pixels per footprint axis; larger footprints read a coarser (box-filtered, so still
-// area-exact at power-of-two ratios) pyramid level instead. 4 keeps ratios 3 and 4 exact at level
-// 0 and bounds the cost at 16 taps per pixel.
-constexpr int kMaxTapsPerAxis = 4;
-// A footprint of 4.0005 source pixels is still 4 taps: the map's float nodes make the identity's
-// Jacobian 1 only to ~1e-7, and an integer ratio must stay exact.
-constexpr double kTapTolerance = 1e-3;
+constexpr int kMaxTapsPerAxis = kEncodeMaxTaps;  // encode.h says why
+constexpr double kTapTolerance = kEncodeTapTolerance;
 
 // Source-pixel intervals covered by each output pixel along one axis, with exact overlap weights.
 struct AxisWeights {

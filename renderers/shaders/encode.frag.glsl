@@ -1,8 +1,8 @@
 #version 450 core
 // One CoNUS pixel: a box filter over its footprint in the source, as codec::encodeImage does.
 // The footprint's edges are the screen-space derivatives of the undistorted coordinate (the local
-// inverse Jacobian over one pixel); up to kMaxTaps x kMaxTaps bilinear taps cover it, on the
-// first pyramid level where it is at most kMaxTaps texels long.
+// inverse Jacobian over one pixel); up to kEncodeMaxTaps x kEncodeMaxTaps bilinear taps cover it, on the
+// first pyramid level where it is at most kEncodeMaxTaps texels long.
 //
 // Tiling (sources over the texture limit): the textures may hold only a crop of each level (the
 // tile's core plus a margin that covers every tap), placed by uLevelRect; the pixels whose
@@ -18,10 +18,6 @@ uniform int uLevels;
 uniform ivec4 uLevelRect[32];
 // u0, v0, u1, v1: only pixels with the undistorted centre in [u0, u1) x [v0, v1) are drawn.
 uniform vec4 uCore;
-
-const int kMaxTaps = 4;
-// As in the CPU encoder: a footprint of 4.0005 texels is still 4 taps (float map nodes).
-const float kTapTolerance = 1e-3;
 
 // Bilinear at normalized q on a pyramid level, clamped to that level's edge: coordinates stay
 // between its edge texel centres, so the atlas neighbours never bleed in.
@@ -41,14 +37,14 @@ void main() {
     const vec2 a = da * size0, b = db * size0;  // in level-0 texels
     int level = 0;
     float la = length(a), lb = length(b);
-    while (max(la, lb) > float(kMaxTaps) + kTapTolerance && level + 1 < uLevels) {
+    while (max(la, lb) > float(kEncodeMaxTaps) + kEncodeTapTolerance && level + 1 < uLevels) {
         ++level;
         const vec2 s = vec2(uLevelRect[level].zw) / size0;
         la = length(a * s);
         lb = length(b * s);
     }
-    const int na = clamp(int(ceil(la - kTapTolerance)), 1, kMaxTaps);
-    const int nb = clamp(int(ceil(lb - kTapTolerance)), 1, kMaxTaps);
+    const int na = clamp(int(ceil(la - kEncodeTapTolerance)), 1, kEncodeMaxTaps);
+    const int nb = clamp(int(ceil(lb - kEncodeTapTolerance)), 1, kEncodeMaxTaps);
     vec4 sum = vec4(0.0);
     for (int j = 0; j < nb; ++j) {
         const vec2 q = p + db * ((float(j) + 0.5) / float(nb) - 0.5);

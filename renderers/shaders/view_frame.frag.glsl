@@ -1,7 +1,6 @@
 #version 450 core
 // One window pixel of conus-view: the undistorted (u,v) of the pixel, then by mode the CoNUS image
-// decoded there (Equation 1 from the nodes, bilinear taps over the pixel's footprint exactly as
-// decode.frag.glsl does), the raw CoNUS image, the uniform image, a wipe of the two, or the
+// decoded there (equation1.inc.glsl, as decode.frag.glsl), the raw CoNUS image, the uniform image, a wipe of the two, or the
 // sampling density det J; then the CoNUS pixel grid and focus outlines over it.
 // uBottomUp flips rows for a window's default framebuffer (row 0 at the bottom); offscreen targets
 // are read back top row first and need no flip.
@@ -37,59 +36,19 @@ uniform bool uBottomUp;
 uniform vec2 uGridLines;     // CoNUS pixels (or every n-th) across u and v; 0: no grid
 uniform vec2 uSourceSize;    // conventional frame in pixels (focus radii are fractions of its width)
 uniform int uFocusCount;
-uniform vec3 uFoci[16];      // u, v, r
+uniform vec3 uFoci[kMaxFoci];  // u, v, r
 uniform float uExposure;     // 2^ev, applied before gamma
 uniform float uInvGamma;     // 0: the sRGB curve
 uniform int uToneMap;        // conus::ToneMap: 0 none, 1 reinhard, 2 aces
 uniform float uWipeX;        // pixels
 uniform vec2 uLogDensity;    // log density range for the heat map
 
-const float kMultiTap = 1.5;
-const int kMaxTaps = 8;
-const vec3 kBackground = vec3(0.11);
+#include "equation1.inc.glsl"
 
-int taps(float len) { return len <= kMultiTap ? 1 : min(kMaxTaps, int(ceil(len))); }
-
-// Equation 1 at uv with its partial derivatives (d/du, d/dv), as decode.frag.glsl evaluates it.
-struct MapPoint { vec2 pd; vec2 du; vec2 dv; };
-MapPoint evalMap(vec2 uv) {
-    const ivec2 nodes = textureSize(uMap, 0);
-    const vec2 cells = vec2(nodes - 1);
-    const vec2 g = clamp(uv, 0.0, 1.0) * cells;
-    const ivec2 c = clamp(ivec2(g), ivec2(0), nodes - 2);
-    const vec2 st = g - vec2(c);
-    const vec2 n00 = texelFetch(uMap, c, 0).xy;
-    const vec2 n10 = texelFetch(uMap, c + ivec2(1, 0), 0).xy;
-    const vec2 n01 = texelFetch(uMap, c + ivec2(0, 1), 0).xy;
-    const vec2 n11 = texelFetch(uMap, c + ivec2(1, 1), 0).xy;
-    const vec2 left = mix(n00, n01, st.y), right = mix(n10, n11, st.y);
-    MapPoint p;
-    p.pd = mix(left, right, st.x);
-    p.du = (right - left) * cells.x;
-    p.dv = mix(n01 - n00, n11 - n10, st.x) * cells.y;
-    return p;
-}
-
-// Bilinear taps over the footprint (edges a, b in normalized texture units) centred at q.
-vec4 filtered(sampler2D tex, vec2 q, vec2 a, vec2 b) {
-    const vec2 size = vec2(textureSize(tex, 0));
-    const int na = taps(length(a * size)), nb = taps(length(b * size));
-    if (na == 1 && nb == 1) return textureLod(tex, q, 0.0);
-    vec4 sum = vec4(0.0);
-    for (int j = 0; j < nb; ++j) {
-        const vec2 r = q + b * ((float(j) + 0.5) / float(nb) - 0.5);
-        for (int i = 0; i < na; ++i)
-            sum += textureLod(tex, clamp(r + a * ((float(i) + 0.5) / float(na) - 0.5), 0.0, 1.0), 0.0);
-    }
-    return sum / float(na * nb);
-}
-
-vec3 heat(float t) {  // after matplotlib's "inferno", as cli/pictures.cpp
-    const vec3 ramp[6] = vec3[6](vec3(0.001, 0.000, 0.014), vec3(0.258, 0.039, 0.406), vec3(0.578, 0.148, 0.404),
-                                 vec3(0.865, 0.317, 0.226), vec3(0.988, 0.645, 0.040), vec3(0.988, 0.998, 0.645));
-    t = clamp(t, 0.0, 1.0) * 5.0;
-    const int i = min(int(t), 4);
-    return mix(ramp[i], ramp[i + 1], t - float(i));
+vec3 heat(float t) {  // kInferno, as cli/pictures.cpp draws it
+    t = clamp(t, 0.0, 1.0) * float(kInferno.length() - 1);
+    const int i = min(int(t), kInferno.length() - 2);
+    return mix(kInferno[i], kInferno[i + 1], t - float(i));
 }
 
 // color := mix(color, c, t), and the same step on the premultiplied overlay `over`.
@@ -118,7 +77,7 @@ void main() {
     const bool inside = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
     const vec2 insideAxes = vec2(uv.x >= 0.0 && uv.x <= 1.0 ? 1.0 : 0.0, uv.y >= 0.0 && uv.y <= 1.0 ? 1.0 : 0.0);
     const vec2 astep = abs(step) * insideAxes;
-    const MapPoint m = evalMap(uv);
+    const MapPoint m = evalMap(uMap, uv);
 
     int mode = kMode;
     if (mode == 3) mode = gl_FragCoord.x < uWipeX ? 0 : 2;
@@ -129,11 +88,11 @@ void main() {
     } else if (!inside && mode != 4) {
         color = kBackground;
     } else if (mode == 0) {
-        color = display(filtered(uConus, m.pd, m.du * astep.x, m.dv * astep.y));
+        color = display(footprintFiltered(uConus, m.pd, m.du * astep.x, m.dv * astep.y));
     } else if (mode == 1) {
-        color = display(filtered(uConus, clamp(uv, 0.0, 1.0), vec2(astep.x, 0.0), vec2(0.0, astep.y)));
+        color = display(footprintFiltered(uConus, clamp(uv, 0.0, 1.0), vec2(astep.x, 0.0), vec2(0.0, astep.y)));
     } else if (mode == 2) {
-        color = display(filtered(uUniform, clamp(uv, 0.0, 1.0), vec2(astep.x, 0.0), vec2(0.0, astep.y)));
+        color = display(footprintFiltered(uUniform, clamp(uv, 0.0, 1.0), vec2(astep.x, 0.0), vec2(0.0, astep.y)));
     } else {
         const float det = m.du.x * m.dv.y - m.du.y * m.dv.x;
         const float range = uLogDensity.y - uLogDensity.x;
@@ -144,8 +103,8 @@ void main() {
     // The CoNUS pixel grid: this pixel is on a line where the distorted column (row) index changes
     // between it and its right (lower) neighbour, as cli/pictures.cpp draws it.
     if (kGrid && inside) {
-        const vec2 right = evalMap(uv + vec2(step.x, 0.0)).pd;
-        const vec2 below = evalMap(uv + vec2(0.0, step.y)).pd;
+        const vec2 right = evalMap(uMap, uv + vec2(step.x, 0.0)).pd;
+        const vec2 below = evalMap(uMap, uv + vec2(0.0, step.y)).pd;
         const vec2 lines = uGridLines;
         const bool edge = floor(m.pd.x * lines.x) != floor(right.x * lines.x) ||
                           floor(m.pd.y * lines.y) != floor(below.y * lines.y);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "context_pvt.h"
+#include "shader_constants.h"
 #include "conus/core/error.h"
 
 namespace conus::gl {
@@ -219,10 +220,10 @@ GLuint cachedProgram(Context& context, const std::string& key, const char* verte
     Context::Impl& impl = context.impl();
     if (auto it = impl.programs.find(key); it != impl.programs.end()) return it->second;
     const GladGLContext& gl = impl.gl;
-    const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, vertex, key);
+    const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, withSharedConstants(vertex).c_str(), key);
     GLuint fs = 0;
     try {
-        fs = compileShader(gl, GL_FRAGMENT_SHADER, fragment, key);
+        fs = compileShader(gl, GL_FRAGMENT_SHADER, withSharedConstants(fragment).c_str(), key);
     } catch (...) {
         gl.DeleteShader(vs);
         throw;

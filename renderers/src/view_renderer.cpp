@@ -20,6 +20,7 @@
 #include "conus/renderers/view_renderer.h"
 #include "embedded_shaders.h"
 #include "gl_objects.h"
+#include "shader_constants.h"
 
 namespace conus::gl {
 namespace {
@@ -36,10 +37,8 @@ float inverseGamma(const ViewOptions& options) {
     return options.gamma == 0.0 ? 0.0f : static_cast<float>(1.0 / std::max(options.gamma, 0.05));
 }
 
-constexpr int kMaxFoci = 16;             // uFoci in view_frame.frag.glsl
 constexpr int kDensitySamples = 128;     // per side, for the heat map's log-density range
 constexpr double kMinGridSpacing = 6.0;  // pixels between automatic grid lines (at density 1)
-constexpr float kBackground = 0.11f;     // kBackground in view_frame.frag.glsl
 
 // The 8-bit display table of the CPU path: a display value for every float in [2^-32, 1) by its
 // top 12 mantissa bits (131072 buckets, relative width 2^-12); 0 below, 255 at 1 and above.
@@ -184,7 +183,7 @@ struct ViewRenderer::Impl {
                             const float t = exposeAndToneMap(in[c], exposure, options.toneMap);
                             out[c] = rowInside[y] && colInside[x]
                                          ? (invGamma == 0.0f ? linearToSrgbDisplay(t) : std::pow(std::max(t, 0.0f), invGamma))
-                                         : kBackground;
+                                         : kViewBackground;
                         }
                         out[3] = 1.0f;
                     }
@@ -193,7 +192,7 @@ struct ViewRenderer::Impl {
         } else {
             buildLut(exposure, invGamma, options.toneMap);
             frameBytes.resize(count);
-            const std::uint8_t background = static_cast<std::uint8_t>(std::lround(kBackground * 255.0f));
+            const std::uint8_t background = static_cast<std::uint8_t>(std::lround(kViewBackground * 255.0f));
             const std::uint8_t* table = lut.data();
             parallelRows(height, 0, [&](int y0, int y1) {
                 for (int y = y0; y < y1; ++y) {
@@ -335,7 +334,7 @@ void ViewRenderer::setImage(const format::ConusFile& file) {
     d.foci.clear();
     if (file.analytic && file.analytic->kind == "foci")
         for (const auto& f : file.analytic->foci) {
-            if (static_cast<int>(d.foci.size()) / 3 >= kMaxFoci) break;
+            if (static_cast<int>(d.foci.size()) / 3 >= kViewMaxFoci) break;
             d.foci.insert(d.foci.end(), {float(f.u), float(f.v), float(f.r)});
         }
 }

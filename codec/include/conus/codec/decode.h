@@ -11,6 +11,12 @@
 
 namespace conus::codec {
 
+// The decoder's footprint rule, shared with its GLSL twins (renderers inject these values): an
+// output pixel whose footprint in the CoNUS image is at most kDecodeMultiTap pixels long on both
+// axes takes one bilinear tap; a longer axis takes ceil(length) taps, at most kDecodeMaxTaps.
+inline constexpr double kDecodeMultiTap = 1.5;
+inline constexpr int kDecodeMaxTaps = 8;
+
 struct View {
     double u0 = 0, v0 = 0, u1 = 1, v1 = 1;  // undistorted rectangle; may extend past [0,1]^2 (background there)
 };

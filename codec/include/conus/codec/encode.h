@@ -13,6 +13,13 @@
 
 namespace conus::codec {
 
+// The encoder's footprint rule, shared with its GLSL twin (renderers inject these values): at most
+// kEncodeMaxTaps sub-pixels per footprint axis, on the first pyramid level where the footprint is
+// at most that long; kEncodeTapTolerance keeps integer ratios exact despite float map nodes (a
+// footprint of 4.0005 source pixels is still 4 taps).
+inline constexpr int kEncodeMaxTaps = 4;
+inline constexpr double kEncodeTapTolerance = 1e-3;
+
 struct EncodeOptions {
     int width = 0, height = 0;  // CoNUS image size
     int threads = 0;

@@ -4,6 +4,7 @@
 // (its CPU path calls these; its shader mirrors them, renderers/shaders/display.glsl).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <optional>
 #include <string_view>
@@ -20,6 +21,16 @@ struct DisplayOptions {
     double exposure = 0.0;  // stops: values are multiplied by 2^exposure first
     ToneMap toneMap = ToneMap::None;
 };
+
+// The heat-map ramp of density pictures (after matplotlib's "inferno", six display-encoded sRGB
+// stops from dark to bright): cli's pictures and the viewer's density mode (its shader gets these
+// values injected) draw with it.
+inline constexpr std::array<std::array<float, 3>, 6> kInfernoRamp{{{0.001f, 0.000f, 0.014f},
+                                                                   {0.258f, 0.039f, 0.406f},
+                                                                   {0.578f, 0.148f, 0.404f},
+                                                                   {0.865f, 0.317f, 0.226f},
+                                                                   {0.988f, 0.645f, 0.040f},
+                                                                   {0.988f, 0.998f, 0.645f}}};
 
 const char* toString(ToneMap toneMap);  // "none", "reinhard", "aces"
 std::optional<ToneMap> parseToneMap(std::string_view text);

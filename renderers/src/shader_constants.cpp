@@ -1,0 +1,45 @@
+#include "shader_constants.h"
+
+#include <cstdio>
+
+#include "conus/codec/decode.h"
+#include "conus/codec/encode.h"
+#include "conus/core/display.h"
+
+namespace conus::gl {
+namespace {
+
+// Exact decimal text of a float (9 significant digits round-trip it).
+std::string glslFloat(double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.9g", value);
+    std::string text = buffer;
+    if (text.find_first_of(".e") == std::string::npos) text += ".0";
+    return text;
+}
+
+std::string constantsBlock() {
+    std::string s = "// shared with C++ (renderers/src/shader_constants.h)\n";
+    s += "const float kDecodeMultiTap = " + glslFloat(codec::kDecodeMultiTap) + ";\n";
+    s += "const int kDecodeMaxTaps = " + std::to_string(codec::kDecodeMaxTaps) + ";\n";
+    s += "const int kEncodeMaxTaps = " + std::to_string(codec::kEncodeMaxTaps) + ";\n";
+    s += "const float kEncodeTapTolerance = " + glslFloat(codec::kEncodeTapTolerance) + ";\n";
+    s += "const vec3 kBackground = vec3(" + glslFloat(kViewBackground) + ");\n";
+    s += "const int kMaxFoci = " + std::to_string(kViewMaxFoci) + ";\n";
+    s += "const vec3 kInferno[" + std::to_string(kInfernoRamp.size()) + "] = vec3[](";
+    for (std::size_t i = 0; i < kInfernoRamp.size(); ++i)
+        s += std::string(i ? ", " : "") + "vec3(" + glslFloat(kInfernoRamp[i][0]) + ", " + glslFloat(kInfernoRamp[i][1]) +
+             ", " + glslFloat(kInfernoRamp[i][2]) + ")";
+    return s + ");\n";
+}
+
+}  // namespace
+
+std::string withSharedConstants(const std::string& source) {
+    static const std::string block = constantsBlock();
+    const std::size_t eol = source.find('\n');
+    if (source.rfind("#version", 0) != 0 || eol == std::string::npos) return block + source;
+    return source.substr(0, eol + 1) + block + source.substr(eol + 1);
+}
+
+}  // namespace conus::gl

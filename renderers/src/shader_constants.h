@@ -1,0 +1,18 @@
+// Private: the constants C++ and GLSL share, defined once on the C++ side and injected into every
+// shader's source after its #version line when a program is built (context.cpp's cachedProgram),
+// so a shader never types one of these values again.
+#pragma once
+
+#include <string>
+
+namespace conus::gl {
+
+inline constexpr float kViewBackground = 0.11f;  // grey around the image in conus-view (GLSL: kBackground)
+inline constexpr int kViewMaxFoci = 16;          // focus outlines conus-view draws (GLSL: kMaxFoci)
+
+// `source` with the shared constants declared after its first line (#version):
+// kDecodeMultiTap, kDecodeMaxTaps (codec/decode.h), kEncodeMaxTaps, kEncodeTapTolerance
+// (codec/encode.h), kBackground, kMaxFoci (above) and kInferno[6] (core/display.h).
+std::string withSharedConstants(const std::string& source);
+
+}  // namespace conus::gl
