@@ -4,6 +4,8 @@
 #include <cctype>
 #include <vector>
 
+#include "conus/core/error.h"
+
 namespace conus::viewer {
 namespace {
 
@@ -117,6 +119,24 @@ std::string helpText(bool editing) {
     if (editing) add(kEditBindings);
     add(kViewBindings);
     return text;
+}
+
+gl::ViewMode parseMode(const std::string& name) {
+    for (gl::ViewMode m : {gl::ViewMode::Reconstructed, gl::ViewMode::Raw, gl::ViewMode::Uniform, gl::ViewMode::Wipe,
+                           gl::ViewMode::Density})
+        if (name == modeName(m)) return m;
+    throw Error(ErrorCode::InvalidArgument, "--mode \"" + name + "\" is not reconstructed, raw, uniform, wipe or density");
+}
+
+const char* modeName(gl::ViewMode mode) {
+    switch (mode) {
+    case gl::ViewMode::Reconstructed: return "reconstructed";
+    case gl::ViewMode::Raw: return "raw";
+    case gl::ViewMode::Uniform: return "uniform";
+    case gl::ViewMode::Wipe: return "wipe";
+    case gl::ViewMode::Density: return "density";
+    }
+    return "?";
 }
 
 }  // namespace conus::viewer

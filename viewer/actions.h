@@ -9,6 +9,8 @@
 #include <optional>
 #include <string>
 
+#include "conus/renderers/view_renderer.h"
+
 namespace conus::viewer {
 
 enum class Action {
@@ -53,5 +55,10 @@ Action actionFor(const KeyChord& chord, bool editing);
 
 // One line per key of the table in use.
 std::string helpText(bool editing);
+
+// The display modes by name: "reconstructed|raw|uniform|wipe|density" -> ViewMode;
+// conus::Error(InvalidArgument) otherwise.
+gl::ViewMode parseMode(const std::string& name);
+const char* modeName(gl::ViewMode mode);
 
 }  // namespace conus::viewer

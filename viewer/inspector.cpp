@@ -40,8 +40,11 @@ std::string formatProbe(const Probe& p) {
                   p.sourcePixel.x, p.sourcePixel.y, p.uv.x, p.uv.y, p.distorted.x, p.distorted.y, p.conusPixel.x,
                   p.conusPixel.y, p.density, std::sqrt(std::max(p.density, 0.0)), p.inside ? "" : " (outside)");
     std::string text = buffer;
-    for (std::size_t c = 0; c < p.channels.size() && c < p.values.size(); ++c) {
-        std::snprintf(buffer, sizeof buffer, " %s=%.4g", p.channels[c].c_str(), p.values[c]);
+    // Channels in the order people read them (R,G,B,A), not OpenEXR's sorted one.
+    for (const std::string& name : format::displayOrder(p.channels)) {
+        const auto c = static_cast<std::size_t>(std::find(p.channels.begin(), p.channels.end(), name) - p.channels.begin());
+        if (c >= p.values.size()) continue;
+        std::snprintf(buffer, sizeof buffer, " %s=%.4g", name.c_str(), p.values[c]);
         text += buffer;
     }
     return text;

@@ -39,24 +39,6 @@ codec::View parseView(const std::string& text) {
 
 }  // namespace
 
-gl::ViewMode parseMode(const std::string& name) {
-    for (gl::ViewMode m : {gl::ViewMode::Reconstructed, gl::ViewMode::Raw, gl::ViewMode::Uniform, gl::ViewMode::Wipe,
-                           gl::ViewMode::Density})
-        if (name == modeName(m)) return m;
-    throw Error(ErrorCode::InvalidArgument, "--mode \"" + name + "\" is not reconstructed, raw, uniform, wipe or density");
-}
-
-const char* modeName(gl::ViewMode mode) {
-    switch (mode) {
-    case gl::ViewMode::Reconstructed: return "reconstructed";
-    case gl::ViewMode::Raw: return "raw";
-    case gl::ViewMode::Uniform: return "uniform";
-    case gl::ViewMode::Wipe: return "wipe";
-    case gl::ViewMode::Density: return "density";
-    }
-    return "?";
-}
-
 std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     Options o;
     std::string view, size, window = "1280x800", mode = "reconstructed", decode = "auto", toneMap = "none";

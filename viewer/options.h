@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "conus/codec/decode.h"
+#include "actions.h"
 #include "conus/renderers/view_renderer.h"
 
 namespace conus::viewer {
@@ -29,8 +30,5 @@ struct Options {
 // Parses argv. Returns nullopt after printing help (exit 0) or an error (exit 2, in *exitCode).
 std::optional<Options> parseOptions(int argc, char** argv, int* exitCode);
 
-// "reconstructed|raw|uniform|wipe|density" -> ViewMode; conus::Error(InvalidArgument) otherwise.
-gl::ViewMode parseMode(const std::string& name);
-const char* modeName(gl::ViewMode mode);
 
 }  // namespace conus::viewer

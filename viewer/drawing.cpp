@@ -1,0 +1,74 @@
+#include "drawing.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "overlay.h"
+
+namespace conus::viewer {
+
+Drawing::Drawing(gl::Context& context) : m_renderer(context) {}
+
+void Drawing::frame(Controller& controller, int fw, int fh) {
+    if (m_imageVersion != controller.imageVersion()) {
+        m_imageVersion = controller.imageVersion();
+        m_mapVersion = controller.mapVersion();
+        m_shown = false;
+        if (const std::optional<format::ConusFile> file = controller.shownFile()) {
+            try {
+                m_renderer.setImage(*file);
+                m_shown = true;
+            } catch (const std::exception& e) {
+                controller.cannotDisplay(e.what());
+            }
+        }
+    } else if (m_mapVersion != controller.mapVersion()) {
+        m_mapVersion = controller.mapVersion();
+        if (const MapEditor* editor = controller.editor()) m_renderer.setMap(editor->map());
+    }
+    const Document* doc = controller.current();
+    if (!controller.editing() && (!m_shown || (doc && !doc->ok()))) {
+        // The window turns dark red with the error written over it (also in the title and on stderr).
+        m_renderer.clear(fw, fh, 0.35f, 0.05f, 0.05f);
+    } else {
+        m_renderer.draw(controller.state().view(), fw, fh, controller.display());
+    }
+    drawOverlays(controller, fw, fh);
+}
+
+template <class Make>
+bool Drawing::prepareOverlay(int slot, const std::string& key, Make make) {
+    if (m_textBroken) return false;
+    if (m_overlayKey[slot] == key && m_renderer.hasOverlay(slot)) return true;
+    try {
+        const format::Image panel = make();
+        m_renderer.setOverlay(slot, panel);
+        m_overlayKey[slot] = key;
+        m_overlayHeight[slot] = panel.height;
+        return true;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "conus-view: no text in the window: %s\n", e.what());
+        m_textBroken = true;
+        return false;
+    }
+}
+
+void Drawing::drawOverlays(const Controller& controller, int fw, int fh) {
+    const Document* doc = controller.current();
+    if (!controller.editing() && doc && !doc->ok()) {
+        const std::string name = std::filesystem::path(doc->path).filename().string();
+        if (prepareOverlay(kErrorSlot, name + "\n" + doc->error + "\n" + std::to_string(fw),
+                           [&] { return errorPanel(name, doc->error, fw); }))
+            m_renderer.drawOverlay(kErrorSlot, kOverlayMargin, kOverlayMargin, fw, fh);
+    }
+    if (controller.showStatus()) {
+        const std::string text = controller.statusText();
+        if (prepareOverlay(kStatusSlot, text + "\n" + std::to_string(fw), [&] { return statusPanel(text, fw); }))
+            m_renderer.drawOverlay(kStatusSlot, 0, fh - m_overlayHeight[kStatusSlot], fw, fh);
+    }
+    const bool editing = controller.editing();
+    if (controller.showHelp() && prepareOverlay(kHelpSlot, editing ? "edit" : "view", [&] { return helpPanel(editing); }))
+        m_renderer.drawOverlay(kHelpSlot, kOverlayMargin, kOverlayMargin, fw, fh);
+}
+
+}  // namespace conus::viewer

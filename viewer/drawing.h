@@ -1,0 +1,37 @@
+// conus-view's drawing: a frame of what the controller describes, through the renderers'
+// ViewRenderer on the window's context, with the text overlays (help, error, status bar) over it.
+#pragma once
+
+#include <string>
+
+#include "controller.h"
+#include "conus/renderers/view_renderer.h"
+
+namespace conus::viewer {
+
+class Drawing {
+public:
+    explicit Drawing(gl::Context& context);
+
+    // Draws into the bound framebuffer (fw x fh): uploads the image or map first when the
+    // controller's versions moved.
+    void frame(Controller& controller, int fw, int fh);
+    // The frame just drawn, display values, top row first.
+    format::Image readFramebuffer(int fw, int fh) { return m_renderer.readFramebuffer(fw, fh); }
+    gl::ViewRenderer& renderer() { return m_renderer; }
+
+private:
+    void drawOverlays(const Controller& controller, int fw, int fh);
+    // Uploads `make()`'s panel into `slot` when `key` (what the panel shows) has changed.
+    template <class Make>
+    bool prepareOverlay(int slot, const std::string& key, Make make);
+
+    gl::ViewRenderer m_renderer;
+    int m_imageVersion = -1, m_mapVersion = -1;
+    bool m_shown = false;  // the renderer holds an image
+    std::string m_overlayKey[gl::ViewRenderer::kOverlaySlots];
+    int m_overlayHeight[gl::ViewRenderer::kOverlaySlots] = {};
+    bool m_textBroken = false;  // the font could not be drawn: overlays off, said once on stderr
+};
+
+}  // namespace conus::viewer
