@@ -124,8 +124,7 @@ Command addDemoCommand(CLI::App& root) {
                     codec::FociOptions fociOptions;
                     fociOptions.aspect = double(w) / h;
                     built = codec::buildFociMap(foci, fociOptions);
-                    analytic = format::AnalyticMap{"foci", {}, "density", {}};
-                    for (const auto& f : foci) analytic->foci.push_back({f.u, f.v, f.r, f.k});
+                    analytic = codec::toAnalytic(foci, fociOptions.composition);
                 }
                 const codec::SamplingMap& map = *built;
                 building.done();

@@ -49,17 +49,13 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const format::Image& source) 
 
 BuiltMap mapFromFoci(const EncodeOptions& o, const format::Image& source) {
     std::vector<codec::Focus> foci;
-    format::AnalyticMap params{"foci", {}, o.compose, {}};
-    for (const auto& text : o.foci) {
-        foci.push_back(codec::parseFocus(text));
-        params.foci.push_back({foci.back().u, foci.back().v, foci.back().r, foci.back().k});
-    }
+    for (const auto& text : o.foci) foci.push_back(codec::parseFocus(text));
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
     fo.aspect = double(source.width) / source.height;
     fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
-    BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo)), params};
+    BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo)), codec::toAnalytic(foci, fo.composition)};
     progress.done();
     return built;
 }

@@ -17,7 +17,7 @@
 #include "conus/codec/compose.h"
 #include "conus/codec/foci.h"
 #include "conus/codec/ground_map.h"
-#include "conus/codec/map_file.h"
+#include "conus/codec/conus_file.h"
 #include "conus/codec/springs.h"
 #include "conus/format/container.h"
 #include "conus/core/atomic_file.h"
@@ -55,7 +55,7 @@ std::pair<double, double> parsePair(const std::string& text, const char* what) {
     return {a, b};
 }
 
-// Writes the map file (codec/map_file.h), reports it, and draws its preview.
+// Writes the map file (codec/conus_file.h), reports it, and draws its preview.
 void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticMap> analytic, const OutputOptions& out) {
     const format::ConusFile file = codec::makeMapFile(map, std::move(analytic));
     format::writeConusFile(out.output, file);
@@ -247,11 +247,7 @@ Command addMapCommand(CLI::App& root) {
                     writeMapFile(map, std::nullopt, o->autoOut);
                 } else if (foci->parsed()) {
                     std::vector<codec::Focus> list;
-                    format::AnalyticMap params{"foci", {}, o->composition, {}};
-                    for (const auto& text : o->foci) {
-                        list.push_back(codec::parseFocus(text));
-                        params.foci.push_back({list.back().u, list.back().v, list.back().r, list.back().k});
-                    }
+                    for (const auto& text : o->foci) list.push_back(codec::parseFocus(text));
                     codec::FociOptions fo;
                     fo.columns = fo.rows = o->fociGrid;
                     fo.aspect = o->aspect;
@@ -259,7 +255,7 @@ Command addMapCommand(CLI::App& root) {
                     Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
                     const codec::SamplingMap map = codec::buildFociMap(list, fo);
                     progress.done();
-                    writeMapFile(map, params, o->fociOut);
+                    writeMapFile(map, codec::toAnalytic(list, fo.composition), o->fociOut);
                 }
                 return 0;
             }};

@@ -7,6 +7,7 @@
 
 #include "conus/core/atomic_file.h"
 
+#include "conus/codec/conus_file.h"
 #include "conus/codec/encode.h"
 #include "conus/renderers/gpu_image.h"
 #include "progress.h"
@@ -55,20 +56,9 @@ format::ConusFile encodeToConus(const gl::Device& device, const format::Image& s
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                       std::to_string(size.width) + "x" + std::to_string(size.height));
-    format::ConusFile file;
-    file.image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
+    format::Image image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
-    file.sourceWidth = source.width;
-    file.sourceHeight = source.height;
-    file.map = map.toGrid();
-    file.analytic = std::move(analytic);
-    file.sourceEncoding = encoding;
-    if (file.image.channelIndex("Z") >= 0) {
-        file.depth.kind = format::DepthKind::CameraDepth;
-        file.depth.near = 0;
-        file.depth.far = 1;
-    }
-    return file;
+    return codec::makeImageFile(std::move(image), map, source.width, source.height, encoding, std::move(analytic));
 }
 
 }  // namespace conus::cli

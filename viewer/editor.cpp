@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "conus/codec/encode.h"
-#include "conus/codec/map_file.h"
+#include "conus/codec/conus_file.h"
 
 namespace conus::viewer {
 
@@ -52,14 +52,9 @@ format::ConusFile MapEditor::encode(int width, int height) const {
     codec::EncodeOptions options;
     options.width = width;
     options.height = height;
-    format::ConusFile file;
-    file.image = codec::encodeImage(m_source, map, options);
+    format::ConusFile file =
+        codec::makeImageFile(codec::encodeImage(m_source, map, options), map, m_source.width, m_source.height, m_encoding);
     file.pixelType = format::PixelType::Half;
-    file.sourceWidth = m_source.width;
-    file.sourceHeight = m_source.height;
-    file.dataKind = format::DataKind::Image;
-    file.sourceEncoding = m_encoding;
-    file.map = map.toGrid();
     return file;
 }
 

@@ -177,4 +177,12 @@ Focus parseFocus(const std::string& text) {
     return focus;
 }
 
+format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition composition) {
+    format::AnalyticMap analytic;
+    analytic.kind = "foci";
+    analytic.composition = composition == FociComposition::Add ? "add" : "density";
+    for (const Focus& f : foci) analytic.foci.push_back({f.u, f.v, f.r, f.k});
+    return analytic;
+}
+
 }  // namespace conus::codec

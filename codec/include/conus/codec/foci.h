@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "conus/codec/sampling_map.h"
+#include "conus/format/container.h"
 
 namespace conus::codec {
 
@@ -38,5 +39,8 @@ double fociDensity(std::span<const Focus> foci, double aspect, double u, double 
 
 // "u,v,r,k" -> Focus; throws conus::Error(InvalidArgument) with the reason.
 Focus parseFocus(const std::string& text);
+
+// Analytic parameters for the file: kind "foci", the foci and how they were composed.
+format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition composition);
 
 }  // namespace conus::codec

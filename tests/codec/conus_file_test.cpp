@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "conus/codec/foci.h"
-#include "conus/codec/map_file.h"
+#include "conus/codec/conus_file.h"
 
 using namespace conus;
 
@@ -21,4 +21,18 @@ TEST(MapFile, HoldsTheMapAndItsDensityAndIsValid) {
     EXPECT_LT(file.image.at(map.columns() - 1, map.rows() - 1), 1.0f);
     ASSERT_TRUE(file.analytic.has_value());
     EXPECT_EQ(file.analytic->foci.size(), 1u);
+}
+
+TEST(ConusFile, ImageFilesWithDepthAreValidDepthImages) {
+    // The editor used to build its file by hand and forgot the depth kind a Z channel needs (V14).
+    const auto map = conus::codec::SamplingMap::identity(3, 3);
+    conus::format::Image image = conus::format::makeImage(4, 4, {"R", "G", "B", "Z"});
+    for (std::size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = float(i % 7) / 7.0f;
+    conus::SourceEncoding encoding;
+    encoding.transfer = conus::Transfer::Srgb;
+    const conus::format::ConusFile file = conus::codec::makeImageFile(image, map, 16, 16, encoding);
+    EXPECT_TRUE(conus::format::validateConusFile(file).ok()) << conus::format::validateConusFile(file).str();
+    EXPECT_EQ(file.depth.kind, conus::format::DepthKind::CameraDepth);
+    EXPECT_EQ(file.sourceEncoding.transfer, conus::Transfer::Srgb);
+    EXPECT_EQ(file.sourceWidth, 16);
 }

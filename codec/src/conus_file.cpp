@@ -1,0 +1,39 @@
+#include "conus/codec/conus_file.h"
+
+namespace conus::codec {
+
+format::ConusFile makeImageFile(format::Image image, const SamplingMap& map, int sourceWidth, int sourceHeight,
+                                SourceEncoding encoding, std::optional<format::AnalyticMap> analytic) {
+    format::ConusFile file;
+    file.image = std::move(image);
+    file.sourceWidth = sourceWidth;
+    file.sourceHeight = sourceHeight;
+    file.dataKind = format::DataKind::Image;
+    file.map = map.toGrid();
+    file.analytic = std::move(analytic);
+    file.sourceEncoding = std::move(encoding);
+    if (file.image.channelIndex("Z") >= 0) {  // V14: a Z channel needs a depth kind
+        file.depth.kind = format::DepthKind::CameraDepth;
+        file.depth.near = 0;
+        file.depth.far = 1;
+    }
+    return file;
+}
+
+format::ConusFile makeMapFile(const SamplingMap& map, std::optional<format::AnalyticMap> analytic) {
+    format::ConusFile file;
+    file.image = format::makeImage(map.columns(), map.rows(), {"Y"});
+    for (int j = 0; j < map.rows(); ++j)
+        for (int i = 0; i < map.columns(); ++i)
+            file.image.at(i, j) =
+                static_cast<float>(map.density({double(i) / (map.columns() - 1), double(j) / (map.rows() - 1)}));
+    file.pixelType = format::PixelType::Float;
+    file.sourceWidth = map.columns();
+    file.sourceHeight = map.rows();
+    file.dataKind = format::DataKind::Image;
+    file.map = map.toGrid();
+    file.analytic = std::move(analytic);
+    return file;
+}
+
+}  // namespace conus::codec
