@@ -58,16 +58,148 @@ codec::Focus hottestRegion(const format::Image& importance, int width, int heigh
     return {0.5 * (u0 + u1), 0.5 * (v0 + v1), std::max(half, 8.0 / width), 1};
 }
 
+struct DemoOptions {
+    std::string out = "demo-out", input, importance, backend = "auto";
+    std::vector<std::string> foci;
+    int size = 4096;
+    double k = 4;
+};
+
+// The picture the demo runs on, what it was, and the foci whose views it compares.
+struct DemoSource {
+    format::Image image;
+    SourceEncoding encoding;
+    std::vector<codec::Focus> foci;
+};
+
+DemoSource demoSource(const DemoOptions& o) {
+    DemoSource s;
+    if (!o.input.empty()) {
+        imageio::ImageFile file = readSource(o.input, {});
+        s.image = std::move(file.image);
+        s.encoding = file.info.encoding;
+        for (const auto& text : o.foci) s.foci.push_back(codec::parseFocus(text));
+        if (s.foci.empty()) s.foci.push_back({0.5, 0.5, 0.1, o.k});
+        return s;
+    }
+    Progress picture("build the " + std::to_string(o.size) + "x" + std::to_string(o.size) + " demo picture");
+    s.image = makeDemoPicture(o.size);
+    // Drawn as an 8-bit sRGB picture would hold it; CoNUS works in linear light.
+    imageio::linearize(s.image);
+    s.encoding.transfer = Transfer::Srgb;
+    s.encoding.sampleType = SampleType::Uint8;
+    s.encoding.chromaticities = kRec709Chromaticities;
+    picture.done();
+    s.foci = {{0.28, 0.30, 0.07, o.k}, {0.70, 0.66, 0.07, o.k}};
+    return s;
+}
+
+struct DemoMap {
+    std::optional<codec::SamplingMap> map;
+    std::optional<format::AnalyticMap> analytic;
+};
+
+// From importance (its hottest region becomes the view when no focus names one), else the foci.
+DemoMap demoMap(const DemoOptions& o, DemoSource& source) {
+    Progress building("build the sampling map");
+    DemoMap m;
+    const int w = source.image.width, h = source.image.height;
+    if (!o.importance.empty()) {
+        const format::Image importance = importanceFrom(o.importance, source.image);
+        m.map = codec::buildAutoMap(importance, {});
+        if (o.foci.empty()) source.foci = {hottestRegion(importance, w, h)};
+    } else {
+        codec::FociOptions fociOptions;
+        fociOptions.aspect = double(w) / h;
+        m.map = codec::buildFociMap(source.foci, fociOptions);
+        m.analytic = codec::toAnalytic(source.foci, fociOptions.composition);
+    }
+    building.done();
+    return m;
+}
+
+struct ViewCase {
+    std::string name, label;
+    int x0, y0, width, height;  // source pixels
+    int outWidth, outHeight;    // size of the picture written
+};
+
+// A view of each focus (its disc's bounding square, r a fraction of the width, kept inside the
+// image) at source resolution, then the whole frame shrunk to at most `shrink`.
+std::vector<ViewCase> demoViews(const DemoOptions& o, const std::vector<codec::Focus>& foci, int w, int h, double shrink) {
+    std::vector<ViewCase> views;
+    for (std::size_t i = 0; i < foci.size(); ++i) {
+        const int half = std::max(1, static_cast<int>(std::lround(foci[i].r * w)));
+        const int x0 = std::clamp(static_cast<int>(std::lround(foci[i].u * w)) - half, 0, std::max(0, w - 2 * half));
+        const int y0 = std::clamp(static_cast<int>(std::lround(foci[i].v * h)) - half, 0, std::max(0, h - 2 * half));
+        const int vw = std::min(w, 2 * half), vh = std::min(h, 2 * half);
+        std::string label = "focus " + std::to_string(i + 1);
+        if (o.input.empty()) label += i == 0 ? " (fine print)" : " (zone plate)";
+        views.push_back({"focus" + std::to_string(i + 1), label, x0, y0, vw, vh, vw, vh});
+    }
+    views.push_back({"frame", "whole frame", 0, 0, w, h, std::max(1, int(w * shrink)), std::max(1, int(h * shrink))});
+    return views;
+}
+
+int runDemo(const DemoOptions& o) {
+    namespace fs = std::filesystem;
+    fs::create_directories(o.out);
+    const fs::path out(o.out);
+    DemoSource source = demoSource(o);
+    const DemoMap built = demoMap(o, source);
+    const codec::SamplingMap& map = *built.map;
+    const int w = source.image.width, h = source.image.height;
+
+    const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
+    const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "the demo");
+    const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
+    const format::ConusFile conus = encodeToConus(device, source.image, source.encoding, map, size, built.analytic);
+    const format::ConusFile uniform = encodeToConus(device, source.image, source.encoding, identity, size, std::nullopt);
+    format::writeConusFile((out / "conus.exr").string(), conus);
+    format::writeConusFile((out / "uniform.exr").string(), uniform);
+    imageio::WriteOptions picture;
+    picture.source = &source.encoding;
+    writePicture((out / "conus.png").string(), conus.image, picture);
+    writePicture((out / "uniform.png").string(), uniform.image, picture);
+    const double shrink = std::min(1.0, 1024.0 / std::max(w, h));
+    const int pw = std::max(16, int(w * shrink)), ph = std::max(16, int(h * shrink));
+    writeDrawing((out / "density.png").string(), densityPicture(map, pw, ph, 32, built.analytic ? &*built.analytic : nullptr));
+
+    const std::vector<ViewCase> views = demoViews(o, source.foci, w, h, shrink);
+    std::printf("\nCoNUS demo: %dx%d %s -> %dx%d (1/16 of the pixels), ", w, h,
+                o.input.empty() ? "built-in picture" : o.input.c_str(), size.width, size.height);
+    if (!o.importance.empty()) std::printf("map from '%s' importance", o.importance.c_str());
+    else std::printf("%s", plural(source.foci.size(), "focus", "foci").c_str());
+    for (const auto& f : source.foci) std::printf(" (%g,%g,r=%g,k=%g)", f.u, f.v, f.r, f.k);
+    std::printf("\nrenderer: %s\n", device.describe().c_str());
+    std::printf("%-22s %12s %14s %8s\n", "view", "CoNUS PSNR", "uniform PSNR", "gain");
+    for (const auto& v : views) {
+        codec::DecodeOptions decode;
+        decode.view = {double(v.x0) / w, double(v.y0) / h, double(v.x0 + v.width) / w, double(v.y0 + v.height) / h};
+        decode.width = v.width;
+        decode.height = v.height;
+        const format::Image reference = crop(source.image, v.x0, v.y0, v.width, v.height);
+        const format::Image fromConus = gl::decodeImage(device, conus.image, map, decode);
+        const format::Image fromUniform = gl::decodeImage(device, uniform.image, identity, decode);
+        const double a = codec::psnr(reference, fromConus), b = codec::psnr(reference, fromUniform);
+        std::printf("%-22s %9.2f dB %11.2f dB %+7.2f\n", v.label.c_str(), a, b, a - b);
+        std::vector<format::Image> strip{reference, fromConus, fromUniform};
+        if (v.outWidth != v.width)
+            for (auto& image : strip) image = codec::areaDownsample(image, v.outWidth, v.outHeight);
+        writePicture((out / ("view-" + v.name + ".png")).string(), sideBySide(strip), picture);
+    }
+    std::string written;
+    for (const auto& v : views) written += ", view-" + v.name + ".png";
+    std::printf("\nwrote %s/: conus.exr, uniform.exr, conus.png, uniform.png, density.png%s\n"
+                "  (each view-*.png: source | CoNUS | uniform)\n",
+                o.out.c_str(), written.c_str());
+    return 0;
+}
+
 }  // namespace
 
 Command addDemoCommand(CLI::App& root) {
-    struct Options {
-        std::string out = "demo-out", input, importance, backend = "auto";
-        std::vector<std::string> foci;
-        int size = 4096;
-        double k = 4;
-    };
-    auto options = std::make_shared<Options>();
+    auto options = std::make_shared<DemoOptions>();
     CLI::App* command = root.add_subcommand(
         "demo", "The main job on a built-in picture: CoNUS vs uniform at 1/16 of the pixels, with PSNR");
     command->footer(
@@ -87,115 +219,7 @@ Command addDemoCommand(CLI::App& root) {
                         "instead of foci; --focus then only names the views to compare");
     addBackendOption(*command, options->backend);
     addQuietOption(*command);
-    return {command, [options] {
-                namespace fs = std::filesystem;
-                fs::create_directories(options->out);
-                const fs::path out(options->out);
-                format::Image source;
-                SourceEncoding encoding;
-                std::vector<codec::Focus> foci;
-                if (options->input.empty()) {
-                    Progress picture("build the " + std::to_string(options->size) + "x" +
-                                     std::to_string(options->size) + " demo picture");
-                    source = makeDemoPicture(options->size);
-                    // Drawn as an 8-bit sRGB picture would hold it; CoNUS works in linear light.
-                    imageio::linearize(source);
-                    encoding.transfer = Transfer::Srgb;
-                    encoding.sampleType = SampleType::Uint8;
-                    encoding.chromaticities = kRec709Chromaticities;
-                    picture.done();
-                    foci = {{0.28, 0.30, 0.07, options->k}, {0.70, 0.66, 0.07, options->k}};
-                } else {
-                    imageio::ImageFile file = readSource(options->input, {});
-                    source = std::move(file.image);
-                    encoding = file.info.encoding;
-                    for (const auto& text : options->foci) foci.push_back(codec::parseFocus(text));
-                    if (foci.empty()) foci.push_back({0.5, 0.5, 0.1, options->k});
-                }
-                const int w = source.width, h = source.height;
-                Progress building("build the sampling map");
-                std::optional<format::AnalyticMap> analytic;
-                std::optional<codec::SamplingMap> built;
-                if (!options->importance.empty()) {
-                    const format::Image importance = importanceFrom(options->importance, source);
-                    built = codec::buildAutoMap(importance, {});
-                    if (options->foci.empty()) foci = {hottestRegion(importance, w, h)};
-                } else {
-                    codec::FociOptions fociOptions;
-                    fociOptions.aspect = double(w) / h;
-                    built = codec::buildFociMap(foci, fociOptions);
-                    analytic = codec::toAnalytic(foci, fociOptions.composition);
-                }
-                const codec::SamplingMap& map = *built;
-                building.done();
-
-                const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
-                const gl::Device device = deviceFor(options->backend, gl::CpuPath::Available, "the demo");
-                format::ConusFile conus = encodeToConus(device, source, encoding, map, size, analytic);
-                format::ConusFile uniform =
-                    encodeToConus(device, source, encoding, codec::SamplingMap::identity(2, 2), size, std::nullopt);
-                format::writeConusFile((out / "conus.exr").string(), conus);
-                format::writeConusFile((out / "uniform.exr").string(), uniform);
-                imageio::WriteOptions picture;
-                picture.source = &encoding;
-                writePicture((out / "conus.png").string(), conus.image, picture);
-                writePicture((out / "uniform.png").string(), uniform.image, picture);
-                const double shrink = std::min(1.0, 1024.0 / std::max(w, h));
-                const int pw = std::max(16, int(w * shrink)), ph = std::max(16, int(h * shrink));
-                writeDrawing((out / "density.png").string(), densityPicture(map, pw, ph, 32, analytic ? &*analytic : nullptr));
-                const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
-
-                struct ViewCase {
-                    std::string name, label;
-                    int x0, y0, width, height;  // source pixels
-                    int outWidth, outHeight;    // size of the picture written
-                };
-                std::vector<ViewCase> views;
-                for (std::size_t i = 0; i < foci.size(); ++i) {
-                    // The focus disc's bounding square (r is a fraction of the width), kept inside the image.
-                    const int half = std::max(1, static_cast<int>(std::lround(foci[i].r * w)));
-                    const int x0 = std::clamp(static_cast<int>(std::lround(foci[i].u * w)) - half, 0, std::max(0, w - 2 * half));
-                    const int y0 = std::clamp(static_cast<int>(std::lround(foci[i].v * h)) - half, 0, std::max(0, h - 2 * half));
-                    const int vw = std::min(w, 2 * half), vh = std::min(h, 2 * half);
-                    std::string label = "focus " + std::to_string(i + 1);
-                    if (options->input.empty()) label += i == 0 ? " (fine print)" : " (zone plate)";
-                    views.push_back({"focus" + std::to_string(i + 1), label, x0, y0, vw, vh, vw, vh});
-                }
-                views.push_back({"frame", "whole frame", 0, 0, w, h, std::max(1, int(w * shrink)), std::max(1, int(h * shrink))});
-
-                std::printf("\nCoNUS demo: %dx%d %s -> %dx%d (1/16 of the pixels), ", w, h,
-                            options->input.empty() ? "built-in picture" : options->input.c_str(), size.width,
-                            size.height);
-                if (!options->importance.empty())
-                    std::printf("map from '%s' importance", options->importance.c_str());
-                else
-                    std::printf("%zu foci", foci.size());
-                for (const auto& f : foci) std::printf(" (%g,%g,r=%g,k=%g)", f.u, f.v, f.r, f.k);
-                std::printf("\nrenderer: %s\n", device.describe().c_str());
-                std::printf("%-22s %12s %14s %8s\n", "view", "CoNUS PSNR", "uniform PSNR", "gain");
-                for (const auto& v : views) {
-                    codec::DecodeOptions decode;
-                    decode.view = {double(v.x0) / w, double(v.y0) / h, double(v.x0 + v.width) / w,
-                                   double(v.y0 + v.height) / h};
-                    decode.width = v.width;
-                    decode.height = v.height;
-                    const format::Image reference = crop(source, v.x0, v.y0, v.width, v.height);
-                    const format::Image fromConus = gl::decodeImage(device, conus.image, map, decode);
-                    const format::Image fromUniform = gl::decodeImage(device, uniform.image, identity, decode);
-                    const double a = codec::psnr(reference, fromConus), b = codec::psnr(reference, fromUniform);
-                    std::printf("%-22s %9.2f dB %11.2f dB %+7.2f\n", v.label.c_str(), a, b, a - b);
-                    std::vector<format::Image> strip{reference, fromConus, fromUniform};
-                    if (v.outWidth != v.width)
-                        for (auto& image : strip) image = codec::areaDownsample(image, v.outWidth, v.outHeight);
-                    writePicture((out / ("view-" + v.name + ".png")).string(), sideBySide(strip), picture);
-                }
-                std::string written;
-                for (const auto& v : views) written += ", view-" + v.name + ".png";
-                std::printf("\nwrote %s/: conus.exr, uniform.exr, conus.png, uniform.png, density.png%s\n"
-                            "  (each view-*.png: source | CoNUS | uniform)\n",
-                            options->out.c_str(), written.c_str());
-                return 0;
-            }};
+    return {command, [options] { return runDemo(*options); }};
 }
 
 }  // namespace conus::cli
