@@ -18,19 +18,13 @@ bool onlyMapRules(const ValidationReport& r) {
     return true;
 }
 
-std::string firstLines(const ValidationReport& r) {
-    std::string s = r.str();
-    if (!s.empty() && s.back() == '\n') s.pop_back();
-    return s;
-}
-
 }  // namespace
 
 void writeConusFile(const std::string& path, const ConusFile& file) {
     const ValidationReport report = validateConusFile(file);
     if (!report.ok()) {
         throw Error(onlyMapRules(report) ? ErrorCode::InvalidMap : ErrorCode::Corrupt,
-                    "refusing to write invalid CoNUS file " + path + ":\n" + firstLines(report));
+                    "refusing to write invalid CoNUS file " + path + ": " + report.str());
     }
     // Write beside the destination and rename: a reader never sees a half-written file and an
     // existing destination survives any failure. The pid keeps concurrent writers apart.
@@ -47,16 +41,25 @@ void writeConusFile(const std::string& path, const ConusFile& file) {
     }
 }
 
-ConusFile readConusFile(const std::string& path, const ReadLimits& limits) {
+namespace {
+
+ConusFile load(const std::string& path, const ReadLimits& limits, bool readPixels) {
     ConusFile file;
-    const detail::LoadResult result = detail::loadConusFile(path, limits, file);
-    if (!result.report.ok()) throw Error(result.code, path + ": " + firstLines(result.report));
+    const detail::LoadResult result = detail::loadConusFile(path, limits, readPixels, file);
+    if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.str());
     return file;
 }
 
+}  // namespace
+
+ConusFile readConusFile(const std::string& path, const ReadLimits& limits) { return load(path, limits, true); }
+
+ConusFile readConusHeader(const std::string& path, const ReadLimits& limits) { return load(path, limits, false); }
+
 ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits) {
+    // The rules concern headers, the map and the chunk tables, never pixel values: pixels are not read.
     ConusFile file;
-    return detail::loadConusFile(path, limits, file).report;
+    return detail::loadConusFile(path, limits, false, file).report;
 }
 
 }  // namespace conus::format

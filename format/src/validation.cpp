@@ -10,9 +10,15 @@ bool ValidationReport::violates(int rule) const {
     return std::any_of(issues.begin(), issues.end(), [rule](const Issue& i) { return i.rule == rule; });
 }
 
+void ValidationReport::add(int rule, std::string message) {
+    std::replace_if(message.begin(), message.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+    issues.push_back({rule, std::move(message)});
+}
+
 std::string ValidationReport::str() const {
     std::string out;
     for (const Issue& issue : issues) {
+        if (!out.empty()) out += "; ";
         if (issue.rule == 0) {
             out += "error: ";
         } else {
@@ -21,7 +27,6 @@ std::string ValidationReport::str() const {
             out += ": ";
         }
         out += issue.message;
-        out += '\n';
     }
     return out;
 }

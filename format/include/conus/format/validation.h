@@ -18,8 +18,10 @@ struct ValidationReport {
 
     bool ok() const { return issues.empty(); }
     bool violates(int rule) const;
-    void add(int rule, std::string message) { issues.push_back({rule, std::move(message)}); }
-    // One line per issue: "V7: <message>".
+    // Line breaks in the message (a library's text may hold some) become spaces.
+    void add(int rule, std::string message);
+    // Every issue on one line, "V7: <message>; V9: <message>" (rule 0 reads "error: ..."), so an
+    // error message built from a report never spans lines.
     std::string str() const;
 };
 
