@@ -38,6 +38,7 @@ format::Image Renderer::encode(const format::Image& source, const codec::Samplin
 format::Image Renderer::decode(const format::Image& conus, const codec::SamplingMap& map,
                                const codec::DecodeOptions& options) {
     if (!m_context) return codec::decodeImage(conus, map, options);
+    codec::checkDecodeMemory(conus, options.width, options.height);
     return gl::decodeImageGpu(*m_context, conus, map, options);
 }
 

@@ -66,6 +66,11 @@ Command addDecodeCommand(CLI::App& root) {
                     decode.width = std::max(1, static_cast<int>(w));
                     decode.height = std::max(1, static_cast<int>(h));
                 }
+                try {
+                    codec::checkDecodeMemory(file.image, decode.width, decode.height);
+                } catch (const Error& e) {
+                    throw Error(e.code(), std::string(e.what()) + "; give a smaller --size");
+                }
                 Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
                 decode.progress = progress.callback();
                 Renderer renderer(options->backend);

@@ -9,6 +9,7 @@
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/format/error.h"
+#include "conus/format/limits.h"
 #include "conus/renderers/context.h"
 #include "image_io.h"
 #include "pictures.h"
@@ -38,25 +39,44 @@ int printBackends(bool json) {
     return 0;
 }
 
+// The caps every reader applies (limits.h), as the spec's "Limits" section lists them.
+int printLimits(bool json) {
+    if (json) {
+        nlohmann::ordered_json j;
+        for (const LimitEntry& l : limitTable()) j[l.name] = {{"value", l.value}, {"unit", l.unit}, {"meaning", l.meaning}};
+        std::printf("%s\n", j.dump(2).c_str());
+        return 0;
+    }
+    for (const LimitEntry& l : limitTable())
+        std::printf("%-18s %12lld %-8s %s\n", l.name, static_cast<long long>(l.value), l.unit, l.meaning);
+    return 0;
+}
+
 }  // namespace
 
 Command addInfoCommand(CLI::App& root) {
     struct Options {
         std::string input, densityPng;
-        bool json = false, backends = false;
+        bool json = false, backends = false, limits = false;
     };
     auto options = std::make_shared<Options>();
     CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth");
     command->add_option("input", options->input, "CoNUS file (.exr)");
     command->add_flag("--backends", options->backends,
                       "list the rendering backends (EGL, OSMesa, CPU): whether each works, its GL_RENDERER, why not");
+    command->add_flag("--limits", options->limits,
+                      "print the resource limits every reader checks before allocating (image, map, header, "
+                      "index, decode memory)");
     command->add_flag("--json", options->json, "print JSON instead of text");
     command->add_option("--density", options->densityPng,
                         "write the sampling density as a heat map with the sampling pattern over it (.png)");
     return {command, [options] {
                 if (options->backends) return printBackends(options->json);
-                if (options->input.empty()) throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends)");
-                const format::ConusFile file = format::readConusFile(options->input);
+                if (options->limits) return printLimits(options->json);
+                if (options->input.empty())
+                    throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends, --limits)");
+                // Everything but the image's pixels, which nothing here needs.
+                const format::ConusFile file = format::readConusHeader(options->input);
                 const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
                 const DensityStats stats = densityStats(map);
 
@@ -110,7 +130,9 @@ Command addInfoCommand(CLI::App& root) {
                 }
 
                 if (options->json) {
-                    std::printf("%s\n", j.dump(2).c_str());
+                    // Attribute strings come from the file and need not be UTF-8: invalid bytes
+                    // become U+FFFD rather than failing the whole dump.
+                    std::printf("%s\n", j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
                     return 0;
                 }
                 std::printf("%s: CoNUS file, format version %d, data kind %s\n", options->input.c_str(),

@@ -4,6 +4,8 @@
 // CoNUS image there (zoomed out), several taps over the pixel's footprint are averaged.
 #pragma once
 
+#include <cstdint>
+
 #include "conus/codec/sampling_map.h"
 #include "conus/format/error.h"
 #include "conus/format/image.h"
@@ -20,6 +22,12 @@ struct DecodeOptions {
     int threads = 0;
     ProgressFn progress;
 };
+
+// Throws conus::Error(LimitExceeded) when decoding `conus` (only its size and channels are read)
+// to a width x height frame would hold more than `maxBytes` of pixels, the CoNUS image's and the
+// frame's together, as float (limits.h: kMaxDecodeBytes). decodeImage checks this before it
+// allocates; other decoders (the GPU one) call it too.
+void checkDecodeMemory(const format::Image& conus, int width, int height, std::int64_t maxBytes = kMaxDecodeBytes);
 
 format::Image decodeImage(const format::Image& conus, const SamplingMap& map, const DecodeOptions& options);
 
