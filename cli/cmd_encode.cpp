@@ -84,6 +84,7 @@ Command addEncodeCommand(CLI::App& root) {
                                                                : codec::FociComposition::Density;
                     Progress progress("build sampling map (" + std::to_string(foci.size()) + " foci)");
                     map = std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo));
+                    codec::checkFociHeld(*map, foci, fo);  // the file must not record a focus its map ignores
                     progress.done();
                     analytic = params;
                 } else {
