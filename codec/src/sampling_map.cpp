@@ -26,6 +26,8 @@ constexpr double kInsideTolerance = 1e-14;
 
 // Residual |distort(s,t) - q| (L1, coordinates in [0,1]) below which Newton cannot improve.
 constexpr double kResidualAtRounding = 4e-16;
+// Residual above which a root of the closed form is not a solution (a true root leaves ~1e-16).
+constexpr double kRootResidual = 1e-9;
 
 // Clamps to [0,1]; NaN goes to 0 so that no index is ever computed from it.
 inline double clamp01(double x) { return x > 0.0 ? (x < 1.0 ? x : 1.0) : 0.0; }
@@ -91,11 +93,20 @@ glm::dvec2 invertCell(glm::dvec2 p00, glm::dvec2 p10, glm::dvec2 p01, glm::dvec2
             if (std::abs(f.x) + std::abs(f.y) <= kResidualAtRounding) return {s, t};
         }
     }
+    auto residual = [&](double ss, double tt) {
+        const glm::dvec2 f = bilinear(p00, p10, p01, p11, ss, tt) - q;
+        const double r = std::abs(f.x) + std::abs(f.y);
+        return r == r ? r : std::numeric_limits<double>::infinity();  // NaN: worst
+    };
     double s = sOf(t);
-    if (!(outside(s, t) <= kInRange)) {
+    // The other root too when this one is out of range or does not solve the equations: a t on the
+    // line where the patch's extension folds (b + d t = 0, as in a cell tapering to a point)
+    // leaves s undetermined. In range first, then the smaller residual.
+    if (!(outside(s, t) <= kInRange) || !(residual(s, t) <= kRootResidual)) {
         const double t2 = qa != 0.0 ? h / qa : std::numeric_limits<double>::quiet_NaN();
         const double s2 = sOf(t2);
-        if (outside(s2, t2) < outside(s, t)) s = s2, t = t2;
+        const bool in1 = outside(s, t) <= kInRange, in2 = outside(s2, t2) <= kInRange;
+        if (in2 != in1 ? in2 : in1 ? residual(s2, t2) < residual(s, t) : outside(s2, t2) < outside(s, t)) s = s2, t = t2;
         if (!std::isfinite(s) || !std::isfinite(t)) s = t = 0.5;  // Newton from the middle
     }
     // Newton on the same evaluation as distort, skipped once the residual is at rounding level
