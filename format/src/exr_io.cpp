@@ -30,21 +30,25 @@
 #include <system_error>
 
 #include "header_model.h"
+#include "header_scan.h"
 
 namespace conus::format::detail {
 namespace {
 
-// ---- The C core's pass ------------------------------------------------------------------------
-// OpenEXR's C core parses headers defensively (its validation.c checks every window, channel and
-// attribute; every attribute's size is checked against the file's size before it is read, so
-// parsing costs at most the file's own bytes) and allocates no pixels. Every file passes through
-// it first, and the C++ library, which trusts sizes it reads (a 1.9 GB string attribute in a 4 KB
-// file costs it 13 s and 2 GB), only sees headers the core accepted and the caps below allow.
-//
-// Attribute caps: the core has no hook for a per-attribute cap (its context initializer offers
-// only read and size functions, and a smaller size would break chunk reads), so the caps are
-// applied to the attribute sizes the core parsed, bounded by the file, before the C++ library
-// reads them.
+// ---- Before OpenEXR reads a header -------------------------------------------------------------
+// Three readers look at each header, in this order, and the file reaches the next only if the one
+// before accepts it:
+// 1. scanHeaders (header_scan.cpp) walks the raw bytes: every attribute's size inside the file and
+//    within the caps (limits.h), and the values whose C++ reader ignores the declared size
+//    (chlist, preview, stringvector) exactly as long as declared. This is where the attribute
+//    caps apply, before anything is allocated: OpenEXR 3.1's C core has no hook for a cap (its
+//    context initializer offers read and size functions only, and a smaller size would break
+//    chunk reads), and its C++ library allocates whatever a size says (a 1.9 GB string in a
+//    4 KB file cost 13 s and 2 GB). A chlist one byte short of its terminator made the C core end
+//    the header where the C++ library went on to read a 1.8 GB string the core never saw.
+// 2. OpenEXR's C core parses defensively (validation.c checks every window, channel and
+//    attribute against the file) and allocates no pixels; any error it reports refuses the file.
+// 3. The C++ library, which trusts more, reads the headers the first two agree on.
 
 void recordCoreError(exr_const_context_t ctx, exr_result_t code, const char* msg) {
     void* user = nullptr;
@@ -95,32 +99,9 @@ std::string partLabel(exr_const_context_t ctx, int p) {
     return "part " + std::to_string(p);
 }
 
-// Bytes an attribute's value holds, as stored in the file (what the C++ library would allocate).
-std::int64_t attributeBytes(const exr_attribute_t& a) {
-    switch (a.type) {
-        case EXR_ATTR_STRING: return a.string ? a.string->length : 0;
-        case EXR_ATTR_STRING_VECTOR: {
-            if (!a.stringvector) return 0;
-            std::int64_t bytes = 0;
-            for (int32_t i = 0; i < a.stringvector->n_strings; ++i) bytes += 4 + std::int64_t{a.stringvector->strings[i].length};
-            return bytes;
-        }
-        case EXR_ATTR_FLOAT_VECTOR: return a.floatvector ? std::int64_t{a.floatvector->length} * 4 : 0;
-        case EXR_ATTR_CHLIST: {
-            if (!a.chlist) return 0;
-            std::int64_t bytes = 1;
-            for (int c = 0; c < a.chlist->num_channels; ++c) bytes += a.chlist->entries[c].name.length + 1 + 16;
-            return bytes;
-        }
-        case EXR_ATTR_PREVIEW: return a.preview ? 8 + std::int64_t{a.preview->width} * a.preview->height * 4 : 0;
-        case EXR_ATTR_OPAQUE: return a.opaque ? std::max<std::int64_t>(a.opaque->size, a.opaque->unpacked_size) : 0;
-        default: return 64;  // fixed-size types: at most an m44d (128 bytes); counted as 64
-    }
-}
-
 // The header-level checks on the core's parse: display windows (V15), storage, chunk counts the
-// file can hold, and the attribute caps.
-Problem checkCoreHeaders(exr_const_context_t ctx, std::uintmax_t fileSize, const ReadLimits& limits) {
+// file can hold.
+Problem checkCoreHeaders(exr_const_context_t ctx, std::uintmax_t fileSize) {
     int parts = 0;
     if (exr_get_count(ctx, &parts) != EXR_ERR_SUCCESS || parts < 1) return {1, ErrorCode::Corrupt, "no parts"};
     exr_attr_box2i_t firstDisplay{};
@@ -148,26 +129,6 @@ Problem checkCoreHeaders(exr_const_context_t ctx, std::uintmax_t fileSize, const
             return {1, ErrorCode::Corrupt,
                     partLabel(ctx, p) + " needs " + std::to_string(chunks) + " chunk offsets, more than a " +
                         std::to_string(fileSize) + "-byte file can hold"};
-        }
-        int32_t count = 0;
-        if (exr_get_attribute_count(ctx, p, &count) != EXR_ERR_SUCCESS) return {1, ErrorCode::Corrupt, partLabel(ctx, p) + ": no attributes"};
-        std::int64_t total = 0;
-        for (int32_t i = 0; i < count; ++i) {
-            const exr_attribute_t* a = nullptr;
-            if (exr_get_attribute_by_index(ctx, p, EXR_ATTR_LIST_FILE_ORDER, i, &a) != EXR_ERR_SUCCESS || !a) continue;
-            const std::int64_t bytes = attributeBytes(*a);
-            if (bytes > limits.maxAttributeBytes) {
-                return {1, ErrorCode::LimitExceeded,
-                        partLabel(ctx, p) + " attribute `" + std::string(a->name ? a->name : "?") + "` holds " +
-                            std::to_string(bytes) + " bytes, beyond the limit of " + std::to_string(limits.maxAttributeBytes) +
-                            " bytes an attribute"};
-            }
-            total += bytes;
-        }
-        if (total > limits.maxHeaderBytes) {
-            return {1, ErrorCode::LimitExceeded,
-                    partLabel(ctx, p) + " header holds " + std::to_string(total) + " bytes of attributes, beyond the limit of " +
-                        std::to_string(limits.maxHeaderBytes)};
         }
     }
     return {};
@@ -484,9 +445,12 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool
     if (ec || !std::ifstream(path, std::ios::binary)) {
         return refuse({1, ErrorCode::Io, "cannot open " + path + (ec ? ": " + ec.message() : std::string())});
     }
+    if (const ScanResult scan = scanHeaders(path, size, limits); !scan.problem.empty()) {
+        return refuse({1, scan.code, "not a readable OpenEXR file: " + scan.problem});
+    }
     const CoreFile core(path);
     if (!core.error().empty()) return refuse({1, ErrorCode::Corrupt, "not a readable OpenEXR file: " + core.error()});
-    if (Problem problem = checkCoreHeaders(core.ctx(), size, limits); !problem.message.empty()) return refuse(problem);
+    if (Problem problem = checkCoreHeaders(core.ctx(), size); !problem.message.empty()) return refuse(problem);
     try {
         Imf::MultiPartInputFile file(path.c_str());
         const HeaderModel model = modelOf(file);
