@@ -7,6 +7,8 @@
 #include <sys/stat.h>
 
 #include <chrono>
+#include <fstream>
+#include <iterator>
 #include <set>
 
 #include <ImfFloatVectorAttribute.h>
@@ -70,6 +72,16 @@ TEST(Limits, ReadLimitsDefaultToTheStatedCapsAndTheTableListsEach) {
         EXPECT_GT(e.value, 0) << e.name;
     }
     EXPECT_TRUE(names.count("attributeBytes") && names.count("indexBytes") && names.count("decodeBytes"));
+}
+
+TEST(Limits, TheSpecListsEveryLimit) {
+    std::ifstream in(std::string(CONUS_SOURCE_DIR) + "/spec/conus-format.md");
+    const std::string spec((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_FALSE(spec.empty());
+    const auto section = spec.find("## Limits");
+    ASSERT_NE(section, std::string::npos);
+    for (const LimitEntry& e : limitTable())
+        EXPECT_NE(spec.find("`" + std::string(e.name) + "`", section), std::string::npos) << e.name;
 }
 
 TEST(Limits, AnAttributeBeyondTheCapIsRefusedBeforeOpenExrReadsIt) {
