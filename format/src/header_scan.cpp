@@ -68,8 +68,11 @@ std::string checkSelfDelimited(const std::string& type, const std::vector<unsign
         if (p != size - 1) return "the channel list does not end exactly at its declared size";
     } else if (type == "preview") {
         if (size < 8) return "shorter than its width and height";
-        const std::int64_t w = std::uint32_t(int32At(v.data())), h = std::uint32_t(int32At(v.data() + 4));
-        if (8 + w * h * 4 != std::int64_t(size)) return "a " + std::to_string(w) + "x" + std::to_string(h) + " preview in " + std::to_string(size) + " bytes";
+        // w * h * 4 == size - 8, without forming w * h (two 32-bit factors overflow 64 bits times 4).
+        const std::uint64_t w = std::uint32_t(int32At(v.data())), h = std::uint32_t(int32At(v.data() + 4));
+        const std::uint64_t bytes = size - 8, pixels = bytes / 4;
+        const bool exact = bytes % 4 == 0 && (w == 0 || h == 0 ? pixels == 0 : pixels % w == 0 && pixels / w == h);
+        if (!exact) return "a " + std::to_string(w) + "x" + std::to_string(h) + " preview in " + std::to_string(size) + " bytes";
     } else if (type == "stringvector") {
         std::size_t p = 0;
         while (p < size) {

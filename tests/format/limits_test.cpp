@@ -230,6 +230,24 @@ TEST(Hostile, AHugeTiledPartWithoutItsDataIsRefused) {
     EXPECT_LT(r.seconds, 1.0);
 }
 
+TEST(Hostile, EveryFuzzFindingIsRefused) {
+    // Inputs the fuzzer found (tests/fuzz/corpus/container/found-*): each is refused, on one line,
+    // under V1, at once. A 2603220992x1093730560 preview in 8 bytes overflowed the walk's own
+    // size arithmetic (UBSan).
+    int seen = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(std::string(CONUS_FUZZ_CORPUS) + "/container")) {
+        if (entry.path().filename().string().rfind("found-", 0) != 0) continue;
+        ++seen;
+        const Refusal r = refusal([&] { readConusFile(entry.path().string()); });
+        EXPECT_TRUE(contains(r.message, "V1: ")) << entry.path() << ": " << r.message;
+        EXPECT_TRUE(oneLine(r.message));
+        EXPECT_LT(r.seconds, 1.0) << entry.path();
+    }
+    EXPECT_GE(seen, 2);
+    EXPECT_TRUE(contains(refusal([] { readConusFile(std::string(CONUS_FUZZ_CORPUS) + "/container/found-preview-size-overflow.exr"); }).message,
+                         "a 2603220992x1093730560 preview in 8 bytes"));
+}
+
 TEST(Hostile, AHugeSourceSizeIsReadAsDeclared) {
     // Valid: the limit applies to what a decode allocates (decode_test.cpp, cli hostile_test.cpp).
     const ConusFile f = readConusFile(hostile("source_65536x16384.exr"));
