@@ -164,7 +164,7 @@ TEST(Limits, ReadConusHeaderHasTheImageShapeButNoPixels) {
 TEST(Limits, OnlyRegularFilesAreRead) {
     TempDir dir;
     ASSERT_EQ(::mkfifo(dir.file("fifo.exr").c_str(), 0600), 0);
-    for (const std::string path : {dir.file("fifo.exr"), dir.path().string(), std::string("/dev/zero")}) {
+    for (const std::string& path : {dir.file("fifo.exr"), dir.path().string(), std::string("/dev/zero")}) {
         const Refusal r = refusal([&] { readConusFile(path); });
         EXPECT_EQ(r.code, ErrorCode::Io) << path << ": " << r.message;
         EXPECT_LT(r.seconds, 1.0) << path;
