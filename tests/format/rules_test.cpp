@@ -28,6 +28,7 @@ namespace {
 using testing::TempDir;
 using testing::validFile;
 using testing::Mutate;
+using testing::eraseAttribute;
 using testing::writeRaw;
 
 // The report is not ok and names only `rule`.
@@ -91,9 +92,9 @@ TEST_F(RuleTest, V2NewerVersionIsRefused) {
 }
 
 TEST_F(RuleTest, V2VersionMissingOrMistyped) {
-    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.erase("conus:version"); }), 2));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { eraseAttribute(c, "conus:version"); }), 2));
     EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) {
-                             c.erase("conus:version");
+                             eraseAttribute(c, "conus:version");
                              c.insert("conus:version", Imf::StringAttribute("1"));
                          }),
                          2));
@@ -133,7 +134,7 @@ TEST_F(RuleTest, V5SourceSize) {
     ConusFile f = validFile();
     f.sourceHeight = 70000;
     EXPECT_TRUE(onlyRule(validateConusFile(f), 5));
-    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.erase("conus:sourceSize"); }), 5));
+    EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { eraseAttribute(c, "conus:sourceSize"); }), 5));
 }
 
 TEST_F(RuleTest, V6DataKind) {
