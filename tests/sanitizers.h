@@ -1,5 +1,6 @@
-// Tests that bound wall time multiply the bound by kTimeScale: builds with AddressSanitizer (the
-// nightly suite, scripts/run-tests.sh --sanitize) run about 3-5 times slower.
+// Tests that bound wall time or peak memory multiply the bound by kTimeScale or kMemoryScale:
+// builds with AddressSanitizer (the nightly suite, scripts/run-tests.sh --sanitize) run about 3-5
+// times slower and hold more (shadow memory, redzones, the quarantine of freed blocks).
 #pragma once
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -13,7 +14,9 @@
 namespace conus::testing {
 #ifdef CONUS_TESTS_SANITIZED
 inline constexpr double kTimeScale = 5.0;
+inline constexpr long kMemoryScale = 2;
 #else
 inline constexpr double kTimeScale = 1.0;
+inline constexpr long kMemoryScale = 1;
 #endif
 }  // namespace conus::testing

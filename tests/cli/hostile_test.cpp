@@ -120,7 +120,7 @@ protected:
     // Handled within a second (plus the start) and with no more than `maxMb` of peak memory.
     static void expectBounded(const Outcome& r, long maxMb = 700) {
         EXPECT_LT(r.seconds, 2.0 * conus::testing::kTimeScale);
-        EXPECT_LT(r.peakKb / 1024, maxMb);
+        EXPECT_LT(r.peakKb / 1024, maxMb * conus::testing::kMemoryScale);
     }
 
     fs::path m_dir;
