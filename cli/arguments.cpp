@@ -48,6 +48,22 @@ codec::View parseView(const std::string& text) {
     return view;
 }
 
+CLI::Validator finiteRange(double low, double high, bool lowIncluded) {
+    std::ostringstream range;
+    range << (lowIncluded ? "[" : "(") << low << ", " << high << ")";
+    const std::string description = "a finite number in " + range.str();
+    return CLI::Validator(
+        [=](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double value = std::strtod(text.c_str(), &end);
+            const bool aboveLow = lowIncluded ? value >= low : value > low;
+            if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value) || !aboveLow || !(value < high))
+                return "'" + text + "' is not " + description;
+            return {};
+        },
+        description);
+}
+
 format::Compression parseCompression(const std::string& text) {
     if (text == "zip") return format::Compression::Zip;
     if (text == "piz") return format::Compression::Piz;

@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include <CLI/CLI.hpp>
+
 #include "conus/codec/decode.h"
 #include "conus/format/container.h"
 
@@ -16,5 +18,10 @@ struct Size {
 Size parseSize(const std::string& text);        // "1024x768"; each side in [1, 65536]
 codec::View parseView(const std::string& text);  // "u0,v0,u1,v1" with u0 < u1, v0 < v1, all finite
 format::Compression parseCompression(const std::string& text);  // zip | piz | dwaa | none
+
+// A CLI11 check for a number option: finite, above `low` (or equal to it when `lowIncluded`) and
+// below `high`. CLI::Range lets NaN through (every comparison with NaN is false); this does not,
+// so a bad value is a usage error (exit 2) instead of a silent fallback.
+CLI::Validator finiteRange(double low, double high, bool lowIncluded = false);
 
 }  // namespace conus::cli

@@ -63,6 +63,11 @@ int runDecode(const DecodeCommandOptions& o) {
     decode.view = view;
     decode.width = size.width;
     decode.height = size.height;
+    try {
+        codec::checkDecodeMemory(file.image, decode.width, decode.height);
+    } catch (const Error& e) {
+        throw Error(e.code(), std::string(e.what()) + "; give a smaller --size");
+    }
     Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
     decode.progress = progress.callback();
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "decoding");

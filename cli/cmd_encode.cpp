@@ -56,6 +56,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const format::Image& source) {
     fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
     BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo)), codec::toAnalytic(foci, fo.composition)};
+    codec::checkFociHeld(*built.map, foci, fo);  // the file must not record a focus its map ignores
     progress.done();
     return built;
 }

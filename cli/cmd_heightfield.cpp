@@ -110,7 +110,7 @@ format::Image renderHeightFieldFrame(const format::ConusFile& file, const std::s
 Command addHeightFieldCommand(CLI::App& root) {
     struct Options {
         std::string dem, output, sizeText = "512x512", colour, compression = "zip";
-        double eyeHeight = 150, near = 200, far = 0, fov = 0, heightScale = 1;
+        double eyeHeight = 150, near = 200, far = 0, fov = 0, heightScale = 1;  // far, fov: 0 until given
         int grid = 129;
         std::string input, frame, cameraText, frameSize = "960x540", compare, backend = "auto";
     };
@@ -126,15 +126,28 @@ Command addHeightFieldCommand(CLI::App& root) {
         ->required();
     encode->add_option("-o,--output", o->output, "CoNUS file (.exr)")->required();
     encode->add_option("--size", o->sizeText, "CoNUS image size WxH")->capture_default_str();
-    encode->add_option("--eye-height", o->eyeHeight, "viewer's eye above the base plane, metres")->capture_default_str();
+    // The ground map's own ranges (ground_map.h), checked here so a bad value is a usage error.
+    encode->add_option("--eye-height", o->eyeHeight, "viewer's eye above the base plane, metres")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e9));
     encode->add_option("--near", o->near, "distance from the viewer to the field's near edge, metres")
-        ->capture_default_str();
-    encode->add_option("--far", o->far,
-                       "distance to the far edge, metres (default: near + the DEM's depth when the file gives its "
-                       "spacing, else 6000)");
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e9, true));
+    CLI::Option* far = encode->add_option("--far", o->far,
+                                          "distance to the far edge, metres, beyond --near (default: near + the DEM's "
+                                          "depth when the file gives its spacing, else 6000)")
+                           ->check(finiteRange(0, 1e9));
     encode->add_option("--fov", o->fov,
                        "horizontal field of view at the far edge, degrees; sets the field's width (default: the "
-                       "DEM's own width when known, else 60)");
+                       "DEM's own width when known, else 60)")
+        ->check(finiteRange(0, 170));
+    encode->callback([o, far] {
+        if (far->count() > 0 && !(o->far > o->near)) {
+            std::ostringstream why;
+            why << o->far << " is not beyond --near " << o->near;
+            throw CLI::ValidationError("--far", why.str());
+        }
+    });
     encode->add_option("--grid", o->grid, "sampling-map nodes per side stored in the file")->capture_default_str();
     encode->add_option("--height-scale", o->heightScale, "multiplies the DEM's values (to metres)")
         ->capture_default_str();

@@ -9,6 +9,7 @@
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
+#include "conus/format/limits.h"
 #include "conus/renderers/context.h"
 #include "image_files.h"
 #include "pictures.h"
@@ -39,18 +40,34 @@ int printBackends(bool json) {
     return 0;
 }
 
+// The caps every reader applies (limits.h), as the spec's "Limits" section lists them.
+int printLimits(bool json) {
+    if (json) {
+        nlohmann::ordered_json j;
+        for (const LimitEntry& l : limitTable()) j[l.name] = {{"value", l.value}, {"unit", l.unit}, {"meaning", l.meaning}};
+        std::printf("%s\n", j.dump(2).c_str());
+        return 0;
+    }
+    for (const LimitEntry& l : limitTable())
+        std::printf("%-18s %12lld %-8s %s\n", l.name, static_cast<long long>(l.value), l.unit, l.meaning);
+    return 0;
+}
+
 }  // namespace
 
 Command addInfoCommand(CLI::App& root) {
     struct Options {
         std::string input, densityPng;
-        bool json = false, backends = false, verbose = false;
+        bool json = false, backends = false, limits = false, verbose = false;
     };
     auto options = std::make_shared<Options>();
     CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth");
     command->add_option("input", options->input, "CoNUS file (.exr)");
     command->add_flag("--backends", options->backends,
                       "list the rendering backends (EGL, OSMesa, CPU): whether each works, its GL_RENDERER, why not");
+    command->add_flag("--limits", options->limits,
+                      "print the resource limits every reader checks before allocating (image, map, header, "
+                      "index, decode memory)");
     command->add_flag("--json", options->json, "print JSON instead of text");
     command->add_flag("-v,--verbose", options->verbose,
                       "also list the source's metadata; for an invalid file, every broken rule (as `conus validate`)");
@@ -63,7 +80,9 @@ Command addInfoCommand(CLI::App& root) {
                         "write the sampling density as a heat map with the sampling pattern over it (.png)");
     return {command, [options] {
                 if (options->backends) return printBackends(options->json);
-                if (options->input.empty()) throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends)");
+                if (options->limits) return printLimits(options->json);
+                if (options->input.empty())
+                    throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends, --limits)");
                 if (options->verbose) {
                     const format::ValidationReport report = format::validateConusFile(options->input);
                     if (!report.ok()) {
@@ -73,7 +92,8 @@ Command addInfoCommand(CLI::App& root) {
                                                             plural(static_cast<std::size_t>(report.problemCount()), "problem", "problems") + ")");
                     }
                 }
-                const format::ConusFile file = format::readConusFile(options->input);
+                // Everything but the image's pixels, which nothing here needs.
+                const format::ConusFile file = format::readConusHeader(options->input);
                 const std::vector<std::string> channels = format::displayOrder(file.image.channels);
                 const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
                 const DensityStats stats = densityStats(map);
@@ -136,7 +156,9 @@ Command addInfoCommand(CLI::App& root) {
                 }
 
                 if (options->json) {
-                    std::printf("%s\n", j.dump(2).c_str());
+                    // Attribute strings come from the file and need not be UTF-8: invalid bytes
+                    // become U+FFFD rather than failing the whole dump.
+                    std::printf("%s\n", j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
                     return 0;
                 }
                 std::printf("%s: CoNUS file, format version %d, data kind %s\n", options->input.c_str(),

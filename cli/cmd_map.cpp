@@ -136,7 +136,8 @@ Command addMapCommand(CLI::App& root) {
     compose->add_option("--translate", o->translate, "dx,dy: move the k-th input's pattern (k-th use, k-th input)");
     compose->add_option("--scale", o->scale, "s or s,cu,cv: scale the k-th input's pattern by s about (cu,cv), default centre 0.5,0.5");
     compose->add_option("--weight", o->weights, "weight of the k-th input's displacement (default 1)");
-    compose->add_option("--grid", o->composeGrid, "nodes per side of the result (default: the largest input's)")->check(CLI::Range(2, 4097));
+    compose->add_option("--grid", o->composeGrid, "nodes per side of the result (default: the largest input's)")
+        ->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addOutputOptions(*compose, o->composeOut);
 
     CLI::App* ground = command->add_subcommand(
@@ -145,7 +146,7 @@ Command addMapCommand(CLI::App& root) {
     ground->add_option("--near", o->ground.near, "ground distance of the bottom edge (v = 1)")->required();
     ground->add_option("--far", o->ground.far, "ground distance of the top edge (v = 0)")->required();
     ground->add_option("--fov", o->ground.fovDegrees, "horizontal field of view in degrees at the far edge (default 60)");
-    ground->add_option("--grid", o->groundGrid, "nodes per side (default 65)")->check(CLI::Range(2, 4097));
+    ground->add_option("--grid", o->groundGrid, "nodes per side (default 65)")->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addOutputOptions(*ground, o->groundOut);
 
     CLI::App* foci = command->add_subcommand("foci", "Circular foci u,v,r,k");
@@ -254,6 +255,7 @@ Command addMapCommand(CLI::App& root) {
                     fo.composition = o->composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
                     Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
                     const codec::SamplingMap map = codec::buildFociMap(list, fo);
+                    codec::checkFociHeld(map, list, fo);  // the file must not record a focus its map ignores
                     progress.done();
                     writeMapFile(map, codec::toAnalytic(list, fo.composition), o->fociOut);
                 }

@@ -7,11 +7,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <memory>
 #include <regex>
+#include <sstream>
 #include <vector>
 
 #include "conus/codec/heightfield.h"
@@ -21,89 +22,166 @@
 namespace conus::cli {
 namespace {
 
-// One parsed .npy array, values converted to double.
-struct NpyArray {
+// A .npy header never needs more than this (NumPy writes a few hundred bytes); a larger one is
+// refused before anything is read past it.
+constexpr std::size_t kMaxNpyHeaderBytes = 64 * 1024;
+// Deflate expands at most 1032 times (a 258-byte match in 2 bits): an .npz member claiming more
+// is lying about its size.
+constexpr std::uint64_t kMaxDeflateRatio = 1032;
+
+// One parsed .npy header: dtype, shape and where the C-order data starts.
+struct NpyHeader {
     std::vector<std::int64_t> shape;
-    std::vector<double> values;
     std::string dtype;
+    std::string kind;  // dtype without its byte-order character: f8, i2, ...
+    bool swap = false;
+    std::size_t itemSize = 0;
+    std::size_t dataOffset = 0;
+    std::int64_t count = 1;
+    std::uint64_t bytes() const { return dataOffset + std::uint64_t(count) * itemSize; }
 };
 
-template <typename T>
-void convert(const unsigned char* data, std::size_t count, bool swap, std::vector<double>& out) {
-    out.resize(count);
+// One array: its header and the file's bytes (the data starts at header.dataOffset).
+struct NpyArray {
+    NpyHeader header;
+    std::vector<unsigned char> bytes;
+};
+
+// A file that does not hold what it says: a failure (exit 1), not a usage error.
+[[noreturn]] void fail(const std::string& what, const std::string& why) {
+    throw Error(ErrorCode::Corrupt, what + ": " + why);
+}
+
+// "4", " 4", "4L" -> 4; anything else (a sign, a fraction, too many digits) is refused.
+std::int64_t dimension(std::string item, const std::string& shape, const std::string& what) {
+    const auto first = item.find_first_not_of(" \t"), last = item.find_last_not_of(" \t");
+    item = first == std::string::npos ? std::string() : item.substr(first, last - first + 1);
+    if (!item.empty() && item.back() == 'L') item.pop_back();  // Python 2 longs
+    if (item.empty() || item.size() > 9 || item.find_first_not_of("0123456789") != std::string::npos)
+        fail(what, "shape (" + shape + ") has a dimension '" + item + "' that is not a whole number in [1, " +
+                       std::to_string(kMaxImageSide) + "]");
+    const std::int64_t n = std::stoll(item);
+    if (n < 1 || n > kMaxImageSide)
+        fail(what, "shape (" + shape + ") has a dimension " + item + " outside [1, " + std::to_string(kMaxImageSide) + "]");
+    return n;
+}
+
+// Format: magic "\x93NUMPY", major, minor, header length (2 bytes in v1, 4 in v2/3), then a Python
+// dict literal {'descr': '<f8', 'fortran_order': False, 'shape': (344, 403), }, then C-order data.
+// `available` bytes of the file are at `data`; the header must lie within them.
+NpyHeader parseNpyHeader(const unsigned char* data, std::size_t available, const std::string& what) {
+    if (available < 10 || std::memcmp(data, "\x93NUMPY", 6) != 0) fail(what, "not a NumPy .npy array");
+    const int major = data[6];
+    std::size_t headerLength = 0, offset = 0;
+    if (major == 1) {
+        headerLength = data[8] | (data[9] << 8);
+        offset = 10;
+    } else if (major == 2 || major == 3) {
+        if (available < 12) fail(what, "truncated header");
+        headerLength = data[8] | (data[9] << 8) | (data[10] << 16) | (std::size_t(data[11]) << 24);
+        offset = 12;
+    } else {
+        fail(what, ".npy version " + std::to_string(major) + " is not supported");
+    }
+    if (headerLength > kMaxNpyHeaderBytes)
+        fail(what, "header of " + std::to_string(headerLength) + " bytes, more than " + std::to_string(kMaxNpyHeaderBytes));
+    if (offset + headerLength > available) fail(what, "header runs past the end of the data");
+    const std::string header(reinterpret_cast<const char*>(data + offset), headerLength);
+    std::smatch m;
+    NpyHeader h;
+    if (!std::regex_search(header, m, std::regex("'descr'\\s*:\\s*'([^']*)'"))) fail(what, "no dtype in the header");
+    h.dtype = m[1];
+    if (std::regex_search(header, m, std::regex("'fortran_order'\\s*:\\s*True")))
+        fail(what, "Fortran-ordered arrays are not supported");
+    if (!std::regex_search(header, m, std::regex("'shape'\\s*:\\s*\\(([^)]*)\\)"))) fail(what, "no shape in the header");
+    const std::string shape = m[1];
+    std::stringstream items(shape);
+    for (std::string item; std::getline(items, item, ',');) {
+        if (item.find_first_not_of(" \t") == std::string::npos && items.eof()) break;  // "(5,)": the trailing comma
+        h.shape.push_back(dimension(item, shape, what));
+        h.count *= h.shape.back();  // each factor <= 2^16 and the product is checked at each step: no overflow
+        if (h.count > kMaxImagePixels) fail(what, "shape (" + shape + ") holds more than " + std::to_string(kMaxImagePixels) + " values");
+    }
+    const std::string& d = h.dtype;
+    if (d.size() < 3) fail(what, "dtype '" + d + "' is not supported");
+    h.swap = d[0] == '>';  // this machine is little-endian ('<', '|' and '=' need nothing)
+    h.kind = d.substr(1);
+    static const std::map<std::string, std::size_t> kSizes = {{"f8", 8}, {"f4", 4}, {"i2", 2}, {"u2", 2}, {"i4", 4},
+                                                              {"u4", 4}, {"i8", 8}, {"u1", 1}, {"i1", 1}};
+    const auto size = kSizes.find(h.kind);
+    if (size == kSizes.end()) fail(what, "dtype '" + d + "' is not supported (f4, f8, i1/u1, i2/u2, i4/u4, i8)");
+    h.itemSize = size->second;
+    h.dataOffset = offset + headerLength;
+    return h;
+}
+
+// An array from a stream of `size` bytes, read through read(buffer, n) (which throws on a short
+// read): the header first, then exactly the bytes its shape needs, so memory follows the shape
+// only once the stream is known to be long enough for it.
+template <class Read>
+NpyArray readNpy(std::uint64_t size, Read read, const std::string& what) {
+    NpyArray a;
+    a.bytes.resize(std::min<std::uint64_t>(size, kMaxNpyHeaderBytes + 12));
+    read(a.bytes.data(), a.bytes.size());
+    a.header = parseNpyHeader(a.bytes.data(), a.bytes.size(), what);
+    if (size < a.header.bytes())
+        fail(what, "holds " + std::to_string(size) + " bytes, the shape needs " + std::to_string(a.header.bytes()));
+    const std::size_t have = a.bytes.size();
+    a.bytes.resize(a.header.bytes());
+    if (a.bytes.size() > have) read(a.bytes.data() + have, a.bytes.size() - have);
+    return a;
+}
+
+template <typename T, typename Out>
+void convert(const unsigned char* data, std::size_t count, bool swap, double scale, Out* out) {
     for (std::size_t i = 0; i < count; ++i) {
         unsigned char bytes[sizeof(T)];
         std::memcpy(bytes, data + i * sizeof(T), sizeof(T));
         if (swap) std::reverse(bytes, bytes + sizeof(T));
         T value;
         std::memcpy(&value, bytes, sizeof(T));
-        out[i] = static_cast<double>(value);
+        out[i] = static_cast<Out>(static_cast<double>(value) * scale);
     }
 }
 
-// Format: magic "\x93NUMPY", major, minor, header length (2 bytes in v1, 4 in v2/3), then a Python
-// dict literal {'descr': '<f8', 'fortran_order': False, 'shape': (344, 403), }, then C-order data.
-NpyArray parseNpy(const std::vector<unsigned char>& bytes, const std::string& what) {
-    const auto fail = [&](const std::string& why) { return Error(ErrorCode::InvalidArgument, what + ": " + why); };
-    if (bytes.size() < 10 || std::memcmp(bytes.data(), "\x93NUMPY", 6) != 0) throw fail("not a NumPy .npy array");
-    const int major = bytes[6];
-    std::size_t headerLength = 0, offset = 0;
-    if (major == 1) {
-        headerLength = bytes[8] | (bytes[9] << 8);
-        offset = 10;
-    } else if (major == 2 || major == 3) {
-        if (bytes.size() < 12) throw fail("truncated header");
-        headerLength = bytes[8] | (bytes[9] << 8) | (bytes[10] << 16) | (std::size_t(bytes[11]) << 24);
-        offset = 12;
-    } else {
-        throw fail(".npy version " + std::to_string(major) + " is not supported");
-    }
-    if (offset + headerLength > bytes.size()) throw fail("header runs past the end of the data");
-    const std::string header(reinterpret_cast<const char*>(bytes.data() + offset), headerLength);
-    std::smatch m;
-    NpyArray a;
-    if (!std::regex_search(header, m, std::regex("'descr'\\s*:\\s*'([^']*)'"))) throw fail("no dtype in the header");
-    a.dtype = m[1];
-    if (std::regex_search(header, m, std::regex("'fortran_order'\\s*:\\s*True")))
-        throw fail("Fortran-ordered arrays are not supported");
-    if (!std::regex_search(header, m, std::regex("'shape'\\s*:\\s*\\(([^)]*)\\)"))) throw fail("no shape in the header");
-    const std::string shape = m[1];
-    std::int64_t count = 1;
-    const std::regex number("\\d+");
-    for (std::sregex_iterator it(shape.begin(), shape.end(), number), end; it != end; ++it) {
-        const std::int64_t n = std::stoll(it->str());
-        if (n <= 0 || n > format::kMaxImageSide) throw fail("dimension " + it->str() + " is outside [1, 65536]");
-        a.shape.push_back(n);
-        count *= n;
-        if (count > format::kMaxImagePixels) throw fail("more than 2^30 values");
-    }
-    const std::string& d = a.dtype;
-    if (d.size() < 3) throw fail("dtype '" + d + "' is not supported");
-    const bool swap = d[0] == '>';  // this machine is little-endian ('<', '|' and '=' need nothing)
-    const std::string kind = d.substr(1);
-    static const std::map<std::string, std::size_t> kSizes = {{"f8", 8}, {"f4", 4}, {"i2", 2}, {"u2", 2}, {"i4", 4},
-                                                              {"u4", 4}, {"i8", 8}, {"u1", 1}, {"i1", 1}};
-    const auto size = kSizes.find(kind);
-    if (size == kSizes.end()) throw fail("dtype '" + d + "' is not supported (f4, f8, i1/u1, i2/u2, i4/u4, i8)");
-    const std::size_t dataOffset = offset + headerLength;
-    if (bytes.size() - dataOffset < static_cast<std::size_t>(count) * size->second)
-        throw fail("holds " + std::to_string(bytes.size() - dataOffset) + " data bytes, the shape needs " +
-                   std::to_string(count * size->second));
-    const unsigned char* data = bytes.data() + dataOffset;
-    if (kind == "f8") convert<double>(data, count, swap, a.values);
-    else if (kind == "f4") convert<float>(data, count, swap, a.values);
-    else if (kind == "i2") convert<std::int16_t>(data, count, swap, a.values);
-    else if (kind == "u2") convert<std::uint16_t>(data, count, swap, a.values);
-    else if (kind == "i4") convert<std::int32_t>(data, count, swap, a.values);
-    else if (kind == "u4") convert<std::uint32_t>(data, count, swap, a.values);
-    else if (kind == "i8") convert<std::int64_t>(data, count, swap, a.values);
-    else if (kind == "u1") convert<std::uint8_t>(data, count, swap, a.values);
-    else convert<std::int8_t>(data, count, swap, a.values);
-    return a;
+// The first `count` values of the array, times scale.
+template <typename Out>
+void values(const NpyArray& a, std::size_t count, double scale, Out* out) {
+    const unsigned char* data = a.bytes.data() + a.header.dataOffset;
+    const std::string& kind = a.header.kind;
+    const bool swap = a.header.swap;
+    if (kind == "f8") convert<double>(data, count, swap, scale, out);
+    else if (kind == "f4") convert<float>(data, count, swap, scale, out);
+    else if (kind == "i2") convert<std::int16_t>(data, count, swap, scale, out);
+    else if (kind == "u2") convert<std::uint16_t>(data, count, swap, scale, out);
+    else if (kind == "i4") convert<std::int32_t>(data, count, swap, scale, out);
+    else if (kind == "u4") convert<std::uint32_t>(data, count, swap, scale, out);
+    else if (kind == "i8") convert<std::int64_t>(data, count, swap, scale, out);
+    else if (kind == "u1") convert<std::uint8_t>(data, count, swap, scale, out);
+    else convert<std::int8_t>(data, count, swap, scale, out);
 }
 
-// Every member of a .npz archive, by name without ".npy".
+// A one-value array's value (matplotlib's DEMs store their spacing so), else NaN.
+double scalar(const NpyArray& a) {
+    if (a.header.count != 1) return std::nan("");
+    double v = 0;
+    values(a, 1, 1.0, &v);
+    return v;
+}
+
+// A FIFO or a device (/dev/zero) never ends: DEM files are read only when they are regular files.
+void requireRegularFile(const std::string& path) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (ec || !std::filesystem::exists(status))
+        throw Error(ErrorCode::Io, path + ": cannot open (" + (ec ? ec.message() : std::string("no such file")) + ")");
+    if (!std::filesystem::is_regular_file(status)) throw Error(ErrorCode::Io, path + ": not a regular file");
+}
+
+// Every .npy member of a .npz archive, by name without ".npy". Each member's claimed size is
+// checked against its compressed size, its own header and the limits before memory is committed.
 std::map<std::string, NpyArray> readNpz(const std::string& path) {
+    const std::uintmax_t archiveSize = std::filesystem::file_size(path);
     int error = 0;
     std::unique_ptr<zip_t, decltype(&zip_close)> archive(zip_open(path.c_str(), ZIP_RDONLY, &error), &zip_close);
     if (!archive) throw Error(ErrorCode::Io, path + ": cannot open as a .npz (zip) archive (libzip error " +
@@ -112,26 +190,41 @@ std::map<std::string, NpyArray> readNpz(const std::string& path) {
     const zip_int64_t entries = zip_get_num_entries(archive.get(), 0);
     for (zip_int64_t i = 0; i < entries; ++i) {
         zip_stat_t stat;
-        if (zip_stat_index(archive.get(), i, 0, &stat) != 0 || !(stat.valid & ZIP_STAT_SIZE)) continue;
+        zip_stat_init(&stat);
+        constexpr zip_uint64_t kNeeded = ZIP_STAT_NAME | ZIP_STAT_SIZE | ZIP_STAT_COMP_SIZE | ZIP_STAT_COMP_METHOD;
+        if (zip_stat_index(archive.get(), i, 0, &stat) != 0 || (stat.valid & kNeeded) != kNeeded) continue;
         std::string name = stat.name;
         if (name.size() < 4 || name.substr(name.size() - 4) != ".npy") continue;
-        if (stat.size > (std::uint64_t(1) << 34))
-            throw Error(ErrorCode::LimitExceeded, path + ": member " + name + " is too large");
+        const std::string what = path + ":" + name;
+        if (stat.comp_method != ZIP_CM_STORE && stat.comp_method != ZIP_CM_DEFLATE)
+            throw Error(ErrorCode::Unsupported, what + ": compression method " + std::to_string(stat.comp_method) +
+                                                    " is not supported (stored or deflate, as NumPy writes)");
+        const std::uint64_t ratio = stat.comp_method == ZIP_CM_STORE ? 1 : kMaxDeflateRatio;
+        if (stat.comp_size > archiveSize || stat.size > stat.comp_size * ratio + 64)
+            throw Error(ErrorCode::Corrupt, what + ": claims " + std::to_string(stat.size) + " bytes from " +
+                                                std::to_string(stat.comp_size) + " compressed bytes in a " +
+                                                std::to_string(archiveSize) + "-byte archive; " +
+                                                (ratio == 1 ? std::string("stored data cannot expand")
+                                                            : "deflate expands at most " + std::to_string(ratio) + " times"));
         std::unique_ptr<zip_file_t, decltype(&zip_fclose)> file(zip_fopen_index(archive.get(), i, 0), &zip_fclose);
-        if (!file) throw Error(ErrorCode::Io, path + ": cannot read member " + name);
-        std::vector<unsigned char> bytes(stat.size);
-        if (zip_fread(file.get(), bytes.data(), stat.size) != static_cast<zip_int64_t>(stat.size))
-            throw Error(ErrorCode::Io, path + ": member " + name + " is truncated");
+        if (!file) throw Error(ErrorCode::Io, what + ": cannot read the member");
+        NpyArray array = readNpy(
+            stat.size,
+            [&](unsigned char* buffer, std::size_t n) {
+                if (zip_fread(file.get(), buffer, n) != static_cast<zip_int64_t>(n))
+                    throw Error(ErrorCode::Io, what + ": the member is truncated or damaged");
+            },
+            what);
         name.resize(name.size() - 4);
-        arrays.emplace(name, parseNpy(bytes, path + ":" + name));
+        arrays.emplace(name, std::move(array));
     }
     return arrays;
 }
 
 format::Image toHeights(const NpyArray& a, double scale, const std::string& what) {
-    if (a.shape.size() != 2) throw Error(ErrorCode::InvalidArgument, what + ": not a 2-D array");
-    format::Image im = format::makeImage(static_cast<int>(a.shape[1]), static_cast<int>(a.shape[0]), {"Z"});
-    for (std::size_t i = 0; i < a.values.size(); ++i) im.pixels[i] = static_cast<float>(a.values[i] * scale);
+    if (a.header.shape.size() != 2) throw Error(ErrorCode::Corrupt, what + ": not a 2-D array");
+    format::Image im = format::makeImage(static_cast<int>(a.header.shape[1]), static_cast<int>(a.header.shape[0]), {"Z"});
+    values(a, im.pixels.size(), scale, im.pixels.data());
     return im;
 }
 
@@ -160,19 +253,20 @@ Dem readDem(const std::string& source, double heightScale) {
                           " seed " + std::to_string(options.seed);
         return dem;
     }
+    requireRegularFile(source);
     if (endsWith(source, ".npz")) {
         const auto arrays = readNpz(source);
         auto it = arrays.find("elevation");
         if (it == arrays.end())
-            it = std::find_if(arrays.begin(), arrays.end(), [](const auto& a) { return a.second.shape.size() == 2; });
-        if (it == arrays.end()) throw Error(ErrorCode::InvalidArgument, source + ": holds no 2-D array");
+            it = std::find_if(arrays.begin(), arrays.end(), [](const auto& a) { return a.second.header.shape.size() == 2; });
+        if (it == arrays.end()) throw Error(ErrorCode::Corrupt, source + ": holds no 2-D array");
         dem.heights = toHeights(it->second, heightScale, source + ":" + it->first);
         // matplotlib's sample stores its spacing in degrees of longitude / latitude.
-        const auto scalar = [&](const char* name) {
+        const auto scalarOf = [&](const char* name) {
             const auto s = arrays.find(name);
-            return s != arrays.end() && s->second.values.size() == 1 ? s->second.values[0] : std::nan("");
+            return s != arrays.end() ? scalar(s->second) : std::nan("");
         };
-        const double dx = scalar("dx"), dy = scalar("dy"), y0 = scalar("ymin"), y1 = scalar("ymax");
+        const double dx = scalarOf("dx"), dy = scalarOf("dy"), y0 = scalarOf("ymin"), y1 = scalarOf("ymax");
         if (std::isfinite(dx) && std::isfinite(dy) && dx > 0 && dy > 0) {
             if (dx < 0.1 && std::isfinite(y0) && std::isfinite(y1) && std::abs(y0) <= 90) {
                 constexpr double kMetresPerDegree = 111320.0;
@@ -183,17 +277,22 @@ Dem readDem(const std::string& source, double heightScale) {
             }
         }
         dem.description = source + " " + it->first + " " + std::to_string(dem.heights.width) + "x" +
-                          std::to_string(dem.heights.height) + " " + it->second.dtype;
+                          std::to_string(dem.heights.height) + " " + it->second.header.dtype;
         return dem;
     }
     if (endsWith(source, ".npy")) {
         std::ifstream in(source, std::ios::binary);
         if (!in) throw Error(ErrorCode::Io, source + ": cannot open");
-        const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        const NpyArray a = parseNpy(bytes, source);
+        const NpyArray a = readNpy(
+            std::filesystem::file_size(source),
+            [&](unsigned char* buffer, std::size_t n) {
+                if (!in.read(reinterpret_cast<char*>(buffer), static_cast<std::streamsize>(n)))
+                    throw Error(ErrorCode::Io, source + ": cannot read (truncated?)");
+            },
+            source);
         dem.heights = toHeights(a, heightScale, source);
         dem.description = source + " " + std::to_string(dem.heights.width) + "x" + std::to_string(dem.heights.height) +
-                          " " + a.dtype;
+                          " " + a.header.dtype;
         return dem;
     }
     const format::Image image = readData(source);

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every Debian package CoNUS uses (a fast no-op when all are present) and builds the
-# project into build/ (Release, Ninja). Safe to run again at any time.
+# project into build/ (Release, Ninja); with --packages-only, only the first. Safe to run again at
+# any time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -16,6 +17,8 @@ if ((${#missing[@]})); then
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+
+if [ "${1:-}" = "--packages-only" ]; then exit 0; fi
 
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build --parallel "$(nproc)"

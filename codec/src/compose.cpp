@@ -14,7 +14,6 @@ namespace {
 
 // Bisection halvings on the global factor: 2^-24 is far below anything visible in a map.
 constexpr int kBisectionSteps = 24;
-constexpr int kMaxSide = 4097;
 
 std::string str(double x) {
     std::ostringstream out;
@@ -23,9 +22,10 @@ std::string str(double x) {
 }
 
 void checkGrid(int columns, int rows, const char* what) {
-    if (columns < 2 || rows < 2 || columns > kMaxSide || rows > kMaxSide) {
+    if (columns < 2 || rows < 2 || columns > kMaxMapSide || rows > kMaxMapSide) {
         throw Error(ErrorCode::InvalidArgument, std::string(what) + ": grid " + std::to_string(columns) + "x" +
-                                                    std::to_string(rows) + " is outside [2, 4097] nodes per side");
+                                                    std::to_string(rows) + " is outside [2, " + std::to_string(kMaxMapSide) +
+                                                    "] nodes per side");
     }
 }
 

@@ -324,9 +324,23 @@ void clearOutside(format::Image& out, const View& view) {
 
 }  // namespace
 
+void checkDecodeMemory(const format::Image& conus, int width, int height, std::int64_t maxBytes) {
+    const std::int64_t channels = conus.channelCount();
+    const std::int64_t bytes = (std::int64_t{conus.width} * conus.height + std::int64_t{width} * height) * channels *
+                               std::int64_t(sizeof(float));
+    if (bytes > maxBytes) {
+        throw Error(ErrorCode::LimitExceeded,
+                    "decoding a " + std::to_string(conus.width) + "x" + std::to_string(conus.height) + " image to " +
+                        std::to_string(width) + "x" + std::to_string(height) + " pixels of " + std::to_string(channels) +
+                        " channels takes " + std::to_string(bytes) + " bytes, beyond the decode memory limit of " +
+                        std::to_string(maxBytes));
+    }
+}
+
 format::Image decodeImage(const format::Image& conus, const SamplingMap& map, const DecodeOptions& options) {
     format::checkImage(conus, "decodeImage");
     detail::checkOutputSize(options.width, options.height, "decodeImage");
+    checkDecodeMemory(conus, options.width, options.height);
     checkView(options.view, "decodeImage");
     format::Image out = detail::makeOutput(conus, options.width, options.height);
     const detail::ViewColumns cols = detail::viewColumns(map.columns(), options.view.u0, options.view.u1, out.width);

@@ -263,9 +263,9 @@ void checkInput(const DensityField& target, const DensityMapOptions& options) {
                                                         std::to_string(k / target.width) + ") is not finite and > 0");
         }
     }
-    if (options.columns < 2 || options.rows < 2 || options.columns > 4097 || options.rows > 4097 || options.steps < 1) {
+    if (options.columns < 2 || options.rows < 2 || options.columns > kMaxMapSide || options.rows > kMaxMapSide || options.steps < 1) {
         throw Error(ErrorCode::InvalidArgument, "density map options: grid " + std::to_string(options.columns) + "x" +
-                                                    std::to_string(options.rows) + " (each in [2,4097]), steps " +
+                                                    std::to_string(options.rows) + " (each in [2," + std::to_string(kMaxMapSide) + "]), steps " +
                                                     std::to_string(options.steps) + " (>= 1)");
     }
 }

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -138,6 +139,45 @@ SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options
     if (foci.empty()) return SamplingMap::identity(options.columns, options.rows);
     return options.composition == FociComposition::Add ? buildAddComposition(foci, options)
                                                        : buildDensityComposition(foci, options);
+}
+
+std::vector<double> reachedMagnification(const SamplingMap& map, std::span<const Focus> foci) {
+    // The lowest density, sampled finely enough to find the context between and around foci.
+    constexpr int kSamples = 64;
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < kSamples; ++j)
+        for (int i = 0; i < kSamples; ++i) lowest = std::min(lowest, map.density({(i + 0.5) / kSamples, (j + 0.5) / kSamples}));
+    std::vector<double> reached;
+    for (const Focus& f : foci) reached.push_back(std::sqrt(std::max(0.0, map.density({f.u, f.v}) / lowest)));
+    return reached;
+}
+
+void checkFociHeld(const SamplingMap& map, std::span<const Focus> foci, const FociOptions& options) {
+    constexpr int kLargestSuggestion = 257;
+    auto firstMissed = [&](const SamplingMap& m) -> int {
+        const std::vector<double> reached = reachedMagnification(m, foci);
+        for (std::size_t i = 0; i < foci.size(); ++i)
+            if (reached[i] < 1.0 + 0.5 * (foci[i].k - 1.0)) return static_cast<int>(i);
+        return -1;
+    };
+    const int missed = firstMissed(map);
+    if (missed < 0) return;
+    const Focus& f = foci[missed];
+    const double reached = reachedMagnification(map, foci)[missed];
+    std::string advice = "no grid up to " + std::to_string(kLargestSuggestion) + " nodes a side holds it";
+    for (int side = 3; side <= kLargestSuggestion; side = 2 * side - 1) {
+        if (side <= std::max(options.columns, options.rows)) continue;
+        FociOptions finer = options;
+        finer.columns = finer.rows = side;
+        if (firstMissed(buildFociMap(foci, finer)) < 0) {
+            advice = "a grid of " + std::to_string(side) + " nodes a side or more does";
+            break;
+        }
+    }
+    throw Error(ErrorCode::InvalidArgument,
+                "a " + std::to_string(options.columns) + "x" + std::to_string(options.rows) + " grid is too coarse for focus " +
+                    str(f.u) + "," + str(f.v) + "," + str(f.r) + "," + str(f.k) + ": it reaches a magnification of " +
+                    str(std::round(reached * 100) / 100) + " there; " + advice);
 }
 
 Focus parseFocus(const std::string& text) {

@@ -87,9 +87,9 @@ glm::dvec2 groundUndistort(const GroundParams& params, glm::dvec2 pd) {
 
 SamplingMap buildGroundMap(const GroundParams& params, int columns, int rows) {
     checkGroundParams(params);
-    if (columns < 2 || rows < 2 || columns > 4097 || rows > 4097) {
+    if (columns < 2 || rows < 2 || columns > kMaxMapSide || rows > kMaxMapSide) {
         throw Error(ErrorCode::InvalidArgument, "ground map grid " + std::to_string(columns) + "x" + std::to_string(rows) +
-                                                    " is outside [2, 4097] nodes per side");
+                                                    " is outside [2, " + std::to_string(kMaxMapSide) + "] nodes per side");
     }
     std::vector<glm::vec2> nodes(std::size_t(columns) * rows);
     for (int j = 0; j < rows; ++j)

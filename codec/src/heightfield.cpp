@@ -247,14 +247,14 @@ format::ConusFile encodeHeightField(const format::Image& heights, const format::
     constexpr const char* kWhat = "encodeHeightField";
     checkGroundParams(options.ground);
     checkSize(options.width, options.height, kWhat);
-    if (options.mapGrid < 2 || options.mapGrid > 4097)
+    if (options.mapGrid < 2 || options.mapGrid > kMaxMapSide)
         throw Error(ErrorCode::InvalidArgument,
-                    std::string(kWhat) + ": map grid " + std::to_string(options.mapGrid) + " is outside [2, 4097]");
+                    std::string(kWhat) + ": map grid " + std::to_string(options.mapGrid) + " is outside [2, " + std::to_string(kMaxMapSide) + "]");
     const format::Image source = combine(heights, colour, kWhat);
 
     // Sample through a grid as fine as the image: a sample then sits where the analytic inverse
     // puts it (the piecewise-bilinear error of a coarse grid would shift the mesh's vertices).
-    const int fine = std::clamp(std::max(options.width, options.height) + 1, options.mapGrid, 4097);
+    const int fine = std::clamp(std::max(options.width, options.height) + 1, options.mapGrid, kMaxMapSide);
     const SamplingMap sampling = buildGroundMap(options.ground, fine, fine);
     EncodeOptions encode;
     encode.width = options.width;

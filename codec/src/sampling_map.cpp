@@ -3,9 +3,11 @@
 #include "conus/codec/sampling_map.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <mutex>
 #include <string>
 
 #include "conus/core/error.h"
@@ -13,16 +15,19 @@
 namespace conus::codec {
 namespace {
 
-// Buckets per cell along each axis: 2 keeps the candidate list short (about 2-4 cells) for the
-// usual 65x65 maps; huge maps use 1 so the index stays about as large as the grid itself.
+// Buckets per cell along each axis for ordinary maps: 2 keeps the candidate list short (about 2-4
+// cells) for the usual 65x65 maps. The index then takes about 13 words a cell; maps whose cells
+// overlap many buckets get coarser buckets so the index stays within its budget (limits.h).
 constexpr int kBucketsPerCell = 2;
-constexpr std::size_t kMaxCellsForFineBuckets = std::size_t{1} << 20;
+static_assert(kMaxMapSide < (1 << 16), "cells are packed as i | j << 16");
 // Inside-cell test tolerance on the edge cross products (length^2 units): a point on a shared
 // edge must be accepted by at least one of the two cells despite rounding.
 constexpr double kInsideTolerance = 1e-14;
 
 // Residual |distort(s,t) - q| (L1, coordinates in [0,1]) below which Newton cannot improve.
 constexpr double kResidualAtRounding = 4e-16;
+// Residual above which a root of the closed form is not a solution (a true root leaves ~1e-16).
+constexpr double kRootResidual = 1e-9;
 
 // Clamps to [0,1]; NaN goes to 0 so that no index is ever computed from it.
 inline double clamp01(double x) { return x > 0.0 ? (x < 1.0 ? x : 1.0) : 0.0; }
@@ -88,11 +93,20 @@ glm::dvec2 invertCell(glm::dvec2 p00, glm::dvec2 p10, glm::dvec2 p01, glm::dvec2
             if (std::abs(f.x) + std::abs(f.y) <= kResidualAtRounding) return {s, t};
         }
     }
+    auto residual = [&](double ss, double tt) {
+        const glm::dvec2 f = bilinear(p00, p10, p01, p11, ss, tt) - q;
+        const double r = std::abs(f.x) + std::abs(f.y);
+        return r == r ? r : std::numeric_limits<double>::infinity();  // NaN: worst
+    };
     double s = sOf(t);
-    if (!(outside(s, t) <= kInRange)) {
+    // The other root too when this one is out of range or does not solve the equations: a t on the
+    // line where the patch's extension folds (b + d t = 0, as in a cell tapering to a point)
+    // leaves s undetermined. In range first, then the smaller residual.
+    if (!(outside(s, t) <= kInRange) || !(residual(s, t) <= kRootResidual)) {
         const double t2 = qa != 0.0 ? h / qa : std::numeric_limits<double>::quiet_NaN();
         const double s2 = sOf(t2);
-        if (outside(s2, t2) < outside(s, t)) s = s2, t = t2;
+        const bool in1 = outside(s, t) <= kInRange, in2 = outside(s2, t2) <= kInRange;
+        if (in2 != in1 ? in2 : in1 ? residual(s2, t2) < residual(s, t) : outside(s2, t2) < outside(s, t)) s = s2, t = t2;
         if (!std::isfinite(s) || !std::isfinite(t)) s = t = 0.5;  // Newton from the middle
     }
     // Newton on the same evaluation as distort, skipped once the residual is at rounding level
@@ -127,46 +141,63 @@ format::GridNodes makeGrid(int columns, int rows, const std::vector<glm::vec2>& 
 
 }  // namespace
 
-// The acceleration structure: double copies of the nodes and, per bucket of the distorted plane,
-// the cells whose bounding box overlaps it (compressed rows: cells[start[b] .. start[b+1])).
+// The acceleration structure: per bucket of the distorted plane, the cells whose bounding box
+// overlaps it (compressed rows: cells[start[b] .. start[b+1])). Its size is the sum over cells of
+// the buckets their boxes cover, which a hostile map (long thin cells) makes cubic in the side at
+// a fixed bucket size; so the bucket grid is the finest of 2, 1, 1/2, 1/4, ... buckets per cell
+// whose size, counted in 64-bit before anything is allocated, fits the budget. A single bucket
+// always fits (4 bytes a cell), so every valid map gets an index; lookups in a coarse one scan
+// longer lists but stay exact.
 struct SamplingMap::Index {
-    int cellsX = 0, cellsY = 0;
     int bucketsX = 0, bucketsY = 0;
-    double invCellsX = 1.0, invCellsY = 1.0;
-    std::vector<glm::dvec2> nodes;
     std::vector<std::uint32_t> start;
-    std::vector<std::uint32_t> cells;  // the cell's (i, j) packed as i | j << 16 (sides <= 4097)
+    std::vector<std::uint32_t> cells;  // the cell's (i, j) packed as i | j << 16
 
-    Index(int columns, int rows, const std::vector<glm::vec2>& floatNodes) {
-        cellsX = columns - 1;
-        cellsY = rows - 1;
-        invCellsX = 1.0 / cellsX;
-        invCellsY = 1.0 / cellsY;
-        const std::size_t cellCount = std::size_t(cellsX) * cellsY;
-        const int perCell = cellCount <= kMaxCellsForFineBuckets ? kBucketsPerCell : 1;
-        bucketsX = cellsX * perCell;
-        bucketsY = cellsY * perCell;
-        nodes.assign(floatNodes.begin(), floatNodes.end());
+    static std::int64_t budget(std::int64_t cellCount) {
+        return std::min(kMaxIndexBytes, kIndexBytesPerCell * cellCount + kIndexBytesBase);
+    }
 
-        auto bucketRange = [&](int i, int j, int& x0, int& x1, int& y0, int& y1) {
+    Index(int columns, int rows, const std::vector<glm::dvec2>& nodes) {
+        const int cellsX = columns - 1, cellsY = rows - 1;
+        const std::int64_t cellCount = std::int64_t{cellsX} * cellsY;
+        // Buckets covered by cell (i, j)'s bounding box on a bx x by grid. Multiplication and
+        // truncation are monotone, so a point inside the box always falls in one of these buckets
+        // (lookups use the same expression).
+        auto bucketRange = [&](int i, int j, int bx, int by, int& x0, int& x1, int& y0, int& y1) {
             const std::size_t k = std::size_t(j) * columns + i;
             const glm::dvec2 p[4] = {nodes[k], nodes[k + 1], nodes[k + columns], nodes[k + columns + 1]};
-            double lo_x = p[0].x, hi_x = p[0].x, lo_y = p[0].y, hi_y = p[0].y;
+            double loX = p[0].x, hiX = p[0].x, loY = p[0].y, hiY = p[0].y;
             for (int c = 1; c < 4; ++c) {
-                lo_x = std::min(lo_x, p[c].x), hi_x = std::max(hi_x, p[c].x);
-                lo_y = std::min(lo_y, p[c].y), hi_y = std::max(hi_y, p[c].y);
+                loX = std::min(loX, p[c].x), hiX = std::max(hiX, p[c].x);
+                loY = std::min(loY, p[c].y), hiY = std::max(hiY, p[c].y);
             }
-            // Multiplication and truncation are monotone, so a point inside the box always falls
-            // in one of these buckets (lookups use the same expression).
             auto bucket = [](double x, int n) { return std::clamp(static_cast<int>(clamp01(x) * n), 0, n - 1); };
-            x0 = bucket(lo_x, bucketsX), x1 = bucket(hi_x, bucketsX);
-            y0 = bucket(lo_y, bucketsY), y1 = bucket(hi_y, bucketsY);
+            x0 = bucket(loX, bx), x1 = bucket(hiX, bx);
+            y0 = bucket(loY, by), y1 = bucket(hiY, by);
         };
+        const std::int64_t budgetBytes = budget(cellCount);
+        int bx = cellsX * kBucketsPerCell, by = cellsY * kBucketsPerCell;
+        for (;; bx = std::max(1, (bx + 1) / 2), by = std::max(1, (by + 1) / 2)) {
+            const std::int64_t startBytes = 4 * (std::int64_t{bx} * by + 1);
+            const std::int64_t maxEntries = (budgetBytes - startBytes) / 4;
+            std::int64_t entries = 0;
+            for (int j = 0; j < cellsY && entries <= maxEntries; ++j) {
+                for (int i = 0; i < cellsX; ++i) {
+                    int x0, x1, y0, y1;
+                    bucketRange(i, j, bx, by, x0, x1, y0, y1);
+                    entries += std::int64_t{x1 - x0 + 1} * (y1 - y0 + 1);
+                }
+            }
+            if (startBytes <= budgetBytes && entries <= maxEntries) break;
+            if (bx == 1 && by == 1) break;  // cannot happen (cellCount * 4 + 8 bytes fit), but never loop forever
+        }
+        bucketsX = bx;
+        bucketsY = by;
         start.assign(std::size_t(bucketsX) * bucketsY + 1, 0);
         for (int j = 0; j < cellsY; ++j) {
             for (int i = 0; i < cellsX; ++i) {
                 int x0, x1, y0, y1;
-                bucketRange(i, j, x0, x1, y0, y1);
+                bucketRange(i, j, bx, by, x0, x1, y0, y1);
                 for (int y = y0; y <= y1; ++y)
                     for (int x = x0; x <= x1; ++x) ++start[std::size_t(y) * bucketsX + x + 1];
             }
@@ -177,14 +208,37 @@ struct SamplingMap::Index {
         for (int j = 0; j < cellsY; ++j) {
             for (int i = 0; i < cellsX; ++i) {
                 int x0, x1, y0, y1;
-                bucketRange(i, j, x0, x1, y0, y1);
+                bucketRange(i, j, bx, by, x0, x1, y0, y1);
                 const auto k = static_cast<std::uint32_t>(i) | static_cast<std::uint32_t>(j) << 16;
                 for (int y = y0; y <= y1; ++y)
                     for (int x = x0; x <= x1; ++x) cells[fill[std::size_t(y) * bucketsX + x]++] = k;
             }
         }
     }
+
+    std::size_t bytes() const { return (start.capacity() + cells.capacity()) * sizeof(std::uint32_t); }
 };
+
+// Built on the first undistort (decoding only distorts), once, whichever thread asks first: the
+// encoder calls undistort from several threads. Copies of a map share the built index (it is
+// immutable), so `owner` is written once before `ready` is published and never again.
+struct SamplingMap::LazyIndex {
+    std::mutex mutex;
+    std::shared_ptr<const Index> owner;
+    std::atomic<const Index*> ready{nullptr};
+};
+
+const SamplingMap::Index& SamplingMap::index() const {
+    if (const Index* built = m_lazy->ready.load(std::memory_order_acquire)) return *built;
+    const std::lock_guard<std::mutex> lock(m_lazy->mutex);
+    if (!m_lazy->owner) {
+        m_lazy->owner = std::make_shared<const Index>(m_columns, m_rows, m_dnodes);
+        m_lazy->ready.store(m_lazy->owner.get(), std::memory_order_release);
+    }
+    return *m_lazy->owner;
+}
+
+std::size_t SamplingMap::indexBytes() const { return index().bytes(); }
 
 SamplingMap::SamplingMap(int columns, int rows, std::vector<glm::vec2> nodes) {
     const format::ValidationReport report = format::validateGrid(makeGrid(columns, rows, nodes));
@@ -192,7 +246,10 @@ SamplingMap::SamplingMap(int columns, int rows, std::vector<glm::vec2> nodes) {
     m_columns = columns;
     m_rows = rows;
     m_nodes = std::move(nodes);
-    m_index = std::make_unique<Index>(m_columns, m_rows, m_nodes);
+    m_dnodes.assign(m_nodes.begin(), m_nodes.end());
+    m_invCellsX = 1.0 / (m_columns - 1);
+    m_invCellsY = 1.0 / (m_rows - 1);
+    m_lazy = std::make_unique<LazyIndex>();
 }
 
 SamplingMap SamplingMap::identity(int columns, int rows) {
@@ -221,18 +278,18 @@ glm::dvec2 SamplingMap::distort(glm::dvec2 p) const {
     double s, t;
     const int i = cellOf(clamp01(p.x), m_columns - 1, s);
     const int j = cellOf(clamp01(p.y), m_rows - 1, t);
-    const glm::dvec2* n = m_index->nodes.data() + std::size_t(j) * m_columns + i;
+    const glm::dvec2* n = m_dnodes.data() + std::size_t(j) * m_columns + i;
     const glm::dvec2 r = bilinear(n[0], n[1], n[m_columns], n[m_columns + 1], s, t);
     return {clamp01(r.x), clamp01(r.y)};
 }
 
 glm::dvec2 SamplingMap::undistort(glm::dvec2 pd) const {
-    const Index& index = *m_index;
+    const Index& index = this->index();
     const glm::dvec2 q{clamp01(pd.x), clamp01(pd.y)};
     const int bx = std::min(static_cast<int>(q.x * index.bucketsX), index.bucketsX - 1);
     const int by = std::min(static_cast<int>(q.y * index.bucketsY), index.bucketsY - 1);
     const std::size_t bucket = std::size_t(by) * index.bucketsX + bx;
-    const glm::dvec2* nodes = index.nodes.data();
+    const glm::dvec2* nodes = m_dnodes.data();
     const int stride = m_columns;
 
     auto first = [&](std::uint32_t cell) { return nodes + std::size_t(cell >> 16) * stride + (cell & 0xffffu); };
@@ -240,7 +297,7 @@ glm::dvec2 SamplingMap::undistort(glm::dvec2 pd) const {
         const glm::dvec2* n = first(cell);
         const glm::dvec2 st = invertCell(n[0], n[1], n[stride], n[stride + 1], q);
         const int i = static_cast<int>(cell & 0xffffu), j = static_cast<int>(cell >> 16);
-        return glm::dvec2{(i + std::clamp(st.x, 0.0, 1.0)) * index.invCellsX, (j + std::clamp(st.y, 0.0, 1.0)) * index.invCellsY};
+        return glm::dvec2{(i + std::clamp(st.x, 0.0, 1.0)) * m_invCellsX, (j + std::clamp(st.y, 0.0, 1.0)) * m_invCellsY};
     };
 
     // Cells are convex and a convex cell's bilinear patch covers exactly the quad, so a point is
@@ -276,8 +333,8 @@ glm::dvec2 SamplingMap::undistort(glm::dvec2 pd) const {
     if (index.start[bucket] != index.start[bucket + 1]) {
         for (std::uint32_t c = index.start[bucket]; c < index.start[bucket + 1]; ++c) consider(index.cells[c]);
     } else {
-        for (int j = 0; j < index.cellsY; ++j)
-            for (int i = 0; i < index.cellsX; ++i) consider(static_cast<std::uint32_t>(i) | static_cast<std::uint32_t>(j) << 16);
+        for (int j = 0; j + 1 < m_rows; ++j)
+            for (int i = 0; i + 1 < m_columns; ++i) consider(static_cast<std::uint32_t>(i) | static_cast<std::uint32_t>(j) << 16);
     }
     return solve(best);
 }
@@ -286,7 +343,7 @@ glm::dmat2 SamplingMap::jacobian(glm::dvec2 p) const {
     double s, t;
     const int i = cellOf(clamp01(p.x), m_columns - 1, s);
     const int j = cellOf(clamp01(p.y), m_rows - 1, t);
-    const glm::dvec2* n = m_index->nodes.data() + std::size_t(j) * m_columns + i;
+    const glm::dvec2* n = m_dnodes.data() + std::size_t(j) * m_columns + i;
     const glm::dvec2 p00 = n[0], p10 = n[1], p01 = n[m_columns], p11 = n[m_columns + 1];
     const glm::dvec2 du = ((p10 - p00) * (1.0 - t) + (p11 - p01) * t) * double(m_columns - 1);
     const glm::dvec2 dv = ((p01 - p00) * (1.0 - s) + (p11 - p10) * s) * double(m_rows - 1);
@@ -319,7 +376,15 @@ SamplingMap::SamplingMap(const SamplingMap& other)
     : m_columns(other.m_columns),
       m_rows(other.m_rows),
       m_nodes(other.m_nodes),
-      m_index(other.m_index ? std::make_unique<Index>(*other.m_index) : nullptr) {}
+      m_dnodes(other.m_dnodes),
+      m_invCellsX(other.m_invCellsX),
+      m_invCellsY(other.m_invCellsY),
+      m_lazy(std::make_unique<LazyIndex>()) {
+    if (other.m_lazy && other.m_lazy->ready.load(std::memory_order_acquire)) {
+        m_lazy->owner = other.m_lazy->owner;
+        m_lazy->ready.store(m_lazy->owner.get(), std::memory_order_release);
+    }
+}
 
 SamplingMap& SamplingMap::operator=(const SamplingMap& other) {
     if (this != &other) {

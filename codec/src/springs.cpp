@@ -16,7 +16,6 @@
 namespace conus::codec {
 namespace {
 
-constexpr int kMaxSide = 4097;
 // Brush falloff exp(-kFalloff s^2), shifted and rescaled to reach exactly 0 at the rim.
 constexpr double kFalloff = 4.0;
 // The guard keeps every corner cross product above this fraction of its rest value (hx * hy), so
@@ -103,9 +102,9 @@ std::vector<Stroke> parseStrokes(const std::string& jsonText) {
 
 SpringSystem::SpringSystem(int columns, int rows, const SpringOptions& options)
     : m_columns(columns), m_rows(rows), m_options(options) {
-    if (columns < 2 || rows < 2 || columns > kMaxSide || rows > kMaxSide) {
+    if (columns < 2 || rows < 2 || columns > kMaxMapSide || rows > kMaxMapSide) {
         fail("spring system of " + std::to_string(columns) + "x" + std::to_string(rows) +
-             " particles; each side must be in [2, 4097]");
+             " particles; each side must be in [2, " + std::to_string(kMaxMapSide) + "]");
     }
     const SpringOptions& o = options;
     if (!(o.stiffness > 0.0) || !std::isfinite(o.stiffness)) fail("spring stiffness " + str(o.stiffness) + " is not finite and > 0");
@@ -518,8 +517,9 @@ SamplingMap SpringSystem::toMap(int columns, int rows, double* scale) const {
         std::vector<glm::vec2> nodes = positions();
         if (isValidGrid(columns, rows, nodes)) return SamplingMap(columns, rows, std::move(nodes));
     }
-    if (columns < 2 || rows < 2 || columns > kMaxSide || rows > kMaxSide) {
-        fail("spring map of " + std::to_string(columns) + "x" + std::to_string(rows) + " nodes; each side must be in [2, 4097]");
+    if (columns < 2 || rows < 2 || columns > kMaxMapSide || rows > kMaxMapSide) {
+        fail("spring map of " + std::to_string(columns) + "x" + std::to_string(rows) + " nodes; each side must be in [2, " +
+             std::to_string(kMaxMapSide) + "]");
     }
     // Eq. 1 on the particle grid at each node's undistorted position, as a displacement.
     std::vector<glm::dvec2> d(std::size_t(columns) * rows);

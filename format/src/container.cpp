@@ -1,5 +1,6 @@
 // The public container entry points: validate, then write atomically; load, then throw or report.
 #include "conus/format/container.h"
+#include "conus/core/atomic_file.h"
 #include "exr_io.h"
 
 namespace conus::format {
@@ -26,16 +27,25 @@ void writeConusFile(const std::string& path, const ConusFile& file) {
     out.commit();
 }
 
-ConusFile readConusFile(const std::string& path, const ReadLimits& limits) {
+namespace {
+
+ConusFile load(const std::string& path, const ReadLimits& limits, bool readPixels) {
     ConusFile file;
-    const detail::LoadResult result = detail::loadConusFile(path, limits, file);
+    const detail::LoadResult result = detail::loadConusFile(path, limits, readPixels, file);
     if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.summary());
     return file;
 }
 
+}  // namespace
+
+ConusFile readConusFile(const std::string& path, const ReadLimits& limits) { return load(path, limits, true); }
+
+ConusFile readConusHeader(const std::string& path, const ReadLimits& limits) { return load(path, limits, false); }
+
 ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits) {
+    // The rules concern headers, the map and the chunk tables, never pixel values: pixels are not read.
     ConusFile file;
-    return detail::loadConusFile(path, limits, file).report;
+    return detail::loadConusFile(path, limits, false, file).report;
 }
 
 }  // namespace conus::format

@@ -32,69 +32,207 @@
 #include <system_error>
 
 #include "header_model.h"
+#include "header_scan.h"
 
 namespace conus::format::detail {
 namespace {
 
-// ---- Core pre-check ----------------------------------------------------------------------------
-// OpenEXR's C core parses headers defensively (its validation.c checks every window, channel and
-// attribute) without allocating chunk tables, so hostile headers are refused here before the C++
-// library, which trusts more, ever sees them. The C++ library then reads the offset table of each
-// part: a part needing more 8-byte offsets than the file has bytes is truncated or lying.
+// ---- Before OpenEXR reads a header -------------------------------------------------------------
+// Three readers look at each header, in this order, and the file reaches the next only if the one
+// before accepts it:
+// 1. scanHeaders (header_scan.cpp) walks the raw bytes: every attribute's size inside the file and
+//    within the caps (limits.h), and the values whose C++ reader ignores the declared size
+//    (chlist, preview, stringvector) exactly as long as declared. This is where the attribute
+//    caps apply, before anything is allocated: OpenEXR 3.1's C core has no hook for a cap (its
+//    context initializer offers read and size functions only, and a smaller size would break
+//    chunk reads), and its C++ library allocates whatever a size says (a 1.9 GB string in a
+//    4 KB file cost 13 s and 2 GB). A chlist one byte short of its terminator made the C core end
+//    the header where the C++ library went on to read a 1.8 GB string the core never saw.
+// 2. OpenEXR's C core parses defensively (validation.c checks every window, channel and
+//    attribute against the file) and allocates no pixels; any error it reports refuses the file.
+// 3. The C++ library, which trusts more, reads the headers the first two agree on.
 
-void silentCoreError(exr_const_context_t ctx, exr_result_t code, const char* msg) {
+void recordCoreError(exr_const_context_t ctx, exr_result_t code, const char* msg) {
     void* user = nullptr;
     if (exr_get_user_data(ctx, &user) == EXR_ERR_SUCCESS && user != nullptr) {
-        auto* last = static_cast<std::string*>(user);
-        if (last->empty()) *last = msg ? msg : exr_get_default_error_message(code);
+        auto* first = static_cast<std::string*>(user);
+        if (first->empty()) *first = msg ? msg : exr_get_default_error_message(code);
     }
 }
 
-// Empty on success, else what is wrong.
-std::string coreCheck(const std::string& path, std::uintmax_t fileSize) {
-    std::string message;
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = &silentCoreError;
-    init.user_data = &message;
-    init.flags = EXR_CONTEXT_FLAG_SILENT_HEADER_PARSE;
-    exr_context_t ctx = nullptr;
-    exr_result_t rv = exr_start_read(&ctx, path.c_str(), &init);
-    if (rv != EXR_ERR_SUCCESS) {
-        if (ctx) exr_finish(&ctx);
-        return message.empty() ? exr_get_default_error_message(rv) : message;
+// An open C core context. The core reports some header errors (an attribute larger than the
+// file, say) through the handler and still returns success, skipping the attribute; CoNUS refuses
+// such a file, so `error` holds the first message the core reported, whatever it returned.
+class CoreFile {
+public:
+    explicit CoreFile(const std::string& path) {
+        exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+        init.error_handler_fn = &recordCoreError;
+        init.user_data = &m_error;
+        // A damaged offset table is refused, not rebuilt by scanning the file.
+        init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+        const exr_result_t rv = exr_start_read(&m_ctx, path.c_str(), &init);
+        if (rv != EXR_ERR_SUCCESS && m_error.empty()) m_error = exr_get_default_error_message(rv);
     }
+    ~CoreFile() {
+        if (m_ctx) exr_finish(&m_ctx);
+    }
+    CoreFile(const CoreFile&) = delete;
+    CoreFile& operator=(const CoreFile&) = delete;
+
+    exr_const_context_t ctx() const { return m_ctx; }
+    const std::string& error() const { return m_error; }
+
+private:
+    exr_context_t m_ctx = nullptr;
+    std::string m_error;
+};
+
+// A refusal: the rule it breaks and how readConusFile throws.
+struct Problem {
+    int rule = 1;
+    ErrorCode code = ErrorCode::Corrupt;
+    std::string message;  // empty: no problem
+};
+
+std::string partLabel(exr_const_context_t ctx, int p) {
+    const char* name = nullptr;
+    if (exr_get_name(ctx, p, &name) == EXR_ERR_SUCCESS && name) return "part " + std::to_string(p) + " (`" + name + "`)";
+    return "part " + std::to_string(p);
+}
+
+// The header-level checks on the core's parse: display windows (V15), storage, chunk counts the
+// file can hold.
+Problem checkCoreHeaders(exr_const_context_t ctx, std::uintmax_t fileSize) {
     int parts = 0;
-    rv = exr_get_count(ctx, &parts);
-    std::string result;
-    if (rv != EXR_ERR_SUCCESS || parts < 1) result = "no parts";
+    if (exr_get_count(ctx, &parts) != EXR_ERR_SUCCESS || parts < 1) return {1, ErrorCode::Corrupt, "no parts"};
     exr_attr_box2i_t firstDisplay{};
-    for (int p = 0; p < parts && result.empty(); ++p) {
+    for (int p = 0; p < parts; ++p) {
         exr_attr_box2i_t display{};
         if (exr_get_display_window(ctx, p, &display) == EXR_ERR_SUCCESS) {
             if (p == 0) firstDisplay = display;
             if (std::memcmp(&display, &firstDisplay, sizeof display) != 0) {
                 // OpenEXR's C++ library refuses such a file with a vague message; name the rule.
-                result = "V15: part " + std::to_string(p) + " displayWindow (" + std::to_string(display.min.x) + ", " +
-                         std::to_string(display.min.y) + ") - (" + std::to_string(display.max.x) + ", " +
-                         std::to_string(display.max.y) + ") differs from part 0's (" + std::to_string(firstDisplay.min.x) +
-                         ", " + std::to_string(firstDisplay.min.y) + ") - (" + std::to_string(firstDisplay.max.x) + ", " +
-                         std::to_string(firstDisplay.max.y) + ")";
-                break;
+                return {15, ErrorCode::Corrupt,
+                        "part " + std::to_string(p) + " displayWindow (" + std::to_string(display.min.x) + ", " +
+                            std::to_string(display.min.y) + ") - (" + std::to_string(display.max.x) + ", " +
+                            std::to_string(display.max.y) + ") differs from part 0's (" + std::to_string(firstDisplay.min.x) +
+                            ", " + std::to_string(firstDisplay.min.y) + ") - (" + std::to_string(firstDisplay.max.x) + ", " +
+                            std::to_string(firstDisplay.max.y) + ")"};
             }
         }
         int32_t chunks = 0;
         exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
-        if (exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS) {
-            result = "part " + std::to_string(p) + ": unknown storage";
-        } else if (exr_get_chunk_count(ctx, p, &chunks) != EXR_ERR_SUCCESS || chunks < 0) {
-            result = "part " + std::to_string(p) + ": invalid chunk count";
-        } else if (std::uintmax_t(chunks) * 8 > fileSize) {
-            result = "part " + std::to_string(p) + " needs " + std::to_string(chunks) + " chunk offsets, more than a " +
-                     std::to_string(fileSize) + "-byte file can hold";
+        if (exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS) return {1, ErrorCode::Corrupt, partLabel(ctx, p) + ": unknown storage"};
+        if (exr_get_chunk_count(ctx, p, &chunks) != EXR_ERR_SUCCESS || chunks < 0)
+            return {1, ErrorCode::Corrupt, partLabel(ctx, p) + ": invalid chunk count"};
+        // The C++ library reads every part's offset table (8 bytes a chunk) when it opens the file.
+        if (std::uintmax_t(chunks) * 8 > fileSize) {
+            return {1, ErrorCode::Corrupt,
+                    partLabel(ctx, p) + " needs " + std::to_string(chunks) + " chunk offsets, more than a " +
+                        std::to_string(fileSize) + "-byte file can hold"};
         }
     }
-    exr_finish(&ctx);
-    return result;
+    return {};
+}
+
+// ---- chunk table -------------------------------------------------------------------------------
+// Before any pixel memory is committed, the chunk table and the file size must show that the data
+// can be there: every chunk inside the file, the chunks together no larger than the file, and no
+// chunk declaring more unpacked bytes than its packed bytes can expand to under its compression.
+
+// The largest unpacked / packed ratio each compression can reach (so a declared size beyond it is
+// a lie), rounded up generously:
+// - RLE: a 2-byte run expands to at most 128 bytes (64).
+// - ZIP, ZIPS: deflate expands at most 1032 times; PXR24 also drops float32 to 24 bits (1376).
+// - PIZ: Huffman with run-length codes: 256 16-bit values in >= 10 bits (~410).
+// - B44, B44A: a flat 4x4 block of halves (32 bytes) in 3 bytes (~11).
+// - DWAA, DWAB: DC and RLE data are zlib-compressed after a 64:1 reduction (64 x 1032 = 66048).
+std::uint64_t maxExpansion(exr_compression_t c) {
+    switch (c) {
+        case EXR_COMPRESSION_NONE: return 1;
+        case EXR_COMPRESSION_RLE: return 128;
+        case EXR_COMPRESSION_ZIPS:
+        case EXR_COMPRESSION_ZIP:
+        case EXR_COMPRESSION_PXR24: return 2048;
+        case EXR_COMPRESSION_PIZ: return 1024;
+        case EXR_COMPRESSION_B44:
+        case EXR_COMPRESSION_B44A: return 16;
+        case EXR_COMPRESSION_DWAA:
+        case EXR_COMPRESSION_DWAB: return 131072;
+        default: return 0;
+    }
+}
+
+const char* compressionName(exr_compression_t c) {
+    static const char* const kNames[] = {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"};
+    return c >= 0 && c < EXR_COMPRESSION_LAST_TYPE ? kNames[c] : "unknown";
+}
+
+// Level 0 of part `p` (what CoNUS reads), chunk by chunk.
+Problem checkChunks(exr_const_context_t ctx, int p, std::uintmax_t fileSize) {
+    const std::string label = partLabel(ctx, p);
+    exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
+    exr_compression_t compression = EXR_COMPRESSION_LAST_TYPE;
+    exr_attr_box2i_t dw{};
+    if (exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS || exr_get_compression(ctx, p, &compression) != EXR_ERR_SUCCESS ||
+        exr_get_data_window(ctx, p, &dw) != EXR_ERR_SUCCESS)
+        return {1, ErrorCode::Corrupt, label + ": unreadable storage, compression or data window"};
+    const std::uint64_t ratio = maxExpansion(compression);
+    if (ratio == 0) return {1, ErrorCode::Corrupt, label + ": unknown compression"};
+    const std::int64_t width = std::int64_t{dw.max.x} - dw.min.x + 1, height = std::int64_t{dw.max.y} - dw.min.y + 1;
+    std::uint64_t packedTotal = 0;
+    auto visit = [&](exr_result_t rv, const exr_chunk_info_t& c, const std::string& where) -> Problem {
+        if (rv != EXR_ERR_SUCCESS) return {1, ErrorCode::Corrupt, label + " " + where + ": unreadable chunk (" + exr_get_default_error_message(rv) + ")"};
+        if (c.data_offset > fileSize || c.packed_size > fileSize - c.data_offset) {
+            return {1, ErrorCode::Corrupt,
+                    label + " " + where + ": chunk of " + std::to_string(c.packed_size) + " bytes at offset " +
+                        std::to_string(c.data_offset) + " runs past the end of the " + std::to_string(fileSize) + "-byte file"};
+        }
+        if (c.unpacked_size / ratio > c.packed_size) {
+            return {1, ErrorCode::Corrupt,
+                    label + " " + where + ": chunk declares " + std::to_string(c.unpacked_size) + " bytes of pixels in " +
+                        std::to_string(c.packed_size) + " bytes; " + compressionName(compression) + " expands at most " +
+                        std::to_string(ratio) + " times"};
+        }
+        packedTotal += c.packed_size;
+        return {};
+    };
+    if (storage == EXR_STORAGE_SCANLINE) {
+        int32_t lines = 0;
+        if (exr_get_scanlines_per_chunk(ctx, p, &lines) != EXR_ERR_SUCCESS || lines < 1)
+            return {1, ErrorCode::Corrupt, label + ": invalid scanlines per chunk"};
+        for (std::int64_t y = dw.min.y; y <= dw.max.y; y += lines) {
+            exr_chunk_info_t c{};
+            const exr_result_t rv = exr_read_scanline_chunk_info(ctx, p, static_cast<int>(y), &c);
+            if (Problem problem = visit(rv, c, "scanline " + std::to_string(y)); !problem.message.empty()) return problem;
+        }
+    } else if (storage == EXR_STORAGE_TILED) {
+        uint32_t tw = 0, th = 0;
+        exr_tile_level_mode_t level{};
+        exr_tile_round_mode_t round{};
+        if (exr_get_tile_descriptor(ctx, p, &tw, &th, &level, &round) != EXR_ERR_SUCCESS || tw < 1 || th < 1)
+            return {1, ErrorCode::Corrupt, label + ": invalid tile description"};
+        const std::int64_t tilesX = (width + tw - 1) / tw, tilesY = (height + th - 1) / th;
+        for (std::int64_t ty = 0; ty < tilesY; ++ty) {
+            for (std::int64_t tx = 0; tx < tilesX; ++tx) {
+                exr_chunk_info_t c{};
+                const exr_result_t rv = exr_read_tile_chunk_info(ctx, p, int(tx), int(ty), 0, 0, &c);
+                if (Problem problem = visit(rv, c, "tile (" + std::to_string(tx) + ", " + std::to_string(ty) + ")");
+                    !problem.message.empty())
+                    return problem;
+            }
+        }
+    } else {
+        return {};  // deep parts are never read; the header rules refuse them where they matter
+    }
+    // Chunks do not overlap: together they fit in the file.
+    if (packedTotal > fileSize) {
+        return {1, ErrorCode::Corrupt,
+                label + ": chunks hold " + std::to_string(packedTotal) + " bytes in all, more than the " +
+                    std::to_string(fileSize) + "-byte file"};
+    }
+    return {};
 }
 
 // ---- headers -> HeaderModel ------------------------------------------------------------------
@@ -338,24 +476,31 @@ Imath::M44f toM44(const std::array<float, 16>& a) {
 
 }  // namespace
 
-LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, ConusFile& out) {
+LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool readPixels, ConusFile& out) {
     LoadResult result;
     ValidationReport& r = result.report;
+    auto refuse = [&](const Problem& problem) {
+        r.add(problem.rule, problem.message);
+        result.code = problem.code;
+        return result;
+    };
+    // A FIFO never ends and a device may not either: only regular files are read.
     std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (ec || !std::filesystem::exists(status)) {
+        return refuse({1, ErrorCode::Io, "cannot open " + path + ": " + (ec ? ec.message() : std::string("no such file"))});
+    }
+    if (!std::filesystem::is_regular_file(status)) return refuse({1, ErrorCode::Io, "cannot read " + path + ": not a regular file"});
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
     if (ec || !std::ifstream(path, std::ios::binary)) {
-        r.add(1, "cannot open " + path + (ec ? ": " + ec.message() : std::string()));
-        result.code = ErrorCode::Io;
-        return result;
+        return refuse({1, ErrorCode::Io, "cannot open " + path + (ec ? ": " + ec.message() : std::string())});
     }
-    if (const std::string problem = coreCheck(path, size); !problem.empty()) {
-        if (problem.rfind("V15: ", 0) == 0) {
-            r.add(15, problem.substr(5));
-        } else {
-            r.add(1, "not a readable OpenEXR file: " + problem);
-        }
-        return result;
+    if (const ScanResult scan = scanHeaders(path, size, limits); !scan.problem.empty()) {
+        return refuse({1, scan.code, "not a readable OpenEXR file: " + scan.problem});
     }
+    const CoreFile core(path);
+    if (!core.error().empty()) return refuse({1, ErrorCode::Corrupt, "not a readable OpenEXR file: " + core.error()});
+    if (Problem problem = checkCoreHeaders(core.ctx(), size); !problem.message.empty()) return refuse(problem);
     try {
         Imf::MultiPartInputFile file(path.c_str());
         const HeaderModel model = modelOf(file);
@@ -364,10 +509,31 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, Conu
             result.code = hc.notConus ? ErrorCode::NotConus : hc.limitExceeded ? ErrorCode::LimitExceeded : ErrorCode::Corrupt;
             return result;
         }
-        // Headers passed every rule, so every size below is within limits.
+        // Headers passed every rule, so every size below is within limits; the chunk tables must
+        // still show that the pixels are in the file before memory is committed for them.
+        const PartModel& part = model.parts[model.conusPart];
+        if (readPixels) {
+            const std::int64_t bytes = part.dataWindow.width() * part.dataWindow.height() *
+                                       std::int64_t(part.channels.size()) * std::int64_t(sizeof(float));
+            if (bytes > limits.maxDecodeBytes) {
+                return refuse({4, ErrorCode::LimitExceeded,
+                               "image of " + std::to_string(part.dataWindow.width()) + "x" + std::to_string(part.dataWindow.height()) +
+                                   "x" + std::to_string(part.channels.size()) + " floats takes " + std::to_string(bytes) +
+                                   " bytes, beyond the decode memory limit of " + std::to_string(limits.maxDecodeBytes)});
+            }
+        }
+        for (const int p : {model.conusPart, model.mapPart}) {
+            if (Problem problem = checkChunks(core.ctx(), p, size); !problem.message.empty()) return refuse(problem);
+        }
         ConusFile loaded;
         fillMetadata(model, file.header(model.conusPart), loaded);
-        readImage(file, model, loaded.image);
+        if (readPixels) {
+            readImage(file, model, loaded.image);
+        } else {
+            loaded.image.width = int(part.dataWindow.width());
+            loaded.image.height = int(part.dataWindow.height());
+            for (const ChannelModel& c : part.channels) loaded.image.channels.push_back(c.name);
+        }
         readMap(file, model, loaded.map);
         const ValidationReport grid = validateGrid(loaded.map);
         r.issues.insert(r.issues.end(), grid.issues.begin(), grid.issues.end());

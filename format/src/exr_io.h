@@ -13,10 +13,12 @@ struct LoadResult {
     ErrorCode code = ErrorCode::Corrupt;  // how readConusFile throws when the report is not ok
 };
 
-// Opens `path`, checks the header rules, then (only if they pass) reads pixels and map and checks
-// the map rules. Never throws for bad content: every problem lands in the report. `out` is filled
-// only when the report is ok.
-LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, ConusFile& out);
+// Opens `path` (a regular file only), checks the headers (OpenEXR's C core, the attribute caps,
+// the header rules), then the chunk tables against the file, then (only if all pass) reads the map
+// and, when `readPixels`, the image, and checks the map rules. Never throws for bad content: every
+// problem lands in the report. `out` is filled only when the report is ok; without `readPixels`
+// its image has width, height and channels but no pixels.
+LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool readPixels, ConusFile& out);
 
 // Writes an already validated file into `out` (the caller commits it): throws conus::Error(Io)
 // naming out.destination() on failure.

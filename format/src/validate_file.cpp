@@ -12,9 +12,6 @@ namespace conus::format {
 namespace detail {
 namespace {
 
-constexpr int kMaxChannels = 64;
-constexpr std::int64_t kMaxTileArea = std::int64_t{1} << 24;
-
 std::string num(double value) {
     char buf[48];
     std::snprintf(buf, sizeof buf, "%.9g", value);
@@ -66,9 +63,9 @@ void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport&
         r.add(2, "part `conus` has type `" + part.type + "`, expected scanlineimage or tiledimage");
     }
     if (part.type == "tiledimage" &&
-        (part.tileWidth < 1 || part.tileHeight < 1 || part.tileWidth * part.tileHeight > kMaxTileArea)) {
+        (part.tileWidth < 1 || part.tileHeight < 1 || part.tileWidth * part.tileHeight > kMaxTilePixels)) {
         r.add(2, "part `conus` has tiles of " + std::to_string(part.tileWidth) + "x" + std::to_string(part.tileHeight) +
-                     " pixels; at most " + std::to_string(kMaxTileArea) + " pixels a tile are read");
+                     " pixels; at most " + std::to_string(kMaxTilePixels) + " pixels a tile are read");
     }
     if (!need(m.version, kAttrVersion, "int", 2, r)) return;
     if (m.version.value > kFormatVersion) {
@@ -147,8 +144,9 @@ void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationRepo
     }
     const Box& dw = p.dataWindow;
     const std::int64_t n = dw.width(), rows = dw.height();
-    if (dw.minX != 0 || dw.minY != 0 || n < 2 || rows < 2 || n > 4097 || rows > 4097) {
-        r.add(7, "part `samplingmap` dataWindow " + boxStr(dw) + " must be (0, 0) - (columns-1, rows-1) with columns and rows in [2, 4097]");
+    if (dw.minX != 0 || dw.minY != 0 || n < kMinMapSide || rows < kMinMapSide || n > kMaxMapSide || rows > kMaxMapSide) {
+        r.add(7, "part `samplingmap` dataWindow " + boxStr(dw) + " must be (0, 0) - (columns-1, rows-1) with columns and rows in [" +
+                     std::to_string(kMinMapSide) + ", " + std::to_string(kMaxMapSide) + "]");
     } else if (n > limits.maxMapSide || rows > limits.maxMapSide) {
         r.add(7, "sampling map of " + std::to_string(n) + "x" + std::to_string(rows) + " nodes exceeds the reader's limit of " +
                      std::to_string(limits.maxMapSide) + " a side");

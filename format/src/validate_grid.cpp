@@ -9,8 +9,6 @@
 namespace conus::format {
 namespace {
 
-constexpr int kMinMapSide = 2;
-constexpr int kMaxMapSide = 4097;
 // Each rule reports at most this many problems, then one summary line, so that a 4097² broken
 // grid yields a readable report instead of megabytes.
 constexpr int kMaxMessagesPerRule = 20;

@@ -10,19 +10,23 @@ bool ValidationReport::violates(int rule) const {
     return std::any_of(issues.begin(), issues.end(), [rule](const Issue& i) { return i.rule == rule; });
 }
 
+namespace {
+
+// "V7: message", or "error: message" for rule 0.
+std::string line(const Issue& issue) {
+    return (issue.rule == 0 ? std::string("error: ") : "V" + std::to_string(issue.rule) + ": ") + issue.message;
+}
+
+}  // namespace
+
+void ValidationReport::add(int rule, std::string message, long long count) {
+    std::replace_if(message.begin(), message.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+    issues.push_back({rule, std::move(message), count});
+}
+
 std::string ValidationReport::str() const {
     std::string out;
-    for (const Issue& issue : issues) {
-        if (issue.rule == 0) {
-            out += "error: ";
-        } else {
-            out += 'V';
-            out += std::to_string(issue.rule);
-            out += ": ";
-        }
-        out += issue.message;
-        out += '\n';
-    }
+    for (const Issue& issue : issues) out += (out.empty() ? "" : "; ") + line(issue);
     return out;
 }
 
@@ -33,11 +37,15 @@ long long ValidationReport::problemCount() const {
 }
 
 std::string ValidationReport::summary() const {
+    constexpr std::size_t kShown = 3;  // enough to see what is wrong, short enough for one line
     if (issues.empty()) return "valid";
-    const Issue& first = issues.front();
-    std::string out = first.rule == 0 ? std::string() : "V" + std::to_string(first.rule) + ": ";
-    out += first.message;
-    if (const long long more = problemCount() - first.count; more > 0)
+    std::string out;
+    long long shown = 0;
+    for (std::size_t i = 0; i < issues.size() && i < kShown; ++i) {
+        out += (i ? "; " : "") + line(issues[i]);
+        shown += issues[i].count;
+    }
+    if (const long long more = problemCount() - shown; more > 0)
         out += " (and " + std::to_string(more) + " more problem" + (more == 1 ? "" : "s") + "; `conus validate` lists them)";
     return out;
 }

@@ -548,6 +548,7 @@ format::Image decodeImageGpu(Context& context, const format::Image& conus, const
                              const codec::DecodeOptions& options, GpuTimings* timings) {
     constexpr const char* kWhat = "decodeImageGpu";
     format::checkImage(conus, kWhat);
+    codec::checkDecodeMemory(conus, options.width, options.height);
     const codec::View& view = options.view;
     if (!std::isfinite(view.u0) || !std::isfinite(view.u1) || !std::isfinite(view.v0) || !std::isfinite(view.v1) ||
         view.u0 == view.u1 || view.v0 == view.v1 || std::abs(view.u1 - view.u0) > 1e6 ||

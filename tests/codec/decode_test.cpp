@@ -194,5 +194,20 @@ TEST(Decode, RejectsBadArguments) {
     EXPECT_THROW(resizeBilinear(format::Image{}, {}, 4, 4), conus::Error);
 }
 
+TEST(Decode, MemoryIsCheckedBeforeAllocating) {
+    // A 24x16 image whose source is 65536x16384 (a hostile reproducer): the frame alone is 12 GB.
+    const format::Image conus = noise(24, 16, {"R", "G", "B"});
+    const SamplingMap map = SamplingMap::identity(2, 2);
+    try {
+        decodeImage(conus, map, viewOf({}, 65536, 16384));
+        FAIL() << "decoded";
+    } catch (const conus::Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::LimitExceeded);
+        EXPECT_NE(std::string(e.what()).find("decode memory limit"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW(checkDecodeMemory(conus, 4096, 4096));
+    EXPECT_THROW(checkDecodeMemory(conus, 64, 64, 1000), conus::Error);
+}
+
 }  // namespace
 }  // namespace conus::codec

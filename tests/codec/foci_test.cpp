@@ -156,6 +156,26 @@ TEST(Foci, RejectsBadFoci) {
     EXPECT_EQ(code({0.5, 0.5, 0.1, 2}, o), ErrorCode::InvalidArgument);
 }
 
+TEST(Foci, AGridTooCoarseForAFocusIsRefusedNamingOneThatHoldsIt) {
+    const std::vector<Focus> foci{{0.5, 0.5, 0.1, 4}};
+    FociOptions options;
+    options.columns = options.rows = 2;  // always the identity: the focus would be recorded, not made
+    const SamplingMap coarse = buildFociMap(foci, options);
+    EXPECT_NEAR(reachedMagnification(coarse, foci)[0], 1.0, 1e-9);
+    try {
+        checkFociHeld(coarse, foci, options);
+        FAIL() << "accepted";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+        EXPECT_NE(std::string(e.what()).find("a 2x2 grid is too coarse for focus 0.5,0.5,0.1,4"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("5 nodes a side"), std::string::npos) << e.what();
+    }
+    options.columns = options.rows = 65;
+    const SamplingMap fine = buildFociMap(foci, options);
+    EXPECT_GT(reachedMagnification(fine, foci)[0], 3.5);
+    EXPECT_NO_THROW(checkFociHeld(fine, foci, options));
+}
+
 TEST(Foci, ParseFocus) {
     const Focus f = parseFocus("0.42,0.31,0.08,4");
     EXPECT_DOUBLE_EQ(f.u, 0.42);

@@ -3,14 +3,19 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <random>
 #include <string>
+#include <thread>
 
 #include "conus/codec/density_map.h"
 #include "conus/codec/foci.h"
 #include "conus/core/error.h"
+#include "conus/format/container.h"
+#include "sanitizers.h"
 
 namespace conus::codec {
 namespace {
@@ -359,6 +364,98 @@ TEST(SamplingMap, GridRoundTripCopyAndMove) {
     format::GridNodes bad = map.toGrid();
     bad.xy.pop_back();
     EXPECT_THROW(SamplingMap::fromGrid(bad), Error);
+}
+
+
+// ---- the inverse's index: bounded memory whatever the map's shape ------------------------------
+
+std::int64_t indexBudget(const SamplingMap& map) {
+    const std::int64_t cells = std::int64_t{map.columns() - 1} * (map.rows() - 1);
+    return std::min(kMaxIndexBytes, kIndexBytesPerCell * cells + kIndexBytesBase);
+}
+
+// The shape of the hostile maps in ../shared/data/hostile, at any size: even rows crowd into the
+// left strip [0, (n-2) eps], odd rows into the right strip, so every cell is a sliver across the
+// whole width (bounding boxes cover the plane n times over) and the cells next to the right edge
+// taper to a point (a root of the inverse's quadratic where the patch folds).
+SamplingMap zigzagMap(int n, int m) {
+    const double eps = 0.01 / (n - 2);
+    std::vector<glm::vec2> nodes(std::size_t(n) * m);
+    for (int j = 0; j < m; ++j)
+        for (int i = 0; i < n; ++i) {
+            double x = j % 2 == 0 ? i * eps : (i == 0 ? 0.0 : 1.0 - (n - 1 - i) * eps);
+            if (i == n - 1) x = 1.0;
+            if (j == m - 1) x = double(i) / (n - 1);
+            nodes[std::size_t(j) * n + i] = {float(x), float(double(j) / (m - 1))};
+        }
+    return SamplingMap(n, m, std::move(nodes));
+}
+
+TEST(SamplingMapIndex, OrdinaryMapsKeepTwoBucketsPerCell) {
+    // About 9 cells listed and 4 bucket starts per cell at 2x2 buckets per cell: 52 bytes a cell.
+    for (int side : {17, 65, 257}) {
+        const SamplingMap map = SamplingMap::identity(side, side);
+        const double perCell = double(map.indexBytes()) / ((side - 1) * (side - 1));
+        EXPECT_GT(perCell, 45.0) << side;
+        EXPECT_LE(std::int64_t(map.indexBytes()), indexBudget(map)) << side;
+    }
+    std::vector<Focus> foci{{0.42, 0.31, 0.08, 4}, {0.7, 0.65, 0.1, 3}};
+    FociOptions options;
+    options.columns = options.rows = 257;
+    const SamplingMap map = buildFociMap(foci, options);
+    EXPECT_GT(double(map.indexBytes()) / (256 * 256), 45.0);
+}
+
+TEST(SamplingMapIndex, SliverCellsStayWithinBudgetAndInvertExactly) {
+    std::mt19937 rng(15);
+    for (int n : {5, 17, 65, 257}) {
+        const SamplingMap map = zigzagMap(n, n);
+        EXPECT_LE(std::int64_t(map.indexBytes()), indexBudget(map)) << n;
+        const RoundTrip r = roundTrip(map, rng, 2000);
+        EXPECT_LT(r.backward, 1e-9) << n;
+    }
+}
+
+TEST(SamplingMapIndex, TaperedCellInvertsToTheRootThatSolvesIt) {
+    // Regression: on the edge shared by two tapered cells the closed form picked the root on the
+    // fold line (b + d t = 0), where s is undetermined, and returned s = 0.5.
+    const SamplingMap map = zigzagMap(257, 257);
+    for (const glm::dvec2 q : {glm::dvec2(0.5, 0.5), glm::dvec2(0.1, 0.9), glm::dvec2(0.3, 0.3)}) {
+        const glm::dvec2 back = map.distort(map.undistort(q));
+        EXPECT_NEAR(back.x, q.x, 1e-12);
+        EXPECT_NEAR(back.y, q.y, 1e-12);
+    }
+}
+
+TEST(SamplingMapIndex, BuiltOnFirstUseOnceAcrossThreads) {
+    const SamplingMap map = zigzagMap(65, 65);
+    const SamplingMap copy = map;  // not built yet: the copy builds its own
+    std::vector<glm::dvec2> results(8);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 8; ++t)
+        threads.emplace_back([&, t] { results[t] = map.undistort({0.125 * t + 0.01, 0.5}); });
+    for (std::thread& t : threads) t.join();
+    for (int t = 0; t < 8; ++t) {
+        EXPECT_NEAR(map.distort(results[t]).x, 0.125 * t + 0.01, 1e-12);
+        EXPECT_EQ(copy.undistort({0.125 * t + 0.01, 0.5}), results[t]);
+    }
+    const SamplingMap built = map;  // built: shared
+    EXPECT_EQ(built.indexBytes(), map.indexBytes());
+}
+
+TEST(SamplingMapIndex, HostileMapsFromFiles) {
+    const std::filesystem::path folder = std::filesystem::path(CONUS_SHARED_DATA) / "hostile";
+    if (!std::filesystem::is_directory(folder)) GTEST_SKIP() << "shared data not found at " << folder;
+    std::mt19937 rng(15);
+    // 900x900: the index's 32-bit counts overflowed (heap overflow); 257x257: 575 MB.
+    for (const char* name : {"samplingmap-index-uint32-overflow-n900.exr", "samplingmap-index-blowup-n257-575MB.exr"}) {
+        const auto start = std::chrono::steady_clock::now();
+        const SamplingMap map = SamplingMap::fromGrid(format::readConusHeader((folder / name).string()).map);
+        EXPECT_LE(std::int64_t(map.indexBytes()), indexBudget(map)) << name;
+        EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0 * conus::testing::kTimeScale)
+            << name;
+        EXPECT_LT(roundTrip(map, rng, 200).backward, 1e-9) << name;
+    }
 }
 
 }  // namespace

@@ -122,10 +122,11 @@ TEST(ValidationReport, StrAndViolates) {
     ValidationReport r;
     EXPECT_TRUE(r.ok());
     r.add(3, "bad channel");
-    r.add(0, "unreadable");
+    r.add(0, "unreadable\nfrom a library");
     EXPECT_TRUE(r.violates(3));
     EXPECT_FALSE(r.violates(4));
-    EXPECT_EQ(r.str(), "V3: bad channel\nerror: unreadable\n");
+    // One line, whatever the messages held: errors built from a report never span lines.
+    EXPECT_EQ(r.str(), "V3: bad channel; error: unreadable from a library");
 }
 
 TEST(Image, MakeImageAndChannelIndex) {

@@ -5,6 +5,8 @@
 // pixels whose centre lies outside the image show the background (0 in every channel).
 #pragma once
 
+#include <cstdint>
+
 #include "conus/codec/sampling_map.h"
 #include "conus/core/error.h"
 #include "conus/format/image.h"
@@ -27,6 +29,12 @@ struct DecodeOptions {
     int threads = 0;
     ProgressFn progress;
 };
+
+// Throws conus::Error(LimitExceeded) when decoding `conus` (only its size and channels are read)
+// to a width x height frame would hold more than `maxBytes` of pixels, the CoNUS image's and the
+// frame's together, as float (limits.h: kMaxDecodeBytes). decodeImage checks this before it
+// allocates; other decoders (the GPU one) call it too.
+void checkDecodeMemory(const format::Image& conus, int width, int height, std::int64_t maxBytes = kMaxDecodeBytes);
 
 format::Image decodeImage(const format::Image& conus, const SamplingMap& map, const DecodeOptions& options);
 

@@ -34,6 +34,16 @@ struct FociOptions {
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r <= 0 or k < 1 or k > 64.
 SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options = {});
 
+// The linear magnification `map` reaches at each focus centre: the square root of its density
+// there over its lowest density (which stands for "far from every focus"). 1 for the identity.
+std::vector<double> reachedMagnification(const SamplingMap& map, std::span<const Focus> foci);
+
+// Throws conus::Error(InvalidArgument) when `map` (built for `foci` with `options`) reaches less
+// than half of some focus's extra magnification (below 1 + (k - 1) / 2), naming the smallest grid
+// of 2^j + 1 nodes a side (up to 257) that does: a grid too coarse for a focus ignores it (a 2x2
+// grid is always the identity), and a file would record a focus its map does not have.
+void checkFociHeld(const SamplingMap& map, std::span<const Focus> foci, const FociOptions& options);
+
 // The target density (before normalization) of a set of foci at undistorted p.
 double fociDensity(std::span<const Focus> foci, double aspect, double u, double v);
 

@@ -9,6 +9,7 @@
 // Coordinates are normalized: u right, v down, origin top-left. Points outside [0,1]^2 are clamped.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <vector>
 
@@ -32,8 +33,12 @@ public:
 
     // Equation 1: undistorted (u,v) -> distorted (u_d,v_d).
     glm::dvec2 distort(glm::dvec2 p) const;
-    // The exact inverse of distort: distorted -> undistorted, to 1e-9.
+    // The exact inverse of distort: distorted -> undistorted, to 1e-9. Its index is built on the
+    // first call (thread-safe) and is bounded whatever the map's shape (limits.h: kIndexBytesPerCell
+    // a cell plus kIndexBytesBase, at most kMaxIndexBytes); maps never undistorted never build it.
     glm::dvec2 undistort(glm::dvec2 pd) const;
+    // Bytes held by undistort's index (building it if needed): for tests and `conus info`.
+    std::size_t indexBytes() const;
     // d distort / d p at undistorted p; column 0 is d/du, column 1 is d/dv.
     glm::dmat2 jacobian(glm::dvec2 p) const;
     // Sampling density at undistorted p: det(jacobian). 1 everywhere for the identity; d means the
@@ -50,11 +55,16 @@ public:
     ~SamplingMap();
 
 private:
-    struct Index;  // bucket grid for undistort
+    struct Index;      // bucket grid for undistort
+    struct LazyIndex;  // builds it once, on first use
+    const Index& index() const;
+
     int m_columns = 0;
     int m_rows = 0;
     std::vector<glm::vec2> m_nodes;
-    std::unique_ptr<Index> m_index;
+    std::vector<glm::dvec2> m_dnodes;  // the nodes in double: what distort and undistort compute with
+    double m_invCellsX = 1.0, m_invCellsY = 1.0;
+    std::unique_ptr<LazyIndex> m_lazy;
 };
 
 }  // namespace conus::codec

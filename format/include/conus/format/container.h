@@ -6,9 +6,11 @@
 // Rules shared by the functions below:
 // - writeConusFile validates first and writes nothing for an invalid file; it writes through
 //   conus::AtomicFile (core/atomic_file.h), so no half-written file is ever left.
-// - readConusFile checks every size against ReadLimits before allocating, and throws conus::Error:
-//   NotConus for an EXR without a `conus` part, Corrupt for a damaged file or a broken V-rule,
-//   LimitExceeded for sizes beyond the limits, Io when the file cannot be opened.
+// - readConusFile reads regular files only. It checks every size against ReadLimits (limits.h)
+//   before allocating, and the chunk tables against the file's size before committing memory for
+//   pixels; it throws conus::Error: NotConus for an EXR without a `conus` part, Corrupt for a
+//   damaged file or a broken V-rule, LimitExceeded for sizes beyond the limits, Io when the file
+//   cannot be opened or is not a regular file. Messages are one line.
 #pragma once
 
 #include <array>
@@ -21,6 +23,7 @@
 #include "conus/core/color.h"
 #include "conus/core/error.h"
 #include "conus/format/image.h"
+#include "conus/format/limits.h"
 #include "conus/format/validation.h"
 
 namespace conus::format {
@@ -87,14 +90,15 @@ struct ConusFile {
     std::string software;  // free text; the writer fills "conus <version>" when empty
 };
 
-struct ReadLimits {
-    std::int64_t maxPixels = kMaxImagePixels;  // CoNUS image pixels
-    int maxMapSide = 4097;                     // sampling-map nodes per side
-    int maxChannels = 64;
-};
+// The caps readConusFile checks before allocating (limits.h; a caller may lower them).
+using ReadLimits = conus::Limits;
 
 void writeConusFile(const std::string& path, const ConusFile& file);
 ConusFile readConusFile(const std::string& path, const ReadLimits& limits = {});
+// Everything readConusFile reads but the CoNUS image's pixels (what `conus info` and `validate`
+// need): the image has its width, height and channels and no pixels. The same checks run, the
+// chunk tables included, so a file this accepts does hold its pixel data's bytes.
+ConusFile readConusHeader(const std::string& path, const ReadLimits& limits = {});
 
 // Every violated rule of the file at `path` (never throws for bad content).
 ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits = {});

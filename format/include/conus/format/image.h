@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "conus/format/limits.h"
+
 namespace conus::format {
 
 struct Image {
@@ -27,9 +29,10 @@ struct Image {
     int channelIndex(const std::string& name) const;
 };
 
-// Largest image any CoNUS library allocates: 2^16 pixels a side, 2^30 pixels in all.
-inline constexpr int kMaxImageSide = 1 << 16;
-inline constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 30;
+// Largest image any CoNUS library allocates (limits.h states them; named here too for callers
+// that write format::kMaxImageSide).
+using conus::kMaxImageSide;
+using conus::kMaxImagePixels;
 
 // Channel names in the order people read them: R, G, B, Y, A, Z, then the rest as given (OpenEXR
 // stores them sorted: B, G, R).

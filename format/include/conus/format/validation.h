@@ -19,12 +19,15 @@ struct ValidationReport {
 
     bool ok() const { return issues.empty(); }
     bool violates(int rule) const;
-    void add(int rule, std::string message, long long count = 1) { issues.push_back({rule, std::move(message), count}); }
+    // Line breaks in the message (a library's text may hold some) become spaces. `count` is the
+    // number of problems the issue stands for (N for a capped rule's "... and N more" line).
+    void add(int rule, std::string message, long long count = 1);
     // Every problem, counting the ones a capped rule summed up in "... and N more".
     long long problemCount() const;
-    // One line: the first issue, then how many more problems there are.
+    // One line for an error message: the first few issues, "V5: <message>; V6: <message>", then
+    // how many more problems there are.
     std::string summary() const;
-    // One line per issue: "V7: <message>".
+    // Every issue on one line, "V7: <message>; V9: <message>" (rule 0 reads "error: ...").
     std::string str() const;
 };
 

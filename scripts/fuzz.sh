@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer harnesses (tests/fuzz/fuzz_*.cpp) with clang, AddressSanitizer and
+# UndefinedBehaviorSanitizer into build-fuzz/ and runs each in turn for SECONDS (default 60), one
+# process at a time, on its seeds (tests/fuzz/corpus/<harness>), the shared damaged and hostile
+# files, and the dictionary (tests/fuzz/conus.dict), inputs of at most 16 KB (the seeds are a few
+# KB; the large hostile maps are replayed by ctest). Inputs that reach new code are kept in
+# build-fuzz/corpus/<harness>/ between runs. A crash, a leak, a timeout or a broken check stops
+# that harness, leaves the input in build-fuzz/artifacts/ and makes the script fail; reproduce it
+# with build-fuzz/bin/fuzz_<harness> <file>, then add the file to the harness's seeds.
+# Usage: scripts/fuzz.sh [SECONDS] [HARNESS...]   e.g. nice -n 10 scripts/fuzz.sh 1800 container
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-60}"
+shift $(($# > 0 ? 1 : 0))
+
+# clang and its sanitizer and libFuzzer runtimes: a fast no-op when present (as scripts/setup.sh).
+missing=()
+for p in clang-14 libclang-rt-14-dev; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "fuzz: installing ${missing[*]}"
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang-14 \
+  -DCMAKE_CXX_COMPILER=clang++-14 -DCONUS_FUZZ=ON "${launcher[@]}" >/dev/null
+cmake --build build-fuzz --parallel "${CONUS_FUZZ_JOBS:-$(nproc)}"
+
+harnesses=("$@")
+if ((${#harnesses[@]} == 0)); then
+  for binary in build-fuzz/bin/fuzz_*; do harnesses+=("$(basename "$binary" | sed 's/^fuzz_//')"); done
+fi
+shared=../shared/data
+mkdir -p build-fuzz/artifacts
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=0}"
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+status=0
+summary=()
+total=0
+for name in "${harnesses[@]}"; do
+  mkdir -p "build-fuzz/corpus/$name"
+  corpora=("build-fuzz/corpus/$name" "tests/fuzz/corpus/$name")
+  for extra in "$shared/exr/damaged" "$shared/hostile"; do [ -d "$extra" ] && corpora+=("$extra"); done
+  log="build-fuzz/$name.log"
+  echo "fuzz: $name for ${seconds} s (log: $log)"
+  set +e
+  "build-fuzz/bin/fuzz_$name" -max_total_time="$seconds" -dict=tests/fuzz/conus.dict -timeout=10 -rss_limit_mb=2048 -max_len=16384 \
+    -print_final_stats=1 -artifact_prefix="build-fuzz/artifacts/$name-" "${corpora[@]}" >"$log" 2>&1
+  rc=$?
+  set -e
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+  execs=${execs:-0}
+  total=$((total + execs))
+  if [ "$rc" -ne 0 ]; then
+    status=1
+    summary+=("$(printf '%-14s %12s execs %8s execs/s  FAILED (rc %d): %s' "$name" "$execs" "${rate:-?}" "$rc" \
+      "$(grep -m1 -E 'ERROR|fuzz check failed|runtime error' "$log" || echo "see $log")")")
+  else
+    summary+=("$(printf '%-14s %12s execs %8s execs/s  ok' "$name" "$execs" "${rate:-?}")")
+  fi
+done
+printf '%s\n' "${summary[@]}"
+echo "fuzz: $total executions in all"
+exit $status

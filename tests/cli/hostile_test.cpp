@@ -1,0 +1,292 @@
+// The hostile reproducers of ../shared/data/hostile (and other inputs that never end or lie)
+// through the real `conus` binary: each is refused with one line `conus <cmd>: <reason>` naming
+// the rule where one is broken, or handled, within a second (plus the ~0.5 s a start costs) and
+// bounded memory. The small reproducers are committed as fuzz seeds, so most cases never skip.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "sanitizers.h"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Outcome {
+    int exitCode = -1;
+    std::string out, err;
+    double seconds = 0;
+    long peakKb = 0;  // the child's peak resident memory
+};
+
+std::string slurp(const fs::path& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+// stderr's lines, without the progress lines commands print while they work.
+std::vector<std::string> errorLines(const std::string& err) {
+    std::vector<std::string> lines;
+    std::stringstream in(err);
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty() && !contains(line, " done (")) lines.push_back(line);
+    return lines;
+}
+
+class Hostile : public ::testing::Test {
+protected:
+    void SetUp() override {
+        m_dir = fs::temp_directory_path() /
+                ("conus-hostile-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
+                 std::to_string(::getpid()));
+        fs::remove_all(m_dir);
+        fs::create_directories(m_dir);
+    }
+    void TearDown() override { fs::remove_all(m_dir); }
+
+    // Runs conus with `args` (no shell), stdin from /dev/null, measuring wall time and peak memory
+    // of that one child (wait4), killed after 60 s so a hang fails instead of blocking the suite.
+    Outcome run(const std::vector<std::string>& args) {
+        const std::string out = (m_dir / "stdout.txt").string(), err = (m_dir / "stderr.txt").string();
+        std::vector<std::string> all{"timeout", "60", std::string(CONUS_BIN_DIR) + "/conus"};
+        all.insert(all.end(), args.begin(), args.end());
+        std::vector<char*> argv;
+        for (std::string& a : all) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        posix_spawn_file_actions_t actions;
+        posix_spawn_file_actions_init(&actions);
+        posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+        posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        Outcome r;
+        const auto start = std::chrono::steady_clock::now();
+        pid_t pid = 0;
+        if (posix_spawnp(&pid, "timeout", &actions, nullptr, argv.data(), environ) != 0) {
+            posix_spawn_file_actions_destroy(&actions);
+            ADD_FAILURE() << "cannot start conus";
+            return r;
+        }
+        int status = 0;
+        rusage usage{};
+        ::wait4(pid, &status, 0, &usage);
+        posix_spawn_file_actions_destroy(&actions);
+        r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        r.peakKb = usage.ru_maxrss;
+        r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        r.out = slurp(out);
+        r.err = slurp(err);
+        return r;
+    }
+
+    std::string path(const std::string& name) const { return (m_dir / name).string(); }
+
+    // A committed copy of a small reproducer, or the shared one.
+    static std::string reproducer(const std::string& name) {
+        const fs::path seed = fs::path(CONUS_FUZZ_CORPUS) / "container" / ("hostile-" + name);
+        if (fs::exists(seed)) return seed.string();
+        return (fs::path(CONUS_SHARED_DATA) / "hostile" / name).string();
+    }
+
+    // Refused: exit 1, the last stderr line is the one error line of `command`, holding `reason`.
+    void expectRefused(const Outcome& r, const std::string& command, const std::string& reason, int exitCode = 1) {
+        EXPECT_EQ(r.exitCode, exitCode) << r.err;
+        const std::vector<std::string> lines = errorLines(r.err);
+        ASSERT_FALSE(lines.empty()) << "no error line";
+        EXPECT_EQ(lines.size(), 1u) << r.err;
+        EXPECT_EQ(lines.back().rfind("conus " + command + ": ", 0), 0u) << lines.back();
+        EXPECT_TRUE(contains(lines.back(), reason)) << lines.back();
+    }
+
+    // Handled within a second (plus the start) and with no more than `maxMb` of peak memory.
+    static void expectBounded(const Outcome& r, long maxMb = 700) {
+        EXPECT_LT(r.seconds, 2.0 * conus::testing::kTimeScale);
+        EXPECT_LT(r.peakKb / 1024, maxMb * conus::testing::kMemoryScale);
+    }
+
+    fs::path m_dir;
+};
+
+#define CONUS_REQUIRE(file)                                                                   \
+    do {                                                                                      \
+        if (!fs::exists(file)) GTEST_SKIP() << "shared data not found: " << (file);           \
+    } while (0)
+
+TEST_F(Hostile, HugeStringAttributeIsRefusedAtOnce) {
+    const std::string file = reproducer("oom-string-attr-1.9GB.exr");
+    Outcome r = run({"validate", file});
+    expectRefused(r, "validate", "not a valid CoNUS file (1 problem)");
+    EXPECT_TRUE(contains(r.out, ": V1: not a readable OpenEXR file: ") && contains(r.out, "declares 1929379846 bytes")) << r.out;
+    expectBounded(r, 400);
+    r = run({"info", file});
+    expectRefused(r, "info", "V1: not a readable OpenEXR file");
+    expectBounded(r, 400);
+}
+
+TEST_F(Hostile, DeclaredWindowWithoutDataIsRefusedBeforeAllocating) {
+    const std::string file = reproducer("dw_32768x32768_rgb_dwab.exr");
+    Outcome r = run({"info", file});
+    expectRefused(r, "info", "V1: part 0 (`conus`) scanline 0: chunk declares 50331648 bytes of pixels in 144 bytes");
+    expectBounded(r, 400);
+    r = run({"decode", file, "-o", path("x.png"), "--size", "64x64"});
+    expectRefused(r, "decode", "V4: image of 32768x32768x3 floats");
+    expectBounded(r, 400);
+    EXPECT_FALSE(fs::exists(path("x.png")));
+}
+
+TEST_F(Hostile, HugeTiledPartIsRefused) {
+    const Outcome r = run({"info", reproducer("tiled_65536x16384_tile_4096_64ch.exr")});
+    expectRefused(r, "info", "V1: part 0 (`conus`) tile (0, 0)");
+    expectBounded(r, 400);
+}
+
+TEST_F(Hostile, SourceSizedDecodeBeyondTheMemoryLimitIsRefused) {
+    const std::string file = reproducer("source_65536x16384.exr");
+    Outcome r = run({"decode", file, "-o", path("x.png")});
+    expectRefused(r, "decode", "beyond the decode memory limit of 8589934592; give a smaller --size");
+    expectBounded(r, 400);
+    r = run({"decode", file, "-o", path("y.png"), "--size", "64x16"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+}
+
+TEST_F(Hostile, LargeMapsDecodeWithBoundedMemory) {
+    // 900x900 nodes: SIGSEGV in the inverse's index; 257x257: 575 MB for a 300x200 view.
+    for (const char* name : {"samplingmap-index-uint32-overflow-n900.exr", "samplingmap-index-blowup-n257-575MB.exr"}) {
+        const std::string file = (fs::path(CONUS_SHARED_DATA) / "hostile" / name).string();
+        CONUS_REQUIRE(file);
+        Outcome r = run({"decode", file, "-o", path("view.png")});
+        EXPECT_EQ(r.exitCode, 0) << name << ": " << r.err;
+        EXPECT_TRUE(contains(r.out, "300x200")) << r.out;
+        expectBounded(r, 450);
+        r = run({"info", file});
+        EXPECT_EQ(r.exitCode, 0) << name << ": " << r.err;
+        expectBounded(r, 450);
+        // Encoding through the map undistorts: the index is built, within its budget. (The file's
+        // own image, 24x16, is the source.)
+        r = run({"encode", file, "--map", file, "-o", path("again.exr"), "--size", "24x16", "--backend", "cpu"});
+        EXPECT_EQ(r.exitCode, 0) << name << ": " << r.err;
+        expectBounded(r, 450);
+    }
+}
+
+TEST_F(Hostile, LyingNpzIsRefusedBeforeAllocating) {
+    const std::string file = (fs::path(CONUS_SHARED_DATA) / "hostile" / "npz-lying-size-4GB.npz").string();
+    CONUS_REQUIRE(file);
+    const Outcome r = run({"heightfield", "encode", file, "-o", path("t.exr"), "--size", "32x32"});
+    expectRefused(r, "heightfield", "claims 4294967280 bytes from 73 compressed bytes");
+    EXPECT_TRUE(contains(r.err, "deflate expands at most 1032 times")) << r.err;
+    expectBounded(r, 400);
+    EXPECT_FALSE(fs::exists(path("t.exr")));
+}
+
+TEST_F(Hostile, NpyShapesMustBePositiveWholeNumbers) {
+    // "(-4, 4)" was read as 4x4; an overflowing dimension threw std::out_of_range.
+    for (const char* shape : {"(-4, 4)", "(4, 99999999999999999999)", "(4.5, 4)"}) {
+        std::string header = std::string("{'descr': '<f4', 'fortran_order': False, 'shape': ") + shape + ", }";
+        header.resize(118, ' ');
+        header += '\n';
+        std::ofstream out(path("dem.npy"), std::ios::binary);
+        out << "\x93NUMPY" << char(1) << char(0) << char(header.size() & 0xff) << char(header.size() >> 8) << header
+            << std::string(64, '\0');
+        out.close();
+        const Outcome r = run({"heightfield", "encode", path("dem.npy"), "-o", path("t.exr"), "--size", "16x16"});
+        expectRefused(r, "heightfield", "shape");
+    }
+}
+
+TEST_F(Hostile, NonUtf8AttributesStillGiveJson) {
+    const Outcome r = run({"info", "--json", reproducer("info-json-nonutf8-software.exr")});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(contains(j["software"].get<std::string>(), "\xEF\xBF\xBD")) << r.out;  // U+FFFD
+}
+
+TEST_F(Hostile, TwoBrokenRulesGiveOneErrorLine) {
+    const std::string file = reproducer("multiline-error-two-rules.exr");
+    Outcome r = run({"info", file});
+    expectRefused(r, "info", "V5: source size 0x-1 outside [1, 65536]; V6: data kind `bogus`");
+    // validate lists one problem a line on stdout, and ends with one line on stderr.
+    r = run({"validate", file});
+    expectRefused(r, "validate", "not a valid CoNUS file (2 problems)");
+    EXPECT_TRUE(contains(r.out, file + ": V5: ") && contains(r.out, file + ": V6: ")) << r.out;
+}
+
+TEST_F(Hostile, InputsThatAreNotRegularFilesAreRefused) {
+    ASSERT_EQ(::mkfifo(path("fifo.exr").c_str(), 0600), 0);
+    ASSERT_EQ(::mkfifo(path("fifo.npy").c_str(), 0600), 0);
+    for (const std::string& input : {path("fifo.exr"), std::string("/dev/zero")}) {
+        Outcome r = run({"info", input});
+        expectRefused(r, "info", "not a regular file");
+        EXPECT_LT(r.seconds, 2.0 * conus::testing::kTimeScale);
+        r = run({"decode", input, "-o", path("x.png")});
+        expectRefused(r, "decode", "not a regular file");
+        r = run({"validate", input});
+        EXPECT_EQ(r.exitCode, 1);
+        EXPECT_TRUE(contains(r.out, "not a regular file")) << r.out;
+    }
+    for (const std::string& dem : {path("fifo.npy"), std::string("/dev/zero")}) {
+        const Outcome r = run({"heightfield", "encode", dem, "-o", path("t.exr")});
+        expectRefused(r, "heightfield", "not a regular file");
+        EXPECT_LT(r.seconds, 2.0 * conus::testing::kTimeScale);
+    }
+}
+
+TEST_F(Hostile, HeightFieldOptionsMustBeFiniteAndInRange) {
+    // NaN and -10 fell back to the defaults silently.
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+        {{"--fov", "-10"}, "--fov: '-10' is not a finite number in (0, 170)"},
+        {{"--fov", "nan"}, "--fov: 'nan' is not a finite number"},
+        {{"--far", "nan"}, "--far: 'nan' is not a finite number"},
+        {{"--near", "inf"}, "--near: 'inf' is not a finite number"},
+        {{"--eye-height", "0"}, "--eye-height: '0' is not a finite number"},
+        {{"--far", "100", "--near", "200"}, "--far: 100 is not beyond --near 200"},
+    };
+    for (const auto& [options, reason] : cases) {
+        std::vector<std::string> args{"heightfield", "encode", "procedural:32", "-o", path("t.exr"), "--size", "16x16"};
+        args.insert(args.end(), options.begin(), options.end());
+        const Outcome r = run(args);
+        expectRefused(r, "heightfield", reason, 2);
+        EXPECT_FALSE(fs::exists(path("t.exr")));
+    }
+}
+
+TEST_F(Hostile, AFocusTheGridCannotHoldIsRefused) {
+    const Outcome r = run({"map", "foci", "--focus", "0.5,0.5,0.1,4", "--grid", "2", "-o", path("m.exr")});
+    expectRefused(r, "map", "a 2x2 grid is too coarse for focus 0.5,0.5,0.1,4", 2);  // options that contradict: usage
+    EXPECT_TRUE(contains(r.err, "a grid of 5 nodes a side or more does")) << r.err;
+    EXPECT_FALSE(fs::exists(path("m.exr")));
+}
+
+TEST_F(Hostile, InfoPrintsTheLimits) {
+    Outcome r = run({"info", "--limits"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (const char* name : {"imageSide", "imagePixels", "channels", "mapSide", "mapNodes", "attributeBytes", "headerBytes",
+                             "indexBytes", "decodeBytes"})
+        EXPECT_TRUE(contains(r.out, name)) << name;
+    r = run({"info", "--limits", "--json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["mapSide"]["value"], 4097);
+    EXPECT_EQ(j["decodeBytes"]["unit"], "bytes");
+}
+
+}  // namespace
