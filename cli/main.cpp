@@ -12,21 +12,6 @@
 #include "conus/format/container.h"
 #include "progress.h"
 
-namespace {
-
-// Errors print as one line (scripts read the last line of stderr): line breaks in a library's
-// message become "; ".
-std::string oneLine(std::string text) {
-    while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
-    std::string out;
-    for (char c : text) {
-        if (c == '\r') continue;
-        out += c == '\n' ? std::string("; ") : std::string(1, c);
-    }
-    return out;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"conus: coherent non-uniform sampling images (flexible pinhole camera)", "conus"};
@@ -68,7 +53,7 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         for (CLI::App* sub : app.get_subcommands()) name = sub->get_name();
-        std::fprintf(stderr, "conus%s%s: %s (see --help)\n", name.empty() ? "" : " ", name.c_str(), oneLine(e.what()).c_str());
+        std::fprintf(stderr, "conus%s%s: %s (see --help)\n", name.empty() ? "" : " ", name.c_str(), conus::oneLine(e.what()).c_str());
         return 2;
     }
 
@@ -84,7 +69,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "conus %s: %s\n", name.c_str(), e.what());
             return e.code() == conus::ErrorCode::InvalidArgument ? 2 : 1;
         } catch (const std::exception& e) {
-            std::fprintf(stderr, "conus %s: %s\n", name.c_str(), oneLine(e.what()).c_str());
+            std::fprintf(stderr, "conus %s: %s\n", name.c_str(), conus::oneLine(e.what()).c_str());
             return 1;
         }
     }

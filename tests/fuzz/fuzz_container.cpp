@@ -38,7 +38,7 @@ private:
     std::string m_path;
 };
 
-bool oneLine(const std::string& s) { return s.find('\n') == std::string::npos && s.find('\r') == std::string::npos; }
+bool isOneLine(const std::string& s) { return s.find('\n') == std::string::npos && s.find('\r') == std::string::npos; }
 
 }  // namespace
 
@@ -56,7 +56,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::fprintf(stderr, "validateConusFile threw: %s\n", e.what());
         CONUS_FUZZ_CHECK(false, "validateConusFile never throws for bad content");
     }
-    CONUS_FUZZ_CHECK(oneLine(report.str()), "a report is one line");
+    CONUS_FUZZ_CHECK(isOneLine(report.str()), "a report is one line");
 
     try {
         const format::ConusFile conusFile = format::readConusFile(file.path(), limits);
@@ -73,7 +73,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const format::Image frame = codec::decodeImage(conusFile.image, map, decode);
         CONUS_FUZZ_CHECK(frame.width == 8 && frame.height == 6, "decode size");
     } catch (const Error& e) {
-        CONUS_FUZZ_CHECK(oneLine(e.what()), "an error is one line");
+        CONUS_FUZZ_CHECK(isOneLine(e.what()), "an error is one line");
     } catch (const std::exception& e) {
         std::fprintf(stderr, "non-CoNUS exception: %s\n", e.what());
         CONUS_FUZZ_CHECK(false, "the reader throws only conus::Error");

@@ -18,9 +18,14 @@ enum class ErrorCode {
     Unsupported,      // a valid request this build cannot serve
 };
 
+// `text` on one line: line breaks (a library's multi-line message) become "; ", trailing ones go.
+// Scripts read the last line of stderr, so every CoNUS error is one line.
+std::string oneLine(std::string text);
+
 class Error : public std::runtime_error {
 public:
-    Error(ErrorCode code, const std::string& message) : std::runtime_error(message), m_code(code) {}
+    // The message is kept on one line (oneLine), whatever a library underneath said.
+    Error(ErrorCode code, const std::string& message) : std::runtime_error(oneLine(message)), m_code(code) {}
     ErrorCode code() const noexcept { return m_code; }
 
 private:

@@ -1,0 +1,17 @@
+#include "conus/core/error.h"
+
+namespace conus {
+
+std::string oneLine(std::string text) {
+    while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+    std::string out;
+    out.reserve(text.size());
+    for (char c : text) {
+        if (c == '\r') continue;
+        if (c == '\n') out += "; ";
+        else out += c;
+    }
+    return out;
+}
+
+}  // namespace conus

@@ -1,0 +1,50 @@
+// Fuzz harness: ordinary image files through conus::imageio (the one reader of PNG, JPEG, TIFF,
+// EXR, BMP, HDR, PPM, TGA): its size checks, channel placement, colour conversion, orientation and
+// metadata on top of OpenImageIO. The first byte picks the format (the reader goes by the name's
+// extension), the rest is the file, written to /dev/shm (memory). A file that reads must keep the
+// reader's promises: within the limits, one line per error, values placed by name.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "conus/core/error.h"
+#include "conus/imageio/image_file.h"
+#include "fuzz.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    static const char* kExtensions[] = {"png", "jpg", "tif", "exr", "bmp", "hdr", "ppm", "tga"};
+    if (size < 1) return 0;
+    const std::string path = "/dev/shm/conus-fuzz-image-" + std::to_string(::getpid()) + "." +
+                             kExtensions[data[0] % (sizeof kExtensions / sizeof *kExtensions)];
+    {
+        std::FILE* f = std::fopen(path.c_str(), "wb");
+        CONUS_FUZZ_CHECK(f != nullptr, "cannot write to /dev/shm");
+        CONUS_FUZZ_CHECK(std::fwrite(data + 1, 1, size - 1, f) == size - 1, "fwrite");
+        std::fclose(f);
+    }
+    for (const bool raw : {false, true}) {
+        conus::imageio::ReadOptions options;
+        if (raw) options.colorspace = conus::Transfer::Raw;
+        try {
+            const conus::imageio::ImageFile file = conus::imageio::readImageFile(path, options);
+            const conus::format::Image& image = file.image;
+            CONUS_FUZZ_CHECK(image.width >= 1 && image.height >= 1 && image.width <= conus::kMaxImageSide &&
+                                 image.height <= conus::kMaxImageSide,
+                             "a read image is within the limits");
+            CONUS_FUZZ_CHECK(image.pixels.size() ==
+                                 static_cast<std::size_t>(image.width) * image.height * image.channels.size(),
+                             "pixels match the size");
+            CONUS_FUZZ_CHECK(file.info.nonFinite == conus::imageio::countNonFinite(image), "non-finite count");
+        } catch (const conus::Error& e) {
+            const std::string what = e.what();
+            CONUS_FUZZ_CHECK(what.find('\n') == std::string::npos, "an error is one line");
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "non-CoNUS exception: %s\n", e.what());
+            CONUS_FUZZ_CHECK(false, "the reader throws only conus::Error");
+        }
+    }
+    ::unlink(path.c_str());
+    return 0;
+}
