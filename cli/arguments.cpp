@@ -32,7 +32,7 @@ Size parseSize(const std::string& text) {
     const auto values = parseNumbers(text, 'x');
     if (values.size() != 2 || text.back() == 'x') invalid("size '" + text + "' is not of the form WxH");
     for (double v : values)
-        if (v != std::floor(v) || v < 1 || v > format::kMaxImageSide)
+        if (v != std::floor(v) || v < 1 || v > kMaxImageSide)
             invalid("size '" + text + "': each side must be a whole number in [1, 65536]");
     return {static_cast<int>(values[0]), static_cast<int>(values[1])};
 }

@@ -28,11 +28,11 @@ Size outputSize(const DecodeCommandOptions& o, const codec::View& view, const fo
     if (!o.sizeText.empty()) return parseSize(o.sizeText);
     const double w = std::round((view.u1 - view.u0) * file.sourceWidth);
     const double h = std::round((view.v1 - view.v0) * file.sourceHeight);
-    if (w > format::kMaxImageSide || h > format::kMaxImageSide || w * h > double(format::kMaxImagePixels))
+    if (w > kMaxImageSide || h > kMaxImageSide || w * h > double(kMaxImagePixels))
         throw Error(ErrorCode::InvalidArgument, "the view at source resolution would be " + std::to_string(long(w)) + "x" +
                                                     std::to_string(long(h)) + " pixels, past the limits (" +
-                                                    std::to_string(format::kMaxImageSide) + " a side, " +
-                                                    std::to_string(format::kMaxImagePixels) + " in all); give --size");
+                                                    std::to_string(kMaxImageSide) + " a side, " +
+                                                    std::to_string(kMaxImagePixels) + " in all); give --size");
     return {std::max(1, static_cast<int>(w)), std::max(1, static_cast<int>(h))};
 }
 
@@ -51,7 +51,7 @@ int runDecode(const DecodeCommandOptions& o) {
     if (!o.cameraText.empty()) {
         // A height field seen from a camera: undistort to a mesh and render it.
         const Size size = parseSize(o.sizeText.empty() ? "960x540" : o.sizeText);
-        const format::Image frame = renderHeightFieldFrame(file, o.cameraText == "viewer" ? "" : o.cameraText, size.width,
+        const Image frame = renderHeightFieldFrame(file, o.cameraText == "viewer" ? "" : o.cameraText, size.width,
                                                            size.height, o.backend);
         writePicture(o.output, frame, writeOptionsOf(o.picture, nullptr));
         std::printf("wrote %s: %dx%d frame of the height field\n", o.output.c_str(), frame.width, frame.height);
@@ -71,7 +71,7 @@ int runDecode(const DecodeCommandOptions& o) {
     Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
     decode.progress = progress.callback();
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "decoding");
-    const format::Image frame = gl::decodeImage(device, file.image, map, decode);
+    const Image frame = gl::decodeImage(device, file.image, map, decode);
     progress.done();
     writePicture(o.output, frame, write);
     std::printf("wrote %s: %dx%d view [%g,%g]-[%g,%g]\n", o.output.c_str(), frame.width, frame.height, view.u0, view.v0,

@@ -30,8 +30,8 @@ namespace conus::cli {
 namespace {
 
 // The source pixels under a view whose edges fall on pixel edges.
-format::Image crop(const format::Image& source, int x0, int y0, int width, int height) {
-    format::Image out = format::makeImage(width, height, source.channels);
+Image crop(const Image& source, int x0, int y0, int width, int height) {
+    Image out = makeImage(width, height, source.channels);
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
             for (int c = 0; c < source.channelCount(); ++c) out.at(x, y, c) = source.at(x0 + x, y0 + y, c);
@@ -40,7 +40,7 @@ format::Image crop(const format::Image& source, int x0, int y0, int width, int h
 
 // The view around the most important region: the bounding square of the importance above half its
 // peak, as a focus-shaped rectangle (centre, half side as a fraction of the width).
-codec::Focus hottestRegion(const format::Image& importance, int width, int height) {
+codec::Focus hottestRegion(const Image& importance, int width, int height) {
     float peak = 0;
     for (int y = 0; y < importance.height; ++y)
         for (int x = 0; x < importance.width; ++x) peak = std::max(peak, importance.at(x, y));
@@ -67,7 +67,7 @@ struct DemoOptions {
 
 // The picture the demo runs on, what it was, and the foci whose views it compares.
 struct DemoSource {
-    format::Image image;
+    Image image;
     SourceEncoding encoding;
     std::vector<codec::Focus> foci;
 };
@@ -105,7 +105,7 @@ DemoMap demoMap(const DemoOptions& o, DemoSource& source) {
     DemoMap m;
     const int w = source.image.width, h = source.image.height;
     if (!o.importance.empty()) {
-        const format::Image importance = importanceFrom(o.importance, source.image);
+        const Image importance = importanceFrom(o.importance, source.image);
         m.map = codec::buildAutoMap(importance, {});
         if (o.foci.empty()) source.foci = {hottestRegion(importance, w, h)};
     } else {
@@ -178,12 +178,12 @@ int runDemo(const DemoOptions& o) {
         decode.view = {double(v.x0) / w, double(v.y0) / h, double(v.x0 + v.width) / w, double(v.y0 + v.height) / h};
         decode.width = v.width;
         decode.height = v.height;
-        const format::Image reference = crop(source.image, v.x0, v.y0, v.width, v.height);
-        const format::Image fromConus = gl::decodeImage(device, conus.image, map, decode);
-        const format::Image fromUniform = gl::decodeImage(device, uniform.image, identity, decode);
+        const Image reference = crop(source.image, v.x0, v.y0, v.width, v.height);
+        const Image fromConus = gl::decodeImage(device, conus.image, map, decode);
+        const Image fromUniform = gl::decodeImage(device, uniform.image, identity, decode);
         const double a = codec::psnr(reference, fromConus), b = codec::psnr(reference, fromUniform);
         std::printf("%-22s %9.2f dB %11.2f dB %+7.2f\n", v.label.c_str(), a, b, a - b);
-        std::vector<format::Image> strip{reference, fromConus, fromUniform};
+        std::vector<Image> strip{reference, fromConus, fromUniform};
         if (v.outWidth != v.width)
             for (auto& image : strip) image = codec::areaDownsample(image, v.outWidth, v.outHeight);
         writePicture((out / ("view-" + v.name + ".png")).string(), sideBySide(strip), picture);

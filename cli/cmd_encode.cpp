@@ -34,7 +34,7 @@ BuiltMap mapFromFile(const std::string& path) {
     return {std::make_unique<codec::SamplingMap>(codec::SamplingMap::fromGrid(mapSource.map)), mapSource.analytic};
 }
 
-BuiltMap mapFromImportance(const EncodeOptions& o, const format::Image& source) {
+BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source) {
     Progress progress("build sampling map from " + o.importance + " importance");
     codec::AutoMapOptions autoOptions;
     autoOptions.columns = autoOptions.rows = o.grid;
@@ -47,7 +47,7 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const format::Image& source) 
     return built;
 }
 
-BuiltMap mapFromFoci(const EncodeOptions& o, const format::Image& source) {
+BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source) {
     std::vector<codec::Focus> foci;
     for (const auto& text : o.foci) foci.push_back(codec::parseFocus(text));
     codec::FociOptions fo;

@@ -30,16 +30,16 @@ namespace {
 
 // The DEM's colour in linear light: a texture (resized down to the DEM when larger), else the
 // height/slope ramp (drawn as display colours). `encoding` receives what the colour came from.
-format::Image demColour(const Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding = nullptr) {
+Image demColour(const Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding = nullptr) {
     if (texture.empty()) {
-        format::Image ramp = codec::terrainColours(dem.heights, extent);
+        Image ramp = codec::terrainColours(dem.heights, extent);
         imageio::linearize(ramp);
         if (encoding) *encoding = {Transfer::Srgb, SampleType::Uint8, kRec709Chromaticities, {}, {}};
         return ramp;
     }
     imageio::ImageFile file = readSource(texture, {});
     if (encoding) *encoding = file.info.encoding;
-    format::Image image = std::move(file.image);
+    Image image = std::move(file.image);
     if (image.width == dem.heights.width && image.height == dem.heights.height) return image;
     if (image.width < dem.heights.width || image.height < dem.heights.height)
         throw Error(ErrorCode::InvalidArgument, "colour texture " + texture + " (" + std::to_string(image.width) + "x" +
@@ -49,7 +49,13 @@ format::Image demColour(const Dem& dem, const std::string& texture, glm::dvec2 e
     return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
 }
 
-gl::TerrainCamera parseCamera(const std::string& text) {
+// "x,y,z,lx,ly,lz,fovDeg": eye, look-at point, vertical field of view.
+struct CameraText {
+    glm::dvec3 eye, target;
+    double fovYDegrees = 50;
+};
+
+CameraText parseCamera(const std::string& text) {
     std::vector<double> v;
     std::stringstream in(text);
     std::string item;
@@ -64,16 +70,13 @@ gl::TerrainCamera parseCamera(const std::string& text) {
     }
     if (v.size() != 7)
         throw Error(ErrorCode::InvalidArgument, "camera '" + text + "' needs 7 values x,y,z,lx,ly,lz,fovDeg");
-    gl::TerrainCamera camera;
-    camera.eye = {v[0], v[1], v[2]};
-    camera.target = {v[3], v[4], v[5]};
-    camera.fovYDegrees = v[6];
-    return camera;
+    return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6]};
 }
 
-void printCamera(const gl::TerrainCamera& c) {
-    std::printf("camera %.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f\n", c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y,
-                c.target.z, c.fovYDegrees);
+void printCamera(const Camera& c) {
+    const glm::dvec3 eye = c.eye(), look = eye + c.forward() * 1000.0;
+    std::printf("camera %.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f\n", eye.x, eye.y, eye.z, look.x, look.y, look.z,
+                c.verticalFovDegrees());
 }
 
 }  // namespace
@@ -84,24 +87,21 @@ codec::GroundParams groundOf(const format::ConusFile& file, const std::string& n
     return codec::groundFromAnalytic(*file.analytic);
 }
 
-gl::TerrainCamera terrainCamera(const format::ConusFile& file, const std::string& cameraText) {
-    gl::TerrainCamera camera = gl::viewerCamera(groundOf(file, "the file"), codec::heightAt(file, {0.5, 1.0}));
-    if (!cameraText.empty()) {
-        const gl::TerrainCamera given = parseCamera(cameraText);
-        camera.eye = given.eye;
-        camera.target = given.target;
-        camera.fovYDegrees = given.fovYDegrees;
-    }
-    return camera;
+// The ground map's own viewer, or the one the text names (with the viewer's clip distances).
+Camera terrainCamera(const format::ConusFile& file, const std::string& cameraText, double aspect) {
+    const Camera viewer = gl::viewerCamera(groundOf(file, "the file"), codec::heightAt(file, {0.5, 1.0}), aspect);
+    if (cameraText.empty()) return viewer;
+    const CameraText given = parseCamera(cameraText);
+    return Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, viewer.near(), viewer.far());
 }
 
-format::Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
+Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
                                      int height, const std::string& backendName) {
     const gl::Device device = deviceFor(backendName, gl::CpuPath::None, "terrain rendering");
     const glm::dvec2 extent = codec::fieldExtent(groundOf(file, "the file"));
-    const gl::TerrainCamera camera = terrainCamera(file, cameraText);
+    const Camera camera = terrainCamera(file, cameraText, double(width) / height);
     Progress progress("undistort the height field and render " + std::to_string(width) + "x" + std::to_string(height));
-    format::Image frame = gl::renderTerrain(device.context(), codec::undistortHeightField(file, extent), camera, width, height);
+    Image frame = gl::renderTerrain(device.context(), codec::undistortHeightField(file, extent), camera, width, height);
     progress.done();
     printCamera(camera);
     return frame;
@@ -204,7 +204,7 @@ Command addHeightFieldCommand(CLI::App& root) {
                     options.mapGrid = o->grid;
                     const glm::dvec2 extent = codec::fieldExtent(options.ground);
                     SourceEncoding encoding;
-                    const format::Image colour = demColour(dem, o->colour, extent, &encoding);
+                    const Image colour = demColour(dem, o->colour, extent, &encoding);
                     Progress progress("encode height field " + o->sizeText);
                     options.progress = progress.callback();
                     format::ConusFile file = codec::encodeHeightField(dem.heights, colour, options);
@@ -225,9 +225,9 @@ Command addHeightFieldCommand(CLI::App& root) {
                 gl::Context* context = &device.context();
                 const codec::GroundParams ground = groundOf(file, o->input);
                 const glm::dvec2 extent = codec::fieldExtent(ground);
-                const gl::TerrainCamera camera = terrainCamera(file, o->cameraText);
+                const Camera camera = terrainCamera(file, o->cameraText, double(size.width) / size.height);
                 Progress progress("undistort and render");
-                const format::Image frame =
+                const Image frame =
                     gl::renderTerrain(*context, codec::undistortHeightField(file, extent), camera, size.width, size.height);
                 progress.done();
                 printCamera(camera);
@@ -239,19 +239,19 @@ Command addHeightFieldCommand(CLI::App& root) {
                 }
                 Progress comparing("render full resolution and uniform");
                 const Dem dem = readDem(o->compare, o->heightScale);
-                const format::Image colour = demColour(dem, o->colour, extent);
-                const format::Image full = gl::renderTerrain(
+                const Image colour = demColour(dem, o->colour, extent);
+                const Image full = gl::renderTerrain(
                     *context,
                     codec::undistortHeightField(
                         codec::uniformHeightField(dem.heights, colour, dem.heights.width, dem.heights.height), extent),
                     camera, size.width, size.height);
-                const format::Image uniform = gl::renderTerrain(
+                const Image uniform = gl::renderTerrain(
                     *context,
                     codec::undistortHeightField(
                         codec::uniformHeightField(dem.heights, colour, file.image.width, file.image.height), extent),
                     camera, size.width, size.height);
                 comparing.done();
-                const format::Image panels[] = {full, frame, uniform};
+                const Image panels[] = {full, frame, uniform};
                 writePicture(o->frame, sideBySide(panels));
                 std::printf("wrote %s: full resolution %dx%d | CoNUS %dx%d | uniform %dx%d (%s)\n", o->frame.c_str(),
                             dem.heights.width, dem.heights.height, file.image.width, file.image.height,

@@ -9,7 +9,7 @@
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
-#include "conus/format/limits.h"
+#include "conus/core/limits.h"
 #include "conus/renderers/context.h"
 #include "image_files.h"
 #include "pictures.h"
@@ -94,7 +94,7 @@ Command addInfoCommand(CLI::App& root) {
                 }
                 // Everything but the image's pixels, which nothing here needs.
                 const format::ConusFile file = format::readConusHeader(options->input);
-                const std::vector<std::string> channels = format::displayOrder(file.image.channels);
+                const std::vector<std::string> channels = displayOrder(file.image.channels);
                 const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
                 const DensityStats stats = densityStats(map);
 

@@ -233,8 +233,8 @@ Command addMapCommand(CLI::App& root) {
                     const codec::SamplingMap map = codec::buildGroundMap(o->ground, o->groundGrid, o->groundGrid);
                     writeMapFile(map, codec::toAnalytic(o->ground), o->groundOut);
                 } else if (automatic->parsed()) {
-                    const format::Image picture = o->image.empty() ? format::Image{} : imageio::readImageFile(o->image).image;
-                    const format::Image importance = importanceFrom(o->importance, picture);
+                    const Image picture = o->image.empty() ? Image{} : imageio::readImageFile(o->image).image;
+                    const Image importance = importanceFrom(o->importance, picture);
                     codec::AutoMapOptions options;
                     options.columns = options.rows = o->autoGrid;
                     options.minDensity = o->minDensity;

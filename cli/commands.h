@@ -31,7 +31,7 @@ Command addHeightFieldCommand(CLI::App& root);
 
 // A frame of a CoNUS height field from a camera "x,y,z,lx,ly,lz,fovDeg" (empty: the ground map's
 // own viewer), rendered with GL: what `decode` does for height fields and `heightfield render` does.
-format::Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
+Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
                                      int height, const std::string& backendName);
 
 }  // namespace conus::cli

@@ -221,9 +221,9 @@ std::map<std::string, NpyArray> readNpz(const std::string& path) {
     return arrays;
 }
 
-format::Image toHeights(const NpyArray& a, double scale, const std::string& what) {
+Image toHeights(const NpyArray& a, double scale, const std::string& what) {
     if (a.header.shape.size() != 2) throw Error(ErrorCode::Corrupt, what + ": not a 2-D array");
-    format::Image im = format::makeImage(static_cast<int>(a.header.shape[1]), static_cast<int>(a.header.shape[0]), {"Z"});
+    Image im = makeImage(static_cast<int>(a.header.shape[1]), static_cast<int>(a.header.shape[0]), {"Z"});
     values(a, im.pixels.size(), scale, im.pixels.data());
     return im;
 }
@@ -295,11 +295,11 @@ Dem readDem(const std::string& source, double heightScale) {
                           " " + a.header.dtype;
         return dem;
     }
-    const format::Image image = readData(source);
+    const Image image = readData(source);
     int channel = image.channelIndex("Z");
     if (channel < 0) channel = image.channelIndex("Y");
     if (channel < 0) channel = 0;  // a grey or RGB image: its first channel
-    dem.heights = format::makeImage(image.width, image.height, {"Z"});
+    dem.heights = makeImage(image.width, image.height, {"Z"});
     for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x)
             dem.heights.at(x, y) = static_cast<float>(image.at(x, y, channel) * heightScale);

@@ -9,12 +9,12 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::cli {
 
 struct Dem {
-    format::Image heights;  // one channel "Z", already multiplied by the height scale
+    Image heights;  // one channel "Z", already multiplied by the height scale
     glm::dvec2 cellMetres{0.0, 0.0};  // sample spacing (x, y) when the file says, else 0
     std::string description;          // for messages: "jacksboro_fault_dem.npz elevation 403x344 int16"
 };

@@ -11,7 +11,7 @@
 namespace conus::cli {
 namespace {
 
-void fillRect(format::Image& img, int x0, int y0, int x1, int y1, const float rgb[3]) {
+void fillRect(Image& img, int x0, int y0, int x1, int y1, const float rgb[3]) {
     for (int y = std::max(0, y0); y < std::min(img.height, y1); ++y)
         for (int x = std::max(0, x0); x < std::min(img.width, x1); ++x)
             for (int c = 0; c < 3; ++c) img.at(x, y, c) = rgb[c];
@@ -19,7 +19,7 @@ void fillRect(format::Image& img, int x0, int y0, int x1, int y1, const float rg
 
 // A face-like figure: skin ellipse, eyes with pupils, a mouth, and hair of fine stripes whose
 // period (`hairPeriod` px) is what a low sampling rate loses first.
-void drawFace(format::Image& img, double cx, double cy, double radius, double hairPeriod, double hue) {
+void drawFace(Image& img, double cx, double cy, double radius, double hairPeriod, double hue) {
     const float skin[3] = {static_cast<float>(0.85 - 0.2 * hue), static_cast<float>(0.66 - 0.15 * hue),
                            static_cast<float>(0.52 - 0.1 * hue)};
     const int x0 = std::max(0, int(cx - 1.3 * radius)), x1 = std::min(img.width, int(cx + 1.3 * radius));
@@ -65,7 +65,7 @@ void drawFace(format::Image& img, double cx, double cy, double radius, double ha
 
 // Zone plate: cos(pi * r^2 / period^2 ...) whose local frequency grows linearly with the radius
 // up to `maxFrequency` cycles per pixel at `radius`.
-void drawZonePlate(format::Image& img, double cx, double cy, double radius, double maxFrequency) {
+void drawZonePlate(Image& img, double cx, double cy, double radius, double maxFrequency) {
     const double a = std::numbers::pi * maxFrequency / radius;
     for (int y = std::max(0, int(cy - radius)); y < std::min(img.height, int(cy + radius)); ++y)
         for (int x = std::max(0, int(cx - radius)); x < std::min(img.width, int(cx + radius)); ++x) {
@@ -81,8 +81,8 @@ void drawZonePlate(format::Image& img, double cx, double cy, double radius, doub
 
 }  // namespace
 
-format::Image makeDemoPicture(int size) {
-    format::Image img = format::makeImage(size, size, {"R", "G", "B"});
+Image makeDemoPicture(int size) {
+    Image img = makeImage(size, size, {"R", "G", "B"});
     const double s = size / 4096.0;  // every length below is given for 4096 px and scaled
 
     // Background: a smooth sky-to-ground gradient with gentle low-frequency variation.

@@ -2,12 +2,12 @@
 // fine print, a zone plate, and face-like figures with hair-fine stripes, on a smooth background.
 #pragma once
 
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::cli {
 
 // Square picture `size` pixels a side (RGB, values in [0,1]). The fine print sits around
 // (0.28,0.30) and the zone plate around (0.70,0.66), the demo's two foci.
-format::Image makeDemoPicture(int size);
+Image makeDemoPicture(int size);
 
 }  // namespace conus::cli

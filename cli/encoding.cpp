@@ -27,7 +27,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
     addBackendOption(command, options.backend);
 }
 
-Size conusSize(const StorageOptions& options, const format::Image& source) {
+Size conusSize(const StorageOptions& options, const Image& source) {
     if (!options.sizeText.empty()) return parseSize(options.sizeText);
     return {std::max(1, (source.width + 2) / 4), std::max(1, (source.height + 2) / 4)};
 }
@@ -52,11 +52,11 @@ void checkConusOutput(const std::string& output, const std::string& input) {
     checkOutputPath(output, inputs);
 }
 
-format::ConusFile encodeToConus(const gl::Device& device, const format::Image& source, const SourceEncoding& encoding,
+format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                       std::to_string(size.width) + "x" + std::to_string(size.height));
-    format::Image image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
+    Image image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
     return codec::makeImageFile(std::move(image), map, source.width, source.height, encoding, std::move(analytic));
 }

@@ -26,11 +26,11 @@ struct StorageOptions {
 void addStorageOptions(CLI::App& command, StorageOptions& options);
 
 // Resolves the CoNUS image size (checking it against the source) and the storage settings.
-Size conusSize(const StorageOptions& options, const format::Image& source);
+Size conusSize(const StorageOptions& options, const Image& source);
 
 // Encodes `source` through `map` at `size` (with progress) into a file model ready to write,
 // remembering the source's encoding.
-format::ConusFile encodeToConus(const gl::Device& device, const format::Image& source, const SourceEncoding& encoding,
+format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic);
 
 // Applies the storage options to a file model. Without --half or --float, colour is stored as

@@ -23,7 +23,7 @@ constexpr const char* kCascadePaths[] = {
 }  // namespace
 
 // `image` is display-encoded (the cascade was trained on ordinary 8-bit photographs).
-format::Image faceImportance(const format::Image& image) {
+Image faceImportance(const Image& image) {
     if (image.empty()) throw Error(ErrorCode::InvalidArgument, "no image to find faces in");
     // Detection on an 8-bit grey copy at most 1024 px a side: the cascade works on 24 px windows,
     // and larger pictures only cost time.
@@ -57,7 +57,7 @@ format::Image faceImportance(const format::Image& image) {
         throw Error(ErrorCode::InvalidArgument, "no face found in the image; give --focus or an importance image");
 
     // A soft disc over each face (a little larger than the detection box, which crops the hair).
-    format::Image importance = format::makeImage(w, h, {"Y"});
+    Image importance = makeImage(w, h, {"Y"});
     for (const auto& f : faces) {
         const double cx = f.x + 0.5 * f.width, cy = f.y + 0.45 * f.height, radius = 0.75 * std::max(f.width, f.height);
         for (int y = 0; y < h; ++y)

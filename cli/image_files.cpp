@@ -43,7 +43,7 @@ imageio::ImageFile readSource(const std::string& path, const SourceOptions& opti
     return file;
 }
 
-format::Image readData(const std::string& path) {
+Image readData(const std::string& path) {
     imageio::ReadOptions read;
     read.colorspace = Transfer::Raw;
     return imageio::readImageFile(path, read).image;
@@ -84,7 +84,7 @@ void checkPictureOutput(const std::string& path, const imageio::WriteOptions& op
                         " picture keeps the linear values (use --exposure alone)");
 }
 
-void writePicture(const std::string& path, const format::Image& image, const imageio::WriteOptions& options) {
+void writePicture(const std::string& path, const Image& image, const imageio::WriteOptions& options) {
     const std::int64_t nonFinite = imageio::countNonFinite(image);
     if (nonFinite > 0)
         warn(path + ": the picture holds " + plural(static_cast<std::size_t>(nonFinite), "NaN or infinite value", "NaN or infinite values") +
@@ -94,7 +94,7 @@ void writePicture(const std::string& path, const format::Image& image, const ima
     progress.done();
 }
 
-void writeDrawing(const std::string& path, const format::Image& image) {
+void writeDrawing(const std::string& path, const Image& image) {
     imageio::WriteOptions options;
     options.meaning = imageio::PixelMeaning::Display;
     imageio::writeImageFile(path, image, options);

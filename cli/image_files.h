@@ -29,7 +29,7 @@ void addSourceOptions(CLI::App& command, SourceOptions& options);
 imageio::ImageFile readSource(const std::string& path, const SourceOptions& options);
 
 // Reads a data image (importance map, DEM): raw values, never converted, upright.
-format::Image readData(const std::string& path);
+Image readData(const std::string& path);
 
 struct PictureOptions {
     std::string bits;  // "", 8, 16, half, float
@@ -49,10 +49,10 @@ void checkPictureOutput(const std::string& path, const imageio::WriteOptions& op
                         std::initializer_list<std::string> inputs = {});
 
 // Writes a picture (a progress stage), warning when it holds NaN or infinite values.
-void writePicture(const std::string& path, const format::Image& image, const imageio::WriteOptions& options = {});
+void writePicture(const std::string& path, const Image& image, const imageio::WriteOptions& options = {});
 
 // Writes a picture drawn for people (heat maps, comparison strips with labels) whose values are
 // already display-encoded.
-void writeDrawing(const std::string& path, const format::Image& image);
+void writeDrawing(const std::string& path, const Image& image);
 
 }  // namespace conus::cli

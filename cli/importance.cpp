@@ -7,7 +7,7 @@
 
 namespace conus::cli {
 
-format::Image importanceFrom(const std::string& source, const format::Image& image) {
+Image importanceFrom(const std::string& source, const Image& image) {
     if (source == "detail") {
         if (image.empty()) throw Error(ErrorCode::InvalidArgument, "'detail' importance needs an input image");
         // Detail as people see it: on the display-encoded picture, where NaN cannot reach.

@@ -4,17 +4,17 @@
 
 #include <string>
 
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::cli {
 
 // `source` is "detail", "faces", or the path of a single-channel (or RGB) importance image.
 // `image` is the picture being encoded (detail and faces are computed from it; may be empty for a
 // file source).
-format::Image importanceFrom(const std::string& source, const format::Image& image);
+Image importanceFrom(const std::string& source, const Image& image);
 
 // Importance that is high on each face found in `image` (display-encoded: imageio::displayEncoded) (a soft disc over every detection), zero
 // elsewhere; throws conus::Error(InvalidArgument) when no face is found.
-format::Image faceImportance(const format::Image& image);
+Image faceImportance(const Image& image);
 
 }  // namespace conus::cli

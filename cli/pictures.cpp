@@ -21,7 +21,7 @@ glm::vec3 heat(double t) {
     return a * (1 - f) + b * f;
 }
 
-void blend(format::Image& image, int x, int y, glm::vec3 color, float alpha) {
+void blend(Image& image, int x, int y, glm::vec3 color, float alpha) {
     if (x < 0 || y < 0 || x >= image.width || y >= image.height) return;
     for (int c = 0; c < 3; ++c) image.at(x, y, c) = image.at(x, y, c) * (1 - alpha) + color[c] * alpha;
 }
@@ -41,9 +41,9 @@ DensityStats densityStats(const codec::SamplingMap& map, int samples) {
     return stats;
 }
 
-format::Image densityPicture(const codec::SamplingMap& map, int width, int height, int lines,
+Image densityPicture(const codec::SamplingMap& map, int width, int height, int lines,
                              const format::AnalyticMap* analytic) {
-    format::Image picture = format::makeImage(width, height, {"R", "G", "B"});
+    Image picture = makeImage(width, height, {"R", "G", "B"});
     std::vector<glm::dvec2> distorted(static_cast<std::size_t>(width) * height);
     std::vector<double> logDensity(distorted.size());
     double lo = 1e300, hi = -1e300;
@@ -89,8 +89,8 @@ format::Image densityPicture(const codec::SamplingMap& map, int width, int heigh
     return picture;
 }
 
-format::Image toRgb(const format::Image& image) {
-    format::Image rgb = format::makeImage(image.width, image.height, {"R", "G", "B"});
+Image toRgb(const Image& image) {
+    Image rgb = makeImage(image.width, image.height, {"R", "G", "B"});
     int source[3] = {image.channelIndex("R"), image.channelIndex("G"), image.channelIndex("B")};
     if (source[0] < 0 || source[1] < 0 || source[2] < 0) {
         int grey = image.channelIndex("Y");
@@ -103,17 +103,17 @@ format::Image toRgb(const format::Image& image) {
     return rgb;
 }
 
-format::Image sideBySide(std::span<const format::Image> images, int gap) {
+Image sideBySide(std::span<const Image> images, int gap) {
     int width = gap, height = 0;
     for (const auto& image : images) {
         width += image.width + gap;
         height = std::max(height, image.height);
     }
-    format::Image strip = format::makeImage(width, height + 2 * gap, {"R", "G", "B"});
+    Image strip = makeImage(width, height + 2 * gap, {"R", "G", "B"});
     std::fill(strip.pixels.begin(), strip.pixels.end(), 0.12f);
     int x0 = gap;
     for (const auto& image : images) {
-        const format::Image rgb = toRgb(image);
+        const Image rgb = toRgb(image);
         for (int y = 0; y < rgb.height; ++y)
             for (int x = 0; x < rgb.width; ++x)
                 for (int c = 0; c < 3; ++c) strip.at(x0 + x, gap + y, c) = rgb.at(x, y, c);

@@ -7,7 +7,7 @@
 
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::cli {
 
@@ -21,13 +21,13 @@ DensityStats densityStats(const codec::SamplingMap& map, int samples = 256);
 // RGB heat map of log(density) over the undistorted plane (width x height), with the lines of the
 // CoNUS pixel grid (every `spacing`-th distorted column and row, mapped back through the map) drawn
 // over it, and focus outlines where `analytic` describes foci.
-format::Image densityPicture(const codec::SamplingMap& map, int width, int height, int lines,
+Image densityPicture(const codec::SamplingMap& map, int width, int height, int lines,
                              const format::AnalyticMap* analytic = nullptr);
 
 // Images placed left to right on a dark background, each RGB; taller ones set the strip's height.
-format::Image sideBySide(std::span<const format::Image> images, int gap = 8);
+Image sideBySide(std::span<const Image> images, int gap = 8);
 
 // The image as RGB (grey for one channel; other channels dropped) for pictures and PSNR.
-format::Image toRgb(const format::Image& image);
+Image toRgb(const Image& image);
 
 }  // namespace conus::cli

@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::test {
 
 // Uniform noise in [0,1) in every channel.
-inline format::Image noise(int w, int h, std::vector<std::string> channels, unsigned seed = 1) {
-    format::Image im = format::makeImage(w, h, std::move(channels));
+inline Image noise(int w, int h, std::vector<std::string> channels, unsigned seed = 1) {
+    Image im = makeImage(w, h, std::move(channels));
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> d(0.0f, 1.0f);
     for (float& v : im.pixels) v = d(rng);
@@ -22,9 +22,9 @@ inline format::Image noise(int w, int h, std::vector<std::string> channels, unsi
 }
 
 // Noise box-blurred over 3x3: a detailed texture with little energy at the very top frequencies.
-inline format::Image texture(int size, unsigned seed) {
-    const format::Image n = noise(size, size, {"Y"}, seed);
-    format::Image t = format::makeImage(size, size, {"Y"});
+inline Image texture(int size, unsigned seed) {
+    const Image n = noise(size, size, {"Y"}, seed);
+    Image t = makeImage(size, size, {"Y"});
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) {
             float sum = 0;
@@ -38,8 +38,8 @@ inline format::Image texture(int size, unsigned seed) {
 
 // cos(pi * k * r^2) with r in pixels from the centre: the local frequency grows linearly with r
 // and reaches `edgeFrequency` cycles per pixel at the middle of the sides.
-inline format::Image zonePlate(int size, double edgeFrequency) {
-    format::Image im = format::makeImage(size, size, {"Y"});
+inline Image zonePlate(int size, double edgeFrequency) {
+    Image im = makeImage(size, size, {"Y"});
     const double half = size / 2.0, k = edgeFrequency / half;
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) {

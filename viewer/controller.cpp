@@ -183,7 +183,7 @@ void Controller::saveFromEditor(bool mapOnly) {
                                                                 : std::filesystem::path(m_options.output);
     const std::string path = base.string() + (mapOnly ? ".map.exr" : ".conus.exr");
     try {
-        const format::Image& source = m_editor->source();
+        const Image& source = m_editor->source();
         const int w = m_options.width > 0 ? m_options.width : source.width;
         const int h = m_options.height > 0 ? m_options.height : source.height;
         format::writeConusFile(path, mapOnly ? m_editor->mapFile() : m_editor->encode(w, h));

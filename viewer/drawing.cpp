@@ -41,7 +41,7 @@ bool Drawing::prepareOverlay(int slot, const std::string& key, Make make) {
     if (m_textBroken) return false;
     if (m_overlayKey[slot] == key && m_renderer.hasOverlay(slot)) return true;
     try {
-        const format::Image panel = make();
+        const Image panel = make();
         m_renderer.setOverlay(slot, panel);
         m_overlayKey[slot] = key;
         m_overlayHeight[slot] = panel.height;

@@ -17,7 +17,7 @@ public:
     // controller's versions moved.
     void frame(Controller& controller, int fw, int fh);
     // The frame just drawn, display values, top row first.
-    format::Image readFramebuffer(int fw, int fh) { return m_renderer.readFramebuffer(fw, fh); }
+    Image readFramebuffer(int fw, int fh) { return m_renderer.readFramebuffer(fw, fh); }
     gl::ViewRenderer& renderer() { return m_renderer; }
 
 private:

@@ -7,7 +7,7 @@
 
 namespace conus::viewer {
 
-MapEditor::MapEditor(format::Image source, SourceEncoding encoding, int gridColumns, int gridRows)
+MapEditor::MapEditor(Image source, SourceEncoding encoding, int gridColumns, int gridRows)
     : m_source(std::move(source)), m_encoding(std::move(encoding)), m_columns(gridColumns), m_rows(gridRows), m_springs(gridColumns, gridRows) {}
 
 void MapEditor::scaleRadius(double factor) { m_brush.radius = std::clamp(m_brush.radius * factor, 0.01, 1.0); }

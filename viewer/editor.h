@@ -10,7 +10,7 @@
 
 #include "conus/codec/springs.h"
 #include "conus/format/container.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::viewer {
 
@@ -26,7 +26,7 @@ class MapEditor {
 public:
     // `source` is the image painted over (linear light), `encoding` what its file held; the encode
     // size defaults to the source's.
-    explicit MapEditor(format::Image source, SourceEncoding encoding = {}, int gridColumns = kEditorGrid,
+    explicit MapEditor(Image source, SourceEncoding encoding = {}, int gridColumns = kEditorGrid,
                        int gridRows = kEditorGrid);
 
     Brush& brush() { return m_brush; }
@@ -46,7 +46,7 @@ public:
     bool stable() const { return m_springs.stable(); }
     void reset();
 
-    const format::Image& source() const { return m_source; }
+    const Image& source() const { return m_source; }
     codec::SamplingMap map() const { return m_springs.toMap(); }
     // The map as `conus map` writes it: image = density at the nodes (channel Y), float.
     format::ConusFile mapFile() const;
@@ -55,7 +55,7 @@ public:
 
 private:
     void addStroke(glm::dvec2 uv);
-    format::Image m_source;
+    Image m_source;
     SourceEncoding m_encoding;
     int m_columns, m_rows;
     codec::SpringSystem m_springs;

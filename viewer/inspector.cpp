@@ -13,7 +13,7 @@ Probe probe(const format::ConusFile& file, const codec::SamplingMap& map, glm::d
     const glm::dvec2 clamped = glm::clamp(uv, glm::dvec2(0.0), glm::dvec2(1.0));
     p.distorted = map.distort(clamped);
     p.density = map.density(clamped);
-    const format::Image& image = file.image;
+    const Image& image = file.image;
     const int sw = file.sourceWidth > 0 ? file.sourceWidth : image.width;
     const int sh = file.sourceHeight > 0 ? file.sourceHeight : image.height;
     p.sourcePixel = {std::min(sw - 1, int(clamped.x * sw)), std::min(sh - 1, int(clamped.y * sh))};
@@ -41,7 +41,7 @@ std::string formatProbe(const Probe& p) {
                   p.conusPixel.y, p.density, std::sqrt(std::max(p.density, 0.0)), p.inside ? "" : " (outside)");
     std::string text = buffer;
     // Channels in the order people read them (R,G,B,A), not OpenEXR's sorted one.
-    for (const std::string& name : format::displayOrder(p.channels)) {
+    for (const std::string& name : displayOrder(p.channels)) {
         const auto c = static_cast<std::size_t>(std::find(p.channels.begin(), p.channels.end(), name) - p.channels.begin());
         if (c >= p.values.size()) continue;
         std::snprintf(buffer, sizeof buffer, " %s=%.4g", name.c_str(), p.values[c]);

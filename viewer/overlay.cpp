@@ -9,7 +9,7 @@
 
 namespace conus::viewer {
 
-format::Image helpPanel(bool editing) {
+Image helpPanel(bool editing) {
     // helpText's lines are "  KEYS       what they do": the keys in a column of their own.
     constexpr std::size_t kKeyColumn = 13;
     std::vector<std::string> lines;
@@ -33,7 +33,7 @@ format::Image helpPanel(bool editing) {
     return imageio::renderTextPanel(lines, style);
 }
 
-format::Image errorPanel(const std::string& fileName, const std::string& error, int windowWidth) {
+Image errorPanel(const std::string& fileName, const std::string& error, int windowWidth) {
     imageio::TextPanelStyle style;
     style.fontSize = 16;
     style.panel[3] = 0.55f;
@@ -46,7 +46,7 @@ format::Image errorPanel(const std::string& fileName, const std::string& error, 
     return imageio::renderTextPanel(lines, style);
 }
 
-format::Image statusPanel(const std::string& text, int windowWidth) {
+Image statusPanel(const std::string& text, int windowWidth) {
     imageio::TextPanelStyle style;
     style.fontSize = 13;
     style.padding = 4;

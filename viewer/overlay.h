@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::viewer {
 
@@ -13,10 +13,10 @@ inline constexpr int kHelpSlot = 0, kErrorSlot = 1, kStatusSlot = 2;  // ViewRen
 inline constexpr int kOverlayMargin = 16;  // window pixels between the panels and the window's edge
 
 // The key list of helpText(editing) on a semi-transparent dark panel, white text.
-format::Image helpPanel(bool editing);
+Image helpPanel(bool editing);
 // "Cannot open <file>" and the reason, wrapped to fit a window `windowWidth` pixels wide.
-format::Image errorPanel(const std::string& fileName, const std::string& error, int windowWidth);
+Image errorPanel(const std::string& fileName, const std::string& error, int windowWidth);
 // One line across the window's width (file, mode, zoom, the pixel under the cursor).
-format::Image statusPanel(const std::string& text, int windowWidth);
+Image statusPanel(const std::string& text, int windowWidth);
 
 }  // namespace conus::viewer

@@ -52,11 +52,11 @@ int runScreenshot(const Options& options) {
             char text[160];
             std::snprintf(text, sizeof text, "%s | %s | %dx%d", std::filesystem::path(doc.path).filename().string().c_str(),
                           modeName(options.display.mode), width, height);
-            const format::Image bar = statusPanel(text, width);
+            const Image bar = statusPanel(text, width);
             renderer.setOverlay(kStatusSlot, bar);
             overlays.push_back({kStatusSlot, 0, height - bar.height});
         }
-        const format::Image frame = renderer.renderToImage(view, width, height, options.display, overlays);
+        const Image frame = renderer.renderToImage(view, width, height, options.display, overlays);
         imageio::WriteOptions write;
         write.meaning = imageio::PixelMeaning::Display;  // the framebuffer: already what the screen shows
         imageio::writeImageFile(options.screenshot, frame, write);

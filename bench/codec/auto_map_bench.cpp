@@ -10,9 +10,9 @@ namespace {
 
 using namespace conus;
 
-const format::Image& importance4096() {
-    static const format::Image image = [] {
-        format::Image img = format::makeImage(4096, 4096, {"Y"});
+const Image& importance4096() {
+    static const Image image = [] {
+        Image img = makeImage(4096, 4096, {"Y"});
         const double blobs[][3] = {{0.3, 0.3, 0.05}, {0.7, 0.65, 0.04}, {0.25, 0.8, 0.03}};
         for (int y = 0; y < 4096; ++y)
             for (int x = 0; x < 4096; ++x) {
@@ -29,7 +29,7 @@ const format::Image& importance4096() {
 }
 
 void run(benchmark::State& state, codec::AutoMethod method) {
-    const format::Image& importance = importance4096();
+    const Image& importance = importance4096();
     codec::AutoMapOptions options;
     options.method = method;
     double correlation = 0;

@@ -17,8 +17,8 @@ using namespace conus;
 using namespace conus::codec;
 
 // Hash noise: content does not change the cost of these kernels, and this is quick to build.
-format::Image hashImage(int side, unsigned seed) {
-    format::Image im;
+Image hashImage(int side, unsigned seed) {
+    Image im;
     im.width = im.height = side;
     im.channels = {"R", "G", "B"};
     im.pixels.resize(static_cast<std::size_t>(side) * side * 3);
@@ -40,12 +40,12 @@ const SamplingMap& fociMap() {
     static const SamplingMap map = buildFociMap(foci());
     return map;
 }
-const format::Image& source4096() {
-    static const format::Image im = hashImage(4096, 1);
+const Image& source4096() {
+    static const Image im = hashImage(4096, 1);
     return im;
 }
-const format::Image& image2048() {
-    static const format::Image im = hashImage(2048, 2);
+const Image& image2048() {
+    static const Image im = hashImage(2048, 2);
     return im;
 }
 
@@ -58,43 +58,43 @@ View viewFor(int which) {
 }
 
 void BM_EncodeConus(benchmark::State& state) {
-    const format::Image& src = source4096();
+    const Image& src = source4096();
     const SamplingMap& map = fociMap();
     for (auto _ : state) {
-        format::Image out = encodeImage(src, map, {1024, 1024, 0, {}});
+        Image out = encodeImage(src, map, {1024, 1024, 0, {}});
         benchmark::DoNotOptimize(out.pixels.data());
     }
     state.SetItemsProcessed(state.iterations() * 1024 * 1024);
 }
 
 void BM_EncodeBaselineAreaDownsample(benchmark::State& state) {
-    const format::Image& src = source4096();
+    const Image& src = source4096();
     for (auto _ : state) {
-        format::Image out = areaDownsample(src, 1024, 1024);
+        Image out = areaDownsample(src, 1024, 1024);
         benchmark::DoNotOptimize(out.pixels.data());
     }
     state.SetItemsProcessed(state.iterations() * 1024 * 1024);
 }
 
 void BM_DecodeConusView(benchmark::State& state) {
-    const format::Image& conus = image2048();
+    const Image& conus = image2048();
     const SamplingMap& map = fociMap();
     DecodeOptions options;
     options.view = viewFor(static_cast<int>(state.range(0)));
     options.width = kViewWidth;
     options.height = kViewHeight;
     for (auto _ : state) {
-        format::Image out = decodeImage(conus, map, options);
+        Image out = decodeImage(conus, map, options);
         benchmark::DoNotOptimize(out.pixels.data());
     }
     state.SetItemsProcessed(state.iterations() * kViewWidth * kViewHeight);
 }
 
 void BM_DecodeBaselineBilinear(benchmark::State& state) {
-    const format::Image& image = image2048();
+    const Image& image = image2048();
     const View view = viewFor(static_cast<int>(state.range(0)));
     for (auto _ : state) {
-        format::Image out = resizeBilinear(image, view, kViewWidth, kViewHeight);
+        Image out = resizeBilinear(image, view, kViewWidth, kViewHeight);
         benchmark::DoNotOptimize(out.pixels.data());
     }
     state.SetItemsProcessed(state.iterations() * kViewWidth * kViewHeight);

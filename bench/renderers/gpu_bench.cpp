@@ -22,8 +22,8 @@ namespace {
 
 using namespace conus;
 
-format::Image smoothSource(int size) {
-    format::Image im = format::makeImage(size, size, {"R", "G", "B"});
+Image smoothSource(int size) {
+    Image im = makeImage(size, size, {"R", "G", "B"});
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) {
             const double u = (x + 0.5) / size, v = (y + 0.5) / size;
@@ -40,13 +40,13 @@ const codec::SamplingMap& focusMap() {
     return map;
 }
 
-const format::Image& encodeSource() {
-    static const format::Image image = smoothSource(4096);
+const Image& encodeSource() {
+    static const Image image = smoothSource(4096);
     return image;
 }
 
-const format::Image& decodeSource() {
-    static const format::Image image = smoothSource(2048);
+const Image& decodeSource() {
+    static const Image image = smoothSource(2048);
     return image;
 }
 
@@ -91,13 +91,13 @@ codec::DecodeOptions decodeOptions() {
 }
 
 void BM_EncodeCpu(benchmark::State& state) {
-    const format::Image& source = encodeSource();
+    const Image& source = encodeSource();
     for (auto _ : state) benchmark::DoNotOptimize(codec::encodeImage(source, focusMap(), encodeOptions()));
 }
 
 void BM_EncodeGpu(benchmark::State& state) {
     if (!context()) return state.SkipWithError("no GL backend");
-    const format::Image& source = encodeSource();
+    const Image& source = encodeSource();
     gl::encodeImageGpu(*context(), source, focusMap(), encodeOptions());  // compile shaders outside the timing
     gl::GpuTimings sum, t;
     for (auto _ : state) {
@@ -109,26 +109,26 @@ void BM_EncodeGpu(benchmark::State& state) {
     reportTimings(state, sum);
 }
 
-format::Image decodeInput() {
+Image decodeInput() {
     codec::EncodeOptions o;
     o.width = 2048;
     o.height = 2048;
     return codec::encodeImage(decodeSource(), focusMap(), o);
 }
 
-const format::Image& conusImage() {
-    static const format::Image image = decodeInput();
+const Image& conusImage() {
+    static const Image image = decodeInput();
     return image;
 }
 
 void BM_DecodeCpu(benchmark::State& state) {
-    const format::Image& conus = conusImage();
+    const Image& conus = conusImage();
     for (auto _ : state) benchmark::DoNotOptimize(codec::decodeImage(conus, focusMap(), decodeOptions()));
 }
 
 void BM_DecodeGpu(benchmark::State& state) {
     if (!context()) return state.SkipWithError("no GL backend");
-    const format::Image& conus = conusImage();
+    const Image& conus = conusImage();
     gl::decodeImageGpu(*context(), conus, focusMap(), decodeOptions());
     gl::GpuTimings sum, t;
     for (auto _ : state) {

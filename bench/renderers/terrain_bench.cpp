@@ -18,9 +18,9 @@ constexpr int kDem = 2048, kSamples = 1024, kFrameWidth = 1280, kFrameHeight = 7
 const codec::GroundParams kGround{150.0, 200.0, 6000.0, 60.0};
 
 struct Data {
-    format::Image dem, colour;
+    Image dem, colour;
     format::ConusFile conus, uniform;
-    codec::Mesh conusMesh, uniformMesh;
+    Mesh conusMesh, uniformMesh;
     std::unique_ptr<gl::Context> context;
 };
 
@@ -66,10 +66,10 @@ void BM_UndistortUniform(benchmark::State& state) {
     const glm::dvec2 extent = codec::fieldExtent(kGround);
     for (auto _ : state) benchmark::DoNotOptimize(codec::undistortHeightField(d.uniform, extent));
 }
-void renderFrames(benchmark::State& state, const codec::Mesh& mesh) {
+void renderFrames(benchmark::State& state, const Mesh& mesh) {
     Data& d = data();
     gl::TerrainRenderer renderer(*d.context, mesh);
-    const gl::TerrainCamera camera = gl::viewerCamera(kGround, d.dem.at(kDem / 2, kDem - 1));
+    const Camera camera = gl::viewerCamera(kGround, d.dem.at(kDem / 2, kDem - 1), double(kFrameWidth) / kFrameHeight);
     for (auto _ : state) benchmark::DoNotOptimize(renderer.render(camera, kFrameWidth, kFrameHeight));
     state.counters["frames/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
     state.SetLabel(d.context->renderer());

@@ -17,7 +17,7 @@ constexpr int kMaxGrid = 256;
 [[noreturn]] void invalid(const std::string& what) { throw Error(ErrorCode::InvalidArgument, what); }
 
 // One channel: "Y" or the first channel, or the mean of R, G, B when present.
-std::vector<float> luminance(const format::Image& image) {
+std::vector<float> luminance(const Image& image) {
     const int r = image.channelIndex("R"), g = image.channelIndex("G"), b = image.channelIndex("B");
     int single = image.channelIndex("Y");
     if (single < 0) single = 0;
@@ -52,7 +52,7 @@ void blur(std::vector<double>& field, int width, int height, int radius) {
 
 }  // namespace
 
-DensityField importanceToDensity(const format::Image& importance, const AutoMapOptions& options) {
+DensityField importanceToDensity(const Image& importance, const AutoMapOptions& options) {
     if (importance.empty()) invalid("the importance image is empty");
     if (!(options.minDensity > 0 && options.minDensity < 1))
         invalid("min density " + std::to_string(options.minDensity) + " must lie in (0, 1)");
@@ -69,9 +69,9 @@ DensityField importanceToDensity(const format::Image& importance, const AutoMapO
     const double scale = std::min(1.0, double(kMaxGrid) / std::max(importance.width, importance.height));
     const int gw = std::max(2, static_cast<int>(std::lround(importance.width * scale)));
     const int gh = std::max(2, static_cast<int>(std::lround(importance.height * scale)));
-    format::Image single = format::makeImage(importance.width, importance.height, {"Y"});
+    Image single = makeImage(importance.width, importance.height, {"Y"});
     single.pixels = luminance(importance);
-    const format::Image small = (gw <= importance.width && gh <= importance.height)
+    const Image small = (gw <= importance.width && gh <= importance.height)
                                     ? areaDownsample(single, gw, gh)
                                     : resizeBilinear(single, {}, gw, gh);
     std::vector<double> field(small.pixels.begin(), small.pixels.end());
@@ -156,7 +156,7 @@ SamplingMap buildSeparableMap(const DensityField& target, int columns, int rows)
     return SamplingMap(columns, rows, std::move(nodes));
 }
 
-SamplingMap buildAutoMap(const format::Image& importance, const AutoMapOptions& options) {
+SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options) {
     const DensityField target = importanceToDensity(importance, options);
     if (options.method == AutoMethod::Separable) return buildSeparableMap(target, options.columns, options.rows);
     DensityMapOptions mapOptions;
@@ -165,15 +165,15 @@ SamplingMap buildAutoMap(const format::Image& importance, const AutoMapOptions& 
     return buildMapFromDensity(target, mapOptions);
 }
 
-format::Image detailImportance(const format::Image& image) {
+Image detailImportance(const Image& image) {
     if (image.empty()) invalid("the image is empty");
     const double scale = std::min(1.0, 1024.0 / std::max(image.width, image.height));
-    format::Image single = format::makeImage(image.width, image.height, {"Y"});
+    Image single = makeImage(image.width, image.height, {"Y"});
     single.pixels = luminance(image);
     const int w = std::max(1, static_cast<int>(std::lround(image.width * scale)));
     const int h = std::max(1, static_cast<int>(std::lround(image.height * scale)));
-    const format::Image small = scale < 1 ? areaDownsample(single, w, h) : single;
-    format::Image detail = format::makeImage(w, h, {"Y"});
+    const Image small = scale < 1 ? areaDownsample(single, w, h) : single;
+    Image detail = makeImage(w, h, {"Y"});
     auto at = [&](int x, int y) { return small.at(std::clamp(x, 0, w - 1), std::clamp(y, 0, h - 1)); };
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {

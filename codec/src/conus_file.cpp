@@ -2,7 +2,7 @@
 
 namespace conus::codec {
 
-format::ConusFile makeImageFile(format::Image image, const SamplingMap& map, int sourceWidth, int sourceHeight,
+format::ConusFile makeImageFile(Image image, const SamplingMap& map, int sourceWidth, int sourceHeight,
                                 SourceEncoding encoding, std::optional<format::AnalyticMap> analytic) {
     format::ConusFile file;
     file.image = std::move(image);
@@ -22,7 +22,7 @@ format::ConusFile makeImageFile(format::Image image, const SamplingMap& map, int
 
 format::ConusFile makeMapFile(const SamplingMap& map, std::optional<format::AnalyticMap> analytic) {
     format::ConusFile file;
-    file.image = format::makeImage(map.columns(), map.rows(), {"Y"});
+    file.image = makeImage(map.columns(), map.rows(), {"Y"});
     for (int j = 0; j < map.rows(); ++j)
         for (int i = 0; i < map.columns(); ++i)
             file.image.at(i, j) =

@@ -156,7 +156,7 @@ inline bool interior(double xlo, double xhi, double ylo, double yhi, int width, 
 }
 
 template <int kC>
-void decodeRows(const format::Image& src, const SamplingMap& map, const View& view, format::Image& dst,
+void decodeRows(const Image& src, const SamplingMap& map, const View& view, Image& dst,
                 const detail::ViewColumns& cols, int y0, int y1) {
     const int channels = kC > 0 ? kC : src.channelCount();
     const int W = dst.width, H = dst.height, Wc = src.width, Hc = src.height;
@@ -280,7 +280,7 @@ AxisTaps axisTaps(int size, double a0, double a1, int count) {
 }
 
 template <int kC>
-void bilinearRows(const format::Image& src, format::Image& dst, const AxisTaps& tx, const AxisTaps& ty, int y0,
+void bilinearRows(const Image& src, Image& dst, const AxisTaps& tx, const AxisTaps& ty, int y0,
                   int y1) {
     const int channels = kC > 0 ? kC : src.channelCount();
     const std::size_t stride = static_cast<std::size_t>(src.width) * channels;
@@ -303,7 +303,7 @@ void bilinearRows(const format::Image& src, format::Image& dst, const AxisTaps& 
 
 // Pixels whose centre lies outside the image ([0,1]^2 undistorted) show the background, 0 in every
 // channel, instead of the edge pixels smeared outward.
-void clearOutside(format::Image& out, const View& view) {
+void clearOutside(Image& out, const View& view) {
     const std::size_t rowValues = static_cast<std::size_t>(out.width) * out.channels.size();
     std::vector<char> columnOutside(out.width);
     for (int x = 0; x < out.width; ++x) {
@@ -324,7 +324,7 @@ void clearOutside(format::Image& out, const View& view) {
 
 }  // namespace
 
-void checkDecodeMemory(const format::Image& conus, int width, int height, std::int64_t maxBytes) {
+void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes) {
     const std::int64_t channels = conus.channelCount();
     const std::int64_t bytes = (std::int64_t{conus.width} * conus.height + std::int64_t{width} * height) * channels *
                                std::int64_t(sizeof(float));
@@ -337,12 +337,12 @@ void checkDecodeMemory(const format::Image& conus, int width, int height, std::i
     }
 }
 
-format::Image decodeImage(const format::Image& conus, const SamplingMap& map, const DecodeOptions& options) {
-    format::checkImage(conus, "decodeImage");
+Image decodeImage(const Image& conus, const SamplingMap& map, const DecodeOptions& options) {
+    checkImage(conus, "decodeImage");
     detail::checkOutputSize(options.width, options.height, "decodeImage");
     checkDecodeMemory(conus, options.width, options.height);
     checkView(options.view, "decodeImage");
-    format::Image out = detail::makeOutput(conus, options.width, options.height);
+    Image out = detail::makeOutput(conus, options.width, options.height);
     const detail::ViewColumns cols = detail::viewColumns(map.columns(), options.view.u0, options.view.u1, out.width);
     detail::RowProgress progress(options.progress, out.height);
     parallelRows(
@@ -358,11 +358,11 @@ format::Image decodeImage(const format::Image& conus, const SamplingMap& map, co
     return out;
 }
 
-format::Image resizeBilinear(const format::Image& image, const View& view, int width, int height, int threads) {
-    format::checkImage(image, "resizeBilinear");
+Image resizeBilinear(const Image& image, const View& view, int width, int height, int threads) {
+    checkImage(image, "resizeBilinear");
     detail::checkOutputSize(width, height, "resizeBilinear");
     checkView(view, "resizeBilinear");
-    format::Image out = detail::makeOutput(image, width, height);
+    Image out = detail::makeOutput(image, width, height);
     const AxisTaps tx = axisTaps(image.width, view.u0, view.u1, width);
     const AxisTaps ty = axisTaps(image.height, view.v0, view.v1, height);
     parallelRows(

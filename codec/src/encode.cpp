@@ -98,7 +98,7 @@ class Pyramid {
 public:
     static constexpr int kMaxLevels = 40;
 
-    explicit Pyramid(const format::Image& source) : m_source(source), m_channels(source.channelCount()) {
+    explicit Pyramid(const Image& source) : m_source(source), m_channels(source.channelCount()) {
         int w = source.width, h = source.height;
         m_sizes.push_back({w, h});
         while ((w > 1 || h > 1) && static_cast<int>(m_sizes.size()) < kMaxLevels) {
@@ -122,7 +122,7 @@ public:
     }
 
 private:
-    const format::Image& m_source;
+    const Image& m_source;
     int m_channels;
     std::vector<std::array<int, 2>> m_sizes;
     std::array<std::unique_ptr<float[]>, kMaxLevels> m_levels;
@@ -132,7 +132,7 @@ private:
 constexpr detail::TapOffsets<kMaxTapsPerAxis> kTapOffsets;
 
 template <int kC>
-void encodeRows(const format::Image& src, const SamplingMap& map, Pyramid& pyramid, format::Image& dst, int threads,
+void encodeRows(const Image& src, const SamplingMap& map, Pyramid& pyramid, Image& dst, int threads,
                 int y0, int y1) {
     const int channels = kC > 0 ? kC : src.channelCount();
     const int W = dst.width, H = dst.height;
@@ -192,10 +192,10 @@ void encodeRows(const format::Image& src, const SamplingMap& map, Pyramid& pyram
 
 }  // namespace
 
-format::Image encodeImage(const format::Image& source, const SamplingMap& map, const EncodeOptions& options) {
-    format::checkImage(source, "encodeImage");
+Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options) {
+    checkImage(source, "encodeImage");
     detail::checkOutputSize(options.width, options.height, "encodeImage");
-    format::Image out = detail::makeOutput(source, options.width, options.height);
+    Image out = detail::makeOutput(source, options.width, options.height);
     Pyramid pyramid(source);
     detail::RowProgress progress(options.progress, out.height);
     parallelRows(out.height, options.threads, [&](int y0, int y1) {
@@ -209,15 +209,15 @@ format::Image encodeImage(const format::Image& source, const SamplingMap& map, c
 
 // Downsample only: growing an axis has no area to average over, and the decoder's bilinear
 // baseline (resizeBilinear) is the tool for that.
-format::Image areaDownsample(const format::Image& source, int width, int height, int threads) {
-    format::checkImage(source, "areaDownsample");
+Image areaDownsample(const Image& source, int width, int height, int threads) {
+    checkImage(source, "areaDownsample");
     detail::checkOutputSize(width, height, "areaDownsample");
     if (width > source.width || height > source.height)
         throw Error(ErrorCode::InvalidArgument,
                     "areaDownsample: " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                         std::to_string(width) + "x" + std::to_string(height) +
                         " grows the image; it only shrinks (use resizeBilinear)");
-    format::Image out = detail::makeOutput(source, width, height);
+    Image out = detail::makeOutput(source, width, height);
     areaDownsamplePlane({source.pixels.data(), source.width, source.height}, out.pixels.data(), width, height,
                         source.channelCount(), threads);
     return out;

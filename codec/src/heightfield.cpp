@@ -73,13 +73,13 @@ double terrainValue(double u, double v, const TerrainOptions& o) {
 // ---- Checks and helpers ----
 
 void checkSize(int w, int h, const char* what) {
-    if (w < 1 || h < 1 || w > format::kMaxImageSide || h > format::kMaxImageSide)
+    if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
         throw Error(ErrorCode::InvalidArgument, std::string(what) + ": size " + std::to_string(w) + "x" +
                                                     std::to_string(h) + " is outside [1, 65536] per side");
 }
 
-int heightChannel(const format::Image& heights, const char* what) {
-    format::checkImage(heights, what);
+int heightChannel(const Image& heights, const char* what) {
+    checkImage(heights, what);
     const int z = heights.channelIndex("Z");
     if (z >= 0) return z;
     if (heights.channelCount() == 1) return 0;
@@ -89,9 +89,9 @@ int heightChannel(const format::Image& heights, const char* what) {
 }
 
 // R,G,B,Z at the DEM's size: the one source image the encoder filters.
-format::Image combine(const format::Image& heights, const format::Image& colour, const char* what) {
+Image combine(const Image& heights, const Image& colour, const char* what) {
     const int z = heightChannel(heights, what);
-    format::checkImage(colour, what);
+    checkImage(colour, what);
     if (colour.width != heights.width || colour.height != heights.height)
         throw Error(ErrorCode::InvalidArgument, std::string(what) + ": colour " + std::to_string(colour.width) + "x" +
                                                     std::to_string(colour.height) + " differs from the DEM's " +
@@ -102,7 +102,7 @@ format::Image combine(const format::Image& heights, const format::Image& colour,
         rgb[c] = colour.channelIndex(std::string(1, "RGB"[c]));
         if (rgb[c] < 0) rgb[c] = std::min(c, colour.channelCount() - 1);  // grey or unnamed channels
     }
-    format::Image out = format::makeImage(heights.width, heights.height, {"R", "G", "B", "Z"});
+    Image out = makeImage(heights.width, heights.height, {"R", "G", "B", "Z"});
     const std::size_t n = static_cast<std::size_t>(heights.width) * heights.height;
     for (std::size_t i = 0; i < n; ++i) {
         for (int c = 0; c < 3; ++c) out.pixels[i * 4 + c] = colour.pixels[i * colour.channels.size() + rgb[c]];
@@ -116,7 +116,7 @@ format::Image combine(const format::Image& heights, const format::Image& colour,
     return out;
 }
 
-format::DepthInfo heightDepth(const format::Image& rgbz, const std::string& units) {
+format::DepthInfo heightDepth(const Image& rgbz, const std::string& units) {
     float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
     const int z = rgbz.channelIndex("Z");
     for (std::size_t i = z; i < rgbz.pixels.size(); i += rgbz.channels.size()) {
@@ -156,7 +156,7 @@ void addNormals(Mesh& mesh) {
 
 }  // namespace
 
-format::Image generateTerrain(const TerrainOptions& o) {
+Image generateTerrain(const TerrainOptions& o) {
     checkSize(o.width, o.height, "generateTerrain");
     if (!(o.reliefMetres >= 0.0 && o.reliefMetres < 1e6) || !(o.features > 0.0 && o.features < 1e4) ||
         o.octaves < 1 || o.octaves > 24 || !(o.ridges >= 0.0 && o.ridges <= 1.0))
@@ -165,7 +165,7 @@ format::Image generateTerrain(const TerrainOptions& o) {
                         std::to_string(o.features) + ", octaves " + std::to_string(o.octaves) + ", ridges " +
                         std::to_string(o.ridges) + ": want relief in [0,1e6), features in (0,1e4), octaves in "
                         "[1,24], ridges in [0,1]");
-    format::Image out = format::makeImage(o.width, o.height, {"Z"});
+    Image out = makeImage(o.width, o.height, {"Z"});
     parallelRows(o.height, 0, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < o.width; ++x)
@@ -175,7 +175,7 @@ format::Image generateTerrain(const TerrainOptions& o) {
     return out;
 }
 
-format::Image terrainColours(const format::Image& heights, glm::dvec2 extent) {
+Image terrainColours(const Image& heights, glm::dvec2 extent) {
     const int z = heightChannel(heights, "terrainColours");
     if (!(extent.x > 0 && extent.y > 0))
         throw Error(ErrorCode::InvalidArgument, "terrainColours: field extent " + std::to_string(extent.x) + " x " +
@@ -198,7 +198,7 @@ format::Image terrainColours(const format::Image& heights, glm::dvec2 extent) {
                                      {0.55, {0.55, 0.47, 0.30}}, {0.78, {0.50, 0.46, 0.43}},
                                      {0.90, {0.93, 0.94, 0.97}}, {1.00, {1.00, 1.00, 1.00}}};
     const glm::dvec3 rock(0.42, 0.40, 0.38);
-    format::Image out = format::makeImage(w, h, {"R", "G", "B"});
+    Image out = makeImage(w, h, {"R", "G", "B"});
     parallelRows(h, 0, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < w; ++x) {
@@ -242,7 +242,7 @@ double fovForFieldWidth(double eyeHeight, double near, double far, double width)
     return fov;
 }
 
-format::ConusFile encodeHeightField(const format::Image& heights, const format::Image& colour,
+format::ConusFile encodeHeightField(const Image& heights, const Image& colour,
                                     const HeightFieldOptions& options) {
     constexpr const char* kWhat = "encodeHeightField";
     checkGroundParams(options.ground);
@@ -250,7 +250,7 @@ format::ConusFile encodeHeightField(const format::Image& heights, const format::
     if (options.mapGrid < 2 || options.mapGrid > kMaxMapSide)
         throw Error(ErrorCode::InvalidArgument,
                     std::string(kWhat) + ": map grid " + std::to_string(options.mapGrid) + " is outside [2, " + std::to_string(kMaxMapSide) + "]");
-    const format::Image source = combine(heights, colour, kWhat);
+    const Image source = combine(heights, colour, kWhat);
 
     // Sample through a grid as fine as the image: a sample then sits where the analytic inverse
     // puts it (the piecewise-bilinear error of a coarse grid would shift the mesh's vertices).
@@ -274,11 +274,11 @@ format::ConusFile encodeHeightField(const format::Image& heights, const format::
     return file;
 }
 
-format::ConusFile uniformHeightField(const format::Image& heights, const format::Image& colour, int width, int height,
+format::ConusFile uniformHeightField(const Image& heights, const Image& colour, int width, int height,
                                      const std::string& units, int threads) {
     constexpr const char* kWhat = "uniformHeightField";
     checkSize(width, height, kWhat);
-    const format::Image source = combine(heights, colour, kWhat);
+    const Image source = combine(heights, colour, kWhat);
     format::ConusFile file;
     file.image = width == source.width && height == source.height ? source
                                                                   : areaDownsample(source, width, height, threads);
@@ -293,8 +293,8 @@ format::ConusFile uniformHeightField(const format::Image& heights, const format:
 
 Mesh undistortHeightField(const format::ConusFile& file, glm::dvec2 extent) {
     constexpr const char* kWhat = "undistortHeightField";
-    const format::Image& image = file.image;
-    format::checkImage(image, kWhat);
+    const Image& image = file.image;
+    checkImage(image, kWhat);
     const int z = image.channelIndex("Z");
     if (z < 0) throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": the CoNUS image has no Z channel");
     if (!(extent.x > 0 && extent.y > 0 && std::isfinite(extent.x) && std::isfinite(extent.y)))
@@ -349,8 +349,8 @@ Mesh undistortHeightField(const format::ConusFile& file) {
 }
 
 double heightAt(const format::ConusFile& file, glm::dvec2 p) {
-    const format::Image& image = file.image;
-    format::checkImage(image, "heightAt");
+    const Image& image = file.image;
+    checkImage(image, "heightAt");
     const int z = image.channelIndex("Z");
     if (z < 0) throw Error(ErrorCode::InvalidArgument, "heightAt: the CoNUS image has no Z channel");
     const glm::dvec2 pd = file.analytic && file.analytic->kind == "ground"

@@ -12,7 +12,7 @@
 namespace conus::codec {
 namespace {
 
-int findChannel(const format::Image& image, const std::string& name) {
+int findChannel(const Image& image, const std::string& name) {
     for (int c = 0; c < image.channelCount(); ++c)
         if (image.channels[c] == name) return c;
     return -1;
@@ -20,7 +20,7 @@ int findChannel(const format::Image& image, const std::string& name) {
 
 // Pairs of channel indices (in a, in b) to compare. Alpha and depth say nothing about how the
 // picture looks, so they count only when nothing else is shared.
-std::vector<std::pair<int, int>> sharedChannels(const format::Image& a, const format::Image& b) {
+std::vector<std::pair<int, int>> sharedChannels(const Image& a, const Image& b) {
     std::vector<std::pair<int, int>> colour, other;
     for (int c = 0; c < a.channelCount(); ++c) {
         const int cb = findChannel(b, a.channels[c]);
@@ -31,19 +31,19 @@ std::vector<std::pair<int, int>> sharedChannels(const format::Image& a, const fo
     return colour.empty() ? other : colour;
 }
 
-void checkComparable(const format::Image& a, const format::Image& b) {
+void checkComparable(const Image& a, const Image& b) {
     if (a.width != b.width || a.height != b.height)
         throw Error(ErrorCode::InvalidArgument, "meanSquaredError: sizes differ (" + std::to_string(a.width) + "x" +
                                                     std::to_string(a.height) + " vs " + std::to_string(b.width) +
                                                     "x" + std::to_string(b.height) + ")");
-    for (const format::Image* im : {&a, &b})
+    for (const Image* im : {&a, &b})
         if (im->pixels.size() != static_cast<std::size_t>(im->width) * im->height * im->channels.size())
             throw Error(ErrorCode::InvalidArgument, "meanSquaredError: pixel array does not match the image size");
 }
 
 }  // namespace
 
-double meanSquaredError(const format::Image& a, const format::Image& b) {
+double meanSquaredError(const Image& a, const Image& b) {
     checkComparable(a, b);
     const auto pairs = sharedChannels(a, b);
     if (pairs.empty()) throw Error(ErrorCode::InvalidArgument, "meanSquaredError: the images share no channel");
@@ -62,7 +62,7 @@ double meanSquaredError(const format::Image& a, const format::Image& b) {
     return sum / (static_cast<double>(count) * pairs.size());
 }
 
-double psnr(const format::Image& a, const format::Image& b, double peak) {
+double psnr(const Image& a, const Image& b, double peak) {
     const double mse = meanSquaredError(a, b);
     if (mse == 0.0) return std::numeric_limits<double>::infinity();
     return 10.0 * std::log10(peak * peak / mse);

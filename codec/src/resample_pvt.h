@@ -12,7 +12,7 @@
 #include <utility>
 
 #include "conus/core/error.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::codec::detail {
 
@@ -20,17 +20,17 @@ inline void checkOutputSize(int width, int height, const char* what) {
     if (width < 1 || height < 1)
         throw Error(ErrorCode::InvalidArgument, std::string(what) + ": output size " + std::to_string(width) + "x" +
                                                     std::to_string(height) + " must be at least 1x1");
-    if (width > format::kMaxImageSide || height > format::kMaxImageSide ||
-        std::int64_t{width} * height > format::kMaxImagePixels)
+    if (width > kMaxImageSide || height > kMaxImageSide ||
+        std::int64_t{width} * height > kMaxImagePixels)
         throw Error(ErrorCode::LimitExceeded, std::string(what) + ": output size " + std::to_string(width) + "x" +
                                                   std::to_string(height) + " exceeds the image limits (" +
-                                                  std::to_string(format::kMaxImageSide) + " a side, " +
-                                                  std::to_string(format::kMaxImagePixels) + " pixels in all)");
+                                                  std::to_string(kMaxImageSide) + " a side, " +
+                                                  std::to_string(kMaxImagePixels) + " pixels in all)");
 }
 
 // Same channels as `like`, zero-filled; sizes already checked.
-inline format::Image makeOutput(const format::Image& like, int width, int height) {
-    format::Image out;
+inline Image makeOutput(const Image& like, int width, int height) {
+    Image out;
     out.width = width;
     out.height = height;
     out.channels = like.channels;

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "conus/core/error.h"
-#include "conus/format/limits.h"
+#include "conus/core/limits.h"
 
 namespace conus::format::detail {
 

@@ -95,7 +95,7 @@ struct ChannelRoles {
     int alpha = -1;
 };
 
-ChannelRoles rolesOf(const format::Image& image) {
+ChannelRoles rolesOf(const Image& image) {
     ChannelRoles roles;
     const int r = image.channelIndex("R"), g = image.channelIndex("G"), b = image.channelIndex("B");
     const int y = image.channelIndex("Y");
@@ -259,7 +259,7 @@ Transfer detectTransfer(const OIIO::ImageSpec& spec) {
 
 }  // namespace
 
-std::int64_t countNonFinite(const format::Image& image) {
+std::int64_t countNonFinite(const Image& image) {
     std::int64_t n = 0;
     for (float v : image.pixels) n += !std::isfinite(v);
     return n;
@@ -297,12 +297,12 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
     if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
         throw Error(ErrorCode::Io, shown + ": the image is empty (" + std::to_string(spec.width) + "x" +
                                        std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) + " channels)");
-    if (spec.width > format::kMaxImageSide || spec.height > format::kMaxImageSide || pixels > format::kMaxImagePixels ||
+    if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || pixels > kMaxImagePixels ||
         spec.nchannels > 64)
         throw Error(ErrorCode::LimitExceeded,
                     shown + ": image of " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels and " +
                         std::to_string(spec.nchannels) + " channels is beyond the limits (sides up to " +
-                        std::to_string(format::kMaxImageSide) + ", " + std::to_string(format::kMaxImagePixels) +
+                        std::to_string(kMaxImageSide) + ", " + std::to_string(kMaxImagePixels) +
                         " pixels, 64 channels)");
 
     std::vector<std::string> names;
@@ -312,8 +312,8 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
         const std::string n = spec.channel_name(c);
         names.push_back(n.empty() ? std::string(unnamed) : n);
     }
-    format::Image& image = result.image;
-    image = format::makeImage(spec.width, spec.height, names);
+    Image& image = result.image;
+    image = makeImage(spec.width, spec.height, names);
     if (!in->read_image(info.part, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
         std::string reason = in->geterror();
         if (reason.empty()) reason = "the file ends early or is damaged";
@@ -369,24 +369,24 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
         OIIO::ImageBuf upright = OIIO::ImageBufAlgo::reorient(OIIO::ImageBuf(oriented, image.pixels.data()));
         if (upright.has_error()) throw Error(ErrorCode::Io, shown + ": cannot apply the EXIF orientation: " + upright.geterror());
         const OIIO::ROI roi = upright.roi();
-        format::Image turned = format::makeImage(roi.width(), roi.height(), image.channels);
+        Image turned = makeImage(roi.width(), roi.height(), image.channels);
         upright.get_pixels(roi, OIIO::TypeDesc::FLOAT, turned.pixels.data());
         image = std::move(turned);
     }
     return result;
 }
 
-void linearize(format::Image& image) {
-    format::checkImage(image, "linearize");
+void linearize(Image& image) {
+    checkImage(image, "linearize");
     const ChannelRoles roles = rolesOf(image);
     convertColour(image.pixels.data(), image.width, image.height, image.channelCount(), roles.colour, "sRGB", "linear",
                   "an image");
     if (roles.alpha >= 0) premultiply(image.pixels.data(), image.width, image.height, image.channelCount(), roles.alpha, true);
 }
 
-format::Image displayEncoded(const format::Image& image) {
-    format::checkImage(image, "displayEncoded");
-    format::Image out = image;
+Image displayEncoded(const Image& image) {
+    checkImage(image, "displayEncoded");
+    Image out = image;
     for (float& v : out.pixels)
         if (!std::isfinite(v)) v = 0.0f;
     const ChannelRoles roles = rolesOf(out);
@@ -499,8 +499,8 @@ std::string sampleTypesOf(const std::string& path) {
     return joinTypes(traitsOf(output->format_name(), *output).sampleTypes);
 }
 
-void writeImageFile(const std::string& path, const format::Image& image, const WriteOptions& options) {
-    format::checkImage(image, "writeImageFile");
+void writeImageFile(const std::string& path, const Image& image, const WriteOptions& options) {
+    checkImage(image, "writeImageFile");
     Target target = targetFor(path, options);
     const bool integer = isInteger(target.sampleType);
 

@@ -14,7 +14,7 @@ namespace conus::imageio {
 
 constexpr const char* kFont = "DejaVuSans";
 
-void drawText(format::Image& image, int x, int y, int size, const std::string& text, const float color[3]) {
+void drawText(Image& image, int x, int y, int size, const std::string& text, const float color[3]) {
     OIIO::ImageSpec spec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT);
     OIIO::ImageBuf buffer(spec, image.pixels.data());  // wraps our pixels: drawn in place
     const float rgba[4] = {color[0], color[1], color[2], 1.0f};
@@ -59,7 +59,7 @@ std::vector<std::string> wrapText(const std::string& text, int maxWidth, int fon
     return out;
 }
 
-format::Image renderTextPanel(const std::vector<std::string>& lines, const TextPanelStyle& style) {
+Image renderTextPanel(const std::vector<std::string>& lines, const TextPanelStyle& style) {
     const int lineHeight = static_cast<int>(std::lround(style.fontSize * 1.3));
     int width = 0;
     // A line "key\tdescription" is two columns, the second at style.tabStop.
@@ -72,9 +72,9 @@ format::Image renderTextPanel(const std::vector<std::string>& lines, const TextP
         const auto [left, right] = columns(line);
         width = std::max(width, right.empty() ? textWidth(left, style.fontSize) : style.tabStop + textWidth(right, style.fontSize));
     }
-    width = std::clamp(std::max(width + 2 * style.padding, style.minWidth), 1, format::kMaxImageSide);
-    const int height = std::clamp(static_cast<int>(lines.size()) * lineHeight + 2 * style.padding, 1, format::kMaxImageSide);
-    format::Image panel = format::makeImage(width, height, {"R", "G", "B", "A"});
+    width = std::clamp(std::max(width + 2 * style.padding, style.minWidth), 1, kMaxImageSide);
+    const int height = std::clamp(static_cast<int>(lines.size()) * lineHeight + 2 * style.padding, 1, kMaxImageSide);
+    Image panel = makeImage(width, height, {"R", "G", "B", "A"});
     for (std::size_t i = 0; i < panel.pixels.size(); ++i) panel.pixels[i] = style.panel[i % 4];
     OIIO::ImageBuf buffer(OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::FLOAT), panel.pixels.data());
     // render_text's y is the baseline: the ascent (about 0.8 of the size) below each line's top.

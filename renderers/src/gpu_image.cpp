@@ -70,7 +70,7 @@ GLenum pixelFormat(int channels) {
 // RGBA on the CPU made the upload slower, not faster.
 class PassPixels {
 public:
-    PassPixels(const format::Image& image, int first, int count) {
+    PassPixels(const Image& image, int first, int count) {
         const int channels = image.channelCount();
         if (first == 0 && count == channels) {
             m_data = image.pixels.data();
@@ -90,7 +90,7 @@ private:
 };
 
 // Reads the bound framebuffer's first `count` channels into channels [first, first + count).
-void readBack(const GladGLContext& gl, format::Image& out, int first, int count) {
+void readBack(const GladGLContext& gl, Image& out, int first, int count) {
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
     const int channels = out.channelCount();
     if (first == 0 && count == channels) {
@@ -368,7 +368,7 @@ namespace {
 // target, and (for sources past the texture limit) the tile plan with the CPU-built pyramid.
 class GpuEncoder {
 public:
-    GpuEncoder(Context& context, const format::Image& source, const codec::SamplingMap& map, format::Image& out)
+    GpuEncoder(Context& context, const Image& source, const codec::SamplingMap& map, Image& out)
         : m_context(context), m_gl(makeCurrentGl(context)), m_source(source), m_out(out),
           m_pyramid(pyramidLayout(source.width, source.height)), m_mesh(buildMesh(map, out.width, out.height)),
           m_vertexArray(makeVertexArray(m_gl)), m_vertexBuffer(makeBuffer(m_gl)), m_indexBuffer(makeBuffer(m_gl)),
@@ -480,7 +480,7 @@ private:
         gl.Clear(GL_COLOR_BUFFER_BIT);
         std::vector<PassPixels> levelPixels;
         levelPixels.reserve(m_levels.size());
-        for (const format::Image& level : m_levels) levelPixels.emplace_back(level, first, count);
+        for (const Image& level : m_levels) levelPixels.emplace_back(level, first, count);
         for (const Tile& tile : m_tiles) {
             if (tile.indices.empty()) continue;
             GlHandle texture = makeTexture(gl), atlas = makeTexture(gl);
@@ -517,23 +517,23 @@ private:
 
     Context& m_context;
     const GladGLContext& m_gl;
-    const format::Image& m_source;
-    format::Image& m_out;
+    const Image& m_source;
+    Image& m_out;
     const Pyramid m_pyramid;
     const Mesh m_mesh;
     GlHandle m_vertexArray, m_vertexBuffer, m_indexBuffer;
     Target m_target;
     GLuint m_program = 0;
     std::vector<Tile> m_tiles;  // empty: not tiled
-    std::vector<format::Image> m_levels;
+    std::vector<Image> m_levels;
 };
 
 }  // namespace
 
-format::Image encodeImageGpu(Context& context, const format::Image& source, const codec::SamplingMap& map,
+Image encodeImageGpu(Context& context, const Image& source, const codec::SamplingMap& map,
                              const codec::EncodeOptions& options, GpuTimings* timings) {
-    format::checkImage(source, "encodeImageGpu");
-    format::Image out = format::makeImage(options.width, options.height, source.channels);
+    checkImage(source, "encodeImageGpu");
+    Image out = makeImage(options.width, options.height, source.channels);
     checkTextureSize(context, out.width, out.height, "encodeImageGpu", "output");
     GpuTimings t;
     Clock::time_point start = Clock::now();
@@ -544,10 +544,10 @@ format::Image encodeImageGpu(Context& context, const format::Image& source, cons
     return out;
 }
 
-format::Image decodeImageGpu(Context& context, const format::Image& conus, const codec::SamplingMap& map,
+Image decodeImageGpu(Context& context, const Image& conus, const codec::SamplingMap& map,
                              const codec::DecodeOptions& options, GpuTimings* timings) {
     constexpr const char* kWhat = "decodeImageGpu";
-    format::checkImage(conus, kWhat);
+    checkImage(conus, kWhat);
     codec::checkDecodeMemory(conus, options.width, options.height);
     const codec::View& view = options.view;
     if (!std::isfinite(view.u0) || !std::isfinite(view.u1) || !std::isfinite(view.v0) || !std::isfinite(view.v1) ||
@@ -556,7 +556,7 @@ format::Image decodeImageGpu(Context& context, const format::Image& conus, const
         throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": view (" + std::to_string(view.u0) + ", " +
                                                     std::to_string(view.v0) + ") - (" + std::to_string(view.u1) +
                                                     ", " + std::to_string(view.v1) + ") is empty or not finite");
-    format::Image out = format::makeImage(options.width, options.height, conus.channels);
+    Image out = makeImage(options.width, options.height, conus.channels);
     checkTextureSize(context, conus.width, conus.height, kWhat, "CoNUS image");
     checkTextureSize(context, out.width, out.height, kWhat, "output");
 
@@ -621,13 +621,13 @@ format::Image decodeImageGpu(Context& context, const format::Image& conus, const
     return out;
 }
 
-format::Image encodeImage(const Device& device, const format::Image& source, const codec::SamplingMap& map,
+Image encodeImage(const Device& device, const Image& source, const codec::SamplingMap& map,
                           const codec::EncodeOptions& options) {
     return device.run([&] { return codec::encodeImage(source, map, options); },
                       [&](Context& context) { return encodeImageGpu(context, source, map, options); });
 }
 
-format::Image decodeImage(const Device& device, const format::Image& conus, const codec::SamplingMap& map,
+Image decodeImage(const Device& device, const Image& conus, const codec::SamplingMap& map,
                           const codec::DecodeOptions& options) {
     return device.run([&] { return codec::decodeImage(conus, map, options); },
                       [&](Context& context) { return decodeImageGpu(context, conus, map, options); });

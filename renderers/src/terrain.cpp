@@ -1,9 +1,9 @@
 // Height-field mesh rendering on a Context: one indexed draw into a (multisampled) RGBA32F + 32-bit
 // float depth framebuffer, resolved and read back.
 //
-// Rows: GL's window row 0 is the bottom of a perspective frame; the projection's y is negated so
-// row 0 is the top, and the readback is then already in the image-plane order (the winding flips
-// too, which does not matter: no face culling, a height field is seen from both sides).
+// Rows: the camera's v (down) becomes GL's y unflipped, so GL's window row 0 holds the top of the
+// frame and the readback is already in the image-plane order (the winding flips too, which does
+// not matter: no face culling, a height field is seen from both sides).
 #include "conus/renderers/terrain.h"
 
 #include <algorithm>
@@ -29,31 +29,12 @@ constexpr int kMaxFrameSide = 16384;
 constexpr double kPi = 3.14159265358979323846;
 
 
-void checkCamera(const TerrainCamera& c) {
-    const auto finite = [](glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-    const glm::dvec3 forward = c.target - c.eye;
-    const double horizontal = std::hypot(forward.x, forward.z);
-    if (!finite(c.eye) || !finite(c.target) || glm::length(forward) <= 0.0 || horizontal <= 1e-9 * glm::length(forward))
-        throw Error(ErrorCode::InvalidArgument, std::string(kWhat) +
-                                                    ": the camera needs a finite eye and target, not straight above "
-                                                    "or below each other");
-    if (!(c.fovYDegrees > 0.0 && c.fovYDegrees < 170.0))
-        throw Error(ErrorCode::InvalidArgument,
-                    std::string(kWhat) + ": vertical fov " + std::to_string(c.fovYDegrees) + " is not in (0, 170)");
-    if (!(c.near > 0.0 && c.far > c.near && std::isfinite(c.far)))
-        throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": clip distances near " +
-                                                    std::to_string(c.near) + ", far " + std::to_string(c.far) +
-                                                    " need 0 < near < far");
-}
-
 }  // namespace
 
-TerrainCamera viewerCamera(const codec::GroundParams& ground, double groundHeight, double sideways,
-                           double turnDegrees, double fovYDegrees) {
+Camera viewerCamera(const codec::GroundParams& ground, double groundHeight, double aspect, double sideways,
+                    double turnDegrees, double fovYDegrees) {
     const glm::dvec2 extent = codec::fieldExtent(ground);
-    TerrainCamera camera;
-    camera.fovYDegrees = fovYDegrees;
-    camera.eye = {0.5 * extent.x + sideways, groundHeight + ground.eyeHeight, extent.y + ground.near};
+    const glm::dvec3 eye{0.5 * extent.x + sideways, groundHeight + ground.eyeHeight, extent.y + ground.near};
     // Pitched so the field's near edge lands on the bottom row (the rows the ground map samples
     // most densely are then in view), unless that would lift the far edge out of the top half.
     const double halfFov = 0.5 * fovYDegrees * kPi / 180.0;
@@ -61,10 +42,8 @@ TerrainCamera viewerCamera(const codec::GroundParams& ground, double groundHeigh
                                   std::atan2(ground.eyeHeight, ground.far) + 0.5 * halfFov);
     const double turn = turnDegrees * kPi / 180.0;
     const glm::dvec3 direction(-std::sin(turn) * std::cos(pitch), -std::sin(pitch), -std::cos(turn) * std::cos(pitch));
-    camera.target = camera.eye + direction * ground.far;
-    camera.near = std::max(0.05, 0.02 * ground.eyeHeight);
-    camera.far = 4.0 * (ground.far + extent.x);
-    return camera;
+    return Camera::perspective(eye, eye + direction * ground.far, {0, 1, 0}, fovYDegrees, aspect,
+                               std::max(0.05, 0.02 * ground.eyeHeight), 4.0 * (ground.far + extent.x));
 }
 
 struct TerrainRenderer::Impl {
@@ -118,7 +97,7 @@ struct TerrainRenderer::Impl {
     }
 };
 
-TerrainRenderer::TerrainRenderer(Context& context, const codec::Mesh& mesh, const TerrainLook& look) {
+TerrainRenderer::TerrainRenderer(Context& context, const Mesh& mesh, const TerrainLook& look) {
     const std::size_t n = mesh.positions.size();
     if (n == 0 || mesh.colours.size() != n || mesh.normals.size() != n || mesh.indices.empty() ||
         mesh.indices.size() % 3 != 0)
@@ -163,8 +142,7 @@ TerrainRenderer::~TerrainRenderer() {
     if (m_impl) makeCurrentGl(m_impl->context);
 }
 
-format::Image TerrainRenderer::render(const TerrainCamera& camera, int width, int height) {
-    checkCamera(camera);
+Image TerrainRenderer::render(const Camera& camera, int width, int height) {
     if (width < 1 || height < 1 || width > kMaxFrameSide || height > kMaxFrameSide)
         throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": frame " + std::to_string(width) + "x" +
                                                     std::to_string(height) + " is outside [1, 16384] per side");
@@ -177,11 +155,12 @@ format::Image TerrainRenderer::render(const TerrainCamera& camera, int width, in
     const GLuint program = cachedProgram(context, "terrain", shaders::kShaderTerrainVert, shaders::kShaderTerrainFrag);
     m_impl->ensureTargets(gl, width, height);
 
-    glm::dmat4 projection = glm::perspective(camera.fovYDegrees * kPi / 180.0, double(width) / height, camera.near,
-                                             camera.far);
-    projection[1][1] = -projection[1][1];  // row 0 at the top (see the file comment)
-    const glm::dmat4 view = glm::lookAt(camera.eye, camera.target, glm::dvec3(0, 1, 0));
-    const glm::mat4 viewProjection(projection * view);
+    // The camera's NDC (u, v, z in [0,1]) to GL's clip space ([-1,1]^3). v stays the row index,
+    // so GL's row 0 holds v = 0 and the readback comes out top row first (see the file comment).
+    glm::dmat4 toClip(0.0);
+    toClip[0][0] = toClip[1][1] = toClip[2][2] = 2.0;
+    toClip[3] = glm::dvec4(-1.0, -1.0, -1.0, 1.0);
+    const glm::mat4 viewProjection(toClip * camera.worldToNdcMatrix());
     const glm::vec3 towardSun = glm::normalize(m_impl->look.towardSun);
 
     gl.BindFramebuffer(GL_FRAMEBUFFER, m_impl->drawFramebuffer->id());
@@ -208,7 +187,7 @@ format::Image TerrainRenderer::render(const TerrainCamera& camera, int width, in
     gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, m_impl->resolveFramebuffer->id());
     gl.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     gl.BindFramebuffer(GL_FRAMEBUFFER, m_impl->resolveFramebuffer->id());
-    format::Image frame = format::makeImage(width, height, {"R", "G", "B"});
+    Image frame = makeImage(width, height, {"R", "G", "B"});
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
     gl.ReadPixels(0, 0, width, height, GL_RGB, GL_FLOAT, frame.pixels.data());
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -216,7 +195,7 @@ format::Image TerrainRenderer::render(const TerrainCamera& camera, int width, in
     return frame;
 }
 
-format::Image renderTerrain(Context& context, const codec::Mesh& mesh, const TerrainCamera& camera, int width,
+Image renderTerrain(Context& context, const Mesh& mesh, const Camera& camera, int width,
                             int height, const TerrainLook& look) {
     TerrainRenderer renderer(context, mesh, look);
     return renderer.render(camera, width, height);

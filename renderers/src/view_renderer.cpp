@@ -53,8 +53,8 @@ std::uint32_t floatBits(float f) {
 }
 
 // The display channels as R,G,B (the shader writes alpha 1 whatever the image's alpha).
-format::Image displayRgb(const format::Image& rgba) {
-    format::Image out = format::makeImage(rgba.width, rgba.height, {"R", "G", "B"});
+Image displayRgb(const Image& rgba) {
+    Image out = makeImage(rgba.width, rgba.height, {"R", "G", "B"});
     const std::size_t pixels = static_cast<std::size_t>(rgba.width) * rgba.height;
     for (std::size_t i = 0; i < pixels; ++i)
         for (int c = 0; c < 3; ++c) out.pixels[i * 3 + c] = rgba.pixels[i * 4 + c];
@@ -63,8 +63,8 @@ format::Image displayRgb(const format::Image& rgba) {
 
 // The display channels of a CoNUS image as RGBA: R,G,B(,A) when present, else Y (or the first
 // channel) as grey. A depth-only image shows its Z as grey too, which is what one wants to see.
-format::Image displayRgba(const format::Image& image) {
-    format::Image out = format::makeImage(image.width, image.height, {"R", "G", "B", "A"});
+Image displayRgba(const Image& image) {
+    Image out = makeImage(image.width, image.height, {"R", "G", "B", "A"});
     int source[4] = {image.channelIndex("R"), image.channelIndex("G"), image.channelIndex("B"), image.channelIndex("A")};
     if (source[0] < 0 || source[1] < 0 || source[2] < 0) {
         int grey = image.channelIndex("Y");
@@ -80,7 +80,7 @@ format::Image displayRgba(const format::Image& image) {
     return out;
 }
 
-GlHandle uploadRgba(const GladGLContext& gl, const format::Image& image) {
+GlHandle uploadRgba(const GladGLContext& gl, const Image& image) {
     GlHandle texture = makeTexture(gl);
     gl.ActiveTexture(GL_TEXTURE0);
     gl.BindTexture(GL_TEXTURE_2D, texture.id());
@@ -101,7 +101,7 @@ struct ViewRenderer::Impl {
     GlHandle conus, map, uniform;
     // The CPU decode path: the display channels and the map on the CPU, the frame texture (RGBA8
     // for a window, RGBA32F when rendering to a float target) and a framebuffer to blit it from.
-    format::Image rgb;
+    Image rgb;
     std::optional<codec::SamplingMap> cpuMap;
     GlHandle frameTexture, frameFramebuffer;
     int frameWidth = 0, frameHeight = 0;
@@ -116,7 +116,7 @@ struct ViewRenderer::Impl {
     double sourceWidth = 1, sourceHeight = 1;
     std::vector<float> foci;  // u, v, r per focus
     float logDensityLo = 0, logDensityHi = 0;
-    format::Image uniformImage;
+    Image uniformImage;
     GlHandle overlays[ViewRenderer::kOverlaySlots];
     int overlayWidth[ViewRenderer::kOverlaySlots] = {}, overlayHeight[ViewRenderer::kOverlaySlots] = {};
 
@@ -156,7 +156,7 @@ struct ViewRenderer::Impl {
         decode.view = view;
         decode.width = width;
         decode.height = height;
-        const format::Image frame = codec::decodeImage(rgb, *cpuMap, decode);
+        const Image frame = codec::decodeImage(rgb, *cpuMap, decode);
         const float exposure = static_cast<float>(std::exp2(options.exposure));
         const float invGamma = inverseGamma(options);
         // Which columns / rows are inside [0,1]^2 at the pixel centres (gl_FragCoord in the shader).
@@ -300,12 +300,12 @@ ViewRenderer::ViewRenderer(Context& context) : m_impl(std::make_unique<Impl>(con
 ViewRenderer::~ViewRenderer() = default;
 
 bool ViewRenderer::hasImage() const { return static_cast<bool>(m_impl->conus); }
-const format::Image& ViewRenderer::uniformImage() const { return m_impl->uniformImage; }
+const Image& ViewRenderer::uniformImage() const { return m_impl->uniformImage; }
 
 void ViewRenderer::setImage(const format::ConusFile& file) {
     Impl& d = *m_impl;
     const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
-    const format::Image rgba = displayRgba(file.image);
+    const Image rgba = displayRgba(file.image);
     const int limit = d.context.textureLimit();
     if (rgba.width > limit || rgba.height > limit)
         throw Error(ErrorCode::LimitExceeded, "ViewRenderer: CoNUS image " + std::to_string(rgba.width) + "x" +
@@ -408,10 +408,10 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
     checkGl(gl, "ViewRenderer::draw");
 }
 
-format::Image ViewRenderer::renderToImage(const codec::View& view, int width, int height, ViewOptions options,
+Image ViewRenderer::renderToImage(const codec::View& view, int width, int height, ViewOptions options,
                                           const std::vector<OverlayPlacement>& overlays) {
     constexpr const char* kWhat = "ViewRenderer::renderToImage";
-    format::Image out = format::makeImage(width, height, {"R", "G", "B", "A"});
+    Image out = makeImage(width, height, {"R", "G", "B", "A"});
     const GladGLContext& gl = makeCurrentGl(m_impl->context);
     GlHandle texture = makeTexture(gl), framebuffer = makeFramebuffer(gl);
     gl.BindTexture(GL_TEXTURE_2D, texture.id());
@@ -439,13 +439,13 @@ format::Image ViewRenderer::renderToImage(const codec::View& view, int width, in
     return out;
 }
 
-format::Image ViewRenderer::readFramebuffer(int width, int height, bool bottomUp) {
+Image ViewRenderer::readFramebuffer(int width, int height, bool bottomUp) {
     const GladGLContext& gl = makeCurrentGl(m_impl->context);
     std::vector<std::uint8_t> bytes(static_cast<std::size_t>(width) * height * 4);
     gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
     gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
     checkGl(gl, "ViewRenderer::readFramebuffer");
-    format::Image out = format::makeImage(width, height, {"R", "G", "B", "A"});
+    Image out = makeImage(width, height, {"R", "G", "B", "A"});
     for (int y = 0; y < height; ++y) {
         const int row = bottomUp ? height - 1 - y : y;
         for (int x = 0; x < width * 4; ++x)
@@ -462,7 +462,7 @@ void ViewRenderer::clear(int width, int height, float red, float green, float bl
     gl.Clear(GL_COLOR_BUFFER_BIT);
 }
 
-void ViewRenderer::setOverlay(int slot, const format::Image& rgba) {
+void ViewRenderer::setOverlay(int slot, const Image& rgba) {
     if (slot < 0 || slot >= kOverlaySlots)
         throw Error(ErrorCode::InvalidArgument, "ViewRenderer::setOverlay: slot " + std::to_string(slot) + " out of range");
     Impl& d = *m_impl;

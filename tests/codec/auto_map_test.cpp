@@ -13,8 +13,8 @@ using namespace conus::codec;
 namespace {
 
 // Importance with Gaussian blobs at the given centres (u,v,sigma) on a w x h image.
-format::Image blobs(int w, int h, std::initializer_list<std::array<double, 3>> centres, double base = 0.0) {
-    format::Image img = format::makeImage(w, h, {"Y"});
+Image blobs(int w, int h, std::initializer_list<std::array<double, 3>> centres, double base = 0.0) {
+    Image img = makeImage(w, h, {"Y"});
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             double v = base;
@@ -50,7 +50,7 @@ TEST(AutoMap, TargetHasMeanOneAndRespectsFloorAndCap) {
 
 TEST(AutoMap, FlowFollowsTheTargetBetterThanSeparable) {
     // Two blobs on a diagonal: a separable map also magnifies the off-diagonal crossings.
-    const format::Image importance = blobs(256, 256, {{0.3, 0.3, 0.06}, {0.7, 0.7, 0.06}});
+    const Image importance = blobs(256, 256, {{0.3, 0.3, 0.06}, {0.7, 0.7, 0.06}});
     AutoMapOptions options;
     const DensityField target = importanceToDensity(importance, options);
     const SamplingMap flow = buildAutoMap(importance, options);
@@ -76,18 +76,18 @@ TEST(AutoMap, FlowFollowsTheTargetBetterThanSeparable) {
 }
 
 TEST(AutoMap, AdversarialImportanceGivesValidMaps) {
-    format::Image hot = format::makeImage(128, 96, {"Y"});
+    Image hot = makeImage(128, 96, {"Y"});
     hot.at(17, 80) = 1000.0f;  // a single hot pixel
     const SamplingMap a = buildAutoMap(hot);
     EXPECT_GT(a.density({17.5 / 128, 80.5 / 96}), 1.5);
 
-    const format::Image zero = format::makeImage(64, 64, {"Y"});
+    const Image zero = makeImage(64, 64, {"Y"});
     const SamplingMap b = buildAutoMap(zero);
     EXPECT_NEAR(b.density({0.37, 0.61}), 1.0, 1e-6);
 
     std::mt19937 random(7);
     std::uniform_real_distribution<float> noise(0, 1);
-    format::Image rough = format::makeImage(200, 150, {"R", "G", "B"});
+    Image rough = makeImage(200, 150, {"R", "G", "B"});
     for (float& v : rough.pixels) v = noise(random) * noise(random) * noise(random);
     for (AutoMethod method : {AutoMethod::Flow, AutoMethod::Separable}) {
         AutoMapOptions options;
@@ -100,7 +100,7 @@ TEST(AutoMap, AdversarialImportanceGivesValidMaps) {
 }
 
 TEST(AutoMap, BadInputIsAClearError) {
-    format::Image img = blobs(32, 32, {{0.5, 0.5, 0.1}});
+    Image img = blobs(32, 32, {{0.5, 0.5, 0.1}});
     img.at(3, 4) = std::numeric_limits<float>::quiet_NaN();
     try {
         buildAutoMap(img);
@@ -114,15 +114,15 @@ TEST(AutoMap, BadInputIsAClearError) {
     AutoMapOptions options;
     options.minDensity = 1.5;
     EXPECT_THROW(buildAutoMap(blobs(8, 8, {{0.5, 0.5, 0.1}}), options), Error);
-    EXPECT_THROW(buildAutoMap(format::Image{}), Error);
+    EXPECT_THROW(buildAutoMap(Image{}), Error);
 }
 
 TEST(AutoMap, DetailIsHighAtEdgesAndZeroInFlatRegions) {
-    format::Image img = format::makeImage(100, 80, {"R", "G", "B"});
+    Image img = makeImage(100, 80, {"R", "G", "B"});
     for (int y = 0; y < 80; ++y)
         for (int x = 50; x < 100; ++x)
             for (int c = 0; c < 3; ++c) img.at(x, y, c) = 1.0f;
-    const format::Image detail = detailImportance(img);
+    const Image detail = detailImportance(img);
     EXPECT_GT(detail.at(49, 40), 1.0f);
     EXPECT_EQ(detail.at(10, 40), 0.0f);
     EXPECT_EQ(detail.at(90, 40), 0.0f);

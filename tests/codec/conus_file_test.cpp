@@ -26,7 +26,7 @@ TEST(MapFile, HoldsTheMapAndItsDensityAndIsValid) {
 TEST(ConusFile, ImageFilesWithDepthAreValidDepthImages) {
     // The editor used to build its file by hand and forgot the depth kind a Z channel needs (V14).
     const auto map = conus::codec::SamplingMap::identity(3, 3);
-    conus::format::Image image = conus::format::makeImage(4, 4, {"R", "G", "B", "Z"});
+    conus::Image image = conus::makeImage(4, 4, {"R", "G", "B", "Z"});
     for (std::size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = float(i % 7) / 7.0f;
     conus::SourceEncoding encoding;
     encoding.transfer = conus::Transfer::Srgb;

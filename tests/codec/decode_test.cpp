@@ -21,15 +21,15 @@ using test::noise;
 using test::texture;
 using test::zonePlate;
 
-format::Image crop(const format::Image& im, int x0, int y0, int w, int h) {
-    format::Image out = format::makeImage(w, h, im.channels);
+Image crop(const Image& im, int x0, int y0, int w, int h) {
+    Image out = makeImage(w, h, im.channels);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
             for (int c = 0; c < im.channelCount(); ++c) out.at(x, y, c) = im.at(x0 + x, y0 + y, c);
     return out;
 }
 
-float maxAbsDifference(const format::Image& a, const format::Image& b) {
+float maxAbsDifference(const Image& a, const Image& b) {
     EXPECT_EQ(a.pixels.size(), b.pixels.size());
     float worst = 0;
     for (std::size_t i = 0; i < std::min(a.pixels.size(), b.pixels.size()); ++i)
@@ -71,18 +71,18 @@ TEST(Decode, RowSteppingEqualsEquationOne) {
 }
 
 TEST(Decode, IdentityMapEqualsResizeBilinear) {
-    const format::Image conus = noise(200, 150, {"R", "G", "B", "A"}, 2);
+    const Image conus = noise(200, 150, {"R", "G", "B", "A"}, 2);
     const SamplingMap map = SamplingMap::identity(9, 7);
     const View views[] = {{0, 0, 1, 1}, {0.2, 0.3, 0.6, 0.5}, {-0.2, -0.1, 1.1, 1.3}};
     for (const View& view : views) {
-        const format::Image dec = decodeImage(conus, map, viewOf(view, 300, 240));
-        const format::Image ref = resizeBilinear(conus, view, 300, 240);
+        const Image dec = decodeImage(conus, map, viewOf(view, 300, 240));
+        const Image ref = resizeBilinear(conus, view, 300, 240);
         EXPECT_EQ(dec.channels, conus.channels);
         EXPECT_LT(maxAbsDifference(dec, ref), 1e-5f) << view.u0 << "," << view.v0;
     }
     // A channel count without a fixed kernel, and one channel.
     for (const auto& channels : {std::vector<std::string>{"R", "G", "B", "A", "Z"}, std::vector<std::string>{"Y"}}) {
-        const format::Image im = noise(120, 90, channels, 6);
+        const Image im = noise(120, 90, channels, 6);
         const View view{0.1, 0.2, 0.7, 0.9};
         EXPECT_LT(maxAbsDifference(decodeImage(im, map, viewOf(view, 200, 150)), resizeBilinear(im, view, 200, 150)),
                   1e-5f);
@@ -90,11 +90,11 @@ TEST(Decode, IdentityMapEqualsResizeBilinear) {
 }
 
 TEST(Decode, MatchesPerPixelEquationOneWhenMagnifying) {
-    const format::Image conus = noise(256, 256, {"R", "G", "B"}, 3);
+    const Image conus = noise(256, 256, {"R", "G", "B"}, 3);
     const SamplingMap map = twoFoci();
     const View view{0.1, 0.2, 0.5, 0.5};
     const int W = 640, H = 480;
-    const format::Image dec = decodeImage(conus, map, viewOf(view, W, H));
+    const Image dec = decodeImage(conus, map, viewOf(view, W, H));
     float worst = 0;
     for (int y = 0; y < H; y += 3)
         for (int x = 0; x < W; x += 3) {
@@ -114,10 +114,10 @@ TEST(Decode, MatchesPerPixelEquationOneWhenMagnifying) {
 }
 
 TEST(Decode, IdentityRoundTripMatchesBaseline) {
-    const format::Image src = noise(512, 512, {"R", "G", "B", "A"}, 4);
-    const format::Image small = areaDownsample(src, 128, 128);
-    const format::Image enc = encodeImage(src, SamplingMap::identity(17, 17), {128, 128, 0, {}});
-    const format::Image dec = decodeImage(enc, SamplingMap::identity(17, 17), viewOf({}, 512, 512));
+    const Image src = noise(512, 512, {"R", "G", "B", "A"}, 4);
+    const Image small = areaDownsample(src, 128, 128);
+    const Image enc = encodeImage(src, SamplingMap::identity(17, 17), {128, 128, 0, {}});
+    const Image dec = decodeImage(enc, SamplingMap::identity(17, 17), viewOf({}, 512, 512));
     EXPECT_LT(maxAbsDifference(dec, resizeBilinear(small, {}, 512, 512)), 1e-5f);
 }
 
@@ -131,14 +131,14 @@ TEST(Decode, FocusRegionBeatsUniformImageOfTheSameSize) {
     const View view{x0 / double(S), x0 / double(S), (x0 + side) / double(S), (x0 + side) / double(S)};
     struct Input {
         const char* name;
-        format::Image image;
+        Image image;
     };
     const Input inputs[] = {{"zone plate", zonePlate(S, 0.9)}, {"texture", texture(S, 7)}};
     for (const Input& in : inputs) {
-        const format::Image truth = crop(in.image, x0, x0, side, side);
-        const format::Image enc = encodeImage(in.image, map, {C, C, 0, {}});
-        const format::Image fromConus = decodeImage(enc, map, viewOf(view, side, side));
-        const format::Image fromUniform = resizeBilinear(areaDownsample(in.image, C, C), view, side, side);
+        const Image truth = crop(in.image, x0, x0, side, side);
+        const Image enc = encodeImage(in.image, map, {C, C, 0, {}});
+        const Image fromConus = decodeImage(enc, map, viewOf(view, side, side));
+        const Image fromUniform = resizeBilinear(areaDownsample(in.image, C, C), view, side, side);
         const double conusDb = psnr(fromConus, truth), uniformDb = psnr(fromUniform, truth);
         RecordProperty(std::string(in.name) + "_conus_db", std::to_string(conusDb));
         RecordProperty(std::string(in.name) + "_uniform_db", std::to_string(uniformDb));
@@ -149,31 +149,31 @@ TEST(Decode, FocusRegionBeatsUniformImageOfTheSameSize) {
 
 TEST(Decode, ZoomedOutViewAveragesInsteadOfAliasing) {
     // A one-pixel checkerboard: any honest view coarser than the image is flat grey.
-    format::Image conus = format::makeImage(512, 512, {"Y"});
+    Image conus = makeImage(512, 512, {"Y"});
     for (int y = 0; y < 512; ++y)
         for (int x = 0; x < 512; ++x) conus.at(x, y) = static_cast<float>((x + y) % 2);
     for (const SamplingMap& map : {SamplingMap::identity(5, 5), twoFoci()}) {
-        const format::Image dec = decodeImage(conus, map, viewOf({}, 72, 60));
+        const Image dec = decodeImage(conus, map, viewOf({}, 72, 60));
         double energy = 0;
         for (float v : dec.pixels) energy += (v - 0.5) * (v - 0.5);
         EXPECT_LT(std::sqrt(energy / dec.pixels.size()), 0.03);
     }
     // Zoomed out past the image: clamped columns and rows stay inside the image and in range.
-    const format::Image wide = decodeImage(conus, twoFoci(), viewOf({-0.5, -0.3, 1.5, 1.4}, 50, 40));
+    const Image wide = decodeImage(conus, twoFoci(), viewOf({-0.5, -0.3, 1.5, 1.4}, 50, 40));
     for (float v : wide.pixels) ASSERT_TRUE(v >= 0.0f && v <= 1.0f) << v;
     // The single-tap baseline does alias here, which is what the test guards against.
-    const format::Image aliased = resizeBilinear(conus, {}, 72, 60);
+    const Image aliased = resizeBilinear(conus, {}, 72, 60);
     double energy = 0;
     for (float v : aliased.pixels) energy += (v - 0.5) * (v - 0.5);
     EXPECT_GT(std::sqrt(energy / aliased.pixels.size()), 0.1);
 }
 
 TEST(Decode, ThreadCountDoesNotChangeTheResult) {
-    const format::Image conus = noise(300, 200, {"R", "G", "B", "A"}, 5);
+    const Image conus = noise(300, 200, {"R", "G", "B", "A"}, 5);
     const SamplingMap map = twoFoci();
     for (const View& view : {View{}, View{0.2, 0.25, 0.4, 0.45}}) {
-        const format::Image one = decodeImage(conus, map, viewOf(view, 333, 222, 1));
-        const format::Image two = decodeImage(conus, map, viewOf(view, 333, 222, 2));
+        const Image one = decodeImage(conus, map, viewOf(view, 333, 222, 1));
+        const Image two = decodeImage(conus, map, viewOf(view, 333, 222, 2));
         EXPECT_EQ(one.pixels, two.pixels);
         EXPECT_EQ(resizeBilinear(conus, view, 333, 222, 1).pixels, resizeBilinear(conus, view, 333, 222, 2).pixels);
     }
@@ -182,21 +182,21 @@ TEST(Decode, ThreadCountDoesNotChangeTheResult) {
 }
 
 TEST(Decode, RejectsBadArguments) {
-    const format::Image conus = noise(16, 16, {"Y"});
+    const Image conus = noise(16, 16, {"Y"});
     const SamplingMap map = SamplingMap::identity(2, 2);
     EXPECT_THROW(decodeImage(conus, map, viewOf({}, 0, 10)), conus::Error);
     EXPECT_THROW(decodeImage(conus, map, viewOf({}, 10, -1)), conus::Error);
-    EXPECT_THROW(decodeImage(conus, map, viewOf({}, format::kMaxImageSide + 1, 1)), conus::Error);
-    EXPECT_THROW(decodeImage(format::Image{}, map, viewOf({}, 10, 10)), conus::Error);
+    EXPECT_THROW(decodeImage(conus, map, viewOf({}, kMaxImageSide + 1, 1)), conus::Error);
+    EXPECT_THROW(decodeImage(Image{}, map, viewOf({}, 10, 10)), conus::Error);
     EXPECT_THROW(decodeImage(conus, map, viewOf({0.5, 0, 0.5, 1}, 10, 10)), conus::Error);
     EXPECT_THROW(decodeImage(conus, map, viewOf({0, NAN, 1, 1}, 10, 10)), conus::Error);
     EXPECT_THROW(resizeBilinear(conus, {}, 0, 0), conus::Error);
-    EXPECT_THROW(resizeBilinear(format::Image{}, {}, 4, 4), conus::Error);
+    EXPECT_THROW(resizeBilinear(Image{}, {}, 4, 4), conus::Error);
 }
 
 TEST(Decode, MemoryIsCheckedBeforeAllocating) {
     // A 24x16 image whose source is 65536x16384 (a hostile reproducer): the frame alone is 12 GB.
-    const format::Image conus = noise(24, 16, {"R", "G", "B"});
+    const Image conus = noise(24, 16, {"R", "G", "B"});
     const SamplingMap map = SamplingMap::identity(2, 2);
     try {
         decodeImage(conus, map, viewOf({}, 65536, 16384));

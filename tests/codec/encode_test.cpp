@@ -20,7 +20,7 @@ using test::noise;
 using test::texture;
 using test::zonePlate;
 
-float maxAbsDifference(const format::Image& a, const format::Image& b) {
+float maxAbsDifference(const Image& a, const Image& b) {
     EXPECT_EQ(a.pixels.size(), b.pixels.size());
     float worst = 0;
     for (std::size_t i = 0; i < std::min(a.pixels.size(), b.pixels.size()); ++i)
@@ -45,7 +45,7 @@ EncodeOptions sized(int w, int h, int threads = 0) {
 }
 
 // Bilinear source sample at normalized (u,v), clamp to edge: the single-tap encoder.
-float sampleBilinear(const format::Image& im, double u, double v) {
+float sampleBilinear(const Image& im, double u, double v) {
     const double x = std::clamp(u * im.width - 0.5, 0.0, im.width - 1.0);
     const double y = std::clamp(v * im.height - 0.5, 0.0, im.height - 1.0);
     const int x0 = std::min(static_cast<int>(x), im.width - 2), y0 = std::min(static_cast<int>(y), im.height - 2);
@@ -55,8 +55,8 @@ float sampleBilinear(const format::Image& im, double u, double v) {
 }
 
 TEST(EncodeAreaDownsample, MatchesExactAreaIntegralForAnyRatio) {
-    const format::Image src = noise(10, 7, {"Y"});
-    const format::Image out = areaDownsample(src, 3, 4);
+    const Image src = noise(10, 7, {"Y"});
+    const Image out = areaDownsample(src, 3, 4);
     // Brute force: integrate the piecewise-constant source over each output pixel.
     for (int y = 0; y < 4; ++y)
         for (int x = 0; x < 3; ++x) {
@@ -73,8 +73,8 @@ TEST(EncodeAreaDownsample, MatchesExactAreaIntegralForAnyRatio) {
 }
 
 TEST(EncodeAreaDownsample, KeepsChannelsAndRejectsGrowing) {
-    const format::Image src = noise(40, 30, {"R", "G", "B", "A"});
-    const format::Image same = areaDownsample(src, 40, 30);
+    const Image src = noise(40, 30, {"R", "G", "B", "A"});
+    const Image same = areaDownsample(src, 40, 30);
     EXPECT_EQ(same.channels, src.channels);
     EXPECT_LT(maxAbsDifference(same, src), 1e-6f);
     EXPECT_THROW(areaDownsample(src, 41, 30), conus::Error);
@@ -97,33 +97,33 @@ TEST(Encode, IdentityMapEqualsAreaDownsampleAtIntegerRatios) {
         {300, 150, {"Y", "A"}, 3},                 // ratio 2
     };
     for (const Case& c : cases) {
-        const format::Image src = noise(c.from, c.from, c.channels, c.from + c.to);
+        const Image src = noise(c.from, c.from, c.channels, c.from + c.to);
         const SamplingMap map = SamplingMap::identity(c.mapSide, c.mapSide);
-        const format::Image enc = encodeImage(src, map, sized(c.to, c.to));
-        const format::Image ref = areaDownsample(src, c.to, c.to);
+        const Image enc = encodeImage(src, map, sized(c.to, c.to));
+        const Image ref = areaDownsample(src, c.to, c.to);
         EXPECT_EQ(enc.channels, c.channels);
         EXPECT_LT(maxAbsDifference(enc, ref), 1e-5f) << c.from << "->" << c.to << " with " << c.channels.size()
                                                      << " channels";
     }
     // Different ratios per axis: 300x200 -> 100x100 (3 and 2).
-    const format::Image src = noise(300, 200, {"R", "G", "B"}, 9);
-    const format::Image enc = encodeImage(src, SamplingMap::identity(5, 5), sized(100, 100));
+    const Image src = noise(300, 200, {"R", "G", "B"}, 9);
+    const Image enc = encodeImage(src, SamplingMap::identity(5, 5), sized(100, 100));
     EXPECT_LT(maxAbsDifference(enc, areaDownsample(src, 100, 100)), 1e-5f);
 }
 
 TEST(Encode, FootprintsBeyondTheTapCapUseThePyramid) {
     // A 64x ratio is four times the tap cap: the encoder reads a box-filtered mip level, which for
     // powers of two is still the exact area average.
-    const format::Image src = noise(1024, 1024, {"Y"}, 3);
-    const format::Image enc = encodeImage(src, SamplingMap::identity(9, 9), sized(16, 16));
+    const Image src = noise(1024, 1024, {"Y"}, 3);
+    const Image enc = encodeImage(src, SamplingMap::identity(9, 9), sized(16, 16));
     EXPECT_LT(maxAbsDifference(enc, areaDownsample(src, 16, 16)), 1e-5f);
     // Non-power-of-two: close to the area average of a smooth image.
-    const format::Image zp = zonePlate(1000, 0.01);
+    const Image zp = zonePlate(1000, 0.01);
     EXPECT_GT(psnr(encodeImage(zp, SamplingMap::identity(9, 9), sized(20, 20)), areaDownsample(zp, 20, 20)), 35.0);
 }
 
 TEST(Encode, ConstantImageStaysConstantUnderAnyMapAndKeepsAlpha) {
-    format::Image src = format::makeImage(256, 192, {"R", "G", "B", "A"});
+    Image src = makeImage(256, 192, {"R", "G", "B", "A"});
     for (std::size_t i = 0; i < src.pixels.size(); i += 4) {
         src.pixels[i] = 0.25f;
         src.pixels[i + 1] = 0.5f;
@@ -132,7 +132,7 @@ TEST(Encode, ConstantImageStaysConstantUnderAnyMapAndKeepsAlpha) {
     }
     for (const SamplingMap& map : {SamplingMap::identity(2, 2), twoFoci(256.0 / 192.0),
                                    twoFoci(256.0 / 192.0, FociComposition::Add)}) {
-        const format::Image enc = encodeImage(src, map, sized(96, 64));
+        const Image enc = encodeImage(src, map, sized(96, 64));
         ASSERT_EQ(enc.channels, src.channels);
         for (std::size_t i = 0; i < enc.pixels.size(); i += 4) {
             ASSERT_NEAR(enc.pixels[i], 0.25f, 1e-5f);
@@ -145,11 +145,11 @@ TEST(Encode, ConstantImageStaysConstantUnderAnyMapAndKeepsAlpha) {
 
 TEST(Encode, AlphaIsCarriedThroughTheMap) {
     // Alpha a ramp in u, colour noise: the encoded alpha must be the ramp at the undistorted u.
-    format::Image src = noise(400, 400, {"R", "G", "B", "A"}, 5);
+    Image src = noise(400, 400, {"R", "G", "B", "A"}, 5);
     for (int y = 0; y < 400; ++y)
         for (int x = 0; x < 400; ++x) src.at(x, y, 3) = (x + 0.5f) / 400;
     const SamplingMap map = twoFoci();
-    const format::Image enc = encodeImage(src, map, sized(100, 100));
+    const Image enc = encodeImage(src, map, sized(100, 100));
     for (int y = 0; y < 100; y += 7)
         for (int x = 0; x < 100; x += 7) {
             const glm::dvec2 p = map.undistort({(x + 0.5) / 100, (y + 0.5) / 100});
@@ -164,7 +164,7 @@ TEST(Encode, AlphaIsCarriedThroughTheMap) {
 // R edges must sit where Eq. 1 sends the source edges (and likewise G along columns).
 TEST(Encode, EdgesLandWhereEquationOnePutsThem) {
     const int S = 1024, C = 256, period = 64;
-    format::Image src = format::makeImage(S, S, {"R", "G"});
+    Image src = makeImage(S, S, {"R", "G"});
     for (int y = 0; y < S; ++y)
         for (int x = 0; x < S; ++x) {
             src.at(x, y, 0) = (x / period) % 2 ? 1.0f : 0.0f;
@@ -172,7 +172,7 @@ TEST(Encode, EdgesLandWhereEquationOnePutsThem) {
         }
     const std::vector<Focus> foci = {{0.5, 0.45, 0.1, 4}};
     const SamplingMap map = buildFociMap(foci);
-    const format::Image enc = encodeImage(src, map, sized(C, C));
+    const Image enc = encodeImage(src, map, sized(C, C));
 
     const int edges = S / period - 1;
     double maxShift = 0, maxError = 0;
@@ -207,12 +207,12 @@ TEST(Encode, EdgesLandWhereEquationOnePutsThem) {
 // rings: compare with an exact supersampled reference, and with point sampling.
 TEST(Encode, FootprintFilterPreventsAliasing) {
     const int S = 768, C = 160;
-    const format::Image src = zonePlate(S, 0.45);
+    const Image src = zonePlate(S, 0.45);
     const std::vector<Focus> foci = {{0.5, 0.5, 0.08, 3}};
     const SamplingMap map = buildFociMap(foci);
-    const format::Image enc = encodeImage(src, map, sized(C, C));
+    const Image enc = encodeImage(src, map, sized(C, C));
 
-    format::Image reference = format::makeImage(C, C, {"Y"}), pointSampled = format::makeImage(C, C, {"Y"});
+    Image reference = makeImage(C, C, {"Y"}), pointSampled = makeImage(C, C, {"Y"});
     const int kSuper = 12;  // sub-pixels per axis per CoNUS pixel, each undistorted exactly
     for (int y = 0; y < C; ++y)
         for (int x = 0; x < C; ++x) {
@@ -236,17 +236,17 @@ TEST(Encode, FootprintFilterPreventsAliasing) {
 }
 
 TEST(Encode, ThreadCountDoesNotChangeTheResult) {
-    const format::Image src = noise(512, 384, {"R", "G", "B", "A"}, 11);
+    const Image src = noise(512, 384, {"R", "G", "B", "A"}, 11);
     const SamplingMap map = twoFoci(512.0 / 384.0);
-    const format::Image one = encodeImage(src, map, sized(160, 120, 1));
-    const format::Image two = encodeImage(src, map, sized(160, 120, 2));
+    const Image one = encodeImage(src, map, sized(160, 120, 1));
+    const Image two = encodeImage(src, map, sized(160, 120, 2));
     EXPECT_EQ(one.pixels, two.pixels);
-    const format::Image a1 = areaDownsample(src, 100, 70, 1), a2 = areaDownsample(src, 100, 70, 2);
+    const Image a1 = areaDownsample(src, 100, 70, 1), a2 = areaDownsample(src, 100, 70, 2);
     EXPECT_EQ(a1.pixels, a2.pixels);
 }
 
 TEST(Encode, ReportsProgressUpToOne) {
-    const format::Image src = noise(128, 128, {"Y"});
+    const Image src = noise(128, 128, {"Y"});
     std::vector<double> seen;
     EncodeOptions o = sized(64, 64, 2);
     o.progress = [&](double f) { seen.push_back(f); };
@@ -257,9 +257,9 @@ TEST(Encode, ReportsProgressUpToOne) {
 }
 
 TEST(Encode, RejectsBadArguments) {
-    const format::Image src = noise(16, 16, {"Y"});
+    const Image src = noise(16, 16, {"Y"});
     const SamplingMap map = SamplingMap::identity(2, 2);
-    auto code = [&](const format::Image& s, int w, int h) {
+    auto code = [&](const Image& s, int w, int h) {
         try {
             encodeImage(s, map, sized(w, h));
         } catch (const conus::Error& e) {
@@ -269,13 +269,13 @@ TEST(Encode, RejectsBadArguments) {
     };
     EXPECT_EQ(code(src, 0, 8), static_cast<int>(ErrorCode::InvalidArgument));
     EXPECT_EQ(code(src, 8, -3), static_cast<int>(ErrorCode::InvalidArgument));
-    EXPECT_EQ(code(src, format::kMaxImageSide + 1, 8), static_cast<int>(ErrorCode::LimitExceeded));
-    EXPECT_EQ(code(src, format::kMaxImageSide, format::kMaxImageSide), static_cast<int>(ErrorCode::LimitExceeded));
-    EXPECT_EQ(code(format::Image{}, 8, 8), static_cast<int>(ErrorCode::InvalidArgument));
-    format::Image broken = src;
+    EXPECT_EQ(code(src, kMaxImageSide + 1, 8), static_cast<int>(ErrorCode::LimitExceeded));
+    EXPECT_EQ(code(src, kMaxImageSide, kMaxImageSide), static_cast<int>(ErrorCode::LimitExceeded));
+    EXPECT_EQ(code(Image{}, 8, 8), static_cast<int>(ErrorCode::InvalidArgument));
+    Image broken = src;
     broken.pixels.resize(10);
     EXPECT_EQ(code(broken, 8, 8), static_cast<int>(ErrorCode::InvalidArgument));
-    EXPECT_THROW(areaDownsample(format::Image{}, 4, 4), conus::Error);
+    EXPECT_THROW(areaDownsample(Image{}, 4, 4), conus::Error);
 }
 
 }  // namespace

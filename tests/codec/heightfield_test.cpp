@@ -24,8 +24,8 @@ TerrainOptions smallTerrain(int size = 256) {
 }
 
 format::ConusFile encodeSmall(int size, int conus) {
-    const format::Image dem = generateTerrain(smallTerrain(size));
-    const format::Image colour = terrainColours(dem, fieldExtent(testGround()));
+    const Image dem = generateTerrain(smallTerrain(size));
+    const Image colour = terrainColours(dem, fieldExtent(testGround()));
     HeightFieldOptions options;
     options.ground = testGround();
     options.width = options.height = conus;
@@ -34,8 +34,8 @@ format::ConusFile encodeSmall(int size, int conus) {
 }
 
 TEST(HeightFieldTerrain, DeterministicAndSizeIndependent) {
-    const format::Image a = generateTerrain(smallTerrain(128));
-    const format::Image b = generateTerrain(smallTerrain(128));
+    const Image a = generateTerrain(smallTerrain(128));
+    const Image b = generateTerrain(smallTerrain(128));
     EXPECT_EQ(a.pixels, b.pixels);
     TerrainOptions other = smallTerrain(128);
     other.seed = 4;
@@ -43,7 +43,7 @@ TEST(HeightFieldTerrain, DeterministicAndSizeIndependent) {
     // The same landscape at twice the size: pixel (2x+1/2) of the large one sits between samples;
     // compare the sample at the same (u,v) instead: large pixel centres (2x+0.5)/256 vs (x+0.5)/128
     // differ by a quarter of a small pixel, so heights agree to the local slope only.
-    const format::Image big = generateTerrain(smallTerrain(256));
+    const Image big = generateTerrain(smallTerrain(256));
     double diff = 0;
     for (int y = 0; y < 128; ++y)
         for (int x = 0; x < 128; ++x) {
@@ -58,8 +58,8 @@ TEST(HeightFieldTerrain, DeterministicAndSizeIndependent) {
 }
 
 TEST(HeightFieldTerrain, ColoursInRange) {
-    const format::Image dem = generateTerrain(smallTerrain(64));
-    const format::Image colour = terrainColours(dem, {1000, 1000});
+    const Image dem = generateTerrain(smallTerrain(64));
+    const Image colour = terrainColours(dem, {1000, 1000});
     ASSERT_EQ(colour.channels, (std::vector<std::string>{"R", "G", "B"}));
     for (float c : colour.pixels) {
         EXPECT_GE(c, 0.0f);
@@ -97,7 +97,7 @@ TEST(HeightFieldEncode, ValidFileWithHeightAndGroundParams) {
 
 TEST(HeightFieldEncode, ZIsFilteredHeight) {
     // A flat DEM at 42 m stays 42 m everywhere: filtering never invents heights.
-    format::Image dem = format::makeImage(64, 64, {"Z"});
+    Image dem = makeImage(64, 64, {"Z"});
     std::fill(dem.pixels.begin(), dem.pixels.end(), 42.0f);
     HeightFieldOptions options;
     options.ground = testGround();
@@ -152,10 +152,10 @@ TEST(HeightFieldMesh, GridUndistortWithoutAnalytic) {
 
 TEST(HeightFieldMesh, DenserNearSparserFar) {
     const int size = 64;
-    const format::Image dem = generateTerrain(smallTerrain(256));
+    const Image dem = generateTerrain(smallTerrain(256));
     const GroundParams ground = testGround();
     const glm::dvec2 extent = fieldExtent(ground);
-    const format::Image colour = terrainColours(dem, extent);
+    const Image colour = terrainColours(dem, extent);
     HeightFieldOptions options;
     options.ground = ground;
     options.width = options.height = size;
@@ -184,15 +184,15 @@ TEST(HeightFieldExtent, FovForWidthInvertsFieldExtent) {
 }
 
 TEST(HeightFieldEncode, RejectsBadInput) {
-    format::Image dem = format::makeImage(16, 16, {"Z"});
+    Image dem = makeImage(16, 16, {"Z"});
     HeightFieldOptions options;
     options.ground = testGround();
     options.width = options.height = 8;
-    EXPECT_THROW(encodeHeightField(dem, format::makeImage(8, 8, {"R", "G", "B"}), options), Error);
+    EXPECT_THROW(encodeHeightField(dem, makeImage(8, 8, {"R", "G", "B"}), options), Error);
     dem.at(3, 3) = std::nanf("");
-    EXPECT_THROW(encodeHeightField(dem, format::makeImage(16, 16, {"R", "G", "B"}), options), Error);
+    EXPECT_THROW(encodeHeightField(dem, makeImage(16, 16, {"R", "G", "B"}), options), Error);
     options.width = 0;
-    EXPECT_THROW(encodeHeightField(dem, format::makeImage(16, 16, {"R", "G", "B"}), options), Error);
+    EXPECT_THROW(encodeHeightField(dem, makeImage(16, 16, {"R", "G", "B"}), options), Error);
 }
 
 }  // namespace

@@ -70,7 +70,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         decode.width = 8;
         decode.height = 6;
         decode.threads = 1;
-        const format::Image frame = codec::decodeImage(conusFile.image, map, decode);
+        const Image frame = codec::decodeImage(conusFile.image, map, decode);
         CONUS_FUZZ_CHECK(frame.width == 8 && frame.height == 6, "decode size");
     } catch (const Error& e) {
         CONUS_FUZZ_CHECK(isOneLine(e.what()), "an error is one line");

@@ -29,7 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (raw) options.colorspace = conus::Transfer::Raw;
         try {
             const conus::imageio::ImageFile file = conus::imageio::readImageFile(path, options);
-            const conus::format::Image& image = file.image;
+            const conus::Image& image = file.image;
             CONUS_FUZZ_CHECK(image.width >= 1 && image.height >= 1 && image.width <= conus::kMaxImageSide &&
                                  image.height <= conus::kMaxImageSide,
                              "a read image is within the limits");

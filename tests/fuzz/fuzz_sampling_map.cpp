@@ -77,14 +77,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             CONUS_FUZZ_CHECK(std::abs(back.x - q.x) < 1e-7 && std::abs(back.y - q.y) < 1e-7, "distort(undistort(q)) == q");
         }
     }
-    format::Image image = format::makeImage(5, 4, {"Y"});
+    Image image = makeImage(5, 4, {"Y"});
     for (std::size_t k = 0; k < image.pixels.size(); ++k) image.pixels[k] = float(k);
     codec::DecodeOptions decode;
     decode.view = {0.2, 0.1, 0.7, 0.9};
     decode.width = 7;
     decode.height = 5;
     decode.threads = 1;
-    const format::Image frame = codec::decodeImage(image, map, decode);
+    const Image frame = codec::decodeImage(image, map, decode);
     for (float v : frame.pixels) CONUS_FUZZ_CHECK(v >= 0.0f && v <= 19.0f, "decoded values stay within the image's");
     return 0;
 }

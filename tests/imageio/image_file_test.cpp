@@ -17,7 +17,7 @@
 #include "conus/imageio/image_file.h"
 
 namespace fs = std::filesystem;
-using conus::format::Image;
+using conus::Image;
 
 namespace {
 
@@ -47,7 +47,7 @@ Read oiioRead(const std::string& path) {
 
 // A 4x2 image whose channel c at pixel p holds (p + 1) / 16 + c / 64: every value tells where it came from.
 Image tagged(const std::vector<std::string>& channels) {
-    Image im = conus::format::makeImage(4, 2, channels);
+    Image im = conus::makeImage(4, 2, channels);
     for (int p = 0; p < 8; ++p)
         for (int c = 0; c < im.channelCount(); ++c) im.pixels[p * im.channelCount() + c] = (p + 1) / 16.0f + c / 64.0f;
     return im;

@@ -117,14 +117,14 @@ TEST(Context, DisabledBackendGivesAClearErrorAndAutoFallsBack) {
 
 // Each EGL platform on its own: the device platform's software device, then surfaceless.
 TEST(Context, EglSurfacelessPlatformWorksWhenTheDevicePlatformIsRefused) {
-    const format::Image source = test::photoLike(96, 64);
+    const Image source = test::photoLike(96, 64);
     const codec::SamplingMap map = test::randomFociMap(2);
     codec::EncodeOptions options;
     options.width = 48;
     options.height = 40;
     auto device = Context::create(Backend::Egl);
     EXPECT_NE(device->description().find("device platform"), std::string::npos) << device->description();
-    const format::Image a = encodeImageGpu(*device, source, map, options);
+    const Image a = encodeImageGpu(*device, source, map, options);
     ScopedEnv env("CONUS_GL_DISABLE", "egl-device");
     auto surfaceless = Context::create(Backend::Egl);
     EXPECT_NE(surfaceless->description().find("surfaceless platform"), std::string::npos)
@@ -162,16 +162,16 @@ TEST(ContextDeathTest, BrokenEglGivesAClearErrorAndAutoFallsBackToOsMesa) {
 TEST(Context, BackendsInterleaveInOneProcess) {
     auto egl = Context::create(Backend::Egl);
     auto osmesa = Context::create(Backend::OsMesa);
-    const format::Image source = test::photoLike(128, 96);
+    const Image source = test::photoLike(128, 96);
     const codec::SamplingMap map = test::randomFociMap(3);
     codec::EncodeOptions options;
     options.width = 64;
     options.height = 48;
-    const format::Image a = encodeImageGpu(*egl, source, map, options);
-    const format::Image b = encodeImageGpu(*osmesa, source, map, options);
-    const format::Image c = encodeImageGpu(*egl, source, map, options);
+    const Image a = encodeImageGpu(*egl, source, map, options);
+    const Image b = encodeImageGpu(*osmesa, source, map, options);
+    const Image c = encodeImageGpu(*egl, source, map, options);
     osmesa.reset();
-    const format::Image d = encodeImageGpu(*egl, source, map, options);
+    const Image d = encodeImageGpu(*egl, source, map, options);
     EXPECT_EQ(a.pixels, b.pixels);
     EXPECT_EQ(a.pixels, c.pixels);
     EXPECT_EQ(a.pixels, d.pixels);

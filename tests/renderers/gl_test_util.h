@@ -11,7 +11,7 @@
 
 #include "conus/codec/foci.h"
 #include "conus/codec/sampling_map.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 #include "conus/renderers/context.h"
 
 namespace conus::gl::test {
@@ -30,8 +30,8 @@ inline std::string paramName(const ::testing::TestParamInfo<Backend>& info) { re
 
 // Photo-like: smooth shading, hard-edged shapes, fine texture and a little noise, per channel
 // slightly different.
-inline format::Image photoLike(int w, int h, std::vector<std::string> channels = {"R", "G", "B"}, unsigned seed = 7) {
-    format::Image im = format::makeImage(w, h, std::move(channels));
+inline Image photoLike(int w, int h, std::vector<std::string> channels = {"R", "G", "B"}, unsigned seed = 7) {
+    Image im = makeImage(w, h, std::move(channels));
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> noise(-0.03f, 0.03f);
     for (int y = 0; y < h; ++y)

@@ -47,7 +47,7 @@ codec::SamplingMap twoFoci() {
 }
 
 // The skimage sample photos when installed (OpenImageIO reads them), as float RGB; empty if not.
-format::Image readPhoto(const std::string& name) {
+Image readPhoto(const std::string& name) {
     const std::string path = "/usr/lib/python3/dist-packages/skimage/data/" + name;
     if (!std::filesystem::exists(path)) return {};
     auto in = OIIO::ImageInput::open(path);
@@ -55,7 +55,7 @@ format::Image readPhoto(const std::string& name) {
     const OIIO::ImageSpec& spec = in->spec();
     std::vector<float> all(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) return {};
-    format::Image im = format::makeImage(spec.width, spec.height, {"R", "G", "B"});
+    Image im = makeImage(spec.width, spec.height, {"R", "G", "B"});
     for (std::size_t i = 0; i < static_cast<std::size_t>(spec.width) * spec.height; ++i)
         for (int c = 0; c < 3; ++c) im.pixels[i * 3 + c] = all[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
     return im;
@@ -84,9 +84,9 @@ class GpuImage : public ::testing::TestWithParam<Backend> {
 protected:
     Context& context() { return contextFor(GetParam()); }
 
-    double encodePsnr(const format::Image& source, const codec::SamplingMap& map, int w, int h) {
-        const format::Image cpu = codec::encodeImage(source, map, encodeSize(w, h));
-        const format::Image gpu = encodeImageGpu(context(), source, map, encodeSize(w, h));
+    double encodePsnr(const Image& source, const codec::SamplingMap& map, int w, int h) {
+        const Image cpu = codec::encodeImage(source, map, encodeSize(w, h));
+        const Image gpu = encodeImageGpu(context(), source, map, encodeSize(w, h));
         EXPECT_EQ(gpu.channels, source.channels);
         const double psnr = codec::psnr(cpu, gpu);
         std::printf("    encode %dx%d -> %dx%d, map %dx%d, %s: PSNR %.2f dB\n", source.width, source.height, w, h,
@@ -94,9 +94,9 @@ protected:
         return psnr;
     }
 
-    double decodePsnr(const format::Image& conus, const codec::SamplingMap& map, codec::View view, int w, int h) {
-        const format::Image cpu = codec::decodeImage(conus, map, decodeView(view, w, h));
-        const format::Image gpu = decodeImageGpu(context(), conus, map, decodeView(view, w, h));
+    double decodePsnr(const Image& conus, const codec::SamplingMap& map, codec::View view, int w, int h) {
+        const Image cpu = codec::decodeImage(conus, map, decodeView(view, w, h));
+        const Image gpu = decodeImageGpu(context(), conus, map, decodeView(view, w, h));
         EXPECT_EQ(gpu.channels, conus.channels);
         const double psnr = codec::psnr(cpu, gpu);
         std::printf("    decode %dx%d view (%.2f,%.2f)-(%.2f,%.2f) -> %dx%d, %s: PSNR %.2f dB\n", conus.width,
@@ -111,7 +111,7 @@ TEST_P(GpuImage, RunsOnTheBackendAskedFor) {
 }
 
 TEST_P(GpuImage, EncodeMatchesCpuWithIdentityMap) {
-    const format::Image source = test::photoLike(512, 512);
+    const Image source = test::photoLike(512, 512);
     // Integer ratios (exact box filters on the CPU), a non-integer ratio, and magnification.
     EXPECT_GE(encodePsnr(source, codec::SamplingMap::identity(65, 65), 256, 256), kEncodePsnr);
     EXPECT_GE(encodePsnr(source, codec::SamplingMap::identity(2, 2), 128, 128), kEncodePsnr);
@@ -120,13 +120,13 @@ TEST_P(GpuImage, EncodeMatchesCpuWithIdentityMap) {
 }
 
 TEST_P(GpuImage, EncodeMatchesCpuWithFocusMap) {
-    const format::Image source = test::photoLike(512, 512);
+    const Image source = test::photoLike(512, 512);
     EXPECT_GE(encodePsnr(source, twoFoci(), 256, 256), kEncodePsnr);
     EXPECT_GE(encodePsnr(source, twoFoci(), 128, 160), kEncodePsnr);
 }
 
 TEST_P(GpuImage, EncodeMatchesCpuWithRandomMaps) {
-    const format::Image source = test::photoLike(384, 320, {"R", "G", "B"}, 3);
+    const Image source = test::photoLike(384, 320, {"R", "G", "B"}, 3);
     for (unsigned seed = 1; seed <= 4; ++seed) {
         SCOPED_TRACE(seed);
         EXPECT_GE(encodePsnr(source, test::randomFociMap(seed), 192, 160), kEncodePsnr);
@@ -137,7 +137,7 @@ TEST_P(GpuImage, EncodeMatchesCpuWithRandomMaps) {
 TEST_P(GpuImage, EncodeMatchesCpuOnPhotos) {
     for (const char* name : {"astronaut.png", "motorcycle_left.png"}) {
         SCOPED_TRACE(name);
-        format::Image photo = readPhoto(name);
+        Image photo = readPhoto(name);
         if (photo.empty()) {
             std::printf("    %s not installed: a procedural image stands in\n", name);
             photo = test::photoLike(512, 384, {"R", "G", "B"}, 11);
@@ -151,20 +151,20 @@ TEST_P(GpuImage, EncodeMatchesCpuOnPhotos) {
 }
 
 TEST_P(GpuImage, EncodeHandlesAnyChannelCount) {
-    const format::Image full = test::photoLike(256, 192, {"R", "G", "B", "A", "Z", "N"}, 5);
+    const Image full = test::photoLike(256, 192, {"R", "G", "B", "A", "Z", "N"}, 5);
     for (int count : {1, 2, 3, 4, 5, 6}) {
         SCOPED_TRACE(count);
-        format::Image source = format::makeImage(
+        Image source = makeImage(
             full.width, full.height, std::vector<std::string>(full.channels.begin(), full.channels.begin() + count));
         for (std::size_t i = 0; i < static_cast<std::size_t>(source.width) * source.height; ++i)
             for (int c = 0; c < count; ++c) source.pixels[i * count + c] = full.pixels[i * 6 + c];
         const codec::SamplingMap map = twoFoci();
-        const format::Image cpu = codec::encodeImage(source, map, encodeSize(128, 96));
-        const format::Image gpu = encodeImageGpu(context(), source, map, encodeSize(128, 96));
+        const Image cpu = codec::encodeImage(source, map, encodeSize(128, 96));
+        const Image gpu = encodeImageGpu(context(), source, map, encodeSize(128, 96));
         ASSERT_EQ(gpu.channels, source.channels);
         // Per channel: each pass must land in its own channels.
         for (int c = 0; c < count; ++c) {
-            format::Image a = format::makeImage(128, 96, {"Y"}), b = format::makeImage(128, 96, {"Y"});
+            Image a = makeImage(128, 96, {"Y"}), b = makeImage(128, 96, {"Y"});
             for (std::size_t i = 0; i < a.pixels.size(); ++i) {
                 a.pixels[i] = cpu.pixels[i * count + c];
                 b.pixels[i] = gpu.pixels[i * count + c];
@@ -178,11 +178,11 @@ TEST_P(GpuImage, EncodeHandlesAnyChannelCount) {
 // crosses CoNUS row y where distort(e, v).y is that row's centre, at x = distort(e, v).x.
 TEST_P(GpuImage, CheckerboardEdgesFollowEquation1) {
     constexpr int kSource = 512, kSquare = 64, kW = 256, kH = 256;
-    format::Image board = format::makeImage(kSource, kSource, {"Y"});
+    Image board = makeImage(kSource, kSource, {"Y"});
     for (int y = 0; y < kSource; ++y)
         for (int x = 0; x < kSource; ++x) board.at(x, y) = float(((x / kSquare) + (y / kSquare)) % 2);
     const codec::SamplingMap map = codec::buildFociMap(std::vector<codec::Focus>{{0.4, 0.45, 0.1, 4}});
-    const format::Image conus = encodeImageGpu(context(), board, map, encodeSize(kW, kH));
+    const Image conus = encodeImageGpu(context(), board, map, encodeSize(kW, kH));
 
     int checked = 0;
     double worst = 0;
@@ -218,11 +218,11 @@ TEST_P(GpuImage, CheckerboardEdgesFollowEquation1) {
 }
 
 TEST_P(GpuImage, DecodeMatchesCpu) {
-    const format::Image source = test::photoLike(512, 512);
+    const Image source = test::photoLike(512, 512);
     for (unsigned seed = 0; seed < 3; ++seed) {
         SCOPED_TRACE(seed);
         const codec::SamplingMap map = seed == 0 ? twoFoci() : test::randomFociMap(seed);
-        const format::Image conus = codec::encodeImage(source, map, encodeSize(256, 256));
+        const Image conus = codec::encodeImage(source, map, encodeSize(256, 256));
         EXPECT_GE(decodePsnr(conus, map, {}, 512, 512), kDecodePsnr);                      // full frame
         EXPECT_GE(decodePsnr(conus, map, {0.25, 0.3, 0.45, 0.5}, 320, 240), kDecodePsnr);  // zoomed in
         EXPECT_GE(decodePsnr(conus, map, {0, 0, 1, 1}, 96, 80), kDecodePsnr);              // zoomed out: taps
@@ -230,15 +230,15 @@ TEST_P(GpuImage, DecodeMatchesCpu) {
         EXPECT_GE(decodePsnr(conus, map, {1, 1, 0, 0}, 200, 200), kDecodePsnr);            // mirrored
     }
     const codec::SamplingMap jittered = test::jitteredMap(7, 6, 0.3, 9);
-    const format::Image conus = codec::encodeImage(source, jittered, encodeSize(200, 220));
+    const Image conus = codec::encodeImage(source, jittered, encodeSize(200, 220));
     EXPECT_GE(decodePsnr(conus, jittered, {}, 400, 300), kDecodePsnr);
 }
 
 TEST_P(GpuImage, DecodeHandlesAnyChannelCount) {
-    const format::Image conus = test::photoLike(128, 128, {"R", "G", "B", "A", "Z"}, 4);
+    const Image conus = test::photoLike(128, 128, {"R", "G", "B", "A", "Z"}, 4);
     const codec::SamplingMap map = twoFoci();
-    const format::Image cpu = codec::decodeImage(conus, map, decodeView({}, 160, 120));
-    const format::Image gpu = decodeImageGpu(context(), conus, map, decodeView({}, 160, 120));
+    const Image cpu = codec::decodeImage(conus, map, decodeView({}, 160, 120));
+    const Image gpu = decodeImageGpu(context(), conus, map, decodeView({}, 160, 120));
     ASSERT_EQ(gpu.channels, conus.channels);
     EXPECT_GE(codec::psnr(cpu, gpu), kDecodePsnr);
     // Z is left out of psnr(); compare it directly.
@@ -248,10 +248,10 @@ TEST_P(GpuImage, DecodeHandlesAnyChannelCount) {
 }
 
 TEST_P(GpuImage, ReportsTimings) {
-    const format::Image source = test::photoLike(256, 256);
+    const Image source = test::photoLike(256, 256);
     GpuTimings t;
     t.uploadMs = t.drawMs = t.readbackMs = -1;
-    const format::Image conus = encodeImageGpu(context(), source, twoFoci(), encodeSize(128, 128), &t);
+    const Image conus = encodeImageGpu(context(), source, twoFoci(), encodeSize(128, 128), &t);
     EXPECT_GT(t.uploadMs, 0);
     EXPECT_GT(t.drawMs, 0);
     EXPECT_GE(t.readbackMs, 0);
@@ -263,7 +263,7 @@ TEST_P(GpuImage, ReportsTimings) {
 }
 
 TEST_P(GpuImage, RejectsBadArguments) {
-    const format::Image source = test::photoLike(64, 64);
+    const Image source = test::photoLike(64, 64);
     const codec::SamplingMap map = codec::SamplingMap::identity(2, 2);
     const auto code = [](auto&& fn) {
         try {
@@ -273,12 +273,12 @@ TEST_P(GpuImage, RejectsBadArguments) {
         }
         return ErrorCode::Io;  // "did not throw"
     };
-    EXPECT_EQ(code([&] { encodeImageGpu(context(), format::Image{}, map, encodeSize(8, 8)); }),
+    EXPECT_EQ(code([&] { encodeImageGpu(context(), Image{}, map, encodeSize(8, 8)); }),
               ErrorCode::InvalidArgument);
     EXPECT_EQ(code([&] { encodeImageGpu(context(), source, map, encodeSize(0, 8)); }), ErrorCode::InvalidArgument);
     EXPECT_EQ(code([&] { decodeImageGpu(context(), source, map, decodeView({0.5, 0, 0.5, 1}, 8, 8)); }),
               ErrorCode::InvalidArgument);
-    format::Image broken = source;
+    Image broken = source;
     broken.pixels.pop_back();
     EXPECT_EQ(code([&] { decodeImageGpu(context(), broken, map, decodeView({}, 8, 8)); }), ErrorCode::InvalidArgument);
     // An output wider than any texture the context can hold: refused clearly (only sources tile).
@@ -293,7 +293,7 @@ TEST_P(GpuImage, RejectsBadArguments) {
 // Sources over the texture limit are tiled: the limit lowered to 256 texels cuts a 700 x 500
 // source (and its pyramid) into tiles, and the result matches the CPU reference and the untiled GPU.
 TEST_P(GpuImage, EncodeTilesSourcesOverTheLimit) {
-    const format::Image source = test::photoLike(700, 500);
+    const Image source = test::photoLike(700, 500);
     struct Case {
         const char* name;
         codec::SamplingMap map;
@@ -305,9 +305,9 @@ TEST_P(GpuImage, EncodeTilesSourcesOverTheLimit) {
                                      {"random foci", test::randomFociMap(3), 200, 150}};
     for (const Case& c : cases) {
         SCOPED_TRACE(c.name);
-        const format::Image cpu = codec::encodeImage(source, c.map, encodeSize(c.width, c.height));
-        const format::Image untiled = encodeImageGpu(context(), source, c.map, encodeSize(c.width, c.height));
-        format::Image tiled;
+        const Image cpu = codec::encodeImage(source, c.map, encodeSize(c.width, c.height));
+        const Image untiled = encodeImageGpu(context(), source, c.map, encodeSize(c.width, c.height));
+        Image tiled;
         {
             const TextureLimit limit("256");
             tiled = encodeImageGpu(context(), source, c.map, encodeSize(c.width, c.height));
@@ -327,17 +327,17 @@ TEST_P(GpuImage, EncodeTilesSourcesOverTheLimit) {
     }
     // A source past the real GL_MAX_TEXTURE_SIZE: a 1-texel strip, tiled along its length.
     const int wide = context().maxTextureSize() + 1;
-    format::Image strip = format::makeImage(wide, 1, {"Y"});
+    Image strip = makeImage(wide, 1, {"Y"});
     for (int x = 0; x < wide; ++x) strip.at(x, 0) = float(x % 97) / 97.0f;
     const codec::SamplingMap map = codec::SamplingMap::identity(2, 2);
-    const format::Image cpu = codec::encodeImage(strip, map, encodeSize(64, 1));
-    const format::Image gpu = encodeImageGpu(context(), strip, map, encodeSize(64, 1));
+    const Image cpu = codec::encodeImage(strip, map, encodeSize(64, 1));
+    const Image gpu = encodeImageGpu(context(), strip, map, encodeSize(64, 1));
     EXPECT_GE(codec::psnr(cpu, gpu), kEncodePsnr);
 }
 
 // Decode is not tiled: a CoNUS image over the limit is refused with a message naming the limit.
 TEST_P(GpuImage, DecodeRefusesImagesOverTheLimit) {
-    const format::Image conus = test::photoLike(300, 200);
+    const Image conus = test::photoLike(300, 200);
     const TextureLimit limit("256");
     try {
         decodeImageGpu(context(), conus, twoFoci(), decodeView({}, 100, 100));

@@ -32,24 +32,22 @@ TEST_P(Terrain, FlatFieldHorizonWhereTheCameraPutsIt) {
     Context& context = contextFor(GetParam());
     const codec::GroundParams ground = testGround();
     const glm::dvec2 extent = codec::fieldExtent(ground);
-    format::Image dem = format::makeImage(32, 32, {"Z"});
-    const format::Image colour = codec::terrainColours(dem, extent);
-    const codec::Mesh mesh = codec::undistortHeightField(codec::uniformHeightField(dem, colour, 32, 32), extent);
+    Image dem = makeImage(32, 32, {"Z"});
+    const Image colour = codec::terrainColours(dem, extent);
+    const Mesh mesh = codec::undistortHeightField(codec::uniformHeightField(dem, colour, 32, 32), extent);
 
     // Level camera 600 m up at the viewer: the far edge (distance `far`) lies atan(600 / far)
     // below the horizon, i.e. (h/2) * tan(angle) / tan(fovY/2) rows below the frame's middle.
-    TerrainCamera camera;
-    camera.eye = {0.5 * extent.x, 600.0, extent.y + ground.near};
-    camera.target = camera.eye + glm::dvec3(0, 0, -1);
-    camera.fovYDegrees = 50.0;
-    camera.near = 1.0;
-    camera.far = 1e5;
+    const glm::dvec3 eye{0.5 * extent.x, 600.0, extent.y + ground.near};
+    const double fovYDegrees = 50.0;
+    const Camera camera = Camera::perspective(eye, eye + glm::dvec3(0, 0, -1), {0, 1, 0}, fovYDegrees,
+                                              double(kFrameWidth) / kFrameHeight, 1.0, 1e5);
     TerrainLook look;
-    const format::Image frame = renderTerrain(context, mesh, camera, kFrameWidth, kFrameHeight, look);
+    const Image frame = renderTerrain(context, mesh, camera, kFrameWidth, kFrameHeight, look);
     ASSERT_EQ(frame.width, kFrameWidth);
     ASSERT_EQ(frame.channels, (std::vector<std::string>{"R", "G", "B"}));
     const double predicted = 0.5 * kFrameHeight + 0.5 * kFrameHeight * (600.0 / ground.far) /
-                                                      std::tan(0.5 * camera.fovYDegrees * 3.14159265358979 / 180.0);
+                                                      std::tan(0.5 * fovYDegrees * 3.14159265358979 / 180.0);
     // The edge: where the centre column stops being (mostly) sky, top row first.
     const int x = kFrameWidth / 2;
     double edge = -1;
@@ -73,22 +71,20 @@ TEST_P(Terrain, RendererKeepsMeshAcrossFramesAndSizes) {
     Context& context = contextFor(GetParam());
     codec::TerrainOptions options;
     options.width = options.height = 64;
-    const format::Image dem = codec::generateTerrain(options);
+    const Image dem = codec::generateTerrain(options);
     const glm::dvec2 extent = codec::fieldExtent(testGround());
-    const codec::Mesh mesh =
+    const Mesh mesh =
         codec::undistortHeightField(codec::uniformHeightField(dem, codec::terrainColours(dem, extent), 64, 64), extent);
     TerrainRenderer renderer(context, mesh);
-    const TerrainCamera camera = viewerCamera(testGround(), dem.at(32, 63));
-    const format::Image a = renderer.render(camera, 64, 48);
-    const format::Image b = renderer.render(camera, 32, 24);
-    const format::Image c = renderer.render(camera, 64, 48);
+    const Camera camera = viewerCamera(testGround(), dem.at(32, 63), 64.0 / 48.0);
+    const Image a = renderer.render(camera, 64, 48);
+    const Image b = renderer.render(camera, 32, 24);
+    const Image c = renderer.render(camera, 64, 48);
     EXPECT_EQ(a.pixels, c.pixels);
     EXPECT_EQ(b.width, 32);
     EXPECT_THROW(renderer.render(camera, 0, 10), Error);
-    TerrainCamera bad = camera;
-    bad.near = 0;
-    EXPECT_THROW(renderer.render(bad, 8, 8), Error);
-    EXPECT_THROW(renderTerrain(context, codec::Mesh{}, camera, 8, 8), Error);
+    EXPECT_THROW(viewerCamera(testGround(), dem.at(32, 63), 0.0), Error) << "a camera without an aspect";
+    EXPECT_THROW(renderTerrain(context, Mesh{}, camera, 8, 8), Error);
 }
 
 // Figure 5 of the paper: frames near the viewer from the CoNUS height field are closer to the
@@ -100,24 +96,25 @@ TEST_P(Terrain, ConusBeatsUniformNearTheViewer) {
     codec::TerrainOptions options;
     options.width = options.height = 512;
     options.seed = 11;
-    const format::Image dem = codec::generateTerrain(options);
-    const format::Image colour = codec::terrainColours(dem, extent);
+    const Image dem = codec::generateTerrain(options);
+    const Image colour = codec::terrainColours(dem, extent);
     const int samples = 128;
     codec::HeightFieldOptions encode;
     encode.ground = ground;
     encode.width = encode.height = samples;
-    const codec::Mesh full = codec::undistortHeightField(codec::uniformHeightField(dem, colour, 512, 512), extent);
-    const codec::Mesh conus = codec::undistortHeightField(codec::encodeHeightField(dem, colour, encode));
-    const codec::Mesh uniform =
+    const Mesh full = codec::undistortHeightField(codec::uniformHeightField(dem, colour, 512, 512), extent);
+    const Mesh conus = codec::undistortHeightField(codec::encodeHeightField(dem, colour, encode));
+    const Mesh uniform =
         codec::undistortHeightField(codec::uniformHeightField(dem, colour, samples, samples), extent);
 
     TerrainRenderer fullRenderer(context, full), conusRenderer(context, conus), uniformRenderer(context, uniform);
     const double groundHeight = dem.at(255, 511);
-    const std::array<TerrainCamera, 3> poses = {viewerCamera(ground, groundHeight),
-                                                viewerCamera(ground, groundHeight, 300.0, 10.0),
-                                                viewerCamera(ground, groundHeight, -200.0, -15.0)};
+    const double aspect = double(kFrameWidth) / kFrameHeight;
+    const std::array<Camera, 3> poses = {viewerCamera(ground, groundHeight, aspect),
+                                         viewerCamera(ground, groundHeight, aspect, 300.0, 10.0),
+                                         viewerCamera(ground, groundHeight, aspect, -200.0, -15.0)};
     for (std::size_t i = 0; i < poses.size(); ++i) {
-        const format::Image reference = fullRenderer.render(poses[i], kFrameWidth, kFrameHeight);
+        const Image reference = fullRenderer.render(poses[i], kFrameWidth, kFrameHeight);
         const double conusPsnr = codec::psnr(conusRenderer.render(poses[i], kFrameWidth, kFrameHeight), reference);
         const double uniformPsnr = codec::psnr(uniformRenderer.render(poses[i], kFrameWidth, kFrameHeight), reference);
         std::printf("pose %zu: PSNR vs full resolution: CoNUS %.2f dB, uniform %.2f dB\n", i, conusPsnr, uniformPsnr);

@@ -11,7 +11,7 @@ namespace {
 
 TEST(Inspector, IdentityMapReadsThePixel) {
     format::ConusFile file;
-    file.image = format::makeImage(4, 2, {"R", "G", "B", "Z"});
+    file.image = makeImage(4, 2, {"R", "G", "B", "Z"});
     for (int y = 0; y < 2; ++y)
         for (int x = 0; x < 4; ++x)
             for (int c = 0; c < 4; ++c) file.image.at(x, y, c) = float(x + 10 * y + 100 * c);

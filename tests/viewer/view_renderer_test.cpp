@@ -32,11 +32,11 @@ ViewOptions linear(ViewMode mode = ViewMode::Reconstructed) {
     return o;
 }
 
-float channelDiff(const format::Image& a, const format::Image& b, int x, int y, int c) {
+float channelDiff(const Image& a, const Image& b, int x, int y, int c) {
     return std::abs(a.at(x, y, c) - b.at(x, y, c));
 }
 
-double psnrRgb(const format::Image& a, const format::Image& b) {
+double psnrRgb(const Image& a, const Image& b) {
     double se = 0;
     for (int y = 0; y < a.height; ++y)
         for (int x = 0; x < a.width; ++x)
@@ -48,12 +48,12 @@ double psnrRgb(const format::Image& a, const format::Image& b) {
 TEST(ViewRenderer, ReconstructedMatchesTheCpuDecoder) {
     Fixture& f = fixture();
     const codec::View view{0.1, 0.15, 0.9, 0.8};
-    const format::Image gpu = f.renderer.renderToImage(view, 256, 208, linear());
+    const Image gpu = f.renderer.renderToImage(view, 256, 208, linear());
     codec::DecodeOptions options;
     options.view = view;
     options.width = 256;
     options.height = 208;
-    const format::Image cpu = codec::decodeImage(f.file.image, f.map, options);
+    const Image cpu = codec::decodeImage(f.file.image, f.map, options);
     EXPECT_GT(psnrRgb(gpu, cpu), 50.0);
     // Zoomed far in: still decoded from the CoNUS data (a zoom on the focus).
     const codec::View close{0.6, 0.5, 0.7, 0.6};
@@ -76,10 +76,10 @@ TEST(ViewRenderer, CpuDecodeMatchesTheShader) {
             o.outlines = overlays;
             o.decode = gl::DecodePath::Gpu;
             EXPECT_FALSE(f.renderer.decodesOnCpu(o));
-            const format::Image gpu = f.renderer.renderToImage(view, 240, 180, o);
+            const Image gpu = f.renderer.renderToImage(view, 240, 180, o);
             o.decode = gl::DecodePath::Cpu;
             EXPECT_TRUE(f.renderer.decodesOnCpu(o));
-            const format::Image cpu = f.renderer.renderToImage(view, 240, 180, o);
+            const Image cpu = f.renderer.renderToImage(view, 240, 180, o);
             EXPECT_GT(psnrRgb(gpu, cpu), overlays ? 40.0 : 50.0) << view.u0 << "," << view.v0 << " overlays " << overlays;
             // Same background outside [0,1]^2, same alpha.
             EXPECT_EQ(gpu.at(0, 0, 3), cpu.at(0, 0, 3));
@@ -96,7 +96,7 @@ TEST(ViewRenderer, CpuDecodeMatchesTheShader) {
 
 TEST(ViewRenderer, RawShowsTheCoNUSImageItself) {
     Fixture& f = fixture();
-    const format::Image raw = f.renderer.renderToImage({}, test::kConusWidth, test::kConusHeight, linear(ViewMode::Raw));
+    const Image raw = f.renderer.renderToImage({}, test::kConusWidth, test::kConusHeight, linear(ViewMode::Raw));
     for (int y = 0; y < raw.height; y += 7)
         for (int x = 0; x < raw.width; x += 5)
             for (int c = 0; c < 3; ++c) ASSERT_LT(channelDiff(raw, f.file.image, x, y, c), 1e-4) << x << "," << y;
@@ -104,13 +104,13 @@ TEST(ViewRenderer, RawShowsTheCoNUSImageItself) {
 
 TEST(ViewRenderer, UniformImageHasTheSamePixelCountAndLooksLikeTheSource) {
     Fixture& f = fixture();
-    const format::Image& uniform = f.renderer.uniformImage();
+    const Image& uniform = f.renderer.uniformImage();
     EXPECT_EQ(uniform.width, test::kConusWidth);
     EXPECT_EQ(uniform.height, test::kConusHeight);
-    const format::Image reference = codec::areaDownsample(test::sourceImage(), test::kConusWidth, test::kConusHeight);
+    const Image reference = codec::areaDownsample(test::sourceImage(), test::kConusWidth, test::kConusHeight);
     EXPECT_GT(psnrRgb(uniform, reference), 28.0);
     // Uniform mode at the uniform image's own size shows it pixel for pixel.
-    const format::Image shown = f.renderer.renderToImage({}, uniform.width, uniform.height, linear(ViewMode::Uniform));
+    const Image shown = f.renderer.renderToImage({}, uniform.width, uniform.height, linear(ViewMode::Uniform));
     EXPECT_GT(psnrRgb(shown, uniform), 60.0);
 }
 
@@ -118,11 +118,11 @@ TEST(ViewRenderer, WipeSplitsReconstructedAndUniform) {
     Fixture& f = fixture();
     ViewOptions wipe = linear(ViewMode::Wipe);
     wipe.wipeX = 0.5;
-    const format::Image w = f.renderer.renderToImage({}, 200, 150, wipe);
+    const Image w = f.renderer.renderToImage({}, 200, 150, wipe);
     ViewOptions shader = linear();
     shader.decode = gl::DecodePath::Gpu;  // the wipe is drawn by the shader (pixel for pixel; the CPU path is within 50 dB)
-    const format::Image r = f.renderer.renderToImage({}, 200, 150, shader);
-    const format::Image u = f.renderer.renderToImage({}, 200, 150, linear(ViewMode::Uniform));
+    const Image r = f.renderer.renderToImage({}, 200, 150, shader);
+    const Image u = f.renderer.renderToImage({}, 200, 150, linear(ViewMode::Uniform));
     for (int y = 0; y < 150; y += 3) {
         for (int c = 0; c < 3; ++c) {
             EXPECT_EQ(w.at(40, y, c), r.at(40, y, c));
@@ -137,10 +137,10 @@ TEST(ViewRenderer, GridLinesAreWhereEquationOnePutsThem) {
     const int width = 400, height = 300, every = 5;
     const codec::View view{0.0, 0.0, 1.0, 1.0};
     ViewOptions options = linear();
-    const format::Image plain = f.renderer.renderToImage(view, width, height, options);
+    const Image plain = f.renderer.renderToImage(view, width, height, options);
     options.grid = true;
     options.gridEvery = every;
-    const format::Image grid = f.renderer.renderToImage(view, width, height, options);
+    const Image grid = f.renderer.renderToImage(view, width, height, options);
     const double lx = double(test::kConusWidth) / every, ly = double(test::kConusHeight) / every;
     const auto distorted = [&](int x, int y) {
         return f.map.distort({(x + 0.5) / width, (y + 0.5) / height});
@@ -169,7 +169,7 @@ TEST(ViewRenderer, GridLinesAreWhereEquationOnePutsThem) {
 
 TEST(ViewRenderer, DensityIsBrightAtTheFocus) {
     Fixture& f = fixture();
-    const format::Image d = f.renderer.renderToImage({}, 160, 120, linear(ViewMode::Density));
+    const Image d = f.renderer.renderToImage({}, 160, 120, linear(ViewMode::Density));
     const auto brightness = [&](double u, double v) {
         const int x = int(u * 160), y = int(v * 120);
         return d.at(x, y, 0) + d.at(x, y, 1) + d.at(x, y, 2);
@@ -184,7 +184,7 @@ TEST(ViewRenderer, OutlinesCircleTheFocus) {
     ViewOptions o = linear();
     o.outlines = true;
     const int width = test::kSourceWidth, height = test::kSourceHeight;
-    const format::Image im = f.renderer.renderToImage({}, width, height, o);
+    const Image im = f.renderer.renderToImage({}, width, height, o);
     // r = 0.1 of the width: 32 pixels right of the centre.
     const int x = int(test::kFocusU * width + 0.1 * width), y = int(test::kFocusV * height);
     EXPECT_FLOAT_EQ(im.at(x, y, 1), 1.0f);
@@ -195,12 +195,12 @@ TEST(ViewRenderer, OutlinesCircleTheFocus) {
 TEST(ViewRenderer, ExposureAndGamma) {
     Fixture& f = fixture();
     ViewOptions o = linear();
-    const format::Image base = f.renderer.renderToImage({}, 64, 48, o);
+    const Image base = f.renderer.renderToImage({}, 64, 48, o);
     o.exposure = 1.0;
-    const format::Image brighter = f.renderer.renderToImage({}, 64, 48, o);
+    const Image brighter = f.renderer.renderToImage({}, 64, 48, o);
     o.exposure = 0.0;
     o.gamma = 2.0;
-    const format::Image gamma = f.renderer.renderToImage({}, 64, 48, o);
+    const Image gamma = f.renderer.renderToImage({}, 64, 48, o);
     for (int x = 0; x < 64; x += 9) {
         EXPECT_NEAR(brighter.at(x, 20, 0), 2 * base.at(x, 20, 0), 1e-5);
         EXPECT_NEAR(gamma.at(x, 20, 0), std::sqrt(base.at(x, 20, 0)), 1e-5);
@@ -209,14 +209,14 @@ TEST(ViewRenderer, ExposureAndGamma) {
 
 TEST(ViewRenderer, SrgbCurveAndToneMapsAgreeWithCoreOnBothPaths) {
     Fixture& f = fixture();
-    const format::Image base = f.renderer.renderToImage({}, 64, 48, linear());
+    const Image base = f.renderer.renderToImage({}, 64, 48, linear());
     for (ToneMap toneMap : {ToneMap::None, ToneMap::Reinhard, ToneMap::Aces}) {
         ViewOptions o;  // gamma 0: the sRGB curve
         o.exposure = 2.0;  // pushes the bright parts above 1
         o.toneMap = toneMap;
         for (gl::DecodePath path : {gl::DecodePath::Gpu, gl::DecodePath::Cpu}) {
             o.decode = path;
-            const format::Image shown = f.renderer.renderToImage({}, 64, 48, o);
+            const Image shown = f.renderer.renderToImage({}, 64, 48, o);
             for (int x = 0; x < 64; x += 7)
                 for (int c = 0; c < 3; ++c) {
                     const float want = linearToSrgbDisplay(exposeAndToneMap(base.at(x, 20, c), 4.0f, toneMap));
@@ -228,7 +228,7 @@ TEST(ViewRenderer, SrgbCurveAndToneMapsAgreeWithCoreOnBothPaths) {
 
 TEST(ViewRenderer, OutsideTheImageIsBackground) {
     Fixture& f = fixture();
-    const format::Image im = f.renderer.renderToImage({-1.0, -1.0, 2.0, 2.0}, 90, 90, linear());
+    const Image im = f.renderer.renderToImage({-1.0, -1.0, 2.0, 2.0}, 90, 90, linear());
     EXPECT_NEAR(im.at(5, 5, 0), 0.11f, 1e-6);
     EXPECT_NE(im.at(45, 45, 0), 0.11f);
 }
@@ -236,7 +236,7 @@ TEST(ViewRenderer, OutsideTheImageIsBackground) {
 TEST(ViewRenderer, OverlayBlendsOverTheFrameInItsRectangleOnly) {
     Fixture& f = fixture();
     // A 40x20 overlay: left half opaque white, right half black at alpha 0.5.
-    format::Image overlay = format::makeImage(40, 20, {"R", "G", "B", "A"});
+    Image overlay = makeImage(40, 20, {"R", "G", "B", "A"});
     for (int y = 0; y < 20; ++y)
         for (int x = 0; x < 40; ++x) {
             const float v = x < 20 ? 1.0f : 0.0f;
@@ -247,8 +247,8 @@ TEST(ViewRenderer, OverlayBlendsOverTheFrameInItsRectangleOnly) {
     f.renderer.setOverlay(slot, overlay);
     ASSERT_TRUE(f.renderer.hasOverlay(slot));
     const codec::View view{0.0, 0.0, 1.0, 1.0};
-    const format::Image plain = f.renderer.renderToImage(view, 160, 120, linear());
-    const format::Image over = f.renderer.renderToImage(view, 160, 120, linear(), {{slot, 30, 50}});
+    const Image plain = f.renderer.renderToImage(view, 160, 120, linear());
+    const Image over = f.renderer.renderToImage(view, 160, 120, linear(), {{slot, 30, 50}});
     for (int y = 0; y < 120; ++y)
         for (int x = 0; x < 160; ++x) {
             const bool inside = x >= 30 && x < 70 && y >= 50 && y < 70;
@@ -258,12 +258,12 @@ TEST(ViewRenderer, OverlayBlendsOverTheFrameInItsRectangleOnly) {
             }
         }
     // Clipped at the edges, and an empty image empties the slot.
-    const format::Image corner = f.renderer.renderToImage(view, 160, 120, linear(), {{slot, 150, -10}});
+    const Image corner = f.renderer.renderToImage(view, 160, 120, linear(), {{slot, 150, -10}});
     EXPECT_NEAR(corner.at(155, 5, 0), 1.0f, 1e-4);
     EXPECT_NEAR(corner.at(140, 5, 0), plain.at(140, 5, 0), 1e-4);
-    f.renderer.setOverlay(slot, format::Image{});
+    f.renderer.setOverlay(slot, Image{});
     EXPECT_FALSE(f.renderer.hasOverlay(slot));
-    const format::Image none = f.renderer.renderToImage(view, 160, 120, linear(), {{slot, 30, 50}});
+    const Image none = f.renderer.renderToImage(view, 160, 120, linear(), {{slot, 30, 50}});
     EXPECT_NEAR(none.at(40, 60, 1), plain.at(40, 60, 1), 1e-6);
 }
 

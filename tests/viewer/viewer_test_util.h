@@ -34,8 +34,8 @@ inline std::filesystem::path tempDir() {
 }
 
 // Dark smooth colours, a white disc of radius 5 source pixels at the marker.
-inline format::Image sourceImage() {
-    format::Image im = format::makeImage(kSourceWidth, kSourceHeight, {"R", "G", "B"});
+inline Image sourceImage() {
+    Image im = makeImage(kSourceWidth, kSourceHeight, {"R", "G", "B"});
     for (int y = 0; y < kSourceHeight; ++y)
         for (int x = 0; x < kSourceWidth; ++x) {
             const double u = (x + 0.5) / kSourceWidth, v = (y + 0.5) / kSourceHeight;

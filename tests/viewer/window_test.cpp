@@ -25,16 +25,16 @@ public:
 };
 [[maybe_unused]] ::testing::Environment* const kRemoveTempDir = ::testing::AddGlobalTestEnvironment(new RemoveTempDir);
 
-format::Image readPng(const fs::path& path) {
+Image readPng(const fs::path& path) {
     auto in = OIIO::ImageInput::open(path.string());
     if (!in) return {};
     const OIIO::ImageSpec spec = in->spec();
-    format::Image im = format::makeImage(spec.width, spec.height, std::vector<std::string>(spec.nchannels, "C"));
+    Image im = makeImage(spec.width, spec.height, std::vector<std::string>(spec.nchannels, "C"));
     in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, im.pixels.data());
     return im;
 }
 
-void writePng(const fs::path& path, const format::Image& im) {
+void writePng(const fs::path& path, const Image& im) {
     auto out = OIIO::ImageOutput::create(path.string());
     OIIO::ImageSpec spec(im.width, im.height, im.channelCount(), OIIO::TypeDesc::UINT8);
     out->open(path.string(), spec);
@@ -43,7 +43,7 @@ void writePng(const fs::path& path, const format::Image& im) {
 }
 
 // Centroid and count of the pixels bright in every channel (the white marker).
-glm::dvec3 marker(const format::Image& im) {
+glm::dvec3 marker(const Image& im) {
     glm::dvec3 sum{0.0};
     for (int y = 0; y < im.height; ++y)
         for (int x = 0; x < im.width; ++x)
@@ -52,7 +52,7 @@ glm::dvec3 marker(const format::Image& im) {
 }
 
 // Pixels in [x0,x1)x[y0,y1) bright in every channel (white text).
-int brightPixels(const format::Image& im, int x0, int y0, int x1, int y1) {
+int brightPixels(const Image& im, int x0, int y0, int x1, int y1) {
     int n = 0;
     for (int y = y0; y < std::min(y1, im.height); ++y)
         for (int x = x0; x < std::min(x1, im.width); ++x)
@@ -62,7 +62,7 @@ int brightPixels(const format::Image& im, int x0, int y0, int x1, int y1) {
 
 // The rectangle [x0,x1)x[y0,y1) of the pixels that differ between a and b (x0 == x1 == 0: none).
 struct Box { int x0 = 0, y0 = 0, x1 = 0, y1 = 0; };
-Box changed(const format::Image& a, const format::Image& b) {
+Box changed(const Image& a, const Image& b) {
     Box box{a.width, a.height, 0, 0};
     for (int y = 0; y < a.height; ++y)
         for (int x = 0; x < a.width; ++x)
@@ -83,14 +83,14 @@ TEST(ConusView, ScreenshotIsTheDecodedFrameWithoutADisplay) {
     std::string log;
     ASSERT_EQ(test::run("env -u DISPLAY " + test::viewerBinary() + " " + test::conusPath() + " --screenshot " + out.string() +
                             " --view 0.1,0.2,0.9,0.8 --size 256x144 --gamma 1", &log), 0) << log;
-    const format::Image shot = readPng(out);
+    const Image shot = readPng(out);
     ASSERT_EQ(shot.width, 256);
     const format::ConusFile file = format::readConusFile(test::conusPath());
     codec::DecodeOptions options;
     options.view = {0.1, 0.2, 0.9, 0.8};  // 256x144 source pixels: the size's aspect, no letterbox
     options.width = 256;
     options.height = 144;
-    const format::Image cpu = codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
+    const Image cpu = codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
     // EXR stores channels sorted by name (B,G,R); the PNG is R,G,B.
     const int channel[3] = {cpu.channelIndex("R"), cpu.channelIndex("G"), cpu.channelIndex("B")};
     double worst = 0;
@@ -108,7 +108,7 @@ TEST(ConusView, ScreenshotLetterboxesLikeTheWindow) {
     std::string log;
     ASSERT_EQ(test::run("env -u DISPLAY " + test::viewerBinary() + " " + test::conusPath() + " --screenshot " + out.string() +
                             " --view 0.1,0.2,0.9,0.8 --size 256x256 --gamma 1", &log), 0) << log;
-    const format::Image shot = readPng(out);
+    const Image shot = readPng(out);
     ASSERT_EQ(shot.width, 256);
     ASSERT_EQ(shot.height, 256);
     const format::ConusFile file = format::readConusFile(test::conusPath());
@@ -116,7 +116,7 @@ TEST(ConusView, ScreenshotLetterboxesLikeTheWindow) {
     options.view = {0.1, 0.2, 0.9, 0.8};
     options.width = 256;
     options.height = 144;
-    const format::Image cpu = codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
+    const Image cpu = codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
     const int channel[3] = {cpu.channelIndex("R"), cpu.channelIndex("G"), cpu.channelIndex("B")};
     const int top = (256 - 144) / 2;
     double worst = 0;
@@ -158,7 +158,7 @@ TEST(ConusView, ScreenshotHelpOverlayDrawsTheKeyList) {
     std::string log;
     ASSERT_EQ(test::run(test::viewerBinary() + common + (dir / "plain.png").string(), &log), 0) << log;
     ASSERT_EQ(test::run(test::viewerBinary() + common + (dir / "help.png").string() + " --help-overlay", &log), 0) << log;
-    const format::Image plain = readPng(dir / "plain.png"), help = readPng(dir / "help.png");
+    const Image plain = readPng(dir / "plain.png"), help = readPng(dir / "help.png");
     ASSERT_EQ(help.width, 800);
     ASSERT_EQ(help.height, 640);
     // The panel starts at the 16-pixel margin; everything outside it is the frame untouched.
@@ -189,7 +189,7 @@ TEST(ConusView, WindowHelpOverlayAndStatusBarToggle) {
                                           "\nkey B\nscreenshot " + (dir / "w3.png").string() + "\n");
     std::string log;
     ASSERT_EQ(test::run(xvfb(test::conusPath() + " --window 640x560 --script " + (dir / "help.txt").string()), &log), 0) << log;
-    const format::Image w0 = readPng(dir / "w0.png"), w1 = readPng(dir / "w1.png"), w2 = readPng(dir / "w2.png"),
+    const Image w0 = readPng(dir / "w0.png"), w1 = readPng(dir / "w1.png"), w2 = readPng(dir / "w2.png"),
                         w3 = readPng(dir / "w3.png");
     ASSERT_EQ(w1.width, 640);
     const Box help = changed(w0, w1);
@@ -216,7 +216,7 @@ TEST(ConusView, WindowZoomKeepsTheFeatureUnderTheCursor) {
                                           "\ninspect " + std::to_string(at.x) + " " + std::to_string(at.y) + "\n");
     std::string log;
     ASSERT_EQ(test::run(xvfb(test::conusPath() + " --window 400x300 --script " + (dir / "zoom.txt").string()), &log), 0) << log;
-    const format::Image before = readPng(dir / "before.png"), after = readPng(dir / "after.png"), grid = readPng(dir / "grid.png");
+    const Image before = readPng(dir / "before.png"), after = readPng(dir / "after.png"), grid = readPng(dir / "grid.png");
     ASSERT_EQ(before.width, 400);
     ASSERT_EQ(after.height, 300);
     const glm::dvec3 a = marker(before), b = marker(after);
@@ -242,7 +242,7 @@ TEST(ConusView, WindowShowsAnInvalidFileAsAnErrorWithoutCrashing) {
     EXPECT_EQ(test::run(xvfb((dir / "broken.exr").string() + " " + test::conusPath() + " --window 320x240 --script " +
                              (dir / "bad.txt").string()), &log), 1) << log;
     EXPECT_NE(log.find("broken.exr"), std::string::npos) << log;
-    const format::Image bad = readPng(dir / "bad.png"), good = readPng(dir / "good.png");
+    const Image bad = readPng(dir / "bad.png"), good = readPng(dir / "good.png");
     ASSERT_EQ(bad.width, 320);
     EXPECT_GT(bad.at(310, 230, 0), 0.3f);  // dark red (the bottom-right corner, clear of the text)
     EXPECT_LT(bad.at(310, 230, 1), 0.1f);

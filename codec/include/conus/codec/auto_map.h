@@ -14,7 +14,7 @@
 
 #include "conus/codec/density_map.h"
 #include "conus/codec/sampling_map.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::codec {
 
@@ -30,14 +30,14 @@ struct AutoMapOptions {
 
 // The target density field for an importance image (one channel, or the mean of R,G,B); throws
 // conus::Error(InvalidArgument) on NaN/Inf or negative importance, or bad options.
-DensityField importanceToDensity(const format::Image& importance, const AutoMapOptions& options = {});
+DensityField importanceToDensity(const Image& importance, const AutoMapOptions& options = {});
 
-SamplingMap buildAutoMap(const format::Image& importance, const AutoMapOptions& options = {});
+SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options = {});
 SamplingMap buildSeparableMap(const DensityField& target, int columns, int rows);
 
 // Local detail of an image: gradient magnitude of its luminance (one channel "Y"), computed at
 // most 1024 px a side; an importance source for `--importance detail`.
-format::Image detailImportance(const format::Image& image);
+Image detailImportance(const Image& image);
 
 // Pearson correlation between the density a map achieves and a target field (both sampled at the
 // field's cell centres): 1 means the map follows the target exactly (up to scale).

@@ -18,7 +18,7 @@
 
 namespace conus::codec {
 
-format::ConusFile makeImageFile(format::Image image, const SamplingMap& map, int sourceWidth, int sourceHeight,
+format::ConusFile makeImageFile(Image image, const SamplingMap& map, int sourceWidth, int sourceHeight,
                                 SourceEncoding encoding, std::optional<format::AnalyticMap> analytic = std::nullopt);
 
 format::ConusFile makeMapFile(const SamplingMap& map, std::optional<format::AnalyticMap> analytic = std::nullopt);

@@ -9,7 +9,7 @@
 
 #include "conus/codec/sampling_map.h"
 #include "conus/core/error.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::codec {
 
@@ -34,11 +34,11 @@ struct DecodeOptions {
 // to a width x height frame would hold more than `maxBytes` of pixels, the CoNUS image's and the
 // frame's together, as float (limits.h: kMaxDecodeBytes). decodeImage checks this before it
 // allocates; other decoders (the GPU one) call it too.
-void checkDecodeMemory(const format::Image& conus, int width, int height, std::int64_t maxBytes = kMaxDecodeBytes);
+void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes = kMaxDecodeBytes);
 
-format::Image decodeImage(const format::Image& conus, const SamplingMap& map, const DecodeOptions& options);
+Image decodeImage(const Image& conus, const SamplingMap& map, const DecodeOptions& options);
 
 // The plain baseline: the same view of a uniform image by bilinear resampling.
-format::Image resizeBilinear(const format::Image& image, const View& view, int width, int height, int threads = 0);
+Image resizeBilinear(const Image& image, const View& view, int width, int height, int threads = 0);
 
 }  // namespace conus::codec

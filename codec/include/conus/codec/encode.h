@@ -9,7 +9,7 @@
 
 #include "conus/codec/sampling_map.h"
 #include "conus/core/error.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::codec {
 
@@ -26,10 +26,10 @@ struct EncodeOptions {
     ProgressFn progress;
 };
 
-format::Image encodeImage(const format::Image& source, const SamplingMap& map, const EncodeOptions& options);
+Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options);
 
 // The plain baseline: box-filter area downsample to width x height (exact area weights). It only
 // shrinks: a width or height above the source's throws conus::Error(InvalidArgument).
-format::Image areaDownsample(const format::Image& source, int width, int height, int threads = 0);
+Image areaDownsample(const Image& source, int width, int height, int threads = 0);
 
 }  // namespace conus::codec

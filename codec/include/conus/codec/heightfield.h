@@ -11,7 +11,7 @@
 // depth + near) looking toward -z. The field's size in metres is fieldExtent(GroundParams): the
 // ground parameters are read as metres (the map itself only needs their ratios).
 //
-// Shared rules: DEMs and colours are format::Image, row 0 at the far edge (v = 0, the image-plane
+// Shared rules: DEMs and colours are Image, row 0 at the far edge (v = 0, the image-plane
 // convention), heights in one channel named "Z" (or the only channel), colours in "R","G","B"
 // of the same size; sizes are checked (conus::Error InvalidArgument / LimitExceeded); threads = 0
 // uses every core; nothing is printed.
@@ -27,7 +27,8 @@
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
-#include "conus/format/image.h"
+#include "conus/core/mesh.h"
+#include "conus/core/image.h"
 
 namespace conus::codec {
 
@@ -44,12 +45,12 @@ struct TerrainOptions {
 
 // fBm of gradient noise blended with ridged noise, one channel "Z" in metres (>= 0). The terrain is
 // a function of (u, v) in [0,1]^2, so two sizes of the same seed sample the same landscape.
-format::Image generateTerrain(const TerrainOptions& options);
+Image generateTerrain(const TerrainOptions& options);
 
 // Colour ramp by height (water-green lowlands, brown slopes, grey rock, snow on the highest) and
 // slope (steep faces turn to rock), RGB in [0,1]. `extent` is the field's size in metres (width,
 // depth), which turns height differences into slopes; the ramp spans the DEM's own min..max.
-format::Image terrainColours(const format::Image& heights, glm::dvec2 extent);
+Image terrainColours(const Image& heights, glm::dvec2 extent);
 
 // ---- Encode (server) -----------------------------------------------------------------------
 
@@ -75,24 +76,19 @@ struct HeightFieldOptions {
 // by encodeImage. The samples are taken through a map grid as fine as the CoNUS image (not the
 // coarse stored grid), so each sample lies where the exact groundUndistort puts it to a small
 // fraction of a pixel, and the client may undistort analytically.
-format::ConusFile encodeHeightField(const format::Image& heights, const format::Image& colour,
+format::ConusFile encodeHeightField(const Image& heights, const Image& colour,
                                     const HeightFieldOptions& options);
 
 // The baseline: the DEM area-downsampled to width x height (an identity map, no analytic
 // parameters), with the same channels and depth attributes. width x height equal to the DEM's
 // size gives the full-resolution reference.
-format::ConusFile uniformHeightField(const format::Image& heights, const format::Image& colour, int width, int height,
+format::ConusFile uniformHeightField(const Image& heights, const Image& colour, int width, int height,
                                      const std::string& units = "m", int threads = 0);
 
 // ---- Undistort (client) --------------------------------------------------------------------
 
-struct Mesh {
-    std::vector<glm::vec3> positions;  // world frame above
-    std::vector<glm::vec3> colours;    // RGB
-    std::vector<glm::vec3> normals;    // unit, per vertex (area-weighted face normals), y > 0 up
-    std::vector<std::uint32_t> indices;  // triangles, counter-clockwise seen from above (+y)
-};
-
+// A conus::Mesh (core/mesh.h) in the world frame above: colours RGB, normals per vertex
+// (area-weighted face normals, y > 0 up), triangles counter-clockwise seen from above (+y).
 // One vertex per CoNUS pixel at its undistorted ground position, plus a ring of border vertices on
 // the field's edges (values of the nearest pixel) so the mesh covers the whole field; two
 // triangles per quad of neighbouring vertices (the CoNUS image is a regular grid). Undistorts with

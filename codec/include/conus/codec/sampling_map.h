@@ -15,11 +15,13 @@
 
 #include <glm/glm.hpp>
 
+#include "conus/core/fpc.h"
 #include "conus/format/container.h"
 
 namespace conus::codec {
 
-class SamplingMap {
+// The grid distortion of the FPC (core/fpc.h): final, so direct calls are not virtual.
+class SamplingMap final : public Distortion {
 public:
     SamplingMap(int columns, int rows, std::vector<glm::vec2> nodes);
     static SamplingMap identity(int columns, int rows);
@@ -32,15 +34,15 @@ public:
     glm::vec2 node(int i, int j) const { return m_nodes[static_cast<std::size_t>(j) * m_columns + i]; }
 
     // Equation 1: undistorted (u,v) -> distorted (u_d,v_d).
-    glm::dvec2 distort(glm::dvec2 p) const;
+    glm::dvec2 distort(glm::dvec2 p) const override;
     // The exact inverse of distort: distorted -> undistorted, to 1e-9. Its index is built on the
     // first call (thread-safe) and is bounded whatever the map's shape (limits.h: kIndexBytesPerCell
     // a cell plus kIndexBytesBase, at most kMaxIndexBytes); maps never undistorted never build it.
-    glm::dvec2 undistort(glm::dvec2 pd) const;
+    glm::dvec2 undistort(glm::dvec2 pd) const override;
     // Bytes held by undistort's index (building it if needed): for tests and `conus info`.
     std::size_t indexBytes() const;
     // d distort / d p at undistorted p; column 0 is d/du, column 1 is d/dv.
-    glm::dmat2 jacobian(glm::dvec2 p) const;
+    glm::dmat2 jacobian(glm::dvec2 p) const override;
     // Sampling density at undistorted p: det(jacobian). 1 everywhere for the identity; d means the
     // CoNUS image holds d times as many samples per unit area there as a uniform image.
     double density(glm::dvec2 p) const;

@@ -22,8 +22,8 @@
 
 #include "conus/core/color.h"
 #include "conus/core/error.h"
-#include "conus/format/image.h"
-#include "conus/format/limits.h"
+#include "conus/core/image.h"
+#include "conus/core/limits.h"
 #include "conus/format/validation.h"
 
 namespace conus::format {

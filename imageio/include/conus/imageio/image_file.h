@@ -21,7 +21,7 @@
 
 #include "conus/core/color.h"
 #include "conus/core/display.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::imageio {
 
@@ -51,7 +51,7 @@ struct ImageFileInfo {
 };
 
 struct ImageFile {
-    format::Image image;
+    Image image;
     ImageFileInfo info;
 };
 
@@ -78,7 +78,7 @@ struct WriteOptions {
 };
 
 // Writes `image` to `path`, its format chosen by the extension.
-void writeImageFile(const std::string& path, const format::Image& image, const WriteOptions& options = {});
+void writeImageFile(const std::string& path, const Image& image, const WriteOptions& options = {});
 
 // Checks, before any work, that writeImageFile can write `path` with these options: a known
 // extension, a sample type the format holds. Throws conus::Error(InvalidArgument).
@@ -88,15 +88,15 @@ void checkImageOutput(const std::string& path, const WriteOptions& options = {})
 std::string sampleTypesOf(const std::string& path);
 
 // NaN and infinite values in `image`.
-std::int64_t countNonFinite(const format::Image& image);
+std::int64_t countNonFinite(const Image& image);
 
 // Converts an image of display-encoded sRGB values (a picture drawn in memory) to linear light
 // with associated alpha, as if it had been read from an 8-bit file.
-void linearize(format::Image& image);
+void linearize(Image& image);
 
 // A copy of `image` as a display shows it: alpha divided out, colour channels encoded to sRGB
 // (through OpenImageIO) and clamped to [0,1], non-finite values 0. For algorithms tuned on
 // photographs as people see them (face detection, detail importance).
-format::Image displayEncoded(const format::Image& image);
+Image displayEncoded(const Image& image);
 
 }  // namespace conus::imageio

@@ -6,13 +6,13 @@
 #include <string>
 #include <vector>
 
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
 namespace conus::imageio {
 
 // Draws `text` in `color` (RGB) with its baseline-left at (x,y), `size` pixels tall, into the
 // image's first channels (at most four: R, G, B and an opaque A).
-void drawText(format::Image& image, int x, int y, int size, const std::string& text, const float color[3]);
+void drawText(Image& image, int x, int y, int size, const std::string& text, const float color[3]);
 
 struct TextPanelStyle {
     int fontSize = 15;                          // pixels
@@ -24,7 +24,7 @@ struct TextPanelStyle {
 };
 
 // The lines on a panel sized to fit them: RGBA floats, top row first, straight alpha.
-format::Image renderTextPanel(const std::vector<std::string>& lines, const TextPanelStyle& style);
+Image renderTextPanel(const std::vector<std::string>& lines, const TextPanelStyle& style);
 
 // Width of `text` in pixels at `fontSize` (0 for empty text; an estimate without the font).
 int textWidth(const std::string& text, int fontSize);

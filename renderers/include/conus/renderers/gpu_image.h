@@ -34,7 +34,7 @@
 #include "conus/codec/decode.h"
 #include "conus/codec/encode.h"
 #include "conus/codec/sampling_map.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 #include "conus/renderers/backend.h"
 #include "conus/renderers/context.h"
 
@@ -47,16 +47,16 @@ struct GpuTimings {
     double uploadMs = 0, drawMs = 0, readbackMs = 0;
 };
 
-format::Image encodeImageGpu(Context& context, const format::Image& source, const codec::SamplingMap& map,
+Image encodeImageGpu(Context& context, const Image& source, const codec::SamplingMap& map,
                              const codec::EncodeOptions& options, GpuTimings* timings = nullptr);
 
-format::Image decodeImageGpu(Context& context, const format::Image& conus, const codec::SamplingMap& map,
+Image decodeImageGpu(Context& context, const Image& conus, const codec::SamplingMap& map,
                              const codec::DecodeOptions& options, GpuTimings* timings = nullptr);
 
 // Encode and decode on a device: the GPU paths above, or codec's CPU reference.
-format::Image encodeImage(const Device& device, const format::Image& source, const codec::SamplingMap& map,
+Image encodeImage(const Device& device, const Image& source, const codec::SamplingMap& map,
                           const codec::EncodeOptions& options);
-format::Image decodeImage(const Device& device, const format::Image& conus, const codec::SamplingMap& map,
+Image decodeImage(const Device& device, const Image& conus, const codec::SamplingMap& map,
                           const codec::DecodeOptions& options);
 
 }  // namespace conus::gl

@@ -1,10 +1,10 @@
 // Client-side rendering of height-field meshes (paper section 4, Figure 5): the mesh that
 // codec::undistortHeightField makes from a CoNUS (or uniform) height field, rasterized with a
 // perspective camera, per-vertex normals lit by one directional light plus ambient, a depth test
-// and a sky-coloured background, into an RGBA32F framebuffer read back as an RGB format::Image
+// and a sky-coloured background, into an RGBA32F framebuffer read back as an RGB Image
 // (top row first, the image-plane convention; the flip from GL's bottom-up rows happens here).
 //
-// Shared rules: the world frame is codec::Mesh's (x right, y up, z toward the viewer, metres);
+// Shared rules: the world frame is Mesh's (x right, y up, z toward the viewer, metres);
 // frames are float RGB, 1 to 16384 pixels a side (and at most GL_MAX_TEXTURE_SIZE); a failed GL
 // call throws conus::Error(Unsupported), out of GL memory LimitExceeded, bad arguments
 // InvalidArgument. The context is made current on the calling thread.
@@ -15,18 +15,12 @@
 #include <glm/glm.hpp>
 
 #include "conus/codec/ground_map.h"
+#include "conus/core/camera.h"
 #include "conus/codec/heightfield.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 #include "conus/renderers/context.h"
 
 namespace conus::gl {
-
-struct TerrainCamera {
-    glm::dvec3 eye{0, 0, 0};
-    glm::dvec3 target{0, 0, -1};  // looked at; the up direction is +y
-    double fovYDegrees = 50.0;    // vertical field of view, in (0, 170)
-    double near = 1.0, far = 1e5;  // clip distances, 0 < near < far
-};
 
 struct TerrainLook {
     glm::vec3 sky{0.62f, 0.74f, 0.88f};
@@ -40,18 +34,20 @@ struct TerrainLook {
 // -z, pitched so the field's near edge lands on the bottom row (or, for a field deeper than the
 // frame, so the far edge stays in the top half). `sideways` moves it along
 // x (metres) and `turnDegrees` turns it (positive to the left), for nearby poses.
-TerrainCamera viewerCamera(const codec::GroundParams& ground, double groundHeight, double sideways = 0.0,
-                           double turnDegrees = 0.0, double fovYDegrees = 50.0);
+// `aspect` is the frame's width / height.
+Camera viewerCamera(const codec::GroundParams& ground, double groundHeight, double aspect, double sideways = 0.0,
+                    double turnDegrees = 0.0, double fovYDegrees = 50.0);
 
 // Keeps a mesh uploaded so that frames cost only the draw and the readback (the client's loop).
 class TerrainRenderer {
 public:
-    TerrainRenderer(Context& context, const codec::Mesh& mesh, const TerrainLook& look = {});
+    TerrainRenderer(Context& context, const Mesh& mesh, const TerrainLook& look = {});
     ~TerrainRenderer();
     TerrainRenderer(const TerrainRenderer&) = delete;
     TerrainRenderer& operator=(const TerrainRenderer&) = delete;
 
-    format::Image render(const TerrainCamera& camera, int width, int height);
+    // The camera's aspect should be the frame's (else the picture is stretched).
+    Image render(const Camera& camera, int width, int height);
 
 private:
     struct Impl;
@@ -59,7 +55,7 @@ private:
 };
 
 // One frame: upload, draw, read back.
-format::Image renderTerrain(Context& context, const codec::Mesh& mesh, const TerrainCamera& camera, int width,
+Image renderTerrain(Context& context, const Mesh& mesh, const Camera& camera, int width,
                             int height, const TerrainLook& look = {});
 
 }  // namespace conus::gl

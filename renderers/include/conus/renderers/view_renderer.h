@@ -18,7 +18,7 @@
 #include "conus/codec/decode.h"
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 #include "conus/renderers/context.h"
 
 namespace conus::gl {
@@ -83,11 +83,11 @@ public:
     // Draws into an offscreen RGBA32F target and reads it back: RGBA, top row first, display
     // values (after exposure and gamma). options.bottomUp is ignored.
     // `overlays` are drawn over the frame (drawOverlay) before the read-back.
-    format::Image renderToImage(const codec::View& view, int width, int height, ViewOptions options,
+    Image renderToImage(const codec::View& view, int width, int height, ViewOptions options,
                                 const std::vector<OverlayPlacement>& overlays = {});
     // Reads the currently bound read framebuffer (a window's back buffer before the swap) as
     // 8-bit-range RGBA floats in [0,1], top row first.
-    format::Image readFramebuffer(int width, int height, bool bottomUp = true);
+    Image readFramebuffer(int width, int height, bool bottomUp = true);
     // Clears the bound framebuffer to one colour (the viewer's "this file could not be opened").
     void clear(int width, int height, float red, float green, float blue);
     // Overlays (the viewer's help panel, error text, status bar): straight-alpha RGBA images (R,G,B,A,
@@ -95,7 +95,7 @@ public:
     // by drawOverlay every redraw. An image of width or height 0 empties the slot. Throws
     // conus::Error(InvalidArgument) for a bad slot or an image that is not 4 channels,
     // LimitExceeded beyond GL_MAX_TEXTURE_SIZE.
-    void setOverlay(int slot, const format::Image& rgba);
+    void setOverlay(int slot, const Image& rgba);
     bool hasOverlay(int slot) const;
     // Blends the slot's image (premultiplied "over") into the bound framebuffer, one texel per
     // pixel, its top-left at (x, y) counted from the top-left of the viewport (0,0,width,height);
@@ -107,7 +107,7 @@ public:
     bool decodesOnCpu(const ViewOptions& options) const;
 
     // The uniform image computed by setImage (for tests and the inspector).
-    const format::Image& uniformImage() const;
+    const Image& uniformImage() const;
 
 private:
     struct Impl;

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "conus/format/limits.h"
+#include "conus/core/limits.h"
 
-namespace conus::format {
+namespace conus {
 
 struct Image {
     int width = 0;
@@ -29,11 +29,6 @@ struct Image {
     int channelIndex(const std::string& name) const;
 };
 
-// Largest image any CoNUS library allocates (limits.h states them; named here too for callers
-// that write format::kMaxImageSide).
-using conus::kMaxImageSide;
-using conus::kMaxImagePixels;
-
 // Channel names in the order people read them: R, G, B, Y, A, Z, then the rest as given (OpenEXR
 // stores them sorted: B, G, R).
 std::vector<std::string> displayOrder(const std::vector<std::string>& channels);
@@ -45,4 +40,4 @@ Image makeImage(int width, int height, std::vector<std::string> channels);
 // does not hold width * height * channels values: the check every consumer of an Image starts with.
 void checkImage(const Image& image, const char* what);
 
-}  // namespace conus::format
+}  // namespace conus

@@ -3,9 +3,9 @@
 #include <string>
 
 #include "conus/core/error.h"
-#include "conus/format/image.h"
+#include "conus/core/image.h"
 
-namespace conus::format {
+namespace conus {
 
 int Image::channelIndex(const std::string& name) const {
     for (std::size_t c = 0; c < channels.size(); ++c) {
@@ -58,4 +58,4 @@ std::vector<std::string> displayOrder(const std::vector<std::string>& channels) 
     return out;
 }
 
-}  // namespace conus::format
+}  // namespace conus
