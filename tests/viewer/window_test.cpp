@@ -7,6 +7,7 @@
 
 #include "conus/codec/decode.h"
 #include "conus/format/container.h"
+#include "sanitizers.h"
 #include "view_state.h"
 #include "viewer_test_util.h"
 
@@ -75,7 +76,7 @@ Box changed(const Image& a, const Image& b) {
 }
 
 std::string xvfb(const std::string& args) {
-    return "xvfb-run -a -s '-screen 0 1024x768x24' " + test::viewerBinary() + " " + args;
+    return "xvfb-run -a -s '-screen 0 1024x768x24' " + conus::testing::glxLeakCheckPrefix() + test::viewerBinary() + " " + args;
 }
 
 TEST(ConusView, ScreenshotIsTheDecodedFrameWithoutADisplay) {
