@@ -7,6 +7,8 @@
 #include "commands.h"
 #include "conus/codec/auto_map.h"
 #include "conus/codec/foci.h"
+#include "conus/core/limits.h"
+#include "conus/core/map_rules.h"
 #include "encoding.h"
 #include "image_files.h"
 #include "importance.h"
@@ -19,7 +21,7 @@ struct EncodeOptions {
     std::string input, output, mapFile, compose = "density", importance, method = "flow";
     double minDensity = 0.25, maxDensity = 16;
     std::vector<std::string> foci;
-    int grid = 65;
+    int grid = map_rules::kDefaultSide;
     SourceOptions source;
     StorageOptions storage;
 };
@@ -117,8 +119,8 @@ Command addEncodeCommand(CLI::App& root) {
         ->check(CLI::IsMember({"flow", "separable"}));
     command->add_option("--compose", options->compose, "how several foci combine: density (default) | add")
         ->check(CLI::IsMember({"density", "add"}));
-    command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus and --importance (default 65)")
-        ->check(CLI::Range(2, 1025));
+    command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus and --importance (default " + std::to_string(map_rules::kDefaultSide) + ")")
+        ->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addSourceOptions(*command, options->source);
     addStorageOptions(*command, options->storage);
     addQuietOption(*command);

@@ -22,6 +22,8 @@
 #include "conus/format/container.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
+#include "conus/core/limits.h"
+#include "conus/core/map_rules.h"
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
 #include "importance.h"
@@ -30,6 +32,8 @@
 
 namespace conus::cli {
 namespace {
+
+const std::string kGridHelp = "nodes per side (default " + std::to_string(map_rules::kDefaultSide) + ")";
 
 constexpr int kPreviewSide = 512;
 
@@ -89,7 +93,7 @@ Command addMapCommand(CLI::App& root) {
         // auto
         std::string importance, image, method = "flow";
         double minDensity = 0.25, maxDensity = 16;
-        int autoGrid = 65;
+        int autoGrid = map_rules::kDefaultSide;
         // springs
         std::string strokes;
         int particles = 256, springsGrid = 33, maxSteps = 20000;
@@ -99,11 +103,11 @@ Command addMapCommand(CLI::App& root) {
         int composeGrid = 0;
         // ground
         codec::GroundParams ground;
-        int groundGrid = 65;
+        int groundGrid = map_rules::kDefaultSide;
         // foci
         std::vector<std::string> foci;
         std::string composition = "density";
-        int fociGrid = 65;
+        int fociGrid = map_rules::kDefaultSide;
         double aspect = 1.0;
     };
     auto o = std::make_shared<Options>();
@@ -124,8 +128,8 @@ Command addMapCommand(CLI::App& root) {
     springs->add_option("--strokes", o->strokes,
                         "strokes as JSON, inline or a file: [{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1.0,\"duration\":0.5}, ...]")
         ->required();
-    springs->add_option("--grid", o->particles, "particles per side (default 256)")->check(CLI::Range(2, 1025));
-    springs->add_option("--out-grid", o->springsGrid, "nodes per side of the written map (default 33)")->check(CLI::Range(2, 1025));
+    springs->add_option("--grid", o->particles, "particles per side (default 256)")->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    springs->add_option("--out-grid", o->springsGrid, "nodes per side of the written map (default 33)")->check(CLI::Range(kMinMapSide, kMaxMapSide));
     springs->add_option("--max-steps", o->maxSteps, "give up waiting for the stable state after this many steps (default 20000)")
         ->check(CLI::Range(1, 10000000));
     addOutputOptions(*springs, o->springsOut);
@@ -146,14 +150,14 @@ Command addMapCommand(CLI::App& root) {
     ground->add_option("--near", o->ground.near, "ground distance of the bottom edge (v = 1)")->required();
     ground->add_option("--far", o->ground.far, "ground distance of the top edge (v = 0)")->required();
     ground->add_option("--fov", o->ground.fovDegrees, "horizontal field of view in degrees at the far edge (default 60)");
-    ground->add_option("--grid", o->groundGrid, "nodes per side (default 65)")->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    ground->add_option("--grid", o->groundGrid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addOutputOptions(*ground, o->groundOut);
 
     CLI::App* foci = command->add_subcommand("foci", "Circular foci u,v,r,k");
     foci->add_option("--focus", o->foci, "focus u,v,r,k (repeat for several)")->required();
     foci->add_option("--compose", o->composition, "how several foci combine: density (default) | add")
         ->check(CLI::IsMember({"density", "add"}));
-    foci->add_option("--grid", o->fociGrid, "nodes per side (default 65)")->check(CLI::Range(2, 1025));
+    foci->add_option("--grid", o->fociGrid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     foci->add_option("--aspect", o->aspect, "image width / height, so foci are circular in pixels (default 1)");
     addOutputOptions(*foci, o->fociOut);
 
@@ -170,7 +174,7 @@ Command addMapCommand(CLI::App& root) {
         ->check(CLI::Range(1.001, 4096.0));
     automatic->add_option("--method", o->method, "flow (2-D, default) | separable (baseline)")
         ->check(CLI::IsMember({"flow", "separable"}));
-    automatic->add_option("--grid", o->autoGrid, "nodes per side (default 65)")->check(CLI::Range(2, 1025));
+    automatic->add_option("--grid", o->autoGrid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addOutputOptions(*automatic, o->autoOut);
 
     return {command, [o, springs, compose, ground, foci, automatic] {

@@ -11,10 +11,11 @@
 #include "conus/codec/springs.h"
 #include "conus/format/container.h"
 #include "conus/core/image.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::viewer {
 
-inline constexpr int kEditorGrid = 65;          // particles per side
+inline constexpr int kEditorGrid = map_rules::kDefaultSide;          // particles per side
 inline constexpr int kEditorStepsPerFrame = 8;  // solver steps between frames
 
 struct Brush {

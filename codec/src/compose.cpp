@@ -7,7 +7,10 @@
 #include <sstream>
 #include <string>
 
+#include <glm/gtc/type_ptr.hpp>
+
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec {
 namespace {
@@ -66,32 +69,9 @@ std::vector<glm::dvec2> resampleField(int columns, int rows, auto&& field) {
 
 }  // namespace
 
-bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes, double minCross) {
+bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes) {
     if (columns < 2 || rows < 2 || nodes.size() != std::size_t(columns) * rows) return false;
-    for (int j = 0; j < rows; ++j) {
-        for (int i = 0; i < columns; ++i) {
-            const glm::vec2 p = nodes[std::size_t(j) * columns + i];
-            if (!(p.x >= 0.0f && p.x <= 1.0f && p.y >= 0.0f && p.y <= 1.0f)) return false;  // NaN fails too
-            if ((i == 0 && p.x != 0.0f) || (i == columns - 1 && p.x != 1.0f)) return false;
-            if ((j == 0 && p.y != 0.0f) || (j == rows - 1 && p.y != 1.0f)) return false;
-        }
-    }
-    // Corner order and arithmetic as in format::validateGrid (V11), so both always agree.
-    for (int j = 0; j + 1 < rows; ++j) {
-        const glm::vec2* top = nodes.data() + std::size_t(j) * columns;
-        const glm::vec2* bottom = top + columns;
-        for (int i = 0; i + 1 < columns; ++i) {
-            const double px[4] = {top[i].x, top[i + 1].x, bottom[i + 1].x, bottom[i].x};
-            const double py[4] = {top[i].y, top[i + 1].y, bottom[i + 1].y, bottom[i].y};
-            for (int c = 0; c < 4; ++c) {
-                const int prev = (c + 3) & 3, next = (c + 1) & 3;
-                const double ax = px[c] - px[prev], ay = py[c] - py[prev];
-                const double bx = px[next] - px[c], by = py[next] - py[c];
-                if (!(ax * by - ay * bx > minCross)) return false;
-            }
-        }
-    }
-    return true;
+    return map_rules::isValidGrid({columns, rows, glm::value_ptr(nodes.front())});
 }
 
 ComposeResult fitDisplacement(int columns, int rows, std::span<const glm::dvec2> displacement) {

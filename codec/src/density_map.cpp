@@ -16,6 +16,7 @@
 #include <string>
 
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 #include "conus/core/parallel.h"
 
 namespace conus::codec {
@@ -176,26 +177,8 @@ format::GridNodes integrateNodes(const FlowField& field, const DensityMapOptions
     return grid;
 }
 
-// V11's test of one cell (format/src/validate_grid.cpp), with a margin so that what passes here
-// passes there: every corner's cross product of incoming and outgoing edge is positive.
-constexpr double kConvexMargin = 4e-12;
-
 bool cellConvex(const format::GridNodes& grid, int i, int j) {
-    const int n = grid.columns;
-    static constexpr int kDi[4] = {0, 1, 1, 0};
-    static constexpr int kDj[4] = {0, 0, 1, 1};
-    double px[4], py[4];
-    for (int c = 0; c < 4; ++c) {
-        const std::size_t k = 2 * (std::size_t(j + kDj[c]) * n + i + kDi[c]);
-        px[c] = grid.xy[k];
-        py[c] = grid.xy[k + 1];
-    }
-    for (int c = 0; c < 4; ++c) {
-        const int prev = (c + 3) % 4, next = (c + 1) % 4;
-        const double cross = (px[c] - px[prev]) * (py[next] - py[c]) - (py[c] - py[prev]) * (px[next] - px[c]);
-        if (!(cross > kConvexMargin)) return false;
-    }
-    return true;
+    return map_rules::firstBadCorner({grid.columns, grid.rows, grid.xy.data()}, i, j) < 0;
 }
 
 // Moser's flow is injective, but where it swirls (context squeezed between nearby foci) the grid

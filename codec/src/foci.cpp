@@ -12,11 +12,11 @@
 
 #include "conus/codec/density_map.h"
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec {
 namespace {
 
-constexpr double kMaxMagnification = 64.0;
 // The density grid resolves the smallest focus radius with at least this many samples, within
 // [kMinDensitySide, kMaxDensitySide] samples along the longer side.
 constexpr double kSamplesPerRadius = 12.0;
@@ -38,8 +38,8 @@ void checkFocus(const Focus& f) {
         throw Error(ErrorCode::InvalidArgument, "focus centre (" + str(f.u) + ", " + str(f.v) + ") is outside [0,1]^2");
     }
     if (!(f.r > 0.0 && f.r <= 1.0)) throw Error(ErrorCode::InvalidArgument, "focus radius " + str(f.r) + " is not in (0, 1]");
-    if (!(f.k >= 1.0 && f.k <= kMaxMagnification)) {
-        throw Error(ErrorCode::InvalidArgument, "focus magnification " + str(f.k) + " is not in [1, 64]");
+    if (!(f.k >= 1.0 && f.k <= map_rules::kMaxMagnification)) {
+        throw Error(ErrorCode::InvalidArgument, "focus magnification " + str(f.k) + " is not in [1, " + str(map_rules::kMaxMagnification) + "]");
     }
 }
 

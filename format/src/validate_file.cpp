@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 
+#include "conus/core/map_rules.h"
 #include "header_model.h"
 
 namespace conus::format {
@@ -172,9 +173,9 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
                 for (std::size_t i = 0; i < f.size() / 4; ++i) {
                     const float u = f[4 * i], v = f[4 * i + 1], rad = f[4 * i + 2], k = f[4 * i + 3];
                     // Written as negations so NaN fails every test.
-                    if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1 && rad > 0 && std::isfinite(rad) && k >= 1 && k <= 64)) {
+                    if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1 && rad > 0 && std::isfinite(rad) && k >= 1 && k <= map_rules::kMaxMagnification)) {
                         r.add(12, "focus " + std::to_string(i) + " (u,v,r,k) = (" + num(u) + ", " + num(v) + ", " + num(rad) + ", " +
-                                      num(k) + "): need u,v in [0,1], r > 0 finite, k in [1,64]");
+                                      num(k) + "): need u,v in [0,1], r > 0 finite, k in [1," + num(map_rules::kMaxMagnification) + "]");
                     }
                 }
             }

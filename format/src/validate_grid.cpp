@@ -1,18 +1,18 @@
-// The sampling-map rules V7..V11 (spec/conus-format.md), shared by the container and by
-// codec::SamplingMap so they live in one place.
+// The sampling-map rules V7..V11 (spec/conus-format.md) in words: the tests themselves are
+// core/map_rules.h, which codec's builders call too.
 #include <cmath>
 #include <cstdio>
 #include <string>
 
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 
 namespace conus::format {
 namespace {
 
-// Each rule reports at most this many problems, then one summary line, so that a 4097² broken
-// grid yields a readable report instead of megabytes.
+// Each rule reports at most this many problems, then one summary line, so that a broken grid at the
+// size limit yields a readable report instead of megabytes.
 constexpr int kMaxMessagesPerRule = 20;
-constexpr double kMinCornerCross = 1e-12;
 
 std::string fmt(double value) {
     char buf[48];
@@ -96,30 +96,18 @@ ValidationReport validateGrid(const GridNodes& grid) {
     }
     if (!allFinite) return report;  // cross products of NaN say nothing useful
 
-    // V11: at every corner of every cell (cyclic order (i,j),(i+1,j),(i+1,j+1),(i,j+1)) the cross
-    // product of the incoming and outgoing edge is positive, as for the identity. A bilinear patch
-    // has a positive Jacobian everywhere iff it does at its four corners, so this is exactly
-    // injectivity of the piecewise-bilinear map.
+    // V11: at every corner of every cell the cross product of the incoming and outgoing edge is
+    // positive, as for the identity. A bilinear patch has a positive Jacobian everywhere iff it
+    // does at its four corners, so this is exactly injectivity of the piecewise-bilinear map.
+    const map_rules::GridView view{n, m, grid.xy.data()};
     CappedRule v11(report, 11, "cells");
-    static constexpr int kDi[4] = {0, 1, 1, 0};
-    static constexpr int kDj[4] = {0, 0, 1, 1};
     for (int j = 0; j + 1 < m; ++j) {
         for (int i = 0; i + 1 < n; ++i) {
-            double px[4], py[4];
-            for (int c = 0; c < 4; ++c) {
-                px[c] = U(i + kDi[c], j + kDj[c]);
-                py[c] = V(i + kDi[c], j + kDj[c]);
-            }
-            for (int c = 0; c < 4; ++c) {
-                const int prev = (c + 3) % 4, next = (c + 1) % 4;
-                const double ax = px[c] - px[prev], ay = py[c] - py[prev];
-                const double bx = px[next] - px[c], by = py[next] - py[c];
-                const double cross = ax * by - ay * bx;
-                if (!(cross > kMinCornerCross)) {
-                    v11.add("cell " + node(i, j) + " is not strictly convex: corner " +
-                            node(i + kDi[c], j + kDj[c]) + " cross = " + fmt(cross));
-                    break;  // one message per cell
-                }
+            const int c = map_rules::firstBadCorner(view, i, j);
+            if (c >= 0) {
+                v11.add("cell " + node(i, j) + " is not strictly convex: corner " +
+                        node(i + map_rules::kCornerDi[c], j + map_rules::kCornerDj[c]) +
+                        " cross = " + fmt(map_rules::cornerCross(view, i, j, c)));
             }
         }
     }

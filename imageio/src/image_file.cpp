@@ -298,12 +298,12 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
         throw Error(ErrorCode::Io, shown + ": the image is empty (" + std::to_string(spec.width) + "x" +
                                        std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) + " channels)");
     if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || pixels > kMaxImagePixels ||
-        spec.nchannels > 64)
+        spec.nchannels > kMaxChannels)
         throw Error(ErrorCode::LimitExceeded,
                     shown + ": image of " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels and " +
                         std::to_string(spec.nchannels) + " channels is beyond the limits (sides up to " +
                         std::to_string(kMaxImageSide) + ", " + std::to_string(kMaxImagePixels) +
-                        " pixels, 64 channels)");
+                        " pixels, " + std::to_string(kMaxChannels) + " channels)");
 
     std::vector<std::string> names;
     for (int c = 0; c < spec.nchannels; ++c) {

@@ -15,13 +15,14 @@
 #include "conus/codec/density_map.h"
 #include "conus/codec/sampling_map.h"
 #include "conus/core/image.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec {
 
 enum class AutoMethod { Flow, Separable };
 
 struct AutoMapOptions {
-    int columns = 65, rows = 65;  // map grid
+    int columns = map_rules::kDefaultSide, rows = map_rules::kDefaultSide;  // map grid
     double minDensity = 0.25;     // context density (0 < minDensity < 1)
     double maxDensity = 16.0;     // cap of the density (> 1)
     double smoothing = 0.01;      // blur radius as a fraction of the image width

@@ -28,10 +28,9 @@ struct ComposeResult {
     double scale = 1.0;  // factor applied to all displacement vectors; 1: none needed
 };
 
-// True when `nodes` (columns x rows, row-major) form a valid map: finite, in [0,1]^2, boundary
-// nodes exactly on their edge, and every cell corner's cross product above `minCross` (rule V11
-// uses 1e-12). Computed exactly as format::validateGrid does, without building messages.
-bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes, double minCross = 1e-12);
+// True when `nodes` (columns x rows, row-major) form a valid map (rules V8..V11): the test of
+// core/map_rules.h, which format::validateGrid words.
+bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes);
 
 // The shared rule above: node (i,j) = p + scale * displacement[j*columns+i]. Throws
 // conus::Error(InvalidArgument) for a grid smaller than 2x2 or a span of the wrong size.

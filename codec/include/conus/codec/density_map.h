@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "conus/codec/sampling_map.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec {
 
@@ -20,7 +21,7 @@ struct DensityField {
 };
 
 struct DensityMapOptions {
-    int columns = 65, rows = 65;  // map grid size
+    int columns = map_rules::kDefaultSide, rows = map_rules::kDefaultSide;  // map grid size
     int steps = 48;               // flow integration steps (RK4)
 };
 

@@ -16,6 +16,7 @@
 
 #include "conus/codec/sampling_map.h"
 #include "conus/format/container.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec {
 
@@ -26,7 +27,7 @@ struct Focus {
 enum class FociComposition { Density, Add };
 
 struct FociOptions {
-    int columns = 65, rows = 65;  // grid of the built map
+    int columns = map_rules::kDefaultSide, rows = map_rules::kDefaultSide;  // grid of the built map
     double aspect = 1.0;          // image width / height: makes a focus circular in pixels
     FociComposition composition = FociComposition::Density;
 };

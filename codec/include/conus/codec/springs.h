@@ -87,7 +87,7 @@ std::vector<Stroke> parseStrokes(const std::string& jsonText);
 
 class SpringSystem {
 public:
-    // columns x rows particles, each in [2, 4097]; throws conus::Error(InvalidArgument) for bad
+    // columns x rows particles, each in [kMinMapSide, kMaxMapSide]; throws conus::Error(InvalidArgument) for bad
     // sizes or options.
     SpringSystem(int columns, int rows, const SpringOptions& options = {});
 

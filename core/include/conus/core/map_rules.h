@@ -1,0 +1,65 @@
+// The sampling-map rules of spec/conus-format.md, written once: the grid's node count (V7), finite
+// nodes (V8) inside [0,1]^2 (V9), boundary nodes exactly on their edge (V10) and strictly convex
+// cells with the identity's orientation (V11); the focus parameters (V12). format's validator
+// reports on them in words; codec's builders (compose, density, springs) test them here, with the
+// same arithmetic and the same margin, so what a builder accepts the validator accepts.
+#pragma once
+
+#include <cstddef>
+
+namespace conus::map_rules {
+
+// V11: every corner cross product of every cell must exceed this (folded, flipped and degenerate
+// cells fail).
+inline constexpr double kMinCornerCross = 1e-12;
+// V12: a focus magnifies by k in [1, kMaxMagnification].
+inline constexpr double kMaxMagnification = 64.0;
+// The grid the builders make when a user does not say (nodes per side).
+inline constexpr int kDefaultSide = 65;
+
+// The corners of cell (i,j) in its cyclic order: (i,j), (i+1,j), (i+1,j+1), (i,j+1).
+inline constexpr int kCornerDi[4] = {0, 1, 1, 0};
+inline constexpr int kCornerDj[4] = {0, 0, 1, 1};
+
+// A grid of columns x rows nodes, row-major, (u, v) interleaved: what format::GridNodes holds and
+// what an array of glm::vec2 is in memory.
+struct GridView {
+    int columns = 0, rows = 0;
+    const float* uv = nullptr;
+
+    double u(int i, int j) const { return uv[2 * (std::size_t(j) * columns + i)]; }
+    double v(int i, int j) const { return uv[2 * (std::size_t(j) * columns + i) + 1]; }
+};
+
+// V11 at corner c (0..3) of cell (i,j): the cross product of its incoming and outgoing edge.
+inline double cornerCross(const GridView& g, int i, int j, int c) {
+    const int prev = (c + 3) & 3, next = (c + 1) & 3;
+    const double pu = g.u(i + kCornerDi[prev], j + kCornerDj[prev]), pv = g.v(i + kCornerDi[prev], j + kCornerDj[prev]);
+    const double cu = g.u(i + kCornerDi[c], j + kCornerDj[c]), cv = g.v(i + kCornerDi[c], j + kCornerDj[c]);
+    const double nu = g.u(i + kCornerDi[next], j + kCornerDj[next]), nv = g.v(i + kCornerDi[next], j + kCornerDj[next]);
+    return (cu - pu) * (nv - cv) - (cv - pv) * (nu - cu);
+}
+
+// The first corner of cell (i,j) that breaks V11, or -1 when the cell is strictly convex.
+inline int firstBadCorner(const GridView& g, int i, int j) {
+    for (int c = 0; c < 4; ++c)
+        if (!(cornerCross(g, i, j, c) > kMinCornerCross)) return c;  // NaN fails too
+    return -1;
+}
+
+// V9 and V10 for node (i,j), assuming it is finite.
+inline bool nodeInside(const GridView& g, int i, int j) {
+    const double u = g.u(i, j), v = g.v(i, j);
+    return u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0;
+}
+inline bool nodeOnItsEdge(const GridView& g, int i, int j) {
+    const double u = g.u(i, j), v = g.v(i, j);
+    return !((i == 0 && u != 0.0) || (i == g.columns - 1 && u != 1.0) || (j == 0 && v != 0.0) ||
+             (j == g.rows - 1 && v != 1.0));
+}
+
+// V8..V11 together, without messages (format::validateGrid says what is wrong): what a builder
+// asks of a grid it made. Does not check V7's size limits, only that the grid has cells.
+bool isValidGrid(const GridView& g);
+
+}  // namespace conus::map_rules
