@@ -87,7 +87,7 @@ Command addInfoCommand(CLI::App& root) {
                     const format::ValidationReport report = format::validateConusFile(options->input);
                     if (!report.ok()) {
                         for (const auto& issue : report.issues)
-                            std::printf("%s: V%d: %s\n", options->input.c_str(), issue.rule, issue.message.c_str());
+                            std::printf("%s: %s: %s\n", options->input.c_str(), format::label(issue.rule).c_str(), issue.message.c_str());
                         throw Error(ErrorCode::Corrupt, options->input + ": not a valid CoNUS file (" +
                                                             plural(static_cast<std::size_t>(report.problemCount()), "problem", "problems") + ")");
                     }

@@ -25,7 +25,7 @@ Command addValidateCommand(CLI::App& root) {
                     return 0;
                 }
                 for (const auto& issue : report.issues)
-                    std::printf("%s: V%d: %s\n", input->c_str(), issue.rule, issue.message.c_str());
+                    std::printf("%s: %s: %s\n", input->c_str(), format::label(issue.rule).c_str(), issue.message.c_str());
                 const long long problems = report.problemCount();
                 std::fprintf(stderr, "conus validate: %s: not a valid CoNUS file (%lld problem%s)\n", input->c_str(),
                              problems, problems == 1 ? "" : "s");

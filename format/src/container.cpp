@@ -9,7 +9,7 @@ namespace {
 
 bool onlyMapRules(const ValidationReport& r) {
     for (const Issue& issue : r.issues) {
-        if (issue.rule < 8 || issue.rule > 11) return false;
+        if (number(issue.rule) < 8 || number(issue.rule) > 11) return false;
     }
     return true;
 }

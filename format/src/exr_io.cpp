@@ -90,7 +90,7 @@ private:
 
 // A refusal: the rule it breaks and how readConusFile throws.
 struct Problem {
-    int rule = 1;
+    Rule rule = Rule::V1;
     ErrorCode code = ErrorCode::Corrupt;
     std::string message;  // empty: no problem
 };
@@ -105,7 +105,7 @@ std::string partLabel(exr_const_context_t ctx, int p) {
 // file can hold.
 Problem checkCoreHeaders(exr_const_context_t ctx, std::uintmax_t fileSize) {
     int parts = 0;
-    if (exr_get_count(ctx, &parts) != EXR_ERR_SUCCESS || parts < 1) return {1, ErrorCode::Corrupt, "no parts"};
+    if (exr_get_count(ctx, &parts) != EXR_ERR_SUCCESS || parts < 1) return {Rule::V1, ErrorCode::Corrupt, "no parts"};
     exr_attr_box2i_t firstDisplay{};
     for (int p = 0; p < parts; ++p) {
         exr_attr_box2i_t display{};
@@ -113,7 +113,7 @@ Problem checkCoreHeaders(exr_const_context_t ctx, std::uintmax_t fileSize) {
             if (p == 0) firstDisplay = display;
             if (std::memcmp(&display, &firstDisplay, sizeof display) != 0) {
                 // OpenEXR's C++ library refuses such a file with a vague message; name the rule.
-                return {15, ErrorCode::Corrupt,
+                return {Rule::V15, ErrorCode::Corrupt,
                         "part " + std::to_string(p) + " displayWindow (" + std::to_string(display.min.x) + ", " +
                             std::to_string(display.min.y) + ") - (" + std::to_string(display.max.x) + ", " +
                             std::to_string(display.max.y) + ") differs from part 0's (" + std::to_string(firstDisplay.min.x) +
@@ -123,12 +123,12 @@ Problem checkCoreHeaders(exr_const_context_t ctx, std::uintmax_t fileSize) {
         }
         int32_t chunks = 0;
         exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
-        if (exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS) return {1, ErrorCode::Corrupt, partLabel(ctx, p) + ": unknown storage"};
+        if (exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS) return {Rule::V1, ErrorCode::Corrupt, partLabel(ctx, p) + ": unknown storage"};
         if (exr_get_chunk_count(ctx, p, &chunks) != EXR_ERR_SUCCESS || chunks < 0)
-            return {1, ErrorCode::Corrupt, partLabel(ctx, p) + ": invalid chunk count"};
+            return {Rule::V1, ErrorCode::Corrupt, partLabel(ctx, p) + ": invalid chunk count"};
         // The C++ library reads every part's offset table (8 bytes a chunk) when it opens the file.
         if (std::uintmax_t(chunks) * 8 > fileSize) {
-            return {1, ErrorCode::Corrupt,
+            return {Rule::V1, ErrorCode::Corrupt,
                     partLabel(ctx, p) + " needs " + std::to_string(chunks) + " chunk offsets, more than a " +
                         std::to_string(fileSize) + "-byte file can hold"};
         }
@@ -177,20 +177,20 @@ Problem checkChunks(exr_const_context_t ctx, int p, std::uintmax_t fileSize) {
     exr_attr_box2i_t dw{};
     if (exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS || exr_get_compression(ctx, p, &compression) != EXR_ERR_SUCCESS ||
         exr_get_data_window(ctx, p, &dw) != EXR_ERR_SUCCESS)
-        return {1, ErrorCode::Corrupt, label + ": unreadable storage, compression or data window"};
+        return {Rule::V1, ErrorCode::Corrupt, label + ": unreadable storage, compression or data window"};
     const std::uint64_t ratio = maxExpansion(compression);
-    if (ratio == 0) return {1, ErrorCode::Corrupt, label + ": unknown compression"};
+    if (ratio == 0) return {Rule::V1, ErrorCode::Corrupt, label + ": unknown compression"};
     const std::int64_t width = std::int64_t{dw.max.x} - dw.min.x + 1, height = std::int64_t{dw.max.y} - dw.min.y + 1;
     std::uint64_t packedTotal = 0;
     auto visit = [&](exr_result_t rv, const exr_chunk_info_t& c, const std::string& where) -> Problem {
-        if (rv != EXR_ERR_SUCCESS) return {1, ErrorCode::Corrupt, label + " " + where + ": unreadable chunk (" + exr_get_default_error_message(rv) + ")"};
+        if (rv != EXR_ERR_SUCCESS) return {Rule::V1, ErrorCode::Corrupt, label + " " + where + ": unreadable chunk (" + exr_get_default_error_message(rv) + ")"};
         if (c.data_offset > fileSize || c.packed_size > fileSize - c.data_offset) {
-            return {1, ErrorCode::Corrupt,
+            return {Rule::V1, ErrorCode::Corrupt,
                     label + " " + where + ": chunk of " + std::to_string(c.packed_size) + " bytes at offset " +
                         std::to_string(c.data_offset) + " runs past the end of the " + std::to_string(fileSize) + "-byte file"};
         }
         if (c.unpacked_size / ratio > c.packed_size) {
-            return {1, ErrorCode::Corrupt,
+            return {Rule::V1, ErrorCode::Corrupt,
                     label + " " + where + ": chunk declares " + std::to_string(c.unpacked_size) + " bytes of pixels in " +
                         std::to_string(c.packed_size) + " bytes; " + compressionName(compression) + " expands at most " +
                         std::to_string(ratio) + " times"};
@@ -201,7 +201,7 @@ Problem checkChunks(exr_const_context_t ctx, int p, std::uintmax_t fileSize) {
     if (storage == EXR_STORAGE_SCANLINE) {
         int32_t lines = 0;
         if (exr_get_scanlines_per_chunk(ctx, p, &lines) != EXR_ERR_SUCCESS || lines < 1)
-            return {1, ErrorCode::Corrupt, label + ": invalid scanlines per chunk"};
+            return {Rule::V1, ErrorCode::Corrupt, label + ": invalid scanlines per chunk"};
         for (std::int64_t y = dw.min.y; y <= dw.max.y; y += lines) {
             exr_chunk_info_t c{};
             const exr_result_t rv = exr_read_scanline_chunk_info(ctx, p, static_cast<int>(y), &c);
@@ -212,7 +212,7 @@ Problem checkChunks(exr_const_context_t ctx, int p, std::uintmax_t fileSize) {
         exr_tile_level_mode_t level{};
         exr_tile_round_mode_t round{};
         if (exr_get_tile_descriptor(ctx, p, &tw, &th, &level, &round) != EXR_ERR_SUCCESS || tw < 1 || th < 1)
-            return {1, ErrorCode::Corrupt, label + ": invalid tile description"};
+            return {Rule::V1, ErrorCode::Corrupt, label + ": invalid tile description"};
         const std::int64_t tilesX = (width + tw - 1) / tw, tilesY = (height + th - 1) / th;
         for (std::int64_t ty = 0; ty < tilesY; ++ty) {
             for (std::int64_t tx = 0; tx < tilesX; ++tx) {
@@ -228,7 +228,7 @@ Problem checkChunks(exr_const_context_t ctx, int p, std::uintmax_t fileSize) {
     }
     // Chunks do not overlap: together they fit in the file.
     if (packedTotal > fileSize) {
-        return {1, ErrorCode::Corrupt,
+        return {Rule::V1, ErrorCode::Corrupt,
                 label + ": chunks hold " + std::to_string(packedTotal) + " bytes in all, more than the " +
                     std::to_string(fileSize) + "-byte file"};
     }
@@ -488,18 +488,18 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);
     if (ec || !std::filesystem::exists(status)) {
-        return refuse({1, ErrorCode::Io, "cannot open " + path + ": " + (ec ? ec.message() : std::string("no such file"))});
+        return refuse({Rule::V1, ErrorCode::Io, "cannot open " + path + ": " + (ec ? ec.message() : std::string("no such file"))});
     }
-    if (!std::filesystem::is_regular_file(status)) return refuse({1, ErrorCode::Io, "cannot read " + path + ": not a regular file"});
+    if (!std::filesystem::is_regular_file(status)) return refuse({Rule::V1, ErrorCode::Io, "cannot read " + path + ": not a regular file"});
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
     if (ec || !std::ifstream(path, std::ios::binary)) {
-        return refuse({1, ErrorCode::Io, "cannot open " + path + (ec ? ": " + ec.message() : std::string())});
+        return refuse({Rule::V1, ErrorCode::Io, "cannot open " + path + (ec ? ": " + ec.message() : std::string())});
     }
     if (const ScanResult scan = scanHeaders(path, size, limits); !scan.problem.empty()) {
-        return refuse({1, scan.code, "not a readable OpenEXR file: " + scan.problem});
+        return refuse({Rule::V1, scan.code, "not a readable OpenEXR file: " + scan.problem});
     }
     const CoreFile core(path);
-    if (!core.error().empty()) return refuse({1, ErrorCode::Corrupt, "not a readable OpenEXR file: " + core.error()});
+    if (!core.error().empty()) return refuse({Rule::V1, ErrorCode::Corrupt, "not a readable OpenEXR file: " + core.error()});
     if (Problem problem = checkCoreHeaders(core.ctx(), size); !problem.message.empty()) return refuse(problem);
     try {
         Imf::MultiPartInputFile file(path.c_str());
@@ -516,7 +516,7 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool
             const std::int64_t bytes = part.dataWindow.width() * part.dataWindow.height() *
                                        std::int64_t(part.channels.size()) * std::int64_t(sizeof(float));
             if (bytes > limits.maxDecodeBytes) {
-                return refuse({4, ErrorCode::LimitExceeded,
+                return refuse({Rule::V4, ErrorCode::LimitExceeded,
                                "image of " + std::to_string(part.dataWindow.width()) + "x" + std::to_string(part.dataWindow.height()) +
                                    "x" + std::to_string(part.channels.size()) + " floats takes " + std::to_string(bytes) +
                                    " bytes, beyond the decode memory limit of " + std::to_string(limits.maxDecodeBytes)});
@@ -543,7 +543,7 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool
         }
         out = std::move(loaded);
     } catch (const std::exception& e) {
-        r.add(1, std::string("damaged OpenEXR data: ") + e.what());
+        r.add(Rule::V1, std::string("damaged OpenEXR data: ") + e.what());
         result.code = ErrorCode::Corrupt;
     }
     return result;

@@ -37,7 +37,7 @@ const char* typeName(ChannelType t) {
 
 // "present with the right type" or a message for `rule`; returns whether the value can be used.
 template <class T>
-bool need(const Attr<T>& a, const char* name, const char* expected, int rule, ValidationReport& r) {
+bool need(const Attr<T>& a, const char* name, const char* expected, Rule rule, ValidationReport& r) {
     if (!a.present) {
         r.add(rule, std::string("missing attribute ") + name + " (" + expected + ")");
         return false;
@@ -50,7 +50,7 @@ bool need(const Attr<T>& a, const char* name, const char* expected, int rule, Va
 }
 
 template <class T>
-bool optional(const Attr<T>& a, const char* name, const char* expected, int rule, ValidationReport& r) {
+bool optional(const Attr<T>& a, const char* name, const char* expected, Rule rule, ValidationReport& r) {
     return a.present && need(a, name, expected, rule, r);
 }
 
@@ -59,81 +59,81 @@ bool oneOf(const std::string& s, std::initializer_list<const char*> allowed) {
 }
 
 void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport& r) {
-    if (m.conusPartCount > 1) r.add(2, std::to_string(m.conusPartCount) + " parts are named `conus`; exactly one is allowed");
+    if (m.conusPartCount > 1) r.add(Rule::V2, std::to_string(m.conusPartCount) + " parts are named `conus`; exactly one is allowed");
     if (part.type != "scanlineimage" && part.type != "tiledimage") {
-        r.add(2, "part `conus` has type `" + part.type + "`, expected scanlineimage or tiledimage");
+        r.add(Rule::V2, "part `conus` has type `" + part.type + "`, expected scanlineimage or tiledimage");
     }
     if (part.type == "tiledimage" &&
         (part.tileWidth < 1 || part.tileHeight < 1 || part.tileWidth * part.tileHeight > kMaxTilePixels)) {
-        r.add(2, "part `conus` has tiles of " + std::to_string(part.tileWidth) + "x" + std::to_string(part.tileHeight) +
+        r.add(Rule::V2, "part `conus` has tiles of " + std::to_string(part.tileWidth) + "x" + std::to_string(part.tileHeight) +
                      " pixels; at most " + std::to_string(kMaxTilePixels) + " pixels a tile are read");
     }
-    if (!need(m.version, kAttrVersion, "int", 2, r)) return;
+    if (!need(m.version, kAttrVersion, "int", Rule::V2, r)) return;
     if (m.version.value > kFormatVersion) {
-        r.add(2, "written by a newer CoNUS (version " + std::to_string(m.version.value) + "); this reader knows version " +
+        r.add(Rule::V2, "written by a newer CoNUS (version " + std::to_string(m.version.value) + "); this reader knows version " +
                      std::to_string(kFormatVersion));
     } else if (m.version.value < 1) {
-        r.add(2, "invalid " + std::string(kAttrVersion) + " " + std::to_string(m.version.value));
+        r.add(Rule::V2, "invalid " + std::string(kAttrVersion) + " " + std::to_string(m.version.value));
     }
 }
 
 void checkChannels(const PartModel& part, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
     const auto n = static_cast<std::int64_t>(part.channels.size());
     if (n < 1 || n > kMaxChannels) {
-        r.add(3, "part `conus` has " + std::to_string(n) + " channels; 1 to " + std::to_string(kMaxChannels) + " allowed");
+        r.add(Rule::V3, "part `conus` has " + std::to_string(n) + " channels; 1 to " + std::to_string(kMaxChannels) + " allowed");
     } else if (n > limits.maxChannels) {
-        r.add(3, "part `conus` has " + std::to_string(n) + " channels, beyond the reader's limit of " +
+        r.add(Rule::V3, "part `conus` has " + std::to_string(n) + " channels, beyond the reader's limit of " +
                      std::to_string(limits.maxChannels));
         hc.limitExceeded = true;
     }
     std::set<std::string> seen;
     for (const ChannelModel& c : part.channels) {
-        if (c.name.empty() || !seen.insert(c.name).second) r.add(3, "channel name `" + c.name + "` is empty or repeated");
-        if (c.type == ChannelType::Uint) r.add(3, "channel `" + c.name + "` is UINT; HALF or FLOAT expected");
+        if (c.name.empty() || !seen.insert(c.name).second) r.add(Rule::V3, "channel name `" + c.name + "` is empty or repeated");
+        if (c.type == ChannelType::Uint) r.add(Rule::V3, "channel `" + c.name + "` is UINT; HALF or FLOAT expected");
         if (c.xSampling != 1 || c.ySampling != 1) {
-            r.add(3, "channel `" + c.name + "` has sampling " + std::to_string(c.xSampling) + "x" +
+            r.add(Rule::V3, "channel `" + c.name + "` has sampling " + std::to_string(c.xSampling) + "x" +
                          std::to_string(c.ySampling) + "; 1x1 expected");
         }
-        if (c.name == "Z" && c.type != ChannelType::Float) r.add(3, std::string("channel `Z` is ") + typeName(c.type) + "; FLOAT expected");
+        if (c.name == "Z" && c.type != ChannelType::Float) r.add(Rule::V3, std::string("channel `Z` is ") + typeName(c.type) + "; FLOAT expected");
     }
 }
 
 void checkWindows(const PartModel& part, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
     const Box& dw = part.dataWindow;
     if (!(dw == part.displayWindow) || dw.minX != 0 || dw.minY != 0) {
-        r.add(4, "part `conus` dataWindow " + boxStr(dw) + " must equal displayWindow " + boxStr(part.displayWindow) +
+        r.add(Rule::V4, "part `conus` dataWindow " + boxStr(dw) + " must equal displayWindow " + boxStr(part.displayWindow) +
                      " with origin (0, 0)");
     }
     const std::int64_t w = dw.width(), h = dw.height();
     if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide) {
-        r.add(4, "image size " + std::to_string(w) + "x" + std::to_string(h) + " outside [1, " + std::to_string(kMaxImageSide) + "]");
+        r.add(Rule::V4, "image size " + std::to_string(w) + "x" + std::to_string(h) + " outside [1, " + std::to_string(kMaxImageSide) + "]");
     } else if (w * h > limits.maxPixels) {
-        r.add(4, "image of " + std::to_string(w) + "x" + std::to_string(h) + " = " + std::to_string(w * h) +
+        r.add(Rule::V4, "image of " + std::to_string(w) + "x" + std::to_string(h) + " = " + std::to_string(w * h) +
                      " pixels exceeds the reader's limit of " + std::to_string(limits.maxPixels));
         hc.limitExceeded = true;
     }
 }
 
 void checkSourceAndKind(const HeaderModel& m, ValidationReport& r) {
-    if (need(m.sourceSize, kAttrSourceSize, "v2i", 5, r)) {
+    if (need(m.sourceSize, kAttrSourceSize, "v2i", Rule::V5, r)) {
         const auto [sw, sh] = m.sourceSize.value;
         if (sw < 1 || sh < 1 || sw > kMaxImageSide || sh > kMaxImageSide) {
-            r.add(5, "source size " + std::to_string(sw) + "x" + std::to_string(sh) + " outside [1, " +
+            r.add(Rule::V5, "source size " + std::to_string(sw) + "x" + std::to_string(sh) + " outside [1, " +
                          std::to_string(kMaxImageSide) + "]");
         }
     }
-    if (need(m.dataKind, kAttrDataKind, "string", 6, r) && !oneOf(m.dataKind.value, {"image", "heightfield", "depthimage"})) {
-        r.add(6, "data kind `" + m.dataKind.value + "` is not one of image, heightfield, depthimage");
+    if (need(m.dataKind, kAttrDataKind, "string", Rule::V6, r) && !oneOf(m.dataKind.value, {"image", "heightfield", "depthimage"})) {
+        r.add(Rule::V6, "data kind `" + m.dataKind.value + "` is not one of image, heightfield, depthimage");
     }
 }
 
 void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
     if (m.mapPartCount != 1) {
-        r.add(7, std::to_string(m.mapPartCount) + " parts are named `samplingmap`; exactly one is required");
+        r.add(Rule::V7, std::to_string(m.mapPartCount) + " parts are named `samplingmap`; exactly one is required");
         if (m.mapPart < 0) return;
     }
     const PartModel& p = m.parts[m.mapPart];
-    if (p.type != "scanlineimage") r.add(7, "part `samplingmap` has type `" + p.type + "`, expected scanlineimage");
+    if (p.type != "scanlineimage") r.add(Rule::V7, "part `samplingmap` has type `" + p.type + "`, expected scanlineimage");
     const bool channelsOk = p.channels.size() == 2 && p.channels[0].name == kMapChannelU && p.channels[1].name == kMapChannelV &&
                             std::all_of(p.channels.begin(), p.channels.end(), [](const ChannelModel& c) {
                                 return c.type == ChannelType::Float && c.xSampling == 1 && c.ySampling == 1;
@@ -141,15 +141,15 @@ void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationRepo
     if (!channelsOk) {
         std::string list;
         for (const ChannelModel& c : p.channels) list += (list.empty() ? "" : ", ") + c.name + ":" + typeName(c.type);
-        r.add(7, "part `samplingmap` has channels {" + list + "}; exactly FLOAT `ud` and `vd` expected");
+        r.add(Rule::V7, "part `samplingmap` has channels {" + list + "}; exactly FLOAT `ud` and `vd` expected");
     }
     const Box& dw = p.dataWindow;
     const std::int64_t n = dw.width(), rows = dw.height();
     if (dw.minX != 0 || dw.minY != 0 || n < kMinMapSide || rows < kMinMapSide || n > kMaxMapSide || rows > kMaxMapSide) {
-        r.add(7, "part `samplingmap` dataWindow " + boxStr(dw) + " must be (0, 0) - (columns-1, rows-1) with columns and rows in [" +
+        r.add(Rule::V7, "part `samplingmap` dataWindow " + boxStr(dw) + " must be (0, 0) - (columns-1, rows-1) with columns and rows in [" +
                      std::to_string(kMinMapSide) + ", " + std::to_string(kMaxMapSide) + "]");
     } else if (n > limits.maxMapSide || rows > limits.maxMapSide) {
-        r.add(7, "sampling map of " + std::to_string(n) + "x" + std::to_string(rows) + " nodes exceeds the reader's limit of " +
+        r.add(Rule::V7, "sampling map of " + std::to_string(n) + "x" + std::to_string(rows) + " nodes exceeds the reader's limit of " +
                      std::to_string(limits.maxMapSide) + " a side");
         hc.limitExceeded = true;
     }
@@ -158,38 +158,38 @@ void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationRepo
 void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
     if (!m.mapKind.present) {
         if (m.foci.present || m.composition.present || !m.params.empty()) {
-            r.add(12, std::string("analytic map parameters without ") + kAttrMapKind);
+            r.add(Rule::V12, std::string("analytic map parameters without ") + kAttrMapKind);
         }
         return;
     }
-    if (!need(m.mapKind, kAttrMapKind, "string", 12, r)) return;
+    if (!need(m.mapKind, kAttrMapKind, "string", Rule::V12, r)) return;
     const std::string& kind = m.mapKind.value;
     if (kind == "foci") {
-        if (need(m.foci, kAttrFoci, "floatvector", 12, r)) {
+        if (need(m.foci, kAttrFoci, "floatvector", Rule::V12, r)) {
             const std::vector<float>& f = m.foci.value;
             if (f.empty() || f.size() % 4 != 0) {
-                r.add(12, std::string(kAttrFoci) + " has " + std::to_string(f.size()) + " values; 4 per focus (u,v,r,k), at least one focus");
+                r.add(Rule::V12, std::string(kAttrFoci) + " has " + std::to_string(f.size()) + " values; 4 per focus (u,v,r,k), at least one focus");
             } else {
                 for (std::size_t i = 0; i < f.size() / 4; ++i) {
                     const float u = f[4 * i], v = f[4 * i + 1], rad = f[4 * i + 2], k = f[4 * i + 3];
                     // Written as negations so NaN fails every test.
                     if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1 && rad > 0 && std::isfinite(rad) && k >= 1 && k <= map_rules::kMaxMagnification)) {
-                        r.add(12, "focus " + std::to_string(i) + " (u,v,r,k) = (" + num(u) + ", " + num(v) + ", " + num(rad) + ", " +
+                        r.add(Rule::V12, "focus " + std::to_string(i) + " (u,v,r,k) = (" + num(u) + ", " + num(v) + ", " + num(rad) + ", " +
                                       num(k) + "): need u,v in [0,1], r > 0 finite, k in [1," + num(map_rules::kMaxMagnification) + "]");
                     }
                 }
             }
         }
-        if (need(m.composition, kAttrComposition, "string", 12, r) && !oneOf(m.composition.value, {"density", "add"})) {
-            r.add(12, "composition `" + m.composition.value + "` is not density or add");
+        if (need(m.composition, kAttrComposition, "string", Rule::V12, r) && !oneOf(m.composition.value, {"density", "add"})) {
+            r.add(Rule::V12, "composition `" + m.composition.value + "` is not density or add");
         }
     } else if (kind != "ground") {
-        r.add(12, "map kind `" + kind + "` is not foci or ground");
+        r.add(Rule::V12, "map kind `" + kind + "` is not foci or ground");
     }
     for (const auto& [name, a] : m.params) {
         const std::string full = kAttrParamPrefix + name;
-        if (need(a, full.c_str(), "double or float", 12, r) && !std::isfinite(a.value)) {
-            r.add(12, full + " = " + num(a.value) + " is not finite");
+        if (need(a, full.c_str(), "double or float", Rule::V12, r) && !std::isfinite(a.value)) {
+            r.add(Rule::V12, full + " = " + num(a.value) + " is not finite");
         }
     }
 }
@@ -198,53 +198,53 @@ void checkCamera(const HeaderModel& m, ValidationReport& r) {
     if (!m.worldToCamera.present && !m.worldToNDC.present && !m.projection.present) return;
     for (const auto* a : {&m.worldToCamera, &m.worldToNDC}) {
         const char* name = a == &m.worldToCamera ? kAttrWorldToCamera : kAttrWorldToNDC;
-        if (need(*a, name, "m44f", 13, r) &&
+        if (need(*a, name, "m44f", Rule::V13, r) &&
             !std::all_of(a->value.begin(), a->value.end(), [](float x) { return std::isfinite(x); })) {
-            r.add(13, std::string(name) + " has a non-finite element");
+            r.add(Rule::V13, std::string(name) + " has a non-finite element");
         }
     }
-    if (need(m.projection, kAttrProjection, "string", 13, r) && !oneOf(m.projection.value, {"perspective", "orthographic"})) {
-        r.add(13, "projection `" + m.projection.value + "` is not perspective or orthographic");
+    if (need(m.projection, kAttrProjection, "string", Rule::V13, r) && !oneOf(m.projection.value, {"perspective", "orthographic"})) {
+        r.add(Rule::V13, "projection `" + m.projection.value + "` is not perspective or orthographic");
     }
 }
 
 void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r) {
     std::string kind = "none";  // absent means no depth
-    if (optional(m.depthKind, kAttrDepthKind, "string", 14, r)) {
+    if (optional(m.depthKind, kAttrDepthKind, "string", Rule::V14, r)) {
         kind = m.depthKind.value;
         if (!oneOf(kind, {"none", "cameraDepth", "height"})) {
-            r.add(14, "depth kind `" + kind + "` is not none, cameraDepth or height");
+            r.add(Rule::V14, "depth kind `" + kind + "` is not none, cameraDepth or height");
             return;
         }
     }
     const bool hasZ = std::any_of(part.channels.begin(), part.channels.end(), [](const ChannelModel& c) { return c.name == "Z"; });
-    if (hasZ && kind == "none") r.add(14, "a `Z` channel needs conus:depthKind cameraDepth or height, not none");
-    if (!hasZ && kind != "none") r.add(14, "conus:depthKind is " + kind + " but there is no `Z` channel");
-    if (kind != "none" && need(m.depthRange, kAttrDepthRange, "v2f", 14, r)) {
+    if (hasZ && kind == "none") r.add(Rule::V14, "a `Z` channel needs conus:depthKind cameraDepth or height, not none");
+    if (!hasZ && kind != "none") r.add(Rule::V14, "conus:depthKind is " + kind + " but there is no `Z` channel");
+    if (kind != "none" && need(m.depthRange, kAttrDepthRange, "v2f", Rule::V14, r)) {
         const auto [nearV, farV] = m.depthRange.value;
         if (!(std::isfinite(nearV) && std::isfinite(farV) && nearV < farV)) {
-            r.add(14, "depth range (" + num(nearV) + ", " + num(farV) + ") must be finite with near < far");
+            r.add(Rule::V14, "depth range (" + num(nearV) + ", " + num(farV) + ") must be finite with near < far");
         }
     }
-    optional(m.depthUnits, kAttrDepthUnits, "string", 14, r);
+    optional(m.depthUnits, kAttrDepthUnits, "string", Rule::V14, r);
 }
 
 void checkColour(const HeaderModel& m, ValidationReport& r) {
-    if (optional(m.sourceTransfer, kAttrSourceTransfer, "string", 16, r) && !parseTransfer(m.sourceTransfer.value))
-        r.add(16, "source transfer `" + m.sourceTransfer.value + "` is not linear, srgb or raw");
-    if (optional(m.sourceSampleType, kAttrSourceSampleType, "string", 16, r) && !parseSampleType(m.sourceSampleType.value))
-        r.add(16, "source sample type `" + m.sourceSampleType.value + "` is not uint8, uint16, uint32, half or float");
-    if (optional(m.chromaticities, kAttrChromaticities, "chromaticities", 16, r) &&
+    if (optional(m.sourceTransfer, kAttrSourceTransfer, "string", Rule::V16, r) && !parseTransfer(m.sourceTransfer.value))
+        r.add(Rule::V16, "source transfer `" + m.sourceTransfer.value + "` is not linear, srgb or raw");
+    if (optional(m.sourceSampleType, kAttrSourceSampleType, "string", Rule::V16, r) && !parseSampleType(m.sourceSampleType.value))
+        r.add(Rule::V16, "source sample type `" + m.sourceSampleType.value + "` is not uint8, uint16, uint32, half or float");
+    if (optional(m.chromaticities, kAttrChromaticities, "chromaticities", Rule::V16, r) &&
         !std::all_of(m.chromaticities.value.begin(), m.chromaticities.value.end(), [](float x) { return std::isfinite(x); }))
-        r.add(16, "chromaticities hold a non-finite value");
-    if (optional(m.iccProfile, kAttrIccProfile, "string", 16, r) && !base64Decode(m.iccProfile.value))
-        r.add(16, std::string(kAttrIccProfile) + " is not base64 text (" + std::to_string(m.iccProfile.value.size()) + " characters)");
+        r.add(Rule::V16, "chromaticities hold a non-finite value");
+    if (optional(m.iccProfile, kAttrIccProfile, "string", Rule::V16, r) && !base64Decode(m.iccProfile.value))
+        r.add(Rule::V16, std::string(kAttrIccProfile) + " is not base64 text (" + std::to_string(m.iccProfile.value.size()) + " characters)");
 }
 
 void checkDisplayWindows(const HeaderModel& m, ValidationReport& r) {
     for (std::size_t i = 1; i < m.parts.size(); ++i) {
         if (!(m.parts[i].displayWindow == m.parts[0].displayWindow)) {
-            r.add(15, "part " + std::to_string(i) + " (`" + m.parts[i].name + "`) displayWindow " + boxStr(m.parts[i].displayWindow) +
+            r.add(Rule::V15, "part " + std::to_string(i) + " (`" + m.parts[i].name + "`) displayWindow " + boxStr(m.parts[i].displayWindow) +
                           " differs from part 0's " + boxStr(m.parts[0].displayWindow));
         }
     }
@@ -255,7 +255,7 @@ void checkDisplayWindows(const HeaderModel& m, ValidationReport& r) {
 HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r) {
     HeaderCheck hc;
     if (m.conusPart < 0) {
-        r.add(2, "not a CoNUS file: no part named `conus` among " + std::to_string(m.parts.size()) + " part(s)");
+        r.add(Rule::V2, "not a CoNUS file: no part named `conus` among " + std::to_string(m.parts.size()) + " part(s)");
         hc.notConus = true;
         return hc;
     }
@@ -348,13 +348,13 @@ ValidationReport validateConusFile(const ConusFile& file) {
     const Image& im = file.image;
     if (im.width >= 1 && im.height >= 1 &&
         im.pixels.size() != std::size_t(im.width) * std::size_t(im.height) * im.channels.size()) {
-        report.add(4, "image holds " + std::to_string(im.pixels.size()) + " values; " + std::to_string(im.width) + "x" +
+        report.add(Rule::V4, "image holds " + std::to_string(im.pixels.size()) + " values; " + std::to_string(im.width) + "x" +
                           std::to_string(im.height) + "x" + std::to_string(im.channels.size()) + " expected");
     }
     const ValidationReport grid = validateGrid(file.map);
     // V7's shape was already reported from the header model; keep the grid's own messages otherwise.
     for (const Issue& issue : grid.issues) {
-        if (issue.rule != 7 || !report.violates(7)) report.issues.push_back(issue);
+        if (issue.rule != Rule::V7 || !report.violates(Rule::V7)) report.issues.push_back(issue);
     }
     return report;
 }

@@ -23,7 +23,7 @@ std::string fmt(double value) {
 // Adds messages for one rule up to the cap, and the "... and N more" line at the end.
 class CappedRule {
 public:
-    CappedRule(ValidationReport& report, int rule, const char* what)
+    CappedRule(ValidationReport& report, Rule rule, const char* what)
         : m_report(report), m_rule(rule), m_what(what) {}
     ~CappedRule() {
         if (m_count > kMaxMessagesPerRule) {
@@ -37,7 +37,7 @@ public:
 
 private:
     ValidationReport& m_report;
-    int m_rule;
+    Rule m_rule;
     const char* m_what;
     long long m_count = 0;
 };
@@ -56,13 +56,13 @@ ValidationReport validateGrid(const GridNodes& grid) {
     const int n = grid.columns;
     const int m = grid.rows;
     if (n < kMinMapSide || n > kMaxMapSide || m < kMinMapSide || m > kMaxMapSide) {
-        report.add(7, "map grid is " + std::to_string(n) + "x" + std::to_string(m) + " nodes; columns and rows must be in [" +
+        report.add(Rule::V7, "map grid is " + std::to_string(n) + "x" + std::to_string(m) + " nodes; columns and rows must be in [" +
                           std::to_string(kMinMapSide) + ", " + std::to_string(kMaxMapSide) + "]");
         return report;  // nothing below can be indexed safely
     }
     const std::size_t expected = std::size_t{2} * n * m;
     if (grid.xy.size() != expected) {
-        report.add(7, "map grid " + std::to_string(n) + "x" + std::to_string(m) + " needs " + std::to_string(expected) +
+        report.add(Rule::V7, "map grid " + std::to_string(n) + "x" + std::to_string(m) + " needs " + std::to_string(expected) +
                           " values, has " + std::to_string(grid.xy.size()));
         return report;
     }
@@ -71,9 +71,9 @@ ValidationReport validateGrid(const GridNodes& grid) {
 
     bool allFinite = true;
     {
-        CappedRule v8(report, 8, "nodes");
-        CappedRule v9(report, 9, "nodes");
-        CappedRule v10(report, 10, "nodes");
+        CappedRule v8(report, Rule::V8, "nodes");
+        CappedRule v9(report, Rule::V9, "nodes");
+        CappedRule v10(report, Rule::V10, "nodes");
         for (int j = 0; j < m; ++j) {
             for (int i = 0; i < n; ++i) {
                 const double u = U(i, j), v = V(i, j);
@@ -100,7 +100,7 @@ ValidationReport validateGrid(const GridNodes& grid) {
     // positive, as for the identity. A bilinear patch has a positive Jacobian everywhere iff it
     // does at its four corners, so this is exactly injectivity of the piecewise-bilinear map.
     const map_rules::GridView view{n, m, grid.xy.data()};
-    CappedRule v11(report, 11, "cells");
+    CappedRule v11(report, Rule::V11, "cells");
     for (int j = 0; j + 1 < m; ++j) {
         for (int i = 0; i + 1 < n; ++i) {
             const int c = map_rules::firstBadCorner(view, i, j);

@@ -6,7 +6,9 @@
 
 namespace conus::format {
 
-bool ValidationReport::violates(int rule) const {
+std::string label(Rule rule) { return rule == Rule::Unreadable ? "error" : "V" + std::to_string(number(rule)); }
+
+bool ValidationReport::violates(Rule rule) const {
     return std::any_of(issues.begin(), issues.end(), [rule](const Issue& i) { return i.rule == rule; });
 }
 
@@ -14,12 +16,12 @@ namespace {
 
 // "V7: message", or "error: message" for rule 0.
 std::string line(const Issue& issue) {
-    return (issue.rule == 0 ? std::string("error: ") : "V" + std::to_string(issue.rule) + ": ") + issue.message;
+    return label(issue.rule) + ": " + issue.message;
 }
 
 }  // namespace
 
-void ValidationReport::add(int rule, std::string message, long long count) {
+void ValidationReport::add(Rule rule, std::string message, long long count) {
     std::replace_if(message.begin(), message.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
     issues.push_back({rule, std::move(message), count});
 }

@@ -266,10 +266,10 @@ TEST(Container, ReadLimitsAreEnforced) {
     }
     ReadLimits mapLimit;
     mapLimit.maxMapSide = 4;
-    EXPECT_TRUE(validateConusFile(dir.file("x.exr"), mapLimit).violates(7));
+    EXPECT_TRUE(validateConusFile(dir.file("x.exr"), mapLimit).violates(Rule::V7));
     ReadLimits channelLimit;
     channelLimit.maxChannels = 3;
-    EXPECT_TRUE(validateConusFile(dir.file("x.exr"), channelLimit).violates(3));
+    EXPECT_TRUE(validateConusFile(dir.file("x.exr"), channelLimit).violates(Rule::V3));
 }
 
 TEST(Container, TruncatedAndFlippedFilesNeverCrash) {

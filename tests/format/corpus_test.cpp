@@ -26,7 +26,7 @@ TEST(Corpus, OrdinaryExrsAreNotConus) {
             EXPECT_EQ(e.code(), ErrorCode::NotConus) << e.what();
         }
         const ValidationReport r = validateConusFile(entry.path().string());
-        EXPECT_TRUE(r.violates(2)) << r.str();
+        EXPECT_TRUE(r.violates(Rule::V2)) << r.str();
     }
     EXPECT_GE(seen, 1);
 }

@@ -98,7 +98,7 @@ TEST(Limits, AnAttributeBeyondTheCapIsRefusedBeforeOpenExrReadsIt) {
     EXPECT_TRUE(contains(r.message, "V1: ") && contains(r.message, "conus:note") &&
                 contains(r.message, std::to_string(kMaxAttributeBytes + 1)))
         << r.message;
-    EXPECT_TRUE(validateConusFile(dir.file("big.exr")).violates(1));
+    EXPECT_TRUE(validateConusFile(dir.file("big.exr")).violates(Rule::V1));
 
     // At the cap it reads (the header's total stays below its own cap).
     writeRaw(dir.file("ok.exr"), validFile(), [](Imf::Header& c, Imf::Header&) {
@@ -172,7 +172,7 @@ TEST(Limits, OnlyRegularFilesAreRead) {
         const Refusal r = refusal([&] { readConusFile(path); });
         EXPECT_EQ(r.code, ErrorCode::Io) << path << ": " << r.message;
         EXPECT_LT(r.seconds, kSecond) << path;
-        EXPECT_TRUE(validateConusFile(path).violates(1)) << path;
+        EXPECT_TRUE(validateConusFile(path).violates(Rule::V1)) << path;
     }
     EXPECT_TRUE(contains(refusal([&] { readConusHeader(dir.file("fifo.exr")); }).message, "not a regular file"));
 }
@@ -270,7 +270,7 @@ TEST(Hostile, TwoBrokenRulesGiveOneLineNamingBoth) {
     EXPECT_TRUE(oneLine(r.message));
     EXPECT_TRUE(contains(r.message, "V5: source size 0x-1") && contains(r.message, "; V6: data kind `bogus`")) << r.message;
     const ValidationReport report = validateConusFile(hostile("multiline-error-two-rules.exr"));
-    EXPECT_TRUE(report.violates(5) && report.violates(6)) << report.str();
+    EXPECT_TRUE(report.violates(Rule::V5) && report.violates(Rule::V6)) << report.str();
 }
 
 TEST(Hostile, LargeMapsAreReadWithinBounds) {

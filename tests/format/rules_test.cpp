@@ -35,7 +35,7 @@ using testing::writeRaw;
 ::testing::AssertionResult onlyRule(const ValidationReport& r, int rule) {
     if (r.ok()) return ::testing::AssertionFailure() << "report is ok, expected V" << rule;
     for (const Issue& i : r.issues) {
-        if (i.rule != rule) return ::testing::AssertionFailure() << "expected only V" << rule << ", got:\n" << r.str();
+        if (number(i.rule) != rule) return ::testing::AssertionFailure() << "expected only V" << rule << ", got:\n" << r.str();
     }
     return ::testing::AssertionSuccess();
 }
@@ -165,7 +165,7 @@ TEST_F(RuleTest, V8ToV11MapGeometry) {
     EXPECT_TRUE(onlyRule(validateConusFile(f), 8));
     f = validFile();
     f.map.xy[2 * 6 + 1] = -0.5f;  // node (1,1) above the top edge: outside and folded
-    EXPECT_TRUE(validateConusFile(f).violates(9));
+    EXPECT_TRUE(validateConusFile(f).violates(Rule::V9));
     f = validFile();
     f.map.xy[1] = 0.01f;  // top-left corner off its edge
     EXPECT_TRUE(onlyRule(validateConusFile(f), 10));

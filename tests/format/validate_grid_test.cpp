@@ -18,7 +18,7 @@ float& v(GridNodes& g, int i, int j) { return g.xy[2 * (std::size_t(j) * g.colum
 // The report breaks exactly `rule` and nothing else.
 void expectOnly(const ValidationReport& r, int rule) {
     ASSERT_FALSE(r.ok());
-    for (const Issue& issue : r.issues) EXPECT_EQ(issue.rule, rule) << r.str();
+    for (const Issue& issue : r.issues) EXPECT_EQ(number(issue.rule), rule) << r.str();
 }
 
 TEST(ValidateGrid, IdentityIsValid) {
@@ -63,8 +63,8 @@ TEST(ValidateGrid, V9OutsideUnitSquare) {
     GridNodes g = identityGrid(3, 3);
     u(g, 1, 1) = 1.5f;
     const ValidationReport r = validateGrid(g);
-    EXPECT_TRUE(r.violates(9)) << r.str();
-    EXPECT_FALSE(r.violates(10));
+    EXPECT_TRUE(r.violates(Rule::V9)) << r.str();
+    EXPECT_FALSE(r.violates(Rule::V10));
     EXPECT_NE(r.str().find("(1,1)"), std::string::npos) << r.str();
 }
 
@@ -98,8 +98,8 @@ TEST(ValidateGrid, V11MirroredGridHasWrongOrientation) {
         for (int i = 0; i < 4; ++i) u(g, i, j) = 1.0f - u(g, i, j);
     }
     const ValidationReport r = validateGrid(g);
-    EXPECT_TRUE(r.violates(11));
-    EXPECT_TRUE(r.violates(10));
+    EXPECT_TRUE(r.violates(Rule::V11));
+    EXPECT_TRUE(r.violates(Rule::V10));
 }
 
 TEST(ValidateGrid, MessagesAreCapped) {
@@ -121,10 +121,10 @@ TEST(ValidateGrid, MessagesAreCapped) {
 TEST(ValidationReport, StrAndViolates) {
     ValidationReport r;
     EXPECT_TRUE(r.ok());
-    r.add(3, "bad channel");
-    r.add(0, "unreadable\nfrom a library");
-    EXPECT_TRUE(r.violates(3));
-    EXPECT_FALSE(r.violates(4));
+    r.add(Rule::V3, "bad channel");
+    r.add(Rule::Unreadable, "unreadable\nfrom a library");
+    EXPECT_TRUE(r.violates(Rule::V3));
+    EXPECT_FALSE(r.violates(Rule::V4));
     // One line, whatever the messages held: errors built from a report never span lines.
     EXPECT_EQ(r.str(), "V3: bad channel; error: unreadable from a library");
 }
