@@ -65,11 +65,8 @@ CLI::Validator finiteRange(double low, double high, bool lowIncluded) {
 }
 
 format::Compression parseCompression(const std::string& text) {
-    if (text == "zip") return format::Compression::Zip;
-    if (text == "piz") return format::Compression::Piz;
-    if (text == "dwaa") return format::Compression::Dwaa;
-    if (text == "none") return format::Compression::None;
-    invalid("compression '" + text + "' is not one of zip, piz, dwaa, none");
+    if (const auto compression = format::parseName<format::Compression>(text)) return *compression;
+    invalid("compression '" + text + "' is not one of " + format::nameList<format::Compression>());
 }
 
 }  // namespace conus::cli

@@ -154,7 +154,7 @@ Command addHeightFieldCommand(CLI::App& root) {
     encode->add_option("--colour,--color", o->colour, "colour texture (default: a ramp by height and slope)");
     encode->add_option("--compression", o->compression, "zip | piz | dwaa | none")
         ->capture_default_str()
-        ->check(CLI::IsMember({"zip", "piz", "dwaa", "none"}));
+        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
     addQuietOption(*encode);
     encode->footer(
         "Examples:\n"

@@ -126,9 +126,16 @@ Command addInfoCommand(CLI::App& root) {
                     for (const auto& [name, value] : file.analytic->scalars) a["params"][name] = value;
                     j["analyticMap"] = a;
                 }
-                if (file.camera) j["camera"] = {{"projection", file.camera->projection},
-                                                {"worldToCamera", file.camera->worldToCamera},
-                                                {"worldToNDC", file.camera->worldToNDC}};
+                if (file.camera) {
+                    const Camera camera = format::toCamera(*file.camera);
+                    const glm::dvec3 eye = camera.eye(), forward = camera.forward();
+                    j["camera"] = {{"projection", file.camera->projection},
+                                   {"eye", {eye.x, eye.y, eye.z}},
+                                   {"forward", {forward.x, forward.y, forward.z}},
+                                   {"worldToCamera", file.camera->worldToCamera},
+                                   {"worldToNDC", file.camera->worldToNDC}};
+                    if (camera.projection() == Projection::Perspective) j["camera"]["verticalFov"] = camera.verticalFovDegrees();
+                }
                 if (file.depth.kind != format::DepthKind::None)
                     j["depth"] = {{"kind", format::toString(file.depth.kind)},
                                   {"units", file.depth.units},
@@ -200,7 +207,14 @@ Command addInfoCommand(CLI::App& root) {
                         std::printf("\n    %s = %g", name.c_str(), value);
                     std::printf("\n");
                 }
-                if (file.camera) std::printf("  camera        %s\n", file.camera->projection.c_str());
+                if (file.camera) {
+                    const Camera camera = format::toCamera(*file.camera);
+                    const glm::dvec3 eye = camera.eye(), forward = camera.forward();
+                    std::printf("  camera        %s, eye (%g, %g, %g), looking along (%.4g, %.4g, %.4g)", toString(camera.projection()),
+                                eye.x, eye.y, eye.z, forward.x, forward.y, forward.z);
+                    if (camera.projection() == Projection::Perspective) std::printf(", vertical fov %.4g deg", camera.verticalFovDegrees());
+                    std::printf("\n");
+                }
                 if (file.depth.kind != format::DepthKind::None)
                     std::printf("  depth         %s in [%g, %g] %s\n", format::toString(file.depth.kind),
                                 file.depth.near, file.depth.far, file.depth.units.c_str());

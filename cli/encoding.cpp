@@ -23,7 +23,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
         ->excludes(half);
     command.add_option("--compression", options.compression, "zip | piz | dwaa | none")
         ->default_val("zip")
-        ->check(CLI::IsMember({"zip", "piz", "dwaa", "none"}));
+        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
     addBackendOption(command, options.backend);
 }
 

@@ -2,6 +2,7 @@
 #include "conus/format/container.h"
 #include "conus/core/atomic_file.h"
 #include "exr_io.h"
+#include "header_model.h"
 
 namespace conus::format {
 
@@ -15,6 +16,30 @@ bool onlyMapRules(const ValidationReport& r) {
 }
 
 }  // namespace
+
+namespace detail {
+
+CameraCheck describeCamera(const CameraAttributes& a) {
+    const std::optional<Projection> projection = parseProjection(a.projection);
+    if (!projection) return {std::nullopt, "projection `" + a.projection + "` is not perspective or orthographic"};
+    try {
+        return {Camera::fromMatrices(a.worldToCamera, a.worldToNDC, *projection), {}};
+    } catch (const Error& e) {
+        return {std::nullopt, e.what()};
+    }
+}
+
+}  // namespace detail
+
+conus::Camera toCamera(const CameraAttributes& attributes) {
+    detail::CameraCheck check = detail::describeCamera(attributes);
+    if (!check.camera) throw Error(ErrorCode::Corrupt, "the file's camera (rule " + label(Rule::V13) + ") describes none: " + check.problem);
+    return std::move(*check.camera);
+}
+
+CameraAttributes toAttributes(const conus::Camera& camera) {
+    return {toString(camera.projection()), camera.worldToCamera(), camera.worldToNDC()};
+}
 
 void writeConusFile(const std::string& path, const ConusFile& file) {
     const ValidationReport report = validateConusFile(file);

@@ -352,8 +352,7 @@ void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
     out.compression = compressionOf(h.compression());
     out.sourceWidth = m.sourceSize.value[0];
     out.sourceHeight = m.sourceSize.value[1];
-    const std::string& kind = m.dataKind.value;
-    out.dataKind = kind == "heightfield" ? DataKind::HeightField : kind == "depthimage" ? DataKind::DepthImage : DataKind::Image;
+    out.dataKind = parseName<DataKind>(m.dataKind.value).value_or(DataKind::Image);
     if (m.mapKind.ok()) {
         AnalyticMap a;
         a.kind = m.mapKind.value;
@@ -363,9 +362,8 @@ void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
         for (const auto& [name, attr] : m.params) a.scalars[name] = attr.value;
         out.analytic = std::move(a);
     }
-    if (m.projection.ok()) out.camera = Camera{m.projection.value, m.worldToCamera.value, m.worldToNDC.value};
-    const std::string depth = m.depthKind.ok() ? m.depthKind.value : "none";
-    out.depth.kind = depth == "cameraDepth" ? DepthKind::CameraDepth : depth == "height" ? DepthKind::Height : DepthKind::None;
+    if (m.projection.ok()) out.camera = CameraAttributes{m.projection.value, m.worldToCamera.value, m.worldToNDC.value};
+    out.depth.kind = m.depthKind.ok() ? parseName<DepthKind>(m.depthKind.value).value_or(DepthKind::None) : DepthKind::None;
     if (out.depth.kind != DepthKind::None) {
         out.depth.near = m.depthRange.value[0];
         out.depth.far = m.depthRange.value[1];

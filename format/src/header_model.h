@@ -76,6 +76,14 @@ struct HeaderCheck {
     bool limitExceeded = false;  // a size beyond ReadLimits
 };
 
+// The camera the attributes describe, or what is wrong with them (V13's geometric half: known
+// projection, finite invertible matrices that agree with it). toCamera() throws with that text.
+struct CameraCheck {
+    std::optional<conus::Camera> camera;
+    std::string problem;  // empty when `camera` holds one
+};
+CameraCheck describeCamera(const CameraAttributes& attributes);
+
 // Runs V2..V7 (shape only for V7) and V12..V15 on the model, appending to `report`.
 HeaderCheck checkHeaderRules(const HeaderModel& model, const ReadLimits& limits, ValidationReport& report);
 

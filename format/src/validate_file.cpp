@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 
+#include "conus/core/camera.h"
 #include "conus/core/map_rules.h"
 #include "header_model.h"
 
@@ -122,7 +123,7 @@ void checkSourceAndKind(const HeaderModel& m, ValidationReport& r) {
                          std::to_string(kMaxImageSide) + "]");
         }
     }
-    if (need(m.dataKind, kAttrDataKind, "string", Rule::V6, r) && !oneOf(m.dataKind.value, {"image", "heightfield", "depthimage"})) {
+    if (need(m.dataKind, kAttrDataKind, "string", Rule::V6, r) && !parseName<DataKind>(m.dataKind.value)) {
         r.add(Rule::V6, "data kind `" + m.dataKind.value + "` is not one of image, heightfield, depthimage");
     }
 }
@@ -203,8 +204,11 @@ void checkCamera(const HeaderModel& m, ValidationReport& r) {
             r.add(Rule::V13, std::string(name) + " has a non-finite element");
         }
     }
-    if (need(m.projection, kAttrProjection, "string", Rule::V13, r) && !oneOf(m.projection.value, {"perspective", "orthographic"})) {
+    if (need(m.projection, kAttrProjection, "string", Rule::V13, r) && !parseProjection(m.projection.value)) {
         r.add(Rule::V13, "projection `" + m.projection.value + "` is not perspective or orthographic");
+    } else if (!r.violates(Rule::V13)) {
+        const CameraCheck check = describeCamera(CameraAttributes{m.projection.value, m.worldToCamera.value, m.worldToNDC.value});
+        if (!check.problem.empty()) r.add(Rule::V13, check.problem);
     }
 }
 
@@ -212,7 +216,7 @@ void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r
     std::string kind = "none";  // absent means no depth
     if (optional(m.depthKind, kAttrDepthKind, "string", Rule::V14, r)) {
         kind = m.depthKind.value;
-        if (!oneOf(kind, {"none", "cameraDepth", "height"})) {
+        if (!parseName<DepthKind>(kind)) {
             r.add(Rule::V14, "depth kind `" + kind + "` is not none, cameraDepth or height");
             return;
         }

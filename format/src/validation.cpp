@@ -52,40 +52,9 @@ std::string ValidationReport::summary() const {
     return out;
 }
 
-const char* toString(PixelType t) {
-    switch (t) {
-        case PixelType::Half: return "half";
-        case PixelType::Float: return "float";
-    }
-    return "unknown";
-}
-
-const char* toString(Compression c) {
-    switch (c) {
-        case Compression::None: return "none";
-        case Compression::Zip: return "zip";
-        case Compression::Piz: return "piz";
-        case Compression::Dwaa: return "dwaa";
-    }
-    return "unknown";
-}
-
-const char* toString(DataKind k) {
-    switch (k) {
-        case DataKind::Image: return "image";
-        case DataKind::HeightField: return "heightfield";
-        case DataKind::DepthImage: return "depthimage";
-    }
-    return "unknown";
-}
-
-const char* toString(DepthKind k) {
-    switch (k) {
-        case DepthKind::None: return "none";
-        case DepthKind::CameraDepth: return "cameraDepth";
-        case DepthKind::Height: return "height";
-    }
-    return "unknown";
-}
+const char* toString(PixelType t) { return nameOf(t); }
+const char* toString(Compression c) { return nameOf(c); }
+const char* toString(DataKind k) { return nameOf(k); }
+const char* toString(DepthKind k) { return nameOf(k); }
 
 }  // namespace conus::format

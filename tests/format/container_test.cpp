@@ -71,12 +71,9 @@ TEST(Container, EverythingRoundTrips) {
     f.dataKind = DataKind::DepthImage;
     f.depth = {DepthKind::CameraDepth, "m", 0.5f, 120.0f};
     f.analytic = AnalyticMap{"foci", {{0.42, 0.31, 0.08, 4}, {0.7, 0.6, 0.1, 2.5}}, "density", {}};
-    Camera cam;
-    cam.projection = "orthographic";
-    for (int i = 0; i < 16; ++i) {
-        cam.worldToCamera[i] = float(i) * 0.5f;
-        cam.worldToNDC[i] = float(i) - 3.25f;
-    }
+    // A real orthographic camera (V13 asks for invertible matrices that agree with the projection).
+    const CameraAttributes cam =
+        toAttributes(conus::Camera::orthographic({3, 9, -2}, {0.5, 0, 1}, {0, 1, 0}, 12.5, 1.6, -4, 80));
     f.camera = cam;
     f.software = "conus test";
     writeConusFile(dir.file("all.exr"), f);

@@ -214,16 +214,39 @@ TEST_F(RuleTest, V12AnalyticMap) {
 
 TEST_F(RuleTest, V13Camera) {
     ConusFile f = validFile();
-    f.camera = Camera{};
+    f.camera = CameraAttributes{};
     f.camera->worldToNDC[5] = std::numeric_limits<float>::quiet_NaN();
     EXPECT_TRUE(onlyRule(validateConusFile(f), 13));
-    f.camera = Camera{"fisheye", {}, {}};
+    f.camera = CameraAttributes{"fisheye", {}, {}};
     EXPECT_TRUE(onlyRule(validateConusFile(f), 13));
     EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) {
                              c.insert("worldToCamera", Imf::M44fAttribute(Imath::M44f()));
                              c.insert("conus:projection", Imf::StringAttribute("perspective"));
                          }),
                          13));
+}
+
+TEST_F(RuleTest, V13CameraMatricesMustDescribeACamera) {
+    ConusFile f = validFile();
+    const conus::Camera perspective = conus::Camera::perspective({1, 2, 3}, {0, 0, 0}, {0, 1, 0}, 50, 1.5, 0.1, 100);
+    f.camera = toAttributes(perspective);
+    EXPECT_TRUE(validateConusFile(f).ok()) << validateConusFile(f).str();
+    // The same matrices called orthographic disagree with their own projection.
+    f.camera->projection = "orthographic";
+    ValidationReport r = validateConusFile(f);
+    EXPECT_TRUE(onlyRule(r, 13));
+    EXPECT_NE(r.str().find("perspective camera, not orthographic"), std::string::npos) << r.str();
+    // A singular worldToCamera (a zero row) has no inverse: no camera.
+    f.camera = toAttributes(perspective);
+    for (int i = 0; i < 4; ++i) f.camera->worldToCamera[4 + i] = 0.0f;
+    r = validateConusFile(f);
+    EXPECT_TRUE(onlyRule(r, 13));
+    EXPECT_NE(r.str().find("singular"), std::string::npos) << r.str();
+    // toCamera gives back the camera the attributes were written from.
+    const conus::Camera back = toCamera(toAttributes(perspective));
+    EXPECT_NEAR(glm::distance(back.eye(), perspective.eye()), 0.0, 1e-5);
+    EXPECT_NEAR(back.verticalFovDegrees(), 50.0, 1e-3);
+    EXPECT_THROW(toCamera(*f.camera), conus::Error);
 }
 
 TEST_F(RuleTest, V14Depth) {

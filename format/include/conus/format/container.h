@@ -24,6 +24,8 @@
 #include "conus/core/error.h"
 #include "conus/core/image.h"
 #include "conus/core/limits.h"
+#include "conus/core/camera.h"
+#include "conus/format/names.h"
 #include "conus/format/validation.h"
 
 namespace conus::format {
@@ -33,10 +35,6 @@ inline constexpr const char* kSoftwareName = "conus 1.0.0";  // the `software` a
 inline constexpr const char* kConusPartName = "conus";
 inline constexpr const char* kMapPartName = "samplingmap";
 
-enum class PixelType { Half, Float };         // storage type of the image channels (Z is always float)
-enum class Compression { None, Zip, Piz, Dwaa };
-enum class DataKind { Image, HeightField, DepthImage };
-enum class DepthKind { None, CameraDepth, Height };  // what a `Z` channel holds
 
 // The sampling map's nodes: node (i,j), i the column, j the row, sits at undistorted
 // (i/(columns-1), j/(rows-1)) and stores its distorted location (xy[2k], xy[2k+1]), k = j*columns+i.
@@ -61,11 +59,18 @@ struct AnalyticMap {
     std::map<std::string, double> scalars;  // other kinds' named parameters
 };
 
-struct Camera {
+// The camera as the file records it (rule V13): EXR's standard matrices and conus:projection, as
+// read, so that the validator can report on them. toCamera() gives the camera model they describe.
+struct CameraAttributes {
     std::string projection = "perspective";  // "perspective" or "orthographic"
     std::array<float, 16> worldToCamera{};    // row-major, as EXR's standard attribute (M44f)
     std::array<float, 16> worldToNDC{};
 };
+// The pinhole camera the attributes describe; conus::Error(Corrupt), naming V13, when they
+// describe none (an unknown projection, a non-finite or singular matrix, matrices that disagree
+// with the projection).
+conus::Camera toCamera(const CameraAttributes& attributes);
+CameraAttributes toAttributes(const conus::Camera& camera);
 
 struct DepthInfo {
     DepthKind kind = DepthKind::None;
@@ -81,7 +86,7 @@ struct ConusFile {
     DataKind dataKind = DataKind::Image;
     GridNodes map;
     std::optional<AnalyticMap> analytic;
-    std::optional<Camera> camera;
+    std::optional<CameraAttributes> camera;
     DepthInfo depth;
     // What the source picture held (its transfer, sample type, chromaticities, ICC profile, EXIF
     // and camera metadata), so that decode can give it back as it was. The pixels themselves are
