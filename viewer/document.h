@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 
 namespace conus::viewer {

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "conus/codec/encode.h"
+#include "conus/codec/image/encode.h"
 #include "conus/codec/conus_file.h"
 
 namespace conus::viewer {

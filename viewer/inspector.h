@@ -7,7 +7,7 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 
 namespace conus::viewer {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/decode.h"
+#include "conus/codec/image/decode.h"
 #include "actions.h"
 #include "conus/renderers/view_renderer.h"
 

@@ -11,7 +11,7 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/decode.h"
+#include "conus/codec/image/decode.h"
 
 namespace conus::viewer {
 

@@ -12,9 +12,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "conus/codec/decode.h"
-#include "conus/codec/encode.h"
-#include "conus/codec/foci.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/build/foci.h"
 #include "conus/renderers/context.h"
 #include "conus/renderers/gpu_image.h"
 

@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <memory>
 
-#include "conus/codec/heightfield.h"
+#include "conus/codec/depth/heightfield.h"
 #include "conus/renderers/terrain.h"
 
 namespace {

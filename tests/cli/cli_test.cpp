@@ -12,8 +12,8 @@
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
-#include "conus/codec/metrics.h"
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/image/metrics.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "cli_fixture.h"
 

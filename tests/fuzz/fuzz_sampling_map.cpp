@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "conus/codec/decode.h"
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "fuzz.h"
 

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/core/error.h"
 #include "conus/renderers/backend.h"
 #include "conus/renderers/gpu_image.h"

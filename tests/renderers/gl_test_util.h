@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/foci.h"
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"
 

@@ -11,10 +11,10 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
-#include "conus/codec/decode.h"
-#include "conus/codec/encode.h"
-#include "conus/codec/foci.h"
-#include "conus/codec/metrics.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/image/metrics.h"
 #include "conus/core/error.h"
 #include "gl_test_util.h"
 

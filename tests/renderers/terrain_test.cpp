@@ -11,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/heightfield.h"
-#include "conus/codec/metrics.h"
+#include "conus/codec/depth/heightfield.h"
+#include "conus/codec/image/metrics.h"
 #include "conus/core/error.h"
 #include "gl_test_util.h"
 

@@ -3,8 +3,8 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/decode.h"
-#include "conus/codec/encode.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
 #include "viewer_test_util.h"
 
 namespace conus::viewer {

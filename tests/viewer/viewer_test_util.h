@@ -14,8 +14,8 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/encode.h"
-#include "conus/codec/foci.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/build/foci.h"
 #include "conus/format/container.h"
 #include "conus/renderers/context.h"
 

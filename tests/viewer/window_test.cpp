@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/decode.h"
+#include "conus/codec/image/decode.h"
 #include "conus/format/container.h"
 #include "sanitizers.h"
 #include "view_state.h"

@@ -12,7 +12,7 @@
 
 #include <optional>
 
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/core/color.h"
 #include "conus/format/container.h"
 

@@ -1,0 +1,47 @@
+// Automatic sampling maps from an importance image (the paper's future work): higher importance
+// gets more samples, with a floor so context keeps a minimum rate.
+//
+// The target density is rho = clamp(s * I, minDensity, maxDensity), I the importance smoothed on a
+// grid of at most 256 cells a side, and s chosen so that rho has mean 1 (the CoNUS image has as
+// many pixels as a uniform one): so `minDensity` is exactly the density context gets, and
+// `maxDensity` caps the magnification (density 16 = linear rate 4). Two methods build the map:
+// - Flow (default): a true 2-D map whose Jacobian determinant follows rho (density_map.h).
+// - Separable: the baseline; u and v are warped independently by the cumulative marginals of rho,
+//   so density is the product of the marginals (bands through every hot spot).
+// Flow matches the target far better (tests and bench/README.md give the figures), so it is the
+// default. Every result is a valid map; all-zero importance gives the identity.
+#pragma once
+
+#include "conus/codec/build/density_map.h"
+#include "conus/codec/map/sampling_map.h"
+#include "conus/core/image.h"
+#include "conus/core/map_rules.h"
+
+namespace conus::codec {
+
+enum class AutoMethod { Flow, Separable };
+
+struct AutoMapOptions {
+    int columns = map_rules::kDefaultSide, rows = map_rules::kDefaultSide;  // map grid
+    double minDensity = 0.25;     // context density (0 < minDensity < 1)
+    double maxDensity = 16.0;     // cap of the density (> 1)
+    double smoothing = 0.01;      // blur radius as a fraction of the image width
+    AutoMethod method = AutoMethod::Flow;
+};
+
+// The target density field for an importance image (one channel, or the mean of R,G,B); throws
+// conus::Error(InvalidArgument) on NaN/Inf or negative importance, or bad options.
+DensityField importanceToDensity(const Image& importance, const AutoMapOptions& options = {});
+
+SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options = {});
+SamplingMap buildSeparableMap(const DensityField& target, int columns, int rows);
+
+// Local detail of an image: gradient magnitude of its luminance (one channel "Y"), computed at
+// most 1024 px a side; an importance source for `--importance detail`.
+Image detailImportance(const Image& image);
+
+// Pearson correlation between the density a map achieves and a target field (both sampled at the
+// field's cell centres): 1 means the map follows the target exactly (up to scale).
+double densityCorrelation(const SamplingMap& map, const DensityField& target);
+
+}  // namespace conus::codec

@@ -1,0 +1,44 @@
+// CPU reference decoder: reconstructs a conventional frame from a CoNUS image. A view is a
+// rectangle of the undistorted image plane rendered at width x height; each output pixel at (u,v)
+// takes the CoNUS image at SM(u,v) (Equation 1), bilinearly. Where the output is coarser than the
+// CoNUS image there (zoomed out), several taps over the pixel's footprint are averaged. Output
+// pixels whose centre lies outside the image show the background (0 in every channel).
+#pragma once
+
+#include <cstdint>
+
+#include "conus/codec/map/sampling_map.h"
+#include "conus/core/error.h"
+#include "conus/core/image.h"
+
+namespace conus::codec {
+
+// The decoder's footprint rule, shared with its GLSL twins (renderers inject these values): an
+// output pixel whose footprint in the CoNUS image is at most kDecodeMultiTap pixels long on both
+// axes takes one bilinear tap; a longer axis takes ceil(length) taps, at most kDecodeMaxTaps.
+inline constexpr double kDecodeMultiTap = 1.5;
+inline constexpr int kDecodeMaxTaps = 8;
+
+struct View {
+    double u0 = 0, v0 = 0, u1 = 1, v1 = 1;  // undistorted rectangle; may extend past [0,1]^2 (background there)
+};
+
+struct DecodeOptions {
+    View view;
+    int width = 0, height = 0;  // output size
+    int threads = 0;
+    ProgressFn progress;
+};
+
+// Throws conus::Error(LimitExceeded) when decoding `conus` (only its size and channels are read)
+// to a width x height frame would hold more than `maxBytes` of pixels, the CoNUS image's and the
+// frame's together, as float (limits.h: kMaxDecodeBytes). decodeImage checks this before it
+// allocates; other decoders (the GPU one) call it too.
+void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes = kMaxDecodeBytes);
+
+Image decodeImage(const Image& conus, const SamplingMap& map, const DecodeOptions& options);
+
+// The plain baseline: the same view of a uniform image by bilinear resampling.
+Image resizeBilinear(const Image& image, const View& view, int width, int height, int threads = 0);
+
+}  // namespace conus::codec

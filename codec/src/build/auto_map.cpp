@@ -1,0 +1,209 @@
+#include "conus/codec/build/auto_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/core/error.h"
+
+namespace conus::codec {
+namespace {
+
+constexpr int kMaxGrid = 256;
+
+[[noreturn]] void invalid(const std::string& what) { throw Error(ErrorCode::InvalidArgument, what); }
+
+// One channel: "Y" or the first channel, or the mean of R, G, B when present.
+std::vector<float> luminance(const Image& image) {
+    const int r = image.channelIndex("R"), g = image.channelIndex("G"), b = image.channelIndex("B");
+    int single = image.channelIndex("Y");
+    if (single < 0) single = 0;
+    std::vector<float> out(static_cast<std::size_t>(image.width) * image.height);
+    for (std::size_t p = 0; p < out.size(); ++p) {
+        const float* px = &image.pixels[p * image.channels.size()];
+        out[p] = (r >= 0 && g >= 0 && b >= 0) ? (px[r] + px[g] + px[b]) / 3.0f : px[single];
+    }
+    return out;
+}
+
+// Box blur of radius `radius` cells along both axes, edges clamped; applied twice it approximates a
+// Gaussian and keeps the field smooth enough for a smooth map.
+void blur(std::vector<double>& field, int width, int height, int radius) {
+    if (radius <= 0) return;
+    std::vector<double> tmp(field.size());
+    for (int pass = 0; pass < 2; ++pass) {
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x) {
+                double sum = 0;
+                for (int d = -radius; d <= radius; ++d) sum += field[y * width + std::clamp(x + d, 0, width - 1)];
+                tmp[y * width + x] = sum / (2 * radius + 1);
+            }
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x) {
+                double sum = 0;
+                for (int d = -radius; d <= radius; ++d) sum += tmp[std::clamp(y + d, 0, height - 1) * width + x];
+                field[y * width + x] = sum / (2 * radius + 1);
+            }
+    }
+}
+
+}  // namespace
+
+DensityField importanceToDensity(const Image& importance, const AutoMapOptions& options) {
+    if (importance.empty()) invalid("the importance image is empty");
+    if (!(options.minDensity > 0 && options.minDensity < 1))
+        invalid("min density " + std::to_string(options.minDensity) + " must lie in (0, 1)");
+    if (!(options.maxDensity > 1 && options.maxDensity <= 4096))
+        invalid("max density " + std::to_string(options.maxDensity) + " must lie in (1, 4096]");
+    if (!(options.smoothing >= 0 && options.smoothing <= 0.5))
+        invalid("smoothing " + std::to_string(options.smoothing) + " must lie in [0, 0.5]");
+    for (float v : importance.pixels) {
+        if (!std::isfinite(v)) invalid("the importance image holds NaN or infinite values");
+        if (v < 0) invalid("the importance image holds negative values (" + std::to_string(v) + ")");
+    }
+
+    // Down to at most kMaxGrid cells a side, keeping the aspect (cells stay square-ish).
+    const double scale = std::min(1.0, double(kMaxGrid) / std::max(importance.width, importance.height));
+    const int gw = std::max(2, static_cast<int>(std::lround(importance.width * scale)));
+    const int gh = std::max(2, static_cast<int>(std::lround(importance.height * scale)));
+    Image single = makeImage(importance.width, importance.height, {"Y"});
+    single.pixels = luminance(importance);
+    const Image small = (gw <= importance.width && gh <= importance.height)
+                                    ? areaDownsample(single, gw, gh)
+                                    : resizeBilinear(single, {}, gw, gh);
+    std::vector<double> field(small.pixels.begin(), small.pixels.end());
+    // A map of n nodes a side cannot follow detail finer than its cells, and a target it cannot
+    // follow only makes the flow swirl: blur at least over one map cell.
+    const double cell = std::max(double(gw) / std::max(1, options.columns - 1), double(gh) / std::max(1, options.rows - 1));
+    blur(field, gw, gh, static_cast<int>(std::lround(std::max(options.smoothing * gw, 0.5 * cell))));
+
+    DensityField out;
+    out.width = gw;
+    out.height = gh;
+    out.values.assign(field.size(), 1.0f);
+    const double peak = *std::max_element(field.begin(), field.end());
+    if (!(peak > 0)) return out;  // no importance anywhere: uniform
+
+    // s such that mean(clamp(s I, floor, max)) == 1; the mean grows monotonically with s and with
+    // the floor. When even saturating every important cell at maxDensity leaves the mean below 1
+    // (importance on a few cells), the context gets more than the floor instead.
+    auto meanFor = [&](double s, double floor) {
+        double sum = 0;
+        for (double v : field) sum += std::clamp(s * v, floor, options.maxDensity);
+        return sum / field.size();
+    };
+    double smallest = peak;
+    for (double v : field)
+        if (v > 0) smallest = std::min(smallest, v);
+    const double sMax = options.maxDensity / smallest;
+    double s = sMax, floor = options.minDensity;
+    if (meanFor(sMax, floor) < 1.0) {
+        double lo = floor, hi = 1.0;
+        for (int i = 0; i < 100; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            (meanFor(sMax, mid) < 1.0 ? lo : hi) = mid;
+        }
+        floor = hi;
+    } else {
+        double lo = 0, hi = sMax;
+        for (int i = 0; i < 200; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            (meanFor(mid, floor) < 1.0 ? lo : hi) = mid;
+        }
+        s = hi;
+    }
+    for (std::size_t i = 0; i < field.size(); ++i)
+        out.values[i] = static_cast<float>(std::clamp(s * field[i], floor, options.maxDensity));
+    return out;
+}
+
+SamplingMap buildSeparableMap(const DensityField& target, int columns, int rows) {
+    const int w = target.width, h = target.height;
+    // Cumulative marginals, normalized to end at 1; node i sits at F(i/(columns-1)).
+    auto cumulative = [](const std::vector<double>& marginal) {
+        std::vector<double> c(marginal.size() + 1, 0.0);
+        for (std::size_t i = 0; i < marginal.size(); ++i) c[i + 1] = c[i] + marginal[i];
+        for (double& v : c) v /= c.back();
+        return c;
+    };
+    std::vector<double> mu(w, 0.0), mv(h, 0.0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            mu[x] += target.values[y * w + x];
+            mv[y] += target.values[y * w + x];
+        }
+    const auto cu = cumulative(mu), cv = cumulative(mv);
+    auto lookup = [](const std::vector<double>& c, double t) {
+        const double f = t * (c.size() - 1);
+        const int i = std::min(static_cast<int>(f), static_cast<int>(c.size()) - 2);
+        return c[i] + (f - i) * (c[i + 1] - c[i]);
+    };
+    std::vector<glm::vec2> nodes(static_cast<std::size_t>(columns) * rows);
+    for (int j = 0; j < rows; ++j)
+        for (int i = 0; i < columns; ++i) {
+            float x = static_cast<float>(lookup(cu, double(i) / (columns - 1)));
+            float y = static_cast<float>(lookup(cv, double(j) / (rows - 1)));
+            // Exactly on the edges (V10), whatever the rounding of the cumulative sums.
+            if (i == 0) x = 0;
+            if (i == columns - 1) x = 1;
+            if (j == 0) y = 0;
+            if (j == rows - 1) y = 1;
+            nodes[static_cast<std::size_t>(j) * columns + i] = {x, y};
+        }
+    return SamplingMap(columns, rows, std::move(nodes));
+}
+
+SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options) {
+    const DensityField target = importanceToDensity(importance, options);
+    if (options.method == AutoMethod::Separable) return buildSeparableMap(target, options.columns, options.rows);
+    DensityMapOptions mapOptions;
+    mapOptions.columns = options.columns;
+    mapOptions.rows = options.rows;
+    return buildMapFromDensity(target, mapOptions);
+}
+
+Image detailImportance(const Image& image) {
+    if (image.empty()) invalid("the image is empty");
+    const double scale = std::min(1.0, 1024.0 / std::max(image.width, image.height));
+    Image single = makeImage(image.width, image.height, {"Y"});
+    single.pixels = luminance(image);
+    const int w = std::max(1, static_cast<int>(std::lround(image.width * scale)));
+    const int h = std::max(1, static_cast<int>(std::lround(image.height * scale)));
+    const Image small = scale < 1 ? areaDownsample(single, w, h) : single;
+    Image detail = makeImage(w, h, {"Y"});
+    auto at = [&](int x, int y) { return small.at(std::clamp(x, 0, w - 1), std::clamp(y, 0, h - 1)); };
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            // Sobel gradient magnitude.
+            const double gx = (at(x + 1, y - 1) + 2 * at(x + 1, y) + at(x + 1, y + 1)) -
+                              (at(x - 1, y - 1) + 2 * at(x - 1, y) + at(x - 1, y + 1));
+            const double gy = (at(x - 1, y + 1) + 2 * at(x, y + 1) + at(x + 1, y + 1)) -
+                              (at(x - 1, y - 1) + 2 * at(x, y - 1) + at(x + 1, y - 1));
+            detail.at(x, y) = static_cast<float>(std::sqrt(gx * gx + gy * gy));
+        }
+    return detail;
+}
+
+double densityCorrelation(const SamplingMap& map, const DensityField& target) {
+    const std::size_t n = target.values.size();
+    std::vector<double> achieved(n);
+    for (int y = 0; y < target.height; ++y)
+        for (int x = 0; x < target.width; ++x)
+            achieved[y * target.width + x] = map.density({(x + 0.5) / target.width, (y + 0.5) / target.height});
+    const double ma = std::accumulate(achieved.begin(), achieved.end(), 0.0) / n;
+    const double mt = std::accumulate(target.values.begin(), target.values.end(), 0.0) / n;
+    double sab = 0, saa = 0, stt = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double a = achieved[i] - ma, t = target.values[i] - mt;
+        sab += a * t;
+        saa += a * a;
+        stt += t * t;
+    }
+    if (saa <= 0 || stt <= 0) return (saa <= 0 && stt <= 0) ? 1.0 : 0.0;
+    return sab / std::sqrt(saa * stt);
+}
+
+}  // namespace conus::codec

@@ -1,0 +1,222 @@
+// Circular foci: their target density, and maps built from it (joint density, or the paper's
+// addition of displacement vectors).
+#include "conus/codec/build/foci.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include "conus/codec/build/density_map.h"
+#include "conus/core/error.h"
+#include "conus/core/map_rules.h"
+
+namespace conus::codec {
+namespace {
+
+// The density grid resolves the smallest focus radius with at least this many samples, within
+// [kMinDensitySide, kMaxDensitySide] samples along the longer side.
+constexpr double kSamplesPerRadius = 12.0;
+constexpr int kMinDensitySide = 256;
+constexpr int kMaxDensitySide = 512;
+constexpr int kMinShortSide = 32;
+// Add composition: the factor applied to all displacements while the sum folds.
+constexpr double kAddShrink = 0.9;
+
+void checkFocus(const Focus& f) {
+    // Written as negations so that NaN fails every check.
+    if (!(f.u >= 0.0 && f.u <= 1.0 && f.v >= 0.0 && f.v <= 1.0)) {
+        throw Error(ErrorCode::InvalidArgument, "focus centre (" + numberText(f.u) + ", " + numberText(f.v) + ") is outside [0,1]^2");
+    }
+    if (!(f.r > 0.0 && f.r <= 1.0)) throw Error(ErrorCode::InvalidArgument, "focus radius " + numberText(f.r) + " is not in (0, 1]");
+    if (!(f.k >= 1.0 && f.k <= map_rules::kMaxMagnification)) {
+        throw Error(ErrorCode::InvalidArgument, "focus magnification " + numberText(f.k) + " is not in [1, " + numberText(map_rules::kMaxMagnification) + "]");
+    }
+}
+
+void checkOptions(const FociOptions& options) {
+    if (!(options.aspect > 0.0) || !std::isfinite(options.aspect)) {
+        throw Error(ErrorCode::InvalidArgument, "aspect " + numberText(options.aspect) + " is not finite and > 0");
+    }
+}
+
+// Quintic smoothstep falloff: 1 inside the radius, 0 beyond twice it, C2 in between.
+double falloff(double s) {
+    if (s <= 1.0) return 1.0;
+    if (s >= 2.0) return 0.0;
+    const double x = 2.0 - s;  // 1 at s = 1, 0 at s = 2
+    return x * x * x * (x * (x * 6.0 - 15.0) + 10.0);
+}
+
+DensityField sampleFociDensity(std::span<const Focus> foci, double aspect) {
+    double rMin = 1.0;
+    for (const Focus& f : foci) rMin = std::min(rMin, f.r);
+    // Radius in u is r, in v it is r * aspect; sample pixel-isotropically (H = W / aspect).
+    const double needW = kSamplesPerRadius / rMin, needH = kSamplesPerRadius / (rMin * aspect);
+    double w = std::max(needW, needH * aspect), h = w / aspect;
+    const double longSide = std::max(w, h);
+    const double scale = std::clamp(longSide, double(kMinDensitySide), double(kMaxDensitySide)) / longSide;
+    DensityField field;
+    field.width = std::max(kMinShortSide, static_cast<int>(std::lround(w * scale)));
+    field.height = std::max(kMinShortSide, static_cast<int>(std::lround(h * scale)));
+    field.values.resize(std::size_t(field.width) * field.height);
+    for (int y = 0; y < field.height; ++y)
+        for (int x = 0; x < field.width; ++x)
+            field.values[std::size_t(y) * field.width + x] =
+                static_cast<float>(fociDensity(foci, aspect, (x + 0.5) / field.width, (y + 0.5) / field.height));
+    return field;
+}
+
+SamplingMap buildDensityComposition(std::span<const Focus> foci, const FociOptions& options) {
+    DensityMapOptions mapOptions;
+    mapOptions.columns = options.columns;
+    mapOptions.rows = options.rows;
+    return buildMapFromDensity(sampleFociDensity(foci, options.aspect), mapOptions);
+}
+
+SamplingMap buildAddComposition(std::span<const Focus> foci, const FociOptions& options) {
+    const int n = options.columns, m = options.rows;
+    const std::size_t count = std::size_t(n) * m;
+    std::vector<glm::dvec2> displacement(count, glm::dvec2(0.0));
+    for (const Focus& f : foci) {
+        const SamplingMap single = buildDensityComposition(std::span<const Focus>(&f, 1), options);
+        for (int j = 0; j < m; ++j)
+            for (int i = 0; i < n; ++i) {
+                const std::size_t k = std::size_t(j) * n + i;
+                displacement[k] += glm::dvec2(single.nodes()[k]) - glm::dvec2(double(i) / (n - 1), double(j) / (m - 1));
+            }
+    }
+    format::GridNodes grid;
+    grid.columns = n;
+    grid.rows = m;
+    grid.xy.resize(2 * count);
+    for (double scale = 1.0;; scale *= kAddShrink) {
+        if (scale < 1e-3) scale = 0.0;  // the identity: always valid
+        for (int j = 0; j < m; ++j)
+            for (int i = 0; i < n; ++i) {
+                const std::size_t k = std::size_t(j) * n + i;
+                glm::dvec2 p = glm::dvec2(double(i) / (n - 1), double(j) / (m - 1)) + scale * displacement[k];
+                p = glm::clamp(p, 0.0, 1.0);
+                if (i == 0) p.x = 0.0;
+                if (i == n - 1) p.x = 1.0;
+                if (j == 0) p.y = 0.0;
+                if (j == m - 1) p.y = 1.0;
+                grid.xy[2 * k] = static_cast<float>(p.x);
+                grid.xy[2 * k + 1] = static_cast<float>(p.y);
+            }
+        if (scale == 0.0 || format::validateGrid(grid).ok()) return SamplingMap::fromGrid(grid);
+    }
+}
+
+}  // namespace
+
+double fociDensity(std::span<const Focus> foci, double aspect, double u, double v) {
+    double density = 1.0;
+    for (const Focus& f : foci) {
+        const double dx = u - f.u, dy = (v - f.v) / aspect;
+        const double s = std::sqrt(dx * dx + dy * dy) / f.r;
+        density = std::max(density, 1.0 + (f.k * f.k - 1.0) * falloff(s));
+    }
+    return density;
+}
+
+SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options) {
+    checkOptions(options);
+    for (const Focus& f : foci) checkFocus(f);
+    if (options.columns < 2 || options.rows < 2) {
+        throw Error(ErrorCode::InvalidArgument, "foci map grid " + std::to_string(options.columns) + "x" +
+                                                    std::to_string(options.rows) + " needs at least 2x2 nodes");
+    }
+    if (foci.empty()) return SamplingMap::identity(options.columns, options.rows);
+    return options.composition == FociComposition::Add ? buildAddComposition(foci, options)
+                                                       : buildDensityComposition(foci, options);
+}
+
+std::vector<double> reachedMagnification(const SamplingMap& map, std::span<const Focus> foci) {
+    // The lowest density, sampled finely enough to find the context between and around foci.
+    constexpr int kSamples = 64;
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < kSamples; ++j)
+        for (int i = 0; i < kSamples; ++i) lowest = std::min(lowest, map.density({(i + 0.5) / kSamples, (j + 0.5) / kSamples}));
+    std::vector<double> reached;
+    for (const Focus& f : foci) reached.push_back(std::sqrt(std::max(0.0, map.density({f.u, f.v}) / lowest)));
+    return reached;
+}
+
+void checkFociHeld(const SamplingMap& map, std::span<const Focus> foci, const FociOptions& options) {
+    constexpr int kLargestSuggestion = 257;
+    auto firstMissed = [&](const SamplingMap& m) -> int {
+        const std::vector<double> reached = reachedMagnification(m, foci);
+        for (std::size_t i = 0; i < foci.size(); ++i)
+            if (reached[i] < 1.0 + 0.5 * (foci[i].k - 1.0)) return static_cast<int>(i);
+        return -1;
+    };
+    const int missed = firstMissed(map);
+    if (missed < 0) return;
+    const Focus& f = foci[missed];
+    const double reached = reachedMagnification(map, foci)[missed];
+    std::string advice = "no grid up to " + std::to_string(kLargestSuggestion) + " nodes a side holds it";
+    for (int side = 3; side <= kLargestSuggestion; side = 2 * side - 1) {
+        if (side <= std::max(options.columns, options.rows)) continue;
+        FociOptions finer = options;
+        finer.columns = finer.rows = side;
+        if (firstMissed(buildFociMap(foci, finer)) < 0) {
+            advice = "a grid of " + std::to_string(side) + " nodes a side or more does";
+            break;
+        }
+    }
+    throw Error(ErrorCode::InvalidArgument,
+                "a " + std::to_string(options.columns) + "x" + std::to_string(options.rows) + " grid is too coarse for focus " +
+                    numberText(f.u) + "," + numberText(f.v) + "," + numberText(f.r) + "," + numberText(f.k) + ": it reaches a magnification of " +
+                    numberText(std::round(reached * 100) / 100) + " there; " + advice);
+}
+
+Focus parseFocus(const std::string& text) {
+    std::vector<std::string> parts;
+    std::size_t begin = 0;
+    while (true) {
+        const std::size_t comma = text.find(',', begin);
+        parts.push_back(text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin));
+        if (comma == std::string::npos) break;
+        begin = comma + 1;
+    }
+    if (parts.size() != 4) {
+        throw Error(ErrorCode::InvalidArgument, "focus \"" + text + "\" has " + std::to_string(parts.size()) +
+                                                    " values; expected u,v,r,k (e.g. 0.42,0.31,0.08,4)");
+    }
+    static constexpr const char* kNames[4] = {"u", "v", "r", "k"};
+    double values[4];
+    for (int c = 0; c < 4; ++c) {
+        const std::string& s = parts[c];
+        const char* first = s.c_str();
+        char* end = nullptr;
+        errno = 0;
+        values[c] = std::strtod(first, &end);
+        while (end && (*end == ' ' || *end == '\t')) ++end;
+        if (s.find_first_not_of(" \t") == std::string::npos || end == first || *end != '\0' || errno == ERANGE ||
+            !std::isfinite(values[c])) {
+            throw Error(ErrorCode::InvalidArgument,
+                        "focus \"" + text + "\": " + kNames[c] + " = \"" + s + "\" is not a finite number");
+        }
+    }
+    const Focus focus{values[0], values[1], values[2], values[3]};
+    try {
+        checkFocus(focus);
+    } catch (const Error& e) {
+        throw Error(ErrorCode::InvalidArgument, "focus \"" + text + "\": " + e.what());
+    }
+    return focus;
+}
+
+format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition composition) {
+    format::AnalyticMap analytic;
+    analytic.kind = "foci";
+    analytic.composition = composition == FociComposition::Add ? "add" : "density";
+    for (const Focus& f : foci) analytic.foci.push_back({f.u, f.v, f.r, f.k});
+    return analytic;
+}
+
+}  // namespace conus::codec

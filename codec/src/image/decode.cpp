@@ -1,0 +1,379 @@
+// CPU reference decoder (paper section 4): a conventional view from a CoNUS image, and the plain
+// bilinear baseline it is timed against.
+//
+// Eq. 1 is evaluated by the row stepping of decode_pvt.h, not by SamplingMap::distort: inside a
+// span the position advances by a constant step, in 32.32 fixed point where no tap can leave the
+// image, so a magnified pixel costs the baseline's one bilinear tap plus a few integer adds. Where
+// the view is coarser than the CoNUS image (zoomed out, or a focus seen from afar) the pixel's
+// footprint, bounded per map cell, decides how many taps to average over it.
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "conus/codec/image/decode.h"
+#include "decode_pvt.h"
+#include "conus/core/parallel.h"
+#include "resample_pvt.h"
+
+namespace conus::codec {
+namespace detail {
+
+ViewColumns viewColumns(int mapColumns, double u0, double u1, int width) {
+    ViewColumns c;
+    c.cell.resize(width);
+    c.s.resize(width);
+    c.inside.resize(width);
+    const int cells = mapColumns - 1;
+    c.firstCell = cells - 1;
+    c.lastCell = 0;
+    for (int x = 0; x < width; ++x) {
+        const double u = u0 + (x + 0.5) / width * (u1 - u0);
+        const double uc = std::clamp(u, 0.0, 1.0);
+        const double f = uc * cells;
+        const int i = std::clamp(static_cast<int>(f), 0, cells - 1);
+        c.cell[x] = i;
+        c.s[x] = f - i;
+        c.inside[x] = (u >= 0.0 && u <= 1.0) ? 1.0 : 0.0;
+        c.firstCell = std::min(c.firstCell, i);
+        c.lastCell = std::max(c.lastCell, i);
+    }
+    // s steps by ds per column inside [0,1]; a span restarts where the cell or the clamp changes.
+    const double ds = (u1 - u0) / width * cells;
+    for (int x = 0; x < width;) {
+        ColumnSpan span;
+        span.x0 = x;
+        span.cell = c.cell[x];
+        span.s0 = c.s[x];
+        span.inside = c.inside[x] != 0.0;
+        span.ds = span.inside ? ds : 0.0;
+        while (x < width && c.cell[x] == span.cell && (c.inside[x] != 0.0) == span.inside) ++x;
+        span.x1 = x;
+        c.spans.push_back(span);
+    }
+    return c;
+}
+
+CellRow cellRow(int mapRows, double v) {
+    CellRow r;
+    const double vc = std::clamp(v, 0.0, 1.0);
+    const double f = vc * (mapRows - 1);
+    r.j = std::clamp(static_cast<int>(f), 0, mapRows - 2);
+    r.t = f - r.j;
+    r.inside = v >= 0.0 && v <= 1.0;
+    return r;
+}
+
+void rowNodes(const SamplingMap& map, const CellRow& row, int first, int last, glm::dvec2 scale, glm::dvec2 offset,
+              RowNodes& out) {
+    const std::size_t n = static_cast<std::size_t>(map.columns());
+    out.x.resize(n);
+    out.y.resize(n);
+    out.dx.resize(n);
+    out.dy.resize(n);
+    for (int i = first; i <= last + 1; ++i) {
+        const glm::dvec2 a(map.node(i, row.j)), b(map.node(i, row.j + 1));
+        const glm::dvec2 p = a + row.t * (b - a);
+        out.x[i] = p.x * scale.x - offset.x;
+        out.y[i] = p.y * scale.y - offset.y;
+    }
+    for (int i = first; i <= last; ++i) {
+        out.dx[i] = out.x[i + 1] - out.x[i];
+        out.dy[i] = out.y[i + 1] - out.y[i];
+    }
+}
+
+std::vector<glm::dvec2> distortViewRow(const SamplingMap& map, const View& view, int width, int height, int y) {
+    const ViewColumns cols = viewColumns(map.columns(), view.u0, view.u1, width);
+    const CellRow row = cellRow(map.rows(), view.v0 + (y + 0.5) / height * (view.v1 - view.v0));
+    RowNodes nodes;
+    rowNodes(map, row, cols.firstCell, cols.lastCell, glm::dvec2(1.0), glm::dvec2(0.0), nodes);
+    std::vector<glm::dvec2> out(width);
+    forEachSpan(cols, nodes, [&](const ColumnSpan& span, double px, double py, double sx, double sy) {
+        for (int x = span.x0; x < span.x1; ++x, px += sx, py += sy) out[x] = {px, py};
+    });
+    return out;
+}
+
+}  // namespace detail
+
+namespace {
+
+// A footprint longer than this (in CoNUS pixels) on either axis gets several taps.
+constexpr double kMultiTapThreshold = kDecodeMultiTap;
+constexpr int kMaxTapsPerAxis = kDecodeMaxTaps;
+
+void checkView(const View& v, const char* what) {
+    if (!std::isfinite(v.u0) || !std::isfinite(v.u1) || !std::isfinite(v.v0) || !std::isfinite(v.v1) ||
+        v.u0 == v.u1 || v.v0 == v.v1 || std::abs(v.u1 - v.u0) > 1e6 || std::abs(v.v1 - v.v0) > 1e6)
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": view (" + std::to_string(v.u0) + ", " +
+                                                    std::to_string(v.v0) + ") - (" + std::to_string(v.u1) + ", " +
+                                                    std::to_string(v.v1) + ") is empty or not finite");
+}
+
+// Taps per footprint axis: an axis up to the threshold is covered by one bilinear tap (its tent
+// spans two pixels), longer ones by ceil(length) taps at most a pixel apart.
+inline int tapsFor(double length) {
+    return length <= kMultiTapThreshold ? 1 : std::min(kMaxTapsPerAxis, static_cast<int>(std::ceil(length)));
+}
+
+constexpr detail::TapOffsets<kMaxTapsPerAxis> kTapOffsets;
+
+// Fixed point 32.32 for the stepped coordinates of interior spans: the integer part and the
+// weight come out of one add and two shifts instead of float-int round trips.
+constexpr double kFixedOne = 4294967296.0;
+
+// Bilinear at CoNUS pixel coordinates plus one, known to lie in [0.5, size + 0.5] (Eq. 1 keeps
+// every point inside the image): positive, so truncation is floor. kClamp = false when the whole
+// 2x2 neighbourhood is known to be inside the image. kAccumulate adds weight * value to out.
+template <int kC, bool kClamp, bool kAccumulate>
+inline void tapBiased(const float* pixels, int width, int height, int c, double x, double y, float weight,
+                      float* out) {
+    const int channels = kC > 0 ? kC : c;
+    const int xi = static_cast<int>(x), yi = static_cast<int>(y);
+    const float fx = static_cast<float>(x - xi), fy = static_cast<float>(y - yi);
+    const int x0 = kClamp ? std::max(xi - 1, 0) : xi - 1, x1 = kClamp ? std::min(xi, width - 1) : xi;
+    const int y0 = kClamp ? std::max(yi - 1, 0) : yi - 1, y1 = kClamp ? std::min(yi, height - 1) : yi;
+    const std::size_t stride = static_cast<std::size_t>(width) * channels;
+    const float* r0 = pixels + y0 * stride;
+    const float* r1 = pixels + y1 * stride;
+    const int o0 = x0 * channels, o1 = x1 * channels;
+    for (int k = 0; k < channels; ++k) {
+        const float top = r0[o0 + k] + fx * (r0[o1 + k] - r0[o0 + k]);
+        const float bottom = r1[o0 + k] + fx * (r1[o1 + k] - r1[o0 + k]);
+        const float value = top + fy * (bottom - top);
+        if constexpr (kAccumulate) out[k] += weight * value;
+        else out[k] = value;
+    }
+}
+
+inline double length(double x, double y) { return std::sqrt(x * x + y * y); }
+
+// Whether every biased point in the box [xlo,xhi] x [ylo,yhi] has its 2x2 neighbourhood inside.
+inline bool interior(double xlo, double xhi, double ylo, double yhi, int width, int height) {
+    constexpr double kMargin = 1e-4;  // covers the fixed-point drift of the longest span
+    return xlo >= 1.0 + kMargin && xhi < width - kMargin && ylo >= 1.0 + kMargin && yhi < height - kMargin;
+}
+
+template <int kC>
+void decodeRows(const Image& src, const SamplingMap& map, const View& view, Image& dst,
+                const detail::ViewColumns& cols, int y0, int y1) {
+    const int channels = kC > 0 ? kC : src.channelCount();
+    const int W = dst.width, H = dst.height, Wc = src.width, Hc = src.height;
+    const int n = map.columns(), m = map.rows();
+    const double du = std::abs(view.u1 - view.u0) / W, dv = std::abs(view.v1 - view.v0) / H;
+    const std::size_t stride = static_cast<std::size_t>(Wc) * channels;
+    detail::RowNodes nodes;
+    // Per node column: d(position)/dv over one output pixel, CoNUS pixels. Per cell: footprint
+    // along u over one output pixel, and whether any pixel of the cell may need several taps.
+    std::vector<double> bx(n), by(n), ax(n), ay(n);
+    std::vector<char> multi(n);
+    std::vector<float> dynamicAcc(kC > 0 ? 0 : channels);
+    const float* pixels = src.pixels.data();
+
+    for (int y = y0; y < y1; ++y) {
+        const detail::CellRow row = detail::cellRow(m, view.v0 + (y + 0.5) / H * (view.v1 - view.v0));
+        // CoNUS pixel coordinates plus one (see tapBiased).
+        detail::rowNodes(map, row, cols.firstCell, cols.lastCell, glm::dvec2(Wc, Hc), glm::dvec2(-0.5), nodes);
+        const double rowInside = row.inside ? 1.0 : 0.0;
+        for (int i = cols.firstCell; i <= cols.lastCell + 1; ++i) {
+            const glm::dvec2 d = glm::dvec2(map.node(i, row.j + 1)) - glm::dvec2(map.node(i, row.j));
+            bx[i] = d.x * (m - 1) * dv * Wc * rowInside;
+            by[i] = d.y * (m - 1) * dv * Hc * rowInside;
+        }
+        for (int i = cols.firstCell; i <= cols.lastCell; ++i) {
+            ax[i] = nodes.dx[i] * (n - 1) * du;
+            ay[i] = nodes.dy[i] * (n - 1) * du;
+            // |b| is convex along the cell, so its larger end bounds it.
+            const double lb = std::max(length(bx[i], by[i]), length(bx[i + 1], by[i + 1]));
+            multi[i] = std::max(length(ax[i], ay[i]), lb) > kMultiTapThreshold;
+        }
+
+        float* const rowOut = dst.pixels.data() + static_cast<std::size_t>(y) * W * channels;
+        detail::forEachSpan(cols, nodes, [&](const detail::ColumnSpan& span, double px, double py, double sx,
+                                             double sy) {
+            const int i = span.cell;
+            float* out = rowOut + static_cast<std::size_t>(span.x0) * channels;
+            const int count = span.x1 - span.x0;
+            const double pxEnd = px + (count - 1) * sx, pyEnd = py + (count - 1) * sy;
+            if (!multi[i]) {
+                // The common case (magnifying): one tap, the position stepped along the span.
+                if (interior(std::min(px, pxEnd), std::max(px, pxEnd), std::min(py, pyEnd), std::max(py, pyEnd),
+                             Wc, Hc)) {
+                    std::int64_t fxp = std::llround(px * kFixedOne), fyp = std::llround(py * kFixedOne);
+                    const std::int64_t fsx = std::llround(sx * kFixedOne), fsy = std::llround(sy * kFixedOne);
+                    constexpr float kFraction = 1.0f / 4294967296.0f;
+                    for (int k = 0; k < count; ++k, fxp += fsx, fyp += fsy, out += channels) {
+                        const int xi = static_cast<int>(fxp >> 32), yi = static_cast<int>(fyp >> 32);
+                        const float fx = static_cast<float>(fxp & 0xffffffff) * kFraction;
+                        const float fy = static_cast<float>(fyp & 0xffffffff) * kFraction;
+                        const float* p0 = pixels + (yi - 1) * stride + static_cast<std::size_t>(xi - 1) * channels;
+                        const float* p1 = p0 + stride;
+                        for (int c = 0; c < channels; ++c) {
+                            const float top = p0[c] + fx * (p0[channels + c] - p0[c]);
+                            const float bottom = p1[c] + fx * (p1[channels + c] - p1[c]);
+                            out[c] = top + fy * (bottom - top);
+                        }
+                    }
+                } else {
+                    for (int k = 0; k < count; ++k, px += sx, py += sy, out += channels)
+                        tapBiased<kC, true, false>(pixels, Wc, Hc, channels, px, py, 1.0f, out);
+                }
+                return;
+            }
+            const double inside = span.inside ? 1.0 : 0.0;
+            const double axp = ax[i] * inside, ayp = ay[i] * inside;
+            const int na = tapsFor(length(axp, ayp));
+            double s = span.s0;
+            for (int k = 0; k < count; ++k, px += sx, py += sy, s += span.ds, out += channels) {
+                const double bxp = bx[i] + s * (bx[i + 1] - bx[i]), byp = by[i] + s * (by[i + 1] - by[i]);
+                const int nb = tapsFor(length(bxp, byp));
+                if (na == 1 && nb == 1) {
+                    tapBiased<kC, true, false>(pixels, Wc, Hc, channels, px, py, 1.0f, out);
+                    continue;
+                }
+                // Average na x nb taps over the footprint parallelogram of the output pixel.
+                const float weight = 1.0f / static_cast<float>(na * nb);
+                float fixedAcc[kC > 0 ? kC : 1];
+                float* acc = kC > 0 ? fixedAcc : dynamicAcc.data();
+                for (int c = 0; c < channels; ++c) acc[c] = 0.0f;
+                const double* oa = kTapOffsets.at[na];
+                const double* ob = kTapOffsets.at[nb];
+                const double ex = std::abs(axp) * 0.5 + std::abs(bxp) * 0.5, ey = std::abs(ayp) * 0.5 + std::abs(byp) * 0.5;
+                const bool inner = interior(px - ex, px + ex, py - ey, py + ey, Wc, Hc);
+                for (int jb = 0; jb < nb; ++jb) {
+                    const double qx = px + bxp * ob[jb], qy = py + byp * ob[jb];
+                    for (int ia = 0; ia < na; ++ia) {
+                        const double tx = qx + axp * oa[ia], ty = qy + ayp * oa[ia];
+                        if (inner) tapBiased<kC, false, true>(pixels, Wc, Hc, channels, tx, ty, weight, acc);
+                        else
+                            tapBiased<kC, true, true>(pixels, Wc, Hc, channels, std::clamp(tx, 0.5, Wc + 0.5),
+                                                      std::clamp(ty, 0.5, Hc + 0.5), weight, acc);
+                    }
+                }
+                for (int c = 0; c < channels; ++c) out[c] = acc[c];
+            }
+        });
+    }
+}
+
+// Per-axis bilinear taps of the baseline, precomputed like the decoder's view columns.
+struct AxisTaps {
+    std::vector<int> i0, i1;
+    std::vector<float> f;
+};
+
+AxisTaps axisTaps(int size, double a0, double a1, int count) {
+    AxisTaps t;
+    t.i0.resize(count);
+    t.i1.resize(count);
+    t.f.resize(count);
+    for (int k = 0; k < count; ++k) {
+        const double a = std::clamp(a0 + (k + 0.5) / count * (a1 - a0), 0.0, 1.0);
+        const double p = a * size - 0.5;
+        const int i = detail::floorToInt(p);
+        t.f[k] = static_cast<float>(p - i);
+        t.i0[k] = std::max(i, 0);
+        t.i1[k] = std::min(i + 1, size - 1);
+    }
+    return t;
+}
+
+template <int kC>
+void bilinearRows(const Image& src, Image& dst, const AxisTaps& tx, const AxisTaps& ty, int y0,
+                  int y1) {
+    const int channels = kC > 0 ? kC : src.channelCount();
+    const std::size_t stride = static_cast<std::size_t>(src.width) * channels;
+    for (int y = y0; y < y1; ++y) {
+        const float* r0 = src.pixels.data() + ty.i0[y] * stride;
+        const float* r1 = src.pixels.data() + ty.i1[y] * stride;
+        const float fy = ty.f[y];
+        float* out = dst.pixels.data() + static_cast<std::size_t>(y) * dst.width * channels;
+        for (int x = 0; x < dst.width; ++x, out += channels) {
+            const int o0 = tx.i0[x] * channels, o1 = tx.i1[x] * channels;
+            const float fx = tx.f[x];
+            for (int k = 0; k < channels; ++k) {
+                const float top = r0[o0 + k] + fx * (r0[o1 + k] - r0[o0 + k]);
+                const float bottom = r1[o0 + k] + fx * (r1[o1 + k] - r1[o0 + k]);
+                out[k] = top + fy * (bottom - top);
+            }
+        }
+    }
+}
+
+// Pixels whose centre lies outside the image ([0,1]^2 undistorted) show the background, 0 in every
+// channel, instead of the edge pixels smeared outward.
+void clearOutside(Image& out, const View& view) {
+    const std::size_t rowValues = static_cast<std::size_t>(out.width) * out.channels.size();
+    std::vector<char> columnOutside(out.width);
+    for (int x = 0; x < out.width; ++x) {
+        const double u = view.u0 + (x + 0.5) / out.width * (view.u1 - view.u0);
+        columnOutside[x] = !(u >= 0.0 && u <= 1.0);
+    }
+    for (int y = 0; y < out.height; ++y) {
+        float* row = out.pixels.data() + y * rowValues;
+        const double v = view.v0 + (y + 0.5) / out.height * (view.v1 - view.v0);
+        if (!(v >= 0.0 && v <= 1.0)) {
+            std::fill(row, row + rowValues, 0.0f);
+            continue;
+        }
+        for (int x = 0; x < out.width; ++x)
+            if (columnOutside[x]) std::fill_n(row + x * out.channels.size(), out.channels.size(), 0.0f);
+    }
+}
+
+}  // namespace
+
+void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes) {
+    const std::int64_t channels = conus.channelCount();
+    const std::int64_t bytes = (std::int64_t{conus.width} * conus.height + std::int64_t{width} * height) * channels *
+                               std::int64_t(sizeof(float));
+    if (bytes > maxBytes) {
+        throw Error(ErrorCode::LimitExceeded,
+                    "decoding a " + std::to_string(conus.width) + "x" + std::to_string(conus.height) + " image to " +
+                        std::to_string(width) + "x" + std::to_string(height) + " pixels of " + std::to_string(channels) +
+                        " channels takes " + std::to_string(bytes) + " bytes, beyond the decode memory limit of " +
+                        std::to_string(maxBytes));
+    }
+}
+
+Image decodeImage(const Image& conus, const SamplingMap& map, const DecodeOptions& options) {
+    checkImage(conus, "decodeImage");
+    detail::checkOutputSize(options.width, options.height, "decodeImage");
+    checkDecodeMemory(conus, options.width, options.height);
+    checkView(options.view, "decodeImage");
+    Image out = detail::makeOutput(conus, options.width, options.height);
+    const detail::ViewColumns cols = detail::viewColumns(map.columns(), options.view.u0, options.view.u1, out.width);
+    detail::RowProgress progress(options.progress, out.height);
+    parallelRows(
+        out.height, options.threads,
+        [&](int y0, int y1) {
+            detail::dispatchChannels(conus.channelCount(), [&]<int kC>() {
+                decodeRows<kC>(conus, map, options.view, out, cols, y0, y1);
+            });
+            progress.add(y1 - y0);
+        },
+        16);
+    clearOutside(out, options.view);
+    return out;
+}
+
+Image resizeBilinear(const Image& image, const View& view, int width, int height, int threads) {
+    checkImage(image, "resizeBilinear");
+    detail::checkOutputSize(width, height, "resizeBilinear");
+    checkView(view, "resizeBilinear");
+    Image out = detail::makeOutput(image, width, height);
+    const AxisTaps tx = axisTaps(image.width, view.u0, view.u1, width);
+    const AxisTaps ty = axisTaps(image.height, view.v0, view.v1, height);
+    parallelRows(
+        height, threads,
+        [&](int y0, int y1) {
+            detail::dispatchChannels(image.channelCount(),
+                                     [&]<int kC>() { bilinearRows<kC>(image, out, tx, ty, y0, y1); });
+        },
+        16);
+    clearOutside(out, view);
+    return out;
+}
+
+}  // namespace conus::codec

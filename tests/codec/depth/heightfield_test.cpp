@@ -1,0 +1,199 @@
+#include "conus/codec/depth/heightfield.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "conus/codec/build/ground_map.h"
+#include "conus/format/container.h"
+#include "conus/core/error.h"
+
+namespace conus::codec {
+namespace {
+
+// Metres: eye 150 m up, the field from 50 m to 6 km in front of the viewer.
+GroundParams testGround() { return {150.0, 50.0, 6000.0, 60.0}; }
+
+TerrainOptions smallTerrain(int size = 256) {
+    TerrainOptions o;
+    o.width = o.height = size;
+    o.seed = 3;
+    return o;
+}
+
+format::ConusFile encodeSmall(int size, int conus) {
+    const Image dem = generateTerrain(smallTerrain(size));
+    const Image colour = terrainColours(dem, fieldExtent(testGround()));
+    HeightFieldOptions options;
+    options.ground = testGround();
+    options.width = options.height = conus;
+    options.mapGrid = 33;
+    return encodeHeightField(dem, colour, options);
+}
+
+TEST(HeightFieldTerrain, DeterministicAndSizeIndependent) {
+    const Image a = generateTerrain(smallTerrain(128));
+    const Image b = generateTerrain(smallTerrain(128));
+    EXPECT_EQ(a.pixels, b.pixels);
+    TerrainOptions other = smallTerrain(128);
+    other.seed = 4;
+    EXPECT_NE(a.pixels, generateTerrain(other).pixels);
+    // The same landscape at twice the size: pixel (2x+1/2) of the large one sits between samples;
+    // compare the sample at the same (u,v) instead: large pixel centres (2x+0.5)/256 vs (x+0.5)/128
+    // differ by a quarter of a small pixel, so heights agree to the local slope only.
+    const Image big = generateTerrain(smallTerrain(256));
+    double diff = 0;
+    for (int y = 0; y < 128; ++y)
+        for (int x = 0; x < 128; ++x) {
+            const double avg = 0.25 * (big.at(2 * x, 2 * y) + big.at(2 * x + 1, 2 * y) + big.at(2 * x, 2 * y + 1) +
+                                       big.at(2 * x + 1, 2 * y + 1));
+            diff += std::abs(avg - a.at(x, y));
+        }
+    EXPECT_LT(diff / (128 * 128), 10.0);  // metres, on ~600 m of relief
+    const auto [lo, hi] = std::minmax_element(a.pixels.begin(), a.pixels.end());
+    EXPECT_GE(*lo, 0.0f);
+    EXPECT_GT(*hi - *lo, 200.0f);
+}
+
+TEST(HeightFieldTerrain, ColoursInRange) {
+    const Image dem = generateTerrain(smallTerrain(64));
+    const Image colour = terrainColours(dem, {1000, 1000});
+    ASSERT_EQ(colour.channels, (std::vector<std::string>{"R", "G", "B"}));
+    for (float c : colour.pixels) {
+        EXPECT_GE(c, 0.0f);
+        EXPECT_LE(c, 1.0f);
+    }
+}
+
+TEST(HeightFieldEncode, ValidFileWithHeightAndGroundParams) {
+    const format::ConusFile file = encodeSmall(256, 64);
+    const format::ValidationReport report = format::validateConusFile(file);
+    EXPECT_TRUE(report.ok()) << report.str();
+    EXPECT_EQ(file.dataKind, format::DataKind::HeightField);
+    EXPECT_EQ(file.depth.kind, format::DepthKind::Height);
+    EXPECT_EQ(file.depth.units, "m");
+    EXPECT_LT(file.depth.near, file.depth.far);
+    EXPECT_GE(file.image.channelIndex("Z"), 0);
+    EXPECT_GE(file.image.channelIndex("R"), 0);
+    ASSERT_TRUE(file.analytic.has_value());
+    EXPECT_EQ(file.analytic->kind, "ground");
+    const GroundParams back = groundFromAnalytic(*file.analytic);
+    EXPECT_EQ(back.far, testGround().far);
+    EXPECT_EQ(file.map.columns, 33);
+    EXPECT_EQ(file.sourceWidth, 256);
+
+    // And through a file on disk.
+    const std::string path = (std::filesystem::temp_directory_path() / "conus_heightfield_test.exr").string();
+    format::writeConusFile(path, file);
+    const format::ValidationReport disk = format::validateConusFile(path);
+    EXPECT_TRUE(disk.ok()) << disk.str();
+    const format::ConusFile read = format::readConusFile(path);
+    EXPECT_EQ(read.depth.kind, format::DepthKind::Height);
+    EXPECT_EQ(read.image.channelIndex("Z") >= 0, true);
+    std::filesystem::remove(path);
+}
+
+TEST(HeightFieldEncode, ZIsFilteredHeight) {
+    // A flat DEM at 42 m stays 42 m everywhere: filtering never invents heights.
+    Image dem = makeImage(64, 64, {"Z"});
+    std::fill(dem.pixels.begin(), dem.pixels.end(), 42.0f);
+    HeightFieldOptions options;
+    options.ground = testGround();
+    options.width = options.height = 32;
+    const format::ConusFile file = encodeHeightField(dem, terrainColours(dem, {100, 100}), options);
+    const int z = file.image.channelIndex("Z");
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) EXPECT_NEAR(file.image.at(x, y, z), 42.0f, 1e-3);
+    EXPECT_TRUE(format::validateConusFile(file).ok());
+}
+
+TEST(HeightFieldMesh, VerticesOnUndistortedGround) {
+    const format::ConusFile file = encodeSmall(128, 48);
+    const GroundParams ground = testGround();
+    const glm::dvec2 extent = fieldExtent(ground);
+    const Mesh mesh = undistortHeightField(file);
+    const int w = file.image.width, h = file.image.height, nx = w + 2, ny = h + 2;
+    ASSERT_EQ(mesh.positions.size(), std::size_t(nx) * ny);
+    ASSERT_EQ(mesh.colours.size(), mesh.positions.size());
+    ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
+    ASSERT_EQ(mesh.indices.size(), std::size_t(nx - 1) * (ny - 1) * 6);
+    const int z = file.image.channelIndex("Z");
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const glm::dvec2 p = groundUndistort(ground, {(x + 0.5) / w, (y + 0.5) / h});
+            const glm::vec3 q = mesh.positions[std::size_t(y + 1) * nx + x + 1];
+            ASSERT_NEAR(q.x / extent.x, p.x, 1e-6) << x << "," << y;
+            ASSERT_NEAR(q.z / extent.y, p.y, 1e-6) << x << "," << y;
+            ASSERT_EQ(q.y, file.image.at(x, y, z));
+        }
+    // The corners of the field are covered exactly.
+    const auto corner = [&](int i, int j) { return mesh.positions[std::size_t(j) * nx + i]; };
+    EXPECT_EQ(corner(0, 0).x, 0.0f);
+    EXPECT_EQ(corner(0, 0).z, 0.0f);
+    EXPECT_NEAR(corner(nx - 1, ny - 1).x, extent.x, 1e-3);
+    EXPECT_NEAR(corner(nx - 1, ny - 1).z, extent.y, 1e-3);
+    EXPECT_NEAR(corner(nx - 1, 0).x, extent.x, 1e-3);
+    EXPECT_NEAR(corner(0, ny - 1).z, extent.y, 1e-3);
+    for (const glm::vec3& n : mesh.normals) ASSERT_GT(n.y, 0.0f);
+}
+
+TEST(HeightFieldMesh, GridUndistortWithoutAnalytic) {
+    format::ConusFile file = encodeSmall(128, 32);
+    const glm::dvec2 extent = fieldExtent(testGround());
+    file.analytic.reset();
+    const Mesh viaGrid = undistortHeightField(file, extent);
+    const SamplingMap map = SamplingMap::fromGrid(file.map);
+    const glm::dvec2 p = map.undistort({10.5 / 32, 20.5 / 32});
+    EXPECT_NEAR(viaGrid.positions[std::size_t(21) * 34 + 11].x / extent.x, p.x, 1e-6);
+    EXPECT_THROW(undistortHeightField(file), Error);
+}
+
+TEST(HeightFieldMesh, DenserNearSparserFar) {
+    const int size = 64;
+    const Image dem = generateTerrain(smallTerrain(256));
+    const GroundParams ground = testGround();
+    const glm::dvec2 extent = fieldExtent(ground);
+    const Image colour = terrainColours(dem, extent);
+    HeightFieldOptions options;
+    options.ground = ground;
+    options.width = options.height = size;
+    const Mesh conus = undistortHeightField(encodeHeightField(dem, colour, options));
+    const Mesh uniform = undistortHeightField(uniformHeightField(dem, colour, size, size), extent);
+    const glm::dvec2 viewer(0.5 * extent.x, extent.y + ground.near);
+    const auto within = [&](const Mesh& m, double lo, double hi) {
+        int count = 0;
+        for (const glm::vec3& p : m.positions) {
+            const double d = glm::length(glm::dvec2(p.x, p.z) - viewer);
+            count += d >= lo && d < hi;
+        }
+        return count;
+    };
+    const int nearConus = within(conus, 0, 1000), nearUniform = within(uniform, 0, 1000);
+    const int farConus = within(conus, 4000, 1e9), farUniform = within(uniform, 4000, 1e9);
+    EXPECT_GT(nearConus, 3 * nearUniform) << nearConus << " vs " << nearUniform;
+    EXPECT_LT(farConus, farUniform) << farConus << " vs " << farUniform;
+}
+
+TEST(HeightFieldExtent, FovForWidthInvertsFieldExtent) {
+    const GroundParams g = testGround();
+    const double width = fieldExtent(g).x;
+    EXPECT_NEAR(fovForFieldWidth(g.eyeHeight, g.near, g.far, width), g.fovDegrees, 1e-9);
+    EXPECT_THROW(fovForFieldWidth(g.eyeHeight, g.near, g.far, 1e9), Error);
+}
+
+TEST(HeightFieldEncode, RejectsBadInput) {
+    Image dem = makeImage(16, 16, {"Z"});
+    HeightFieldOptions options;
+    options.ground = testGround();
+    options.width = options.height = 8;
+    EXPECT_THROW(encodeHeightField(dem, makeImage(8, 8, {"R", "G", "B"}), options), Error);
+    dem.at(3, 3) = std::nanf("");
+    EXPECT_THROW(encodeHeightField(dem, makeImage(16, 16, {"R", "G", "B"}), options), Error);
+    options.width = 0;
+    EXPECT_THROW(encodeHeightField(dem, makeImage(16, 16, {"R", "G", "B"}), options), Error);
+}
+
+}  // namespace
+}  // namespace conus::codec

@@ -1,0 +1,282 @@
+#include "conus/codec/image/encode.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "conus/codec/build/foci.h"
+#include "conus/codec/image/metrics.h"
+#include "conus/core/error.h"
+#include "test_images.h"
+
+namespace conus::codec {
+namespace {
+
+using test::noise;
+using test::texture;
+using test::zonePlate;
+
+float maxAbsDifference(const Image& a, const Image& b) {
+    EXPECT_EQ(a.pixels.size(), b.pixels.size());
+    float worst = 0;
+    for (std::size_t i = 0; i < std::min(a.pixels.size(), b.pixels.size()); ++i)
+        worst = std::max(worst, std::abs(a.pixels[i] - b.pixels[i]));
+    return worst;
+}
+
+SamplingMap twoFoci(double aspect = 1.0, FociComposition composition = FociComposition::Density) {
+    const std::vector<Focus> foci = {{0.3, 0.35, 0.08, 4}, {0.7, 0.6, 0.06, 3}};
+    FociOptions options;
+    options.aspect = aspect;
+    options.composition = composition;
+    return buildFociMap(foci, options);
+}
+
+EncodeOptions sized(int w, int h, int threads = 0) {
+    EncodeOptions o;
+    o.width = w;
+    o.height = h;
+    o.threads = threads;
+    return o;
+}
+
+// Bilinear source sample at normalized (u,v), clamp to edge: the single-tap encoder.
+float sampleBilinear(const Image& im, double u, double v) {
+    const double x = std::clamp(u * im.width - 0.5, 0.0, im.width - 1.0);
+    const double y = std::clamp(v * im.height - 0.5, 0.0, im.height - 1.0);
+    const int x0 = std::min(static_cast<int>(x), im.width - 2), y0 = std::min(static_cast<int>(y), im.height - 2);
+    const double fx = x - x0, fy = y - y0;
+    return static_cast<float>((1 - fy) * ((1 - fx) * im.at(x0, y0) + fx * im.at(x0 + 1, y0)) +
+                              fy * ((1 - fx) * im.at(x0, y0 + 1) + fx * im.at(x0 + 1, y0 + 1)));
+}
+
+TEST(EncodeAreaDownsample, MatchesExactAreaIntegralForAnyRatio) {
+    const Image src = noise(10, 7, {"Y"});
+    const Image out = areaDownsample(src, 3, 4);
+    // Brute force: integrate the piecewise-constant source over each output pixel.
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 3; ++x) {
+            const double x0 = x * 10.0 / 3, x1 = (x + 1) * 10.0 / 3, y0 = y * 7.0 / 4, y1 = (y + 1) * 7.0 / 4;
+            double sum = 0;
+            for (int j = 0; j < 7; ++j)
+                for (int i = 0; i < 10; ++i) {
+                    const double ox = std::max(0.0, std::min(x1, i + 1.0) - std::max(x0, double(i)));
+                    const double oy = std::max(0.0, std::min(y1, j + 1.0) - std::max(y0, double(j)));
+                    sum += ox * oy * src.at(i, j);
+                }
+            EXPECT_NEAR(out.at(x, y), sum / ((x1 - x0) * (y1 - y0)), 1e-6) << x << "," << y;
+        }
+}
+
+TEST(EncodeAreaDownsample, KeepsChannelsAndRejectsGrowing) {
+    const Image src = noise(40, 30, {"R", "G", "B", "A"});
+    const Image same = areaDownsample(src, 40, 30);
+    EXPECT_EQ(same.channels, src.channels);
+    EXPECT_LT(maxAbsDifference(same, src), 1e-6f);
+    EXPECT_THROW(areaDownsample(src, 41, 30), conus::Error);
+    EXPECT_THROW(areaDownsample(src, 0, 30), conus::Error);
+}
+
+TEST(Encode, IdentityMapEqualsAreaDownsampleAtIntegerRatios) {
+    struct Case {
+        int from, to;
+        std::vector<std::string> channels;
+        int mapSide;
+    };
+    const std::vector<Case> cases = {
+        {512, 128, {"Y"}, 2},
+        {512, 128, {"R", "G", "B"}, 17},
+        {512, 128, {"R", "G", "B", "A"}, 33},
+        {300, 100, {"R", "G", "B", "A"}, 9},
+        {300, 100, {"R", "G", "B", "Z"}, 65},
+        {300, 100, {"R", "G", "B", "A", "Z"}, 5},  // a channel count without a fixed kernel
+        {300, 150, {"Y", "A"}, 3},                 // ratio 2
+    };
+    for (const Case& c : cases) {
+        const Image src = noise(c.from, c.from, c.channels, c.from + c.to);
+        const SamplingMap map = SamplingMap::identity(c.mapSide, c.mapSide);
+        const Image enc = encodeImage(src, map, sized(c.to, c.to));
+        const Image ref = areaDownsample(src, c.to, c.to);
+        EXPECT_EQ(enc.channels, c.channels);
+        EXPECT_LT(maxAbsDifference(enc, ref), 1e-5f) << c.from << "->" << c.to << " with " << c.channels.size()
+                                                     << " channels";
+    }
+    // Different ratios per axis: 300x200 -> 100x100 (3 and 2).
+    const Image src = noise(300, 200, {"R", "G", "B"}, 9);
+    const Image enc = encodeImage(src, SamplingMap::identity(5, 5), sized(100, 100));
+    EXPECT_LT(maxAbsDifference(enc, areaDownsample(src, 100, 100)), 1e-5f);
+}
+
+TEST(Encode, FootprintsBeyondTheTapCapUseThePyramid) {
+    // A 64x ratio is four times the tap cap: the encoder reads a box-filtered mip level, which for
+    // powers of two is still the exact area average.
+    const Image src = noise(1024, 1024, {"Y"}, 3);
+    const Image enc = encodeImage(src, SamplingMap::identity(9, 9), sized(16, 16));
+    EXPECT_LT(maxAbsDifference(enc, areaDownsample(src, 16, 16)), 1e-5f);
+    // Non-power-of-two: close to the area average of a smooth image.
+    const Image zp = zonePlate(1000, 0.01);
+    EXPECT_GT(psnr(encodeImage(zp, SamplingMap::identity(9, 9), sized(20, 20)), areaDownsample(zp, 20, 20)), 35.0);
+}
+
+TEST(Encode, ConstantImageStaysConstantUnderAnyMapAndKeepsAlpha) {
+    Image src = makeImage(256, 192, {"R", "G", "B", "A"});
+    for (std::size_t i = 0; i < src.pixels.size(); i += 4) {
+        src.pixels[i] = 0.25f;
+        src.pixels[i + 1] = 0.5f;
+        src.pixels[i + 2] = 0.75f;
+        src.pixels[i + 3] = 0.4f;
+    }
+    for (const SamplingMap& map : {SamplingMap::identity(2, 2), twoFoci(256.0 / 192.0),
+                                   twoFoci(256.0 / 192.0, FociComposition::Add)}) {
+        const Image enc = encodeImage(src, map, sized(96, 64));
+        ASSERT_EQ(enc.channels, src.channels);
+        for (std::size_t i = 0; i < enc.pixels.size(); i += 4) {
+            ASSERT_NEAR(enc.pixels[i], 0.25f, 1e-5f);
+            ASSERT_NEAR(enc.pixels[i + 1], 0.5f, 1e-5f);
+            ASSERT_NEAR(enc.pixels[i + 2], 0.75f, 1e-5f);
+            ASSERT_NEAR(enc.pixels[i + 3], 0.4f, 1e-5f);
+        }
+    }
+}
+
+TEST(Encode, AlphaIsCarriedThroughTheMap) {
+    // Alpha a ramp in u, colour noise: the encoded alpha must be the ramp at the undistorted u.
+    Image src = noise(400, 400, {"R", "G", "B", "A"}, 5);
+    for (int y = 0; y < 400; ++y)
+        for (int x = 0; x < 400; ++x) src.at(x, y, 3) = (x + 0.5f) / 400;
+    const SamplingMap map = twoFoci();
+    const Image enc = encodeImage(src, map, sized(100, 100));
+    for (int y = 0; y < 100; y += 7)
+        for (int x = 0; x < 100; x += 7) {
+            const glm::dvec2 p = map.undistort({(x + 0.5) / 100, (y + 0.5) / 100});
+            // A linear ramp survives a symmetric box filter; clamping at the borders bends it.
+            if (p.x > 0.05 && p.x < 0.95) {
+                EXPECT_NEAR(enc.at(x, y, 3), p.x, 2e-3) << x << "," << y;
+            }
+        }
+}
+
+// Stripes of 64 source pixels: vertical ones in R, horizontal ones in G. Along each CoNUS row, the
+// R edges must sit where Eq. 1 sends the source edges (and likewise G along columns).
+TEST(Encode, EdgesLandWhereEquationOnePutsThem) {
+    const int S = 1024, C = 256, period = 64;
+    Image src = makeImage(S, S, {"R", "G"});
+    for (int y = 0; y < S; ++y)
+        for (int x = 0; x < S; ++x) {
+            src.at(x, y, 0) = (x / period) % 2 ? 1.0f : 0.0f;
+            src.at(x, y, 1) = (y / period) % 2 ? 1.0f : 0.0f;
+        }
+    const std::vector<Focus> foci = {{0.5, 0.45, 0.1, 4}};
+    const SamplingMap map = buildFociMap(foci);
+    const Image enc = encodeImage(src, map, sized(C, C));
+
+    const int edges = S / period - 1;
+    double maxShift = 0, maxError = 0;
+    for (int axis = 0; axis < 2; ++axis) {
+        for (int line = 8; line < C; line += 16) {
+            int found = 0;
+            for (int k = 0; k + 1 < C; ++k) {
+                const float a = axis == 0 ? enc.at(k, line, 0) : enc.at(line, k, 1);
+                const float b = axis == 0 ? enc.at(k + 1, line, 0) : enc.at(line, k + 1, 1);
+                if ((a - 0.5f) * (b - 0.5f) >= 0) continue;
+                ++found;
+                const double crossing = k + (0.5 - a) / (b - a);  // CoNUS pixel coordinate
+                const double along = (crossing + 0.5) / C, across = (line + 0.5) / C;
+                const glm::dvec2 pd = axis == 0 ? glm::dvec2(along, across) : glm::dvec2(across, along);
+                const glm::dvec2 p = map.undistort(pd);
+                // The nearest source edge, moved by Eq. 1 at the same position across it.
+                const double coord = axis == 0 ? p.x : p.y;
+                const double edge = std::round(coord * S / period) * period / double(S);
+                const glm::dvec2 q = map.distort(axis == 0 ? glm::dvec2(edge, p.y) : glm::dvec2(p.x, edge));
+                const double expected = (axis == 0 ? q.x : q.y) * C - 0.5;
+                maxError = std::max(maxError, std::abs(crossing - expected));
+                maxShift = std::max(maxShift, std::abs(expected - (edge * C - 0.5)));
+            }
+            EXPECT_EQ(found, edges) << "axis " << axis << " line " << line;
+        }
+    }
+    EXPECT_GT(maxShift, 5.0) << "the map should move edges by several CoNUS pixels";
+    EXPECT_LT(maxError, 1.0) << "edges must sit where Eq. 1 puts them, within a CoNUS pixel";
+}
+
+// Where the map compresses, a fine zone plate must come out as its local average, not as aliased
+// rings: compare with an exact supersampled reference, and with point sampling.
+TEST(Encode, FootprintFilterPreventsAliasing) {
+    const int S = 768, C = 160;
+    const Image src = zonePlate(S, 0.45);
+    const std::vector<Focus> foci = {{0.5, 0.5, 0.08, 3}};
+    const SamplingMap map = buildFociMap(foci);
+    const Image enc = encodeImage(src, map, sized(C, C));
+
+    Image reference = makeImage(C, C, {"Y"}), pointSampled = makeImage(C, C, {"Y"});
+    const int kSuper = 12;  // sub-pixels per axis per CoNUS pixel, each undistorted exactly
+    for (int y = 0; y < C; ++y)
+        for (int x = 0; x < C; ++x) {
+            double sum = 0;
+            for (int j = 0; j < kSuper; ++j)
+                for (int i = 0; i < kSuper; ++i) {
+                    const glm::dvec2 p = map.undistort({(x + (i + 0.5) / kSuper) / C, (y + (j + 0.5) / kSuper) / C});
+                    sum += sampleBilinear(src, p.x, p.y);
+                }
+            reference.at(x, y) = static_cast<float>(sum / (kSuper * kSuper));
+            const glm::dvec2 p = map.undistort({(x + 0.5) / C, (y + 0.5) / C});
+            pointSampled.at(x, y) = sampleBilinear(src, p.x, p.y);
+        }
+    const double filtered = psnr(enc, reference), single = psnr(pointSampled, reference);
+    RecordProperty("psnr_filtered_db", std::to_string(filtered));
+    RecordProperty("psnr_point_sampled_db", std::to_string(single));
+    std::printf("[ info ] vs 12x12 supersampled reference: footprint filter %.2f dB, point sampling %.2f dB\n",
+                filtered, single);
+    EXPECT_GT(filtered, 25.0);
+    EXPECT_GT(filtered - single, 10.0) << "filtered " << filtered << " dB, point sampled " << single << " dB";
+}
+
+TEST(Encode, ThreadCountDoesNotChangeTheResult) {
+    const Image src = noise(512, 384, {"R", "G", "B", "A"}, 11);
+    const SamplingMap map = twoFoci(512.0 / 384.0);
+    const Image one = encodeImage(src, map, sized(160, 120, 1));
+    const Image two = encodeImage(src, map, sized(160, 120, 2));
+    EXPECT_EQ(one.pixels, two.pixels);
+    const Image a1 = areaDownsample(src, 100, 70, 1), a2 = areaDownsample(src, 100, 70, 2);
+    EXPECT_EQ(a1.pixels, a2.pixels);
+}
+
+TEST(Encode, ReportsProgressUpToOne) {
+    const Image src = noise(128, 128, {"Y"});
+    std::vector<double> seen;
+    EncodeOptions o = sized(64, 64, 2);
+    o.progress = [&](double f) { seen.push_back(f); };
+    encodeImage(src, SamplingMap::identity(3, 3), o);
+    ASSERT_FALSE(seen.empty());
+    EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+    EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+}
+
+TEST(Encode, RejectsBadArguments) {
+    const Image src = noise(16, 16, {"Y"});
+    const SamplingMap map = SamplingMap::identity(2, 2);
+    auto code = [&](const Image& s, int w, int h) {
+        try {
+            encodeImage(s, map, sized(w, h));
+        } catch (const conus::Error& e) {
+            return static_cast<int>(e.code());
+        }
+        return -1;
+    };
+    EXPECT_EQ(code(src, 0, 8), static_cast<int>(ErrorCode::InvalidArgument));
+    EXPECT_EQ(code(src, 8, -3), static_cast<int>(ErrorCode::InvalidArgument));
+    EXPECT_EQ(code(src, kMaxImageSide + 1, 8), static_cast<int>(ErrorCode::LimitExceeded));
+    EXPECT_EQ(code(src, kMaxImageSide, kMaxImageSide), static_cast<int>(ErrorCode::LimitExceeded));
+    EXPECT_EQ(code(Image{}, 8, 8), static_cast<int>(ErrorCode::InvalidArgument));
+    Image broken = src;
+    broken.pixels.resize(10);
+    EXPECT_EQ(code(broken, 8, 8), static_cast<int>(ErrorCode::InvalidArgument));
+    EXPECT_THROW(areaDownsample(Image{}, 4, 4), conus::Error);
+}
+
+}  // namespace
+}  // namespace conus::codec
