@@ -6,7 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "conus/codec/decode.h"
+#include "conus/codec/image/decode.h"
 #include "conus/format/container.h"
 
 namespace conus::cli {

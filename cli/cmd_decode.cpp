@@ -9,7 +9,7 @@
 #include "arguments.h"
 #include "backend.h"
 #include "commands.h"
-#include "conus/codec/decode.h"
+#include "conus/codec/image/decode.h"
 #include "conus/core/error.h"
 #include "conus/renderers/gpu_image.h"
 #include "image_files.h"
@@ -83,13 +83,10 @@ int runDecode(const DecodeCommandOptions& o) {
 
 Command addDecodeCommand(CLI::App& root) {
     auto options = std::make_shared<DecodeCommandOptions>();
-    CLI::App* command = root.add_subcommand(
-        "decode", "Reconstruct a conventional frame from a CoNUS file: zoom and pan anywhere");
-    command->footer(
-        "Examples:\n"
-        "  conus decode photo.exr -o photo.png                          # the whole frame at source size\n"
-        "  conus decode photo.exr -o face.png --view 0.36,0.15,0.52,0.31  # zoomed on a focus\n"
-        "  conus decode hdr.exr -o hdr.png --exposure -1 --tonemap aces --size 1920x1080");
+    CLI::App* command = addSubcommand(root, "decode", "Reconstruct a conventional frame from a CoNUS file: zoom and pan anywhere",
+        {"conus decode photo.exr -o photo.png                          # the whole frame at source size",
+         "conus decode photo.exr -o face.png --view 0.36,0.15,0.52,0.31  # zoomed on a focus",
+         "conus decode hdr.exr -o hdr.png --exposure -1 --tonemap aces --size 1920x1080"});
     command->add_option("input", options->input, "CoNUS file (.exr)")->required();
     command->add_option("-o,--output", options->output, "output image (.png, .jpg, .tif, .exr, .bmp, ...)")->required();
     command->add_option("--view", options->viewText,

@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "commands.h"
-#include "conus/codec/decode.h"
-#include "conus/codec/encode.h"
-#include "conus/codec/auto_map.h"
-#include "conus/codec/foci.h"
-#include "conus/codec/metrics.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/build/auto_map.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/image/metrics.h"
 #include "conus/renderers/gpu_image.h"
 #include "demo_picture.h"
 #include "encoding.h"
@@ -200,13 +200,10 @@ int runDemo(const DemoOptions& o) {
 
 Command addDemoCommand(CLI::App& root) {
     auto options = std::make_shared<DemoOptions>();
-    CLI::App* command = root.add_subcommand(
-        "demo", "The main job on a built-in picture: CoNUS vs uniform at 1/16 of the pixels, with PSNR");
-    command->footer(
-        "Examples:\n"
-        "  conus demo                                   # the built-in 4096x4096 picture, two foci\n"
-        "  conus demo --input photo.jpg --focus 0.42,0.31,0.08,4 --out my-demo\n"
-        "  conus demo --input portrait.jpg --importance faces");
+    CLI::App* command = addSubcommand(root, "demo", "The main job on a built-in picture: CoNUS vs uniform at 1/16 of the pixels, with PSNR",
+        {"conus demo                                   # the built-in 4096x4096 picture, two foci",
+         "conus demo --input photo.jpg --focus 0.42,0.31,0.08,4 --out my-demo",
+         "conus demo --input portrait.jpg --importance faces"});
     command->add_option("--out", options->out, "folder for the pictures and files (default demo-out)");
     command->add_option("--size", options->size, "side of the built-in picture (default 4096)")
         ->check(CLI::Range(256, 8192));

@@ -5,8 +5,8 @@
 #include <memory>
 
 #include "commands.h"
-#include "conus/codec/auto_map.h"
-#include "conus/codec/foci.h"
+#include "conus/codec/build/auto_map.h"
+#include "conus/codec/build/foci.h"
 #include "conus/core/limits.h"
 #include "conus/core/map_rules.h"
 #include "encoding.h"
@@ -91,13 +91,10 @@ int runEncode(const EncodeOptions& o) {
 
 Command addEncodeCommand(CLI::App& root) {
     auto options = std::make_shared<EncodeOptions>();
-    CLI::App* command = root.add_subcommand(
-        "encode", "Encode an image (PNG, JPEG, TIFF, EXR, ...) into a CoNUS file through a sampling map");
-    command->footer(
-        "Examples:\n"
-        "  conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4\n"
-        "  conus encode photo.jpg -o photo.exr --size 1024x768 --importance faces\n"
-        "  conus encode scan.tif -o scan.exr --map painted.exr --float");
+    CLI::App* command = addSubcommand(root, "encode", "Encode an image (PNG, JPEG, TIFF, EXR, ...) into a CoNUS file through a sampling map",
+        {"conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4",
+         "conus encode photo.jpg -o photo.exr --size 1024x768 --importance faces",
+         "conus encode scan.tif -o scan.exr --map painted.exr --float"});
     command->add_option("input", options->input, "source image ('-' reads standard input)")->required();
     command->add_option("-o,--output", options->output, "output CoNUS file (.exr)")->required();
     command->add_option("--focus", options->foci,

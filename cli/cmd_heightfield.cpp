@@ -13,9 +13,9 @@
 #include "arguments.h"
 #include "backend.h"
 #include "commands.h"
-#include "conus/codec/encode.h"
-#include "conus/codec/heightfield.h"
-#include "conus/codec/metrics.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/depth/heightfield.h"
+#include "conus/codec/image/metrics.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 #include "conus/renderers/terrain.h"
@@ -156,11 +156,9 @@ Command addHeightFieldCommand(CLI::App& root) {
         ->capture_default_str()
         ->check(CLI::IsMember(format::namesOf<format::Compression>()));
     addQuietOption(*encode);
-    encode->footer(
-        "Examples:\n"
-        "  conus heightfield encode procedural -o terrain.exr\n"
-        "  conus heightfield encode dem.tif --height-scale 800 -o terrain.exr --size 1024x1024 --eye-height 150\n"
-        "  conus heightfield encode jacksboro_fault_dem.npz --colour ortho.png -o terrain.exr");
+    setExamples(*encode, {"conus heightfield encode procedural -o terrain.exr",
+                       "conus heightfield encode dem.tif --height-scale 800 -o terrain.exr --size 1024x1024 --eye-height 150",
+                       "conus heightfield encode jacksboro_fault_dem.npz --colour ortho.png -o terrain.exr"});
 
     CLI::App* render = command->add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
     render->add_option("input", o->input, "CoNUS height field (.exr)")->required();
@@ -176,11 +174,9 @@ Command addHeightFieldCommand(CLI::App& root) {
     render->add_option("--colour,--color", o->colour, "as given to encode (for --compare)");
     addBackendOption(*render, o->backend, gl::CpuPath::None);
     addQuietOption(*render);
-    render->footer(
-        "Examples:\n"
-        "  conus heightfield render terrain.exr -o frame.png\n"
-        "  conus heightfield render terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720\n"
-        "  conus heightfield render terrain.exr -o compare.png --compare procedural");
+    setExamples(*render, {"conus heightfield render terrain.exr -o frame.png",
+                       "conus heightfield render terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720",
+                       "conus heightfield render terrain.exr -o compare.png --compare procedural"});
 
     return {command, [o, encode, render] {
                 if (encode->parsed()) {

@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "commands.h"
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
@@ -71,11 +71,9 @@ Command addInfoCommand(CLI::App& root) {
     command->add_flag("--json", options->json, "print JSON instead of text");
     command->add_flag("-v,--verbose", options->verbose,
                       "also list the source's metadata; for an invalid file, every broken rule (as `conus validate`)");
-    command->footer(
-        "Examples:\n"
-        "  conus info photo.exr\n"
-        "  conus info photo.exr --json --density density.png\n"
-        "  conus info --backends");
+    setExamples(*command, {"conus info photo.exr",
+                       "conus info photo.exr --json --density density.png",
+                       "conus info --backends"});
     command->add_option("--density", options->densityPng,
                         "write the sampling density as a heat map with the sampling pattern over it (.png)");
     return {command, [options] {

@@ -13,12 +13,12 @@
 #include <vector>
 
 #include "commands.h"
-#include "conus/codec/auto_map.h"
-#include "conus/codec/compose.h"
-#include "conus/codec/foci.h"
-#include "conus/codec/ground_map.h"
+#include "conus/codec/build/auto_map.h"
+#include "conus/codec/build/compose.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/build/ground_map.h"
 #include "conus/codec/conus_file.h"
-#include "conus/codec/springs.h"
+#include "conus/codec/build/springs.h"
 #include "conus/format/container.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
@@ -113,18 +113,13 @@ Command addMapCommand(CLI::App& root) {
     auto o = std::make_shared<Options>();
     CLI::App* command = root.add_subcommand("map", "Build a sampling map and write it as a map file for `conus encode --map`");
     command->require_subcommand(1);
-    command->footer(
-        "Examples:\n"
-        "  conus map foci --focus 0.3,0.4,0.08,4 --focus 0.7,0.6,0.05,3 --aspect 1.5 -o m.exr --preview m.png\n"
-        "  conus map springs --strokes '[{\"u\":0.5,\"v\":0.4,\"radius\":0.1}]' -o m.exr\n"
-        "  conus map auto --importance faces --image portrait.jpg -o m.exr");
+    setExamples(*command, {"conus map foci --focus 0.3,0.4,0.08,4 --focus 0.7,0.6,0.05,3 --aspect 1.5 -o m.exr --preview m.png",
+                       "conus map springs --strokes '[{\"u\":0.5,\"v\":0.4,\"radius\":0.1}]' -o m.exr",
+                       "conus map auto --importance faces --image portrait.jpg -o m.exr"});
 
-    CLI::App* springs = command->add_subcommand(
-        "springs", "Mass-spring brush system (paper 3.1): paint strokes from a JSON list, solve until stable");
-    springs->footer(
-        "Examples:\n"
-        "  conus map springs --strokes '[{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1,\"duration\":0.5}]' -o m.exr\n"
-        "  conus map springs --strokes strokes.json -o m.exr --preview m.png");
+    CLI::App* springs = addSubcommand(*command, "springs", "Mass-spring brush system (paper 3.1): paint strokes from a JSON list, solve until stable",
+        {"conus map springs --strokes '[{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1,\"duration\":0.5}]' -o m.exr",
+         "conus map springs --strokes strokes.json -o m.exr --preview m.png"});
     springs->add_option("--strokes", o->strokes,
                         "strokes as JSON, inline or a file: [{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1.0,\"duration\":0.5}, ...]")
         ->required();

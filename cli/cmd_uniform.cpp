@@ -39,13 +39,10 @@ int runUniform(const UniformOptions& o) {
 
 Command addUniformCommand(CLI::App& root) {
     auto options = std::make_shared<UniformOptions>();
-    CLI::App* command = root.add_subcommand(
-        "uniform", "Encode with the identity map: the uniform image of the same pixel count (the baseline)");
-    command->footer(
-        "Examples:\n"
-        "  conus uniform photo.jpg -o uniform.exr                 # 1/16 of the pixels, like encode's default\n"
-        "  conus uniform photo.jpg -o uniform.exr --size 512x384\n"
-        "  conus uniform photo.png -o same.exr --size 4000x3000   # at source size: an exact round trip");
+    CLI::App* command = addSubcommand(root, "uniform", "Encode with the identity map: the uniform image of the same pixel count (the baseline)",
+        {"conus uniform photo.jpg -o uniform.exr                 # 1/16 of the pixels, like encode's default",
+         "conus uniform photo.jpg -o uniform.exr --size 512x384",
+         "conus uniform photo.png -o same.exr --size 4000x3000   # at source size: an exact round trip"});
     command->add_option("input", options->input, "source image ('-' reads standard input)")->required();
     command->add_option("-o,--output", options->output, "output CoNUS file (.exr)")->required();
     addSourceOptions(*command, options->source);

@@ -14,10 +14,8 @@ Command addValidateCommand(CLI::App& root) {
     CLI::App* command = root.add_subcommand(
         "validate", "Check a file against every rule of the CoNUS spec; exit 0 only if valid");
     command->add_option("input", *input, "file to check")->required();
-    command->footer(
-        "Examples:\n"
-        "  conus validate photo.exr            # exit 0: valid; 1: every broken rule listed, one a line\n"
-        "  conus validate photo.exr >/dev/null && echo ok");
+    setExamples(*command, {"conus validate photo.exr            # exit 0: valid; 1: every broken rule listed, one a line",
+                       "conus validate photo.exr >/dev/null && echo ok"});
     return {command, [input] {
                 const format::ValidationReport report = format::validateConusFile(*input);
                 if (report.ok()) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <initializer_list>
 #include <string>
 
 #include "conus/format/container.h"
@@ -19,6 +20,12 @@ struct Command {
     CLI::App* app = nullptr;
     std::function<int()> run;  // returns the exit code (0 on success)
 };
+
+// A subcommand of `parent` with its one-line description and a help footer of examples, each
+// "conus ...  # what it does" (every subcommand's --help shows two or three).
+CLI::App* addSubcommand(CLI::App& parent, const std::string& name, const std::string& description,
+                        std::initializer_list<const char*> examples);
+void setExamples(CLI::App& command, std::initializer_list<const char*> examples);
 
 Command addEncodeCommand(CLI::App& root);
 Command addUniformCommand(CLI::App& root);

@@ -15,7 +15,7 @@
 #include <sstream>
 #include <vector>
 
-#include "conus/codec/heightfield.h"
+#include "conus/codec/depth/heightfield.h"
 #include "conus/core/error.h"
 #include "image_files.h"
 

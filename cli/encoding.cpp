@@ -8,7 +8,7 @@
 #include "conus/core/atomic_file.h"
 
 #include "conus/codec/conus_file.h"
-#include "conus/codec/encode.h"
+#include "conus/codec/image/encode.h"
 #include "conus/renderers/gpu_image.h"
 #include "progress.h"
 

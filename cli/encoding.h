@@ -7,7 +7,7 @@
 
 #include "arguments.h"
 #include "backend.h"
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 
 namespace CLI {

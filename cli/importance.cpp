@@ -1,6 +1,6 @@
 #include "importance.h"
 
-#include "conus/codec/auto_map.h"
+#include "conus/codec/build/auto_map.h"
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
 #include "image_files.h"

@@ -5,7 +5,7 @@
 #include <span>
 #include <vector>
 
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/core/image.h"
 

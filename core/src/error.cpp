@@ -1,5 +1,7 @@
 #include "conus/core/error.h"
 
+#include <cstdio>
+
 namespace conus {
 
 std::string oneLine(std::string text) {
@@ -12,6 +14,12 @@ std::string oneLine(std::string text) {
         else out += c;
     }
     return out;
+}
+
+std::string numberText(double value, int significantDigits) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*g", significantDigits, value);
+    return buf;
 }
 
 }  // namespace conus

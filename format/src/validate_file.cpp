@@ -14,12 +14,6 @@ namespace conus::format {
 namespace detail {
 namespace {
 
-std::string num(double value) {
-    char buf[48];
-    std::snprintf(buf, sizeof buf, "%.9g", value);
-    return buf;
-}
-
 std::string boxStr(const Box& b) {
     std::string s(1, '(');
     s += std::to_string(b.minX) + ", " + std::to_string(b.minY) + ") - (" + std::to_string(b.maxX) + ", " +
@@ -175,8 +169,8 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
                     const float u = f[4 * i], v = f[4 * i + 1], rad = f[4 * i + 2], k = f[4 * i + 3];
                     // Written as negations so NaN fails every test.
                     if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1 && rad > 0 && std::isfinite(rad) && k >= 1 && k <= map_rules::kMaxMagnification)) {
-                        r.add(Rule::V12, "focus " + std::to_string(i) + " (u,v,r,k) = (" + num(u) + ", " + num(v) + ", " + num(rad) + ", " +
-                                      num(k) + "): need u,v in [0,1], r > 0 finite, k in [1," + num(map_rules::kMaxMagnification) + "]");
+                        r.add(Rule::V12, "focus " + std::to_string(i) + " (u,v,r,k) = (" + numberText(u, 9) + ", " + numberText(v, 9) + ", " + numberText(rad, 9) + ", " +
+                                      numberText(k, 9) + "): need u,v in [0,1], r > 0 finite, k in [1," + numberText(map_rules::kMaxMagnification, 9) + "]");
                     }
                 }
             }
@@ -190,7 +184,7 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
     for (const auto& [name, a] : m.params) {
         const std::string full = kAttrParamPrefix + name;
         if (need(a, full.c_str(), "double or float", Rule::V12, r) && !std::isfinite(a.value)) {
-            r.add(Rule::V12, full + " = " + num(a.value) + " is not finite");
+            r.add(Rule::V12, full + " = " + numberText(a.value, 9) + " is not finite");
         }
     }
 }
@@ -227,7 +221,7 @@ void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r
     if (kind != "none" && need(m.depthRange, kAttrDepthRange, "v2f", Rule::V14, r)) {
         const auto [nearV, farV] = m.depthRange.value;
         if (!(std::isfinite(nearV) && std::isfinite(farV) && nearV < farV)) {
-            r.add(Rule::V14, "depth range (" + num(nearV) + ", " + num(farV) + ") must be finite with near < far");
+            r.add(Rule::V14, "depth range (" + numberText(nearV, 9) + ", " + numberText(farV, 9) + ") must be finite with near < far");
         }
     }
     optional(m.depthUnits, kAttrDepthUnits, "string", Rule::V14, r);

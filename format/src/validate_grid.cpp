@@ -14,12 +14,6 @@ namespace {
 // size limit yields a readable report instead of megabytes.
 constexpr int kMaxMessagesPerRule = 20;
 
-std::string fmt(double value) {
-    char buf[48];
-    std::snprintf(buf, sizeof buf, "%.9g", value);
-    return buf;
-}
-
 // Adds messages for one rule up to the cap, and the "... and N more" line at the end.
 class CappedRule {
 public:
@@ -78,19 +72,19 @@ ValidationReport validateGrid(const GridNodes& grid) {
             for (int i = 0; i < n; ++i) {
                 const double u = U(i, j), v = V(i, j);
                 if (!std::isfinite(u) || !std::isfinite(v)) {
-                    v8.add("node " + node(i, j) + " is not finite: (" + fmt(u) + ", " + fmt(v) + ")");
+                    v8.add("node " + node(i, j) + " is not finite: (" + numberText(u, 9) + ", " + numberText(v, 9) + ")");
                     allFinite = false;
                     continue;
                 }
                 if (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) {
-                    v9.add("node " + node(i, j) + " = (" + fmt(u) + ", " + fmt(v) + ") is outside [0,1]^2");
+                    v9.add("node " + node(i, j) + " = (" + numberText(u, 9) + ", " + numberText(v, 9) + ") is outside [0,1]^2");
                 }
                 // Exact comparisons: boundary nodes must sit on their edge so the CoNUS image covers
                 // exactly the conventional field of view.
-                if (i == 0 && u != 0.0) v10.add("left-column node " + node(i, j) + " has u = " + fmt(u) + ", must be 0");
-                if (i == n - 1 && u != 1.0) v10.add("right-column node " + node(i, j) + " has u = " + fmt(u) + ", must be 1");
-                if (j == 0 && v != 0.0) v10.add("top-row node " + node(i, j) + " has v = " + fmt(v) + ", must be 0");
-                if (j == m - 1 && v != 1.0) v10.add("bottom-row node " + node(i, j) + " has v = " + fmt(v) + ", must be 1");
+                if (i == 0 && u != 0.0) v10.add("left-column node " + node(i, j) + " has u = " + numberText(u, 9) + ", must be 0");
+                if (i == n - 1 && u != 1.0) v10.add("right-column node " + node(i, j) + " has u = " + numberText(u, 9) + ", must be 1");
+                if (j == 0 && v != 0.0) v10.add("top-row node " + node(i, j) + " has v = " + numberText(v, 9) + ", must be 0");
+                if (j == m - 1 && v != 1.0) v10.add("bottom-row node " + node(i, j) + " has v = " + numberText(v, 9) + ", must be 1");
             }
         }
     }
@@ -107,7 +101,7 @@ ValidationReport validateGrid(const GridNodes& grid) {
             if (c >= 0) {
                 v11.add("cell " + node(i, j) + " is not strictly convex: corner " +
                         node(i + map_rules::kCornerDi[c], j + map_rules::kCornerDj[c]) +
-                        " cross = " + fmt(map_rules::cornerCross(view, i, j, c)));
+                        " cross = " + numberText(map_rules::cornerCross(view, i, j, c), 9));
             }
         }
     }

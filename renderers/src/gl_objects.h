@@ -50,6 +50,20 @@ inline GlHandle makeBuffer(const GladGLContext& gl) { return {gl.GenBuffers, gl.
 inline GlHandle makeFramebuffer(const GladGLContext& gl) { return {gl.GenFramebuffers, gl.DeleteFramebuffers}; }
 inline GlHandle makeVertexArray(const GladGLContext& gl) { return {gl.GenVertexArrays, gl.DeleteVertexArrays}; }
 
+// The sampling map's nodes as an RG32F texture on `unit`, read exactly (texelFetch, nearest) by
+// Equation 1 in GLSL (equation1.inc.glsl). Leaves the texture bound on that unit.
+inline GlHandle uploadMapTexture(const GladGLContext& gl, GLenum unit, int columns, int rows, const float* nodes) {
+    GlHandle texture = makeTexture(gl);
+    gl.ActiveTexture(unit);
+    gl.BindTexture(GL_TEXTURE_2D, texture.id());
+    gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, columns, rows);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, columns, rows, GL_RG, GL_FLOAT, nodes);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return texture;
+}
+
 // Throws on a pending GL error: out of memory -> LimitExceeded, anything else -> Unsupported
 // (a driver that refused a valid request).
 inline void checkGl(const GladGLContext& gl, const char* what) {

@@ -566,14 +566,7 @@ Image decodeImageGpu(Context& context, const Image& conus, const codec::Sampling
     const GLuint program = cachedProgram(context, "decode", shaders::kShaderFullscreenVert, shaders::kShaderDecodeFrag);
 
     // The map's nodes, fetched exactly (texelFetch) by the shader.
-    GlHandle mapTexture = makeTexture(gl);
-    gl.ActiveTexture(GL_TEXTURE1);
-    gl.BindTexture(GL_TEXTURE_2D, mapTexture.id());
-    gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, map.columns(), map.rows());
-    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, map.columns(), map.rows(), GL_RG, GL_FLOAT, map.nodes().data());
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    GlHandle mapTexture = uploadMapTexture(gl, GL_TEXTURE1, map.columns(), map.rows(), &map.nodes().front().x);
     Target target(gl, out.width, out.height, kWhat);
     checkGl(gl, kWhat);
 

@@ -2,8 +2,8 @@
 
 #include <cstdio>
 
-#include "conus/codec/decode.h"
-#include "conus/codec/encode.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
 #include "conus/core/display.h"
 
 namespace conus::gl {

@@ -269,14 +269,7 @@ struct ViewRenderer::Impl {
 
     void uploadMap(const codec::SamplingMap& m) {
         const GladGLContext& gl = makeCurrentGl(context);
-        map = makeTexture(gl);
-        gl.ActiveTexture(GL_TEXTURE1);
-        gl.BindTexture(GL_TEXTURE_2D, map.id());
-        gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, m.columns(), m.rows());
-        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
-        gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, m.columns(), m.rows(), GL_RG, GL_FLOAT, m.nodes().data());
-        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        map = uploadMapTexture(gl, GL_TEXTURE1, m.columns(), m.rows(), &m.nodes().front().x);
         checkGl(gl, "ViewRenderer: map upload");
         double lo = 1e300, hi = -1e300;
         for (int j = 0; j < kDensitySamples; ++j)

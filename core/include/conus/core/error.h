@@ -22,6 +22,9 @@ enum class ErrorCode {
 // Scripts read the last line of stderr, so every CoNUS error is one line.
 std::string oneLine(std::string text);
 
+// A number as messages show it: `significantDigits` digits, %g style ("0.1", "1e+06", "nan").
+std::string numberText(double value, int significantDigits = 6);
+
 class Error : public std::runtime_error {
 public:
     // The message is kept on one line (oneLine), whatever a library underneath said.

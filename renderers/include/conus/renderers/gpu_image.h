@@ -31,9 +31,9 @@
 // encoder's output, and the decoder's CoNUS image and output.
 #pragma once
 
-#include "conus/codec/decode.h"
-#include "conus/codec/encode.h"
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/core/image.h"
 #include "conus/renderers/backend.h"
 #include "conus/renderers/context.h"

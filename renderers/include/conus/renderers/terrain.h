@@ -14,9 +14,9 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/ground_map.h"
+#include "conus/codec/build/ground_map.h"
 #include "conus/core/camera.h"
-#include "conus/codec/heightfield.h"
+#include "conus/codec/depth/heightfield.h"
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"
 

@@ -15,8 +15,8 @@
 #include <memory>
 #include <vector>
 
-#include "conus/codec/decode.h"
-#include "conus/codec/sampling_map.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"
