@@ -1,6 +1,9 @@
-// Tests that bound wall time or peak memory multiply the bound by kTimeScale or kMemoryScale:
-// builds with AddressSanitizer (the nightly suite, scripts/run-tests.sh --sanitize) run about 3-5
-// times slower and hold more (shadow memory, redzones, the quarantine of freed blocks).
+// Tests that bound wall time or peak memory multiply the bound by kTimeScale or kMemoryScale.
+// A time bound here is a hang detector, not a speed claim (speed is measured in bench/): the
+// failures it guards took 13 s to minutes. Wall time on a shared 2-core machine running the suite
+// two tests at a time drifts to 1.1-2.4x an idle run, so plain builds allow 3x; builds with
+// AddressSanitizer (the nightly suite, scripts/run-tests.sh --sanitize) run about 3-5 times slower
+// and hold more (shadow memory, redzones, the quarantine of freed blocks).
 #pragma once
 
 #include <string>
@@ -25,7 +28,7 @@ namespace conus::testing {
 inline constexpr double kTimeScale = 5.0;
 inline constexpr long kMemoryScale = 2;
 #else
-inline constexpr double kTimeScale = 1.0;
+inline constexpr double kTimeScale = 3.0;
 inline constexpr long kMemoryScale = 1;
 #endif
 
