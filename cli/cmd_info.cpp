@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "commands.h"
 #include "conus/codec/map/sampling_map.h"
@@ -95,6 +96,8 @@ Command addInfoCommand(CLI::App& root) {
                 const std::vector<std::string> channels = displayOrder(file.image.channels);
                 const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
                 const DensityStats stats = densityStats(map);
+                const std::optional<Camera> camera =
+                    file.camera ? std::optional<Camera>(format::toCamera(*file.camera)) : std::nullopt;
 
                 nlohmann::ordered_json j;
                 j["file"] = options->input;
@@ -124,15 +127,14 @@ Command addInfoCommand(CLI::App& root) {
                     for (const auto& [name, value] : file.analytic->scalars) a["params"][name] = value;
                     j["analyticMap"] = a;
                 }
-                if (file.camera) {
-                    const Camera camera = format::toCamera(*file.camera);
-                    const glm::dvec3 eye = camera.eye(), forward = camera.forward();
+                if (camera) {
+                    const glm::dvec3 eye = camera->eye(), forward = camera->forward();
                     j["camera"] = {{"projection", file.camera->projection},
                                    {"eye", {eye.x, eye.y, eye.z}},
                                    {"forward", {forward.x, forward.y, forward.z}},
                                    {"worldToCamera", file.camera->worldToCamera},
                                    {"worldToNDC", file.camera->worldToNDC}};
-                    if (camera.projection() == Projection::Perspective) j["camera"]["verticalFov"] = camera.verticalFovDegrees();
+                    if (camera->projection() == Projection::Perspective) j["camera"]["verticalFov"] = camera->verticalFovDegrees();
                 }
                 if (file.depth.kind != format::DepthKind::None)
                     j["depth"] = {{"kind", format::toString(file.depth.kind)},
@@ -205,12 +207,11 @@ Command addInfoCommand(CLI::App& root) {
                         std::printf("\n    %s = %g", name.c_str(), value);
                     std::printf("\n");
                 }
-                if (file.camera) {
-                    const Camera camera = format::toCamera(*file.camera);
-                    const glm::dvec3 eye = camera.eye(), forward = camera.forward();
-                    std::printf("  camera        %s, eye (%g, %g, %g), looking along (%.4g, %.4g, %.4g)", toString(camera.projection()),
+                if (camera) {
+                    const glm::dvec3 eye = camera->eye(), forward = camera->forward();
+                    std::printf("  camera        %s, eye (%g, %g, %g), looking along (%.4g, %.4g, %.4g)", toString(camera->projection()),
                                 eye.x, eye.y, eye.z, forward.x, forward.y, forward.z);
-                    if (camera.projection() == Projection::Perspective) std::printf(", vertical fov %.4g deg", camera.verticalFovDegrees());
+                    if (camera->projection() == Projection::Perspective) std::printf(", vertical fov %.4g deg", camera->verticalFovDegrees());
                     std::printf("\n");
                 }
                 if (file.depth.kind != format::DepthKind::None)

@@ -60,8 +60,7 @@ ValidationReport validateGrid(const GridNodes& grid) {
                           " values, has " + std::to_string(grid.xy.size()));
         return report;
     }
-    auto U = [&](int i, int j) { return static_cast<double>(grid.xy[2 * (std::size_t(j) * n + i)]); };
-    auto V = [&](int i, int j) { return static_cast<double>(grid.xy[2 * (std::size_t(j) * n + i) + 1]); };
+    const map_rules::GridView view{n, m, grid.xy.data()};
 
     bool allFinite = true;
     {
@@ -70,13 +69,13 @@ ValidationReport validateGrid(const GridNodes& grid) {
         CappedRule v10(report, Rule::V10, "nodes");
         for (int j = 0; j < m; ++j) {
             for (int i = 0; i < n; ++i) {
-                const double u = U(i, j), v = V(i, j);
+                const double u = view.u(i, j), v = view.v(i, j);
                 if (!std::isfinite(u) || !std::isfinite(v)) {
                     v8.add("node " + node(i, j) + " is not finite: (" + numberText(u, 9) + ", " + numberText(v, 9) + ")");
                     allFinite = false;
                     continue;
                 }
-                if (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) {
+                if (!map_rules::nodeInside(view, i, j)) {
                     v9.add("node " + node(i, j) + " = (" + numberText(u, 9) + ", " + numberText(v, 9) + ") is outside [0,1]^2");
                 }
                 // Exact comparisons: boundary nodes must sit on their edge so the CoNUS image covers
@@ -93,7 +92,6 @@ ValidationReport validateGrid(const GridNodes& grid) {
     // V11: at every corner of every cell the cross product of the incoming and outgoing edge is
     // positive, as for the identity. A bilinear patch has a positive Jacobian everywhere iff it
     // does at its four corners, so this is exactly injectivity of the piecewise-bilinear map.
-    const map_rules::GridView view{n, m, grid.xy.data()};
     CappedRule v11(report, Rule::V11, "cells");
     for (int j = 0; j + 1 < m; ++j) {
         for (int i = 0; i + 1 < n; ++i) {
