@@ -99,14 +99,18 @@ glm::dvec2 invertCell(glm::dvec2 p00, glm::dvec2 p10, glm::dvec2 p01, glm::dvec2
         return r == r ? r : std::numeric_limits<double>::infinity();  // NaN: worst
     };
     double s = sOf(t);
+    const bool in1 = outside(s, t) <= kInRange;
+    const double r1 = residual(s, t);
+    // The usual case: this root solves the equations to rounding, where Newton would stop at once.
+    if (in1 && r1 <= kResidualAtRounding) return {s, t};
     // The other root too when this one is out of range or does not solve the equations: a t on the
     // line where the patch's extension folds (b + d t = 0, as in a cell tapering to a point)
     // leaves s undetermined. In range first, then the smaller residual.
-    if (!(outside(s, t) <= kInRange) || !(residual(s, t) <= kRootResidual)) {
+    if (!in1 || !(r1 <= kRootResidual)) {
         const double t2 = qa != 0.0 ? h / qa : std::numeric_limits<double>::quiet_NaN();
         const double s2 = sOf(t2);
-        const bool in1 = outside(s, t) <= kInRange, in2 = outside(s2, t2) <= kInRange;
-        if (in2 != in1 ? in2 : in1 ? residual(s2, t2) < residual(s, t) : outside(s2, t2) < outside(s, t)) s = s2, t = t2;
+        const bool in2 = outside(s2, t2) <= kInRange;
+        if (in2 != in1 ? in2 : in1 ? residual(s2, t2) < r1 : outside(s2, t2) < outside(s, t)) s = s2, t = t2;
         if (!std::isfinite(s) || !std::isfinite(t)) s = t = 0.5;  // Newton from the middle
     }
     // Newton on the same evaluation as distort, skipped once the residual is at rounding level
