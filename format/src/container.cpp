@@ -1,6 +1,7 @@
 // The public container entry points: validate, then write atomically; load, then throw or report.
 #include "conus/format/container.h"
 #include "conus/core/atomic_file.h"
+#include "conus/format/exr_check.h"
 #include "exr_io.h"
 #include "header_model.h"
 
@@ -72,5 +73,7 @@ ValidationReport validateConusFile(const std::string& path, const ReadLimits& li
     ConusFile file;
     return detail::loadConusFile(path, limits, false, file).report;
 }
+
+void checkExrFile(const std::string& path, const Limits& limits) { detail::checkExr(path, limits); }
 
 }  // namespace conus::format

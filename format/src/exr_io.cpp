@@ -29,6 +29,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <system_error>
 
 #include "header_model.h"
@@ -233,6 +234,16 @@ Problem checkChunks(exr_const_context_t ctx, int p, std::uintmax_t fileSize) {
                     std::to_string(fileSize) + "-byte file"};
     }
     return {};
+}
+
+// Readers 1 and 2 of the three above: the raw scan, then the C core's parse and its header-level
+// checks. On success `core` holds the open context for the chunk checks.
+Problem checkHeaders(const std::string& path, std::uintmax_t size, const Limits& limits, std::unique_ptr<CoreFile>& core) {
+    if (const ScanResult scan = scanHeaders(path, size, limits); !scan.problem.empty())
+        return {Rule::V1, scan.code, "not a readable OpenEXR file: " + scan.problem};
+    core = std::make_unique<CoreFile>(path);
+    if (!core->error().empty()) return {Rule::V1, ErrorCode::Corrupt, "not a readable OpenEXR file: " + core->error()};
+    return checkCoreHeaders(core->ctx(), size);
 }
 
 // ---- headers -> HeaderModel ------------------------------------------------------------------
@@ -474,6 +485,19 @@ Imath::M44f toM44(const std::array<float, 16>& a) {
 
 }  // namespace
 
+void checkExr(const std::string& path, const Limits& limits) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec) throw Error(ErrorCode::Io, "cannot read " + path + ": " + ec.message());
+    std::unique_ptr<CoreFile> core;
+    Problem problem = checkHeaders(path, size, limits, core);
+    int parts = 0;
+    if (problem.message.empty() && exr_get_count(core->ctx(), &parts) != EXR_ERR_SUCCESS)
+        problem = {Rule::V1, ErrorCode::Corrupt, "not a readable OpenEXR file: no parts"};
+    for (int p = 0; p < parts && problem.message.empty(); ++p) problem = checkChunks(core->ctx(), p, size);
+    if (!problem.message.empty()) throw Error(problem.code, path + ": " + problem.message);
+}
+
 LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool readPixels, ConusFile& out) {
     LoadResult result;
     ValidationReport& r = result.report;
@@ -493,12 +517,9 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool
     if (ec || !std::ifstream(path, std::ios::binary)) {
         return refuse({Rule::V1, ErrorCode::Io, "cannot open " + path + (ec ? ": " + ec.message() : std::string())});
     }
-    if (const ScanResult scan = scanHeaders(path, size, limits); !scan.problem.empty()) {
-        return refuse({Rule::V1, scan.code, "not a readable OpenEXR file: " + scan.problem});
-    }
-    const CoreFile core(path);
-    if (!core.error().empty()) return refuse({Rule::V1, ErrorCode::Corrupt, "not a readable OpenEXR file: " + core.error()});
-    if (Problem problem = checkCoreHeaders(core.ctx(), size); !problem.message.empty()) return refuse(problem);
+    std::unique_ptr<CoreFile> opened;
+    if (Problem problem = checkHeaders(path, size, limits, opened); !problem.message.empty()) return refuse(problem);
+    const CoreFile& core = *opened;
     try {
         Imf::MultiPartInputFile file(path.c_str());
         const HeaderModel model = modelOf(file);

@@ -20,6 +20,9 @@ struct LoadResult {
 // its image has width, height and channels but no pixels.
 LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool readPixels, ConusFile& out);
 
+// conus::format::checkExrFile (exr_check.h).
+void checkExr(const std::string& path, const Limits& limits);
+
 // Writes an already validated file into `out` (the caller commits it): throws conus::Error(Io)
 // naming out.destination() on failure.
 void writeExrFile(AtomicFile& out, const ConusFile& file);

@@ -159,6 +159,48 @@ TEST_F(Hostile, HugeTiledPartIsRefused) {
     expectBounded(r, 400);
 }
 
+// The same EXRs given as pictures go through OpenImageIO, which reads them with OpenEXR's C++
+// library: before the screen, `encode` spent 8 s and 2 GB on the first and 73 s and 12.7 GB on
+// the second.
+TEST_F(Hostile, HostileExrPicturesAreScreenedBeforeOpenImageIo) {
+    const struct {
+        const char* file;
+        const char* reason;
+    } cases[] = {
+        {"oom-string-attr-1.9GB.exr", "not a readable OpenEXR file: part 0 header: attribute `conus:depthKind` (string) declares 1929379846 bytes"},
+        {"dw_32768x32768_rgb_dwab.exr", "part 0 (`conus`) scanline 0: chunk declares 50331648 bytes of pixels in 144 bytes"},
+        {"tiled_65536x16384_tile_4096_64ch.exr", "part 0 (`conus`) tile (0, 0): unreadable chunk"},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.file);
+        const std::string file = reproducer(c.file);
+        const Outcome r = run({"encode", file, "-o", path("x.exr")});
+        expectRefused(r, "encode", file + ": " + c.reason);
+        expectBounded(r, 400);
+        EXPECT_FALSE(fs::exists(path("x.exr")));
+    }
+}
+
+// A 74-byte PNG that declares 16000x16000 RGB: refused before 3 GB of floats are committed.
+TEST_F(Hostile, PictureDeclaringMoreThanItsBytesCanHoldIsRefused) {
+    const std::string png = path("lying.png");
+    {
+        // Signature, IHDR (16000x16000, 8-bit RGB), an IDAT of 16 deflated zero bytes, IEND: a
+        // well-formed PNG whose data falls 768 MB short.
+        const unsigned char bytes[] = {
+            0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a,                                   // signature
+            0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 0, 0x3e, 0x80, 0, 0, 0x3e, 0x80, 8, 2, 0, 0, 0,  // 16000x16000 RGB8
+            0xce, 0x1c, 0x48, 0x89,                                                         // CRC of IHDR
+            0x00, 0x00, 0x00, 0x0b, 'I', 'D', 'A', 'T', 0x78, 0x9c, 0x63, 0x60, 0x40, 0x05, 0x00,  // 16 zero bytes
+            0x00, 0x10, 0x00, 0x01, 0x39, 0xbd, 0x8f, 0x65,                                 // ... and the CRC
+            0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};                        // IEND
+        std::ofstream(png, std::ios::binary).write(reinterpret_cast<const char*>(bytes), sizeof bytes);
+    }
+    const Outcome r = run({"encode", png, "-o", path("x.exr")});
+    expectRefused(r, "encode", png + ": declares 16000x16000 pixels (768000000 bytes of samples) in a 68-byte file");
+    expectBounded(r, 400);
+}
+
 TEST_F(Hostile, SourceSizedDecodeBeyondTheMemoryLimitIsRefused) {
     const std::string file = reproducer("source_65536x16384.exr");
     Outcome r = run({"decode", file, "-o", path("x.png")});
