@@ -227,7 +227,7 @@ bool isOpenExr(const unsigned char* bytes, std::size_t size) {
 // OpenEXR's C++ library, which allocates what a header declares (a 1.9 GB attribute in a 4 KB file
 // cost 8 s and 2 GB; a 32768x32768 window in 5 KB, 73 s and 12.7 GB). Standard input is screened
 // from a temporary copy, since the screen reads a file. Returns the file's size in bytes.
-std::uintmax_t screenInput(const std::string& path, const StdinImage& stdinImage) {
+std::uintmax_t screenInput(const std::string& path, const StdinImage& stdinImage, const Limits& limits) {
     if (path == "-") {
         const std::vector<unsigned char>& bytes = stdinImage.bytes;
         if (isOpenExr(bytes.data(), bytes.size())) {
@@ -242,7 +242,7 @@ std::uintmax_t screenInput(const std::string& path, const StdinImage& stdinImage
             if (f && std::fclose(f) != 0) throw Error(ErrorCode::Io, "cannot copy standard input to " + copy.string());
             if (!written) throw Error(ErrorCode::Io, "cannot copy standard input to " + copy.string());
             try {
-                format::checkExrFile(copy.string());
+                format::checkExrFile(copy.string(), limits);
             } catch (const Error& e) {
                 const std::string what = e.what();
                 throw Error(e.code(), "standard input" + what.substr(std::min(what.size(), copy.string().size())));
@@ -254,7 +254,7 @@ std::uintmax_t screenInput(const std::string& path, const StdinImage& stdinImage
     std::FILE* f = std::fopen(path.c_str(), "rb");
     const std::size_t n = f ? std::fread(magic, 1, sizeof magic, f) : 0;
     if (f) std::fclose(f);
-    if (isOpenExr(magic, n)) format::checkExrFile(path);
+    if (isOpenExr(magic, n)) format::checkExrFile(path, limits);
     std::error_code ec;
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
     return ec ? 0 : size;
@@ -318,7 +318,7 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
         openName = stdinImage.name;
     }
     const std::string shown = path == "-" ? std::string("standard input") : path;
-    const std::uintmax_t fileSize = screenInput(path, stdinImage);
+    const std::uintmax_t fileSize = screenInput(path, stdinImage, options.limits);
     // Straight alpha as stored: colour is linearized first, then associated (in linear light).
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
@@ -340,13 +340,14 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
     if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
         throw Error(ErrorCode::Io, shown + ": the image is empty (" + std::to_string(spec.width) + "x" +
                                        std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) + " channels)");
-    if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || pixels > kMaxImagePixels ||
-        spec.nchannels > kMaxChannels)
+    const Limits& limits = options.limits;
+    if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || pixels > limits.maxPixels ||
+        spec.nchannels > limits.maxChannels)
         throw Error(ErrorCode::LimitExceeded,
                     shown + ": image of " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels and " +
                         std::to_string(spec.nchannels) + " channels is beyond the limits (sides up to " +
-                        std::to_string(kMaxImageSide) + ", " + std::to_string(kMaxImagePixels) +
-                        " pixels, " + std::to_string(kMaxChannels) + " channels)");
+                        std::to_string(kMaxImageSide) + ", " + std::to_string(limits.maxPixels) +
+                        " pixels, " + std::to_string(limits.maxChannels) + " channels)");
 
     // Memory for the pixels only once the file can hold them: within the decode memory limit, and
     // (for formats other than OpenEXR, whose chunk tables were checked) no more samples than the
@@ -354,11 +355,11 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
     // (~1300:1), JPEG (~500:1 for a flat colour) or any run-length coding reaches.
     constexpr std::uintmax_t kMaxExpansion = 4096;
     const std::int64_t floatBytes = pixels * spec.nchannels * std::int64_t(sizeof(float));
-    if (floatBytes > kMaxDecodeBytes)
+    if (floatBytes > limits.maxDecodeBytes)
         throw Error(ErrorCode::LimitExceeded, shown + ": image of " + std::to_string(spec.width) + "x" +
                                                   std::to_string(spec.height) + "x" + std::to_string(spec.nchannels) +
                                                   " floats takes " + std::to_string(floatBytes) +
-                                                  " bytes, beyond the decode memory limit of " + std::to_string(kMaxDecodeBytes));
+                                                  " bytes, beyond the decode memory limit of " + std::to_string(limits.maxDecodeBytes));
     const std::uintmax_t fileBytes = std::uintmax_t(pixels) * std::uintmax_t(spec.nchannels) * spec.format.size();
     if (info.format != "openexr" && fileSize > 0 && fileBytes / kMaxExpansion > fileSize)
         throw Error(ErrorCode::Corrupt, shown + ": declares " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +

@@ -22,6 +22,7 @@
 #include "conus/core/color.h"
 #include "conus/core/display.h"
 #include "conus/core/image.h"
+#include "conus/core/limits.h"
 
 namespace conus::imageio {
 
@@ -37,6 +38,7 @@ struct ReadOptions {
     bool autoOrient = true;              // apply the EXIF Orientation, so the frame is the one people see
     std::string part;                    // a part (subimage) by name or index; empty: the first
     NonFiniteRepair repair = NonFiniteRepair::Keep;
+    Limits limits;  // maxPixels, maxChannels, maxAttributeBytes, maxHeaderBytes, maxDecodeBytes apply
 };
 
 struct ImageFileInfo {
