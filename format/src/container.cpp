@@ -1,5 +1,6 @@
 // The public container entry points: validate, then write atomically; load, then throw or report.
 #include "conus/format/container.h"
+
 #include "conus/core/atomic_file.h"
 #include "conus/format/exr_check.h"
 #include "exr_io.h"
@@ -46,7 +47,7 @@ void writeConusFile(const std::string& path, const ConusFile& file) {
     const ValidationReport report = validateConusFile(file);
     if (!report.ok()) {
         throw Error(onlyMapRules(report) ? ErrorCode::InvalidMap : ErrorCode::Corrupt,
-                    "refusing to write invalid CoNUS file " + path + ": " + report.summary());
+                    "refusing to write invalid CoNUS file " + path + ": " + report.summary(), report.ruleNumbers());
     }
     AtomicFile out(path);
     detail::writeExrFile(out, file);
@@ -58,7 +59,7 @@ namespace {
 ConusFile load(const std::string& path, const ReadLimits& limits, bool readPixels) {
     ConusFile file;
     const detail::LoadResult result = detail::loadConusFile(path, limits, readPixels, file);
-    if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.summary());
+    if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.summary(), result.report.ruleNumbers());
     return file;
 }
 

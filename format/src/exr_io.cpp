@@ -495,7 +495,7 @@ void checkExr(const std::string& path, const Limits& limits) {
     if (problem.message.empty() && exr_get_count(core->ctx(), &parts) != EXR_ERR_SUCCESS)
         problem = {Rule::V1, ErrorCode::Corrupt, "not a readable OpenEXR file: no parts"};
     for (int p = 0; p < parts && problem.message.empty(); ++p) problem = checkChunks(core->ctx(), p, size);
-    if (!problem.message.empty()) throw Error(problem.code, path + ": " + problem.message);
+    if (!problem.message.empty()) throw Error(problem.code, path + ": " + problem.message, {number(problem.rule)});
 }
 
 LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool readPixels, ConusFile& out) {

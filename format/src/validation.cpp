@@ -26,6 +26,13 @@ void ValidationReport::add(Rule rule, std::string message, long long count) {
     issues.push_back({rule, std::move(message), count});
 }
 
+std::vector<int> ValidationReport::ruleNumbers() const {
+    std::vector<int> rules;
+    for (const Issue& issue : issues)
+        if (std::find(rules.begin(), rules.end(), number(issue.rule)) == rules.end()) rules.push_back(number(issue.rule));
+    return rules;
+}
+
 std::string ValidationReport::str() const {
     std::string out;
     for (const Issue& issue : issues) out += (out.empty() ? "" : "; ") + line(issue);

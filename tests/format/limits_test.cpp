@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <set>
+#include <vector>
 
 #include <ImfFloatVectorAttribute.h>
 #include <ImfPreviewImageAttribute.h>
@@ -37,6 +38,7 @@ std::string hostile(const std::string& name) {
 struct Refusal {
     ErrorCode code = ErrorCode::Unsupported;
     std::string message;
+    std::vector<int> rules;  // conus::Error::rules
     double seconds = 0;
 };
 
@@ -50,6 +52,7 @@ Refusal refusal(Read read) {
     } catch (const Error& e) {
         r.code = e.code();
         r.message = e.what();
+        r.rules = e.rules();
     }
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return r;
@@ -210,9 +213,11 @@ TEST(Hostile, ADeclaredWindowWithoutItsDataIsRefusedBeforeAllocating) {
             // 12 GB as float: beyond the decode memory limit before the chunks are even looked at.
             EXPECT_EQ(r.code, ErrorCode::LimitExceeded) << r.message;
             EXPECT_TRUE(contains(r.message, "V4: ")) << r.message;
+            EXPECT_EQ(r.rules, std::vector<int>{4});
         } else {
             EXPECT_EQ(r.code, ErrorCode::Corrupt) << r.message;
             EXPECT_TRUE(contains(r.message, "V1: ") && contains(r.message, "dwab expands at most")) << r.message;
+            EXPECT_EQ(r.rules, std::vector<int>{1});
         }
         EXPECT_TRUE(oneLine(r.message));
         EXPECT_LT(r.seconds, kSecond);
@@ -269,6 +274,7 @@ TEST(Hostile, TwoBrokenRulesGiveOneLineNamingBoth) {
     EXPECT_EQ(r.code, ErrorCode::Corrupt);
     EXPECT_TRUE(oneLine(r.message));
     EXPECT_TRUE(contains(r.message, "V5: source size 0x-1") && contains(r.message, "; V6: data kind `bogus`")) << r.message;
+    EXPECT_EQ(r.rules, (std::vector<int>{5, 6}));  // what the bindings' exception carries
     const ValidationReport report = validateConusFile(hostile("multiline-error-two-rules.exr"));
     EXPECT_TRUE(report.violates(Rule::V5) && report.violates(Rule::V6)) << report.str();
 }

@@ -246,7 +246,7 @@ std::size_t SamplingMap::indexBytes() const { return index().bytes(); }
 
 SamplingMap::SamplingMap(int columns, int rows, std::vector<glm::vec2> nodes) {
     const format::ValidationReport report = format::validateGrid(makeGrid(columns, rows, nodes));
-    if (!report.ok()) throw Error(ErrorCode::InvalidMap, report.str());
+    if (!report.ok()) throw Error(ErrorCode::InvalidMap, report.str(), report.ruleNumbers());
     m_columns = columns;
     m_rows = rows;
     m_nodes = std::move(nodes);

@@ -5,6 +5,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace conus {
 
@@ -29,10 +30,16 @@ class Error : public std::runtime_error {
 public:
     // The message is kept on one line (oneLine), whatever a library underneath said.
     Error(ErrorCode code, const std::string& message) : std::runtime_error(oneLine(message)), m_code(code) {}
+    // An error that breaks rules of the format's specification (spec/conus-format.md: V1, V4, ...),
+    // by number, in the order the message names them.
+    Error(ErrorCode code, const std::string& message, std::vector<int> rules)
+        : std::runtime_error(oneLine(message)), m_code(code), m_rules(std::move(rules)) {}
     ErrorCode code() const noexcept { return m_code; }
+    const std::vector<int>& rules() const noexcept { return m_rules; }
 
 private:
     ErrorCode m_code;
+    std::vector<int> m_rules;
 };
 
 // Long operations report progress in [0,1] through this callback; an empty one is allowed.

@@ -36,6 +36,8 @@ struct ValidationReport {
     std::string summary() const;
     // Every issue on one line, "V7: <message>; V9: <message>" (rule 0 reads "error: ...").
     std::string str() const;
+    // The numbers of the rules broken, each once, in the report's order (what conus::Error carries).
+    std::vector<int> ruleNumbers() const;
 };
 
 }  // namespace conus::format
