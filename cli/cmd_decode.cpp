@@ -8,6 +8,7 @@
 
 #include "arguments.h"
 #include "backend.h"
+#include "batch.h"
 #include "commands.h"
 #include "conus/codec/image/decode.h"
 #include "conus/core/error.h"
@@ -19,7 +20,8 @@ namespace conus::cli {
 namespace {
 
 struct DecodeCommandOptions {
-    std::string input, output, viewText, sizeText, cameraText, backend = "auto";
+    BatchOptions batch;
+    std::string viewText, sizeText, cameraText, backend = "auto";
     PictureOptions picture;
 };
 
@@ -36,16 +38,17 @@ Size outputSize(const DecodeCommandOptions& o, const codec::View& view, const fo
     return {std::max(1, static_cast<int>(w)), std::max(1, static_cast<int>(h))};
 }
 
-int runDecode(const DecodeCommandOptions& o) {
+// One input to one output; returns the line that says what was written.
+std::string decodeOne(const DecodeCommandOptions& o, const std::string& input, const std::string& output) {
     imageio::WriteOptions write = writeOptionsOf(o.picture, nullptr);
-    checkPictureOutput(o.output, write, {o.input});
+    checkPictureOutput(output, write, {input});
     const codec::View view = o.viewText.empty() ? codec::View{} : parseView(o.viewText);
-    Progress reading("read " + o.input);
-    const format::ConusFile file = format::readConusFile(o.input);
+    Progress reading("read " + input);
+    const format::ConusFile file = format::readConusFile(input);
     reading.done();
     write.source = &file.sourceEncoding;
     // An EXR keeps the file's own precision: a --float file decodes to float.
-    if (!write.sampleType && std::filesystem::path(o.output).extension() == ".exr")
+    if (!write.sampleType && std::filesystem::path(output).extension() == ".exr")
         write.sampleType = file.pixelType == format::PixelType::Float ? SampleType::Float : SampleType::Half;
 
     if (!o.cameraText.empty()) {
@@ -53,9 +56,9 @@ int runDecode(const DecodeCommandOptions& o) {
         const Size size = parseSize(o.sizeText.empty() ? "960x540" : o.sizeText);
         const Image frame = renderHeightFieldFrame(file, o.cameraText == "viewer" ? "" : o.cameraText, size.width,
                                                            size.height, o.backend);
-        writePicture(o.output, frame, writeOptionsOf(o.picture, nullptr));
-        std::printf("wrote %s: %dx%d frame of the height field\n", o.output.c_str(), frame.width, frame.height);
-        return 0;
+        writePicture(output, frame, writeOptionsOf(o.picture, nullptr));
+        return "wrote " + output + ": " + std::to_string(frame.width) + "x" + std::to_string(frame.height) +
+               " frame of the height field";
     }
     const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
     const Size size = outputSize(o, view, file);
@@ -73,9 +76,17 @@ int runDecode(const DecodeCommandOptions& o) {
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "decoding");
     const Image frame = gl::decodeImage(device, file.image, map, decode);
     progress.done();
-    writePicture(o.output, frame, write);
-    std::printf("wrote %s: %dx%d view [%g,%g]-[%g,%g]\n", o.output.c_str(), frame.width, frame.height, view.u0, view.v0,
-                view.u1, view.v1);
+    writePicture(output, frame, write);
+    char line[256];
+    std::snprintf(line, sizeof line, ": %dx%d view [%g,%g]-[%g,%g]", frame.width, frame.height, view.u0, view.v0, view.u1, view.v1);
+    return "wrote " + output + line;
+}
+
+int runDecode(const DecodeCommandOptions& o) {
+    const std::vector<Job> jobs = planJobs(o.batch);
+    auto convert = [&o](const Job& job) { return decodeOne(o, job.input, job.output); };
+    if (isBatch(o.batch)) return runBatch(jobs, o.batch, convert);
+    std::printf("%s\n", convert(jobs.front()).c_str());
     return 0;
 }
 
@@ -86,9 +97,9 @@ Command addDecodeCommand(CLI::App& root) {
     CLI::App* command = addSubcommand(root, "decode", "Reconstruct a conventional frame from a CoNUS file: zoom and pan anywhere",
         {"conus decode photo.exr -o photo.png                          # the whole frame at source size",
          "conus decode photo.exr -o face.png --view 0.36,0.15,0.52,0.31  # zoomed on a focus",
-         "conus decode hdr.exr -o hdr.png --exposure -1 --tonemap aces --size 1920x1080"});
-    command->add_option("input", options->input, "CoNUS file (.exr)")->required();
-    command->add_option("-o,--output", options->output, "output image (.png, .jpg, .tif, .exr, .bmp, ...)")->required();
+         "conus decode hdr.exr -o hdr.png --exposure -1 --tonemap aces --size 1920x1080",
+         "conus decode exr/*.exr --out-dir views/ --name '{stem}-face.jpg' --view 0.36,0.15,0.52,0.31"});
+    addBatchOptions(*command, options->batch, "CoNUS file (.exr)", "output image (.png, .jpg, .tif, .exr, .bmp, ...)", "{stem}.png");
     command->add_option("--view", options->viewText,
                         "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image; "
                         "outside [0,1] shows the background)");

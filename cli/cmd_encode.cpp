@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "batch.h"
 #include "commands.h"
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
@@ -18,7 +19,8 @@ namespace conus::cli {
 namespace {
 
 struct EncodeOptions {
-    std::string input, output, mapFile, compose = "density", importance, method = "flow";
+    BatchOptions batch;
+    std::string mapFile, compose = "density", importance, method = "flow";
     double minDensity = 0.25, maxDensity = 16;
     std::vector<std::string> foci;
     int grid = map_rules::kDefaultSide;
@@ -63,9 +65,10 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source) {
     return built;
 }
 
-int runEncode(const EncodeOptions& o) {
-    checkConusOutput(o.output, o.input);
-    const imageio::ImageFile source = readSource(o.input, o.source);
+// One input to one output; returns the line that says what was written.
+std::string encodeOne(const EncodeOptions& o, const std::string& input, const std::string& output) {
+    checkConusOutput(output, input);
+    const imageio::ImageFile source = readSource(input, o.source);
     const Size size = conusSize(o.storage, source.image);
     BuiltMap built;
     if (!o.mapFile.empty()) built = mapFromFile(o.mapFile);
@@ -79,11 +82,19 @@ int runEncode(const EncodeOptions& o) {
     const gl::Device device = deviceFor(o.storage.backend, gl::CpuPath::Available, "encoding");
     format::ConusFile file = encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic);
     applyStorage(o.storage, file);
-    Progress writing("write " + o.output);
-    format::writeConusFile(o.output, file);
+    Progress writing("write " + output);
+    format::writeConusFile(output, file);
     writing.done();
-    std::printf("wrote %s: %dx%d CoNUS image of a %dx%d source, %dx%d sampling map\n", o.output.c_str(), size.width,
-                size.height, source.image.width, source.image.height, built.map->columns(), built.map->rows());
+    return "wrote " + output + ": " + std::to_string(size.width) + "x" + std::to_string(size.height) + " CoNUS image of a " +
+           std::to_string(source.image.width) + "x" + std::to_string(source.image.height) + " source, " +
+           std::to_string(built.map->columns()) + "x" + std::to_string(built.map->rows()) + " sampling map";
+}
+
+int runEncode(const EncodeOptions& o) {
+    const std::vector<Job> jobs = planJobs(o.batch);
+    auto convert = [&o](const Job& job) { return encodeOne(o, job.input, job.output); };
+    if (isBatch(o.batch)) return runBatch(jobs, o.batch, convert);
+    std::printf("%s\n", convert(jobs.front()).c_str());
     return 0;
 }
 
@@ -94,9 +105,9 @@ Command addEncodeCommand(CLI::App& root) {
     CLI::App* command = addSubcommand(root, "encode", "Encode an image (PNG, JPEG, TIFF, EXR, ...) into a CoNUS file through a sampling map",
         {"conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4",
          "conus encode photo.jpg -o photo.exr --size 1024x768 --importance faces",
-         "conus encode scan.tif -o scan.exr --map painted.exr --float"});
-    command->add_option("input", options->input, "source image ('-' reads standard input)")->required();
-    command->add_option("-o,--output", options->output, "output CoNUS file (.exr)")->required();
+         "conus encode scan.tif -o scan.exr --map painted.exr --float",
+         "conus encode shots/*.jpg --out-dir exr/ --jobs 2 --skip-existing --focus 0.5,0.5,0.1,4"});
+    addBatchOptions(*command, options->batch, "source image ('-' reads standard input)", "output CoNUS file (.exr)", "{stem}.exr");
     command->add_option("--focus", options->foci,
                         "focus u,v,r,k: centre (u,v) in [0,1], radius r as a fraction of the width, linear "
                         "magnification k (repeat for several foci)");

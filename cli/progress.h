@@ -32,6 +32,14 @@ private:
 // Adds -q/--quiet to a subcommand.
 void addQuietOption(CLI::App& command);
 bool quiet();
+// Silences the stage lines (not warnings or errors) until called again with false: a batch runs
+// its items quiet and reports for them.
+void setQuiet(bool silenced);
+// "conus <command>: <text>" on stderr on a line of its own, even when quiet (a batch's failures).
+void report(const std::string& text);
+// On a terminal, replaces the live line with "conus <command>: <text>"; elsewhere, and when
+// quiet, nothing.
+void liveLine(const std::string& text);
 
 // The subcommand that runs, for the lines below (main.cpp sets it).
 void beginCommand(const std::string& name);

@@ -26,6 +26,13 @@ struct Result {
     std::string out, err;
 };
 
+// A picture's width and height as OpenImageIO reads them; (0, 0) when it cannot.
+inline std::pair<int, int> imageSize(const std::string& path) {
+    auto input = OIIO::ImageInput::open(path);
+    if (!input) return {0, 0};
+    return {input->spec().width, input->spec().height};
+}
+
 inline std::string slurp(const fs::path& path) {
     std::ifstream in(path);
     std::stringstream s;

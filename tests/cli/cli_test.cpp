@@ -23,12 +23,6 @@ using namespace conus::test;
 
 namespace {
 
-std::pair<int, int> imageSize(const std::string& path) {
-    auto input = OIIO::ImageInput::open(path);
-    if (!input) return {0, 0};
-    return {input->spec().width, input->spec().height};
-}
-
 TEST_F(Cli, NoArgumentsIsAnErrorWithUsage) {
     const Result r = run("");
     EXPECT_NE(r.exitCode, 0);

@@ -1,0 +1,205 @@
+#include "batch.h"
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "conus/core/error.h"
+#include "progress.h"
+
+namespace conus::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> readList(const std::string& listFile) {
+    std::ifstream file;
+    if (listFile != "-") {
+        file.open(listFile);
+        if (!file) throw Error(ErrorCode::Io, "cannot read the list " + listFile);
+    }
+    std::istream& in = listFile == "-" ? std::cin : file;
+    std::vector<std::string> inputs;
+    for (std::string line; std::getline(in, line);) {
+        while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
+        const std::size_t start = line.find_first_not_of(" \t");
+        if (start == std::string::npos || line[start] == '#') continue;  // blank lines and comments
+        inputs.push_back(line.substr(start));
+    }
+    return inputs;
+}
+
+std::string replaceAll(std::string text, const std::string& from, const std::string& to) {
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+        text.replace(at, from.size(), to);
+    return text;
+}
+
+std::string outputName(const std::string& pattern, const std::string& input, std::size_t index) {
+    const fs::path path(input);
+    std::string ext = path.extension().string();
+    if (!ext.empty()) ext.erase(0, 1);
+    std::string name = replaceAll(pattern, "{stem}", path.stem().string());
+    name = replaceAll(name, "{name}", path.filename().string());
+    name = replaceAll(name, "{ext}", ext);
+    return replaceAll(name, "{index}", std::to_string(index));
+}
+
+std::string clock(double seconds) {
+    const long s = std::lround(std::max(0.0, seconds));
+    char text[32];
+    if (s >= 3600) std::snprintf(text, sizeof text, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+    else std::snprintf(text, sizeof text, "%ld:%02ld", s / 60, s % 60);
+    return text;
+}
+
+}  // namespace
+
+void addBatchOptions(CLI::App& command, BatchOptions& options, const std::string& inputHelp, const std::string& outputHelp,
+                     const std::string& defaultName) {
+    options.name = defaultName;
+    command.add_option("inputs", options.inputs, inputHelp + " (several make a batch; see --out-dir)");
+    command.add_option("-o,--output", options.output, outputHelp + " (one input)");
+    command.add_option("--out-dir", options.outDir, "batch: write each input's output into this folder (made if missing)");
+    command.add_option("--name", options.name, "batch: output file name, from {stem}, {name}, {ext}, {index} (default " +
+                                                   defaultName + ")");
+    command.add_option("--list", options.listFile, "batch: read the inputs from this file, one a line ('-': standard input)");
+    command.add_option("--jobs,-j", options.jobs, "batch: inputs converted at once (default 1; each already uses every core)")
+        ->check(CLI::Range(1, 256));
+    command.add_flag("--skip-existing", options.skipExisting, "batch: leave inputs whose output exists alone");
+    command.add_flag("--fail-fast", options.failFast, "batch: stop at the first failure (default: try every input)");
+}
+
+bool isBatch(const BatchOptions& o) { return o.inputs.size() > 1 || !o.listFile.empty() || !o.outDir.empty(); }
+
+std::vector<Job> planJobs(const BatchOptions& o) {
+    std::vector<std::string> inputs = o.inputs;
+    if (!o.listFile.empty()) {
+        const std::vector<std::string> listed = readList(o.listFile);
+        inputs.insert(inputs.end(), listed.begin(), listed.end());
+    }
+    if (inputs.empty()) throw Error(ErrorCode::InvalidArgument, "no input given");
+    if (!isBatch(o)) {
+        if (o.output.empty()) throw Error(ErrorCode::InvalidArgument, "-o,--output is required (or --out-dir for a batch)");
+        return {{inputs.front(), o.output}};
+    }
+    if (!o.output.empty())
+        throw Error(ErrorCode::InvalidArgument, "-o names the output of one input; for " + std::to_string(inputs.size()) +
+                                                    " inputs give --out-dir (and --name)");
+    if (o.outDir.empty()) throw Error(ErrorCode::InvalidArgument, "several inputs need --out-dir for their outputs");
+    if (inputs.size() > 1 && o.name.find("{stem}") == std::string::npos && o.name.find("{name}") == std::string::npos &&
+        o.name.find("{index}") == std::string::npos)
+        throw Error(ErrorCode::InvalidArgument, "--name '" + o.name + "' gives every input the same output; use {stem}, {name} or {index}");
+    std::vector<Job> jobs;
+    std::map<std::string, std::string> seen;  // output -> the input that writes it
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+        Job job{inputs[i], (fs::path(o.outDir) / outputName(o.name, inputs[i], i + 1)).string()};
+        const std::string key = fs::path(job.output).lexically_normal().string();
+        if (auto [it, fresh] = seen.emplace(key, job.input); !fresh)
+            throw Error(ErrorCode::InvalidArgument, job.input + " and " + it->second + " would both write " + job.output +
+                                                        "; use {name} or {index} in --name");
+        jobs.push_back(std::move(job));
+    }
+    return jobs;
+}
+
+int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const std::function<std::string(const Job&)>& convert) {
+    std::error_code ec;
+    fs::create_directories(options.outDir, ec);
+    if (ec) throw Error(ErrorCode::Io, "cannot make the folder " + options.outDir + ": " + ec.message());
+
+    const bool userQuiet = quiet();  // -q; the items below run quiet whatever it says
+    const auto start = std::chrono::steady_clock::now();
+    std::atomic<std::size_t> next{0};
+    std::atomic<bool> stop{false};
+    std::mutex mutex;  // the counts and the reasons below
+    std::size_t converted = 0, skipped = 0, failed = 0, finished = 0;
+    std::vector<std::string> reasons;
+    double convertingSeconds = 0;  // work done by the converted items, for the time left
+
+    auto show = [&] {  // under `mutex`
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::string line = std::to_string(finished) + "/" + std::to_string(jobs.size()) + " (" + std::to_string(converted) +
+                           " converted, " + std::to_string(skipped) + " skipped, " + std::to_string(failed) + " failed)";
+        const std::size_t left = jobs.size() - finished;
+        if (converted > 0 && left > 0) {
+            // Converting is what takes the time: the mean so far, over the jobs that run at once.
+            const double each = convertingSeconds / double(converted);
+            const double parallel = double(std::min<std::size_t>(std::size_t(options.jobs), left));
+            line += ", " + clock(each * double(left) / parallel) + " left";
+        }
+        line += " [" + clock(elapsed) + "]";
+        liveLine(line);
+    };
+
+    auto worker = [&] {
+        for (std::size_t i; !stop && (i = next++) < jobs.size();) {
+            const Job& job = jobs[i];
+            const auto begun = std::chrono::steady_clock::now();
+            std::string outcome, error;
+            bool skip = false;
+            if (options.skipExisting && fs::exists(job.output, ec)) {
+                skip = true;
+            } else {
+                try {
+                    outcome = convert(job);
+                } catch (const std::exception& e) {
+                    error = e.what();
+                }
+            }
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begun).count();
+            std::lock_guard lock(mutex);
+            ++finished;
+            if (skip) {
+                ++skipped;
+            } else if (!error.empty()) {
+                ++failed;
+                // Most messages name the file already.
+                const std::string reason = error.rfind(job.input, 0) == 0 ? error : job.input + ": " + error;
+                reasons.push_back(reason);
+                report("[" + std::to_string(finished) + "/" + std::to_string(jobs.size()) + "] failed: " + reason);
+                if (options.failFast) stop = true;
+            } else {
+                ++converted;
+                convertingSeconds += seconds;
+                if (!userQuiet && !::isatty(STDERR_FILENO))  // a log keeps one line an item
+                    report("[" + std::to_string(finished) + "/" + std::to_string(jobs.size()) + "] " + outcome);
+            }
+            show();
+        }
+    };
+
+    setQuiet(true);  // the items' stage lines: the batch reports instead
+    {
+        std::vector<std::thread> threads;
+        const int count = std::max(1, std::min<int>(options.jobs, int(jobs.size())));
+        for (int t = 1; t < count; ++t) threads.emplace_back(worker);
+        worker();
+        for (std::thread& t : threads) t.join();
+    }
+    setQuiet(false);
+
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::string summary = std::to_string(converted) + " converted, " + std::to_string(skipped) + " skipped (output exists), " +
+                          std::to_string(failed) + " failed";
+    if (stop) summary += ", " + std::to_string(jobs.size() - finished) + " not tried (--fail-fast)";
+    summary += " in " + clock(elapsed);
+    if (!userQuiet && ::isatty(STDERR_FILENO)) std::fprintf(stderr, "\r\033[K");
+    std::printf("%s\n", summary.c_str());
+    for (const std::string& reason : reasons) std::printf("  failed: %s\n", reason.c_str());
+    return failed > 0 ? 1 : 0;
+}
+
+}  // namespace conus::cli
