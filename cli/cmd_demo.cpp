@@ -159,6 +159,7 @@ int runDemo(const DemoOptions& o) {
     format::writeConusFile((out / "uniform.exr").string(), uniform);
     imageio::WriteOptions picture;
     picture.source = &source.encoding;
+    if (o.input.empty()) writePicture((out / "source.png").string(), source.image, picture);  // to try the other commands on
     writePicture((out / "conus.png").string(), conus.image, picture);
     writePicture((out / "uniform.png").string(), uniform.image, picture);
     const double shrink = std::min(1.0, 1024.0 / std::max(w, h));
@@ -190,9 +191,9 @@ int runDemo(const DemoOptions& o) {
     }
     std::string written;
     for (const auto& v : views) written += ", view-" + v.name + ".png";
-    std::printf("\nwrote %s/: conus.exr, uniform.exr, conus.png, uniform.png, density.png%s\n"
+    std::printf("\nwrote %s/: %sconus.exr, uniform.exr, conus.png, uniform.png, density.png%s\n"
                 "  (each view-*.png: source | CoNUS | uniform)\n",
-                o.out.c_str(), written.c_str());
+                o.out.c_str(), o.input.empty() ? "source.png, " : "", written.c_str());
     return 0;
 }
 

@@ -1,0 +1,483 @@
+// `import conus`: the toolkit over numpy (pybind11). The compiled part, conus._conus; the package
+// (python/conus/__init__.py) re-exports it and adds the pure-Python helpers.
+//
+// Shared rules:
+// - Pixels are float32 numpy arrays of shape (height, width, channels), linear light, channels
+//   named by the file (R, G, B, A, Y, Z, ...). Arrays CoNUS returns own their memory without a
+//   copy (a capsule holds the C++ image); File.pixels and Map.nodes are views into the object
+//   they come from and keep it alive.
+// - Every long call (read, write, encode, decode, building a map, distort/undistort of many
+//   points) releases the GIL.
+// - A conus::Error becomes conus.Error with .code ("corrupt", "limit-exceeded", ...), .rules (the
+//   spec rules it breaks, by number) and .rule (the first, or None).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "conus/codec/build/auto_map.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/build/springs.h"
+#include "conus/codec/conus_file.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/image/metrics.h"
+#include "conus/core/error.h"
+#include "conus/format/container.h"
+#include "conus/imageio/image_file.h"
+#include "conus/renderers/gpu_image.h"
+
+namespace py = pybind11;
+
+namespace conus::python {
+namespace {
+
+// ---- errors ------------------------------------------------------------------------------------
+
+PyObject* g_error = nullptr;  // conus.Error
+
+const char* codeName(ErrorCode code) {
+    switch (code) {
+        case ErrorCode::InvalidArgument: return "invalid-argument";
+        case ErrorCode::Io: return "io";
+        case ErrorCode::NotConus: return "not-conus";
+        case ErrorCode::Corrupt: return "corrupt";
+        case ErrorCode::LimitExceeded: return "limit-exceeded";
+        case ErrorCode::InvalidMap: return "invalid-map";
+        case ErrorCode::Unsupported: return "unsupported";
+    }
+    return "unknown";
+}
+
+void translateError(std::exception_ptr p) {
+    try {
+        if (p) std::rethrow_exception(p);
+    } catch (const Error& e) {
+        py::object error = py::reinterpret_borrow<py::object>(g_error)(e.what());
+        error.attr("code") = codeName(e.code());
+        error.attr("rules") = py::cast(e.rules());
+        error.attr("rule") = e.rules().empty() ? py::object(py::none()) : py::object(py::int_(e.rules().front()));
+        PyErr_SetObject(g_error, error.ptr());
+    }
+}
+
+// ---- numpy <-> Image ---------------------------------------------------------------------------
+
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+// The image as an array that owns it: no copy of the pixels.
+py::array toArray(Image image) {
+    auto* held = new Image(std::move(image));
+    py::capsule owner(held, [](void* p) { delete static_cast<Image*>(p); });
+    const py::ssize_t c = held->channelCount();
+    return py::array_t<float>({py::ssize_t(held->height), py::ssize_t(held->width), c},
+                              {py::ssize_t(held->width) * c * 4, c * 4, py::ssize_t(4)}, held->pixels.data(), owner);
+}
+
+std::vector<std::string> defaultChannels(py::ssize_t count) {
+    switch (count) {
+        case 1: return {"Y"};
+        case 2: return {"Y", "A"};
+        case 3: return {"R", "G", "B"};
+        case 4: return {"R", "G", "B", "A"};
+        default: {
+            std::vector<std::string> names;
+            for (py::ssize_t c = 0; c < count; ++c) names.push_back("C" + std::to_string(c));
+            return names;
+        }
+    }
+}
+
+// An (H, W) or (H, W, C) array of linear values as an Image (one copy, into the Image).
+Image fromArray(const py::array& input, std::optional<std::vector<std::string>> channels, const char* what) {
+    const FloatArray array = FloatArray::ensure(input);
+    if (!array) throw Error(ErrorCode::InvalidArgument, std::string(what) + " must be an array of numbers");
+    if (array.ndim() != 2 && array.ndim() != 3)
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + " must have shape (height, width) or (height, width, channels), not " +
+                                                    std::to_string(array.ndim()) + " dimensions");
+    const py::ssize_t h = array.shape(0), w = array.shape(1), c = array.ndim() == 3 ? array.shape(2) : 1;
+    std::vector<std::string> names = channels ? *channels : defaultChannels(c);
+    if (py::ssize_t(names.size()) != c)
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + " has " + std::to_string(c) + " channels but " +
+                                                    std::to_string(names.size()) + " names were given");
+    if (h > kMaxImageSide || w > kMaxImageSide)
+        throw Error(ErrorCode::LimitExceeded, std::string(what) + " of " + std::to_string(w) + "x" + std::to_string(h) +
+                                                  " pixels is beyond the limit of " + std::to_string(kMaxImageSide) + " a side");
+    Image image = makeImage(int(w), int(h), std::move(names));
+    std::copy(array.data(), array.data() + image.pixels.size(), image.pixels.begin());
+    return image;
+}
+
+// ---- points ------------------------------------------------------------------------------------
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// f applied to every (u, v) of an (..., 2) array, without the GIL.
+template <class F>
+py::array mapPoints(const py::array& input, F&& f) {
+    const DoubleArray points = DoubleArray::ensure(input);
+    if (!points || points.ndim() < 1 || points.shape(points.ndim() - 1) != 2)
+        throw Error(ErrorCode::InvalidArgument, "points must be an array of shape (..., 2)");
+    DoubleArray out(std::vector<py::ssize_t>(points.shape(), points.shape() + points.ndim()));
+    const double* in = points.data();
+    double* o = out.mutable_data();
+    const py::ssize_t n = points.size() / 2;
+    {
+        py::gil_scoped_release release;
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const glm::dvec2 q = f(glm::dvec2(in[2 * i], in[2 * i + 1]));
+            o[2 * i] = q.x;
+            o[2 * i + 1] = q.y;
+        }
+    }
+    return out;
+}
+
+// ---- the objects -------------------------------------------------------------------------------
+
+struct Map {
+    codec::SamplingMap map;
+    std::optional<format::AnalyticMap> analytic;  // when built from parameters
+};
+
+struct File {
+    format::ConusFile file;
+    std::shared_ptr<Map> map;  // built from file.map on first use
+    std::shared_ptr<Map> samplingMap() {
+        if (!map) map = std::make_shared<Map>(Map{codec::SamplingMap::fromGrid(file.map), file.analytic});
+        return map;
+    }
+};
+
+std::vector<codec::Focus> toFoci(const std::vector<std::tuple<double, double, double, double>>& foci) {
+    std::vector<codec::Focus> out;
+    for (const auto& [u, v, r, k] : foci) out.push_back({u, v, r, k});
+    return out;
+}
+
+py::dict attributesOf(const format::ConusFile& f) {
+    py::dict a;
+    a["source_size"] = py::make_tuple(f.sourceWidth, f.sourceHeight);
+    a["data_kind"] = format::toString(f.dataKind);
+    a["pixel_type"] = format::toString(f.pixelType);
+    a["compression"] = format::toString(f.compression);
+    a["software"] = f.software;
+    a["transfer"] = toString(f.sourceEncoding.transfer);
+    if (f.sourceEncoding.sampleType) a["source_sample_type"] = toString(*f.sourceEncoding.sampleType);
+    if (f.analytic) {
+        py::dict analytic;
+        analytic["kind"] = f.analytic->kind;
+        py::list foci;
+        for (const format::FocusParams& p : f.analytic->foci) foci.append(py::make_tuple(p.u, p.v, p.r, p.k));
+        analytic["foci"] = foci;
+        analytic["composition"] = f.analytic->composition;
+        analytic["scalars"] = f.analytic->scalars;
+        a["analytic"] = analytic;
+    }
+    if (f.depth.kind != format::DepthKind::None) {
+        py::dict depth;
+        depth["kind"] = format::toString(f.depth.kind);
+        depth["units"] = f.depth.units;
+        depth["near"] = f.depth.near;
+        depth["far"] = f.depth.far;
+        a["depth"] = depth;
+    }
+    return a;
+}
+
+// One GL context per backend for the process, used by one call at a time.
+std::mutex g_deviceMutex;
+
+const gl::Device& deviceFor(const std::string& backend) {
+    static std::map<std::string, gl::Device> devices;
+    auto it = devices.find(backend);
+    if (it == devices.end())
+        it = devices.emplace(backend, gl::Device::choose(gl::parseBackend(backend), gl::CpuPath::Available, "image encode")).first;
+    return it->second;
+}
+
+// The image's channels in the order people read them (R, G, B, A, ...; displayOrder), as an
+// array's last axis should be: OpenEXR stores them sorted by name (A, B, G, R).
+void toDisplayOrder(Image& image) {
+    const std::vector<std::string> order = displayOrder(image.channels);
+    if (order == image.channels) return;
+    Image sorted = makeImage(image.width, image.height, order);
+    std::vector<int> from;
+    for (const std::string& name : order) from.push_back(image.channelIndex(name));
+    const std::size_t n = std::size_t(image.width) * image.height, c = order.size();
+    for (std::size_t p = 0; p < n; ++p)
+        for (std::size_t k = 0; k < c; ++k) sorted.pixels[p * c + k] = image.pixels[p * c + std::size_t(from[k])];
+    image = std::move(sorted);
+}
+
+std::pair<int, int> sizeOr(const std::optional<std::pair<int, int>>& size, int w, int h) {
+    return size ? *size : std::pair<int, int>{std::max(1, (w + 2) / 4), std::max(1, (h + 2) / 4)};
+}
+
+}  // namespace
+}  // namespace conus::python
+
+PYBIND11_MODULE(_conus, m) {
+    using namespace conus;
+    using namespace conus::python;
+    namespace codec = conus::codec;
+    m.doc() = "CoNUS: coherent non-uniform sampling images (the compiled part of the conus package)";
+
+    g_error = PyErr_NewExceptionWithDoc("conus.Error",
+                                        "A CoNUS error: .code names its kind, .rules the spec rules it breaks, .rule the first",
+                                        PyExc_RuntimeError, nullptr);
+    m.attr("Error") = py::handle(g_error);
+    py::register_exception_translator(&translateError);
+    m.attr("MAX_IMAGE_SIDE") = kMaxImageSide;
+    m.attr("MAX_MAP_SIDE") = kMaxMapSide;
+    m.attr("DEFAULT_MAP_SIDE") = map_rules::kDefaultSide;
+
+    py::class_<Map, std::shared_ptr<Map>>(m, "Map", "A sampling map: a grid of distorted node positions (Equation 1)")
+        .def_static(
+            "identity", [](int columns, int rows) { return std::make_shared<Map>(Map{codec::SamplingMap::identity(columns, rows), {}}); },
+            py::arg("columns") = map_rules::kDefaultSide, py::arg("rows") = map_rules::kDefaultSide)
+        .def_static(
+            "foci",
+            [](const std::vector<std::tuple<double, double, double, double>>& foci, double aspect, int grid, const std::string& composition) {
+                const std::vector<codec::Focus> f = toFoci(foci);
+                codec::FociOptions options;
+                options.aspect = aspect;
+                options.columns = options.rows = grid;
+                if (composition == "add") options.composition = codec::FociComposition::Add;
+                else if (composition != "density")
+                    throw Error(ErrorCode::InvalidArgument, "composition must be 'density' or 'add', not '" + composition + "'");
+                py::gil_scoped_release release;
+                codec::SamplingMap map = codec::buildFociMap(f, options);
+                return std::make_shared<Map>(Map{std::move(map), codec::toAnalytic(f, options.composition)});
+            },
+            py::arg("foci"), py::arg("aspect") = 1.0, py::arg("grid") = map_rules::kDefaultSide, py::arg("composition") = "density",
+            "Circular foci (u, v, r, k): centre, radius as a fraction of the width, magnification")
+        .def_static(
+            "springs",
+            [](const std::vector<std::tuple<double, double, double, double>>& strokes, int grid, int max_steps) {
+                codec::SpringSystem system(grid, grid);
+                for (const auto& [u, v, radius, strength] : strokes) system.addStroke({u, v, radius, strength});
+                py::gil_scoped_release release;
+                system.runUntilStable(max_steps);
+                return std::make_shared<Map>(Map{system.toMap(grid, grid), {}});
+            },
+            py::arg("strokes"), py::arg("grid") = map_rules::kDefaultSide, py::arg("max_steps") = 200000,
+            "The paper's mass-spring brush: strokes (u, v, radius, strength), relaxed until stable")
+        .def_static(
+            "auto",
+            [](const py::array& importance, int grid, double min_density, double max_density) {
+                Image image = fromArray(importance, std::nullopt, "importance");
+                codec::AutoMapOptions options;
+                options.columns = options.rows = grid;
+                options.minDensity = min_density;
+                options.maxDensity = max_density;
+                py::gil_scoped_release release;
+                return std::make_shared<Map>(Map{codec::buildAutoMap(image, options), {}});
+            },
+            py::arg("importance"), py::arg("grid") = map_rules::kDefaultSide, py::arg("min_density") = 0.25,
+            py::arg("max_density") = 16.0, "A map whose density follows an importance image (H, W)")
+        .def_static(
+            "from_nodes",
+            [](const py::array& nodes) {
+                const FloatArray a = FloatArray::ensure(nodes);
+                if (!a || a.ndim() != 3 || a.shape(2) != 2)
+                    throw Error(ErrorCode::InvalidArgument, "nodes must have shape (rows, columns, 2)");
+                format::GridNodes grid;
+                grid.rows = int(a.shape(0));
+                grid.columns = int(a.shape(1));
+                grid.xy.assign(a.data(), a.data() + a.size());
+                return std::make_shared<Map>(Map{codec::SamplingMap::fromGrid(grid), {}});
+            },
+            py::arg("nodes"), "A map from its nodes' distorted positions, shape (rows, columns, 2); validated")
+        .def_property_readonly("columns", [](const Map& self) { return self.map.columns(); })
+        .def_property_readonly("rows", [](const Map& self) { return self.map.rows(); })
+        .def_property_readonly(
+            "nodes",
+            [](py::object self) {
+                const Map& map = self.cast<const Map&>();
+                py::array_t<float> view({py::ssize_t(map.map.rows()), py::ssize_t(map.map.columns()), py::ssize_t(2)},
+                                        reinterpret_cast<const float*>(map.map.nodes().data()), self);
+                py::detail::array_proxy(view.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+                return view;
+            },
+            "The nodes' distorted positions, (rows, columns, 2), a read-only view")
+        .def("distort", [](const Map& self, const py::array& p) { return mapPoints(p, [&](glm::dvec2 q) { return self.map.distort(q); }); },
+             py::arg("points"), "Equation 1 on an (..., 2) array of undistorted (u, v)")
+        .def("undistort",
+             [](const Map& self, const py::array& p) { return mapPoints(p, [&](glm::dvec2 q) { return self.map.undistort(q); }); },
+             py::arg("points"), "The exact inverse of distort on an (..., 2) array")
+        .def("density",
+             [](const Map& self, const py::array& p) {
+                 py::array both = mapPoints(p, [&](glm::dvec2 q) { return glm::dvec2(self.map.density(q), 0.0); });
+                 return py::object(both[py::make_tuple(py::ellipsis(), 0)]).cast<py::array>();
+             },
+             py::arg("points"), "Sampling density (area ratio) at undistorted points")
+        .def("__repr__", [](const Map& self) {
+            return "<conus.Map " + std::to_string(self.map.columns()) + "x" + std::to_string(self.map.rows()) + " nodes" +
+                   (self.analytic ? ", " + self.analytic->kind : std::string()) + ">";
+        });
+
+    py::class_<File, std::shared_ptr<File>>(m, "File", "A CoNUS file in memory: the CoNUS image, its map and attributes")
+        .def_property_readonly(
+            "pixels",
+            [](py::object self) {
+                Image& image = self.cast<File&>().file.image;
+                const py::ssize_t c = image.channelCount();
+                return py::array_t<float>({py::ssize_t(image.height), py::ssize_t(image.width), c},
+                                          {py::ssize_t(image.width) * c * 4, c * 4, py::ssize_t(4)}, image.pixels.data(), self);
+            },
+            "The CoNUS image, (height, width, channels) float32, a view")
+        .def_property_readonly("channels", [](const File& self) { return self.file.image.channels; })
+        .def_property_readonly("map", [](File& self) { return self.samplingMap(); })
+        .def_property_readonly("attributes", [](const File& self) { return attributesOf(self.file); })
+        .def_property_readonly("source_size", [](const File& self) { return py::make_tuple(self.file.sourceWidth, self.file.sourceHeight); })
+        .def("__repr__", [](const File& self) {
+            const format::ConusFile& f = self.file;
+            return "<conus.File " + std::to_string(f.image.width) + "x" + std::to_string(f.image.height) + " CoNUS image of a " +
+                   std::to_string(f.sourceWidth) + "x" + std::to_string(f.sourceHeight) + " source, " +
+                   std::to_string(f.map.columns) + "x" + std::to_string(f.map.rows) + " map>";
+        });
+
+    m.def(
+        "read",
+        [](const std::string& path) {
+            auto file = std::make_shared<File>();
+            py::gil_scoped_release release;
+            file->file = format::readConusFile(path);
+            toDisplayOrder(file->file.image);
+            return file;
+        },
+        py::arg("path"), "Read a CoNUS file (every rule of the spec checked); channels in display order (R, G, B, A, ...)");
+    m.def(
+        "write",
+        [](const std::string& path, const File& file) {
+            py::gil_scoped_release release;
+            format::writeConusFile(path, file.file);
+        },
+        py::arg("path"), py::arg("file"), "Write a CoNUS file (validated first, written atomically)");
+    m.def(
+        "encode",
+        [](const py::array& pixels, std::optional<std::vector<std::tuple<double, double, double, double>>> foci,
+           std::optional<std::pair<int, int>> size, std::shared_ptr<Map> map, std::optional<std::vector<std::string>> channels,
+           const std::string& backend) {
+            Image source = fromArray(pixels, channels, "pixels");
+            if (foci && map) throw Error(ErrorCode::InvalidArgument, "give foci or a map, not both");
+            const double aspect = double(source.width) / source.height;
+            if (!map) {
+                if (foci && !foci->empty()) {
+                    const std::vector<codec::Focus> f = toFoci(*foci);
+                    codec::FociOptions options;
+                    options.aspect = aspect;
+                    py::gil_scoped_release release;
+                    map = std::make_shared<Map>(Map{codec::buildFociMap(f, options), codec::toAnalytic(f, options.composition)});
+                } else {
+                    map = std::make_shared<Map>(Map{codec::SamplingMap::identity(2, 2), {}});
+                }
+            }
+            const auto [w, h] = sizeOr(size, source.width, source.height);
+            codec::EncodeOptions options;
+            options.width = w;
+            options.height = h;
+            auto file = std::make_shared<File>();
+            {
+                py::gil_scoped_release release;
+                Image encoded;
+                if (backend == "cpu") {
+                    encoded = codec::encodeImage(source, map->map, options);
+                } else {
+                    std::lock_guard<std::mutex> lock(g_deviceMutex);
+                    encoded = gl::encodeImage(deviceFor(backend), source, map->map, options);
+                }
+                file->file = codec::makeImageFile(std::move(encoded), map->map, source.width, source.height, SourceEncoding{},
+                                                  map->analytic);
+            }
+            file->map = map;
+            return file;
+        },
+        py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),
+        py::arg("channels") = py::none(), py::arg("backend") = "cpu",
+        "Encode linear pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file;\n"
+        "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'");
+    m.def(
+        "decode",
+        [](File& file, std::tuple<double, double, double, double> view, std::optional<std::pair<int, int>> size, const std::string& backend) {
+            const auto [u0, v0, u1, v1] = view;
+            codec::DecodeOptions options;
+            options.view = {u0, v0, u1, v1};
+            if (size) {
+                options.width = size->first;
+                options.height = size->second;
+            } else {
+                options.width = std::max(1, int(std::lround(std::abs(u1 - u0) * file.file.sourceWidth)));
+                options.height = std::max(1, int(std::lround(std::abs(v1 - v0) * file.file.sourceHeight)));
+            }
+            const std::shared_ptr<Map> map = file.samplingMap();
+            Image frame;
+            {
+                py::gil_scoped_release release;
+                if (backend == "cpu") {
+                    frame = codec::decodeImage(file.file.image, map->map, options);
+                } else {
+                    std::lock_guard<std::mutex> lock(g_deviceMutex);
+                    frame = gl::decodeImage(deviceFor(backend), file.file.image, map->map, options);
+                }
+            }
+            return toArray(std::move(frame));
+        },
+        py::arg("file"), py::arg("view") = std::make_tuple(0.0, 0.0, 1.0, 1.0), py::arg("size") = py::none(), py::arg("backend") = "cpu",
+        "A conventional frame of the rectangle view (u0, v0, u1, v1), at size (w, h) (default: the source's resolution)");
+    m.def(
+        "uniform",
+        [](const py::array& pixels, std::optional<std::pair<int, int>> size) {
+            Image source = fromArray(pixels, std::nullopt, "pixels");
+            const auto [w, h] = sizeOr(size, source.width, source.height);
+            py::gil_scoped_release release;
+            Image small = codec::areaDownsample(source, w, h);
+            py::gil_scoped_acquire acquire;
+            return toArray(std::move(small));
+        },
+        py::arg("pixels"), py::arg("size") = py::none(), "The uniform baseline: an area downsample to the same pixel count");
+    m.def(
+        "resize",
+        [](const py::array& pixels, std::pair<int, int> size) {
+            Image source = fromArray(pixels, std::nullopt, "pixels");
+            py::gil_scoped_release release;
+            Image out = codec::resizeBilinear(source, {}, size.first, size.second);
+            py::gil_scoped_acquire acquire;
+            return toArray(std::move(out));
+        },
+        py::arg("pixels"), py::arg("size"), "Bilinear resize (how a uniform image is shown at another size)");
+    m.def(
+        "psnr", [](const py::array& a, const py::array& b, double peak) {
+            return codec::psnr(fromArray(a, std::nullopt, "a"), fromArray(b, std::nullopt, "b"), peak);
+        },
+        py::arg("a"), py::arg("b"), py::arg("peak") = 1.0, "PSNR in dB of two images of the same shape");
+    m.def(
+        "read_image",
+        [](const std::string& path) {
+            imageio::ImageFile file;
+            {
+                py::gil_scoped_release release;
+                file = imageio::readImageFile(path);
+            }
+            py::list channels = py::cast(file.image.channels);
+            return py::make_tuple(toArray(std::move(file.image)), channels);
+        },
+        py::arg("path"), "Read an ordinary picture (PNG, JPEG, TIFF, EXR, ...) as linear float: (pixels, channels)");
+    m.def(
+        "write_image",
+        [](const std::string& path, const py::array& pixels, std::optional<std::vector<std::string>> channels) {
+            Image image = fromArray(pixels, channels, "pixels");
+            py::gil_scoped_release release;
+            imageio::writeImageFile(path, image);
+        },
+        py::arg("path"), py::arg("pixels"), py::arg("channels") = py::none(),
+        "Write linear pixels as an ordinary picture (8-bit sRGB for PNG/JPEG, half for EXR), atomically");
+}

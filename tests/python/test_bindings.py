@@ -1,0 +1,148 @@
+"""import conus: the bindings against the real binary, OpenEXR's own tools and numpy."""
+import json
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import conus
+
+FOCUS = (0.1, 0.12, 0.08, 4.0)  # on the red patch
+
+
+def run(*args):
+    return subprocess.run(list(args), capture_output=True, text=True, check=True)
+
+
+def test_encode_write_read_round_trip(tmp_path, asymmetric, conus_bin):
+    f = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80))
+    assert f.pixels.shape == (80, 120, 4) and f.pixels.dtype == np.float32
+    assert f.channels == ["R", "G", "B", "A"]
+    path = str(tmp_path / "a.exr")
+    conus.write(path, f)
+    g = conus.read(path)
+    assert g.source_size == (240, 160)
+    assert g.attributes["analytic"]["foci"] == [pytest.approx(FOCUS)]
+    # Half floats in the file: within half's precision of what was encoded.
+    np.testing.assert_allclose(g.pixels, f.pixels, rtol=1e-3, atol=1e-3)
+    # The real binary and OpenEXR's own exrheader read the same file.
+    info = json.loads(run(conus_bin, "info", path, "--json").stdout)
+    assert info["source"]["width"] == 240 and info["source"]["height"] == 160
+    header = run("exrheader", path).stdout
+    assert "dataWindow (type box2i): (0 0) - (119 79)" in header and 'name (type string): "samplingmap"' in header
+
+
+def test_python_encode_matches_the_cli(tmp_path, asymmetric, conus_bin):
+    src = str(tmp_path / "src.exr")
+    conus.write_image(src, asymmetric)
+    pixels, channels = conus.read_image(src)  # what the CLI reads: half-float values
+    assert channels == ["R", "G", "B", "A"]
+    cli = str(tmp_path / "cli.exr")
+    run(conus_bin, "encode", src, "-o", cli, "--focus", ",".join(map(str, FOCUS)), "--size", "120x80", "--backend", "cpu", "-q")
+    ours = conus.encode(pixels, foci=[FOCUS], size=(120, 80), channels=channels)
+    theirs = conus.read(cli)
+    np.testing.assert_array_equal(ours.map.nodes, theirs.map.nodes)
+    np.testing.assert_allclose(ours.pixels, theirs.pixels, atol=1e-3)
+
+
+def test_decode_puts_the_patch_back_and_beats_uniform_in_the_focus(asymmetric):
+    f = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80))
+    frame = conus.decode(f)
+    assert frame.shape == (160, 240, 4)
+    assert frame[8, 10, 0] > 0.9 and frame[8, 10, 1] < 0.1  # red, top-left
+    assert frame[150, 230, 0] < 0.3  # not red, bottom-right
+    assert frame[80, 230, 3] == pytest.approx(0.5, abs=0.02)  # partial alpha kept
+    # The focus region, zoomed: CoNUS beats the uniform image of the same pixel count.
+    view = (0.0, 0.0, 0.25, 0.25)
+    zoom = conus.decode(f, view=view, size=(60, 40))
+    truth = asymmetric[:40, :60]
+    small = conus.uniform(asymmetric, size=(120, 80))
+    uniform_zoom = conus.resize(small, (240, 160))[:40, :60]
+    assert conus.psnr(zoom, truth) > conus.psnr(uniform_zoom, truth) + 3.0
+
+
+def test_maps_distort_undistort_and_density():
+    m = conus.Map.foci([(0.5, 0.5, 0.1, 4)])
+    assert (m.columns, m.rows) == (conus.DEFAULT_MAP_SIDE, conus.DEFAULT_MAP_SIDE)
+    rng = np.random.default_rng(7)
+    p = rng.random((1000, 2))
+    d = m.distort(p)
+    assert d.shape == p.shape and not np.allclose(d, p)
+    np.testing.assert_allclose(m.undistort(d), p, atol=1e-9)
+    # Vectorized over any leading shape.
+    assert m.distort(p.reshape(10, 100, 2)).shape == (10, 100, 2)
+    identity = conus.Map.identity(5, 3)
+    np.testing.assert_allclose(identity.distort(p), p, atol=1e-12)
+    density = m.density(np.array([[0.5, 0.5], [0.02, 0.98]]))
+    assert density[0] > 4 and density[1] < 1  # k^2 = 16 at the centre, as far as a 65-node grid resolves it
+    nodes = m.nodes
+    assert nodes.shape == (m.rows, m.columns, 2) and not nodes.flags.writeable
+    assert np.shares_memory(nodes, m.nodes)  # a view, not a copy
+    rebuilt = conus.Map.from_nodes(np.array(nodes))
+    np.testing.assert_allclose(rebuilt.distort(p), d, atol=1e-6)
+
+
+def test_auto_and_springs_maps_concentrate_where_asked():
+    importance = np.zeros((64, 96), np.float32)
+    importance[10:20, 60:80] = 1.0
+    m = conus.Map.auto(importance, grid=33)
+    box, far = m.density(np.array([[0.73, 0.23], [0.2, 0.8]]))
+    assert box > 2 * far
+    s = conus.Map.springs([(0.3, 0.6, 0.15, 1.0)], grid=17)
+    inside, outside = s.density(np.array([[0.3, 0.6], [0.85, 0.15]]))
+    assert inside > outside
+
+
+def test_views_and_ownership(asymmetric):
+    f = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80))
+    a, b = f.pixels, f.pixels
+    assert np.shares_memory(a, b)
+    a[0, 0, 0] = 42.0
+    assert f.pixels[0, 0, 0] == 42.0  # the File's own pixels
+    frame = conus.decode(f, size=(30, 20))
+    assert not frame.flags.owndata and frame.base is not None  # the C++ image, not copied
+    del f
+    assert np.isfinite(frame).all()
+
+
+def test_errors_carry_their_rule(tmp_path):
+    folded = np.array(conus.Map.identity(3, 3).nodes)
+    folded[1, 1] = (0.9, 0.9)  # the centre node past its neighbours: cells fold
+    with pytest.raises(conus.Error) as e:
+        conus.Map.from_nodes(folded)
+    assert e.value.code == "invalid-map" and e.value.rule == 11
+    bad = tmp_path / "bad.exr"
+    bad.write_bytes(b"not an exr at all")
+    with pytest.raises(conus.Error) as e:
+        conus.read(str(bad))
+    assert e.value.rule == 1 and "\n" not in str(e.value)
+    with pytest.raises(conus.Error) as e:
+        conus.encode(np.zeros((4, 4, 3), np.float32), foci=[(0.5, 0.5, 0.1, 100)])
+    assert e.value.code == "invalid-argument" and e.value.rule is None
+    with pytest.raises(conus.Error):
+        conus.encode(np.zeros((4, 4, 2, 2), np.float32))
+
+
+def test_long_calls_release_the_gil(asymmetric):
+    # Two threads decode at once; each result equals the single-threaded one.
+    f = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80))
+    expected = conus.decode(f, size=(480, 320))
+    results = [None, None]
+
+    def work(i):
+        results[i] = conus.decode(f, size=(480, 320))
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        np.testing.assert_array_equal(r, expected)
+
+
+def test_gpu_encode_agrees_with_the_cpu_reference(asymmetric):
+    f_cpu = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80))
+    f_gl = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80), backend="egl")
+    assert conus.psnr(f_gl.pixels, f_cpu.pixels) > 45.0
