@@ -30,7 +30,7 @@ const std::vector<Binding> kViewBindings = {
     {"Down", false, false, Action::PanDown, ""},
     {"C", false, false, Action::ModeReconstructed, "C          reconstructed frame (decoded from the CoNUS data)"},
     {"R", false, false, Action::ModeRaw, "R          raw CoNUS image, stretched"},
-    {"U", false, false, Action::ModeUniform, "U          uniform image of the same pixel count"},
+    {"U", false, false, Action::ModeUniform, "U          uniform image of the same pixel count (--uniform: the real one)"},
     {"W", false, false, Action::ModeWipe, "W          wipe: CoNUS left, uniform right (Shift-drag moves the split)"},
     {"D", false, false, Action::ModeDensity, "D          sampling density heat map (det J)"},
     {"G", false, false, Action::ToggleGrid, "G          CoNUS pixel grid overlay"},

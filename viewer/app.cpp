@@ -30,6 +30,7 @@ public:
             const bool flatOut = !m_options.script.empty() || m_options.benchmarkFrames > 0;
             m_window = std::make_unique<Window>(m_options.windowWidth, m_options.windowHeight, !flatOut, m_controller);
             m_drawing = std::make_unique<Drawing>(m_window->context());
+            if (!m_options.uniform.empty()) m_drawing->setUniform(m_options.files.front(), uniformBaseline(m_options.uniform));
         } catch (const std::exception& e) {
             std::fprintf(stderr, "conus-view: %s\n", e.what());
             return 1;

@@ -2,6 +2,8 @@
 
 #include <exception>
 
+#include "conus/codec/image/decode.h"
+
 namespace conus::viewer {
 
 int Document::sourceWidth() const {
@@ -29,6 +31,14 @@ Document loadDocument(const std::string& path) {
         if (doc.error.empty()) doc.error = "unknown error";
     }
     return doc;
+}
+
+Image uniformBaseline(const std::string& path) {
+    const format::ConusFile file = format::readConusFile(path);
+    codec::DecodeOptions options;
+    options.width = file.image.width;
+    options.height = file.image.height;
+    return codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
 }
 
 }  // namespace conus::viewer

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "conus/codec/map/sampling_map.h"
+#include "conus/core/image.h"
 #include "conus/format/container.h"
 
 namespace conus::viewer {
@@ -23,5 +24,10 @@ struct Document {
 };
 
 Document loadDocument(const std::string& path);
+
+// The uniform baseline in the CoNUS file at `path` (what `conus uniform` wrote: an identity map, so
+// its image is the area-downsampled source), reconstructed through its map at its own size, for
+// --uniform. Throws conus::Error like readConusFile.
+Image uniformBaseline(const std::string& path);
 
 }  // namespace conus::viewer

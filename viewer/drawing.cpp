@@ -9,6 +9,11 @@ namespace conus::viewer {
 
 Drawing::Drawing(gl::Context& context) : m_renderer(context) {}
 
+void Drawing::setUniform(const std::string& path, Image uniform) {
+    m_uniformPath = path;
+    m_uniform = std::move(uniform);
+}
+
 void Drawing::frame(Controller& controller, int fw, int fh) {
     if (m_imageVersion != controller.imageVersion()) {
         m_imageVersion = controller.imageVersion();
@@ -17,6 +22,8 @@ void Drawing::frame(Controller& controller, int fw, int fh) {
         if (const std::optional<format::ConusFile> file = controller.shownFile()) {
             try {
                 m_renderer.setImage(*file);
+                const Document* shown = controller.current();
+                if (!m_uniformPath.empty() && shown && shown->path == m_uniformPath) m_renderer.setUniform(m_uniform);
                 m_shown = true;
             } catch (const std::exception& e) {
                 controller.cannotDisplay(e.what());

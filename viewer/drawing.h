@@ -19,6 +19,8 @@ public:
     // The frame just drawn, display values, top row first.
     Image readFramebuffer(int fw, int fh) { return m_renderer.readFramebuffer(fw, fh); }
     gl::ViewRenderer& renderer() { return m_renderer; }
+    // Shows `uniform` as the uniform image whenever the file at `path` is shown (--uniform).
+    void setUniform(const std::string& path, Image uniform);
 
 private:
     void drawOverlays(const Controller& controller, int fw, int fh);
@@ -29,6 +31,8 @@ private:
     gl::ViewRenderer m_renderer;
     int m_imageVersion = -1, m_mapVersion = -1;
     bool m_shown = false;  // the renderer holds an image
+    std::string m_uniformPath;  // --uniform: the file it belongs to, and the image
+    Image m_uniform;
     std::string m_overlayKey[gl::ViewRenderer::kOverlaySlots];
     int m_overlayHeight[gl::ViewRenderer::kOverlaySlots] = {};
     bool m_textBroken = false;  // the font could not be drawn: overlays off, said once on stderr

@@ -47,6 +47,9 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("--edit", o.edit, "paint a sampling map over IMAGE (PNG, JPEG, EXR, ...)");
     app.add_option("-o,--output", o.output, "--edit: base path for S (<base>.map.exr) and Ctrl-S (<base>.conus.exr)");
     app.add_option("--screenshot", o.screenshot, "render the first file offscreen (no display needed) to a PNG and exit");
+    app.add_option("--uniform", o.uniform,
+                   "the first file's uniform baseline for U and W (a CoNUS file `conus uniform` wrote from the same source; "
+                   "without it, the uniform image is resampled from the CoNUS data)");
     app.add_option("--view", view, "undistorted rectangle u0,v0,u1,v1 to show");
     app.add_option("--size", size, "WxH of --screenshot, or of the CoNUS image --edit encodes");
     app.add_option("--window", window, "window size WxH")->capture_default_str();
@@ -83,6 +86,7 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
         if (o.files.empty() && o.edit.empty()) throw Error(ErrorCode::InvalidArgument, "no file given (conus-view FILE.exr or --edit IMAGE)");
         if (!o.edit.empty() && !o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--edit takes no CoNUS files");
         if (!o.screenshot.empty() && o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--screenshot needs a CoNUS file");
+        if (!o.uniform.empty() && o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--uniform goes with a CoNUS file");
         if (o.benchmarkFrames < 0) throw Error(ErrorCode::InvalidArgument, "--benchmark-frames must be >= 0");
     } catch (const CLI::ParseError& e) {
         *exitCode = app.exit(e);

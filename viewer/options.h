@@ -16,6 +16,7 @@ struct Options {
     std::string edit;                    // --edit IMAGE: the map editor on this image
     std::string output;                  // --edit: base path of the saved map / CoNUS file
     std::string screenshot;              // --screenshot OUT.png: render offscreen and exit
+    std::string uniform;                 // --uniform FILE: the first file's real uniform baseline
     std::optional<codec::View> view;     // --view u0,v0,u1,v1
     int width = 0, height = 0;           // --size: screenshot size, or the editor's encode size
     int windowWidth = 1280, windowHeight = 800;

@@ -43,6 +43,7 @@ int runScreenshot(const Options& options) {
         gl::Context& context = device.context();
         gl::ViewRenderer renderer(context);
         renderer.setImage(*doc.file);
+        if (!options.uniform.empty()) renderer.setUniform(uniformBaseline(options.uniform));
         std::vector<gl::OverlayPlacement> overlays;
         if (options.helpOverlay) {
             renderer.setOverlay(kHelpSlot, helpPanel(false));

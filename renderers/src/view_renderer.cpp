@@ -295,6 +295,21 @@ ViewRenderer::~ViewRenderer() = default;
 bool ViewRenderer::hasImage() const { return static_cast<bool>(m_impl->conus); }
 const Image& ViewRenderer::uniformImage() const { return m_impl->uniformImage; }
 
+void ViewRenderer::setUniform(const Image& image) {
+    Impl& d = *m_impl;
+    if (!hasImage()) throw Error(ErrorCode::InvalidArgument, "ViewRenderer::setUniform before setImage");
+    const Image rgba = displayRgba(image);
+    const int limit = d.context.textureLimit();
+    if (rgba.width > limit || rgba.height > limit)
+        throw Error(ErrorCode::LimitExceeded, "ViewRenderer: uniform image " + std::to_string(rgba.width) + "x" +
+                                                  std::to_string(rgba.height) + " exceeds the texture limit " +
+                                                  std::to_string(limit));
+    const GladGLContext& gl = makeCurrentGl(d.context);
+    d.uniform = uploadRgba(gl, rgba);
+    checkGl(gl, "ViewRenderer: uniform image upload");
+    d.uniformImage = rgba;
+}
+
 void ViewRenderer::setImage(const format::ConusFile& file) {
     Impl& d = *m_impl;
     const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include "conus/codec/conus_file.h"
 #include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
 #include "conus/format/container.h"
 #include "sanitizers.h"
 #include "view_state.h"
@@ -100,6 +102,39 @@ TEST(ConusView, ScreenshotIsTheDecodedFrameWithoutADisplay) {
             for (int c = 0; c < 3; ++c)
                 worst = std::max(worst, double(std::abs(shot.at(x, y, c) - std::clamp(cpu.at(x, y, channel[c]), 0.0f, 1.0f))));
     EXPECT_LT(worst, 3.0 / 255) << "8-bit rounding plus float differences";
+}
+
+// --uniform shows the real baseline (what `conus uniform` makes from the source) in U mode; without
+// it the uniform image can only be resampled from the CoNUS data, which is not the same picture.
+TEST(ConusView, UniformModeShowsTheGivenBaseline) {
+    const Image uniform = codec::areaDownsample(test::sourceImage(), test::kConusWidth, test::kConusHeight);
+    const fs::path uniformPath = test::tempDir() / "uniform.exr";
+    format::writeConusFile(uniformPath.string(), codec::makeImageFile(uniform, codec::SamplingMap::identity(2, 2), test::kSourceWidth,
+                                                                      test::kSourceHeight, {}));
+    codec::DecodeOptions options;
+    options.width = test::kSourceWidth;
+    options.height = test::kSourceHeight;
+    const Image expected = codec::decodeImage(uniform, codec::SamplingMap::identity(2, 2), options);
+    const auto worstDifference = [&](const Image& shot) {
+        double worst = 0;
+        for (int y = 0; y < expected.height; ++y)
+            for (int x = 0; x < expected.width; ++x)
+                for (int c = 0; c < 3; ++c)
+                    worst = std::max(worst, double(std::abs(shot.at(x, y, c) - std::clamp(expected.at(x, y, c), 0.0f, 1.0f))));
+        return worst;
+    };
+    const std::string size = " --size " + std::to_string(test::kSourceWidth) + "x" + std::to_string(test::kSourceHeight);
+    const fs::path given = test::tempDir() / "given.png", resampled = test::tempDir() / "resampled.png";
+    std::string log;
+    ASSERT_EQ(test::run(test::viewerBinary() + " " + test::conusPath() + " --mode uniform --gamma 1 --uniform " + uniformPath.string() +
+                            " --screenshot " + given.string() + size, &log), 0) << log;
+    ASSERT_EQ(test::run(test::viewerBinary() + " " + test::conusPath() + " --mode uniform --gamma 1 --screenshot " + resampled.string() + size,
+                        &log), 0) << log;
+    const Image shotGiven = readPng(given), shotResampled = readPng(resampled);
+    ASSERT_EQ(shotGiven.width, test::kSourceWidth);
+    EXPECT_LT(worstDifference(shotGiven), 3.0 / 255) << "8-bit rounding plus float differences";
+    EXPECT_GT(worstDifference(shotResampled), 6.0 / 255) << "the resampled uniform image is another picture";
+    EXPECT_EQ(test::run(test::viewerBinary() + " --uniform " + uniformPath.string(), &log), 2) << log;
 }
 
 TEST(ConusView, ScreenshotLetterboxesLikeTheWindow) {

@@ -73,6 +73,10 @@ public:
     // whose footprint filter is an area downsample of the reconstructed frame. Throws
     // conus::Error(InvalidMap) for a bad map, LimitExceeded beyond GL_MAX_TEXTURE_SIZE.
     void setImage(const format::ConusFile& file);
+    // Replaces the uniform image that U and W show with `image` (any size; its display channels,
+    // as setImage takes them): the real baseline, what `conus uniform` made from the source, where
+    // setImage's can only be resampled from the CoNUS data. Call after setImage.
+    void setUniform(const Image& image);
     // Replaces the map alone (the map editor's live grid); the uniform image is not recomputed.
     void setMap(const codec::SamplingMap& map);
     bool hasImage() const;
@@ -106,7 +110,7 @@ public:
     // Whether draw() with these options decodes on the CPU (DecodePath resolved for this context).
     bool decodesOnCpu(const ViewOptions& options) const;
 
-    // The uniform image computed by setImage (for tests and the inspector).
+    // The uniform image shown: setImage's, or the one setUniform gave (for tests and the inspector).
     const Image& uniformImage() const;
 
 private:
