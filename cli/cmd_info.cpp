@@ -54,14 +54,184 @@ int printLimits(bool json) {
     return 0;
 }
 
+struct InfoOptions {
+    std::string input, densityPng;
+    bool json = false, backends = false, limits = false, verbose = false;
+};
+
+// --verbose on an invalid file: every broken rule, one a line (as `conus validate`), then the error.
+void explainIfInvalid(const std::string& input) {
+    const format::ValidationReport report = format::validateConusFile(input);
+    if (report.ok()) return;
+    for (const auto& issue : report.issues)
+        std::printf("%s: %s: %s\n", input.c_str(), format::label(issue.rule).c_str(), issue.message.c_str());
+    throw Error(ErrorCode::Corrupt, input + ": not a valid CoNUS file (" +
+                                        plural(static_cast<std::size_t>(report.problemCount()), "problem", "problems") + ")");
+}
+
+// What info reports about one file, read once.
+struct FileFacts {
+    format::ConusFile file;  // everything but the image's pixels, which nothing here needs
+    std::vector<std::string> channels;  // display order
+    codec::SamplingMap map;
+    DensityStats stats;
+    std::optional<Camera> camera;
+    double pixelRatio = 0;  // CoNUS pixels over source pixels
+};
+
+FileFacts readFacts(const std::string& input) {
+    format::ConusFile file = format::readConusHeader(input);
+    codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
+    const DensityStats stats = densityStats(map);
+    std::optional<Camera> camera = file.camera ? std::optional<Camera>(format::toCamera(*file.camera)) : std::nullopt;
+    const double ratio = double(file.image.width) * file.image.height / (double(file.sourceWidth) * file.sourceHeight);
+    std::vector<std::string> channels = displayOrder(file.image.channels);
+    return {std::move(file), std::move(channels), std::move(map), stats, camera, ratio};
+}
+
+nlohmann::ordered_json toJson(const std::string& input, const FileFacts& f) {
+    const format::ConusFile& file = f.file;
+    nlohmann::ordered_json j;
+    j["file"] = input;
+    j["formatVersion"] = format::kFormatVersion;
+    j["dataKind"] = format::toString(file.dataKind);
+    j["image"] = {{"width", file.image.width},
+                  {"height", file.image.height},
+                  {"channels", f.channels},
+                  {"pixelType", format::toString(file.pixelType)},
+                  {"compression", format::toString(file.compression)}};
+    j["source"] = {{"width", file.sourceWidth}, {"height", file.sourceHeight}};
+    j["pixelRatio"] = f.pixelRatio;
+    j["samplingMap"] = {{"columns", f.map.columns()},
+                        {"rows", f.map.rows()},
+                        {"densityMin", f.stats.min},
+                        {"densityMax", f.stats.max},
+                        {"densityMean", f.stats.mean}};
+    if (file.analytic) {
+        nlohmann::ordered_json a{{"kind", file.analytic->kind}};
+        if (file.analytic->kind == "foci") {
+            a["composition"] = file.analytic->composition;
+            for (const auto& focus : file.analytic->foci)
+                a["foci"].push_back({{"u", focus.u}, {"v", focus.v}, {"r", focus.r}, {"k", focus.k}});
+        }
+        for (const auto& [name, value] : file.analytic->scalars) a["params"][name] = value;
+        j["analyticMap"] = a;
+    }
+    if (f.camera) {
+        const glm::dvec3 eye = f.camera->eye(), forward = f.camera->forward();
+        j["camera"] = {{"projection", file.camera->projection},
+                       {"eye", {eye.x, eye.y, eye.z}},
+                       {"forward", {forward.x, forward.y, forward.z}},
+                       {"worldToCamera", file.camera->worldToCamera},
+                       {"worldToNDC", file.camera->worldToNDC}};
+        if (f.camera->projection() == Projection::Perspective) j["camera"]["verticalFov"] = f.camera->verticalFovDegrees();
+    }
+    if (file.depth.kind != format::DepthKind::None)
+        j["depth"] = {{"kind", format::toString(file.depth.kind)},
+                      {"units", file.depth.units},
+                      {"near", file.depth.near},
+                      {"far", file.depth.far}};
+    if (!file.software.empty()) j["software"] = file.software;
+    const SourceEncoding& encoding = file.sourceEncoding;
+    nlohmann::ordered_json colour{{"sourceTransfer", toString(encoding.transfer)}};
+    if (encoding.sampleType) colour["sourceSampleType"] = toString(*encoding.sampleType);
+    if (encoding.chromaticities) colour["chromaticities"] = *encoding.chromaticities;
+    colour["iccProfileBytes"] = encoding.iccProfile.size();
+    for (const MetadataItem& item : encoding.metadata)
+        std::visit([&](const auto& v) { colour["metadata"][item.name] = v; }, item.value);
+    j["colour"] = colour;
+    return j;
+}
+
+void printColour(const SourceEncoding& encoding, bool verbose) {
+    std::printf("  colour        %s%s%s\n",
+                encoding.transfer == Transfer::Raw ? "raw data (never converted)" : "linear light, associated alpha",
+                encoding.sampleType ? (std::string("; source ") + toString(encoding.transfer) + " " + toString(*encoding.sampleType)).c_str()
+                                    : "",
+                encoding.iccProfile.empty() ? "" : (", ICC profile of " + std::to_string(encoding.iccProfile.size()) + " bytes").c_str());
+    if (!verbose) return;
+    for (const MetadataItem& item : encoding.metadata) {
+        std::string value;
+        std::visit([&](const auto& v) {
+            if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) value = v;
+            else value = std::to_string(v);
+        }, item.value);
+        std::printf("    %s = %s\n", item.name.c_str(), value.c_str());
+    }
+}
+
+void printText(const InfoOptions& o, const FileFacts& f) {
+    const format::ConusFile& file = f.file;
+    std::printf("%s: CoNUS file, format version %d, data kind %s\n", o.input.c_str(), format::kFormatVersion,
+                format::toString(file.dataKind));
+    std::string channelList;
+    for (const auto& c : f.channels) channelList += (channelList.empty() ? "" : ",") + c;
+    std::printf("  CoNUS image   %d x %d, channels %s, %s, %s compression\n", file.image.width, file.image.height,
+                channelList.c_str(), format::toString(file.pixelType), format::toString(file.compression));
+    printColour(file.sourceEncoding, o.verbose);
+    std::printf("  source        %d x %d (CoNUS image holds %.2f%% of its pixels)\n", file.sourceWidth, file.sourceHeight,
+                100.0 * f.pixelRatio);
+    std::printf("  sampling map  %d x %d nodes; density min %.3f, max %.3f, mean %.3f\n", f.map.columns(), f.map.rows(),
+                f.stats.min, f.stats.max, f.stats.mean);
+    if (file.analytic) {
+        std::printf("  analytic map  %s", file.analytic->kind.c_str());
+        if (file.analytic->kind == "foci") {
+            std::printf(" (%s composition)", file.analytic->composition.c_str());
+            for (const auto& focus : file.analytic->foci)
+                std::printf("\n    focus u=%g v=%g r=%g k=%g", focus.u, focus.v, focus.r, focus.k);
+        }
+        for (const auto& [name, value] : file.analytic->scalars) std::printf("\n    %s = %g", name.c_str(), value);
+        std::printf("\n");
+    }
+    if (f.camera) {
+        const glm::dvec3 eye = f.camera->eye(), forward = f.camera->forward();
+        std::printf("  camera        %s, eye (%g, %g, %g), looking along (%.4g, %.4g, %.4g)", toString(f.camera->projection()),
+                    eye.x, eye.y, eye.z, forward.x, forward.y, forward.z);
+        if (f.camera->projection() == Projection::Perspective) std::printf(", vertical fov %.4g deg", f.camera->verticalFovDegrees());
+        std::printf("\n");
+    }
+    if (file.depth.kind != format::DepthKind::None)
+        std::printf("  depth         %s in [%g, %g] %s\n", format::toString(file.depth.kind), file.depth.near, file.depth.far,
+                    file.depth.units.c_str());
+    if (!o.densityPng.empty()) std::printf("  density       written to %s\n", o.densityPng.c_str());
+}
+
+// The density as a heat map with the sampling pattern over it, covering the conventional frame at
+// most 1024 px on its long side.
+void writeDensityPicture(const std::string& path, const FileFacts& f) {
+    const format::ConusFile& file = f.file;
+    const double scale = 1024.0 / std::max(file.sourceWidth, file.sourceHeight);
+    const int w = std::max(16, static_cast<int>(file.sourceWidth * std::min(1.0, scale)));
+    const int h = std::max(16, static_cast<int>(file.sourceHeight * std::min(1.0, scale)));
+    const int lines = std::max(8, std::min(64, file.image.width / 8));
+    writeDrawing(path, densityPicture(f.map, w, h, lines, file.analytic ? &*file.analytic : nullptr));
+}
+
+int runInfo(const InfoOptions& o) {
+    if (o.backends) return printBackends(o.json);
+    if (o.limits) return printLimits(o.json);
+    if (o.input.empty()) throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends, --limits)");
+    if (o.verbose) explainIfInvalid(o.input);
+    const FileFacts facts = readFacts(o.input);
+    nlohmann::ordered_json j = toJson(o.input, facts);
+    if (!o.densityPng.empty()) {
+        writeDensityPicture(o.densityPng, facts);
+        j["densityPicture"] = o.densityPng;
+    }
+    if (o.json) {
+        // Attribute strings come from the file and need not be UTF-8: invalid bytes become U+FFFD
+        // rather than failing the whole dump.
+        std::printf("%s\n", j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
+        return 0;
+    }
+    printText(o, facts);
+    return 0;
+}
+
 }  // namespace
 
 Command addInfoCommand(CLI::App& root) {
-    struct Options {
-        std::string input, densityPng;
-        bool json = false, backends = false, limits = false, verbose = false;
-    };
-    auto options = std::make_shared<Options>();
+    auto options = std::make_shared<InfoOptions>();
     CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth");
     command->add_option("input", options->input, "CoNUS file (.exr)");
     command->add_flag("--backends", options->backends,
@@ -77,150 +247,7 @@ Command addInfoCommand(CLI::App& root) {
                        "conus info --backends"});
     command->add_option("--density", options->densityPng,
                         "write the sampling density as a heat map with the sampling pattern over it (.png)");
-    return {command, [options] {
-                if (options->backends) return printBackends(options->json);
-                if (options->limits) return printLimits(options->json);
-                if (options->input.empty())
-                    throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends, --limits)");
-                if (options->verbose) {
-                    const format::ValidationReport report = format::validateConusFile(options->input);
-                    if (!report.ok()) {
-                        for (const auto& issue : report.issues)
-                            std::printf("%s: %s: %s\n", options->input.c_str(), format::label(issue.rule).c_str(), issue.message.c_str());
-                        throw Error(ErrorCode::Corrupt, options->input + ": not a valid CoNUS file (" +
-                                                            plural(static_cast<std::size_t>(report.problemCount()), "problem", "problems") + ")");
-                    }
-                }
-                // Everything but the image's pixels, which nothing here needs.
-                const format::ConusFile file = format::readConusHeader(options->input);
-                const std::vector<std::string> channels = displayOrder(file.image.channels);
-                const codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
-                const DensityStats stats = densityStats(map);
-                const std::optional<Camera> camera =
-                    file.camera ? std::optional<Camera>(format::toCamera(*file.camera)) : std::nullopt;
-
-                nlohmann::ordered_json j;
-                j["file"] = options->input;
-                j["formatVersion"] = format::kFormatVersion;
-                j["dataKind"] = format::toString(file.dataKind);
-                j["image"] = {{"width", file.image.width},
-                              {"height", file.image.height},
-                              {"channels", channels},
-                              {"pixelType", format::toString(file.pixelType)},
-                              {"compression", format::toString(file.compression)}};
-                j["source"] = {{"width", file.sourceWidth}, {"height", file.sourceHeight}};
-                const double pixelRatio = double(file.image.width) * file.image.height /
-                                          (double(file.sourceWidth) * file.sourceHeight);
-                j["pixelRatio"] = pixelRatio;
-                j["samplingMap"] = {{"columns", map.columns()},
-                                    {"rows", map.rows()},
-                                    {"densityMin", stats.min},
-                                    {"densityMax", stats.max},
-                                    {"densityMean", stats.mean}};
-                if (file.analytic) {
-                    nlohmann::ordered_json a{{"kind", file.analytic->kind}};
-                    if (file.analytic->kind == "foci") {
-                        a["composition"] = file.analytic->composition;
-                        for (const auto& f : file.analytic->foci)
-                            a["foci"].push_back({{"u", f.u}, {"v", f.v}, {"r", f.r}, {"k", f.k}});
-                    }
-                    for (const auto& [name, value] : file.analytic->scalars) a["params"][name] = value;
-                    j["analyticMap"] = a;
-                }
-                if (camera) {
-                    const glm::dvec3 eye = camera->eye(), forward = camera->forward();
-                    j["camera"] = {{"projection", file.camera->projection},
-                                   {"eye", {eye.x, eye.y, eye.z}},
-                                   {"forward", {forward.x, forward.y, forward.z}},
-                                   {"worldToCamera", file.camera->worldToCamera},
-                                   {"worldToNDC", file.camera->worldToNDC}};
-                    if (camera->projection() == Projection::Perspective) j["camera"]["verticalFov"] = camera->verticalFovDegrees();
-                }
-                if (file.depth.kind != format::DepthKind::None)
-                    j["depth"] = {{"kind", format::toString(file.depth.kind)},
-                                  {"units", file.depth.units},
-                                  {"near", file.depth.near},
-                                  {"far", file.depth.far}};
-                if (!file.software.empty()) j["software"] = file.software;
-                const SourceEncoding& encoding = file.sourceEncoding;
-                nlohmann::ordered_json colour{{"sourceTransfer", toString(encoding.transfer)}};
-                if (encoding.sampleType) colour["sourceSampleType"] = toString(*encoding.sampleType);
-                if (encoding.chromaticities) colour["chromaticities"] = *encoding.chromaticities;
-                colour["iccProfileBytes"] = encoding.iccProfile.size();
-                for (const MetadataItem& item : encoding.metadata)
-                    std::visit([&](const auto& v) { colour["metadata"][item.name] = v; }, item.value);
-                j["colour"] = colour;
-
-                if (!options->densityPng.empty()) {
-                    // The picture covers the conventional frame, at most 1024 px on its long side.
-                    const double scale = 1024.0 / std::max(file.sourceWidth, file.sourceHeight);
-                    const int w = std::max(16, static_cast<int>(file.sourceWidth * std::min(1.0, scale)));
-                    const int h = std::max(16, static_cast<int>(file.sourceHeight * std::min(1.0, scale)));
-                    const int lines = std::max(8, std::min(64, file.image.width / 8));
-                    writeDrawing(options->densityPng,
-                               densityPicture(map, w, h, lines, file.analytic ? &*file.analytic : nullptr));
-                    j["densityPicture"] = options->densityPng;
-                }
-
-                if (options->json) {
-                    // Attribute strings come from the file and need not be UTF-8: invalid bytes
-                    // become U+FFFD rather than failing the whole dump.
-                    std::printf("%s\n", j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
-                    return 0;
-                }
-                std::printf("%s: CoNUS file, format version %d, data kind %s\n", options->input.c_str(),
-                            format::kFormatVersion, format::toString(file.dataKind));
-                std::string channelList;
-                for (const auto& c : channels) channelList += (channelList.empty() ? "" : ",") + c;
-                std::printf("  CoNUS image   %d x %d, channels %s, %s, %s compression\n", file.image.width,
-                            file.image.height, channelList.c_str(), format::toString(file.pixelType),
-                            format::toString(file.compression));
-                std::printf("  colour        %s%s%s\n",
-                            encoding.transfer == Transfer::Raw ? "raw data (never converted)"
-                                                               : "linear light, associated alpha",
-                            encoding.sampleType ? (std::string("; source ") + toString(encoding.transfer) + " " +
-                                                   toString(*encoding.sampleType))
-                                                      .c_str()
-                                                : "",
-                            encoding.iccProfile.empty() ? "" : (", ICC profile of " + std::to_string(encoding.iccProfile.size()) + " bytes").c_str());
-                if (options->verbose)
-                    for (const MetadataItem& item : encoding.metadata) {
-                        std::string value;
-                        std::visit([&](const auto& v) {
-                            if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) value = v;
-                            else value = std::to_string(v);
-                        }, item.value);
-                        std::printf("    %s = %s\n", item.name.c_str(), value.c_str());
-                    }
-                std::printf("  source        %d x %d (CoNUS image holds %.2f%% of its pixels)\n", file.sourceWidth,
-                            file.sourceHeight, 100.0 * pixelRatio);
-                std::printf("  sampling map  %d x %d nodes; density min %.3f, max %.3f, mean %.3f\n", map.columns(),
-                            map.rows(), stats.min, stats.max, stats.mean);
-                if (file.analytic) {
-                    std::printf("  analytic map  %s", file.analytic->kind.c_str());
-                    if (file.analytic->kind == "foci") {
-                        std::printf(" (%s composition)", file.analytic->composition.c_str());
-                        for (const auto& f : file.analytic->foci)
-                            std::printf("\n    focus u=%g v=%g r=%g k=%g", f.u, f.v, f.r, f.k);
-                    }
-                    for (const auto& [name, value] : file.analytic->scalars)
-                        std::printf("\n    %s = %g", name.c_str(), value);
-                    std::printf("\n");
-                }
-                if (camera) {
-                    const glm::dvec3 eye = camera->eye(), forward = camera->forward();
-                    std::printf("  camera        %s, eye (%g, %g, %g), looking along (%.4g, %.4g, %.4g)", toString(camera->projection()),
-                                eye.x, eye.y, eye.z, forward.x, forward.y, forward.z);
-                    if (camera->projection() == Projection::Perspective) std::printf(", vertical fov %.4g deg", camera->verticalFovDegrees());
-                    std::printf("\n");
-                }
-                if (file.depth.kind != format::DepthKind::None)
-                    std::printf("  depth         %s in [%g, %g] %s\n", format::toString(file.depth.kind),
-                                file.depth.near, file.depth.far, file.depth.units.c_str());
-                if (!options->densityPng.empty())
-                    std::printf("  density       written to %s\n", options->densityPng.c_str());
-                return 0;
-            }};
+    return {command, [options] { return runInfo(*options); }};
 }
 
 }  // namespace conus::cli
