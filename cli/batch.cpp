@@ -150,7 +150,8 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
             const auto begun = std::chrono::steady_clock::now();
             std::string outcome, error;
             bool skip = false;
-            if (options.skipExisting && fs::exists(job.output, ec)) {
+            std::error_code missing;  // this thread's own
+            if (options.skipExisting && fs::exists(job.output, missing)) {
                 skip = true;
             } else {
                 try {
