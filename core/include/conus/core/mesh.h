@@ -24,4 +24,14 @@ struct Mesh {
     std::size_t triangleCount() const { return indices.size() / 3; }
 };
 
+// Throws conus::Error(InvalidArgument), naming `what`, unless `mesh` is well formed: at least one
+// triangle, indices a multiple of 3 and all in range, finite positions, and normals, colours and
+// UVs each either empty or one per vertex. Every consumer of a Mesh starts with it.
+void checkMesh(const Mesh& mesh, const char* what);
+
+// Sets mesh.normals to unit area-weighted vertex normals: each vertex takes the sum of the
+// (unnormalized, so area-weighted) face normals of its triangles, counter-clockwise = outside.
+// A vertex no non-degenerate triangle touches gets (0, 0, 1).
+void computeVertexNormals(Mesh& mesh);
+
 }  // namespace conus

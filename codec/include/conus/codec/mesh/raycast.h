@@ -1,0 +1,75 @@
+// The exact CPU reference of the mesh encoder: CoNUS ray casting with Embree (kept inside
+// codec/src/mesh/raycast.cpp; no Embree type leaves it). For every CoNUS pixel, its undistorted
+// image position by the FPC's exact inverse (Fpc::ray), the camera's ray through it, the first
+// hit, shaded by shading.h. This is the ground truth the GPU path (vertex distortion by Eq. 1 and
+// rasterization) approximates. An identity Fpc (null distortion) renders the conventional image
+// of the same pixel count, and the full-resolution frame.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+
+#include <glm/glm.hpp>
+
+#include "conus/core/error.h"
+#include "conus/core/fpc.h"
+#include "conus/core/image.h"
+#include "conus/core/mesh.h"
+
+namespace conus::codec {
+
+// A mesh with its ray-tracing acceleration structure, built once, then shared by any number of
+// renders and threads (read-only).
+class MeshScene {
+public:
+    // Checks the mesh (checkMesh) and computes its normals when it has none. Degenerate triangles
+    // are kept (they are never hit). Throws conus::Error(InvalidArgument) for a bad mesh.
+    explicit MeshScene(Mesh mesh);
+    ~MeshScene();
+    MeshScene(MeshScene&&) noexcept;
+    MeshScene& operator=(MeshScene&&) noexcept;
+    MeshScene(const MeshScene&) = delete;
+    MeshScene& operator=(const MeshScene&) = delete;
+
+    const Mesh& mesh() const;
+
+    struct Hit {
+        double distance = 0;       // along the ray's unit direction from its origin
+        glm::dvec3 position{0.0};  // world
+        std::uint32_t triangle = 0;
+        float b1 = 0, b2 = 0;      // barycentric weights of corners 1 and 2
+        glm::vec3 normal{0.0f};    // interpolated unit vertex normal
+    };
+    // The first hit along `ray` at distance in [tNear, tFar], if any.
+    std::optional<Hit> intersect(const Ray& ray, double tNear = 0.0,
+                                 double tFar = std::numeric_limits<double>::infinity()) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
+
+struct ReferenceOptions {
+    // 1: one ray through the distorted pixel centre. n*n (4, 9, 16, ...): stratified sub-pixel
+    // positions on an n x n grid of the *distorted* pixel, each undistorted exactly and averaged
+    // (what a multisampling rasterizer approximates): RGB and A averaged over all samples (misses
+    // count 0), Z the mean depth of the samples that hit (far when none did).
+    int samplesPerPixel = 1;
+    int threads = 0;  // 0: all cores
+    ProgressFn progress;
+};
+
+// A width x height CoNUS render of `scene` through `fpc`, channels R, G, B, A, Z (shading.h).
+// Hits count between the camera's near and far depths. Throws conus::Error(InvalidArgument) for a
+// bad size or a samplesPerPixel that is not a square in [1, 256].
+Image renderMeshReference(const MeshScene& scene, const Fpc& fpc, int width, int height,
+                          const ReferenceOptions& options = {});
+
+// The shaded R, G, B, A, Z of one ray of `camera`'s through undistorted image position uv (what
+// one sample of renderMeshReference computes).
+std::array<float, 5> shadeRay(const MeshScene& scene, const Camera& camera, glm::dvec2 uv);
+
+}  // namespace conus::codec
