@@ -1,7 +1,7 @@
 # The installed package as a user meets it (ctest Install.*): `cmake --install` of BUILD_DIR into
 # a fresh prefix under WORK_DIR, then
 # 1. the shared libraries carry a SONAME and the programs, the headers and the spec are in place;
-# 2. no installed header includes OpenEXR, Imath, OpenImageIO or OpenGL, and the exported targets
+# 2. no installed header includes OpenEXR, Imath, OpenImageIO, OpenGL, Assimp or Embree, and the exported targets
 #    name none of them;
 # 3. the consumer project (consumer/) builds with find_package(conus) and runs;
 # 4. the same program builds with pkg-config's flags alone and runs.
@@ -35,7 +35,7 @@ foreach(path bin/conus ${LIBDIR}/cmake/conus/conusConfig.cmake ${LIBDIR}/cmake/c
     message(FATAL_ERROR "consumer_test: ${path} is not installed")
   endif()
 endforeach()
-foreach(lib core format imageio codec renderers)
+foreach(lib core format imageio sceneio codec renderers)
   run(objdump -p ${libdir}/libconus_${lib}.so)
   if(NOT run_output MATCHES "SONAME +libconus_${lib}\\.so\\.1\n")
     message(FATAL_ERROR "consumer_test: libconus_${lib}.so has no SONAME libconus_${lib}.so.1")
@@ -56,7 +56,7 @@ endif()
 # 2. Nothing of OpenEXR, OpenImageIO or OpenGL leaks through the headers or the targets.
 file(GLOB_RECURSE headers RELATIVE ${prefix}/include ${prefix}/include/conus/*.h)
 foreach(header IN LISTS headers)
-  file(STRINGS ${prefix}/include/${header} bad REGEX "^#[ \t]*include[ \t]*[<\"](Imf|Imath|OpenEXR|openexr|OpenImageIO|glad|EGL|GL/|GLES|osmesa)")
+  file(STRINGS ${prefix}/include/${header} bad REGEX "^#[ \t]*include[ \t]*[<\"](Imf|Imath|OpenEXR|openexr|OpenImageIO|glad|EGL|GL/|GLES|osmesa|assimp|embree)")
   if(bad)
     message(FATAL_ERROR "consumer_test: ${header} includes a dependency's header: ${bad}")
   endif()
@@ -67,7 +67,7 @@ file(GLOB targets_files ${libdir}/cmake/conus/conusTargets*.cmake)
 foreach(f IN LISTS targets_files)
   file(STRINGS ${f} lines REGEX "INTERFACE_")
   foreach(line IN LISTS lines)
-    if(line MATCHES "OpenEXR|OpenImageIO|OpenGL|OSMESA|Imath|EGL")
+    if(line MATCHES "OpenEXR|OpenImageIO|OpenGL|OSMESA|Imath|EGL|assimp|embree")
       message(FATAL_ERROR "consumer_test: ${f} gives consumers a private dependency: ${line}")
     endif()
   endforeach()
