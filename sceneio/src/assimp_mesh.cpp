@@ -13,6 +13,8 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <system_error>
 
@@ -28,6 +30,29 @@ namespace fs = std::filesystem;
     throw Error(code, "mesh '" + path + "': " + why);
 }
 
+// PLY headers declare their element counts up front and Assimp reserves memory for them before
+// reading a single vertex; a count no file of this size can hold (every element takes at least a
+// byte) or one past the caps is refused here, before Assimp sees the file.
+void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    if (!std::getline(in, line) || (line != "ply" && line != "ply\r" && line != "PLY" && line != "PLY\r")) return;
+    for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
+        if (line.rfind("end_header", 0) == 0) return;
+        std::istringstream words(line);
+        std::string keyword, element;
+        long double count = 0;
+        if (!(words >> keyword >> element >> count) || keyword != "element") continue;
+        const std::int64_t cap = element == "vertex" ? options.maxVertices : element == "face" ? options.maxTriangles : -1;
+        if (count > static_cast<long double>(bytes))
+            fail(ErrorCode::Corrupt, path, "its header declares " + numberText(double(count)) + " " + element +
+                                               " elements in a file of " + std::to_string(bytes) + " bytes");
+        if (cap >= 0 && count > static_cast<long double>(cap))
+            fail(ErrorCode::LimitExceeded, path, "its header declares " + numberText(double(count)) + " " + element +
+                                                     " elements, more than the limit of " + std::to_string(cap));
+    }
+}
+
 void checkFile(const std::string& path, const MeshReadOptions& options) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);
@@ -39,6 +64,7 @@ void checkFile(const std::string& path, const MeshReadOptions& options) {
     if (static_cast<std::int64_t>(bytes) > options.maxFileBytes)
         fail(ErrorCode::LimitExceeded, path, std::to_string(bytes) + " bytes, more than the limit of " +
                                                  std::to_string(options.maxFileBytes));
+    checkPlyCounts(path, bytes, options);
 }
 
 // glTF states its vertex colours in linear light; the older formats (PLY, OBJ extensions, OFF)
@@ -86,6 +112,8 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
         if (why.empty()) why = "Assimp could not read it";
         // Assimp says "No suitable reader found" for formats it does not know.
         const bool unknown = why.find("suitable reader") != std::string::npos;
+        if (why.find("bad_alloc") != std::string::npos)
+            fail(ErrorCode::LimitExceeded, path, "it asks for more memory than there is (" + why + ")");
         fail(unknown ? ErrorCode::Io : ErrorCode::Corrupt, path, why);
     }
 
