@@ -150,22 +150,24 @@ void CityScene::loopAt(const Car& car, double s, glm::dvec2& position, glm::dvec
     }
 }
 
-glm::dvec3 CityScene::carCentre(int car, double t) const {
-    if (car < 0 || car >= carCount())
-        throw Error(ErrorCode::InvalidArgument, "city: no car " + std::to_string(car) + " (it has " + std::to_string(carCount()) + ")");
-    const Car& c = m_cars[std::size_t(car)];
+const CityScene::Car& CityScene::car(int index) const {
+    if (index < 0 || index >= carCount())
+        throw Error(ErrorCode::InvalidArgument, "city: no car " + std::to_string(index) + " (it has " + std::to_string(carCount()) + ")");
+    return m_cars[std::size_t(index)];
+}
+
+glm::dvec3 CityScene::carCentre(int index, double t) const {
+    const Car& c = car(index);
     glm::dvec2 position, heading;
     loopAt(c, c.phase + c.speed * t, position, heading);
     return {position.x, c.size.y / 2 + 0.3, position.y};
 }
 
-glm::dvec3 CityScene::carHeading(int car, double t) const {
-    if (car < 0 || car >= carCount())
-        throw Error(ErrorCode::InvalidArgument, "city: no car " + std::to_string(car) + " (it has " + std::to_string(carCount()) + ")");
-    const Car& c = m_cars[std::size_t(car)];
+glm::dvec3 CityScene::carHeading(int index, double t) const {
+    const Car& c = car(index);
     glm::dvec2 position, heading;
     loopAt(c, c.phase + c.speed * t, position, heading);
-    if (c.speed < 0) heading = -heading;
+    if (c.speed < 0) heading = -heading;  // the loop runs counter-clockwise; this car drives it backwards
     return {heading.x, 0, heading.y};
 }
 
@@ -173,9 +175,8 @@ Mesh CityScene::meshAt(double t) const {
     if (!std::isfinite(t)) throw Error(ErrorCode::InvalidArgument, "city: time must be finite");
     Mesh mesh = m_static;
     for (int c = 0; c < carCount(); ++c) {
-        const Car& car = m_cars[std::size_t(c)];
         const glm::dvec3 heading = carHeading(c, t);
-        addBox(mesh, carCentre(c, t), car.size / 2.0, {heading.x, heading.z}, car.colour);
+        addBox(mesh, carCentre(c, t), car(c).size / 2.0, {heading.x, heading.z}, car(c).colour);
     }
     return mesh;
 }

@@ -79,7 +79,9 @@ TEST(City, CarsMoveContinuouslyAlongTheStreets) {
             EXPECT_LE(glm::length(h - previousHeading), maxSpeed / (S / 4) * dt * 1.01);
             EXPECT_NEAR(glm::length(h), 1.0, 1e-9);
             // It moves the way it faces.
-            if (step > 0) EXPECT_GT(glm::dot(c - previous, h), 0.9 * step);
+            if (step > 0) {
+                EXPECT_GT(glm::dot(c - previous, h), 0.9 * step);
+            }
             // On a street: never inside a block.
             const double fx = std::fmod(c.x + city.halfExtentX(), B + S), fz = std::fmod(c.z + city.halfExtentZ(), B + S);
             EXPECT_FALSE(fx > S && fz > S) << "inside a block at t = " << t;
@@ -88,8 +90,8 @@ TEST(City, CarsMoveContinuouslyAlongTheStreets) {
         }
         EXPECT_LE(largestStep, maxSpeed * dt * (1 + 1e-9));
         EXPECT_GT(travelled, 0.7 * options.carSpeed * 40 * 0.99);
-        // Whole vertices too: a car box's corners move at most (speed + turn rate * half diagonal) dt.
     }
+    // Whole vertices too: a car box's corners move at most (speed + turn rate * half diagonal) dt.
     const Mesh a = city.meshAt(5.0), b = city.meshAt(5.0 + dt);
     const std::size_t first = city.staticMesh().positions.size();
     double largest = 0;

@@ -56,6 +56,7 @@ private:
         glm::vec3 colour;
         glm::dvec3 size;              // length (along heading), height, width
     };
+    const Car& car(int index) const;  // throws InvalidArgument out of range
     // Position (x, z) and unit heading on a car's loop at arc length s.
     void loopAt(const Car& car, double s, glm::dvec2& position, glm::dvec2& heading) const;
 
