@@ -1,6 +1,7 @@
 // Image files through OpenImageIO: channels by name, colour conversion, metadata, atomic writes.
 // OpenImageIO reports failures through geterror(); they become conus::Error right where it is
-// called, naming the user's path.
+// called, naming the user's path. Built into the module libconus_imageio_oiio (oiio_module.h):
+// libconus_imageio forwards to it on first use.
 #include "conus/imageio/image_file.h"
 
 #include <unistd.h>
@@ -22,8 +23,9 @@
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "conus/format/exr_check.h"
+#include "oiio_module.h"
 
-namespace conus::imageio {
+namespace conus::imageio::oiio {
 namespace {
 
 // ---- what a file format holds ------------------------------------------------------------------
@@ -300,12 +302,6 @@ Transfer detectTransfer(const OIIO::ImageSpec& spec) {
 }
 
 }  // namespace
-
-std::int64_t countNonFinite(const Image& image) {
-    std::int64_t n = 0;
-    for (float v : image.pixels) n += !std::isfinite(v);
-    return n;
-}
 
 ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
     checkInputPath(path, /*allowStdin=*/true);
@@ -667,4 +663,4 @@ void writeImageFile(const std::string& path, const Image& image, const WriteOpti
     file.commit();
 }
 
-}  // namespace conus::imageio
+}  // namespace conus::imageio::oiio
