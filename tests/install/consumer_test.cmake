@@ -45,7 +45,7 @@ endforeach()
 run(${prefix}/bin/conus --version)
 # The modules loaded on first use (core/plugin.h) are found where they were installed: the demo
 # reads nothing but writes PNG pictures through OpenImageIO's module.
-run(${prefix}/bin/conus demo --size 128 --out ${WORK_DIR}/demo -q)
+run(${prefix}/bin/conus demo --size 256 --out ${WORK_DIR}/demo -q)
 if(NOT EXISTS ${WORK_DIR}/demo/view-frame.png)
   message(FATAL_ERROR "consumer_test: the installed conus wrote no pictures: ${run_output}")
 endif()
