@@ -28,7 +28,7 @@ TEST_F(Cli, StartUpLoadsNoHeavyLibraryUntilACommandNeedsIt) {
     ::setenv("LD_DEBUG", "files", 1);
     const Result help = run("--help");
     const Result backends = run("info --backends");
-    const Result uniform = run("uniform " + picture + " -o u.exr --size 32x24 -q");
+    const Result uniform = run("uniform " + picture + " -o " + (m_dir / "u.exr").string() + " --size 32x24 -q");
     ::unsetenv("LD_DEBUG");
     ASSERT_EQ(help.exitCode, 0) << help.err;
     ASSERT_EQ(backends.exitCode, 0) << backends.err;
