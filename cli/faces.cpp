@@ -1,5 +1,7 @@
 // Face detection for `--importance faces`: OpenCV's Haar cascade (Debian's opencv-data). The only
-// file of cli/ that includes OpenCV; its exceptions become conus::Error here.
+// file of cli/ that includes OpenCV; its exceptions become conus::Error here. Built as the module
+// libconus_faces (cli/CMakeLists.txt), which `conus` loads only when asked for faces: OpenCV's
+// detectors and their dnn stack no longer load with every command.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -20,10 +22,8 @@ constexpr const char* kCascadePaths[] = {
     "/usr/share/opencv/haarcascades/haarcascade_frontalface_default.xml",
 };
 
-}  // namespace
-
 // `image` is display-encoded (the cascade was trained on ordinary 8-bit photographs).
-Image faceImportance(const Image& image) {
+Image detectFaceImportance(const Image& image) {
     if (image.empty()) throw Error(ErrorCode::InvalidArgument, "no image to find faces in");
     // Detection on an 8-bit grey copy at most 1024 px a side: the cascade works on 24 px windows,
     // and larger pictures only cost time.
@@ -70,4 +70,10 @@ Image faceImportance(const Image& image) {
     return importance;
 }
 
+}  // namespace
 }  // namespace conus::cli
+
+// The module's one exported symbol (importance.cpp loads it).
+extern "C" __attribute__((visibility("default"))) conus::cli::FaceImportanceFunction conusFaceImportance() {
+    return &conus::cli::detectFaceImportance;
+}

@@ -2,10 +2,18 @@
 
 #include "conus/codec/build/auto_map.h"
 #include "conus/core/error.h"
+#include "conus/core/plugin.h"
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
 
 namespace conus::cli {
+
+Image faceImportance(const Image& image) {
+    // CONUS_FACES_MODULE: the module's path relative to this program (cli/CMakeLists.txt).
+    static const FaceImportanceFunction detect = reinterpret_cast<FaceImportanceFunction (*)()>(
+        loadPluginSymbol(reinterpret_cast<const void*>(&faceImportance), CONUS_FACES_MODULE, "conusFaceImportance"))();
+    return detect(image);
+}
 
 Image importanceFrom(const std::string& source, const Image& image) {
     if (source == "detail") {

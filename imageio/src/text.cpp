@@ -1,4 +1,4 @@
-// Text through OpenImageIO's render_text.
+// Text through OpenImageIO's render_text (in the module libconus_imageio_oiio, oiio_module.h).
 #include "conus/imageio/text.h"
 
 #include <algorithm>
@@ -9,8 +9,9 @@
 #include <OpenImageIO/imagebufalgo.h>
 
 #include "conus/core/error.h"
+#include "oiio_module.h"
 
-namespace conus::imageio {
+namespace conus::imageio::oiio {
 
 constexpr const char* kFont = "DejaVuSans";
 
@@ -95,4 +96,4 @@ Image renderTextPanel(const std::vector<std::string>& lines, const TextPanelStyl
     return panel;
 }
 
-}  // namespace conus::imageio
+}  // namespace conus::imageio::oiio

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include "test_dir.h"
@@ -135,6 +137,55 @@ TEST_F(ImageFileTest, SrgbIsConvertedThroughOpenImageIoAndRawIsNot) {
     EXPECT_LT(drawn.pixels[0], before.pixels[0]);
     const Image shown = conus::imageio::displayEncoded(drawn);
     for (std::size_t i = 0; i < before.pixels.size(); ++i) EXPECT_NEAR(shown.pixels[i], before.pixels[i], 1e-5);
+}
+
+// 8- and 16-bit files without alpha are read through per-value tables (image_file.cpp) instead of
+// converting a float copy in place: every pixel must equal what OpenImageIO's own float read and
+// colour conversion give, to the bit, across several strips of rows and every sample value.
+TEST_F(ImageFileTest, IntegerSamplesThroughTablesEqualOpenImageIoToTheBit) {
+    struct Case {
+        const char* name;
+        int channels;
+        OIIO::TypeDesc type;
+        bool srgb;
+    };
+    for (const Case& k : {Case{"rgb8.png", 3, OIIO::TypeDesc::UINT8, true}, Case{"grey16.png", 1, OIIO::TypeDesc::UINT16, true},
+                          Case{"rgb16raw.png", 3, OIIO::TypeDesc::UINT16, false}}) {
+        SCOPED_TRACE(k.name);
+        const int w = 97, h = 150;  // 150 rows: three strips of 64, the last one short
+        const int top = k.type == OIIO::TypeDesc::UINT8 ? 255 : 65535;
+        std::vector<unsigned short> values(static_cast<std::size_t>(w) * h * k.channels);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (int c = 0; c < k.channels; ++c)  // every value, in no simple order
+                    values[(static_cast<std::size_t>(y) * w + x) * k.channels + c] =
+                        static_cast<unsigned short>((x * 7919L + y * 104729L + c * 31L + x * y) % (top + 1));
+        {
+            auto out = OIIO::ImageOutput::create(path(k.name));
+            ASSERT_TRUE(out->open(path(k.name), OIIO::ImageSpec(w, h, k.channels, k.type)));
+            ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT16, values.data()));
+            ASSERT_TRUE(out->close());
+        }
+        conus::imageio::ReadOptions options;
+        if (!k.srgb) options.colorspace = conus::Transfer::Raw;
+        const conus::imageio::ImageFile read = conus::imageio::readImageFile(path(k.name), options);
+
+        Read expected = oiioRead(path(k.name));
+        ASSERT_EQ(expected.pixels.size(), read.image.pixels.size());
+        if (k.srgb) {
+            OIIO::ImageBuf buffer(OIIO::ImageSpec(w, h, k.channels, OIIO::TypeDesc::FLOAT), expected.pixels.data());
+            ASSERT_TRUE(OIIO::ImageBufAlgo::colorconvert(buffer, buffer, "sRGB", "linear", false));
+        }
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < expected.pixels.size(); ++i) differ += expected.pixels[i] != read.image.pixels[i];
+        EXPECT_EQ(differ, 0u);
+        EXPECT_EQ(read.info.nonFinite, 0);
+        // Not a table of zeros or of the raw codes: dark stays dark, linear light is below the code.
+        const std::size_t mid = (static_cast<std::size_t>(h / 2) * w + w / 3) * k.channels;
+        const float code = float(values[mid]) / top;
+        if (k.srgb && code > 0.1f) EXPECT_LT(read.image.pixels[mid], code);
+        if (!k.srgb) EXPECT_FLOAT_EQ(read.image.pixels[mid], code);
+    }
 }
 
 TEST_F(ImageFileTest, RequestsAFormatCannotHoldAreRefusedBeforeWriting) {

@@ -30,7 +30,8 @@ run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
 set(libdir ${prefix}/${LIBDIR})
 foreach(path bin/conus ${LIBDIR}/cmake/conus/conusConfig.cmake ${LIBDIR}/cmake/conus/conusConfigVersion.cmake
         ${LIBDIR}/pkgconfig/conus.pc include/conus/codec/image/encode.h share/doc/conus/spec/conus-format.md
-        share/man/man1/conus.1 ${LIBDIR}/python3/dist-packages/conus/__init__.py)
+        share/man/man1/conus.1 ${LIBDIR}/python3/dist-packages/conus/__init__.py
+        ${LIBDIR}/libconus_imageio_oiio.so ${LIBDIR}/conus/libconus_faces.so)
   if(NOT EXISTS ${prefix}/${path})
     message(FATAL_ERROR "consumer_test: ${path} is not installed")
   endif()
@@ -42,6 +43,12 @@ foreach(lib core format imageio sceneio codec renderers)
   endif()
 endforeach()
 run(${prefix}/bin/conus --version)
+# The modules loaded on first use (core/plugin.h) are found where they were installed: the demo
+# reads nothing but writes PNG pictures through OpenImageIO's module.
+run(${prefix}/bin/conus demo --size 256 --out ${WORK_DIR}/demo -q)
+if(NOT EXISTS ${WORK_DIR}/demo/view-frame.png)
+  message(FATAL_ERROR "consumer_test: the installed conus wrote no pictures: ${run_output}")
+endif()
 if(PYTHON)
   # The installed Python package finds the installed libraries (its RPATH), from any folder.
   set(ENV{PYTHONPATH} ${libdir}/python3/dist-packages)

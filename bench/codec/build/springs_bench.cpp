@@ -66,4 +66,20 @@ void BM_SpringTimeToStable256(benchmark::State& state) {
 }
 BENCHMARK(BM_SpringTimeToStable256)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
+// The same for strong strokes (strength 3-4: a brush pressed hard, the case people wait for; what
+// bench/end_to_end.sh runs through `conus map springs`). Target: under 0.5 s.
+void BM_SpringTimeToStableStrong256(benchmark::State& state) {
+    const std::vector<conus::codec::Stroke> strokes{
+        {0.35, 0.4, 0.15, 4.0, 0.3}, {0.65, 0.6, 0.1, 3.0, 0.3}, {0.5, 0.8, 0.08, 4.0, 0.2}};
+    int steps = 0;
+    for (auto _ : state) {
+        conus::codec::SpringSystem system(kSide, kSide);
+        for (const auto& s : strokes) system.addStroke(s);
+        steps = system.runUntilStable(100000);
+        benchmark::DoNotOptimize(system.time());
+    }
+    state.counters["steps"] = steps;
+}
+BENCHMARK(BM_SpringTimeToStableStrong256)->Unit(benchmark::kMillisecond);
+
 }  // namespace
