@@ -155,20 +155,26 @@ inline constexpr const char* kMapChannelU = "ud";
 inline constexpr const char* kMapChannelV = "vd";
 
 inline constexpr AttributeSpec kAttributes[] = {
+    // Every file: its version, its source, what it holds (V2, V5, V6).
     {kAttrVersion, PartKind::Conus, Rule::V2, &HeaderModel::version},
     {kAttrSourceSize, PartKind::Conus, Rule::V5, &HeaderModel::sourceSize},
     {kAttrDataKind, PartKind::Conus, Rule::V6, &HeaderModel::dataKind},
+    // The analytic map, when the map was built from one (V12).
     {kAttrMapKind, PartKind::Conus, Rule::V12, &HeaderModel::mapKind},
     {kAttrFoci, PartKind::Conus, Rule::V12, &HeaderModel::foci},
     {kAttrComposition, PartKind::Conus, Rule::V12, &HeaderModel::composition},
     {kAttrParamPrefix, PartKind::Conus, Rule::V12, &HeaderModel::params},
+    // The camera (V13).
     {kAttrWorldToCamera, PartKind::Conus, Rule::V13, &HeaderModel::worldToCamera},
     {kAttrWorldToNDC, PartKind::Conus, Rule::V13, &HeaderModel::worldToNDC},
     {kAttrProjection, PartKind::Conus, Rule::V13, &HeaderModel::projection},
+    // Depth (V14).
     {kAttrDepthKind, PartKind::Conus, Rule::V14, &HeaderModel::depthKind},
     {kAttrDepthRange, PartKind::Conus, Rule::V14, &HeaderModel::depthRange},
     {kAttrDepthUnits, PartKind::Conus, Rule::V14, &HeaderModel::depthUnits},
-    {kAttrSoftware, PartKind::Conus, Rule::Unreadable, &HeaderModel::software},  // free text, no rule
+    // Free text that no rule checks.
+    {kAttrSoftware, PartKind::Conus, Rule::Unreadable, &HeaderModel::software},
+    // Colour (V16).
     {kAttrSourceTransfer, PartKind::Conus, Rule::V16, &HeaderModel::sourceTransfer},
     {kAttrSourceSampleType, PartKind::Conus, Rule::V16, &HeaderModel::sourceSampleType},
     {kAttrIccProfile, PartKind::Conus, Rule::V16, &HeaderModel::iccProfile},
