@@ -203,4 +203,11 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
     return failed > 0 ? 1 : 0;
 }
 
+int runConversions(const BatchOptions& options, const std::function<std::string(const Job&)>& convert) {
+    const std::vector<Job> jobs = planJobs(options);
+    if (isBatch(options)) return runBatch(jobs, options, convert);
+    std::printf("%s\n", convert(jobs.front()).c_str());
+    return 0;
+}
+
 }  // namespace conus::cli

@@ -52,4 +52,8 @@ std::vector<Job> planJobs(const BatchOptions& options);
 // it happens, and the summary on stdout; returns the exit code.
 int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const std::function<std::string(const Job&)>& convert);
 
+// What `encode` and `decode` run: the jobs the options plan, as a batch (runBatch) or, for a
+// single input, one conversion whose line is printed. Returns the exit code.
+int runConversions(const BatchOptions& options, const std::function<std::string(const Job&)>& convert);
+
 }  // namespace conus::cli

@@ -83,11 +83,7 @@ std::string decodeOne(const DecodeCommandOptions& o, const std::string& input, c
 }
 
 int runDecode(const DecodeCommandOptions& o) {
-    const std::vector<Job> jobs = planJobs(o.batch);
-    auto convert = [&o](const Job& job) { return decodeOne(o, job.input, job.output); };
-    if (isBatch(o.batch)) return runBatch(jobs, o.batch, convert);
-    std::printf("%s\n", convert(jobs.front()).c_str());
-    return 0;
+    return runConversions(o.batch, [&o](const Job& job) { return decodeOne(o, job.input, job.output); });
 }
 
 }  // namespace

@@ -29,15 +29,6 @@
 namespace conus::cli {
 namespace {
 
-// The source pixels under a view whose edges fall on pixel edges.
-Image crop(const Image& source, int x0, int y0, int width, int height) {
-    Image out = makeImage(width, height, source.channels);
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x)
-            for (int c = 0; c < source.channelCount(); ++c) out.at(x, y, c) = source.at(x0 + x, y0 + y, c);
-    return out;
-}
-
 // The view around the most important region: the bounding square of the importance above half its
 // peak, as a focus-shaped rectangle (centre, half side as a fraction of the width).
 codec::Focus hottestRegion(const Image& importance, int width, int height) {
@@ -179,7 +170,7 @@ int runDemo(const DemoOptions& o) {
         decode.view = {double(v.x0) / w, double(v.y0) / h, double(v.x0 + v.width) / w, double(v.y0 + v.height) / h};
         decode.width = v.width;
         decode.height = v.height;
-        const Image reference = crop(source.image, v.x0, v.y0, v.width, v.height);
+        const Image reference = codec::crop(source.image, v.x0, v.y0, v.width, v.height);
         const Image fromConus = gl::decodeImage(device, conus.image, map, decode);
         const Image fromUniform = gl::decodeImage(device, uniform.image, identity, decode);
         const double a = codec::psnr(reference, fromConus), b = codec::psnr(reference, fromUniform);

@@ -91,11 +91,7 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
 }
 
 int runEncode(const EncodeOptions& o) {
-    const std::vector<Job> jobs = planJobs(o.batch);
-    auto convert = [&o](const Job& job) { return encodeOne(o, job.input, job.output); };
-    if (isBatch(o.batch)) return runBatch(jobs, o.batch, convert);
-    std::printf("%s\n", convert(jobs.front()).c_str());
-    return 0;
+    return runConversions(o.batch, [&o](const Job& job) { return encodeOne(o, job.input, job.output); });
 }
 
 }  // namespace

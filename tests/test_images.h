@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "conus/core/image.h"
 
 namespace conus::test {
@@ -47,6 +49,15 @@ inline Image zonePlate(int size, double edgeFrequency) {
             im.at(x, y) = static_cast<float>(0.5 + 0.5 * std::cos(M_PI * k * (dx * dx + dy * dy)));
         }
     return im;
+}
+
+// The largest difference between two images' values; a size mismatch fails the calling test.
+inline float maxAbsDifference(const Image& a, const Image& b) {
+    EXPECT_EQ(a.pixels.size(), b.pixels.size());
+    float worst = 0;
+    for (std::size_t i = 0; i < std::min(a.pixels.size(), b.pixels.size()); ++i)
+        worst = std::max(worst, std::abs(a.pixels[i] - b.pixels[i]));
+    return worst;
 }
 
 }  // namespace conus::test

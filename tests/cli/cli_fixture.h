@@ -73,6 +73,13 @@ protected:
         return path;
     }
 
+    // path(name): the 16x16 uniform CoNUS file of a 64x64 picture that many tests decode. Call it
+    // as ASSERT_NO_FATAL_FAILURE(makeUniformFile()), so a failed encode ends the test.
+    void makeUniformFile(const std::string& name = "u.exr") {
+        const std::string in = makePicture(64, 64);
+        ASSERT_EQ(run("uniform " + in + " -o " + path(name) + " --size 16x16").exitCode, 0);
+    }
+
     // A grey PNG that is bright in a disc around (0.3, 0.6) and dark elsewhere.
     std::string makeImportance(int width, int height) {
         std::vector<unsigned char> pixels(static_cast<std::size_t>(width) * height);

@@ -125,8 +125,7 @@ TEST_F(Cli, BadArgumentsGiveOneLineReasons) {
 }
 
 TEST_F(Cli, DecodeViewMustNotBeEmpty) {
-    const std::string in = makePicture(64, 64);
-    ASSERT_EQ(run("uniform " + in + " -o " + path("u.exr") + " --size 16x16").exitCode, 0);
+    ASSERT_NO_FATAL_FAILURE(makeUniformFile());
     const Result r = run("decode " + path("u.exr") + " -o " + path("v.png") + " --view 0.5,0.5,0.4,0.6");
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.err.find("view"), std::string::npos) << r.err;
@@ -134,8 +133,7 @@ TEST_F(Cli, DecodeViewMustNotBeEmpty) {
 }
 
 TEST_F(Cli, DecodeRefusesToOverwriteItsInputAndOversizedJpeg) {
-    const std::string in = makePicture(64, 64);
-    ASSERT_EQ(run("uniform " + in + " -o " + path("u.exr") + " --size 16x16").exitCode, 0);
+    ASSERT_NO_FATAL_FAILURE(makeUniformFile());
     const std::string before = slurp(path("u.exr"));
     Result r = run("decode " + path("u.exr") + " -o " + path("u.exr"));
     EXPECT_NE(r.exitCode, 0);
@@ -159,8 +157,7 @@ TEST_F(Cli, FailedWriteLeavesNoFile) {
 }
 
 TEST_F(Cli, ExistingOutputIsUntouchedOnFailure) {
-    const std::string in = makePicture(64, 64);
-    ASSERT_EQ(run("uniform " + in + " -o " + path("keep.exr") + " --size 16x16").exitCode, 0);
+    ASSERT_NO_FATAL_FAILURE(makeUniformFile("keep.exr"));
     const std::string before = slurp(path("keep.exr"));
     EXPECT_NE(run("encode " + path("missing.png") + " -o " + path("keep.exr")).exitCode, 0);
     EXPECT_EQ(slurp(path("keep.exr")), before);
@@ -324,8 +321,7 @@ TEST_F(Cli, HeightFieldEncodeDecodeAndCompare) {
     EXPECT_NE(r.out.find("PSNR vs full resolution: CoNUS"), std::string::npos) << r.out;
 
     // An image is not a height field: asking for a 3-D frame of it says so.
-    const std::string in = makePicture(64, 64);
-    ASSERT_EQ(run("uniform " + in + " -o " + path("u.exr") + " --size 16x16").exitCode, 0);
+    ASSERT_NO_FATAL_FAILURE(makeUniformFile());
     r = run("decode " + path("u.exr") + " --camera viewer -o " + path("x.png"));
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.err.find("not a CoNUS height field"), std::string::npos) << r.err;

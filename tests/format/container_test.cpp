@@ -11,6 +11,7 @@ namespace conus::format {
 namespace {
 
 using testing::TempDir;
+using testing::errorFrom;
 using testing::validFile;
 
 std::uint32_t bits(float f) {
@@ -160,13 +161,9 @@ TEST(Container, InvalidFileIsNotWritten) {
     TempDir dir;
     ConusFile f = validFile();
     f.sourceWidth = 0;
-    try {
-        writeConusFile(dir.file("bad.exr"), f);
-        FAIL() << "expected conus::Error";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ErrorCode::Corrupt);
-        EXPECT_NE(std::string(e.what()).find("V5"), std::string::npos) << e.what();
-    }
+    const Error e = errorFrom([&] { writeConusFile(dir.file("bad.exr"), f); });
+    EXPECT_EQ(e.code(), ErrorCode::Corrupt);
+    EXPECT_NE(std::string(e.what()).find("V5"), std::string::npos) << e.what();
     EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
@@ -174,13 +171,9 @@ TEST(Container, InvalidMapIsNotWritten) {
     TempDir dir;
     ConusFile f = validFile();
     f.map.xy[2 * (1 * 5 + 2)] = 0.9f;  // folds
-    try {
-        writeConusFile(dir.file("bad.exr"), f);
-        FAIL() << "expected conus::Error";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ErrorCode::InvalidMap);
-        EXPECT_NE(std::string(e.what()).find("V11"), std::string::npos) << e.what();
-    }
+    const Error e = errorFrom([&] { writeConusFile(dir.file("bad.exr"), f); });
+    EXPECT_EQ(e.code(), ErrorCode::InvalidMap);
+    EXPECT_NE(std::string(e.what()).find("V11"), std::string::npos) << e.what();
     EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
@@ -203,12 +196,8 @@ TEST(Container, FailedWriteLeavesDestinationUntouched) {
 TEST(Container, UnwritableFolderLeavesNothing) {
     TempDir dir;
     const std::string missing = dir.file("no/such/folder/x.exr");
-    try {
-        writeConusFile(missing, validFile());
-        FAIL() << "expected conus::Error";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ErrorCode::Io) << e.what();
-    }
+    const Error e = errorFrom([&] { writeConusFile(missing, validFile()); });
+    EXPECT_EQ(e.code(), ErrorCode::Io) << e.what();
     EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 
     // A read-only folder (root ignores permissions, so only check when the write really fails).
@@ -241,12 +230,8 @@ TEST(Container, OverwriteReplacesAtomically) {
 
 TEST(Container, MissingFileIsIo) {
     TempDir dir;
-    try {
-        readConusFile(dir.file("nothing.exr"));
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ErrorCode::Io);
-    }
+    const Error e = errorFrom([&] { readConusFile(dir.file("nothing.exr")); });
+    EXPECT_EQ(e.code(), ErrorCode::Io);
     EXPECT_FALSE(validateConusFile(dir.file("nothing.exr")).ok());
 }
 
@@ -255,12 +240,8 @@ TEST(Container, ReadLimitsAreEnforced) {
     writeConusFile(dir.file("x.exr"), validFile());
     ReadLimits small;
     small.maxPixels = 47;  // the image has 48
-    try {
-        readConusFile(dir.file("x.exr"), small);
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ErrorCode::LimitExceeded) << e.what();
-    }
+    const Error e = errorFrom([&] { readConusFile(dir.file("x.exr"), small); });
+    EXPECT_EQ(e.code(), ErrorCode::LimitExceeded) << e.what();
     ReadLimits mapLimit;
     mapLimit.maxMapSide = 4;
     EXPECT_TRUE(validateConusFile(dir.file("x.exr"), mapLimit).violates(Rule::V7));

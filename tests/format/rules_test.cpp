@@ -26,6 +26,7 @@ namespace conus::format {
 namespace {
 
 using testing::TempDir;
+using testing::errorFrom;
 using testing::validFile;
 using testing::Mutate;
 using testing::eraseAttribute;
@@ -65,24 +66,16 @@ TEST_F(RuleTest, V1NotAnExrFile) {
     EXPECT_TRUE(onlyRule(r, 1));
     std::ofstream(m_dir.file("empty.exr")).close();
     EXPECT_TRUE(onlyRule(validateConusFile(m_dir.file("empty.exr")), 1));
-    try {
-        readConusFile(m_dir.file("junk.exr"));
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ErrorCode::Corrupt);
-    }
+    const Error e = errorFrom([&] { readConusFile(m_dir.file("junk.exr")); });
+    EXPECT_EQ(e.code(), ErrorCode::Corrupt);
 }
 
 TEST_F(RuleTest, V2NoConusPartIsNotConus) {
     const ValidationReport r = raw([](Imf::Header& c, Imf::Header&) { c.setName("other"); });
     EXPECT_TRUE(onlyRule(r, 2));
-    try {
-        readConusFile(m_dir.file("raw.exr"));
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ErrorCode::NotConus);
-        EXPECT_NE(std::string(e.what()).find("not a CoNUS file"), std::string::npos) << e.what();
-    }
+    const Error e = errorFrom([&] { readConusFile(m_dir.file("raw.exr")); });
+    EXPECT_EQ(e.code(), ErrorCode::NotConus);
+    EXPECT_NE(std::string(e.what()).find("not a CoNUS file"), std::string::npos) << e.what();
 }
 
 TEST_F(RuleTest, V2NewerVersionIsRefused) {
@@ -179,12 +172,8 @@ TEST_F(RuleTest, MapRulesAreCheckedInFiles) {
     f.map.xy[2 * 6] = 0.6f;
     writeRaw(m_dir.file("fold.exr"), f, [](Imf::Header&, Imf::Header&) {});
     EXPECT_TRUE(onlyRule(validateConusFile(m_dir.file("fold.exr")), 11));
-    try {
-        readConusFile(m_dir.file("fold.exr"));
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ErrorCode::InvalidMap);
-    }
+    const Error e = errorFrom([&] { readConusFile(m_dir.file("fold.exr")); });
+    EXPECT_EQ(e.code(), ErrorCode::InvalidMap);
 }
 
 TEST_F(RuleTest, V12AnalyticMap) {

@@ -7,9 +7,23 @@
 #include <filesystem>
 #include <string>
 
+#include "conus/core/error.h"
 #include "conus/format/container.h"
 
 namespace conus::format::testing {
+
+// The conus::Error that `action` throws; when it throws none, a failure of the calling test (and
+// an Error that says so).
+template <class Action>
+Error errorFrom(Action&& action) {
+    try {
+        action();
+    } catch (const Error& e) {
+        return e;
+    }
+    ADD_FAILURE() << "expected conus::Error";
+    return Error(ErrorCode::Io, "no conus::Error was thrown");
+}
 
 inline GridNodes identityGrid(int columns, int rows) {
     GridNodes g;

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "conus/codec/build/density_map.h"
@@ -76,23 +77,17 @@ void lookups(benchmark::State& state, const SamplingMap& map, bool inverse) {
     state.SetItemsProcessed(state.iterations() * kPoints);
 }
 
-void BM_DistortIdentity(benchmark::State& state) {
-    static const SamplingMap map = SamplingMap::identity(kSide, kSide);
-    lookups(state, map, false);
-}
-BENCHMARK(BM_DistortIdentity);
-
-void BM_Distort(benchmark::State& state) { lookups(state, twoFocusMap(), false); }
-BENCHMARK(BM_Distort);
-
-void BM_UndistortIdentity(benchmark::State& state) {
-    static const SamplingMap map = SamplingMap::identity(kSide, kSide);
-    lookups(state, map, true);
-}
-BENCHMARK(BM_UndistortIdentity);
-
-void BM_Undistort(benchmark::State& state) { lookups(state, twoFocusMap(), true); }
-BENCHMARK(BM_Undistort);
+// BM_Distort, BM_DistortIdentity, BM_Undistort, BM_UndistortIdentity: each lookup on the two-focus
+// map and on the identity.
+const bool kLookupsRegistered = [] {
+    static const SamplingMap identity = SamplingMap::identity(kSide, kSide);
+    for (const bool inverse : {false, true}) {
+        const std::string name = inverse ? "BM_Undistort" : "BM_Distort";
+        benchmark::RegisterBenchmark((name + "Identity").c_str(), [inverse](benchmark::State& s) { lookups(s, identity, inverse); });
+        benchmark::RegisterBenchmark(name.c_str(), [inverse](benchmark::State& s) { lookups(s, twoFocusMap(), inverse); });
+    }
+    return true;
+}();
 
 void BM_BuildMapFromDensity(benchmark::State& state) {
     const int side = int(state.range(0));

@@ -16,6 +16,28 @@
 namespace conus::codec {
 namespace {
 
+// Where node (i, j) of an outColumns x outRows grid over the unit square falls in a columns x rows
+// grid over the same square, and the bilinear interpolation of that grid's values there: how the
+// particle grid is resampled (coarse to fine in the warm start, particles to map nodes in toMap).
+struct GridPoint {
+    std::size_t k = 0;  // the enclosing cell's top-left value
+    int stride = 0;     // values per row
+    double tx = 0, ty = 0;
+
+    double interpolate(const std::vector<float>& a) const {
+        const std::size_t k2 = k + stride;
+        return (1 - ty) * ((1 - tx) * double(a[k]) + tx * double(a[k + 1])) +
+               ty * ((1 - tx) * double(a[k2]) + tx * double(a[k2 + 1]));
+    }
+};
+
+GridPoint gridPoint(int columns, int rows, int outColumns, int outRows, int i, int j) {
+    const double gx = double(i) * (columns - 1) / (outColumns - 1);
+    const double gy = double(j) * (rows - 1) / (outRows - 1);
+    const int ci = std::min(int(gx), columns - 2), cj = std::min(int(gy), rows - 2);
+    return {std::size_t(cj) * columns + ci, columns, gx - ci, gy - cj};
+}
+
 // Brush falloff exp(-kFalloff s^2), shifted and rescaled to reach exactly 0 at the rim.
 constexpr double kFalloff = 4.0;
 // The guard keeps every corner cross product above this fraction of its rest value (hx * hy), so
@@ -454,21 +476,11 @@ void SpringSystem::warmStart(int maxSteps) {
     m_warmWork += ratio * (double(coarse.steps()) + coarse.warmStartWork());
     // Prolong: bilinear in displacement at each particle's rest position.
     for (int j = 0; j < r; ++j) {
-        const double gy = double(j) * (cr - 1) / (r - 1);
-        const int jj = std::min(int(gy), cr - 2);
-        const double ty = gy - jj;
         for (int i = 0; i < c; ++i) {
-            const double gx = double(i) * (cc - 1) / (c - 1);
-            const int ii = std::min(int(gx), cc - 2);
-            const double tx = gx - ii;
-            const std::size_t k = std::size_t(jj) * cc + ii, k2 = k + cc;
-            auto lerp2 = [&](const std::vector<float>& a) {
-                return float((1 - ty) * ((1 - tx) * double(a[k]) + tx * double(a[k + 1])) +
-                             ty * ((1 - tx) * double(a[k2]) + tx * double(a[k2 + 1])));
-            };
+            const GridPoint g = gridPoint(cc, cr, c, r, i, j);
             const std::size_t q = std::size_t(j) * c + i;
-            m_nx[q] = lerp2(coarse.m_x);
-            m_ny[q] = lerp2(coarse.m_y);
+            m_nx[q] = float(g.interpolate(coarse.m_x));
+            m_ny[q] = float(g.interpolate(coarse.m_y));
         }
     }
     // Edge particles keep their normal coordinate exact (the coarse edges have zero normal
@@ -541,19 +553,10 @@ SamplingMap SpringSystem::toMap(int columns, int rows, double* scale) const {
     // Eq. 1 on the particle grid at each node's undistorted position, as a displacement.
     std::vector<glm::dvec2> d(std::size_t(columns) * rows);
     for (int J = 0; J < rows; ++J) {
-        const double gy = double(J) * (m_rows - 1) / (rows - 1);
-        const int j = std::min(int(gy), m_rows - 2);
-        const double ty = gy - j;
         for (int I = 0; I < columns; ++I) {
-            const double gx = double(I) * (m_columns - 1) / (columns - 1);
-            const int i = std::min(int(gx), m_columns - 2);
-            const double tx = gx - i;
-            const std::size_t k = std::size_t(j) * m_columns + i, k2 = k + m_columns;
-            auto lerp2 = [&](const std::vector<float>& a) {
-                return (1 - ty) * ((1 - tx) * a[k] + tx * a[k + 1]) + ty * ((1 - tx) * a[k2] + tx * a[k2 + 1]);
-            };
+            const GridPoint g = gridPoint(m_columns, m_rows, columns, rows, I, J);
             // Bilinear in displacement = bilinear in position: the rest grid is itself bilinear.
-            d[std::size_t(J) * columns + I] = glm::dvec2(lerp2(m_x), lerp2(m_y));
+            d[std::size_t(J) * columns + I] = glm::dvec2(g.interpolate(m_x), g.interpolate(m_y));
         }
     }
     ComposeResult fitted = fitDisplacement(columns, rows, d);

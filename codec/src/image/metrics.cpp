@@ -1,7 +1,10 @@
 // Image quality measures: MSE over the colour channels two images share, and PSNR from it.
 #include "conus/codec/image/metrics.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstddef>
 #include <limits>
 #include <string>
 #include <utility>
@@ -66,6 +69,22 @@ double psnr(const Image& a, const Image& b, double peak) {
     const double mse = meanSquaredError(a, b);
     if (mse == 0.0) return std::numeric_limits<double>::infinity();
     return 10.0 * std::log10(peak * peak / mse);
+}
+
+Image crop(const Image& image, int x0, int y0, int width, int height) {
+    // In 64 bits so that x0 + width cannot overflow.
+    if (width < 1 || height < 1 || x0 < 0 || y0 < 0 || std::int64_t{x0} + width > image.width ||
+        std::int64_t{y0} + height > image.height)
+        throw Error(ErrorCode::InvalidArgument, "crop " + std::to_string(width) + "x" + std::to_string(height) + " at (" +
+                                                    std::to_string(x0) + ", " + std::to_string(y0) + ") is not inside the " +
+                                                    std::to_string(image.width) + "x" + std::to_string(image.height) + " image");
+    Image out = makeImage(width, height, image.channels);
+    const auto rowValues = static_cast<std::ptrdiff_t>(static_cast<std::size_t>(width) * image.channels.size());
+    for (int y = 0; y < height; ++y) {
+        const auto from = image.pixels.begin() + static_cast<std::ptrdiff_t>(image.index(x0, y0 + y));
+        std::copy(from, from + rowValues, out.pixels.begin() + static_cast<std::ptrdiff_t>(out.index(0, y)));
+    }
+    return out;
 }
 
 }  // namespace conus::codec

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <random>
+#include <string>
+#include <utility>
 
 #include "conus/format/container.h"
 #include "conus/core/error.h"
@@ -192,18 +194,14 @@ TEST(Foci, ParseFocus) {
         }
         return "accepted";
     };
-    EXPECT_NE(message("0.4,0.3,0.1").find("expected u,v,r,k"), std::string::npos);
-    EXPECT_NE(message("0.4,0.3,0.1,2,5").find("has 5 values"), std::string::npos);
-    EXPECT_NE(message("").find("values"), std::string::npos);
-    EXPECT_NE(message("0.4,abc,0.1,2").find("v = \"abc\""), std::string::npos);
-    EXPECT_NE(message("0.4,0.3,,2").find("r = \"\""), std::string::npos);
-    EXPECT_NE(message("0.4,0.3,0.1,2x").find("not a finite number"), std::string::npos);
-    EXPECT_NE(message("0.4,0.3,0.1,nan").find("not a finite number"), std::string::npos);
-    EXPECT_NE(message("1.5,0.3,0.1,2").find("outside [0,1]^2"), std::string::npos);
-    EXPECT_NE(message("0.5,0.3,0,2").find("radius"), std::string::npos);
-    EXPECT_NE(message("0.5,0.3,1.5,2").find("radius"), std::string::npos);
-    EXPECT_NE(message("0.5,0.3,0.1,0.9").find("magnification"), std::string::npos);
-    EXPECT_NE(message("0.5,0.3,0.1,100").find("magnification"), std::string::npos);
+    // Each refused text with what its message must say.
+    const std::pair<const char*, const char*> refused[] = {
+        {"0.4,0.3,0.1", "expected u,v,r,k"}, {"0.4,0.3,0.1,2,5", "has 5 values"}, {"", "values"},
+        {"0.4,abc,0.1,2", "v = \"abc\""}, {"0.4,0.3,,2", "r = \"\""},
+        {"0.4,0.3,0.1,2x", "not a finite number"}, {"0.4,0.3,0.1,nan", "not a finite number"},
+        {"1.5,0.3,0.1,2", "outside [0,1]^2"}, {"0.5,0.3,0,2", "radius"}, {"0.5,0.3,1.5,2", "radius"},
+        {"0.5,0.3,0.1,0.9", "magnification"}, {"0.5,0.3,0.1,100", "magnification"}};
+    for (const auto& [text, says] : refused) EXPECT_NE(message(text).find(says), std::string::npos) << '"' << text << '"';
 }
 
 }  // namespace

@@ -21,21 +21,7 @@ using test::noise;
 using test::texture;
 using test::zonePlate;
 
-Image crop(const Image& im, int x0, int y0, int w, int h) {
-    Image out = makeImage(w, h, im.channels);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-            for (int c = 0; c < im.channelCount(); ++c) out.at(x, y, c) = im.at(x0 + x, y0 + y, c);
-    return out;
-}
-
-float maxAbsDifference(const Image& a, const Image& b) {
-    EXPECT_EQ(a.pixels.size(), b.pixels.size());
-    float worst = 0;
-    for (std::size_t i = 0; i < std::min(a.pixels.size(), b.pixels.size()); ++i)
-        worst = std::max(worst, std::abs(a.pixels[i] - b.pixels[i]));
-    return worst;
-}
+using test::maxAbsDifference;
 
 SamplingMap twoFoci() {
     const std::vector<Focus> foci = {{0.3, 0.35, 0.08, 4}, {0.7, 0.6, 0.06, 3}};

@@ -16,17 +16,7 @@
 namespace conus::codec {
 namespace {
 
-using test::noise;
-using test::texture;
-using test::zonePlate;
-
-float maxAbsDifference(const Image& a, const Image& b) {
-    EXPECT_EQ(a.pixels.size(), b.pixels.size());
-    float worst = 0;
-    for (std::size_t i = 0; i < std::min(a.pixels.size(), b.pixels.size()); ++i)
-        worst = std::max(worst, std::abs(a.pixels[i] - b.pixels[i]));
-    return worst;
-}
+using namespace conus::test;  // the shared test images and maxAbsDifference
 
 SamplingMap twoFoci(double aspect = 1.0, FociComposition composition = FociComposition::Density) {
     const std::vector<Focus> foci = {{0.3, 0.35, 0.08, 4}, {0.7, 0.6, 0.06, 3}};

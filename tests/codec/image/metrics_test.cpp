@@ -61,5 +61,39 @@ TEST(Metrics, RejectsDifferentSizesAndDisjointChannels) {
     }
 }
 
+// Every value distinct, so a crop that reads the wrong row, column or channel cannot match.
+Image numbered(int width, int height) {
+    Image im = makeImage(width, height, {"R", "G", "B"});
+    for (std::size_t i = 0; i < im.pixels.size(); ++i) im.pixels[i] = static_cast<float>(i);
+    return im;
+}
+
+TEST(Crop, TakesTheRectangleWithEveryChannel) {
+    const Image im = numbered(7, 5);
+    const Image c = crop(im, 2, 1, 4, 3);
+    ASSERT_EQ(c.width, 4);
+    ASSERT_EQ(c.height, 3);
+    EXPECT_EQ(c.channels, im.channels);
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 4; ++x)
+            for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(c.at(x, y, ch), im.at(2 + x, 1 + y, ch)) << x << "," << y << "," << ch;
+    // The crop's bottom-right value is the source's pixel (5, 3), channel B: (3 * 7 + 5) * 3 + 2.
+    EXPECT_EQ(c.at(3, 2, 2), 80.0f);
+}
+
+TEST(Crop, WholeImageIsACopy) {
+    const Image im = numbered(3, 2);
+    EXPECT_EQ(crop(im, 0, 0, 3, 2).pixels, im.pixels);
+}
+
+TEST(Crop, RefusesRectanglesOutsideTheImage) {
+    const Image im = numbered(4, 4);
+    EXPECT_THROW(crop(im, 1, 0, 4, 1), Error);
+    EXPECT_THROW(crop(im, 0, 3, 1, 2), Error);
+    EXPECT_THROW(crop(im, -1, 0, 1, 1), Error);
+    EXPECT_THROW(crop(im, 0, 0, 0, 1), Error);
+    EXPECT_THROW(crop(im, 2147483647, 0, 1, 1), Error);
+}
+
 }  // namespace
 }  // namespace conus::codec
