@@ -235,6 +235,18 @@ void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r
     optional(m, &HeaderModel::depthUnits, r);
 }
 
+// V17: a depth image's Z means something only through its camera (cameraDepth along its axis).
+void checkDepthImage(const HeaderModel& m, ValidationReport& r) {
+    if (!m.dataKind.present || m.dataKind.value != "depthimage") return;
+    std::string missing;
+    if (!m.worldToCamera.present) missing += kAttrWorldToCamera;
+    if (!m.worldToNDC.present) missing += std::string(missing.empty() ? "" : ", ") + kAttrWorldToNDC;
+    if (!m.projection.present) missing += std::string(missing.empty() ? "" : ", ") + kAttrProjection;
+    if (!missing.empty()) r.add(Rule::V17, "a depth image needs its camera; missing " + missing);
+    const std::string kind = m.depthKind.present ? m.depthKind.value : "none";
+    if (kind != "cameraDepth") r.add(Rule::V17, "a depth image's conus:depthKind is " + kind + ", not cameraDepth");
+}
+
 void checkColour(const HeaderModel& m, ValidationReport& r) {
     if (optional(m, &HeaderModel::sourceTransfer, r) && !parseTransfer(m.sourceTransfer.value))
         r.add(Rule::V16, "source transfer `" + m.sourceTransfer.value + "` is not linear, srgb or raw");
@@ -274,6 +286,7 @@ HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, Val
     checkAnalytic(m, r);
     checkCamera(m, r);
     checkDepth(m, part, r);
+    checkDepthImage(m, r);
     checkColour(m, r);
     checkDisplayWindows(m, r);
     return hc;
