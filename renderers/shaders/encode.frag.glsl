@@ -39,26 +39,21 @@ float erfApprox(float x) {
     return sign(x) * (1.0 - poly * exp(-x * x));
 }
 
+// Narrows [lo, hi] to the offsets o for which |x - o * d| <= 0.5; false when none is left.
+bool slab(float x, float d, inout float lo, inout float hi) {
+    if (abs(d) < 1e-9) return abs(x) <= 0.5;
+    const float o1 = (x - 0.5) / d, o2 = (x + 0.5) / d;
+    lo = max(lo, min(o1, o2));
+    hi = min(hi, max(o1, o2));
+    return hi > lo;
+}
+
 // The filter's weight at (s,t) in CoNUS pixels: the Gaussian's mass (std sigma along the unit
 // direction major, cut at +-reach) over the offsets that keep (s,t) - o * major in the unit box.
 float filterWeight(float s, float t, float sigma, vec2 major, float reach) {
     if (sigma < 1e-4) return abs(s) <= 0.5 && abs(t) <= 0.5 ? 1.0 : 0.0;
     float lo = -reach, hi = reach;
-    if (abs(major.x) < 1e-9) {
-        if (abs(s) > 0.5) return 0.0;
-    } else {
-        const float o1 = (s - 0.5) / major.x, o2 = (s + 0.5) / major.x;
-        lo = max(lo, min(o1, o2));
-        hi = min(hi, max(o1, o2));
-    }
-    if (abs(major.y) < 1e-9) {
-        if (abs(t) > 0.5) return 0.0;
-    } else {
-        const float o1 = (t - 0.5) / major.y, o2 = (t + 0.5) / major.y;
-        lo = max(lo, min(o1, o2));
-        hi = min(hi, max(o1, o2));
-    }
-    if (hi <= lo) return 0.0;
+    if (!slab(s, major.x, lo, hi) || !slab(t, major.y, lo, hi)) return 0.0;
     const float k = 1.0 / (sqrt(2.0) * sigma);
     return 0.5 * (erfApprox(hi * k) - erfApprox(lo * k));
 }
