@@ -1,13 +1,16 @@
 #version 450 core
-// One CoNUS pixel: a box filter over its footprint in the source, as codec::encodeImage does.
-// The footprint's edges are the screen-space derivatives of the undistorted coordinate (the local
-// inverse Jacobian over one pixel); up to kEncodeMaxTaps x kEncodeMaxTaps bilinear taps cover it, on the
-// first pyramid level where it is at most kEncodeMaxTaps texels long.
+// One CoNUS pixel, filtered as codec::encodeImage does (encode.h states the rule): the footprint's
+// edges a and b come from the mesh (codec::FootprintField, interpolated); the filter is the unit box
+// in CoNUS pixel units convolved with a Gaussian along the footprint's major axis that grows with
+// its anisotropy; taps at most a texel apart along each edge, on a continuous pyramid level (the
+// two levels around it blended) where the minor axis is at most kEncodeMaxTaps texels and the
+// filter at most kEncodeMaxAxisTaps texels along each edge.
 //
 // Tiling (sources over the texture limit): the textures may hold only a crop of each level (the
 // tile's core plus a margin that covers every tap), placed by uLevelRect; the pixels whose
 // undistorted centre lies outside the tile's core (uCore) are left to the other tiles.
 in vec2 vUndistorted;
+in vec4 vFootprint;
 layout(location = 0) out vec4 fragColor;
 uniform sampler2D uLevel0;   // level 0: the source or a crop of it, bilinear, clamp to edge
 uniform sampler2D uPyramid;  // levels 1.. (or crops of them) side by side (pyramid.frag.glsl), bilinear
@@ -29,26 +32,84 @@ vec4 tap(vec2 q, int level) {
     return textureLod(uPyramid, at / vec2(textureSize(uPyramid, 0)), 0.0);
 }
 
+// erf, Abramowitz and Stegun 7.1.26 (absolute error below 1.5e-7; GLSL has none built in).
+float erfApprox(float x) {
+    const float t = 1.0 / (1.0 + 0.3275911 * abs(x));
+    const float poly = t * (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
+    return sign(x) * (1.0 - poly * exp(-x * x));
+}
+
+// Narrows [lo, hi] to the offsets o for which |x - o * d| <= 0.5; false when none is left.
+bool slab(float x, float d, inout float lo, inout float hi) {
+    if (abs(d) < 1e-9) return abs(x) <= 0.5;
+    const float o1 = (x - 0.5) / d, o2 = (x + 0.5) / d;
+    lo = max(lo, min(o1, o2));
+    hi = min(hi, max(o1, o2));
+    return hi > lo;
+}
+
+// The filter's weight at (s,t) in CoNUS pixels: the Gaussian's mass (std sigma along the unit
+// direction major, cut at +-reach) over the offsets that keep (s,t) - o * major in the unit box.
+float filterWeight(float s, float t, float sigma, vec2 major, float reach) {
+    if (sigma < 1e-4) return abs(s) <= 0.5 && abs(t) <= 0.5 ? 1.0 : 0.0;
+    float lo = -reach, hi = reach;
+    if (!slab(s, major.x, lo, hi) || !slab(t, major.y, lo, hi)) return 0.0;
+    const float k = 1.0 / (sqrt(2.0) * sigma);
+    return 0.5 * (erfApprox(hi * k) - erfApprox(lo * k));
+}
+
+// The normalized filtered value on one level.
+vec4 filterOnLevel(int level, vec2 p, vec2 a, vec2 b, float sigma, vec2 major, float reach, vec2 extent) {
+    const vec2 scale = vec2(uLevelRect[level].zw) / vec2(uLevelRect[0].zw);
+    const vec2 aL = a * scale, bL = b * scale;
+    const int ns = clamp(int(ceil(length(aL) * extent.x - kEncodeTapTolerance)), 1, 2 * kEncodeMaxAxisTaps);
+    const int nt = clamp(int(ceil(length(bL) * extent.y - kEncodeTapTolerance)), 1, 2 * kEncodeMaxAxisTaps);
+    // Normalized source units per unit of s and t.
+    const vec2 da = a / vec2(uLevelRect[0].zw), db = b / vec2(uLevelRect[0].zw);
+    vec4 sum = vec4(0.0);
+    float total = 0.0;
+    for (int j = 0; j < nt; ++j) {
+        const float t = ((float(j) + 0.5) / float(nt) - 0.5) * extent.y;
+        for (int i = 0; i < ns; ++i) {
+            const float s = ((float(i) + 0.5) / float(ns) - 0.5) * extent.x;
+            const float w = filterWeight(s, t, sigma, major, reach);
+            if (w <= 0.0) continue;
+            total += w;
+            sum += w * tap(p + da * s + db * t, level);
+        }
+    }
+    return total > 0.0 ? sum / total : vec4(0.0);
+}
+
 void main() {
     const vec2 p = vUndistorted;
-    const vec2 da = dFdx(p), db = dFdy(p);  // normalized source units per CoNUS pixel
     if (any(lessThan(p, uCore.xy)) || any(greaterThanEqual(p, uCore.zw))) discard;
     const vec2 size0 = vec2(uLevelRect[0].zw);
-    const vec2 a = da * size0, b = db * size0;  // in level-0 texels
-    int level = 0;
-    float la = length(a), lb = length(b);
-    while (max(la, lb) > float(kEncodeMaxTaps) + kEncodeTapTolerance && level + 1 < uLevels) {
-        ++level;
-        const vec2 s = vec2(uLevelRect[level].zw) / size0;
-        la = length(a * s);
-        lb = length(b * s);
+    const vec2 a = vFootprint.xy * size0, b = vFootprint.zw * size0;  // in level-0 texels
+    // The footprint's major and minor lengths and the major direction in (s,t): the singular
+    // values and right singular vector of [a b].
+    const float P = dot(a, a), Q = dot(a, b), R = dot(b, b);
+    const float mean = 0.5 * (P + R), spread = sqrt(0.25 * (P - R) * (P - R) + Q * Q);
+    const float l1 = mean + spread, l2 = max(0.0, mean - spread);
+    const float minor = sqrt(l2);
+    float sigma = 0.0;
+    vec2 major = vec2(1.0, 0.0);
+    if (l1 > 0.0) {
+        sigma = kEncodeAnisotropicSigma * max(0.0, 1.0 - kEncodeBoxAnisotropy * sqrt(l2 / l1));
+        const vec2 e1 = vec2(Q, l1 - P), e2 = vec2(l1 - R, Q);
+        const vec2 e = dot(e1, e1) >= dot(e2, e2) ? e1 : e2;
+        if (length(e) > 0.0) major = normalize(e);
     }
-    const int na = clamp(int(ceil(la - kEncodeTapTolerance)), 1, kEncodeMaxTaps);
-    const int nb = clamp(int(ceil(lb - kEncodeTapTolerance)), 1, kEncodeMaxTaps);
-    vec4 sum = vec4(0.0);
-    for (int j = 0; j < nb; ++j) {
-        const vec2 q = p + db * ((float(j) + 0.5) / float(nb) - 0.5);
-        for (int i = 0; i < na; ++i) sum += tap(q + da * ((float(i) + 0.5) / float(na) - 0.5), level);
-    }
-    fragColor = sum / float(na * nb);
+    const float reach = kEncodeGaussianReach * sigma;
+    const vec2 extent = vec2(1.0) + 2.0 * reach * abs(major);
+    const float tol = kEncodeTapTolerance;
+    const float coarsest = max(max(minor / (float(kEncodeMaxTaps) + tol), 1.0),
+                               max(length(a) * extent.x, length(b) * extent.y) / (float(kEncodeMaxAxisTaps) + tol));
+    const float lambda = log2(coarsest);
+    const int top = uLevels - 1;
+    const int level = min(int(lambda), top);
+    const float blend = level < top ? lambda - float(level) : 0.0;
+    vec4 value = filterOnLevel(level, p, a, b, sigma, major, reach, extent);
+    if (blend > 0.0) value = mix(value, filterOnLevel(level + 1, p, a, b, sigma, major, reach, extent), blend);
+    fragColor = value;
 }

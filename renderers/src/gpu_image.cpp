@@ -134,8 +134,12 @@ std::vector<double> meshAxis(const std::vector<int>& splits) {
     return out;
 }
 
+constexpr int kVertexFloats = 8;
+
 struct Mesh {
-    std::vector<float> vertices;  // distorted x, y, undistorted u, v
+    // Per vertex: distorted x, y; undistorted u, v; the footprint (codec::FootprintField), as the
+    // undistorted change per CoNUS pixel along x and along y.
+    std::vector<float> vertices;
     std::vector<GLuint> indices;
 };
 
@@ -160,11 +164,15 @@ Mesh buildMesh(const codec::SamplingMap& map, int width, int height) {
 
     Mesh mesh;
     const std::size_t nu = us.size(), nv = vs.size();
-    mesh.vertices.reserve(nu * nv * 4);
+    const codec::FootprintField field(map);
+    mesh.vertices.reserve(nu * nv * kVertexFloats);
     for (double v : vs)
         for (double u : us) {
             const glm::dvec2 d = map.distort({u, v});
-            mesh.vertices.insert(mesh.vertices.end(), {float(d.x), float(d.y), float(u), float(v)});
+            const glm::dmat2 f = field.inverseJacobian({u, v});
+            const glm::dvec2 a = f[0] / double(width), b = f[1] / double(height);
+            mesh.vertices.insert(mesh.vertices.end(), {float(d.x), float(d.y), float(u), float(v), float(a.x),
+                                                       float(a.y), float(b.x), float(b.y)});
         }
     mesh.indices.reserve((nu - 1) * (nv - 1) * 6);
     for (std::size_t j = 0; j + 1 < nv; ++j)
@@ -240,11 +248,28 @@ void buildPyramid(Context& context, const GladGLContext& gl, const Pyramid& pyra
 // full image's (built once, at the CPU reference's sizes), so a crop's texels are the full
 // pyramid's texels and a tiled pixel reads exactly what an untiled one would.
 //
-// A tap on level L lies within (kMaxTaps / 2) * 2 = 4 texels of the pixel's centre along each
-// footprint edge (the level is the first where the footprint is at most kMaxTaps long, the 1 x 1
-// top level aside, which is always whole), plus one texel for the bilinear filter: kTileMargin
-// texels of each level around the core, with rounding to spare.
-constexpr int kTileMargin = 6;
+// A tap lies within half the filter's extent along each footprint edge of the pixel's centre, plus
+// a texel for the bilinear filter; the finer of the two blended levels reaches furthest in its own
+// texels. The margin every level's crop needs is the largest such reach over the mesh's vertices
+// (codec::planFootprint on their footprints), with room for the interpolation in between:
+// kMarginSlack of it plus kMarginTexels. Maps with long footprints get wide margins, most get a few
+// texels.
+constexpr double kMarginSlack = 1.25;
+constexpr int kMarginTexels = 3;
+
+int tileMargin(const Mesh& mesh, int width, int height) {
+    double reach = 0;
+    for (std::size_t k = 0; k + kVertexFloats <= mesh.vertices.size(); k += kVertexFloats) {
+        const float* f = &mesh.vertices[k + 4];
+        const glm::dvec2 a(f[0] * double(width), f[1] * double(height)), b(f[2] * double(width), f[3] * double(height));
+        const codec::FootprintPlan plan = codec::planFootprint(a, b);
+        const double scale = std::ldexp(1.0, -static_cast<int>(plan.level));  // level sizes round up: no smaller
+        const double rx = 0.5 * (std::abs(a.x) * plan.extent.x + std::abs(b.x) * plan.extent.y);
+        const double ry = 0.5 * (std::abs(a.y) * plan.extent.x + std::abs(b.y) * plan.extent.y);
+        reach = std::max(reach, std::max(rx, ry) * scale);
+    }
+    return static_cast<int>(std::ceil(kMarginSlack * reach)) + kMarginTexels;
+}
 
 struct TileLevel {
     int x = 0, y = 0, width = 0, height = 0;  // the crop, in the full level's texels
@@ -260,17 +285,17 @@ struct Tile {
 
 // The crops of every level around core [x0, x1) x [y0, y1) of a width x height source: level 1 at
 // the atlas's origin, levels 2.. stacked to its right.
-Tile planTile(const Pyramid& pyramid, int x0, int y0, int x1, int y1) {
+Tile planTile(const Pyramid& pyramid, int margin, int x0, int y0, int x1, int y1) {
     Tile tile{x0, y0, x1, y1, {}, 1, 1, {}};
     const double width = pyramid.rects[0][2], height = pyramid.rects[0][3];
     int stackY = 0, stackWidth = 0;
     for (std::size_t level = 0; level < pyramid.rects.size(); ++level) {
         const int w = pyramid.rects[level][2], h = pyramid.rects[level][3];
         TileLevel crop;
-        crop.x = std::max(0, static_cast<int>(std::floor(x0 * (w / width))) - kTileMargin);
-        crop.y = std::max(0, static_cast<int>(std::floor(y0 * (h / height))) - kTileMargin);
-        crop.width = std::min(w, static_cast<int>(std::ceil(x1 * (w / width))) + kTileMargin) - crop.x;
-        crop.height = std::min(h, static_cast<int>(std::ceil(y1 * (h / height))) + kTileMargin) - crop.y;
+        crop.x = std::max(0, static_cast<int>(std::floor(x0 * (w / width))) - margin);
+        crop.y = std::max(0, static_cast<int>(std::floor(y0 * (h / height))) - margin);
+        crop.width = std::min(w, static_cast<int>(std::ceil(x1 * (w / width))) + margin) - crop.x;
+        crop.height = std::min(h, static_cast<int>(std::ceil(y1 * (h / height))) + margin) - crop.y;
         if (level >= 2) {
             crop.atlasX = tile.levels[1].width;
             crop.atlasY = stackY;
@@ -294,16 +319,16 @@ std::vector<int> splitAxis(int size, int count) {
 }
 
 // The tiles of the source: the largest near-square cores whose crops fit the limit.
-std::vector<Tile> planTiles(const Pyramid& pyramid, int limit) {
+std::vector<Tile> planTiles(const Pyramid& pyramid, int margin, int limit) {
     const int width = pyramid.rects[0][2], height = pyramid.rects[0][3];
-    for (int core = std::max(1, limit - 2 * kTileMargin - 2);; core = std::max(1, core - std::max(1, core / 16))) {
+    for (int core = std::max(1, limit - 2 * margin - 2);; core = std::max(1, core - std::max(1, core / 16))) {
         const std::vector<int> xs = splitAxis(width, (width + core - 1) / core);
         const std::vector<int> ys = splitAxis(height, (height + core - 1) / core);
         std::vector<Tile> tiles;
         bool fits = true;
         for (std::size_t j = 0; j + 1 < ys.size() && fits; ++j)
             for (std::size_t i = 0; i + 1 < xs.size() && fits; ++i) {
-                tiles.push_back(planTile(pyramid, xs[i], ys[j], xs[i + 1], ys[j + 1]));
+                tiles.push_back(planTile(pyramid, margin, xs[i], ys[j], xs[i + 1], ys[j + 1]));
                 const Tile& t = tiles.back();
                 fits = t.levels[0].width <= limit && t.levels[0].height <= limit && t.atlasWidth <= limit &&
                        t.atlasHeight <= limit;
@@ -333,7 +358,7 @@ std::vector<GLuint> tileIndices(const Mesh& mesh, const std::array<float, 4>& co
     for (std::size_t k = 0; k + 2 < mesh.indices.size(); k += 3) {
         float u0 = std::numeric_limits<float>::max(), v0 = u0, u1 = -u0, v1 = -u0;
         for (int c = 0; c < 3; ++c) {
-            const float* vertex = &mesh.vertices[std::size_t(mesh.indices[k + c]) * 4];
+            const float* vertex = &mesh.vertices[std::size_t(mesh.indices[k + c]) * kVertexFloats];
             u0 = std::min(u0, vertex[2]);
             u1 = std::max(u1, vertex[2]);
             v0 = std::min(v0, vertex[3]);
@@ -409,16 +434,19 @@ private:
         m_gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(m_mesh.indices.size() * sizeof(GLuint)),
                         m_mesh.indices.data(), GL_STATIC_DRAW);
         m_gl.EnableVertexAttribArray(0);
-        m_gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), nullptr);
+        constexpr GLsizei kStride = kVertexFloats * sizeof(float);
+        m_gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, kStride, nullptr);
         m_gl.EnableVertexAttribArray(1);
-        m_gl.VertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), reinterpret_cast<const void*>(2 * sizeof(float)));
+        m_gl.VertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(2 * sizeof(float)));
+        m_gl.EnableVertexAttribArray(2);
+        m_gl.VertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(4 * sizeof(float)));
         checkGl(m_gl, kWhat);
     }
 
     // The plan, each tile's share of the mesh, and the pyramid's levels 1.. (built once on the
     // CPU with the reference's own area filter; the GPU then reads crops of them per tile).
     void planTiling(int limit) {
-        m_tiles = planTiles(m_pyramid, limit);
+        m_tiles = planTiles(m_pyramid, tileMargin(m_mesh, m_source.width, m_source.height), limit);
         m_levels.reserve(m_pyramid.rects.size());
         for (Tile& tile : m_tiles) tile.indices = tileIndices(m_mesh, tileCore(tile, m_source.width, m_source.height));
         for (std::size_t level = 1; level < m_pyramid.rects.size(); ++level)

@@ -25,6 +25,10 @@ std::string constantsBlock() {
     s += "const int kDecodeMaxTaps = " + std::to_string(codec::kDecodeMaxTaps) + ";\n";
     s += "const int kEncodeMaxTaps = " + std::to_string(codec::kEncodeMaxTaps) + ";\n";
     s += "const float kEncodeTapTolerance = " + glslFloat(codec::kEncodeTapTolerance) + ";\n";
+    s += "const int kEncodeMaxAxisTaps = " + std::to_string(codec::kEncodeMaxAxisTaps) + ";\n";
+    s += "const float kEncodeAnisotropicSigma = " + glslFloat(codec::kEncodeAnisotropicSigma) + ";\n";
+    s += "const float kEncodeGaussianReach = " + glslFloat(codec::kEncodeGaussianReach) + ";\n";
+    s += "const float kEncodeBoxAnisotropy = " + glslFloat(codec::kEncodeBoxAnisotropy) + ";\n";
     s += "const vec3 kBackground = vec3(" + glslFloat(kViewBackground) + ");\n";
     s += "const int kMaxFoci = " + std::to_string(kViewMaxFoci) + ";\n";
     s += "const vec3 kInferno[" + std::to_string(kInfernoRamp.size()) + "] = vec3[](";

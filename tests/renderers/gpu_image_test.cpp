@@ -290,8 +290,9 @@ TEST_P(GpuImage, RejectsBadArguments) {
     }
 }
 
-// Sources over the texture limit are tiled: the limit lowered to 256 texels cuts a 700 x 500
+// Sources over the texture limit are tiled: the limit lowered to 512 texels cuts a 700 x 500
 // source (and its pyramid) into tiles, and the result matches the CPU reference and the untiled GPU.
+// (512, not less: the two-focus map's long footprints need margins of 86 texels on every level.)
 TEST_P(GpuImage, EncodeTilesSourcesOverTheLimit) {
     const Image source = test::photoLike(700, 500);
     struct Case {
@@ -309,7 +310,7 @@ TEST_P(GpuImage, EncodeTilesSourcesOverTheLimit) {
         const Image untiled = encodeImageGpu(context(), source, c.map, encodeSize(c.width, c.height));
         Image tiled;
         {
-            const TextureLimit limit("256");
+            const TextureLimit limit("512");
             tiled = encodeImageGpu(context(), source, c.map, encodeSize(c.width, c.height));
         }
         ASSERT_EQ(tiled.channels, source.channels);
@@ -317,7 +318,7 @@ TEST_P(GpuImage, EncodeTilesSourcesOverTheLimit) {
         for (std::size_t i = 0; i < tiled.pixels.size(); ++i)
             worst = std::max(worst, std::abs(tiled.pixels[i] - untiled.pixels[i]));
         const double vsCpu = codec::psnr(cpu, tiled), vsUntiled = codec::psnr(untiled, tiled);
-        std::printf("    tiled encode 700x500 -> %dx%d (%s), limit 256, %s: PSNR %.2f dB vs CPU, %.2f dB vs untiled "
+        std::printf("    tiled encode 700x500 -> %dx%d (%s), limit 512, %s: PSNR %.2f dB vs CPU, %.2f dB vs untiled "
                     "GPU (largest difference %.2g), untiled vs CPU %.2f dB\n",
                     c.width, c.height, c.name, backendName(GetParam()).c_str(), vsCpu, vsUntiled, worst,
                     codec::psnr(cpu, untiled));

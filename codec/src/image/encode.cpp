@@ -1,9 +1,10 @@
 // CPU reference encoder (paper section 3.2) and the area-downsample baseline.
 //
-// Each CoNUS pixel is a box filter over its footprint in the source: the distorted pixel is split
-// into na x nb sub-pixels whose centres are carried into the source through the local inverse
-// Jacobian, one bilinear fetch each. With the identity map and an integer ratio the sub-pixel
-// centres land exactly on source pixel centres, so the result is the exact area average.
+// Each CoNUS pixel filters the source over its footprint (encode.h states the rule): a grid of
+// bilinear taps in the pixel's own units (s,t), carried into the source through the local inverse
+// Jacobian (FootprintField), weighted by the unit box convolved with a Gaussian along the
+// footprint's major axis. A square footprint has no Gaussian: with the identity map and an integer
+// ratio the taps land exactly on source pixel centres, so the result is the exact area average.
 #include <array>
 #include <memory>
 #include <cmath>
@@ -17,7 +18,7 @@
 namespace conus::codec {
 namespace {
 
-constexpr int kMaxTapsPerAxis = kEncodeMaxTaps;  // encode.h says why
+constexpr int kMaxTapsPerAxis = kEncodeMaxTaps;  // encode.h says why (the minor axis's bound)
 constexpr double kTapTolerance = kEncodeTapTolerance;
 
 // Source-pixel intervals covered by each output pixel along one axis, with exact overlap weights.
@@ -129,78 +130,188 @@ private:
     std::array<std::once_flag, kMaxLevels> m_once;
 };
 
-constexpr detail::TapOffsets<kMaxTapsPerAxis> kTapOffsets;
+// The footprint filter of encode.h: the unit box in CoNUS pixel units (s,t), convolved with a
+// Gaussian of standard deviation `sigma` along the unit direction `major` (sigma 0: the plain box).
+struct FootprintFilter {
+    double sigma = 0;
+    glm::dvec2 major{1.0, 0.0};
+    double reach = 0;  // the Gaussian's cut, kEncodeGaussianReach * sigma
+};
+
+// a and b are the footprint's edges (source pixels per CoNUS pixel along x and y); the singular
+// values of [a b] are the footprint's major and minor lengths, the right singular vectors their
+// directions in CoNUS pixel units.
+FootprintFilter footprintFilter(glm::dvec2 a, glm::dvec2 b, double& minor) {
+    const double p = glm::dot(a, a), q = glm::dot(a, b), r = glm::dot(b, b);
+    const double mean = 0.5 * (p + r), half = std::sqrt(0.25 * (p - r) * (p - r) + q * q);
+    const double l1 = mean + half, l2 = std::max(0.0, mean - half);
+    minor = std::sqrt(l2);
+    FootprintFilter f;
+    if (!(l1 > 0)) return f;
+    f.sigma = kEncodeAnisotropicSigma * std::max(0.0, 1.0 - kEncodeBoxAnisotropy * std::sqrt(l2 / l1));
+    f.reach = kEncodeGaussianReach * f.sigma;
+    // The eigenvector of [[p q] [q r]] for l1, from whichever row is better conditioned; it only
+    // matters where sigma is not negligible, i.e. where l1 and l2 differ.
+    const glm::dvec2 e1(q, l1 - p), e2(l1 - r, q);
+    const glm::dvec2 e = glm::dot(e1, e1) >= glm::dot(e2, e2) ? e1 : e2;
+    const double len = glm::length(e);
+    f.major = len > 0 ? e / len : glm::dvec2(1.0, 0.0);
+    return f;
+}
+
+// Extent of the filter along s and t (CoNUS pixels): the box, widened by the Gaussian's reach.
+glm::dvec2 filterExtent(const FootprintFilter& f) {
+    return {1.0 + 2.0 * f.reach * std::abs(f.major.x), 1.0 + 2.0 * f.reach * std::abs(f.major.y)};
+}
+
+// The filter's weight at (s,t): the Gaussian's mass over the offsets o along `major` for which
+// (s,t) - o * major lies in the unit box (two slabs), within the cut.
+double filterWeight(const FootprintFilter& f, double s, double t) {
+    constexpr double kMinSigma = 1e-4;
+    if (f.sigma < kMinSigma) return std::abs(s) <= 0.5 && std::abs(t) <= 0.5 ? 1.0 : 0.0;
+    double lo = -f.reach, hi = f.reach;
+    const auto slab = [&](double x, double d) {
+        if (std::abs(d) < 1e-9) {
+            if (std::abs(x) > 0.5) hi = lo;
+            return;
+        }
+        const double o1 = (x - 0.5) / d, o2 = (x + 0.5) / d;
+        lo = std::max(lo, std::min(o1, o2));
+        hi = std::min(hi, std::max(o1, o2));
+    };
+    slab(s, f.major.x);
+    slab(t, f.major.y);
+    if (hi <= lo) return 0.0;
+    const double k = 1.0 / (std::sqrt(2.0) * f.sigma);
+    return 0.5 * (std::erf(hi * k) - std::erf(lo * k));
+}
+
+// The continuous pyramid level: where the minor axis is kEncodeMaxTaps texels, or the filter's
+// extent along an edge kEncodeMaxAxisTaps, whichever is coarser; 0 at least. Blending the levels
+// around it keeps the blur from jumping where a footprint crosses a level.
+double footprintLevel(glm::dvec2 a, glm::dvec2 b, double minor, glm::dvec2 extent) {
+    const double tol = kTapTolerance;
+    const double coarsest = std::max({minor / (kMaxTapsPerAxis + tol),
+                                      glm::length(a) * extent.x / (kEncodeMaxAxisTaps + tol),
+                                      glm::length(b) * extent.y / (kEncodeMaxAxisTaps + tol), 1.0});
+    return std::log2(coarsest);
+}
+
+// The filtered value on one level, normalized, written to out.
+template <int kC>
+void filterOnLevel(Pyramid& pyramid, int level, int threads, int channels, const Image& src, glm::dvec2 p,
+                   glm::dvec2 a, glm::dvec2 b, const FootprintFilter& filter, glm::dvec2 extent, float* out) {
+    const Plane img = pyramid.level(level, threads);
+    const glm::dvec2 scale(double(img.width) / src.width, double(img.height) / src.height);
+    const glm::dvec2 aL = a * scale, bL = b * scale;
+    // Taps at most a texel apart along each edge; the cap only bounds rounding and degenerate maps.
+    const int ns = std::clamp(static_cast<int>(std::ceil(glm::length(aL) * extent.x - kTapTolerance)), 1,
+                              2 * kEncodeMaxAxisTaps);
+    const int nt = std::clamp(static_cast<int>(std::ceil(glm::length(bL) * extent.y - kTapTolerance)), 1,
+                              2 * kEncodeMaxAxisTaps);
+    const double cx = p.x * img.width - 0.5, cy = p.y * img.height - 0.5;
+    for (int c = 0; c < channels; ++c) out[c] = 0.0f;
+    // Away from the borders no tap needs clamping: decide once for the whole footprint.
+    const double ex = 0.5 * (std::abs(aL.x) * extent.x + std::abs(bL.x) * extent.y);
+    const double ey = 0.5 * (std::abs(aL.y) * extent.x + std::abs(bL.y) * extent.y);
+    const bool inner = cx - ex >= 0 && cx + ex < img.width - 1 && cy - ey >= 0 && cy + ey < img.height - 1;
+    const std::size_t stride = static_cast<std::size_t>(img.width) * channels;
+    double total = 0;
+    for (int j = 0; j < nt; ++j) {
+        const double t = ((j + 0.5) / nt - 0.5) * extent.y;
+        for (int i = 0; i < ns; ++i) {
+            const double s = ((i + 0.5) / ns - 0.5) * extent.x;
+            const double w = filterWeight(filter, s, t);
+            if (w <= 0) continue;
+            total += w;
+            const double tx = cx + aL.x * s + bL.x * t, ty = cy + aL.y * s + bL.y * t;
+            if (inner) detail::addBilinearInterior<kC>(img.data, stride, channels, tx, ty, float(w), out);
+            else detail::addBilinear<kC>(img.data, img.width, img.height, channels, tx, ty, float(w), out);
+        }
+    }
+    const float norm = total > 0 ? static_cast<float>(1.0 / total) : 0.0f;
+    for (int c = 0; c < channels; ++c) out[c] *= norm;
+}
 
 template <int kC>
-void encodeRows(const Image& src, const SamplingMap& map, Pyramid& pyramid, Image& dst, int threads,
+void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& field, Pyramid& pyramid, Image& dst,
+                int threads,
                 int y0, int y1) {
     const int channels = kC > 0 ? kC : src.channelCount();
     const int W = dst.width, H = dst.height;
-    std::vector<float> dynamicAcc(kC > 0 ? 0 : channels);
+    std::vector<float> dynamicUpper(kC > 0 ? 0 : channels);
     for (int y = y0; y < y1; ++y) {
         float* out = dst.pixels.data() + static_cast<std::size_t>(y) * W * channels;
         for (int x = 0; x < W; ++x, out += channels) {
             const glm::dvec2 pd((x + 0.5) / W, (y + 0.5) / H);
             const glm::dvec2 p = map.undistort(pd);
-            const glm::dmat2 J = map.jacobian(p);
-            const double det = glm::determinant(J);
             // The pixel's edges (1/W,0) and (0,1/H) in distorted space, carried back into the
             // source: the columns of J^-1 scaled, in level-0 source pixels.
-            glm::dvec2 a(0.0), b(0.0);
-            if (std::isfinite(det) && det > 0) {
-                const glm::dmat2 Jinv = glm::inverse(J);
-                a = Jinv[0] / double(W) * glm::dvec2(src.width, src.height);
-                b = Jinv[1] / double(H) * glm::dvec2(src.width, src.height);
+            const glm::dmat2 Jinv = field.inverseJacobian(p);
+            const glm::dvec2 a = Jinv[0] / double(W) * glm::dvec2(src.width, src.height);
+            const glm::dvec2 b = Jinv[1] / double(H) * glm::dvec2(src.width, src.height);
+            double minor = 0;
+            const FootprintFilter filter = footprintFilter(a, b, minor);
+            const glm::dvec2 extent = filterExtent(filter);
+            const double lambda = footprintLevel(a, b, minor, extent);
+            const int top = pyramid.levels() - 1;
+            const int level = std::min(static_cast<int>(lambda), top);
+            const double blend = level < top ? lambda - level : 0.0;
+            filterOnLevel<kC>(pyramid, level, threads, channels, src, p, a, b, filter, extent, out);
+            if (blend > 0) {
+                float fixedUpper[kC > 0 ? kC : 1];
+                float* upper = kC > 0 ? fixedUpper : dynamicUpper.data();
+                filterOnLevel<kC>(pyramid, level + 1, threads, channels, src, p, a, b, filter, extent, upper);
+                const float f = static_cast<float>(blend);
+                for (int c = 0; c < channels; ++c) out[c] += f * (upper[c] - out[c]);
             }
-            int level = 0;
-            double la = glm::length(a), lb = glm::length(b);
-            while (std::max(la, lb) > kMaxTapsPerAxis + kTapTolerance && level + 1 < pyramid.levels()) {
-                ++level;
-                const glm::dvec2 s(double(pyramid.width(level)) / src.width, double(pyramid.height(level)) / src.height);
-                la = glm::length(a * s);
-                lb = glm::length(b * s);
-            }
-            const glm::dvec2 scale(double(pyramid.width(level)) / src.width, double(pyramid.height(level)) / src.height);
-            const glm::dvec2 aL = a * scale, bL = b * scale;
-            const int na = std::clamp(static_cast<int>(std::ceil(la - kTapTolerance)), 1, kMaxTapsPerAxis);
-            const int nb = std::clamp(static_cast<int>(std::ceil(lb - kTapTolerance)), 1, kMaxTapsPerAxis);
-
-            const Plane img = pyramid.level(level, threads);
-            const double cx = p.x * img.width - 0.5, cy = p.y * img.height - 0.5;
-            const float weight = 1.0f / static_cast<float>(na * nb);
-            float fixedAcc[kC > 0 ? kC : 1];
-            float* acc = kC > 0 ? fixedAcc : dynamicAcc.data();
-            for (int c = 0; c < channels; ++c) acc[c] = 0.0f;
-            const double* oa = kTapOffsets.at[na];
-            const double* ob = kTapOffsets.at[nb];
-            // Away from the borders no tap needs clamping: decide once for the whole footprint.
-            const double ex = 0.5 * (std::abs(aL.x) + std::abs(bL.x)), ey = 0.5 * (std::abs(aL.y) + std::abs(bL.y));
-            const bool inner = cx - ex >= 0 && cx + ex < img.width - 1 && cy - ey >= 0 && cy + ey < img.height - 1;
-            const std::size_t stride = static_cast<std::size_t>(img.width) * channels;
-            for (int j = 0; j < nb; ++j) {
-                const double qx = cx + bL.x * ob[j], qy = cy + bL.y * ob[j];
-                for (int i = 0; i < na; ++i) {
-                    const double x = qx + aL.x * oa[i], y = qy + aL.y * oa[i];
-                    if (inner) detail::addBilinearInterior<kC>(img.data, stride, channels, x, y, weight, acc);
-                    else detail::addBilinear<kC>(img.data, img.width, img.height, channels, x, y, weight, acc);
-                }
-            }
-            for (int c = 0; c < channels; ++c) out[c] = acc[c];
         }
     }
 }
 
 }  // namespace
 
+FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b) {
+    double minor = 0;
+    const glm::dvec2 extent = filterExtent(footprintFilter(a, b, minor));
+    return {footprintLevel(a, b, minor, extent), extent};
+}
+
+FootprintField::FootprintField(const SamplingMap& map) : m_columns(map.columns()), m_rows(map.rows()) {
+    m_nodes.resize(static_cast<std::size_t>(m_columns) * m_rows);
+    for (int j = 0; j < m_rows; ++j)
+        for (int i = 0; i < m_columns; ++i) {
+            const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, m_columns - 1);
+            const int j0 = std::max(j - 1, 0), j1 = std::min(j + 1, m_rows - 1);
+            const glm::dvec2 du = (glm::dvec2(map.node(i1, j)) - glm::dvec2(map.node(i0, j))) *
+                                  (double(m_columns - 1) / (i1 - i0));
+            const glm::dvec2 dv = (glm::dvec2(map.node(i, j1)) - glm::dvec2(map.node(i, j0))) *
+                                  (double(m_rows - 1) / (j1 - j0));
+            const glm::dmat2 J(du, dv);
+            const double det = glm::determinant(J);
+            m_nodes[static_cast<std::size_t>(j) * m_columns + i] =
+                std::isfinite(det) && det > 0 ? glm::inverse(J) : glm::dmat2(0.0);
+        }
+}
+
+glm::dmat2 FootprintField::inverseJacobian(glm::dvec2 p) const {
+    const double fu = std::clamp(p.x, 0.0, 1.0) * (m_columns - 1), fv = std::clamp(p.y, 0.0, 1.0) * (m_rows - 1);
+    const int i = std::min(static_cast<int>(fu), m_columns - 2), j = std::min(static_cast<int>(fv), m_rows - 2);
+    const double s = fu - i, t = fv - j;
+    const auto at = [&](int di, int dj) { return m_nodes[static_cast<std::size_t>(j + dj) * m_columns + i + di]; };
+    return (at(0, 0) * (1 - s) + at(1, 0) * s) * (1 - t) + (at(0, 1) * (1 - s) + at(1, 1) * s) * t;
+}
+
 Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options) {
     checkImage(source, "encodeImage");
     detail::checkOutputSize(options.width, options.height, "encodeImage");
     Image out = detail::makeOutput(source, options.width, options.height);
     Pyramid pyramid(source);
+    const FootprintField field(map);
     detail::RowProgress progress(options.progress, out.height);
     parallelRows(out.height, options.threads, [&](int y0, int y1) {
         detail::dispatchChannels(source.channelCount(), [&]<int kC>() {
-            encodeRows<kC>(source, map, pyramid, out, options.threads, y0, y1);
+            encodeRows<kC>(source, map, field, pyramid, out, options.threads, y0, y1);
         });
         progress.add(y1 - y0);
     });

@@ -7,18 +7,62 @@
 // threads = 0 uses every core; sizes are checked (conus::Error InvalidArgument / LimitExceeded).
 #pragma once
 
+#include <vector>
+
+#include <glm/glm.hpp>
+
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/error.h"
 #include "conus/core/image.h"
 
 namespace conus::codec {
 
-// The encoder's footprint rule, shared with its GLSL twin (renderers inject these values): at most
-// kEncodeMaxTaps sub-pixels per footprint axis, on the first pyramid level where the footprint is
-// at most that long; kEncodeTapTolerance keeps integer ratios exact despite float map nodes (a
-// footprint of 4.0005 source pixels is still 4 taps).
+// The encoder's footprint rule, shared with its GLSL twin (renderers inject these values).
+// A CoNUS pixel's footprint in the source is the parallelogram spanned by the inverse Jacobian's
+// columns a and b (one CoNUS pixel each way). Its filter, in CoNUS pixel units (s,t), is the unit
+// box convolved with a Gaussian along the footprint's major axis whose standard deviation grows
+// with the anisotropy: kEncodeAnisotropicSigma * (1 - kEncodeBoxAnisotropy * minor / major) CoNUS
+// pixels where that is positive, cut at kEncodeGaussianReach standard deviations. A footprint up to
+// kEncodeBoxAnisotropy : 1 keeps the plain box (the exact area average; a pixel grid with different
+// ratios per axis is one); a long thin one is low-passed along its length, where a box's side lobes alias into a
+// radial comb once the decoder magnifies it (issue 10; tests/codec/image/comb_test.cpp measures it).
+// The pyramid level is the first where the minor axis is at most kEncodeMaxTaps texels and the
+// filter's extent along a and b at most kEncodeMaxAxisTaps: taps are at most a texel apart along
+// each edge, so a long axis takes many taps instead of being truncated (a longer one moves up a
+// level, blurring more, never aliasing). kEncodeTapTolerance keeps integer ratios exact despite
+// float map nodes (a footprint of 4.0005 source pixels is still 4 taps).
 inline constexpr int kEncodeMaxTaps = 4;
+inline constexpr int kEncodeMaxAxisTaps = 64;
 inline constexpr double kEncodeTapTolerance = 1e-3;
+inline constexpr double kEncodeAnisotropicSigma = 1.5;
+inline constexpr double kEncodeGaussianReach = 2.5;
+inline constexpr double kEncodeBoxAnisotropy = 1.5;
+
+// The rule above for one footprint whose edges are a and b (level-0 source pixels per CoNUS pixel):
+// the continuous pyramid level (its floor and the next level are blended) and the filter's extent
+// along a and along b in CoNUS pixels. The GPU encoder sizes its tiles' margins with it.
+struct FootprintPlan {
+    double level = 0;
+    glm::dvec2 extent{1.0, 1.0};
+};
+FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b);
+
+// The footprint of a CoNUS pixel as a continuous field: d(undistorted)/d(distorted) at each map
+// node, from central differences of the node positions (one-sided at the edges), interpolated
+// bilinearly in between. The map's own Jacobian is constant along a cell and jumps from cell to
+// cell; a filter sized by it would jump with it (a visible seam at every cell edge). The GPU
+// encoder gives the same values to its mesh's vertices.
+class FootprintField {
+public:
+    explicit FootprintField(const SamplingMap& map);
+    // Columns: undistorted change per unit of distorted u and of distorted v, at undistorted p
+    // (clamped to [0,1]^2). Zero where the map folds (a node with det <= 0).
+    glm::dmat2 inverseJacobian(glm::dvec2 p) const;
+
+private:
+    int m_columns = 0, m_rows = 0;
+    std::vector<glm::dmat2> m_nodes;
+};
 
 struct EncodeOptions {
     int width = 0, height = 0;  // CoNUS image size
