@@ -61,47 +61,6 @@ std::vector<glm::dvec2> resampleField(int columns, int rows, auto&& field) {
     return d;
 }
 
-// A moved or scaled pattern must stay continuous, or its cells fold and fitDisplacement shrinks
-// everything (the seam and slit of issue 10): a map slides its edge nodes along its edges, so its
-// displacement does not vanish at its own border, and the image's border drops the normal part of
-// whatever displacement reaches it. Both are tapered to zero over this fraction of the square,
-// with a C2 ramp, on the sides where the cut would be seen.
-constexpr double kTaper = 0.25;
-
-double ramp(double x) {  // 0 at x <= 0, 1 at x >= 1, C2
-    x = std::clamp(x, 0.0, 1.0);
-    return x * x * x * (x * (x * 6.0 - 15.0) + 10.0);
-}
-
-// The pattern of `map` moved by p -> centre + factor (p - centre) + offset: D'(p) =
-// factor * D(q), q the pattern point under p, tapered where its border or the image's cuts it.
-std::vector<glm::dvec2> transformedField(const SamplingMap& map, double factor, glm::dvec2 centre, glm::dvec2 offset) {
-    const auto toImage = [&](double q, int axis) { return centre[axis] + factor * (q - centre[axis]) + offset[axis]; };
-    // The pattern's sides that land strictly inside the image: its displacement there would jump.
-    // The image's sides that cut the pattern (it reaches beyond them): the normal part would jump.
-    bool low[2], high[2], cutLow[2], cutHigh[2];
-    for (int a = 0; a < 2; ++a) {
-        low[a] = toImage(0.0, a) > 1e-9;
-        high[a] = toImage(1.0, a) < 1.0 - 1e-9;
-        cutLow[a] = toImage(0.0, a) < -1e-9;
-        cutHigh[a] = toImage(1.0, a) > 1.0 + 1e-9;
-    }
-    const bool moved = factor != 1.0 || offset != glm::dvec2(0.0);
-    return resampleField(map.columns(), map.rows(), [&](glm::dvec2 p) {
-        const glm::dvec2 q = centre + (p - centre - offset) / factor;
-        glm::dvec2 d = factor * displacementAt(map, q);
-        if (!moved) return d;
-        double w = 1.0;
-        for (int a = 0; a < 2; ++a) {
-            if (low[a]) w *= ramp(q[a] / kTaper);
-            if (high[a]) w *= ramp((1.0 - q[a]) / kTaper);
-            if (cutLow[a]) d[a] *= ramp(p[a] / kTaper);
-            if (cutHigh[a]) d[a] *= ramp((1.0 - p[a]) / kTaper);
-        }
-        return w * d;
-    });
-}
-
 }  // namespace
 
 bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes) {
@@ -134,7 +93,8 @@ ComposeResult translateMap(const SamplingMap& map, glm::dvec2 offset) {
     if (!std::isfinite(offset.x) || !std::isfinite(offset.y)) {
         throw Error(ErrorCode::InvalidArgument, "translateMap: offset (" + numberText(offset.x) + ", " + numberText(offset.y) + ") is not finite");
     }
-    return fitDisplacement(map.columns(), map.rows(), transformedField(map, 1.0, {0.5, 0.5}, offset));
+    const auto d = resampleField(map.columns(), map.rows(), [&](glm::dvec2 p) { return displacementAt(map, p - offset); });
+    return fitDisplacement(map.columns(), map.rows(), d);
 }
 
 ComposeResult scaleMap(const SamplingMap& map, double factor, glm::dvec2 centre) {
@@ -144,7 +104,10 @@ ComposeResult scaleMap(const SamplingMap& map, double factor, glm::dvec2 centre)
     if (!std::isfinite(centre.x) || !std::isfinite(centre.y)) {
         throw Error(ErrorCode::InvalidArgument, "scaleMap: centre (" + numberText(centre.x) + ", " + numberText(centre.y) + ") is not finite");
     }
-    return fitDisplacement(map.columns(), map.rows(), transformedField(map, factor, centre, {0.0, 0.0}));
+    const auto d = resampleField(map.columns(), map.rows(), [&](glm::dvec2 p) {
+        return factor * displacementAt(map, centre + (p - centre) / factor);
+    });
+    return fitDisplacement(map.columns(), map.rows(), d);
 }
 
 ComposeResult addMaps(std::span<const SamplingMap> maps, int columns, int rows, std::span<const double> weights) {

@@ -11,10 +11,7 @@
 //   combination that folds.
 // - Boundary nodes keep only the tangential part of their displacement (the normal part is
 //   dropped) so they stay exactly on their edge; corners stay fixed.
-// - Displacement fetched from outside [0,1]^2 (translation, scaling) is zero. So that a moved or
-//   scaled pattern has no seam, its displacement is tapered to zero (C2, over a quarter of the
-//   square) towards each of its sides that lands inside the image, and its normal part towards
-//   each image side that cuts it.
+// - Displacement fetched from outside [0,1]^2 (translation, scaling) is zero.
 #pragma once
 
 #include <span>
