@@ -19,6 +19,12 @@ map_rules::GridView viewOf(const SamplingMap& map) {
 }
 }  // namespace
 
+glm::dmat2 cellJacobianAt(const SamplingMap& map, glm::dvec2 p) {
+    const int n = map.columns(), m = map.rows();
+    const int i = std::clamp(static_cast<int>(p.x * (n - 1)), 0, n - 2), j = std::clamp(static_cast<int>(p.y * (m - 1)), 0, m - 2);
+    return map.jacobian({(i + 0.5) / (n - 1), (j + 0.5) / (m - 1)});
+}
+
 double cellDensityAt(const SamplingMap& map, glm::dvec2 p) {
     const int n = map.columns(), m = map.rows();
     const int i = std::clamp(static_cast<int>(p.x * (n - 1)), 0, n - 2), j = std::clamp(static_cast<int>(p.y * (m - 1)), 0, m - 2);
@@ -46,24 +52,19 @@ MapMeasures measureMap(const SamplingMap& map, double aspect) {
     out.minCellDensity = HUGE_VAL;
     out.maxCellDensity = 0.0;
     out.maxAnisotropy = 1.0;
-    // The Jacobian of a bilinear cell is linear along each of its edges; its extremes lie at the
-    // corners (taken just inside the cell) or along the middle, which the centre samples.
-    constexpr double kInset = 1e-6;
-    static constexpr double kAt[3] = {kInset, 0.5, 1.0 - kInset};
     for (int j = 0; j + 1 < m; ++j)
         for (int i = 0; i + 1 < n; ++i) {
             const double density = cellDensity(grid, i, j);
             out.minCellDensity = std::min(out.minCellDensity, density);
             out.maxCellDensity = std::max(out.maxCellDensity, density);
-            for (double b : kAt)
-                for (double a : kAt) {
-                    const glm::dvec2 p{(i + a) / (n - 1), (j + b) / (m - 1)};
-                    const double ratio = anisotropy(map.jacobian(p), aspect);
-                    if (ratio > out.maxAnisotropy) {
-                        out.maxAnisotropy = ratio;
-                        out.mostAnisotropic = p;
-                    }
-                }
+            // The cell's mean Jacobian (at a corner of a sheared cell it can be far larger; that is
+            // one point, not a pixel's footprint).
+            const glm::dvec2 p{(i + 0.5) / (n - 1), (j + 0.5) / (m - 1)};
+            const double ratio = anisotropy(cellJacobianAt(map, p), aspect);
+            if (ratio > out.maxAnisotropy) {
+                out.maxAnisotropy = ratio;
+                out.mostAnisotropic = p;
+            }
         }
     return out;
 }

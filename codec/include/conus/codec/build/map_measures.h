@@ -21,12 +21,16 @@ double cellDensity(const map_rules::GridView& grid, int i, int j);
 // The same for the cell of `map` that holds undistorted p.
 double cellDensityAt(const SamplingMap& map, glm::dvec2 p);
 
+// The mean Jacobian of the cell of `map` that holds undistorted p: a bilinear map's Jacobian is
+// linear along each axis, so its mean over a cell is its value at the centre.
+glm::dmat2 cellJacobianAt(const SamplingMap& map, glm::dvec2 p);
+
 // Singular value ratio (>= 1) of J in pixel units; `aspect` is the image's width / height.
 double anisotropy(const glm::dmat2& jacobian, double aspect);
 
 struct MapMeasures {
     double minCellDensity = 1, maxCellDensity = 1;  // over the map's cells
-    double maxAnisotropy = 1;                         // over every cell's corners and centre
+    double maxAnisotropy = 1;                         // of every cell's mean Jacobian
     glm::dvec2 mostAnisotropic{0.5, 0.5};             // undistorted point where it is reached
 };
 
