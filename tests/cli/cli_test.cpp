@@ -279,7 +279,7 @@ TEST_F(Cli, AnisotropyIsLimitedReportedAndDrawn) {
     EXPECT_GT(imageSize(path("m.png")).first, 0);
     // A limit below what a focus needs is refused, naming the limit.
     const Result tight = run(foci + " --max-anisotropy 1.05 -o " + path("t.exr"));
-    EXPECT_EQ(tight.exitCode, 1) << tight.out;
+    EXPECT_EQ(tight.exitCode, 2) << tight.out;  // a value that cannot be held: usage
     EXPECT_NE(tight.err.find("anisotropy limit 1.05"), std::string::npos) << tight.err;
     EXPECT_FALSE(fs::exists(path("t.exr")));
 }
@@ -294,7 +294,7 @@ TEST_F(Cli, DensityBoundsAreHeldOrRefused) {
     EXPECT_LE(m.maxCellDensity, 9 * 1.05);
     // Separable maps put bands through the hot spot: a floor of 0.6 cannot be held on them.
     const Result refused = run("map auto --importance " + importance + " --method separable --min-density 0.6 -o " + path("b.exr"));
-    EXPECT_EQ(refused.exitCode, 1) << refused.out;
+    EXPECT_EQ(refused.exitCode, 2) << refused.out;
     EXPECT_NE(refused.err.find("the map reaches"), std::string::npos) << refused.err;
     EXPECT_FALSE(fs::exists(path("b.exr")));
 }
