@@ -21,7 +21,7 @@ namespace {
 struct EncodeOptions {
     BatchOptions batch;
     std::string mapFile, compose = "density", importance, method = "flow";
-    double minDensity = 0.25, maxDensity = 16;
+    double minDensity = 0.25, maxDensity = 16, maxAnisotropy = 0;
     std::vector<std::string> foci;
     int grid = map_rules::kDefaultSide;
     SourceOptions source;
@@ -40,11 +40,7 @@ BuiltMap mapFromFile(const std::string& path) {
 
 BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source) {
     Progress progress("build sampling map from " + o.importance + " importance");
-    codec::AutoMapOptions autoOptions;
-    autoOptions.columns = autoOptions.rows = o.grid;
-    autoOptions.minDensity = o.minDensity;
-    autoOptions.maxDensity = o.maxDensity;
-    autoOptions.method = o.method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
+    const codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
     BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildAutoMap(importanceFrom(o.importance, source), autoOptions)),
                    std::nullopt};
     progress.done();
@@ -57,6 +53,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source) {
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
     fo.aspect = double(source.width) / source.height;
+    fo.maxAnisotropy = o.maxAnisotropy;
     fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
     BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo)), codec::toAnalytic(foci, fo.composition)};
@@ -113,12 +110,8 @@ Command addEncodeCommand(CLI::App& root) {
                         "'detail' (the image's own edges) or 'faces' (faces found in it)")
         ->excludes("--focus")
         ->excludes("--map");
-    command->add_option("--min-density", options->minDensity,
-                        "with --importance: sampling density kept everywhere (0..1, default 0.25)")
-        ->check(CLI::Range(0.001, 0.999));
-    command->add_option("--max-density", options->maxDensity,
-                        "with --importance: cap on the density (default 16, i.e. 4x the linear rate)")
-        ->check(CLI::Range(1.001, 4096.0));
+    addDensityBoundOptions(*command, options->minDensity, options->maxDensity, "with --importance: ");
+    addMaxAnisotropyOption(*command, options->maxAnisotropy);
     command->add_option("--method", options->method, "with --importance: flow (default) | separable")
         ->check(CLI::IsMember({"flow", "separable"}));
     command->add_option("--compose", options->compose, "how several foci combine: density (default) | add")

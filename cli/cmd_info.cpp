@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "conus/codec/build/map_measures.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
@@ -75,6 +76,7 @@ struct FileFacts {
     std::vector<std::string> channels;  // display order
     codec::SamplingMap map;
     DensityStats stats;
+    codec::MapMeasures measures;  // anisotropy in the source's pixels
     std::optional<Camera> camera;
     double pixelRatio = 0;  // CoNUS pixels over source pixels
 };
@@ -83,10 +85,11 @@ FileFacts readFacts(const std::string& input) {
     format::ConusFile file = format::readConusHeader(input);
     codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
     const DensityStats stats = densityStats(map);
+    const codec::MapMeasures measures = codec::measureMap(map, double(file.sourceWidth) / file.sourceHeight);
     std::optional<Camera> camera = file.camera ? std::optional<Camera>(format::toCamera(*file.camera)) : std::nullopt;
     const double ratio = double(file.image.width) * file.image.height / (double(file.sourceWidth) * file.sourceHeight);
     std::vector<std::string> channels = displayOrder(file.image.channels);
-    return {std::move(file), std::move(channels), std::move(map), stats, camera, ratio};
+    return {std::move(file), std::move(channels), std::move(map), stats, measures, camera, ratio};
 }
 
 nlohmann::ordered_json toJson(const std::string& input, const FileFacts& f) {
@@ -106,7 +109,9 @@ nlohmann::ordered_json toJson(const std::string& input, const FileFacts& f) {
                         {"rows", f.map.rows()},
                         {"densityMin", f.stats.min},
                         {"densityMax", f.stats.max},
-                        {"densityMean", f.stats.mean}};
+                        {"densityMean", f.stats.mean},
+                        {"maxAnisotropy", f.measures.maxAnisotropy},
+                        {"mostAnisotropicAt", {f.measures.mostAnisotropic.x, f.measures.mostAnisotropic.y}}};
     if (file.analytic) {
         nlohmann::ordered_json a{{"kind", file.analytic->kind}};
         if (file.analytic->kind == "foci") {
@@ -173,6 +178,8 @@ void printText(const InfoOptions& o, const FileFacts& f) {
                 100.0 * f.pixelRatio);
     std::printf("  sampling map  %d x %d nodes; density min %.3f, max %.3f, mean %.3f\n", f.map.columns(), f.map.rows(),
                 f.stats.min, f.stats.max, f.stats.mean);
+    std::printf("  anisotropy    up to %.3g (a CoNUS pixel's footprint that many times longer than wide), at %.3f,%.3f\n",
+                f.measures.maxAnisotropy, f.measures.mostAnisotropic.x, f.measures.mostAnisotropic.y);
     if (file.analytic) {
         std::printf("  analytic map  %s", file.analytic->kind.c_str());
         if (file.analytic->kind == "foci") {
@@ -204,7 +211,8 @@ void writeDensityPicture(const std::string& path, const FileFacts& f) {
     const int w = std::max(16, static_cast<int>(file.sourceWidth * std::min(1.0, scale)));
     const int h = std::max(16, static_cast<int>(file.sourceHeight * std::min(1.0, scale)));
     const int lines = std::max(8, std::min(64, file.image.width / 8));
-    writeDrawing(path, densityPicture(f.map, w, h, lines, file.analytic ? &*file.analytic : nullptr));
+    writeDrawing(path, densityPicture(f.map, w, h, lines, file.analytic ? &*file.analytic : nullptr,
+                                      double(file.sourceWidth) / file.sourceHeight));
 }
 
 int runInfo(const InfoOptions& o) {

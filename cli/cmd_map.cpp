@@ -17,6 +17,7 @@
 #include "conus/codec/build/compose.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/build/ground_map.h"
+#include "conus/codec/build/map_measures.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/build/springs.h"
 #include "conus/format/container.h"
@@ -26,6 +27,7 @@
 #include "conus/core/map_rules.h"
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
+#include "encoding.h"
 #include "importance.h"
 #include "pictures.h"
 #include "progress.h"
@@ -59,15 +61,19 @@ std::pair<double, double> parsePair(const std::string& text, const char* what) {
     return {a, b};
 }
 
-// Writes the map file (codec/conus_file.h), reports it, and draws its preview.
-void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticMap> analytic, const OutputOptions& out) {
+// Writes the map file (codec/conus_file.h), reports it, and draws its preview. `aspect` (width /
+// height of the pictures it is meant for) makes the anisotropy one of pixels.
+void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticMap> analytic, const OutputOptions& out,
+                  double aspect = 1.0) {
     const format::ConusFile file = codec::makeMapFile(map, std::move(analytic));
     format::writeConusFile(out.output, file);
     const DensityStats stats = densityStats(map);
-    std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g\n", out.output.c_str(), map.columns(), map.rows(),
-                stats.min, stats.max);
+    const codec::MapMeasures measures = codec::measureMap(map, aspect);
+    std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
+                map.rows(), stats.min, stats.max, measures.maxAnisotropy);
     if (!out.preview.empty()) {
-        writeDrawing(out.preview, densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr));
+        writeDrawing(out.preview,
+                     densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr, aspect));
         std::printf("wrote %s\n", out.preview.c_str());
     }
 }
@@ -225,11 +231,12 @@ struct FociOptions {
     std::vector<std::string> foci;
     std::string composition = "density";
     int grid = map_rules::kDefaultSide;
-    double aspect = 1.0;
+    double aspect = 1.0, maxAnisotropy = 0;
     OutputOptions out;
 };
 
 void addFociOptions(CLI::App& command, FociOptions& o) {
+    addMaxAnisotropyOption(command, o.maxAnisotropy);
     command.add_option("--focus", o.foci, "focus u,v,r,k (repeat for several)")->required();
     command.add_option("--compose", o.composition, "how several foci combine: density (default) | add")
         ->check(CLI::IsMember({"density", "add"}));
@@ -244,33 +251,32 @@ void runFoci(const FociOptions& o) {
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
     fo.aspect = o.aspect;
+    fo.maxAnisotropy = o.maxAnisotropy;
     fo.composition = o.composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
     Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
     const codec::SamplingMap map = codec::buildFociMap(list, fo);
     codec::checkFociHeld(map, list, fo);  // the file must not record a focus its map ignores
     progress.done();
-    writeMapFile(map, codec::toAnalytic(list, fo.composition), o.out);
+    writeMapFile(map, codec::toAnalytic(list, fo.composition), o.out, o.aspect);
 }
 
 // ---- auto ----
 
 struct AutoOptions {
     std::string importance, image, method = "flow";
-    double minDensity = 0.25, maxDensity = 16;
+    double minDensity = 0.25, maxDensity = 16, maxAnisotropy = 0;
     int grid = map_rules::kDefaultSide;
     OutputOptions out;
 };
 
 void addAutoOptions(CLI::App& command, AutoOptions& o) {
+    addMaxAnisotropyOption(command, o.maxAnisotropy);
     command.add_option("--importance", o.importance,
                        "importance image (one channel or RGB; higher = more samples), or 'detail' / 'faces' "
                        "computed from --image")
         ->required();
     command.add_option("--image", o.image, "the picture that 'detail' and 'faces' look at");
-    command.add_option("--min-density", o.minDensity, "density kept everywhere (0..1, default 0.25)")
-        ->check(CLI::Range(0.001, 0.999));
-    command.add_option("--max-density", o.maxDensity, "cap on the density (default 16: 4x the linear rate)")
-        ->check(CLI::Range(1.001, 4096.0));
+    addDensityBoundOptions(command, o.minDensity, o.maxDensity);
     command.add_option("--method", o.method, "flow (2-D, default) | separable (baseline)")
         ->check(CLI::IsMember({"flow", "separable"}));
     command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
@@ -280,17 +286,15 @@ void addAutoOptions(CLI::App& command, AutoOptions& o) {
 void runAuto(const AutoOptions& o) {
     const Image picture = o.image.empty() ? Image{} : imageio::readImageFile(o.image).image;
     const Image importance = importanceFrom(o.importance, picture);
-    codec::AutoMapOptions options;
-    options.columns = options.rows = o.grid;
-    options.minDensity = o.minDensity;
-    options.maxDensity = o.maxDensity;
-    options.method = o.method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
+    const codec::AutoMapOptions options = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
     Progress progress("build sampling map from importance");
     const codec::SamplingMap map = codec::buildAutoMap(importance, options);
     progress.done();
-    std::printf("achieved density follows the target with correlation %.3f\n",
-                codec::densityCorrelation(map, codec::importanceToDensity(importance, options)));
-    writeMapFile(map, std::nullopt, o.out);
+    const codec::MapMeasures measures = codec::measureMap(map);
+    std::printf("achieved density follows the target with correlation %.3f; cell density %.3g .. %.3g (asked: %.3g .. %.3g)\n",
+                codec::densityCorrelation(map, codec::importanceToDensity(importance, options)), measures.minCellDensity,
+                measures.maxCellDensity, o.minDensity, o.maxDensity);
+    writeMapFile(map, std::nullopt, o.out, double(importance.width) / importance.height);
 }
 
 struct MapOptions {

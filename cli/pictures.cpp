@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "conus/codec/build/map_measures.h"
 #include "conus/core/display.h"
 
 namespace conus::cli {
@@ -42,7 +43,7 @@ DensityStats densityStats(const codec::SamplingMap& map, int samples) {
 }
 
 Image densityPicture(const codec::SamplingMap& map, int width, int height, int lines,
-                             const format::AnalyticMap* analytic) {
+                             const format::AnalyticMap* analytic, double aspect) {
     Image picture = makeImage(width, height, {"R", "G", "B"});
     std::vector<glm::dvec2> distorted(static_cast<std::size_t>(width) * height);
     std::vector<double> logDensity(distorted.size());
@@ -74,6 +75,27 @@ Image densityPicture(const codec::SamplingMap& map, int width, int height, int l
             if (y + 1 < height) edge |= std::floor(d.y) != std::floor(distorted[k + width].y * lines);
             if (edge) blend(picture, x, y, glm::vec3(1.0f), 0.55f);
         }
+    // Anisotropy of each cell's mean Jacobian (map_measures.h): contours at the levels below, and a
+    // cross at the most elongated cell.
+    static constexpr double kAnisotropyLevels[] = {2.0, 4.0};
+    std::vector<double> ratio(distorted.size());
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            ratio[static_cast<std::size_t>(y) * width + x] = codec::anisotropy(codec::cellJacobianAt(map, {(x + 0.5) / width, (y + 0.5) / height}), aspect);
+    const glm::vec3 cyan(0.2f, 0.9f, 1.0f);
+    for (int y = 0; y + 1 < height; ++y)
+        for (int x = 0; x + 1 < width; ++x) {
+            const std::size_t k = static_cast<std::size_t>(y) * width + x;
+            for (double level : kAnisotropyLevels)
+                if ((ratio[k] >= level) != (ratio[k + 1] >= level) || (ratio[k] >= level) != (ratio[k + width] >= level))
+                    blend(picture, x, y, cyan, 0.9f);
+        }
+    const codec::MapMeasures measures = codec::measureMap(map, aspect);
+    const int cx = static_cast<int>(measures.mostAnisotropic.x * width), cy = static_cast<int>(measures.mostAnisotropic.y * height);
+    for (int d = -6; d <= 6; ++d) {
+        blend(picture, cx + d, cy + d, cyan, 1.0f);
+        blend(picture, cx + d, cy - d, cyan, 1.0f);
+    }
     if (analytic && analytic->kind == "foci") {
         for (const auto& f : analytic->foci) {
             // r is a fraction of the image width, circular in pixels.

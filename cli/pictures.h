@@ -20,9 +20,11 @@ DensityStats densityStats(const codec::SamplingMap& map, int samples = 256);
 
 // RGB heat map of log(density) over the undistorted plane (width x height), with the lines of the
 // CoNUS pixel grid (every `spacing`-th distorted column and row, mapped back through the map) drawn
-// over it, and focus outlines where `analytic` describes foci.
+// over it, focus outlines where `analytic` describes foci, and the anisotropy (map_measures.h, in
+// the pixels of an image of `aspect`, per map cell): cyan contours where the footprints of CoNUS
+// pixels are 2 and 4 times longer than wide, and a cyan cross where they are most elongated.
 Image densityPicture(const codec::SamplingMap& map, int width, int height, int lines,
-                             const format::AnalyticMap* analytic = nullptr);
+                             const format::AnalyticMap* analytic = nullptr, double aspect = 1.0);
 
 // Images placed left to right on a dark background, each RGB; taller ones set the strip's height.
 Image sideBySide(std::span<const Image> images, int gap = 8);

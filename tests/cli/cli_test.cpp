@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "conus/codec/image/metrics.h"
+#include "conus/codec/build/map_measures.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "cli_fixture.h"
@@ -246,6 +247,53 @@ TEST_F(Cli, MapErrorsAreOneLine) {
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.err.find("needs an input image"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(path("x.exr")));
+}
+
+TEST_F(Cli, AnisotropyIsLimitedReportedAndDrawn) {
+    // A wide focus: without a limit the footprints at its rim are > 3 times longer than wide;
+    // with --max-anisotropy 3 the map says so, holds it, and info reports the same figure.
+    const std::string foci = "map foci --focus 0.5,0.5,0.2,2 --aspect 1.7778";
+    const Result free = run(foci + " -o " + path("free.exr"));
+    ASSERT_EQ(free.exitCode, 0) << free.err;
+    const Result r = run(foci + " --max-anisotropy 3 -o " + path("m.exr") + " --preview " + path("m.png"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    auto reported = [](const std::string& text) {
+        const auto at = text.find("anisotropy up to ");
+        return at == std::string::npos ? -1.0 : std::stod(text.substr(at + 17));
+    };
+    EXPECT_GT(reported(free.out), 3.0) << free.out;
+    EXPECT_LE(reported(r.out), 3.0) << r.out;
+    EXPECT_GT(reported(r.out), 1.5) << r.out;
+    const auto map = conus::codec::SamplingMap::fromGrid(conus::format::readConusFile(path("m.exr")).map);
+    EXPECT_LE(conus::codec::measureMap(map, 1.7778).maxAnisotropy, 3.0);
+    const std::string in = makePicture(320, 180);
+    ASSERT_EQ(run("encode " + in + " --map " + path("m.exr") + " -o " + path("e.exr") + " --size 80x45").exitCode, 0);
+    const Result info = run("info " + path("e.exr") + " --json");
+    ASSERT_EQ(info.exitCode, 0) << info.err;
+    const auto json = nlohmann::json::parse(info.out);
+    EXPECT_NEAR(json["samplingMap"]["maxAnisotropy"].get<double>(), conus::codec::measureMap(map, 320.0 / 180.0).maxAnisotropy, 1e-6);
+    EXPECT_NE(run("info " + path("e.exr")).out.find("anisotropy    up to"), std::string::npos);
+    EXPECT_GT(imageSize(path("m.png")).first, 0);
+    // A limit below what a focus needs is refused, naming the limit.
+    const Result tight = run(foci + " --max-anisotropy 1.05 -o " + path("t.exr"));
+    EXPECT_EQ(tight.exitCode, 2) << tight.out;  // a value that cannot be held: usage
+    EXPECT_NE(tight.err.find("anisotropy limit 1.05"), std::string::npos) << tight.err;
+    EXPECT_FALSE(fs::exists(path("t.exr")));
+}
+
+TEST_F(Cli, DensityBoundsAreHeldOrRefused) {
+    const std::string importance = makeImportance(160, 120);
+    const Result held = run("map auto --importance " + importance + " --min-density 0.4 --max-density 9 -o " + path("a.exr"));
+    ASSERT_EQ(held.exitCode, 0) << held.err;
+    const auto map = conus::codec::SamplingMap::fromGrid(conus::format::readConusFile(path("a.exr")).map);
+    const conus::codec::MapMeasures m = conus::codec::measureMap(map);
+    EXPECT_GE(m.minCellDensity, 0.4 * 0.95);
+    EXPECT_LE(m.maxCellDensity, 9 * 1.05);
+    // Separable maps put bands through the hot spot: a floor of 0.6 cannot be held on them.
+    const Result refused = run("map auto --importance " + importance + " --method separable --min-density 0.6 -o " + path("b.exr"));
+    EXPECT_EQ(refused.exitCode, 2) << refused.out;
+    EXPECT_NE(refused.err.find("the map reaches"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(path("b.exr")));
 }
 
 TEST_F(Cli, FacesImportanceFindsTheAstronautsFace) {

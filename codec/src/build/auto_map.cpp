@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <string>
 
+#include "conus/codec/build/map_measures.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/core/error.h"
@@ -48,6 +50,18 @@ void blur(std::vector<double>& field, int width, int height, int radius) {
                 field[y * width + x] = sum / (2 * radius + 1);
             }
     }
+}
+
+constexpr int kBoundRounds = 4;
+
+[[noreturn]] void refuseBounds(const MapMeasures& m, const AutoMapOptions& options) {
+    const auto round3 = [](double v) { return numberText(v, 3); };
+    invalid("density bounds " + round3(options.minDensity) + " .. " + round3(options.maxDensity) + " cannot be held on a " +
+            std::to_string(options.columns) + "x" + std::to_string(options.rows) + " grid with this importance: the map reaches " +
+            round3(m.minCellDensity) + " .. " + round3(m.maxCellDensity) + " per cell (" +
+            numberText(100 * kDensityBoundTolerance, 2) + "% outside is allowed); lower --min-density towards " +
+            round3(m.minCellDensity) + " or raise --max-density towards " + round3(m.maxCellDensity) +
+            ", or use a finer --grid");
 }
 
 }  // namespace
@@ -158,11 +172,54 @@ SamplingMap buildSeparableMap(const DensityField& target, int columns, int rows)
 
 SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options) {
     const DensityField target = importanceToDensity(importance, options);
-    if (options.method == AutoMethod::Separable) return buildSeparableMap(target, options.columns, options.rows);
+    const auto within = [&](const MapMeasures& m) {
+        return m.minCellDensity >= options.minDensity * (1.0 - kDensityBoundTolerance) &&
+               m.maxCellDensity <= options.maxDensity * (1.0 + kDensityBoundTolerance);
+    };
+    const double aspect = fieldAspect(target);
+    if (options.method == AutoMethod::Separable) {
+        SamplingMap map = buildSeparableMap(target, options.columns, options.rows);
+        const MapMeasures m = measureMap(map, aspect);
+        if (!within(m)) refuseBounds(m, options);
+        return map;
+    }
     DensityMapOptions mapOptions;
     mapOptions.columns = options.columns;
     mapOptions.rows = options.rows;
-    return buildMapFromDensity(target, mapOptions);
+    mapOptions.maxAnisotropy = options.maxAnisotropy;
+    // A grid cannot follow a steep rise exactly: the cells beside it come out denser or sparser than
+    // the target. Each round divides the followed field by what the map achieved there (its cell
+    // density at each sample) and rebuilds; the best map by its worst bound violation is kept.
+    DensityField followed = target;
+    std::optional<SamplingMap> best;
+    double bestExcess = HUGE_VAL;
+    MapMeasures bestMeasures;
+    for (int round = 0; round < kBoundRounds; ++round) {
+        SamplingMap map = buildMapFromDensity(followed, mapOptions);
+        const MapMeasures m = measureMap(map, aspect);
+        const double excess = std::max(options.minDensity / m.minCellDensity, m.maxCellDensity / options.maxDensity);
+        if (excess < bestExcess) {
+            bestExcess = excess;
+            bestMeasures = m;
+            best = std::move(map);
+        }
+        if (within(m)) break;
+        const SamplingMap& last = *best;
+        for (int y = 0; y < followed.height; ++y)
+            for (int x = 0; x < followed.width; ++x) {
+                const std::size_t k = std::size_t(y) * followed.width + x;
+                const double achieved = cellDensityAt(last, {(x + 0.5) / followed.width, (y + 0.5) / followed.height});
+                const double wanted = target.values[k];
+                // Only the cells that break a bound are pushed, half-way (in log) past their bound.
+                double factor = 1.0;
+                if (achieved < options.minDensity) factor = std::sqrt(options.minDensity / achieved) * options.minDensity / achieved;
+                if (achieved > options.maxDensity) factor = std::sqrt(options.maxDensity / achieved) * options.maxDensity / achieved;
+                if (factor == 1.0) continue;
+                followed.values[k] = static_cast<float>(std::clamp(followed.values[k] * factor, wanted * 1e-3, wanted * 1e3));
+            }
+    }
+    if (!within(bestMeasures)) refuseBounds(bestMeasures, options);
+    return std::move(*best);
 }
 
 Image detailImportance(const Image& image) {

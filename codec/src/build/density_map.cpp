@@ -1,3 +1,15 @@
+// Where issue 10's staircase came from: not the rasterized foci (their density is C2 and sampled
+// at >= 12 samples a radius) nor the Poisson solve's boundary (exact Neumann, zero normal flow),
+// but fitting the grid to the flow. Moser's flow is injective, but it shears: between two foci the
+// context divides between them, and along the divide the nodes' paths fan out so fast that
+// bilinear cells fold although the nodes are exact (more integration steps or a finer density
+// grid change nothing). The fold used to be repaired by relaxing a growing region of nodes to the
+// mean of their neighbours: inside it the density flattened, at its border it jumped (the steps),
+// and beside it cells were left barely convex (the channel of almost no samples). Relaxing with a
+// smooth weight only spread the damage. So a grid that folds, or has a cell sparser than half the
+// lowest target density, is not repaired: the density is tempered (rho^gamma) until the flow's
+// own grid is valid and healthy, which keeps the map as smooth as the flow.
+//
 // buildMapFromDensity: Moser's flow. The Neumann Poisson problem is solved by a DCT on the density
 // grid (the only FFTW user in this file); grad(phi) lives on the cell faces (a staggered grid), so
 // its discrete divergence is exactly rho - 1 and its normal component is exactly 0 on the border.
@@ -6,6 +18,8 @@
 // (a width/height aspect), not in (u,v), so a focus circular in pixels is magnified equally along
 // u and v. det J is the same either way; only the shape of the magnification differs.
 #include "conus/codec/build/density_map.h"
+
+#include "conus/codec/build/map_measures.h"
 
 #include <fftw3.h>
 
@@ -23,10 +37,15 @@ namespace conus::codec {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-// When the flow's grid folds beyond local repair (untangle below) the density is tempered to
-// rho^gamma, gamma found by this many bisection steps between 0 (the identity, always valid) and
-// 1: the strongest valid map within 1/32 in gamma.
-constexpr int kTemperingSteps = 5;
+// When the flow's grid folds the density is tempered to rho^gamma, gamma found by this many
+// bisection steps between 0 (the identity, always valid) and 1: the strongest valid map within
+// 1/64 in gamma.
+constexpr int kTemperingSteps = 6;
+// The anisotropy limit is a promise, so it is bisected finer: within 1/256 in gamma.
+constexpr int kAnisotropyTemperingSteps = 8;
+// No cell may come out sparser than this share of the lowest target density: below it the flow's
+// grid is treated as folded.
+constexpr double kMinDensityShare = 0.5;
 
 // FFTW's planner is not thread-safe; plans are created and destroyed under this lock.
 std::mutex& fftwPlannerMutex() {
@@ -177,59 +196,11 @@ format::GridNodes integrateNodes(const FlowField& field, const DensityMapOptions
     return grid;
 }
 
-bool cellConvex(const format::GridNodes& grid, int i, int j) {
-    return map_rules::firstBadCorner({grid.columns, grid.rows, grid.xy.data()}, i, j) < 0;
-}
-
-// Moser's flow is injective, but where it swirls (context squeezed between nearby foci) the grid
-// can be too coarse to follow it and cells fold. Untangles locally: nodes of folded cells and
-// their neighbours are relaxed towards the mean of their neighbours (edge nodes along the edge),
-// the relaxed region growing while folds remain. The magnified regions keep their density; only
-// the folded context is smoothed. Returns false if folds remain after the budget.
-bool untangle(format::GridNodes& grid) {
-    constexpr int kMaxRounds = 200;
-    constexpr int kSweepsPerRound = 4;
-    const int n = grid.columns, m = grid.rows;
-    std::vector<char> movable(std::size_t(n) * m, 0);
-    std::vector<std::pair<int, int>> moving;
-    for (int round = 0; round < kMaxRounds; ++round) {
-        bool folded = false;
-        for (int j = 0; j + 1 < m; ++j)
-            for (int i = 0; i + 1 < n; ++i) {
-                if (cellConvex(grid, i, j)) continue;
-                folded = true;
-                for (int y = std::max(0, j - 1); y <= std::min(m - 1, j + 2); ++y)
-                    for (int x = std::max(0, i - 1); x <= std::min(n - 1, i + 2); ++x) {
-                        const bool corner = (x == 0 || x == n - 1) && (y == 0 || y == m - 1);
-                        char& flag = movable[std::size_t(y) * n + x];
-                        if (!flag && !corner) moving.emplace_back(x, y);
-                        flag = 1;
-                    }
-            }
-        if (!folded) return true;
-        for (int sweep = 0; sweep < kSweepsPerRound; ++sweep) {
-            for (auto [x, y] : moving) {
-                auto at = [&](int a, int b) -> float* { return &grid.xy[2 * (std::size_t(b) * n + a)]; };
-                float* p = at(x, y);
-                // Edge nodes move along their edge only (V10 is exact).
-                if (x > 0 && x < n - 1) {
-                    double sum = at(x - 1, y)[0] + double(at(x + 1, y)[0]);
-                    int count = 2;
-                    if (y > 0) sum += at(x, y - 1)[0], ++count;
-                    if (y < m - 1) sum += at(x, y + 1)[0], ++count;
-                    p[0] = static_cast<float>(sum / count);
-                }
-                if (y > 0 && y < m - 1) {
-                    double sum = at(x, y - 1)[1] + double(at(x, y + 1)[1]);
-                    int count = 2;
-                    if (x > 0) sum += at(x - 1, y)[1], ++count;
-                    if (x < n - 1) sum += at(x + 1, y)[1], ++count;
-                    p[1] = static_cast<float>(sum / count);
-                }
-            }
-        }
-    }
-    return false;
+double minCellDensityOf(const format::GridNodes& grid) {
+    double lowest = HUGE_VAL;
+    for (int j = 0; j + 1 < grid.rows; ++j)
+        for (int i = 0; i + 1 < grid.columns; ++i) lowest = std::min(lowest, cellDensity({grid.columns, grid.rows, grid.xy.data()}, i, j));
+    return lowest;
 }
 
 void checkInput(const DensityField& target, const DensityMapOptions& options) {
@@ -246,6 +217,9 @@ void checkInput(const DensityField& target, const DensityMapOptions& options) {
                                                         std::to_string(k / target.width) + ") is not finite and > 0");
         }
     }
+    if (!(options.maxAnisotropy == 0 || options.maxAnisotropy >= 1.0) || !std::isfinite(options.maxAnisotropy)) {
+        throw Error(ErrorCode::InvalidArgument, "max anisotropy " + numberText(options.maxAnisotropy) + " must be >= 1 (or 0: no limit)");
+    }
     if (options.columns < 2 || options.rows < 2 || options.columns > kMaxMapSide || options.rows > kMaxMapSide || options.steps < 1) {
         throw Error(ErrorCode::InvalidArgument, "density map options: grid " + std::to_string(options.columns) + "x" +
                                                     std::to_string(options.rows) + " (each in [2," + std::to_string(kMaxMapSide) + "]), steps " +
@@ -255,7 +229,7 @@ void checkInput(const DensityField& target, const DensityMapOptions& options) {
 
 }  // namespace
 
-SamplingMap buildMapFromDensity(const DensityField& target, const DensityMapOptions& options) {
+SamplingMap buildMapFromDensity(const DensityField& target, const DensityMapOptions& options, DensityMapReport* report) {
     checkInput(target, options);
     // Work with log(rho) relative to its maximum so that tempering rho^gamma cannot overflow.
     std::vector<double> logRho(target.values.size());
@@ -268,6 +242,8 @@ SamplingMap buildMapFromDensity(const DensityField& target, const DensityMapOpti
     field.width = target.width;
     field.height = target.height;
     field.rho.resize(logRho.size());
+    const double aspect = fieldAspect(target);
+    bool anisotropyBound = false;
     auto attempt = [&](double gamma, format::GridNodes& grid) {
         double sum = 0.0;
         for (std::size_t k = 0; k < logRho.size(); ++k) sum += field.rho[k] = std::exp(gamma * (logRho[k] - maxLog));
@@ -275,14 +251,26 @@ SamplingMap buildMapFromDensity(const DensityField& target, const DensityMapOpti
         for (double& r : field.rho) r /= mean;
         solveFlowField(field);
         grid = integrateNodes(field, options);
-        if (format::validateGrid(grid).ok()) return true;
-        return untangle(grid) && format::validateGrid(grid).ok();
+        // Folded, or a cell much sparser than the sparsest density asked for: the grid could not
+        // follow the flow here (see the top of this file); a weaker density is tried.
+        if (!format::validateGrid(grid).ok()) return false;
+        if (minCellDensityOf(grid) < kMinDensityShare * *std::min_element(field.rho.begin(), field.rho.end())) return false;
+        if (options.maxAnisotropy > 0 && measureMap(SamplingMap::fromGrid(grid), aspect).maxAnisotropy > options.maxAnisotropy) {
+            anisotropyBound = true;
+            return false;
+        }
+        return true;
+    };
+    const auto finish = [&](format::GridNodes&& grid, double gamma) {
+        if (report) *report = {gamma, anisotropyBound};
+        return SamplingMap::fromGrid(grid);
     };
     format::GridNodes grid;
-    if (attempt(1.0, grid)) return SamplingMap::fromGrid(grid);
+    if (attempt(1.0, grid)) return finish(std::move(grid), 1.0);
     double lo = 0.0, hi = 1.0;
     format::GridNodes best = SamplingMap::identity(options.columns, options.rows).toGrid();
-    for (int step = 0; step < kTemperingSteps; ++step) {
+    const int steps = anisotropyBound ? kAnisotropyTemperingSteps : kTemperingSteps;
+    for (int step = 0; step < steps; ++step) {
         const double mid = 0.5 * (lo + hi);
         if (attempt(mid, grid)) {
             lo = mid;
@@ -291,7 +279,7 @@ SamplingMap buildMapFromDensity(const DensityField& target, const DensityMapOpti
             hi = mid;
         }
     }
-    return SamplingMap::fromGrid(best);
+    return finish(std::move(best), lo);
 }
 
 }  // namespace conus::codec

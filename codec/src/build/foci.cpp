@@ -74,6 +74,7 @@ SamplingMap buildDensityComposition(std::span<const Focus> foci, const FociOptio
     DensityMapOptions mapOptions;
     mapOptions.columns = options.columns;
     mapOptions.rows = options.rows;
+    mapOptions.maxAnisotropy = options.maxAnisotropy;
     return buildMapFromDensity(sampleFociDensity(foci, options.aspect), mapOptions);
 }
 
@@ -158,6 +159,17 @@ void checkFociHeld(const SamplingMap& map, std::span<const Focus> foci, const Fo
     if (missed < 0) return;
     const Focus& f = foci[missed];
     const double reached = reachedMagnification(map, foci)[missed];
+    const std::string focusText = numberText(f.u) + "," + numberText(f.v) + "," + numberText(f.r) + "," + numberText(f.k);
+    if (options.maxAnisotropy > 0) {
+        FociOptions unlimited = options;
+        unlimited.maxAnisotropy = 0;
+        if (firstMissed(buildFociMap(foci, unlimited)) < 0) {
+            throw Error(ErrorCode::InvalidArgument,
+                        "the anisotropy limit " + numberText(options.maxAnisotropy) + " leaves focus " + focusText +
+                            " a magnification of " + numberText(std::round(reached * 100) / 100) +
+                            ": raise --max-anisotropy, widen the focus (larger r) or lower its k");
+        }
+    }
     std::string advice = "no grid up to " + std::to_string(kLargestSuggestion) + " nodes a side holds it";
     for (int side = 3; side <= kLargestSuggestion; side = 2 * side - 1) {
         if (side <= std::max(options.columns, options.rows)) continue;
@@ -170,7 +182,7 @@ void checkFociHeld(const SamplingMap& map, std::span<const Focus> foci, const Fo
     }
     throw Error(ErrorCode::InvalidArgument,
                 "a " + std::to_string(options.columns) + "x" + std::to_string(options.rows) + " grid is too coarse for focus " +
-                    numberText(f.u) + "," + numberText(f.v) + "," + numberText(f.r) + "," + numberText(f.k) + ": it reaches a magnification of " +
+                    focusText + ": it reaches a magnification of " +
                     numberText(std::round(reached * 100) / 100) + " there; " + advice);
 }
 

@@ -54,8 +54,8 @@ TEST(AutoMap, FlowFollowsTheTargetBetterThanSeparable) {
     AutoMapOptions options;
     const DensityField target = importanceToDensity(importance, options);
     const SamplingMap flow = buildAutoMap(importance, options);
-    options.method = AutoMethod::Separable;
-    const SamplingMap separable = buildAutoMap(importance, options);
+    // (buildAutoMap refuses the separable map here: its bands leave cells at 1/4 of the floor.)
+    const SamplingMap separable = buildSeparableMap(target, options.columns, options.rows);
     const double cFlow = densityCorrelation(flow, target), cSep = densityCorrelation(separable, target);
     EXPECT_GT(cFlow, 0.9);
     EXPECT_GT(cFlow, cSep + 0.1) << "flow " << cFlow << " separable " << cSep;

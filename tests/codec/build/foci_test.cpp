@@ -65,14 +65,16 @@ TEST(Foci, SingleFocusMagnification) {
 }
 
 TEST(Foci, NearbyFociKeepTheirMagnification) {
-    // The context squeezed between two foci swirls under Moser's flow and folds on a 65x65 grid;
-    // the builder untangles it locally instead of weakening the foci.
+    // The context squeezed between two foci shears under Moser's flow and folds on a 65x65 grid.
+    // Repairing the fold locally left steps (issue 10), so the builder tempers the density: the
+    // foci keep most of their magnification, and more than half of their extra one.
     const std::vector<Focus> foci{{0.42, 0.31, 0.08, 4}, {0.7, 0.65, 0.1, 3}};
     const SamplingMap map = buildFociMap(foci, options(1.0));
     expectValid(map);
     const double far = map.density({0.05, 0.95});
-    EXPECT_NEAR(map.density({0.42, 0.31}) / far, 16.0, 16.0 * 0.1);
-    EXPECT_NEAR(map.density({0.7, 0.65}) / far, 9.0, 9.0 * 0.1);
+    EXPECT_GT(map.density({0.42, 0.31}) / far, 0.6 * 16.0);
+    EXPECT_GT(map.density({0.7, 0.65}) / far, 0.6 * 9.0);
+    EXPECT_NO_THROW(checkFociHeld(map, foci, options(1.0)));
 }
 
 TEST(Foci, BothCompositionsValidForHardCases) {

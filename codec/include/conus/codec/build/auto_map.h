@@ -27,12 +27,20 @@ struct AutoMapOptions {
     double maxDensity = 16.0;     // cap of the density (> 1)
     double smoothing = 0.01;      // blur radius as a fraction of the image width
     AutoMethod method = AutoMethod::Flow;
+    double maxAnisotropy = 0;     // flow: DensityMapOptions::maxAnisotropy (0: none)
 };
+
+// How far the achieved cell density (map_measures.h) may stray outside [minDensity, maxDensity]:
+// the promise of `--min-density` and `--max-density`.
+inline constexpr double kDensityBoundTolerance = 0.05;
 
 // The target density field for an importance image (one channel, or the mean of R,G,B); throws
 // conus::Error(InvalidArgument) on NaN/Inf or negative importance, or bad options.
 DensityField importanceToDensity(const Image& importance, const AutoMapOptions& options = {});
 
+// The flow map follows the target, corrected (a few multiplicative rounds) until its cell density
+// lies within kDensityBoundTolerance of [minDensity, maxDensity]. Throws conus::Error
+// (InvalidArgument) naming the bounds this importance and grid can reach when it cannot.
 SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options = {});
 SamplingMap buildSeparableMap(const DensityField& target, int columns, int rows);
 

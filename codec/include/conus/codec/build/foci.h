@@ -30,6 +30,7 @@ struct FociOptions {
     int columns = map_rules::kDefaultSide, rows = map_rules::kDefaultSide;  // grid of the built map
     double aspect = 1.0;          // image width / height: makes a focus circular in pixels
     FociComposition composition = FociComposition::Density;
+    double maxAnisotropy = 0;     // density composition: DensityMapOptions::maxAnisotropy (0: none)
 };
 
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r <= 0 or k < 1 or k > 64.
