@@ -69,4 +69,22 @@ format::Compression parseCompression(const std::string& text) {
     invalid("compression '" + text + "' is not one of " + format::nameList<format::Compression>());
 }
 
+LookAt parseLookAt(const std::string& text) {
+    std::vector<double> v;
+    std::stringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        try {
+            std::size_t used = 0;
+            v.push_back(std::stod(item, &used));
+            if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+            throw Error(ErrorCode::InvalidArgument, "camera '" + text + "': '" + item + "' is not a finite number");
+        }
+    }
+    if (v.size() != 7)
+        throw Error(ErrorCode::InvalidArgument, "camera '" + text + "' needs 7 values x,y,z,lx,ly,lz,fovDeg");
+    return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6]};
+}
+
 }  // namespace conus::cli

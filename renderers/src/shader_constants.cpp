@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "conus/codec/depth/intersect.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/core/display.h"
@@ -30,7 +31,9 @@ std::string constantsBlock() {
     for (std::size_t i = 0; i < kInfernoRamp.size(); ++i)
         s += std::string(i ? ", " : "") + "vec3(" + glslFloat(kInfernoRamp[i][0]) + ", " + glslFloat(kInfernoRamp[i][1]) +
              ", " + glslFloat(kInfernoRamp[i][2]) + ")";
-    return s + ");\n";
+    s += ");\n";
+    s += "const float kIntersectDepthMargin = " + glslFloat(codec::kIntersectDepthMargin) + ";\n";
+    return s;
 }
 
 }  // namespace
