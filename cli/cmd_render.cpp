@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "arguments.h"
 #include "backend.h"
@@ -35,21 +36,22 @@ int runRenderRelief(const RenderOptions& o) {
     const Size size = parseSize(o.sizeText);
     const imageio::WriteOptions write = writeOptionsOf({}, nullptr);
     checkPictureOutput(o.output, write, {o.input});
+    // Values first, so that a bad one is a usage error before any work.
+    const std::optional<LookAt> given = o.cameraText.empty() ? std::nullopt : std::optional(parseLookAt(o.cameraText));
+    const glm::dvec3 towardLight = parseDirection(o.lightText);
     const format::ConusFile file = format::readConusFile(o.input);
     if (file.dataKind != format::DataKind::HeightField || file.depth.kind != format::DepthKind::Height)
-        throw Error(ErrorCode::InvalidArgument, o.input + " is not a relief asset (a height field with heights and a "
+        throw Error(ErrorCode::Unsupported, o.input + " is not a relief asset (a height field with heights and a "
                                                           "camera; make one with `conus bake relief`)");
     const codec::DepthImage asset = codec::DepthImage::fromFile(file);
     const double aspect = double(size.width) / size.height;
     Camera camera = codec::defaultReliefView(asset, aspect);
-    if (!o.cameraText.empty()) {
-        const LookAt given = parseLookAt(o.cameraText);
-        camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, camera.near(),
+    if (given)
+        camera = Camera::perspective(given->eye, given->target, {0, 1, 0}, given->fovYDegrees, aspect, camera.near(),
                                      camera.far());
-    }
     gl::ReliefLook look;
     look.shadows = o.shadows;
-    look.towardLight = glm::vec3(parseDirection(o.lightText));
+    look.towardLight = glm::vec3(towardLight);
     look.intersect.stepTexels = o.step;
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::None, "relief rendering");
     Progress progress("render " + std::to_string(size.width) + "x" + std::to_string(size.height));

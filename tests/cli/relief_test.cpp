@@ -2,6 +2,8 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
+#include <algorithm>
+
 #include "cli/cli_fixture.h"
 #include "conus/format/container.h"
 
@@ -58,12 +60,19 @@ TEST_F(ReliefCli, BakeValidatesAndRenders) {
     EXPECT_GT(spread, 0.05);  // the tablet in front of the background, shaded
     EXPECT_GT(mean, 0.1);
     ASSERT_EQ(run("render relief " + uniform + " -o " + frameUniform + " --size 160x120").exitCode, 0);
-    ASSERT_EQ(run("render relief " + conus + " -o " + shadowed + " --size 160x120 --shadows").exitCode, 0);
+    // A low light from +x: the frame and the strokes' walls cast shadows.
+    const std::string lowLight = path("low.png");
+    ASSERT_EQ(run("render relief " + conus + " -o " + lowLight + " --size 160x120 --light 1,0.3,0").exitCode, 0);
+    ASSERT_EQ(run("render relief " + conus + " -o " + shadowed + " --size 160x120 --light 1,0.3,0 --shadows").exitCode, 0);
     // The same tablet from the same default view: close, but not the same samples; shadows darken.
     const double assets = meanDifference(frame, frameUniform);
     EXPECT_GT(assets, 0.0);
     EXPECT_LT(assets, 0.05);
-    EXPECT_LT(meanAndSpread(shadowed).first, mean);
+    // Shadows only take light away: some pixels darker, none brighter.
+    const auto darkening = OIIO::ImageBufAlgo::computePixelStats(
+        OIIO::ImageBufAlgo::sub(OIIO::ImageBuf(lowLight), OIIO::ImageBuf(shadowed)));
+    EXPECT_GT(*std::max_element(darkening.max.begin(), darkening.max.end()), 0.1f);
+    EXPECT_GE(*std::min_element(darkening.min.begin(), darkening.min.end()), -0.01f);
     // A camera given: from straight above the centre, the field fills the frame.
     ASSERT_EQ(run("render relief " + conus + " -o " + path("above.png") +
                   " --size 64x48 --camera 0.5,3,0.376,0.5,0,0.375,12")
@@ -84,13 +93,14 @@ TEST_F(ReliefCli, BadInputFailsWithOneLine) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     r = run("render relief " + path("missing.exr") + " -o " + path("f.png"));
     EXPECT_EQ(r.exitCode, 1);
+    // Bad values are usage errors (2); a file that cannot serve is a failure (1).
     r = run("bake relief tablet --tablet-size 64x48 --size 128x96 -o " + path("t.exr"));
-    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("larger than the height field"), std::string::npos) << r.err;
-    EXPECT_EQ(run("bake relief tablet --text '' -o " + path("t.exr")).exitCode, 1);
+    EXPECT_EQ(run("bake relief tablet --text '' -o " + path("t.exr")).exitCode, 2);
     EXPECT_EQ(run("bake relief tablet --uniform --focus 0.5,0.5,0.1,2 -o " + path("t.exr")).exitCode, 2);
     EXPECT_EQ(run("render relief " + plain + " -o " + path("f.png") + " --step 0").exitCode, 2);
-    EXPECT_EQ(run("render relief " + plain + " -o " + path("f.png") + " --camera 1,2,3").exitCode, 1);
+    EXPECT_EQ(run("render relief " + path("missing.exr") + " -o " + path("f.png") + " --camera 1,2,3").exitCode, 2);
     EXPECT_FALSE(fs::exists(path("t.exr")));
     EXPECT_FALSE(fs::exists(path("f.png")));
     EXPECT_TRUE(leftovers().empty());
