@@ -5,6 +5,7 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <glm/glm.hpp>
 
 #include <glm/glm.hpp>
 

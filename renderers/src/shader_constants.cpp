@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "conus/codec/depth/intersect.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/mesh/shading.h"
@@ -38,6 +39,7 @@ std::string constantsBlock() {
     s += ");\n";
     s += "const float kMeshAmbient = " + glslFloat(codec::kAmbient) + ";\n";
     s += "const float kMeshGrey = " + glslFloat(codec::kDefaultAlbedo) + ";\n";
+    s += "const float kIntersectDepthMargin = " + glslFloat(codec::kIntersectDepthMargin) + ";\n";
     return s;
 }
 

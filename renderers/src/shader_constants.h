@@ -14,7 +14,8 @@ inline constexpr int kViewMaxFoci = 16;          // focus outlines conus-view dr
 // kDecodeMultiTap, kDecodeMaxTaps (codec/decode.h), kEncodeMaxTaps, kEncodeTapTolerance,
 // kEncodeMaxAxisTaps, kEncodeAnisotropicSigma, kEncodeGaussianReach, kEncodeBoxAnisotropy
 // (codec/encode.h), kBackground, kMaxFoci (above), kInferno[6] (core/display.h), and the mesh
-// shading's kMeshAmbient, kMeshGrey (codec/mesh/shading.h: kAmbient, kDefaultAlbedo).
+// shading's kMeshAmbient, kMeshGrey (codec/mesh/shading.h: kAmbient, kDefaultAlbedo), and
+// kIntersectDepthMargin (codec/depth/intersect.h).
 std::string withSharedConstants(const std::string& source);
 
 }  // namespace conus::gl

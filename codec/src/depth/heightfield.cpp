@@ -274,6 +274,25 @@ format::ConusFile encodeHeightField(const Image& heights, const Image& colour,
     return file;
 }
 
+format::ConusFile encodeHeightField(const Image& heights, const Image& colour, const SamplingMap& map, int width,
+                                    int height, const std::string& units, int threads) {
+    constexpr const char* kWhat = "encodeHeightField";
+    checkSize(width, height, kWhat);
+    EncodeOptions encode;
+    encode.width = width;
+    encode.height = height;
+    encode.threads = threads;
+    format::ConusFile file;
+    file.image = encodeImage(combine(heights, colour, kWhat), map, encode);
+    file.pixelType = format::PixelType::Half;  // colour; Z is always FLOAT in the file
+    file.sourceWidth = heights.width;
+    file.sourceHeight = heights.height;
+    file.dataKind = format::DataKind::HeightField;
+    file.map = map.toGrid();
+    file.depth = heightDepth(file.image, units);
+    return file;
+}
+
 format::ConusFile uniformHeightField(const Image& heights, const Image& colour, int width, int height,
                                      const std::string& units, int threads) {
     constexpr const char* kWhat = "uniformHeightField";

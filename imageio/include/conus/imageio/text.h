@@ -14,6 +14,12 @@ namespace conus::imageio {
 // image's first channels (at most four: R, G, B and an opaque A).
 void drawText(Image& image, int x, int y, int size, const std::string& text, const float color[3]);
 
+// An inscription: `text`'s lines (split at '|') drawn white on black into a width x height RGB
+// image, centred, each as large as fits in about three quarters of the width and of the height
+// together (the engraved tablet's ink, codec/depth/relief.h). conus::Error(InvalidArgument) for
+// empty text.
+Image inscription(const std::string& text, int width, int height);
+
 struct TextPanelStyle {
     int fontSize = 15;                          // pixels
     float text[4] = {1.0f, 1.0f, 1.0f, 1.0f};   // straight RGBA

@@ -79,6 +79,11 @@ struct HeightFieldOptions {
 format::ConusFile encodeHeightField(const Image& heights, const Image& colour,
                                     const HeightFieldOptions& options);
 
+// The same through any sampling map (a relief asset's foci or importance map, relief.h): the map
+// is sampled and stored as it is, without analytic parameters.
+format::ConusFile encodeHeightField(const Image& heights, const Image& colour, const SamplingMap& map, int width,
+                                    int height, const std::string& units = "m", int threads = 0);
+
 // The baseline: the DEM area-downsampled to width x height (an identity map, no analytic
 // parameters), with the same channels and depth attributes. width x height equal to the DEM's
 // size gives the full-resolution reference.

@@ -1,0 +1,183 @@
+// conus bake relief: a height field plus colour -> an orthographic CoNUS depth image (a relief
+// asset, paper section 5) whose map gives the samples to what matters: --focus discs, an
+// --importance image, or by default the source's own detail (the engraved text of a tablet).
+// --uniform bakes the conventional asset of the same texel count, the baseline.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+
+#include "arguments.h"
+#include "commands.h"
+#include "conus/codec/build/auto_map.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/depth/heightfield.h"
+#include "conus/codec/depth/relief.h"
+#include "conus/codec/image/encode.h"
+#include "conus/core/error.h"
+#include "conus/imageio/image_file.h"
+#include "conus/imageio/text.h"
+#include "dem_io.h"
+#include "encoding.h"
+#include "image_files.h"
+#include "importance.h"
+#include "progress.h"
+
+namespace conus::cli {
+namespace {
+
+constexpr const char* kTabletSource = "tablet";
+constexpr const char* kDefaultText = "CoNUS|FLEXIBLE PINHOLE|CAMERA";
+
+struct BakeOptions {
+    std::string source, output, sizeText, colour, importance, text = kDefaultText, compression = "zip";
+    std::string tabletSize = "1024x768";
+    std::vector<std::string> foci;
+    bool uniform = false;
+    int grid = map_rules::kDefaultSide;
+    double heightScale = 1.0, width = 1.0, minDensity = 0.7, maxDensity = 16.0;
+};
+
+struct Source {
+    Image heights, colour;
+    glm::dvec2 extent;
+    std::string description;
+};
+
+Source readReliefSource(const BakeOptions& o) {
+    if (o.source == kTabletSource) {
+        const Size size = parseSize(o.tabletSize);
+        codec::TabletOptions tablet;
+        tablet.width = o.width;
+        codec::Tablet made = codec::makeTablet(imageio::inscription(o.text, size.width, size.height), tablet);
+        return {std::move(made.heights), std::move(made.colour), made.extent,
+                "engraved tablet " + o.tabletSize + " \"" + o.text + "\""};
+    }
+    Dem dem = readDem(o.source, o.heightScale);
+    const glm::dvec2 extent(o.width, o.width * dem.heights.height / dem.heights.width);
+    Image colour;
+    if (o.colour.empty()) {
+        colour = codec::terrainColours(dem.heights, extent);
+        imageio::linearize(colour);
+    } else {
+        colour = readSource(o.colour, {}).image;
+        if (colour.width != dem.heights.width || colour.height != dem.heights.height)
+            colour = codec::areaDownsample(colour, dem.heights.width, dem.heights.height);
+    }
+    return {std::move(dem.heights), std::move(colour), extent, dem.description};
+}
+
+int runBakeRelief(const BakeOptions& o) {
+    checkConusOutput(o.output, o.source);
+    Progress reading("make " + o.source);
+    const Source source = readReliefSource(o);
+    reading.done();
+    Size size;
+    if (o.sizeText.empty())
+        size = {std::max(1, source.heights.width / 4), std::max(1, source.heights.height / 4)};
+    else
+        size = parseSize(o.sizeText);
+    if (size.width > source.heights.width || size.height > source.heights.height)
+        throw Error(ErrorCode::InvalidArgument, "--size " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+                                                    " is larger than the height field (" +
+                                                    std::to_string(source.heights.width) + "x" +
+                                                    std::to_string(source.heights.height) + ")");
+
+    std::optional<codec::SamplingMap> map;
+    std::optional<format::AnalyticMap> analytic;
+    std::string how = "conventional (identity map)";
+    if (!o.uniform) {
+        Progress building("build the sampling map");
+        if (!o.foci.empty()) {
+            std::vector<codec::Focus> foci;
+            for (const auto& text : o.foci) foci.push_back(codec::parseFocus(text));
+            codec::FociOptions fo;
+            fo.columns = fo.rows = o.grid;
+            fo.aspect = double(source.heights.width) / source.heights.height;
+            map = codec::buildFociMap(foci, fo);
+            codec::checkFociHeld(*map, foci, fo);
+            analytic = codec::toAnalytic(foci, fo.composition);
+            how = plural(foci.size(), "focus", "foci") + " map";
+        } else {
+            codec::AutoMapOptions ao;
+            ao.columns = ao.rows = o.grid;
+            ao.minDensity = o.minDensity;
+            ao.maxDensity = o.maxDensity;
+            const std::string importance = o.importance.empty() ? "detail" : o.importance;
+            map = codec::buildAutoMap(importanceFrom(importance, source.colour), ao);
+            how = importance + " importance map";
+        }
+        building.done();
+    }
+
+    Progress baking("bake " + std::to_string(size.width) + "x" + std::to_string(size.height));
+    codec::ReliefBakeOptions options;
+    options.width = size.width;
+    options.height = size.height;
+    options.extent = source.extent;
+    options.units = "";
+    format::ConusFile file = codec::bakeRelief(source.heights, source.colour, map ? &*map : nullptr, options);
+    baking.done();
+    file.analytic = analytic;
+    file.compression = parseCompression(o.compression);
+    Progress writing("write " + o.output);
+    format::writeConusFile(o.output, file);
+    writing.done();
+    std::printf("wrote %s: %dx%d relief asset of %s (%dx%d), %s; field %g x %g, heights %g..%g\n", o.output.c_str(),
+                size.width, size.height, source.description.c_str(), source.heights.width, source.heights.height,
+                how.c_str(), source.extent.x, source.extent.y, file.depth.near, file.depth.far);
+    return 0;
+}
+
+}  // namespace
+
+Command addBakeCommand(CLI::App& root) {
+    auto o = std::make_shared<BakeOptions>();
+    CLI::App* command = root.add_subcommand("bake", "Bake assets for ray intersection (relief)");
+    command->require_subcommand(1);
+    CLI::App* relief = addSubcommand(
+        *command, "relief", "A height field plus colour -> an orthographic CoNUS depth image (relief asset)",
+        {"conus bake relief tablet -o tablet.exr --size 256x192",
+         "conus bake relief tablet --text 'HELLO|WORLD' --uniform -o tablet-uniform.exr --size 256x192",
+         "conus bake relief dem.tif --height-scale 0.1 --colour ortho.png -o relief.exr --focus 0.5,0.5,0.1,4"});
+    relief->add_option("source", o->source,
+                       "'tablet' (the engraved tablet made in code) or a height field: 16-bit PNG/TIFF, float EXR, "
+                       ".npy, .npz or procedural[:SIZE[:SEED]]")
+        ->required();
+    relief->add_option("-o,--output", o->output, "relief asset (.exr)")->required();
+    relief->add_option("--size", o->sizeText, "CoNUS image size WxH (default: a quarter of each side)");
+    relief->add_option("--focus", o->foci, "focus u,v,r,k (repeatable): magnify these discs");
+    relief->add_option("--importance", o->importance,
+                       "detail (default) | faces | an importance image: where the samples go")
+        ->excludes("--focus");
+    relief->add_flag("--uniform", o->uniform, "bake the conventional asset (identity map), the baseline")
+        ->excludes("--focus")
+        ->excludes("--importance");
+    relief->add_option("--grid", o->grid, "sampling-map nodes per side")->capture_default_str();
+    relief->add_option("--min-density", o->minDensity,
+                       "with importance: density kept everywhere (the tablet: 0.7 gains 3.5 dB on the text for "
+                       "0.5 dB elsewhere, bench/README.md)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1));
+    relief->add_option("--max-density", o->maxDensity, "with importance: cap on the density")
+        ->capture_default_str()
+        ->check(finiteRange(1, 1e6));
+    relief->add_option("--text", o->text, "tablet: the inscription, lines split at '|'")->capture_default_str();
+    relief->add_option("--tablet-size", o->tabletSize, "tablet: full-resolution height field WxH")
+        ->capture_default_str();
+    relief->add_option("--width", o->width, "the field's width in world units (its depth follows the aspect)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e9));
+    relief->add_option("--height-scale", o->heightScale, "multiplies a height file's values")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e9));
+    relief->add_option("--colour,--color", o->colour, "colour image (default: a ramp by height and slope)");
+    relief->add_option("--compression", o->compression, "zip | piz | dwaa | none")
+        ->capture_default_str()
+        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
+    addQuietOption(*relief);
+    return {command, [o] { return runBakeRelief(*o); }};
+}
+
+}  // namespace conus::cli

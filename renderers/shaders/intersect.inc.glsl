@@ -1,0 +1,144 @@
+// Ray / depth-image intersection in GLSL: the twin of codec/src/depth/intersect.cpp, function for
+// function (clip in homogeneous coordinates, project, walk the projected segment distorting each
+// point with Equation 1, bisect). Include equation1.inc.glsl first. kIntersectDepthMargin is
+// injected from C++ (codec/depth/intersect.h).
+struct DepthView {
+    mat4 worldToNdc;  // the camera's worldToNdcMatrix (u, v = xy / w)
+    mat4 ndcToWorld;  // its inverse, for unprojectDepth
+    vec3 eye;
+    vec3 forward;
+    float near;
+    bool perspective;
+    float minDepth, maxDepth;  // the range of the stored camera depths
+};
+
+struct DepthHit {
+    bool hit;
+    float t;
+    vec3 position;
+    float depth;
+    vec2 point;      // undistorted image point
+    vec2 distorted;  // its place in the CoNUS image
+    ivec2 texel;
+    int steps;
+    int face;  // the face of the clipped volume the ray entered through when steps == 0 (0..5), else -1
+};
+
+// Bilinear in the CoNUS image at pd, pixel centres at (i + 0.5) / size, clamped to the edge pixels:
+// exact weights (texelFetch), as DepthImage::sampleDepth computes them.
+float sampleDepth(sampler2D depths, vec2 pd) {
+    const ivec2 size = textureSize(depths, 0);
+    const vec2 g = clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
+    const ivec2 i0 = min(ivec2(g), size - 1), i1 = min(i0 + 1, size - 1);
+    const vec2 f = g - vec2(i0);
+    const float top = mix(texelFetch(depths, i0, 0).r, texelFetch(depths, ivec2(i1.x, i0.y), 0).r, f.x);
+    const float bottom = mix(texelFetch(depths, ivec2(i0.x, i1.y), 0).r, texelFetch(depths, i1, 0).r, f.x);
+    return mix(top, bottom, f.y);
+}
+
+// The world point at image point uv and camera depth `depth` (perspective or orthographic: depth is
+// affine along the line from the near plane's point to the far plane's).
+vec3 unprojectDepth(DepthView view, vec2 uv, float depth) {
+    const vec4 a = view.ndcToWorld * vec4(uv, 0.0, 1.0), b = view.ndcToWorld * vec4(uv, 1.0, 1.0);
+    const vec3 pa = a.xyz / a.w, pb = b.xyz / b.w;
+    const float da = dot(pa - view.eye, view.forward), db = dot(pb - view.eye, view.forward);
+    return mix(pa, pb, (depth - da) / (db - da));
+}
+
+// The outward normal (world) of face `face` of the clipped volume, at no point in particular.
+vec3 clipFaceNormal(DepthView view, int face) {
+    const mat4 m = transpose(view.worldToNdc);  // rows of the matrix as columns
+    vec3 inward;
+    if (face == 0) inward = m[0].xyz;
+    else if (face == 1) inward = m[3].xyz - m[0].xyz;
+    else if (face == 2) inward = m[1].xyz;
+    else if (face == 3) inward = m[3].xyz - m[1].xyz;
+    else if (face == 4) inward = view.forward;
+    else inward = -view.forward;
+    return -normalize(inward);
+}
+
+DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, vec3 origin, vec3 direction,
+                             float stepTexels, int refinements, int maxSteps, float tMax) {
+    DepthHit result;
+    result.hit = false;
+    result.steps = 0;
+    result.face = -1;
+    // 1. Clip: u, v in [0,1] and depth in [lo, hi], each a + b t >= 0.
+    const vec4 c0 = view.worldToNdc * vec4(origin, 1.0), cd = view.worldToNdc * vec4(direction, 0.0);
+    const float z0 = dot(origin - view.eye, view.forward), zd = dot(direction, view.forward);
+    const float margin = kIntersectDepthMargin * (1.0 + max(abs(view.minDepth), abs(view.maxDepth)));
+    float lo = view.minDepth - margin;
+    const float hi = view.maxDepth + margin;
+    if (view.perspective) lo = max(lo, view.near);
+    float planes[12] = float[12](c0.x, cd.x, c0.w - c0.x, cd.w - cd.x, c0.y, cd.y, c0.w - c0.y, cd.w - cd.y, z0 - lo,
+                                 zd, hi - z0, -zd);
+    float tEnter = 0.0, tExit = tMax;
+    int entered = -1;
+    for (int k = 0; k < 6; ++k) {
+        const float a = planes[2 * k], b = planes[2 * k + 1];
+        if (b == 0.0) {
+            if (a < 0.0) return result;
+            continue;
+        }
+        const float t = -a / b;
+        if (b > 0.0) {
+            if (t > tEnter) {
+                tEnter = t;
+                entered = k;
+            }
+        } else {
+            tExit = min(tExit, t);
+        }
+    }
+    if (!(tEnter <= tExit)) return result;
+
+    // 2. Project the ends; 1/w, depth/w and t/w are linear along the projected segment.
+    const vec4 ca = c0 + cd * tEnter, cb = c0 + cd * tExit;
+    const float iw0 = 1.0 / ca.w, iw1 = 1.0 / cb.w;
+    const vec2 p0 = clamp(ca.xy * iw0, 0.0, 1.0), p1 = clamp(cb.xy * iw1, 0.0, 1.0);
+    const float dw0 = (z0 + zd * tEnter) * iw0, dw1 = (z0 + zd * tExit) * iw1;
+    const float tw0 = tEnter * iw0, tw1 = tExit * iw1;
+    const vec2 along = p1 - p0;
+    const vec2 size = vec2(textureSize(depths, 0));
+
+    // 3. Walk near to far, each step stepTexels CoNUS pixels along the distorted curve.
+    float before = 0.0, s = 0.0;
+    int steps = 0;
+    MapPoint m = evalMap(map, p0);
+    float gap = sampleDepth(depths, m.pd) - (dw0 / iw0);
+    while (gap > 0.0) {
+        if (s >= 1.0 || steps >= maxSteps) return result;
+        const float speed = length((m.du * along.x + m.dv * along.y) * size);
+        before = s;
+        s = min(1.0, s + (speed > 0.0 ? stepTexels / speed : 1.0));
+        ++steps;
+        m = evalMap(map, p0 + along * s);
+        gap = sampleDepth(depths, m.pd) - mix(dw0, dw1, s) / mix(iw0, iw1, s);
+    }
+    // 4. Bisect between the last sample in front and the first behind.
+    if (steps > 0) {
+        float a = before, b = s;
+        for (int k = 0; k < refinements; ++k) {
+            const float mid = 0.5 * (a + b);
+            const MapPoint q = evalMap(map, p0 + along * mid);
+            if (sampleDepth(depths, q.pd) - mix(dw0, dw1, mid) / mix(iw0, iw1, mid) > 0.0)
+                a = mid;
+            else
+                b = mid;
+        }
+        s = 0.5 * (a + b);
+        m = evalMap(map, p0 + along * s);
+    }
+    const float iw = mix(iw0, iw1, s);
+    result.hit = true;
+    result.t = mix(tw0, tw1, s) / iw;
+    result.position = origin + direction * result.t;
+    result.depth = mix(dw0, dw1, s) / iw;
+    result.point = p0 + along * s;
+    result.distorted = m.pd;
+    result.texel = clamp(ivec2(floor(m.pd * size)), ivec2(0), ivec2(size) - 1);
+    result.steps = steps;
+    result.face = steps == 0 ? entered : -1;
+    return result;
+}

@@ -1,0 +1,110 @@
+// `conus bake relief` and `conus render relief` through the real binary.
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
+#include <algorithm>
+
+#include "cli/cli_fixture.h"
+#include "conus/format/container.h"
+
+namespace conus::test {
+namespace {
+
+using ReliefCli = Cli;
+
+// The mean and spread of a picture's values, read by OpenImageIO.
+std::pair<double, double> meanAndSpread(const std::string& path) {
+    const OIIO::ImageBuf image(path);
+    const auto stats = OIIO::ImageBufAlgo::computePixelStats(image);
+    double mean = 0, spread = 0;
+    for (std::size_t c = 0; c < stats.avg.size(); ++c) {
+        mean += stats.avg[c];
+        spread += stats.stddev[c];
+    }
+    return {mean / stats.avg.size(), spread / stats.avg.size()};
+}
+
+double meanDifference(const std::string& a, const std::string& b) {
+    const OIIO::ImageBuf difference = OIIO::ImageBufAlgo::absdiff(OIIO::ImageBuf(a), OIIO::ImageBuf(b));
+    const auto stats = OIIO::ImageBufAlgo::computePixelStats(difference);
+    double sum = 0;
+    for (const float v : stats.avg) sum += v;
+    return sum / stats.avg.size();
+}
+
+TEST_F(ReliefCli, BakeValidatesAndRenders) {
+    const std::string conus = path("tablet.exr"), uniform = path("uniform.exr");
+    Result r = run("bake relief tablet --tablet-size 320x240 --size 80x60 --text 'AB|CD' -o " + conus);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("detail importance map"), std::string::npos) << r.out;
+    r = run("bake relief tablet --tablet-size 320x240 --size 80x60 --text 'AB|CD' --uniform -o " + uniform);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(run("validate " + conus).exitCode, 0);
+    EXPECT_EQ(run("validate " + uniform).exitCode, 0);
+
+    const format::ConusFile baked = format::readConusFile(conus), flat = format::readConusFile(uniform);
+    EXPECT_EQ(baked.dataKind, format::DataKind::HeightField);
+    EXPECT_EQ(baked.depth.kind, format::DepthKind::Height);
+    ASSERT_TRUE(baked.camera);
+    EXPECT_EQ(baked.camera->projection, "orthographic");
+    EXPECT_EQ(baked.image.width, 80);
+    EXPECT_GT(baked.map.columns, 2);  // a real map
+    EXPECT_EQ(flat.map.columns, 2);   // the identity
+    EXPECT_EQ(flat.image.width * flat.image.height, baked.image.width * baked.image.height);
+
+    const std::string frame = path("frame.png"), frameUniform = path("frame-uniform.png"), shadowed = path("shadows.png");
+    r = run("render relief " + conus + " -o " + frame + " --size 160x120");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(imageSize(frame), std::make_pair(160, 120));
+    const auto [mean, spread] = meanAndSpread(frame);
+    EXPECT_GT(spread, 0.05);  // the tablet in front of the background, shaded
+    EXPECT_GT(mean, 0.1);
+    ASSERT_EQ(run("render relief " + uniform + " -o " + frameUniform + " --size 160x120").exitCode, 0);
+    // A low light from +x: the frame and the strokes' walls cast shadows.
+    const std::string lowLight = path("low.png");
+    ASSERT_EQ(run("render relief " + conus + " -o " + lowLight + " --size 160x120 --light 1,0.3,0").exitCode, 0);
+    ASSERT_EQ(run("render relief " + conus + " -o " + shadowed + " --size 160x120 --light 1,0.3,0 --shadows").exitCode, 0);
+    // The same tablet from the same default view: close, but not the same samples; shadows darken.
+    const double assets = meanDifference(frame, frameUniform);
+    EXPECT_GT(assets, 0.0);
+    EXPECT_LT(assets, 0.05);
+    // Shadows only take light away: some pixels darker, none brighter.
+    const auto darkening = OIIO::ImageBufAlgo::computePixelStats(
+        OIIO::ImageBufAlgo::sub(OIIO::ImageBuf(lowLight), OIIO::ImageBuf(shadowed)));
+    EXPECT_GT(*std::max_element(darkening.max.begin(), darkening.max.end()), 0.1f);
+    EXPECT_GE(*std::min_element(darkening.min.begin(), darkening.min.end()), -0.01f);
+    // A camera given: from straight above the centre, the field fills the frame.
+    ASSERT_EQ(run("render relief " + conus + " -o " + path("above.png") +
+                  " --size 64x48 --camera 0.5,3,0.376,0.5,0,0.375,12")
+                  .exitCode,
+              0);
+    EXPECT_GT(meanAndSpread(path("above.png")).first, 0.25);
+    EXPECT_TRUE(leftovers().empty());
+}
+
+TEST_F(ReliefCli, BadInputFailsWithOneLine) {
+    const std::string picture = makePicture(64, 48);
+    const std::string plain = path("plain.exr");
+    ASSERT_EQ(run("encode " + picture + " -o " + plain + " --focus 0.5,0.5,0.1,2").exitCode, 0);
+    Result r = run("render relief " + plain + " -o " + path("f.png"));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("conus render: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("not a relief asset"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    r = run("render relief " + path("missing.exr") + " -o " + path("f.png"));
+    EXPECT_EQ(r.exitCode, 1);
+    // Bad values are usage errors (2); a file that cannot serve is a failure (1).
+    r = run("bake relief tablet --tablet-size 64x48 --size 128x96 -o " + path("t.exr"));
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("larger than the height field"), std::string::npos) << r.err;
+    EXPECT_EQ(run("bake relief tablet --text '' -o " + path("t.exr")).exitCode, 2);
+    EXPECT_EQ(run("bake relief tablet --uniform --focus 0.5,0.5,0.1,2 -o " + path("t.exr")).exitCode, 2);
+    EXPECT_EQ(run("render relief " + plain + " -o " + path("f.png") + " --step 0").exitCode, 2);
+    EXPECT_EQ(run("render relief " + path("missing.exr") + " -o " + path("f.png") + " --camera 1,2,3").exitCode, 2);
+    EXPECT_FALSE(fs::exists(path("t.exr")));
+    EXPECT_FALSE(fs::exists(path("f.png")));
+    EXPECT_TRUE(leftovers().empty());
+}
+
+}  // namespace
+}  // namespace conus::test

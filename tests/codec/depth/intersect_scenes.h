@@ -1,0 +1,102 @@
+// Shared by the intersection tests (codec: analytic; renderers: CPU == GLSL): depth images of
+// surfaces known in closed form, sampled through a map the way an encoder samples them (each
+// CoNUS pixel centre undistorted, its ray cast at the true surface), and that surface's own
+// intersection for comparison.
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "conus/codec/build/foci.h"
+#include "conus/codec/depth/intersect.h"
+#include "conus/codec/depth/relief.h"
+
+namespace conus::codec::test {
+
+// A relief box over x, z in [0,1] (world), heights along +y, seen from straight above: u = x, v = z.
+inline Camera reliefCamera() { return codec::reliefCamera({1.0, 1.0}, 2.0); }
+
+// A perspective view of a sphere in front of a wall (the reflection case: depth along the axis).
+inline Camera sphereCamera() { return Camera::perspective({0.0, 0.0, -5.0}, {0.0, 0.0, 0.0}, {0, 1, 0}, 40.0, 1.0, 0.5, 20.0); }
+inline constexpr double kWallZ = 2.0;
+inline const glm::dvec3 kSphereCentre{0.2, -0.1, 0.0};
+inline constexpr double kSphereRadius = 1.0;
+
+using HeightFn = std::function<double(double x, double z)>;
+
+inline std::shared_ptr<const SamplingMap> identityMap() { return std::make_shared<SamplingMap>(SamplingMap::identity(2, 2)); }
+// Magnifies a disc around (u, v) k times (a CoNUS map).
+inline std::shared_ptr<const SamplingMap> focusMap(double u, double v, double r = 0.15, double k = 4.0) {
+    const Focus focus{u, v, r, k};
+    FociOptions options;
+    options.columns = options.rows = 65;
+    return std::make_shared<SamplingMap>(buildFociMap(std::span<const Focus>(&focus, 1), options));
+}
+
+inline DepthImage heightImage(const HeightFn& height, std::shared_ptr<const SamplingMap> map, int size) {
+    const Camera camera = reliefCamera();
+    std::vector<float> depths(static_cast<std::size_t>(size) * size);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const glm::dvec2 p = map->undistort({(x + 0.5) / size, (y + 0.5) / size});
+            depths[static_cast<std::size_t>(y) * size + x] = static_cast<float>(heightToDepth(camera, height(p.x, p.y)));
+        }
+    return DepthImage(camera, std::move(map), size, size, std::move(depths));
+}
+
+// Where a ray meets the sphere or the wall behind it (nearest positive t).
+inline std::optional<double> sphereSceneHit(const Ray& ray) {
+    std::optional<double> best;
+    const glm::dvec3 oc = ray.origin - kSphereCentre;
+    const double b = glm::dot(oc, ray.direction), c = glm::dot(oc, oc) - kSphereRadius * kSphereRadius;
+    const double disc = b * b - c;
+    if (disc >= 0.0) {
+        const double t = -b - std::sqrt(disc);
+        if (t > 0.0) best = t;
+    }
+    if (!best && ray.direction.z > 0.0) {
+        const double t = (kWallZ - ray.origin.z) / ray.direction.z;
+        if (t > 0.0) best = t;
+    }
+    return best;
+}
+
+inline DepthImage sphereImage(std::shared_ptr<const SamplingMap> map, int size) {
+    const Camera camera = sphereCamera();
+    std::vector<float> depths(static_cast<std::size_t>(size) * size);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const glm::dvec2 p = map->undistort({(x + 0.5) / size, (y + 0.5) / size});
+            const Ray ray = camera.ray(p);
+            const double t = sphereSceneHit(ray).value();  // the wall fills the whole view
+            depths[static_cast<std::size_t>(y) * size + x] =
+                static_cast<float>(glm::dot(ray.origin + ray.direction * t - camera.eye(), camera.forward()));
+        }
+    return DepthImage(camera, std::move(map), size, size, std::move(depths));
+}
+
+// A ray from `from` toward `to`.
+inline Ray rayThrough(glm::dvec3 from, glm::dvec3 to) { return {from, glm::normalize(to - from)}; }
+
+// The first t where the ray is at or below height(x, z) inside the unit box (heights in [0, top]):
+// dense marching on the true function, then bisection.
+inline std::optional<double> heightFieldHit(const HeightFn& height, const Ray& ray, double tFar = 6.0) {
+    const auto below = [&](double t) {
+        const glm::dvec3 q = ray.origin + ray.direction * t;
+        if (q.x < 0 || q.x > 1 || q.z < 0 || q.z > 1) return false;
+        return q.y <= height(q.x, q.z);
+    };
+    const double dt = 1e-4;
+    for (double t = 0.0; t < tFar; t += dt)
+        if (below(t)) {
+            double a = t - dt, b = t;
+            for (int k = 0; k < 40; ++k) (below(0.5 * (a + b)) ? b : a) = 0.5 * (a + b);
+            return 0.5 * (a + b);
+        }
+    return std::nullopt;
+}
+
+}  // namespace conus::codec::test

@@ -1,0 +1,247 @@
+#include "conus/codec/depth/intersect.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "codec/depth/intersect_scenes.h"
+#include "conus/core/error.h"
+
+namespace conus::codec {
+namespace {
+
+using test::focusMap;
+using test::heightFieldHit;
+using test::heightImage;
+using test::identityMap;
+using test::rayThrough;
+
+// What every hit must satisfy, whatever the surface: its fields describe one point.
+void expectConsistent(const DepthImage& image, const Ray& ray, const DepthHit& hit) {
+    EXPECT_NEAR(glm::distance(hit.position, ray.origin + ray.direction * hit.t), 0.0, 1e-9);
+    const glm::dvec3 projected = image.camera().project(hit.position);
+    EXPECT_NEAR(projected.x, hit.point.x, 1e-6);
+    EXPECT_NEAR(projected.y, hit.point.y, 1e-6);
+    EXPECT_NEAR(projected.z, hit.depth, 1e-6);
+    const glm::dvec2 pd = image.map().distort(hit.point);
+    EXPECT_NEAR(pd.x, hit.distorted.x, 1e-9);
+    EXPECT_NEAR(pd.y, hit.distorted.y, 1e-9);
+    EXPECT_EQ(hit.texel.x, std::min(int(pd.x * image.width()), image.width() - 1));
+    EXPECT_EQ(hit.texel.y, std::min(int(pd.y * image.height()), image.height() - 1));
+    // The hit lies on the stored surface (the bisection's tolerance).
+    EXPECT_NEAR(image.sampleDepth(hit.distorted), hit.depth, 1e-4);
+}
+
+TEST(Intersect, ReliefCameraSeesTheBoxFromAbove) {
+    const Camera camera = test::reliefCamera();
+    const glm::dvec3 a = camera.project({0.0, 0.3, 0.0}), b = camera.project({1.0, 0.3, 1.0});
+    EXPECT_NEAR(a.x, 0.0, 1e-9);
+    EXPECT_NEAR(a.y, 0.0, 1e-9);
+    EXPECT_NEAR(b.x, 1.0, 1e-9);
+    EXPECT_NEAR(b.y, 1.0, 1e-9);
+    EXPECT_NEAR(a.z, heightToDepth(camera, 0.3), 1e-9);
+}
+
+// A tilted plane: bilinear interpolation of an affine function is exact in a conventional image;
+// through a CoNUS map it is exact at the samples and close between them.
+TEST(Intersect, TiltedPlaneMatchesClosedForm) {
+    const auto plane = [](double x, double z) { return 0.2 + 0.1 * x + 0.05 * z; };
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> unit(0.05, 0.95), tilt(-0.6, 0.6);
+    for (const bool conus : {false, true}) {
+        const DepthImage image = heightImage(plane, conus ? focusMap(0.3, 0.6) : identityMap(), 128);
+        for (int i = 0; i < 60; ++i) {
+            const glm::dvec3 target(unit(rng), 0.0, unit(rng));
+            const glm::dvec3 target3(target.x, plane(target.x, target.z), target.z);
+            const Ray ray = rayThrough(target3 + glm::dvec3(tilt(rng), 1.2, tilt(rng)), target3);
+            // Closed form: origin.y + t d.y = plane(origin + t d).
+            const double num = plane(ray.origin.x, ray.origin.z) - ray.origin.y;
+            const double den = ray.direction.y - 0.1 * ray.direction.x - 0.05 * ray.direction.z;
+            const double truth = num / den;
+            const auto hit = intersect(image, ray);
+            ASSERT_TRUE(hit) << (conus ? "CoNUS" : "identity") << " ray " << i;
+            EXPECT_NEAR(hit->t, truth, conus ? 2e-3 : 2e-4) << (conus ? "CoNUS" : "identity") << " ray " << i;
+            expectConsistent(image, ray, *hit);
+        }
+    }
+}
+
+// A sphere in front of a wall, seen by a perspective camera; rays from elsewhere (as reflected
+// rays would come) must find the sphere where it truly is.
+TEST(Intersect, PerspectiveSphereFromAnotherViewpoint) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> angle(-0.9, 0.9);
+    for (const bool conus : {false, true}) {
+        const DepthImage image = test::sphereImage(conus ? focusMap(0.52, 0.5, 0.2, 3.0) : identityMap(), 256);
+        const glm::dvec3 origin(1.5, 1.0, -3.5);
+        int hits = 0;
+        for (int i = 0; i < 60; ++i) {
+            // Points on the sphere facing both the camera (-z) and the ray's origin, away from the
+            // silhouette, where a depth image holds the surface.
+            const double a = angle(rng), b = angle(rng) * 0.7;
+            const glm::dvec3 normal = glm::normalize(glm::dvec3(std::sin(a) * 0.6 + 0.25, std::sin(b) * 0.6 + 0.15, -1.0));
+            const glm::dvec3 target = test::kSphereCentre + normal * test::kSphereRadius;
+            const Ray ray = rayThrough(origin, target);
+            const auto truth = test::sphereSceneHit(ray);
+            ASSERT_TRUE(truth);
+            const auto hit = intersect(image, ray);
+            ASSERT_TRUE(hit) << i;
+            EXPECT_NEAR(hit->t, *truth, 0.01) << (conus ? "CoNUS" : "identity") << " ray " << i;
+            expectConsistent(image, ray, *hit);
+            ++hits;
+        }
+        EXPECT_EQ(hits, 60);
+        // Rays into the wall past the sphere hit the wall.
+        const Ray wallRay = rayThrough({-1.0, 1.2, -4.0}, {-1.2, 0.9, test::kWallZ});
+        const auto wall = intersect(image, wallRay);
+        ASSERT_TRUE(wall);
+        EXPECT_NEAR(wall->position.z, test::kWallZ, 0.01);
+    }
+}
+
+// A step: heights jump at x = 0.5. A focus on the edge holds it sharper than the identity at the
+// same texel count, so rays that hit the wall are placed better.
+TEST(Intersect, StepWallSharperWhereTheMapMagnifies) {
+    const auto step = [](double x, double) { return x > 0.5 ? 0.4 : 0.1; };
+    double error[2] = {0, 0};
+    for (const bool conus : {false, true}) {
+        const DepthImage image = heightImage(step, conus ? focusMap(0.5, 0.5, 0.06, 4.0) : identityMap(), 64);
+        int n = 0;
+        for (double z = 0.4; z <= 0.6; z += 0.01)
+            for (const double y : {0.15, 0.25, 0.35}) {
+                // From the low side, level, into the wall.
+                const Ray ray = rayThrough({0.1, y + 0.05, z}, {0.7, y - 0.05, z + 0.03});
+                const auto truth = heightFieldHit(step, ray);
+                ASSERT_TRUE(truth);
+                const auto hit = intersect(image, ray);
+                ASSERT_TRUE(hit) << "z " << z << " y " << y;
+                error[conus] += std::abs(hit->t - *truth);
+                expectConsistent(image, ray, *hit);
+                ++n;
+            }
+        error[conus] /= n;
+        // At most about a texel (1/64) off, even where the wall is a one-texel ramp.
+        EXPECT_LT(error[conus], 1.5 / 64) << (conus ? "CoNUS" : "identity");
+    }
+    EXPECT_LT(error[1], 0.5 * error[0]);
+}
+
+// A spike two texels wide: rays at it hit its side; rays beside it miss and hit the floor beyond.
+TEST(Intersect, ThinSpikeIsFoundAndMissedWhereItIsNot) {
+    const glm::dvec2 spike(0.37, 0.61);
+    const double radius = 1.0 / 64;
+    const auto field = [&](double x, double z) { return glm::distance(glm::dvec2(x, z), spike) < radius ? 0.5 : 0.05; };
+    for (const bool conus : {false, true}) {
+        const DepthImage image = heightImage(field, conus ? focusMap(0.37, 0.61, 0.1, 3.0) : identityMap(), 64);
+        IntersectOptions fine;
+        fine.stepTexels = 0.5;
+        // Nearly level, at half the spike's height, straight at it.
+        const Ray at = rayThrough({0.05, 0.3, 0.55}, {spike.x, 0.28, spike.y});
+        const auto hit = intersect(image, at, fine);
+        ASSERT_TRUE(hit) << (conus ? "CoNUS" : "identity");
+        EXPECT_LT(glm::distance(glm::dvec2(hit->position.x, hit->position.z), spike), 2.5 * radius);
+        EXPECT_GT(hit->position.y, 0.2);
+        // Beside it by six radii, lower than its top: passes, and comes down on the floor beyond it.
+        const Ray beside = rayThrough({0.05, 0.3, 0.55 + 6 * radius}, {spike.x, 0.2, spike.y + 6 * radius});
+        const auto floor = intersect(image, beside, fine);
+        ASSERT_TRUE(floor);
+        EXPECT_NEAR(floor->position.y, 0.05, 0.01);
+        const auto truth = heightFieldHit(field, beside);
+        ASSERT_TRUE(truth);
+        EXPECT_NEAR(floor->t, *truth, 0.02);
+    }
+}
+
+TEST(Intersect, GrazingAndMissingRays) {
+    const auto plane = [](double, double) { return 0.25; };
+    for (const bool conus : {false, true}) {
+        const DepthImage image = heightImage(plane, conus ? focusMap(0.5, 0.5) : identityMap(), 64);
+        // Level, just above the plane: never touches it.
+        EXPECT_FALSE(intersect(image, rayThrough({-0.5, 0.2501, 0.3}, {1.5, 0.2501, 0.7})));
+        // Grazing down at 1/200: comes down where the closed form says.
+        const Ray grazing = rayThrough({0.0, 0.2525, 0.5}, {1.0, 0.2475, 0.5});
+        const auto hit = intersect(image, grazing);
+        ASSERT_TRUE(hit);
+        EXPECT_NEAR(hit->position.x, 0.5, 1e-3);
+        // Beside the box, above it going up, pointing away, and cut short by tMax.
+        EXPECT_FALSE(intersect(image, rayThrough({1.2, 0.1, 0.5}, {1.2, 0.1, 0.9})));
+        EXPECT_FALSE(intersect(image, rayThrough({0.5, 0.5, 0.5}, {0.6, 0.9, 0.5})));
+        EXPECT_FALSE(intersect(image, rayThrough({0.5, 1.0, -0.5}, {0.5, 1.5, -1.0})));
+        IntersectOptions shortRay;
+        shortRay.tMax = 0.5;
+        EXPECT_FALSE(intersect(image, rayThrough({0.5, 1.0, 0.5}, {0.5, 0.0, 0.5}), shortRay));
+        // Straight down (the projection is a point): still found.
+        const auto down = intersect(image, rayThrough({0.3, 1.0, 0.7}, {0.3, 0.0, 0.7}));
+        ASSERT_TRUE(down);
+        EXPECT_NEAR(down->t, 0.75, 1e-6);
+    }
+}
+
+// A ray entering the box through its side below the surface hits the side wall where it enters.
+TEST(Intersect, SideWallOfTheBox) {
+    const auto field = [](double x, double z) { return 0.3 + 0.1 * std::sin(6 * x + 2 * z); };
+    const DepthImage image = heightImage(field, focusMap(0.6, 0.4), 64);
+    const Ray ray = rayThrough({-0.5, 0.25, 0.4}, {1.0, 0.25, 0.45});
+    const auto hit = intersect(image, ray);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->position.x, 0.0, 1e-9);
+    EXPECT_EQ(hit->steps, 0);
+    EXPECT_EQ(hit->face, 0);  // u = 0
+}
+
+// Step counts follow the map's density: a walk through a 4x focus takes several times the
+// identity's steps over the same stretch, one through the compressed context fewer. (Over the
+// whole image the totals agree: the CoNUS image is as wide as the conventional one.)
+TEST(Intersect, StepsFollowTheLocalDensity) {
+    // A floor with a bump in a corner, away from the rays (the clip keeps the bump's depth range).
+    const auto floor = [](double x, double z) { return std::hypot(x - 0.9, z - 0.1) < 0.05 ? 0.5 : 0.1; };
+    const DepthImage flat = heightImage(floor, identityMap(), 128);
+    const DepthImage focused = heightImage(floor, focusMap(0.5, 0.5, 0.1, 4.0), 128);
+    // Rays across a fifth of the field, coming down on the floor at its end.
+    const auto steps = [&](const DepthImage& image, double x, double z) {
+        const auto hit = intersect(image, rayThrough({x, 0.3, z}, {x + 0.2, 0.099, z}));
+        return hit ? hit->steps : -1;
+    };
+    const int throughFlat = steps(flat, 0.4, 0.5), throughFocus = steps(focused, 0.4, 0.5);
+    EXPECT_NEAR(throughFlat, 0.2 * 128, 2);
+    EXPECT_GT(throughFocus, 2 * throughFlat);
+    const int contextFlat = steps(flat, 0.02, 0.97), contextFocused = steps(focused, 0.02, 0.97);
+    EXPECT_NEAR(contextFlat, 0.2 * 128, 2);
+    EXPECT_LT(contextFocused, contextFlat);
+    EXPECT_GT(contextFocused, 0);
+}
+
+TEST(Intersect, FromFileReadsHeightsAndCamera) {
+    const auto field = [](double x, double z) { return 0.2 + 0.15 * x * z; };
+    const DepthImage direct = heightImage(field, identityMap(), 16);
+    format::ConusFile file;
+    file.image = makeImage(16, 16, {"R", "G", "B", "Z"});
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) file.image.at(x, y, 3) = static_cast<float>(field((x + 0.5) / 16, (y + 0.5) / 16));
+    file.dataKind = format::DataKind::HeightField;
+    file.depth.kind = format::DepthKind::Height;
+    file.map = SamplingMap::identity(2, 2).toGrid();
+    file.camera = format::toAttributes(test::reliefCamera());
+    const DepthImage read = DepthImage::fromFile(file);
+    for (std::size_t i = 0; i < direct.depths().size(); ++i) EXPECT_NEAR(read.depths()[i], direct.depths()[i], 1e-5);
+    file.camera.reset();
+    EXPECT_THROW(DepthImage::fromFile(file), Error);
+}
+
+TEST(Intersect, BadOptionsAndRaysAreRefused) {
+    IntersectOptions bad;
+    bad.stepTexels = 0;
+    EXPECT_THROW(checkIntersectOptions(bad), Error);
+    bad = {};
+    bad.refinements = 100;
+    EXPECT_THROW(checkIntersectOptions(bad), Error);
+    EXPECT_NO_THROW(checkIntersectOptions({}));
+    EXPECT_THROW(checkRay({{0, 0, 0}, {0, 0, 2}}), Error);
+    EXPECT_THROW(checkRay({{NAN, 0, 0}, {0, 0, 1}}), Error);
+    EXPECT_THROW(DepthImage(test::reliefCamera(), nullptr, 2, 2, {1.0f, 2.0f, 3.0f}), Error);
+    EXPECT_THROW(DepthImage(test::reliefCamera(), nullptr, 1, 1, {INFINITY}), Error);
+}
+
+}  // namespace
+}  // namespace conus::codec
