@@ -49,30 +49,6 @@ Image demColour(const Dem& dem, const std::string& texture, glm::dvec2 extent, S
     return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
 }
 
-// "x,y,z,lx,ly,lz,fovDeg": eye, look-at point, vertical field of view.
-struct CameraText {
-    glm::dvec3 eye, target;
-    double fovYDegrees = 50;
-};
-
-CameraText parseCamera(const std::string& text) {
-    std::vector<double> v;
-    std::stringstream in(text);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-        try {
-            std::size_t used = 0;
-            v.push_back(std::stod(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::exception&) {
-            throw Error(ErrorCode::InvalidArgument, "camera '" + text + "': '" + item + "' is not a number");
-        }
-    }
-    if (v.size() != 7)
-        throw Error(ErrorCode::InvalidArgument, "camera '" + text + "' needs 7 values x,y,z,lx,ly,lz,fovDeg");
-    return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6]};
-}
-
 void printCamera(const Camera& c) {
     const glm::dvec3 eye = c.eye(), look = eye + c.forward() * 1000.0;
     std::printf("camera %.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f\n", eye.x, eye.y, eye.z, look.x, look.y, look.z,

@@ -4,6 +4,7 @@
 
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
+#include "conus/codec/mesh/shading.h"
 #include "conus/core/display.h"
 
 namespace conus::gl {
@@ -30,7 +31,10 @@ std::string constantsBlock() {
     for (std::size_t i = 0; i < kInfernoRamp.size(); ++i)
         s += std::string(i ? ", " : "") + "vec3(" + glslFloat(kInfernoRamp[i][0]) + ", " + glslFloat(kInfernoRamp[i][1]) +
              ", " + glslFloat(kInfernoRamp[i][2]) + ")";
-    return s + ");\n";
+    s += ");\n";
+    s += "const float kMeshAmbient = " + glslFloat(codec::kAmbient) + ";\n";
+    s += "const float kMeshGrey = " + glslFloat(codec::kDefaultAlbedo) + ";\n";
+    return s;
 }
 
 }  // namespace
