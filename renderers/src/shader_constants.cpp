@@ -5,6 +5,7 @@
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/mesh/shading.h"
+#include "conus/codec/volume/raycast.h"
 #include "conus/core/display.h"
 
 namespace conus::gl {
@@ -25,6 +26,8 @@ std::string constantsBlock() {
     s += "const int kDecodeMaxTaps = " + std::to_string(codec::kDecodeMaxTaps) + ";\n";
     s += "const int kEncodeMaxTaps = " + std::to_string(codec::kEncodeMaxTaps) + ";\n";
     s += "const float kEncodeTapTolerance = " + glslFloat(codec::kEncodeTapTolerance) + ";\n";
+    s += "const int kTransferTableSize = " + std::to_string(codec::kTransferTableSize) + ";\n";
+    s += "const float kTerminationOpacity = " + glslFloat(codec::kTerminationOpacity) + ";\n";
     s += "const vec3 kBackground = vec3(" + glslFloat(kViewBackground) + ");\n";
     s += "const int kMaxFoci = " + std::to_string(kViewMaxFoci) + ";\n";
     s += "const vec3 kInferno[" + std::to_string(kInfernoRamp.size()) + "] = vec3[](";
