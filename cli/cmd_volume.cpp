@@ -1,11 +1,13 @@
-// conus volume render: scalar volumes through the flexible pinhole camera (paper section 3.2,
+// conus volume render|animate: scalar volumes through the flexible pinhole camera (paper section 3.2,
 // "Volume data"): one CoNUS ray per pixel through the undistorted image-plane point, composited
 // front to back through a transfer function; written as a CoNUS depth image (R, G, B, A and the
-// camera depth Z of the first sample past the opacity threshold, with its camera).
+// camera depth Z of the first sample past the opacity threshold, with its camera). animate slides
+// one focus across the frame and writes each frame so.
 #include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -154,6 +156,75 @@ int runRender(const VolumeOptions& o) {
     return 0;
 }
 
+// --- animate ----------------------------------------------------------------------------------
+
+struct AnimateOptions {
+    VolumeOptions volume;
+    std::string outDir, from = "0.3,0.5", to = "0.7,0.5";
+    int frames = 12;
+    double radius = 0.1, k = 3;
+};
+
+glm::dvec2 parsePoint(const std::string& text, const std::string& what) {
+    const std::size_t comma = text.find(',');
+    char* end = nullptr;
+    const std::string a = text.substr(0, comma), b = comma == std::string::npos ? "" : text.substr(comma + 1);
+    const double u = std::strtod(a.c_str(), &end);
+    const bool uOk = !a.empty() && *end == '\0';
+    const double v = std::strtod(b.c_str(), &end);
+    if (!uOk || b.empty() || *end != '\0' || !(u >= 0 && u <= 1) || !(v >= 0 && v <= 1))
+        throw Error(ErrorCode::InvalidArgument, what + " '" + text + "' is not u,v in [0,1]");
+    return {u, v};
+}
+
+// The focus slides from --from to --to at constant speed; each frame's map is built from that one
+// focus, so every node moves a bounded distance a frame (the map is a continuous function of the
+// focus: tests/cli/volume_test.cpp bounds the step).
+int runAnimate(const AnimateOptions& a) {
+    const VolumeOptions& o = a.volume;
+    const glm::dvec2 from = parsePoint(a.from, "--from"), to = parsePoint(a.to, "--to");
+    const Size size = parseSize(o.sizeText);
+    const double aspect = double(size.width) / size.height;
+    std::error_code ec;
+    std::filesystem::create_directories(a.outDir, ec);
+    if (ec || !std::filesystem::is_directory(a.outDir))
+        throw Error(ErrorCode::Io, "--out-dir '" + a.outDir + "' cannot be made (" + ec.message() + ")");
+    codec::VolumeRenderOptions options = renderOptions(o);
+    const codec::TransferFunction tf = loadTransferFunction(o.tf);
+    Progress loading("read " + o.volume);
+    const Volume volume = loadVolume(o.volume);
+    loading.done();
+    const Camera camera = volumeCamera(o, volume, aspect);
+    const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "volume rendering");
+    codec::FociOptions fo;
+    fo.columns = fo.rows = o.grid;
+    fo.aspect = aspect;
+    std::optional<codec::SamplingMap> previous;
+    double largest = 0;
+    Progress rendering("render " + std::to_string(a.frames) + " frames at " + o.sizeText + " (" + device.describe() + ")");
+    for (int f = 0; f < a.frames; ++f) {
+        const double t = a.frames > 1 ? double(f) / (a.frames - 1) : 0.0;
+        const glm::dvec2 centre = glm::mix(from, to, t);
+        const std::vector<codec::Focus> foci{{centre.x, centre.y, a.radius, a.k}};
+        codec::SamplingMap map = gl::frameMap(foci, fo);
+        if (previous) largest = std::max(largest, gl::largestNodeStep(*previous, map));
+        const Fpc fpc(camera, std::make_shared<codec::SamplingMap>(map));
+        const Image image = gl::renderVolume(device, volume, tf, fpc, size.width, size.height, options);
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%04d", f);
+        const std::filesystem::path base = std::filesystem::path(a.outDir) / name;
+        format::writeConusFile(base.string() + ".exr",
+                               codec::makeDepthImageFile(image, map, camera, o.units, codec::toAnalytic(foci, fo.composition)));
+        writePicture(base.string() + ".png", toRgb(image));
+        previous = std::move(map);
+        rendering.callback()(double(f + 1) / a.frames);
+    }
+    rendering.done();
+    std::printf("wrote %d frames to %s; largest node step between frames %.4g (normalized units)\n", a.frames,
+                a.outDir.c_str(), largest);
+    return 0;
+}
+
 }  // namespace
 
 Command addVolumeCommand(CLI::App& root) {
@@ -202,7 +273,29 @@ Command addVolumeCommand(CLI::App& root) {
     render->add_option("--units", o->units, "the volume's length unit, recorded as the depth's units")->capture_default_str();
     addBackendOption(*render, o->backend, gl::CpuPath::Available);
     addQuietOption(*render);
-    return {volume, [o] { return runRender(*o); }};
+
+    auto a = std::make_shared<AnimateOptions>();
+    CLI::App* animate = addSubcommand(
+        *volume, "animate", "Render a focus sliding across a volume: numbered CoNUS frames and pictures",
+        {"conus volume animate procedural:shepp-logan --out-dir frames --from 0.3,0.45 --to 0.7,0.45 --frames 24"});
+    animate->add_option("volume", a->volume.volume, "the volume, as for render")->required();
+    animate->add_option("--out-dir", a->outDir, "folder for frame_NNNN.exr and frame_NNNN.png")->required();
+    animate->add_option("--from", a->from, "u,v: the focus's first centre")->capture_default_str();
+    animate->add_option("--to", a->to, "u,v: the focus's last centre")->capture_default_str();
+    animate->add_option("--frames", a->frames, "number of frames")->capture_default_str()->check(CLI::Range(1, 100000));
+    animate->add_option("--radius", a->radius, "the focus's radius, a fraction of the width")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1));
+    animate->add_option("--k", a->k, "the focus's magnification")->capture_default_str()->check(finiteRange(1, 64, true));
+    animate->add_option("--size", a->volume.sizeText, "CoNUS image size WxH")->capture_default_str();
+    animate->add_option("--camera", a->volume.cameraText, "ex,ey,ez,lx,ly,lz,fovDeg (default: frames the volume)");
+    animate->add_option("--tf", a->volume.tf, "transfer function: a preset or a file")->capture_default_str();
+    animate->add_option("--grid", a->volume.grid, "sampling-map nodes per side")
+        ->capture_default_str()
+        ->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    addBackendOption(*animate, a->volume.backend, gl::CpuPath::Available);
+    addQuietOption(*animate);
+    return {volume, [o, a, render] { return render->parsed() ? runRender(*o) : runAnimate(*a); }};
 }
 
 }  // namespace conus::cli

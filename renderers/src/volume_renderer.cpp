@@ -88,15 +88,7 @@ void VolumeRendererGpu::setTransferFunction(const codec::TransferFunction& tf) {
 Image VolumeRendererGpu::render(const Fpc& fpc, int width, int height, const codec::VolumeRenderOptions& options,
                                 GpuTimings* timings) {
     Impl& impl = *m_impl;
-    // The checks need a Volume with samples only for their count and finiteness: check the
-    // options and sizes against a two-voxel stand-in of the same spacing.
-    {
-        Volume probe;
-        probe.width = probe.height = probe.depth = 2;
-        probe.spacing = impl.volume.spacing;
-        probe.values.assign(8, 0.0f);
-        codec::checkVolumeRender(probe, width, height, options);
-    }
+    codec::checkVolumeRenderOptions(width, height, options);  // the volume was checked on upload
     Context& context = impl.context;
     if (width > context.textureLimit() || height > context.textureLimit())
         throw Error(ErrorCode::LimitExceeded, std::string(kWhat) + ": output " + std::to_string(width) + "x" +

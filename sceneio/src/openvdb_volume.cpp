@@ -52,6 +52,12 @@ Volume readVdbVolume(const std::string& path, const VolumeReadOptions& options) 
     } catch (const openvdb::Exception& e) {
         throw Error(ErrorCode::Corrupt, what + ": " + e.what());
     } catch (const std::bad_alloc&) {
+        // A damaged file makes OpenVDB read garbage counts and ask for absurd buffers; a small file
+        // that exhausts memory is damaged, a large one may just be too large for this machine.
+        const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+        if (!ec && bytes < (std::uintmax_t{1} << 30))
+            throw Error(ErrorCode::Corrupt, what + ": damaged (reading its " + std::to_string(bytes) +
+                                                " bytes asked for more memory than there is)");
         throw Error(ErrorCode::LimitExceeded, what + ": not enough memory to read it");
     } catch (const std::ios_base::failure& e) {
         throw Error(ErrorCode::Corrupt, what + ": " + e.what());

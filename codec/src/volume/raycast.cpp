@@ -56,8 +56,7 @@ float pixelJitter(int x, int y) {
     return static_cast<float>(h >> 8) * (1.0f / 16777216.0f);
 }
 
-void checkVolumeRender(const Volume& volume, int width, int height, const VolumeRenderOptions& options) {
-    checkVolume(volume, "volume render");
+void checkVolumeRenderOptions(int width, int height, const VolumeRenderOptions& options) {
     if (width < 1 || height < 1 || width > kMaxRenderSide || height > kMaxRenderSide)
         throw Error(ErrorCode::InvalidArgument, "volume render: size " + std::to_string(width) + "x" +
                                                     std::to_string(height) + " is outside [1, 16384] per side");
@@ -129,7 +128,8 @@ std::array<float, 5> castVolumeRay(const Volume& volume, const TransferFunction&
 
 Image renderVolumeReference(const Volume& volume, const TransferFunction& tf, const Fpc& fpc, int width, int height,
                             const VolumeRenderOptions& options) {
-    checkVolumeRender(volume, width, height, options);
+    checkVolume(volume, "volume render");
+    checkVolumeRenderOptions(width, height, options);
     Image out = makeImage(width, height, {kVolumeChannels.begin(), kVolumeChannels.end()});
     const glm::vec2 range = renderRange(volume, options);
     const Distortion* distortion = fpc.distortion();

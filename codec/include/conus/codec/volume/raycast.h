@@ -52,9 +52,9 @@ glm::vec2 renderRange(const Volume& volume, const VolumeRenderOptions& options);
 // pixelJitter in renderers/shaders/volume.frag.glsl.
 float pixelJitter(int x, int y);
 
-// Checks the volume (sizes, finite samples), the size and the options: conus::Error
-// InvalidArgument otherwise.
-void checkVolumeRender(const Volume& volume, int width, int height, const VolumeRenderOptions& options);
+// Checks the output size and the options: conus::Error(InvalidArgument) otherwise. Every
+// renderer calls it, after checkVolume (core/volume.h).
+void checkVolumeRenderOptions(int width, int height, const VolumeRenderOptions& options);
 
 Image renderVolumeReference(const Volume& volume, const TransferFunction& tf, const Fpc& fpc, int width, int height,
                             const VolumeRenderOptions& options = {});
