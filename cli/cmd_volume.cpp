@@ -80,6 +80,13 @@ Camera volumeCamera(const VolumeOptions& o, const Volume& volume, double aspect)
     return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, std::max(lo * 0.98, far * 1e-4), far);
 }
 
+// --camera and --up, checked before any work (the camera itself needs the volume's box).
+void checkCameraOptions(const VolumeOptions& o) {
+    if (o.cameraText.empty()) return;
+    parseCamera(o.cameraText);
+    parseVector3(o.upText, "--up");
+}
+
 codec::VolumeRenderOptions renderOptions(const VolumeOptions& o) {
     codec::VolumeRenderOptions options;
     options.stepVoxels = o.step;
@@ -101,6 +108,7 @@ codec::VolumeRenderOptions renderOptions(const VolumeOptions& o) {
 
 int runRender(const VolumeOptions& o) {
     checkConusOutput(o.output, o.volume);
+    checkCameraOptions(o);
     const Size size = parseSize(o.sizeText);
     const double aspect = double(size.width) / size.height;
     codec::VolumeRenderOptions options = renderOptions(o);
@@ -183,6 +191,7 @@ glm::dvec2 parsePoint(const std::string& text, const std::string& what) {
 int runAnimate(const AnimateOptions& a) {
     const VolumeOptions& o = a.volume;
     const glm::dvec2 from = parsePoint(a.from, "--from"), to = parsePoint(a.to, "--to");
+    checkCameraOptions(o);
     const Size size = parseSize(o.sizeText);
     const double aspect = double(size.width) / size.height;
     std::error_code ec;
@@ -217,7 +226,7 @@ int runAnimate(const AnimateOptions& a) {
                                codec::makeDepthImageFile(image, map, camera, o.units, codec::toAnalytic(foci, fo.composition)));
         writePicture(base.string() + ".png", toRgb(image));
         previous = std::move(map);
-        rendering.callback()(double(f + 1) / a.frames);
+        if (const ProgressFn report = rendering.callback()) report(double(f + 1) / a.frames);
     }
     rendering.done();
     std::printf("wrote %d frames to %s; largest node step between frames %.4g (normalized units)\n", a.frames,

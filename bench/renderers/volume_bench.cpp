@@ -6,6 +6,7 @@
 //           Shepp-Logan phantom at 128^3; transfer function "bone"; the default camera
 //   GPU rows: 512 x 512; CPU rows (the reference): 256 x 256
 //   CoNUS: two foci on the head (k = 3 and 2.5); conventional: the identity FPC
+//   framed (the default camera) and filled (closer, the volume covering the frame): see fpc()
 // Counters: hit_fraction (pixels whose ray reaches an opacity above zero) and mean_steps (samples
 // a pixel, counted on the CPU reference) explain the ratio: a focus on the volume spends more of
 // the frame's rays inside it, each of them longer than a ray through the empty border.
@@ -43,8 +44,17 @@ const codec::TransferFunction& transfer() {
     return tf;
 }
 
-Fpc fpc(bool conus, int width, int height) {
-    const Camera camera = codec::defaultVolumeCamera(volume(), double(width) / height);
+// framed: the default camera, the whole volume in view (much of the frame is empty air around it);
+// filled: the eye moved to half the distance, the volume covering the frame, so conventional and
+// CoNUS rays alike cross it and the ratio shows the per-ray overhead of CoNUS alone.
+Fpc fpc(bool conus, int width, int height, bool filled = false) {
+    Camera camera = codec::defaultVolumeCamera(volume(), double(width) / height);
+    if (filled) {
+        const glm::dvec3 centre = 0.5 * volume().extent();
+        const double distance = glm::distance(camera.eye(), centre);
+        camera = Camera::perspective(centre - camera.forward() * (0.5 * distance), centre, {0.0, -1.0, 0.0},
+                                     camera.verticalFovDegrees(), double(width) / height, 0.01 * distance, 2.0 * distance);
+    }
     if (!conus) return Fpc(camera, nullptr);
     return Fpc(camera, std::make_shared<codec::SamplingMap>(codec::buildFociMap(
                            std::vector<codec::Focus>{{0.45, 0.45, 0.1, 3.0}, {0.6, 0.6, 0.08, 2.5}},
@@ -89,11 +99,11 @@ double meanSteps(const Fpc& f, int width, int height) {
     return sum / count;
 }
 
-void runGpu(benchmark::State& state, bool conus) {
+void runGpu(benchmark::State& state, bool conus, bool filled = false) {
     if (!context()) return state.SkipWithError("no GL backend");
     const int w = 512, h = 512;
     gl::VolumeRendererGpu renderer(*context(), volume(), transfer());
-    const Fpc f = fpc(conus, w, h);
+    const Fpc f = fpc(conus, w, h, filled);
     Image last = renderer.render(f, w, h, {});  // compile the shader outside the timing
     gl::GpuTimings sum, t;
     for (auto _ : state) {
@@ -110,9 +120,9 @@ void runGpu(benchmark::State& state, bool conus) {
     state.SetLabel(context()->renderer());
 }
 
-void runCpu(benchmark::State& state, bool conus) {
+void runCpu(benchmark::State& state, bool conus, bool filled = false) {
     const int w = 256, h = 256;
-    const Fpc f = fpc(conus, w, h);
+    const Fpc f = fpc(conus, w, h, filled);
     Image last;
     for (auto _ : state) last = codec::renderVolumeReference(volume(), transfer(), f, w, h);
     state.counters["hit_fraction"] = hitFraction(last);
@@ -123,6 +133,10 @@ void BM_VolumeGpuConventional(benchmark::State& state) { runGpu(state, false); }
 void BM_VolumeGpuConus(benchmark::State& state) { runGpu(state, true); }
 void BM_VolumeCpuConventional(benchmark::State& state) { runCpu(state, false); }
 void BM_VolumeCpuConus(benchmark::State& state) { runCpu(state, true); }
+void BM_VolumeGpuConventionalFilled(benchmark::State& state) { runGpu(state, false, true); }
+void BM_VolumeGpuConusFilled(benchmark::State& state) { runGpu(state, true, true); }
+void BM_VolumeCpuConventionalFilled(benchmark::State& state) { runCpu(state, false, true); }
+void BM_VolumeCpuConusFilled(benchmark::State& state) { runCpu(state, true, true); }
 
 }  // namespace
 
@@ -130,3 +144,7 @@ BENCHMARK(BM_VolumeGpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime(
 BENCHMARK(BM_VolumeGpuConus)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_VolumeCpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_VolumeCpuConus)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeGpuConventionalFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeGpuConusFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeCpuConventionalFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeCpuConusFilled)->Unit(benchmark::kMillisecond)->UseRealTime();

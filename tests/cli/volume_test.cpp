@@ -76,7 +76,9 @@ TEST_F(Volume, RenderWritesACameraDepthImage) {
             EXPECT_GT(z[p], camera.near());
             EXPECT_LT(z[p], camera.far());
         }
-        if (a[p] == 0.0f) EXPECT_FLOAT_EQ(z[p], float(camera.far()));
+        if (a[p] == 0.0f) {
+            EXPECT_FLOAT_EQ(z[p], float(camera.far()));
+        }
     }
     EXPECT_GT(seen, 80 * 60 / 10);
     EXPECT_EQ(imageSize(path("head.png")), std::make_pair(80, 60));
@@ -139,8 +141,8 @@ TEST_F(Volume, BadInputGetsOneLineAndANonZeroExit) {
 }
 
 // A focus sliding across the volume: every frame is a CoNUS depth image with its own map, and no
-// node of the map jumps between frames (the largest step is bounded by a small multiple of the
-// focus's own step).
+// node of the map jumps between frames (the largest step is bounded by (k - 1) times the focus's
+// own step, the rate at which a magnifier's inside moves, with a margin).
 TEST_F(Volume, AnimateMovesTheFocusWithoutJumps) {
     const int frames = 6;
     const Result r = run("volume animate procedural:marschner-lobb:24 --out-dir " + path("frames") +
@@ -167,7 +169,9 @@ TEST_F(Volume, AnimateMovesTheFocusWithoutJumps) {
         previous = nodes;
     }
     std::printf("largest node step %.4f for a focus step of %.4f\n", largest, focusStep);
-    EXPECT_LT(largest, 1.5 * focusStep);
+    // Near a focus of magnification k the map is about c + k (p - c): moving the centre c by D moves
+    // those nodes by (k - 1) D, and nothing may move more (measured: 2.03 D for k = 3).
+    EXPECT_LT(largest, 1.25 * (3 - 1) * focusStep);
     EXPECT_NE(r.out.find("largest node step"), std::string::npos);
 }
 
