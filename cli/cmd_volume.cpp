@@ -80,6 +80,18 @@ Camera volumeCamera(const VolumeOptions& o, const Volume& volume, double aspect)
     return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, std::max(lo * 0.98, far * 1e-4), far);
 }
 
+// "a,b": two finite numbers.
+glm::dvec2 parsePair(const std::string& text, const std::string& what) {
+    const std::size_t comma = text.find(',');
+    const std::string a = text.substr(0, comma), b = comma == std::string::npos ? "" : text.substr(comma + 1);
+    char* endA = nullptr;
+    char* endB = nullptr;
+    const double x = std::strtod(a.c_str(), &endA), y = std::strtod(b.c_str(), &endB);
+    if (a.empty() || b.empty() || *endA != '\0' || *endB != '\0' || !std::isfinite(x) || !std::isfinite(y))
+        throw Error(ErrorCode::InvalidArgument, what + " '" + text + "' is not two numbers a,b");
+    return {x, y};
+}
+
 // --camera and --up, checked before any work (the camera itself needs the volume's box).
 void checkCameraOptions(const VolumeOptions& o) {
     if (o.cameraText.empty()) return;
@@ -93,17 +105,29 @@ codec::VolumeRenderOptions renderOptions(const VolumeOptions& o) {
     options.depthOpacity = float(o.depthOpacity);
     options.jitter = !o.noJitter;
     if (!o.rangeText.empty()) {
-        const std::size_t comma = o.rangeText.find(',');
-        char* end = nullptr;
-        const std::string lo = o.rangeText.substr(0, comma), hi = comma == std::string::npos ? "" : o.rangeText.substr(comma + 1);
-        options.rangeLo = std::strtof(lo.c_str(), &end);
-        const bool loOk = !lo.empty() && *end == '\0';
-        options.rangeHi = std::strtof(hi.c_str(), &end);
-        if (!loOk || hi.empty() || *end != '\0' || !std::isfinite(options.rangeLo) || !std::isfinite(options.rangeHi) ||
-            !(options.rangeHi > options.rangeLo))
+        const glm::dvec2 range = parsePair(o.rangeText, "--range");
+        if (!(range.y > range.x) || std::abs(range.x) > 3e38 || std::abs(range.y) > 3e38)
             throw Error(ErrorCode::InvalidArgument, "--range '" + o.rangeText + "' is not lo,hi with lo < hi");
+        options.rangeLo = float(range.x);
+        options.rangeHi = float(range.y);
     }
     return options;
+}
+
+// What render and animate read before rendering: the transfer function, the volume, the camera.
+struct Scene {
+    codec::TransferFunction tf;
+    Volume volume;
+    Camera camera;
+};
+
+Scene loadScene(const VolumeOptions& o, double aspect) {
+    codec::TransferFunction tf = loadTransferFunction(o.tf);
+    Progress loading("read " + o.volume);
+    Volume volume = loadVolume(o.volume);
+    loading.done();
+    const Camera camera = volumeCamera(o, volume, aspect);
+    return {std::move(tf), std::move(volume), camera};
 }
 
 int runRender(const VolumeOptions& o) {
@@ -112,12 +136,10 @@ int runRender(const VolumeOptions& o) {
     const Size size = parseSize(o.sizeText);
     const double aspect = double(size.width) / size.height;
     codec::VolumeRenderOptions options = renderOptions(o);
-    const codec::TransferFunction tf = loadTransferFunction(o.tf);
-
-    Progress loading("read " + o.volume);
-    const Volume volume = loadVolume(o.volume);
-    loading.done();
-    const Camera camera = volumeCamera(o, volume, aspect);
+    const Scene scene = loadScene(o, aspect);
+    const Volume& volume = scene.volume;
+    const Camera& camera = scene.camera;
+    const codec::TransferFunction& tf = scene.tf;
 
     std::optional<codec::SamplingMap> map;
     std::optional<format::AnalyticMap> analytic;
@@ -174,15 +196,10 @@ struct AnimateOptions {
 };
 
 glm::dvec2 parsePoint(const std::string& text, const std::string& what) {
-    const std::size_t comma = text.find(',');
-    char* end = nullptr;
-    const std::string a = text.substr(0, comma), b = comma == std::string::npos ? "" : text.substr(comma + 1);
-    const double u = std::strtod(a.c_str(), &end);
-    const bool uOk = !a.empty() && *end == '\0';
-    const double v = std::strtod(b.c_str(), &end);
-    if (!uOk || b.empty() || *end != '\0' || !(u >= 0 && u <= 1) || !(v >= 0 && v <= 1))
+    const glm::dvec2 p = parsePair(text, what);
+    if (!(p.x >= 0 && p.x <= 1 && p.y >= 0 && p.y <= 1))
         throw Error(ErrorCode::InvalidArgument, what + " '" + text + "' is not u,v in [0,1]");
-    return {u, v};
+    return p;
 }
 
 // The focus slides from --from to --to at constant speed; each frame's map is built from that one
@@ -199,11 +216,10 @@ int runAnimate(const AnimateOptions& a) {
     if (ec || !std::filesystem::is_directory(a.outDir))
         throw Error(ErrorCode::Io, "--out-dir '" + a.outDir + "' cannot be made (" + ec.message() + ")");
     codec::VolumeRenderOptions options = renderOptions(o);
-    const codec::TransferFunction tf = loadTransferFunction(o.tf);
-    Progress loading("read " + o.volume);
-    const Volume volume = loadVolume(o.volume);
-    loading.done();
-    const Camera camera = volumeCamera(o, volume, aspect);
+    const Scene scene = loadScene(o, aspect);
+    const Volume& volume = scene.volume;
+    const Camera& camera = scene.camera;
+    const codec::TransferFunction& tf = scene.tf;
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "volume rendering");
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
