@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
         conus::cli::addDecodeCommand(app),   conus::cli::addInfoCommand(app),
         conus::cli::addValidateCommand(app), conus::cli::addDemoCommand(app),
         conus::cli::addMapCommand(app),  conus::cli::addHeightFieldCommand(app),
-        conus::cli::addMeshCommand(app),
+        conus::cli::addMeshCommand(app), conus::cli::addVolumeCommand(app),
         conus::cli::addBakeCommand(app), conus::cli::addRenderCommand(app),
     };
 

@@ -6,6 +6,7 @@
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/mesh/shading.h"
+#include "conus/codec/volume/raycast.h"
 #include "conus/core/display.h"
 
 namespace conus::gl {
@@ -30,6 +31,8 @@ std::string constantsBlock() {
     s += "const float kEncodeAnisotropicSigma = " + glslFloat(codec::kEncodeAnisotropicSigma) + ";\n";
     s += "const float kEncodeGaussianReach = " + glslFloat(codec::kEncodeGaussianReach) + ";\n";
     s += "const float kEncodeBoxAnisotropy = " + glslFloat(codec::kEncodeBoxAnisotropy) + ";\n";
+    s += "const int kTransferTableSize = " + std::to_string(codec::kTransferTableSize) + ";\n";
+    s += "const float kTerminationOpacity = " + glslFloat(codec::kTerminationOpacity) + ";\n";
     s += "const vec3 kBackground = vec3(" + glslFloat(kViewBackground) + ");\n";
     s += "const int kMaxFoci = " + std::to_string(kViewMaxFoci) + ";\n";
     s += "const vec3 kInferno[" + std::to_string(kInfernoRamp.size()) + "] = vec3[](";

@@ -7,8 +7,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -31,6 +33,43 @@ inline std::pair<int, int> imageSize(const std::string& path) {
     auto input = OIIO::ImageInput::open(path);
     if (!input) return {0, 0};
     return {input->spec().width, input->spec().height};
+}
+
+// An EXR's first part as OpenImageIO reads it: channels by name, and its string attributes.
+struct ExrRead {
+    int width = 0, height = 0;
+    std::map<std::string, std::vector<float>> channels;  // name -> width * height values
+    OIIO::ImageSpec spec;
+};
+
+inline ExrRead readExr(const std::string& path) {
+    ExrRead r;
+    auto input = OIIO::ImageInput::open(path);
+    if (!input) return r;
+    r.spec = input->spec();
+    r.width = r.spec.width;
+    r.height = r.spec.height;
+    std::vector<float> all(static_cast<std::size_t>(r.width) * r.height * r.spec.nchannels);
+    if (!input->read_image(0, 0, 0, r.spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) return r;
+    for (int c = 0; c < r.spec.nchannels; ++c) {
+        auto& values = r.channels[r.spec.channelnames[c]];
+        for (std::size_t p = 0; p < static_cast<std::size_t>(r.width) * r.height; ++p)
+            values.push_back(all[p * r.spec.nchannels + c]);
+    }
+    return r;
+}
+
+// PSNR of R, G, B, A between two renders of one size (peak 1).
+inline double psnrRgb(const ExrRead& a, const ExrRead& b) {
+    double se = 0;
+    std::size_t n = 0;
+    for (const char* c : {"R", "G", "B", "A"})
+        for (std::size_t p = 0; p < a.channels.at(c).size(); ++p) {
+            const double d = a.channels.at(c)[p] - b.channels.at(c)[p];
+            se += d * d;
+            ++n;
+        }
+    return 10.0 * std::log10(1.0 / std::max(se / n, 1e-12));
 }
 
 inline std::string slurp(const fs::path& path) {

@@ -15,30 +15,6 @@
 namespace conus::test {
 namespace {
 
-// An EXR's first part as OpenImageIO reads it: channels by name, and its string attributes.
-struct ExrRead {
-    int width = 0, height = 0;
-    std::map<std::string, std::vector<float>> channels;  // name -> width * height values
-    OIIO::ImageSpec spec;
-};
-
-ExrRead readExr(const std::string& path) {
-    ExrRead r;
-    auto input = OIIO::ImageInput::open(path);
-    if (!input) return r;
-    r.spec = input->spec();
-    r.width = r.spec.width;
-    r.height = r.spec.height;
-    std::vector<float> all(static_cast<std::size_t>(r.width) * r.height * r.spec.nchannels);
-    if (!input->read_image(0, 0, 0, r.spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) return r;
-    for (int c = 0; c < r.spec.nchannels; ++c) {
-        auto& values = r.channels[r.spec.channelnames[c]];
-        for (std::size_t p = 0; p < static_cast<std::size_t>(r.width) * r.height; ++p)
-            values.push_back(all[p * r.spec.nchannels + c]);
-    }
-    return r;
-}
-
 // A unit cube centred at (0.2, 0, 0) with a colour per corner (OBJ's "v x y z r g b"), and a
 // small triangle floating in front of it so the picture has no symmetry.
 std::string writeObj(const fs::path& path) {
@@ -55,18 +31,6 @@ double covered(const ExrRead& r) {
     double sum = 0;
     for (float a : r.channels.at("A")) sum += a;
     return sum;
-}
-
-double psnrRgb(const ExrRead& a, const ExrRead& b) {
-    double se = 0;
-    std::size_t n = 0;
-    for (const char* c : {"R", "G", "B", "A"})
-        for (std::size_t p = 0; p < a.channels.at(c).size(); ++p) {
-            const double d = a.channels.at(c)[p] - b.channels.at(c)[p];
-            se += d * d;
-            ++n;
-        }
-    return 10.0 * std::log10(1.0 / std::max(se / n, 1e-12));
 }
 
 using Mesh = Cli;

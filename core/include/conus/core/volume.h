@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -22,5 +23,10 @@ struct Volume {
     // The world size of the box the samples span (sample centres at i * spacing).
     glm::dvec3 extent() const { return glm::dvec3(width - 1, height - 1, depth - 1) * spacing; }
 };
+
+// Throws conus::Error, naming `what`, unless `volume` is well formed: every side at least 2, one
+// value per sample, positive finite spacing (InvalidArgument), every value finite (Corrupt, naming
+// the first sample that is not). Every reader and renderer of a Volume starts with it.
+void checkVolume(const Volume& volume, const std::string& what);
 
 }  // namespace conus

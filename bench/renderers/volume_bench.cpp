@@ -1,0 +1,150 @@
+// CoNUS volume ray casting against the conventional render of the same volume at the same size,
+// in one binary so ratios come from one run (the bound: CoNUS <= 1.05x conventional; the
+// paper measured +7%). CONUS_BACKEND picks the GL backend as in gpu_bench.cpp.
+//
+//   volume: the MRI scan brainsmall.den (128 x 128 x 84) when the shared data is there, else the
+//           Shepp-Logan phantom at 128^3; transfer function "bone"; the default camera
+//   GPU rows: 512 x 512; CPU rows (the reference): 256 x 256
+//   CoNUS: two foci on the head (k = 3 and 2.5); conventional: the identity FPC
+//   framed (the default camera) and filled (closer, the volume covering the frame): see fpc()
+// Counters: hit_fraction (pixels whose ray reaches an opacity above zero) and mean_steps (samples
+// a pixel, counted on the CPU reference) explain the ratio: a focus on the volume spends more of
+// the frame's rays inside it, each of them longer than a ray through the empty border.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "conus/codec/build/foci.h"
+#include "conus/codec/volume/procedural.h"
+#include "conus/codec/volume/raycast.h"
+#include "conus/renderers/context.h"
+#include "conus/renderers/volume_renderer.h"
+#include "conus/sceneio/volume_file.h"
+
+namespace {
+
+using namespace conus;
+
+const Volume& volume() {
+    static const Volume v = [] {
+        const std::string brain = std::string(CONUS_SHARED_DATA) + "/volumes/brainsmall.den";
+        if (std::filesystem::exists(brain)) return sceneio::readVolume(brain);
+        return codec::sheppLogan3d(128);
+    }();
+    return v;
+}
+
+const codec::TransferFunction& transfer() {
+    static const codec::TransferFunction tf = codec::TransferFunction::preset("bone");
+    return tf;
+}
+
+// framed: the default camera, the whole volume in view (much of the frame is empty air around it);
+// filled: the eye moved to half the distance, the volume covering the frame, so conventional and
+// CoNUS rays alike cross it and the ratio shows the per-ray overhead of CoNUS alone.
+Fpc fpc(bool conus, int width, int height, bool filled = false) {
+    Camera camera = codec::defaultVolumeCamera(volume(), double(width) / height);
+    if (filled) {
+        const glm::dvec3 centre = 0.5 * volume().extent();
+        const double distance = glm::distance(camera.eye(), centre);
+        camera = Camera::perspective(centre - camera.forward() * (0.5 * distance), centre, {0.0, -1.0, 0.0},
+                                     camera.verticalFovDegrees(), double(width) / height, 0.01 * distance, 2.0 * distance);
+    }
+    if (!conus) return Fpc(camera, nullptr);
+    return Fpc(camera, std::make_shared<codec::SamplingMap>(codec::buildFociMap(
+                           std::vector<codec::Focus>{{0.45, 0.45, 0.1, 3.0}, {0.6, 0.6, 0.08, 2.5}},
+                           {.aspect = double(width) / height})));
+}
+
+gl::Context* context() {
+    static std::unique_ptr<gl::Context> ctx;
+    static bool tried = false;
+    if (!tried) {
+        tried = true;
+        const char* env = std::getenv("CONUS_BACKEND");
+        try {
+            ctx = gl::Context::create(gl::parseBackend(env ? env : "auto"));
+        } catch (const Error&) {
+        }
+    }
+    return ctx.get();
+}
+
+double hitFraction(const Image& image) {
+    double hits = 0;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) hits += image.at(x, y, 3) > 0.0f;
+    return hits / (double(image.width) * image.height);
+}
+
+// Samples a pixel of the reference (every 4th pixel each way, outside the timing).
+double meanSteps(const Fpc& f, int width, int height) {
+    const Volume& v = volume();
+    const glm::vec2 range = codec::renderRange(v, {});
+    double sum = 0, count = 0;
+    for (int y = 0; y < height; y += 4)
+        for (int x = 0; x < width; x += 4) {
+            const glm::dvec2 pd((x + 0.5) / width, (y + 0.5) / height);
+            int steps = 0;
+            codec::castVolumeRay(v, transfer(), f.camera(), f.distortion() ? f.distortion()->undistort(pd) : pd,
+                                 codec::pixelJitter(x, y), range, {}, &steps);
+            sum += steps;
+            ++count;
+        }
+    return sum / count;
+}
+
+void runGpu(benchmark::State& state, bool conus, bool filled = false) {
+    if (!context()) return state.SkipWithError("no GL backend");
+    const int w = 512, h = 512;
+    gl::VolumeRendererGpu renderer(*context(), volume(), transfer());
+    const Fpc f = fpc(conus, w, h, filled);
+    Image last = renderer.render(f, w, h, {});  // compile the shader outside the timing
+    gl::GpuTimings sum, t;
+    for (auto _ : state) {
+        last = renderer.render(f, w, h, {}, &t);
+        sum.uploadMs += t.uploadMs;
+        sum.drawMs += t.drawMs;
+        sum.readbackMs += t.readbackMs;
+    }
+    const auto avg = benchmark::Counter::kAvgIterations;
+    state.counters["upload_ms"] = benchmark::Counter(sum.uploadMs, avg);
+    state.counters["draw_ms"] = benchmark::Counter(sum.drawMs, avg);
+    state.counters["readback_ms"] = benchmark::Counter(sum.readbackMs, avg);
+    state.counters["hit_fraction"] = hitFraction(last);
+    state.SetLabel(context()->renderer());
+}
+
+void runCpu(benchmark::State& state, bool conus, bool filled = false) {
+    const int w = 256, h = 256;
+    const Fpc f = fpc(conus, w, h, filled);
+    Image last;
+    for (auto _ : state) last = codec::renderVolumeReference(volume(), transfer(), f, w, h);
+    state.counters["hit_fraction"] = hitFraction(last);
+    state.counters["mean_steps"] = meanSteps(f, w, h);
+}
+
+void BM_VolumeGpuConventional(benchmark::State& state) { runGpu(state, false); }
+void BM_VolumeGpuConus(benchmark::State& state) { runGpu(state, true); }
+void BM_VolumeCpuConventional(benchmark::State& state) { runCpu(state, false); }
+void BM_VolumeCpuConus(benchmark::State& state) { runCpu(state, true); }
+void BM_VolumeGpuConventionalFilled(benchmark::State& state) { runGpu(state, false, true); }
+void BM_VolumeGpuConusFilled(benchmark::State& state) { runGpu(state, true, true); }
+void BM_VolumeCpuConventionalFilled(benchmark::State& state) { runCpu(state, false, true); }
+void BM_VolumeCpuConusFilled(benchmark::State& state) { runCpu(state, true, true); }
+
+}  // namespace
+
+BENCHMARK(BM_VolumeGpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeGpuConus)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeCpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeCpuConus)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeGpuConventionalFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeGpuConusFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeCpuConventionalFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VolumeCpuConusFilled)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -1,0 +1,326 @@
+// conus volume render|animate: scalar volumes through the flexible pinhole camera (paper section 3.2,
+// "Volume data"): one CoNUS ray per pixel through the undistorted image-plane point, composited
+// front to back through a transfer function; written as a CoNUS depth image (R, G, B, A and the
+// camera depth Z of the first sample past the opacity threshold, with its camera). animate slides
+// one focus across the frame and writes each frame so.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arguments.h"
+#include "backend.h"
+#include "commands.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/conus_file.h"
+#include "conus/codec/volume/procedural.h"
+#include "conus/codec/volume/raycast.h"
+#include "conus/codec/volume/transfer_function.h"
+#include "conus/core/error.h"
+#include "conus/format/container.h"
+#include "conus/renderers/mesh_sequence.h"
+#include "conus/renderers/volume_renderer.h"
+#include "conus/sceneio/volume_file.h"
+#include "encoding.h"
+#include "image_files.h"
+#include "pictures.h"
+#include "progress.h"
+
+namespace conus::cli {
+namespace {
+
+struct VolumeOptions {
+    std::string volume, output, picture, sizeText = "512x512", cameraText, upText = "0,-1,0", tf = "bone",
+                                         rangeText, backend = "auto", units = "voxel", mapFile;
+    std::vector<std::string> foci;
+    int grid = map_rules::kDefaultSide;
+    std::string compose = "density";
+    double step = 0.5, depthOpacity = 0.5;
+    bool uniform = false, noJitter = false;
+};
+
+// procedural:... through codec, every file form through sceneio.
+Volume loadVolume(const std::string& spec) {
+    if (spec.rfind("procedural:", 0) == 0) return codec::proceduralVolume(spec);
+    return sceneio::readVolume(spec);
+}
+
+// A preset's name, or the path of a transfer-function file (anything with a '/' or '.' or that exists).
+codec::TransferFunction loadTransferFunction(const std::string& text) {
+    std::error_code ec;
+    if (text.find_first_of("/.") != std::string::npos || std::filesystem::exists(text, ec))
+        return codec::TransferFunction::load(text);
+    return codec::TransferFunction::preset(text);
+}
+
+Camera volumeCamera(const VolumeOptions& o, const Volume& volume, double aspect) {
+    if (o.cameraText.empty()) return codec::defaultVolumeCamera(volume, aspect);
+    const CameraText given = parseCamera(o.cameraText);
+    const glm::dvec3 up = parseVector3(o.upText, "--up");
+    const glm::dvec3 forward = given.target - given.eye;
+    if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
+        throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText +
+                                                    "': the eye must differ from the look-at point and not look along --up");
+    // Near and far bracket the volume's box along the view axis.
+    const glm::dvec3 axis = glm::normalize(forward), extent = volume.extent();
+    double lo = 1e300, hi = -1e300;
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 p((corner & 1) ? extent.x : 0.0, (corner & 2) ? extent.y : 0.0, (corner & 4) ? extent.z : 0.0);
+        lo = std::min(lo, glm::dot(p - given.eye, axis));
+        hi = std::max(hi, glm::dot(p - given.eye, axis));
+    }
+    if (!(hi > 0))
+        throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText + "': the volume lies entirely behind the camera");
+    const double far = hi * 1.02 + 1e-6;
+    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, std::max(lo * 0.98, far * 1e-4), far);
+}
+
+// "a,b": two finite numbers.
+glm::dvec2 parsePair(const std::string& text, const std::string& what) {
+    const std::size_t comma = text.find(',');
+    const std::string a = text.substr(0, comma), b = comma == std::string::npos ? "" : text.substr(comma + 1);
+    char* endA = nullptr;
+    char* endB = nullptr;
+    const double x = std::strtod(a.c_str(), &endA), y = std::strtod(b.c_str(), &endB);
+    if (a.empty() || b.empty() || *endA != '\0' || *endB != '\0' || !std::isfinite(x) || !std::isfinite(y))
+        throw Error(ErrorCode::InvalidArgument, what + " '" + text + "' is not two numbers a,b");
+    return {x, y};
+}
+
+// --camera and --up, checked before any work (the camera itself needs the volume's box).
+void checkCameraOptions(const VolumeOptions& o) {
+    if (o.cameraText.empty()) return;
+    parseCamera(o.cameraText);
+    parseVector3(o.upText, "--up");
+}
+
+codec::VolumeRenderOptions renderOptions(const VolumeOptions& o) {
+    codec::VolumeRenderOptions options;
+    options.stepVoxels = o.step;
+    options.depthOpacity = float(o.depthOpacity);
+    options.jitter = !o.noJitter;
+    if (!o.rangeText.empty()) {
+        const glm::dvec2 range = parsePair(o.rangeText, "--range");
+        if (!(range.y > range.x) || std::abs(range.x) > 3e38 || std::abs(range.y) > 3e38)
+            throw Error(ErrorCode::InvalidArgument, "--range '" + o.rangeText + "' is not lo,hi with lo < hi");
+        options.rangeLo = float(range.x);
+        options.rangeHi = float(range.y);
+    }
+    return options;
+}
+
+// What render and animate read before rendering: the transfer function, the volume, the camera.
+struct Scene {
+    codec::TransferFunction tf;
+    Volume volume;
+    Camera camera;
+};
+
+Scene loadScene(const VolumeOptions& o, double aspect) {
+    codec::TransferFunction tf = loadTransferFunction(o.tf);
+    Progress loading("read " + o.volume);
+    Volume volume = loadVolume(o.volume);
+    loading.done();
+    const Camera camera = volumeCamera(o, volume, aspect);
+    return {std::move(tf), std::move(volume), camera};
+}
+
+int runRender(const VolumeOptions& o) {
+    checkConusOutput(o.output, o.volume);
+    checkCameraOptions(o);
+    const Size size = parseSize(o.sizeText);
+    const double aspect = double(size.width) / size.height;
+    codec::VolumeRenderOptions options = renderOptions(o);
+    const Scene scene = loadScene(o, aspect);
+    const Volume& volume = scene.volume;
+    const Camera& camera = scene.camera;
+    const codec::TransferFunction& tf = scene.tf;
+
+    std::optional<codec::SamplingMap> map;
+    std::optional<format::AnalyticMap> analytic;
+    if (o.uniform) {
+        map.emplace(codec::SamplingMap::identity(2, 2));
+    } else if (!o.mapFile.empty()) {
+        const format::ConusFile source = format::readConusFile(o.mapFile);
+        map.emplace(codec::SamplingMap::fromGrid(source.map));
+        analytic = source.analytic;
+    } else if (!o.foci.empty()) {
+        std::vector<codec::Focus> foci;
+        for (const auto& text : o.foci) foci.push_back(codec::parseFocus(text));
+        codec::FociOptions fo;
+        fo.columns = fo.rows = o.grid;
+        fo.aspect = aspect;
+        fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+        Progress building("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
+        map.emplace(gl::frameMap(foci, fo));
+        analytic = codec::toAnalytic(foci, fo.composition);
+        building.done();
+    } else {
+        warn("no --focus or --map: rendering the uniform image of the same pixel count (what --uniform makes)");
+        map.emplace(codec::SamplingMap::identity(2, 2));
+    }
+    const bool identity = o.uniform || (o.mapFile.empty() && o.foci.empty());
+    const Fpc fpc(camera, identity ? nullptr : std::make_shared<codec::SamplingMap>(*map));
+
+    const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "volume rendering");
+    Progress rendering("render " + std::to_string(volume.width) + "x" + std::to_string(volume.height) + "x" +
+                       std::to_string(volume.depth) + " volume at " + o.sizeText + " (" + device.describe() + ")");
+    options.progress = rendering.callback();
+    const Image image = gl::renderVolume(device, volume, tf, fpc, size.width, size.height, options);
+    rendering.done();
+    Progress writing("write " + o.output);
+    format::writeConusFile(o.output, codec::makeDepthImageFile(image, *map, camera, o.units, analytic));
+    if (!o.picture.empty()) writePicture(o.picture, toRgb(image));
+    writing.done();
+    const glm::dvec3 eye = camera.eye(), look = eye + camera.forward();
+    std::printf("camera %.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g (near %.4g, far %.4g)\n", eye.x, eye.y, eye.z, look.x, look.y,
+                look.z, camera.verticalFovDegrees(), camera.near(), camera.far());
+    std::printf("wrote %s: %dx%d CoNUS colour + depth image of %s (%dx%dx%d), %dx%d sampling map, %s\n", o.output.c_str(),
+                size.width, size.height, o.volume.c_str(), volume.width, volume.height, volume.depth, map->columns(),
+                map->rows(), device.describe().c_str());
+    return 0;
+}
+
+// --- animate ----------------------------------------------------------------------------------
+
+struct AnimateOptions {
+    VolumeOptions volume;
+    std::string outDir, from = "0.3,0.5", to = "0.7,0.5";
+    int frames = 12;
+    double radius = 0.1, k = 3;
+};
+
+glm::dvec2 parsePoint(const std::string& text, const std::string& what) {
+    const glm::dvec2 p = parsePair(text, what);
+    if (!(p.x >= 0 && p.x <= 1 && p.y >= 0 && p.y <= 1))
+        throw Error(ErrorCode::InvalidArgument, what + " '" + text + "' is not u,v in [0,1]");
+    return p;
+}
+
+// The focus slides from --from to --to at constant speed; each frame's map is built from that one
+// focus, so every node moves a bounded distance a frame (the map is a continuous function of the
+// focus: tests/cli/volume_test.cpp bounds the step).
+int runAnimate(const AnimateOptions& a) {
+    const VolumeOptions& o = a.volume;
+    const glm::dvec2 from = parsePoint(a.from, "--from"), to = parsePoint(a.to, "--to");
+    checkCameraOptions(o);
+    const Size size = parseSize(o.sizeText);
+    const double aspect = double(size.width) / size.height;
+    std::error_code ec;
+    std::filesystem::create_directories(a.outDir, ec);
+    if (ec || !std::filesystem::is_directory(a.outDir))
+        throw Error(ErrorCode::Io, "--out-dir '" + a.outDir + "' cannot be made (" + ec.message() + ")");
+    codec::VolumeRenderOptions options = renderOptions(o);
+    const Scene scene = loadScene(o, aspect);
+    const Volume& volume = scene.volume;
+    const Camera& camera = scene.camera;
+    const codec::TransferFunction& tf = scene.tf;
+    const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "volume rendering");
+    codec::FociOptions fo;
+    fo.columns = fo.rows = o.grid;
+    fo.aspect = aspect;
+    std::optional<codec::SamplingMap> previous;
+    double largest = 0;
+    Progress rendering("render " + std::to_string(a.frames) + " frames at " + o.sizeText + " (" + device.describe() + ")");
+    for (int f = 0; f < a.frames; ++f) {
+        const double t = a.frames > 1 ? double(f) / (a.frames - 1) : 0.0;
+        const glm::dvec2 centre = glm::mix(from, to, t);
+        const std::vector<codec::Focus> foci{{centre.x, centre.y, a.radius, a.k}};
+        codec::SamplingMap map = gl::frameMap(foci, fo);
+        if (previous) largest = std::max(largest, gl::largestNodeStep(*previous, map));
+        const Fpc fpc(camera, std::make_shared<codec::SamplingMap>(map));
+        const Image image = gl::renderVolume(device, volume, tf, fpc, size.width, size.height, options);
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%04d", f);
+        const std::filesystem::path base = std::filesystem::path(a.outDir) / name;
+        format::writeConusFile(base.string() + ".exr",
+                               codec::makeDepthImageFile(image, map, camera, o.units, codec::toAnalytic(foci, fo.composition)));
+        writePicture(base.string() + ".png", toRgb(image));
+        previous = std::move(map);
+        if (const ProgressFn report = rendering.callback()) report(double(f + 1) / a.frames);
+    }
+    rendering.done();
+    std::printf("wrote %d frames to %s; largest node step between frames %.4g (normalized units)\n", a.frames,
+                a.outDir.c_str(), largest);
+    return 0;
+}
+
+}  // namespace
+
+Command addVolumeCommand(CLI::App& root) {
+    CLI::App* volume = root.add_subcommand(
+        "volume", "Scalar volumes through the flexible pinhole camera: CoNUS ray casting into colour + depth images");
+    volume->require_subcommand(1);
+    auto o = std::make_shared<VolumeOptions>();
+    CLI::App* render = addSubcommand(
+        *volume, "render", "Render a volume as a CoNUS colour + depth image (R, G, B, A, Z and its camera)",
+        {"conus volume render procedural:shepp-logan -o head.exr --focus 0.5,0.45,0.12,3 --picture head.png  # a phantom, a focus",
+         "conus volume render brain.den -o brain.exr --tf bone --size 640x480 --uniform  # the uniform baseline",
+         "conus volume render raw:256x256x128:uint16:0.8:ct.raw -o ct.exr --tf grey --range 0,4095  # a raw brick"});
+    render->add_option("volume", o->volume,
+                       "file.vdb | file.nrrd | file.nhdr | file.den | raw:WxHxD:uint8|uint16|float32[:spacing]:path | "
+                       "procedural:marschner-lobb[:n] | procedural:shepp-logan[:n]")
+        ->required();
+    render->add_option("-o,--output", o->output, "the CoNUS file to write (.exr)")->required();
+    render->add_option("--picture", o->picture, "also write the CoNUS image's colour as a picture (PNG)");
+    render->add_option("--size", o->sizeText, "CoNUS image size WxH")->capture_default_str();
+    render->add_option("--camera", o->cameraText,
+                       "ex,ey,ez,lx,ly,lz,fovDeg: eye, look-at point and vertical field of view, in the volume's world "
+                       "units (sample (i,j,k) at (i,j,k) * spacing; default: one that frames the volume)");
+    render->add_option("--up", o->upText, "the camera's up direction x,y,z (with --camera)")->capture_default_str();
+    render->add_option("--tf", o->tf,
+                       "transfer function: a preset (grey, bone, fire, shells) or a file of lines \"value r g b a\" "
+                       "(numbers in [0,1], values increasing)")
+        ->capture_default_str();
+    render->add_option("--range", o->rangeText, "lo,hi: the sample values mapped to the transfer function's 0..1 "
+                                                "(default: the volume's min..max)");
+    render->add_option("--step", o->step, "ray step in voxels (the smallest spacing)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 16));
+    render->add_option("--depth-opacity", o->depthOpacity, "Z is where the accumulated opacity first reaches this")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1));
+    render->add_flag("--no-jitter", o->noJitter, "start every ray half a step in (banding) instead of a per-pixel jitter");
+    render->add_option("--focus", o->foci, "u,v,r,k: a focus (centre, radius as a fraction of the width, magnification); repeatable");
+    render->add_option("--map", o->mapFile, "take the sampling map from this CoNUS file");
+    render->add_option("--grid", o->grid, "sampling-map nodes per side for --focus")
+        ->capture_default_str()
+        ->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    render->add_option("--compose", o->compose, "how foci combine: density | add")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"density", "add"}));
+    render->add_flag("--uniform", o->uniform, "render the uniform image of the same pixel count (the baseline)");
+    render->add_option("--units", o->units, "the volume's length unit, recorded as the depth's units")->capture_default_str();
+    addBackendOption(*render, o->backend, gl::CpuPath::Available);
+    addQuietOption(*render);
+
+    auto a = std::make_shared<AnimateOptions>();
+    CLI::App* animate = addSubcommand(
+        *volume, "animate", "Render a focus sliding across a volume: numbered CoNUS frames and pictures",
+        {"conus volume animate procedural:shepp-logan --out-dir frames --from 0.3,0.45 --to 0.7,0.45 --frames 24"});
+    animate->add_option("volume", a->volume.volume, "the volume, as for render")->required();
+    animate->add_option("--out-dir", a->outDir, "folder for frame_NNNN.exr and frame_NNNN.png")->required();
+    animate->add_option("--from", a->from, "u,v: the focus's first centre")->capture_default_str();
+    animate->add_option("--to", a->to, "u,v: the focus's last centre")->capture_default_str();
+    animate->add_option("--frames", a->frames, "number of frames")->capture_default_str()->check(CLI::Range(1, 100000));
+    animate->add_option("--radius", a->radius, "the focus's radius, a fraction of the width")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1));
+    animate->add_option("--k", a->k, "the focus's magnification")->capture_default_str()->check(finiteRange(1, 64, true));
+    animate->add_option("--size", a->volume.sizeText, "CoNUS image size WxH")->capture_default_str();
+    animate->add_option("--camera", a->volume.cameraText, "ex,ey,ez,lx,ly,lz,fovDeg (default: frames the volume)");
+    animate->add_option("--tf", a->volume.tf, "transfer function: a preset or a file")->capture_default_str();
+    animate->add_option("--grid", a->volume.grid, "sampling-map nodes per side")
+        ->capture_default_str()
+        ->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    addBackendOption(*animate, a->volume.backend, gl::CpuPath::Available);
+    addQuietOption(*animate);
+    return {volume, [o, a, render] { return render->parsed() ? runRender(*o) : runAnimate(*a); }};
+}
+
+}  // namespace conus::cli
