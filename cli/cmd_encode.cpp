@@ -13,6 +13,7 @@
 #include "encoding.h"
 #include "image_files.h"
 #include "importance.h"
+#include "map_options.h"
 #include "progress.h"
 
 namespace conus::cli {

@@ -29,6 +29,7 @@
 #include "image_files.h"
 #include "encoding.h"
 #include "importance.h"
+#include "map_options.h"
 #include "pictures.h"
 #include "progress.h"
 

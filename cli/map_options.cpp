@@ -1,0 +1,33 @@
+#include "map_options.h"
+
+#include <CLI/CLI.hpp>
+
+namespace conus::cli {
+
+codec::AutoMapOptions autoMapOptions(int grid, double minDensity, double maxDensity, double maxAnisotropy, const std::string& method) {
+    codec::AutoMapOptions options;
+    options.columns = options.rows = grid;
+    options.minDensity = minDensity;
+    options.maxDensity = maxDensity;
+    options.maxAnisotropy = maxAnisotropy;
+    options.method = method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
+    return options;
+}
+
+void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy) {
+    command.add_option("--max-anisotropy", maxAnisotropy,
+                       "largest ratio of a CoNUS pixel's long to short side in the source (the Jacobian's singular "
+                       "values; >= 1, default: no limit); a tight limit costs magnification")
+        ->check(CLI::Range(1.0, 1e6));
+}
+
+void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDensity, const std::string& prefix) {
+    command.add_option("--min-density", minDensity,
+                       prefix + "density every map cell keeps (0..1, default 0.25), held to 5% or refused")
+        ->check(CLI::Range(0.001, 0.999));
+    command.add_option("--max-density", maxDensity,
+                       prefix + "cap on every map cell's density (default 16: 4x the linear rate), held to 5% or refused")
+        ->check(CLI::Range(1.001, 4096.0));
+}
+
+}  // namespace conus::cli
