@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "conus/codec/build/frame_foci.h"
 #include "conus/core/error.h"
 
 namespace conus::gl {
@@ -31,6 +32,7 @@ std::vector<codec::Focus> trackedFoci(const Camera& camera, std::span<const glm:
 }
 
 codec::SamplingMap frameMap(std::span<const codec::Focus> foci, const codec::FociOptions& options) {
+    if (options.composition == codec::FociComposition::Add) return codec::buildFrameFociMap(foci, options);
     if (foci.empty()) return codec::SamplingMap::identity(options.columns, options.rows);
     return codec::buildFociMap(foci, options);
 }

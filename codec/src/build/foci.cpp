@@ -26,17 +26,6 @@ constexpr int kMinShortSide = 32;
 // Add composition: the factor applied to all displacements while the sum folds.
 constexpr double kAddShrink = 0.9;
 
-void checkFocus(const Focus& f) {
-    // Written as negations so that NaN fails every check.
-    if (!(f.u >= 0.0 && f.u <= 1.0 && f.v >= 0.0 && f.v <= 1.0)) {
-        throw Error(ErrorCode::InvalidArgument, "focus centre (" + numberText(f.u) + ", " + numberText(f.v) + ") is outside [0,1]^2");
-    }
-    if (!(f.r > 0.0 && f.r <= 1.0)) throw Error(ErrorCode::InvalidArgument, "focus radius " + numberText(f.r) + " is not in (0, 1]");
-    if (!(f.k >= 1.0 && f.k <= map_rules::kMaxMagnification)) {
-        throw Error(ErrorCode::InvalidArgument, "focus magnification " + numberText(f.k) + " is not in [1, " + numberText(map_rules::kMaxMagnification) + "]");
-    }
-}
-
 void checkOptions(const FociOptions& options) {
     if (!(options.aspect > 0.0) || !std::isfinite(options.aspect)) {
         throw Error(ErrorCode::InvalidArgument, "aspect " + numberText(options.aspect) + " is not finite and > 0");
@@ -122,6 +111,17 @@ double fociDensity(std::span<const Focus> foci, double aspect, double u, double 
         density = std::max(density, 1.0 + (f.k * f.k - 1.0) * falloff(s));
     }
     return density;
+}
+
+void checkFocus(const Focus& f) {
+    // Written as negations so that NaN fails every check.
+    if (!(f.u >= 0.0 && f.u <= 1.0 && f.v >= 0.0 && f.v <= 1.0)) {
+        throw Error(ErrorCode::InvalidArgument, "focus centre (" + numberText(f.u) + ", " + numberText(f.v) + ") is outside [0,1]^2");
+    }
+    if (!(f.r > 0.0 && f.r <= 1.0)) throw Error(ErrorCode::InvalidArgument, "focus radius " + numberText(f.r) + " is not in (0, 1]");
+    if (!(f.k >= 1.0 && f.k <= map_rules::kMaxMagnification)) {
+        throw Error(ErrorCode::InvalidArgument, "focus magnification " + numberText(f.k) + " is not in [1, " + numberText(map_rules::kMaxMagnification) + "]");
+    }
 }
 
 SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options) {

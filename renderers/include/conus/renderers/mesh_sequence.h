@@ -7,7 +7,7 @@
 // linearly to 1 as the projected centre goes from the border to one radius beyond it; a radius is
 // measured in widths, as Focus::r), and an object at or behind the camera's near plane has no focus.
 // Two foci that pass each other merge and separate smoothly because the map of a set of foci is a
-// continuous function of their parameters (codec/build/foci.h).
+// continuous function of their parameters (codec/build/frame_foci.h).
 #pragma once
 
 #include <span>
@@ -31,7 +31,9 @@ struct TrackOptions {
 std::vector<codec::Focus> trackedFoci(const Camera& camera, std::span<const glm::dvec3> points, double aspect,
                                       const TrackOptions& options = {});
 
-// One frame's map: buildFociMap of the foci, or the identity of the same grid when there are none.
+// One frame's map. The add composition (the animation's, the paper's) is built in closed form by
+// codec::buildFrameFociMap, microseconds a frame; the density composition by codec::buildFociMap.
+// The identity of the same grid when there are no foci.
 codec::SamplingMap frameMap(std::span<const codec::Focus> foci, const codec::FociOptions& options);
 
 // The largest distance any node moved between two maps of the same grid (normalized units).

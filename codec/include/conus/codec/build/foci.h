@@ -33,6 +33,10 @@ struct FociOptions {
     double maxAnisotropy = 0;     // density composition: DensityMapOptions::maxAnisotropy (0: none)
 };
 
+// Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r outside (0, 1] or k outside
+// [1, 64] (NaN fails): what every builder of foci asks of a focus.
+void checkFocus(const Focus& focus);
+
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r <= 0 or k < 1 or k > 64.
 SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options = {});
 
