@@ -64,27 +64,22 @@ CLI::Validator finiteRange(double low, double high, bool lowIncluded) {
         description);
 }
 
+CameraText parseCamera(const std::string& text) {
+    const auto v = parseNumbers(text, ',');
+    if (v.size() != 7 || text.back() == ',') invalid("camera '" + text + "' needs 7 values x,y,z,lx,ly,lz,fovDeg");
+    if (!(v[6] > 0 && v[6] < 180)) invalid("camera '" + text + "': the field of view must lie in (0, 180) degrees");
+    return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6]};
+}
+
+glm::dvec3 parseVector3(const std::string& text, const std::string& what) {
+    const auto v = parseNumbers(text, ',');
+    if (v.size() != 3 || text.back() == ',') invalid(what + " '" + text + "' needs 3 values x,y,z");
+    return {v[0], v[1], v[2]};
+}
+
 format::Compression parseCompression(const std::string& text) {
     if (const auto compression = format::parseName<format::Compression>(text)) return *compression;
     invalid("compression '" + text + "' is not one of " + format::nameList<format::Compression>());
-}
-
-LookAt parseLookAt(const std::string& text) {
-    std::vector<double> v;
-    std::stringstream in(text);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-        try {
-            std::size_t used = 0;
-            v.push_back(std::stod(item, &used));
-            if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
-        } catch (const std::exception&) {
-            throw Error(ErrorCode::InvalidArgument, "camera '" + text + "': '" + item + "' is not a finite number");
-        }
-    }
-    if (v.size() != 7)
-        throw Error(ErrorCode::InvalidArgument, "camera '" + text + "' needs 7 values x,y,z,lx,ly,lz,fovDeg");
-    return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6]};
 }
 
 }  // namespace conus::cli

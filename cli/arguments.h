@@ -20,12 +20,14 @@ Size parseSize(const std::string& text);        // "1024x768"; each side in [1, 
 codec::View parseView(const std::string& text);  // "u0,v0,u1,v1" with u0 < u1, v0 < v1, all finite
 format::Compression parseCompression(const std::string& text);  // zip | piz | dwaa | none
 
-// A camera given as "x,y,z,lx,ly,lz,fovDeg": eye, look-at point, vertical field of view (degrees).
-struct LookAt {
+// "x,y,z,lx,ly,lz,fovDeg": eye, look-at point, vertical field of view in degrees (what
+// `heightfield render` and `mesh render` take as --camera).
+struct CameraText {
     glm::dvec3 eye{0.0}, target{0.0};
     double fovYDegrees = 50;
 };
-LookAt parseLookAt(const std::string& text);
+CameraText parseCamera(const std::string& text);
+glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "x,y,z", all finite
 
 // A CLI11 check for a number option: finite, above `low` (or equal to it when `lowIncluded`) and
 // below `high`. CLI::Range lets NaN through (every comparison with NaN is false); this does not,

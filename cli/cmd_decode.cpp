@@ -5,11 +5,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "arguments.h"
 #include "backend.h"
 #include "batch.h"
 #include "commands.h"
+#include "conus/codec/depth/depth_image.h"
 #include "conus/codec/image/decode.h"
 #include "conus/core/error.h"
 #include "conus/renderers/gpu_image.h"
@@ -36,6 +39,35 @@ Size outputSize(const DecodeCommandOptions& o, const codec::View& view, const fo
                                                     std::to_string(kMaxImageSide) + " a side, " +
                                                     std::to_string(kMaxImagePixels) + " in all); give --size");
     return {std::max(1, static_cast<int>(w)), std::max(1, static_cast<int>(h))};
+}
+
+// A depth image's view: colour and coverage bilinear on `device`, Z nearest (depth_image.h: a
+// mean across a silhouette would be a depth on neither surface); Z outside the image is the far.
+Image decodeDepthImage(const gl::Device& device, const format::ConusFile& file, const codec::SamplingMap& map,
+                       const codec::DecodeOptions& decode) {
+    const Image& conus = file.image;
+    const int z = conus.channelIndex("Z");
+    std::vector<std::string> names;
+    for (const auto& name : conus.channels)
+        if (name != "Z") names.push_back(name);
+    Image frame;
+    if (!names.empty()) {
+        Image colour = makeImage(conus.width, conus.height, names);
+        const std::size_t n = static_cast<std::size_t>(conus.width) * conus.height, from = conus.channels.size();
+        for (std::size_t p = 0; p < n; ++p)
+            for (std::size_t c = 0, k = 0; c < from; ++c)
+                if (static_cast<int>(c) != z) colour.pixels[p * names.size() + k++] = conus.pixels[p * from + c];
+        frame = gl::decodeImage(device, colour, map, decode);
+    }
+    const Image depth = codec::decodeDepthNearest(conus, map, decode, file.depth.far);
+    names.push_back("Z");
+    Image out = makeImage(decode.width, decode.height, names);
+    const std::size_t n = static_cast<std::size_t>(decode.width) * decode.height, c = names.size();
+    for (std::size_t p = 0; p < n; ++p) {
+        for (std::size_t k = 0; k + 1 < c; ++k) out.pixels[p * c + k] = frame.pixels[p * (c - 1) + k];
+        out.pixels[p * c + c - 1] = depth.pixels[p];
+    }
+    return out;
 }
 
 // One input to one output; returns the line that says what was written.
@@ -74,12 +106,13 @@ std::string decodeOne(const DecodeCommandOptions& o, const std::string& input, c
     Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
     decode.progress = progress.callback();
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "decoding");
-    const Image frame = gl::decodeImage(device, file.image, map, decode);
+    const bool depthImage = file.dataKind == format::DataKind::DepthImage && file.image.channelIndex("Z") >= 0;
+    const Image frame = depthImage ? decodeDepthImage(device, file, map, decode) : gl::decodeImage(device, file.image, map, decode);
     progress.done();
     writePicture(output, frame, write);
     char line[256];
     std::snprintf(line, sizeof line, ": %dx%d view [%g,%g]-[%g,%g]", frame.width, frame.height, view.u0, view.v0, view.u1, view.v1);
-    return "wrote " + output + line;
+    return "wrote " + output + line + (depthImage ? " (Z: the nearest CoNUS pixel's depth)" : "");
 }
 
 int runDecode(const DecodeCommandOptions& o) {

@@ -55,8 +55,6 @@ void printCamera(const Camera& c) {
                 c.verticalFovDegrees());
 }
 
-}  // namespace
-
 codec::GroundParams groundOf(const format::ConusFile& file, const std::string& name) {
     if (file.dataKind != format::DataKind::HeightField || !file.analytic || file.analytic->kind != "ground")
         throw Error(ErrorCode::InvalidArgument, name + " is not a CoNUS height field with ground-map parameters");
@@ -67,169 +65,204 @@ codec::GroundParams groundOf(const format::ConusFile& file, const std::string& n
 Camera terrainCamera(const format::ConusFile& file, const std::string& cameraText, double aspect) {
     const Camera viewer = gl::viewerCamera(groundOf(file, "the file"), codec::heightAt(file, {0.5, 1.0}), aspect);
     if (cameraText.empty()) return viewer;
-    const LookAt given = parseLookAt(cameraText);
+    const CameraText given = parseCamera(cameraText);
     return Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, viewer.near(), viewer.far());
 }
 
-Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
-                                     int height, const std::string& backendName) {
-    const gl::Device device = deviceFor(backendName, gl::CpuPath::None, "terrain rendering");
-    const glm::dvec2 extent = codec::fieldExtent(groundOf(file, "the file"));
-    const Camera camera = terrainCamera(file, cameraText, double(width) / height);
-    Progress progress("undistort the height field and render " + std::to_string(width) + "x" + std::to_string(height));
-    Image frame = gl::renderTerrain(device.context(), codec::undistortHeightField(file, extent), camera, width, height);
+// A frame of the height field `file` (called `name` in messages) seen from `cameraText`.
+struct Frame {
+    Image image;
+    Camera camera;
+    glm::dvec2 extent;  // the field's size on the ground
+};
+
+Frame renderFrame(gl::Context& context, const format::ConusFile& file, const std::string& name,
+                  const std::string& cameraText, Size size, const std::string& stage) {
+    const glm::dvec2 extent = codec::fieldExtent(groundOf(file, name));
+    const Camera camera = terrainCamera(file, cameraText, double(size.width) / size.height);
+    Progress progress(stage);
+    Image image = gl::renderTerrain(context, codec::undistortHeightField(file, extent), camera, size.width, size.height);
     progress.done();
     printCamera(camera);
-    return frame;
+    return {std::move(image), camera, extent};
 }
 
-Command addHeightFieldCommand(CLI::App& root) {
-    struct Options {
-        std::string dem, output, sizeText = "512x512", colour, compression = "zip";
-        double eyeHeight = 150, near = 200, far = 0, fov = 0, heightScale = 1;  // far, fov: 0 until given
-        int grid = 129;
-        std::string input, frame, cameraText, frameSize = "960x540", compare, backend = "auto";
-    };
-    auto o = std::make_shared<Options>();
-    CLI::App* command = root.add_subcommand(
-        "heightfield", "CoNUS height fields: sample a DEM densely near a viewer (encode), render it (render)");
-    command->require_subcommand(1);
+// ---- encode ----
 
-    CLI::App* encode = command->add_subcommand("encode", "Sample a DEM through the perspective ground map");
-    encode->add_option("dem", o->dem,
-                       "DEM: 16-bit PNG/TIFF (read as [0,1]: give --height-scale), float EXR, .npy, .npz "
-                       "(e.g. matplotlib's jacksboro_fault_dem.npz) or procedural[:SIZE[:SEED]]")
+struct EncodeOptions {
+    std::string dem, output, sizeText = "512x512", colour, compression = "zip";
+    double eyeHeight = 150, near = 200, far = 0, fov = 0, heightScale = 1;  // far, fov: 0 until given
+    int grid = 129;
+};
+
+void addEncodeOptions(CLI::App& encode, const std::shared_ptr<EncodeOptions>& o) {
+    encode.add_option("dem", o->dem,
+                      "DEM: 16-bit PNG/TIFF (read as [0,1]: give --height-scale), float EXR, .npy, .npz "
+                      "(e.g. matplotlib's jacksboro_fault_dem.npz) or procedural[:SIZE[:SEED]]")
         ->required();
-    encode->add_option("-o,--output", o->output, "CoNUS file (.exr)")->required();
-    encode->add_option("--size", o->sizeText, "CoNUS image size WxH")->capture_default_str();
+    encode.add_option("-o,--output", o->output, "CoNUS file (.exr)")->required();
+    encode.add_option("--size", o->sizeText, "CoNUS image size WxH")->capture_default_str();
     // The ground map's own ranges (ground_map.h), checked here so a bad value is a usage error.
-    encode->add_option("--eye-height", o->eyeHeight, "viewer's eye above the base plane, metres")
+    encode.add_option("--eye-height", o->eyeHeight, "viewer's eye above the base plane, metres")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9));
-    encode->add_option("--near", o->near, "distance from the viewer to the field's near edge, metres")
+    encode.add_option("--near", o->near, "distance from the viewer to the field's near edge, metres")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9, true));
-    CLI::Option* far = encode->add_option("--far", o->far,
-                                          "distance to the far edge, metres, beyond --near (default: near + the DEM's "
-                                          "depth when the file gives its spacing, else 6000)")
+    CLI::Option* far = encode.add_option("--far", o->far,
+                                         "distance to the far edge, metres, beyond --near (default: near + the DEM's "
+                                         "depth when the file gives its spacing, else 6000)")
                            ->check(finiteRange(0, 1e9));
-    encode->add_option("--fov", o->fov,
-                       "horizontal field of view at the far edge, degrees; sets the field's width (default: the "
-                       "DEM's own width when known, else 60)")
+    encode.add_option("--fov", o->fov,
+                      "horizontal field of view at the far edge, degrees; sets the field's width (default: the "
+                      "DEM's own width when known, else 60)")
         ->check(finiteRange(0, 170));
-    encode->callback([o, far] {
+    encode.callback([o, far] {
         if (far->count() > 0 && !(o->far > o->near)) {
             std::ostringstream why;
             why << o->far << " is not beyond --near " << o->near;
             throw CLI::ValidationError("--far", why.str());
         }
     });
-    encode->add_option("--grid", o->grid, "sampling-map nodes per side stored in the file")->capture_default_str();
-    encode->add_option("--height-scale", o->heightScale, "multiplies the DEM's values (to metres)")
+    encode.add_option("--grid", o->grid, "sampling-map nodes per side stored in the file")->capture_default_str();
+    encode.add_option("--height-scale", o->heightScale, "multiplies the DEM's values (to metres)")
         ->capture_default_str();
-    encode->add_option("--colour,--color", o->colour, "colour texture (default: a ramp by height and slope)");
-    encode->add_option("--compression", o->compression, "zip | piz | dwaa | none")
+    encode.add_option("--colour,--color", o->colour, "colour texture (default: a ramp by height and slope)");
+    encode.add_option("--compression", o->compression, "zip | piz | dwaa | none")
         ->capture_default_str()
         ->check(CLI::IsMember(format::namesOf<format::Compression>()));
-    addQuietOption(*encode);
-    setExamples(*encode, {"conus heightfield encode procedural -o terrain.exr",
+    addQuietOption(encode);
+    setExamples(encode, {"conus heightfield encode procedural -o terrain.exr",
                        "conus heightfield encode dem.tif --height-scale 800 -o terrain.exr --size 1024x1024 --eye-height 150",
                        "conus heightfield encode jacksboro_fault_dem.npz --colour ortho.png -o terrain.exr"});
+}
 
-    CLI::App* render = command->add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
-    render->add_option("input", o->input, "CoNUS height field (.exr)")->required();
-    render->add_option("-o,--output", o->frame, "frame (.png, .exr, ...)")->required();
-    render->add_option("--camera", o->cameraText,
-                       "x,y,z,lx,ly,lz,fovDeg: eye, look-at point (world metres: x right, y up, z toward the "
-                       "viewer) and vertical fov (default: the ground map's viewer)");
-    render->add_option("--size", o->frameSize, "frame size WxH")->capture_default_str();
-    render->add_option("--compare", o->compare,
-                       "the DEM the file was made from: also render it at full resolution and a uniform height "
-                       "field of the same sample count, side by side (full | CoNUS | uniform), with PSNRs");
-    render->add_option("--height-scale", o->heightScale, "as given to encode (for --compare)")->capture_default_str();
-    render->add_option("--colour,--color", o->colour, "as given to encode (for --compare)");
-    addBackendOption(*render, o->backend, gl::CpuPath::None);
-    addQuietOption(*render);
-    setExamples(*render, {"conus heightfield render terrain.exr -o frame.png",
+// The ground map: the options as given, the DEM's own size in metres where the user left
+// --far or --fov out and the file knows its spacing, else the defaults.
+codec::GroundParams groundFor(const EncodeOptions& o, const Dem& dem) {
+    const glm::dvec2 demMetres(dem.cellMetres.x * dem.heights.width, dem.cellMetres.y * dem.heights.height);
+    codec::GroundParams ground;
+    ground.eyeHeight = o.eyeHeight;
+    ground.near = o.near;
+    ground.far = o.far > 0 ? o.far : demMetres.y > 0 ? o.near + demMetres.y : 6000.0;
+    ground.fovDegrees = o.fov > 0           ? o.fov
+                        : demMetres.x > 0 ? codec::fovForFieldWidth(o.eyeHeight, o.near, ground.far, demMetres.x)
+                                          : 60.0;
+    return ground;
+}
+
+void runEncode(const EncodeOptions& o) {
+    Progress loading("read " + o.dem);
+    const Dem dem = readDem(o.dem, o.heightScale);
+    loading.done();
+    codec::HeightFieldOptions options;
+    options.ground = groundFor(o, dem);
+    const Size size = parseSize(o.sizeText);
+    options.width = size.width;
+    options.height = size.height;
+    options.mapGrid = o.grid;
+    const glm::dvec2 extent = codec::fieldExtent(options.ground);
+    SourceEncoding encoding;
+    const Image colour = demColour(dem, o.colour, extent, &encoding);
+    Progress progress("encode height field " + o.sizeText);
+    options.progress = progress.callback();
+    format::ConusFile file = codec::encodeHeightField(dem.heights, colour, options);
+    progress.done();
+    file.compression = parseCompression(o.compression);
+    file.sourceEncoding = encoding;
+    format::writeConusFile(o.output, file);
+    std::printf("wrote %s: %dx%d CoNUS height field of %s; field %.0f x %.0f m (eye %g m, near %g m, "
+                "far %g m, fov %.2f deg); heights %.1f..%.1f m\n",
+                o.output.c_str(), file.image.width, file.image.height, dem.description.c_str(), extent.x, extent.y,
+                options.ground.eyeHeight, options.ground.near, options.ground.far, options.ground.fovDegrees,
+                file.depth.near, file.depth.far);
+}
+
+// ---- render ----
+
+struct RenderOptions {
+    std::string input, frame, cameraText, frameSize = "960x540", compare, backend = "auto", colour;
+    double heightScale = 1;
+};
+
+void addRenderOptions(CLI::App& render, RenderOptions& o) {
+    render.add_option("input", o.input, "CoNUS height field (.exr)")->required();
+    render.add_option("-o,--output", o.frame, "frame (.png, .exr, ...)")->required();
+    render.add_option("--camera", o.cameraText,
+                      "x,y,z,lx,ly,lz,fovDeg: eye, look-at point (world metres: x right, y up, z toward the "
+                      "viewer) and vertical fov (default: the ground map's viewer)");
+    render.add_option("--size", o.frameSize, "frame size WxH")->capture_default_str();
+    render.add_option("--compare", o.compare,
+                      "the DEM the file was made from: also render it at full resolution and a uniform height "
+                      "field of the same sample count, side by side (full | CoNUS | uniform), with PSNRs");
+    render.add_option("--height-scale", o.heightScale, "as given to encode (for --compare)")->capture_default_str();
+    render.add_option("--colour,--color", o.colour, "as given to encode (for --compare)");
+    addBackendOption(render, o.backend, gl::CpuPath::None);
+    addQuietOption(render);
+    setExamples(render, {"conus heightfield render terrain.exr -o frame.png",
                        "conus heightfield render terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720",
                        "conus heightfield render terrain.exr -o compare.png --compare procedural"});
+}
 
-    return {command, [o, encode, render] {
-                if (encode->parsed()) {
-                    Progress loading("read " + o->dem);
-                    const Dem dem = readDem(o->dem, o->heightScale);
-                    loading.done();
-                    const glm::dvec2 demMetres(dem.cellMetres.x * dem.heights.width,
-                                               dem.cellMetres.y * dem.heights.height);
-                    codec::HeightFieldOptions options;
-                    options.ground.eyeHeight = o->eyeHeight;
-                    options.ground.near = o->near;
-                    options.ground.far = o->far > 0 ? o->far : demMetres.y > 0 ? o->near + demMetres.y : 6000.0;
-                    options.ground.fovDegrees =
-                        o->fov > 0 ? o->fov
-                        : demMetres.x > 0
-                            ? codec::fovForFieldWidth(o->eyeHeight, o->near, options.ground.far, demMetres.x)
-                            : 60.0;
-                    const Size size = parseSize(o->sizeText);
-                    options.width = size.width;
-                    options.height = size.height;
-                    options.mapGrid = o->grid;
-                    const glm::dvec2 extent = codec::fieldExtent(options.ground);
-                    SourceEncoding encoding;
-                    const Image colour = demColour(dem, o->colour, extent, &encoding);
-                    Progress progress("encode height field " + o->sizeText);
-                    options.progress = progress.callback();
-                    format::ConusFile file = codec::encodeHeightField(dem.heights, colour, options);
-                    progress.done();
-                    file.compression = parseCompression(o->compression);
-                    file.sourceEncoding = encoding;
-                    format::writeConusFile(o->output, file);
-                    std::printf("wrote %s: %dx%d CoNUS height field of %s; field %.0f x %.0f m (eye %g m, near %g m, "
-                                "far %g m, fov %.2f deg); heights %.1f..%.1f m\n",
-                                o->output.c_str(), file.image.width, file.image.height, dem.description.c_str(),
-                                extent.x, extent.y, options.ground.eyeHeight, options.ground.near, options.ground.far,
-                                options.ground.fovDegrees, file.depth.near, file.depth.far);
-                    return 0;
-                }
-                const format::ConusFile file = format::readConusFile(o->input);
-                const Size size = parseSize(o->frameSize);
-                const gl::Device device = deviceFor(o->backend, gl::CpuPath::None, "terrain rendering");
-                gl::Context* context = &device.context();
-                const codec::GroundParams ground = groundOf(file, o->input);
-                const glm::dvec2 extent = codec::fieldExtent(ground);
-                const Camera camera = terrainCamera(file, o->cameraText, double(size.width) / size.height);
-                Progress progress("undistort and render");
-                const Image frame =
-                    gl::renderTerrain(*context, codec::undistortHeightField(file, extent), camera, size.width, size.height);
-                progress.done();
-                printCamera(camera);
-                if (o->compare.empty()) {
-                    writePicture(o->frame, frame);
-                    std::printf("wrote %s: %dx%d frame (%s)\n", o->frame.c_str(), frame.width, frame.height,
-                                context->renderer().c_str());
-                    return 0;
-                }
-                Progress comparing("render full resolution and uniform");
-                const Dem dem = readDem(o->compare, o->heightScale);
-                const Image colour = demColour(dem, o->colour, extent);
-                const Image full = gl::renderTerrain(
-                    *context,
-                    codec::undistortHeightField(
-                        codec::uniformHeightField(dem.heights, colour, dem.heights.width, dem.heights.height), extent),
-                    camera, size.width, size.height);
-                const Image uniform = gl::renderTerrain(
-                    *context,
-                    codec::undistortHeightField(
-                        codec::uniformHeightField(dem.heights, colour, file.image.width, file.image.height), extent),
-                    camera, size.width, size.height);
-                comparing.done();
-                const Image panels[] = {full, frame, uniform};
-                writePicture(o->frame, sideBySide(panels));
-                std::printf("wrote %s: full resolution %dx%d | CoNUS %dx%d | uniform %dx%d (%s)\n", o->frame.c_str(),
-                            dem.heights.width, dem.heights.height, file.image.width, file.image.height,
-                            file.image.width, file.image.height, context->renderer().c_str());
-                std::printf("PSNR vs full resolution: CoNUS %.2f dB, uniform %.2f dB\n", codec::psnr(frame, full),
-                            codec::psnr(uniform, full));
+// The DEM resampled uniformly to columns x rows, rendered as `frame` was.
+Image renderUniform(gl::Context& context, const Dem& dem, const Image& colour, int columns, int rows, const Frame& frame) {
+    const format::ConusFile field = codec::uniformHeightField(dem.heights, colour, columns, rows);
+    return gl::renderTerrain(context, codec::undistortHeightField(field, frame.extent), frame.camera, frame.image.width,
+                             frame.image.height);
+}
+
+// --compare: full resolution | CoNUS | uniform of the CoNUS image's sample count, with PSNRs.
+void writeComparison(gl::Context& context, const RenderOptions& o, const format::ConusFile& file, const Frame& frame) {
+    Progress comparing("render full resolution and uniform");
+    const Dem dem = readDem(o.compare, o.heightScale);
+    const Image colour = demColour(dem, o.colour, frame.extent);
+    const Image full = renderUniform(context, dem, colour, dem.heights.width, dem.heights.height, frame);
+    const Image uniform = renderUniform(context, dem, colour, file.image.width, file.image.height, frame);
+    comparing.done();
+    const Image panels[] = {full, frame.image, uniform};
+    writePicture(o.frame, sideBySide(panels));
+    std::printf("wrote %s: full resolution %dx%d | CoNUS %dx%d | uniform %dx%d (%s)\n", o.frame.c_str(), dem.heights.width,
+                dem.heights.height, file.image.width, file.image.height, file.image.width, file.image.height,
+                context.renderer().c_str());
+    std::printf("PSNR vs full resolution: CoNUS %.2f dB, uniform %.2f dB\n", codec::psnr(frame.image, full),
+                codec::psnr(uniform, full));
+}
+
+void runRender(const RenderOptions& o) {
+    const format::ConusFile file = format::readConusFile(o.input);
+    const Size size = parseSize(o.frameSize);
+    const gl::Device device = deviceFor(o.backend, gl::CpuPath::None, "terrain rendering");
+    gl::Context& context = device.context();
+    const Frame frame = renderFrame(context, file, o.input, o.cameraText, size, "undistort and render");
+    if (!o.compare.empty()) return writeComparison(context, o, file, frame);
+    writePicture(o.frame, frame.image);
+    std::printf("wrote %s: %dx%d frame (%s)\n", o.frame.c_str(), frame.image.width, frame.image.height,
+                context.renderer().c_str());
+}
+
+}  // namespace
+
+Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
+                                     int height, const std::string& backendName) {
+    const gl::Device device = deviceFor(backendName, gl::CpuPath::None, "terrain rendering");
+    return renderFrame(device.context(), file, "the file", cameraText, {width, height},
+                       "undistort the height field and render " + std::to_string(width) + "x" + std::to_string(height))
+        .image;
+}
+
+Command addHeightFieldCommand(CLI::App& root) {
+    auto encodeOptions = std::make_shared<EncodeOptions>();
+    auto renderOptions = std::make_shared<RenderOptions>();
+    CLI::App* command = root.add_subcommand(
+        "heightfield", "CoNUS height fields: sample a DEM densely near a viewer (encode), render it (render)");
+    command->require_subcommand(1);
+    CLI::App* encode = command->add_subcommand("encode", "Sample a DEM through the perspective ground map");
+    addEncodeOptions(*encode, encodeOptions);
+    CLI::App* render = command->add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
+    addRenderOptions(*render, *renderOptions);
+    return {command, [encodeOptions, renderOptions, encode] {
+                if (encode->parsed()) runEncode(*encodeOptions);
+                else runRender(*renderOptions);
                 return 0;
             }};
 }

@@ -85,32 +85,226 @@ std::string strokesText(const std::string& argument) {
     return text.str();
 }
 
+// ---- springs ----
+
+struct SpringsOptions {
+    std::string strokes;
+    int particles = 256, grid = 33, maxSteps = 20000;
+    OutputOptions out;
+};
+
+void addSpringsOptions(CLI::App& command, SpringsOptions& o) {
+    command.add_option("--strokes", o.strokes,
+                       "strokes as JSON, inline or a file: [{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1.0,\"duration\":0.5}, ...]")
+        ->required();
+    command.add_option("--grid", o.particles, "particles per side (default 256)")->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    command.add_option("--out-grid", o.grid, "nodes per side of the written map (default 33)")->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    command.add_option("--max-steps", o.maxSteps, "give up waiting for the stable state after this many steps (default 20000)")
+        ->check(CLI::Range(1, 10000000));
+    addOutputOptions(command, o.out);
+}
+
+void runSprings(const SpringsOptions& o) {
+    const std::vector<codec::Stroke> strokes = codec::parseStrokes(strokesText(o.strokes));
+    codec::SpringSystem system(o.particles, o.particles);
+    for (const codec::Stroke& s : strokes) system.addStroke(s);
+    Progress progress("solve " + std::to_string(o.particles) + "x" + std::to_string(o.particles) + " springs, " +
+                      std::to_string(strokes.size()) + " strokes");
+    const int steps = system.runUntilStable(o.maxSteps, progress.callback());
+    progress.done();
+    if (system.stable()) {
+        std::printf("stable after %d steps (%.2f simulated s)\n", steps, system.time());
+    } else {
+        std::printf("not stable after %d steps; writing the current state\n", steps);
+    }
+    double scale = 1.0;
+    const codec::SamplingMap map = system.toMap(o.grid, o.grid, &scale);
+    if (scale < 1.0) std::printf("the %d-node grid folded; displacements scaled by %.4f\n", o.grid, scale);
+    writeMapFile(map, std::nullopt, o.out);
+}
+
+// ---- compose ----
+
+struct ComposeOptions {
+    std::vector<std::string> inputs, translate, scale;
+    std::vector<double> weights;
+    int grid = 0;  // 0: the largest input's
+    OutputOptions out;
+};
+
+void addComposeOptions(CLI::App& command, ComposeOptions& o) {
+    command.add_option("inputs", o.inputs, "map files (any CoNUS file)")->required()->expected(1, -1);
+    command.add_option("--translate", o.translate, "dx,dy: move the k-th input's pattern (k-th use, k-th input)");
+    command.add_option("--scale", o.scale, "s or s,cu,cv: scale the k-th input's pattern by s about (cu,cv), default centre 0.5,0.5");
+    command.add_option("--weight", o.weights, "weight of the k-th input's displacement (default 1)");
+    command.add_option("--grid", o.grid, "nodes per side of the result (default: the largest input's)")
+        ->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    addOutputOptions(command, o.out);
+}
+
+// "s" or "s,cu,cv": a scale factor and its centre (default the middle).
+struct ScaleText {
+    double s = 0;
+    glm::dvec2 centre{0.5, 0.5};
+};
+
+ScaleText parseScale(const std::string& text) {
+    ScaleText r;
+    std::istringstream in(text);
+    char c1 = 0, c2 = 0;
+    const bool ok = (in >> r.s) && (in.eof() || ((in >> c1 >> r.centre.x >> c2 >> r.centre.y) && c1 == ',' && c2 == ',' && in.eof()));
+    if (!ok) throw Error(ErrorCode::InvalidArgument, "--scale \"" + text + "\" is not s or s,cu,cv");
+    return r;
+}
+
+// The k-th input, moved and scaled as its --translate and --scale say.
+codec::SamplingMap composeInput(const ComposeOptions& o, std::size_t k, codec::SamplingMap map) {
+    if (k < o.translate.size()) {
+        const auto [dx, dy] = parsePair(o.translate[k], "--translate");
+        codec::ComposeResult r = codec::translateMap(map, {dx, dy});
+        if (r.scale < 1.0) std::printf("%s: translated pattern scaled by %.4f to stay valid\n", o.inputs[k].c_str(), r.scale);
+        map = std::move(r.map);
+    }
+    if (k < o.scale.size()) {
+        const ScaleText scale = parseScale(o.scale[k]);
+        codec::ComposeResult r = codec::scaleMap(map, scale.s, scale.centre);
+        if (r.scale < 1.0) std::printf("%s: scaled pattern's displacement scaled by %.4f to stay valid\n", o.inputs[k].c_str(), r.scale);
+        map = std::move(r.map);
+    }
+    return map;
+}
+
+void runCompose(const ComposeOptions& o) {
+    if (o.translate.size() > o.inputs.size() || o.scale.size() > o.inputs.size() || o.weights.size() > o.inputs.size()) {
+        throw Error(ErrorCode::InvalidArgument, "more --translate, --scale or --weight values than inputs");
+    }
+    std::vector<codec::SamplingMap> maps;
+    int grid = o.grid;
+    for (std::size_t k = 0; k < o.inputs.size(); ++k) {
+        const format::ConusFile file = format::readConusFile(o.inputs[k]);
+        codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
+        if (o.grid == 0) grid = std::max({grid, map.columns(), map.rows()});
+        maps.push_back(composeInput(o, k, std::move(map)));
+    }
+    std::vector<double> weights;
+    if (!o.weights.empty()) {
+        weights.assign(maps.size(), 1.0);
+        std::copy(o.weights.begin(), o.weights.end(), weights.begin());
+    }
+    const codec::ComposeResult sum = codec::addMaps(maps, grid, grid, weights);
+    std::printf("added %zu maps; displacement scale %.4f%s\n", maps.size(), sum.scale,
+                sum.scale < 1.0 ? " (the plain sum folds)" : "");
+    writeMapFile(sum.map, std::nullopt, o.out);
+}
+
+// ---- ground ----
+
+struct GroundOptions {
+    codec::GroundParams ground;
+    int grid = map_rules::kDefaultSide;
+    OutputOptions out;
+};
+
+void addGroundOptions(CLI::App& command, GroundOptions& o) {
+    command.add_option("--eye-height", o.ground.eyeHeight, "eye height above the ground (ground units)")->required();
+    command.add_option("--near", o.ground.near, "ground distance of the bottom edge (v = 1)")->required();
+    command.add_option("--far", o.ground.far, "ground distance of the top edge (v = 0)")->required();
+    command.add_option("--fov", o.ground.fovDegrees, "horizontal field of view in degrees at the far edge (default 60)");
+    command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    addOutputOptions(command, o.out);
+}
+
+void runGround(const GroundOptions& o) {
+    const codec::SamplingMap map = codec::buildGroundMap(o.ground, o.grid, o.grid);
+    writeMapFile(map, codec::toAnalytic(o.ground), o.out);
+}
+
+// ---- foci ----
+
+struct FociOptions {
+    std::vector<std::string> foci;
+    std::string composition = "density";
+    int grid = map_rules::kDefaultSide;
+    double aspect = 1.0;
+    OutputOptions out;
+};
+
+void addFociOptions(CLI::App& command, FociOptions& o) {
+    command.add_option("--focus", o.foci, "focus u,v,r,k (repeat for several)")->required();
+    command.add_option("--compose", o.composition, "how several foci combine: density (default) | add")
+        ->check(CLI::IsMember({"density", "add"}));
+    command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    command.add_option("--aspect", o.aspect, "image width / height, so foci are circular in pixels (default 1)");
+    addOutputOptions(command, o.out);
+}
+
+void runFoci(const FociOptions& o) {
+    std::vector<codec::Focus> list;
+    for (const auto& text : o.foci) list.push_back(codec::parseFocus(text));
+    codec::FociOptions fo;
+    fo.columns = fo.rows = o.grid;
+    fo.aspect = o.aspect;
+    fo.composition = o.composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+    Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
+    const codec::SamplingMap map = codec::buildFociMap(list, fo);
+    codec::checkFociHeld(map, list, fo);  // the file must not record a focus its map ignores
+    progress.done();
+    writeMapFile(map, codec::toAnalytic(list, fo.composition), o.out);
+}
+
+// ---- auto ----
+
+struct AutoOptions {
+    std::string importance, image, method = "flow";
+    double minDensity = 0.25, maxDensity = 16;
+    int grid = map_rules::kDefaultSide;
+    OutputOptions out;
+};
+
+void addAutoOptions(CLI::App& command, AutoOptions& o) {
+    command.add_option("--importance", o.importance,
+                       "importance image (one channel or RGB; higher = more samples), or 'detail' / 'faces' "
+                       "computed from --image")
+        ->required();
+    command.add_option("--image", o.image, "the picture that 'detail' and 'faces' look at");
+    command.add_option("--min-density", o.minDensity, "density kept everywhere (0..1, default 0.25)")
+        ->check(CLI::Range(0.001, 0.999));
+    command.add_option("--max-density", o.maxDensity, "cap on the density (default 16: 4x the linear rate)")
+        ->check(CLI::Range(1.001, 4096.0));
+    command.add_option("--method", o.method, "flow (2-D, default) | separable (baseline)")
+        ->check(CLI::IsMember({"flow", "separable"}));
+    command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    addOutputOptions(command, o.out);
+}
+
+void runAuto(const AutoOptions& o) {
+    const Image picture = o.image.empty() ? Image{} : imageio::readImageFile(o.image).image;
+    const Image importance = importanceFrom(o.importance, picture);
+    codec::AutoMapOptions options;
+    options.columns = options.rows = o.grid;
+    options.minDensity = o.minDensity;
+    options.maxDensity = o.maxDensity;
+    options.method = o.method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
+    Progress progress("build sampling map from importance");
+    const codec::SamplingMap map = codec::buildAutoMap(importance, options);
+    progress.done();
+    std::printf("achieved density follows the target with correlation %.3f\n",
+                codec::densityCorrelation(map, codec::importanceToDensity(importance, options)));
+    writeMapFile(map, std::nullopt, o.out);
+}
+
+struct MapOptions {
+    SpringsOptions springs;
+    ComposeOptions compose;
+    GroundOptions ground;
+    FociOptions foci;
+    AutoOptions automatic;
+};
+
 }  // namespace
 
 Command addMapCommand(CLI::App& root) {
-    struct Options {
-        OutputOptions springsOut, composeOut, groundOut, fociOut, autoOut;
-        // auto
-        std::string importance, image, method = "flow";
-        double minDensity = 0.25, maxDensity = 16;
-        int autoGrid = map_rules::kDefaultSide;
-        // springs
-        std::string strokes;
-        int particles = 256, springsGrid = 33, maxSteps = 20000;
-        // compose
-        std::vector<std::string> inputs, translate, scale;
-        std::vector<double> weights;
-        int composeGrid = 0;
-        // ground
-        codec::GroundParams ground;
-        int groundGrid = map_rules::kDefaultSide;
-        // foci
-        std::vector<std::string> foci;
-        std::string composition = "density";
-        int fociGrid = map_rules::kDefaultSide;
-        double aspect = 1.0;
-    };
-    auto o = std::make_shared<Options>();
+    auto o = std::make_shared<MapOptions>();
     CLI::App* command = root.add_subcommand("map", "Build a sampling map and write it as a map file for `conus encode --map`");
     command->require_subcommand(1);
     setExamples(*command, {"conus map foci --focus 0.3,0.4,0.08,4 --focus 0.7,0.6,0.05,3 --aspect 1.5 -o m.exr --preview m.png",
@@ -120,144 +314,25 @@ Command addMapCommand(CLI::App& root) {
     CLI::App* springs = addSubcommand(*command, "springs", "Mass-spring brush system (paper 3.1): paint strokes from a JSON list, solve until stable",
         {"conus map springs --strokes '[{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1,\"duration\":0.5}]' -o m.exr",
          "conus map springs --strokes strokes.json -o m.exr --preview m.png"});
-    springs->add_option("--strokes", o->strokes,
-                        "strokes as JSON, inline or a file: [{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1.0,\"duration\":0.5}, ...]")
-        ->required();
-    springs->add_option("--grid", o->particles, "particles per side (default 256)")->check(CLI::Range(kMinMapSide, kMaxMapSide));
-    springs->add_option("--out-grid", o->springsGrid, "nodes per side of the written map (default 33)")->check(CLI::Range(kMinMapSide, kMaxMapSide));
-    springs->add_option("--max-steps", o->maxSteps, "give up waiting for the stable state after this many steps (default 20000)")
-        ->check(CLI::Range(1, 10000000));
-    addOutputOptions(*springs, o->springsOut);
-
+    addSpringsOptions(*springs, o->springs);
     CLI::App* compose = command->add_subcommand(
         "compose", "Add the displacement fields of map files (paper Fig. 9), each optionally translated and scaled");
-    compose->add_option("inputs", o->inputs, "map files (any CoNUS file)")->required()->expected(1, -1);
-    compose->add_option("--translate", o->translate, "dx,dy: move the k-th input's pattern (k-th use, k-th input)");
-    compose->add_option("--scale", o->scale, "s or s,cu,cv: scale the k-th input's pattern by s about (cu,cv), default centre 0.5,0.5");
-    compose->add_option("--weight", o->weights, "weight of the k-th input's displacement (default 1)");
-    compose->add_option("--grid", o->composeGrid, "nodes per side of the result (default: the largest input's)")
-        ->check(CLI::Range(kMinMapSide, kMaxMapSide));
-    addOutputOptions(*compose, o->composeOut);
-
+    addComposeOptions(*compose, o->compose);
     CLI::App* ground = command->add_subcommand(
         "ground", "Perspective ground-plane map of a height field (paper section 4), viewer at the bottom edge's middle");
-    ground->add_option("--eye-height", o->ground.eyeHeight, "eye height above the ground (ground units)")->required();
-    ground->add_option("--near", o->ground.near, "ground distance of the bottom edge (v = 1)")->required();
-    ground->add_option("--far", o->ground.far, "ground distance of the top edge (v = 0)")->required();
-    ground->add_option("--fov", o->ground.fovDegrees, "horizontal field of view in degrees at the far edge (default 60)");
-    ground->add_option("--grid", o->groundGrid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
-    addOutputOptions(*ground, o->groundOut);
-
+    addGroundOptions(*ground, o->ground);
     CLI::App* foci = command->add_subcommand("foci", "Circular foci u,v,r,k");
-    foci->add_option("--focus", o->foci, "focus u,v,r,k (repeat for several)")->required();
-    foci->add_option("--compose", o->composition, "how several foci combine: density (default) | add")
-        ->check(CLI::IsMember({"density", "add"}));
-    foci->add_option("--grid", o->fociGrid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
-    foci->add_option("--aspect", o->aspect, "image width / height, so foci are circular in pixels (default 1)");
-    addOutputOptions(*foci, o->fociOut);
-
+    addFociOptions(*foci, o->foci);
     CLI::App* automatic = command->add_subcommand(
         "auto", "Automatic map from importance: density follows the importance, with a floor for context");
-    automatic->add_option("--importance", o->importance,
-                          "importance image (one channel or RGB; higher = more samples), or 'detail' / 'faces' "
-                          "computed from --image")
-        ->required();
-    automatic->add_option("--image", o->image, "the picture that 'detail' and 'faces' look at");
-    automatic->add_option("--min-density", o->minDensity, "density kept everywhere (0..1, default 0.25)")
-        ->check(CLI::Range(0.001, 0.999));
-    automatic->add_option("--max-density", o->maxDensity, "cap on the density (default 16: 4x the linear rate)")
-        ->check(CLI::Range(1.001, 4096.0));
-    automatic->add_option("--method", o->method, "flow (2-D, default) | separable (baseline)")
-        ->check(CLI::IsMember({"flow", "separable"}));
-    automatic->add_option("--grid", o->autoGrid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
-    addOutputOptions(*automatic, o->autoOut);
+    addAutoOptions(*automatic, o->automatic);
 
     return {command, [o, springs, compose, ground, foci, automatic] {
-                if (springs->parsed()) {
-                    const std::vector<codec::Stroke> strokes = codec::parseStrokes(strokesText(o->strokes));
-                    codec::SpringSystem system(o->particles, o->particles);
-                    for (const codec::Stroke& s : strokes) system.addStroke(s);
-                    Progress progress("solve " + std::to_string(o->particles) + "x" + std::to_string(o->particles) +
-                                      " springs, " + std::to_string(strokes.size()) + " strokes");
-                    const int steps = system.runUntilStable(o->maxSteps, progress.callback());
-                    progress.done();
-                    if (system.stable()) {
-                        std::printf("stable after %d steps (%.2f simulated s)\n", steps, system.time());
-                    } else {
-                        std::printf("not stable after %d steps; writing the current state\n", steps);
-                    }
-                    double scale = 1.0;
-                    const codec::SamplingMap map = system.toMap(o->springsGrid, o->springsGrid, &scale);
-                    if (scale < 1.0) std::printf("the %d-node grid folded; displacements scaled by %.4f\n", o->springsGrid, scale);
-                    writeMapFile(map, std::nullopt, o->springsOut);
-                } else if (compose->parsed()) {
-                    if (o->translate.size() > o->inputs.size() || o->scale.size() > o->inputs.size() ||
-                        o->weights.size() > o->inputs.size()) {
-                        throw Error(ErrorCode::InvalidArgument, "more --translate, --scale or --weight values than inputs");
-                    }
-                    std::vector<codec::SamplingMap> maps;
-                    int grid = o->composeGrid;
-                    for (std::size_t k = 0; k < o->inputs.size(); ++k) {
-                        const format::ConusFile file = format::readConusFile(o->inputs[k]);
-                        codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
-                        if (o->composeGrid == 0) grid = std::max({grid, map.columns(), map.rows()});
-                        if (k < o->translate.size()) {
-                            const auto [dx, dy] = parsePair(o->translate[k], "--translate");
-                            codec::ComposeResult r = codec::translateMap(map, {dx, dy});
-                            if (r.scale < 1.0) std::printf("%s: translated pattern scaled by %.4f to stay valid\n", o->inputs[k].c_str(), r.scale);
-                            map = std::move(r.map);
-                        }
-                        if (k < o->scale.size()) {
-                            double s = 0, cu = 0.5, cv = 0.5;
-                            std::istringstream in(o->scale[k]);
-                            char c1 = 0, c2 = 0;
-                            const bool ok = (in >> s) && (in.eof() || ((in >> c1 >> cu >> c2 >> cv) && c1 == ',' && c2 == ',' && in.eof()));
-                            if (!ok) throw Error(ErrorCode::InvalidArgument, "--scale \"" + o->scale[k] + "\" is not s or s,cu,cv");
-                            codec::ComposeResult r = codec::scaleMap(map, s, {cu, cv});
-                            if (r.scale < 1.0) std::printf("%s: scaled pattern's displacement scaled by %.4f to stay valid\n", o->inputs[k].c_str(), r.scale);
-                            map = std::move(r.map);
-                        }
-                        maps.push_back(std::move(map));
-                    }
-                    std::vector<double> weights;
-                    if (!o->weights.empty()) {
-                        weights.assign(maps.size(), 1.0);
-                        std::copy(o->weights.begin(), o->weights.end(), weights.begin());
-                    }
-                    const codec::ComposeResult sum = codec::addMaps(maps, grid, grid, weights);
-                    std::printf("added %zu maps; displacement scale %.4f%s\n", maps.size(), sum.scale,
-                                sum.scale < 1.0 ? " (the plain sum folds)" : "");
-                    writeMapFile(sum.map, std::nullopt, o->composeOut);
-                } else if (ground->parsed()) {
-                    const codec::SamplingMap map = codec::buildGroundMap(o->ground, o->groundGrid, o->groundGrid);
-                    writeMapFile(map, codec::toAnalytic(o->ground), o->groundOut);
-                } else if (automatic->parsed()) {
-                    const Image picture = o->image.empty() ? Image{} : imageio::readImageFile(o->image).image;
-                    const Image importance = importanceFrom(o->importance, picture);
-                    codec::AutoMapOptions options;
-                    options.columns = options.rows = o->autoGrid;
-                    options.minDensity = o->minDensity;
-                    options.maxDensity = o->maxDensity;
-                    options.method = o->method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
-                    Progress progress("build sampling map from importance");
-                    const codec::SamplingMap map = codec::buildAutoMap(importance, options);
-                    progress.done();
-                    std::printf("achieved density follows the target with correlation %.3f\n",
-                                codec::densityCorrelation(map, codec::importanceToDensity(importance, options)));
-                    writeMapFile(map, std::nullopt, o->autoOut);
-                } else if (foci->parsed()) {
-                    std::vector<codec::Focus> list;
-                    for (const auto& text : o->foci) list.push_back(codec::parseFocus(text));
-                    codec::FociOptions fo;
-                    fo.columns = fo.rows = o->fociGrid;
-                    fo.aspect = o->aspect;
-                    fo.composition = o->composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
-                    Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
-                    const codec::SamplingMap map = codec::buildFociMap(list, fo);
-                    codec::checkFociHeld(map, list, fo);  // the file must not record a focus its map ignores
-                    progress.done();
-                    writeMapFile(map, codec::toAnalytic(list, fo.composition), o->fociOut);
-                }
+                if (springs->parsed()) runSprings(o->springs);
+                else if (compose->parsed()) runCompose(o->compose);
+                else if (ground->parsed()) runGround(o->ground);
+                else if (automatic->parsed()) runAuto(o->automatic);
+                else if (foci->parsed()) runFoci(o->foci);
                 return 0;
             }};
 }

@@ -26,10 +26,10 @@ struct RenderOptions {
 };
 
 glm::dvec3 parseDirection(const std::string& text) {
-    const LookAt parsed = parseLookAt(text + ",0,0,0,1");  // three numbers, checked like a camera's
-    if (!(glm::length(parsed.eye) > 0.0))
+    const glm::dvec3 direction = parseVector3(text, "light");
+    if (!(glm::length(direction) > 0.0))
         throw Error(ErrorCode::InvalidArgument, "light '" + text + "' has no direction");
-    return parsed.eye;
+    return direction;
 }
 
 int runRenderRelief(const RenderOptions& o) {
@@ -37,7 +37,7 @@ int runRenderRelief(const RenderOptions& o) {
     const imageio::WriteOptions write = writeOptionsOf({}, nullptr);
     checkPictureOutput(o.output, write, {o.input});
     // Values first, so that a bad one is a usage error before any work.
-    const std::optional<LookAt> given = o.cameraText.empty() ? std::nullopt : std::optional(parseLookAt(o.cameraText));
+    const std::optional<CameraText> given = o.cameraText.empty() ? std::nullopt : std::optional(parseCamera(o.cameraText));
     const glm::dvec3 towardLight = parseDirection(o.lightText);
     const format::ConusFile file = format::readConusFile(o.input);
     if (file.dataKind != format::DataKind::HeightField || file.depth.kind != format::DepthKind::Height)

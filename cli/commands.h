@@ -37,6 +37,7 @@ Command addMapCommand(CLI::App& root);
 Command addHeightFieldCommand(CLI::App& root);
 Command addBakeCommand(CLI::App& root);
 Command addRenderCommand(CLI::App& root);
+Command addMeshCommand(CLI::App& root);
 
 // A frame of a CoNUS height field from a camera "x,y,z,lx,ly,lz,fovDeg" (empty: the ground map's
 // own viewer), rendered with GL: what `decode` does for height fields and `heightfield render` does.

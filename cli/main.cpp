@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
         conus::cli::addValidateCommand(app), conus::cli::addDemoCommand(app),
         conus::cli::addMapCommand(app),  conus::cli::addHeightFieldCommand(app),
         conus::cli::addBakeCommand(app), conus::cli::addRenderCommand(app),
+        conus::cli::addMeshCommand(app),
     };
 
     std::string name;

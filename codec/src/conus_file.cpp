@@ -20,6 +20,20 @@ format::ConusFile makeImageFile(Image image, const SamplingMap& map, int sourceW
     return file;
 }
 
+format::ConusFile makeDepthImageFile(Image image, const SamplingMap& map, const Camera& camera, std::string units,
+                                     std::optional<format::AnalyticMap> analytic) {
+    if (image.channelIndex("Z") < 0)
+        throw Error(ErrorCode::InvalidArgument, "makeDepthImageFile: the image has no Z channel");
+    const int width = image.width, height = image.height;
+    format::ConusFile file = makeImageFile(std::move(image), map, width, height, {}, std::move(analytic));
+    file.dataKind = format::DataKind::DepthImage;
+    file.pixelType = format::PixelType::Float;
+    file.camera = format::toAttributes(camera);
+    file.depth = {format::DepthKind::CameraDepth, std::move(units), static_cast<float>(camera.near()),
+                  static_cast<float>(camera.far())};
+    return file;
+}
+
 format::ConusFile makeMapFile(const SamplingMap& map, std::optional<format::AnalyticMap> analytic) {
     format::ConusFile file;
     file.image = makeImage(map.columns(), map.rows(), {"Y"});

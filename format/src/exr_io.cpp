@@ -31,6 +31,8 @@
 #include <fstream>
 #include <memory>
 #include <system_error>
+#include <type_traits>
+#include <variant>
 
 #include "header_model.h"
 #include "header_scan.h"
@@ -246,35 +248,159 @@ Problem checkHeaders(const std::string& path, std::uintmax_t size, const Limits&
     return checkCoreHeaders(core->ctx(), size);
 }
 
-// ---- headers -> HeaderModel ------------------------------------------------------------------
+// ---- headers <-> HeaderModel ------------------------------------------------------------------
 
 Box boxOf(const Imath::Box2i& b) { return Box{b.min.x, b.min.y, b.max.x, b.max.y}; }
 
-template <class ExrAttr, class T, class Convert>
-Attr<T> readAttr(const Imf::Header& h, const char* name, Convert convert) {
+Imath::Box2i box2i(const Box& b) {
+    return Imath::Box2i(Imath::V2i(int(b.minX), int(b.minY)), Imath::V2i(int(b.maxX), int(b.maxY)));
+}
+
+Compression compressionOf(Imf::Compression c) {
+    switch (c) {
+        case Imf::NO_COMPRESSION: return Compression::None;
+        case Imf::PIZ_COMPRESSION: return Compression::Piz;
+        case Imf::DWAA_COMPRESSION:
+        case Imf::DWAB_COMPRESSION: return Compression::Dwaa;
+        default: return Compression::Zip;  // other codecs (RLE, ZIPS, PXR24, B44) are read as-is
+    }
+}
+
+Imf::Compression exrCompression(Compression c) {
+    switch (c) {
+        case Compression::None: return Imf::NO_COMPRESSION;
+        case Compression::Zip: return Imf::ZIP_COMPRESSION;
+        case Compression::Piz: return Imf::PIZ_COMPRESSION;
+        case Compression::Dwaa: return Imf::DWAA_COMPRESSION;
+    }
+    return Imf::ZIP_COMPRESSION;
+}
+
+// Each value type of kAttributes with its OpenEXR attribute class, both ways.
+template <class T>
+struct ExrAttribute;
+template <>
+struct ExrAttribute<int> {
+    using Type = Imf::IntAttribute;
+    static int from(int v) { return v; }
+    static Type to(int v) { return Type(v); }
+};
+template <>
+struct ExrAttribute<double> {
+    using Type = Imf::DoubleAttribute;
+    static double from(double v) { return v; }
+    static Type to(double v) { return Type(v); }
+};
+template <>
+struct ExrAttribute<std::string> {
+    using Type = Imf::StringAttribute;
+    static std::string from(const std::string& v) { return v; }
+    static Type to(const std::string& v) { return Type(v); }
+};
+template <>
+struct ExrAttribute<std::array<int, 2>> {
+    using Type = Imf::V2iAttribute;
+    static std::array<int, 2> from(const Imath::V2i& v) { return {v.x, v.y}; }
+    static Type to(const std::array<int, 2>& v) { return Type(Imath::V2i(v[0], v[1])); }
+};
+template <>
+struct ExrAttribute<std::array<float, 2>> {
+    using Type = Imf::V2fAttribute;
+    static std::array<float, 2> from(const Imath::V2f& v) { return {v.x, v.y}; }
+    static Type to(const std::array<float, 2>& v) { return Type(Imath::V2f(v[0], v[1])); }
+};
+template <>
+struct ExrAttribute<std::vector<float>> {
+    using Type = Imf::FloatVectorAttribute;
+    static std::vector<float> from(const std::vector<float>& v) { return v; }
+    static Type to(const std::vector<float>& v) { return Type(v); }
+};
+template <>
+struct ExrAttribute<std::array<float, 16>> {  // row-major, as Imath stores a matrix
+    using Type = Imf::M44fAttribute;
+    static std::array<float, 16> from(const Imath::M44f& m) {
+        std::array<float, 16> a{};
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c) a[r * 4 + c] = m[r][c];
+        return a;
+    }
+    static Type to(const std::array<float, 16>& a) {
+        Imath::M44f m;
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c) m[r][c] = a[r * 4 + c];
+        return Type(m);
+    }
+};
+template <>
+struct ExrAttribute<std::array<float, 8>> {  // red, green, blue, white: x, y each
+    using Type = Imf::ChromaticitiesAttribute;
+    static std::array<float, 8> from(const Imf::Chromaticities& c) {
+        return {c.red.x, c.red.y, c.green.x, c.green.y, c.blue.x, c.blue.y, c.white.x, c.white.y};
+    }
+    static Type to(const std::array<float, 8>& c) {
+        return Type(Imf::Chromaticities(Imath::V2f(c[0], c[1]), Imath::V2f(c[2], c[3]), Imath::V2f(c[4], c[5]),
+                                        Imath::V2f(c[6], c[7])));
+    }
+};
+
+template <class T>
+Attr<T> readAttr(const Imf::Attribute& attribute) {
     Attr<T> a;
-    auto it = h.find(name);
-    if (it == h.end()) return a;
     a.present = true;
-    a.typeName = it.attribute().typeName();
-    if (const auto* typed = dynamic_cast<const ExrAttr*>(&it.attribute())) {
+    a.typeName = attribute.typeName();
+    if (const auto* typed = dynamic_cast<const typename ExrAttribute<T>::Type*>(&attribute)) {
         a.typeOk = true;
-        a.value = convert(typed->value());
+        a.value = ExrAttribute<T>::from(typed->value());
+    } else if constexpr (std::is_same_v<T, double>) {  // parameters may be stored as float
+        if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&attribute)) {
+            a.typeOk = true;
+            a.value = f->value();
+        }
     }
     return a;
 }
 
-template <class ExrAttr, class T>
-Attr<T> readAttr(const Imf::Header& h, const char* name) {
-    return readAttr<ExrAttr, T>(h, name, [](const auto& v) { return T(v); });
+template <class... F>
+struct Overloaded : F... {
+    using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+// Every attribute kAttributes places in `part`, from its header `h`.
+void readAttributes(const Imf::Header& h, PartKind part, HeaderModel& m) {
+    for (const AttributeSpec& spec : kAttributes) {
+        if (spec.part != part) continue;
+        std::visit(Overloaded{[&](ParamsMember family) {
+                                  const std::size_t prefix = std::strlen(spec.name);
+                                  for (auto it = h.begin(); it != h.end(); ++it) {
+                                      if (std::strncmp(it.name(), spec.name, prefix) == 0)
+                                          (m.*family)[it.name() + prefix] = readAttr<double>(it.attribute());
+                                  }
+                              },
+                              [&](auto member) {
+                                  using T = typename std::decay_t<decltype(m.*member)>::Value;
+                                  if (auto it = h.find(spec.name); it != h.end()) m.*member = readAttr<T>(it.attribute());
+                              }},
+                   spec.field);
+    }
 }
 
-std::array<float, 16> toArray(const Imath::M44f& m) {
-    std::array<float, 16> a{};
-    for (int r = 0; r < 4; ++r) {
-        for (int c = 0; c < 4; ++c) a[r * 4 + c] = m[r][c];
+// Every attribute of `part` the model holds, into its header `h`.
+void writeAttributes(const HeaderModel& m, PartKind part, Imf::Header& h) {
+    for (const AttributeSpec& spec : kAttributes) {
+        if (spec.part != part) continue;
+        std::visit(Overloaded{[&](ParamsMember family) {
+                                  for (const auto& [name, a] : m.*family)
+                                      h.insert(spec.name + name, ExrAttribute<double>::to(a.value));
+                              },
+                              [&](auto member) {
+                                  const auto& a = m.*member;
+                                  using T = typename std::decay_t<decltype(a)>::Value;
+                                  if (a.present) h.insert(spec.name, ExrAttribute<T>::to(a.value));
+                              }},
+                   spec.field);
     }
-    return a;
 }
 
 PartModel partOf(const Imf::Header& h) {
@@ -292,75 +418,45 @@ PartModel partOf(const Imf::Header& h) {
         p.tileWidth = h.tileDescription().xSize;
         p.tileHeight = h.tileDescription().ySize;
     }
+    p.compression = compressionOf(h.compression());
     return p;
+}
+
+// The header of one part as the writer writes it (its attributes come separately).
+Imf::Header exrHeader(const PartModel& p) {
+    Imf::Header h(box2i(p.displayWindow), box2i(p.dataWindow));
+    h.setName(p.name);
+    h.setType(p.type);
+    h.compression() = exrCompression(p.compression);
+    for (const ChannelModel& c : p.channels)
+        h.channels().insert(c.name, Imf::Channel(c.type == ChannelType::Half ? Imf::HALF : c.type == ChannelType::Float ? Imf::FLOAT : Imf::UINT));
+    return h;
 }
 
 HeaderModel modelOf(const Imf::MultiPartInputFile& file) {
     HeaderModel m;
     for (int i = 0; i < file.parts(); ++i) {
         m.parts.push_back(partOf(file.header(i)));
-        if (m.parts.back().name == kConusPartName && m.conusPartCount++ == 0) m.conusPart = i;
-        if (m.parts.back().name == kMapPartName && m.mapPartCount++ == 0) m.mapPart = i;
-    }
-    if (m.conusPart < 0) return m;
-    const Imf::Header& h = file.header(m.conusPart);
-    m.version = readAttr<Imf::IntAttribute, int>(h, kAttrVersion);
-    m.sourceSize = readAttr<Imf::V2iAttribute, std::array<int, 2>>(h, kAttrSourceSize,
-                                                                    [](const Imath::V2i& v) { return std::array<int, 2>{v.x, v.y}; });
-    m.dataKind = readAttr<Imf::StringAttribute, std::string>(h, kAttrDataKind);
-    m.mapKind = readAttr<Imf::StringAttribute, std::string>(h, kAttrMapKind);
-    m.foci = readAttr<Imf::FloatVectorAttribute, std::vector<float>>(h, kAttrFoci);
-    m.composition = readAttr<Imf::StringAttribute, std::string>(h, kAttrComposition);
-    const std::size_t prefixLen = std::strlen(kAttrParamPrefix);
-    for (auto it = h.begin(); it != h.end(); ++it) {
-        if (std::strncmp(it.name(), kAttrParamPrefix, prefixLen) != 0) continue;
-        Attr<double>& a = m.params[it.name() + prefixLen];
-        a.present = true;
-        a.typeName = it.attribute().typeName();
-        if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&it.attribute())) {
-            a.typeOk = true;
-            a.value = d->value();
-        } else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&it.attribute())) {
-            a.typeOk = true;
-            a.value = f->value();
+        for (const PartSpec& spec : kParts) {
+            PartSlot& slot = m.slot(spec.kind);
+            if (m.parts.back().name == spec.name && slot.count++ == 0) slot.index = i;
         }
     }
-    m.worldToCamera = readAttr<Imf::M44fAttribute, std::array<float, 16>>(h, kAttrWorldToCamera, toArray);
-    m.worldToNDC = readAttr<Imf::M44fAttribute, std::array<float, 16>>(h, kAttrWorldToNDC, toArray);
-    m.projection = readAttr<Imf::StringAttribute, std::string>(h, kAttrProjection);
-    m.depthKind = readAttr<Imf::StringAttribute, std::string>(h, kAttrDepthKind);
-    m.depthRange = readAttr<Imf::V2fAttribute, std::array<float, 2>>(h, kAttrDepthRange,
-                                                                      [](const Imath::V2f& v) { return std::array<float, 2>{v.x, v.y}; });
-    m.depthUnits = readAttr<Imf::StringAttribute, std::string>(h, kAttrDepthUnits);
-    m.sourceTransfer = readAttr<Imf::StringAttribute, std::string>(h, kAttrSourceTransfer);
-    m.sourceSampleType = readAttr<Imf::StringAttribute, std::string>(h, kAttrSourceSampleType);
-    m.iccProfile = readAttr<Imf::StringAttribute, std::string>(h, kAttrIccProfile);
-    m.chromaticities = readAttr<Imf::ChromaticitiesAttribute, std::array<float, 8>>(
-        h, kAttrChromaticities, [](const Imf::Chromaticities& c) {
-            return std::array<float, 8>{c.red.x, c.red.y, c.green.x, c.green.y, c.blue.x, c.blue.y, c.white.x, c.white.y};
-        });
+    for (const PartSpec& spec : kParts) {
+        if (const int index = m.slot(spec.kind).index; index >= 0) readAttributes(file.header(index), spec.kind, m);
+    }
     return m;
 }
 
 // ---- HeaderModel -> ConusFile fields ----------------------------------------------------------
 
-Compression compressionOf(Imf::Compression c) {
-    switch (c) {
-        case Imf::NO_COMPRESSION: return Compression::None;
-        case Imf::PIZ_COMPRESSION: return Compression::Piz;
-        case Imf::DWAA_COMPRESSION:
-        case Imf::DWAB_COMPRESSION: return Compression::Dwaa;
-        default: return Compression::Zip;  // other codecs (RLE, ZIPS, PXR24, B44) are read as-is
-    }
-}
-
 void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
-    const PartModel& part = m.parts[m.conusPart];
+    const PartModel& part = m.part(PartKind::Conus);
     out.pixelType = PixelType::Half;
     for (const ChannelModel& c : part.channels) {
         if (c.name != "Z" && c.type == ChannelType::Float) out.pixelType = PixelType::Float;
     }
-    out.compression = compressionOf(h.compression());
+    out.compression = part.compression;
     out.sourceWidth = m.sourceSize.value[0];
     out.sourceHeight = m.sourceSize.value[1];
     out.dataKind = parseName<DataKind>(m.dataKind.value).value_or(DataKind::Image);
@@ -393,7 +489,7 @@ void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
         else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&a)) e.metadata.push_back({it.name(), f->value()});
         else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&a)) e.metadata.push_back({it.name(), d->value()});
     }
-    if (const auto* sw = h.findTypedAttribute<Imf::StringAttribute>(kAttrSoftware)) out.software = sw->value();
+    if (m.software.ok()) out.software = m.software.value;
 }
 
 // ---- writing through an AtomicFile ---------------------------------------------------------------
@@ -427,7 +523,8 @@ private:
 // ---- pixels ---------------------------------------------------------------------------------
 
 void readImage(Imf::MultiPartInputFile& file, const HeaderModel& m, Image& image) {
-    const PartModel& part = m.parts[m.conusPart];
+    const int index = m.slot(PartKind::Conus).index;
+    const PartModel& part = m.parts[index];
     std::vector<std::string> names;
     for (const ChannelModel& c : part.channels) names.push_back(c.name);
     image = makeImage(int(part.dataWindow.width()), int(part.dataWindow.height()), std::move(names));
@@ -440,47 +537,35 @@ void readImage(Imf::MultiPartInputFile& file, const HeaderModel& m, Image& image
         fb.insert(image.channels[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(image.pixels.data() + c), xStride, yStride));
     }
     if (part.type == Imf::TILEDIMAGE) {
-        Imf::TiledInputPart in(file, m.conusPart);
+        Imf::TiledInputPart in(file, index);
         in.setFrameBuffer(fb);
         in.readTiles(0, in.numXTiles(0) - 1, 0, in.numYTiles(0) - 1, 0, 0);
     } else {
-        Imf::InputPart in(file, m.conusPart);
+        Imf::InputPart in(file, index);
         in.setFrameBuffer(fb);
         in.readPixels(0, image.height - 1);
     }
 }
 
-void readMap(Imf::MultiPartInputFile& file, const HeaderModel& m, GridNodes& grid) {
-    const PartModel& part = m.parts[m.mapPart];
-    grid.columns = int(part.dataWindow.width());
-    grid.rows = int(part.dataWindow.height());
-    grid.xy.assign(std::size_t{2} * grid.columns * grid.rows, 0.0f);
+// The map's nodes, interleaved (u, v) in GridNodes, as the part's two planes `ud` and `vd`.
+Imf::FrameBuffer mapFrameBuffer(const GridNodes& grid) {
     Imf::FrameBuffer fb;
-    char* base = reinterpret_cast<char*>(grid.xy.data());
+    char* base = const_cast<char*>(reinterpret_cast<const char*>(grid.xy.data()));
     const std::size_t xStride = 2 * sizeof(float);
     fb.insert(kMapChannelU, Imf::Slice(Imf::FLOAT, base, xStride, xStride * grid.columns));
     fb.insert(kMapChannelV, Imf::Slice(Imf::FLOAT, base + sizeof(float), xStride, xStride * grid.columns));
-    Imf::InputPart in(file, m.mapPart);
-    in.setFrameBuffer(fb);
+    return fb;
+}
+
+void readMap(Imf::MultiPartInputFile& file, const HeaderModel& m, GridNodes& grid) {
+    const int index = m.slot(PartKind::SamplingMap).index;
+    const PartModel& part = m.parts[index];
+    grid.columns = int(part.dataWindow.width());
+    grid.rows = int(part.dataWindow.height());
+    grid.xy.assign(std::size_t{2} * grid.columns * grid.rows, 0.0f);
+    Imf::InputPart in(file, index);
+    in.setFrameBuffer(mapFrameBuffer(grid));
     in.readPixels(0, grid.rows - 1);
-}
-
-Imf::Compression exrCompression(Compression c) {
-    switch (c) {
-        case Compression::None: return Imf::NO_COMPRESSION;
-        case Compression::Zip: return Imf::ZIP_COMPRESSION;
-        case Compression::Piz: return Imf::PIZ_COMPRESSION;
-        case Compression::Dwaa: return Imf::DWAA_COMPRESSION;
-    }
-    return Imf::ZIP_COMPRESSION;
-}
-
-Imath::M44f toM44(const std::array<float, 16>& a) {
-    Imath::M44f m;
-    for (int r = 0; r < 4; ++r) {
-        for (int c = 0; c < 4; ++c) m[r][c] = a[r * 4 + c];
-    }
-    return m;
 }
 
 }  // namespace
@@ -530,7 +615,7 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool
         }
         // Headers passed every rule, so every size below is within limits; the chunk tables must
         // still show that the pixels are in the file before memory is committed for them.
-        const PartModel& part = model.parts[model.conusPart];
+        const PartModel& part = model.part(PartKind::Conus);
         if (readPixels) {
             const std::int64_t bytes = part.dataWindow.width() * part.dataWindow.height() *
                                        std::int64_t(part.channels.size()) * std::int64_t(sizeof(float));
@@ -541,11 +626,12 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool
                                    " bytes, beyond the decode memory limit of " + std::to_string(limits.maxDecodeBytes)});
             }
         }
-        for (const int p : {model.conusPart, model.mapPart}) {
+        for (const PartSpec& spec : kParts) {
+            const int p = model.slot(spec.kind).index;
             if (Problem problem = checkChunks(core.ctx(), p, size); !problem.message.empty()) return refuse(problem);
         }
         ConusFile loaded;
-        fillMetadata(model, file.header(model.conusPart), loaded);
+        fillMetadata(model, file.header(model.slot(PartKind::Conus).index), loaded);
         if (readPixels) {
             readImage(file, model, loaded.image);
         } else {
@@ -573,71 +659,21 @@ void writeExrFile(AtomicFile& out, const ConusFile& file) {
     const std::string& path = out.destination();
     AtomicOStream stream(out);
     try {
-        Imf::Header conus(im.width, im.height);
-        conus.setName(kConusPartName);
-        conus.setType(Imf::SCANLINEIMAGE);
-        conus.compression() = exrCompression(file.compression);
-        for (const std::string& name : im.channels) {
-            const bool asFloat = name == "Z" || file.pixelType == PixelType::Float;
-            conus.channels().insert(name, Imf::Channel(asFloat ? Imf::FLOAT : Imf::HALF));
-        }
-        conus.insert(kAttrVersion, Imf::IntAttribute(kFormatVersion));
-        conus.insert(kAttrSourceSize, Imf::V2iAttribute(Imath::V2i(file.sourceWidth, file.sourceHeight)));
-        conus.insert(kAttrDataKind, Imf::StringAttribute(toString(file.dataKind)));
-        conus.insert(kAttrSoftware,
-                     Imf::StringAttribute(file.software.empty() ? std::string(kSoftwareName) : file.software));
-        if (file.analytic) {
-            const AnalyticMap& a = *file.analytic;
-            conus.insert(kAttrMapKind, Imf::StringAttribute(a.kind));
-            if (!a.foci.empty()) {
-                std::vector<float> f;
-                for (const FocusParams& p : a.foci) f.insert(f.end(), {float(p.u), float(p.v), float(p.r), float(p.k)});
-                conus.insert(kAttrFoci, Imf::FloatVectorAttribute(f));
-            }
-            if (!a.composition.empty()) conus.insert(kAttrComposition, Imf::StringAttribute(a.composition));
-            for (const auto& [name, value] : a.scalars) {
-                conus.insert(kAttrParamPrefix + name, Imf::DoubleAttribute(value));
-            }
-        }
-        if (file.camera) {
-            Imf::addWorldToCamera(conus, toM44(file.camera->worldToCamera));
-            Imf::addWorldToNDC(conus, toM44(file.camera->worldToNDC));
-            conus.insert(kAttrProjection, Imf::StringAttribute(file.camera->projection));
-        }
-        conus.insert(kAttrDepthKind, Imf::StringAttribute(toString(file.depth.kind)));
-        if (file.depth.kind != DepthKind::None) {
-            conus.insert(kAttrDepthRange, Imf::V2fAttribute(Imath::V2f(file.depth.near, file.depth.far)));
-        }
-        if (!file.depth.units.empty()) conus.insert(kAttrDepthUnits, Imf::StringAttribute(file.depth.units));
-        const SourceEncoding& e = file.sourceEncoding;
-        conus.insert(kAttrSourceTransfer, Imf::StringAttribute(toString(e.transfer)));
-        if (e.sampleType) conus.insert(kAttrSourceSampleType, Imf::StringAttribute(toString(*e.sampleType)));
-        if (e.chromaticities) {
-            const std::array<float, 8>& c = *e.chromaticities;
-            Imf::addChromaticities(conus, Imf::Chromaticities(Imath::V2f(c[0], c[1]), Imath::V2f(c[2], c[3]),
-                                                              Imath::V2f(c[4], c[5]), Imath::V2f(c[6], c[7])));
-        }
-        if (!e.iccProfile.empty()) conus.insert(kAttrIccProfile, Imf::StringAttribute(base64Encode(e.iccProfile)));
-        for (const MetadataItem& item : e.metadata) {
+        // The parts and attributes the validator checked (header_model.cpp), then the source's
+        // metadata, which only the `conus` part carries.
+        const HeaderModel model = modelOf(file);
+        std::vector<Imf::Header> headers;
+        for (const PartModel& part : model.parts) headers.push_back(exrHeader(part));
+        for (const PartSpec& spec : kParts) writeAttributes(model, spec.kind, headers[model.slot(spec.kind).index]);
+        Imf::Header& conus = headers[model.slot(PartKind::Conus).index];
+        for (const MetadataItem& item : file.sourceEncoding.metadata) {
             if (!isCarriedMetadata(item.name)) continue;  // never let an item overwrite a CoNUS attribute
             if (const auto* v = std::get_if<std::string>(&item.value)) conus.insert(item.name, Imf::StringAttribute(*v));
             else if (const auto* i = std::get_if<int>(&item.value)) conus.insert(item.name, Imf::IntAttribute(*i));
             else if (const auto* f = std::get_if<float>(&item.value)) conus.insert(item.name, Imf::FloatAttribute(*f));
             else if (const auto* d = std::get_if<double>(&item.value)) conus.insert(item.name, Imf::DoubleAttribute(*d));
         }
-
-        // OpenEXR requires every part to share displayWindow: the map part gets the image's and its
-        // own dataWindow. It is always stored losslessly (DWAA would quantize the node positions).
-        Imf::Header map(conus.displayWindow(),
-                        Imath::Box2i(Imath::V2i(0, 0), Imath::V2i(file.map.columns - 1, file.map.rows - 1)));
-        map.setName(kMapPartName);
-        map.setType(Imf::SCANLINEIMAGE);
-        map.compression() = file.compression == Compression::None ? Imf::NO_COMPRESSION : Imf::ZIP_COMPRESSION;
-        map.channels().insert(kMapChannelU, Imf::Channel(Imf::FLOAT));
-        map.channels().insert(kMapChannelV, Imf::Channel(Imf::FLOAT));
-
-        const Imf::Header headers[2] = {conus, map};
-        Imf::MultiPartOutputFile exr(stream, headers, 2);
+        Imf::MultiPartOutputFile exr(stream, headers.data(), int(headers.size()));
         {
             // OpenEXR converts types when reading but not when writing: HALF channels get their own
             // planar half buffers (rounded to nearest), FLOAT ones are written from the image.
@@ -656,18 +692,13 @@ void writeExrFile(AtomicFile& out, const ConusFile& file) {
                                                          nc * sizeof(float), nc * sizeof(float) * im.width));
                 }
             }
-            Imf::OutputPart part(exr, 0);
+            Imf::OutputPart part(exr, model.slot(PartKind::Conus).index);
             part.setFrameBuffer(fb);
             part.writePixels(im.height);
         }
         {
-            Imf::FrameBuffer fb;
-            char* base = const_cast<char*>(reinterpret_cast<const char*>(file.map.xy.data()));
-            const std::size_t xStride = 2 * sizeof(float);
-            fb.insert(kMapChannelU, Imf::Slice(Imf::FLOAT, base, xStride, xStride * file.map.columns));
-            fb.insert(kMapChannelV, Imf::Slice(Imf::FLOAT, base + sizeof(float), xStride, xStride * file.map.columns));
-            Imf::OutputPart part(exr, 1);
-            part.setFrameBuffer(fb);
+            Imf::OutputPart part(exr, model.slot(PartKind::SamplingMap).index);
+            part.setFrameBuffer(mapFrameBuffer(file.map));
             part.writePixels(file.map.rows);
         }
     } catch (const std::exception& e) {

@@ -1,13 +1,18 @@
 // Private to format/: a neutral description of a CoNUS file's parts and attributes, filled either
-// from OpenEXR headers (exr_io.cpp) or from an in-memory ConusFile (validate_file.cpp), so the
-// header rules V2..V7 and V12..V15 are written once and checked the same way for both.
+// from OpenEXR headers (exr_io.cpp) or from an in-memory ConusFile (header_model.cpp), so the
+// header rules V2..V7 and V12..V16 are written once and checked the same way for both, and the
+// writer writes exactly what the validator checked. The known parts and attributes are tables
+// (kParts, kAttributes) that the reader, the writer and the validator share.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <iterator>
+#include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "conus/format/container.h"
@@ -17,6 +22,7 @@ namespace conus::format::detail {
 // An attribute as found: absent, present with the wrong EXR type, or present with a value.
 template <class T>
 struct Attr {
+    using Value = T;
     bool present = false;
     bool typeOk = false;
     std::string typeName;  // the EXR type it had, for messages
@@ -39,20 +45,47 @@ struct Box {
     bool operator==(const Box&) const = default;
 };
 
+// The parts CoNUS knows (spec "High-level layout"), in the order the writer stores them. A new
+// part is a value here and a row in kParts; its attributes name it in kAttributes.
+enum class PartKind { Conus, SamplingMap };
+
+struct PartSpec {
+    PartKind kind;
+    const char* name;  // the part's `name` attribute
+    Rule rule;         // the rule that requires exactly one such part
+};
+
+inline constexpr PartSpec kParts[] = {
+    {PartKind::Conus, kConusPartName, Rule::V2},
+    {PartKind::SamplingMap, kMapPartName, Rule::V7},
+};
+inline constexpr std::size_t kPartCount = std::size(kParts);
+
 struct PartModel {
     std::string name;
     std::string type;  // "scanlineimage", "tiledimage", "deepscanline", ...
     std::vector<ChannelModel> channels;
     Box dataWindow, displayWindow;
     std::int64_t tileWidth = 0, tileHeight = 0;  // tiled parts only
+    Compression compression = Compression::Zip;
+};
+
+// Where a known part was found: the index of the first part with its name, and how many have it.
+struct PartSlot {
+    int index = -1;
+    int count = 0;
 };
 
 struct HeaderModel {
     std::vector<PartModel> parts;
-    int conusPart = -1, mapPart = -1;  // index of the first part with that name
-    int conusPartCount = 0, mapPartCount = 0;
+    std::array<PartSlot, kPartCount> found;  // by PartKind
 
-    // Attributes of the `conus` part.
+    const PartSlot& slot(PartKind kind) const { return found[static_cast<std::size_t>(kind)]; }
+    PartSlot& slot(PartKind kind) { return found[static_cast<std::size_t>(kind)]; }
+    // The first part of that kind; only when slot(kind).index >= 0.
+    const PartModel& part(PartKind kind) const { return parts[static_cast<std::size_t>(slot(kind).index)]; }
+
+    // Attributes of the `conus` part (kAttributes says each one's name and type).
     Attr<int> version;
     Attr<std::array<int, 2>> sourceSize;
     Attr<std::string> dataKind;
@@ -65,37 +98,41 @@ struct HeaderModel {
     Attr<std::string> depthKind;
     Attr<std::array<float, 2>> depthRange;
     Attr<std::string> depthUnits;
+    Attr<std::string> software;
     // Colour (V16).
     Attr<std::string> sourceTransfer, sourceSampleType, iccProfile;
     Attr<std::array<float, 8>> chromaticities;
 };
 
-// Which rule a failure maps to is part of the report; this says how readConusFile should throw.
-struct HeaderCheck {
-    bool notConus = false;       // readable EXR without a `conus` part
-    bool limitExceeded = false;  // a size beyond ReadLimits
+// ---- The attributes CoNUS reads and writes, as data ----------------------------------------------
+// Each known attribute once: its name in the file, the part that carries it, the rule that checks
+// it, and the HeaderModel member that holds it (whose C++ type fixes the EXR type: int, v2i,
+// string, floatvector, m44f, v2f, chromaticities; double for a family of named parameters). The
+// reader fills every member from this table and the writer writes every member through it, so a
+// new attribute is a member, a row, a check in validate_file.cpp and its ConusFile field.
+
+template <class T>
+using AttrMember = Attr<T> HeaderModel::*;
+using ParamsMember = std::map<std::string, Attr<double>> HeaderModel::*;
+using AttrField = std::variant<AttrMember<int>, AttrMember<std::string>, AttrMember<std::array<int, 2>>,
+                               AttrMember<std::array<float, 2>>, AttrMember<std::vector<float>>,
+                               AttrMember<std::array<float, 16>>, AttrMember<std::array<float, 8>>, ParamsMember>;
+
+// The EXR type of each of AttrField's alternatives, in its order, as messages and the spec name it.
+inline constexpr const char* kAttrTypeNames[] = {"int", "string", "v2i", "v2f", "floatvector", "m44f", "chromaticities",
+                                                 "double or float"};
+static_assert(std::size(kAttrTypeNames) == std::variant_size_v<AttrField>);
+
+struct AttributeSpec {
+    const char* name;  // for a ParamsMember, the prefix of every name in the family
+    PartKind part;
+    Rule rule;  // the rule that checks its presence, type and value
+    AttrField field;
+
+    constexpr const char* typeName() const { return kAttrTypeNames[field.index()]; }
 };
 
-// The camera the attributes describe, or what is wrong with them (V13's geometric half: known
-// projection, finite invertible matrices that agree with it). toCamera() throws with that text.
-struct CameraCheck {
-    std::optional<conus::Camera> camera;
-    std::string problem;  // empty when `camera` holds one
-};
-CameraCheck describeCamera(const CameraAttributes& attributes);
-
-// Runs V2..V7 (shape only for V7) and V12..V15 on the model, appending to `report`.
-HeaderCheck checkHeaderRules(const HeaderModel& model, const ReadLimits& limits, ValidationReport& report);
-
-// The header an in-memory file would be written with.
-HeaderModel modelOf(const ConusFile& file);
-
-// Base64 (RFC 4648) for the ICC profile, which OpenEXR 3.1 has no byte-array attribute for.
-std::string base64Encode(const std::string& bytes);
-// Empty optional for text that is not base64.
-std::optional<std::string> base64Decode(const std::string& text);
-
-// Attribute names (spec/conus-format.md).
+// Attribute names (spec/conus-format.md, "Attributes").
 inline constexpr const char* kAttrVersion = "conus:version";
 inline constexpr const char* kAttrSourceSize = "conus:sourceSize";
 inline constexpr const char* kAttrDataKind = "conus:dataKind";
@@ -116,5 +153,59 @@ inline constexpr const char* kAttrIccProfile = "conus:iccProfile";  // base64
 inline constexpr const char* kAttrChromaticities = "chromaticities";
 inline constexpr const char* kMapChannelU = "ud";
 inline constexpr const char* kMapChannelV = "vd";
+
+inline constexpr AttributeSpec kAttributes[] = {
+    {kAttrVersion, PartKind::Conus, Rule::V2, &HeaderModel::version},
+    {kAttrSourceSize, PartKind::Conus, Rule::V5, &HeaderModel::sourceSize},
+    {kAttrDataKind, PartKind::Conus, Rule::V6, &HeaderModel::dataKind},
+    {kAttrMapKind, PartKind::Conus, Rule::V12, &HeaderModel::mapKind},
+    {kAttrFoci, PartKind::Conus, Rule::V12, &HeaderModel::foci},
+    {kAttrComposition, PartKind::Conus, Rule::V12, &HeaderModel::composition},
+    {kAttrParamPrefix, PartKind::Conus, Rule::V12, &HeaderModel::params},
+    {kAttrWorldToCamera, PartKind::Conus, Rule::V13, &HeaderModel::worldToCamera},
+    {kAttrWorldToNDC, PartKind::Conus, Rule::V13, &HeaderModel::worldToNDC},
+    {kAttrProjection, PartKind::Conus, Rule::V13, &HeaderModel::projection},
+    {kAttrDepthKind, PartKind::Conus, Rule::V14, &HeaderModel::depthKind},
+    {kAttrDepthRange, PartKind::Conus, Rule::V14, &HeaderModel::depthRange},
+    {kAttrDepthUnits, PartKind::Conus, Rule::V14, &HeaderModel::depthUnits},
+    {kAttrSoftware, PartKind::Conus, Rule::Unreadable, &HeaderModel::software},  // free text, no rule
+    {kAttrSourceTransfer, PartKind::Conus, Rule::V16, &HeaderModel::sourceTransfer},
+    {kAttrSourceSampleType, PartKind::Conus, Rule::V16, &HeaderModel::sourceSampleType},
+    {kAttrIccProfile, PartKind::Conus, Rule::V16, &HeaderModel::iccProfile},
+    {kAttrChromaticities, PartKind::Conus, Rule::V16, &HeaderModel::chromaticities},
+};
+
+// The row of the attribute `member` holds.
+template <class Member>
+constexpr const AttributeSpec& specOf(Member member) {
+    for (const AttributeSpec& spec : kAttributes)
+        if (const auto* m = std::get_if<Member>(&spec.field); m && *m == member) return spec;
+    throw std::logic_error("attribute missing from kAttributes");
+}
+
+// Which rule a failure maps to is part of the report; this says how readConusFile should throw.
+struct HeaderCheck {
+    bool notConus = false;       // readable EXR without a `conus` part
+    bool limitExceeded = false;  // a size beyond ReadLimits
+};
+
+// The camera the attributes describe, or what is wrong with them (V13's geometric half: known
+// projection, finite invertible matrices that agree with it). toCamera() throws with that text.
+struct CameraCheck {
+    std::optional<conus::Camera> camera;
+    std::string problem;  // empty when `camera` holds one
+};
+CameraCheck describeCamera(const CameraAttributes& attributes);
+
+// Runs V2..V7 (shape only for V7) and V12..V15 on the model, appending to `report`.
+HeaderCheck checkHeaderRules(const HeaderModel& model, const ReadLimits& limits, ValidationReport& report);
+
+// The header an in-memory file is written with (header_model.cpp).
+HeaderModel modelOf(const ConusFile& file);
+
+// Base64 (RFC 4648) for the ICC profile, which OpenEXR 3.1 has no byte-array attribute for.
+std::string base64Encode(const std::string& bytes);
+// Empty optional for text that is not base64.
+std::optional<std::string> base64Decode(const std::string& text);
 
 }  // namespace conus::format::detail

@@ -44,9 +44,16 @@ bool need(const Attr<T>& a, const char* name, const char* expected, Rule rule, V
     return true;
 }
 
+// The same for a known attribute, named, typed and ruled by its row in kAttributes.
 template <class T>
-bool optional(const Attr<T>& a, const char* name, const char* expected, Rule rule, ValidationReport& r) {
-    return a.present && need(a, name, expected, rule, r);
+bool need(const HeaderModel& m, AttrMember<T> member, ValidationReport& r) {
+    const AttributeSpec& spec = specOf(member);
+    return need(m.*member, spec.name, spec.typeName(), spec.rule, r);
+}
+
+template <class T>
+bool optional(const HeaderModel& m, AttrMember<T> member, ValidationReport& r) {
+    return (m.*member).present && need(m, member, r);
 }
 
 bool oneOf(const std::string& s, std::initializer_list<const char*> allowed) {
@@ -54,7 +61,7 @@ bool oneOf(const std::string& s, std::initializer_list<const char*> allowed) {
 }
 
 void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport& r) {
-    if (m.conusPartCount > 1) r.add(Rule::V2, std::to_string(m.conusPartCount) + " parts are named `conus`; exactly one is allowed");
+    if (const int n = m.slot(PartKind::Conus).count; n > 1) r.add(Rule::V2, std::to_string(n) + " parts are named `conus`; exactly one is allowed");
     if (part.type != "scanlineimage" && part.type != "tiledimage") {
         r.add(Rule::V2, "part `conus` has type `" + part.type + "`, expected scanlineimage or tiledimage");
     }
@@ -63,7 +70,7 @@ void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport&
         r.add(Rule::V2, "part `conus` has tiles of " + std::to_string(part.tileWidth) + "x" + std::to_string(part.tileHeight) +
                      " pixels; at most " + std::to_string(kMaxTilePixels) + " pixels a tile are read");
     }
-    if (!need(m.version, kAttrVersion, "int", Rule::V2, r)) return;
+    if (!need(m, &HeaderModel::version, r)) return;
     if (m.version.value > kFormatVersion) {
         r.add(Rule::V2, "written by a newer CoNUS (version " + std::to_string(m.version.value) + "); this reader knows version " +
                      std::to_string(kFormatVersion));
@@ -110,24 +117,25 @@ void checkWindows(const PartModel& part, const ReadLimits& limits, ValidationRep
 }
 
 void checkSourceAndKind(const HeaderModel& m, ValidationReport& r) {
-    if (need(m.sourceSize, kAttrSourceSize, "v2i", Rule::V5, r)) {
+    if (need(m, &HeaderModel::sourceSize, r)) {
         const auto [sw, sh] = m.sourceSize.value;
         if (sw < 1 || sh < 1 || sw > kMaxImageSide || sh > kMaxImageSide) {
             r.add(Rule::V5, "source size " + std::to_string(sw) + "x" + std::to_string(sh) + " outside [1, " +
                          std::to_string(kMaxImageSide) + "]");
         }
     }
-    if (need(m.dataKind, kAttrDataKind, "string", Rule::V6, r) && !parseName<DataKind>(m.dataKind.value)) {
+    if (need(m, &HeaderModel::dataKind, r) && !parseName<DataKind>(m.dataKind.value)) {
         r.add(Rule::V6, "data kind `" + m.dataKind.value + "` is not one of image, heightfield, depthimage");
     }
 }
 
 void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
-    if (m.mapPartCount != 1) {
-        r.add(Rule::V7, std::to_string(m.mapPartCount) + " parts are named `samplingmap`; exactly one is required");
-        if (m.mapPart < 0) return;
+    const PartSlot& slot = m.slot(PartKind::SamplingMap);
+    if (slot.count != 1) {
+        r.add(Rule::V7, std::to_string(slot.count) + " parts are named `samplingmap`; exactly one is required");
+        if (slot.index < 0) return;
     }
-    const PartModel& p = m.parts[m.mapPart];
+    const PartModel& p = m.part(PartKind::SamplingMap);
     if (p.type != "scanlineimage") r.add(Rule::V7, "part `samplingmap` has type `" + p.type + "`, expected scanlineimage");
     const bool channelsOk = p.channels.size() == 2 && p.channels[0].name == kMapChannelU && p.channels[1].name == kMapChannelV &&
                             std::all_of(p.channels.begin(), p.channels.end(), [](const ChannelModel& c) {
@@ -157,10 +165,10 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
         }
         return;
     }
-    if (!need(m.mapKind, kAttrMapKind, "string", Rule::V12, r)) return;
+    if (!need(m, &HeaderModel::mapKind, r)) return;
     const std::string& kind = m.mapKind.value;
     if (kind == "foci") {
-        if (need(m.foci, kAttrFoci, "floatvector", Rule::V12, r)) {
+        if (need(m, &HeaderModel::foci, r)) {
             const std::vector<float>& f = m.foci.value;
             if (f.empty() || f.size() % 4 != 0) {
                 r.add(Rule::V12, std::string(kAttrFoci) + " has " + std::to_string(f.size()) + " values; 4 per focus (u,v,r,k), at least one focus");
@@ -175,30 +183,30 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
                 }
             }
         }
-        if (need(m.composition, kAttrComposition, "string", Rule::V12, r) && !oneOf(m.composition.value, {"density", "add"})) {
+        if (need(m, &HeaderModel::composition, r) && !oneOf(m.composition.value, {"density", "add"})) {
             r.add(Rule::V12, "composition `" + m.composition.value + "` is not density or add");
         }
     } else if (kind != "ground") {
         r.add(Rule::V12, "map kind `" + kind + "` is not foci or ground");
     }
+    const AttributeSpec& params = specOf(&HeaderModel::params);
     for (const auto& [name, a] : m.params) {
-        const std::string full = kAttrParamPrefix + name;
-        if (need(a, full.c_str(), "double or float", Rule::V12, r) && !std::isfinite(a.value)) {
-            r.add(Rule::V12, full + " = " + numberText(a.value, 9) + " is not finite");
+        const std::string full = params.name + name;
+        if (need(a, full.c_str(), params.typeName(), params.rule, r) && !std::isfinite(a.value)) {
+            r.add(params.rule, full + " = " + numberText(a.value, 9) + " is not finite");
         }
     }
 }
 
 void checkCamera(const HeaderModel& m, ValidationReport& r) {
     if (!m.worldToCamera.present && !m.worldToNDC.present && !m.projection.present) return;
-    for (const auto* a : {&m.worldToCamera, &m.worldToNDC}) {
-        const char* name = a == &m.worldToCamera ? kAttrWorldToCamera : kAttrWorldToNDC;
-        if (need(*a, name, "m44f", Rule::V13, r) &&
-            !std::all_of(a->value.begin(), a->value.end(), [](float x) { return std::isfinite(x); })) {
-            r.add(Rule::V13, std::string(name) + " has a non-finite element");
+    for (const AttrMember<std::array<float, 16>> matrix : {&HeaderModel::worldToCamera, &HeaderModel::worldToNDC}) {
+        const std::array<float, 16>& value = (m.*matrix).value;
+        if (need(m, matrix, r) && !std::all_of(value.begin(), value.end(), [](float x) { return std::isfinite(x); })) {
+            r.add(Rule::V13, std::string(specOf(matrix).name) + " has a non-finite element");
         }
     }
-    if (need(m.projection, kAttrProjection, "string", Rule::V13, r) && !parseProjection(m.projection.value)) {
+    if (need(m, &HeaderModel::projection, r) && !parseProjection(m.projection.value)) {
         r.add(Rule::V13, "projection `" + m.projection.value + "` is not perspective or orthographic");
     } else if (!r.violates(Rule::V13)) {
         const CameraCheck check = describeCamera(CameraAttributes{m.projection.value, m.worldToCamera.value, m.worldToNDC.value});
@@ -208,7 +216,7 @@ void checkCamera(const HeaderModel& m, ValidationReport& r) {
 
 void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r) {
     std::string kind = "none";  // absent means no depth
-    if (optional(m.depthKind, kAttrDepthKind, "string", Rule::V14, r)) {
+    if (optional(m, &HeaderModel::depthKind, r)) {
         kind = m.depthKind.value;
         if (!parseName<DepthKind>(kind)) {
             r.add(Rule::V14, "depth kind `" + kind + "` is not none, cameraDepth or height");
@@ -218,24 +226,36 @@ void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r
     const bool hasZ = std::any_of(part.channels.begin(), part.channels.end(), [](const ChannelModel& c) { return c.name == "Z"; });
     if (hasZ && kind == "none") r.add(Rule::V14, "a `Z` channel needs conus:depthKind cameraDepth or height, not none");
     if (!hasZ && kind != "none") r.add(Rule::V14, "conus:depthKind is " + kind + " but there is no `Z` channel");
-    if (kind != "none" && need(m.depthRange, kAttrDepthRange, "v2f", Rule::V14, r)) {
+    if (kind != "none" && need(m, &HeaderModel::depthRange, r)) {
         const auto [nearV, farV] = m.depthRange.value;
         if (!(std::isfinite(nearV) && std::isfinite(farV) && nearV < farV)) {
             r.add(Rule::V14, "depth range (" + numberText(nearV, 9) + ", " + numberText(farV, 9) + ") must be finite with near < far");
         }
     }
-    optional(m.depthUnits, kAttrDepthUnits, "string", Rule::V14, r);
+    optional(m, &HeaderModel::depthUnits, r);
+}
+
+// V17: a depth image's Z means something only through its camera (cameraDepth along its axis).
+void checkDepthImage(const HeaderModel& m, ValidationReport& r) {
+    if (!m.dataKind.present || m.dataKind.value != "depthimage") return;
+    std::string missing;
+    if (!m.worldToCamera.present) missing += kAttrWorldToCamera;
+    if (!m.worldToNDC.present) missing += std::string(missing.empty() ? "" : ", ") + kAttrWorldToNDC;
+    if (!m.projection.present) missing += std::string(missing.empty() ? "" : ", ") + kAttrProjection;
+    if (!missing.empty()) r.add(Rule::V17, "a depth image needs its camera; missing " + missing);
+    const std::string kind = m.depthKind.present ? m.depthKind.value : "none";
+    if (kind != "cameraDepth") r.add(Rule::V17, "a depth image's conus:depthKind is " + kind + ", not cameraDepth");
 }
 
 void checkColour(const HeaderModel& m, ValidationReport& r) {
-    if (optional(m.sourceTransfer, kAttrSourceTransfer, "string", Rule::V16, r) && !parseTransfer(m.sourceTransfer.value))
+    if (optional(m, &HeaderModel::sourceTransfer, r) && !parseTransfer(m.sourceTransfer.value))
         r.add(Rule::V16, "source transfer `" + m.sourceTransfer.value + "` is not linear, srgb or raw");
-    if (optional(m.sourceSampleType, kAttrSourceSampleType, "string", Rule::V16, r) && !parseSampleType(m.sourceSampleType.value))
+    if (optional(m, &HeaderModel::sourceSampleType, r) && !parseSampleType(m.sourceSampleType.value))
         r.add(Rule::V16, "source sample type `" + m.sourceSampleType.value + "` is not uint8, uint16, uint32, half or float");
-    if (optional(m.chromaticities, kAttrChromaticities, "chromaticities", Rule::V16, r) &&
+    if (optional(m, &HeaderModel::chromaticities, r) &&
         !std::all_of(m.chromaticities.value.begin(), m.chromaticities.value.end(), [](float x) { return std::isfinite(x); }))
         r.add(Rule::V16, "chromaticities hold a non-finite value");
-    if (optional(m.iccProfile, kAttrIccProfile, "string", Rule::V16, r) && !base64Decode(m.iccProfile.value))
+    if (optional(m, &HeaderModel::iccProfile, r) && !base64Decode(m.iccProfile.value))
         r.add(Rule::V16, std::string(kAttrIccProfile) + " is not base64 text (" + std::to_string(m.iccProfile.value.size()) + " characters)");
 }
 
@@ -252,12 +272,12 @@ void checkDisplayWindows(const HeaderModel& m, ValidationReport& r) {
 
 HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r) {
     HeaderCheck hc;
-    if (m.conusPart < 0) {
+    if (m.slot(PartKind::Conus).index < 0) {
         r.add(Rule::V2, "not a CoNUS file: no part named `conus` among " + std::to_string(m.parts.size()) + " part(s)");
         hc.notConus = true;
         return hc;
     }
-    const PartModel& part = m.parts[m.conusPart];
+    const PartModel& part = m.part(PartKind::Conus);
     checkVersion(m, part, r);
     checkChannels(part, limits, r, hc);
     checkWindows(part, limits, r, hc);
@@ -266,74 +286,10 @@ HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, Val
     checkAnalytic(m, r);
     checkCamera(m, r);
     checkDepth(m, part, r);
+    checkDepthImage(m, r);
     checkColour(m, r);
     checkDisplayWindows(m, r);
     return hc;
-}
-
-namespace {
-template <class T>
-Attr<T> attr(T value) {
-    Attr<T> a;
-    a.present = a.typeOk = true;
-    a.value = std::move(value);
-    return a;
-}
-}  // namespace
-
-HeaderModel modelOf(const ConusFile& file) {
-    HeaderModel m;
-    const Image& im = file.image;
-    PartModel conus;
-    conus.name = kConusPartName;
-    conus.type = "scanlineimage";
-    for (const std::string& name : im.channels) {
-        conus.channels.push_back({name, name == "Z" || file.pixelType == PixelType::Float ? ChannelType::Float : ChannelType::Half, 1, 1});
-    }
-    // OpenEXR stores channels sorted by name; so does the model, so checks read the same.
-    std::sort(conus.channels.begin(), conus.channels.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
-    conus.dataWindow = conus.displayWindow = Box{0, 0, std::int64_t{im.width} - 1, std::int64_t{im.height} - 1};
-    PartModel map;
-    map.name = kMapPartName;
-    map.type = "scanlineimage";
-    map.channels = {{kMapChannelU, ChannelType::Float, 1, 1}, {kMapChannelV, ChannelType::Float, 1, 1}};
-    map.displayWindow = conus.displayWindow;
-    map.dataWindow = Box{0, 0, std::int64_t{file.map.columns} - 1, std::int64_t{file.map.rows} - 1};
-    m.parts = {conus, map};
-    m.conusPart = 0;
-    m.mapPart = 1;
-    m.conusPartCount = m.mapPartCount = 1;
-
-    m.version = attr(kFormatVersion);
-    m.sourceSize = attr(std::array<int, 2>{file.sourceWidth, file.sourceHeight});
-    m.dataKind = attr(std::string(toString(file.dataKind)));
-    if (file.analytic) {
-        const AnalyticMap& a = *file.analytic;
-        m.mapKind = attr(a.kind);
-        if (a.kind == "foci" || !a.foci.empty()) {
-            std::vector<float> f;
-            for (const FocusParams& p : a.foci) {
-                f.insert(f.end(), {float(p.u), float(p.v), float(p.r), float(p.k)});
-            }
-            m.foci = attr(std::move(f));
-        }
-        if (a.kind == "foci" || !a.composition.empty()) m.composition = attr(a.composition);
-        for (const auto& [name, value] : a.scalars) m.params[name] = attr(value);
-    }
-    if (file.camera) {
-        m.worldToCamera = attr(file.camera->worldToCamera);
-        m.worldToNDC = attr(file.camera->worldToNDC);
-        m.projection = attr(file.camera->projection);
-    }
-    m.depthKind = attr(std::string(toString(file.depth.kind)));
-    if (file.depth.kind != DepthKind::None) m.depthRange = attr(std::array<float, 2>{file.depth.near, file.depth.far});
-    if (!file.depth.units.empty()) m.depthUnits = attr(file.depth.units);
-    const SourceEncoding& e = file.sourceEncoding;
-    m.sourceTransfer = attr(std::string(toString(e.transfer)));
-    if (e.sampleType) m.sourceSampleType = attr(std::string(toString(*e.sampleType)));
-    if (e.chromaticities) m.chromaticities = attr(*e.chromaticities);
-    if (!e.iccProfile.empty()) m.iccProfile = attr(base64Encode(e.iccProfile));
-    return m;
 }
 
 }  // namespace detail

@@ -5,6 +5,7 @@
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
+#include "conus/codec/mesh/shading.h"
 #include "conus/core/display.h"
 
 namespace conus::gl {
@@ -33,6 +34,8 @@ std::string constantsBlock() {
              ", " + glslFloat(kInfernoRamp[i][2]) + ")";
     s += ");\n";
     s += "const float kIntersectDepthMargin = " + glslFloat(codec::kIntersectDepthMargin) + ";\n";
+    s += "const float kMeshAmbient = " + glslFloat(codec::kAmbient) + ";\n";
+    s += "const float kMeshGrey = " + glslFloat(codec::kDefaultAlbedo) + ";\n";
     return s;
 }
 

@@ -12,8 +12,9 @@ inline constexpr int kViewMaxFoci = 16;          // focus outlines conus-view dr
 
 // `source` with the shared constants declared after its first line (#version):
 // kDecodeMultiTap, kDecodeMaxTaps (codec/decode.h), kEncodeMaxTaps, kEncodeTapTolerance
-// (codec/encode.h), kBackground, kMaxFoci (above), kInferno[6] (core/display.h) and
-// kIntersectDepthMargin (codec/depth/intersect.h).
+// (codec/encode.h), kBackground, kMaxFoci (above), kInferno[6] (core/display.h),
+// kIntersectDepthMargin (codec/depth/intersect.h), and the mesh shading's kMeshAmbient, kMeshGrey
+// (codec/mesh/shading.h: kAmbient, kDefaultAlbedo).
 std::string withSharedConstants(const std::string& source);
 
 }  // namespace conus::gl

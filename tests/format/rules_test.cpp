@@ -1,4 +1,4 @@
-// Every rule V1..V15 of spec/conus-format.md, each broken once: in memory where a ConusFile can
+// Every rule V1..V17 of spec/conus-format.md, each broken once: in memory where a ConusFile can
 // express the fault, else as a malformed file written with OpenEXR directly.
 #include <gtest/gtest.h>
 
@@ -259,6 +259,26 @@ TEST_F(RuleTest, V14Depth) {
     f.depth = {DepthKind::Height, "m", 0.0f, 1.0f};
     EXPECT_TRUE(onlyRule(validateConusFile(f), 14));  // depthKind without Z
     EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) { c.insert("conus:depthKind", Imf::StringAttribute("altitude")); }), 14));
+}
+
+TEST_F(RuleTest, V17DepthImageNeedsItsCamera) {
+    ConusFile f = validFile();
+    f.image = makeImage(8, 6, {"R", "G", "B", "A", "Z"});
+    f.dataKind = DataKind::DepthImage;
+    f.depth = {DepthKind::CameraDepth, "m", 0.5f, 40.0f};
+    ValidationReport r = validateConusFile(f);  // no camera
+    EXPECT_TRUE(onlyRule(r, 17));
+    EXPECT_NE(r.str().find("missing worldToCamera, worldToNDC, conus:projection"), std::string::npos) << r.str();
+    f.camera = toAttributes(conus::Camera::perspective({1, 2, 3}, {0, 0, 0}, {0, 1, 0}, 50, 8.0 / 6.0, 0.5, 40));
+    EXPECT_TRUE(validateConusFile(f).ok()) << validateConusFile(f).str();
+    f.depth.kind = DepthKind::Height;  // a depth image holds camera depth, not heights
+    r = validateConusFile(f);
+    EXPECT_TRUE(onlyRule(r, 17));
+    EXPECT_NE(r.str().find("not cameraDepth"), std::string::npos) << r.str();
+    // On disk: an ordinary image file relabelled `depthimage` has neither camera nor camera depth.
+    r = raw([](Imf::Header& c, Imf::Header&) { c.insert("conus:dataKind", Imf::StringAttribute("depthimage")); });
+    EXPECT_TRUE(onlyRule(r, 17));
+    EXPECT_NE(r.str().find("missing worldToCamera"), std::string::npos) << r.str();
 }
 
 TEST_F(RuleTest, V15DisplayWindows) {

@@ -4,6 +4,9 @@
 // - Image files: a CoNUS image encoded through a map, the size and encoding of its source, and the
 //   analytic parameters when the map was built from some; a `Z` channel makes it a depth image
 //   of camera depth over [0, 1] unless the caller says otherwise afterwards.
+// - Depth images (a mesh render: R, G, B, A, Z): data kind `depthimage`, Z camera depth over the
+//   camera's [near, far] in `units`, the camera recorded, float pixels (depth needs them), the
+//   conventional frame of the same pixel count as the source size.
 // - Map files (spec/conus-format.md, "Map files"): a sampling map on its own, as an ordinary CoNUS
 //   file whose image is the map's density at its nodes (one FLOAT channel Y, one pixel per node),
 //   so any EXR viewer shows where the samples go. Every reader takes the map from any CoNUS file
@@ -20,6 +23,9 @@ namespace conus::codec {
 
 format::ConusFile makeImageFile(Image image, const SamplingMap& map, int sourceWidth, int sourceHeight,
                                 SourceEncoding encoding, std::optional<format::AnalyticMap> analytic = std::nullopt);
+
+format::ConusFile makeDepthImageFile(Image image, const SamplingMap& map, const Camera& camera, std::string units,
+                                     std::optional<format::AnalyticMap> analytic = std::nullopt);
 
 format::ConusFile makeMapFile(const SamplingMap& map, std::optional<format::AnalyticMap> analytic = std::nullopt);
 

@@ -1,0 +1,130 @@
+// The GPU mesh encoder on the procedural city (paper section 6) at 1024 x 576, on the GL backend of
+// CONUS_BACKEND (default auto): the CoNUS render (two tracked foci) next to the conventional render
+// of the same mesh at the same size (the identity map: the paper measured no cost for the vertex
+// distortion), the cost of subdividing for --max-edge, the Embree reference at the same size (rays
+// a second), and per-frame map construction from 1..8 foci on a 65 x 65 grid, both compositions
+// (the animation builds one every frame). GPU and Embree times are wall-clock (the work runs on
+// other threads). Read ratios within one run (bench/README.md).
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <memory>
+#include <vector>
+
+#include "conus/codec/mesh/city.h"
+#include "conus/codec/mesh/raycast.h"
+#include "conus/codec/mesh/subdivide.h"
+#include "conus/renderers/mesh_render.h"
+#include "conus/renderers/mesh_sequence.h"
+
+namespace {
+
+using namespace conus;
+
+constexpr int kWidth = 1024, kHeight = 576;
+constexpr double kAspect = double(kWidth) / kHeight;
+
+struct Data {
+    codec::CityScene city;
+    Mesh mesh, fine;
+    Camera camera = Camera::perspective({30, 110, 160}, {0, 0, -10}, {0, 1, 0}, 50.0, kAspect, 1.0, 600.0);
+    std::unique_ptr<codec::SamplingMap> map, identity;
+    std::unique_ptr<gl::Context> context;
+    std::unique_ptr<gl::MeshRenderer> renderer, fineRenderer;
+};
+
+Data& data() {
+    static Data* d = [] {
+        auto* d = new Data;
+        d->mesh = d->city.meshAt(0.0);
+        const std::vector<glm::dvec3> cars{d->city.carCentre(0, 0.0), d->city.carCentre(2, 0.0)};
+        codec::FociOptions fo;
+        fo.aspect = kAspect;
+        d->map = std::make_unique<codec::SamplingMap>(gl::frameMap(gl::trackedFoci(d->camera, cars, kAspect), fo));
+        d->identity = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
+        d->fine = codec::subdivideForMap(d->mesh, d->camera, *d->map, 0.5);
+        const char* backend = std::getenv("CONUS_BACKEND");
+        d->context = gl::Context::create(gl::parseBackend(backend ? backend : "auto"));
+        d->renderer = std::make_unique<gl::MeshRenderer>(*d->context, d->mesh);
+        d->fineRenderer = std::make_unique<gl::MeshRenderer>(*d->context, d->fine);
+        // Warm up: shader compilation and the framebuffers belong to no frame.
+        d->renderer->render(d->camera, *d->map, kWidth, kHeight);
+        return d;
+    }();
+    return *d;
+}
+
+void setCounters(benchmark::State& state, const Mesh& mesh) {
+    state.counters["triangles"] = static_cast<double>(mesh.triangleCount());
+    state.counters["pixels/s"] =
+        benchmark::Counter(double(kWidth) * kHeight, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+// Draw + resolve + readback, the mesh already uploaded (the frame loop's cost).
+void BM_GpuConventional(benchmark::State& state) {
+    Data& d = data();
+    for (auto _ : state) benchmark::DoNotOptimize(d.renderer->render(d.camera, *d.identity, kWidth, kHeight));
+    setCounters(state, d.mesh);
+}
+void BM_GpuConus(benchmark::State& state) {
+    Data& d = data();
+    for (auto _ : state) benchmark::DoNotOptimize(d.renderer->render(d.camera, *d.map, kWidth, kHeight));
+    setCounters(state, d.mesh);
+}
+void BM_GpuConusSubdivided(benchmark::State& state) {
+    Data& d = data();
+    for (auto _ : state) benchmark::DoNotOptimize(d.fineRenderer->render(d.camera, *d.map, kWidth, kHeight));
+    setCounters(state, d.fine);
+}
+// Only the draw (no readback): where the vertex distortion's cost would show.
+void BM_GpuDrawOnly(benchmark::State& state) {
+    Data& d = data();
+    const codec::SamplingMap& map = state.range(0) ? *d.map : *d.identity;
+    double ms = 0;
+    for (auto _ : state) {
+        gl::GpuTimings timings;
+        benchmark::DoNotOptimize(d.renderer->render(d.camera, map, kWidth, kHeight, {}, &timings));
+        ms += timings.drawMs;
+    }
+    state.counters["drawMs"] = ms / static_cast<double>(state.iterations());
+    state.SetLabel(state.range(0) ? "conus" : "conventional");
+}
+void BM_Subdivide(benchmark::State& state) {
+    Data& d = data();
+    for (auto _ : state) benchmark::DoNotOptimize(codec::subdivideForMap(d.mesh, d.camera, *d.map, 0.5));
+    state.counters["triangles out"] = static_cast<double>(d.fine.triangleCount());
+}
+void BM_EmbreeReference(benchmark::State& state) {
+    Data& d = data();
+    static const codec::MeshScene scene(d.mesh);
+    const Fpc fpc(d.camera, std::make_shared<codec::SamplingMap>(*d.map));
+    codec::ReferenceOptions options;
+    options.samplesPerPixel = 4;
+    for (auto _ : state) benchmark::DoNotOptimize(codec::renderMeshReference(scene, fpc, kWidth, kHeight, options));
+    state.counters["rays/s"] =
+        benchmark::Counter(4.0 * kWidth * kHeight, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+// Per-frame map from N foci spread over the frame, 65 x 65 nodes, on one core.
+void fociFrame(benchmark::State& state, codec::FociComposition composition) {
+    std::vector<codec::Focus> foci;
+    for (int i = 0; i < state.range(0); ++i)
+        foci.push_back({0.1 + 0.8 * ((i * 37) % 8) / 7.0, 0.15 + 0.7 * ((i * 5) % 8) / 7.0, 0.06, 4.0});
+    codec::FociOptions options;
+    options.aspect = kAspect;
+    options.composition = composition;
+    for (auto _ : state) benchmark::DoNotOptimize(gl::frameMap(foci, options));
+}
+void BM_FociFrameDensity(benchmark::State& state) { fociFrame(state, codec::FociComposition::Density); }
+void BM_FociFrameAdd(benchmark::State& state) { fociFrame(state, codec::FociComposition::Add); }
+
+BENCHMARK(BM_GpuConventional)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GpuConus)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GpuConusSubdivided)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GpuDrawOnly)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Subdivide)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EmbreeReference)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FociFrameDensity)->Arg(1)->Arg(2)->Arg(8)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FociFrameAdd)->Arg(1)->Arg(2)->Arg(8)->Unit(benchmark::kMillisecond);
+
+}  // namespace

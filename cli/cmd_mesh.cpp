@@ -1,0 +1,467 @@
+// conus mesh render|animate: triangle meshes through the flexible pinhole camera (paper sections
+// 3.2 and 6). render writes one CoNUS colour + depth image (a `depthimage` file with its camera);
+// animate renders the procedural city's focus-plus-context sequence, each frame's foci following
+// chosen cars, as numbered CoNUS files and pictures, a contact sheet and (with ffmpeg) an MP4.
+#include <CLI/CLI.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "arguments.h"
+#include "backend.h"
+#include "commands.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/conus_file.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/mesh/city.h"
+#include "conus/codec/mesh/subdivide.h"
+#include "conus/core/atomic_file.h"
+#include "conus/core/error.h"
+#include "conus/format/container.h"
+#include "conus/renderers/mesh_render.h"
+#include "conus/renderers/mesh_sequence.h"
+#include "conus/sceneio/mesh_file.h"
+#include "encoding.h"
+#include "image_files.h"
+#include "pictures.h"
+#include "progress.h"
+
+namespace conus::cli {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr const char* kCity = "city";
+
+// What render and animate share.
+struct MeshOptions {
+    std::string model, sizeText = "512x512", cameraText, upText = "0,1,0", backend = "auto", units = "m";
+    double time = 0, maxEdge = 0.5;
+    int samples = 4, grid = map_rules::kDefaultSide;
+    std::vector<int> track;
+    double trackRadius = 0.08, trackK = 4;
+    std::string compose = "add";  // smooth from frame to frame (tests/renderers/mesh_sequence_test.cpp)
+};
+
+struct Bounds {
+    glm::dvec3 lo{std::numeric_limits<double>::max()}, hi{std::numeric_limits<double>::lowest()};
+};
+
+Bounds boundsOf(const Mesh& mesh) {
+    Bounds b;
+    for (const glm::vec3& p : mesh.positions) {
+        b.lo = glm::min(b.lo, glm::dvec3(p));
+        b.hi = glm::max(b.hi, glm::dvec3(p));
+    }
+    return b;
+}
+
+// The clip range that holds the whole box: its corners' depths along the view axis, a little wider.
+void clipRange(const Bounds& b, glm::dvec3 eye, glm::dvec3 forward, double& near, double& far) {
+    double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 p((corner & 1) ? b.hi.x : b.lo.x, (corner & 2) ? b.hi.y : b.lo.y, (corner & 4) ? b.hi.z : b.lo.z);
+        const double depth = glm::dot(p - eye, forward);
+        lo = std::min(lo, depth);
+        hi = std::max(hi, depth);
+    }
+    if (!(hi > 0))
+        throw Error(ErrorCode::InvalidArgument, "the model lies entirely behind the camera (look toward it with --camera)");
+    far = hi * 1.02 + 1e-6;
+    near = std::max(lo * 0.98, far * 1e-4);
+}
+
+// --camera (with --up), or one that frames the model's bounding box: looking at its centre from
+// the front right and above (+x, +y, +z), far enough that the bounding sphere fits both fields of view.
+// --camera and --up as given (checked before any work).
+struct CameraChoice {
+    std::optional<CameraText> given;
+    glm::dvec3 up{0, 1, 0};
+};
+
+CameraChoice parseCameraOptions(const MeshOptions& o) {
+    CameraChoice choice;
+    choice.up = parseVector3(o.upText, "--up");
+    if (!(glm::length(choice.up) > 0)) throw Error(ErrorCode::InvalidArgument, "--up '" + o.upText + "' is the zero vector");
+    if (!o.cameraText.empty()) choice.given = parseCamera(o.cameraText);
+    return choice;
+}
+
+Camera meshCamera(const MeshOptions& o, const CameraChoice& choice, const Bounds& b, double aspect) {
+    const glm::dvec3 up = choice.up;
+    if (choice.given) {
+        const CameraText& given = *choice.given;
+        const glm::dvec3 forward = given.target - given.eye;
+        if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
+            throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText +
+                                                        "': the eye must differ from the look-at point and not look along --up");
+        double near = 0, far = 0;
+        clipRange(b, given.eye, glm::normalize(forward), near, far);
+        return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, near, far);
+    }
+    const double fovY = 40.0;
+    const glm::dvec3 centre = 0.5 * (b.lo + b.hi);
+    const double radius = std::max(0.5 * glm::length(b.hi - b.lo), 1e-6);
+    const double halfY = 0.5 * fovY * kPi / 180.0, halfX = std::atan(std::tan(halfY) * aspect);
+    const double distance = 1.05 * radius / std::sin(std::min(halfX, halfY));
+    glm::dvec3 direction = glm::normalize(glm::dvec3(0.55, 0.45, 1.0));
+    if (glm::length(glm::cross(direction, up)) < 1e-6) direction = glm::normalize(glm::dvec3(1.0, 0.0, 0.2));
+    const glm::dvec3 eye = centre + direction * distance;
+    double near = 0, far = 0;
+    clipRange(b, eye, -direction, near, far);
+    return Camera::perspective(eye, centre, up, fovY, aspect, near, far);
+}
+
+// The city seen from above one corner, the whole of it in view.
+Camera cityCamera(const codec::CityScene& city, double aspect) {
+    const double extent = std::max(city.halfExtentX(), city.halfExtentZ());
+    const glm::dvec3 eye(0.35 * extent, 1.1 * extent, 1.6 * extent), target(0.0, 0.0, -0.1 * extent);
+    const glm::dvec3 forward = glm::normalize(target - eye);
+    Bounds b;
+    b.lo = {-city.halfExtentX(), 0.0, -city.halfExtentZ()};
+    b.hi = {city.halfExtentX(), city.maxHeight(), city.halfExtentZ()};
+    double near = 0, far = 0;
+    clipRange(b, eye, forward, near, far);
+    return Camera::perspective(eye, target, {0, 1, 0}, 50.0, aspect, near, far);
+}
+
+void printCamera(const Camera& c) {
+    const glm::dvec3 eye = c.eye(), look = eye + c.forward();
+    std::printf("camera %.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g (near %.4g, far %.4g)\n", eye.x, eye.y, eye.z, look.x, look.y,
+                look.z, c.verticalFovDegrees(), c.near(), c.far());
+}
+
+codec::FociOptions fociOptions(const MeshOptions& o, double aspect) {
+    codec::FociOptions fo;
+    fo.columns = fo.rows = o.grid;
+    fo.aspect = aspect;
+    fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+    return fo;
+}
+
+std::vector<glm::dvec3> carCentres(const codec::CityScene& city, const std::vector<int>& cars, double t) {
+    std::vector<glm::dvec3> centres;
+    for (int car : cars) {
+        if (car < 0 || car >= city.carCount())
+            throw Error(ErrorCode::InvalidArgument, "--track " + std::to_string(car) + ": the city has cars 0.." +
+                                                        std::to_string(city.carCount() - 1));
+        centres.push_back(city.carCentre(car, t));
+    }
+    return centres;
+}
+
+// Renders one frame on `device`: on a GPU the mesh is first subdivided for the map (--max-edge).
+Image renderFrame(const gl::Device& device, const Mesh& mesh, const Camera& camera, const codec::SamplingMap& map,
+                  Size size, const MeshOptions& o, bool report) {
+    gl::MeshRenderOptions options;
+    options.samples = o.samples;
+    if (device.onGpu() && o.maxEdge > 0) {
+        const double before = codec::longestProjectedEdge(mesh, camera, map);
+        Mesh fine = codec::subdivideForMap(mesh, camera, map, o.maxEdge);
+        if (report)
+            std::printf("subdivided %zu -> %zu triangles: longest projected edge %.3g -> %.3g map cells (--max-edge %g)\n",
+                        mesh.triangleCount(), fine.triangleCount(), before,
+                        codec::longestProjectedEdge(fine, camera, map), o.maxEdge);
+        return gl::renderMesh(device, fine, camera, map, size.width, size.height, options);
+    }
+    return gl::renderMesh(device, mesh, camera, map, size.width, size.height, options);
+}
+
+gl::Device meshDevice(const MeshOptions& o, bool reference) {
+    if (reference) return gl::Device::cpu();
+    return deviceFor(o.backend, gl::CpuPath::Available, "mesh rendering");
+}
+
+void addSharedOptions(CLI::App& command, MeshOptions& o, bool withCamera) {
+    command.add_option("--size", o.sizeText, "CoNUS image size WxH")->capture_default_str();
+    if (withCamera) {
+        command.add_option("--camera", o.cameraText,
+                           "ex,ey,ez,lx,ly,lz,fovDeg: eye, look-at point and vertical field of view (default: one that "
+                           "frames the model's bounding box; the city: seen from above a corner)");
+        command.add_option("--up", o.upText, "the camera's up direction x,y,z")->capture_default_str();
+    }
+    command.add_option("--time", o.time, "the city's time in seconds (cars move)")->capture_default_str()->check(finiteRange(-1e6, 1e6, true));
+    command.add_option("--track-radius", o.trackRadius, "--track: each focus's radius, a fraction of the width")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1));
+    command.add_option("--track-k", o.trackK, "--track: each focus's magnification")
+        ->capture_default_str()
+        ->check(finiteRange(1, 64, true));
+    command.add_option("--compose", o.compose, "how foci combine: density | add")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"density", "add"}));
+    command.add_option("--grid", o.grid, "sampling-map nodes per side for --focus and --track")
+        ->capture_default_str()
+        ->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    command.add_option("--max-edge", o.maxEdge,
+                       "GPU: split triangles until no projected edge spans more than this many map cells, so the "
+                       "straight edges follow Equation 1's curves (0: no subdivision)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e6, true));
+    command.add_option("--samples", o.samples, "samples a pixel (multisampling; the reference takes round(sqrt)^2 rays)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
+    command.add_option("--units", o.units, "the model's length unit, recorded as the depth's units")->capture_default_str();
+    addBackendOption(command, o.backend, gl::CpuPath::Available);
+    addQuietOption(command);
+}
+
+// --- render -----------------------------------------------------------------------------------
+
+struct RenderOptions {
+    MeshOptions mesh;
+    std::string output, mapFile;
+    std::vector<std::string> foci;
+    bool uniform = false, reference = false;
+};
+
+int runRender(const RenderOptions& r) {
+    const MeshOptions& o = r.mesh;
+    checkConusOutput(r.output, o.model);
+    const Size size = parseSize(o.sizeText);
+    const CameraChoice cameraChoice = parseCameraOptions(o);
+    if (!o.track.empty() && o.model != kCity)
+        throw Error(ErrorCode::InvalidArgument, "--track follows the city's cars: give `city` as the model");
+    const double aspect = double(size.width) / size.height;
+    std::optional<codec::CityScene> city;
+    Progress loading("read " + o.model);
+    Mesh mesh;
+    if (o.model == kCity) mesh = city.emplace().meshAt(o.time);
+    else mesh = sceneio::readMesh(o.model);
+    loading.done();
+    const Camera camera =
+        city && !cameraChoice.given ? cityCamera(*city, aspect) : meshCamera(o, cameraChoice, boundsOf(mesh), aspect);
+
+    std::optional<codec::SamplingMap> map;
+    std::optional<format::AnalyticMap> analytic;
+    const codec::FociOptions fo = fociOptions(o, aspect);
+    if (r.uniform) {
+        map.emplace(codec::SamplingMap::identity(2, 2));
+    } else if (!r.mapFile.empty()) {
+        const format::ConusFile source = format::readConusFile(r.mapFile);
+        map.emplace(codec::SamplingMap::fromGrid(source.map));
+        analytic = source.analytic;
+    } else if (!r.foci.empty() || !o.track.empty()) {
+        std::vector<codec::Focus> foci;
+        for (const auto& text : r.foci) foci.push_back(codec::parseFocus(text));
+        if (city) {
+            const auto centres = carCentres(*city, o.track, o.time);
+            const auto tracked = gl::trackedFoci(camera, centres, aspect, {o.trackRadius, o.trackK});
+            foci.insert(foci.end(), tracked.begin(), tracked.end());
+        }
+        Progress building("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
+        map.emplace(gl::frameMap(foci, fo));
+        if (!foci.empty()) analytic = codec::toAnalytic(foci, fo.composition);
+        building.done();
+    } else {
+        warn("no --focus, --map or --track: rendering the uniform image of the same pixel count (what --uniform makes)");
+        map.emplace(codec::SamplingMap::identity(2, 2));
+    }
+
+    const gl::Device device = meshDevice(o, r.reference);
+    Progress rendering("render " + std::to_string(mesh.triangleCount()) + " triangles at " + o.sizeText + " (" +
+                       device.describe() + ")");
+    const Image image = renderFrame(device, mesh, camera, *map, size, o, !quiet());
+    rendering.done();
+    Progress writing("write " + r.output);
+    format::writeConusFile(r.output, codec::makeDepthImageFile(image, *map, camera, o.units, analytic));
+    writing.done();
+    printCamera(camera);
+    std::printf("wrote %s: %dx%d CoNUS colour + depth image of %s (%zu triangles), %dx%d sampling map, %s\n",
+                r.output.c_str(), size.width, size.height, o.model.c_str(), mesh.triangleCount(), map->columns(),
+                map->rows(), device.describe().c_str());
+    return 0;
+}
+
+// --- animate ----------------------------------------------------------------------------------
+
+struct AnimateOptions {
+    MeshOptions mesh;
+    std::string outDir;
+    int frames = 24;
+    double fps = 12;
+    bool video = true;
+};
+
+// Frames side by side in rows of `columns`, each scaled to `tileWidth`, on black.
+Image contactSheet(const std::vector<Image>& tiles, int columns) {
+    const int tw = tiles.front().width, th = tiles.front().height, gap = 4;
+    const int rows = (static_cast<int>(tiles.size()) + columns - 1) / columns;
+    Image sheet = makeImage(columns * tw + (columns + 1) * gap, rows * th + (rows + 1) * gap, {"R", "G", "B"});
+    for (std::size_t k = 0; k < tiles.size(); ++k) {
+        const int x0 = gap + static_cast<int>(k % columns) * (tw + gap), y0 = gap + static_cast<int>(k / columns) * (th + gap);
+        for (int y = 0; y < th; ++y)
+            for (int x = 0; x < tw; ++x)
+                for (int c = 0; c < 3; ++c) sheet.at(x0 + x, y0 + y, c) = tiles[k].at(x, y, c);
+    }
+    return sheet;
+}
+
+std::optional<std::string> findOnPath(const std::string& program) {
+    const char* path = std::getenv("PATH");
+    if (!path) return std::nullopt;
+    std::string all = path;
+    std::size_t start = 0;
+    while (start <= all.size()) {
+        const std::size_t end = std::min(all.find(':', start), all.size());
+        const std::filesystem::path candidate = std::filesystem::path(all.substr(start, end - start)) / program;
+        if (end > start && access(candidate.c_str(), X_OK) == 0) return candidate.string();
+        start = end + 1;
+    }
+    return std::nullopt;
+}
+
+// Runs ffmpeg on the numbered PNGs into `output` (atomically); returns why it did not, or nothing.
+std::optional<std::string> encodeVideo(const std::string& ffmpeg, const std::filesystem::path& dir, double fps,
+                                       const std::string& output) {
+    AtomicFile file(output);
+    const std::string rate = std::to_string(fps), pattern = (dir / "frame_%04d.png").string();
+    // Even sides (yuv420p needs them); no audio; overwrite the (empty) temporary file.
+    std::vector<std::string> args = {ffmpeg, "-nostdin", "-loglevel", "error", "-y", "-framerate", rate, "-i", pattern,
+                                     "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", "-f", "mp4",
+                                     file.temporaryPath()};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::fflush(nullptr);
+    const pid_t child = fork();
+    if (child < 0) return "fork failed";
+    if (child == 0) {
+        execv(argv[0], argv.data());
+        _exit(127);
+    }
+    int status = 0;
+    if (waitpid(child, &status, 0) != child) return "waiting for ffmpeg failed";
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        return "ffmpeg failed (exit status " + std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
+    file.commit();
+    return std::nullopt;
+}
+
+int runAnimate(const AnimateOptions& a) {
+    const MeshOptions& o = a.mesh;
+    if (o.model != kCity)
+        throw Error(ErrorCode::InvalidArgument, "animate renders the procedural city: give `city` as the model, not '" + o.model + "'");
+    if (o.track.empty()) warn("no --track: every frame is the uniform image (give --track 0,2 to follow cars)");
+    const Size size = parseSize(o.sizeText);
+    const CameraChoice cameraChoice = parseCameraOptions(o);
+    const double aspect = double(size.width) / size.height;
+    const std::filesystem::path dir(a.outDir);
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec || !std::filesystem::is_directory(dir))
+        throw Error(ErrorCode::Io, "cannot create the output folder " + a.outDir + (ec ? ": " + ec.message() : ""));
+    const codec::CityScene city;
+    const Camera camera =
+        cameraChoice.given ? meshCamera(o, cameraChoice, boundsOf(city.meshAt(o.time)), aspect) : cityCamera(city, aspect);
+    const codec::FociOptions fo = fociOptions(o, aspect);
+    const gl::Device device = meshDevice(o, false);
+    printCamera(camera);
+
+    std::vector<Image> tiles;
+    const int columns = std::min(a.frames, 6);
+    const int tileWidth = std::max(16, std::min(size.width, 960 / columns));
+    const int tileHeight = std::max(1, static_cast<int>(std::lround(tileWidth / aspect)));
+    double largestStep = 0;
+    std::optional<codec::SamplingMap> previous;
+    Progress rendering("render " + std::to_string(a.frames) + " frames at " + o.sizeText + " (" + device.describe() + ")");
+    for (int i = 0; i < a.frames; ++i) {
+        const double t = o.time + i / a.fps;
+        const auto foci = gl::trackedFoci(camera, carCentres(city, o.track, t), aspect, {o.trackRadius, o.trackK});
+        codec::SamplingMap map = gl::frameMap(foci, fo);
+        if (previous) largestStep = std::max(largestStep, gl::largestNodeStep(*previous, map));
+        const Image image = renderFrame(device, city.meshAt(t), camera, map, size, o, false);
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%04d", i);
+        format::writeConusFile((dir / (std::string(name) + ".exr")).string(),
+                               codec::makeDepthImageFile(image, map, camera, o.units,
+                                                         foci.empty() ? std::nullopt
+                                                                      : std::optional(codec::toAnalytic(foci, fo.composition))));
+        const Image rgb = toRgb(image);
+        setQuiet(true);
+        writePicture((dir / (std::string(name) + ".png")).string(), rgb);
+        setQuiet(false);
+        tiles.push_back(codec::areaDownsample(rgb, tileWidth, tileHeight));
+        liveLine("frame " + std::to_string(i + 1) + "/" + std::to_string(a.frames) + " (" +
+                 plural(foci.size(), "focus", "foci") + ")");
+        previous = std::move(map);
+    }
+    rendering.done();
+    const std::string sheet = (dir / "contact_sheet.png").string();
+    writePicture(sheet, contactSheet(tiles, columns));
+    std::printf("wrote %d frames to %s (frame_0000.exr/.png ...), contact sheet %s; largest per-frame move of a map "
+                "node %.4f (normalized)\n",
+                a.frames, a.outDir.c_str(), sheet.c_str(), largestStep);
+    if (!a.video) return 0;
+    const auto ffmpeg = findOnPath("ffmpeg");
+    if (!ffmpeg) {
+        std::printf("no MP4: ffmpeg is not on PATH (Debian: apt-get install ffmpeg)\n");
+        return 0;
+    }
+    const std::string video = (dir / "sequence.mp4").string();
+    Progress encoding("encode " + video + " with ffmpeg");
+    if (const auto why = encodeVideo(*ffmpeg, dir, a.fps, video)) {
+        warn("no MP4: " + *why);
+        return 0;
+    }
+    encoding.done();
+    std::printf("wrote %s: %d frames at %g fps\n", video.c_str(), a.frames, a.fps);
+    return 0;
+}
+
+}  // namespace
+
+Command addMeshCommand(CLI::App& root) {
+    auto r = std::make_shared<RenderOptions>();
+    auto a = std::make_shared<AnimateOptions>();
+    CLI::App* command = root.add_subcommand(
+        "mesh", "Triangle meshes through the flexible pinhole camera: CoNUS colour + depth images, focus-plus-context sequences");
+    command->require_subcommand(1);
+
+    CLI::App* render = addSubcommand(
+        *command, "render", "Render a mesh (OBJ, PLY, STL, glTF, ... or `city`) as a CoNUS colour + depth image",
+        {"conus mesh render bunny.ply -o bunny.exr --focus 0.45,0.4,0.1,4",
+         "conus mesh render model.obj -o model.exr --size 1024x1024 --camera 0,1,3,0,0,0,40 --max-edge 0.25",
+         "conus mesh render city -o city.exr --track 0,2 --time 3.5 --reference"});
+    render->add_option("model", r->mesh.model, "mesh file (anything Assimp reads) or `city` (the procedural city)")->required();
+    render->add_option("-o,--output", r->output, "CoNUS file (.exr): R, G, B, A (coverage), Z (camera depth)")->required();
+    render->add_option("--focus", r->foci, "focus u,v,r,k (repeatable): centre, radius (fraction of the width), magnification");
+    render->add_option("--map", r->mapFile, "take the sampling map from this CoNUS file")->excludes("--focus");
+    render->add_option("--track", r->mesh.track, "city: foci on these cars' projected centres (e.g. 0,2)")
+        ->delimiter(',')
+        ->excludes("--map");
+    render->add_flag("--uniform", r->uniform, "the identity map: the conventional image of the same pixel count")
+        ->excludes("--focus")
+        ->excludes("--map")
+        ->excludes("--track");
+    render->add_flag("--reference", r->reference, "the exact CPU reference (Embree ray casting) instead of the GPU");
+    addSharedOptions(*render, r->mesh, true);
+
+    CLI::App* animate = addSubcommand(
+        *command, "animate", "Render the city's focus-plus-context sequence: foci follow moving cars (paper section 6)",
+        {"conus mesh animate city --frames 24 --out-dir frames --track 0,2",
+         "conus mesh animate city --frames 48 --fps 24 --out-dir frames --track 1,3,4 --track-k 5 --size 640x360"});
+    animate->add_option("model", a->mesh.model, "`city`")->required();
+    animate->add_option("--frames", a->frames, "number of frames")->capture_default_str()->check(CLI::Range(1, 100000));
+    animate->add_option("--fps", a->fps, "frames a second of city time (and of the MP4)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1000));
+    animate->add_option("--out-dir", a->outDir, "folder for frame_NNNN.exr/.png, contact_sheet.png and sequence.mp4")->required();
+    animate->add_option("--track", a->mesh.track, "cars whose projected centres carry the foci (e.g. 0,2)")->delimiter(',');
+    animate->add_flag("!--no-video", a->video, "do not encode sequence.mp4 even when ffmpeg is on PATH");
+    addSharedOptions(*animate, a->mesh, true);
+
+    return {command, [r, a, render] { return render->parsed() ? runRender(*r) : runAnimate(*a); }};
+}
+
+}  // namespace conus::cli
