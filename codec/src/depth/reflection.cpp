@@ -37,8 +37,12 @@ AxisBox boundsOf(const Mesh& mesh) {
 
 bool finite(glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// A face's far plane lies where nothing was seen: a hit there is the sky, not a surface.
-bool onFarPlane(const DepthHit& hit, const Camera& camera) { return hit.depth >= camera.far() * (1.0 - 1e-4); }
+// A face's far plane lies where nothing was seen (coverage 0): a hit there, or one the bisection
+// leaves just short of it, is the sky, not a surface.
+bool onSky(const DepthHit& hit, const ReflectionFace& face) {
+    return face.image.at(hit.texel.x, hit.texel.y, kMeshChannelA) < 0.5f ||
+           hit.depth >= face.depth.camera().far() * (1.0 - 1e-4);
+}
 
 }  // namespace
 
@@ -148,7 +152,7 @@ std::optional<ReflectionHit> traceReflection(const std::vector<ReflectionFace>& 
         IntersectOptions o = options;
         if (best) o.tMax = best->hit.t;
         const auto hit = intersect(faces[f].depth, ray, o);
-        if (!hit || onFarPlane(*hit, faces[f].depth.camera()) || (best && hit->t >= best->hit.t)) continue;
+        if (!hit || onSky(*hit, faces[f]) || (best && hit->t >= best->hit.t)) continue;
         const Image& c = faces[f].image;
         best = ReflectionHit{*hit, static_cast<int>(f),
                              glm::vec3(c.at(hit->texel.x, hit->texel.y, 0), c.at(hit->texel.x, hit->texel.y, 1),
