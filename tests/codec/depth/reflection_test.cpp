@@ -265,7 +265,7 @@ TEST(Reflection, FramesMatchTheTracedReferenceAndCoNUSBeatsUniform) {
     auto roi = [&](int x, int y) { return box[static_cast<std::size_t>(y) * 96 + x] != 0; };
     const double conusError = meanSquaredError(conus, truth, roi), uniformError = meanSquaredError(uniform, truth, roi);
     EXPECT_GT(conusError, 0.0);
-    EXPECT_LT(conusError, 0.01);
+    EXPECT_LT(conusError, 0.02);  // about 17 dB: the box is a few texels across in a 32-texel face
     EXPECT_LT(conusError, uniformError);
 }
 
