@@ -49,7 +49,7 @@ struct MeshOptions {
     double time = 0, maxEdge = 0.5;
     int samples = 4, grid = map_rules::kDefaultSide;
     std::vector<int> track;
-    double trackRadius = 0.08, trackK = 4;
+    double trackRadius = 0.05, trackK = 3;  // a car is small: a small, moderate focus keeps the context
     std::string compose = "add";  // smooth from frame to frame (tests/renderers/mesh_sequence_test.cpp)
 };
 
@@ -97,42 +97,60 @@ CameraChoice parseCameraOptions(const MeshOptions& o) {
     return choice;
 }
 
-Camera meshCamera(const MeshOptions& o, const CameraChoice& choice, const Bounds& b, double aspect) {
-    const glm::dvec3 up = choice.up;
-    if (choice.given) {
-        const CameraText& given = *choice.given;
-        const glm::dvec3 forward = given.target - given.eye;
-        if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
-            throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText +
-                                                        "': the eye must differ from the look-at point and not look along --up");
-        double near = 0, far = 0;
-        clipRange(b, given.eye, glm::normalize(forward), near, far);
-        return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, near, far);
-    }
+// Looking at the box's centre from `direction` (toward the eye), far enough that the box's
+// bounding sphere fits both fields of view.
+Camera framingCamera(const Bounds& b, glm::dvec3 direction, glm::dvec3 up, double aspect) {
     const double fovY = 40.0;
     const glm::dvec3 centre = 0.5 * (b.lo + b.hi);
     const double radius = std::max(0.5 * glm::length(b.hi - b.lo), 1e-6);
     const double halfY = 0.5 * fovY * kPi / 180.0, halfX = std::atan(std::tan(halfY) * aspect);
-    const double distance = 1.05 * radius / std::sin(std::min(halfX, halfY));
-    glm::dvec3 direction = glm::normalize(glm::dvec3(0.55, 0.45, 1.0));
-    if (glm::length(glm::cross(direction, up)) < 1e-6) direction = glm::normalize(glm::dvec3(1.0, 0.0, 0.2));
-    const glm::dvec3 eye = centre + direction * distance;
-    double near = 0, far = 0;
-    clipRange(b, eye, -direction, near, far);
-    return Camera::perspective(eye, centre, up, fovY, aspect, near, far);
+    direction = glm::normalize(direction);
+    if (glm::length(glm::cross(direction, glm::normalize(up))) < 1e-6) direction = glm::normalize(glm::dvec3(1.0, 0.0, 0.2));
+    // The sphere always fits; then move closer until the box's corners (not the sphere) span 90%
+    // of the frame (a few steps: the image size of the box scales about as 1 / distance).
+    double distance = 1.05 * radius / std::sin(std::min(halfX, halfY));
+    const auto at = [&](double d) {
+        const glm::dvec3 eye = centre + direction * d;
+        double near = 0, far = 0;
+        clipRange(b, eye, -direction, near, far);
+        return Camera::perspective(eye, centre, up, fovY, aspect, near, far);
+    };
+    for (int step = 0; step < 4; ++step) {
+        const Camera camera = at(distance);
+        double extent = 0;
+        for (int corner = 0; corner < 8; ++corner) {
+            const glm::dvec3 p = camera.project({(corner & 1) ? b.hi.x : b.lo.x, (corner & 2) ? b.hi.y : b.lo.y,
+                                                 (corner & 4) ? b.hi.z : b.lo.z});
+            extent = std::max({extent, std::abs(p.x - 0.5), std::abs(p.y - 0.5)});
+        }
+        const double scale = std::clamp(extent / 0.45, 0.5, 1.0);
+        if (scale > 0.98) break;
+        distance = std::max(distance * scale, radius * 1.05);  // never inside the bounding sphere
+    }
+    return at(distance);
 }
 
-// The city seen from above one corner, the whole of it in view.
+// --camera (with --up), or one that frames the model's bounding box from the front right and
+// above (+x, +y, +z).
+Camera meshCamera(const CameraChoice& choice, const Bounds& b, double aspect) {
+    const glm::dvec3 up = choice.up;
+    if (!choice.given) return framingCamera(b, {0.55, 0.45, 1.0}, up, aspect);
+    const CameraText& given = *choice.given;
+    const glm::dvec3 forward = given.target - given.eye;
+    if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
+        throw Error(ErrorCode::InvalidArgument,
+                    "--camera: the eye must differ from the look-at point and not look along --up");
+    double near = 0, far = 0;
+    clipRange(b, given.eye, glm::normalize(forward), near, far);
+    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, near, far);
+}
+
+// The whole city from high above its front edge, steep enough that buildings hide few streets.
 Camera cityCamera(const codec::CityScene& city, double aspect) {
-    const double extent = std::max(city.halfExtentX(), city.halfExtentZ());
-    const glm::dvec3 eye(0.35 * extent, 1.1 * extent, 1.6 * extent), target(0.0, 0.0, -0.1 * extent);
-    const glm::dvec3 forward = glm::normalize(target - eye);
     Bounds b;
     b.lo = {-city.halfExtentX(), 0.0, -city.halfExtentZ()};
     b.hi = {city.halfExtentX(), city.maxHeight(), city.halfExtentZ()};
-    double near = 0, far = 0;
-    clipRange(b, eye, forward, near, far);
-    return Camera::perspective(eye, target, {0, 1, 0}, 50.0, aspect, near, far);
+    return framingCamera(b, {0.15, 1.3, 1.0}, {0, 1, 0}, aspect);
 }
 
 void printCamera(const Camera& c) {
@@ -240,7 +258,7 @@ int runRender(const RenderOptions& r) {
     else mesh = sceneio::readMesh(o.model);
     loading.done();
     const Camera camera =
-        city && !cameraChoice.given ? cityCamera(*city, aspect) : meshCamera(o, cameraChoice, boundsOf(mesh), aspect);
+        city && !cameraChoice.given ? cityCamera(*city, aspect) : meshCamera(cameraChoice, boundsOf(mesh), aspect);
 
     std::optional<codec::SamplingMap> map;
     std::optional<format::AnalyticMap> analytic;
@@ -363,7 +381,7 @@ int runAnimate(const AnimateOptions& a) {
         throw Error(ErrorCode::Io, "cannot create the output folder " + a.outDir + (ec ? ": " + ec.message() : ""));
     const codec::CityScene city;
     const Camera camera =
-        cameraChoice.given ? meshCamera(o, cameraChoice, boundsOf(city.meshAt(o.time)), aspect) : cityCamera(city, aspect);
+        cameraChoice.given ? meshCamera(cameraChoice, boundsOf(city.meshAt(o.time)), aspect) : cityCamera(city, aspect);
     const codec::FociOptions fo = fociOptions(o, aspect);
     const gl::Device device = meshDevice(o, false);
     printCamera(camera);
