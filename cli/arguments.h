@@ -7,8 +7,6 @@
 #include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
 
-#include <glm/glm.hpp>
-
 #include "conus/codec/image/decode.h"
 #include "conus/format/container.h"
 

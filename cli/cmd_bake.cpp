@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "arguments.h"
@@ -13,11 +14,13 @@
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/depth/heightfield.h"
+#include "conus/codec/depth/reflection.h"
 #include "conus/codec/depth/relief.h"
 #include "conus/codec/image/encode.h"
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
 #include "conus/imageio/text.h"
+#include "conus/sceneio/mesh_file.h"
 #include "dem_io.h"
 #include "encoding.h"
 #include "image_files.h"
@@ -130,6 +133,64 @@ int runBakeRelief(const BakeOptions& o) {
     return 0;
 }
 
+// --- reflection -------------------------------------------------------------------------------
+
+struct ReflectionBakeText {
+    std::string scene, outDir, centre = "0,0,0", roiMin, roiMax;
+    int size = 128;
+    double magnification = 3.0;
+    bool uniform = false;
+};
+
+int runBakeReflection(const ReflectionBakeText& o) {
+    codec::ReflectionBakeOptions options;
+    options.centre = parseVector3(o.centre, "--center");
+    options.size = o.size;
+    options.uniform = o.uniform;
+    options.magnification = o.magnification;
+    if (o.roiMin.empty() != o.roiMax.empty())
+        throw Error(ErrorCode::InvalidArgument, "--roi-min and --roi-max go together");
+    if (!o.roiMin.empty()) {
+        const glm::dvec3 lo = parseVector3(o.roiMin, "--roi-min"), hi = parseVector3(o.roiMax, "--roi-max");
+        if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
+            throw Error(ErrorCode::InvalidArgument, "--roi-min must lie below --roi-max on every axis");
+        options.roi = codec::AxisBox{lo, hi};
+    }
+    Progress loading("read " + o.scene);
+    const codec::MeshScene scene(sceneio::readMesh(o.scene));
+    loading.done();
+    Progress baking("bake six " + std::to_string(o.size) + "x" + std::to_string(o.size) + " faces (Embree)");
+    const auto faces = codec::bakeReflection(scene, options);
+    baking.done();
+    std::filesystem::create_directories(o.outDir);
+    for (int f = 0; f < codec::kCubeFaces; ++f) {
+        const std::string path = (std::filesystem::path(o.outDir) / (codec::kCubeFaceNames[f] + std::string(".exr"))).string();
+        format::writeConusFile(path, codec::reflectionFaceFile(faces[static_cast<std::size_t>(f)]));
+    }
+    std::printf("wrote %s: six %dx%d CoNUS colour + depth faces from %g,%g,%g (%s)\n", o.outDir.c_str(), o.size, o.size,
+                options.centre.x, options.centre.y, options.centre.z,
+                o.uniform ? "uniform, the baseline" : "foci on the region of interest");
+    return 0;
+}
+
+void addBakeReflection(CLI::App& command, ReflectionBakeText& o) {
+    CLI::App* reflection = addSubcommand(
+        command, "reflection",
+        "A mesh seen from a reflector's centre -> six CoNUS colour + depth faces (a reflection asset)",
+        {"conus bake reflection scene.obj --center 0,0.5,0 -o asset", "conus bake reflection scene.obj --uniform -o asset-uniform"});
+    reflection->add_option("scene", o.scene, "mesh file (.obj, .ply, .gltf, ...)")->required();
+    reflection->add_option("-o,--output", o.outDir, "folder for the six faces (px nx py ny pz nz .exr)")->required();
+    reflection->add_option("--center,--centre", o.centre, "the reflector's centre x,y,z")->capture_default_str();
+    reflection->add_option("--size", o.size, "texels a face side")->capture_default_str()->check(CLI::Range(8, 4096));
+    reflection->add_option("--magnification", o.magnification, "linear magnification of the region of interest")
+        ->capture_default_str()
+        ->check(finiteRange(1, 16, true));
+    reflection->add_option("--roi-min", o.roiMin, "region of interest, lowest corner x,y,z (default: the whole scene)");
+    reflection->add_option("--roi-max", o.roiMax, "region of interest, highest corner x,y,z");
+    reflection->add_flag("--uniform", o.uniform, "identity maps: the conventional asset of the same texel count");
+    addQuietOption(*reflection);
+}
+
 }  // namespace
 
 Command addBakeCommand(CLI::App& root) {
@@ -177,7 +238,9 @@ Command addBakeCommand(CLI::App& root) {
         ->capture_default_str()
         ->check(CLI::IsMember(format::namesOf<format::Compression>()));
     addQuietOption(*relief);
-    return {command, [o] { return runBakeRelief(*o); }};
+    auto r = std::make_shared<ReflectionBakeText>();
+    addBakeReflection(*command, *r);
+    return {command, [o, r, relief] { return relief->parsed() ? runBakeRelief(*o) : runBakeReflection(*r); }};
 }
 
 }  // namespace conus::cli

@@ -4,15 +4,19 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
 #include "arguments.h"
 #include "backend.h"
 #include "commands.h"
+#include "conus/codec/depth/reflection.h"
 #include "conus/codec/depth/relief.h"
 #include "conus/core/error.h"
+#include "conus/format/container.h"
 #include "conus/renderers/relief.h"
+#include "conus/sceneio/mesh_file.h"
 #include "image_files.h"
 #include "progress.h"
 
@@ -66,6 +70,76 @@ int runRenderRelief(const RenderOptions& o) {
     return 0;
 }
 
+// --- reflection -------------------------------------------------------------------------------
+
+struct ReflectionRenderText {
+    std::string asset, scene, output, cameraText, sizeText = "640x480", reflector = "sphere", at, normal = "0,0,1";
+    double radius = 0.5, step = 1.0;
+    bool reference = false;
+};
+
+int runRenderReflection(const ReflectionRenderText& o) {
+    const Size size = parseSize(o.sizeText);
+    const imageio::WriteOptions write = writeOptionsOf({}, nullptr);
+    checkPictureOutput(o.output, write, {o.scene});
+    if (o.cameraText.empty()) throw Error(ErrorCode::InvalidArgument, "--camera is required (x,y,z,lx,ly,lz,fovDeg)");
+    const CameraText given = parseCamera(o.cameraText);
+    codec::ReflectionFrameOptions options;
+    options.reflector.kind = o.reflector == "plane" ? codec::Reflector::Kind::Plane : codec::Reflector::Kind::Sphere;
+    options.reflector.radius = o.radius;
+    options.reflector.normal = parseVector3(o.normal, "--normal");
+    if (!(glm::length(options.reflector.normal) > 0)) throw Error(ErrorCode::InvalidArgument, "--normal is the zero vector");
+    options.reflector.normal = glm::normalize(options.reflector.normal);
+    options.intersect.stepTexels = o.step;
+    std::vector<codec::ReflectionFace> faces;
+    for (int f = 0; f < codec::kCubeFaces; ++f) {
+        const std::string path = (std::filesystem::path(o.asset) / (codec::kCubeFaceNames[f] + std::string(".exr"))).string();
+        if (!std::filesystem::is_regular_file(path))
+            throw Error(ErrorCode::Io, o.asset + " is not a reflection asset: it has no " + path + " (make one with `conus bake reflection`)");
+        faces.push_back(codec::reflectionFaceFromFile(format::readConusFile(path)));
+    }
+    const glm::dvec3 centre = faces.front().depth.camera().eye();
+    options.reflector.centre = o.at.empty() ? centre : parseVector3(o.at, "--at");
+    Progress loading("read " + o.scene);
+    const codec::MeshScene scene(sceneio::readMesh(o.scene));
+    loading.done();
+    const double aspect = double(size.width) / size.height;
+    const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);
+    Progress rendering("render " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+                       (o.reference ? " (reflections traced against the mesh)" : " (reflections from the faces)"));
+    Image frame = codec::renderReflectionFrame(scene, o.reference ? nullptr : &faces, centre, camera, size.width,
+                                               size.height, options);
+    rendering.done();
+    Image rgb{frame.width, frame.height, {"R", "G", "B"}, {}};
+    rgb.pixels.reserve(static_cast<std::size_t>(frame.width) * frame.height * 3);
+    for (std::size_t i = 0; i < frame.pixels.size(); i += 4) rgb.pixels.insert(rgb.pixels.end(), &frame.pixels[i], &frame.pixels[i + 3]);
+    writePicture(o.output, rgb, write);
+    std::printf("wrote %s: %dx%d frame, a %s reflector at %g,%g,%g\n", o.output.c_str(), size.width, size.height,
+                o.reflector.c_str(), options.reflector.centre.x, options.reflector.centre.y, options.reflector.centre.z);
+    return 0;
+}
+
+void addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
+    CLI::App* reflection = addSubcommand(
+        command, "reflection", "A specular reflector whose reflected rays intersect a reflection asset's faces (CPU)",
+        {"conus render reflection asset --scene scene.obj --camera 0,1,4,0,0,0,40 -o frame.png",
+         "conus render reflection asset --scene scene.obj --reflector plane --normal 0,0,1 --radius 2 --camera 0,1,4,0,0,0,40 -o frame.png"});
+    reflection->add_option("asset", o.asset, "folder from `conus bake reflection`")->required();
+    reflection->add_option("--scene", o.scene, "the mesh file the asset was baked from (drawn behind)")->required();
+    reflection->add_option("-o,--output", o.output, "frame (.png, .exr, ...)")->required();
+    reflection->add_option("--camera", o.cameraText, "x,y,z,lx,ly,lz,fovDeg")->required();
+    reflection->add_option("--size", o.sizeText, "frame size WxH")->capture_default_str();
+    reflection->add_option("--reflector", o.reflector, "sphere | plane")->capture_default_str()->check(CLI::IsMember({"sphere", "plane"}));
+    reflection->add_option("--at", o.at, "the reflector's centre x,y,z (default: the asset's centre)");
+    reflection->add_option("--radius", o.radius, "sphere radius, or half the plane mirror's side")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e9));
+    reflection->add_option("--normal", o.normal, "plane: the mirror's facing direction x,y,z")->capture_default_str();
+    reflection->add_option("--step", o.step, "linear-search step in CoNUS pixels")->capture_default_str()->check(finiteRange(0, 64));
+    reflection->add_flag("--reference", o.reference, "trace reflected rays against the mesh (Embree): the ground truth");
+    addQuietOption(*reflection);
+}
+
 }  // namespace
 
 Command addRenderCommand(CLI::App& root) {
@@ -89,7 +163,9 @@ Command addRenderCommand(CLI::App& root) {
         ->check(finiteRange(0, 64));
     addBackendOption(*relief, o->backend, gl::CpuPath::None);
     addQuietOption(*relief);
-    return {command, [o] { return runRenderRelief(*o); }};
+    auto r = std::make_shared<ReflectionRenderText>();
+    addRenderReflection(*command, *r);
+    return {command, [o, r, relief] { return relief->parsed() ? runRenderRelief(*o) : runRenderReflection(*r); }};
 }
 
 }  // namespace conus::cli

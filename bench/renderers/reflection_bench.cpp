@@ -1,0 +1,130 @@
+// Reflections (paper section 5, Figure 6): a sphere mirror reflecting a box above a floor, the
+// reflected rays intersecting six cube faces baked from the sphere's centre, CoNUS (a focus on the
+// box) against conventional faces of the same texel count. BM_ReflectionQuality reports the PSNR
+// of both against the ground truth (the reflected rays traced against the mesh with Embree) in the
+// region of interest (reflector pixels showing the box) and over the rest of the reflector, and
+// writes bench/img/reflection.png (CoNUS | conventional | truth) when CONUS_BENCH_PICTURE names a
+// path. BM_ReflectionFrame times the CPU frame with either set of faces (the ratio is the cost).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <memory>
+
+#include "conus/codec/depth/reflection.h"
+#include "conus/imageio/image_file.h"
+
+namespace conus {
+namespace {
+
+constexpr int kFace = 48;      // texels a face side: 6 x 48^2 texels for either set
+constexpr int kFrame = 192;    // frame side
+constexpr std::uint32_t kBoxTriangles = 12;
+
+Mesh boxAndFloor() {
+    Mesh m;
+    const glm::vec3 lo(0.4f, -0.3f, 1.5f), hi(1.0f, 0.5f, 2.2f);
+    // Each face its own four corners, so the flat faces shade flat; a colour ramp across the box
+    // so that a misplaced hit shows.
+    const int faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    for (const auto& f : faces) {
+        const auto base = static_cast<std::uint32_t>(m.positions.size());
+        for (int c : f) {
+            const glm::vec3 p(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+            m.positions.push_back(p);
+            m.colours.emplace_back((p.x - lo.x) / (hi.x - lo.x), 0.25f + 0.5f * (p.y - lo.y) / (hi.y - lo.y),
+                                   (p.z - lo.z) / (hi.z - lo.z));
+        }
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+    const auto base = static_cast<std::uint32_t>(m.positions.size());
+    for (const glm::vec3 p : {glm::vec3(-4, -1, -4), glm::vec3(-4, -1, 4), glm::vec3(4, -1, 4), glm::vec3(4, -1, -4)}) {
+        m.positions.push_back(p);
+        m.colours.emplace_back(0.6f, 0.6f, 0.55f);
+    }
+    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    return m;
+}
+
+struct Setup {
+    codec::MeshScene scene{boxAndFloor()};
+    codec::ReflectionFrameOptions options;
+    Camera camera = Camera::perspective({-0.8, 0.5, 3.0}, {0.0, 0.0, 0.0}, {0, 1, 0}, 22.0, 1.0, 0.1, 20.0);
+    std::vector<codec::ReflectionFace> faces[2];  // 0 conventional, 1 CoNUS
+    explicit Setup(double magnification) {
+        options.reflector.radius = 0.5;
+        codec::ReflectionBakeOptions bake;
+        bake.size = kFace;
+        bake.magnification = magnification;
+        bake.roi = codec::AxisBox{{0.4, -0.3, 1.5}, {1.0, 0.5, 2.2}};
+        faces[1] = codec::bakeReflection(scene, bake);
+        bake.uniform = true;
+        faces[0] = codec::bakeReflection(scene, bake);
+    }
+};
+
+// The focus's magnification k (bake reflection's default: 3).
+Setup& setup(int k) {
+    static std::map<int, std::unique_ptr<Setup>> setups;
+    auto& s = setups[k];
+    if (!s) s = std::make_unique<Setup>(k);
+    return *s;
+}
+
+void BM_ReflectionFrame(benchmark::State& state) {
+    Setup& s = setup(3);
+    for (auto _ : state)
+        benchmark::DoNotOptimize(codec::renderReflectionFrame(s.scene, &s.faces[state.range(0)], s.options.reflector.centre,
+                                                              s.camera, kFrame, kFrame, s.options));
+    state.SetLabel(state.range(0) ? "CoNUS" : "conventional");
+}
+
+void BM_ReflectionQuality(benchmark::State& state) {
+    Setup& s = setup(static_cast<int>(state.range(0)));
+    Image frames[2], truth;
+    for (auto _ : state) {
+        truth = codec::renderReflectionFrame(s.scene, nullptr, s.options.reflector.centre, s.camera, kFrame, kFrame, s.options);
+        for (int k = 0; k < 2; ++k)
+            frames[k] = codec::renderReflectionFrame(s.scene, &s.faces[k], s.options.reflector.centre, s.camera, kFrame,
+                                                     kFrame, s.options);
+    }
+    // ROI: reflector pixels whose traced reflected ray meets the box.
+    double squared[2][2] = {}, count[2] = {};
+    for (int y = 0; y < kFrame; ++y)
+        for (int x = 0; x < kFrame; ++x) {
+            if (truth.at(x, y, 3) == 0.0f) continue;
+            const auto mirror = codec::hitReflector(s.options.reflector, s.camera.ray({(x + 0.5) / kFrame, (y + 0.5) / kFrame}));
+            const auto hit = mirror ? s.scene.intersect(mirror->reflected, 1e-6) : std::nullopt;
+            const int region = hit && hit->triangle < kBoxTriangles ? 0 : 1;
+            for (int k = 0; k < 2; ++k)
+                for (int c = 0; c < 3; ++c) {
+                    const double d = std::clamp(frames[k].at(x, y, c), 0.0f, 1.0f) - std::clamp(truth.at(x, y, c), 0.0f, 1.0f);
+                    squared[k][region] += d * d / 3.0;
+                }
+            count[region] += 1;
+        }
+    auto psnr = [&](int k, int region) { return 10.0 * std::log10(count[region] / std::max(squared[k][region], 1e-30)); };
+    state.counters["roi_conus_dB"] = psnr(1, 0);
+    state.counters["roi_conventional_dB"] = psnr(0, 0);
+    state.counters["rest_conus_dB"] = psnr(1, 1);
+    state.counters["rest_conventional_dB"] = psnr(0, 1);
+    state.counters["roi_pixels"] = count[0];
+    const char* picture = std::getenv("CONUS_BENCH_PICTURE");
+    if (picture && state.range(0) == 3) {
+        Image strip{3 * kFrame, kFrame, {"R", "G", "B"}, std::vector<float>(std::size_t(3) * kFrame * kFrame * 3)};
+        const Image* parts[3] = {&frames[1], &frames[0], &truth};
+        for (int p = 0; p < 3; ++p)
+            for (int y = 0; y < kFrame; ++y)
+                for (int x = 0; x < kFrame; ++x)
+                    for (int c = 0; c < 3; ++c) strip.at(p * kFrame + x, y, c) = parts[p]->at(x, y, c);
+        imageio::writeImageFile(picture, strip);
+    }
+}
+
+BENCHMARK(BM_ReflectionFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReflectionQuality)->Arg(3)->Arg(5)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace conus

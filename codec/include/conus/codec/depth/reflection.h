@@ -1,0 +1,124 @@
+// Reflection assets (paper section 5, Figure 6): the scene around a specular reflector stored as
+// perspective CoNUS colour + depth images taken from the reflector's centre, and the reflected
+// rays that intersect them (intersect.h, the one algorithm for any depth image).
+//
+// The asset is a cube of six faces (90 degree square frusta from the centre): six faces cover
+// every direction a sphere reflects with no face wider than 90 degrees, where a perspective
+// image's texels stay within a factor 3^(3/2) of each other in solid angle; fewer, wider faces
+// would spend their texels unevenly before any map does. Each face is an ordinary CoNUS depth
+// image (camera, map, Z = camera depth, the far plane where nothing was seen), so a face file
+// needs no format change.
+//
+// The faces' maps favour what the reflector shows most: a focus on the projection of a region of
+// interest (by default the scene's bounding box; in practice the object nearest the reflector) in
+// every face that sees it. The uniform baseline has the identity map and the same texel count.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "conus/codec/build/foci.h"
+#include "conus/codec/depth/intersect.h"
+#include "conus/codec/mesh/raycast.h"
+#include "conus/core/image.h"
+
+namespace conus::codec {
+
+inline constexpr int kCubeFaces = 6;
+// The faces' names, in order (the files `conus bake reflection` writes).
+inline constexpr const char* kCubeFaceNames[kCubeFaces] = {"px", "nx", "py", "ny", "pz", "nz"};
+
+// The camera of cube face `face` (0..5: +x, -x, +y, -y, +z, -z) at `centre`: 90 degrees, square,
+// depths in [near, far]. Throws conus::Error(InvalidArgument) for a face outside 0..5 or bad clips.
+Camera cubeFaceCamera(glm::dvec3 centre, int face, double near, double far);
+
+// One face: its depth image (what rays intersect) and the mesh render it came from (R, G, B, A, Z
+// per CoNUS pixel, codec/mesh/shading.h's channels; the colour a hit takes).
+struct ReflectionFace {
+    DepthImage depth;
+    Image image;
+};
+
+// A face as an ordinary CoNUS depth image file (codec/conus_file.h's makeDepthImageFile, units
+// "world"), and back. fromFile throws conus::Error(InvalidArgument) for a file that is not a
+// camera-depth image with R, G, B and Z channels.
+format::ConusFile reflectionFaceFile(const ReflectionFace& face);
+ReflectionFace reflectionFaceFromFile(const format::ConusFile& file);
+
+struct AxisBox {
+    glm::dvec3 lo{0.0}, hi{0.0};
+};
+
+struct ReflectionBakeOptions {
+    glm::dvec3 centre{0.0};      // the reflector's centre (the faces' common eye)
+    int size = 128;              // texels a face side
+    bool uniform = false;        // identity maps: the conventional baseline of the same texel count
+    double magnification = 3.0;  // linear magnification of the focus on the region of interest
+    std::optional<AxisBox> roi;  // the region of interest; none: the scene's bounding box
+    double near = 0.01;          // the faces' near clip (far: beyond the scene's bounding box)
+};
+
+// The focus a face puts on the region of interest: the bounding disc of the box's projection,
+// clipped to the image; nothing when the box is not in front of the face or misses its image.
+std::optional<Focus> reflectionFocus(const Camera& face, const AxisBox& roi, double magnification);
+
+// The six faces of `scene` from options.centre, each rendered by the Embree reference (one exact
+// ray per CoNUS pixel: depths of one surface, never a mean across a silhouette). Throws
+// conus::Error(InvalidArgument) for a size outside [8, 4096], a magnification outside [1, 16], a
+// non-finite centre, or a centre inside no free space (a near clip at or beyond the far one).
+std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const ReflectionBakeOptions& options);
+
+// A specular reflector: a sphere (centre, radius) or a square plane mirror (centre, unit normal,
+// half the side, its in-plane axes from `up`).
+struct Reflector {
+    enum class Kind { Sphere, Plane } kind = Kind::Sphere;
+    glm::dvec3 centre{0.0};
+    double radius = 1.0;              // sphere radius, or half the plane mirror's side
+    glm::dvec3 normal{0.0, 0.0, 1.0};  // plane: the mirror's face
+};
+
+struct ReflectorHit {
+    double t = 0;          // along the eye ray
+    glm::dvec3 normal{0.0};  // unit, facing the eye
+    Ray reflected;         // from the hit point, direction d - 2 (d.n) n
+};
+
+// Where the eye ray meets the reflector's mirror side, and the reflected ray; nothing on a miss.
+std::optional<ReflectorHit> hitReflector(const Reflector& reflector, const Ray& ray);
+
+struct ReflectionHit {
+    DepthHit hit;
+    int face = 0;
+    glm::vec3 colour{0.0f};  // the CoNUS texel's colour
+};
+
+// The nearest hit of `ray` among the faces (each face intersected by intersect.h; the nearest t
+// wins), or nothing when it meets only the far planes.
+std::optional<ReflectionHit> traceReflection(const std::vector<ReflectionFace>& faces, const Ray& ray,
+                                             const IntersectOptions& options = {});
+
+// The ground truth of a reflected ray: the mesh itself traced (Embree), the hit shaded as the
+// faces are (the headlight from `centre`, the faces' eye), so that only where the ray lands differs.
+std::optional<glm::vec3> traceReflectionReference(const MeshScene& scene, const Ray& ray, glm::dvec3 centre);
+
+// What the reflector shows where a reflected ray meets nothing: a constant sky.
+inline constexpr float kReflectionSky[3] = {0.55f, 0.65f, 0.8f};
+
+struct ReflectionFrameOptions {
+    Reflector reflector;
+    IntersectOptions intersect;
+    int threads = 0;  // 0: all cores
+};
+
+// The CPU reference of `render reflection`, width x height: each pixel's ray from `camera`; where
+// it meets the reflector before the scene, the reflected ray's colour from `faces` (null: traced
+// against the mesh, traceReflectionReference, the ground truth); elsewhere the scene as the mesh
+// reference shades it (identity map). Channels R, G, B and M: 0 scene or nothing, 1 the reflector
+// showing the sky, 2 the reflector showing the scene.
+Image renderReflectionFrame(const MeshScene& scene, const std::vector<ReflectionFace>* faces, glm::dvec3 centre,
+                            const Camera& camera, int width, int height, const ReflectionFrameOptions& options);
+
+}  // namespace conus::codec

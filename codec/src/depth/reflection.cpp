@@ -1,0 +1,230 @@
+#include "conus/codec/depth/reflection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "conus/codec/conus_file.h"
+#include "conus/codec/mesh/shading.h"
+#include "conus/core/error.h"
+#include "conus/core/fpc.h"
+#include "conus/core/parallel.h"
+
+namespace conus::codec {
+namespace {
+
+// Forward and up of each face: the usual cube-map layout, any fixed one would do as every face
+// carries its own camera.
+constexpr std::array<std::array<double, 6>, kCubeFaces> kFaceAxes{{
+    {1, 0, 0, 0, 1, 0},
+    {-1, 0, 0, 0, 1, 0},
+    {0, 1, 0, 0, 0, -1},
+    {0, -1, 0, 0, 0, 1},
+    {0, 0, 1, 0, 1, 0},
+    {0, 0, -1, 0, 1, 0},
+}};
+
+AxisBox boundsOf(const Mesh& mesh) {
+    AxisBox box{glm::dvec3(std::numeric_limits<double>::max()), glm::dvec3(std::numeric_limits<double>::lowest())};
+    for (const glm::vec3& p : mesh.positions) {
+        box.lo = glm::min(box.lo, glm::dvec3(p));
+        box.hi = glm::max(box.hi, glm::dvec3(p));
+    }
+    return box;
+}
+
+bool finite(glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// A face's far plane lies where nothing was seen (coverage 0): a hit there, or one the bisection
+// leaves just short of it, is the sky, not a surface.
+bool onSky(const DepthHit& hit, const ReflectionFace& face) {
+    return face.image.at(hit.texel.x, hit.texel.y, kMeshChannelA) < 0.5f ||
+           hit.depth >= face.depth.camera().far() * (1.0 - 1e-4);
+}
+
+}  // namespace
+
+Camera cubeFaceCamera(glm::dvec3 centre, int face, double near, double far) {
+    if (face < 0 || face >= kCubeFaces) throw Error(ErrorCode::InvalidArgument, "cube face " + std::to_string(face) + " is not 0..5");
+    if (!finite(centre) || !(near > 0) || !(far > near) || !std::isfinite(far))
+        throw Error(ErrorCode::InvalidArgument, "cube face camera: needs a finite centre and 0 < near < far");
+    const auto& a = kFaceAxes[static_cast<std::size_t>(face)];
+    const glm::dvec3 forward(a[0], a[1], a[2]), up(a[3], a[4], a[5]);
+    return Camera::perspective(centre, centre + forward, up, 90.0, 1.0, near, far);
+}
+
+std::optional<Focus> reflectionFocus(const Camera& face, const AxisBox& roi, double magnification) {
+    glm::dvec2 lo(std::numeric_limits<double>::max()), hi(std::numeric_limits<double>::lowest());
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 p(corner & 1 ? roi.hi.x : roi.lo.x, corner & 2 ? roi.hi.y : roi.lo.y,
+                           corner & 4 ? roi.hi.z : roi.lo.z);
+        const glm::dvec3 q = face.project(p);
+        // A corner behind the eye: the box straddles the face's plane, so its projection is
+        // unbounded; the face sees part of it at most obliquely, and a focus would be a guess.
+        if (!(q.z > 0)) return std::nullopt;
+        lo = glm::min(lo, glm::dvec2(q));
+        hi = glm::max(hi, glm::dvec2(q));
+    }
+    lo = glm::clamp(lo, 0.0, 1.0);
+    hi = glm::clamp(hi, 0.0, 1.0);
+    if (!(hi.x > lo.x && hi.y > lo.y)) return std::nullopt;
+    // The focus disc inside the magnified radius r falls off to the context by 2r: the bounding
+    // disc of the clipped box (radius a fraction of the width; faces are square) is the region to
+    // magnify fully.
+    const glm::dvec2 c = 0.5 * (lo + hi);
+    const double r = std::clamp(0.5 * glm::length(hi - lo), 0.02, 0.5);
+    return Focus{std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0), r, magnification};
+}
+
+std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const ReflectionBakeOptions& o) {
+    if (o.size < 8 || o.size > 4096) throw Error(ErrorCode::InvalidArgument, "reflection faces must be 8 to 4096 texels a side");
+    if (!(o.magnification >= 1.0 && o.magnification <= 16.0))
+        throw Error(ErrorCode::InvalidArgument, "reflection magnification must lie in [1, 16]");
+    if (!finite(o.centre)) throw Error(ErrorCode::InvalidArgument, "the reflector's centre is not finite");
+    const AxisBox bounds = boundsOf(scene.mesh());
+    // Far: beyond every point of the scene from the centre (the farthest box corner), with room.
+    const glm::dvec3 reach = glm::max(glm::abs(bounds.lo - o.centre), glm::abs(bounds.hi - o.centre));
+    const double far = 1.01 * glm::length(reach) + 1e-6;
+    if (!(o.near > 0) || !(far > o.near))
+        throw Error(ErrorCode::InvalidArgument, "the reflector's near clip must be positive and closer than the scene");
+    const AxisBox roi = o.roi.value_or(bounds);
+
+    std::vector<ReflectionFace> faces;
+    faces.reserve(kCubeFaces);
+    for (int f = 0; f < kCubeFaces; ++f) {
+        const Camera camera = cubeFaceCamera(o.centre, f, o.near, far);
+        std::shared_ptr<const SamplingMap> map;
+        std::optional<Focus> focus;
+        if (!o.uniform) focus = reflectionFocus(camera, roi, o.magnification);
+        if (focus) {
+            FociOptions foci;
+            foci.aspect = 1.0;
+            map = std::make_shared<SamplingMap>(buildFociMap(std::span<const Focus>(&*focus, 1), foci));
+        } else {
+            map = std::make_shared<SamplingMap>(SamplingMap::identity(2, 2));
+        }
+        const Image rgbaz = renderMeshReference(scene, Fpc(camera, map), o.size, o.size);
+        std::vector<float> depths(static_cast<std::size_t>(o.size) * o.size);
+        for (std::size_t i = 0; i < depths.size(); ++i) depths[i] = rgbaz.pixels[i * rgbaz.channels.size() + kMeshChannelZ];
+        faces.push_back({DepthImage(camera, map, o.size, o.size, std::move(depths)), rgbaz});
+    }
+    return faces;
+}
+
+std::optional<ReflectorHit> hitReflector(const Reflector& r, const Ray& ray) {
+    const glm::dvec3 d = ray.direction;
+    ReflectorHit out;
+    if (r.kind == Reflector::Kind::Sphere) {
+        const glm::dvec3 oc = ray.origin - r.centre;
+        const double b = glm::dot(oc, d), c = glm::dot(oc, oc) - r.radius * r.radius;
+        const double disc = b * b - c;
+        if (!(disc >= 0)) return std::nullopt;
+        const double t = -b - std::sqrt(disc);  // the outside of the sphere: the eye is outside
+        if (!(t > 0)) return std::nullopt;
+        out.t = t;
+        out.normal = glm::normalize(ray.origin + d * t - r.centre);
+    } else {
+        const glm::dvec3 n = glm::normalize(r.normal);
+        const double facing = glm::dot(d, n);
+        if (!(facing < 0)) return std::nullopt;  // the mirror's back or edge-on
+        const double t = glm::dot(r.centre - ray.origin, n) / facing;
+        if (!(t > 0)) return std::nullopt;
+        const glm::dvec3 p = ray.origin + d * t - r.centre;
+        // The square's in-plane axes: any orthonormal pair; the mirror is square about its centre,
+        // so a disc test would not do, but the pair's choice only turns the square in its plane.
+        const glm::dvec3 helper = std::abs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+        const glm::dvec3 s = glm::normalize(glm::cross(helper, n)), u = glm::cross(n, s);
+        if (std::abs(glm::dot(p, s)) > r.radius || std::abs(glm::dot(p, u)) > r.radius) return std::nullopt;
+        out.t = t;
+        out.normal = n;
+    }
+    out.reflected.origin = ray.origin + d * out.t;
+    out.reflected.direction = glm::normalize(d - 2.0 * glm::dot(d, out.normal) * out.normal);
+    return out;
+}
+
+std::optional<ReflectionHit> traceReflection(const std::vector<ReflectionFace>& faces, const Ray& ray,
+                                             const IntersectOptions& options) {
+    std::optional<ReflectionHit> best;
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+        IntersectOptions o = options;
+        if (best) o.tMax = best->hit.t;
+        const auto hit = intersect(faces[f].depth, ray, o);
+        if (!hit || onSky(*hit, faces[f]) || (best && hit->t >= best->hit.t)) continue;
+        const Image& c = faces[f].image;
+        best = ReflectionHit{*hit, static_cast<int>(f),
+                             glm::vec3(c.at(hit->texel.x, hit->texel.y, 0), c.at(hit->texel.x, hit->texel.y, 1),
+                                       c.at(hit->texel.x, hit->texel.y, 2))};
+    }
+    return best;
+}
+
+format::ConusFile reflectionFaceFile(const ReflectionFace& face) {
+    return makeDepthImageFile(face.image, face.depth.map(), face.depth.camera(), "world");
+}
+
+ReflectionFace reflectionFaceFromFile(const format::ConusFile& file) {
+    const std::vector<std::string> names = meshChannelNames();
+    if (file.dataKind != format::DataKind::DepthImage || file.depth.kind != format::DepthKind::CameraDepth ||
+        file.image.channelIndex("R") < 0 || file.image.channelIndex("G") < 0 || file.image.channelIndex("B") < 0)
+        throw Error(ErrorCode::InvalidArgument,
+                    "not a reflection face (a camera-depth image with R, G, B and Z; make them with `conus bake reflection`)");
+    DepthImage depth = DepthImage::fromFile(file);
+    // The file keeps channels in its own (EXR: alphabetical) order; faces hold the mesh render's.
+    Image image{file.image.width, file.image.height, names, std::vector<float>(file.image.pixels.size() / file.image.channels.size() * names.size())};
+    for (std::size_t c = 0; c < names.size(); ++c) {
+        const int from = file.image.channelIndex(names[c]);
+        for (int y = 0; y < image.height; ++y)
+            for (int x = 0; x < image.width; ++x)
+                image.at(x, y, static_cast<int>(c)) = from < 0 ? 1.0f : file.image.at(x, y, from);
+    }
+    return {std::move(depth), std::move(image)};
+}
+
+std::optional<glm::vec3> traceReflectionReference(const MeshScene& scene, const Ray& ray, glm::dvec3 centre) {
+    const auto hit = scene.intersect(ray, 1e-6);
+    if (!hit) return std::nullopt;
+    const glm::vec3 albedo = meshAlbedo(scene.mesh(), hit->triangle, hit->b1, hit->b2);
+    const glm::dvec3 toCentre = centre - hit->position;
+    const double length = glm::length(toCentre);
+    const glm::vec3 l = length > 0 ? glm::vec3(toCentre / length) : hit->normal;
+    return shadeHeadlight(albedo, hit->normal, l);
+}
+
+Image renderReflectionFrame(const MeshScene& scene, const std::vector<ReflectionFace>* faces, glm::dvec3 centre,
+                            const Camera& camera, int width, int height, const ReflectionFrameOptions& o) {
+    if (width < 1 || height < 1 || width > 16384 || height > 16384)
+        throw Error(ErrorCode::InvalidArgument, "reflection frames are 1 to 16384 pixels a side");
+    checkIntersectOptions(o.intersect);
+    Image frame{width, height, {"R", "G", "B", "M"}, std::vector<float>(static_cast<std::size_t>(width) * height * 4)};
+    parallelRows(height, o.threads, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < width; ++x) {
+            const glm::dvec2 uv((x + 0.5) / width, (y + 0.5) / height);
+            const Ray ray = camera.ray(uv);
+            const std::array<float, 5> behind = shadeRay(scene, camera, uv);
+            glm::vec3 colour(behind[0], behind[1], behind[2]);
+            float mask = 0;
+            if (const auto mirror = hitReflector(o.reflector, ray)) {
+                const double depth = camera.project(ray.origin + ray.direction * mirror->t).z;
+                if (behind[kMeshChannelA] <= 0 || depth < behind[kMeshChannelZ]) {
+                    std::optional<glm::vec3> seen;
+                    if (faces) {
+                        if (const auto hit = traceReflection(*faces, mirror->reflected, o.intersect)) seen = hit->colour;
+                    } else {
+                        seen = traceReflectionReference(scene, mirror->reflected, centre);
+                    }
+                    colour = seen ? *seen : glm::vec3(kReflectionSky[0], kReflectionSky[1], kReflectionSky[2]);
+                    mask = seen ? 2.0f : 1.0f;
+                }
+            }
+            for (int c = 0; c < 3; ++c) frame.at(x, y, c) = colour[c];
+            frame.at(x, y, 3) = mask;
+        }
+    });
+    return frame;
+}
+
+}  // namespace conus::codec

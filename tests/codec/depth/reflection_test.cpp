@@ -1,0 +1,273 @@
+#include "conus/codec/depth/reflection.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "codec/mesh/mesh_test_scenes.h"
+#include "conus/core/error.h"
+#include "conus/format/container.h"
+#include "test_dir.h"
+
+namespace conus::codec {
+namespace {
+
+using test::flatBox;
+using test::hitBox;
+
+// Mirror z = 0 facing +z; the box in front of it, off every axis so nothing lines up by chance.
+const glm::dvec3 kBoxLo(0.4, -0.3, 1.5), kBoxHi(1.0, 0.5, 2.2);
+const glm::dvec3 kEye(-1.2, 0.1, 3.0);
+
+glm::dvec3 mirrorZ(glm::dvec3 p) { return {p.x, p.y, -p.z}; }
+
+Reflector planeMirror() {
+    Reflector r;
+    r.kind = Reflector::Kind::Plane;
+    r.centre = {0.0, 0.0, 0.0};
+    r.normal = {0.0, 0.0, 1.0};
+    r.radius = 3.0;
+    return r;
+}
+
+std::vector<ReflectionFace> bakeBox(int size, bool uniform) {
+    static const MeshScene scene(flatBox(glm::vec3(kBoxLo), glm::vec3(kBoxHi)));
+    ReflectionBakeOptions o;
+    o.centre = {0.0, 0.0, 0.0};
+    o.size = size;
+    o.uniform = uniform;
+    o.magnification = 3.0;
+    return bakeReflection(scene, o);
+}
+
+struct Errors {
+    int checked = 0, missed = 0;
+    double sum = 0, max = 0;
+};
+
+// Eye rays aimed at points of the mirror-image box's faces seen from the mirror's centre (its
+// near face z = -1.5 and its side x = 0.4, inset so no ray grazes an edge): the reflected hit must
+// be the mirror image of where the straight ray meets the mirror-image box.
+Errors mirrorErrors(const std::vector<ReflectionFace>& faces, int rays, unsigned seed) {
+    const glm::dvec3 imageLo = glm::min(mirrorZ(kBoxLo), mirrorZ(kBoxHi)), imageHi = glm::max(mirrorZ(kBoxLo), mirrorZ(kBoxHi));
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<double> inset(0.12, 0.88);
+    const Reflector mirror = planeMirror();
+    Errors e;
+    while (e.checked + e.missed < rays) {
+        const glm::dvec3 target(imageLo.x + inset(random) * (imageHi.x - imageLo.x),
+                                imageLo.y + inset(random) * (imageHi.y - imageLo.y),
+                                imageLo.z + inset(random) * (imageHi.z - imageLo.z));
+        const Ray eye{kEye, glm::normalize(target - kEye)};
+        const auto expected = hitBox(eye, imageLo, imageHi);
+        if (!expected || expected->axis == 1) continue;  // the y faces are hidden from the centre
+        if (hitBox(eye, kBoxLo, kBoxHi)) continue;        // the real box in the way
+        const auto onMirror = hitReflector(mirror, eye);
+        if (!onMirror) continue;
+        const glm::dvec3 want = mirrorZ(eye.origin + eye.direction * expected->t);
+        const auto got = traceReflection(faces, onMirror->reflected);
+        if (!got) {
+            ++e.missed;
+            continue;
+        }
+        const double error = glm::distance(got->hit.position, want);
+        // The path's length is kept by the mirror: eye -> mirror -> hit = the straight ray's t.
+        EXPECT_NEAR(onMirror->t + got->hit.t, expected->t, error + 1e-9);
+        e.sum += error;
+        e.max = std::max(e.max, error);
+        ++e.checked;
+    }
+    return e;
+}
+
+TEST(Reflection, PlaneMirrorReflectsByTheLaw) {
+    const Reflector mirror = planeMirror();
+    const Ray eye{kEye, glm::normalize(glm::dvec3(0.3, -0.2, 0.0) - kEye)};
+    const auto hit = hitReflector(mirror, eye);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->reflected.origin.x, 0.3, 1e-12);
+    EXPECT_NEAR(hit->reflected.origin.y, -0.2, 1e-12);
+    EXPECT_NEAR(hit->reflected.origin.z, 0.0, 1e-12);
+    const glm::dvec3 d = eye.direction, r = hit->reflected.direction;
+    EXPECT_NEAR(r.x, d.x, 1e-12);
+    EXPECT_NEAR(r.y, d.y, 1e-12);
+    EXPECT_NEAR(r.z, -d.z, 1e-12);
+    // The back of the mirror and beyond its edge reflect nothing.
+    EXPECT_FALSE(hitReflector(mirror, Ray{{0, 0, -2}, {0, 0, 1}}));
+    EXPECT_FALSE(hitReflector(mirror, Ray{{3.5, 0, 2}, {0, 0, -1}}));
+}
+
+TEST(Reflection, SphereReflectsAboutItsNormal) {
+    Reflector sphere;
+    sphere.centre = {0.2, -0.1, 0.3};
+    sphere.radius = 0.7;
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> offset(-0.6, 0.6);
+    for (int i = 0; i < 200; ++i) {
+        const glm::dvec3 origin(1.5, 2.0, 4.0);
+        const Ray eye{origin, glm::normalize(sphere.centre + glm::dvec3(offset(random), offset(random), 0) - origin)};
+        const auto hit = hitReflector(sphere, eye);
+        if (!hit) continue;
+        EXPECT_NEAR(glm::distance(hit->reflected.origin, sphere.centre), sphere.radius, 1e-9);
+        EXPECT_NEAR(glm::length(hit->reflected.direction), 1.0, 1e-12);
+        // Angle in = angle out, in the plane of the ray and the normal.
+        EXPECT_NEAR(glm::dot(hit->reflected.direction, hit->normal), -glm::dot(eye.direction, hit->normal), 1e-9);
+        EXPECT_NEAR(glm::dot(glm::cross(eye.direction, hit->normal), hit->reflected.direction), 0.0, 1e-9);
+        EXPECT_LT(glm::dot(eye.direction, hit->normal), 0.0);
+    }
+    EXPECT_FALSE(hitReflector(sphere, Ray{{5, 5, 5}, {1, 0, 0}}));
+}
+
+TEST(Reflection, CubeFacesCoverEveryDirectionOnce) {
+    std::mt19937 random(3);
+    std::normal_distribution<double> n;
+    for (int i = 0; i < 500; ++i) {
+        const glm::dvec3 d = glm::normalize(glm::dvec3(n(random), n(random), n(random)));
+        int seen = 0;
+        for (int f = 0; f < kCubeFaces; ++f) {
+            const glm::dvec3 q = cubeFaceCamera({1, 2, 3}, f, 0.1, 10).project(glm::dvec3(1, 2, 3) + d);
+            if (q.z > 0 && q.x > 0 && q.x < 1 && q.y > 0 && q.y < 1) ++seen;
+        }
+        EXPECT_EQ(seen, 1);
+    }
+    EXPECT_THROW(cubeFaceCamera({0, 0, 0}, 6, 0.1, 1), Error);
+}
+
+TEST(Reflection, PlaneMirrorHitsAreTheMirrorImageOfTheBox) {
+    const auto faces = bakeReflection(MeshScene(flatBox(glm::vec3(kBoxLo), glm::vec3(kBoxHi))), [] {
+        ReflectionBakeOptions o;
+        o.size = 128;
+        return o;
+    }());
+    ASSERT_EQ(faces.size(), std::size_t(kCubeFaces));
+    const Errors e = mirrorErrors(faces, 300, 11);
+    EXPECT_EQ(e.missed, 0);
+    // A texel of a 90-degree face 128 wide, 2 units away, is about 0.03 wide.
+    EXPECT_LT(e.sum / e.checked, 0.01);
+    EXPECT_LT(e.max, 0.05);
+    // Reflected rays that leave past the box meet only the far planes: no hit.
+    const Reflector mirror = planeMirror();
+    const auto away = hitReflector(mirror, Ray{kEye, glm::normalize(glm::dvec3(-2.0, 0.5, 0.0) - kEye)});
+    ASSERT_TRUE(away);
+    EXPECT_FALSE(traceReflection(faces, away->reflected));
+}
+
+TEST(Reflection, FocusedFacesBeatUniformOnTheBoxAtEqualTexels) {
+    const Errors conus = mirrorErrors(bakeBox(48, false), 300, 5);
+    const Errors uniform = mirrorErrors(bakeBox(48, true), 300, 5);
+    ASSERT_GT(conus.checked, 250);
+    ASSERT_GT(uniform.checked, 250);
+    EXPECT_LT(conus.sum / conus.checked, 0.8 * uniform.sum / uniform.checked);
+}
+
+TEST(Reflection, FocusSitsOnTheProjectedBox) {
+    const Camera front = cubeFaceCamera({0, 0, 0}, 4, 0.01, 10);  // +z: sees the box
+    const auto focus = reflectionFocus(front, {kBoxLo, kBoxHi}, 3.0);
+    ASSERT_TRUE(focus);
+    const glm::dvec3 centre = front.project(0.5 * (kBoxLo + kBoxHi));
+    EXPECT_NEAR(focus->u, centre.x, 0.1);
+    EXPECT_NEAR(focus->v, centre.y, 0.1);
+    EXPECT_DOUBLE_EQ(focus->k, 3.0);
+    EXPECT_FALSE(reflectionFocus(cubeFaceCamera({0, 0, 0}, 5, 0.01, 10), {kBoxLo, kBoxHi}, 3.0));  // -z: behind
+}
+
+TEST(Reflection, BadBakeOptionsAreRefused) {
+    const MeshScene scene(flatBox(glm::vec3(kBoxLo), glm::vec3(kBoxHi)));
+    ReflectionBakeOptions o;
+    o.size = 4;
+    EXPECT_THROW(bakeReflection(scene, o), Error);
+    o.size = 64;
+    o.magnification = 0.5;
+    EXPECT_THROW(bakeReflection(scene, o), Error);
+    o.magnification = 2;
+    o.centre = {std::nan(""), 0, 0};
+    EXPECT_THROW(bakeReflection(scene, o), Error);
+}
+
+TEST(Reflection, FacesValidateAndRoundTripThroughFiles) {
+    const auto faces = bakeBox(32, false);
+    conus::test::TestDir dir("reflection");
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+        const std::string path = dir.file("face" + std::to_string(f) + ".exr");
+        format::writeConusFile(path, reflectionFaceFile(faces[f]));
+        EXPECT_TRUE(format::validateConusFile(path).ok()) << path;
+        const ReflectionFace back = reflectionFaceFromFile(format::readConusFile(path));
+        EXPECT_EQ(back.depth.depths(), faces[f].depth.depths());
+        EXPECT_EQ(back.image.pixels, faces[f].image.pixels);
+        EXPECT_EQ(back.depth.map().nodes(), faces[f].depth.map().nodes());
+        const glm::dvec3 p(0.7, 0.1, 1.8);
+        const glm::dvec3 a = back.depth.camera().project(p), b = faces[f].depth.camera().project(p);
+        EXPECT_NEAR(glm::distance(a, b), 0.0, 1e-4);
+    }
+    // The +z face sees the box, so its map is not the identity; -z sees nothing of it.
+    EXPECT_GT(faces[4].depth.map().columns(), 2);
+    EXPECT_EQ(faces[5].depth.map().columns(), 2);
+    format::ConusFile notAFace = reflectionFaceFile(faces[0]);
+    notAFace.depth.kind = format::DepthKind::Height;
+    EXPECT_THROW(reflectionFaceFromFile(notAFace), Error);
+}
+
+// Mean squared RGB error of `a` against `truth` over the pixels `inRegion` picks.
+template <typename Pick>
+double meanSquaredError(const Image& a, const Image& truth, Pick inRegion) {
+    double sum = 0;
+    int n = 0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) {
+            if (!inRegion(x, y)) continue;
+            for (int c = 0; c < 3; ++c) sum += (a.at(x, y, c) - truth.at(x, y, c)) * (a.at(x, y, c) - truth.at(x, y, c));
+            ++n;
+        }
+    return n ? sum / (3.0 * n) : 0.0;
+}
+
+TEST(Reflection, FramesMatchTheTracedReferenceAndCoNUSBeatsUniform) {
+    // The box and a floor, a sphere mirror between them and the camera.
+    Mesh scene = flatBox(glm::vec3(kBoxLo), glm::vec3(kBoxHi));
+    const Mesh floor = test::plane(-1.0f, 4.0f);
+    const auto base = static_cast<std::uint32_t>(scene.positions.size());
+    scene.positions.insert(scene.positions.end(), floor.positions.begin(), floor.positions.end());
+    scene.normals.insert(scene.normals.end(), floor.normals.begin(), floor.normals.end());
+    for (std::uint32_t i : floor.indices) scene.indices.push_back(base + i);
+    scene.colours.assign(scene.positions.size(), glm::vec3(0.8f));
+    for (std::size_t i = 0; i < base; ++i)  // the box: a colour ramp across it, so misplaced hits show
+        scene.colours[i] = glm::vec3((scene.positions[i].x - 0.4f) / 0.6f, 0.3f, (scene.positions[i].z - 1.5f) / 0.7f);
+    const MeshScene mesh(scene);
+    ReflectionFrameOptions o;
+    o.reflector.centre = {0.0, 0.0, 0.0};
+    o.reflector.radius = 0.5;
+    const Camera camera = Camera::perspective({-0.8, 0.5, 3.0}, {0.0, 0.0, 0.0}, {0, 1, 0}, 22.0, 1.0, 0.1, 20.0);
+    const Image truth = renderReflectionFrame(mesh, nullptr, o.reflector.centre, camera, 96, 96, o);
+    ReflectionBakeOptions bake;
+    bake.size = 32;
+    bake.roi = AxisBox{kBoxLo, kBoxHi};
+    const auto conusFaces = bakeReflection(mesh, bake);
+    bake.uniform = true;
+    const auto uniformFaces = bakeReflection(mesh, bake);
+    const Image conus = renderReflectionFrame(mesh, &conusFaces, o.reflector.centre, camera, 96, 96, o);
+    const Image uniform = renderReflectionFrame(mesh, &uniformFaces, o.reflector.centre, camera, 96, 96, o);
+    // The region of interest: reflector pixels whose traced reflected ray meets the box (its 12
+    // triangles come first).
+    std::vector<char> box(static_cast<std::size_t>(96) * 96, 0);
+    int reflecting = 0, onBox = 0;
+    for (int y = 0; y < truth.height; ++y)
+        for (int x = 0; x < truth.width; ++x) {
+            reflecting += truth.at(x, y, 3) == 2.0f;
+            const auto mirror = hitReflector(o.reflector, camera.ray({(x + 0.5) / 96, (y + 0.5) / 96}));
+            const auto hit = mirror ? mesh.intersect(mirror->reflected, 1e-6) : std::nullopt;
+            onBox += box[static_cast<std::size_t>(y) * 96 + x] = hit && hit->triangle < 12;
+        }
+    ASSERT_GT(reflecting, 500);
+    ASSERT_GT(onBox, 30);
+    // Outside the reflector the frames are the same mesh render.
+    EXPECT_EQ(meanSquaredError(conus, truth, [&](int x, int y) { return truth.at(x, y, 3) == 0.0f; }), 0.0);
+    auto roi = [&](int x, int y) { return box[static_cast<std::size_t>(y) * 96 + x] != 0; };
+    const double conusError = meanSquaredError(conus, truth, roi), uniformError = meanSquaredError(uniform, truth, roi);
+    EXPECT_GT(conusError, 0.0);
+    EXPECT_LT(conusError, 0.02);  // about 17 dB: the box is a few texels across in a 32-texel face
+    EXPECT_LT(conusError, uniformError);
+}
+
+}  // namespace
+}  // namespace conus::codec
