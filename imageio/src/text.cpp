@@ -24,27 +24,6 @@ void drawText(Image& image, int x, int y, int size, const std::string& text, con
                                        buffer.geterror());
 }
 
-Image inscription(const std::string& text, int width, int height) {
-    std::vector<std::string> lines;
-    std::stringstream in(text);
-    for (std::string line; std::getline(in, line, '|');)
-        if (!line.empty()) lines.push_back(line);
-    if (lines.empty()) throw Error(ErrorCode::InvalidArgument, "an inscription needs some text");
-    Image ink = makeImage(width, height, {"R", "G", "B"});
-    const int usable = static_cast<int>(0.72 * width);
-    int fontSize = std::max(4, static_cast<int>(0.62 * height / lines.size()));
-    for (const std::string& line : lines)
-        if (const int w = textWidth(line, fontSize); w > usable) fontSize = std::max(4, fontSize * usable / w);
-    const float white[3] = {1.0f, 1.0f, 1.0f};
-    // Baselines spaced 1.25 font sizes apart, the block centred (a cap is about 0.7 of the size).
-    const double lineHeight = 1.25 * fontSize;
-    const double first = 0.5 * height - 0.5 * lineHeight * (lines.size() - 1) + 0.35 * fontSize;
-    for (std::size_t i = 0; i < lines.size(); ++i)
-        drawText(ink, (width - textWidth(lines[i], fontSize)) / 2, static_cast<int>(first + lineHeight * i), fontSize,
-                 lines[i], white);
-    return ink;
-}
-
 int textWidth(const std::string& text, int fontSize) {
     if (text.empty()) return 0;
     const OIIO::ROI roi = OIIO::ImageBufAlgo::text_size(text, fontSize, kFont);
