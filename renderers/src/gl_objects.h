@@ -2,8 +2,11 @@
 // (a failed allocation, a GL error) leaves nothing behind in the context.
 #pragma once
 
+#include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include <glad/gl.h>
 
@@ -78,6 +81,28 @@ inline void checkGl(const GladGLContext& gl, const char* what) {
         std::snprintf(buffer, sizeof buffer, "%04X", error);
         return std::string(buffer);
     }());
+}
+
+// Stage timings of the GPU paths: the milliseconds since `start`, which then moves to now.
+using Clock = std::chrono::steady_clock;
+inline double millisecondsSince(Clock::time_point& start) {
+    const Clock::time_point now = Clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - start).count();
+    start = now;
+    return ms;
+}
+
+// Fills a vertex array's interleaved float vertices and its triangle indices (static draw); the
+// caller then describes the attributes.
+inline void uploadIndexedMesh(const GladGLContext& gl, GLuint vertexArray, GLuint vertexBuffer, GLuint indexBuffer,
+                              const std::vector<float>& vertices, const std::vector<std::uint32_t>& indices) {
+    gl.BindVertexArray(vertexArray);
+    gl.BindBuffer(GL_ARRAY_BUFFER, vertexBuffer);
+    gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)), vertices.data(),
+                  GL_STATIC_DRAW);
+    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, indexBuffer);
+    gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)),
+                  indices.data(), GL_STATIC_DRAW);
 }
 
 }  // namespace conus::gl

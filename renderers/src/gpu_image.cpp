@@ -31,14 +31,6 @@ constexpr double kMaxSubQuadPixels = 8.0;
 constexpr double kMaxMeshVertices = 4.0e6;
 constexpr int kChannelsPerPass = 4;
 
-using Clock = std::chrono::steady_clock;
-
-double millisecondsSince(Clock::time_point& start) {
-    const Clock::time_point now = Clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - start).count();
-    start = now;
-    return ms;
-}
 
 std::string limitDescription(const Context& context, int limit) {
     std::string text = "the texture limit " + std::to_string(limit) + " (GL_MAX_TEXTURE_SIZE " +

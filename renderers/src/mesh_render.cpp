@@ -36,7 +36,7 @@ Albedo albedoOf(const Mesh& mesh) {
     return Albedo::Grey;
 }
 
-double millisecondsSince(std::chrono::steady_clock::time_point start) {
+double elapsedMilliseconds(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -136,13 +136,8 @@ MeshRenderer::MeshRenderer(Context& context, const Mesh& given) {
         if (!mesh.colours.empty()) std::copy_n(glm::value_ptr(mesh.colours[i]), 3, v + 6);
         if (!mesh.uvs.empty()) std::copy_n(glm::value_ptr(mesh.uvs[i]), 2, v + 9);
     }
-    gl.BindVertexArray(m_impl->vertexArray.id());
-    gl.BindBuffer(GL_ARRAY_BUFFER, m_impl->vertexBuffer.id());
-    gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)), vertices.data(),
-                  GL_STATIC_DRAW);
-    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m_impl->indexBuffer.id());
-    gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(std::uint32_t)),
-                  mesh.indices.data(), GL_STATIC_DRAW);
+    uploadIndexedMesh(gl, m_impl->vertexArray.id(), m_impl->vertexBuffer.id(), m_impl->indexBuffer.id(), vertices,
+                      mesh.indices);
     const GLint sizes[kAttributes] = {3, 3, 3, 2};
     std::size_t offset = 0;
     for (GLuint a = 0; a < kAttributes; ++a) {
@@ -215,7 +210,7 @@ Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, 
     const GlHandle mapTexture = uploadMapTexture(gl, GL_TEXTURE0, map.columns(), map.rows(), nodes.data());
     if (timings) {
         gl.Finish();
-        timings->uploadMs = millisecondsSince(phase);
+        timings->uploadMs = elapsedMilliseconds(phase);
         phase = std::chrono::steady_clock::now();
     }
 
@@ -281,7 +276,7 @@ Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, 
     }
     if (timings) {
         gl.Finish();
-        timings->drawMs = millisecondsSince(phase);
+        timings->drawMs = elapsedMilliseconds(phase);
         phase = std::chrono::steady_clock::now();
     }
 
@@ -301,7 +296,7 @@ Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, 
         std::copy_n(&rgba[p * 4], 4, &frame.pixels[p * 5]);
         frame.pixels[p * 5 + 4] = z[p];
     }
-    if (timings) timings->readbackMs = millisecondsSince(phase);
+    if (timings) timings->readbackMs = elapsedMilliseconds(phase);
     return frame;
 }
 

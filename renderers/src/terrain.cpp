@@ -120,13 +120,8 @@ TerrainRenderer::TerrainRenderer(Context& context, const Mesh& mesh, const Terra
         std::copy_n(glm::value_ptr(mesh.colours[i]), 3, &vertices[i * 9 + 3]);
         std::copy_n(glm::value_ptr(mesh.normals[i]), 3, &vertices[i * 9 + 6]);
     }
-    gl.BindVertexArray(m_impl->vertexArray.id());
-    gl.BindBuffer(GL_ARRAY_BUFFER, m_impl->vertexBuffer.id());
-    gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)), vertices.data(),
-                  GL_STATIC_DRAW);
-    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m_impl->indexBuffer.id());
-    gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(std::uint32_t)),
-                  mesh.indices.data(), GL_STATIC_DRAW);
+    uploadIndexedMesh(gl, m_impl->vertexArray.id(), m_impl->vertexBuffer.id(), m_impl->indexBuffer.id(), vertices,
+                      mesh.indices);
     for (GLuint a = 0; a < 3; ++a) {
         gl.EnableVertexAttribArray(a);
         gl.VertexAttribPointer(a, 3, GL_FLOAT, GL_FALSE, 9 * sizeof(float),

@@ -19,14 +19,6 @@ namespace conus::gl {
 namespace {
 
 constexpr const char* kWhat = "renderVolumeGpu";
-using Clock = std::chrono::steady_clock;
-
-double millisecondsSince(Clock::time_point& start) {
-    const Clock::time_point now = Clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - start).count();
-    start = now;
-    return ms;
-}
 
 void setFilter(const GladGLContext& gl, GLenum target, GLint filter) {
     gl.TexParameteri(target, GL_TEXTURE_MIN_FILTER, filter);
