@@ -18,13 +18,13 @@
 #include "conus/codec/mesh/raycast.h"
 #include "context_pvt.h"
 #include "embedded_shaders.h"
+#include "frame_pvt.h"
 #include "gl_objects.h"
 
 namespace conus::gl {
 namespace {
 
 constexpr const char* kWhat = "renderMesh";
-constexpr int kMaxFrameSide = 16384;
 constexpr GLuint kAttributes = 4;     // position, normal, colour, uv
 constexpr GLsizei kFloatsPerVertex = 11;
 
@@ -185,17 +185,11 @@ MeshRenderer::~MeshRenderer() {
 
 Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, int width, int height,
                            const MeshRenderOptions& options, GpuTimings* timings) {
-    if (width < 1 || height < 1 || width > kMaxFrameSide || height > kMaxFrameSide)
-        throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": frame " + std::to_string(width) + "x" +
-                                                    std::to_string(height) + " is outside [1, 16384] per side");
+    Context& context = m_impl->context;
+    checkFrame(context, width, height, kWhat);
     if (options.samples < 1)
         throw Error(ErrorCode::InvalidArgument,
                     std::string(kWhat) + ": samples " + std::to_string(options.samples) + " is below 1");
-    Context& context = m_impl->context;
-    if (width > context.maxTextureSize() || height > context.maxTextureSize())
-        throw Error(ErrorCode::LimitExceeded, std::string(kWhat) + ": frame " + std::to_string(width) + "x" +
-                                                  std::to_string(height) + " exceeds GL_MAX_TEXTURE_SIZE " +
-                                                  std::to_string(context.maxTextureSize()));
     const GladGLContext& gl = makeCurrentGl(context);
     auto phase = std::chrono::steady_clock::now();
     const GLuint program = cachedProgram(context, "mesh", shaders::kShaderMeshVert, shaders::kShaderMeshFrag);

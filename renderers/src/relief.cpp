@@ -13,13 +13,13 @@
 
 #include "context_pvt.h"
 #include "embedded_shaders.h"
+#include "frame_pvt.h"
 #include "gl_objects.h"
 
 namespace conus::gl {
 namespace {
 
 constexpr const char* kWhat = "relief";
-constexpr int kMaxFrameSide = 16384;
 constexpr int kRayRowLength = 1024;  // rays per row of the ray textures
 
 // A float texture of `channels` channels from interleaved data, nearest filtering, clamped.
@@ -39,16 +39,6 @@ GlHandle floatTexture(const GladGLContext& gl, GLenum unit, int width, int heigh
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     return texture;
-}
-
-void checkFrame(const Context& context, int width, int height) {
-    if (width < 1 || height < 1 || width > kMaxFrameSide || height > kMaxFrameSide)
-        throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": frame " + std::to_string(width) + "x" +
-                                                    std::to_string(height) + " is outside [1, 16384] per side");
-    if (width > context.maxTextureSize() || height > context.maxTextureSize())
-        throw Error(ErrorCode::LimitExceeded, std::string(kWhat) + ": frame " + std::to_string(width) + "x" +
-                                                  std::to_string(height) + " exceeds GL_MAX_TEXTURE_SIZE " +
-                                                  std::to_string(context.maxTextureSize()));
 }
 
 // The depth image's textures (depths on unit 0, map nodes on unit 1) and its DepthView uniforms.
@@ -109,7 +99,7 @@ std::vector<std::optional<codec::DepthHit>> intersectRays(Context& context, cons
     if (rays.empty()) return {};
     const int width = static_cast<int>(std::min<std::size_t>(rays.size(), kRayRowLength));
     const int height = static_cast<int>((rays.size() + kRayRowLength - 1) / kRayRowLength);
-    checkFrame(context, width, height);
+    checkFrame(context, width, height, kWhat);
 
     const GladGLContext& gl = makeCurrentGl(context);
     const GLuint program = cachedProgram(context, "intersect_rays", shaders::kShaderFullscreenVert,
@@ -224,7 +214,7 @@ struct ReliefRenderer::Impl {
     }
 
     void drawFrame(const Camera& camera, int w, int h) {
-        checkFrame(context, w, h);
+        checkFrame(context, w, h, kWhat);
         const GladGLContext& gl = makeCurrentGl(context);
         const GLuint program =
             cachedProgram(context, "relief", shaders::kShaderFullscreenVert, shaders::kShaderReliefFrag);
@@ -284,9 +274,7 @@ void ReliefRenderer::draw(const Camera& camera, int width, int height) {
 Image ReliefRenderer::render(const Camera& camera, int width, int height) {
     m_impl->drawFrame(camera, width, height);
     const GladGLContext& gl = makeCurrentGl(m_impl->context);
-    Image frame = makeImage(width, height, {"R", "G", "B"});
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    gl.ReadPixels(0, 0, width, height, GL_RGB, GL_FLOAT, frame.pixels.data());
+    Image frame = readRgbFrame(gl, width, height);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     checkGl(gl, kWhat);
     return frame;

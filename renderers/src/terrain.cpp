@@ -19,13 +19,13 @@
 
 #include "context_pvt.h"
 #include "embedded_shaders.h"
+#include "frame_pvt.h"
 #include "gl_objects.h"
 
 namespace conus::gl {
 namespace {
 
 constexpr const char* kWhat = "renderTerrain";
-constexpr int kMaxFrameSide = 16384;
 constexpr double kPi = 3.14159265358979323846;
 
 
@@ -138,14 +138,8 @@ TerrainRenderer::~TerrainRenderer() {
 }
 
 Image TerrainRenderer::render(const Camera& camera, int width, int height) {
-    if (width < 1 || height < 1 || width > kMaxFrameSide || height > kMaxFrameSide)
-        throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": frame " + std::to_string(width) + "x" +
-                                                    std::to_string(height) + " is outside [1, 16384] per side");
     Context& context = m_impl->context;
-    if (width > context.maxTextureSize() || height > context.maxTextureSize())
-        throw Error(ErrorCode::LimitExceeded, std::string(kWhat) + ": frame " + std::to_string(width) + "x" +
-                                                  std::to_string(height) + " exceeds GL_MAX_TEXTURE_SIZE " +
-                                                  std::to_string(context.maxTextureSize()));
+    checkFrame(context, width, height, kWhat);
     const GladGLContext& gl = makeCurrentGl(context);
     const GLuint program = cachedProgram(context, "terrain", shaders::kShaderTerrainVert, shaders::kShaderTerrainFrag);
     m_impl->ensureTargets(gl, width, height);
@@ -182,9 +176,7 @@ Image TerrainRenderer::render(const Camera& camera, int width, int height) {
     gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, m_impl->resolveFramebuffer->id());
     gl.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     gl.BindFramebuffer(GL_FRAMEBUFFER, m_impl->resolveFramebuffer->id());
-    Image frame = makeImage(width, height, {"R", "G", "B"});
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    gl.ReadPixels(0, 0, width, height, GL_RGB, GL_FLOAT, frame.pixels.data());
+    Image frame = readRgbFrame(gl, width, height);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     checkGl(gl, kWhat);
     return frame;
