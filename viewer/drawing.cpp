@@ -1,5 +1,6 @@
 #include "drawing.h"
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 
@@ -14,7 +15,37 @@ void Drawing::setUniform(const std::string& path, Image uniform) {
     m_uniform = std::move(uniform);
 }
 
+void Drawing::renderScene(Controller& controller) {
+    const SceneState& state = *controller.scene();
+    bool changed = false;
+    for (; m_looksSeen < controller.lookRequests(); ++m_looksSeen) {
+        controller.setLook(m_scene->nextLook());
+        changed = true;
+    }
+    const glm::ivec2 size = controller.sceneFrameSize();
+    if (!changed && state.version() == m_sceneVersion && size == m_sceneSize) return;
+    m_sceneVersion = state.version();
+    m_sceneSize = size;
+    const double aspect = double(size.x) / size.y;
+    try {
+        const Camera camera = state.camera(aspect);
+        const codec::SamplingMap map = m_scene->throughMap() ? state.map(aspect) : codec::SamplingMap::identity(2, 2);
+        const auto start = std::chrono::steady_clock::now();
+        Image image = m_scene->render(camera, map, state.conus(), size.x, size.y);
+        m_sceneSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        ++m_sceneRenders;
+        const bool live = m_scene->throughMap() && state.conus();
+        controller.setSceneFrame(sceneFrameFile(std::move(image), map, camera, live ? state.foci() : std::vector<codec::Focus>{}));
+        m_sceneFailed = false;
+    } catch (const std::exception& e) {
+        if (!m_sceneFailed) std::fprintf(stderr, "conus-view: %s: %s\n", m_scene->name().c_str(), e.what());
+        m_sceneFailed = true;
+        controller.failed();
+    }
+}
+
 void Drawing::frame(Controller& controller, int fw, int fh) {
+    if (m_scene && controller.scene()) renderScene(controller);
     if (m_imageVersion != controller.imageVersion()) {
         m_imageVersion = controller.imageVersion();
         m_mapVersion = controller.mapVersion();
@@ -34,7 +65,7 @@ void Drawing::frame(Controller& controller, int fw, int fh) {
         if (const MapEditor* editor = controller.editor()) m_renderer.setMap(editor->map());
     }
     const Document* doc = controller.current();
-    if (!controller.editing() && (!m_shown || (doc && !doc->ok()))) {
+    if (!controller.editing() && (!m_shown || (doc && !doc->ok()) || (controller.scene() && m_sceneFailed))) {
         // The window turns dark red with the error written over it (also in the title and on stderr).
         m_renderer.clear(fw, fh, 0.35f, 0.05f, 0.05f);
     } else {
@@ -73,8 +104,8 @@ void Drawing::drawOverlays(const Controller& controller, int fw, int fh) {
         if (prepareOverlay(kStatusSlot, text + "\n" + std::to_string(fw), [&] { return statusPanel(text, fw); }))
             m_renderer.drawOverlay(kStatusSlot, 0, fh - m_overlayHeight[kStatusSlot], fw, fh);
     }
-    const bool editing = controller.editing();
-    if (controller.showHelp() && prepareOverlay(kHelpSlot, editing ? "edit" : "view", [&] { return helpPanel(editing); }))
+    const KeyTable table = controller.keyTable();
+    if (controller.showHelp() && prepareOverlay(kHelpSlot, std::to_string(int(table)), [&] { return helpPanel(table); }))
         m_renderer.drawOverlay(kHelpSlot, kOverlayMargin, kOverlayMargin, fw, fh);
 }
 
