@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <limits>
 #include <vector>
 
 #include "conus/codec/depth/intersect.h"
@@ -19,25 +18,16 @@
 #include "conus/renderers/volume_renderer.h"
 #include "conus/sceneio/mesh_file.h"
 #include "conus/sceneio/volume_file.h"
+#include "scene_state.h"
 
 namespace conus::viewer {
 namespace {
 
 std::string fileName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
 
-// The sphere around a set of points: the centre of their box, half its diagonal.
-struct Sphere {
-    glm::dvec3 centre{0.0};
-    double radius = 1.0;
-};
 template <class Points>
-Sphere sphereAround(const Points& points) {
-    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-    for (const auto& p : points) {
-        lo = glm::min(lo, glm::dvec3(p));
-        hi = glm::max(hi, glm::dvec3(p));
-    }
-    return {0.5 * (lo + hi), std::max(1e-6, 0.5 * glm::length(hi - lo))};
+BoundingSphere sphereAround(const Points& points) {
+    return boundingSphere(std::vector<glm::dvec3>(points.begin(), points.end()));
 }
 
 // Only R, G, B of a frame with more channels (the reflection frame's M is a label, not a colour).
@@ -64,7 +54,7 @@ public:
 private:
     std::string m_name;
     Mesh m_mesh;
-    Sphere m_bounds;
+    BoundingSphere m_bounds;
     gl::MeshRenderer m_renderer;
 };
 
@@ -143,7 +133,7 @@ private:
         return std::make_unique<gl::ReliefRenderer>(context, asset, file.image);
     }
     std::string m_name;
-    Sphere m_bounds;
+    BoundingSphere m_bounds;
     bool m_bounded = false;
     std::unique_ptr<gl::ReliefRenderer> m_conus, m_uniform;
 };
@@ -184,7 +174,7 @@ private:
         return faces;
     }
     std::string m_name;
-    Sphere m_bounds;
+    BoundingSphere m_bounds;
     codec::MeshScene m_scene;
     std::vector<codec::ReflectionFace> m_conus, m_uniform;
     glm::dvec3 m_centre{0.0};

@@ -110,6 +110,16 @@ void SceneState::scaleFocusRadius(double factor) {
     ++m_version;
 }
 
+BoundingSphere boundingSphere(const std::vector<glm::dvec3>& points) {
+    glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
+    for (const glm::dvec3& p : points) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    if (points.empty()) return {};
+    return {0.5 * (lo + hi), std::max(1e-6, 0.5 * glm::length(hi - lo))};
+}
+
 format::ConusFile sceneFrameFile(Image image, const codec::SamplingMap& map, const Camera& camera,
                                  const std::vector<codec::Focus>& foci) {
     std::optional<format::AnalyticMap> analytic;

@@ -82,6 +82,14 @@ private:
     int m_version = 0;
 };
 
+// The sphere the orbit turns about, for a set of points: the centre of their bounding box and half
+// its diagonal (at least 1e-6).
+struct BoundingSphere {
+    glm::dvec3 centre{0.0};
+    double radius = 1.0;
+};
+BoundingSphere boundingSphere(const std::vector<glm::dvec3>& points);
+
 // A rendered frame as the CoNUS file the viewer shows and probes: a depth image with the camera
 // when the image has Z (codec::makeDepthImageFile), else an image file; the foci recorded as the
 // analytic map (the outlines of O); give no foci for a conventional frame.
