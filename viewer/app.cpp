@@ -43,7 +43,8 @@ public:
         }
         const auto [fw, fh] = m_window->framebufferSize();
         m_controller.setWindowSize(fw, fh);
-        if (m_scene) m_controller.startScene(m_scene->centre(), m_scene->radius(), m_scene->name(), m_scene->throughMap(), m_scene->look());
+        if (m_scene) m_controller.startScene(m_scene->centre(), m_scene->radius(), m_scene->name(), m_scene->throughMap(), m_scene->look(),
+                                           m_scene->home());
         if (!m_controller.load()) return 1;
         if (m_options.benchmarkFrames > 0) return m_scene ? benchmarkScene() : benchmark();
         const bool scripted = !m_script.empty() || !m_options.script.empty();

@@ -60,8 +60,9 @@ bool Controller::load() {
 
 void Controller::setWindowSize(int width, int height) { m_state.setWindowSize(width, height); }
 
-void Controller::startScene(glm::dvec3 centre, double radius, std::string name, bool throughMap, std::string look) {
-    m_scene.emplace(centre, radius, m_options.foci);
+void Controller::startScene(glm::dvec3 centre, double radius, std::string name, bool throughMap, std::string look,
+                            std::optional<Orbit> home) {
+    m_scene.emplace(centre, radius, m_options.foci, home);
     m_sceneName = std::move(name);
     m_sceneThroughMap = throughMap;
     m_sceneLook = std::move(look);

@@ -49,7 +49,8 @@ public:
     // The 3-D modes (scene_state.h, scene.h): the window opened the scene and says what it holds;
     // from then on the controller orbits, drags foci and toggles, and the drawing renders a frame
     // whenever sceneVersion() moves and hands it back with setSceneFrame.
-    void startScene(glm::dvec3 centre, double radius, std::string name, bool throughMap, std::string look);
+    void startScene(glm::dvec3 centre, double radius, std::string name, bool throughMap, std::string look,
+                    std::optional<Orbit> home = std::nullopt);
     const SceneState* scene() const { return m_scene ? &*m_scene : nullptr; }
     bool sceneThroughMap() const { return m_sceneThroughMap; }
     int sceneVersion() const { return m_scene ? m_scene->version() : 0; }

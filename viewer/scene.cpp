@@ -111,6 +111,15 @@ public:
     glm::dvec3 centre() const override { return m_bounds.centre; }
     double radius() const override { return m_bounds.radius; }
     bool throughMap() const override { return false; }
+    // A tablet lies flat: seen from the front (+z) and well above.
+    std::optional<Orbit> home() const override {
+        Orbit orbit;
+        orbit.target = m_bounds.centre;
+        orbit.yawDegrees = 15;
+        orbit.pitchDegrees = 50;
+        orbit.distance = 1.15 * m_bounds.radius / std::sin(glm::radians(0.5 * orbit.fovYDegrees));
+        return orbit;
+    }
     Image render(const Camera& camera, const codec::SamplingMap&, bool conus, int width, int height) override {
         return (conus || !m_uniform ? *m_conus : *m_uniform).render(camera, width, height);
     }
@@ -154,8 +163,18 @@ public:
     }
     std::string name() const override { return m_name; }
     glm::dvec3 centre() const override { return m_centre; }
-    double radius() const override { return std::max(m_bounds.radius, m_options.reflector.radius); }
+    // The whole scene seen from the mirror's centre (the frame's near and far planes enclose it).
+    double radius() const override {
+        return std::max(glm::length(m_bounds.centre - m_centre) + m_bounds.radius, m_options.reflector.radius);
+    }
     bool throughMap() const override { return false; }
+    // Near the mirror, which fills about a third of the frame's height: the reflections are the subject.
+    std::optional<Orbit> home() const override {
+        Orbit orbit;
+        orbit.target = m_centre;
+        orbit.distance = 3.0 * m_options.reflector.radius / std::tan(glm::radians(0.5 * orbit.fovYDegrees));
+        return orbit;
+    }
     Image render(const Camera& camera, const codec::SamplingMap&, bool conus, int width, int height) override {
         const std::vector<codec::ReflectionFace>& faces = conus || m_uniform.empty() ? m_conus : m_uniform;
         return colourOf(codec::renderReflectionFrame(m_scene, &faces, m_centre, camera, width, height, m_options));

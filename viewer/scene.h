@@ -11,6 +11,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -20,6 +21,7 @@
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"
 #include "options.h"
+#include "scene_state.h"
 
 namespace conus::viewer {
 
@@ -40,6 +42,9 @@ public:
     // T: the next look (a volume's next transfer function preset); its name, empty when the scene has one look.
     virtual std::string nextLook() { return {}; }
     virtual std::string look() const { return {}; }
+    // The first camera, when the scene knows a better one than scene_state.h's default (a view
+    // from the front right and a little above, framing the sphere).
+    virtual std::optional<Orbit> home() const { return std::nullopt; }
 };
 
 // The scene Options ask for (options.sceneKind), its data read and uploaded to `context`. Throws
