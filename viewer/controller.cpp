@@ -69,7 +69,14 @@ void Controller::startScene(glm::dvec3 centre, double radius, std::string name, 
     m_display.mode = gl::ViewMode::Raw;  // the CoNUS image itself: the paper's focus-plus-context display
     const glm::ivec2 size = sceneFrameSize();
     m_state.setImageSize(size.x, size.y);
-    std::printf("conus-view: %s; H lists the keys\n", m_sceneName.c_str());
+    std::printf("conus-view: %s%s%s; H lists the keys\n", m_sceneName.c_str(), m_sceneLook.empty() ? "" : ", ",
+                m_sceneLook.c_str());
+    std::fflush(stdout);
+}
+
+void Controller::setLook(std::string look) {
+    m_sceneLook = std::move(look);
+    std::printf("conus-view: %s\n", m_sceneLook.c_str());
     std::fflush(stdout);
 }
 

@@ -58,7 +58,7 @@ public:
     glm::ivec2 sceneFrameSize() const;
     // T pressed this many times: the drawing asks the scene for its next look and reports it.
     int lookRequests() const { return m_lookRequests; }
-    void setLook(std::string look) { m_sceneLook = std::move(look); }
+    void setLook(std::string look);
     // The frame just rendered (a CoNUS file: the image, its map and foci, the camera and, when the
     // renderer gave Z, its depth), shown from now on and probed by the inspector.
     void setSceneFrame(format::ConusFile frame);

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include "conus/core/display.h"
+#include "conus/codec/volume/procedural.h"
 #include "conus/renderers/mesh_render.h"
+#include "conus/renderers/volume_renderer.h"
 #include "conus/sceneio/mesh_file.h"
 #include "sanitizers.h"
 #include "scene_state.h"
@@ -104,6 +106,134 @@ TEST(SceneWindow, MeshFramesAreTheEncodersAndFollowTheCommands) {
     EXPECT_GT(meanDifference(m1, m2), 2.0 / 255) << "dragging the focus changes the picture";
     EXPECT_GT(compare(m1, conventional).mean, 2.0 / 255) << "CoNUS and conventional differ";
     EXPECT_GT(meanDifference(m3, m4), 4.0 / 255);
+}
+
+// T cycles the transfer function, U drops the map; each frame is the GPU ray caster's for the scene
+// state's camera and map (the volume box's sphere: centre extent / 2, radius |extent| / 2).
+TEST(SceneWindow, VolumeFramesAreTheRayCastersAndTCyclesTheLook) {
+    ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";
+    const std::string spec = "procedural:shepp-logan:48";
+    const codec::Focus focus{0.5, 0.45, 0.15, 3.0};
+    const fs::path dir = test::tempDir();
+    const std::string script = "screenshot " + (dir / "v1.png").string() + "\nkey T\nscreenshot " + (dir / "v2.png").string() +
+                               "\nkey U\nscreenshot " + (dir / "v3.png").string() + "\n";
+    const std::string log = runScript("--volume " + spec + " --focus 0.5,0.45,0.15,3 --status-bar", script);
+    const Image v1 = readPicture(dir / "v1.png"), v2 = readPicture(dir / "v2.png"), v3 = readPicture(dir / "v3.png");
+    ASSERT_EQ(v3.width, kW) << log;
+
+    const Volume volume = codec::proceduralVolume(spec);
+    SceneState state(0.5 * volume.extent(), 0.5 * glm::length(volume.extent()), {focus});
+    const double aspect = double(kW) / kH;
+    const std::vector<std::string> presets = codec::TransferFunction::presetNames();
+    ASSERT_GE(presets.size(), 2u);
+    gl::VolumeRendererGpu renderer(test::context(), volume, codec::TransferFunction::preset(presets[0]));
+    const auto render = [&](const codec::SamplingMap& map) {
+        return renderer.render(Fpc(state.camera(aspect), std::make_shared<codec::SamplingMap>(map)), kW, kH, {});
+    };
+    const Image first = render(state.map(aspect));
+    renderer.setTransferFunction(codec::TransferFunction::preset(presets[1]));
+    const Image second = render(state.map(aspect));
+    const Image conventional = render(codec::SamplingMap::identity(2, 2));
+    // The status bar covers the bottom rows: compare above it.
+    const auto top = [](const Image& im) {
+        Image t = im;
+        t.height = kH * 3 / 4;
+        t.pixels.resize(std::size_t(t.width) * t.height * t.channelCount());
+        return t;
+    };
+    EXPECT_LT(compare(top(v1), top(first)).mean, 1.0 / 255) << "the CoNUS frame with the first preset";
+    EXPECT_LT(compare(top(v2), top(second)).mean, 1.0 / 255) << "T: the next preset";
+    EXPECT_LT(compare(top(v3), top(conventional)).mean, 1.0 / 255) << "U: the identity map";
+    EXPECT_GT(meanDifference(v1, v2), 2.0 / 255);
+    EXPECT_GT(compare(top(v3), top(second)).mean, 2.0 / 255);
+    EXPECT_NE(log.find("(volume), tf " + presets[0]), std::string::npos) << log;
+    EXPECT_NE(log.find("conus-view: tf " + presets[1]), std::string::npos) << "T says the look it chose\n" << log;
+}
+
+// A relief asset and its conventional twin: U swaps them (the engraving differs, the frame around
+// it does not), an orbit turns the tablet.
+TEST(SceneWindow, ReliefAssetToggleAndOrbit) {
+    ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";
+    const fs::path dir = test::tempDir();
+    const std::string conus = std::string(CONUS_BIN_DIR) + "/conus";
+    std::string log;
+    for (const char* flag : {"", " --uniform"})
+        ASSERT_EQ(test::run(conus + " bake relief tablet --text 'AB' -q --size 128x96 -o " +
+                                (dir / (std::string("tablet") + (*flag ? "-u" : "") + ".exr")).string() + flag,
+                            &log),
+                  0)
+            << log;
+    const std::string script = "screenshot " + (dir / "r1.png").string() + "\nkey U\nscreenshot " + (dir / "r2.png").string() +
+                               "\norbit 60 20\nscreenshot " + (dir / "r3.png").string() + "\n";
+    log = runScript("--relief " + (dir / "tablet.exr").string() + " --uniform " + (dir / "tablet-u.exr").string(), script);
+    const Image r1 = readPicture(dir / "r1.png"), r2 = readPicture(dir / "r2.png"), r3 = readPicture(dir / "r3.png");
+    ASSERT_EQ(r3.width, kW) << log;
+    int changed = 0, tablet = 0;
+    const float background = r1.at(0, 0, 0);
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            changed += std::abs(r1.at(x, y, 0) - r2.at(x, y, 0)) > 3.0f / 255;
+            tablet += std::abs(r1.at(x, y, 0) - background) > 3.0f / 255;
+        }
+    EXPECT_GT(tablet, kW * kH / 10) << "the tablet fills a good part of the frame";
+    EXPECT_GT(changed, 20) << "the conventional asset shows the engraving differently";
+    EXPECT_LT(changed, tablet / 2) << "the same tablet, the same camera";
+    EXPECT_GT(meanDifference(r2, r3), 4.0 / 255) << "the orbit turned it";
+}
+
+// A floor and two boxes around the origin, counter-clockwise from outside.
+std::string roomObj() {
+    std::string text;
+    int n = 0;
+    const auto quad = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
+        for (const glm::dvec3& p : {a, b, c, d}) text += "v " + std::to_string(p.x) + " " + std::to_string(p.y) + " " + std::to_string(p.z) + "\n";
+        text += "f " + std::to_string(n + 1) + " " + std::to_string(n + 2) + " " + std::to_string(n + 3) + "\n";
+        text += "f " + std::to_string(n + 1) + " " + std::to_string(n + 3) + " " + std::to_string(n + 4) + "\n";
+        n += 4;
+    };
+    quad({-4, -1, -4}, {-4, -1, 4}, {4, -1, 4}, {4, -1, -4});
+    const auto box = [&](glm::dvec3 lo, glm::dvec3 hi) {
+        quad({lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z});
+        quad({hi.x, lo.y, lo.z}, {lo.x, lo.y, lo.z}, {lo.x, hi.y, lo.z}, {hi.x, hi.y, lo.z});
+        quad({hi.x, lo.y, hi.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {hi.x, hi.y, hi.z});
+        quad({lo.x, lo.y, lo.z}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, lo.z});
+        quad({lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z});
+    };
+    box({1.5, -1, -0.5}, {2.5, 0.5, 0.5});
+    box({-2.5, -1, -2}, {-1.8, 1, -1.3});
+    const fs::path path = test::tempDir() / "room.obj";
+    test::writeText(path, text);
+    return path.string();
+}
+
+// A reflection asset (CPU frames) whose faces magnify the first box: U swaps them for the
+// conventional ones, which changes the mirror and nothing else.
+TEST(SceneWindow, ReflectionAssetToggleChangesTheMirrorOnly) {
+    ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";
+    const fs::path dir = test::tempDir();
+    const std::string room = roomObj(), conus = std::string(CONUS_BIN_DIR) + "/conus";
+    std::string log;
+    for (const char* flag : {"", " --uniform"})
+        ASSERT_EQ(test::run(conus + " bake reflection " + room + " --center 0,0,0 --size 32 -q --roi-min 1.5,-1,-0.5 " +
+                                "--roi-max 2.5,0.5,0.5 --magnification 4 -o " +
+                                (dir / (std::string("mirror") + (*flag ? "-u" : ""))).string() + flag,
+                            &log),
+                  0)
+            << log;
+    const std::string script = "screenshot " + (dir / "f1.png").string() + "\nkey U\nscreenshot " + (dir / "f2.png").string() + "\n";
+    log = runScript("--reflection " + (dir / "mirror").string() + " --uniform " + (dir / "mirror-u").string() + " --scene " + room, script);
+    const Image f1 = readPicture(dir / "f1.png"), f2 = readPicture(dir / "f2.png");
+    ASSERT_EQ(f2.width, kW) << log;
+    // The mirror sphere (radius 0.5 at the origin) is the frame's centre, a third of its height.
+    int changedInside = 0, changedOutside = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            const bool changed = std::abs(f1.at(x, y, 0) - f2.at(x, y, 0)) + std::abs(f1.at(x, y, 1) - f2.at(x, y, 1)) > 3.0f / 255;
+            const bool mirror = std::hypot(x + 0.5 - kW / 2.0, y + 0.5 - kH / 2.0) < kH / 6.0 + 2;
+            (mirror ? changedInside : changedOutside) += changed;
+        }
+    EXPECT_GT(changedInside, 20) << "the reflection differs between the CoNUS and conventional faces";
+    EXPECT_EQ(changedOutside, 0) << "the scene behind is the same";
 }
 
 }  // namespace
