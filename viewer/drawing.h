@@ -32,6 +32,8 @@ private:
     void drawOverlays(const Controller& controller, int fw, int fh);
     // Renders a new scene frame into the controller when what it shows has changed.
     void renderScene(Controller& controller);
+    // Whether the scene's frame can go to the window directly (see drawing.cpp).
+    static bool showsSceneDirectly(const Controller& controller, int fw, int fh);
     // Uploads `make()`'s panel into `slot` when `key` (what the panel shows) has changed.
     template <class Make>
     bool prepareOverlay(int slot, const std::string& key, Make make);
@@ -48,6 +50,7 @@ private:
     int m_sceneVersion = -1, m_looksSeen = 0;
     glm::ivec2 m_sceneSize{0};
     bool m_sceneFailed = false;
+    int m_directVersion = -1;  // the frame in kSceneSlot (the controller's imageVersion)
     int m_sceneRenders = 0;
     double m_sceneSeconds = 0;  // the font could not be drawn: overlays off, said once on stderr
 };

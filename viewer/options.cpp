@@ -15,7 +15,9 @@ namespace {
 constexpr const char* kDescription =
     "conus-view: a small viewer for CoNUS files (coherent non-uniform sampling images).\n"
     "The frame is reconstructed from the CoNUS data at every zoom level (GPU shader, or the CPU decoder on software GL).\n"
-    "Press H in the window for the keys. --edit IMAGE opens the mass-spring map editor.";
+    "Press H in the window for the keys. --edit IMAGE opens the mass-spring map editor.\n"
+    "3-D modes (--mesh, --volume, --relief, --reflection) render the CoNUS frame live and show it as the paper's\n"
+    "focus-plus-context display: orbit with the arrows or a drag, drag a focus, U toggles CoNUS / conventional.";
 
 std::pair<int, int> parseSize(const std::string& text, const char* what) {
     int w = 0, h = 0;

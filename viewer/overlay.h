@@ -11,6 +11,7 @@
 namespace conus::viewer {
 
 inline constexpr int kHelpSlot = 0, kErrorSlot = 1, kStatusSlot = 2;  // ViewRenderer overlay slots
+inline constexpr int kSceneSlot = 3;  // a 3-D mode's frame, drawn 1:1 under the panels (drawing.cpp)
 inline constexpr int kOverlayMargin = 16;  // window pixels between the panels and the window's edge
 
 // The key list of helpText(table) on a semi-transparent dark panel, white text.

@@ -80,7 +80,8 @@ TEST(SceneWindow, MeshFramesAreTheEncodersAndFollowTheCommands) {
                                "drag " + std::to_string(from.x) + " " + std::to_string(from.y) + " " + std::to_string(to.x) +
                                " " + std::to_string(to.y) + "\nscreenshot " + (dir / "m2.png").string() + "\n" +  //
                                "key U\nscreenshot " + (dir / "m3.png").string() + "\n" +                           //
-                               "orbit 40 10\nscreenshot " + (dir / "m4.png").string() + "\n";
+                               "orbit 40 10\nscreenshot " + (dir / "m4.png").string() + "\n" +                   //
+                               "key Z\nscreenshot " + (dir / "m5.png").string() + "\n";
     const std::string log = runScript("--mesh " + model + " --focus 0.45,0.4,0.12,3", script);
     const Image m1 = readPicture(dir / "m1.png"), m2 = readPicture(dir / "m2.png"), m3 = readPicture(dir / "m3.png"),
                 m4 = readPicture(dir / "m4.png");
@@ -106,6 +107,15 @@ TEST(SceneWindow, MeshFramesAreTheEncodersAndFollowTheCommands) {
     EXPECT_GT(meanDifference(m1, m2), 2.0 / 255) << "dragging the focus changes the picture";
     EXPECT_GT(compare(m1, conventional).mean, 2.0 / 255) << "CoNUS and conventional differ";
     EXPECT_GT(meanDifference(m3, m4), 4.0 / 255);
+    // Z: the live frame's depth picture (through the file viewer's path): the background is blue,
+    // the model on the ramp, brighter than the frame's darkest surface.
+    const Image m5 = readPicture(dir / "m5.png");
+    ASSERT_EQ(m5.width, kW);
+    EXPECT_GT(m5.at(1, 1, 2), m5.at(1, 1, 0) + 0.1) << "background";
+    double brightest = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) brightest = std::max(brightest, double(m5.at(x, y, 0) + m5.at(x, y, 1)));
+    EXPECT_GT(brightest, 1.6) << "the nearest surface is the ramp's bright end";
 }
 
 // T cycles the transfer function, U drops the map; each frame is the GPU ray caster's for the scene
