@@ -191,6 +191,30 @@ TEST(SceneWindow, ReliefAssetToggleAndOrbit) {
     EXPECT_GT(meanDifference(r2, r3), 4.0 / 255) << "the orbit turned it";
 }
 
+// Bad scenes and arguments: a clear message and a non-zero status, before or after the window opens.
+TEST(SceneWindow, BadScenesFailClearly) {
+    const struct {
+        std::string args, says;
+        int status;
+        bool window;
+    } cases[] = {
+        {"--mesh a.obj --volume b", "give one of --mesh", 2, false},
+        {"--reflection folder", "needs --scene", 2, false},
+        {"--mesh a.obj --focus 2,0,0.1,2", "outside [0,1]^2", 2, false},
+        {"--mesh a.obj --uniform b.obj", "--uniform in a 3-D mode", 2, false},
+        {"--mesh /nonexistent/model.obj", "no such file", 1, true},
+        {"--volume procedural:nothing", "procedural:shepp-logan", 1, true},
+        {"--relief " + test::conusPath(), "is not a relief asset", 1, true},
+    };
+    for (const auto& c : cases) {
+        std::string log;
+        const std::string command = (c.window ? "xvfb-run -a -s '-screen 0 640x480x24' " : "env -u DISPLAY ") +
+                                    test::viewerBinary() + " " + c.args;
+        EXPECT_EQ(test::run(command, &log), c.status) << c.args << "\n" << log;
+        EXPECT_NE(log.find(c.says), std::string::npos) << c.args << "\n" << log;
+    }
+}
+
 // A floor and two boxes around the origin, counter-clockwise from outside.
 std::string roomObj() {
     std::string text;
