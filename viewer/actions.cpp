@@ -33,7 +33,7 @@ const std::vector<Binding> kViewBindings = {
     {"U", false, false, Action::ModeUniform, "U          uniform image of the same pixel count (--uniform: the real one)"},
     {"W", false, false, Action::ModeWipe, "W          wipe: CoNUS left, uniform right (Shift-drag moves the split)"},
     {"D", false, false, Action::ModeDensity, "D          sampling density heat map (det J)"},
-    {"Z", false, false, Action::ToggleDepth, "Z          depth images: Z as a picture (near bright, far dark, background blue); again: colour"},
+    {"Z", false, false, Action::ToggleDepth, "Z          a depth image's Z as a picture (near bright); again: colour"},
     {"G", false, false, Action::ToggleGrid, "G          CoNUS pixel grid overlay"},
     {"O", false, false, Action::ToggleOutlines, "O          focus outlines (r and 2r)"},
     {"E", true, false, Action::ExposureDown, "E / Shift-E exposure +/- 0.5 stop; 0 resets"},
