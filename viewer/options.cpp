@@ -76,6 +76,11 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
                    "3-D mode: orbit a reflection asset folder (`conus bake reflection`) with --scene; --uniform: its conventional twin");
     app.add_option("--scene", o.reflectionScene, "--reflection: the mesh the asset was baked from");
     app.add_option("--radius", o.reflectorRadius, "--reflection: the mirror sphere's radius")->capture_default_str()->check(CLI::PositiveNumber);
+    app.add_option("--max-edge", o.maxEdge,
+                   "--mesh: split triangles each CoNUS frame until no projected edge spans more than this many map cells "
+                   "(straight edges follow Eq. 1's curves; costs a CPU subdivision and an upload a frame; 0: never)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1e6));
     app.add_option("--tf", o.transferFunction, "--volume: transfer function preset or file (T cycles the presets)");
     app.add_option("--focus", foci, "3-D modes: a focus u,v,r,k (repeat for more; N adds one at the cursor)");
     app.add_option("--view", view, "undistorted rectangle u0,v0,u1,v1 to show");

@@ -37,6 +37,7 @@ struct Options {
     std::string reflectionScene;         // --scene: the mesh a reflection asset was baked from
     double reflectorRadius = 0.5;        // --radius: the mirror sphere of --reflection
     std::string transferFunction;        // --tf: a volume's transfer function preset or file
+    double maxEdge = 0;                  // --max-edge: --mesh subdivides each CoNUS frame's mesh (0: never)
     std::vector<codec::Focus> foci;      // --focus u,v,r,k (repeated): the 3-D modes' first foci
     bool depthPicture = false;           // --mode z: a depth image's Z as a picture (key Z)
 };

@@ -8,6 +8,7 @@
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/depth/reflection.h"
 #include "conus/codec/mesh/raycast.h"
+#include "conus/codec/mesh/subdivide.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/codec/volume/raycast.h"
 #include "conus/codec/volume/transfer_function.h"
@@ -41,20 +42,25 @@ Image colourOf(const Image& frame) {
 
 class MeshView final : public Scene {
 public:
-    MeshView(gl::Context& context, const std::string& path)
-        : m_name(fileName(path) + " (mesh)"), m_mesh(sceneio::readMesh(path)), m_bounds(sphereAround(m_mesh.positions)),
-          m_renderer(context, m_mesh) {}
+    MeshView(gl::Context& context, const std::string& path, double maxEdge)
+        : m_context(context), m_name(fileName(path) + " (mesh)"), m_mesh(sceneio::readMesh(path)),
+          m_bounds(sphereAround(m_mesh.positions)), m_maxEdge(maxEdge), m_renderer(context, m_mesh) {}
     std::string name() const override { return m_name; }
     glm::dvec3 centre() const override { return m_bounds.centre; }
     double radius() const override { return m_bounds.radius; }
-    Image render(const Camera& camera, const codec::SamplingMap& map, bool, int width, int height) override {
+    Image render(const Camera& camera, const codec::SamplingMap& map, bool conus, int width, int height) override {
+        // --max-edge: this frame's subdivision (the camera and the map decide it), uploaded for this frame.
+        if (m_maxEdge > 0 && conus)
+            return gl::renderMeshGpu(m_context, codec::subdivideForMap(m_mesh, camera, map, m_maxEdge), camera, map, width, height);
         return m_renderer.render(camera, map, width, height);
     }
 
 private:
+    gl::Context& m_context;
     std::string m_name;
     Mesh m_mesh;
     BoundingSphere m_bounds;
+    double m_maxEdge;
     gl::MeshRenderer m_renderer;
 };
 
@@ -204,7 +210,7 @@ private:
 
 std::unique_ptr<Scene> openScene(const Options& options, gl::Context& context) {
     switch (options.sceneKind) {
-    case SceneKind::Mesh: return std::make_unique<MeshView>(context, options.scenePath);
+    case SceneKind::Mesh: return std::make_unique<MeshView>(context, options.scenePath, options.maxEdge);
     case SceneKind::Volume: return std::make_unique<VolumeView>(context, options);
     case SceneKind::Relief: return std::make_unique<ReliefView>(context, options);
     case SceneKind::Reflection: return std::make_unique<ReflectionView>(options);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "conus/core/display.h"
+#include "conus/codec/mesh/subdivide.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/renderers/mesh_render.h"
 #include "conus/renderers/volume_renderer.h"
@@ -116,6 +117,26 @@ TEST(SceneWindow, MeshFramesAreTheEncodersAndFollowTheCommands) {
     for (int y = 0; y < kH; ++y)
         for (int x = 0; x < kW; ++x) brightest = std::max(brightest, double(m5.at(x, y, 0) + m5.at(x, y, 1)));
     EXPECT_GT(brightest, 1.6) << "the nearest surface is the ramp's bright end";
+}
+
+// --max-edge: each CoNUS frame is the encoder's of the mesh subdivided for that frame's camera and map.
+TEST(SceneWindow, MeshMaxEdgeSubdividesEachFrame) {
+    ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";
+    const std::string model = std::string(CONUS_SHARED_DATA) + "/meshes/suzanne.obj";
+    const codec::Focus focus{0.5, 0.45, 0.15, 4.0};
+    const fs::path shot = test::tempDir() / "edge.png";
+    const std::string log = runScript("--mesh " + model + " --focus 0.5,0.45,0.15,4 --max-edge 0.5", "screenshot " + shot.string() + "\n");
+    const Image window = readPicture(shot);
+    ASSERT_EQ(window.width, kW) << log;
+    const Mesh mesh = sceneio::readMesh(model);
+    const BoundingSphere sphere = boundingSphere(std::vector<glm::dvec3>(mesh.positions.begin(), mesh.positions.end()));
+    const SceneState state(sphere.centre, sphere.radius, {focus});
+    const double aspect = double(kW) / kH;
+    const Camera camera = state.camera(aspect);
+    const codec::SamplingMap map = state.map(aspect);
+    const Mesh fine = codec::subdivideForMap(mesh, camera, map, 0.5);
+    ASSERT_GT(fine.triangleCount(), mesh.triangleCount()) << "the focus makes some edges long";
+    EXPECT_LT(compare(window, gl::renderMeshGpu(test::context(), fine, camera, map, kW, kH)).mean, 1.0 / 255);
 }
 
 // T cycles the transfer function, U drops the map; each frame is the GPU ray caster's for the scene
