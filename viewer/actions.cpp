@@ -33,6 +33,7 @@ const std::vector<Binding> kViewBindings = {
     {"U", false, false, Action::ModeUniform, "U          uniform image of the same pixel count (--uniform: the real one)"},
     {"W", false, false, Action::ModeWipe, "W          wipe: CoNUS left, uniform right (Shift-drag moves the split)"},
     {"D", false, false, Action::ModeDensity, "D          sampling density heat map (det J)"},
+    {"Z", false, false, Action::ToggleDepth, "Z          a depth image's Z as a picture (near bright); again: colour"},
     {"G", false, false, Action::ToggleGrid, "G          CoNUS pixel grid overlay"},
     {"O", false, false, Action::ToggleOutlines, "O          focus outlines (r and 2r)"},
     {"E", true, false, Action::ExposureDown, "E / Shift-E exposure +/- 0.5 stop; 0 resets"},
@@ -61,6 +62,33 @@ const std::vector<Binding> kEditBindings = {
     {"]", false, false, Action::StrengthUp, ""},
     {"X", false, false, Action::ResetMap, "X          start again from the identity map"},
 };
+
+// The 3-D modes: searched before the viewer's table, whose display keys (R, C, Z, G, O, D, exposure,
+// B, I, H, Q) still apply to the rendered frame; the file and navigation keys are not listed.
+const std::vector<Binding> kSceneBindings = {
+    {"Left", false, false, Action::OrbitLeft, "arrows     orbit the camera (left drag away from a focus too)"},
+    {"Right", false, false, Action::OrbitRight, ""},
+    {"Up", false, false, Action::OrbitUp, ""},
+    {"Down", false, false, Action::OrbitDown, ""},
+    {"+", false, false, Action::DollyIn, "+ / -      camera nearer / farther (wheel too)"},
+    {"=", false, false, Action::DollyIn, ""},
+    {"-", false, false, Action::DollyOut, ""},
+    {"F", false, false, Action::HomeCamera, "F          the first camera again"},
+    {"U", false, false, Action::ToggleConus, "U          CoNUS / conventional (identity map, or the --uniform asset)"},
+    {"N", false, false, Action::AddFocus, "N          a new focus at the cursor (left drag on a focus moves it)"},
+    {"X", false, false, Action::RemoveFocus, "X          remove the focus nearest the cursor"},
+    {"[", false, false, Action::FocusSmaller, "[ / ]      foci smaller / larger"},
+    {"]", false, false, Action::FocusLarger, ""},
+    {"T", false, false, Action::NextLook, "T          volume: the next transfer function preset"},
+};
+
+// The viewer keys a 3-D mode keeps (listed after its own): the display of the rendered frame.
+const Action kSceneKeeps[] = {Action::Help, Action::ModeReconstructed, Action::ModeRaw, Action::ModeDensity,
+                              Action::ToggleDepth, Action::ToggleGrid, Action::ToggleOutlines, Action::ExposureUp,
+                              Action::ExposureDown, Action::ResetExposure, Action::ToggleGamma, Action::Inspect,
+                              Action::ToggleStatusBar, Action::Quit};
+
+bool sceneKeeps(Action action) { return std::find(std::begin(kSceneKeeps), std::end(kSceneKeeps), action) != std::end(kSceneKeeps); }
 
 const Binding* find(const std::vector<Binding>& table, const KeyChord& chord) {
     for (const auto& b : table)
@@ -101,23 +129,31 @@ std::optional<KeyChord> parseChord(const std::string& text) {
     return chord;
 }
 
-Action actionFor(const KeyChord& chord, bool editing) {
-    if (editing)
+Action actionFor(const KeyChord& chord, KeyTable table) {
+    if (table == KeyTable::Edit)
         if (const Binding* b = find(kEditBindings, chord)) return b->action;
+    if (table == KeyTable::Scene) {
+        if (const Binding* b = find(kSceneBindings, chord)) return b->action;
+        const Binding* b = find(kViewBindings, chord);
+        if (!b) b = find(kExposureUp, chord);
+        return b && sceneKeeps(b->action) ? b->action : Action::None;
+    }
     if (const Binding* b = find(kViewBindings, chord)) return b->action;
     if (const Binding* b = find(kExposureUp, chord)) return b->action;
     return Action::None;
 }
 
-std::string helpText(bool editing) {
-    std::string text = editing ? "conus-view --edit: paint with the left button (mass-spring brush, paper Fig. 8)\n"
-                               : "conus-view keys:\n";
-    const auto add = [&](const std::vector<Binding>& table) {
-        for (const auto& b : table)
-            if (*b.help) text += std::string("  ") + b.help + "\n";
+std::string helpText(KeyTable table) {
+    std::string text = table == KeyTable::Edit ? "conus-view --edit: paint with the left button (mass-spring brush, paper Fig. 8)\n"
+                       : table == KeyTable::Scene ? "conus-view 3-D mode: the CoNUS frame rendered live (raw: the paper's focus-plus-context display)\n"
+                                                  : "conus-view keys:\n";
+    const auto add = [&](const std::vector<Binding>& bindings, bool keptOnly) {
+        for (const auto& b : bindings)
+            if (*b.help && (!keptOnly || sceneKeeps(b.action))) text += std::string("  ") + b.help + "\n";
     };
-    if (editing) add(kEditBindings);
-    add(kViewBindings);
+    if (table == KeyTable::Edit) add(kEditBindings, false);
+    if (table == KeyTable::Scene) add(kSceneBindings, false);
+    add(kViewBindings, table == KeyTable::Scene);
     return text;
 }
 

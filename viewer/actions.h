@@ -25,6 +25,7 @@ enum class Action {
     ModeUniform,        // U
     ModeWipe,           // W
     ModeDensity,        // D
+    ToggleDepth,        // Z: a depth image's Z channel as a picture (the inferno ramp, near bright)
     ToggleGrid,         // G
     ToggleOutlines,     // O
     ExposureUp, ExposureDown, ResetExposure,  // E, Shift-E, 0
@@ -40,7 +41,19 @@ enum class Action {
     EncodeImage,        // Ctrl-S, E
     StrengthDown, StrengthUp,  // [ ]
     ResetMap,           // Backspace... here: X
+    // 3-D modes (--mesh, --volume, --relief, --reflection)
+    OrbitLeft, OrbitRight, OrbitUp, OrbitDown,  // arrows
+    DollyIn, DollyOut,  // + / -
+    HomeCamera,         // F
+    ToggleConus,        // U: CoNUS (the foci's map, or the CoNUS asset) / conventional
+    AddFocus,           // N: a focus at the cursor
+    RemoveFocus,        // X: the focus nearest the cursor
+    FocusSmaller, FocusLarger,  // [ ]
+    NextLook,           // T: a volume's next transfer function
 };
+
+// Which key table is in use: the file viewer's, the map editor's (--edit), a 3-D mode's.
+enum class KeyTable { View, Edit, Scene };
 
 struct KeyChord {
     std::string key;  // a key name (above)
@@ -50,14 +63,16 @@ struct KeyChord {
 // "G", "shift+E", "ctrl+R", "Ctrl+Shift+Tab" -> chord; nullopt for an unknown key name.
 std::optional<KeyChord> parseChord(const std::string& text);
 
-// The action of a chord; `editing` selects the map editor's table (E encodes there).
-Action actionFor(const KeyChord& chord, bool editing);
+// The action of a chord in `table` (the editor's and the 3-D modes' keys come first, then the
+// viewer's they keep).
+Action actionFor(const KeyChord& chord, KeyTable table);
 
 // One line per key of the table in use.
-std::string helpText(bool editing);
+std::string helpText(KeyTable table);
 
 // The display modes by name: "reconstructed|raw|uniform|wipe|density" -> ViewMode;
-// conus::Error(InvalidArgument) otherwise.
+// conus::Error(InvalidArgument) otherwise. ("z", the depth picture, is options.cpp's: the depth
+// picture is an image the viewer makes, shown in any of these modes.)
 gl::ViewMode parseMode(const std::string& name);
 const char* modeName(gl::ViewMode mode);
 

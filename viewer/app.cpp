@@ -12,6 +12,7 @@
 #include "controller.h"
 #include "conus/imageio/image_file.h"
 #include "drawing.h"
+#include "scene.h"
 #include "script.h"
 #include "window.h"
 
@@ -30,15 +31,22 @@ public:
             const bool flatOut = !m_options.script.empty() || m_options.benchmarkFrames > 0;
             m_window = std::make_unique<Window>(m_options.windowWidth, m_options.windowHeight, !flatOut, m_controller);
             m_drawing = std::make_unique<Drawing>(m_window->context());
-            if (!m_options.uniform.empty()) m_drawing->setUniform(m_options.files.front(), uniformBaseline(m_options.uniform));
+            if (m_options.sceneKind != SceneKind::None) {
+                m_scene = openScene(m_options, m_window->context());
+                m_drawing->setScene(m_scene.get());
+            } else if (!m_options.uniform.empty()) {
+                m_drawing->setUniform(m_options.files.front(), uniformBaseline(m_options.uniform));
+            }
         } catch (const std::exception& e) {
             std::fprintf(stderr, "conus-view: %s\n", e.what());
             return 1;
         }
         const auto [fw, fh] = m_window->framebufferSize();
         m_controller.setWindowSize(fw, fh);
+        if (m_scene) m_controller.startScene(m_scene->centre(), m_scene->radius(), m_scene->name(), m_scene->throughMap(), m_scene->look(),
+                                           m_scene->home());
         if (!m_controller.load()) return 1;
-        if (m_options.benchmarkFrames > 0) return benchmark();
+        if (m_options.benchmarkFrames > 0) return m_scene ? benchmarkScene() : benchmark();
         const bool scripted = !m_script.empty() || !m_options.script.empty();
         while (!m_window->shouldClose() && !m_controller.quitRequested()) {
             const MapEditor* editor = m_controller.editor();
@@ -128,11 +136,48 @@ private:
         return m_controller.exitCode();
     }
 
+    // The 3-D modes: every frame a new camera (one degree of orbit, back and forth), so every frame
+    // renders the scene, uploads the CoNUS frame and draws it.
+    int benchmarkScene() {
+        for (const ScriptCommand& command : m_script) {
+            if (command.name == "quit") break;
+            m_controller.run(command);
+            frame();
+        }
+        for (int k = 0; k < kBenchmarkWarmup; ++k) {
+            m_controller.run({"orbit", {k % 2 ? -1.0 : 1.0, 0.0}, "", 0});
+            frame();
+        }
+        m_drawing->renderer().finish();
+        const int frames = m_options.benchmarkFrames, rendersBefore = m_drawing->sceneRenders();
+        const double renderBefore = m_drawing->sceneSeconds();
+        const auto start = std::chrono::steady_clock::now();
+        for (int k = 0; k < frames; ++k) {
+            m_controller.run({"orbit", {k % 2 ? -1.0 : 1.0, 0.0}, "", 0});
+            frame();
+            m_window->poll();
+        }
+        m_drawing->renderer().finish();
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const int renders = std::max(1, m_drawing->sceneRenders() - rendersBefore);
+        const glm::ivec2 size = m_controller.sceneFrameSize();
+        const SceneState& state = *m_controller.scene();
+        std::printf("benchmark: render (scene to CoNUS image, read back) %.1f ms/frame, the rest (upload, draw, swap) %.1f ms/frame\n",
+                    1000.0 * (m_drawing->sceneSeconds() - renderBefore) / renders,
+                    1000.0 * (seconds - (m_drawing->sceneSeconds() - renderBefore)) / std::max(1, frames));
+        std::printf("benchmark: %d frames of %s, %dx%d %s frame (%zu foci), window %dx%d: %.2f frames/s, %.1f ms/frame; %s\n",
+                    frames, m_scene->name().c_str(), size.x, size.y, state.conus() ? "CoNUS" : "conventional", state.foci().size(),
+                    m_controller.state().windowWidth(), m_controller.state().windowHeight(), frames / seconds,
+                    1000.0 * seconds / std::max(1, frames), m_window->context().renderer().c_str());
+        return m_controller.exitCode();
+    }
+
     const Options& m_options;
     std::vector<ScriptCommand> m_script;
     std::size_t m_next = 0;
     Controller m_controller;
     std::unique_ptr<Window> m_window;
+    std::unique_ptr<Scene> m_scene;      // GL objects of the window's context: destroyed before it
     std::unique_ptr<Drawing> m_drawing;  // destroyed before the window (it deletes GL objects)
     std::string m_title;
 };

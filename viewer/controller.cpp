@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "conus/imageio/image_file.h"
+#include "depth_view.h"
 #include "inspector.h"
 
 namespace conus::viewer {
@@ -23,9 +24,11 @@ ToneMap nextToneMap(ToneMap t) {
 }  // namespace
 
 Controller::Controller(const Options& options)
-    : m_options(options), m_display(options.display), m_showHelp(options.helpOverlay), m_showStatus(options.statusBar) {}
+    : m_options(options), m_display(options.display), m_showHelp(options.helpOverlay), m_showStatus(options.statusBar),
+      m_depthPicture(options.depthPicture) {}
 
 bool Controller::load() {
+    if (m_options.sceneKind != SceneKind::None) return true;  // the window opens the scene (startScene)
     if (!m_options.edit.empty()) {
         try {
             imageio::ImageFile source = imageio::readImageFile(m_options.edit);
@@ -57,6 +60,54 @@ bool Controller::load() {
 
 void Controller::setWindowSize(int width, int height) { m_state.setWindowSize(width, height); }
 
+void Controller::startScene(glm::dvec3 centre, double radius, std::string name, bool throughMap, std::string look,
+                            std::optional<Orbit> home) {
+    m_scene.emplace(centre, radius, m_options.foci, home);
+    m_sceneName = std::move(name);
+    m_sceneThroughMap = throughMap;
+    m_sceneLook = std::move(look);
+    m_display.mode = gl::ViewMode::Raw;  // the CoNUS image itself: the paper's focus-plus-context display
+    const glm::ivec2 size = sceneFrameSize();
+    m_state.setImageSize(size.x, size.y);
+    std::printf("conus-view: %s%s%s; H lists the keys\n", m_sceneName.c_str(), m_sceneLook.empty() ? "" : ", ",
+                m_sceneLook.c_str());
+    std::fflush(stdout);
+}
+
+void Controller::setLook(std::string look) {
+    m_sceneLook = std::move(look);
+    std::printf("conus-view: %s\n", m_sceneLook.c_str());
+    std::fflush(stdout);
+}
+
+glm::ivec2 Controller::sceneFrameSize() const {
+    if (m_options.width > 0 && m_options.height > 0) return {m_options.width, m_options.height};
+    return {std::max(1, m_state.windowWidth()), std::max(1, m_state.windowHeight())};
+}
+
+void Controller::setSceneFrame(format::ConusFile frame) {
+    m_sceneMap.emplace(codec::SamplingMap::fromGrid(frame.map));
+    if (!m_sceneFrame || m_sceneFrame->image.width != frame.image.width || m_sceneFrame->image.height != frame.image.height)
+        m_state.setImageSize(frame.image.width, frame.image.height);
+    m_sceneFrame = std::move(frame);
+    ++m_imageVersion;
+    m_probe = probeAt(m_cursor);
+}
+
+std::string Controller::probeAt(glm::dvec2 pixel) const {
+    const glm::dvec2 shown = m_state.windowToImage(pixel);
+    if (m_scene) {
+        if (!m_sceneFrame) return {};
+        // Raw shows the CoNUS image itself: the cursor is at a distorted position.
+        const glm::dvec2 uv = m_display.mode == gl::ViewMode::Raw
+                                  ? m_sceneMap->undistort(glm::clamp(shown, glm::dvec2(0.0), glm::dvec2(1.0)))
+                                  : shown;
+        return formatProbe(probe(*m_sceneFrame, *m_sceneMap, uv));
+    }
+    if (const Document* doc = current(); doc && doc->ok()) return formatProbe(probe(*doc->file, *doc->map, shown));
+    return {};
+}
+
 void Controller::tick() {
     if (m_editor && !m_editor->stable()) {
         m_editor->step();
@@ -73,8 +124,12 @@ std::optional<format::ConusFile> Controller::shownFile() const {
         shown.map = m_editor->map().toGrid();
         return shown;
     }
+    if (m_scene) {
+        if (!m_sceneFrame) return std::nullopt;
+        return m_depthPicture && hasDepth(*m_sceneFrame) ? viewer::depthPicture(*m_sceneFrame) : *m_sceneFrame;
+    }
     const Document* doc = current();
-    if (doc && doc->ok()) return *doc->file;
+    if (doc && doc->ok()) return m_depthPicture && hasDepth(*doc->file) ? viewer::depthPicture(*doc->file) : *doc->file;
     return std::nullopt;
 }
 
@@ -106,6 +161,14 @@ std::string Controller::summary(const char* separator) const {
                       m_editor->stable() ? " | stable" : " | relaxing");
         return line + (m_editorMessage.empty() ? std::string() : " | " + m_editorMessage);
     }
+    if (m_scene) {
+        std::string text = m_sceneName + sep + (m_scene->conus() ? "CoNUS" : "conventional");
+        if (m_sceneThroughMap && m_scene->conus())
+            text += " (" + std::to_string(m_scene->foci().size()) + (m_scene->foci().size() == 1 ? " focus)" : " foci)");
+        if (!m_sceneLook.empty()) text += sep + m_sceneLook;
+        if (m_depthPicture) text += sep + "z";
+        return text + sep + modeName(m_display.mode);
+    }
     const Document* doc = current();
     if (!doc) return {};
     std::string text = fileName(doc->path);
@@ -113,6 +176,8 @@ std::string Controller::summary(const char* separator) const {
     if (!doc->ok()) return text + sep + "ERROR: " + doc->error;
     char zoom[32];
     std::snprintf(zoom, sizeof zoom, "zoom %.3g", m_state.zoom());
+    if (m_depthPicture && !hasDepth(*doc->file)) text += sep + "no Z channel";
+    else if (m_depthPicture) text += sep + "z";
     text += sep + modeName(m_display.mode) + sep + zoom;
     if (m_display.exposure != 0) text += sep + "ev " + std::to_string(m_display.exposure).substr(0, 4);
     if (m_display.toneMap != ToneMap::None) text += sep + toString(m_display.toneMap);
@@ -126,13 +191,13 @@ std::string Controller::title() const {
     if (m_editor) return title + " " + text;
     if (text.empty()) return title;
     title += " - " + text;
-    if (!m_probe.empty() && current() && current()->ok()) title += " - " + m_probe;
+    if (!m_probe.empty() && ((current() && current()->ok()) || m_sceneFrame)) title += " - " + m_probe;
     return title;
 }
 
 std::string Controller::statusText() const {
     std::string text = summary(" | ");
-    if (m_editor || !current() || !current()->ok()) return text;
+    if (m_editor || ((!current() || !current()->ok()) && !m_sceneFrame)) return text;
     if (m_display.grid) text += " | grid";
     if (m_display.outlines) text += " | outlines";
     if (!m_probe.empty()) text += " | " + m_probe;
@@ -150,20 +215,28 @@ void Controller::cursor(glm::dvec2 pixel) {
     m_cursor = pixel;
     if (m_panning) m_state.pan(delta);
     if (m_wiping) m_display.wipeX = std::clamp(pixel.x / m_state.windowWidth(), 0.0, 1.0);
-    if (m_editor) {
-        m_editor->moveTo(m_state.windowToImage(pixel));
-    } else if (const Document* doc = current(); doc && doc->ok()) {
-        m_probe = formatProbe(probe(*doc->file, *doc->map, m_state.windowToImage(pixel)));
-    }
+    if (m_scene && m_draggedFocus >= 0) m_scene->moveFocus(m_draggedFocus, m_state.windowToImage(pixel));
+    if (m_scene && m_orbiting) m_scene->rotate(-kOrbitDegreesPerPixel * delta.x, kOrbitDegreesPerPixel * delta.y);
+    if (m_editor) m_editor->moveTo(m_state.windowToImage(pixel));
+    else m_probe = probeAt(pixel);
 }
 
 void Controller::button(MouseButton button, bool press, Modifiers modifiers) {
     if (!press) {
-        m_panning = m_wiping = false;
+        m_panning = m_wiping = m_orbiting = false;
+        m_draggedFocus = -1;
         if (m_editor) m_editor->release();
         return;
     }
-    if (button == MouseButton::Left && m_editor && !modifiers.ctrl) {
+    if (m_scene) {
+        // A press on a focus grabs it (a live map only); anywhere else the drag orbits.
+        const glm::ivec2 size = sceneFrameSize();
+        const int focus = m_sceneThroughMap && button == MouseButton::Left
+                              ? m_scene->focusNear(m_state.windowToImage(m_cursor), double(size.x) / size.y)
+                              : -1;
+        if (focus >= 0) m_draggedFocus = focus;
+        else m_orbiting = true;
+    } else if (button == MouseButton::Left && m_editor && !modifiers.ctrl) {
         m_editor->press(m_state.windowToImage(m_cursor));  // undistorted: the source is shown undistorted
     } else if (button == MouseButton::Left && modifiers.shift && m_display.mode == gl::ViewMode::Wipe) {
         m_wiping = true;
@@ -174,7 +247,8 @@ void Controller::button(MouseButton button, bool press, Modifiers modifiers) {
 }
 
 void Controller::scroll(double notches, bool shift) {
-    if (m_editor && shift) m_editor->scaleRadius(std::pow(kWheelStep, notches));
+    if (m_scene) m_scene->dolly(std::pow(kWheelStep, -notches));
+    else if (m_editor && shift) m_editor->scaleRadius(std::pow(kWheelStep, notches));
     else m_state.scroll(notches, m_cursor);
 }
 
@@ -196,7 +270,32 @@ void Controller::saveFromEditor(bool mapOnly) {
     std::fflush(stdout);
 }
 
+bool Controller::sceneAction(Action action) {
+    const glm::ivec2 size = sceneFrameSize();
+    const double aspect = double(size.x) / size.y;
+    const glm::dvec2 at = m_state.windowToImage(m_cursor);
+    switch (action) {
+    case Action::OrbitLeft: m_scene->rotate(-kOrbitStepDegrees, 0); return true;
+    case Action::OrbitRight: m_scene->rotate(kOrbitStepDegrees, 0); return true;
+    case Action::OrbitUp: m_scene->rotate(0, kOrbitStepDegrees); return true;
+    case Action::OrbitDown: m_scene->rotate(0, -kOrbitStepDegrees); return true;
+    case Action::DollyIn: m_scene->dolly(1.0 / kDollyStep); return true;
+    case Action::DollyOut: m_scene->dolly(kDollyStep); return true;
+    case Action::HomeCamera: m_scene->home(); return true;
+    case Action::ToggleConus: m_scene->toggleConus(); return true;
+    case Action::AddFocus:
+        if (m_sceneThroughMap && !m_scene->addFocus(at)) std::printf("conus-view: at most %d foci\n", kMaxSceneFoci);
+        return true;
+    case Action::RemoveFocus: if (m_sceneThroughMap) m_scene->removeFocusNear(at, aspect); return true;
+    case Action::FocusSmaller: m_scene->scaleFocusRadius(1.0 / kStrengthStep); return true;
+    case Action::FocusLarger: m_scene->scaleFocusRadius(kStrengthStep); return true;
+    case Action::NextLook: ++m_lookRequests; return true;
+    default: return false;
+    }
+}
+
 void Controller::doAction(Action action) {
+    if (m_scene && sceneAction(action)) return;
     const glm::dvec2 centre = 0.5 * glm::dvec2(m_state.windowWidth(), m_state.windowHeight());
     const glm::dvec2 panStep = kKeyPanFraction * glm::dvec2(m_state.windowWidth(), m_state.windowHeight());
     switch (action) {
@@ -204,7 +303,7 @@ void Controller::doAction(Action action) {
     case Action::Help:
         m_showHelp = !m_showHelp;
         if (m_showHelp) {
-            std::fputs(helpText(editing()).c_str(), stdout);
+            std::fputs(helpText(keyTable()).c_str(), stdout);
             std::fflush(stdout);
         }
         break;
@@ -224,6 +323,10 @@ void Controller::doAction(Action action) {
     case Action::ModeWipe: m_display.mode = gl::ViewMode::Wipe; break;
     case Action::ModeDensity:
         m_display.mode = m_display.mode == gl::ViewMode::Density && editing() ? gl::ViewMode::Raw : gl::ViewMode::Density;
+        break;
+    case Action::ToggleDepth:
+        m_depthPicture = !m_depthPicture;
+        ++m_imageVersion;
         break;
     case Action::ToggleGrid: m_display.grid = !m_display.grid; break;
     case Action::ToggleOutlines: m_display.outlines = !m_display.outlines; break;
@@ -249,8 +352,7 @@ void Controller::doAction(Action action) {
         }
         break;
     case Action::Inspect:
-        if (const Document* doc = current(); doc && doc->ok())
-            std::printf("%s\n", formatProbe(probe(*doc->file, *doc->map, m_state.windowToImage(m_cursor))).c_str());
+        if (const std::string line = probeAt(m_cursor); !line.empty()) std::printf("%s\n", line.c_str());
         std::fflush(stdout);
         break;
     case Action::Quit: m_quit = true; break;
@@ -265,6 +367,12 @@ void Controller::doAction(Action action) {
     case Action::SaveMap:
     case Action::EncodeImage:
         if (m_editor) saveFromEditor(action == Action::SaveMap);
+        break;
+    // The 3-D modes' own (sceneAction); nothing outside them.
+    case Action::OrbitLeft: case Action::OrbitRight: case Action::OrbitUp: case Action::OrbitDown:
+    case Action::DollyIn: case Action::DollyOut: case Action::HomeCamera: case Action::ToggleConus:
+    case Action::AddFocus: case Action::RemoveFocus: case Action::FocusSmaller: case Action::FocusLarger:
+    case Action::NextLook:
         break;
     }
 }
@@ -290,14 +398,17 @@ void Controller::run(const ScriptCommand& c) {
     } else if (c.name == "key") {
         key(*parseChord(c.text));
     } else if (c.name == "inspect") {
-        if (const Document* doc = current(); doc && doc->ok())
-            std::printf("%s\n", formatProbe(probe(*doc->file, *doc->map, m_state.windowToImage({n[0], n[1]}))).c_str());
+        if (const std::string line = probeAt({n[0], n[1]}); !line.empty()) std::printf("%s\n", line.c_str());
         else if (const Document* bad = current()) std::printf("error: %s\n", bad->error.c_str());
         std::fflush(stdout);
     } else if (c.name == "wait") {
         m_waitFrames = static_cast<int>(n[0]);
     } else if (c.name == "screenshot") {
         m_screenshot = c.text;
+    } else if (c.name == "orbit") {
+        if (m_scene) m_scene->rotate(n[0], n[1]);
+    } else if (c.name == "dolly") {
+        if (m_scene) m_scene->dolly(n[0]);
     } else if (c.name == "quit") {
         m_quit = true;
     }

@@ -16,6 +16,7 @@
 #include "editor.h"
 #include "options.h"
 #include "script.h"
+#include "scene_state.h"
 #include "view_state.h"
 #include "input.h"
 
@@ -35,7 +36,7 @@ public:
     void cursor(glm::dvec2 pixel) override;
     void button(MouseButton button, bool press, Modifiers modifiers) override;
     void scroll(double notches, bool shift) override;
-    void key(const KeyChord& chord) override { doAction(actionFor(chord, editing())); }
+    void key(const KeyChord& chord) override { doAction(actionFor(chord, keyTable())); }
     void doAction(Action action);
     void run(const ScriptCommand& command);
 
@@ -43,6 +44,25 @@ public:
     const ViewState& state() const { return m_state; }
     const gl::ViewOptions& display() const { return m_display; }
     bool editing() const { return m_editor.has_value(); }
+    KeyTable keyTable() const { return m_scene ? KeyTable::Scene : editing() ? KeyTable::Edit : KeyTable::View; }
+
+    // The 3-D modes (scene_state.h, scene.h): the window opened the scene and says what it holds;
+    // from then on the controller orbits, drags foci and toggles, and the drawing renders a frame
+    // whenever sceneVersion() moves and hands it back with setSceneFrame.
+    void startScene(glm::dvec3 centre, double radius, std::string name, bool throughMap, std::string look,
+                    std::optional<Orbit> home = std::nullopt);
+    const SceneState* scene() const { return m_scene ? &*m_scene : nullptr; }
+    bool sceneThroughMap() const { return m_sceneThroughMap; }
+    int sceneVersion() const { return m_scene ? m_scene->version() : 0; }
+    // The frame's size: --size, else the window's.
+    glm::ivec2 sceneFrameSize() const;
+    // T pressed this many times: the drawing asks the scene for its next look and reports it.
+    int lookRequests() const { return m_lookRequests; }
+    void setLook(std::string look);
+    // The frame just rendered (a CoNUS file: the image, its map and foci, the camera and, when the
+    // renderer gave Z, its depth), shown from now on and probed by the inspector.
+    void setSceneFrame(format::ConusFile frame);
+    const format::ConusFile* sceneFrame() const { return m_sceneFrame ? &*m_sceneFrame : nullptr; }
     const MapEditor* editor() const { return m_editor ? &*m_editor : nullptr; }
     const Document* current() const { return m_docs.empty() ? nullptr : &m_docs[m_current]; }
     // The file the renderer shows: the current document's, or the editor's source with its map.
@@ -54,6 +74,8 @@ public:
     void cannotDisplay(const std::string& error);
     bool showHelp() const { return m_showHelp; }
     bool showStatus() const { return m_showStatus; }
+    // Z: the current document's Z channel shown as a picture (depth_view.h) instead of its colour.
+    bool depthPicture() const { return m_depthPicture; }
     std::string title() const;
     std::string statusText() const;
 
@@ -69,11 +91,22 @@ private:
     Document* currentDocument() { return m_docs.empty() ? nullptr : &m_docs[m_current]; }
     std::string summary(const char* separator) const;  // the title's and the status bar's text
     void saveFromEditor(bool mapOnly);
+    bool sceneAction(Action action);
+    // The inspector's line for window pixel `pixel` (the current document or the scene's frame).
+    std::string probeAt(glm::dvec2 pixel) const;
 
     const Options& m_options;
     std::vector<Document> m_docs;
     int m_current = 0;
     std::optional<MapEditor> m_editor;
+    std::optional<SceneState> m_scene;
+    std::string m_sceneName, m_sceneLook;
+    bool m_sceneThroughMap = true;
+    std::optional<format::ConusFile> m_sceneFrame;
+    std::optional<codec::SamplingMap> m_sceneMap;
+    int m_lookRequests = 0;
+    int m_draggedFocus = -1;
+    bool m_orbiting = false;
     std::string m_editorMessage;
     ViewState m_state;
     gl::ViewOptions m_display;
@@ -81,6 +114,7 @@ private:
     bool m_panning = false, m_wiping = false;
     std::string m_probe;
     bool m_showHelp = false, m_showStatus = false;
+    bool m_depthPicture = false;
     int m_imageVersion = 0, m_mapVersion = 0;
     std::string m_screenshot;
     int m_waitFrames = 0;

@@ -6,6 +6,7 @@
 
 #include "controller.h"
 #include "conus/renderers/view_renderer.h"
+#include "scene.h"
 
 namespace conus::viewer {
 
@@ -21,9 +22,18 @@ public:
     gl::ViewRenderer& renderer() { return m_renderer; }
     // Shows `uniform` as the uniform image whenever the file at `path` is shown (--uniform).
     void setUniform(const std::string& path, Image uniform);
+    // The 3-D modes: the scene frames are rendered from (owned by the caller, outliving the drawing's use).
+    void setScene(Scene* scene) { m_scene = scene; }
+    // Frames the scene has rendered, and the seconds they took (the render and its readback alone).
+    int sceneRenders() const { return m_sceneRenders; }
+    double sceneSeconds() const { return m_sceneSeconds; }
 
 private:
     void drawOverlays(const Controller& controller, int fw, int fh);
+    // Renders a new scene frame into the controller when what it shows has changed.
+    void renderScene(Controller& controller);
+    // Whether the scene's frame can go to the window directly (see drawing.cpp).
+    static bool showsSceneDirectly(const Controller& controller, int fw, int fh);
     // Uploads `make()`'s panel into `slot` when `key` (what the panel shows) has changed.
     template <class Make>
     bool prepareOverlay(int slot, const std::string& key, Make make);
@@ -35,7 +45,14 @@ private:
     Image m_uniform;
     std::string m_overlayKey[gl::ViewRenderer::kOverlaySlots];
     int m_overlayHeight[gl::ViewRenderer::kOverlaySlots] = {};
-    bool m_textBroken = false;  // the font could not be drawn: overlays off, said once on stderr
+    bool m_textBroken = false;
+    Scene* m_scene = nullptr;
+    int m_sceneVersion = -1, m_looksSeen = 0;
+    glm::ivec2 m_sceneSize{0};
+    bool m_sceneFailed = false;
+    int m_directVersion = -1;  // the frame in kSceneSlot (the controller's imageVersion)
+    int m_sceneRenders = 0;
+    double m_sceneSeconds = 0;  // the font could not be drawn: overlays off, said once on stderr
 };
 
 }  // namespace conus::viewer

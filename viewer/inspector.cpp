@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "depth_view.h"
+
 namespace conus::viewer {
 
 Probe probe(const format::ConusFile& file, const codec::SamplingMap& map, glm::dvec2 uv) {
@@ -31,6 +33,8 @@ Probe probe(const format::ConusFile& file, const codec::SamplingMap& map, glm::d
         const double bottom = image.at(x0, y1, c) * (1 - tx) + image.at(x1, y1, c) * tx;
         p.values.push_back(static_cast<float>(top * (1 - ty) + bottom * ty));
     }
+    p.depthImage = file.camera.has_value() && file.depth.kind == format::DepthKind::CameraDepth && hasDepth(file);
+    if (p.depthImage) p.world = worldPoint(file, map, p.conusPixel);
     return p;
 }
 
@@ -46,6 +50,12 @@ std::string formatProbe(const Probe& p) {
         if (c >= p.values.size()) continue;
         std::snprintf(buffer, sizeof buffer, " %s=%.4g", name.c_str(), p.values[c]);
         text += buffer;
+    }
+    if (p.world) {
+        std::snprintf(buffer, sizeof buffer, " P=(%.5g,%.5g,%.5g)", p.world->x, p.world->y, p.world->z);
+        text += buffer;
+    } else if (p.depthImage) {
+        text += " P=background";
     }
     return text;
 }

@@ -2,6 +2,7 @@
 // read back from the screen, so it shows every channel, Z included, at full precision).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,11 +22,16 @@ struct Probe {
     double density = 0;              // det J: samples per area relative to a uniform image
     std::vector<std::string> channels;
     std::vector<float> values;       // the CoNUS image sampled bilinearly at SM(u,v), as decode does
+    // Depth images with a camera: the world point conusPixel saw (depth_view.h's worldPoint), or
+    // nullopt on the background (then `depthImage` still says the file could give one).
+    bool depthImage = false;
+    std::optional<glm::dvec3> world;
 };
 
 Probe probe(const format::ConusFile& file, const codec::SamplingMap& map, glm::dvec2 uv);
 
-// "u,v=(0.4210,0.3100) ud,vd=(...) density 3.91 (linear 1.98) R=0.51 G=... Z=..."
+// "u,v=(0.4210,0.3100) ud,vd=(...) density 3.91 (linear 1.98) R=0.51 G=... Z=... P=(x,y,z)"
+// (P: the 3-D point of a depth image; "P=background" where its pixel saw nothing)
 std::string formatProbe(const Probe& p);
 
 }  // namespace conus::viewer

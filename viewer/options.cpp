@@ -15,7 +15,9 @@ namespace {
 constexpr const char* kDescription =
     "conus-view: a small viewer for CoNUS files (coherent non-uniform sampling images).\n"
     "The frame is reconstructed from the CoNUS data at every zoom level (GPU shader, or the CPU decoder on software GL).\n"
-    "Press H in the window for the keys. --edit IMAGE opens the mass-spring map editor.";
+    "Press H in the window for the keys. --edit IMAGE opens the mass-spring map editor.\n"
+    "3-D modes (--mesh, --volume, --relief, --reflection) render the CoNUS frame live and show it as the paper's\n"
+    "focus-plus-context display: orbit with the arrows or a drag, drag a focus, U toggles CoNUS / conventional.";
 
 std::pair<int, int> parseSize(const std::string& text, const char* what) {
     int w = 0, h = 0;
@@ -37,11 +39,28 @@ codec::View parseView(const std::string& text) {
     return v;
 }
 
+// "u,v,r,k" -> a focus, checked as every builder of foci checks one.
+codec::Focus parseFocus(const std::string& text) {
+    codec::Focus f;
+    char c1 = 0, c2 = 0, c3 = 0;
+    std::istringstream in(text);
+    if (!(in >> f.u >> c1 >> f.v >> c2 >> f.r >> c3 >> f.k) || c1 != ',' || c2 != ',' || c3 != ',' || !in.eof())
+        throw Error(ErrorCode::InvalidArgument, "--focus \"" + text + "\" is not u,v,r,k");
+    try {
+        codec::checkFocus(f);
+    } catch (const Error& e) {
+        throw Error(ErrorCode::InvalidArgument, "--focus \"" + text + "\": " + e.what());
+    }
+    return f;
+}
+
 }  // namespace
 
 std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     Options o;
     std::string view, size, window = "1280x800", mode = "reconstructed", decode = "auto", toneMap = "none";
+    std::string mesh, volume, relief, reflection;
+    std::vector<std::string> foci;
     CLI::App app(kDescription, "conus-view");
     app.add_option("files", o.files, "CoNUS files (.exr); Tab / PageDown switch between them");
     app.add_option("--edit", o.edit, "paint a sampling map over IMAGE (PNG, JPEG, EXR, ...)");
@@ -50,10 +69,24 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("--uniform", o.uniform,
                    "the first file's uniform baseline for U and W (a CoNUS file `conus uniform` wrote from the same source; "
                    "without it, the uniform image is resampled from the CoNUS data)");
+    app.add_option("--mesh", mesh, "3-D mode: render this mesh (OBJ, PLY, glTF, ...) live through the flexible pinhole camera");
+    app.add_option("--volume", volume, "3-D mode: ray-cast this volume live (.den, .nrrd, .vdb, raw:..., procedural:...)");
+    app.add_option("--relief", relief, "3-D mode: orbit a relief asset (`conus bake relief`); --uniform: its conventional twin");
+    app.add_option("--reflection", reflection,
+                   "3-D mode: orbit a reflection asset folder (`conus bake reflection`) with --scene; --uniform: its conventional twin");
+    app.add_option("--scene", o.reflectionScene, "--reflection: the mesh the asset was baked from");
+    app.add_option("--radius", o.reflectorRadius, "--reflection: the mirror sphere's radius")->capture_default_str()->check(CLI::PositiveNumber);
+    app.add_option("--max-edge", o.maxEdge,
+                   "--mesh: split triangles each CoNUS frame until no projected edge spans more than this many map cells "
+                   "(straight edges follow Eq. 1's curves; costs a CPU subdivision and an upload a frame; 0: never)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1e6));
+    app.add_option("--tf", o.transferFunction, "--volume: transfer function preset or file (T cycles the presets)");
+    app.add_option("--focus", foci, "3-D modes: a focus u,v,r,k (repeat for more; N adds one at the cursor)");
     app.add_option("--view", view, "undistorted rectangle u0,v0,u1,v1 to show");
     app.add_option("--size", size, "WxH of --screenshot, or of the CoNUS image --edit encodes");
     app.add_option("--window", window, "window size WxH")->capture_default_str();
-    app.add_option("--mode", mode, "reconstructed|raw|uniform|wipe|density")->capture_default_str();
+    app.add_option("--mode", mode, "reconstructed|raw|uniform|wipe|density|z (z: a depth image's Z as a picture)")->capture_default_str();
     app.add_flag("--grid", o.display.grid, "draw the CoNUS pixel grid");
     app.add_option("--grid-every", o.display.gridEvery, "draw every n-th grid line (0: automatic)");
     app.add_flag("--outlines", o.display.outlines, "draw the focus outlines");
@@ -80,13 +113,33 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
         if (!view.empty()) o.view = parseView(view);
         if (!size.empty()) std::tie(o.width, o.height) = parseSize(size, "--size");
         std::tie(o.windowWidth, o.windowHeight) = parseSize(window, "--window");
-        o.display.mode = parseMode(mode);
+        o.depthPicture = mode == "z";
+        o.display.mode = o.depthPicture ? gl::ViewMode::Reconstructed : parseMode(mode);
         o.display.toneMap = parseToneMap(toneMap).value_or(ToneMap::None);
         o.display.decode = decode == "cpu" ? gl::DecodePath::Cpu : decode == "gpu" ? gl::DecodePath::Gpu : gl::DecodePath::Auto;
-        if (o.files.empty() && o.edit.empty()) throw Error(ErrorCode::InvalidArgument, "no file given (conus-view FILE.exr or --edit IMAGE)");
+        const std::pair<SceneKind, const std::string*> scenes[] = {
+            {SceneKind::Mesh, &mesh}, {SceneKind::Volume, &volume}, {SceneKind::Relief, &relief}, {SceneKind::Reflection, &reflection}};
+        for (const auto& [kind, path] : scenes) {
+            if (path->empty()) continue;
+            if (o.sceneKind != SceneKind::None) throw Error(ErrorCode::InvalidArgument, "give one of --mesh, --volume, --relief, --reflection");
+            o.sceneKind = kind;
+            o.scenePath = *path;
+        }
+        for (const std::string& text : foci) o.foci.push_back(parseFocus(text));
+        if (o.sceneKind != SceneKind::None) {
+            if (!o.files.empty() || !o.edit.empty() || !o.screenshot.empty())
+                throw Error(ErrorCode::InvalidArgument, "a 3-D mode takes no CoNUS files, --edit or --screenshot (use --script's screenshot)");
+            if (o.sceneKind == SceneKind::Reflection && o.reflectionScene.empty())
+                throw Error(ErrorCode::InvalidArgument, "--reflection needs --scene MESH (the mesh the asset was baked from)");
+            if (!o.uniform.empty() && o.sceneKind != SceneKind::Relief && o.sceneKind != SceneKind::Reflection)
+                throw Error(ErrorCode::InvalidArgument, "--uniform in a 3-D mode is a relief's or reflection's conventional asset "
+                                                        "(meshes and volumes: C toggles the identity map)");
+        } else if (o.files.empty() && o.edit.empty()) {
+            throw Error(ErrorCode::InvalidArgument, "no file given (conus-view FILE.exr, --edit IMAGE, --mesh, --volume, --relief or --reflection)");
+        }
         if (!o.edit.empty() && !o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--edit takes no CoNUS files");
         if (!o.screenshot.empty() && o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--screenshot needs a CoNUS file");
-        if (!o.uniform.empty() && o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--uniform goes with a CoNUS file");
+        if (!o.uniform.empty() && o.files.empty() && o.sceneKind == SceneKind::None) throw Error(ErrorCode::InvalidArgument, "--uniform goes with a CoNUS file");
         if (o.benchmarkFrames < 0) throw Error(ErrorCode::InvalidArgument, "--benchmark-frames must be >= 0");
     } catch (const CLI::ParseError& e) {
         *exitCode = app.exit(e);

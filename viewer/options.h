@@ -5,11 +5,15 @@
 #include <string>
 #include <vector>
 
+#include "conus/codec/build/foci.h"
 #include "conus/codec/image/decode.h"
 #include "actions.h"
 #include "conus/renderers/view_renderer.h"
 
 namespace conus::viewer {
+
+// The 3-D modes (scene.h): what is rendered live instead of CoNUS files being viewed.
+enum class SceneKind { None, Mesh, Volume, Relief, Reflection };
 
 struct Options {
     std::vector<std::string> files;      // CoNUS files to view
@@ -26,6 +30,16 @@ struct Options {
     std::string backend = "auto";        // --backend for --screenshot (egl, osmesa)
     bool helpOverlay = false;            // --help-overlay: start with the key list (H) shown
     bool statusBar = false;              // --status-bar: start with the status bar (B) shown
+    // 3-D modes: --mesh FILE, --volume SPEC, --relief ASSET or --reflection DIR (with --scene MESH);
+    // --uniform is then the conventional asset of a relief or reflection; --size the frame's size.
+    SceneKind sceneKind = SceneKind::None;
+    std::string scenePath;
+    std::string reflectionScene;         // --scene: the mesh a reflection asset was baked from
+    double reflectorRadius = 0.5;        // --radius: the mirror sphere of --reflection
+    std::string transferFunction;        // --tf: a volume's transfer function preset or file
+    double maxEdge = 0;                  // --max-edge: --mesh subdivides each CoNUS frame's mesh (0: never)
+    std::vector<codec::Focus> foci;      // --focus u,v,r,k (repeated): the 3-D modes' first foci
+    bool depthPicture = false;           // --mode z: a depth image's Z as a picture (key Z)
 };
 
 // Parses argv. Returns nullopt after printing help (exit 0) or an error (exit 2, in *exitCode).

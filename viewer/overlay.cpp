@@ -9,11 +9,11 @@
 
 namespace conus::viewer {
 
-Image helpPanel(bool editing) {
+Image helpPanel(KeyTable table) {
     // helpText's lines are "  KEYS       what they do": the keys in a column of their own.
     constexpr std::size_t kKeyColumn = 13;
     std::vector<std::string> lines;
-    std::istringstream text(helpText(editing));
+    std::istringstream text(helpText(table));
     for (std::string line; std::getline(text, line);) {
         if (line.rfind("  ", 0) == 0 && line.size() > kKeyColumn) {
             std::string keys = line.substr(2, kKeyColumn - 2);

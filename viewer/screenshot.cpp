@@ -8,6 +8,7 @@
 
 #include "conus/renderers/backend.h"
 #include "conus/renderers/view_renderer.h"
+#include "depth_view.h"
 #include "document.h"
 #include "conus/imageio/image_file.h"
 #include "view_state.h"
@@ -42,17 +43,19 @@ int runScreenshot(const Options& options) {
         const gl::Device device = gl::Device::choose(gl::parseBackend(options.backend), gl::CpuPath::None, "the viewer's screenshot");
         gl::Context& context = device.context();
         gl::ViewRenderer renderer(context);
-        renderer.setImage(*doc.file);
+        const bool depth = options.depthPicture && hasDepth(*doc.file);
+        if (options.depthPicture && !depth) std::fprintf(stderr, "conus-view: %s has no Z channel: showing its colour\n", doc.path.c_str());
+        renderer.setImage(depth ? depthPicture(*doc.file) : *doc.file);
         if (!options.uniform.empty()) renderer.setUniform(uniformBaseline(options.uniform));
         std::vector<gl::OverlayPlacement> overlays;
         if (options.helpOverlay) {
-            renderer.setOverlay(kHelpSlot, helpPanel(false));
+            renderer.setOverlay(kHelpSlot, helpPanel(KeyTable::View));
             overlays.push_back({kHelpSlot, kOverlayMargin, kOverlayMargin});
         }
         if (options.statusBar) {
             char text[160];
             std::snprintf(text, sizeof text, "%s | %s | %dx%d", std::filesystem::path(doc.path).filename().string().c_str(),
-                          modeName(options.display.mode), width, height);
+                          depth ? "z" : modeName(options.display.mode), width, height);
             const Image bar = statusPanel(text, width);
             renderer.setOverlay(kStatusSlot, bar);
             overlays.push_back({kStatusSlot, 0, height - bar.height});
@@ -62,7 +65,7 @@ int runScreenshot(const Options& options) {
         write.meaning = imageio::PixelMeaning::Display;  // the framebuffer: already what the screen shows
         imageio::writeImageFile(options.screenshot, frame, write);
         std::printf("wrote %s: %dx%d, %s view of %s (%s)\n", options.screenshot.c_str(), width, height,
-                    modeName(options.display.mode), doc.path.c_str(), context.renderer().c_str());
+                    depth ? "z" : modeName(options.display.mode), doc.path.c_str(), context.renderer().c_str());
         return 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "conus-view: %s\n", e.what());

@@ -32,7 +32,8 @@ double number(const std::string& word, int line) {
 std::vector<ScriptCommand> parseScript(const std::string& text) {
     // Numeric argument counts; "zoom" also takes 3 (F at X Y).
     static const std::map<std::string, int> kNumbers = {{"zoom", 1}, {"wheel", 3}, {"pan", 2},  {"drag", 4},
-                                                        {"mouse", 2}, {"inspect", 2}, {"wait", 1}, {"quit", 0}};
+                                                        {"mouse", 2}, {"inspect", 2}, {"wait", 1}, {"quit", 0},
+                                                        {"orbit", 2}, {"dolly", 1}};
     std::vector<ScriptCommand> out;
     std::istringstream lines(text);
     int lineNumber = 0;
@@ -61,6 +62,7 @@ std::vector<ScriptCommand> parseScript(const std::string& text) {
         const int n = static_cast<int>(cmd.numbers.size());
         const bool ok = n == it->second || (cmd.name == "zoom" && n == 3);
         if (!ok) fail(lineNumber, cmd.name + " takes " + std::to_string(it->second) + " numbers, got " + std::to_string(n));
+        if (cmd.name == "dolly" && !(cmd.numbers[0] > 0)) fail(lineNumber, "dolly factor must be positive");
         if (cmd.name == "zoom" && !(cmd.numbers[0] > 0)) fail(lineNumber, "zoom factor must be positive");
         if (cmd.name == "wait" && (cmd.numbers[0] < 0 || cmd.numbers[0] > 1e6)) fail(lineNumber, "wait takes 0 .. 1e6 frames");
         out.push_back(cmd);

@@ -11,6 +11,9 @@
 //   inspect X Y            print the pixel inspector's line for (X,Y)
 //   wait N                 N frames (the editor's solver steps meanwhile)
 //   screenshot PATH        save the window's frame (PNG)
+//   orbit DYAW DPITCH      3-D modes: turn the camera about the scene (degrees)
+//   dolly F                3-D modes: multiply the camera's distance by F
+// In the 3-D modes a `drag` that starts on a focus moves it; elsewhere it orbits.
 //   quit                   stop here
 #pragma once
 
@@ -20,7 +23,7 @@
 namespace conus::viewer {
 
 struct ScriptCommand {
-    std::string name;             // zoom, wheel, pan, drag, mouse, key, inspect, wait, screenshot, quit
+    std::string name;             // zoom, wheel, pan, drag, mouse, key, inspect, wait, screenshot, quit, orbit, dolly
     std::vector<double> numbers;  // numeric arguments in order ("at" dropped)
     std::string text;             // key chord or path
     int line = 0;

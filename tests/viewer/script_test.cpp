@@ -28,7 +28,9 @@ TEST(Actions, ChordsParse) {
 }
 
 TEST(Actions, TheKeysTheIssueAsksFor) {
-    const auto act = [](const char* chord, bool editing = false) { return actionFor(*parseChord(chord), editing); };
+    const auto act = [](const char* chord, bool editing = false) {
+        return actionFor(*parseChord(chord), editing ? KeyTable::Edit : KeyTable::View);
+    };
     EXPECT_EQ(act("1"), Action::SourceResolution);  // 1 is 1:1, not a file number
     EXPECT_EQ(act("F"), Action::Fit);
     EXPECT_EQ(act("R"), Action::ModeRaw);
@@ -43,8 +45,30 @@ TEST(Actions, TheKeysTheIssueAsksFor) {
     EXPECT_EQ(act("Tab"), Action::NextFile);
     EXPECT_EQ(act("shift+Tab"), Action::PreviousFile);
     for (const char* key : {"C", "U", "W", "D", "G", "O", "H", "I", "+", "-", "Left"}) EXPECT_NE(act(key), Action::None) << key;
-    EXPECT_NE(helpText(false).find("G "), std::string::npos);
-    EXPECT_NE(helpText(true).find("Ctrl-S"), std::string::npos);
+    EXPECT_NE(helpText(KeyTable::View).find("G "), std::string::npos);
+    EXPECT_NE(helpText(KeyTable::Edit).find("Ctrl-S"), std::string::npos);
+    EXPECT_EQ(act("Z"), Action::ToggleDepth);
+}
+
+// The 3-D modes orbit with the arrows and toggle CoNUS with U; the display keys of the frame stay,
+// the file and pan keys do not, and the help lists exactly what works.
+TEST(Actions, SceneKeys) {
+    const auto act = [](const char* chord) { return actionFor(*parseChord(chord), KeyTable::Scene); };
+    EXPECT_EQ(act("Left"), Action::OrbitLeft);
+    EXPECT_EQ(act("+"), Action::DollyIn);
+    EXPECT_EQ(act("U"), Action::ToggleConus);
+    EXPECT_EQ(act("N"), Action::AddFocus);
+    EXPECT_EQ(act("T"), Action::NextLook);
+    EXPECT_EQ(act("F"), Action::HomeCamera);
+    EXPECT_EQ(act("Z"), Action::ToggleDepth);
+    EXPECT_EQ(act("R"), Action::ModeRaw);
+    EXPECT_EQ(act("E"), Action::ExposureUp);
+    EXPECT_EQ(act("Tab"), Action::None);
+    EXPECT_EQ(act("W"), Action::None);
+    const std::string help = helpText(KeyTable::Scene);
+    EXPECT_NE(help.find("orbit"), std::string::npos);
+    EXPECT_EQ(help.find("Tab"), std::string::npos);
+    EXPECT_NE(help.find("Z "), std::string::npos);
 }
 
 TEST(Script, ParsesCommands) {
