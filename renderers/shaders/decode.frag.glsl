@@ -3,7 +3,11 @@
 // then the CoNUS image sampled bilinearly there, as codec::decodeImage does. Where the pixel's
 // footprint in the CoNUS image is longer than kDecodeMultiTap pixels (zoomed out, or inside a
 // focus) several taps are averaged. Window y is the output's row index (images travel top row
-// first), so no flip.
+// first), so no flip. DECODE_PYRAMID 1 (defined by the renderer): uConus is mipmapped with
+// codec::buildPyramid's levels and a zoomed-out pixel takes one trilinear tap instead.
+#ifndef DECODE_PYRAMID
+#define DECODE_PYRAMID 0
+#endif
 layout(location = 0) out vec4 fragColor;
 uniform sampler2D uConus;  // bilinear, clamp to edge
 uniform sampler2D uMap;    // columns x rows texels, RG32F: the distorted node positions
@@ -22,5 +26,9 @@ void main() {
     const MapPoint m = evalMap(uMap, uv);
     // The output pixel's edges carried into the CoNUS image (normalized units).
     const vec2 step = abs(uView.zw - uView.xy) / uOutputSize;
+#if DECODE_PYRAMID
+    fragColor = trilinearFiltered(uConus, m.pd, m.du * step.x, m.dv * step.y);
+#else
     fragColor = footprintFiltered(uConus, m.pd, m.du * step.x, m.dv * step.y);
+#endif
 }

@@ -3,7 +3,8 @@
 // nodes of its cell fetched exactly (texelFetch and manual weights, not the sampler's), along v
 // first and then u as codec's row stepping does, with its partial derivatives. Outside [0,1] the
 // point is clamped to the edge, as SamplingMap::distort does. And the decoder's footprint filter:
-// bilinear taps over a pixel's footprint, as many as codec::decodeImage takes.
+// bilinear taps over a pixel's footprint, as many as codec::decodeImage takes; or, with a mipmapped
+// texture, one trilinear tap at the level codec's pyramid decode chooses.
 struct MapPoint {
     vec2 pd;  // distorted position
     vec2 du;  // d pd / du
@@ -43,4 +44,22 @@ vec4 footprintFiltered(sampler2D tex, vec2 q, vec2 a, vec2 b) {
             sum += textureLod(tex, clamp(r + a * ((float(i) + 0.5) / float(na) - 0.5), 0.0, 1.0), 0.0);
     }
     return sum / float(na * nb);
+}
+
+// The pyramid's level of detail, codec::pyramidLevel's formula: lambda = log2(rho) - bias (at
+// least 0) for rho^2, the squared longer footprint edge in CoNUS pixels, with log2 by a quadratic
+// in the mantissa.
+float pyramidLevel(float rhoSquared) {
+    if (!(rhoSquared > 1.0)) return 0.0;
+    const uint bits = floatBitsToUint(rhoSquared);
+    const float t = uintBitsToFloat((bits & 0x7fffffu) | 0x3f800000u) - 1.0;
+    return max(0.0, 0.5 * (float(int(bits >> 23) - 127) + t * (1.3465553 - 0.3465553 * t)) - kDecodePyramidBias);
+}
+
+// One trilinear tap of a mipmapped texture (the levels codec::buildPyramid makes) over the
+// footprint with edges a, b (normalized texture units) centred at q: codec's pyramid decode.
+vec4 trilinearFiltered(sampler2D tex, vec2 q, vec2 a, vec2 b) {
+    const vec2 size = vec2(textureSize(tex, 0));
+    const vec2 ap = a * size, bp = b * size;
+    return textureLod(tex, q, pyramidLevel(max(dot(ap, ap), dot(bp, bp))));
 }

@@ -88,7 +88,8 @@ void main() {
     } else if (!inside && mode != 4) {
         color = kBackground;
     } else if (mode == 0) {
-        color = display(footprintFiltered(uConus, m.pd, m.du * astep.x, m.dv * astep.y));
+        // uConus holds codec::buildPyramid's levels: one trilinear tap, as the CPU path's decode.
+        color = display(trilinearFiltered(uConus, m.pd, m.du * astep.x, m.dv * astep.y));
     } else if (mode == 1) {
         color = display(footprintFiltered(uConus, clamp(uv, 0.0, 1.0), vec2(astep.x, 0.0), vec2(0.0, astep.y)));
     } else if (mode == 2) {

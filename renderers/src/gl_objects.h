@@ -67,6 +67,31 @@ inline GlHandle uploadMapTexture(const GladGLContext& gl, GLenum unit, int colum
     return texture;
 }
 
+// One level of a float image for texture upload: `pixels` holds width x height pixels of
+// `channels` values, interleaved.
+struct TextureLevel {
+    const float* pixels;
+    int width, height;
+};
+
+// Allocates the texture bound to GL_TEXTURE_2D on the active unit with levels.size() mip levels
+// of internalFormat and uploads each from `format` floats; bilinear (trilinear between levels with
+// more than one), clamp to edge. codec::buildPyramid's levels after the image make the mip chain
+// that equation1.inc.glsl's trilinearFiltered reads.
+inline void storeLevels(const GladGLContext& gl, GLenum internalFormat, GLenum format,
+                        const std::vector<TextureLevel>& levels) {
+    gl.TexStorage2D(GL_TEXTURE_2D, static_cast<GLsizei>(levels.size()), internalFormat, levels[0].width,
+                    levels[0].height);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    for (std::size_t k = 0; k < levels.size(); ++k)
+        gl.TexSubImage2D(GL_TEXTURE_2D, static_cast<GLint>(k), 0, 0, levels[k].width, levels[k].height, format,
+                         GL_FLOAT, levels[k].pixels);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, levels.size() > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
 // Throws on a pending GL error: out of memory -> LimitExceeded, anything else -> Unsupported
 // (a driver that refused a valid request).
 inline void checkGl(const GladGLContext& gl, const char* what) {

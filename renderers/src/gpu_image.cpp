@@ -569,6 +569,7 @@ Image decodeImageGpu(Context& context, const Image& conus, const codec::Sampling
     constexpr const char* kWhat = "decodeImageGpu";
     checkImage(conus, kWhat);
     codec::checkDecodeMemory(conus, options.width, options.height);
+    if (options.pyramid) codec::checkPyramid(conus, *options.pyramid);
     const codec::View& view = options.view;
     if (!std::isfinite(view.u0) || !std::isfinite(view.u1) || !std::isfinite(view.v0) || !std::isfinite(view.v1) ||
         view.u0 == view.u1 || view.v0 == view.v1 || std::abs(view.u1 - view.u0) > 1e6 ||
@@ -583,7 +584,11 @@ Image decodeImageGpu(Context& context, const Image& conus, const codec::Sampling
     GpuTimings t;
     Clock::time_point start = Clock::now();
     const GladGLContext& gl = makeCurrentGl(context);
-    const GLuint program = cachedProgram(context, "decode", shaders::kShaderFullscreenVert, shaders::kShaderDecodeFrag);
+    const bool pyramid = options.pyramid != nullptr;
+    std::string source = shaders::kShaderDecodeFrag;
+    if (pyramid) source.insert(source.find('\n') + 1, "#define DECODE_PYRAMID 1\n");
+    const GLuint program =
+        cachedProgram(context, pyramid ? "decode/pyramid" : "decode", shaders::kShaderFullscreenVert, source.c_str());
 
     // The map's nodes, fetched exactly (texelFetch) by the shader.
     GlHandle mapTexture = uploadMapTexture(gl, GL_TEXTURE1, map.columns(), map.rows(), &map.nodes().front().x);
@@ -594,16 +599,20 @@ Image decodeImageGpu(Context& context, const Image& conus, const codec::Sampling
         const int count = std::min(kChannelsPerPass, conus.channelCount() - first);
         GlHandle texture = makeTexture(gl);
         {
-            const PassPixels pixels(conus, first, count);
+            // The image, then (pyramid decode) the pyramid's levels as its mip chain.
+            std::vector<PassPixels> pixels;
+            pixels.reserve(1 + (pyramid ? options.pyramid->levels.size() : 0));
+            pixels.emplace_back(conus, first, count);
+            if (pyramid)
+                for (const Image& level : options.pyramid->levels) pixels.emplace_back(level, first, count);
+            std::vector<TextureLevel> levels{{pixels[0].data(), conus.width, conus.height}};
+            if (pyramid)
+                for (std::size_t k = 0; k < options.pyramid->levels.size(); ++k)
+                    levels.push_back({pixels[k + 1].data(), options.pyramid->levels[k].width,
+                                      options.pyramid->levels[k].height});
             gl.ActiveTexture(GL_TEXTURE0);
             gl.BindTexture(GL_TEXTURE_2D, texture.id());
-            gl.TexStorage2D(GL_TEXTURE_2D, 1, internalFormat(count), conus.width, conus.height);
-            gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, conus.width, conus.height, pixelFormat(count), GL_FLOAT,
-                             pixels.data());
-            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            storeLevels(gl, internalFormat(count), pixelFormat(count), levels);
             checkGl(gl, kWhat);
             gl.Finish();
         }

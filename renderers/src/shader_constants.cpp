@@ -25,6 +25,7 @@ std::string constantsBlock() {
     std::string s = "// shared with C++ (renderers/src/shader_constants.h)\n";
     s += "const float kDecodeMultiTap = " + glslFloat(codec::kDecodeMultiTap) + ";\n";
     s += "const int kDecodeMaxTaps = " + std::to_string(codec::kDecodeMaxTaps) + ";\n";
+    s += "const float kDecodePyramidBias = " + glslFloat(codec::kDecodePyramidBias) + ";\n";
     s += "const int kEncodeMaxTaps = " + std::to_string(codec::kEncodeMaxTaps) + ";\n";
     s += "const float kEncodeTapTolerance = " + glslFloat(codec::kEncodeTapTolerance) + ";\n";
     s += "const int kEncodeMaxAxisTaps = " + std::to_string(codec::kEncodeMaxAxisTaps) + ";\n";

@@ -11,7 +11,7 @@ inline constexpr float kViewBackground = 0.11f;  // grey around the image in con
 inline constexpr int kViewMaxFoci = 16;          // focus outlines conus-view draws (GLSL: kMaxFoci)
 
 // `source` with the shared constants declared after its first line (#version):
-// kDecodeMultiTap, kDecodeMaxTaps (codec/decode.h), kEncodeMaxTaps, kEncodeTapTolerance,
+// kDecodeMultiTap, kDecodeMaxTaps, kDecodePyramidBias (codec/decode.h), kEncodeMaxTaps, kEncodeTapTolerance,
 // kEncodeMaxAxisTaps, kEncodeAnisotropicSigma, kEncodeGaussianReach, kEncodeBoxAnisotropy
 // (codec/encode.h), kBackground, kMaxFoci (above), kInferno[6] (core/display.h), and the mesh
 // shading's kMeshAmbient, kMeshGrey (codec/mesh/shading.h: kAmbient, kDefaultAlbedo), and

@@ -80,6 +80,18 @@ Image displayRgba(const Image& image) {
     return out;
 }
 
+// The CoNUS image with codec::buildPyramid's levels as its mip chain (RGBA32F), for one
+// trilinear tap per zoomed-out pixel (view_frame.frag.glsl, as the CPU path's pyramid decode).
+GlHandle uploadMipmapped(const GladGLContext& gl, const Image& rgba, const codec::ImagePyramid& pyramid) {
+    GlHandle texture = makeTexture(gl);
+    gl.ActiveTexture(GL_TEXTURE0);
+    gl.BindTexture(GL_TEXTURE_2D, texture.id());
+    std::vector<TextureLevel> levels{{rgba.pixels.data(), rgba.width, rgba.height}};
+    for (const Image& level : pyramid.levels) levels.push_back({level.pixels.data(), level.width, level.height});
+    storeLevels(gl, GL_RGBA32F, GL_RGBA, levels);
+    return texture;
+}
+
 GlHandle uploadRgba(const GladGLContext& gl, const Image& image) {
     GlHandle texture = makeTexture(gl);
     gl.ActiveTexture(GL_TEXTURE0);
@@ -102,6 +114,7 @@ struct ViewRenderer::Impl {
     // The CPU decode path: the display channels and the map on the CPU, the frame texture (RGBA8
     // for a window, RGBA32F when rendering to a float target) and a framebuffer to blit it from.
     Image rgb;
+    codec::ImagePyramid rgbPyramid;  // rgb's mip chain: zoomed-out pixels take one trilinear tap
     std::optional<codec::SamplingMap> cpuMap;
     GlHandle frameTexture, frameFramebuffer;
     int frameWidth = 0, frameHeight = 0;
@@ -156,6 +169,7 @@ struct ViewRenderer::Impl {
         decode.view = view;
         decode.width = width;
         decode.height = height;
+        decode.pyramid = &rgbPyramid;
         const Image frame = codec::decodeImage(rgb, *cpuMap, decode);
         const float exposure = static_cast<float>(std::exp2(options.exposure));
         const float invGamma = inverseGamma(options);
@@ -328,12 +342,16 @@ void ViewRenderer::setImage(const format::ConusFile& file) {
     options.height = rgba.height;
     d.uniformImage = decodeImageGpu(d.context, rgba, map, options);
 
+    // One mip chain for both paths: the shader's texture levels and, without alpha, the CPU's.
+    codec::ImagePyramid pyramid = codec::buildPyramid(rgba);
     const GladGLContext& gl = makeCurrentGl(d.context);
-    d.conus = uploadRgba(gl, rgba);
+    d.conus = uploadMipmapped(gl, rgba, pyramid);
     d.uniform = uploadRgba(gl, d.uniformImage);
     checkGl(gl, "ViewRenderer: image upload");
     d.uploadMap(map);
     d.rgb = displayRgb(rgba);
+    for (Image& level : pyramid.levels) level = displayRgb(level);
+    d.rgbPyramid = std::move(pyramid);
     d.cpuMap = map;
     d.conusWidth = rgba.width;
     d.conusHeight = rgba.height;

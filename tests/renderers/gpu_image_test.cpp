@@ -234,6 +234,37 @@ TEST_P(GpuImage, DecodeMatchesCpu) {
     EXPECT_GE(decodePsnr(conus, jittered, {}, 400, 300), kDecodePsnr);
 }
 
+// The pyramid decode: the CPU's levels uploaded as the texture's mip chain, one trilinear tap at
+// the level both compute from the map's Jacobian (codec::pyramidLevel and its GLSL twin).
+TEST_P(GpuImage, PyramidDecodeMatchesCpu) {
+    const Image source = test::photoLike(512, 512);
+    for (unsigned seed = 0; seed < 3; ++seed) {
+        SCOPED_TRACE(seed);
+        const codec::SamplingMap map = seed == 0 ? twoFoci() : test::randomFociMap(seed);
+        const Image conus = codec::encodeImage(source, map, encodeSize(256, 200));
+        const codec::ImagePyramid pyramid = codec::buildPyramid(conus);
+        for (const codec::View view : {codec::View{}, codec::View{0.25, 0.3, 0.45, 0.5}, codec::View{-0.2, -0.1, 1.1, 1.3}}) {
+            for (const int w : {97, 180, 400}) {
+                codec::DecodeOptions options = decodeView(view, w, w * 3 / 4);
+                options.pyramid = &pyramid;
+                const Image cpu = codec::decodeImage(conus, map, options);
+                const Image gpu = decodeImageGpu(context(), conus, map, options);
+                ASSERT_EQ(gpu.channels, conus.channels);
+                const double psnr = codec::psnr(cpu, gpu);
+                std::printf("    pyramid decode (%.2f,%.2f)-(%.2f,%.2f) -> %dx%d, %s: PSNR %.2f dB\n", view.u0, view.v0,
+                            view.u1, view.v1, w, w * 3 / 4, backendName(GetParam()).c_str(), psnr);
+                EXPECT_GE(psnr, kDecodePsnr);
+            }
+        }
+    }
+    // A pyramid of another image is refused, as by the CPU decoder.
+    const Image other = test::photoLike(64, 64);
+    const codec::ImagePyramid wrong = codec::buildPyramid(other);
+    codec::DecodeOptions options = decodeView({}, 32, 32);
+    options.pyramid = &wrong;
+    EXPECT_THROW(decodeImageGpu(context(), test::photoLike(128, 128), twoFoci(), options), Error);
+}
+
 TEST_P(GpuImage, DecodeHandlesAnyChannelCount) {
     const Image conus = test::photoLike(128, 128, {"R", "G", "B", "A", "Z"}, 4);
     const codec::SamplingMap map = twoFoci();

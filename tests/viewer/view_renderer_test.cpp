@@ -53,6 +53,9 @@ TEST(ViewRenderer, ReconstructedMatchesTheCpuDecoder) {
     options.view = view;
     options.width = 256;
     options.height = 208;
+    // The viewer decodes zoomed-out pixels from the CoNUS image's mip chain.
+    const codec::ImagePyramid pyramid = codec::buildPyramid(f.file.image);
+    options.pyramid = &pyramid;
     const Image cpu = codec::decodeImage(f.file.image, f.map, options);
     EXPECT_GT(psnrRgb(gpu, cpu), 50.0);
     // Zoomed far in: still decoded from the CoNUS data (a zoom on the focus).

@@ -8,10 +8,12 @@
 // footprint, bounded per map cell, decides how many taps to average over it.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
 #include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
 #include "decode_pvt.h"
 #include "conus/core/parallel.h"
 #include "resample_pvt.h"
@@ -102,6 +104,8 @@ namespace {
 // A footprint longer than this (in CoNUS pixels) on either axis gets several taps.
 constexpr double kMultiTapThreshold = kDecodeMultiTap;
 constexpr int kMaxTapsPerAxis = kDecodeMaxTaps;
+// The pyramid decode's level is 0 (one bilinear tap) up to this footprint: 2^kDecodePyramidBias.
+const double kPyramidOneTap = std::exp2(kDecodePyramidBias);
 
 void checkView(const View& v, const char* what) {
     if (!std::isfinite(v.u0) || !std::isfinite(v.u1) || !std::isfinite(v.v0) || !std::isfinite(v.v1) ||
@@ -155,9 +159,67 @@ inline bool interior(double xlo, double xhi, double ylo, double yhi, int width, 
     return xlo >= 1.0 + kMargin && xhi < width - kMargin && ylo >= 1.0 + kMargin && yhi < height - kMargin;
 }
 
+// The levels of a pyramid decode, level 0 first: a biased level-0 coordinate x (see tapBiased)
+// is x * sx + ox on a level (pixel edges line up: sx is the level's size over level 0's). Float:
+// like the GPU's texture coordinates, 2^-13 pixel or finer on a 4097-pixel side.
+struct Level {
+    const float* pixels;
+    int width, height;
+    float sx, sy, ox, oy;
+};
+
+std::vector<Level> pyramidLevels(const Image& conus, const ImagePyramid* pyramid) {
+    std::vector<Level> levels{{conus.pixels.data(), conus.width, conus.height, 1.0f, 1.0f, 0.0f, 0.0f}};
+    if (!pyramid) return levels;
+    for (const Image& l : pyramid->levels) {
+        const double sx = double(l.width) / conus.width, sy = double(l.height) / conus.height;
+        levels.push_back({l.pixels.data(), l.width, l.height, float(sx), float(sy), float(0.5 - 0.5 * sx),
+                          float(0.5 - 0.5 * sy)});
+    }
+    return levels;
+}
+
+// Bilinear on a level at biased coordinates in [0.5, size + 0.5] (positive: truncation is
+// floor), clamped to the edge.
 template <int kC>
+inline void levelTap(const Level& l, int c, float x, float y, float* out) {
+    const int channels = kC > 0 ? kC : c;
+    const int xi = static_cast<int>(x), yi = static_cast<int>(y);
+    const float fx = x - static_cast<float>(xi), fy = y - static_cast<float>(yi);
+    const int o0 = std::max(xi - 1, 0) * channels, o1 = std::min(xi, l.width - 1) * channels;
+    const std::size_t stride = static_cast<std::size_t>(l.width) * channels;
+    const float* r0 = l.pixels + static_cast<std::size_t>(std::max(yi - 1, 0)) * stride;
+    const float* r1 = l.pixels + static_cast<std::size_t>(std::min(yi, l.height - 1)) * stride;
+    for (int k = 0; k < channels; ++k) {
+        const float top = r0[o0 + k] + fx * (r0[o1 + k] - r0[o0 + k]);
+        const float bottom = r1[o0 + k] + fx * (r1[o1 + k] - r1[o0 + k]);
+        out[k] = top + fy * (bottom - top);
+    }
+}
+
+// One trilinear tap at biased level-0 coordinates (x, y) for a footprint whose longer edge
+// squared is rho2 CoNUS pixels squared: bilinear on the two levels around pyramidLevel, blended.
+// `scratch` holds a pixel's channels.
+template <int kC>
+inline void trilinearTap(const Level* levels, int top, int c, float x, float y, float rho2, float* out,
+                         float* scratch) {
+    const int channels = kC > 0 ? kC : c;
+    const float lambda = std::min(pyramidLevel(rho2), static_cast<float>(top));
+    const int l = static_cast<int>(lambda);
+    const float f = lambda - static_cast<float>(l);
+    const Level& a = levels[l];
+    levelTap<kC>(a, channels, x * a.sx + a.ox, y * a.sy + a.oy, out);
+    if (f <= 0.0f) return;
+    const Level& b = levels[l + 1];
+    levelTap<kC>(b, channels, x * b.sx + b.ox, y * b.sy + b.oy, scratch);
+    for (int k = 0; k < channels; ++k) out[k] += f * (scratch[k] - out[k]);
+}
+
+// kPyramid: zoomed-out pixels take one trilinear tap from `levels` instead of the multi-tap
+// average (DecodeOptions::pyramid).
+template <int kC, bool kPyramid>
 void decodeRows(const Image& src, const SamplingMap& map, const View& view, Image& dst,
-                const detail::ViewColumns& cols, int y0, int y1) {
+                const detail::ViewColumns& cols, const std::vector<Level>& levels, int y0, int y1) {
     const int channels = kC > 0 ? kC : src.channelCount();
     const int W = dst.width, H = dst.height, Wc = src.width, Hc = src.height;
     const int n = map.columns(), m = map.rows();
@@ -169,6 +231,9 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
     std::vector<double> bx(n), by(n), ax(n), ay(n);
     std::vector<char> multi(n);
     std::vector<float> dynamicAcc(kC > 0 ? 0 : channels);
+    float fixedScratch[kC > 0 ? kC : 1];
+    std::vector<float> dynamicScratch(kC > 0 ? 0 : channels);
+    float* const scratch = kC > 0 ? fixedScratch : dynamicScratch.data();
     const float* pixels = src.pixels.data();
 
     for (int y = y0; y < y1; ++y) {
@@ -186,7 +251,7 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
             ay[i] = nodes.dy[i] * (n - 1) * du;
             // |b| is convex along the cell, so its larger end bounds it.
             const double lb = std::max(length(bx[i], by[i]), length(bx[i + 1], by[i + 1]));
-            multi[i] = std::max(length(ax[i], ay[i]), lb) > kMultiTapThreshold;
+            multi[i] = std::max(length(ax[i], ay[i]), lb) > (kPyramid ? kPyramidOneTap : kMultiTapThreshold);
         }
 
         float* const rowOut = dst.pixels.data() + static_cast<std::size_t>(y) * W * channels;
@@ -223,8 +288,23 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
             }
             const double inside = span.inside ? 1.0 : 0.0;
             const double axp = ax[i] * inside, ayp = ay[i] * inside;
-            const int na = tapsFor(length(axp, ayp));
             double s = span.s0;
+            if constexpr (kPyramid) {
+                // b along the span, and the level's inputs in float as the GPU has them.
+                const float a2 = static_cast<float>(axp * axp + ayp * ayp);
+                const float bx0 = static_cast<float>(bx[i] + s * (bx[i + 1] - bx[i]));
+                const float by0 = static_cast<float>(by[i] + s * (by[i + 1] - by[i]));
+                const float dbx = static_cast<float>(span.ds * (bx[i + 1] - bx[i]));
+                const float dby = static_cast<float>(span.ds * (by[i + 1] - by[i]));
+                const int top = static_cast<int>(levels.size()) - 1;
+                for (int k = 0; k < count; ++k, px += sx, py += sy, out += channels) {
+                    const float bxp = bx0 + static_cast<float>(k) * dbx, byp = by0 + static_cast<float>(k) * dby;
+                    trilinearTap<kC>(levels.data(), top, channels, static_cast<float>(px), static_cast<float>(py),
+                                     std::max(a2, bxp * bxp + byp * byp), out, scratch);
+                }
+                return;
+            }
+            const int na = tapsFor(length(axp, ayp));
             for (int k = 0; k < count; ++k, px += sx, py += sy, s += span.ds, out += channels) {
                 const double bxp = bx[i] + s * (bx[i + 1] - bx[i]), byp = by[i] + s * (by[i + 1] - by[i]);
                 const int nb = tapsFor(length(bxp, byp));
@@ -324,6 +404,47 @@ void clearOutside(Image& out, const View& view) {
 
 }  // namespace
 
+float pyramidLevel(float rhoSquared) {
+    if (!(rhoSquared > 1.0f)) return 0.0f;  // magnified (or NaN): level 0
+
+    std::uint32_t bits;
+    std::memcpy(&bits, &rhoSquared, sizeof bits);
+    const int exponent = static_cast<int>(bits >> 23) - 127;
+    const std::uint32_t mantissaBits = (bits & 0x7fffffu) | 0x3f800000u;
+    float mantissa;
+    std::memcpy(&mantissa, &mantissaBits, sizeof mantissa);
+    const float t = mantissa - 1.0f;  // log2(1 + t) ~ t (1.3465553 - 0.3465553 t), exact at t = 0 and 1
+    return std::max(0.0f, 0.5f * (static_cast<float>(exponent) + t * (1.3465553f - 0.3465553f * t)) -
+                              static_cast<float>(kDecodePyramidBias));
+}
+
+void checkPyramid(const Image& conus, const ImagePyramid& pyramid) {
+    int w = conus.width, h = conus.height;
+    for (const Image& level : pyramid.levels) {
+        w = std::max(1, w / 2);
+        h = std::max(1, h / 2);
+        if (level.width != w || level.height != h || level.channels != conus.channels ||
+            level.pixels.size() != static_cast<std::size_t>(w) * h * conus.channels.size())
+            throw Error(ErrorCode::InvalidArgument, "decode: the pyramid was not built from a " +
+                                                        std::to_string(conus.width) + "x" +
+                                                        std::to_string(conus.height) + " image with these channels");
+    }
+    if (w != 1 || h != 1)
+        throw Error(ErrorCode::InvalidArgument, "decode: the pyramid stops before 1x1");
+}
+
+ImagePyramid buildPyramid(const Image& conus, int threads) {
+    checkImage(conus, "buildPyramid");
+    ImagePyramid pyramid;
+    const Image* previous = &conus;
+    while (previous->width > 1 || previous->height > 1) {
+        pyramid.levels.push_back(
+            areaDownsample(*previous, std::max(1, previous->width / 2), std::max(1, previous->height / 2), threads));
+        previous = &pyramid.levels.back();
+    }
+    return pyramid;
+}
+
 void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes) {
     const std::int64_t channels = conus.channelCount();
     const std::int64_t bytes = (std::int64_t{conus.width} * conus.height + std::int64_t{width} * height) * channels *
@@ -342,6 +463,8 @@ Image decodeImage(const Image& conus, const SamplingMap& map, const DecodeOption
     detail::checkOutputSize(options.width, options.height, "decodeImage");
     checkDecodeMemory(conus, options.width, options.height);
     checkView(options.view, "decodeImage");
+    if (options.pyramid) checkPyramid(conus, *options.pyramid);
+    const std::vector<Level> levels = pyramidLevels(conus, options.pyramid);
     Image out = detail::makeOutput(conus, options.width, options.height);
     const detail::ViewColumns cols = detail::viewColumns(map.columns(), options.view.u0, options.view.u1, out.width);
     detail::RowProgress progress(options.progress, out.height);
@@ -349,7 +472,8 @@ Image decodeImage(const Image& conus, const SamplingMap& map, const DecodeOption
         out.height, options.threads,
         [&](int y0, int y1) {
             detail::dispatchChannels(conus.channelCount(), [&]<int kC>() {
-                decodeRows<kC>(conus, map, options.view, out, cols, y0, y1);
+                if (options.pyramid) decodeRows<kC, true>(conus, map, options.view, out, cols, levels, y0, y1);
+                else decodeRows<kC, false>(conus, map, options.view, out, cols, levels, y0, y1);
             });
             progress.add(y1 - y0);
         },

@@ -31,7 +31,9 @@ enum class ViewMode {
     Density,        // heat map of log det J of the map (the sampling density), from the nodes
 };
 
-// Where ViewMode::Reconstructed is decoded. Gpu: view_frame.frag.glsl per pixel. Cpu: codec::decodeImage
+// Where ViewMode::Reconstructed is decoded; either way a zoomed-out pixel takes one trilinear tap
+// from the CoNUS image's mip chain (codec::buildPyramid, built once in setImage), not up to 8x8
+// taps. Gpu: view_frame.frag.glsl per pixel. Cpu: codec::decodeImage
 // at the target's resolution every frame (still from the CoNUS data at every zoom, no cached frame),
 // uploaded and copied into the target, overlays drawn over it by a second pass; on a software
 // rasterizer (llvmpipe) the multithreaded incremental CPU decoder is several times faster than the
