@@ -1,5 +1,6 @@
 // Private: a CoNUS depth image on the GPU, as intersect.inc.glsl reads it (relief and reflection
-// renderers): its textures (camera depths R32F, the map's nodes RG32F) and its DepthView uniforms.
+// renderers): its textures (camera depths R32F, the map's nodes RG32F) and its DepthView uniforms;
+// and what both renderers' frames share: an RGBA32F target and one full-screen pass into it.
 #pragma once
 
 #include <string>
@@ -86,6 +87,43 @@ inline void setIntersectOptions(const GladGLContext& gl, GLuint program, const c
     gl.Uniform1f(gl.GetUniformLocation(program, "uStepTexels"), static_cast<float>(options.stepTexels));
     gl.Uniform1i(gl.GetUniformLocation(program, "uRefinements"), options.refinements);
     gl.Uniform1i(gl.GetUniformLocation(program, "uMaxSteps"), options.maxSteps);
+}
+
+// A float RGBA frame and its framebuffer, allocated again only when the size changes.
+struct FrameTarget {
+    GlHandle texture, framebuffer;
+    int width = 0, height = 0;
+
+    // Leaves the framebuffer bound. `unit` is a texture unit the pass does not sample.
+    void ensure(const GladGLContext& gl, int w, int h, GLenum unit, const char* what) {
+        if (w != width || h != height || !framebuffer) {
+            framebuffer.reset();
+            texture = makeTexture(gl);
+            gl.ActiveTexture(unit);
+            gl.BindTexture(GL_TEXTURE_2D, texture.id());
+            gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
+            framebuffer = makeFramebuffer(gl);
+            gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
+            gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.id(), 0);
+            if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+                throw Error(ErrorCode::Unsupported, std::string(what) + ": the driver cannot render to a " +
+                                                        std::to_string(w) + "x" + std::to_string(h) +
+                                                        " RGBA32F target");
+            width = w;
+            height = h;
+        }
+        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
+    }
+};
+
+// The full-screen triangle (fullscreen.vert.glsl) over a w x h viewport with the bound program.
+inline void drawFullscreen(Context& context, const GladGLContext& gl, int w, int h, const char* what) {
+    gl.Viewport(0, 0, w, h);
+    gl.Disable(GL_DEPTH_TEST);
+    gl.BindVertexArray(context.impl().emptyVertexArray);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl.BindVertexArray(0);
+    checkGl(gl, what);
 }
 
 }  // namespace conus::gl

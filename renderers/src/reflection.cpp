@@ -46,8 +46,7 @@ struct ReflectionRenderer::Impl {
     std::array<GlHandle, codec::kCubeFaces> colours;
     std::vector<codec::DepthImage> images;  // their cameras and depth ranges, for the uniforms
     GlHandle behind;
-    int width = 0, height = 0;
-    GlHandle target, framebuffer;
+    FrameTarget target;
 
     Impl(Context& c, const GladGLContext& gl, const Mesh& mesh, const std::vector<codec::ReflectionFace>& f,
          const codec::ReflectionFrameOptions& o)
@@ -62,23 +61,6 @@ struct ReflectionRenderer::Impl {
                 floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(k * kUnitsPerFace + 2), face.image.width,
                              face.image.height, 4, rgba.data());
         }
-    }
-
-    void ensureTarget(const GladGLContext& gl, int w, int h) {
-        if (w == width && h == height && framebuffer) return;
-        framebuffer.reset();
-        target = makeTexture(gl);
-        gl.ActiveTexture(GL_TEXTURE0 + kBehindUnit + 1);
-        gl.BindTexture(GL_TEXTURE_2D, target.id());
-        gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
-        framebuffer = makeFramebuffer(gl);
-        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
-        gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.id(), 0);
-        if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-            throw Error(ErrorCode::Unsupported, std::string(kWhat) + ": the driver cannot render to a " +
-                                                    std::to_string(w) + "x" + std::to_string(h) + " RGBA32F target");
-        width = w;
-        height = h;
     }
 
     void drawFrame(const Camera& camera, int w, int h) {
@@ -100,8 +82,7 @@ struct ReflectionRenderer::Impl {
 
         const GLuint program =
             cachedProgram(context, "reflection", shaders::kShaderFullscreenVert, shaders::kShaderReflectionFrag);
-        ensureTarget(gl, w, h);
-        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
+        target.ensure(gl, w, h, GL_TEXTURE0 + kBehindUnit + 1, kWhat);
         gl.UseProgram(program);
         const auto at = [&](const std::string& name) { return gl.GetUniformLocation(program, name.c_str()); };
         for (int k = 0; k < codec::kCubeFaces; ++k) {
@@ -143,12 +124,7 @@ struct ReflectionRenderer::Impl {
         gl.Uniform1f(at("uReflectorRadius"), static_cast<float>(r.radius));
         gl.Uniform3f(at("uReflectorNormal"), normal.x, normal.y, normal.z);
         gl.Uniform3f(at("uSky"), codec::kReflectionSky[0], codec::kReflectionSky[1], codec::kReflectionSky[2]);
-        gl.Viewport(0, 0, w, h);
-        gl.Disable(GL_DEPTH_TEST);
-        gl.BindVertexArray(context.impl().emptyVertexArray);
-        gl.DrawArrays(GL_TRIANGLES, 0, 3);
-        gl.BindVertexArray(0);
-        checkGl(gl, kWhat);
+        drawFullscreen(context, gl, w, h, kWhat);
     }
 };
 

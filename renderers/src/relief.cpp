@@ -73,12 +73,7 @@ std::vector<std::optional<codec::DepthHit>> intersectRays(Context& context, cons
     gl.Uniform1f(gl.GetUniformLocation(program, "uTMax"), static_cast<float>(std::min(options.tMax, 1e30)));
     gl.Uniform1i(gl.GetUniformLocation(program, "uOrigins"), 2);
     gl.Uniform1i(gl.GetUniformLocation(program, "uDirections"), 3);
-    gl.Viewport(0, 0, width, height);
-    gl.Disable(GL_DEPTH_TEST);
-    gl.BindVertexArray(context.impl().emptyVertexArray);
-    gl.DrawArrays(GL_TRIANGLES, 0, 3);
-    gl.BindVertexArray(0);
-    checkGl(gl, kWhat);
+    drawFullscreen(context, gl, width, height, kWhat);
 
     std::array<std::vector<float>, 4> out;
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
@@ -116,8 +111,7 @@ struct ReliefRenderer::Impl {
     ReliefLook look;
     DepthTextures textures;
     GlHandle colour;
-    int width = 0, height = 0;
-    GlHandle target, framebuffer;
+    FrameTarget target;
 
     Impl(Context& c, const GladGLContext& gl, const codec::DepthImage& i, const Image& rgb, const ReliefLook& l)
         : context(c), image(i), look(l), textures(c, gl, i, kWhat) {
@@ -130,33 +124,15 @@ struct ReliefRenderer::Impl {
         colour = floatTexture(gl, GL_TEXTURE2, rgb.width, rgb.height, 3, pixels.data(), true);
     }
 
-    void ensureTarget(const GladGLContext& gl, int w, int h) {
-        if (w == width && h == height && framebuffer) return;
-        framebuffer.reset();
-        target = makeTexture(gl);
-        gl.ActiveTexture(GL_TEXTURE4);
-        gl.BindTexture(GL_TEXTURE_2D, target.id());
-        gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
-        framebuffer = makeFramebuffer(gl);
-        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
-        gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.id(), 0);
-        if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-            throw Error(ErrorCode::Unsupported, std::string(kWhat) + ": the driver cannot render to a " +
-                                                    std::to_string(w) + "x" + std::to_string(h) + " RGBA32F target");
-        width = w;
-        height = h;
-    }
-
     void drawFrame(const Camera& camera, int w, int h) {
         checkFrame(context, w, h, kWhat);
         const GladGLContext& gl = makeCurrentGl(context);
         const GLuint program =
             cachedProgram(context, "relief", shaders::kShaderFullscreenVert, shaders::kShaderReliefFrag);
-        ensureTarget(gl, w, h);
+        target.ensure(gl, w, h, GL_TEXTURE4, kWhat);
         textures.bind(gl);
         gl.ActiveTexture(GL_TEXTURE2);
         gl.BindTexture(GL_TEXTURE_2D, colour.id());
-        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
         gl.UseProgram(program);
         setDepthView(gl, program, image, textures);
         setIntersectOptions(gl, program, look.intersect);
@@ -171,12 +147,7 @@ struct ReliefRenderer::Impl {
         gl.Uniform1f(gl.GetUniformLocation(program, "uAmbient"), look.ambient);
         gl.Uniform1i(gl.GetUniformLocation(program, "uShadows"), look.shadows ? 1 : 0);
         gl.Uniform1i(gl.GetUniformLocation(program, "uColour"), 2);
-        gl.Viewport(0, 0, w, h);
-        gl.Disable(GL_DEPTH_TEST);
-        gl.BindVertexArray(context.impl().emptyVertexArray);
-        gl.DrawArrays(GL_TRIANGLES, 0, 3);
-        gl.BindVertexArray(0);
-        checkGl(gl, kWhat);
+        drawFullscreen(context, gl, w, h, kWhat);
     }
 };
 
