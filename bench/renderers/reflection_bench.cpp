@@ -101,23 +101,31 @@ void BM_ReflectionFrameGl(benchmark::State& state) {
     state.SetLabel(std::string(state.range(0) ? "CoNUS, " : "conventional, ") + context->renderer());
 }
 
+// Args: the focus's magnification k and the linear-search step in tenths of a CoNUS pixel.
 void BM_ReflectionQuality(benchmark::State& state) {
     Setup& s = setup(static_cast<int>(state.range(0)));
+    codec::ReflectionFrameOptions options = s.options;
+    options.intersect.stepTexels = state.range(1) / 10.0;
     Image frames[2], truth;
     for (auto _ : state) {
-        truth = codec::renderReflectionFrame(s.scene, nullptr, s.options.reflector.centre, s.camera, kFrame, kFrame, s.options);
+        truth = codec::renderReflectionFrame(s.scene, nullptr, options.reflector.centre, s.camera, kFrame, kFrame, options);
         for (int k = 0; k < 2; ++k)
-            frames[k] = codec::renderReflectionFrame(s.scene, &s.faces[k], s.options.reflector.centre, s.camera, kFrame,
-                                                     kFrame, s.options);
+            frames[k] = codec::renderReflectionFrame(s.scene, &s.faces[k], options.reflector.centre, s.camera, kFrame,
+                                                     kFrame, options);
     }
     // ROI: reflector pixels whose traced reflected ray meets the box.
     double squared[2][2] = {}, count[2] = {}, wrong[2] = {};
+    glm::ivec2 roiLo(kFrame), roiHi(0);
     for (int y = 0; y < kFrame; ++y)
         for (int x = 0; x < kFrame; ++x) {
             if (truth.at(x, y, 3) == 0.0f) continue;
-            const auto mirror = codec::hitReflector(s.options.reflector, s.camera.ray({(x + 0.5) / kFrame, (y + 0.5) / kFrame}));
+            const auto mirror = codec::hitReflector(options.reflector, s.camera.ray({(x + 0.5) / kFrame, (y + 0.5) / kFrame}));
             const auto hit = mirror ? s.scene.intersect(mirror->reflected, 1e-6) : std::nullopt;
             const int region = hit && hit->triangle < kBoxTriangles ? 0 : 1;
+            if (region == 0) {
+                roiLo = glm::min(roiLo, glm::ivec2(x, y));
+                roiHi = glm::max(roiHi, glm::ivec2(x, y));
+            }
             for (int k = 0; k < 2; ++k) {
                 double e = 0;
                 for (int c = 0; c < 3; ++c) {
@@ -144,20 +152,34 @@ void BM_ReflectionQuality(benchmark::State& state) {
     const glm::dvec2 centre(front.camera().project(glm::dvec3(0.7, 0.1, 1.85)));
     state.counters["box_rate"] = std::sqrt(std::abs(glm::determinant(front.map().jacobian(centre))));
     const char* picture = std::getenv("CONUS_BENCH_PICTURE");
-    if (picture && state.range(0) == static_cast<int>(codec::ReflectionBakeOptions{}.magnification)) {
-        Image strip{3 * kFrame, kFrame, {"R", "G", "B"}, std::vector<float>(std::size_t(3) * kFrame * kFrame * 3)};
+    if (picture && state.range(0) == static_cast<int>(codec::ReflectionBakeOptions{}.magnification) &&
+        state.range(1) == 10) {
+        // Top: the frames; below: the box, kZoom times enlarged (nearest), around the ROI's centre.
+        constexpr int kZoom = 4, kCrop = kFrame / kZoom;
+        const glm::ivec2 corner = glm::clamp((roiLo + roiHi) / 2 - kCrop / 2, 0, kFrame - kCrop);
+        Image strip{3 * kFrame, 2 * kFrame, {"R", "G", "B"}, std::vector<float>(std::size_t(6) * kFrame * kFrame * 3)};
         const Image* parts[3] = {&frames[1], &frames[0], &truth};
         for (int p = 0; p < 3; ++p)
             for (int y = 0; y < kFrame; ++y)
                 for (int x = 0; x < kFrame; ++x)
-                    for (int c = 0; c < 3; ++c) strip.at(p * kFrame + x, y, c) = parts[p]->at(x, y, c);
+                    for (int c = 0; c < 3; ++c) {
+                        strip.at(p * kFrame + x, y, c) = parts[p]->at(x, y, c);
+                        strip.at(p * kFrame + x, kFrame + y, c) =
+                            parts[p]->at(corner.x + x / kZoom, corner.y + y / kZoom, c);
+                    }
         imageio::writeImageFile(picture, strip);
     }
 }
 
 BENCHMARK(BM_ReflectionFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReflectionFrameGl)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_ReflectionQuality)->Arg(3)->Arg(4)->Arg(5)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReflectionQuality)
+    ->Args({3, 10})
+    ->Args({4, 10})
+    ->Args({5, 10})
+    ->Args({4, 5})
+    ->Args({4, 20})
+    ->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace conus
