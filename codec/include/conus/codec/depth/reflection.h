@@ -61,8 +61,9 @@ struct ReflectionBakeOptions {
     double near = 0.01;          // the faces' near clip (far: beyond the scene's bounding box)
 };
 
-// The focus a face puts on the region of interest: the bounding disc of the box's projection,
-// clipped to the image; nothing when the box is not in front of the face or misses its image.
+// The focus a face puts on the region of interest: the disc inscribed in the bounding square of
+// the box's projection clipped to the image (its corners in the focus's fall-off); nothing when
+// the box is not in front of the face or misses its image.
 std::optional<Focus> reflectionFocus(const Camera& face, const AxisBox& roi, double magnification);
 
 // The six faces of `scene` from options.centre, each rendered by the Embree reference (one exact
