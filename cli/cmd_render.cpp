@@ -109,11 +109,13 @@ int runRenderReflection(const ReflectionRenderText& o) {
     const double aspect = double(size.width) / size.height;
     const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);
     // The ground truth traces the mesh itself: the CPU only.
-    const gl::Device device = o.reference ? gl::Device::cpu() : deviceFor(o.backend, gl::CpuPath::Available, "reflection rendering");
+    const gl::Device device =
+        o.reference ? gl::Device::cpu() : deviceFor(o.backend, gl::CpuPath::Available, "reflection rendering");
     Progress rendering("render " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                        (o.reference ? " (reflections traced against the mesh)" : " (reflections from the faces)"));
-    Image frame = o.reference ? codec::renderReflectionFrame(scene, nullptr, centre, camera, size.width, size.height, options)
-                              : gl::renderReflection(device, scene, faces, camera, size.width, size.height, options);
+    Image frame = o.reference
+                      ? codec::renderReflectionFrame(scene, nullptr, centre, camera, size.width, size.height, options)
+                      : gl::renderReflection(device, scene, faces, camera, size.width, size.height, options);
     rendering.done();
     Image rgb{frame.width, frame.height, {"R", "G", "B"}, {}};
     rgb.pixels.reserve(static_cast<std::size_t>(frame.width) * frame.height * 3);
@@ -142,7 +144,8 @@ void addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
         ->check(finiteRange(0, 1e9));
     reflection->add_option("--normal", o.normal, "plane: the mirror's facing direction x,y,z")->capture_default_str();
     reflection->add_option("--step", o.step, "linear-search step in CoNUS pixels")->capture_default_str()->check(finiteRange(0, 64));
-    reflection->add_flag("--reference", o.reference, "trace reflected rays against the mesh (Embree, CPU): the ground truth");
+    reflection->add_flag("--reference", o.reference,
+                         "trace reflected rays against the mesh (Embree, CPU): the ground truth");
     addBackendOption(*reflection, o.backend);
     addQuietOption(*reflection);
 }

@@ -183,7 +183,9 @@ Image renderReflection(const Device& device, const codec::MeshScene& scene,
             const glm::dvec3 centre = faces.empty() ? options.reflector.centre : faces.front().depth.camera().eye();
             return codec::renderReflectionFrame(scene, &faces, centre, camera, width, height, options);
         },
-        [&](Context& context) { return ReflectionRenderer(context, scene.mesh(), faces, options).render(camera, width, height); });
+        [&](Context& context) {
+            return ReflectionRenderer(context, scene.mesh(), faces, options).render(camera, width, height);
+        });
 }
 
 }  // namespace conus::gl
