@@ -138,7 +138,7 @@ int runBakeRelief(const BakeOptions& o) {
 struct ReflectionBakeText {
     std::string scene, outDir, centre = "0,0,0", roiMin, roiMax;
     int size = 128;
-    double magnification = 3.0;
+    double magnification = codec::ReflectionBakeOptions{}.magnification;
     bool uniform = false;
 };
 

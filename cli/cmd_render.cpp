@@ -1,5 +1,6 @@
-// conus render relief: a frame of a relief asset (`conus bake relief`) by relief texture mapping:
-// each eye ray intersects the CoNUS height texture in a fragment shader (paper section 5).
+// conus render relief | reflection: frames of baked assets. Relief: each eye ray intersects the
+// CoNUS height texture in a fragment shader (paper section 5); reflection: the reflected rays
+// intersect the six faces of a reflection asset (GLSL, or the CPU reference with --backend cpu).
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include "conus/codec/depth/relief.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
+#include "conus/renderers/reflection.h"
 #include "conus/renderers/relief.h"
 #include "conus/sceneio/mesh_file.h"
 #include "image_files.h"
@@ -73,7 +75,8 @@ int runRenderRelief(const RenderOptions& o) {
 // --- reflection -------------------------------------------------------------------------------
 
 struct ReflectionRenderText {
-    std::string asset, scene, output, cameraText, sizeText = "640x480", reflector = "sphere", at, normal = "0,0,1";
+    std::string asset, scene, output, cameraText, sizeText = "640x480", reflector = "sphere", at, normal = "0,0,1",
+                backend = "auto";
     double radius = 0.5, step = 1.0;
     bool reference = false;
 };
@@ -105,23 +108,28 @@ int runRenderReflection(const ReflectionRenderText& o) {
     loading.done();
     const double aspect = double(size.width) / size.height;
     const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);
+    // The ground truth traces the mesh itself: the CPU only.
+    const gl::Device device =
+        o.reference ? gl::Device::cpu() : deviceFor(o.backend, gl::CpuPath::Available, "reflection rendering");
     Progress rendering("render " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                        (o.reference ? " (reflections traced against the mesh)" : " (reflections from the faces)"));
-    Image frame = codec::renderReflectionFrame(scene, o.reference ? nullptr : &faces, centre, camera, size.width,
-                                               size.height, options);
+    Image frame = o.reference
+                      ? codec::renderReflectionFrame(scene, nullptr, centre, camera, size.width, size.height, options)
+                      : gl::renderReflection(device, scene, faces, camera, size.width, size.height, options);
     rendering.done();
     Image rgb{frame.width, frame.height, {"R", "G", "B"}, {}};
     rgb.pixels.reserve(static_cast<std::size_t>(frame.width) * frame.height * 3);
     for (std::size_t i = 0; i < frame.pixels.size(); i += 4) rgb.pixels.insert(rgb.pixels.end(), &frame.pixels[i], &frame.pixels[i + 3]);
     writePicture(o.output, rgb, write);
-    std::printf("wrote %s: %dx%d frame, a %s reflector at %g,%g,%g\n", o.output.c_str(), size.width, size.height,
-                o.reflector.c_str(), options.reflector.centre.x, options.reflector.centre.y, options.reflector.centre.z);
+    std::printf("wrote %s: %dx%d frame, a %s reflector at %g,%g,%g (%s)\n", o.output.c_str(), size.width, size.height,
+                o.reflector.c_str(), options.reflector.centre.x, options.reflector.centre.y, options.reflector.centre.z,
+                device.describe().c_str());
     return 0;
 }
 
 void addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
     CLI::App* reflection = addSubcommand(
-        command, "reflection", "A specular reflector whose reflected rays intersect a reflection asset's faces (CPU)",
+        command, "reflection", "A specular reflector whose reflected rays intersect a reflection asset's faces",
         {"conus render reflection asset --scene scene.obj --camera 0,1,4,0,0,0,40 -o frame.png",
          "conus render reflection asset --scene scene.obj --reflector plane --normal 0,0,1 --radius 2 --camera 0,1,4,0,0,0,40 -o frame.png"});
     reflection->add_option("asset", o.asset, "folder from `conus bake reflection`")->required();
@@ -136,7 +144,9 @@ void addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
         ->check(finiteRange(0, 1e9));
     reflection->add_option("--normal", o.normal, "plane: the mirror's facing direction x,y,z")->capture_default_str();
     reflection->add_option("--step", o.step, "linear-search step in CoNUS pixels")->capture_default_str()->check(finiteRange(0, 64));
-    reflection->add_flag("--reference", o.reference, "trace reflected rays against the mesh (Embree): the ground truth");
+    reflection->add_flag("--reference", o.reference,
+                         "trace reflected rays against the mesh (Embree, CPU): the ground truth");
+    addBackendOption(*reflection, o.backend);
     addQuietOption(*reflection);
 }
 
@@ -144,7 +154,7 @@ void addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
 
 Command addRenderCommand(CLI::App& root) {
     auto o = std::make_shared<RenderOptions>();
-    CLI::App* command = root.add_subcommand("render", "Render frames of baked assets (relief)");
+    CLI::App* command = root.add_subcommand("render", "Render frames of baked assets (relief, reflection)");
     command->require_subcommand(1);
     CLI::App* relief = addSubcommand(*command, "relief", "Relief texture mapping: eye rays against a relief asset",
                                      {"conus render relief tablet.exr -o frame.png",

@@ -4,17 +4,22 @@
 // of both against the ground truth (the reflected rays traced against the mesh with Embree) in the
 // region of interest (reflector pixels showing the box) and over the rest of the reflector, and
 // writes bench/img/reflection.png (CoNUS | conventional | truth) when CONUS_BENCH_PICTURE names a
-// path. BM_ReflectionFrame times the CPU frame with either set of faces (the ratio is the cost).
+// path. BM_ReflectionFrame times the CPU frame with either set of faces (the ratio is the cost);
+// BM_ReflectionFrameGl the GLSL frame (gl::ReflectionRenderer::draw: the scene behind, its upload
+// and the reflection pass) on the context CONUS_BACKEND names (default auto).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <string>
 
 #include "conus/codec/depth/reflection.h"
 #include "conus/imageio/image_file.h"
+#include "conus/renderers/reflection.h"
 
 namespace conus {
 namespace {
@@ -65,7 +70,7 @@ struct Setup {
     }
 };
 
-// The focus's magnification k (bake reflection's default: 3).
+// The focus's magnification k (bake reflection's default: 4).
 Setup& setup(int k) {
     static std::map<int, std::unique_ptr<Setup>> setups;
     auto& s = setups[k];
@@ -74,35 +79,63 @@ Setup& setup(int k) {
 }
 
 void BM_ReflectionFrame(benchmark::State& state) {
-    Setup& s = setup(3);
+    Setup& s = setup(static_cast<int>(codec::ReflectionBakeOptions{}.magnification));
     for (auto _ : state)
         benchmark::DoNotOptimize(codec::renderReflectionFrame(s.scene, &s.faces[state.range(0)], s.options.reflector.centre,
                                                               s.camera, kFrame, kFrame, s.options));
     state.SetLabel(state.range(0) ? "CoNUS" : "conventional");
 }
 
+void BM_ReflectionFrameGl(benchmark::State& state) {
+    Setup& s = setup(static_cast<int>(codec::ReflectionBakeOptions{}.magnification));
+    static std::unique_ptr<gl::Context> context = [] {
+        const char* backend = std::getenv("CONUS_BACKEND");
+        return gl::Context::create(gl::parseBackend(backend ? backend : "auto"));
+    }();
+    gl::ReflectionRenderer renderer(*context, s.scene.mesh(), s.faces[state.range(0)], s.options);
+    renderer.draw(s.camera, kFrame, kFrame);  // compiles the program
+    const auto start = std::chrono::steady_clock::now();
+    for (auto _ : state) renderer.draw(s.camera, kFrame, kFrame);
+    const std::chrono::duration<double> seconds = std::chrono::steady_clock::now() - start;
+    state.counters["fps"] = double(state.iterations()) / seconds.count();  // wall clock, not this thread's CPU
+    state.SetLabel(std::string(state.range(0) ? "CoNUS, " : "conventional, ") + context->renderer());
+}
+
+// Args: the focus's magnification k and the linear-search step in tenths of a CoNUS pixel.
 void BM_ReflectionQuality(benchmark::State& state) {
     Setup& s = setup(static_cast<int>(state.range(0)));
+    codec::ReflectionFrameOptions options = s.options;
+    options.intersect.stepTexels = state.range(1) / 10.0;
     Image frames[2], truth;
     for (auto _ : state) {
-        truth = codec::renderReflectionFrame(s.scene, nullptr, s.options.reflector.centre, s.camera, kFrame, kFrame, s.options);
+        truth = codec::renderReflectionFrame(s.scene, nullptr, options.reflector.centre, s.camera, kFrame, kFrame, options);
         for (int k = 0; k < 2; ++k)
-            frames[k] = codec::renderReflectionFrame(s.scene, &s.faces[k], s.options.reflector.centre, s.camera, kFrame,
-                                                     kFrame, s.options);
+            frames[k] = codec::renderReflectionFrame(s.scene, &s.faces[k], options.reflector.centre, s.camera, kFrame,
+                                                     kFrame, options);
     }
     // ROI: reflector pixels whose traced reflected ray meets the box.
-    double squared[2][2] = {}, count[2] = {};
+    double squared[2][2] = {}, count[2] = {}, wrong[2] = {};
+    glm::ivec2 roiLo(kFrame), roiHi(0);
     for (int y = 0; y < kFrame; ++y)
         for (int x = 0; x < kFrame; ++x) {
             if (truth.at(x, y, 3) == 0.0f) continue;
-            const auto mirror = codec::hitReflector(s.options.reflector, s.camera.ray({(x + 0.5) / kFrame, (y + 0.5) / kFrame}));
+            const auto mirror = codec::hitReflector(options.reflector, s.camera.ray({(x + 0.5) / kFrame, (y + 0.5) / kFrame}));
             const auto hit = mirror ? s.scene.intersect(mirror->reflected, 1e-6) : std::nullopt;
             const int region = hit && hit->triangle < kBoxTriangles ? 0 : 1;
-            for (int k = 0; k < 2; ++k)
+            if (region == 0) {
+                roiLo = glm::min(roiLo, glm::ivec2(x, y));
+                roiHi = glm::max(roiHi, glm::ivec2(x, y));
+            }
+            for (int k = 0; k < 2; ++k) {
+                double e = 0;
                 for (int c = 0; c < 3; ++c) {
                     const double d = std::clamp(frames[k].at(x, y, c), 0.0f, 1.0f) - std::clamp(truth.at(x, y, c), 0.0f, 1.0f);
-                    squared[k][region] += d * d / 3.0;
+                    e += d * d / 3.0;
                 }
+                squared[k][region] += e;
+                // A pixel off by more than 0.1 RMS: a hit on the wrong surface (the silhouettes).
+                if (region == 0) wrong[k] += e > 0.01;
+            }
             count[region] += 1;
         }
     auto psnr = [&](int k, int region) { return 10.0 * std::log10(count[region] / std::max(squared[k][region], 1e-30)); };
@@ -111,20 +144,42 @@ void BM_ReflectionQuality(benchmark::State& state) {
     state.counters["rest_conus_dB"] = psnr(1, 1);
     state.counters["rest_conventional_dB"] = psnr(0, 1);
     state.counters["roi_pixels"] = count[0];
+    state.counters["roi_wrong_conus"] = wrong[1];
+    state.counters["roi_wrong_conventional"] = wrong[0];
+    // What the focus achieves: the +z face's linear sampling rate at the box's centre, against the
+    // conventional face's (the map's Jacobian determinant, square-rooted).
+    const codec::DepthImage& front = s.faces[1][4].depth;
+    const glm::dvec2 centre(front.camera().project(glm::dvec3(0.7, 0.1, 1.85)));
+    state.counters["box_rate"] = std::sqrt(std::abs(glm::determinant(front.map().jacobian(centre))));
     const char* picture = std::getenv("CONUS_BENCH_PICTURE");
-    if (picture && state.range(0) == 3) {
-        Image strip{3 * kFrame, kFrame, {"R", "G", "B"}, std::vector<float>(std::size_t(3) * kFrame * kFrame * 3)};
+    if (picture && state.range(0) == static_cast<int>(codec::ReflectionBakeOptions{}.magnification) &&
+        state.range(1) == 10) {
+        // Top: the frames; below: the box, kZoom times enlarged (nearest), around the ROI's centre.
+        constexpr int kZoom = 4, kCrop = kFrame / kZoom;
+        const glm::ivec2 corner = glm::clamp((roiLo + roiHi) / 2 - kCrop / 2, 0, kFrame - kCrop);
+        Image strip{3 * kFrame, 2 * kFrame, {"R", "G", "B"}, std::vector<float>(std::size_t(6) * kFrame * kFrame * 3)};
         const Image* parts[3] = {&frames[1], &frames[0], &truth};
         for (int p = 0; p < 3; ++p)
             for (int y = 0; y < kFrame; ++y)
                 for (int x = 0; x < kFrame; ++x)
-                    for (int c = 0; c < 3; ++c) strip.at(p * kFrame + x, y, c) = parts[p]->at(x, y, c);
+                    for (int c = 0; c < 3; ++c) {
+                        strip.at(p * kFrame + x, y, c) = parts[p]->at(x, y, c);
+                        strip.at(p * kFrame + x, kFrame + y, c) =
+                            parts[p]->at(corner.x + x / kZoom, corner.y + y / kZoom, c);
+                    }
         imageio::writeImageFile(picture, strip);
     }
 }
 
 BENCHMARK(BM_ReflectionFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_ReflectionQuality)->Arg(3)->Arg(5)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReflectionFrameGl)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReflectionQuality)
+    ->Args({3, 10})
+    ->Args({4, 10})
+    ->Args({5, 10})
+    ->Args({4, 5})
+    ->Args({4, 20})
+    ->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace conus

@@ -56,6 +56,14 @@ TEST_F(ReflectionCli, BakeValidatesAndRenders) {
     EXPECT_GT(conusError, 0.0);  // the faces are an approximation...
     EXPECT_LT(conusError, 0.02);  // ...of the traced reflection
     EXPECT_GT(meanError(path("conus.png"), path("uniform.png")), 0.0);
+    // The GLSL renderer draws the CPU reference's frame (the scene behind rasterized rather than
+    // traced: its silhouettes may move a pixel; the rest is float rounding under 8-bit PNG steps).
+    r = run("render reflection " + conus + common + " --backend egl -o " + path("gl.png"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("egl"), std::string::npos) << r.out;
+    ASSERT_EQ(run("render reflection " + conus + common + " --backend cpu -o " + path("cpu.png")).exitCode, 0);
+    EXPECT_LT(meanError(path("gl.png"), path("cpu.png")), 2e-3);
+    EXPECT_LT(meanError(path("gl.png"), path("cpu.png")), 0.1 * conusError);
 }
 
 TEST_F(ReflectionCli, BadInputIsOneLineAndNonZero) {

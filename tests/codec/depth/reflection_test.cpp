@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "codec/mesh/mesh_test_scenes.h"
+#include "conus/codec/mesh/shading.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
 #include "test_dir.h"
@@ -172,6 +173,51 @@ TEST(Reflection, FocusSitsOnTheProjectedBox) {
     EXPECT_FALSE(reflectionFocus(cubeFaceCamera({0, 0, 0}, 5, 0.01, 10), {kBoxLo, kBoxHi}, 3.0));  // -z: behind
 }
 
+TEST(Reflection, FocusIsTheDiscInscribedInTheProjectedBoxsSquare) {
+    const Camera front = cubeFaceCamera({0, 0, 0}, 4, 0.01, 10);
+    const auto focus = reflectionFocus(front, {kBoxLo, kBoxHi}, 4.0);
+    ASSERT_TRUE(focus);
+    glm::dvec2 lo(1e9), hi(-1e9);
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 q = front.project({c & 1 ? kBoxHi.x : kBoxLo.x, c & 2 ? kBoxHi.y : kBoxLo.y, c & 4 ? kBoxHi.z : kBoxLo.z});
+        lo = glm::min(lo, glm::dvec2(q));
+        hi = glm::max(hi, glm::dvec2(q));
+    }
+    EXPECT_NEAR(focus->r, 0.5 * std::max(hi.x - lo.x, hi.y - lo.y), 1e-12);
+    EXPECT_LT(focus->r, 0.5 * glm::length(hi - lo));  // not the bounding disc
+}
+
+// The hit's colour: bilinear between texel centres over the covered texels only.
+TEST(Reflection, HitColourIsBilinearOverCoveredTexels) {
+    ReflectionFace face = bakeBox(16, true)[0];
+    Image& image = face.image;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) {
+            image.at(x, y, kMeshChannelR) = 0.1f * x;
+            image.at(x, y, kMeshChannelR + 1) = 0.05f * y + 0.2f;
+            image.at(x, y, kMeshChannelR + 2) = 0.5f;
+            image.at(x, y, kMeshChannelA) = x == 9 ? 0.0f : 1.0f;  // column 9 saw nothing
+        }
+    DepthHit hit;
+    // Between the centres of columns 3 and 4 (x = 3.5 + 0.3) and rows 5 and 6 (y = 5.5 + 0.25).
+    hit.distorted = glm::dvec2(3.8 / 16.0, 5.75 / 16.0);
+    hit.texel = {3, 5};
+    glm::vec3 c = reflectionColour(face, hit);
+    EXPECT_NEAR(c.r, 0.1 * 3.3, 1e-5);
+    EXPECT_NEAR(c.g, 0.05 * 5.25 + 0.2, 1e-5);
+    EXPECT_NEAR(c.b, 0.5, 1e-6);
+    // Beside the uncovered column 9: only column 8 weighs, whatever the fraction toward 9.
+    hit.distorted = glm::dvec2(8.9 / 16.0, 5.5 / 16.0);
+    hit.texel = {8, 5};
+    c = reflectionColour(face, hit);
+    EXPECT_NEAR(c.r, 0.8, 1e-5);
+    // All four uncovered: the hit's own texel.
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) image.at(x, y, kMeshChannelA) = 0.0f;
+    hit.texel = {9, 5};
+    EXPECT_NEAR(reflectionColour(face, hit).r, 0.9, 1e-6);
+}
+
 TEST(Reflection, BadBakeOptionsAreRefused) {
     const MeshScene scene(flatBox(glm::vec3(kBoxLo), glm::vec3(kBoxHi)));
     ReflectionBakeOptions o;
@@ -224,15 +270,7 @@ double meanSquaredError(const Image& a, const Image& truth, Pick inRegion) {
 
 TEST(Reflection, FramesMatchTheTracedReferenceAndCoNUSBeatsUniform) {
     // The box and a floor, a sphere mirror between them and the camera.
-    Mesh scene = flatBox(glm::vec3(kBoxLo), glm::vec3(kBoxHi));
-    const Mesh floor = test::plane(-1.0f, 4.0f);
-    const auto base = static_cast<std::uint32_t>(scene.positions.size());
-    scene.positions.insert(scene.positions.end(), floor.positions.begin(), floor.positions.end());
-    scene.normals.insert(scene.normals.end(), floor.normals.begin(), floor.normals.end());
-    for (std::uint32_t i : floor.indices) scene.indices.push_back(base + i);
-    scene.colours.assign(scene.positions.size(), glm::vec3(0.8f));
-    for (std::size_t i = 0; i < base; ++i)  // the box: a colour ramp across it, so misplaced hits show
-        scene.colours[i] = glm::vec3((scene.positions[i].x - 0.4f) / 0.6f, 0.3f, (scene.positions[i].z - 1.5f) / 0.7f);
+    const Mesh scene = test::rampedBoxAndFloor(glm::vec3(kBoxLo), glm::vec3(kBoxHi));
     const MeshScene mesh(scene);
     ReflectionFrameOptions o;
     o.reflector.centre = {0.0, 0.0, 0.0};

@@ -56,6 +56,23 @@ inline Mesh plane(float y, float half, float repeat = 1, std::optional<Image> te
     return m;
 }
 
+// The reflection tests' scene: a flat box [lo, hi] with a colour ramp across it (so a misplaced hit
+// shows; its 12 triangles first) above a grey floor at y = -1, half side 4.
+inline Mesh rampedBoxAndFloor(glm::vec3 lo, glm::vec3 hi) {
+    Mesh scene = flatBox(lo, hi);
+    const Mesh floor = plane(-1.0f, 4.0f);
+    const auto base = static_cast<std::uint32_t>(scene.positions.size());
+    scene.positions.insert(scene.positions.end(), floor.positions.begin(), floor.positions.end());
+    scene.normals.insert(scene.normals.end(), floor.normals.begin(), floor.normals.end());
+    for (std::uint32_t i : floor.indices) scene.indices.push_back(base + i);
+    scene.colours.assign(scene.positions.size(), glm::vec3(0.8f));
+    for (std::size_t i = 0; i < base; ++i) {
+        const glm::vec3 f = (scene.positions[i] - lo) / (hi - lo);
+        scene.colours[i] = glm::vec3(f.x, 0.3f, f.z);
+    }
+    return scene;
+}
+
 // Ray-sphere: the nearest t >= 0 along a unit-direction ray, if it meets the sphere.
 inline std::optional<double> hitSphere(const Ray& ray, glm::dvec3 centre, double radius) {
     const glm::dvec3 oc = ray.origin - centre;

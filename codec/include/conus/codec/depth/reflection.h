@@ -56,13 +56,14 @@ struct ReflectionBakeOptions {
     glm::dvec3 centre{0.0};      // the reflector's centre (the faces' common eye)
     int size = 128;              // texels a face side
     bool uniform = false;        // identity maps: the conventional baseline of the same texel count
-    double magnification = 3.0;  // linear magnification of the focus on the region of interest
+    double magnification = 4.0;  // linear magnification of the focus on the region of interest
     std::optional<AxisBox> roi;  // the region of interest; none: the scene's bounding box
     double near = 0.01;          // the faces' near clip (far: beyond the scene's bounding box)
 };
 
-// The focus a face puts on the region of interest: the bounding disc of the box's projection,
-// clipped to the image; nothing when the box is not in front of the face or misses its image.
+// The focus a face puts on the region of interest: the disc inscribed in the bounding square of
+// the box's projection clipped to the image (its corners in the focus's fall-off); nothing when
+// the box is not in front of the face or misses its image.
 std::optional<Focus> reflectionFocus(const Camera& face, const AxisBox& roi, double magnification);
 
 // The six faces of `scene` from options.centre, each rendered by the Embree reference (one exact
@@ -89,10 +90,15 @@ struct ReflectorHit {
 // Where the eye ray meets the reflector's mirror side, and the reflected ray; nothing on a miss.
 std::optional<ReflectorHit> hitReflector(const Reflector& reflector, const Ray& ray);
 
+// The colour a hit on `face` takes: bilinear in the face's CoNUS image at the hit's distorted
+// position, over the covered texels among the four around it (the far plane's texels carry no
+// colour); the hit's own texel where none of the four weighs anything.
+glm::vec3 reflectionColour(const ReflectionFace& face, const DepthHit& hit);
+
 struct ReflectionHit {
     DepthHit hit;
     int face = 0;
-    glm::vec3 colour{0.0f};  // the CoNUS texel's colour
+    glm::vec3 colour{0.0f};  // reflectionColour
 };
 
 // The nearest hit of `ray` among the faces (each face intersected by intersect.h; the nearest t

@@ -1,0 +1,107 @@
+#version 450 core
+// Reflections (paper section 5, Figure 6): the GLSL twin of codec::renderReflectionFrame. Each
+// pixel's eye ray meets the reflector (a sphere or a square plane mirror, codec::hitReflector);
+// where the reflector lies in front of the scene behind (a mesh frame of the same camera), the
+// reflected ray is intersected with the six cube faces of the asset (intersect.inc.glsl, the one
+// algorithm), the nearest hit that is not the far plane wins and takes the face's colour there
+// (codec::reflectionColour); a ray that meets nothing shows the sky. Out: R, G, B and the mask M
+// (0 the scene or nothing, 1 the reflector showing the sky, 2 the reflector showing the scene).
+#include "equation1.inc.glsl"
+#include "intersect.inc.glsl"
+
+const int kFaces = 6;
+
+uniform sampler2D uDepths[kFaces];
+uniform sampler2D uMaps[kFaces];
+uniform sampler2D uColours[kFaces];  // R, G, B, coverage per CoNUS pixel
+uniform DepthView uViews[kFaces];
+uniform float uFar[kFaces];          // each face's far clip (where nothing was seen)
+uniform sampler2D uBehind;           // the scene: R, G, B and camera depth (huge where nothing)
+// The frame camera's rays, affine in the image point uv (computed in double precision on the
+// CPU: a matrix through the near and far planes loses them in float when far / near is large):
+// origin o0 + u oU + v oV, direction (unnormalized) d0 + u dU + v dV.
+uniform vec3 uRayO0, uRayOU, uRayOV, uRayD0, uRayDU, uRayDV;
+uniform vec3 uFrameEye, uFrameForward;  // camera depth = dot(p - eye, forward)
+uniform vec2 uFrameSize;
+uniform int uReflectorKind;  // 0 sphere, 1 plane
+uniform vec3 uReflectorCentre;
+uniform float uReflectorRadius;
+uniform vec3 uReflectorNormal;  // unit
+uniform vec3 uSky;
+uniform float uStepTexels;
+uniform int uRefinements;
+uniform int uMaxSteps;
+uniform float uTMax;
+
+out vec4 outColour;
+
+// codec::hitReflector: the t along the eye ray and the unit normal facing it; t < 0 on a miss.
+float hitReflector(vec3 origin, vec3 d, out vec3 normal) {
+    normal = uReflectorNormal;
+    if (uReflectorKind == 0) {
+        const vec3 oc = origin - uReflectorCentre;
+        const float b = dot(oc, d), c = dot(oc, oc) - uReflectorRadius * uReflectorRadius;
+        const float disc = b * b - c;
+        if (!(disc >= 0.0)) return -1.0;
+        const float t = -b - sqrt(disc);
+        if (!(t > 0.0)) return -1.0;
+        normal = normalize(origin + d * t - uReflectorCentre);
+        return t;
+    }
+    const vec3 n = uReflectorNormal;
+    const float facing = dot(d, n);
+    if (!(facing < 0.0)) return -1.0;
+    const float t = dot(uReflectorCentre - origin, n) / facing;
+    if (!(t > 0.0)) return -1.0;
+    const vec3 p = origin + d * t - uReflectorCentre;
+    const vec3 helper = abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    const vec3 s = normalize(cross(helper, n)), u = cross(n, s);
+    if (abs(dot(p, s)) > uReflectorRadius || abs(dot(p, u)) > uReflectorRadius) return -1.0;
+    return t;
+}
+
+// codec::reflectionColour: the face's colour at the hit's CoNUS position, bilinear over the
+// covered texels among the four around it (the far plane's texels carry no colour).
+vec3 reflectionColour(sampler2D colours, vec2 pd, ivec2 texel) {
+    const ivec2 size = textureSize(colours, 0);
+    const vec2 g = clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
+    const ivec2 i0 = min(ivec2(g), size - 1), i1 = min(i0 + 1, size - 1);
+    const vec2 f = g - vec2(i0);
+    const vec4 c00 = texelFetch(colours, i0, 0), c10 = texelFetch(colours, ivec2(i1.x, i0.y), 0);
+    const vec4 c01 = texelFetch(colours, ivec2(i0.x, i1.y), 0), c11 = texelFetch(colours, i1, 0);
+    const float w00 = (1.0 - f.x) * (1.0 - f.y) * c00.a, w10 = f.x * (1.0 - f.y) * c10.a;
+    const float w01 = (1.0 - f.x) * f.y * c01.a, w11 = f.x * f.y * c11.a;
+    const float w = w00 + w10 + w01 + w11;
+    if (!(w > 0.0)) return texelFetch(colours, texel, 0).rgb;
+    return (c00.rgb * w00 + c10.rgb * w10 + c01.rgb * w01 + c11.rgb * w11) / w;
+}
+
+void main() {
+    // GL's window row 0 is the frame's top row (the readback is top row first).
+    const vec2 uv = gl_FragCoord.xy / uFrameSize;
+    const vec3 origin = uRayO0 + uRayOU * uv.x + uRayOV * uv.y;
+    const vec3 direction = normalize(uRayD0 + uRayDU * uv.x + uRayDV * uv.y);
+    const vec4 behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0);
+    outColour = vec4(behind.rgb, 0.0);
+    vec3 normal;
+    const float tMirror = hitReflector(origin, direction, normal);
+    if (tMirror < 0.0) return;
+    const vec3 at = origin + direction * tMirror;
+    if (!(dot(at - uFrameEye, uFrameForward) < behind.a)) return;
+    const vec3 reflected = normalize(direction - 2.0 * dot(direction, normal) * normal);
+
+    // codec::traceReflection: the nearest hit among the faces that is not the far plane.
+    bool found = false;
+    float best = uTMax;
+    vec3 colour = uSky;
+    for (int f = 0; f < kFaces; ++f) {
+        const DepthHit h = intersectDepthImage(uDepths[f], uMaps[f], uViews[f], at, reflected, uStepTexels,
+                                               uRefinements, uMaxSteps, best);
+        if (!h.hit || (found && h.t >= best)) continue;
+        if (texelFetch(uColours[f], h.texel, 0).a < 0.5 || h.depth >= uFar[f] * (1.0 - 1e-4)) continue;
+        found = true;
+        best = h.t;
+        colour = reflectionColour(uColours[f], h.distorted, h.texel);
+    }
+    outColour = vec4(colour, found ? 2.0 : 1.0);
+}
