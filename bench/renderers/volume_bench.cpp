@@ -196,7 +196,7 @@ void BM_VolumeCpuConusFilled(benchmark::State& state) { runCpu(state, true, true
 
 }  // namespace
 
-BENCHMARK(BM_VolumeGpuConusOverConventionalPaired)->Arg(0)->Arg(1)->MinTime(5.0)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VolumeGpuConusOverConventionalPaired)->Arg(0)->Arg(1)->Iterations(21)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VolumeGpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_VolumeGpuConus)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_VolumeCpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -5,8 +5,6 @@
 // rule: on a software rasterizer (llvmpipe, softpipe, swrast), work that has a CPU path runs there
 // instead, since the CPU reference measured several times faster (bench/README.md). Work without
 // a CPU path (terrain rendering) needs GL on any rasterizer, and asking for the CPU is refused.
-// A machine without a GPU device node (/dev/dri/renderD*, NVIDIA's, WSL's) can only have a
-// software rasterizer, so work with a CPU path goes there without making a context at all.
 //
 // A GPU path and its CPU reference are registered once, where the work is declared, through
 // Device::run (gpu_image.h's encodeImage / decodeImage are the pattern to follow).
