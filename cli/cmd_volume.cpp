@@ -224,6 +224,10 @@ int runAnimate(const AnimateOptions& a) {
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
     fo.aspect = aspect;
+    // On a GL device the volume and transfer function go up once for all frames (a 3-D texture
+    // upload per frame cost more than the frame itself on llvmpipe; bench/README.md "Volumes").
+    std::optional<gl::VolumeRendererGpu> gpu;
+    if (device.onGpu()) gpu.emplace(device.context(), volume, tf);
     std::optional<codec::SamplingMap> previous;
     double largest = 0;
     Progress rendering("render " + std::to_string(a.frames) + " frames at " + o.sizeText + " (" + device.describe() + ")");
@@ -234,7 +238,8 @@ int runAnimate(const AnimateOptions& a) {
         codec::SamplingMap map = gl::frameMap(foci, fo);
         if (previous) largest = std::max(largest, gl::largestNodeStep(*previous, map));
         const Fpc fpc(camera, std::make_shared<codec::SamplingMap>(map));
-        const Image image = gl::renderVolume(device, volume, tf, fpc, size.width, size.height, options);
+        const Image image = gpu ? gpu->render(fpc, size.width, size.height, options)
+                                : codec::renderVolumeReference(volume, tf, fpc, size.width, size.height, options);
         char name[32];
         std::snprintf(name, sizeof name, "frame_%04d", f);
         const std::filesystem::path base = std::filesystem::path(a.outDir) / name;

@@ -7,6 +7,7 @@
 // other threads). Read ratios within one run (bench/README.md).
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <memory>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "conus/codec/mesh/subdivide.h"
 #include "conus/renderers/mesh_render.h"
 #include "conus/renderers/mesh_sequence.h"
+#include "paired.h"
 
 namespace {
 
@@ -89,6 +91,21 @@ void BM_GpuDrawOnly(benchmark::State& state) {
     state.counters["drawMs"] = ms / static_cast<double>(state.iterations());
     state.SetLabel(state.range(0) ? "conus" : "conventional");
 }
+// CoNUS over conventional, timed in interleaved pairs (paired.h). Arg 1: the draw time only
+// (GpuTimings, after glFinish) instead of the whole render (which returns after the readback).
+void BM_GpuConusOverConventionalPaired(benchmark::State& state) {
+    Data& d = data();
+    const bool drawOnly = state.range(0) != 0;
+    const auto timeOne = [&](const codec::SamplingMap& map) {
+        gl::GpuTimings timings;
+        const auto start = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(d.renderer->render(d.camera, map, kWidth, kHeight, {}, &timings));
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        return drawOnly ? timings.drawMs : ms;
+    };
+    bench::pairedRatio(state, [&] { return timeOne(*d.identity); }, [&] { return timeOne(*d.map); });
+    state.SetLabel(drawOnly ? "draw only" : "draw + resolve + readback");
+}
 void BM_Subdivide(benchmark::State& state) {
     Data& d = data();
     for (auto _ : state) benchmark::DoNotOptimize(codec::subdivideForMap(d.mesh, d.camera, *d.map, 0.5));
@@ -122,6 +139,7 @@ BENCHMARK(BM_GpuConventional)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuConus)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuConusSubdivided)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuDrawOnly)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GpuConusOverConventionalPaired)->Arg(0)->Arg(1)->Iterations(41)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Subdivide)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EmbreeReference)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FociFrameDensity)->Arg(1)->Arg(2)->Arg(8)->Unit(benchmark::kMillisecond);

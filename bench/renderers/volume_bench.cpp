@@ -7,9 +7,12 @@
 //   GPU rows: 512 x 512; CPU rows (the reference): 256 x 256
 //   CoNUS: two foci on the head (k = 3 and 2.5); conventional: the identity FPC
 //   framed (the default camera) and filled (closer, the volume covering the frame): see fpc()
-// Counters: hit_fraction (pixels whose ray reaches an opacity above zero) and mean_steps (samples
-// a pixel, counted on the CPU reference) explain the ratio: a focus on the volume spends more of
-// the frame's rays inside it, each of them longer than a ray through the empty border.
+// Counters: hit_fraction (pixels whose ray reaches an opacity above zero), entering_fraction (rays
+// that enter the volume's box) and mean_steps (samples a pixel, counted on the CPU reference)
+// explain the ratio: a focus on the volume spends more of the frame's rays inside it, each of them
+// longer than a ray through the empty border. ns_per_pixel, ns_per_entering_ray and ns_per_sample
+// (wall time of a frame divided by those) separate that from what the FPC machinery costs.
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -25,6 +28,7 @@
 #include "conus/renderers/context.h"
 #include "conus/renderers/volume_renderer.h"
 #include "conus/sceneio/volume_file.h"
+#include "paired.h"
 
 namespace {
 
@@ -82,21 +86,45 @@ double hitFraction(const Image& image) {
     return hits / (double(image.width) * image.height);
 }
 
-// Samples a pixel of the reference (every 4th pixel each way, outside the timing).
-double meanSteps(const Fpc& f, int width, int height) {
+// What the frame's rays cost, counted on the CPU reference with the same sampling (every
+// `stride`-th pixel each way, outside the timing): rays that enter the volume's box (take a step)
+// and samples taken, both per pixel.
+struct RayCounts {
+    double entering = 0;  // fraction of the pixels
+    double steps = 0;     // mean samples a pixel
+};
+
+RayCounts countRays(const Fpc& f, int width, int height, int stride) {
     const Volume& v = volume();
     const glm::vec2 range = codec::renderRange(v, {});
-    double sum = 0, count = 0;
-    for (int y = 0; y < height; y += 4)
-        for (int x = 0; x < width; x += 4) {
+    double entering = 0, steps = 0, count = 0;
+    for (int y = 0; y < height; y += stride)
+        for (int x = 0; x < width; x += stride) {
             const glm::dvec2 pd((x + 0.5) / width, (y + 0.5) / height);
-            int steps = 0;
+            int n = 0;
             codec::castVolumeRay(v, transfer(), f.camera(), f.distortion() ? f.distortion()->undistort(pd) : pd,
-                                 codec::pixelJitter(x, y), range, {}, &steps);
-            sum += steps;
+                                 codec::pixelJitter(x, y), range, {}, &n);
+            steps += n;
+            entering += n > 0;
             ++count;
         }
-    return sum / count;
+    return {entering / count, steps / count};
+}
+
+// The counters that take the frame's work out of the ratio: time a pixel, a ray that enters the
+// volume, and a sample. CoNUS and conventional frames of the same size differ in how many rays
+// enter and how long they are; what a sample costs is what the FPC machinery could add.
+void setCostCounters(benchmark::State& state, double frameMs, const RayCounts& rays, int width, int height) {
+    const double pixels = double(width) * height;
+    state.counters["entering_fraction"] = rays.entering;
+    state.counters["mean_steps"] = rays.steps;
+    state.counters["ns_per_pixel"] = frameMs * 1e6 / pixels;
+    state.counters["ns_per_entering_ray"] = frameMs * 1e6 / (rays.entering * pixels);
+    state.counters["ns_per_sample"] = frameMs * 1e6 / (rays.steps * pixels);
+}
+
+double millisecondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 void runGpu(benchmark::State& state, bool conus, bool filled = false) {
@@ -106,17 +134,20 @@ void runGpu(benchmark::State& state, bool conus, bool filled = false) {
     const Fpc f = fpc(conus, w, h, filled);
     Image last = renderer.render(f, w, h, {});  // compile the shader outside the timing
     gl::GpuTimings sum, t;
+    const auto start = std::chrono::steady_clock::now();
     for (auto _ : state) {
         last = renderer.render(f, w, h, {}, &t);
         sum.uploadMs += t.uploadMs;
         sum.drawMs += t.drawMs;
         sum.readbackMs += t.readbackMs;
     }
+    const double frameMs = millisecondsSince(start) / static_cast<double>(state.iterations());
     const auto avg = benchmark::Counter::kAvgIterations;
     state.counters["upload_ms"] = benchmark::Counter(sum.uploadMs, avg);
     state.counters["draw_ms"] = benchmark::Counter(sum.drawMs, avg);
     state.counters["readback_ms"] = benchmark::Counter(sum.readbackMs, avg);
     state.counters["hit_fraction"] = hitFraction(last);
+    setCostCounters(state, frameMs, countRays(f, w, h, 4), w, h);
     state.SetLabel(context()->renderer());
 }
 
@@ -124,9 +155,34 @@ void runCpu(benchmark::State& state, bool conus, bool filled = false) {
     const int w = 256, h = 256;
     const Fpc f = fpc(conus, w, h, filled);
     Image last;
+    const auto start = std::chrono::steady_clock::now();
     for (auto _ : state) last = codec::renderVolumeReference(volume(), transfer(), f, w, h);
+    const double frameMs = millisecondsSince(start) / static_cast<double>(state.iterations());
     state.counters["hit_fraction"] = hitFraction(last);
-    state.counters["mean_steps"] = meanSteps(f, w, h);
+    setCostCounters(state, frameMs, countRays(f, w, h, 1), w, h);
+}
+
+// CoNUS over conventional on the GPU, timed in interleaved pairs (paired.h); Arg 1: filled.
+// samples_ratio is what the frames' work alone predicts (mean steps, CoNUS over conventional), so
+// ratio_median / samples_ratio is the per-sample cost of the FPC machinery.
+void BM_VolumeGpuConusOverConventionalPaired(benchmark::State& state) {
+    if (!context()) return state.SkipWithError("no GL backend");
+    const bool filled = state.range(0) != 0;
+    const int w = 512, h = 512;
+    gl::VolumeRendererGpu renderer(*context(), volume(), transfer());
+    const Fpc conventional = fpc(false, w, h, filled), conus = fpc(true, w, h, filled);
+    renderer.render(conus, w, h, {});  // compile the shader outside the timing
+    const auto timeOne = [&](const Fpc& f) {
+        const auto start = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(renderer.render(f, w, h, {}));
+        return millisecondsSince(start);
+    };
+    bench::pairedRatio(state, [&] { return timeOne(conventional); }, [&] { return timeOne(conus); });
+    const double samplesRatio = countRays(conus, w, h, 4).steps / countRays(conventional, w, h, 4).steps;
+    state.counters["samples_ratio"] = samplesRatio;
+    if (state.counters.count("ratio_median"))
+        state.counters["per_sample_ratio"] = state.counters["ratio_median"] / samplesRatio;
+    state.SetLabel(filled ? "filled" : "framed");
 }
 
 void BM_VolumeGpuConventional(benchmark::State& state) { runGpu(state, false); }
@@ -140,6 +196,7 @@ void BM_VolumeCpuConusFilled(benchmark::State& state) { runCpu(state, true, true
 
 }  // namespace
 
+BENCHMARK(BM_VolumeGpuConusOverConventionalPaired)->Arg(0)->Arg(1)->Iterations(21)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VolumeGpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_VolumeGpuConus)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_VolumeCpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime();

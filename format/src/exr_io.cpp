@@ -3,6 +3,8 @@
 // conus::Error, so nothing from OpenEXR escapes this file.
 #include "exr_io.h"
 
+#include "conus/core/parallel.h"
+
 #include <ImfChannelList.h>
 #include <ImfChromaticitiesAttribute.h>
 #include <ImfIO.h>
@@ -21,12 +23,14 @@
 #include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
 #include <ImfVecAttribute.h>
+#include <ImfThreading.h>
 #include <ImfTiledInputPart.h>
 #include <openexr.h>
 #include <half.h>
 
 #include <algorithm>
 #include <cstring>
+#include <mutex>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -583,7 +587,18 @@ void checkExr(const std::string& path, const Limits& limits) {
     if (!problem.message.empty()) throw Error(problem.code, path + ": " + problem.message, {number(problem.rule)});
 }
 
+// OpenEXR (de)compresses the line blocks of one writePixels/readPixels call on its global thread
+// pool, which is empty unless someone sizes it: one thread a core, once, unless the program set
+// its own. A 1024^2 zip write was a serial tail of `conus encode` (bench/README.md "End to end").
+static void useExrThreads() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+        if (Imf::globalThreadCount() == 0) Imf::setGlobalThreadCount(threadCount(0));
+    });
+}
+
 LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool readPixels, ConusFile& out) {
+    useExrThreads();
     LoadResult result;
     ValidationReport& r = result.report;
     auto refuse = [&](const Problem& problem) {
@@ -655,6 +670,7 @@ LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool
 }
 
 void writeExrFile(AtomicFile& out, const ConusFile& file) {
+    useExrThreads();
     const Image& im = file.image;
     const std::string& path = out.destination();
     AtomicOStream stream(out);

@@ -7,10 +7,13 @@
 #include "conus/imageio/image_file.h"
 #include "conus/imageio/text.h"
 #include "oiio_module.h"
+#include "png_direct.h"
 
 namespace conus::imageio {
 
+// Plain PNG files (most photographs and renders handed to `conus encode`) need no OpenImageIO.
 ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
+    if (std::optional<ImageFile> direct = readPngDirect(path, options)) return std::move(*direct);
     return oiioFunctions().readImageFile(path, options);
 }
 

@@ -1,9 +1,30 @@
 // The backend dispatch: the ordered list and the software-rasterizer rule, written once.
 #include "conus/renderers/backend.h"
 
+#include <filesystem>
+#include <system_error>
+
 #include "conus/core/error.h"
 
 namespace conus::gl {
+
+namespace {
+
+// Whether this machine has a device node a hardware GL driver could use: a DRM render node
+// (Mesa's hardware drivers, EGL surfaceless), NVIDIA's device, or WSL's GPU. Without one, any GL
+// context is a software rasterizer, which work with a CPU path leaves anyway: deciding that here
+// spares loading Mesa and LLVM (~0.2 s of CPU and ~80 MiB for `conus encode`, bench/README.md
+// "End to end") only to read GL_RENDERER.
+bool mayHaveHardwareGpu() {
+    std::error_code ec;
+    for (const char* node : {"/dev/nvidiactl", "/dev/nvidia0", "/dev/dxg"})
+        if (std::filesystem::exists(node, ec)) return true;
+    for (std::filesystem::directory_iterator it("/dev/dri", ec), end; !ec && it != end; it.increment(ec))
+        if (it->path().filename().string().rfind("renderD", 0) == 0) return true;
+    return false;
+}
+
+}  // namespace
 
 bool isSoftwareRasterizer(const std::string& renderer) {
     for (const char* name : {"llvmpipe", "softpipe", "swrast"})
@@ -21,6 +42,7 @@ Device Device::choose(Backend requested, CpuPath cpuPath, const std::string& wor
     }
     if (requested != Backend::Auto || cpuPath == CpuPath::None)
         return on(Context::create(requested));  // asked for by name, or GL is the only way: its failure is an error
+    if (!mayHaveHardwareGpu()) return cpu();
     try {
         std::shared_ptr<Context> context = Context::create(Backend::Auto);
         if (!prefersCpu(*context)) return on(std::move(context));

@@ -6,7 +6,7 @@
 //   gets R,G,B(,A), or Y(,A) for grey, whatever order the image holds them in (1 to 64 channels).
 // - Colour (core/color.h): images in memory hold linear light with associated alpha. Reading
 //   converts display-referred files (8/16-bit, sRGB or untagged) to linear through OpenImageIO's
-//   colour conversion; linear and float files stay as they are; `raw` data is never converted.
+//   colour conversion (plain PNGs, read with libpng: the sRGB formula, within 1.4e-5 of it); linear and float files stay as they are; `raw` data is never converted.
 //   Writing an integer format encodes sRGB again (or restores the source's encoding); float
 //   formats stay linear. Only colour channels (R, G, B, Y) are converted; A, Z and others never.
 // - Sizes are checked against the library limits before any pixel is allocated.
