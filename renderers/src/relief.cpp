@@ -65,6 +65,17 @@ struct DepthTextures {
     }
 };
 
+// One full-screen triangle into the bound width x height framebuffer, without depth test: the
+// fragment shader runs once for every pixel.
+void drawFullScreen(const GladGLContext& gl, Context& context, int width, int height) {
+    gl.Viewport(0, 0, width, height);
+    gl.Disable(GL_DEPTH_TEST);
+    gl.BindVertexArray(context.impl().emptyVertexArray);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl.BindVertexArray(0);
+    checkGl(gl, kWhat);
+}
+
 void setDepthView(const GladGLContext& gl, GLuint program, const codec::DepthImage& image) {
     const Camera& camera = image.camera();
     const glm::dmat4 toNdc = camera.worldToNdcMatrix();
@@ -139,12 +150,7 @@ std::vector<std::optional<codec::DepthHit>> intersectRays(Context& context, cons
     gl.Uniform1f(gl.GetUniformLocation(program, "uTMax"), static_cast<float>(std::min(options.tMax, 1e30)));
     gl.Uniform1i(gl.GetUniformLocation(program, "uOrigins"), 2);
     gl.Uniform1i(gl.GetUniformLocation(program, "uDirections"), 3);
-    gl.Viewport(0, 0, width, height);
-    gl.Disable(GL_DEPTH_TEST);
-    gl.BindVertexArray(context.impl().emptyVertexArray);
-    gl.DrawArrays(GL_TRIANGLES, 0, 3);
-    gl.BindVertexArray(0);
-    checkGl(gl, kWhat);
+    drawFullScreen(gl, context, width, height);
 
     std::array<std::vector<float>, 4> out;
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
@@ -237,12 +243,7 @@ struct ReliefRenderer::Impl {
         gl.Uniform1f(gl.GetUniformLocation(program, "uAmbient"), look.ambient);
         gl.Uniform1i(gl.GetUniformLocation(program, "uShadows"), look.shadows ? 1 : 0);
         gl.Uniform1i(gl.GetUniformLocation(program, "uColour"), 2);
-        gl.Viewport(0, 0, w, h);
-        gl.Disable(GL_DEPTH_TEST);
-        gl.BindVertexArray(context.impl().emptyVertexArray);
-        gl.DrawArrays(GL_TRIANGLES, 0, 3);
-        gl.BindVertexArray(0);
-        checkGl(gl, kWhat);
+        drawFullScreen(gl, context, w, h);
     }
 };
 
