@@ -11,6 +11,7 @@
 #include <memory>
 #include <vector>
 
+#include "bench_context.h"
 #include "conus/codec/mesh/city.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/codec/mesh/subdivide.h"
@@ -43,8 +44,7 @@ Data& data() {
         d->map = std::make_unique<codec::SamplingMap>(gl::frameMap(gl::trackedFoci(d->camera, cars, kAspect), fo));
         d->identity = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
         d->fine = codec::subdivideForMap(d->mesh, d->camera, *d->map, 0.5);
-        const char* backend = std::getenv("CONUS_BACKEND");
-        d->context = gl::Context::create(gl::parseBackend(backend ? backend : "auto"));
+        d->context = bench::createBenchContext();
         d->renderer = std::make_unique<gl::MeshRenderer>(*d->context, d->mesh);
         d->fineRenderer = std::make_unique<gl::MeshRenderer>(*d->context, d->fine);
         // Warm up: shader compilation and the framebuffers belong to no frame.
