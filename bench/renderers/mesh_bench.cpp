@@ -60,21 +60,16 @@ void setCounters(benchmark::State& state, const Mesh& mesh) {
         benchmark::Counter(double(kWidth) * kHeight, benchmark::Counter::kIsIterationInvariantRate);
 }
 
-// Draw + resolve + readback, the mesh already uploaded (the frame loop's cost).
-void BM_GpuConventional(benchmark::State& state) {
-    Data& d = data();
-    for (auto _ : state) benchmark::DoNotOptimize(d.renderer->render(d.camera, *d.identity, kWidth, kHeight));
-    setCounters(state, d.mesh);
+// Draw + resolve + readback of `renderer`, which holds `mesh` already uploaded: the frame loop's cost.
+void renderFrames(benchmark::State& state, gl::MeshRenderer& renderer, const Mesh& mesh, const codec::SamplingMap& map) {
+    const Data& d = data();
+    for (auto _ : state) benchmark::DoNotOptimize(renderer.render(d.camera, map, kWidth, kHeight));
+    setCounters(state, mesh);
 }
-void BM_GpuConus(benchmark::State& state) {
-    Data& d = data();
-    for (auto _ : state) benchmark::DoNotOptimize(d.renderer->render(d.camera, *d.map, kWidth, kHeight));
-    setCounters(state, d.mesh);
-}
+void BM_GpuConventional(benchmark::State& state) { renderFrames(state, *data().renderer, data().mesh, *data().identity); }
+void BM_GpuConus(benchmark::State& state) { renderFrames(state, *data().renderer, data().mesh, *data().map); }
 void BM_GpuConusSubdivided(benchmark::State& state) {
-    Data& d = data();
-    for (auto _ : state) benchmark::DoNotOptimize(d.fineRenderer->render(d.camera, *d.map, kWidth, kHeight));
-    setCounters(state, d.fine);
+    renderFrames(state, *data().fineRenderer, data().fine, *data().map);
 }
 // Only the draw (no readback): where the vertex distortion's cost would show.
 void BM_GpuDrawOnly(benchmark::State& state) {
