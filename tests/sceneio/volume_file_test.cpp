@@ -14,6 +14,7 @@
 
 #include "conus/core/error.h"
 #include "conus/sceneio/volume_file.h"
+#include "error_code.h"
 #include "test_dir.h"
 
 namespace conus::sceneio {
@@ -37,16 +38,7 @@ void append(std::vector<unsigned char>& bytes, T value, bool big = false) {
     bytes.insert(bytes.end(), b, b + sizeof(T));
 }
 
-ErrorCode codeOf(const std::function<void()>& fn, std::string* message = nullptr) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        if (message) *message = e.what();
-        return e.code();
-    }
-    ADD_FAILURE() << "no conus::Error thrown";
-    return ErrorCode::Unsupported;
-}
+using test::codeOf;
 
 TEST(RawVolume, Float32LittleAndBigEndianWithSpacing) {
     TestDir dir("volume");
