@@ -53,18 +53,13 @@ CommandPart commandPart(CLI::App* (*declare)(CLI::App& parent, Options& options)
 Command addCommandGroup(CLI::App& parent, const std::string& name, const std::string& description,
                         std::initializer_list<CommandPart> parts);
 
-Command addEncodeCommand(CLI::App& root);
-Command addUniformCommand(CLI::App& root);
-Command addDecodeCommand(CLI::App& root);
-Command addInfoCommand(CLI::App& root);
-Command addValidateCommand(CLI::App& root);
-Command addDemoCommand(CLI::App& root);
-Command addMapCommand(CLI::App& root);
-Command addHeightFieldCommand(CLI::App& root);
-Command addMeshCommand(CLI::App& root);
-Command addBakeCommand(CLI::App& root);
-Command addRenderCommand(CLI::App& root);
-Command addVolumeCommand(CLI::App& root);
+// The subcommands, in the order `conus --help` lists them: the one list, which declares each
+// cmd_<name>.cpp's `Command add<Name>Command(CLI::App& root)` here and registers them in main.cpp.
+#define CONUS_CLI_COMMANDS(X) \
+    X(Encode) X(Uniform) X(Decode) X(Info) X(Validate) X(Demo) X(Map) X(HeightField) X(Mesh) X(Volume) X(Bake) X(Render)
+#define CONUS_CLI_DECLARE_COMMAND(Name) Command add##Name##Command(CLI::App& root);
+CONUS_CLI_COMMANDS(CONUS_CLI_DECLARE_COMMAND)
+#undef CONUS_CLI_DECLARE_COMMAND
 
 // A frame of a CoNUS height field from a camera "x,y,z,lx,ly,lz,fovDeg" (empty: the ground map's
 // own viewer), rendered with GL: what `decode` does for height fields and `heightfield render` does.
