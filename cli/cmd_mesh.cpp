@@ -28,6 +28,7 @@
 #include "conus/codec/mesh/subdivide.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/renderers/mesh_render.h"
 #include "conus/renderers/mesh_sequence.h"
@@ -214,7 +215,7 @@ void addSharedOptions(CLI::App& command, MeshOptions& o, bool withCamera) {
         ->check(finiteRange(0, 1));
     command.add_option("--track-k", o.trackK, "--track: each focus's magnification")
         ->capture_default_str()
-        ->check(finiteRange(1, 64, true));
+        ->check(finiteRange(1, map_rules::kMaxMagnification, true));
     command.add_option("--compose", o.compose, "how foci combine: density | add")
         ->capture_default_str()
         ->check(CLI::IsMember({"density", "add"}));
