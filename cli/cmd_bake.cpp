@@ -173,7 +173,7 @@ int runBakeReflection(const ReflectionBakeText& o) {
     return 0;
 }
 
-void addBakeReflection(CLI::App& command, ReflectionBakeText& o) {
+CLI::App* addBakeReflection(CLI::App& command, ReflectionBakeText& o) {
     CLI::App* reflection = addSubcommand(
         command, "reflection",
         "A mesh seen from a reflector's centre -> six CoNUS colour + depth faces (a reflection asset)",
@@ -188,59 +188,58 @@ void addBakeReflection(CLI::App& command, ReflectionBakeText& o) {
     reflection->add_option("--roi-min", o.roiMin, "region of interest, lowest corner x,y,z (default: the whole scene)");
     reflection->add_option("--roi-max", o.roiMax, "region of interest, highest corner x,y,z");
     reflection->add_flag("--uniform", o.uniform, "identity maps: the conventional asset of the same texel count");
-    addQuietOption(*reflection);
+    return reflection;
+}
+
+CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
+    CLI::App* relief = addSubcommand(
+        command, "relief", "A height field plus colour -> an orthographic CoNUS depth image (relief asset)",
+        {"conus bake relief tablet -o tablet.exr --size 256x192",
+         "conus bake relief tablet --text 'HELLO|WORLD' --uniform -o tablet-uniform.exr --size 256x192",
+         "conus bake relief dem.tif --height-scale 0.1 --colour ortho.png -o relief.exr --focus 0.5,0.5,0.1,4"});
+    relief->add_option("source", o.source,
+                       "'tablet' (the engraved tablet made in code) or a height field: 16-bit PNG/TIFF, float EXR, "
+                       ".npy, .npz or procedural[:SIZE[:SEED]]")
+        ->required();
+    relief->add_option("-o,--output", o.output, "relief asset (.exr)")->required();
+    relief->add_option("--size", o.sizeText, "CoNUS image size WxH (default: a quarter of each side)");
+    relief->add_option("--focus", o.foci, "focus u,v,r,k (repeatable): magnify these discs");
+    relief->add_option("--importance", o.importance,
+                       "detail (default) | faces | an importance image: where the samples go")
+        ->excludes("--focus");
+    relief->add_flag("--uniform", o.uniform, "bake the conventional asset (identity map), the baseline")
+        ->excludes("--focus")
+        ->excludes("--importance");
+    relief->add_option("--grid", o.grid, "sampling-map nodes per side")->capture_default_str();
+    relief->add_option("--min-density", o.minDensity,
+                       "with importance: density kept everywhere (the tablet: 0.7 gains 3.5 dB on the text for "
+                       "0.5 dB elsewhere, bench/README.md)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1));
+    relief->add_option("--max-density", o.maxDensity, "with importance: cap on the density")
+        ->capture_default_str()
+        ->check(finiteRange(1, 1e6));
+    relief->add_option("--text", o.text, "tablet: the inscription, lines split at '|'")->capture_default_str();
+    relief->add_option("--tablet-size", o.tabletSize, "tablet: full-resolution height field WxH")
+        ->capture_default_str();
+    relief->add_option("--width", o.width, "the field's width in world units (its depth follows the aspect)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e9));
+    relief->add_option("--height-scale", o.heightScale, "multiplies a height file's values")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e9));
+    relief->add_option("--colour,--color", o.colour, "colour image (default: a ramp by height and slope)");
+    relief->add_option("--compression", o.compression, "zip | piz | dwaa | none")
+        ->capture_default_str()
+        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
+    return relief;
 }
 
 }  // namespace
 
 Command addBakeCommand(CLI::App& root) {
-    auto o = std::make_shared<BakeOptions>();
-    CLI::App* command = root.add_subcommand("bake", "Bake assets for ray intersection (relief)");
-    command->require_subcommand(1);
-    CLI::App* relief = addSubcommand(
-        *command, "relief", "A height field plus colour -> an orthographic CoNUS depth image (relief asset)",
-        {"conus bake relief tablet -o tablet.exr --size 256x192",
-         "conus bake relief tablet --text 'HELLO|WORLD' --uniform -o tablet-uniform.exr --size 256x192",
-         "conus bake relief dem.tif --height-scale 0.1 --colour ortho.png -o relief.exr --focus 0.5,0.5,0.1,4"});
-    relief->add_option("source", o->source,
-                       "'tablet' (the engraved tablet made in code) or a height field: 16-bit PNG/TIFF, float EXR, "
-                       ".npy, .npz or procedural[:SIZE[:SEED]]")
-        ->required();
-    relief->add_option("-o,--output", o->output, "relief asset (.exr)")->required();
-    relief->add_option("--size", o->sizeText, "CoNUS image size WxH (default: a quarter of each side)");
-    relief->add_option("--focus", o->foci, "focus u,v,r,k (repeatable): magnify these discs");
-    relief->add_option("--importance", o->importance,
-                       "detail (default) | faces | an importance image: where the samples go")
-        ->excludes("--focus");
-    relief->add_flag("--uniform", o->uniform, "bake the conventional asset (identity map), the baseline")
-        ->excludes("--focus")
-        ->excludes("--importance");
-    relief->add_option("--grid", o->grid, "sampling-map nodes per side")->capture_default_str();
-    relief->add_option("--min-density", o->minDensity,
-                       "with importance: density kept everywhere (the tablet: 0.7 gains 3.5 dB on the text for "
-                       "0.5 dB elsewhere, bench/README.md)")
-        ->capture_default_str()
-        ->check(finiteRange(0, 1));
-    relief->add_option("--max-density", o->maxDensity, "with importance: cap on the density")
-        ->capture_default_str()
-        ->check(finiteRange(1, 1e6));
-    relief->add_option("--text", o->text, "tablet: the inscription, lines split at '|'")->capture_default_str();
-    relief->add_option("--tablet-size", o->tabletSize, "tablet: full-resolution height field WxH")
-        ->capture_default_str();
-    relief->add_option("--width", o->width, "the field's width in world units (its depth follows the aspect)")
-        ->capture_default_str()
-        ->check(finiteRange(0, 1e9));
-    relief->add_option("--height-scale", o->heightScale, "multiplies a height file's values")
-        ->capture_default_str()
-        ->check(finiteRange(0, 1e9));
-    relief->add_option("--colour,--color", o->colour, "colour image (default: a ramp by height and slope)");
-    relief->add_option("--compression", o->compression, "zip | piz | dwaa | none")
-        ->capture_default_str()
-        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
-    addQuietOption(*relief);
-    auto r = std::make_shared<ReflectionBakeText>();
-    addBakeReflection(*command, *r);
-    return {command, [o, r, relief] { return relief->parsed() ? runBakeRelief(*o) : runBakeReflection(*r); }};
+    return addCommandGroup(root, "bake", "Bake assets for ray intersection (relief, reflection)",
+                           {commandPart(addBakeRelief, runBakeRelief), commandPart(addBakeReflection, runBakeReflection)});
 }
 
 }  // namespace conus::cli

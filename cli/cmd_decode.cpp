@@ -119,28 +119,28 @@ int runDecode(const DecodeCommandOptions& o) {
     return runConversions(o.batch, [&o](const Job& job) { return decodeOne(o, job.input, job.output); });
 }
 
-}  // namespace
-
-Command addDecodeCommand(CLI::App& root) {
-    auto options = std::make_shared<DecodeCommandOptions>();
+CLI::App* declareDecode(CLI::App& root, DecodeCommandOptions& options) {
     CLI::App* command = addSubcommand(root, "decode", "Reconstruct a conventional frame from a CoNUS file: zoom and pan anywhere",
         {"conus decode photo.exr -o photo.png                          # the whole frame at source size",
          "conus decode photo.exr -o face.png --view 0.36,0.15,0.52,0.31  # zoomed on a focus",
          "conus decode hdr.exr -o hdr.png --exposure -1 --tonemap aces --size 1920x1080",
          "conus decode exr/*.exr --out-dir views/ --name '{stem}-face.jpg' --view 0.36,0.15,0.52,0.31"});
-    addBatchOptions(*command, options->batch, "CoNUS file (.exr)", "output image (.png, .jpg, .tif, .exr, .bmp, ...)", "{stem}.png");
-    command->add_option("--view", options->viewText,
+    addBatchOptions(*command, options.batch, "CoNUS file (.exr)", "output image (.png, .jpg, .tif, .exr, .bmp, ...)", "{stem}.png");
+    command->add_option("--view", options.viewText,
                         "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image; "
                         "outside [0,1] shows the background)");
-    command->add_option("--size", options->sizeText,
+    command->add_option("--size", options.sizeText,
                         "output size WxH (default: the view at the source's resolution)");
-    command->add_option("--camera", options->cameraText,
+    command->add_option("--camera", options.cameraText,
                         "height fields: render a 3-D frame from x,y,z,lx,ly,lz,fovDeg (eye, look-at, vertical fov; "
                         "world metres) instead of a 2-D view; 'viewer' is the ground map's own viewer");
-    addPictureOptions(*command, options->picture);
-    addBackendOption(*command, options->backend);
-    addQuietOption(*command);
-    return {command, [options] { return runDecode(*options); }};
+    addPictureOptions(*command, options.picture);
+    addBackendOption(*command, options.backend);
+    return command;
 }
+
+}  // namespace
+
+Command addDecodeCommand(CLI::App& root) { return defineCommand(root, declareDecode, runDecode); }
 
 }  // namespace conus::cli

@@ -188,27 +188,27 @@ int runDemo(const DemoOptions& o) {
     return 0;
 }
 
-}  // namespace
-
-Command addDemoCommand(CLI::App& root) {
-    auto options = std::make_shared<DemoOptions>();
+CLI::App* declareDemo(CLI::App& root, DemoOptions& options) {
     CLI::App* command = addSubcommand(root, "demo", "The main job on a built-in picture: CoNUS vs uniform at 1/16 of the pixels, with PSNR",
         {"conus demo                                   # the built-in 4096x4096 picture, two foci",
          "conus demo --input photo.jpg --focus 0.42,0.31,0.08,4 --out my-demo",
          "conus demo --input portrait.jpg --importance faces"});
-    command->add_option("--out", options->out, "folder for the pictures and files (default demo-out)");
-    command->add_option("--size", options->size, "side of the built-in picture (default 4096)")
+    command->add_option("--out", options.out, "folder for the pictures and files (default demo-out)");
+    command->add_option("--size", options.size, "side of the built-in picture (default 4096)")
         ->check(CLI::Range(256, 8192));
-    command->add_option("--k", options->k, "magnification of both foci (default 4)")->check(CLI::Range(1.0, 8.0));
-    command->add_option("--input", options->input,
+    command->add_option("--k", options.k, "magnification of both foci (default 4)")->check(CLI::Range(1.0, 8.0));
+    command->add_option("--input", options.input,
                         "run the same comparison on your own picture instead of the built-in one");
-    command->add_option("--focus", options->foci, "with --input: focus u,v,r,k (repeatable; default: the centre)");
-    command->add_option("--importance", options->importance,
+    command->add_option("--focus", options.foci, "with --input: focus u,v,r,k (repeatable; default: the centre)");
+    command->add_option("--importance", options.importance,
                         "with --input: build the map automatically from importance (a file, 'detail' or 'faces') "
                         "instead of foci; --focus then only names the views to compare");
-    addBackendOption(*command, options->backend);
-    addQuietOption(*command);
-    return {command, [options] { return runDemo(*options); }};
+    addBackendOption(*command, options.backend);
+    return command;
 }
+
+}  // namespace
+
+Command addDemoCommand(CLI::App& root) { return defineCommand(root, declareDemo, runDemo); }
 
 }  // namespace conus::cli

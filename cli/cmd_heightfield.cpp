@@ -95,46 +95,47 @@ struct EncodeOptions {
     int grid = 129;
 };
 
-void addEncodeOptions(CLI::App& encode, const std::shared_ptr<EncodeOptions>& o) {
-    encode.add_option("dem", o->dem,
+CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
+    CLI::App& encode = *command.add_subcommand("encode", "Sample a DEM through the perspective ground map");
+    encode.add_option("dem", o.dem,
                       "DEM: 16-bit PNG/TIFF (read as [0,1]: give --height-scale), float EXR, .npy, .npz "
                       "(e.g. matplotlib's jacksboro_fault_dem.npz) or procedural[:SIZE[:SEED]]")
         ->required();
-    encode.add_option("-o,--output", o->output, "CoNUS file (.exr)")->required();
-    encode.add_option("--size", o->sizeText, "CoNUS image size WxH")->capture_default_str();
+    encode.add_option("-o,--output", o.output, "CoNUS file (.exr)")->required();
+    encode.add_option("--size", o.sizeText, "CoNUS image size WxH")->capture_default_str();
     // The ground map's own ranges (ground_map.h), checked here so a bad value is a usage error.
-    encode.add_option("--eye-height", o->eyeHeight, "viewer's eye above the base plane, metres")
+    encode.add_option("--eye-height", o.eyeHeight, "viewer's eye above the base plane, metres")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9));
-    encode.add_option("--near", o->near, "distance from the viewer to the field's near edge, metres")
+    encode.add_option("--near", o.near, "distance from the viewer to the field's near edge, metres")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9, true));
-    CLI::Option* far = encode.add_option("--far", o->far,
+    CLI::Option* far = encode.add_option("--far", o.far,
                                          "distance to the far edge, metres, beyond --near (default: near + the DEM's "
                                          "depth when the file gives its spacing, else 6000)")
                            ->check(finiteRange(0, 1e9));
-    encode.add_option("--fov", o->fov,
+    encode.add_option("--fov", o.fov,
                       "horizontal field of view at the far edge, degrees; sets the field's width (default: the "
                       "DEM's own width when known, else 60)")
         ->check(finiteRange(0, 170));
-    encode.callback([o, far] {
-        if (far->count() > 0 && !(o->far > o->near)) {
+    encode.callback([&o, far] {
+        if (far->count() > 0 && !(o.far > o.near)) {
             std::ostringstream why;
-            why << o->far << " is not beyond --near " << o->near;
+            why << o.far << " is not beyond --near " << o.near;
             throw CLI::ValidationError("--far", why.str());
         }
     });
-    encode.add_option("--grid", o->grid, "sampling-map nodes per side stored in the file")->capture_default_str();
-    encode.add_option("--height-scale", o->heightScale, "multiplies the DEM's values (to metres)")
+    encode.add_option("--grid", o.grid, "sampling-map nodes per side stored in the file")->capture_default_str();
+    encode.add_option("--height-scale", o.heightScale, "multiplies the DEM's values (to metres)")
         ->capture_default_str();
-    encode.add_option("--colour,--color", o->colour, "colour texture (default: a ramp by height and slope)");
-    encode.add_option("--compression", o->compression, "zip | piz | dwaa | none")
+    encode.add_option("--colour,--color", o.colour, "colour texture (default: a ramp by height and slope)");
+    encode.add_option("--compression", o.compression, "zip | piz | dwaa | none")
         ->capture_default_str()
         ->check(CLI::IsMember(format::namesOf<format::Compression>()));
-    addQuietOption(encode);
     setExamples(encode, {"conus heightfield encode procedural -o terrain.exr",
                        "conus heightfield encode dem.tif --height-scale 800 -o terrain.exr --size 1024x1024 --eye-height 150",
                        "conus heightfield encode jacksboro_fault_dem.npz --colour ortho.png -o terrain.exr"});
+    return &encode;
 }
 
 // The ground map: the options as given, the DEM's own size in metres where the user left
@@ -151,7 +152,7 @@ codec::GroundParams groundFor(const EncodeOptions& o, const Dem& dem) {
     return ground;
 }
 
-void runEncode(const EncodeOptions& o) {
+int runEncode(const EncodeOptions& o) {
     Progress loading("read " + o.dem);
     const Dem dem = readDem(o.dem, o.heightScale);
     loading.done();
@@ -176,6 +177,7 @@ void runEncode(const EncodeOptions& o) {
                 o.output.c_str(), file.image.width, file.image.height, dem.description.c_str(), extent.x, extent.y,
                 options.ground.eyeHeight, options.ground.near, options.ground.far, options.ground.fovDegrees,
                 file.depth.near, file.depth.far);
+    return 0;
 }
 
 // ---- render ----
@@ -185,7 +187,8 @@ struct RenderOptions {
     double heightScale = 1;
 };
 
-void addRenderOptions(CLI::App& render, RenderOptions& o) {
+CLI::App* addRender(CLI::App& command, RenderOptions& o) {
+    CLI::App& render = *command.add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
     render.add_option("input", o.input, "CoNUS height field (.exr)")->required();
     render.add_option("-o,--output", o.frame, "frame (.png, .exr, ...)")->required();
     render.add_option("--camera", o.cameraText,
@@ -198,10 +201,10 @@ void addRenderOptions(CLI::App& render, RenderOptions& o) {
     render.add_option("--height-scale", o.heightScale, "as given to encode (for --compare)")->capture_default_str();
     render.add_option("--colour,--color", o.colour, "as given to encode (for --compare)");
     addBackendOption(render, o.backend, gl::CpuPath::None);
-    addQuietOption(render);
     setExamples(render, {"conus heightfield render terrain.exr -o frame.png",
                        "conus heightfield render terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720",
                        "conus heightfield render terrain.exr -o compare.png --compare procedural"});
+    return &render;
 }
 
 // The DEM resampled uniformly to columns x rows, rendered as `frame` was.
@@ -228,16 +231,20 @@ void writeComparison(gl::Context& context, const RenderOptions& o, const format:
                 codec::psnr(uniform, full));
 }
 
-void runRender(const RenderOptions& o) {
+int runRender(const RenderOptions& o) {
     const format::ConusFile file = format::readConusFile(o.input);
     const Size size = parseSize(o.frameSize);
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::None, "terrain rendering");
     gl::Context& context = device.context();
     const Frame frame = renderFrame(context, file, o.input, o.cameraText, size, "undistort and render");
-    if (!o.compare.empty()) return writeComparison(context, o, file, frame);
+    if (!o.compare.empty()) {
+        writeComparison(context, o, file, frame);
+        return 0;
+    }
     writePicture(o.frame, frame.image);
     std::printf("wrote %s: %dx%d frame (%s)\n", o.frame.c_str(), frame.image.width, frame.image.height,
                 context.renderer().c_str());
+    return 0;
 }
 
 }  // namespace
@@ -251,20 +258,9 @@ Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& c
 }
 
 Command addHeightFieldCommand(CLI::App& root) {
-    auto encodeOptions = std::make_shared<EncodeOptions>();
-    auto renderOptions = std::make_shared<RenderOptions>();
-    CLI::App* command = root.add_subcommand(
-        "heightfield", "CoNUS height fields: sample a DEM densely near a viewer (encode), render it (render)");
-    command->require_subcommand(1);
-    CLI::App* encode = command->add_subcommand("encode", "Sample a DEM through the perspective ground map");
-    addEncodeOptions(*encode, encodeOptions);
-    CLI::App* render = command->add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
-    addRenderOptions(*render, *renderOptions);
-    return {command, [encodeOptions, renderOptions, encode] {
-                if (encode->parsed()) runEncode(*encodeOptions);
-                else runRender(*renderOptions);
-                return 0;
-            }};
+    return addCommandGroup(root, "heightfield",
+                           "CoNUS height fields: sample a DEM densely near a viewer (encode), render it (render)",
+                           {commandPart(addEncode, runEncode), commandPart(addRender, runRender)});
 }
 
 }  // namespace conus::cli

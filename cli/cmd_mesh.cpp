@@ -28,6 +28,7 @@
 #include "conus/codec/mesh/subdivide.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/renderers/mesh_render.h"
 #include "conus/renderers/mesh_sequence.h"
@@ -214,7 +215,7 @@ void addSharedOptions(CLI::App& command, MeshOptions& o, bool withCamera) {
         ->check(finiteRange(0, 1));
     command.add_option("--track-k", o.trackK, "--track: each focus's magnification")
         ->capture_default_str()
-        ->check(finiteRange(1, 64, true));
+        ->check(finiteRange(1, map_rules::kMaxMagnification, true));
     command.add_option("--compose", o.compose, "how foci combine: density | add")
         ->capture_default_str()
         ->check(CLI::IsMember({"density", "add"}));
@@ -231,7 +232,6 @@ void addSharedOptions(CLI::App& command, MeshOptions& o, bool withCamera) {
         ->check(CLI::Range(1, 64));
     command.add_option("--units", o.units, "the model's length unit, recorded as the depth's units")->capture_default_str();
     addBackendOption(command, o.backend, gl::CpuPath::Available);
-    addQuietOption(command);
 }
 
 // --- render -----------------------------------------------------------------------------------
@@ -437,49 +437,52 @@ int runAnimate(const AnimateOptions& a) {
     return 0;
 }
 
-}  // namespace
-
-Command addMeshCommand(CLI::App& root) {
-    auto r = std::make_shared<RenderOptions>();
-    auto a = std::make_shared<AnimateOptions>();
-    CLI::App* command = root.add_subcommand(
-        "mesh", "Triangle meshes through the flexible pinhole camera: CoNUS colour + depth images, focus-plus-context sequences");
-    command->require_subcommand(1);
-
+CLI::App* addRender(CLI::App& command, RenderOptions& r) {
     CLI::App* render = addSubcommand(
-        *command, "render", "Render a mesh (OBJ, PLY, STL, glTF, ... or `city`) as a CoNUS colour + depth image",
+        command, "render", "Render a mesh (OBJ, PLY, STL, glTF, ... or `city`) as a CoNUS colour + depth image",
         {"conus mesh render bunny.ply -o bunny.exr --focus 0.45,0.4,0.1,4",
          "conus mesh render model.obj -o model.exr --size 1024x1024 --camera 0,1,3,0,0,0,40 --max-edge 0.25",
          "conus mesh render city -o city.exr --track 0,2 --time 3.5 --reference"});
-    render->add_option("model", r->mesh.model, "mesh file (anything Assimp reads) or `city` (the procedural city)")->required();
-    render->add_option("-o,--output", r->output, "CoNUS file (.exr): R, G, B, A (coverage), Z (camera depth)")->required();
-    render->add_option("--focus", r->foci, "focus u,v,r,k (repeatable): centre, radius (fraction of the width), magnification");
-    render->add_option("--map", r->mapFile, "take the sampling map from this CoNUS file")->excludes("--focus");
-    render->add_option("--track", r->mesh.track, "city: foci on these cars' projected centres (e.g. 0,2)")
+    render->add_option("model", r.mesh.model, "mesh file (anything Assimp reads) or `city` (the procedural city)")->required();
+    render->add_option("-o,--output", r.output, "CoNUS file (.exr): R, G, B, A (coverage), Z (camera depth)")->required();
+    render->add_option("--focus", r.foci, "focus u,v,r,k (repeatable): centre, radius (fraction of the width), magnification");
+    render->add_option("--map", r.mapFile, "take the sampling map from this CoNUS file")->excludes("--focus");
+    render->add_option("--track", r.mesh.track, "city: foci on these cars' projected centres (e.g. 0,2)")
         ->delimiter(',')
         ->excludes("--map");
-    render->add_flag("--uniform", r->uniform, "the identity map: the conventional image of the same pixel count")
+    render->add_flag("--uniform", r.uniform, "the identity map: the conventional image of the same pixel count")
         ->excludes("--focus")
         ->excludes("--map")
         ->excludes("--track");
-    render->add_flag("--reference", r->reference, "the exact CPU reference (Embree ray casting) instead of the GPU");
-    addSharedOptions(*render, r->mesh, true);
+    render->add_flag("--reference", r.reference, "the exact CPU reference (Embree ray casting) instead of the GPU");
+    addSharedOptions(*render, r.mesh, true);
+    return render;
+}
 
+CLI::App* addAnimate(CLI::App& command, AnimateOptions& a) {
     CLI::App* animate = addSubcommand(
-        *command, "animate", "Render the city's focus-plus-context sequence: foci follow moving cars (paper section 6)",
+        command, "animate", "Render the city's focus-plus-context sequence: foci follow moving cars (paper section 6)",
         {"conus mesh animate city --frames 24 --out-dir frames --track 0,2",
          "conus mesh animate city --frames 48 --fps 24 --out-dir frames --track 1,3,4 --track-k 5 --size 640x360"});
-    animate->add_option("model", a->mesh.model, "`city`")->required();
-    animate->add_option("--frames", a->frames, "number of frames")->capture_default_str()->check(CLI::Range(1, 100000));
-    animate->add_option("--fps", a->fps, "frames a second of city time (and of the MP4)")
+    animate->add_option("model", a.mesh.model, "`city`")->required();
+    animate->add_option("--frames", a.frames, "number of frames")->capture_default_str()->check(CLI::Range(1, 100000));
+    animate->add_option("--fps", a.fps, "frames a second of city time (and of the MP4)")
         ->capture_default_str()
         ->check(finiteRange(0, 1000));
-    animate->add_option("--out-dir", a->outDir, "folder for frame_NNNN.exr/.png, contact_sheet.png and sequence.mp4")->required();
-    animate->add_option("--track", a->mesh.track, "cars whose projected centres carry the foci (e.g. 0,2)")->delimiter(',');
-    animate->add_flag("!--no-video", a->video, "do not encode sequence.mp4 even when ffmpeg is on PATH");
-    addSharedOptions(*animate, a->mesh, true);
+    animate->add_option("--out-dir", a.outDir, "folder for frame_NNNN.exr/.png, contact_sheet.png and sequence.mp4")->required();
+    animate->add_option("--track", a.mesh.track, "cars whose projected centres carry the foci (e.g. 0,2)")->delimiter(',');
+    animate->add_flag("!--no-video", a.video, "do not encode sequence.mp4 even when ffmpeg is on PATH");
+    addSharedOptions(*animate, a.mesh, true);
+    return animate;
+}
 
-    return {command, [r, a, render] { return render->parsed() ? runRender(*r) : runAnimate(*a); }};
+}  // namespace
+
+Command addMeshCommand(CLI::App& root) {
+    return addCommandGroup(
+        root, "mesh",
+        "Triangle meshes through the flexible pinhole camera: CoNUS colour + depth images, focus-plus-context sequences",
+        {commandPart(addRender, runRender), commandPart(addAnimate, runAnimate)});
 }
 
 }  // namespace conus::cli

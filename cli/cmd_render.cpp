@@ -127,7 +127,7 @@ int runRenderReflection(const ReflectionRenderText& o) {
     return 0;
 }
 
-void addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
+CLI::App* addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
     CLI::App* reflection = addSubcommand(
         command, "reflection", "A specular reflector whose reflected rays intersect a reflection asset's faces",
         {"conus render reflection asset --scene scene.obj --camera 0,1,4,0,0,0,40 -o frame.png",
@@ -147,35 +147,34 @@ void addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
     reflection->add_flag("--reference", o.reference,
                          "trace reflected rays against the mesh (Embree, CPU): the ground truth");
     addBackendOption(*reflection, o.backend);
-    addQuietOption(*reflection);
+    return reflection;
+}
+
+CLI::App* addRenderRelief(CLI::App& command, RenderOptions& o) {
+    CLI::App* relief = addSubcommand(command, "relief", "Relief texture mapping: eye rays against a relief asset",
+                                     {"conus render relief tablet.exr -o frame.png",
+                                      "conus render relief tablet.exr -o frame.png --shadows --size 1280x960",
+                                      "conus render relief tablet.exr -o frame.png --camera 0.5,0.6,1.2,0.5,0,0.375,35"});
+    relief->add_option("input", o.input, "relief asset (.exr, from `conus bake relief`)")->required();
+    relief->add_option("-o,--output", o.output, "frame (.png, .exr, ...)")->required();
+    relief->add_option("--camera", o.cameraText,
+                       "x,y,z,lx,ly,lz,fovDeg: eye, look-at point (world: x right, y up, z toward the front "
+                       "edge) and vertical fov (default: from the front, above)");
+    relief->add_option("--size", o.sizeText, "frame size WxH")->capture_default_str();
+    relief->add_option("--light", o.lightText, "direction toward the light x,y,z")->capture_default_str();
+    relief->add_flag("--shadows", o.shadows, "self-shadowing: a second ray toward the light");
+    relief->add_option("--step", o.step, "linear-search step in CoNUS pixels")
+        ->capture_default_str()
+        ->check(finiteRange(0, 64));
+    addBackendOption(*relief, o.backend, gl::CpuPath::None);
+    return relief;
 }
 
 }  // namespace
 
 Command addRenderCommand(CLI::App& root) {
-    auto o = std::make_shared<RenderOptions>();
-    CLI::App* command = root.add_subcommand("render", "Render frames of baked assets (relief, reflection)");
-    command->require_subcommand(1);
-    CLI::App* relief = addSubcommand(*command, "relief", "Relief texture mapping: eye rays against a relief asset",
-                                     {"conus render relief tablet.exr -o frame.png",
-                                      "conus render relief tablet.exr -o frame.png --shadows --size 1280x960",
-                                      "conus render relief tablet.exr -o frame.png --camera 0.5,0.6,1.2,0.5,0,0.375,35"});
-    relief->add_option("input", o->input, "relief asset (.exr, from `conus bake relief`)")->required();
-    relief->add_option("-o,--output", o->output, "frame (.png, .exr, ...)")->required();
-    relief->add_option("--camera", o->cameraText,
-                       "x,y,z,lx,ly,lz,fovDeg: eye, look-at point (world: x right, y up, z toward the front "
-                       "edge) and vertical fov (default: from the front, above)");
-    relief->add_option("--size", o->sizeText, "frame size WxH")->capture_default_str();
-    relief->add_option("--light", o->lightText, "direction toward the light x,y,z")->capture_default_str();
-    relief->add_flag("--shadows", o->shadows, "self-shadowing: a second ray toward the light");
-    relief->add_option("--step", o->step, "linear-search step in CoNUS pixels")
-        ->capture_default_str()
-        ->check(finiteRange(0, 64));
-    addBackendOption(*relief, o->backend, gl::CpuPath::None);
-    addQuietOption(*relief);
-    auto r = std::make_shared<ReflectionRenderText>();
-    addRenderReflection(*command, *r);
-    return {command, [o, r, relief] { return relief->parsed() ? runRenderRelief(*o) : runRenderReflection(*r); }};
+    return addCommandGroup(root, "render", "Render frames of baked assets (relief, reflection)",
+                           {commandPart(addRenderRelief, runRenderRelief), commandPart(addRenderReflection, runRenderReflection)});
 }
 
 }  // namespace conus::cli

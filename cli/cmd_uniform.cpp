@@ -35,20 +35,20 @@ int runUniform(const UniformOptions& o) {
     return 0;
 }
 
-}  // namespace
-
-Command addUniformCommand(CLI::App& root) {
-    auto options = std::make_shared<UniformOptions>();
+CLI::App* declareUniform(CLI::App& root, UniformOptions& options) {
     CLI::App* command = addSubcommand(root, "uniform", "Encode with the identity map: the uniform image of the same pixel count (the baseline)",
         {"conus uniform photo.jpg -o uniform.exr                 # 1/16 of the pixels, like encode's default",
          "conus uniform photo.jpg -o uniform.exr --size 512x384",
          "conus uniform photo.png -o same.exr --size 4000x3000   # at source size: an exact round trip"});
-    command->add_option("input", options->input, "source image ('-' reads standard input)")->required();
-    command->add_option("-o,--output", options->output, "output CoNUS file (.exr)")->required();
-    addSourceOptions(*command, options->source);
-    addStorageOptions(*command, options->storage);
-    addQuietOption(*command);
-    return {command, [options] { return runUniform(*options); }};
+    command->add_option("input", options.input, "source image ('-' reads standard input)")->required();
+    command->add_option("-o,--output", options.output, "output CoNUS file (.exr)")->required();
+    addSourceOptions(*command, options.source);
+    addStorageOptions(*command, options.storage);
+    return command;
 }
+
+}  // namespace
+
+Command addUniformCommand(CLI::App& root) { return defineCommand(root, declareUniform, runUniform); }
 
 }  // namespace conus::cli

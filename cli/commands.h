@@ -6,9 +6,11 @@
 
 #include <functional>
 #include <initializer_list>
+#include <memory>
 #include <string>
 
 #include "conus/format/container.h"
+#include "progress.h"
 
 namespace CLI {
 class App;
@@ -27,18 +29,37 @@ CLI::App* addSubcommand(CLI::App& parent, const std::string& name, const std::st
                         std::initializer_list<const char*> examples);
 void setExamples(CLI::App& command, std::initializer_list<const char*> examples);
 
-Command addEncodeCommand(CLI::App& root);
-Command addUniformCommand(CLI::App& root);
-Command addDecodeCommand(CLI::App& root);
-Command addInfoCommand(CLI::App& root);
-Command addValidateCommand(CLI::App& root);
-Command addDemoCommand(CLI::App& root);
-Command addMapCommand(CLI::App& root);
-Command addHeightFieldCommand(CLI::App& root);
-Command addMeshCommand(CLI::App& root);
-Command addBakeCommand(CLI::App& root);
-Command addRenderCommand(CLI::App& root);
-Command addVolumeCommand(CLI::App& root);
+// A (sub)command whose parsed options are one `Options` value: `declare` adds the subcommand to
+// `parent` with its options bound to that value and returns it; `run` does the work once parsing is
+// done. The value lives as long as the returned Command. Every such command takes --quiet.
+template <class Options>
+Command defineCommand(CLI::App& parent, CLI::App* (*declare)(CLI::App& parent, Options& options),
+                      int (*run)(const Options& options)) {
+    auto options = std::make_shared<Options>();
+    CLI::App* app = declare(parent, *options);
+    addQuietOption(*app);
+    return {app, [options, run] { return run(*options); }};
+}
+
+// One part of a command group: a subcommand to define under the group's app (see defineCommand).
+using CommandPart = std::function<Command(CLI::App& group)>;
+template <class Options>
+CommandPart commandPart(CLI::App* (*declare)(CLI::App& parent, Options& options), int (*run)(const Options& options)) {
+    return [declare, run](CLI::App& group) { return defineCommand(group, declare, run); };
+}
+
+// A command whose work is done by exactly one of its subcommands (`conus mesh render | animate`):
+// the parts are defined under it, and running it runs the part the command line named.
+Command addCommandGroup(CLI::App& parent, const std::string& name, const std::string& description,
+                        std::initializer_list<CommandPart> parts);
+
+// The subcommands, in the order `conus --help` lists them: the one list, which declares each
+// cmd_<name>.cpp's `Command add<Name>Command(CLI::App& root)` here and registers them in main.cpp.
+#define CONUS_CLI_COMMANDS(X) \
+    X(Encode) X(Uniform) X(Decode) X(Info) X(Validate) X(Demo) X(Map) X(HeightField) X(Mesh) X(Volume) X(Bake) X(Render)
+#define CONUS_CLI_DECLARE_COMMAND(Name) Command add##Name##Command(CLI::App& root);
+CONUS_CLI_COMMANDS(CONUS_CLI_DECLARE_COMMAND)
+#undef CONUS_CLI_DECLARE_COMMAND
 
 // A frame of a CoNUS height field from a camera "x,y,z,lx,ly,lz,fovDeg" (empty: the ground map's
 // own viewer), rendered with GL: what `decode` does for height fields and `heightfield render` does.

@@ -24,14 +24,9 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", std::string(conus::format::kSoftwareName) + " (CoNUS file format version " +
                                            std::to_string(conus::format::kFormatVersion) + ")");
 
-    std::vector<conus::cli::Command> commands{
-        conus::cli::addEncodeCommand(app),   conus::cli::addUniformCommand(app),
-        conus::cli::addDecodeCommand(app),   conus::cli::addInfoCommand(app),
-        conus::cli::addValidateCommand(app), conus::cli::addDemoCommand(app),
-        conus::cli::addMapCommand(app),  conus::cli::addHeightFieldCommand(app),
-        conus::cli::addMeshCommand(app), conus::cli::addVolumeCommand(app),
-        conus::cli::addBakeCommand(app), conus::cli::addRenderCommand(app),
-    };
+#define CONUS_CLI_ADD_COMMAND(Name) conus::cli::add##Name##Command(app),
+    std::vector<conus::cli::Command> commands{CONUS_CLI_COMMANDS(CONUS_CLI_ADD_COMMAND)};
+#undef CONUS_CLI_ADD_COMMAND
 
     std::string name;
     // CLI11 would only say "a subcommand is required"; name the word it did not know instead.

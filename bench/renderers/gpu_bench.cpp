@@ -15,6 +15,7 @@
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/build/foci.h"
+#include "bench_context.h"
 #include "conus/renderers/context.h"
 #include "conus/renderers/gpu_image.h"
 
@@ -50,22 +51,8 @@ const Image& decodeSource() {
     return image;
 }
 
-// Null when no GL backend works (the GPU rows then report the error and skip).
-gl::Context* context() {
-    static std::unique_ptr<gl::Context> ctx;
-    static std::string error;
-    static bool tried = false;
-    if (!tried) {
-        tried = true;
-        const char* env = std::getenv("CONUS_BACKEND");
-        try {
-            ctx = gl::Context::create(gl::parseBackend(env ? env : "auto"));
-        } catch (const Error& e) {
-            error = e.what();
-        }
-    }
-    return ctx.get();
-}
+// Null when no GL backend works (the GPU rows then skip).
+gl::Context* context() { return bench::sharedBenchContext(); }
 
 void reportTimings(benchmark::State& state, const gl::GpuTimings& sum) {
     const auto avg = benchmark::Counter::kAvgIterations;

@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "bench_context.h"
 #include "conus/codec/mesh/city.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/codec/mesh/subdivide.h"
@@ -45,8 +46,7 @@ Data& data() {
         d->map = std::make_unique<codec::SamplingMap>(gl::frameMap(gl::trackedFoci(d->camera, cars, kAspect), fo));
         d->identity = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
         d->fine = codec::subdivideForMap(d->mesh, d->camera, *d->map, 0.5);
-        const char* backend = std::getenv("CONUS_BACKEND");
-        d->context = gl::Context::create(gl::parseBackend(backend ? backend : "auto"));
+        d->context = bench::createBenchContext();
         d->renderer = std::make_unique<gl::MeshRenderer>(*d->context, d->mesh);
         d->fineRenderer = std::make_unique<gl::MeshRenderer>(*d->context, d->fine);
         // Warm up: shader compilation and the framebuffers belong to no frame.
@@ -62,21 +62,16 @@ void setCounters(benchmark::State& state, const Mesh& mesh) {
         benchmark::Counter(double(kWidth) * kHeight, benchmark::Counter::kIsIterationInvariantRate);
 }
 
-// Draw + resolve + readback, the mesh already uploaded (the frame loop's cost).
-void BM_GpuConventional(benchmark::State& state) {
-    Data& d = data();
-    for (auto _ : state) benchmark::DoNotOptimize(d.renderer->render(d.camera, *d.identity, kWidth, kHeight));
-    setCounters(state, d.mesh);
+// Draw + resolve + readback of `renderer`, which holds `mesh` already uploaded: the frame loop's cost.
+void renderFrames(benchmark::State& state, gl::MeshRenderer& renderer, const Mesh& mesh, const codec::SamplingMap& map) {
+    const Data& d = data();
+    for (auto _ : state) benchmark::DoNotOptimize(renderer.render(d.camera, map, kWidth, kHeight));
+    setCounters(state, mesh);
 }
-void BM_GpuConus(benchmark::State& state) {
-    Data& d = data();
-    for (auto _ : state) benchmark::DoNotOptimize(d.renderer->render(d.camera, *d.map, kWidth, kHeight));
-    setCounters(state, d.mesh);
-}
+void BM_GpuConventional(benchmark::State& state) { renderFrames(state, *data().renderer, data().mesh, *data().identity); }
+void BM_GpuConus(benchmark::State& state) { renderFrames(state, *data().renderer, data().mesh, *data().map); }
 void BM_GpuConusSubdivided(benchmark::State& state) {
-    Data& d = data();
-    for (auto _ : state) benchmark::DoNotOptimize(d.fineRenderer->render(d.camera, *d.map, kWidth, kHeight));
-    setCounters(state, d.fine);
+    renderFrames(state, *data().fineRenderer, data().fine, *data().map);
 }
 // Only the draw (no readback): where the vertex distortion's cost would show.
 void BM_GpuDrawOnly(benchmark::State& state) {

@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 
+#include "bench_context.h"
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/depth/relief.h"
@@ -56,8 +57,7 @@ Data& data() {
         auto* d = new Data;
         d->ink = imageio::inscription("CoNUS|FLEXIBLE PINHOLE|CAMERA", kTabletWidth, kTabletHeight);
         d->tablet = codec::makeTablet(d->ink);
-        const char* backend = std::getenv("CONUS_BACKEND");
-        d->context = gl::Context::create(gl::parseBackend(backend ? backend : "auto"));
+        d->context = bench::createBenchContext();
         // What `conus bake relief tablet` does by default: the colour's detail decides, the rest
         // keeping 70% of its density.
         codec::AutoMapOptions options;

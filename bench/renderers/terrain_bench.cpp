@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <memory>
 
+#include "bench_context.h"
 #include "conus/codec/depth/heightfield.h"
 #include "conus/renderers/terrain.h"
 
@@ -39,8 +40,7 @@ Data& data() {
         d->uniform = codec::uniformHeightField(d->dem, d->colour, kSamples, kSamples);
         d->conusMesh = codec::undistortHeightField(d->conus);
         d->uniformMesh = codec::undistortHeightField(d->uniform, extent);
-        const char* backend = std::getenv("CONUS_BACKEND");
-        d->context = gl::Context::create(gl::parseBackend(backend ? backend : "auto"));
+        d->context = bench::createBenchContext();
         return d;
     }();
     return *d;

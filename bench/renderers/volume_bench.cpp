@@ -25,6 +25,7 @@
 #include "conus/codec/build/foci.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/codec/volume/raycast.h"
+#include "bench_context.h"
 #include "conus/renderers/context.h"
 #include "conus/renderers/volume_renderer.h"
 #include "conus/sceneio/volume_file.h"
@@ -65,19 +66,8 @@ Fpc fpc(bool conus, int width, int height, bool filled = false) {
                            {.aspect = double(width) / height})));
 }
 
-gl::Context* context() {
-    static std::unique_ptr<gl::Context> ctx;
-    static bool tried = false;
-    if (!tried) {
-        tried = true;
-        const char* env = std::getenv("CONUS_BACKEND");
-        try {
-            ctx = gl::Context::create(gl::parseBackend(env ? env : "auto"));
-        } catch (const Error&) {
-        }
-    }
-    return ctx.get();
-}
+// Null when no GL backend works (the GPU rows then skip).
+gl::Context* context() { return bench::sharedBenchContext(); }
 
 double hitFraction(const Image& image) {
     double hits = 0;

@@ -197,20 +197,28 @@ const GladGLContext& makeCurrentGl(Context& context) {
 
 namespace {
 
+// Returns when the shader `name` compiled or the program `name` linked (`status`: GL_COMPILE_STATUS or
+// GL_LINK_STATUS; the three functions the shader's or the program's); otherwise deletes it and
+// throws Unsupported with `failure` and the compiler's or linker's log.
+void throwUnlessBuilt(GLuint name, GLenum status, PFNGLGETSHADERIVPROC getParameter, PFNGLGETSHADERINFOLOGPROC getLog,
+                      PFNGLDELETESHADERPROC destroy, const std::string& failure) {
+    GLint ok = 0;
+    getParameter(name, status, &ok);
+    if (ok) return;
+    GLint length = 0;
+    getParameter(name, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+    getLog(name, length, nullptr, log.data());
+    destroy(name);
+    throw Error(ErrorCode::Unsupported, failure + ": " + log);
+}
+
 GLuint compileShader(const GladGLContext& gl, GLenum type, const char* source, const std::string& key) {
     const GLuint shader = gl.CreateShader(type);
     gl.ShaderSource(shader, 1, &source, nullptr);
     gl.CompileShader(shader);
-    GLint ok = 0;
-    gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        GLint length = 0;
-        gl.GetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
-        std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
-        gl.GetShaderInfoLog(shader, length, nullptr, log.data());
-        gl.DeleteShader(shader);
-        throw Error(ErrorCode::Unsupported, "GLSL compile failed (" + key + "): " + log);
-    }
+    throwUnlessBuilt(shader, GL_COMPILE_STATUS, gl.GetShaderiv, gl.GetShaderInfoLog, gl.DeleteShader,
+                     "GLSL compile failed (" + key + ")");
     return shader;
 }
 
@@ -234,16 +242,8 @@ GLuint cachedProgram(Context& context, const std::string& key, const char* verte
     gl.LinkProgram(program);
     gl.DeleteShader(vs);
     gl.DeleteShader(fs);
-    GLint ok = 0;
-    gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        GLint length = 0;
-        gl.GetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
-        std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
-        gl.GetProgramInfoLog(program, length, nullptr, log.data());
-        gl.DeleteProgram(program);
-        throw Error(ErrorCode::Unsupported, "GLSL link failed (" + key + "): " + log);
-    }
+    throwUnlessBuilt(program, GL_LINK_STATUS, gl.GetProgramiv, gl.GetProgramInfoLog, gl.DeleteProgram,
+                     "GLSL link failed (" + key + ")");
     impl.programs.emplace(key, program);
     return program;
 }

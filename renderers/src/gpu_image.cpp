@@ -20,15 +20,6 @@
 namespace conus::gl {
 namespace {
 
-// Each map cell is split into sub-quads so the piecewise-linear mesh follows the bilinear cell:
-// a cell of twist t = N00 - N10 - N01 + N11 (in CoNUS pixels) split s ways departs from its
-// bilinear patch by at most |t| / (4 s^2), kept under kMaxBendPixels; and no sub-quad is longer
-// than kMaxSubQuadPixels, so the per-triangle derivatives that size the filter follow the local
-// Jacobian. Finer meshes cost llvmpipe dearly (tiny triangles shade whole 2x2 quads).
-constexpr double kMaxBendPixels = 0.05;
-constexpr double kMaxSubQuadPixels = 8.0;
-// Bounds the mesh (memory and vertex work) for extreme maps; finer subdivision stops here.
-constexpr double kMaxMeshVertices = 4.0e6;
 constexpr int kChannelsPerPass = 4;
 
 
@@ -135,7 +126,16 @@ struct Mesh {
     std::vector<GLuint> indices;
 };
 
+// Each map cell is split into sub-quads so the piecewise-linear mesh follows the bilinear cell:
+// a cell of twist t = N00 - N10 - N01 + N11 (in CoNUS pixels) split s ways departs from its
+// bilinear patch by at most |t| / (4 s^2), kept under kMaxBendPixels; and no sub-quad is longer
+// than kMaxSubQuadPixels, so the per-triangle derivatives that size the filter follow the local
+// Jacobian. Finer meshes cost llvmpipe dearly (tiny triangles shade whole 2x2 quads).
 Mesh buildMesh(const codec::SamplingMap& map, int width, int height) {
+    constexpr double kMaxBendPixels = 0.05;
+    constexpr double kMaxSubQuadPixels = 8.0;
+    // Bounds the mesh (memory and vertex work) for extreme maps; finer subdivision stops here.
+    constexpr double kMaxMeshVertices = 4.0e6;
     const int n = map.columns(), m = map.rows();
     const auto pixels = [&](glm::vec2 d) { return std::hypot(double(d.x) * width, double(d.y) * height); };
     // Most splits per cell that keep the whole mesh under kMaxMeshVertices.

@@ -59,6 +59,17 @@ inline ExrRead readExr(const std::string& path) {
     return r;
 }
 
+// A camera-depth image as `conus mesh render` and `conus volume render` write it: width x height,
+// the channels R, G, B, A (coverage) and Z, the data kind and depth kind. Wrap the call in
+// ASSERT_NO_FATAL_FAILURE: a wrong size or a missing channel stops the test.
+inline void expectCameraDepthImage(const ExrRead& exr, int width, int height) {
+    ASSERT_EQ(exr.width, width);
+    ASSERT_EQ(exr.height, height);
+    for (const char* c : {"R", "G", "B", "A", "Z"}) ASSERT_TRUE(exr.channels.count(c)) << c;
+    EXPECT_EQ(exr.spec.get_string_attribute("conus:dataKind"), "depthimage");
+    EXPECT_EQ(exr.spec.get_string_attribute("conus:depthKind"), "cameraDepth");
+}
+
 // PSNR of R, G, B, A between two renders of one size (peak 1).
 inline double psnrRgb(const ExrRead& a, const ExrRead& b) {
     double se = 0;

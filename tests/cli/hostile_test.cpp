@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "conus/core/limits.h"
 #include "sanitizers.h"
 
 extern char** environ;
@@ -327,7 +328,7 @@ TEST_F(Hostile, InfoPrintsTheLimits) {
     r = run({"info", "--limits", "--json"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
-    EXPECT_EQ(j["mapSide"]["value"], 4097);
+    EXPECT_EQ(j["mapSide"]["value"], conus::kMaxMapSide);
     EXPECT_EQ(j["decodeBytes"]["unit"], "bytes");
 }
 

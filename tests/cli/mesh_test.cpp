@@ -43,11 +43,7 @@ TEST_F(Mesh, RenderWritesACameraDepthImageThatOpenImageIoReads) {
     EXPECT_NE(r.out.find("wrote"), std::string::npos);
     EXPECT_NE(r.out.find("subdivided"), std::string::npos);  // the GPU path splits long edges by default
     const ExrRead exr = readExr(path("cube.exr"));
-    ASSERT_EQ(exr.width, 96);
-    ASSERT_EQ(exr.height, 64);
-    for (const char* c : {"R", "G", "B", "A", "Z"}) ASSERT_TRUE(exr.channels.count(c)) << c;
-    EXPECT_EQ(exr.spec.get_string_attribute("conus:dataKind"), "depthimage");
-    EXPECT_EQ(exr.spec.get_string_attribute("conus:depthKind"), "cameraDepth");
+    ASSERT_NO_FATAL_FAILURE(expectCameraDepthImage(exr, 96, 64));
     EXPECT_EQ(exr.spec.get_string_attribute("conus:projection"), "perspective");
     EXPECT_NE(exr.spec.find_attribute("worldToCamera"), nullptr);
     EXPECT_NE(exr.spec.find_attribute("worldToNDC"), nullptr);

@@ -25,11 +25,7 @@ TEST_F(Volume, RenderWritesACameraDepthImage) {
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("wrote"), std::string::npos);
     const ExrRead exr = readExr(path("head.exr"));
-    ASSERT_EQ(exr.width, 80);
-    ASSERT_EQ(exr.height, 60);
-    for (const char* c : {"R", "G", "B", "A", "Z"}) ASSERT_TRUE(exr.channels.count(c)) << c;
-    EXPECT_EQ(exr.spec.get_string_attribute("conus:dataKind"), "depthimage");
-    EXPECT_EQ(exr.spec.get_string_attribute("conus:depthKind"), "cameraDepth");
+    ASSERT_NO_FATAL_FAILURE(expectCameraDepthImage(exr, 80, 60));
     const format::ConusFile file = format::readConusFile(path("head.exr"));
     ASSERT_TRUE(file.camera.has_value());
     const Camera camera = format::toCamera(*file.camera);

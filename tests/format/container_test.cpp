@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "conus/core/map_rules.h"
 #include "test_files.h"
 
 namespace conus::format {
@@ -149,7 +150,7 @@ TEST(Container, LargerImageRoundTrip) {
     ConusFile f = validFile(PixelType::Float);
     f.image = makeImage(300, 200, {"Y"});
     for (std::size_t i = 0; i < f.image.pixels.size(); ++i) f.image.pixels[i] = std::sin(float(i) * 0.001f);
-    f.map = testing::identityGrid(65, 33);
+    f.map = testing::identityGrid(map_rules::kDefaultSide, 33);
     f.compression = Compression::Piz;
     writeConusFile(dir.file("big.exr"), f);
     const ConusFile g = readConusFile(dir.file("big.exr"));

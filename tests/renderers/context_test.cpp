@@ -10,6 +10,7 @@
 #include "conus/renderers/backend.h"
 #include "conus/renderers/gpu_image.h"
 #include "gl_test_util.h"
+#include "error_code.h"
 
 namespace conus::gl {
 namespace {
@@ -31,16 +32,7 @@ private:
     std::string m_old;
 };
 
-ErrorCode codeOf(auto&& fn, std::string* message = nullptr) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        if (message) *message = e.what();
-        return e.code();
-    }
-    ADD_FAILURE() << "did not throw";
-    return ErrorCode::Io;
-}
+using conus::test::codeOf;
 
 TEST(ParseBackend, AcceptsEveryNameInAnyCase) {
     EXPECT_EQ(parseBackend("auto"), Backend::Auto);

@@ -55,6 +55,28 @@ double depthRange(const Image& reference) {
     return hi - lo;
 }
 
+// `mesh` through one focus, rendered on the GPU as it is and subdivided for the map, each compared
+// with the Embree reference.
+struct SubdivisionRun {
+    Image reference;
+    Mesh fine;  // the subdivided mesh
+    Comparison coarse, split;
+};
+
+SubdivisionRun renderWithAndWithoutSubdivision(const Mesh& mesh, const Camera& camera, const codec::Focus& focus) {
+    const auto map = std::make_shared<codec::SamplingMap>(codec::buildFociMap(std::span(&focus, 1)));
+    const codec::MeshScene scene{Mesh(mesh)};
+    SubdivisionRun run;
+    run.reference = codec::renderMeshReference(scene, Fpc(camera, map), kSide, kSide);
+    Context& context = test::contextFor(Backend::Egl);
+    MeshRenderOptions options;
+    options.samples = 1;  // the pixel centre, like the reference's one ray
+    run.fine = codec::subdivideForMap(mesh, camera, *map, 0.5);
+    run.coarse = compare(renderMeshGpu(context, mesh, camera, *map, kSide, kSide, options), run.reference);
+    run.split = compare(renderMeshGpu(context, run.fine, camera, *map, kSide, kSide, options), run.reference);
+    return run;
+}
+
 class MeshModels : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(MeshModels, GpuMatchesTheEmbreeReferenceWithSubdivision) {
@@ -63,16 +85,7 @@ TEST_P(MeshModels, GpuMatchesTheEmbreeReferenceWithSubdivision) {
     const Mesh mesh = sceneio::readMesh(file.string());
     const Camera camera = framing(mesh);
     // A strong focus a little off the model's centre.
-    const codec::Focus focus{0.42, 0.45, 0.12, 4.0};
-    const auto map = std::make_shared<codec::SamplingMap>(codec::buildFociMap(std::span(&focus, 1)));
-    const codec::MeshScene scene{Mesh(mesh)};
-    const Image reference = codec::renderMeshReference(scene, Fpc(camera, map), kSide, kSide);
-    Context& context = test::contextFor(Backend::Egl);
-    MeshRenderOptions options;
-    options.samples = 1;  // the pixel centre, like the reference's one ray
-    const Mesh fine = codec::subdivideForMap(mesh, camera, *map, 0.5);
-    const Comparison coarse = compare(renderMeshGpu(context, mesh, camera, *map, kSide, kSide, options), reference);
-    const Comparison split = compare(renderMeshGpu(context, fine, camera, *map, kSide, kSide, options), reference);
+    const auto [reference, fine, coarse, split] = renderWithAndWithoutSubdivision(mesh, camera, {0.42, 0.45, 0.12, 4.0});
     const double range = depthRange(reference);
     std::printf("%s: %zu -> %zu triangles; PSNR %.2f dB -> %.2f dB; depth error p99 %.3g%% -> %.3g%% of the range\n",
                 GetParam().c_str(), mesh.triangleCount(), fine.triangleCount(), coarse.psnr, split.psnr,
@@ -97,17 +110,8 @@ TEST(MeshSubdivision, ACoarseBoxUnderAStrongFocusNeedsIt) {
     Mesh box;
     test::appendBox(box, {-2.0, -1.0, -2.0}, {2.0, 1.2, 1.5});
     const Camera camera = Camera::perspective({2.5, 2.0, 5.0}, {0.0, 0.0, 0.0}, {0, 1, 0}, 55.0, 1.0, 1.0, 20.0);
-    const codec::Focus focus{0.45, 0.5, 0.15, 6.0};
-    const auto map = std::make_shared<codec::SamplingMap>(codec::buildFociMap(std::span(&focus, 1)));
-    const codec::MeshScene scene{Mesh(box)};
-    const Image reference = codec::renderMeshReference(scene, Fpc(camera, map), kSide, kSide);
-    Context& context = test::contextFor(Backend::Egl);
-    MeshRenderOptions options;
-    options.samples = 1;
-    const Mesh fine = codec::subdivideForMap(box, camera, *map, 0.5);
+    const auto [reference, fine, coarse, split] = renderWithAndWithoutSubdivision(box, camera, {0.45, 0.5, 0.15, 6.0});
     ASSERT_GT(fine.triangleCount(), 20 * box.triangleCount());
-    const Comparison coarse = compare(renderMeshGpu(context, box, camera, *map, kSide, kSide, options), reference);
-    const Comparison split = compare(renderMeshGpu(context, fine, camera, *map, kSide, kSide, options), reference);
     std::printf("box: %zu -> %zu triangles; PSNR %.2f dB -> %.2f dB; depth error mean %.4g -> %.4g\n",
                 box.triangleCount(), fine.triangleCount(), coarse.psnr, split.psnr, coarse.depth.mean, split.depth.mean);
     EXPECT_GE(split.psnr, 35.0);

@@ -14,6 +14,7 @@
 
 #include "conus/core/error.h"
 #include "conus/sceneio/volume_file.h"
+#include "error_code.h"
 #include "test_dir.h"
 
 namespace conus::sceneio {
@@ -37,15 +38,19 @@ void append(std::vector<unsigned char>& bytes, T value, bool big = false) {
     bytes.insert(bytes.end(), b, b + sizeof(T));
 }
 
-ErrorCode codeOf(const std::function<void()>& fn, std::string* message = nullptr) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        if (message) *message = e.what();
-        return e.code();
-    }
-    ADD_FAILURE() << "no conus::Error thrown";
-    return ErrorCode::Unsupported;
+using test::codeOf;
+
+// v is size.x x size.y x size.z voxels of `spacing`, holding value(x, y, z) at each. Wrap the call
+// in ASSERT_NO_FATAL_FAILURE: a wrong size stops the test.
+template <class Value>
+void expectVolume(const Volume& v, glm::ivec3 size, glm::dvec3 spacing, Value value) {
+    ASSERT_EQ(v.width, size.x);
+    ASSERT_EQ(v.height, size.y);
+    ASSERT_EQ(v.depth, size.z);
+    EXPECT_EQ(v.spacing, spacing);
+    for (int z = 0; z < size.z; ++z)
+        for (int y = 0; y < size.y; ++y)
+            for (int x = 0; x < size.x; ++x) EXPECT_EQ(v.at(x, y, z), value(x, y, z)) << x << "," << y << "," << z;
 }
 
 TEST(RawVolume, Float32LittleAndBigEndianWithSpacing) {
@@ -58,13 +63,7 @@ TEST(RawVolume, Float32LittleAndBigEndianWithSpacing) {
         const std::string path = dir.file(big ? "be.raw" : "le.raw");
         writeBytes(path, bytes);
         const Volume v = readVolume(std::string("raw:5x3x4:") + (big ? "float32-be" : "float32") + ":0.5,1,2:" + path);
-        ASSERT_EQ(v.width, 5);
-        ASSERT_EQ(v.height, 3);
-        ASSERT_EQ(v.depth, 4);
-        EXPECT_EQ(v.spacing, glm::dvec3(0.5, 1, 2));
-        for (int z = 0; z < 4; ++z)
-            for (int y = 0; y < 3; ++y)
-                for (int x = 0; x < 5; ++x) EXPECT_EQ(v.at(x, y, z), expected(x, y, z)) << x << "," << y << "," << z;
+        ASSERT_NO_FATAL_FAILURE(expectVolume(v, {5, 3, 4}, {0.5, 1, 2}, expected));
     }
 }
 
@@ -184,13 +183,8 @@ TEST(NrrdVolume, ShortSamplesAndSpacings) {
               "encoding: raw\n\n",
               data);
     const Volume v = readVolume(dir.file("v.nrrd"));
-    ASSERT_EQ(v.width, 5);
-    ASSERT_EQ(v.height, 4);
-    ASSERT_EQ(v.depth, 3);
-    EXPECT_EQ(v.spacing, glm::dvec3(0.5, 0.75, 2));
-    for (int z = 0; z < 3; ++z)
-        for (int y = 0; y < 4; ++y)
-            for (int x = 0; x < 5; ++x) EXPECT_EQ(v.at(x, y, z), float(x - 10 * y + 100 * z));
+    ASSERT_NO_FATAL_FAILURE(
+        expectVolume(v, {5, 4, 3}, {0.5, 0.75, 2}, [](int x, int y, int z) { return float(x - 10 * y + 100 * z); }));
 }
 
 TEST(NrrdVolume, HostileHeaders) {

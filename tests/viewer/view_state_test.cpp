@@ -5,6 +5,12 @@
 namespace conus::viewer {
 namespace {
 
+// The same point, in window or image coordinates, up to rounding.
+void expectSamePoint(glm::dvec2 got, glm::dvec2 want) {
+    EXPECT_NEAR(got.x, want.x, 1e-9);
+    EXPECT_NEAR(got.y, want.y, 1e-9);
+}
+
 TEST(ViewState, FitShowsTheWholeImageCentred) {
     ViewState s(800, 600, 400, 100);  // wide image: width limits
     EXPECT_DOUBLE_EQ(s.zoom(), 2.0);
@@ -21,8 +27,7 @@ TEST(ViewState, WindowAndImageCoordinatesInvert) {
     s.pan({-33, 12});
     for (glm::dvec2 w : {glm::dvec2(0, 0), glm::dvec2(640, 480), glm::dvec2(123.25, 401.5)}) {
         const glm::dvec2 back = s.imageToWindow(s.windowToImage(w));
-        EXPECT_NEAR(back.x, w.x, 1e-9);
-        EXPECT_NEAR(back.y, w.y, 1e-9);
+        expectSamePoint(back, w);
     }
 }
 
@@ -34,8 +39,7 @@ TEST(ViewState, ZoomAboutTheCursorKeepsItsPointFixed) {
     s.zoomAbout(1.0 / 3.0, cursor);
     s.zoomAbout(7.5, cursor);
     const glm::dvec2 after = s.windowToImage(cursor);
-    EXPECT_NEAR(after.x, before.x, 1e-9);
-    EXPECT_NEAR(after.y, before.y, 1e-9);
+    expectSamePoint(after, before);
 }
 
 TEST(ViewState, ZoomIsClampedAndStillAnchored) {
@@ -44,8 +48,7 @@ TEST(ViewState, ZoomIsClampedAndStillAnchored) {
     const glm::dvec2 before = s.windowToImage(cursor);
     s.zoomAbout(1e6, cursor);
     EXPECT_DOUBLE_EQ(s.zoom(), kMaxZoom);
-    EXPECT_NEAR(s.windowToImage(cursor).x, before.x, 1e-9);
-    EXPECT_NEAR(s.windowToImage(cursor).y, before.y, 1e-9);
+    expectSamePoint(s.windowToImage(cursor), before);
     s.zoomAbout(1e-9, cursor);
     EXPECT_DOUBLE_EQ(s.zoom(), s.fitZoom() * kMinZoomOfFit);
     s.zoomAbout(0.0, cursor);  // ignored
@@ -59,8 +62,7 @@ TEST(ViewState, PanMovesTheContentWithTheMouse) {
     const glm::dvec2 grabbed = s.windowToImage({150, 220});
     s.pan({30, -10});
     const glm::dvec2 now = s.imageToWindow(grabbed);
-    EXPECT_NEAR(now.x, 180, 1e-9);
-    EXPECT_NEAR(now.y, 210, 1e-9);
+    expectSamePoint(now, {180, 210});
 }
 
 TEST(ViewState, PanKeepsTheWindowCentreOverTheImage) {

@@ -7,6 +7,7 @@
 
 #include "conus/codec/build/foci.h"
 #include "conus/codec/build/frame_foci.h"
+#include "conus/core/map_rules.h"
 
 namespace {
 
@@ -35,7 +36,7 @@ void BM_FrameFociClosedForm(benchmark::State& state) {
 
 // What any builder pays to hand back a map: the identity's nodes, validated by SamplingMap.
 void BM_FrameFociIdentity(benchmark::State& state) {
-    for (auto _ : state) benchmark::DoNotOptimize(codec::SamplingMap::identity(65, 65));
+    for (auto _ : state) benchmark::DoNotOptimize(codec::SamplingMap::identity(map_rules::kDefaultSide, map_rules::kDefaultSide));
 }
 
 void BM_FrameFociDensityGridAdd(benchmark::State& state) {

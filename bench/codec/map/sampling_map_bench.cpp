@@ -11,12 +11,13 @@
 #include "conus/codec/build/density_map.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/map/sampling_map.h"
+#include "conus/core/map_rules.h"
 
 namespace {
 
 using namespace conus::codec;
 
-constexpr int kSide = 65;
+constexpr int kSide = conus::map_rules::kDefaultSide;
 constexpr int kPoints = 4096;
 
 const std::vector<Focus>& twoFoci() {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "conus/codec/build/foci.h"
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 
@@ -19,7 +20,7 @@ void expectValid(const SamplingMap& map) {
     EXPECT_TRUE(report.ok()) << report.str();
 }
 
-SamplingMap focusMap(double u, double v, double r, double k, int side = 65) {
+SamplingMap focusMap(double u, double v, double r, double k, int side = map_rules::kDefaultSide) {
     const std::vector<Focus> foci{{u, v, r, k}};
     FociOptions o;
     o.columns = o.rows = side;
@@ -41,7 +42,7 @@ TEST(Compose, AddIdentityGivesSameMap) {
 TEST(Compose, TwoFociFarApartKeepTheirMagnification) {
     const SamplingMap a = focusMap(0.2, 0.25, 0.06, 2.5), b = focusMap(0.8, 0.75, 0.06, 2.5);
     const std::vector<SamplingMap> maps{a, b};
-    const ComposeResult sum = addMaps(maps, 65, 65);
+    const ComposeResult sum = addMaps(maps, map_rules::kDefaultSide, map_rules::kDefaultSide);
     expectValid(sum.map);
     EXPECT_EQ(sum.scale, 1.0);
     const double da = a.density({0.2, 0.25}), db = b.density({0.8, 0.75});
@@ -57,7 +58,7 @@ TEST(Compose, TwoFociFarApartKeepTheirMagnification) {
 TEST(Compose, FoldingSumIsScaledDownAndValid) {
     const SamplingMap a = focusMap(0.5, 0.5, 0.15, 6);
     const std::vector<SamplingMap> maps{a, a, a};
-    const ComposeResult sum = addMaps(maps, 65, 65);
+    const ComposeResult sum = addMaps(maps, map_rules::kDefaultSide, map_rules::kDefaultSide);
     expectValid(sum.map);
     EXPECT_LT(sum.scale, 1.0);
     EXPECT_GT(sum.scale, 0.0);

@@ -9,6 +9,7 @@
 #include <random>
 #include <thread>
 
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 
@@ -61,7 +62,7 @@ void expectValid(const SamplingMap& map) {
 
 TEST(DensityMap, UniformDensityGivesIdentity) {
     const SamplingMap map = buildMapFromDensity(makeField(64, 48, [](double, double) { return 3.0; }));
-    const SamplingMap identity = SamplingMap::identity(65, 65);
+    const SamplingMap identity = SamplingMap::identity(map_rules::kDefaultSide, map_rules::kDefaultSide);
     for (std::size_t k = 0; k < map.nodes().size(); ++k) {
         EXPECT_NEAR(map.nodes()[k].x, identity.nodes()[k].x, 1e-6);
         EXPECT_NEAR(map.nodes()[k].y, identity.nodes()[k].y, 1e-6);

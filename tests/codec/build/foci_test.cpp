@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 
@@ -82,7 +83,7 @@ TEST(Foci, BothCompositionsValidForHardCases) {
         {{0.5, 0.5, 0.1, 4}, {0.56, 0.52, 0.08, 6}},           // overlapping
         {{0.0, 0.0, 0.1, 5}, {1.0, 1.0, 0.05, 8}},             // corners
         {{0.5, 0.0, 0.1, 4}, {0.0, 0.5, 0.2, 3}, {1, 0.4, 0.05, 16}},  // edges
-        {{0.5, 0.5, 0.02, 64}},                                // tiny and extreme
+        {{0.5, 0.5, 0.02, map_rules::kMaxMagnification}},                                // tiny and extreme
         {{0.3, 0.3, 0.3, 8}, {0.6, 0.6, 0.3, 8}, {0.4, 0.7, 0.25, 8}},  // large, overlapping
     };
     for (const auto& foci : cases) {
@@ -90,7 +91,7 @@ TEST(Foci, BothCompositionsValidForHardCases) {
             for (double aspect : {1.0, 2.0}) {
                 const SamplingMap map = buildFociMap(foci, options(aspect, composition));
                 expectValid(map);
-                EXPECT_EQ(map.columns(), 65);
+                EXPECT_EQ(map.columns(), map_rules::kDefaultSide);
                 // Magnifies at the first focus.
                 EXPECT_GT(map.density({foci[0].u, foci[0].v}), 1.0);
             }
@@ -153,7 +154,7 @@ TEST(Foci, RejectsBadFoci) {
     EXPECT_EQ(code({0.5, -0.1, 0.1, 2}), ErrorCode::InvalidArgument);
     EXPECT_EQ(code({0.5, 0.5, 0.0, 2}), ErrorCode::InvalidArgument);
     EXPECT_EQ(code({0.5, 0.5, 0.1, 0.5}), ErrorCode::InvalidArgument);
-    EXPECT_EQ(code({0.5, 0.5, 0.1, 65}), ErrorCode::InvalidArgument);
+    EXPECT_EQ(code({0.5, 0.5, 0.1, map_rules::kMaxMagnification + 1}), ErrorCode::InvalidArgument);
     EXPECT_EQ(code({0.5, std::nan(""), 0.1, 2}), ErrorCode::InvalidArgument);
     FociOptions o;
     o.aspect = 0;
@@ -174,7 +175,7 @@ TEST(Foci, AGridTooCoarseForAFocusIsRefusedNamingOneThatHoldsIt) {
         EXPECT_NE(std::string(e.what()).find("a 2x2 grid is too coarse for focus 0.5,0.5,0.1,4"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("5 nodes a side"), std::string::npos) << e.what();
     }
-    options.columns = options.rows = 65;
+    options.columns = options.rows = map_rules::kDefaultSide;
     const SamplingMap fine = buildFociMap(foci, options);
     EXPECT_GT(reachedMagnification(fine, foci)[0], 3.5);
     EXPECT_NO_THROW(checkFociHeld(fine, foci, options));

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 
 namespace conus::codec {
@@ -38,7 +39,7 @@ double largestMove(const SamplingMap& a, const SamplingMap& b) {
 
 TEST(FrameFoci, LensProfileIsAMonotoneLensJoiningTheIdentity) {
     const double h = 1e-6;
-    for (double k : {1.0, 1.5, 2.0, 4.0, 9.0, 23.0, 64.0}) {
+    for (double k : {1.0, 1.5, 2.0, 4.0, 9.0, 23.0, map_rules::kMaxMagnification}) {
         EXPECT_EQ(lensProfile(0.0, k), 0.0);
         EXPECT_NEAR(lensProfile(h, k) / h, k, 1e-3 * k) << k;                       // slope k at the centre
         EXPECT_NEAR(lensProfile(1.0 - h, k), 1.0 - h, 1e-9) << k;                  // meets the identity
@@ -63,10 +64,10 @@ TEST(FrameFoci, IsolatedFocusMagnifiesByKAtItsCentre) {
     };
     // Grids fine enough that the magnified core (undistorted radius ~ r / (k - 1)) spans cells, and
     // lenses inside the frame (a lens reaching past an edge is scaled down by the fold guard).
-    const Case cases[] = {{{0.5, 0.5, 0.15, 4.0}, 65, 1.0},
-                          {{0.43, 0.57, 0.08, 3.0}, 65, 16.0 / 9.0},
+    const Case cases[] = {{{0.5, 0.5, 0.15, 4.0}, map_rules::kDefaultSide, 1.0},
+                          {{0.43, 0.57, 0.08, 3.0}, map_rules::kDefaultSide, 16.0 / 9.0},
                           {{0.61, 0.38, 0.1, 8.0}, 257, 0.75},
-                          {{0.5, 0.5, 0.08, 2.0}, 65, 1.5}};
+                          {{0.5, 0.5, 0.08, 2.0}, map_rules::kDefaultSide, 1.5}};
     for (const Case& c : cases) {
         const Focus foci[] = {c.focus};
         const SamplingMap map = buildFrameFociMap(foci, grid(c.side, c.aspect));
@@ -107,7 +108,7 @@ TEST(FrameFoci, EightOverlappingFociGiveAValidMap) {
     for (int i = 0; i < 8; ++i)
         foci.push_back({0.35 + 0.04 * i, 0.4 + 0.025 * ((i * 3) % 8), 0.09 + 0.01 * (i % 3), 2.0 + i});
     for (double aspect : {1.0, 16.0 / 9.0, 0.6}) {
-        const SamplingMap map = buildFrameFociMap(foci, grid(65, aspect));
+        const SamplingMap map = buildFrameFociMap(foci, grid(map_rules::kDefaultSide, aspect));
         expectValid(map);
         // The guard scaled the sum down, but every focus is still magnified.
         for (const Focus& f : foci) EXPECT_GT(magnificationAt(map, {f.u, f.v}), 1.2) << aspect;
@@ -115,16 +116,17 @@ TEST(FrameFoci, EightOverlappingFociGiveAValidMap) {
 }
 
 TEST(FrameFoci, FociAtTheBordersKeepBoundaryNodesOnTheirEdges) {
-    const Focus foci[] = {{0.0, 0.0, 0.1, 4.0}, {1.0, 0.4, 0.12, 6.0}, {0.3, 1.0, 0.08, 3.0}, {0.0, 0.7, 0.2, 64.0}};
+    const Focus foci[] = {{0.0, 0.0, 0.1, 4.0}, {1.0, 0.4, 0.12, 6.0}, {0.3, 1.0, 0.08, 3.0}, {0.0, 0.7, 0.2, map_rules::kMaxMagnification}};
     for (double aspect : {1.0, 2.0, 0.5}) {
-        const SamplingMap map = buildFrameFociMap(foci, grid(65, aspect));
+        const SamplingMap map = buildFrameFociMap(foci, grid(map_rules::kDefaultSide, aspect));
         expectValid(map);
-        EXPECT_GT(largestMove(map, SamplingMap::identity(65, 65)), 0.01) << aspect;
+        EXPECT_GT(largestMove(map, SamplingMap::identity(map_rules::kDefaultSide, map_rules::kDefaultSide)), 0.01) << aspect;
         // Edge nodes slide along the edge: the focus on the right edge pushes them apart in v.
-        const double row = 0.4 * 64;
-        const glm::vec2 below = map.node(64, int(row) + 2), above = map.node(64, int(row) - 2);
+        constexpr int kLast = map_rules::kDefaultSide - 1;  // the right edge's column, and cells a side
+        const double row = 0.4 * kLast;
+        const glm::vec2 below = map.node(kLast, int(row) + 2), above = map.node(kLast, int(row) - 2);
         EXPECT_EQ(below.x, 1.0f);
-        EXPECT_GT(below.y - above.y, 4.0 / 64.0 * 1.2) << aspect;
+        EXPECT_GT(below.y - above.y, 4.0 / kLast * 1.2) << aspect;
     }
 }
 
@@ -142,7 +144,7 @@ TEST(FrameFoci, ContinuousInTheFocusParameters) {
     const std::vector<Focus> sets[] = {
         {{0.45, 0.5, 0.1, 4.0}, {0.55, 0.52, 0.1, 4.0}},                              // overlapping pair
         {{0.3, 0.3, 0.12, 8.0}, {0.4, 0.35, 0.1, 6.0}, {0.35, 0.45, 0.1, 5.0}, {1.0, 0.5, 0.1, 4.0}}};
-    const FociOptions options = grid(65, 16.0 / 9.0);
+    const FociOptions options = grid(map_rules::kDefaultSide, 16.0 / 9.0);
     for (const auto& base : sets) {
         const SamplingMap reference = buildFrameFociMap(base, options);
         for (int field = 0; field < 4; ++field)
@@ -160,13 +162,13 @@ TEST(FrameFoci, ContinuousInTheFocusParameters) {
 
 TEST(FrameFoci, BadInputIsAnError) {
     const Focus outside[] = {{1.2, 0.5, 0.1, 2.0}};
-    const Focus tooStrong[] = {{0.5, 0.5, 0.1, 65.0}};
+    const Focus tooStrong[] = {{0.5, 0.5, 0.1, map_rules::kMaxMagnification + 1}};
     const Focus noRadius[] = {{0.5, 0.5, 0.0, 2.0}};
     EXPECT_THROW(buildFrameFociMap(outside), Error);
     EXPECT_THROW(buildFrameFociMap(tooStrong), Error);
     EXPECT_THROW(buildFrameFociMap(noRadius), Error);
     EXPECT_THROW(buildFrameFociMap({}, grid(1, 1.0)), Error);
-    EXPECT_THROW(buildFrameFociMap({}, grid(65, 0.0)), Error);
+    EXPECT_THROW(buildFrameFociMap({}, grid(map_rules::kDefaultSide, 0.0)), Error);
 }
 
 }  // namespace

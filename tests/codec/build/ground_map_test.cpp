@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 
@@ -71,7 +72,7 @@ TEST(Ground, DensityFallsWithDistance) {
 
 TEST(Ground, BuiltGridIsValidAndMatches) {
     for (const GroundParams& g : kCases) {
-        for (int side : {2, 3, 17, 65, 257}) {
+        for (int side : {2, 3, 17, map_rules::kDefaultSide, 257}) {
             const SamplingMap map = buildGroundMap(g, side, side);
             const format::ValidationReport report = format::validateGrid(map.toGrid());
             EXPECT_TRUE(report.ok()) << report.str();

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "conus/codec/build/compose.h"
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 
@@ -63,7 +64,7 @@ TEST(Springs, StrokeConvergesAndMagnifies) {
 }
 
 TEST(Springs, OffCentreStrokeMagnifiesItsCentre) {
-    SpringSystem system(65, 65);
+    SpringSystem system(map_rules::kDefaultSide, map_rules::kDefaultSide);
     system.addStroke({0.3, 0.7, 0.15, 1.5, 0.2});
     system.runUntilStable(20000);
     const SamplingMap map = system.toMap();
@@ -131,7 +132,7 @@ TEST(Springs, ManyOverlappingAndRandomStrokes) {
 }
 
 TEST(Springs, LowerResolutionMapIsValid) {
-    SpringSystem system(65, 65);
+    SpringSystem system(map_rules::kDefaultSide, map_rules::kDefaultSide);
     system.addStroke({0.35, 0.4, 0.2, 2.0, 0.2});
     system.addStroke({0.7, 0.7, 0.1, 1.0, 0.2});
     system.runUntilStable(20000);

@@ -13,6 +13,7 @@
 #include "conus/codec/build/foci.h"
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/depth/relief.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec::test {
 
@@ -32,7 +33,7 @@ inline std::shared_ptr<const SamplingMap> identityMap() { return std::make_share
 inline std::shared_ptr<const SamplingMap> focusMap(double u, double v, double r = 0.15, double k = 4.0) {
     const Focus focus{u, v, r, k};
     FociOptions options;
-    options.columns = options.rows = 65;
+    options.columns = options.rows = map_rules::kDefaultSide;
     return std::make_shared<SamplingMap>(buildFociMap(std::span<const Focus>(&focus, 1), options));
 }
 

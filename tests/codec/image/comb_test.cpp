@@ -22,21 +22,27 @@ namespace {
 constexpr int kSource = 1024, kConus = 256, kSpokes = 48;
 constexpr double kPi = 3.14159265358979323846;
 
-// A 0.1 / 0.9 star of kSpokes dark and light pairs about the image centre, 4x4 supersampled.
-Image siemensStar(int size) {
+// A size x size grey image whose pixel (x, y) is the mean of f over super x super sub-pixel
+// centres (x + (i + 0.5) / super, y + (j + 0.5) / super), in pixels.
+template <class F>
+Image supersampled(int size, int super, F f) {
     Image im = makeImage(size, size, {"Y"});
-    constexpr int kSuper = 4;
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) {
-            int light = 0;
-            for (int j = 0; j < kSuper; ++j)
-                for (int i = 0; i < kSuper; ++i) {
-                    const double dx = x + (i + 0.5) / kSuper - 0.5 * size, dy = y + (j + 0.5) / kSuper - 0.5 * size;
-                    light += std::sin(kSpokes * std::atan2(dy, dx)) > 0 ? 1 : 0;
-                }
-            im.at(x, y) = static_cast<float>(0.1 + 0.8 * light / (kSuper * kSuper));
+            double sum = 0;
+            for (int j = 0; j < super; ++j)
+                for (int i = 0; i < super; ++i) sum += f(x + (i + 0.5) / super, y + (j + 0.5) / super);
+            im.at(x, y) = static_cast<float>(sum / (super * super));
         }
     return im;
+}
+
+// A 0.1 / 0.9 star of kSpokes dark and light pairs about the image centre, 4x4 supersampled.
+Image siemensStar(int size) {
+    return supersampled(size, 4, [size](double x, double y) {
+        const double dx = x - 0.5 * size, dy = y - 0.5 * size;
+        return std::sin(kSpokes * std::atan2(dy, dx)) > 0 ? 0.9 : 0.1;
+    });
 }
 
 double bilinear(const Image& im, double x, double y) {
@@ -79,20 +85,10 @@ CircleSpectrum spectrum(const Image& view, const std::vector<double>& radii) {
 // The old encoder's filter, exactly: the mean of the source over the CoNUS pixel's footprint (a
 // 8x8 grid of sub-pixels, each undistorted exactly), no low-pass beyond the pixel's own box.
 Image boxEncode(const Image& src, const SamplingMap& map, int size) {
-    Image out = makeImage(size, size, {"Y"});
-    constexpr int kSuper = 8;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) {
-            double sum = 0;
-            for (int j = 0; j < kSuper; ++j)
-                for (int i = 0; i < kSuper; ++i) {
-                    const glm::dvec2 p =
-                        map.undistort({(x + (i + 0.5) / kSuper) / size, (y + (j + 0.5) / kSuper) / size});
-                    sum += bilinear(src, p.x * src.width - 0.5, p.y * src.height - 0.5);
-                }
-            out.at(x, y) = static_cast<float>(sum / (kSuper * kSuper));
-        }
-    return out;
+    return supersampled(size, 8, [&](double x, double y) {
+        const glm::dvec2 p = map.undistort({x / size, y / size});
+        return bilinear(src, p.x * src.width - 0.5, p.y * src.height - 0.5);
+    });
 }
 
 TEST(Comb, FocusRingOfASiemensStarAliasesNoMoreThanUniform) {

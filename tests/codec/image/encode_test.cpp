@@ -11,6 +11,7 @@
 #include "conus/codec/build/foci.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 #include "test_images.h"
 
 namespace conus::codec {
@@ -82,7 +83,7 @@ TEST(Encode, IdentityMapEqualsAreaDownsampleAtIntegerRatios) {
         {512, 128, {"R", "G", "B"}, 17},
         {512, 128, {"R", "G", "B", "A"}, 33},
         {300, 100, {"R", "G", "B", "A"}, 9},
-        {300, 100, {"R", "G", "B", "Z"}, 65},
+        {300, 100, {"R", "G", "B", "Z"}, map_rules::kDefaultSide},
         {300, 100, {"R", "G", "B", "A", "Z"}, 5},  // a channel count without a fixed kernel
         {300, 150, {"Y", "A"}, 3},                 // ratio 2
     };

@@ -14,6 +14,7 @@
 #include "conus/codec/build/density_map.h"
 #include "conus/codec/build/foci.h"
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "sanitizers.h"
 
@@ -130,7 +131,7 @@ std::string invalidMessage(int n, int m, std::vector<glm::vec2> nodes) {
 TEST(SamplingMap, IdentityDistortIsIdentity) {
     std::mt19937 rng(1);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
-    for (auto [n, m] : {std::pair{65, 65}, std::pair{10, 7}, std::pair{2, 2}}) {
+    for (auto [n, m] : {std::pair{map_rules::kDefaultSide, map_rules::kDefaultSide}, std::pair{10, 7}, std::pair{2, 2}}) {
         const SamplingMap map = SamplingMap::identity(n, m);
         for (int k = 0; k < 1000; ++k) {
             const glm::dvec2 p{unit(rng), unit(rng)};
@@ -141,8 +142,8 @@ TEST(SamplingMap, IdentityDistortIsIdentity) {
             EXPECT_NEAR(map.density(p), 1.0, 1e-6);
         }
     }
-    // Powers of two are exact in float: Eq. 1 of the 65x65 identity is exact.
-    const SamplingMap map = SamplingMap::identity(65, 65);
+    // Powers of two are exact in float: Eq. 1 of the identity on 2^6 x 2^6 cells is exact.
+    const SamplingMap map = SamplingMap::identity((1 << 6) + 1, (1 << 6) + 1);
     EXPECT_EQ(map.distort({0.3, 0.7}), glm::dvec2(0.3, 0.7));
     EXPECT_EQ(map.distort({1.0, 1.0}), glm::dvec2(1.0, 1.0));
 }
@@ -169,7 +170,7 @@ TEST(SamplingMap, RoundTripJitteredMaps) {
 TEST(SamplingMap, RoundTripFociMaps) {
     for (unsigned seed = 11; seed <= 14; ++seed) {
         std::mt19937 rng(seed);
-        const SamplingMap map = randomFociMap(rng, 65, 49, seed % 2 ? FociComposition::Add : FociComposition::Density);
+        const SamplingMap map = randomFociMap(rng, map_rules::kDefaultSide, 49, seed % 2 ? FociComposition::Add : FociComposition::Density);
         const RoundTrip r = roundTrip(map, rng, 100000);
         EXPECT_LT(r.forward, 1e-9) << "seed " << seed;
         EXPECT_LT(r.backward, 1e-9) << "seed " << seed;
@@ -318,7 +319,7 @@ TEST(SamplingMap, JacobianMatchesFiniteDifferences) {
 TEST(SamplingMap, DensityIntegratesToOne) {
     // det J is an area ratio and the map is onto [0,1]^2: its mean over the square is 1.
     std::mt19937 rng(8);
-    const SamplingMap map = randomFociMap(rng, 65, 65, FociComposition::Density);
+    const SamplingMap map = randomFociMap(rng, map_rules::kDefaultSide, map_rules::kDefaultSide, FociComposition::Density);
     double sum = 0;
     const int s = 512;
     for (int y = 0; y < s; ++y)
@@ -331,8 +332,8 @@ TEST(SamplingMap, ResampledAgreesWithOriginal) {
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     const SamplingMap map = randomFociMap(rng, 33, 33, FociComposition::Density);
     // A grid whose cells subdivide the original ones reproduces it up to float rounding.
-    const SamplingMap finer = map.resampled(65, 129);
-    EXPECT_EQ(finer.columns(), 65);
+    const SamplingMap finer = map.resampled(map_rules::kDefaultSide, 129);
+    EXPECT_EQ(finer.columns(), map_rules::kDefaultSide);
     EXPECT_EQ(finer.rows(), 129);
     // Any other grid approximates it.
     const SamplingMap other = map.resampled(50, 41);
@@ -393,7 +394,7 @@ SamplingMap zigzagMap(int n, int m) {
 
 TEST(SamplingMapIndex, OrdinaryMapsKeepTwoBucketsPerCell) {
     // About 9 cells listed and 4 bucket starts per cell at 2x2 buckets per cell: 52 bytes a cell.
-    for (int side : {17, 65, 257}) {
+    for (int side : {17, map_rules::kDefaultSide, 257}) {
         const SamplingMap map = SamplingMap::identity(side, side);
         const double perCell = double(map.indexBytes()) / ((side - 1) * (side - 1));
         EXPECT_GT(perCell, 45.0) << side;
@@ -408,7 +409,7 @@ TEST(SamplingMapIndex, OrdinaryMapsKeepTwoBucketsPerCell) {
 
 TEST(SamplingMapIndex, SliverCellsStayWithinBudgetAndInvertExactly) {
     std::mt19937 rng(15);
-    for (int n : {5, 17, 65, 257}) {
+    for (int n : {5, 17, map_rules::kDefaultSide, 257}) {
         const SamplingMap map = zigzagMap(n, n);
         EXPECT_LE(std::int64_t(map.indexBytes()), indexBudget(map)) << n;
         const RoundTrip r = roundTrip(map, rng, 2000);
@@ -428,7 +429,7 @@ TEST(SamplingMapIndex, TaperedCellInvertsToTheRootThatSolvesIt) {
 }
 
 TEST(SamplingMapIndex, BuiltOnFirstUseOnceAcrossThreads) {
-    const SamplingMap map = zigzagMap(65, 65);
+    const SamplingMap map = zigzagMap(map_rules::kDefaultSide, map_rules::kDefaultSide);
     const SamplingMap copy = map;  // not built yet: the copy builds its own
     std::vector<glm::dvec2> results(8);
     std::vector<std::thread> threads;

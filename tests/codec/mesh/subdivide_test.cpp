@@ -10,6 +10,7 @@
 #include "codec/mesh/mesh_test_scenes.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec {
 namespace {
@@ -51,7 +52,7 @@ double area(const Mesh& m) {
 
 TEST(Subdivide, ABoxUntilEveryEdgeIsShort) {
     const Mesh box = sharedBox({-1, -0.5f, -0.7f}, {0.8f, 0.6f, 0.9f});
-    const SamplingMap map = SamplingMap::identity(65, 33);  // 64 x 32 cells: not square
+    const SamplingMap map = SamplingMap::identity(map_rules::kDefaultSide, 33);  // wider than tall: not square
     const Camera camera = boxCamera();
     const double before = longestProjectedEdge(box, camera, map);
     EXPECT_GT(before, 10);
@@ -130,7 +131,7 @@ TEST(Subdivide, EdgesBehindTheEyeAreNotMeasured) {
 
 TEST(Subdivide, CapsAndBadArguments) {
     const Mesh box = sharedBox({-1, -1, -1}, {1, 1, 1});
-    const SamplingMap map = SamplingMap::identity(65, 65);
+    const SamplingMap map = SamplingMap::identity(map_rules::kDefaultSide, map_rules::kDefaultSide);
     const Camera camera = boxCamera();
     SubdivideOptions few;
     few.maxTriangles = 100;

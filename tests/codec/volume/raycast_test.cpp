@@ -16,19 +16,12 @@
 #include "conus/codec/volume/raycast.h"
 #include "conus/codec/volume/transfer_function.h"
 #include "conus/core/error.h"
+#include "error_code.h"
 
 namespace conus::codec {
 namespace {
 
-ErrorCode codeOf(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.code();
-    }
-    ADD_FAILURE() << "no conus::Error thrown";
-    return ErrorCode::Unsupported;
-}
+using test::codeOf;
 
 TEST(TransferFunction, TableInterpolatesThePointsAndHoldsTheEnds) {
     const TransferFunction tf({{0.2f, {1, 0, 0, 0.1f}}, {0.6f, {0, 1, 0.5f, 0.9f}}});

@@ -1,0 +1,33 @@
+// The GL context of the renderer benchmarks (one binary, renderers_bench): the backend that
+// CONUS_BACKEND names (auto, egl, osmesa; default auto: the EGL hardware device on a GPU machine,
+// llvmpipe elsewhere).
+#pragma once
+
+#include <cstdlib>
+#include <memory>
+
+#include "conus/core/error.h"
+#include "conus/renderers/context.h"
+
+namespace conus::bench {
+
+// A new context on that backend; throws conus::Error when it cannot start.
+inline std::unique_ptr<gl::Context> createBenchContext() {
+    const char* backend = std::getenv("CONUS_BACKEND");
+    return gl::Context::create(gl::parseBackend(backend ? backend : "auto"));
+}
+
+// One context shared by the GPU rows that can skip, made on first use; null when no backend
+// works (those rows then skip with "no GL backend").
+inline gl::Context* sharedBenchContext() {
+    static const std::unique_ptr<gl::Context> context = []() -> std::unique_ptr<gl::Context> {
+        try {
+            return createBenchContext();
+        } catch (const Error&) {
+            return nullptr;
+        }
+    }();
+    return context.get();
+}
+
+}  // namespace conus::bench
