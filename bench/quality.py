@@ -16,7 +16,8 @@ Everything is measured in linear light (the values the EXR holds) against the so
   bytes. OpenJPEG has no spatial region of interest (its -ROI upshifts a whole component), so the
   full-resolution JPEG 2000 at equal bytes stands for JPEG 2000's own ROI coding;
 - gain against loss: foci of k = 2..6 and automatic maps from ROI importance (1 in the discs, 0
-  elsewhere) with their context floor swept: the frontier each method reaches.
+  elsewhere) with their context floor swept, or chosen by a whole-frame loss budget
+  (Map.auto_for_frame_loss, `encode --frame-loss`): the frontier each method reaches.
 Photographs: Debian's python3-skimage (astronaut, chelsea, motorcycle) and mate-backgrounds
 (ladybird, dandelion, garden; reduced to 1280 px wide by an area filter to keep the run short).
 """
@@ -47,6 +48,8 @@ PHOTOS = [
 MAX_WIDTH = 1280
 FRACTIONS = [(2, "1/4"), (4, "1/16"), (8, "1/64")]  # side divisor, share of the pixels
 K = 4
+BUDGETS = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0]  # --frame-loss budgets swept (dB)
+BUDGET_GRID, BUDGET_MAX_DENSITY = 129, 64.0
 
 
 def psnr(a, b, mask=None):
@@ -176,7 +179,7 @@ def frontier(name, src, regions, quick):
     uview = np.asarray(conus.resize(conus.uniform(src, size=size), size=(w, h)))[..., :3]
     ref_roi, ref_frame = psnr(uview, src, roi), psnr(uview, src)
     importance = discs(src.shape, regions).astype(np.float32)
-    points = {"foci": [], "auto": []}
+    points = {"foci": [], "auto": [], "budget": []}
     for k in ([2, 4, 6] if quick else [2, 3, 4, 5, 6]):
         view = view_of(encode_with(src, size, regions, k=k), w, h)
         points["foci"].append((k, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi))
@@ -188,6 +191,14 @@ def frontier(name, src, regions, quick):
             continue
         view = view_of(encode_with(src, size, regions, map=m), w, h)
         points["auto"].append((floor, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi))
+    # The frame-loss budget (`encode --frame-loss`): the floor chosen by the predicted loss, a higher
+    # density cap so that a loose budget can spend it. The setting records the budget and what was
+    # predicted, beside what is measured.
+    for budget in ([1.0, 2.5] if quick else BUDGETS):
+        m, floor, p_loss, p_gain = conus.Map.auto_for_frame_loss(importance, src, size, budget, grid=BUDGET_GRID,
+                                                                 max_density=BUDGET_MAX_DENSITY)
+        view = view_of(encode_with(src, size, regions, map=m), w, h)
+        points["budget"].append((budget, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi, p_loss, p_gain, floor))
     return points
 
 
@@ -256,10 +267,11 @@ def plots(out, all_curves, all_points):
     fig.savefig(out / "rate-distortion.png", dpi=90)
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(7, 5))
-    for method, marker in (("foci", "o"), ("auto", "s")):
+    for method, marker in (("foci", "o"), ("auto", "s"), ("budget", "^")):
         xs = [np.mean([p[method][i][1] for p in all_points.values()]) for i in range(min(len(p[method]) for p in all_points.values()))]
         ys = [np.mean([p[method][i][2] for p in all_points.values()]) for i in range(len(xs))]
-        ax.plot(xs, ys, "-" + marker, label={"foci": "one focus per region, k = 2..6", "auto": "automatic map from ROI importance, floor swept"}[method])
+        ax.plot(xs, ys, "-" + marker, label={"foci": "one focus per region, k = 2..6", "auto": "automatic map from ROI importance, floor swept",
+                                                "budget": f"automatic map, --frame-loss budget swept (max density {BUDGET_MAX_DENSITY:g}, grid {BUDGET_GRID})"}[method])
     ax.axvline(2.5, color="grey", ls=":")
     ax.axhline(6.5, color="grey", ls=":")
     ax.set_xlabel("whole-frame loss against uniform (dB)")
@@ -288,13 +300,21 @@ def report(rows, all_curves, all_points):
         lines.append(f"- {share}: mean ROI gain {gain:+.1f} dB (worst {worst:+.1f}), mean whole-frame loss {loss:.1f} dB, "
                      f"ring check CoNUS {ring:.1f} dB below uniform")
     lines += ["", "Gain against loss at 1/16 (mean over the photographs): method, setting: frame loss, ROI gain", ""]
-    for method in ("foci", "auto"):
+    for method in ("foci", "auto", "budget"):
         n = min(len(p[method]) for p in all_points.values())
         for i in range(n):
             setting = all_points[next(iter(all_points))][method][i][0]
             loss = np.mean([p[method][i][1] for p in all_points.values()])
             gain = np.mean([p[method][i][2] for p in all_points.values()])
-            lines.append(f"- {method} {'k' if method == 'foci' else 'floor'} {setting}: loss {loss:.2f} dB, gain {gain:+.2f} dB")
+            worst = min(p[method][i][2] for p in all_points.values())
+            name = {"foci": "k", "auto": "floor", "budget": "frame-loss"}[method]
+            line = f"- {method} {name} {setting}: loss {loss:.2f} dB, gain {gain:+.2f} dB (worst photo {worst:+.2f})"
+            if method == "budget":
+                p_loss = np.mean([p[method][i][3] for p in all_points.values()])
+                p_gain = np.mean([p[method][i][4] for p in all_points.values()])
+                floors = ", ".join(f"{p[method][i][5]:.2f}" for p in all_points.values())
+                line += f"; predicted loss {p_loss:.2f} dB, gain {p_gain:+.2f} dB; floors {floors}"
+            lines.append(line)
     lines += ["", "Equal bytes at 1/16: ROI PSNR (dB) of each at the bytes of CoNUS + JPEG XL -d 1 ('-': outside its range)", "",
               "| photo | KiB | CoNUS + jxl | uniform + jxl | full + jxl | CoNUS + j2k | uniform + j2k | full + j2k |", "|---|---|---|---|---|---|---|---|"]
     for name, curves in all_curves.items():
