@@ -167,7 +167,37 @@ def measure(name, src, regions, out, quick):
         if share == "1/16":
             write_png(out / f"{name}-conus.png", srgb8(cview))
             write_png(out / f"{name}-uniform.png", srgb8(uview))
+            rows[-1]["zones"] = zones(src, regions, cfile, cview, uview, size)
     return rows
+
+
+def zones(src, regions, cfile, cview, uview, size):
+    """Where the whole-frame loss comes from: by distance from the regions (in radii), the share of
+    the frame, the map's mean density and median anisotropy (its Jacobian's singular value ratio in
+    pixels, by central differences), CoNUS's error over uniform's, and the uniform image at that
+    mean density's error over uniform's (what the density alone would cost)."""
+    h, w = src.shape[:2]
+    y, x = np.mgrid[0:h, 0:w]
+    points = np.stack([(x + 0.5) / w, (y + 0.5) / h], axis=-1)
+    out = []
+    for lo, hi in ((0, 1), (1, 2), (2, 3), (3, None)):
+        mask = discs(src.shape, regions, lo, hi) if hi else ~discs(src.shape, regions, 0, lo)
+        if not mask.any():
+            continue
+        p = points[mask][::16]
+        e, a = 1e-4, w / h
+        du = (np.asarray(cfile.map.distort(p + [e, 0])) - np.asarray(cfile.map.distort(p - [e, 0]))) / (2 * e)
+        dv = (np.asarray(cfile.map.distort(p + [0, e])) - np.asarray(cfile.map.distort(p - [0, e]))) / (2 * e)
+        jac = np.stack([np.stack([du[:, 0], dv[:, 0] * a], -1), np.stack([du[:, 1] / a, dv[:, 1]], -1)], 1)
+        sv = np.linalg.svd(jac, compute_uv=False)
+        density = float(np.mean(np.asarray(cfile.map.density(points[mask]))))
+        scaled = (max(1, round(size[0] * np.sqrt(min(density, 1e6)))), max(1, round(size[1] * np.sqrt(min(density, 1e6)))))
+        ideal = np.asarray(conus.resize(conus.uniform(src, size=(min(scaled[0], w), min(scaled[1], h))), size=(w, h)))[..., :3]
+        err = lambda view: ((view - src) ** 2)[mask].mean()
+        out.append(dict(zone=f"{lo}r..{hi}r" if hi else f"beyond {lo}r", share=float(mask.mean()), density=density,
+                        anisotropy=float(np.median(sv[:, 0] / sv[:, 1])),
+                        conus=10 * np.log10(err(cview) / err(uview)), ideal=10 * np.log10(err(ideal) / err(uview))))
+    return out
 
 
 def frontier(name, src, regions, quick):
@@ -299,6 +329,13 @@ def report(rows, all_curves, all_points):
         ring = np.mean([r["alias_u"] - r["alias_c"] for r in sel])
         lines.append(f"- {share}: mean ROI gain {gain:+.1f} dB (worst {worst:+.1f}), mean whole-frame loss {loss:.1f} dB, "
                      f"ring check CoNUS {ring:.1f} dB below uniform")
+    lines += ["", "Where the loss comes from at 1/16: error over uniform's by zone (distance from the regions in radii); "
+              "'uniform at that density': the uniform image of the zone's mean density", "",
+              "| photo | zone | share | mean density | median anisotropy | CoNUS | uniform at that density |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        for z in r.get("zones", []):
+            lines.append(f"| {r['photo']} | {z['zone']} | {100 * z['share']:.0f}% | {z['density']:.2f} | {z['anisotropy']:.2f} | "
+                         f"{z['conus']:+.1f} dB | {z['ideal']:+.1f} dB |")
     lines += ["", "Gain against loss at 1/16 (mean over the photographs): method, setting: frame loss, ROI gain", ""]
     for method in ("foci", "auto", "budget"):
         n = min(len(p[method]) for p in all_points.values())
