@@ -17,7 +17,8 @@ Everything is measured in linear light (the values the EXR holds) against the so
   full-resolution JPEG 2000 at equal bytes stands for JPEG 2000's own ROI coding;
 - gain against loss: foci of k = 2..6 and automatic maps from ROI importance (1 in the discs, 0
   elsewhere) with their context floor swept, or chosen by a whole-frame loss budget
-  (Map.auto_for_frame_loss, `encode --frame-loss`): the frontier each method reaches.
+  (Map.auto_for_frame_loss, `encode --frame-loss`), and with an anisotropy limit swept: the
+  frontier each method reaches.
 Photographs: Debian's python3-skimage (astronaut, chelsea, motorcycle) and mate-backgrounds
 (ladybird, dandelion, garden; reduced to 1280 px wide by an area filter to keep the run short).
 """
@@ -50,6 +51,7 @@ FRACTIONS = [(2, "1/4"), (4, "1/16"), (8, "1/64")]  # side divisor, share of the
 K = 4
 BUDGETS = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0]  # --frame-loss budgets swept (dB)
 BUDGET_GRID, BUDGET_MAX_DENSITY = 129, 64.0
+ANISOTROPY_LIMITS = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0]  # --max-anisotropy swept, at the loosest budget
 
 
 def psnr(a, b, mask=None):
@@ -209,7 +211,7 @@ def frontier(name, src, regions, quick):
     uview = np.asarray(conus.resize(conus.uniform(src, size=size), size=(w, h)))[..., :3]
     ref_roi, ref_frame = psnr(uview, src, roi), psnr(uview, src)
     importance = discs(src.shape, regions).astype(np.float32)
-    points = {"foci": [], "auto": [], "budget": []}
+    points = {"foci": [], "auto": [], "budget": [], "limited": []}
     for k in ([2, 4, 6] if quick else [2, 3, 4, 5, 6]):
         view = view_of(encode_with(src, size, regions, k=k), w, h)
         points["foci"].append((k, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi))
@@ -229,6 +231,13 @@ def frontier(name, src, regions, quick):
                                                                  max_density=BUDGET_MAX_DENSITY)
         view = view_of(encode_with(src, size, regions, map=m), w, h)
         points["budget"].append((budget, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi, p_loss, p_gain, floor))
+    # The same with an anisotropy limit (`--max-anisotropy`): the builder tempers the density until
+    # every footprint is at most that elongated, which costs magnification but spares the context.
+    for limit in ([4.0, 8.0] if quick else ANISOTROPY_LIMITS):
+        m, floor, p_loss, p_gain = conus.Map.auto_for_frame_loss(importance, src, size, BUDGETS[-1], grid=BUDGET_GRID,
+                                                                 max_density=BUDGET_MAX_DENSITY, max_anisotropy=limit)
+        view = view_of(encode_with(src, size, regions, map=m), w, h)
+        points["limited"].append((limit, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi, p_loss, p_gain, floor))
     return points
 
 
@@ -297,18 +306,19 @@ def plots(out, all_curves, all_points):
     fig.savefig(out / "rate-distortion.png", dpi=90)
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(7, 5))
-    for method, marker in (("foci", "o"), ("auto", "s"), ("budget", "^")):
+    for method, marker in (("foci", "o"), ("auto", "s"), ("budget", "^"), ("limited", "D")):
         xs = [np.mean([p[method][i][1] for p in all_points.values()]) for i in range(min(len(p[method]) for p in all_points.values()))]
         ys = [np.mean([p[method][i][2] for p in all_points.values()]) for i in range(len(xs))]
         ax.plot(xs, ys, "-" + marker, label={"foci": "one focus per region, k = 2..6", "auto": "automatic map from ROI importance, floor swept",
-                                                "budget": f"automatic map, --frame-loss budget swept (max density {BUDGET_MAX_DENSITY:g}, grid {BUDGET_GRID})"}[method])
+                                                "budget": f"automatic map, --frame-loss budget swept (max density {BUDGET_MAX_DENSITY:g}, grid {BUDGET_GRID})",
+                                                "limited": f"the same at {BUDGETS[-1]:g} dB, --max-anisotropy {ANISOTROPY_LIMITS[0]:g}..{ANISOTROPY_LIMITS[-1]:g} swept"}[method])
     ax.axvline(2.5, color="grey", ls=":")
     ax.axhline(6.5, color="grey", ls=":")
     ax.set_xlabel("whole-frame loss against uniform (dB)")
     ax.set_ylabel("mean ROI gain over uniform (dB)")
     ax.set_title("1/16 of the pixels, mean over the photographs")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    ax.legend(fontsize=8, loc="lower right")
     fig.tight_layout()
     fig.savefig(out / "gain-loss.png", dpi=90)
     plt.close(fig)
@@ -337,16 +347,16 @@ def report(rows, all_curves, all_points):
             lines.append(f"| {r['photo']} | {z['zone']} | {100 * z['share']:.0f}% | {z['density']:.2f} | {z['anisotropy']:.2f} | "
                          f"{z['conus']:+.1f} dB | {z['ideal']:+.1f} dB |")
     lines += ["", "Gain against loss at 1/16 (mean over the photographs): method, setting: frame loss, ROI gain", ""]
-    for method in ("foci", "auto", "budget"):
+    for method in ("foci", "auto", "budget", "limited"):
         n = min(len(p[method]) for p in all_points.values())
         for i in range(n):
             setting = all_points[next(iter(all_points))][method][i][0]
             loss = np.mean([p[method][i][1] for p in all_points.values()])
             gain = np.mean([p[method][i][2] for p in all_points.values()])
             worst = min(p[method][i][2] for p in all_points.values())
-            name = {"foci": "k", "auto": "floor", "budget": "frame-loss"}[method]
+            name = {"foci": "k", "auto": "floor", "budget": "frame-loss", "limited": "max-anisotropy"}[method]
             line = f"- {method} {name} {setting}: loss {loss:.2f} dB, gain {gain:+.2f} dB (worst photo {worst:+.2f})"
-            if method == "budget":
+            if method in ("budget", "limited"):
                 p_loss = np.mean([p[method][i][3] for p in all_points.values()])
                 p_gain = np.mean([p[method][i][4] for p in all_points.values()])
                 floors = ", ".join(f"{p[method][i][5]:.2f}" for p in all_points.values())
