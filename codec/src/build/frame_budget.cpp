@@ -128,7 +128,13 @@ FramePrediction FrameErrorModel::predict(const SamplingMap& map) const {
         const double a = j[0][0], b = j[1][0] * aspect, c = j[0][1] / aspect, d = j[1][1];
         const double sumSquares = a * a + b * b + c * c + d * d, det = std::abs(a * d - b * c);
         const double large = std::sqrt(0.5 * (sumSquares + std::sqrt(std::max(0.0, sumSquares * sumSquares - 4.0 * det * det))));
-        return glm::dvec2(large, det / std::max(large, 1e-300));
+        const double small = det / std::max(large, 1e-300);
+        // The encoder's Gaussian along the footprint's long axis (encode.h), where the rate is the
+        // small one: a box of one CoNUS pixel (variance 1/12) widened by it samples as a box that
+        // much wider would, at that much lower a rate.
+        const double sigma = kEncodeAnisotropicSigma * (1.0 - kEncodeBoxAnisotropy * small / std::max(large, 1e-300));
+        const double widen = sigma > 0.0 ? std::sqrt(1.0 + 12.0 * sigma * sigma) : 1.0;
+        return glm::dvec2(large, small / widen);
     });
 }
 

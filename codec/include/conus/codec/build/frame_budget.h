@@ -9,8 +9,8 @@
 // its Jacobian's singular values along its footprint's axes, and loses the mean of the two. Then
 //   whole-frame loss = 10 log10(mean_x e(x, s0 sqrt d) / mean_x e(x, s0))   (dB, > 0: CoNUS worse)
 //   ROI gain        = 10 log10(mean_R e(x, s0) / mean_R e(x, s0 sqrt d))     (R: importance >= half its peak)
-// It ignores what the encode filter and the decode add (bench/quality.py sets it beside measured
-// figures).
+// Otherwise it takes the encode and decode to be the area downsample and bilinear of the uniform
+// image (bench/quality.py sets it beside measured figures).
 #pragma once
 
 #include <functional>
