@@ -16,7 +16,9 @@ Everything is measured in linear light (the values the EXR holds) against the so
   bytes. OpenJPEG has no spatial region of interest (its -ROI upshifts a whole component), so the
   full-resolution JPEG 2000 at equal bytes stands for JPEG 2000's own ROI coding;
 - gain against loss: foci of k = 2..6 and automatic maps from ROI importance (1 in the discs, 0
-  elsewhere) with their context floor swept: the frontier each method reaches.
+  elsewhere) with their context floor swept, or chosen by a whole-frame loss budget
+  (Map.auto_for_frame_loss, `encode --frame-loss`), and with an anisotropy limit swept: the
+  frontier each method reaches.
 Photographs: Debian's python3-skimage (astronaut, chelsea, motorcycle) and mate-backgrounds
 (ladybird, dandelion, garden; reduced to 1280 px wide by an area filter to keep the run short).
 """
@@ -47,6 +49,9 @@ PHOTOS = [
 MAX_WIDTH = 1280
 FRACTIONS = [(2, "1/4"), (4, "1/16"), (8, "1/64")]  # side divisor, share of the pixels
 K = 4
+BUDGETS = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0]  # --frame-loss budgets swept (dB)
+BUDGET_GRID, BUDGET_MAX_DENSITY = 129, 64.0
+ANISOTROPY_LIMITS = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0]  # --max-anisotropy swept, at the loosest budget
 
 
 def psnr(a, b, mask=None):
@@ -164,7 +169,37 @@ def measure(name, src, regions, out, quick):
         if share == "1/16":
             write_png(out / f"{name}-conus.png", srgb8(cview))
             write_png(out / f"{name}-uniform.png", srgb8(uview))
+            rows[-1]["zones"] = zones(src, regions, cfile, cview, uview, size)
     return rows
+
+
+def zones(src, regions, cfile, cview, uview, size):
+    """Where the whole-frame loss comes from: by distance from the regions (in radii), the share of
+    the frame, the map's mean density and median anisotropy (its Jacobian's singular value ratio in
+    pixels, by central differences), CoNUS's error over uniform's, and the uniform image at that
+    mean density's error over uniform's (what the density alone would cost)."""
+    h, w = src.shape[:2]
+    y, x = np.mgrid[0:h, 0:w]
+    points = np.stack([(x + 0.5) / w, (y + 0.5) / h], axis=-1)
+    out = []
+    for lo, hi in ((0, 1), (1, 2), (2, 3), (3, None)):
+        mask = discs(src.shape, regions, lo, hi) if hi else ~discs(src.shape, regions, 0, lo)
+        if not mask.any():
+            continue
+        p = points[mask][::16]
+        e, a = 1e-4, w / h
+        du = (np.asarray(cfile.map.distort(p + [e, 0])) - np.asarray(cfile.map.distort(p - [e, 0]))) / (2 * e)
+        dv = (np.asarray(cfile.map.distort(p + [0, e])) - np.asarray(cfile.map.distort(p - [0, e]))) / (2 * e)
+        jac = np.stack([np.stack([du[:, 0], dv[:, 0] * a], -1), np.stack([du[:, 1] / a, dv[:, 1]], -1)], 1)
+        sv = np.linalg.svd(jac, compute_uv=False)
+        density = float(np.mean(np.asarray(cfile.map.density(points[mask]))))
+        scaled = (max(1, round(size[0] * np.sqrt(min(density, 1e6)))), max(1, round(size[1] * np.sqrt(min(density, 1e6)))))
+        ideal = np.asarray(conus.resize(conus.uniform(src, size=(min(scaled[0], w), min(scaled[1], h))), size=(w, h)))[..., :3]
+        err = lambda view: ((view - src) ** 2)[mask].mean()
+        out.append(dict(zone=f"{lo}r..{hi}r" if hi else f"beyond {lo}r", share=float(mask.mean()), density=density,
+                        anisotropy=float(np.median(sv[:, 0] / sv[:, 1])),
+                        conus=10 * np.log10(err(cview) / err(uview)), ideal=10 * np.log10(err(ideal) / err(uview))))
+    return out
 
 
 def frontier(name, src, regions, quick):
@@ -176,7 +211,7 @@ def frontier(name, src, regions, quick):
     uview = np.asarray(conus.resize(conus.uniform(src, size=size), size=(w, h)))[..., :3]
     ref_roi, ref_frame = psnr(uview, src, roi), psnr(uview, src)
     importance = discs(src.shape, regions).astype(np.float32)
-    points = {"foci": [], "auto": []}
+    points = {"foci": [], "auto": [], "budget": [], "limited": []}
     for k in ([2, 4, 6] if quick else [2, 3, 4, 5, 6]):
         view = view_of(encode_with(src, size, regions, k=k), w, h)
         points["foci"].append((k, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi))
@@ -188,6 +223,21 @@ def frontier(name, src, regions, quick):
             continue
         view = view_of(encode_with(src, size, regions, map=m), w, h)
         points["auto"].append((floor, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi))
+    # The frame-loss budget (`encode --frame-loss`): the floor chosen by the predicted loss, a higher
+    # density cap so that a loose budget can spend it. The setting records the budget and what was
+    # predicted, beside what is measured.
+    for budget in ([1.0, 2.5] if quick else BUDGETS):
+        m, floor, p_loss, p_gain = conus.Map.auto_for_frame_loss(importance, src, size, budget, grid=BUDGET_GRID,
+                                                                 max_density=BUDGET_MAX_DENSITY)
+        view = view_of(encode_with(src, size, regions, map=m), w, h)
+        points["budget"].append((budget, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi, p_loss, p_gain, floor))
+    # The same with an anisotropy limit (`--max-anisotropy`): the builder tempers the density until
+    # every footprint is at most that elongated, which costs magnification but spares the context.
+    for limit in ([4.0, 8.0] if quick else ANISOTROPY_LIMITS):
+        m, floor, p_loss, p_gain = conus.Map.auto_for_frame_loss(importance, src, size, BUDGETS[-1], grid=BUDGET_GRID,
+                                                                 max_density=BUDGET_MAX_DENSITY, max_anisotropy=limit)
+        view = view_of(encode_with(src, size, regions, map=m), w, h)
+        points["limited"].append((limit, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi, p_loss, p_gain, floor))
     return points
 
 
@@ -256,17 +306,19 @@ def plots(out, all_curves, all_points):
     fig.savefig(out / "rate-distortion.png", dpi=90)
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(7, 5))
-    for method, marker in (("foci", "o"), ("auto", "s")):
+    for method, marker in (("foci", "o"), ("auto", "s"), ("budget", "^"), ("limited", "D")):
         xs = [np.mean([p[method][i][1] for p in all_points.values()]) for i in range(min(len(p[method]) for p in all_points.values()))]
         ys = [np.mean([p[method][i][2] for p in all_points.values()]) for i in range(len(xs))]
-        ax.plot(xs, ys, "-" + marker, label={"foci": "one focus per region, k = 2..6", "auto": "automatic map from ROI importance, floor swept"}[method])
+        ax.plot(xs, ys, "-" + marker, label={"foci": "one focus per region, k = 2..6", "auto": "automatic map from ROI importance, floor swept",
+                                                "budget": f"automatic map, --frame-loss budget swept (max density {BUDGET_MAX_DENSITY:g}, grid {BUDGET_GRID})",
+                                                "limited": f"the same at {BUDGETS[-1]:g} dB, --max-anisotropy {ANISOTROPY_LIMITS[0]:g}..{ANISOTROPY_LIMITS[-1]:g} swept"}[method])
     ax.axvline(2.5, color="grey", ls=":")
     ax.axhline(6.5, color="grey", ls=":")
     ax.set_xlabel("whole-frame loss against uniform (dB)")
     ax.set_ylabel("mean ROI gain over uniform (dB)")
     ax.set_title("1/16 of the pixels, mean over the photographs")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    ax.legend(fontsize=8, loc="lower right")
     fig.tight_layout()
     fig.savefig(out / "gain-loss.png", dpi=90)
     plt.close(fig)
@@ -287,14 +339,29 @@ def report(rows, all_curves, all_points):
         ring = np.mean([r["alias_u"] - r["alias_c"] for r in sel])
         lines.append(f"- {share}: mean ROI gain {gain:+.1f} dB (worst {worst:+.1f}), mean whole-frame loss {loss:.1f} dB, "
                      f"ring check CoNUS {ring:.1f} dB below uniform")
+    lines += ["", "Where the loss comes from at 1/16: error over uniform's by zone (distance from the regions in radii); "
+              "'uniform at that density': the uniform image of the zone's mean density", "",
+              "| photo | zone | share | mean density | median anisotropy | CoNUS | uniform at that density |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        for z in r.get("zones", []):
+            lines.append(f"| {r['photo']} | {z['zone']} | {100 * z['share']:.0f}% | {z['density']:.2f} | {z['anisotropy']:.2f} | "
+                         f"{z['conus']:+.1f} dB | {z['ideal']:+.1f} dB |")
     lines += ["", "Gain against loss at 1/16 (mean over the photographs): method, setting: frame loss, ROI gain", ""]
-    for method in ("foci", "auto"):
+    for method in ("foci", "auto", "budget", "limited"):
         n = min(len(p[method]) for p in all_points.values())
         for i in range(n):
             setting = all_points[next(iter(all_points))][method][i][0]
             loss = np.mean([p[method][i][1] for p in all_points.values()])
             gain = np.mean([p[method][i][2] for p in all_points.values()])
-            lines.append(f"- {method} {'k' if method == 'foci' else 'floor'} {setting}: loss {loss:.2f} dB, gain {gain:+.2f} dB")
+            worst = min(p[method][i][2] for p in all_points.values())
+            name = {"foci": "k", "auto": "floor", "budget": "frame-loss", "limited": "max-anisotropy"}[method]
+            line = f"- {method} {name} {setting}: loss {loss:.2f} dB, gain {gain:+.2f} dB (worst photo {worst:+.2f})"
+            if method in ("budget", "limited"):
+                p_loss = np.mean([p[method][i][3] for p in all_points.values()])
+                p_gain = np.mean([p[method][i][4] for p in all_points.values()])
+                floors = ", ".join(f"{p[method][i][5]:.2f}" for p in all_points.values())
+                line += f"; predicted loss {p_loss:.2f} dB, gain {p_gain:+.2f} dB; floors {floors}"
+            lines.append(line)
     lines += ["", "Equal bytes at 1/16: ROI PSNR (dB) of each at the bytes of CoNUS + JPEG XL -d 1 ('-': outside its range)", "",
               "| photo | KiB | CoNUS + jxl | uniform + jxl | full + jxl | CoNUS + j2k | uniform + j2k | full + j2k |", "|---|---|---|---|---|---|---|---|"]
     for name, curves in all_curves.items():

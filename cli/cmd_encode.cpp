@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/frame_budget.h"
 #include "conus/core/limits.h"
 #include "conus/core/map_rules.h"
 #include "encoding.h"
@@ -23,6 +24,7 @@ struct EncodeOptions {
     BatchOptions batch;
     std::string mapFile, compose = "density", importance, method = "flow";
     double minDensity = 0.25, maxDensity = 16, maxAnisotropy = 0;
+    double frameLoss = -1;  // dB; < 0: no budget (--min-density sets the floor)
     std::vector<std::string> foci;
     int grid = map_rules::kDefaultSide;
     SourceOptions source;
@@ -39,13 +41,23 @@ BuiltMap mapFromFile(const std::string& path) {
     return {std::make_unique<codec::SamplingMap>(codec::SamplingMap::fromGrid(mapSource.map)), mapSource.analytic};
 }
 
-BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source) {
+BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size) {
     Progress progress("build sampling map from " + o.importance + " importance");
-    const codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
-    BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildAutoMap(importanceFrom(o.importance, source), autoOptions)),
-                   std::nullopt};
+    codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
+    const Image importance = importanceFrom(o.importance, source);
+    if (o.frameLoss < 0) {
+        BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildAutoMap(importance, autoOptions)), std::nullopt};
+        progress.done();
+        return built;
+    }
+    // The budget chooses the context floor; say what it achieved.
+    const codec::FrameErrorModel model(source, size.width, size.height, importance);
+    codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions);
     progress.done();
-    return built;
+    std::printf("frame-loss budget %.2f dB: context floor %.3g; predicted whole-frame loss %.2f dB, ROI gain %+.2f dB%s\n",
+                o.frameLoss, r.minDensity, r.predicted.frameLoss, r.predicted.roiGain,
+                r.budgetBinds ? "" : " (the lowest floor stays within the budget: raise --max-density for more)");
+    return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt};
 }
 
 BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source) {
@@ -70,7 +82,7 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     const Size size = conusSize(o.storage, source.image);
     BuiltMap built;
     if (!o.mapFile.empty()) built = mapFromFile(o.mapFile);
-    else if (!o.importance.empty()) built = mapFromImportance(o, source.image);
+    else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size);
     else if (!o.foci.empty()) built = mapFromFoci(o, source.image);
     else {
         warn("no --focus, --map or --importance: writing the uniform image of the same pixel count (what `conus "
@@ -112,6 +124,13 @@ Command addEncodeCommand(CLI::App& root) {
         ->excludes("--focus")
         ->excludes("--map");
     addDensityBoundOptions(*command, options->minDensity, options->maxDensity, "with --importance: ");
+    command->add_option("--frame-loss", options->frameLoss,
+                        "with --importance: whole-frame loss budget in dB against the uniform image; chooses the "
+                        "lowest context floor whose predicted loss stays within it, and prints the predicted loss "
+                        "and ROI gain")
+        ->check(CLI::Range(0.0, 60.0))
+        ->needs("--importance")
+        ->excludes("--min-density");
     addMaxAnisotropyOption(*command, options->maxAnisotropy);
     command->add_option("--method", options->method, "with --importance: flow (default) | separable")
         ->check(CLI::IsMember({"flow", "separable"}));

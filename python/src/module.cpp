@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "conus/codec/build/auto_map.h"
+#include "conus/codec/build/frame_budget.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/build/springs.h"
 #include "conus/codec/conus_file.h"
@@ -283,6 +284,26 @@ PYBIND11_MODULE(_conus, m) {
             },
             py::arg("importance"), py::arg("grid") = map_rules::kDefaultSide, py::arg("min_density") = 0.25,
             py::arg("max_density") = 16.0, "A map whose density follows an importance image (H, W)")
+        .def_static(
+            "auto_for_frame_loss",
+            [](const py::array& importance, const py::array& source, std::pair<int, int> size, double frame_loss, int grid,
+               double max_density, double max_anisotropy) {
+                const Image image = fromArray(importance, std::nullopt, "importance");
+                const Image picture = fromArray(source, std::nullopt, "source");
+                codec::AutoMapOptions options;
+                options.columns = options.rows = grid;
+                options.maxDensity = max_density;
+                options.maxAnisotropy = max_anisotropy;
+                py::gil_scoped_release release;
+                const codec::FrameErrorModel model(picture, size.first, size.second, image);
+                codec::BudgetResult r = codec::buildAutoMapForFrameLoss(image, model, frame_loss, options);
+                return std::make_tuple(std::make_shared<Map>(Map{std::move(r.map), {}}), r.minDensity, r.predicted.frameLoss,
+                                       r.predicted.roiGain);
+            },
+            py::arg("importance"), py::arg("source"), py::arg("size"), py::arg("frame_loss"),
+            py::arg("grid") = map_rules::kDefaultSide, py::arg("max_density") = 16.0, py::arg("max_anisotropy") = 0.0,
+            "The automatic map (max_anisotropy: 0 none, else as --max-anisotropy) with the lowest context floor whose predicted whole-frame loss against the uniform "
+            "image of `size` (width, height) stays within `frame_loss` dB: (map, floor, predicted loss, predicted ROI gain)")
         .def_static(
             "from_nodes",
             [](const py::array& nodes) {

@@ -296,6 +296,21 @@ TEST_F(Cli, DensityBoundsAreHeldOrRefused) {
     EXPECT_FALSE(fs::exists(path("b.exr")));
 }
 
+TEST_F(Cli, FrameLossBudgetSaysWhatItAchieved) {
+    const std::string picture = makePicture(256, 192), importance = makeImportance(64, 48);
+    const std::string encode = "encode " + picture + " --importance " + importance + " --size 64x48 --frame-loss ";
+    const Result tight = run(encode + "0.5 -o " + path("t.exr"));
+    ASSERT_EQ(tight.exitCode, 0) << tight.err;
+    EXPECT_NE(tight.out.find("frame-loss budget 0.50 dB: context floor"), std::string::npos) << tight.out;
+    EXPECT_NE(tight.out.find("predicted whole-frame loss"), std::string::npos) << tight.out;
+    EXPECT_TRUE(fs::exists(path("t.exr")));
+    // The budget stands in for the floor, and needs importance to spend.
+    EXPECT_EQ(run(encode + "1 --min-density 0.3 -o " + path("x.exr")).exitCode, 2);
+    EXPECT_EQ(run("encode " + picture + " --frame-loss 1 -o " + path("y.exr")).exitCode, 2);
+    EXPECT_FALSE(fs::exists(path("x.exr")));
+    EXPECT_FALSE(fs::exists(path("y.exr")));
+}
+
 TEST_F(Cli, FacesImportanceFindsTheAstronautsFace) {
     const std::string photo = "/usr/lib/python3/dist-packages/skimage/data/astronaut.png";
     if (!fs::exists(photo)) GTEST_SKIP() << "python3-skimage's photographs not installed (" << photo << ")";

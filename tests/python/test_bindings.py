@@ -94,6 +94,21 @@ def test_auto_and_springs_maps_concentrate_where_asked():
     assert inside > outside
 
 
+def test_frame_loss_budget_sets_the_floor(asymmetric):
+    h, w = asymmetric.shape[:2]
+    importance = np.zeros((h, w), np.float32)
+    importance[h // 4:h // 2, w // 2:3 * w // 4] = 1.0
+    size = (w // 4, h // 4)
+    tight = conus.Map.auto_for_frame_loss(importance, asymmetric[..., :3], size, 0.3, grid=33)
+    loose = conus.Map.auto_for_frame_loss(importance, asymmetric[..., :3], size, 2.0, grid=33)
+    # (map, floor, predicted loss, predicted ROI gain): a looser budget buys a lower floor and more gain.
+    assert loose[1] < tight[1]
+    assert tight[2] <= 0.3 + 1e-9 and loose[2] <= 2.0 + 1e-9
+    assert loose[3] > tight[3]
+    with pytest.raises(conus.Error):
+        conus.Map.auto_for_frame_loss(importance, asymmetric[..., :3], size, -1.0)
+
+
 def test_views_and_ownership(asymmetric):
     f = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80))
     a, b = f.pixels, f.pixels

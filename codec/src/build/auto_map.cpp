@@ -180,7 +180,7 @@ SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options)
     if (options.method == AutoMethod::Separable) {
         SamplingMap map = buildSeparableMap(target, options.columns, options.rows);
         const MapMeasures m = measureMap(map, aspect);
-        if (!within(m)) refuseBounds(m, options);
+        if (options.refuseBounds && !within(m)) refuseBounds(m, options);
         return map;
     }
     DensityMapOptions mapOptions;
@@ -218,7 +218,7 @@ SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options)
                 followed.values[k] = static_cast<float>(std::clamp(followed.values[k] * factor, wanted * 1e-3, wanted * 1e3));
             }
     }
-    if (!within(bestMeasures)) refuseBounds(bestMeasures, options);
+    if (options.refuseBounds && !within(bestMeasures)) refuseBounds(bestMeasures, options);
     return std::move(*best);
 }
 

@@ -32,6 +32,72 @@ glm::dvec2 displacementAt(const SamplingMap& map, glm::dvec2 q) {
     return map.distort(q) - q;
 }
 
+// 0 for t <= 0, 1 for t >= 1, the quintic smoothstep between (its slope peaks at 15/8).
+double ramp(double t) {
+    t = std::clamp(t, 0.0, 1.0);
+    return t * t * t * (t * (6.0 * t - 15.0) + 10.0);
+}
+constexpr double kRampSlope = 15.0 / 8.0;
+
+// A map's pattern placed in the output by the affine change q = a * p + b (per axis, a > 0): the
+// output's displacement is D(q) / a. Two cuts would leave it discontinuous (issue 10: "a visible
+// square seam and a dark slit"), so both are tapered:
+// - An edge of the pattern's square that falls inside the output (a pattern shrunk or moved in):
+//   D is tangential there but not zero (boundary nodes slide along their edge), and zero outside,
+//   so nodes on either side of the edge jumped apart, and the density stepped from the pattern's
+//   edge density to 1. The whole displacement fades to zero over a band inside the pattern; the
+//   fade of a tangential field is a shear (no change of density), so density meets 1 smoothly.
+// - An edge of the output that cuts the pattern (a pattern enlarged or moved out): D has a normal
+//   part there that only the boundary nodes dropped, squeezing or stretching one row of cells
+//   into a slit. The normal part fades to zero over a band wide enough that the fade changes the
+//   density by at most a half (and at least a quarter of the frame).
+struct Placement {
+    glm::dvec2 a{1.0}, b{0.0};
+};
+
+std::vector<glm::dvec2> placedDisplacement(const SamplingMap& map, Placement placement) {
+    const int columns = map.columns(), rows = map.rows();
+    const glm::dvec2 a = placement.a, b = placement.b;
+    constexpr double kInside = 1e-9;
+    const auto strictlyInside = [](double t) { return t > kInside && t < 1.0 - kInside; };
+    // Pattern edges inside the output, per axis: [axis][0] the q = 0 edge, [axis][1] the q = 1 edge.
+    bool patternEdge[2][2], outputCut[2][2];
+    double bandQ[2], bandOut[2];
+    const double cell[2] = {1.0 / (columns - 1), 1.0 / (rows - 1)};
+    for (int axis = 0; axis < 2; ++axis) {
+        patternEdge[axis][0] = strictlyInside(-b[axis] / a[axis]);
+        patternEdge[axis][1] = strictlyInside((1.0 - b[axis]) / a[axis]);
+        outputCut[axis][0] = strictlyInside(b[axis]);
+        outputCut[axis][1] = strictlyInside(a[axis] + b[axis]);
+        // A tenth of the pattern, and at least two output cells.
+        bandQ[axis] = std::max(0.1, 2.0 * cell[axis] * a[axis]);
+    }
+    // The largest normal displacement anywhere (the band reaches in where it may be larger than at
+    // the edge) sets the band of each cut output edge: its fade then changes the density by at
+    // most half; and at least a quarter of the frame, so that the change is gentle.
+    glm::dvec2 largest(0.0);
+    for (int j = 0; j < rows; ++j)
+        for (int i = 0; i < columns; ++i)
+            largest = glm::max(largest, glm::abs(displacementAt(map, a * glm::dvec2(double(i) / (columns - 1), double(j) / (rows - 1)) + b) / a));
+    for (int axis = 0; axis < 2; ++axis) bandOut[axis] = std::clamp(2.0 * kRampSlope * largest[axis], 0.25, 1.0);
+    std::vector<glm::dvec2> d(std::size_t(columns) * rows);
+    for (int j = 0; j < rows; ++j)
+        for (int i = 0; i < columns; ++i) {
+            const glm::dvec2 p(double(i) / (columns - 1), double(j) / (rows - 1));
+            const glm::dvec2 q = a * p + b;
+            glm::dvec2 disp = displacementAt(map, q) / a;
+            double fade = 1.0;
+            for (int axis = 0; axis < 2; ++axis) {
+                if (patternEdge[axis][0]) fade *= ramp(q[axis] / bandQ[axis]);
+                if (patternEdge[axis][1]) fade *= ramp((1.0 - q[axis]) / bandQ[axis]);
+                if (outputCut[axis][0]) disp[axis] *= ramp(p[axis] / bandOut[axis]);
+                if (outputCut[axis][1]) disp[axis] *= ramp((1.0 - p[axis]) / bandOut[axis]);
+            }
+            d[std::size_t(j) * columns + i] = fade * disp;
+        }
+    return d;
+}
+
 // Node positions p + s*D, boundary nodes snapped onto their edge (tangential part kept, clamped).
 void placeNodes(int columns, int rows, std::span<const glm::dvec2> displacement, double s, std::vector<glm::vec2>& out) {
     out.resize(std::size_t(columns) * rows);
@@ -93,7 +159,7 @@ ComposeResult translateMap(const SamplingMap& map, glm::dvec2 offset) {
     if (!std::isfinite(offset.x) || !std::isfinite(offset.y)) {
         throw Error(ErrorCode::InvalidArgument, "translateMap: offset (" + numberText(offset.x) + ", " + numberText(offset.y) + ") is not finite");
     }
-    const auto d = resampleField(map.columns(), map.rows(), [&](glm::dvec2 p) { return displacementAt(map, p - offset); });
+    const auto d = placedDisplacement(map, {glm::dvec2(1.0), -offset});
     return fitDisplacement(map.columns(), map.rows(), d);
 }
 
@@ -104,9 +170,8 @@ ComposeResult scaleMap(const SamplingMap& map, double factor, glm::dvec2 centre)
     if (!std::isfinite(centre.x) || !std::isfinite(centre.y)) {
         throw Error(ErrorCode::InvalidArgument, "scaleMap: centre (" + numberText(centre.x) + ", " + numberText(centre.y) + ") is not finite");
     }
-    const auto d = resampleField(map.columns(), map.rows(), [&](glm::dvec2 p) {
-        return factor * displacementAt(map, centre + (p - centre) / factor);
-    });
+    // q = centre + (p - centre) / factor
+    const auto d = placedDisplacement(map, {glm::dvec2(1.0 / factor), centre - centre / factor});
     return fitDisplacement(map.columns(), map.rows(), d);
 }
 

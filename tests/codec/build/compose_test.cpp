@@ -5,9 +5,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <vector>
 
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/map_measures.h"
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
@@ -127,6 +129,74 @@ TEST(Compose, ScaleKeepsDensityPatternLarger) {
     const ComposeResult cut = scaleMap(focusMap(0.5, 0.5, 0.2, 8), 3.0, {0.1, 0.9});
     expectValid(cut.map);
     EXPECT_GT(cut.scale, 0.0);
+}
+
+// The largest jump of log cell density between neighbouring cells (both within `near` of the
+// point set `on`, when given): a seam (a density step where a moved or scaled pattern ends) or a
+// slit (one row of cells squeezed at an edge) makes it large.
+double largestLogDensityJump(const SamplingMap& map, const std::function<bool(glm::dvec2)>& on = {}) {
+    const map_rules::GridView grid{map.columns(), map.rows(), &map.nodes().front().x};
+    const int n = map.columns() - 1, m = map.rows() - 1;
+    const auto centre = [&](int i, int j) { return glm::dvec2((i + 0.5) / n, (j + 0.5) / m); };
+    double worst = 0;
+    for (int j = 0; j < m; ++j)
+        for (int i = 0; i < n; ++i) {
+            if (on && !on(centre(i, j))) continue;
+            const double c = std::log(cellDensity(grid, i, j));
+            if (i + 1 < n && (!on || on(centre(i + 1, j))))
+                worst = std::max(worst, std::abs(std::log(cellDensity(grid, i + 1, j)) - c));
+            if (j + 1 < m && (!on || on(centre(i, j + 1))))
+                worst = std::max(worst, std::abs(std::log(cellDensity(grid, i, j + 1)) - c));
+        }
+    return worst;
+}
+
+TEST(Compose, ScaledAndMovedPatternsHaveNoSeam) {
+    // Issue 10: `map compose --scale` left a square seam and a dark slit. A focus map's
+    // displacement reaches every edge (context is squeezed everywhere), so shrinking or moving it
+    // puts its edge inside the frame (a seam), and enlarging or moving it cuts it at the frame's
+    // edge (a slit: the old code folded there and scaled the whole pattern down to 0.1-0.2).
+    const SamplingMap focus = focusMap(0.45, 0.55, 0.1, 2);
+    const double own = largestLogDensityJump(focus);
+    struct Case {
+        const char* what;
+        ComposeResult result;
+        double factor;
+        glm::dvec2 low, high;  // the pattern's square in the output
+    };
+    const Case cases[] = {
+        {"scale 0.5 about the middle", scaleMap(focus, 0.5, {0.5, 0.5}), 0.5, {0.25, 0.25}, {0.75, 0.75}},
+        {"scale 0.6 about (0.3, 0.7)", scaleMap(focus, 0.6, {0.3, 0.7}), 0.6, {0.12, 0.28}, {0.72, 0.88}},
+        {"scale 2 about the focus", scaleMap(focus, 2.0, {0.45, 0.55}), 2.0, {-0.45, -0.55}, {1.55, 1.45}},
+        {"translate (0.3, -0.2)", translateMap(focus, {0.3, -0.2}), 1.0, {0.3, -0.2}, {1.3, 0.8}},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        expectValid(c.result.map);
+        EXPECT_EQ(c.result.scale, 1.0);  // no fold to scale away
+        // Everywhere: no steeper than the pattern's own steepest jump, enlarged by the factor (its
+        // detail spans fewer cells), with 25% for the grid's fit and the fades.
+        const double jump = largestLogDensityJump(c.result.map);
+        EXPECT_LE(jump, 1.25 * own * std::max(1.0, 1.0 / c.factor)) << "own " << own;
+        // Across the pattern's edges inside the frame (cells within 1.5 cells of them): a seam is
+        // a jump from the pattern's edge density to 1 in one cell (the old code: 0.22-0.44 here);
+        // faded, it spreads over a band (0.04-0.07).
+        const double cell = 1.0 / (focus.columns() - 1);
+        const auto nearEdge = [&](glm::dvec2 p) {
+            for (int axis = 0; axis < 2; ++axis)
+                for (double edge : {c.low[axis], c.high[axis]})
+                    if (edge > 0 && edge < 1 && std::abs(p[axis] - edge) < 1.5 * cell) return true;
+            return false;
+        };
+        const double seam = largestLogDensityJump(c.result.map, nearEdge);
+        EXPECT_LE(seam, 0.1);
+        std::printf("%s: largest log density jump %.3f (the pattern alone %.3f), across its edges %.3f\n", c.what, jump,
+                    own, seam);
+        // The fades keep the pattern: its focus is still magnified about as much, less where the
+        // enlarged pattern fills the frame and the fades at its edges reach the focus.
+        const glm::dvec2 at = c.low + (c.high - c.low) * glm::dvec2(0.45, 0.55);
+        EXPECT_GT(c.result.map.density(at), (c.factor > 1 ? 0.45 : 0.6) * focus.density({0.45, 0.55})) << "at " << at.x << "," << at.y;
+    }
 }
 
 TEST(Compose, ValidityCheckAgreesWithValidator) {

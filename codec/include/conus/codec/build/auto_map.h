@@ -28,6 +28,7 @@ struct AutoMapOptions {
     double smoothing = 0.01;      // blur radius as a fraction of the image width
     AutoMethod method = AutoMethod::Flow;
     double maxAnisotropy = 0;     // flow: DensityMapOptions::maxAnisotropy (0: none)
+    bool refuseBounds = true;     // false: return the map closest to the bounds instead of refusing
 };
 
 // How far the achieved cell density (map_measures.h) may stray outside [minDensity, maxDensity]:

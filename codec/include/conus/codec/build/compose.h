@@ -11,7 +11,11 @@
 //   combination that folds.
 // - Boundary nodes keep only the tangential part of their displacement (the normal part is
 //   dropped) so they stay exactly on their edge; corners stay fixed.
-// - Displacement fetched from outside [0,1]^2 (translation, scaling) is zero.
+// - Displacement fetched from outside [0,1]^2 (translation, scaling) is zero. So that a moved or
+//   scaled pattern has no seam, its displacement fades to zero over a band inside each edge of
+//   its square that lands inside the output (a tenth of the pattern, at least two cells), and its
+//   normal part fades to zero over a band inside each output edge that cuts it (a quarter of the
+//   frame or more, so that the fade changes the density by at most a half). Density is continuous across both.
 #pragma once
 
 #include <span>
@@ -37,11 +41,12 @@ bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes);
 ComposeResult fitDisplacement(int columns, int rows, std::span<const glm::dvec2> displacement);
 
 // Moves the distortion pattern by `offset`: D'(p) = D(p - offset), zero where p - offset leaves
-// the unit square. Same grid as the input.
+// the unit square, faded at the cuts (above). Same grid as the input.
 ComposeResult translateMap(const SamplingMap& map, glm::dvec2 offset);
 
 // Scales the pattern about `centre` by `factor` > 0: D'(p) = factor * D(c + (p - c) / factor), so
-// the density pattern is the same one, `factor` times as large. Same grid as the input.
+// the density pattern is the same one, `factor` times as large, faded at the cuts (above). Same
+// grid as the input.
 ComposeResult scaleMap(const SamplingMap& map, double factor, glm::dvec2 centre = {0.5, 0.5});
 
 // The paper's addition: node = p + sum_i w_i D_i(p) on a columns x rows grid. `weights` is empty

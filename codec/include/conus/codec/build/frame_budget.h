@@ -1,0 +1,70 @@
+// What an automatic map costs the rest of the frame, predicted before encoding, and the context
+// floor chosen by a budget on it (`--frame-loss`, issue 10).
+//
+// The prediction: a picture sampled at linear rate s (samples per source pixel along each axis)
+// loses at each pixel about what the uniform image of that rate loses there, e(x, s) =
+// |source - bilinear(area(source, s))|^2 (mean over channels). The model holds e at rates half an
+// octave apart and interpolates in log rate; e = 0 at s >= 1. A map of density d samples at
+// s0 sqrt(d), s0 the rate of the uniform image of the CoNUS pixel count; a map samples at s0 times
+// its Jacobian's singular values along its footprint's axes, and loses the mean of the two. Then
+//   whole-frame loss = 10 log10(mean_x e(x, s0 sqrt d) / mean_x e(x, s0))   (dB, > 0: CoNUS worse)
+//   ROI gain        = 10 log10(mean_R e(x, s0) / mean_R e(x, s0 sqrt d))     (R: importance >= half its peak)
+// Otherwise it takes the encode and decode to be the area downsample and bilinear of the uniform
+// image (bench/quality.py sets it beside measured figures).
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "conus/codec/build/auto_map.h"
+#include "conus/codec/map/sampling_map.h"
+#include "conus/core/image.h"
+
+namespace conus::codec {
+
+struct FramePrediction {
+    double frameLoss = 0;  // dB
+    double roiGain = 0;    // dB
+};
+
+class FrameErrorModel {
+public:
+    // `source` the picture, (width, height) the CoNUS image size (at most the source's), `importance`
+    // any size (its region R is where it reaches half its peak; empty: R is the whole frame). Throws
+    // conus::Error(InvalidArgument) on an empty source or a size outside 1..source size.
+    FrameErrorModel(const Image& source, int width, int height, const Image& importance);
+
+    // For a density at undistorted p in [0,1]^2 (density(p) > 0).
+    FramePrediction predict(const std::function<double(double u, double v)>& density) const;
+    FramePrediction predict(const SamplingMap& map) const;
+    FramePrediction predict(const DensityField& field) const;
+    // For the linear rates along two axes at p, relative to the uniform image's (a density d is
+    // sqrt(d) along both; a map's are its Jacobian's singular values in pixels).
+    FramePrediction predictAxes(const std::function<glm::dvec2(double u, double v)>& scales) const;
+
+private:
+    int m_width = 0, m_height = 0;  // of the model's grid (the source, at most 512 a side)
+    double m_baseRate = 1;          // s0, in source pixels
+    std::vector<double> m_logRates;                // ascending, the last one log(1) = 0
+    std::vector<std::vector<float>> m_error;       // per rate, per pixel of the model's grid
+    std::vector<unsigned char> m_roi;
+};
+
+struct BudgetResult {
+    SamplingMap map;
+    double minDensity = 0;          // the context floor chosen
+    FramePrediction predicted;      // of `map` itself
+    bool budgetBinds = true;        // false: even the lowest floor stays under the budget
+};
+
+// The automatic map (buildAutoMap with `options`, its minDensity replaced) with the lowest context
+// floor in [0.02, 0.99] (to 1.5%, by bisection, a map built for each try) whose own predicted
+// whole-frame loss stays within `frameLossDb`: the most ROI gain the budget allows. The map is built without refusing
+// density bounds (the budget, not the floor, is the promise). Throws conus::Error(InvalidArgument) for a budget that is not finite
+// and >= 0.
+BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorModel& model, double frameLossDb,
+                                      AutoMapOptions options = {});
+
+}  // namespace conus::codec
