@@ -316,7 +316,7 @@ Command addVolumeCommand(CLI::App& root) {
     animate->add_option("--radius", a->radius, "the focus's radius, a fraction of the width")
         ->capture_default_str()
         ->check(finiteRange(0, 1));
-    animate->add_option("--k", a->k, "the focus's magnification")->capture_default_str()->check(finiteRange(1, 64, true));
+    animate->add_option("--k", a->k, "the focus's magnification")->capture_default_str()->check(finiteRange(1, map_rules::kMaxMagnification, true));
     animate->add_option("--size", a->volume.sizeText, "CoNUS image size WxH")->capture_default_str();
     animate->add_option("--camera", a->volume.cameraText, "ex,ey,ez,lx,ly,lz,fovDeg (default: frames the volume)");
     animate->add_option("--tf", a->volume.tf, "transfer function: a preset or a file")->capture_default_str();

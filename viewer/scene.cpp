@@ -15,6 +15,7 @@
 #include "conus/core/error.h"
 #include "conus/format/container.h"
 #include "conus/renderers/mesh_render.h"
+#include "conus/renderers/reflection.h"
 #include "conus/renderers/relief.h"
 #include "conus/renderers/volume_renderer.h"
 #include "conus/sceneio/mesh_file.h"
@@ -153,19 +154,23 @@ private:
     std::unique_ptr<gl::ReliefRenderer> m_conus, m_uniform;
 };
 
-// A baked reflection asset (six faces) and the scene it was baked from, drawn on the CPU: a mirror
-// sphere at the asset's centre whose reflected rays intersect the faces.
+// A baked reflection asset (six faces) and the scene it was baked from, drawn on the GPU
+// (gl::ReflectionRenderer, the GLSL twin of codec::renderReflectionFrame): a mirror sphere at the
+// asset's centre whose reflected rays intersect the faces.
 class ReflectionView final : public Scene {
 public:
-    explicit ReflectionView(const Options& options) : ReflectionView(options, sceneio::readMesh(options.reflectionScene)) {}
-    ReflectionView(const Options& options, Mesh mesh)
-        : m_name(fileName(options.scenePath) + " (reflection)"), m_bounds(sphereAround(mesh.positions)), m_scene(std::move(mesh)) {
-        m_conus = faces(options.scenePath);
-        if (!options.uniform.empty()) m_uniform = faces(options.uniform);
-        m_centre = m_conus.front().depth.camera().eye();
+    ReflectionView(gl::Context& context, const Options& options)
+        : ReflectionView(context, options, sceneio::readMesh(options.reflectionScene)) {}
+    ReflectionView(gl::Context& context, const Options& options, const Mesh& mesh)
+        : m_name(fileName(options.scenePath) + " (reflection)"), m_bounds(sphereAround(mesh.positions)) {
+        const std::vector<codec::ReflectionFace> conusFaces = faces(options.scenePath);
+        m_centre = conusFaces.front().depth.camera().eye();
         m_options.reflector.kind = codec::Reflector::Kind::Sphere;
         m_options.reflector.centre = m_centre;
         m_options.reflector.radius = options.reflectorRadius;
+        m_conus = std::make_unique<gl::ReflectionRenderer>(context, mesh, conusFaces, m_options);
+        if (!options.uniform.empty())
+            m_uniform = std::make_unique<gl::ReflectionRenderer>(context, mesh, faces(options.uniform), m_options);
     }
     std::string name() const override { return m_name; }
     glm::dvec3 centre() const override { return m_centre; }
@@ -182,8 +187,7 @@ public:
         return orbit;
     }
     Image render(const Camera& camera, const codec::SamplingMap&, bool conus, int width, int height) override {
-        const std::vector<codec::ReflectionFace>& faces = conus || m_uniform.empty() ? m_conus : m_uniform;
-        return colourOf(codec::renderReflectionFrame(m_scene, &faces, m_centre, camera, width, height, m_options));
+        return colourOf((conus || !m_uniform ? *m_conus : *m_uniform).render(camera, width, height));
     }
 
 private:
@@ -200,10 +204,9 @@ private:
     }
     std::string m_name;
     BoundingSphere m_bounds;
-    codec::MeshScene m_scene;
-    std::vector<codec::ReflectionFace> m_conus, m_uniform;
     glm::dvec3 m_centre{0.0};
     codec::ReflectionFrameOptions m_options;
+    std::unique_ptr<gl::ReflectionRenderer> m_conus, m_uniform;
 };
 
 }  // namespace
@@ -213,7 +216,7 @@ std::unique_ptr<Scene> openScene(const Options& options, gl::Context& context) {
     case SceneKind::Mesh: return std::make_unique<MeshView>(context, options.scenePath, options.maxEdge);
     case SceneKind::Volume: return std::make_unique<VolumeView>(context, options);
     case SceneKind::Relief: return std::make_unique<ReliefView>(context, options);
-    case SceneKind::Reflection: return std::make_unique<ReflectionView>(options);
+    case SceneKind::Reflection: return std::make_unique<ReflectionView>(context, options);
     case SceneKind::None: break;
     }
     throw Error(ErrorCode::InvalidArgument, "no scene given (--mesh, --volume, --relief or --reflection)");

@@ -19,6 +19,7 @@
 #include <functional>
 #include <limits>
 
+#include "conus/core/limits.h"
 #include "raw_file.h"
 #include "test_files.h"
 
@@ -104,8 +105,8 @@ TEST_F(RuleTest, V3Channels) {
                          }),
                          3));
     ConusFile f = validFile();
-    f.image = makeImage(2, 2, std::vector<std::string>(65, "C"));
-    for (int i = 0; i < 65; ++i) f.image.channels[i] = std::to_string(100 + i).insert(0, 1, 'C');
+    f.image = makeImage(2, 2, std::vector<std::string>(kMaxChannels + 1, "C"));
+    for (int i = 0; i <= kMaxChannels; ++i) f.image.channels[i] = std::to_string(100 + i).insert(0, 1, 'C');
     EXPECT_TRUE(onlyRule(validateConusFile(f), 3));
     f = validFile();
     f.image.channels[1] = f.image.channels[0];

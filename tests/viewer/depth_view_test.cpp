@@ -14,6 +14,7 @@
 #include "document.h"
 #include "inspector.h"
 #include "sanitizers.h"
+#include "oiio_picture.h"
 #include "viewer_test_util.h"
 
 namespace conus::viewer {
@@ -141,14 +142,7 @@ TEST(DepthView, NoZChannelIsAnError) {
     EXPECT_FALSE(probe(test::conusFile(), codec::SamplingMap::fromGrid(test::conusFile().map), {0.5, 0.5}).depthImage);
 }
 
-Image readPicture(const fs::path& path) {
-    auto in = OIIO::ImageInput::open(path.string());
-    if (!in) return {};
-    const OIIO::ImageSpec spec = in->spec();
-    Image im = makeImage(spec.width, spec.height, std::vector<std::string>(spec.nchannels, "C"));
-    in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, im.pixels.data());
-    return im;
-}
+Image readPicture(const fs::path& path) { return conus::test::readPictureWithOiio(path.string()); }
 
 // Mean luminance of the screenshot's pixels (a fitted view: pixel (x, y) shows undistorted
 // ((x+.5)/W, (y+.5)/H)) where the camera sees the floor at depths within [lo, hi).

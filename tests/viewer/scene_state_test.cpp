@@ -60,12 +60,19 @@ TEST(SceneState, MapIsTheFociOrTheIdentity) {
     EXPECT_NEAR(s.map(1.5).density({0.6, 0.4}), 1.0, 1e-9) << "conventional: the identity";
 }
 
-TEST(SceneController, DragOnAFocusMovesItElsewhereOrbits) {
+// A controller in mesh scene mode over a kW x kH window (the controller never opens the scene).
+class SceneController : public ::testing::Test {
+protected:
+    void SetUp() override {
+        c.setWindowSize(kW, kH);
+        ASSERT_TRUE(c.load());
+        c.startScene({0, 0, 0}, 1.0, "test (mesh)", true, "");
+    }
     const Options options = sceneOptions();
-    Controller c(options);
-    c.setWindowSize(kW, kH);
-    ASSERT_TRUE(c.load());
-    c.startScene({0, 0, 0}, 1.0, "test (mesh)", true, "");
+    Controller c{options};
+};
+
+TEST_F(SceneController, DragOnAFocusMovesItElsewhereOrbits) {
     ASSERT_NE(c.scene(), nullptr);
     EXPECT_EQ(c.keyTable(), KeyTable::Scene);
     EXPECT_EQ(c.display().mode, gl::ViewMode::Raw) << "the CoNUS image itself";
@@ -116,12 +123,7 @@ TEST(SceneController, DragOnAFocusMovesItElsewhereOrbits) {
 
 // A frame handed back is what the window shows and what the inspector reads: a depth image with
 // the camera, so the 3-D point under the cursor is the camera's.
-TEST(SceneController, TheFrameIsShownAndInspected) {
-    const Options options = sceneOptions();
-    Controller c(options);
-    c.setWindowSize(kW, kH);
-    ASSERT_TRUE(c.load());
-    c.startScene({0, 0, 0}, 1.0, "test (mesh)", true, "");
+TEST_F(SceneController, TheFrameIsShownAndInspected) {
     const double aspect = double(kW) / kH;
     const Camera camera = c.scene()->camera(aspect);
     const codec::SamplingMap map = c.scene()->map(aspect);

@@ -13,6 +13,7 @@
 #include "conus/sceneio/mesh_file.h"
 #include "sanitizers.h"
 #include "scene_state.h"
+#include "oiio_picture.h"
 #include "viewer_test_util.h"
 
 namespace conus::viewer {
@@ -22,14 +23,7 @@ namespace fs = std::filesystem;
 
 constexpr int kW = 256, kH = 192;
 
-Image readPicture(const fs::path& path) {
-    auto in = OIIO::ImageInput::open(path.string());
-    if (!in) return {};
-    const OIIO::ImageSpec spec = in->spec();
-    Image im = makeImage(spec.width, spec.height, std::vector<std::string>(spec.nchannels, "C"));
-    in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, im.pixels.data());
-    return im;
-}
+Image readPicture(const fs::path& path) { return conus::test::readPictureWithOiio(path.string()); }
 
 // Runs conus-view with `args` and the script under Xvfb in a kW x kH window; the log.
 std::string runScript(const std::string& args, const std::string& script) {
@@ -261,7 +255,7 @@ std::string roomObj() {
     return path.string();
 }
 
-// A reflection asset (CPU frames) whose faces magnify the first box: U swaps them for the
+// A reflection asset (GPU frames) whose faces magnify the first box: U swaps them for the
 // conventional ones, which changes the mirror and nothing else.
 TEST(SceneWindow, ReflectionAssetToggleChangesTheMirrorOnly) {
     ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";

@@ -11,6 +11,7 @@
 #include "conus/format/container.h"
 #include "sanitizers.h"
 #include "view_state.h"
+#include "oiio_picture.h"
 #include "viewer_test_util.h"
 
 namespace conus::viewer {
@@ -28,14 +29,7 @@ public:
 };
 [[maybe_unused]] ::testing::Environment* const kRemoveTempDir = ::testing::AddGlobalTestEnvironment(new RemoveTempDir);
 
-Image readPng(const fs::path& path) {
-    auto in = OIIO::ImageInput::open(path.string());
-    if (!in) return {};
-    const OIIO::ImageSpec spec = in->spec();
-    Image im = makeImage(spec.width, spec.height, std::vector<std::string>(spec.nchannels, "C"));
-    in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, im.pixels.data());
-    return im;
-}
+Image readPng(const fs::path& path) { return conus::test::readPictureWithOiio(path.string()); }
 
 void writePng(const fs::path& path, const Image& im) {
     auto out = OIIO::ImageOutput::create(path.string());

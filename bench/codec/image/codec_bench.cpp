@@ -85,19 +85,23 @@ void BM_EncodeBaselineAreaDownsample(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * 1024 * 1024);
 }
 
-void BM_DecodeConusView(benchmark::State& state) {
+// The 2048^2 CoNUS image decoded to the view of state.range(0), through `pyramid` when given.
+void decodeViews(benchmark::State& state, const ImagePyramid* pyramid) {
     const Image& conus = image2048();
     const SamplingMap& map = fociMap();
     DecodeOptions options;
     options.view = viewFor(static_cast<int>(state.range(0)));
     options.width = kViewWidth;
     options.height = kViewHeight;
+    options.pyramid = pyramid;
     for (auto _ : state) {
         Image out = decodeImage(conus, map, options);
         benchmark::DoNotOptimize(out.pixels.data());
     }
     state.SetItemsProcessed(state.iterations() * kViewWidth * kViewHeight);
 }
+
+void BM_DecodeConusView(benchmark::State& state) { decodeViews(state, nullptr); }
 
 void BM_DecodeBaselineBilinear(benchmark::State& state) {
     const Image& image = image2048();
@@ -114,20 +118,7 @@ const ImagePyramid& pyramid2048() {
     return p;
 }
 
-void BM_DecodeConusPyramid(benchmark::State& state) {
-    const Image& conus = image2048();
-    const SamplingMap& map = fociMap();
-    DecodeOptions options;
-    options.view = viewFor(static_cast<int>(state.range(0)));
-    options.width = kViewWidth;
-    options.height = kViewHeight;
-    options.pyramid = &pyramid2048();
-    for (auto _ : state) {
-        Image out = decodeImage(conus, map, options);
-        benchmark::DoNotOptimize(out.pixels.data());
-    }
-    state.SetItemsProcessed(state.iterations() * kViewWidth * kViewHeight);
-}
+void BM_DecodeConusPyramid(benchmark::State& state) { decodeViews(state, &pyramid2048()); }
 
 void BM_BuildPyramid(benchmark::State& state) {
     const Image& image = image2048();
