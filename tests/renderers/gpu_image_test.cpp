@@ -218,18 +218,27 @@ TEST_P(GpuImage, CheckerboardEdgesFollowEquation1) {
     EXPECT_EQ(checked, 7 * 8);
 }
 
-TEST_P(GpuImage, DecodeMatchesCpu) {
+// Runs `check(map, conus)` for a photo-like source encoded to w x h through each test map: two
+// foci, then two random focus sets.
+template <class Check>
+void forEachEncodedMap(int w, int h, Check check) {
     const Image source = test::photoLike(512, 512);
     for (unsigned seed = 0; seed < 3; ++seed) {
         SCOPED_TRACE(seed);
         const codec::SamplingMap map = seed == 0 ? twoFoci() : test::randomFociMap(seed);
-        const Image conus = codec::encodeImage(source, map, encodeSize(256, 256));
+        check(map, codec::encodeImage(source, map, encodeSize(w, h)));
+    }
+}
+
+TEST_P(GpuImage, DecodeMatchesCpu) {
+    forEachEncodedMap(256, 256, [&](const codec::SamplingMap& map, const Image& conus) {
         EXPECT_GE(decodePsnr(conus, map, {}, 512, 512), kDecodePsnr);                      // full frame
         EXPECT_GE(decodePsnr(conus, map, {0.25, 0.3, 0.45, 0.5}, 320, 240), kDecodePsnr);  // zoomed in
         EXPECT_GE(decodePsnr(conus, map, {0, 0, 1, 1}, 96, 80), kDecodePsnr);              // zoomed out: taps
         EXPECT_GE(decodePsnr(conus, map, {-0.2, -0.1, 1.1, 1.3}, 300, 280), kDecodePsnr);  // past the edges
         EXPECT_GE(decodePsnr(conus, map, {1, 1, 0, 0}, 200, 200), kDecodePsnr);            // mirrored
-    }
+    });
+    const Image source = test::photoLike(512, 512);
     const codec::SamplingMap jittered = test::jitteredMap(7, 6, 0.3, 9);
     const Image conus = codec::encodeImage(source, jittered, encodeSize(200, 220));
     EXPECT_GE(decodePsnr(conus, jittered, {}, 400, 300), kDecodePsnr);
@@ -238,11 +247,7 @@ TEST_P(GpuImage, DecodeMatchesCpu) {
 // The pyramid decode: the CPU's levels uploaded as the texture's mip chain, one trilinear tap at
 // the level both compute from the map's Jacobian (codec::pyramidLevel and its GLSL twin).
 TEST_P(GpuImage, PyramidDecodeMatchesCpu) {
-    const Image source = test::photoLike(512, 512);
-    for (unsigned seed = 0; seed < 3; ++seed) {
-        SCOPED_TRACE(seed);
-        const codec::SamplingMap map = seed == 0 ? twoFoci() : test::randomFociMap(seed);
-        const Image conus = codec::encodeImage(source, map, encodeSize(256, 200));
+    forEachEncodedMap(256, 200, [&](const codec::SamplingMap& map, const Image& conus) {
         const codec::ImagePyramid pyramid = codec::buildPyramid(conus);
         for (const codec::View view : {codec::View{}, codec::View{0.25, 0.3, 0.45, 0.5}, codec::View{-0.2, -0.1, 1.1, 1.3}}) {
             for (const int w : {97, 180, 400}) {
@@ -257,7 +262,7 @@ TEST_P(GpuImage, PyramidDecodeMatchesCpu) {
                 EXPECT_GE(psnr, kDecodePsnr);
             }
         }
-    }
+    });
     // A pyramid of another image is refused, as by the CPU decoder.
     const Image other = test::photoLike(64, 64);
     const codec::ImagePyramid wrong = codec::buildPyramid(other);

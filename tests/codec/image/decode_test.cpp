@@ -12,6 +12,7 @@
 #include "conus/codec/build/foci.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/core/error.h"
+#include "codec/image/decode_views.h"
 #include "test_images.h"
 
 namespace conus::codec {
@@ -28,14 +29,7 @@ SamplingMap twoFoci() {
     return buildFociMap(foci);
 }
 
-DecodeOptions viewOf(View view, int w, int h, int threads = 0) {
-    DecodeOptions o;
-    o.view = view;
-    o.width = w;
-    o.height = h;
-    o.threads = threads;
-    return o;
-}
+using test::viewOf;
 
 TEST(Decode, RowSteppingEqualsEquationOne) {
     const SamplingMap maps[] = {twoFoci(), buildFociMap(std::vector<Focus>{{0.5, 0.5, 0.2, 6}}),
@@ -158,13 +152,13 @@ TEST(Decode, ThreadCountDoesNotChangeTheResult) {
     const Image conus = noise(300, 200, {"R", "G", "B", "A"}, 5);
     const SamplingMap map = twoFoci();
     for (const View& view : {View{}, View{0.2, 0.25, 0.4, 0.45}}) {
-        const Image one = decodeImage(conus, map, viewOf(view, 333, 222, 1));
-        const Image two = decodeImage(conus, map, viewOf(view, 333, 222, 2));
+        const Image one = decodeImage(conus, map, viewOf(view, 333, 222, nullptr, 1));
+        const Image two = decodeImage(conus, map, viewOf(view, 333, 222, nullptr, 2));
         EXPECT_EQ(one.pixels, two.pixels);
         EXPECT_EQ(resizeBilinear(conus, view, 333, 222, 1).pixels, resizeBilinear(conus, view, 333, 222, 2).pixels);
     }
     // Zoomed out: the multi-tap path.
-    EXPECT_EQ(decodeImage(conus, map, viewOf({}, 97, 61, 1)).pixels, decodeImage(conus, map, viewOf({}, 97, 61, 2)).pixels);
+    EXPECT_EQ(decodeImage(conus, map, viewOf({}, 97, 61, nullptr, 1)).pixels, decodeImage(conus, map, viewOf({}, 97, 61, nullptr, 2)).pixels);
 }
 
 TEST(Decode, RejectsBadArguments) {

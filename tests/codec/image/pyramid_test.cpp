@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "codec/image/decode_views.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
@@ -21,14 +22,7 @@ using test::noise;
 using test::texture;
 using test::zonePlate;
 
-DecodeOptions viewOf(View view, int w, int h, const ImagePyramid* pyramid = nullptr) {
-    DecodeOptions o;
-    o.view = view;
-    o.width = w;
-    o.height = h;
-    o.pyramid = pyramid;
-    return o;
-}
+using test::viewOf;
 
 double mean(const Image& im, int channel) {
     const int c = im.channelCount();
