@@ -1,6 +1,7 @@
 // conus-view's drawing: one full-screen pass of view_frame.frag.glsl into the bound framebuffer,
 // or (where the backend rule prefers the CPU) codec's decoder per frame, uploaded and blitted.
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -8,6 +9,7 @@
 #include <cstring>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <optional>
@@ -80,16 +82,31 @@ Image displayRgba(const Image& image) {
     return out;
 }
 
-// The CoNUS image with codec::buildPyramid's levels as its mip chain (RGBA32F), for one
-// trilinear tap per zoomed-out pixel (view_frame.frag.glsl, as the CPU path's pyramid decode).
-GlHandle uploadMipmapped(const GladGLContext& gl, const Image& rgba, const codec::ImagePyramid& pyramid) {
+// The CoNUS image with codec::buildPyramid's levels as its mip chain, for one trilinear tap per
+// zoomed-out pixel (view_frame.frag.glsl, as the CPU path's pyramid decode). `format` is the
+// channels of the data (GL_RGBA, or GL_RGB: alpha 1; the shader shows rgb only).
+GlHandle uploadMipmapped(const GladGLContext& gl, GLenum internalFormat, GLenum format, const Image& image,
+                         const codec::ImagePyramid& pyramid) {
     GlHandle texture = makeTexture(gl);
     gl.ActiveTexture(GL_TEXTURE0);
     gl.BindTexture(GL_TEXTURE_2D, texture.id());
-    std::vector<TextureLevel> levels{{rgba.pixels.data(), rgba.width, rgba.height}};
+    std::vector<TextureLevel> levels{{image.pixels.data(), image.width, image.height}};
     for (const Image& level : pyramid.levels) levels.push_back({level.pixels.data(), level.width, level.height});
-    storeLevels(gl, GL_RGBA32F, GL_RGBA, levels);
+    storeLevels(gl, internalFormat, format, levels);
     return texture;
+}
+
+// The shader's CoNUS texture is RGBA16F where that shows what RGBA32F would on an 8-bit display:
+// llvmpipe fetches a half texel in one load instead of four, and the fitted view's per-pixel-LOD
+// trilinear tap is most of its frame (measured: bench/README.md, Viewer). Half's relative step
+// (2^-11, rounding error 2^-12) is a tenth of the finest 8-bit sRGB step; below 2^-14 its absolute
+// step 2^-24, scaled by an exposure of 2^12, is under half the darkest one (1 / (255 * 12.92) =
+// 2^-11.7). Brighter exposures, and images with values past half's 65504, get RGBA32F.
+constexpr double kHalfTextureMaxExposure = 12.0;  // stops
+constexpr float kHalfMax = 65504.0f;
+
+bool fitsHalf(const Image& image) {
+    return std::all_of(image.pixels.begin(), image.pixels.end(), [](float x) { return std::abs(x) <= kHalfMax; });
 }
 
 GlHandle uploadRgba(const GladGLContext& gl, const Image& image) {
@@ -106,11 +123,31 @@ GlHandle uploadRgba(const GladGLContext& gl, const Image& image) {
     return texture;
 }
 
+// The window pixels whose centres may fall inside [0,1]^2 for view_frame.frag.glsl's mapping
+// (uv = view.xy + pixel * extent / size, rows flipped for a bottom-up target), one pixel wider on
+// every side, clipped to the target: {x0, y0, x1, y1} in GL's framebuffer coordinates. Outside it
+// every pixel is background (kBackground), so the frame shades only this box after a clear.
+std::array<int, 4> imageBox(const codec::View& view, int width, int height, bool bottomUp) {
+    // Pixel coordinate p (a centre is x + 0.5) where the view's coordinate from a to b reaches t.
+    const auto span = [](double a, double b, int size) {
+        const double p0 = (0.0 - a) / (b - a) * size, p1 = (1.0 - a) / (b - a) * size;
+        const double lo = std::floor(std::min(p0, p1)) - 1.0, hi = std::ceil(std::max(p0, p1)) + 1.0;
+        return std::pair<int, int>{static_cast<int>(std::clamp(lo, 0.0, double(size))),
+                                   static_cast<int>(std::clamp(hi, 0.0, double(size)))};
+    };
+    const auto [x0, x1] = span(view.u0, view.u1, width);
+    auto [r0, r1] = span(view.v0, view.v1, height);  // rows from the top
+    if (bottomUp) std::tie(r0, r1) = std::pair<int, int>{height - r1, height - r0};
+    return {x0, r0, x1, r1};
+}
+
 }  // namespace
 
 struct ViewRenderer::Impl {
     Context& context;
     GlHandle conus, map, uniform;
+    bool conusHalf = false;  // conus is RGBA16F; conusFloat, its RGBA32F twin, made when first needed
+    GlHandle conusFloat;
     // The CPU decode path: the display channels and the map on the CPU, the frame texture (RGBA8
     // for a window, RGBA32F when rendering to a float target) and a framebuffer to blit it from.
     Image rgb;
@@ -266,6 +303,18 @@ struct ViewRenderer::Impl {
         checkGl(gl, "ViewRenderer::draw (CPU decode)");
     }
 
+    // The CoNUS texture for these options: the half one for the decoded frame unless the exposure
+    // needs float; the raw mode shows the CoNUS image's own values, so float.
+    GLuint conusTexture(const ViewOptions& options) {
+        if (!conusHalf || (options.mode != ViewMode::Raw && options.exposure <= kHalfTextureMaxExposure)) return conus.id();
+        if (!conusFloat) {
+            const GladGLContext& gl = makeCurrentGl(context);
+            conusFloat = uploadMipmapped(gl, GL_RGBA32F, GL_RGB, rgb, rgbPyramid);
+            checkGl(gl, "ViewRenderer: float texture upload");
+        }
+        return conusFloat.id();
+    }
+
     // The program for a mode and overlays: view_frame.frag.glsl with its VIEW_* switches defined
     // after the #version line (compiled once per combination, cached by the context).
     // overlayOnly: the overlays alone, premultiplied, to blend over a frame already drawn.
@@ -345,7 +394,9 @@ void ViewRenderer::setImage(const format::ConusFile& file) {
     // One mip chain for both paths: the shader's texture levels and, without alpha, the CPU's.
     codec::ImagePyramid pyramid = codec::buildPyramid(rgba);
     const GladGLContext& gl = makeCurrentGl(d.context);
-    d.conus = uploadMipmapped(gl, rgba, pyramid);
+    d.conusHalf = fitsHalf(rgba);  // the levels are averages of level 0: within its range
+    d.conus = uploadMipmapped(gl, d.conusHalf ? GL_RGBA16F : GL_RGBA32F, GL_RGBA, rgba, pyramid);
+    d.conusFloat.reset();
     d.uniform = uploadRgba(gl, d.uniformImage);
     checkGl(gl, "ViewRenderer: image upload");
     d.uploadMap(map);
@@ -397,7 +448,7 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
         gl.Disable(GL_BLEND);
     }
     gl.UseProgram(program);
-    const GLuint textures[3] = {d.conus.id(), d.map.id(), d.uniform.id()};
+    const GLuint textures[3] = {d.conusTexture(options), d.map.id(), d.uniform.id()};
     for (int unit = 0; unit < 3; ++unit) {
         gl.ActiveTexture(GL_TEXTURE0 + unit);
         gl.BindTexture(GL_TEXTURE_2D, textures[unit]);
@@ -427,9 +478,24 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
     gl.Uniform1i(at("uToneMap"), static_cast<int>(options.toneMap));
     gl.Uniform1f(at("uWipeX"), static_cast<float>(options.wipeX * width));
     gl.Uniform2f(at("uLogDensity"), d.logDensityLo, d.logDensityHi);
+    // Modes that paint nothing outside [0,1]^2 (no focus circles past its edge, no wipe line, not
+    // the density's dimmed surround) shade only the image's box after a clear to the background:
+    // a fitted square image leaves ~45% of a 16:9 window shaded for nothing on software GL.
+    const bool boxed = !cpu && !options.outlines &&
+                       (options.mode == ViewMode::Reconstructed || options.mode == ViewMode::Raw || options.mode == ViewMode::Uniform);
+    if (boxed) {
+        const std::array<int, 4> box = imageBox(view, width, height, options.bottomUp);
+        if (box[0] > 0 || box[1] > 0 || box[2] < width || box[3] < height) {
+            gl.ClearColor(kViewBackground, kViewBackground, kViewBackground, 1.0f);
+            gl.Clear(GL_COLOR_BUFFER_BIT);
+        }
+        gl.Enable(GL_SCISSOR_TEST);
+        gl.Scissor(box[0], box[1], box[2] - box[0], box[3] - box[1]);
+    }
     gl.BindVertexArray(d.context.impl().emptyVertexArray);
-    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);  // an empty box (the image out of view) draws nothing
     gl.BindVertexArray(0);
+    gl.Disable(GL_SCISSOR_TEST);
     gl.Disable(GL_BLEND);
     checkGl(gl, "ViewRenderer::draw");
 }

@@ -229,6 +229,29 @@ TEST(ViewRenderer, SrgbCurveAndToneMapsAgreeWithCoreOnBothPaths) {
     }
 }
 
+// The shader's texture is half floats up to +12 stops and float above: a dim image brightened by
+// its exposure shows on the GPU what the CPU decode (float throughout) shows. With the half
+// texture at +20 stops the dim values (2^-20..2^-21, half's subnormals: steps of 2^-24) would
+// keep 3-4 bits and fall far below 50 dB.
+TEST(ViewRenderer, DimImagesAtHighExposureMatchTheCpuDecode) {
+    for (const int stops : {12, 20}) {
+        format::ConusFile file = test::conusFile();
+        for (float& x : file.image.pixels) x = std::ldexp(x, -stops);
+        gl::ViewRenderer renderer{test::context()};
+        renderer.setImage(file);
+        ViewOptions o = linear();
+        o.exposure = stops;
+        for (const codec::View& view : {codec::View{}, codec::View{0.1, 0.15, 0.9, 0.8}}) {
+            o.decode = gl::DecodePath::Gpu;
+            const Image gpu = renderer.renderToImage(view, 160, 120, o);
+            o.decode = gl::DecodePath::Cpu;
+            const Image cpu = renderer.renderToImage(view, 160, 120, o);
+            EXPECT_GT(psnrRgb(gpu, cpu), 50.0) << stops << " stops";
+            EXPECT_GT(gpu.at(80, 60, 0) + gpu.at(80, 60, 1), 0.05f) << "the picture, not black";
+        }
+    }
+}
+
 TEST(ViewRenderer, OutsideTheImageIsBackground) {
     Fixture& f = fixture();
     const Image im = f.renderer.renderToImage({-1.0, -1.0, 2.0, 2.0}, 90, 90, linear());

@@ -307,6 +307,54 @@ TEST(ConusView, EditorPaintsSavesAndEncodes) {
     EXPECT_EQ(readPng(dir / "edit.png").width, 320);
 }
 
+// The window's fitted view shades only the image's box (rows counted from the bottom there) after
+// a clear to the background: the same picture as the headless frame, which counts rows from the
+// top, and the CPU decode's, bands included; and panned off centre, as the CPU decode shows it.
+TEST(ConusView, WindowFittedViewMatchesTheHeadlessFrameAndTheCpuDecode) {
+    ASSERT_TRUE(test::haveXvfb());
+    const fs::path dir = test::tempDir();
+    std::string log;
+    const auto window = [&](const std::string& decode) {
+        const fs::path shot = dir / ("fit-" + decode + ".png");
+        test::writeText(dir / "fit.txt", "screenshot " + shot.string() + "\n");
+        EXPECT_EQ(test::run(xvfb(test::conusPath() + " --window 610x300 --decode " + decode + " --script " + (dir / "fit.txt").string()), &log),
+                  0) << log;
+        return readPng(shot);
+    };
+    const Image gpu = window("gpu"), cpu = window("cpu");
+    ASSERT_EQ(test::run("env -u DISPLAY " + test::viewerBinary() + " " + test::conusPath() + " --decode gpu --size 610x300 --screenshot " +
+                            (dir / "fit-headless.png").string(), &log), 0) << log;
+    const Image headless = readPng(dir / "fit-headless.png");
+    ASSERT_EQ(gpu.width, 610);
+    ASSERT_EQ(headless.height, 300);
+    const Box none{};
+    const Box a = changed(gpu, headless), b = changed(gpu, cpu);
+    EXPECT_EQ(a.x1, none.x1) << "window vs headless differ in " << a.x0 << "," << a.y0 << " - " << a.x1 << "," << a.y1;
+    EXPECT_EQ(b.x1, none.x1) << "shader vs CPU decode differ in " << b.x0 << "," << b.y0 << " - " << b.x1 << "," << b.y1;
+    // Pillarboxed: background bands left and right, the picture between.
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(gpu.at(3, 150, c), 28.0f / 255, 0.5f / 255);
+        EXPECT_NEAR(gpu.at(606, 20, c), 28.0f / 255, 0.5f / 255);
+    }
+    double spread = 0;
+    for (int x = 250; x < 360; ++x) spread = std::max(spread, double(std::abs(gpu.at(x, 150, 0) - gpu.at(305, 150, 0))));
+    EXPECT_GT(spread, 0.05) << "the middle shows the picture";
+
+    // A tall window (bands above and below) panned down and right: the box is off centre.
+    const auto panned = [&](const std::string& decode) {
+        const fs::path shot = dir / ("pan-" + decode + ".png");
+        test::writeText(dir / "pan.txt", "pan 37 61\nscreenshot " + shot.string() + "\n");
+        EXPECT_EQ(test::run(xvfb(test::conusPath() + " --window 300x420 --decode " + decode + " --script " + (dir / "pan.txt").string()), &log),
+                  0) << log;
+        return readPng(shot);
+    };
+    const Image pannedGpu = panned("gpu"), pannedCpu = panned("cpu");
+    ASSERT_EQ(pannedGpu.height, 420);
+    const Box c = changed(pannedGpu, pannedCpu);
+    EXPECT_EQ(c.x1, none.x1) << "panned: shader vs CPU decode differ in " << c.x0 << "," << c.y0 << " - " << c.x1 << "," << c.y1;
+    EXPECT_NE(changed(pannedGpu, gpu).x1, none.x1);
+}
+
 TEST(ConusView, BenchmarkPrintsFramesPerSecond) {
     ASSERT_TRUE(test::haveXvfb());
     std::string log;
