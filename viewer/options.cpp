@@ -98,7 +98,7 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
         ->check(CLI::Range(0.0, 10.0));
     app.add_option("--decode", decode,
                    "where the reconstructed frame is decoded: gpu (shader), cpu (codec::decodeImage each frame, "
-                   "uploaded), auto (cpu on a software rasterizer: llvmpipe, softpipe, swrast)")
+                   "uploaded), auto (gpu, except on a software rasterizer (llvmpipe, softpipe, swrast) where the view is not zoomed out: cpu, the faster there)")
         ->check(CLI::IsMember({"auto", "cpu", "gpu"}))
         ->capture_default_str();
     app.add_option("--script", o.script, "run window commands from a file, then exit (see viewer/script.h)");

@@ -174,14 +174,15 @@ struct ViewRenderer::Impl {
     // The handles delete their objects after this body, with the context current.
     ~Impl() { makeCurrentGl(context); }
 
-    bool cpuDecode(const ViewOptions& options) const {
+    bool cpuDecode(const ViewOptions& options, const codec::View& view, int width) const {
         if (options.mode != ViewMode::Reconstructed || !cpuMap) return false;
         switch (options.decode) {
         case DecodePath::Cpu: return true;
         case DecodePath::Gpu: return false;
         case DecodePath::Auto: break;
         }
-        return prefersCpu(context);
+        const bool minified = std::abs(view.u1 - view.u0) * conusWidth > width;
+        return !minified && prefersCpu(context);
     }
 
     void buildLut(float exposure, float invGamma, ToneMap toneMap) {
@@ -421,7 +422,9 @@ void ViewRenderer::setMap(const codec::SamplingMap& map) {
     if (m_impl->cpuMap) m_impl->cpuMap = map;
 }
 
-bool ViewRenderer::decodesOnCpu(const ViewOptions& options) const { return hasImage() && m_impl->cpuDecode(options); }
+bool ViewRenderer::decodesOnCpu(const ViewOptions& options, const codec::View& view, int width) const {
+    return hasImage() && m_impl->cpuDecode(options, view, width);
+}
 
 void ViewRenderer::draw(const codec::View& view, int width, int height, const ViewOptions& options) {
     Impl& d = *m_impl;
@@ -432,7 +435,7 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
         gl.Clear(GL_COLOR_BUFFER_BIT);
         return;
     }
-    const bool cpu = d.cpuDecode(options);
+    const bool cpu = d.cpuDecode(options, view, width);
     if (cpu) {
         d.decodeFrame(view, width, height, options);
         if (!options.grid && !options.outlines) return;

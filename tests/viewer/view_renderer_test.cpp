@@ -5,6 +5,7 @@
 
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
+#include "conus/renderers/backend.h"
 #include "viewer_test_util.h"
 
 namespace conus::viewer {
@@ -78,10 +79,10 @@ TEST(ViewRenderer, CpuDecodeMatchesTheShader) {
             o.gridEvery = 5;
             o.outlines = overlays;
             o.decode = gl::DecodePath::Gpu;
-            EXPECT_FALSE(f.renderer.decodesOnCpu(o));
+            EXPECT_FALSE(f.renderer.decodesOnCpu(o, view, 240));
             const Image gpu = f.renderer.renderToImage(view, 240, 180, o);
             o.decode = gl::DecodePath::Cpu;
-            EXPECT_TRUE(f.renderer.decodesOnCpu(o));
+            EXPECT_TRUE(f.renderer.decodesOnCpu(o, view, 240));
             const Image cpu = f.renderer.renderToImage(view, 240, 180, o);
             EXPECT_GT(psnrRgb(gpu, cpu), overlays ? 40.0 : 50.0) << view.u0 << "," << view.v0 << " overlays " << overlays;
             // Same background outside [0,1]^2, same alpha.
@@ -94,7 +95,21 @@ TEST(ViewRenderer, CpuDecodeMatchesTheShader) {
     // Other modes never decode on the CPU.
     ViewOptions raw = linear(ViewMode::Raw);
     raw.decode = gl::DecodePath::Cpu;
-    EXPECT_FALSE(f.renderer.decodesOnCpu(raw));
+    EXPECT_FALSE(f.renderer.decodesOnCpu(raw, codec::View{}, 240));
+}
+
+// Auto on a software rasterizer: the CPU decoder where the view is magnified or 1:1, the shader's
+// one trilinear tap where it is minified (measured faster there on llvmpipe); elsewhere the shader.
+TEST(ViewRenderer, AutoDecodeFollowsTheRasterizerAndTheZoom) {
+    Fixture& f = fixture();
+    ViewOptions o;
+    o.decode = gl::DecodePath::Auto;
+    const int across = f.file.image.width;  // target pixels across the whole image: 1:1
+    const bool software = gl::prefersCpu(test::context());
+    EXPECT_EQ(f.renderer.decodesOnCpu(o, codec::View{}, across), software);
+    EXPECT_EQ(f.renderer.decodesOnCpu(o, codec::View{0.2, 0.2, 0.4, 0.4}, across), software);  // magnified
+    EXPECT_FALSE(f.renderer.decodesOnCpu(o, codec::View{}, across / 2));                      // minified
+    EXPECT_FALSE(f.renderer.decodesOnCpu(o, codec::View{-0.5, 0, 1.5, 1}, across));           // minified
 }
 
 TEST(ViewRenderer, RawShowsTheCoNUSImageItself) {

@@ -37,8 +37,11 @@ enum class ViewMode {
 // at the target's resolution every frame (still from the CoNUS data at every zoom, no cached frame),
 // uploaded and copied into the target, overlays drawn over it by a second pass; on a software
 // rasterizer (llvmpipe) the multithreaded incremental CPU decoder is several times faster than the
-// shader. Auto: the backend rule of backend.h (gl::prefersCpu: Cpu when GL_RENDERER names a
-// software rasterizer), else Gpu. Other modes always use the GPU.
+// shader at 1:1 and magnified. Auto: Gpu, except where the backend rule of backend.h
+// (gl::prefersCpu: GL_RENDERER names a software rasterizer) holds and the view is not minified
+// (at most one CoNUS pixel across per target pixel, on average): a minified view takes one
+// trilinear tap from the mip chain per pixel in the shader, which measured faster on llvmpipe than
+// the CPU decoder (bench/README.md, Viewer). Other modes always use the GPU.
 enum class DecodePath { Auto, Gpu, Cpu };
 
 struct ViewOptions {
@@ -109,8 +112,9 @@ public:
     void drawOverlay(int slot, int x, int y, int viewportWidth, int viewportHeight, bool bottomUp = true);
     // Waits for the GPU (for timing).
     void finish();
-    // Whether draw() with these options decodes on the CPU (DecodePath resolved for this context).
-    bool decodesOnCpu(const ViewOptions& options) const;
+    // Whether draw() of `view` at `width` pixels across with these options decodes on the CPU
+    // (DecodePath resolved for this context and this zoom, see DecodePath).
+    bool decodesOnCpu(const ViewOptions& options, const codec::View& view, int width) const;
 
     // The uniform image shown: setImage's, or the one setUniform gave (for tests and the inspector).
     const Image& uniformImage() const;
