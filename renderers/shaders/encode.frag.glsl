@@ -2,7 +2,7 @@
 // One CoNUS pixel, filtered as codec::encodeImage does (encode.h states the rule): the footprint's
 // edges a and b come from the mesh (codec::FootprintField, interpolated); the filter is the unit box
 // in CoNUS pixel units convolved with a Gaussian along the footprint's major axis that grows with
-// its anisotropy; taps at most a texel apart along each edge, on a continuous pyramid level (the
+// its anisotropy and with how far that axis outspans the uniform image's pixel; taps at most a texel apart along each edge, on a continuous pyramid level (the
 // two levels around it blended) where the minor axis is at most kEncodeMaxTaps texels and the
 // filter at most kEncodeMaxAxisTaps texels along each edge.
 //
@@ -21,6 +21,8 @@ uniform int uLevels;
 uniform ivec4 uLevelRect[32];
 // u0, v0, u1, v1: only pixels with the undistorted centre in [u0, u1) x [v0, v1) are drawn.
 uniform vec4 uCore;
+// The uniform image's pixel in level-0 source pixels (codec::uniformSpacing).
+uniform float uUniform;
 
 // Bilinear at normalized q on a pyramid level, clamped to that level's edge: coordinates stay
 // between its edge texel centres, so the atlas neighbours never bleed in.
@@ -95,7 +97,7 @@ void main() {
     float sigma = 0.0;
     vec2 major = vec2(1.0, 0.0);
     if (l1 > 0.0) {
-        sigma = kEncodeAnisotropicSigma * max(0.0, 1.0 - kEncodeBoxAnisotropy * sqrt(l2 / l1));
+        sigma = kEncodeAnisotropicSigma * max(0.0, min(1.0 - kEncodeBoxAnisotropy * sqrt(l2 / l1), 1.0 - uUniform / sqrt(l1)));
         const vec2 e1 = vec2(Q, l1 - P), e2 = vec2(l1 - R, Q);
         const vec2 e = dot(e1, e1) >= dot(e2, e2) ? e1 : e2;
         if (length(e) > 0.0) major = normalize(e);

@@ -249,12 +249,12 @@ void buildPyramid(Context& context, const GladGLContext& gl, const Pyramid& pyra
 constexpr double kMarginSlack = 1.25;
 constexpr int kMarginTexels = 3;
 
-int tileMargin(const Mesh& mesh, int width, int height) {
+int tileMargin(const Mesh& mesh, int width, int height, double uniform) {
     double reach = 0;
     for (std::size_t k = 0; k + kVertexFloats <= mesh.vertices.size(); k += kVertexFloats) {
         const float* f = &mesh.vertices[k + 4];
         const glm::dvec2 a(f[0] * double(width), f[1] * double(height)), b(f[2] * double(width), f[3] * double(height));
-        const codec::FootprintPlan plan = codec::planFootprint(a, b);
+        const codec::FootprintPlan plan = codec::planFootprint(a, b, uniform);
         const double scale = std::ldexp(1.0, -static_cast<int>(plan.level));  // level sizes round up: no smaller
         const double rx = 0.5 * (std::abs(a.x) * plan.extent.x + std::abs(b.x) * plan.extent.y);
         const double ry = 0.5 * (std::abs(a.y) * plan.extent.x + std::abs(b.y) * plan.extent.y);
@@ -415,6 +415,10 @@ public:
 
 private:
     static constexpr const char* kWhat = "encodeImageGpu";
+
+    double uniformSpacing() const {
+        return codec::uniformSpacing(m_source.width, m_source.height, m_out.width, m_out.height);
+    }
     static constexpr float kFar = std::numeric_limits<float>::max();
 
     void uploadMesh() {
@@ -438,7 +442,7 @@ private:
     // The plan, each tile's share of the mesh, and the pyramid's levels 1.. (built once on the
     // CPU with the reference's own area filter; the GPU then reads crops of them per tile).
     void planTiling(int limit) {
-        m_tiles = planTiles(m_pyramid, tileMargin(m_mesh, m_source.width, m_source.height), limit);
+        m_tiles = planTiles(m_pyramid, tileMargin(m_mesh, m_source.width, m_source.height, uniformSpacing()), limit);
         m_levels.reserve(m_pyramid.rects.size());
         for (Tile& tile : m_tiles) tile.indices = tileIndices(m_mesh, tileCore(tile, m_source.width, m_source.height));
         for (std::size_t level = 1; level < m_pyramid.rects.size(); ++level)
@@ -460,6 +464,7 @@ private:
         gl.Uniform1i(gl.GetUniformLocation(m_program, "uLevels"), static_cast<GLint>(rects.size()));
         gl.Uniform4iv(gl.GetUniformLocation(m_program, "uLevelRect"), static_cast<GLsizei>(rects.size()), rects[0].data());
         gl.Uniform4f(gl.GetUniformLocation(m_program, "uCore"), core[0], core[1], core[2], core[3]);
+        gl.Uniform1f(gl.GetUniformLocation(m_program, "uUniform"), static_cast<float>(uniformSpacing()));
         gl.BindVertexArray(m_vertexArray.id());
     }
 

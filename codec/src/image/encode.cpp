@@ -140,15 +140,16 @@ struct FootprintFilter {
 
 // a and b are the footprint's edges (source pixels per CoNUS pixel along x and y); the singular
 // values of [a b] are the footprint's major and minor lengths, the right singular vectors their
-// directions in CoNUS pixel units.
-FootprintFilter footprintFilter(glm::dvec2 a, glm::dvec2 b, double& minor) {
+// directions in CoNUS pixel units; `uniform` the uniform image's pixel (encode.h).
+FootprintFilter footprintFilter(glm::dvec2 a, glm::dvec2 b, double uniform, double& minor) {
     const double p = glm::dot(a, a), q = glm::dot(a, b), r = glm::dot(b, b);
     const double mean = 0.5 * (p + r), half = std::sqrt(0.25 * (p - r) * (p - r) + q * q);
     const double l1 = mean + half, l2 = std::max(0.0, mean - half);
     minor = std::sqrt(l2);
     FootprintFilter f;
     if (!(l1 > 0)) return f;
-    f.sigma = kEncodeAnisotropicSigma * std::max(0.0, 1.0 - kEncodeBoxAnisotropy * std::sqrt(l2 / l1));
+    const double ramp = std::min(1.0 - kEncodeBoxAnisotropy * std::sqrt(l2 / l1), 1.0 - uniform / std::sqrt(l1));
+    f.sigma = kEncodeAnisotropicSigma * std::max(0.0, ramp);
     f.reach = kEncodeGaussianReach * f.sigma;
     // The eigenvector of [[p q] [q r]] for l1, from whichever row is better conditioned; it only
     // matters where sigma is not negligible, i.e. where l1 and l2 differ.
@@ -286,6 +287,7 @@ void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& 
                 int y0, int y1) {
     const int channels = kC > 0 ? kC : src.channelCount();
     const int W = dst.width, H = dst.height;
+    const double uniform = uniformSpacing(src.width, src.height, W, H);
     std::vector<float> dynamicUpper(kC > 0 ? 0 : channels);
     for (int y = y0; y < y1; ++y) {
         float* out = dst.pixels.data() + static_cast<std::size_t>(y) * W * channels;
@@ -298,7 +300,7 @@ void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& 
             const glm::dvec2 a = Jinv[0] / double(W) * glm::dvec2(src.width, src.height);
             const glm::dvec2 b = Jinv[1] / double(H) * glm::dvec2(src.width, src.height);
             double minor = 0;
-            const FootprintFilter filter = footprintFilter(a, b, minor);
+            const FootprintFilter filter = footprintFilter(a, b, uniform, minor);
             const glm::dvec2 extent = filterExtent(filter);
             const double lambda = footprintLevel(a, b, minor, extent);
             const int top = pyramid.levels() - 1;
@@ -318,10 +320,14 @@ void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& 
 
 }  // namespace
 
-FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b) {
+FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b, double uniform) {
     double minor = 0;
-    const glm::dvec2 extent = filterExtent(footprintFilter(a, b, minor));
+    const glm::dvec2 extent = filterExtent(footprintFilter(a, b, uniform, minor));
     return {footprintLevel(a, b, minor, extent), extent};
+}
+
+double uniformSpacing(int sourceWidth, int sourceHeight, int width, int height) {
+    return std::sqrt(double(sourceWidth) * sourceHeight / (double(width) * height));
 }
 
 FootprintField::FootprintField(const SamplingMap& map) : m_columns(map.columns()), m_rows(map.rows()) {

@@ -226,6 +226,35 @@ TEST(Encode, FootprintFilterPreventsAliasing) {
     EXPECT_GT(filtered - single, 10.0) << "filtered " << filtered << " dB, point sampled " << single << " dB";
 }
 
+// The long-axis Gaussian (encode.h): none while the footprint is at most kEncodeBoxAnisotropy : 1
+// or its major axis no longer than the uniform image's pixel; otherwise the filter's extent grows
+// along the major axis only, by the smaller of the two ramps. Rotated, asymmetric footprints.
+TEST(Encode, LongAxisLowPassOnlyWhereTheMajorAxisOutspansBothRules) {
+    const double angle = 0.37;
+    const glm::dvec2 along(std::cos(angle), std::sin(angle)), across(-along.y, along.x);
+    // Edges a = major * along, b = minor * across: in (s,t) the major axis is s, the minor t.
+    const auto plan = [&](double major, double minor, double uniform) {
+        return planFootprint(major * along, minor * across, uniform);
+    };
+    const auto sigma = [](glm::dvec2 extent) { return (extent.x - 1.0) / (2.0 * kEncodeGaussianReach); };
+    // Round enough: plain box, whatever the uniform pixel.
+    EXPECT_DOUBLE_EQ(plan(2.9, 2.0, 1.0).extent.x, 1.0);
+    EXPECT_DOUBLE_EQ(plan(2.9, 2.0, 1.0).extent.y, 1.0);
+    // Long and thin, but finer than the uniform pixel along its length (a focus's inner ring): box.
+    EXPECT_DOUBLE_EQ(plan(3.0, 0.5, 4.0).extent.x, 1.0);
+    EXPECT_DOUBLE_EQ(plan(3.9, 0.4, 4.0).extent.y, 1.0);
+    // Coarser than the uniform pixel: the anisotropy ramp where it is the smaller ...
+    const double minorOverMajor = 1.0 / 6.0;
+    const FootprintPlan a = plan(12.0, 2.0, 2.0);  // 1 - 1.5/6 = 0.75 < 1 - 2/12
+    EXPECT_NEAR(sigma(a.extent), kEncodeAnisotropicSigma * (1.0 - kEncodeBoxAnisotropy * minorOverMajor), 1e-9);
+    EXPECT_DOUBLE_EQ(a.extent.y, 1.0);
+    // ... and the uniform ramp where that is: the same footprint against a wider uniform pixel.
+    const FootprintPlan b = plan(12.0, 2.0, 6.0);  // 1 - 6/12 = 0.5 < 0.75
+    EXPECT_NEAR(sigma(b.extent), kEncodeAnisotropicSigma * 0.5, 1e-9);
+    EXPECT_LT(sigma(b.extent), sigma(a.extent));
+    EXPECT_NEAR(uniformSpacing(1024, 768, 256, 192), 4.0, 1e-12);
+}
+
 TEST(Encode, ThreadCountDoesNotChangeTheResult) {
     const Image src = noise(512, 384, {"R", "G", "B", "A"}, 11);
     const SamplingMap map = twoFoci(512.0 / 384.0);

@@ -21,11 +21,16 @@ namespace conus::codec {
 // A CoNUS pixel's footprint in the source is the parallelogram spanned by the inverse Jacobian's
 // columns a and b (one CoNUS pixel each way). Its filter, in CoNUS pixel units (s,t), is the unit
 // box convolved with a Gaussian along the footprint's major axis whose standard deviation grows
-// with the anisotropy: kEncodeAnisotropicSigma * (1 - kEncodeBoxAnisotropy * minor / major) CoNUS
-// pixels where that is positive, cut at kEncodeGaussianReach standard deviations. A footprint up to
-// kEncodeBoxAnisotropy : 1 keeps the plain box (the exact area average; a pixel grid with different
-// ratios per axis is one); a long thin one is low-passed along its length, where a box's side lobes alias into a
-// radial comb once the decoder magnifies it (issue 10; tests/codec/image/comb_test.cpp measures it).
+// with the anisotropy and with how far the major axis outspans the uniform image's pixel:
+// kEncodeAnisotropicSigma * min(1 - kEncodeBoxAnisotropy * minor / major, 1 - uniform / major) CoNUS
+// pixels where that is positive, cut at kEncodeGaussianReach standard deviations; `uniform` is the
+// spacing of the uniform image of the same pixel count, sqrt(source area / CoNUS area) source pixels.
+// A footprint up to kEncodeBoxAnisotropy : 1 keeps the plain box (the exact area average; a pixel
+// grid with different ratios per axis is one); a long thin one is low-passed along its length, where
+// a box's side lobes alias into a radial comb once the decoder magnifies it (issue 10;
+// tests/codec/image/comb_test.cpp measures it). A major axis no longer than the uniform pixel
+// also keeps the box: it aliases no more than the uniform image's own box filter does (the inner
+// ring of a focus, dense both ways; the Gaussian there cost 0.7 dB for nothing, bench/README.md).
 // The pyramid level is the first where the minor axis is at most kEncodeMaxTaps texels and the
 // filter's extent along a and b at most kEncodeMaxAxisTaps: taps are at most a texel apart along
 // each edge, so a long axis takes many taps instead of being truncated (a longer one moves up a
@@ -38,14 +43,17 @@ inline constexpr double kEncodeAnisotropicSigma = 1.5;
 inline constexpr double kEncodeGaussianReach = 2.5;
 inline constexpr double kEncodeBoxAnisotropy = 1.5;
 
-// The rule above for one footprint whose edges are a and b (level-0 source pixels per CoNUS pixel):
-// the continuous pyramid level (its floor and the next level are blended) and the filter's extent
-// along a and along b in CoNUS pixels. The GPU encoder sizes its tiles' margins with it.
+// The rule above for one footprint whose edges are a and b (level-0 source pixels per CoNUS pixel),
+// the uniform pixel `uniform` source pixels wide (uniformSpacing): the continuous pyramid level (its
+// floor and the next level are blended) and the filter's extent along a and along b in CoNUS
+// pixels. The GPU encoder sizes its tiles' margins with it.
 struct FootprintPlan {
     double level = 0;
     glm::dvec2 extent{1.0, 1.0};
 };
-FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b);
+FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b, double uniform);
+// sqrt(sourceWidth * sourceHeight / (width * height)): the uniform image's pixel, in source pixels.
+double uniformSpacing(int sourceWidth, int sourceHeight, int width, int height);
 
 // The footprint of a CoNUS pixel as a continuous field: d(undistorted)/d(distorted) at each map
 // node, from central differences of the node positions (one-sided at the edges), interpolated
