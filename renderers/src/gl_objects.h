@@ -108,6 +108,25 @@ inline void checkGl(const GladGLContext& gl, const char* what) {
     }());
 }
 
+// An RGBA32F colour attachment of width x height, bound for drawing with the viewport set to it
+// (what a pass reads back as float).
+struct FloatTarget {
+    GlHandle texture, framebuffer;
+    FloatTarget(const GladGLContext& gl, int width, int height, const char* what)
+        : texture(makeTexture(gl)), framebuffer(makeFramebuffer(gl)) {
+        gl.BindTexture(GL_TEXTURE_2D, texture.id());
+        gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
+        gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.id(), 0);
+        checkGl(gl, what);
+        if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            throw Error(ErrorCode::Unsupported, std::string(what) + ": the driver cannot render to a " +
+                                                    std::to_string(width) + "x" + std::to_string(height) +
+                                                    " RGBA32F framebuffer");
+        gl.Viewport(0, 0, width, height);
+    }
+};
+
 // Stage timings of the GPU paths: the milliseconds since `start`, which then moves to now.
 using Clock = std::chrono::steady_clock;
 inline double millisecondsSince(Clock::time_point& start) {

@@ -87,23 +87,6 @@ void readBack(const GladGLContext& gl, Image& out, int first, int count) {
         for (int c = 0; c < count; ++c) out.pixels[i * channels + first + c] = buffer[i * count + c];
 }
 
-// An RGBA32F colour attachment of width x height, bound for drawing.
-struct Target {
-    GlHandle texture, framebuffer;
-    Target(const GladGLContext& gl, int width, int height, const char* what)
-        : texture(makeTexture(gl)), framebuffer(makeFramebuffer(gl)) {
-        gl.BindTexture(GL_TEXTURE_2D, texture.id());
-        gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
-        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
-        gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.id(), 0);
-        checkGl(gl, what);
-        if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-            throw Error(ErrorCode::Unsupported, std::string(what) + ": the driver cannot render to a " +
-                                                    std::to_string(width) + "x" + std::to_string(height) +
-                                                    " RGBA32F framebuffer");
-        gl.Viewport(0, 0, width, height);
-    }
-};
 
 // Positions along one axis of the map at which the mesh has vertices: every node, plus `splits[i]`
 // equal steps across cell column (or row) i. One count per whole column or row of cells keeps
@@ -547,7 +530,7 @@ private:
     const Pyramid m_pyramid;
     const Mesh m_mesh;
     GlHandle m_vertexArray, m_vertexBuffer, m_indexBuffer;
-    Target m_target;
+    FloatTarget m_target;
     GLuint m_program = 0;
     std::vector<Tile> m_tiles;  // empty: not tiled
     std::vector<Image> m_levels;
@@ -597,7 +580,7 @@ Image decodeImageGpu(Context& context, const Image& conus, const codec::Sampling
 
     // The map's nodes, fetched exactly (texelFetch) by the shader.
     GlHandle mapTexture = uploadMapTexture(gl, GL_TEXTURE1, map.columns(), map.rows(), &map.nodes().front().x);
-    Target target(gl, out.width, out.height, kWhat);
+    FloatTarget target(gl, out.width, out.height, kWhat);
     checkGl(gl, kWhat);
 
     for (int first = 0; first < conus.channelCount(); first += kChannelsPerPass) {

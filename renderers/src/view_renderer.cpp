@@ -508,15 +508,7 @@ Image ViewRenderer::renderToImage(const codec::View& view, int width, int height
     constexpr const char* kWhat = "ViewRenderer::renderToImage";
     Image out = makeImage(width, height, {"R", "G", "B", "A"});
     const GladGLContext& gl = makeCurrentGl(m_impl->context);
-    GlHandle texture = makeTexture(gl), framebuffer = makeFramebuffer(gl);
-    gl.BindTexture(GL_TEXTURE_2D, texture.id());
-    gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.id(), 0);
-    checkGl(gl, kWhat);
-    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        throw Error(ErrorCode::Unsupported, std::string(kWhat) + ": cannot render to a " + std::to_string(width) + "x" +
-                                                std::to_string(height) + " RGBA32F framebuffer");
+    const FloatTarget target(gl, width, height, kWhat);
     options.bottomUp = false;  // read back top row first: no flip
     m_impl->floatTarget = true;  // a CPU decode keeps float values
     try {
