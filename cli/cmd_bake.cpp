@@ -25,6 +25,7 @@
 #include "encoding.h"
 #include "image_files.h"
 #include "importance.h"
+#include "map_options.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -93,8 +94,7 @@ int runBakeRelief(const BakeOptions& o) {
     if (!o.uniform) {
         Progress building("build the sampling map");
         if (!o.foci.empty()) {
-            std::vector<codec::Focus> foci;
-            for (const auto& text : o.foci) foci.push_back(codec::parseFocus(text));
+            const std::vector<codec::Focus> foci = parseFoci(o.foci);
             codec::FociOptions fo;
             fo.columns = fo.rows = o.grid;
             fo.aspect = double(source.heights.width) / source.heights.height;

@@ -23,6 +23,7 @@
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
 #include "importance.h"
+#include "map_options.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -69,7 +70,7 @@ DemoSource demoSource(const DemoOptions& o) {
         imageio::ImageFile file = readSource(o.input, {});
         s.image = std::move(file.image);
         s.encoding = file.info.encoding;
-        for (const auto& text : o.foci) s.foci.push_back(codec::parseFocus(text));
+        s.foci = parseFoci(o.foci);
         if (s.foci.empty()) s.foci.push_back({0.5, 0.5, 0.1, o.k});
         return s;
     }

@@ -61,8 +61,7 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
 }
 
 BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source) {
-    std::vector<codec::Focus> foci;
-    for (const auto& text : o.foci) foci.push_back(codec::parseFocus(text));
+    const std::vector<codec::Focus> foci = parseFoci(o.foci);
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
     fo.aspect = double(source.width) / source.height;

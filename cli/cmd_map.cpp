@@ -247,8 +247,7 @@ void addFociOptions(CLI::App& command, FociOptions& o) {
 }
 
 void runFoci(const FociOptions& o) {
-    std::vector<codec::Focus> list;
-    for (const auto& text : o.foci) list.push_back(codec::parseFocus(text));
+    const std::vector<codec::Focus> list = parseFoci(o.foci);
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
     fo.aspect = o.aspect;

@@ -35,6 +35,7 @@
 #include "conus/sceneio/mesh_file.h"
 #include "encoding.h"
 #include "image_files.h"
+#include "map_options.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -160,14 +161,6 @@ void printCamera(const Camera& c) {
                 look.z, c.verticalFovDegrees(), c.near(), c.far());
 }
 
-codec::FociOptions fociOptions(const MeshOptions& o, double aspect) {
-    codec::FociOptions fo;
-    fo.columns = fo.rows = o.grid;
-    fo.aspect = aspect;
-    fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
-    return fo;
-}
-
 std::vector<glm::dvec3> carCentres(const codec::CityScene& city, const std::vector<int>& cars, double t) {
     std::vector<glm::dvec3> centres;
     for (int car : cars) {
@@ -260,44 +253,31 @@ int runRender(const RenderOptions& r) {
     const Camera camera =
         city && !cameraChoice.given ? cityCamera(*city, aspect) : meshCamera(cameraChoice, boundsOf(mesh), aspect);
 
-    std::optional<codec::SamplingMap> map;
-    std::optional<format::AnalyticMap> analytic;
-    const codec::FociOptions fo = fociOptions(o, aspect);
-    if (r.uniform) {
-        map.emplace(codec::SamplingMap::identity(2, 2));
-    } else if (!r.mapFile.empty()) {
-        const format::ConusFile source = format::readConusFile(r.mapFile);
-        map.emplace(codec::SamplingMap::fromGrid(source.map));
-        analytic = source.analytic;
-    } else if (!r.foci.empty() || !o.track.empty()) {
-        std::vector<codec::Focus> foci;
-        for (const auto& text : r.foci) foci.push_back(codec::parseFocus(text));
+    const FociSource foci = r.foci.empty() && o.track.empty() ? FociSource{} : [&] {
+        std::vector<codec::Focus> given = parseFoci(r.foci);
         if (city) {
             const auto centres = carCentres(*city, o.track, o.time);
             const auto tracked = gl::trackedFoci(camera, centres, aspect, {o.trackRadius, o.trackK});
-            foci.insert(foci.end(), tracked.begin(), tracked.end());
+            given.insert(given.end(), tracked.begin(), tracked.end());
         }
-        Progress building("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
-        map.emplace(gl::frameMap(foci, fo));
-        if (!foci.empty()) analytic = codec::toAnalytic(foci, fo.composition);
-        building.done();
-    } else {
-        warn("no --focus, --map or --track: rendering the uniform image of the same pixel count (what --uniform makes)");
-        map.emplace(codec::SamplingMap::identity(2, 2));
-    }
+        return given;
+    };
+    const FrameMap chosen = chooseFrameMap(r.uniform, r.mapFile, foci, frameFociOptions(o.grid, o.compose, aspect),
+                                           "--focus, --map or --track");
+    const codec::SamplingMap& map = chosen.map;
 
     const gl::Device device = meshDevice(o, r.reference);
     Progress rendering("render " + std::to_string(mesh.triangleCount()) + " triangles at " + o.sizeText + " (" +
                        device.describe() + ")");
-    const Image image = renderFrame(device, mesh, camera, *map, size, o, !quiet());
+    const Image image = renderFrame(device, mesh, camera, map, size, o, !quiet());
     rendering.done();
     Progress writing("write " + r.output);
-    format::writeConusFile(r.output, codec::makeDepthImageFile(image, *map, camera, o.units, analytic));
+    format::writeConusFile(r.output, codec::makeDepthImageFile(image, map, camera, o.units, chosen.analytic));
     writing.done();
     printCamera(camera);
     std::printf("wrote %s: %dx%d CoNUS colour + depth image of %s (%zu triangles), %dx%d sampling map, %s\n",
-                r.output.c_str(), size.width, size.height, o.model.c_str(), mesh.triangleCount(), map->columns(),
-                map->rows(), device.describe().c_str());
+                r.output.c_str(), size.width, size.height, o.model.c_str(), mesh.triangleCount(), map.columns(),
+                map.rows(), device.describe().c_str());
     return 0;
 }
 
@@ -382,7 +362,7 @@ int runAnimate(const AnimateOptions& a) {
     const codec::CityScene city;
     const Camera camera =
         cameraChoice.given ? meshCamera(cameraChoice, boundsOf(city.meshAt(o.time)), aspect) : cityCamera(city, aspect);
-    const codec::FociOptions fo = fociOptions(o, aspect);
+    const codec::FociOptions fo = frameFociOptions(o.grid, o.compose, aspect);
     const gl::Device device = meshDevice(o, false);
     printCamera(camera);
 

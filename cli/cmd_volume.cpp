@@ -28,6 +28,7 @@
 #include "conus/sceneio/volume_file.h"
 #include "encoding.h"
 #include "image_files.h"
+#include "map_options.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -141,31 +142,11 @@ int runRender(const VolumeOptions& o) {
     const Camera& camera = scene.camera;
     const codec::TransferFunction& tf = scene.tf;
 
-    std::optional<codec::SamplingMap> map;
-    std::optional<format::AnalyticMap> analytic;
-    if (o.uniform) {
-        map.emplace(codec::SamplingMap::identity(2, 2));
-    } else if (!o.mapFile.empty()) {
-        const format::ConusFile source = format::readConusFile(o.mapFile);
-        map.emplace(codec::SamplingMap::fromGrid(source.map));
-        analytic = source.analytic;
-    } else if (!o.foci.empty()) {
-        std::vector<codec::Focus> foci;
-        for (const auto& text : o.foci) foci.push_back(codec::parseFocus(text));
-        codec::FociOptions fo;
-        fo.columns = fo.rows = o.grid;
-        fo.aspect = aspect;
-        fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
-        Progress building("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
-        map.emplace(gl::frameMap(foci, fo));
-        analytic = codec::toAnalytic(foci, fo.composition);
-        building.done();
-    } else {
-        warn("no --focus or --map: rendering the uniform image of the same pixel count (what --uniform makes)");
-        map.emplace(codec::SamplingMap::identity(2, 2));
-    }
-    const bool identity = o.uniform || (o.mapFile.empty() && o.foci.empty());
-    const Fpc fpc(camera, identity ? nullptr : std::make_shared<codec::SamplingMap>(*map));
+    const FociSource foci = o.foci.empty() ? FociSource{} : [&o] { return parseFoci(o.foci); };
+    const FrameMap chosen =
+        chooseFrameMap(o.uniform, o.mapFile, foci, frameFociOptions(o.grid, o.compose, aspect), "--focus or --map");
+    const codec::SamplingMap& map = chosen.map;
+    const Fpc fpc(camera, chosen.identity ? nullptr : std::make_shared<codec::SamplingMap>(map));
 
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "volume rendering");
     Progress rendering("render " + std::to_string(volume.width) + "x" + std::to_string(volume.height) + "x" +
@@ -174,15 +155,15 @@ int runRender(const VolumeOptions& o) {
     const Image image = gl::renderVolume(device, volume, tf, fpc, size.width, size.height, options);
     rendering.done();
     Progress writing("write " + o.output);
-    format::writeConusFile(o.output, codec::makeDepthImageFile(image, *map, camera, o.units, analytic));
+    format::writeConusFile(o.output, codec::makeDepthImageFile(image, map, camera, o.units, chosen.analytic));
     if (!o.picture.empty()) writePicture(o.picture, toRgb(image));
     writing.done();
     const glm::dvec3 eye = camera.eye(), look = eye + camera.forward();
     std::printf("camera %.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g (near %.4g, far %.4g)\n", eye.x, eye.y, eye.z, look.x, look.y,
                 look.z, camera.verticalFovDegrees(), camera.near(), camera.far());
     std::printf("wrote %s: %dx%d CoNUS colour + depth image of %s (%dx%dx%d), %dx%d sampling map, %s\n", o.output.c_str(),
-                size.width, size.height, o.volume.c_str(), volume.width, volume.height, volume.depth, map->columns(),
-                map->rows(), device.describe().c_str());
+                size.width, size.height, o.volume.c_str(), volume.width, volume.height, volume.depth, map.columns(),
+                map.rows(), device.describe().c_str());
     return 0;
 }
 
@@ -221,9 +202,7 @@ int runAnimate(const AnimateOptions& a) {
     const Camera& camera = scene.camera;
     const codec::TransferFunction& tf = scene.tf;
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "volume rendering");
-    codec::FociOptions fo;
-    fo.columns = fo.rows = o.grid;
-    fo.aspect = aspect;
+    const codec::FociOptions fo = frameFociOptions(o.grid, o.compose, aspect);
     // On a GL device the volume and transfer function go up once for all frames (a 3-D texture
     // upload per frame cost more than the frame itself on llvmpipe; bench/README.md "Volumes").
     std::optional<gl::VolumeRendererGpu> gpu;

@@ -2,6 +2,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "conus/renderers/mesh_sequence.h"
+#include "progress.h"
+
 namespace conus::cli {
 
 codec::AutoMapOptions autoMapOptions(int grid, double minDensity, double maxDensity, double maxAnisotropy, const std::string& method) {
@@ -12,6 +15,39 @@ codec::AutoMapOptions autoMapOptions(int grid, double minDensity, double maxDens
     options.maxAnisotropy = maxAnisotropy;
     options.method = method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
     return options;
+}
+
+std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts) {
+    std::vector<codec::Focus> foci;
+    for (const auto& text : texts) foci.push_back(codec::parseFocus(text));
+    return foci;
+}
+
+codec::FociOptions frameFociOptions(int grid, const std::string& compose, double aspect) {
+    codec::FociOptions options;
+    options.columns = options.rows = grid;
+    options.aspect = aspect;
+    options.composition = compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+    return options;
+}
+
+FrameMap chooseFrameMap(bool uniform, const std::string& mapFile, const FociSource& fociSource,
+                        const codec::FociOptions& options, const std::string& choices) {
+    if (uniform) return {codec::SamplingMap::identity(2, 2), std::nullopt, true};
+    if (!mapFile.empty()) {
+        const format::ConusFile source = format::readConusFile(mapFile);
+        return {codec::SamplingMap::fromGrid(source.map), source.analytic, false};
+    }
+    if (fociSource) {
+        const std::vector<codec::Focus> foci = fociSource();
+        Progress building("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
+        FrameMap chosen{gl::frameMap(foci, options), std::nullopt, false};
+        if (!foci.empty()) chosen.analytic = codec::toAnalytic(foci, options.composition);
+        building.done();
+        return chosen;
+    }
+    warn("no " + choices + ": rendering the uniform image of the same pixel count (what --uniform makes)");
+    return {codec::SamplingMap::identity(2, 2), std::nullopt, true};
 }
 
 void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy) {

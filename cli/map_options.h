@@ -1,9 +1,16 @@
-// The options that shape a built map, shared by `map foci`, `map auto` and `encode`.
+// The options that shape a built map, shared by `map foci`, `map auto` and `encode`, and the map a
+// rendered frame (`mesh render`, `volume render`) is taken through.
 #pragma once
 
+#include <functional>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "conus/codec/build/auto_map.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/map/sampling_map.h"
+#include "conus/format/container.h"
 
 namespace CLI {
 class App;
@@ -19,5 +26,27 @@ void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDe
 // The builder's options from what `map auto` and `encode --importance` are given (method "flow"
 // or "separable").
 codec::AutoMapOptions autoMapOptions(int grid, double minDensity, double maxDensity, double maxAnisotropy, const std::string& method);
+
+// The foci of repeated --focus u,v,r,k options, in order.
+std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);
+
+// The foci builder's options for a frame of `aspect` from --grid and --compose ("add" or "density").
+codec::FociOptions frameFociOptions(int grid, const std::string& compose, double aspect);
+
+// The sampling map of a rendered CoNUS frame, and the analytic form written beside its grid.
+struct FrameMap {
+    codec::SamplingMap map;
+    std::optional<format::AnalyticMap> analytic;
+    bool identity = false;  // --uniform, or nothing asked for: the conventional frame
+};
+
+// The foci a frame asked for, made only when they are used (empty: none were asked for).
+using FociSource = std::function<std::vector<codec::Focus>()>;
+
+// In this order: --uniform: the identity; --map FILE: that file's map (and its analytic form);
+// foci: the map built from them. With none of these, the identity and a warning that names the
+// options that were not given (`choices`, e.g. "--focus or --map").
+FrameMap chooseFrameMap(bool uniform, const std::string& mapFile, const FociSource& foci, const codec::FociOptions& options,
+                        const std::string& choices);
 
 }  // namespace conus::cli

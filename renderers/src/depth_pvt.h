@@ -1,13 +1,17 @@
 // Private: a CoNUS depth image on the GPU, as intersect.inc.glsl reads it (relief and reflection
 // renderers): its textures (camera depths R32F, the map's nodes RG32F) and its DepthView uniforms;
-// and what both renderers' frames share: an RGBA32F target and one full-screen pass into it.
+// and what both renderers' frames share: an RGBA32F target, one full-screen pass into it, and the
+// scene a DepthFrameRenderer keeps (depth_frames.h).
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <glm/gtc/type_ptr.hpp>
 
 #include "conus/codec/depth/intersect.h"
+#include "conus/renderers/depth_frames.h"
 #include "context_pvt.h"
 #include "gl_objects.h"
 
@@ -125,5 +129,22 @@ inline void drawFullscreen(Context& context, const GladGLContext& gl, int w, int
     gl.BindVertexArray(0);
     checkGl(gl, what);
 }
+
+// A DepthFrameRenderer's uploaded assets and its draw: drawFrame leaves the frame in `target`,
+// bound; render reads `channels` of it back (three: GL's R, G, B; four: R, G, B, A).
+struct DepthFrameRenderer::Scene {
+    Scene(Context& c, const char* renderer, std::vector<std::string> frameChannels)
+        : context(c), what(renderer), channels(std::move(frameChannels)) {}
+    virtual ~Scene() = default;
+    Scene(const Scene&) = delete;
+    Scene& operator=(const Scene&) = delete;
+
+    virtual void drawFrame(const Camera& camera, int w, int h) = 0;
+
+    Context& context;
+    const char* what;  // the renderer, in errors
+    std::vector<std::string> channels;
+    FrameTarget target;
+};
 
 }  // namespace conus::gl

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <glad/gl.h>
 
@@ -25,12 +26,17 @@ inline void checkFrame(const Context& context, int width, int height, const char
                     frame + " exceeds GL_MAX_TEXTURE_SIZE " + std::to_string(context.maxTextureSize()));
 }
 
-// The bound read framebuffer's colour as an RGB float image, rows in GL's order.
-inline Image readRgbFrame(const GladGLContext& gl, int width, int height) {
-    Image frame = makeImage(width, height, {"R", "G", "B"});
+// The bound read framebuffer's colour as a float image of three channels (GL's R, G, B) or four
+// (R, G, B, A) named `channels`, rows in GL's order.
+inline Image readFrame(const GladGLContext& gl, int width, int height, const std::vector<std::string>& channels) {
+    Image frame = makeImage(width, height, channels);
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    gl.ReadPixels(0, 0, width, height, GL_RGB, GL_FLOAT, frame.pixels.data());
+    gl.ReadPixels(0, 0, width, height, channels.size() == 4 ? GL_RGBA : GL_RGB, GL_FLOAT, frame.pixels.data());
     return frame;
+}
+
+inline Image readRgbFrame(const GladGLContext& gl, int width, int height) {
+    return readFrame(gl, width, height, {"R", "G", "B"});
 }
 
 }  // namespace conus::gl

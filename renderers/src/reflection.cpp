@@ -36,21 +36,17 @@ std::vector<float> colourAndCoverage(const Image& image) {
     return out;
 }
 
-}  // namespace
-
-struct ReflectionRenderer::Impl {
-    Context& context;
+struct ReflectionScene : DepthFrameRenderer::Scene {
     codec::ReflectionFrameOptions options;
     MeshRenderer scene;
     std::vector<DepthTextures> depths;
     std::array<GlHandle, codec::kCubeFaces> colours;
     std::vector<codec::DepthImage> images;  // their cameras and depth ranges, for the uniforms
     GlHandle behind;
-    FrameTarget target;
 
-    Impl(Context& c, const GladGLContext& gl, const Mesh& mesh, const std::vector<codec::ReflectionFace>& f,
-         const codec::ReflectionFrameOptions& o)
-        : context(c), options(o), scene(c, mesh) {
+    ReflectionScene(Context& c, const GladGLContext& gl, const Mesh& mesh, const std::vector<codec::ReflectionFace>& f,
+                    const codec::ReflectionFrameOptions& o)
+        : Scene(c, kWhat, {"R", "G", "B", "M"}), options(o), scene(c, mesh) {
         depths.reserve(codec::kCubeFaces);
         for (int k = 0; k < codec::kCubeFaces; ++k) {
             const codec::ReflectionFace& face = f[static_cast<std::size_t>(k)];
@@ -63,7 +59,7 @@ struct ReflectionRenderer::Impl {
         }
     }
 
-    void drawFrame(const Camera& camera, int w, int h) {
+    void drawFrame(const Camera& camera, int w, int h) override {
         checkFrame(context, w, h, kWhat);
         // The scene behind: R, G, B and camera depth (kNothingBehind where nothing was hit).
         MeshRenderOptions one;
@@ -128,9 +124,9 @@ struct ReflectionRenderer::Impl {
     }
 };
 
-ReflectionRenderer::ReflectionRenderer(Context& context, const Mesh& scene,
-                                       const std::vector<codec::ReflectionFace>& faces,
-                                       const codec::ReflectionFrameOptions& options) {
+std::unique_ptr<DepthFrameRenderer::Scene> reflectionScene(Context& context, const Mesh& scene,
+                                                           const std::vector<codec::ReflectionFace>& faces,
+                                                           const codec::ReflectionFrameOptions& options) {
     codec::checkIntersectOptions(options.intersect);
     if (faces.size() != static_cast<std::size_t>(codec::kCubeFaces))
         throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": " + std::to_string(faces.size()) +
@@ -151,29 +147,17 @@ ReflectionRenderer::ReflectionRenderer(Context& context, const Mesh& scene,
         throw Error(ErrorCode::Unsupported, std::string(kWhat) + ": the driver has " + std::to_string(units) +
                                                 " fragment texture units; the reflection pass needs " +
                                                 std::to_string(kBehindUnit + 1));
-    m_impl = std::make_unique<Impl>(context, gl, scene, faces, options);
+    auto made = std::make_unique<ReflectionScene>(context, gl, scene, faces, options);
     checkGl(gl, kWhat);
+    return made;
 }
 
-ReflectionRenderer::~ReflectionRenderer() {
-    if (m_impl) makeCurrentGl(m_impl->context);  // the GL objects die in their own context
-}
+}  // namespace
 
-void ReflectionRenderer::draw(const Camera& camera, int width, int height) {
-    m_impl->drawFrame(camera, width, height);
-    makeCurrentGl(m_impl->context).Finish();
-}
-
-Image ReflectionRenderer::render(const Camera& camera, int width, int height) {
-    m_impl->drawFrame(camera, width, height);
-    const GladGLContext& gl = makeCurrentGl(m_impl->context);
-    Image frame = makeImage(width, height, {"R", "G", "B", "M"});
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, frame.pixels.data());
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    checkGl(gl, kWhat);
-    return frame;
-}
+ReflectionRenderer::ReflectionRenderer(Context& context, const Mesh& scene,
+                                       const std::vector<codec::ReflectionFace>& faces,
+                                       const codec::ReflectionFrameOptions& options)
+    : DepthFrameRenderer(reflectionScene(context, scene, faces, options)) {}
 
 Image renderReflection(const Device& device, const codec::MeshScene& scene,
                        const std::vector<codec::ReflectionFace>& faces, const Camera& camera, int width, int height,

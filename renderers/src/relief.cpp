@@ -105,16 +105,16 @@ std::vector<std::optional<codec::DepthHit>> intersectRays(Context& context, cons
     return hits;
 }
 
-struct ReliefRenderer::Impl {
-    Context& context;
+namespace {
+
+struct ReliefScene : DepthFrameRenderer::Scene {
     const codec::DepthImage image;
     ReliefLook look;
     DepthTextures textures;
     GlHandle colour;
-    FrameTarget target;
 
-    Impl(Context& c, const GladGLContext& gl, const codec::DepthImage& i, const Image& rgb, const ReliefLook& l)
-        : context(c), image(i), look(l), textures(c, gl, i, kWhat) {
+    ReliefScene(Context& c, const GladGLContext& gl, const codec::DepthImage& i, const Image& rgb, const ReliefLook& l)
+        : Scene(c, kWhat, {"R", "G", "B"}), image(i), look(l), textures(c, gl, i, kWhat) {
         std::vector<float> pixels(static_cast<std::size_t>(rgb.width) * rgb.height * 3, 0.7f);
         int channels[3];
         for (int k = 0; k < 3; ++k) channels[k] = rgb.channelIndex(std::string(1, "RGB"[k]));
@@ -124,7 +124,7 @@ struct ReliefRenderer::Impl {
         colour = floatTexture(gl, GL_TEXTURE2, rgb.width, rgb.height, 3, pixels.data(), true);
     }
 
-    void drawFrame(const Camera& camera, int w, int h) {
+    void drawFrame(const Camera& camera, int w, int h) override {
         checkFrame(context, w, h, kWhat);
         const GladGLContext& gl = makeCurrentGl(context);
         const GLuint program =
@@ -151,8 +151,8 @@ struct ReliefRenderer::Impl {
     }
 };
 
-ReliefRenderer::ReliefRenderer(Context& context, const codec::DepthImage& image, const Image& colour,
-                               const ReliefLook& look) {
+std::unique_ptr<DepthFrameRenderer::Scene> reliefScene(Context& context, const codec::DepthImage& image,
+                                                       const Image& colour, const ReliefLook& look) {
     codec::checkIntersectOptions(look.intersect);
     checkImage(colour, "ReliefRenderer");
     if (colour.width != image.width() || colour.height != image.height())
@@ -163,26 +163,15 @@ ReliefRenderer::ReliefRenderer(Context& context, const codec::DepthImage& image,
     if (!(glm::length(look.towardLight) > 0.0f))
         throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": the light has no direction");
     const GladGLContext& gl = makeCurrentGl(context);
-    m_impl = std::make_unique<Impl>(context, gl, image, colour, look);
+    auto scene = std::make_unique<ReliefScene>(context, gl, image, colour, look);
     checkGl(gl, kWhat);
+    return scene;
 }
 
-ReliefRenderer::~ReliefRenderer() {
-    if (m_impl) makeCurrentGl(m_impl->context);  // the GL objects die in their own context
-}
+}  // namespace
 
-void ReliefRenderer::draw(const Camera& camera, int width, int height) {
-    m_impl->drawFrame(camera, width, height);
-    makeCurrentGl(m_impl->context).Finish();
-}
-
-Image ReliefRenderer::render(const Camera& camera, int width, int height) {
-    m_impl->drawFrame(camera, width, height);
-    const GladGLContext& gl = makeCurrentGl(m_impl->context);
-    Image frame = readRgbFrame(gl, width, height);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    checkGl(gl, kWhat);
-    return frame;
-}
+ReliefRenderer::ReliefRenderer(Context& context, const codec::DepthImage& image, const Image& colour,
+                               const ReliefLook& look)
+    : DepthFrameRenderer(reliefScene(context, image, colour, look)) {}
 
 }  // namespace conus::gl

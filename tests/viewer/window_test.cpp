@@ -3,6 +3,10 @@
 // CI installs it).
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include "conus/codec/conus_file.h"
@@ -75,31 +79,55 @@ Box changed(const Image& a, const Image& b) {
     return box.x1 == 0 ? Box{} : box;
 }
 
+// A headless screenshot (no DISPLAY) of the test file's view [0.1,0.9]x[0.2,0.8] (256x144 source
+// pixels) asked for at `size` (WxH), into `shot`.
+void screenshotOfTheView(const std::string& size, Image& shot) {
+    const fs::path out = test::tempDir() / ("view-" + size + ".png");
+    std::string log;
+    ASSERT_EQ(test::run("env -u DISPLAY " + test::viewerBinary() + " " + test::conusPath() + " --screenshot " + out.string() +
+                            " --view 0.1,0.2,0.9,0.8 --size " + size + " --gamma 1", &log), 0) << log;
+    shot = readPng(out);
+}
+
+// That view decoded on the CPU: what the screenshot shows.
+Image cpuView() {
+    const format::ConusFile file = format::readConusFile(test::conusPath());
+    codec::DecodeOptions options;
+    options.view = {0.1, 0.2, 0.9, 0.8};
+    options.width = 256;
+    options.height = 144;
+    return codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
+}
+
+// The largest difference between `expected` (channels R, G, B, clamped to [0,1]) and the 8-bit
+// screenshot `shot` (R, G, B in that order, the picture starting at row `top`). A shot too small to
+// hold the picture is a failure.
+double worstDifference(const Image& shot, const Image& expected, int top = 0) {
+    if (shot.width < expected.width || shot.height < top + expected.height || shot.channelCount() < 3) {
+        ADD_FAILURE() << "a " << shot.width << "x" << shot.height << " shot cannot hold a " << expected.width << "x"
+                      << expected.height << " picture at row " << top;
+        return std::numeric_limits<double>::infinity();
+    }
+    // EXR stores channels sorted by name (B,G,R); the PNG is R,G,B.
+    const int channel[3] = {expected.channelIndex("R"), expected.channelIndex("G"), expected.channelIndex("B")};
+    double worst = 0;
+    for (int y = 0; y < expected.height; ++y)
+        for (int x = 0; x < expected.width; ++x)
+            for (int c = 0; c < 3; ++c)
+                worst = std::max(worst, double(std::abs(shot.at(x, top + y, c) - std::clamp(expected.at(x, y, channel[c]), 0.0f, 1.0f))));
+    return worst;
+}
+
 std::string xvfb(const std::string& args) {
     return "xvfb-run -a -s '-screen 0 1024x768x24' " + conus::testing::glxLeakCheckPrefix() + test::viewerBinary() + " " + args;
 }
 
 TEST(ConusView, ScreenshotIsTheDecodedFrameWithoutADisplay) {
-    const fs::path out = test::tempDir() / "shot.png";
-    std::string log;
-    ASSERT_EQ(test::run("env -u DISPLAY " + test::viewerBinary() + " " + test::conusPath() + " --screenshot " + out.string() +
-                            " --view 0.1,0.2,0.9,0.8 --size 256x144 --gamma 1", &log), 0) << log;
-    const Image shot = readPng(out);
+    Image shot;
+    ASSERT_NO_FATAL_FAILURE(screenshotOfTheView("256x144", shot));
     ASSERT_EQ(shot.width, 256);
-    const format::ConusFile file = format::readConusFile(test::conusPath());
-    codec::DecodeOptions options;
-    options.view = {0.1, 0.2, 0.9, 0.8};  // 256x144 source pixels: the size's aspect, no letterbox
-    options.width = 256;
-    options.height = 144;
-    const Image cpu = codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
-    // EXR stores channels sorted by name (B,G,R); the PNG is R,G,B.
-    const int channel[3] = {cpu.channelIndex("R"), cpu.channelIndex("G"), cpu.channelIndex("B")};
-    double worst = 0;
-    for (int y = 0; y < 144; ++y)
-        for (int x = 0; x < 256; ++x)
-            for (int c = 0; c < 3; ++c)
-                worst = std::max(worst, double(std::abs(shot.at(x, y, c) - std::clamp(cpu.at(x, y, channel[c]), 0.0f, 1.0f))));
-    EXPECT_LT(worst, 3.0 / 255) << "8-bit rounding plus float differences";
+    // The view is 256x144 source pixels: the size's aspect, no letterbox.
+    EXPECT_LT(worstDifference(shot, cpuView()), 3.0 / 255) << "8-bit rounding plus float differences";
 }
 
 // --uniform shows the real baseline (what `conus uniform` makes from the source) in U mode; without
@@ -113,14 +141,6 @@ TEST(ConusView, UniformModeShowsTheGivenBaseline) {
     options.width = test::kSourceWidth;
     options.height = test::kSourceHeight;
     const Image expected = codec::decodeImage(uniform, codec::SamplingMap::identity(2, 2), options);
-    const auto worstDifference = [&](const Image& shot) {
-        double worst = 0;
-        for (int y = 0; y < expected.height; ++y)
-            for (int x = 0; x < expected.width; ++x)
-                for (int c = 0; c < 3; ++c)
-                    worst = std::max(worst, double(std::abs(shot.at(x, y, c) - std::clamp(expected.at(x, y, c), 0.0f, 1.0f))));
-        return worst;
-    };
     const std::string size = " --size " + std::to_string(test::kSourceWidth) + "x" + std::to_string(test::kSourceHeight);
     const fs::path given = test::tempDir() / "given.png", resampled = test::tempDir() / "resampled.png";
     std::string log;
@@ -130,35 +150,20 @@ TEST(ConusView, UniformModeShowsTheGivenBaseline) {
                         &log), 0) << log;
     const Image shotGiven = readPng(given), shotResampled = readPng(resampled);
     ASSERT_EQ(shotGiven.width, test::kSourceWidth);
-    EXPECT_LT(worstDifference(shotGiven), 3.0 / 255) << "8-bit rounding plus float differences";
-    EXPECT_GT(worstDifference(shotResampled), 6.0 / 255) << "the resampled uniform image is another picture";
+    EXPECT_LT(worstDifference(shotGiven, expected), 3.0 / 255) << "8-bit rounding plus float differences";
+    EXPECT_GT(worstDifference(shotResampled, expected), 6.0 / 255) << "the resampled uniform image is another picture";
     EXPECT_EQ(test::run(test::viewerBinary() + " --uniform " + uniformPath.string(), &log), 2) << log;
 }
 
 TEST(ConusView, ScreenshotLetterboxesLikeTheWindow) {
     // A 256x144-pixel view asked for at 256x256: shown whole at 256x144, centred, bands above and
     // below, not stretched to fill.
-    const fs::path out = test::tempDir() / "box.png";
-    std::string log;
-    ASSERT_EQ(test::run("env -u DISPLAY " + test::viewerBinary() + " " + test::conusPath() + " --screenshot " + out.string() +
-                            " --view 0.1,0.2,0.9,0.8 --size 256x256 --gamma 1", &log), 0) << log;
-    const Image shot = readPng(out);
+    Image shot;
+    ASSERT_NO_FATAL_FAILURE(screenshotOfTheView("256x256", shot));
     ASSERT_EQ(shot.width, 256);
     ASSERT_EQ(shot.height, 256);
-    const format::ConusFile file = format::readConusFile(test::conusPath());
-    codec::DecodeOptions options;
-    options.view = {0.1, 0.2, 0.9, 0.8};
-    options.width = 256;
-    options.height = 144;
-    const Image cpu = codec::decodeImage(file.image, codec::SamplingMap::fromGrid(file.map), options);
-    const int channel[3] = {cpu.channelIndex("R"), cpu.channelIndex("G"), cpu.channelIndex("B")};
     const int top = (256 - 144) / 2;
-    double worst = 0;
-    for (int y = 0; y < 144; ++y)
-        for (int x = 0; x < 256; ++x)
-            for (int c = 0; c < 3; ++c)
-                worst = std::max(worst, double(std::abs(shot.at(x, top + y, c) - std::clamp(cpu.at(x, y, channel[c]), 0.0f, 1.0f))));
-    EXPECT_LT(worst, 3.0 / 255) << "the picture is the view, unstretched";
+    EXPECT_LT(worstDifference(shot, cpuView(), top), 3.0 / 255) << "the picture is the view, unstretched";
     // The bands show the background: one colour, unlike the picture.
     for (int c = 0; c < 3; ++c) {
         EXPECT_NEAR(shot.at(128, 5, c), shot.at(5, 5, c), 1e-6);

@@ -5,12 +5,9 @@
 // fragment pass, meets each pixel's eye ray with the reflector and intersects the reflected ray
 // with the faces through intersect.inc.glsl, the one intersection algorithm.
 //
-// Shared rules as relief.h: frames are float, top row first, 1 to 16384 pixels a side (and at most
-// GL_MAX_TEXTURE_SIZE); bad arguments throw conus::Error(InvalidArgument), a failed GL call or a
-// driver with fewer than 19 fragment texture units Unsupported, out of GL memory LimitExceeded.
+// Shared rules as depth_frames.h; a driver with fewer than 19 fragment texture units is Unsupported.
 #pragma once
 
-#include <memory>
 #include <vector>
 
 #include "conus/codec/depth/reflection.h"
@@ -18,27 +15,17 @@
 #include "conus/core/image.h"
 #include "conus/renderers/backend.h"
 #include "conus/renderers/context.h"
+#include "conus/renderers/depth_frames.h"
 
 namespace conus::gl {
 
-// Keeps an asset (exactly six faces) and its scene uploaded so that frames cost the two draws and
-// the readback.
-class ReflectionRenderer {
+// Keeps an asset (exactly six faces) and its scene uploaded (a frame is two draws: the scene
+// behind, then the reflection pass); render() gives channels R, G, B, M as
+// codec::renderReflectionFrame's.
+class ReflectionRenderer : public DepthFrameRenderer {
 public:
     ReflectionRenderer(Context& context, const Mesh& scene, const std::vector<codec::ReflectionFace>& faces,
                        const codec::ReflectionFrameOptions& options);
-    ~ReflectionRenderer();
-    ReflectionRenderer(const ReflectionRenderer&) = delete;
-    ReflectionRenderer& operator=(const ReflectionRenderer&) = delete;
-
-    // Channels R, G, B, M as codec::renderReflectionFrame's. The camera's aspect should be the frame's.
-    Image render(const Camera& camera, int width, int height);
-    // Waits for a frame without reading it back (benchmarks: frames per second of the draws).
-    void draw(const Camera& camera, int width, int height);
-
-private:
-    struct Impl;
-    std::unique_ptr<Impl> m_impl;
 };
 
 // A frame on a device: the renderer above, or codec::renderReflectionFrame (the CPU reference) with

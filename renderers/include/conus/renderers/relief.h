@@ -5,14 +5,10 @@
 // shader, shaded by the stored colour and the surface's normal, optionally self-shadowed (a second
 // ray toward the light through the same intersection).
 //
-// Shared rules: the depth image is uploaded once per renderer (camera depths R32F, the map's
-// nodes RG32F, colour RGB32F); frames are float RGB, top row first, 1 to 16384 pixels a side (and
-// at most GL_MAX_TEXTURE_SIZE); bad arguments throw conus::Error(InvalidArgument), a failed GL
-// call Unsupported, out of GL memory LimitExceeded. The context is made current on the calling
-// thread.
+// Shared rules as depth_frames.h: the depth image is uploaded once per renderer (camera depths
+// R32F, the map's nodes RG32F, colour RGB32F); frames are float RGB.
 #pragma once
 
-#include <memory>
 #include <optional>
 #include <vector>
 
@@ -22,6 +18,7 @@
 #include "conus/core/camera.h"
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"
+#include "conus/renderers/depth_frames.h"
 
 namespace conus::gl {
 
@@ -39,24 +36,12 @@ struct ReliefLook {
     codec::IntersectOptions intersect;
 };
 
-// Keeps an asset uploaded so that frames cost only the draw and the readback.
-class ReliefRenderer {
+// Keeps an asset uploaded; render() gives frames of channels R, G, B.
+class ReliefRenderer : public DepthFrameRenderer {
 public:
     // `colour` is the asset's CoNUS image (R, G, B channels; grey when it has none), the size of
     // the depth image.
     ReliefRenderer(Context& context, const codec::DepthImage& image, const Image& colour, const ReliefLook& look = {});
-    ~ReliefRenderer();
-    ReliefRenderer(const ReliefRenderer&) = delete;
-    ReliefRenderer& operator=(const ReliefRenderer&) = delete;
-
-    // The camera's aspect should be the frame's (else the picture is stretched).
-    Image render(const Camera& camera, int width, int height);
-    // Waits for a frame without reading it back (benchmarks: frames per second of the draw).
-    void draw(const Camera& camera, int width, int height);
-
-private:
-    struct Impl;
-    std::unique_ptr<Impl> m_impl;
 };
 
 }  // namespace conus::gl
