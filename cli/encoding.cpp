@@ -3,12 +3,14 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 
 #include "conus/core/atomic_file.h"
 
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
+#include "conus/codec/image/fit.h"
 #include "conus/renderers/gpu_image.h"
 #include "progress.h"
 
@@ -52,12 +54,39 @@ void checkConusOutput(const std::string& output, const std::string& input) {
     checkOutputPath(output, inputs);
 }
 
+void addFitOption(CLI::App& command, int& fit) {
+    command
+        .add_option("--fit", fit,
+                    "fit the CoNUS image to the decoder: N iterations of least squares (CGLS) from the filtered "
+                    "encode, so that the decoded view at the source's size comes closest to the source (default N: " +
+                        std::to_string(codec::kFitIterations) + "; write --fit=N or put --fit after the input)")
+        ->expected(0, 1)
+        ->default_str(std::to_string(codec::kFitIterations))
+        ->type_name("N")
+        ->check(CLI::Range(1, 100));
+}
+
 format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,
-                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic) {
+                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
+                                int fit, std::string* fitNote) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                       std::to_string(size.width) + "x" + std::to_string(size.height));
     Image image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
+    if (fit > 0) {
+        Progress fitting("fit to the decoder (" + std::to_string(fit) + " iterations)");
+        codec::FitOptions options;
+        options.iterations = fit;
+        options.progress = fitting.callback();
+        const codec::FitResult r = codec::fitToDecoder(source, map, image, options);
+        fitting.done();
+        if (fitNote && !r.steps.empty()) {
+            char text[160];
+            std::snprintf(text, sizeof text, "fitted to the decoder: decoded PSNR %.2f -> %.2f dB in %d iterations",
+                          r.steps.front().psnr, r.steps.back().psnr, r.steps.back().iteration);
+            *fitNote = text;
+        }
+    }
     return codec::makeImageFile(std::move(image), map, source.width, source.height, encoding, std::move(analytic));
 }
 
