@@ -55,7 +55,7 @@ K = 4
 BUDGETS = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0]  # --frame-loss budgets swept (dB)
 BUDGET_GRID, BUDGET_MAX_DENSITY = 129, 64.0
 ANISOTROPY_LIMITS = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0]  # --max-anisotropy swept, at the loosest budget
-FIT = 8  # --fit iterations of the fitted variant (0: --no-fit leaves it out)
+FIT = 4  # --fit iterations (the default of `encode --fit`) of the fitted variant (0: --no-fit leaves it out)
 METHODS = ("foci", "auto", "budget", "limited", "foci+fit", "auto+fit", "budget+fit")
 
 

@@ -29,13 +29,14 @@
 
 namespace conus::codec {
 
-// Default iterations (bench/README.md, "Fitted to the decoder": the PSNR per iteration), damping
+// Default iterations: the decoded PSNR of astronaut and chelsea (two foci, 1/16) stops rising
+// after 2-3 (bench/README.md, "Fitted to the decoder": the PSNR per iteration). Damping
 // (0: none where the encoder kept the box filter) and hold: where the encoder low-passed a long
 // footprint axis (encode.h's rule against the radial comb), the damping grows by kFitHoldLowPass
 // times the share of that low-pass (the Gaussian's extent beyond the box, at most 1). Without it
 // the fit undoes that filter and the comb comes back (+13 dB in tests/codec/image/comb_test.cpp);
 // with 3 the ring aliases as much as the uniform image fitted the same way.
-inline constexpr int kFitIterations = 8;
+inline constexpr int kFitIterations = 4;
 inline constexpr double kFitDamping = 0.0;
 inline constexpr double kFitHoldLowPass = 3.0;
 
