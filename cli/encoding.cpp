@@ -81,9 +81,13 @@ format::ConusFile encodeToConus(const gl::Device& device, const Image& source, c
         const codec::FitResult r = codec::fitToDecoder(source, map, image, options);
         fitting.done();
         if (fitNote && !r.steps.empty()) {
-            char text[160];
-            std::snprintf(text, sizeof text, "fitted to the decoder: decoded PSNR %.2f -> %.2f dB in %d iterations",
-                          r.steps.front().psnr, r.steps.back().psnr, r.steps.back().iteration);
+            // Overshoot at hard edges is kept, not clamped (the decoder interpolates it away): say how much.
+            char text[200];
+            std::snprintf(text, sizeof text,
+                          "fitted to the decoder: decoded PSNR %.2f -> %.2f dB in %d iterations; %lld values below 0 "
+                          "(lowest %.3g), kept",
+                          r.steps.front().psnr, r.steps.back().psnr, r.steps.back().iteration,
+                          static_cast<long long>(r.negatives), r.minimum);
             *fitNote = text;
         }
     }
