@@ -56,6 +56,7 @@ BUDGETS = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0]  # --frame-loss budgets swept (dB)
 BUDGET_GRID, BUDGET_MAX_DENSITY = 129, 64.0
 ANISOTROPY_LIMITS = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0]  # --max-anisotropy swept, at the loosest budget
 FIT = 4  # --fit iterations (the default of `encode --fit`) of the fitted variant (0: --no-fit leaves it out)
+FIT_HOLD = None  # --fit-hold (None: the encoder's default)
 METHODS = ("foci", "auto", "budget", "limited", "foci+fit", "auto+fit", "budget+fit")
 
 
@@ -145,9 +146,10 @@ def view_of(file, w, h):
 
 
 def encode_with(src, size, regions, k=K, map=None, fit=0):
+    hold = {} if FIT_HOLD is None else {"fit_hold": FIT_HOLD}
     if map is not None:
-        return conus.encode(src, map=map, size=size, fit=fit)
-    return conus.encode(src, foci=[(u, v, r, k) for u, v, r in regions], size=size, fit=fit)
+        return conus.encode(src, map=map, size=size, fit=fit, **hold)
+    return conus.encode(src, foci=[(u, v, r, k) for u, v, r in regions], size=size, fit=fit, **hold)
 
 
 def uniform_view(src, size, fit=0):
@@ -432,14 +434,16 @@ def report(rows, all_curves, all_points):
 
 
 def main():
-    global FIT
+    global FIT, FIT_HOLD
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", default=str(ROOT / "build" / "quality"))
     parser.add_argument("--quick", action="store_true", help="two photographs, fewer settings (a smoke run)")
     parser.add_argument("--fit", type=int, default=FIT, help=f"iterations of the fitted variant (default {FIT})")
     parser.add_argument("--no-fit", action="store_true", help="leave the fitted variant out")
+    parser.add_argument("--fit-hold", type=float, default=None, help="the fit's --fit-hold (default: the encoder's)")
     args = parser.parse_args()
     FIT = 0 if args.no_fit else args.fit
+    FIT_HOLD = args.fit_hold
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for tool in ("cjxl", "djxl", "opj_compress", "opj_decompress"):

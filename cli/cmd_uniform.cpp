@@ -17,7 +17,7 @@ struct UniformOptions {
     std::string input, output;
     SourceOptions source;
     StorageOptions storage;
-    int fit = 0;
+    FitSetting fit;
 };
 
 int runUniform(const UniformOptions& o) {

@@ -54,9 +54,10 @@ void checkConusOutput(const std::string& output, const std::string& input) {
     checkOutputPath(output, inputs);
 }
 
-void addFitOption(CLI::App& command, int& fit) {
-    command
-        .add_option("--fit", fit,
+void addFitOption(CLI::App& command, FitSetting& fit) {
+    CLI::Option* iterations =
+        command
+        .add_option("--fit", fit.iterations,
                     "fit the CoNUS image to the decoder: N iterations of least squares (CGLS) from the filtered "
                     "encode, so that the decoded view at the source's size comes closest to the source (default N: " +
                         std::to_string(codec::kFitIterations) + "; write --fit=N or put --fit after the input)")
@@ -64,19 +65,27 @@ void addFitOption(CLI::App& command, int& fit) {
         ->default_str(std::to_string(codec::kFitIterations))
         ->type_name("N")
         ->check(CLI::Range(1, 100));
+    command
+        .add_option("--fit-hold", fit.hold,
+                    "with --fit: how strongly the fit keeps the encoder's low-pass along long, thin footprints (the "
+                    "focus rims, where undoing it brings back a radial comb); 0: the plain least squares, sharper and "
+                    "with more aliasing (default " + std::to_string(codec::kFitHoldLowPass).substr(0, 3) + ")")
+        ->check(CLI::Range(0.0, 1000.0))
+        ->needs(iterations);
 }
 
 format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
-                                int fit, std::string* fitNote) {
+                                const FitSetting& fit, std::string* fitNote) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                       std::to_string(size.width) + "x" + std::to_string(size.height));
     Image image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
-    if (fit > 0) {
-        Progress fitting("fit to the decoder (" + std::to_string(fit) + " iterations)");
+    if (fit.iterations > 0) {
+        Progress fitting("fit to the decoder (" + std::to_string(fit.iterations) + " iterations)");
         codec::FitOptions options;
-        options.iterations = fit;
+        options.iterations = fit.iterations;
+        options.holdLowPass = fit.hold;
         options.progress = fitting.callback();
         const codec::FitResult r = codec::fitToDecoder(source, map, image, options);
         fitting.done();

@@ -220,11 +220,13 @@ void toDisplayOrder(Image& image) {
 }
 
 // fit > 0: the encoded image fitted to its decoder with that many iterations (fit.h).
-void fitTo(const Image& source, const codec::SamplingMap& map, Image& encoded, int fit) {
+void fitTo(const Image& source, const codec::SamplingMap& map, Image& encoded, int fit,
+           double hold = codec::kFitHoldLowPass) {
     if (fit < 0) throw Error(ErrorCode::InvalidArgument, "fit must be 0 (none) or a number of iterations");
     if (fit == 0) return;
     codec::FitOptions options;
     options.iterations = fit;
+    options.holdLowPass = hold;
     codec::fitToDecoder(source, map, encoded, options);
 }
 
@@ -397,7 +399,7 @@ PYBIND11_MODULE(_conus, m) {
         "encode",
         [](const py::array& pixels, std::optional<std::vector<std::tuple<double, double, double, double>>> foci,
            std::optional<std::pair<int, int>> size, std::shared_ptr<Map> map, std::optional<std::vector<std::string>> channels,
-           const std::string& backend, int fit) {
+           const std::string& backend, int fit, double fitHold) {
             Image source = fromArray(pixels, channels, "pixels");
             if (foci && map) throw Error(ErrorCode::InvalidArgument, "give foci or a map, not both");
             const double aspect = double(source.width) / source.height;
@@ -426,7 +428,7 @@ PYBIND11_MODULE(_conus, m) {
                     std::lock_guard<std::mutex> lock(g_deviceMutex);
                     encoded = gl::encodeImage(deviceFor(backend), source, map->map, options);
                 }
-                fitTo(source, map->map, encoded, fit);
+                fitTo(source, map->map, encoded, fit, fitHold);
                 file->file = codec::makeImageFile(std::move(encoded), map->map, source.width, source.height, SourceEncoding{},
                                                   map->analytic);
             }
@@ -435,9 +437,11 @@ PYBIND11_MODULE(_conus, m) {
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),
         py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = 0,
+        py::arg("fit_hold") = codec::kFitHoldLowPass,
         "Encode linear pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file;\n"
         "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'; fit = N > 0\n"
-        "fits the image to the decoder with N least-squares iterations (`conus encode --fit N`)");
+        "fits the image to the decoder with N least-squares iterations (`conus encode --fit N`); fit_hold: its\n"
+        "damping where the encoder low-passed a long footprint axis (`--fit-hold`; 0: the plain least squares)");
     m.def(
         "decode",
         [](File& file, std::tuple<double, double, double, double> view, std::optional<std::pair<int, int>> size, const std::string& backend) {

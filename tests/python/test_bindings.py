@@ -182,3 +182,8 @@ def test_fit_brings_the_decoded_frame_closer_for_conus_and_uniform(tmp_path, asy
     np.testing.assert_allclose(ours.pixels, conus.read(cli).pixels, atol=1e-4)
     with pytest.raises(conus.Error):
         conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=-1)
+    # fit_hold=0: the plain least squares, no damping toward the filtered encode: closer still.
+    unheld = conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=3, fit_hold=0.0)
+    assert mse(conus.decode(unheld), asymmetric) <= mse(conus.decode(fitted), asymmetric)
+    with pytest.raises(conus.Error):
+        conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=3, fit_hold=-1.0)
