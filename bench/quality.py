@@ -19,6 +19,9 @@ Everything is measured in linear light (the values the EXR holds) against the so
   elsewhere) with their context floor swept, or chosen by a whole-frame loss budget
   (Map.auto_for_frame_loss, `encode --frame-loss`), and with an anisotropy limit swept: the
   frontier each method reaches.
+- fitted to the decoder (`encode --fit`, `uniform --fit`; codec/image/fit.h): every measure above
+  again with both images fitted, CoNUS against the fitted uniform image, and the gain-loss points of
+  the foci, the automatic maps and the budgets with the fit.
 Photographs: Debian's python3-skimage (astronaut, chelsea, motorcycle) and mate-backgrounds
 (ladybird, dandelion, garden; reduced to 1280 px wide by an area filter to keep the run short).
 """
@@ -52,6 +55,9 @@ K = 4
 BUDGETS = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0]  # --frame-loss budgets swept (dB)
 BUDGET_GRID, BUDGET_MAX_DENSITY = 129, 64.0
 ANISOTROPY_LIMITS = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0]  # --max-anisotropy swept, at the loosest budget
+FIT = 4  # --fit iterations (the default of `encode --fit`) of the fitted variant (0: --no-fit leaves it out)
+FIT_HOLD = None  # --fit-hold (None: the encoder's default)
+METHODS = ("foci", "auto", "budget", "limited", "foci+fit", "auto+fit", "budget+fit")
 
 
 def psnr(a, b, mask=None):
@@ -139,10 +145,16 @@ def view_of(file, w, h):
     return np.asarray(conus.decode(file, size=(w, h)))[..., :3]
 
 
-def encode_with(src, size, regions, k=K, map=None):
+def encode_with(src, size, regions, k=K, map=None, fit=0):
+    hold = {} if FIT_HOLD is None else {"fit_hold": FIT_HOLD}
     if map is not None:
-        return conus.encode(src, map=map, size=size)
-    return conus.encode(src, foci=[(u, v, r, k) for u, v, r in regions], size=size)
+        return conus.encode(src, map=map, size=size, fit=fit, **hold)
+    return conus.encode(src, foci=[(u, v, r, k) for u, v, r in regions], size=size, fit=fit, **hold)
+
+
+def uniform_view(src, size, fit=0):
+    h, w = src.shape[:2]
+    return np.asarray(conus.resize(conus.uniform(src, size=size, fit=fit), size=(w, h)))[..., :3]
 
 
 def measure(name, src, regions, out, quick):
@@ -153,7 +165,7 @@ def measure(name, src, regions, out, quick):
         size = (max(1, w // divisor), max(1, h // divisor))
         cfile = encode_with(src, size, regions)
         cview = view_of(cfile, w, h)
-        uview = np.asarray(conus.resize(conus.uniform(src, size=size), size=(w, h)))[..., :3]
+        uview = uniform_view(src, size)
         # Rates in samples per source pixel: the uniform image's, times sqrt(density) for CoNUS.
         base = np.sqrt(size[0] * size[1] / (w * h))
         y, x = np.mgrid[0:h, 0:w]
@@ -166,6 +178,14 @@ def measure(name, src, regions, out, quick):
                          ssim_c=ssim(cview, src, roi), ssim_u=ssim(uview, src, roi),
                          frame_c=psnr(cview, src), frame_u=psnr(uview, src),
                          alias_c=psnr(cview, ring_ref_c, ring), alias_u=psnr(uview, ring_ref_u, ring)))
+        if FIT:
+            fview, ufview = view_of(encode_with(src, size, regions, fit=FIT), w, h), uniform_view(src, size, FIT)
+            rows[-1].update(fitted=dict(roi_c=psnr(fview, src, roi), roi_u=psnr(ufview, src, roi),
+                                        ssim_c=ssim(fview, src, roi), ssim_u=ssim(ufview, src, roi),
+                                        frame_c=psnr(fview, src), frame_u=psnr(ufview, src),
+                                        alias_c=psnr(fview, ring_ref_c, ring), alias_u=psnr(ufview, ring_ref_u, ring)))
+            if share == "1/16":
+                write_png(out / f"{name}-conus-fit.png", srgb8(fview))
         if share == "1/16":
             write_png(out / f"{name}-conus.png", srgb8(cview))
             write_png(out / f"{name}-uniform.png", srgb8(uview))
@@ -208,13 +228,26 @@ def frontier(name, src, regions, quick):
     h, w = src.shape[:2]
     size = (w // 4, h // 4)
     roi = discs(src.shape, regions)
-    uview = np.asarray(conus.resize(conus.uniform(src, size=size), size=(w, h)))[..., :3]
+    uview = uniform_view(src, size)
     ref_roi, ref_frame = psnr(uview, src, roi), psnr(uview, src)
     importance = discs(src.shape, regions).astype(np.float32)
     points = {"foci": [], "auto": [], "budget": [], "limited": []}
+    if FIT:
+        # The fitted variants against the fitted uniform image: the same settings, each map once.
+        ufview = uniform_view(src, size, FIT)
+        fit_roi, fit_frame = psnr(ufview, src, roi), psnr(ufview, src)
+        points.update({"foci+fit": [], "auto+fit": [], "budget+fit": []})
+
+        def add_fitted(method, setting, m=None, k=K, extra=()):
+            view = view_of(encode_with(src, size, regions, k=k, map=m, fit=FIT), w, h)
+            points[method].append((setting, fit_frame - psnr(view, src), psnr(view, src, roi) - fit_roi) + tuple(extra))
+    else:
+        def add_fitted(*args, **kwargs):
+            pass
     for k in ([2, 4, 6] if quick else [2, 3, 4, 5, 6]):
         view = view_of(encode_with(src, size, regions, k=k), w, h)
         points["foci"].append((k, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi))
+        add_fitted("foci+fit", k, k=k)
     for floor in ([0.6, 0.3] if quick else [0.8, 0.6, 0.45, 0.3, 0.2]):
         try:
             m = conus.Map.auto(importance, min_density=floor, max_density=36.0)
@@ -223,6 +256,7 @@ def frontier(name, src, regions, quick):
             continue
         view = view_of(encode_with(src, size, regions, map=m), w, h)
         points["auto"].append((floor, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi))
+        add_fitted("auto+fit", floor, m=m)
     # The frame-loss budget (`encode --frame-loss`): the floor chosen by the predicted loss, a higher
     # density cap so that a loose budget can spend it. The setting records the budget and what was
     # predicted, beside what is measured.
@@ -231,6 +265,7 @@ def frontier(name, src, regions, quick):
                                                                  max_density=BUDGET_MAX_DENSITY)
         view = view_of(encode_with(src, size, regions, map=m), w, h)
         points["budget"].append((budget, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi, p_loss, p_gain, floor))
+        add_fitted("budget+fit", budget, m=m, extra=(p_loss, p_gain, floor))
     # The same with an anisotropy limit (`--max-anisotropy`): the builder tempers the density until
     # every footprint is at most that elongated, which costs magnification but spares the context.
     for limit in ([4.0, 8.0] if quick else ANISOTROPY_LIMITS):
@@ -306,12 +341,16 @@ def plots(out, all_curves, all_points):
     fig.savefig(out / "rate-distortion.png", dpi=90)
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(7, 5))
-    for method, marker in (("foci", "o"), ("auto", "s"), ("budget", "^"), ("limited", "D")):
+    for method in [m for m in METHODS if m in next(iter(all_points.values()))]:
+        marker = {"foci": "o", "auto": "s", "budget": "^", "limited": "D"}[method.split("+")[0]]
         xs = [np.mean([p[method][i][1] for p in all_points.values()]) for i in range(min(len(p[method]) for p in all_points.values()))]
         ys = [np.mean([p[method][i][2] for p in all_points.values()]) for i in range(len(xs))]
-        ax.plot(xs, ys, "-" + marker, label={"foci": "one focus per region, k = 2..6", "auto": "automatic map from ROI importance, floor swept",
+        ax.plot(xs, ys, (":" if method.endswith("+fit") else "-") + marker, label={"foci": "one focus per region, k = 2..6", "auto": "automatic map from ROI importance, floor swept",
                                                 "budget": f"automatic map, --frame-loss budget swept (max density {BUDGET_MAX_DENSITY:g}, grid {BUDGET_GRID})",
-                                                "limited": f"the same at {BUDGETS[-1]:g} dB, --max-anisotropy {ANISOTROPY_LIMITS[0]:g}..{ANISOTROPY_LIMITS[-1]:g} swept"}[method])
+                                                "limited": f"the same at {BUDGETS[-1]:g} dB, --max-anisotropy {ANISOTROPY_LIMITS[0]:g}..{ANISOTROPY_LIMITS[-1]:g} swept",
+                                                "foci+fit": f"foci, --fit {FIT} (against uniform --fit {FIT})",
+                                                "auto+fit": f"automatic map, floor swept, --fit {FIT}",
+                                                "budget+fit": f"automatic map, --frame-loss swept, --fit {FIT}"}[method])
     ax.axvline(2.5, color="grey", ls=":")
     ax.axhline(6.5, color="grey", ls=":")
     ax.set_xlabel("whole-frame loss against uniform (dB)")
@@ -324,13 +363,8 @@ def plots(out, all_curves, all_points):
     plt.close(fig)
 
 
-def report(rows, all_curves, all_points):
-    lines = ["| photo | pixels | ROI PSNR CoNUS / uniform (gain) | ROI SSIM CoNUS / uniform | whole-frame loss | ring vs low-passed source: CoNUS / uniform |",
-             "|---|---|---|---|---|---|"]
-    for r in rows:
-        lines.append(f"| {r['photo']} | {r['share']} | {r['roi_c']:.1f} / {r['roi_u']:.1f} ({r['roi_c'] - r['roi_u']:+.1f}) | "
-                     f"{r['ssim_c']:.3f} / {r['ssim_u']:.3f} | {r['frame_u'] - r['frame_c']:.1f} dB | {r['alias_c']:.1f} / {r['alias_u']:.1f} |")
-    lines.append("")
+def summary(rows):
+    lines = []
     for share in [s for _, s in FRACTIONS]:
         sel = [r for r in rows if r["share"] == share]
         gain = np.mean([r["roi_c"] - r["roi_u"] for r in sel])
@@ -339,6 +373,29 @@ def report(rows, all_curves, all_points):
         ring = np.mean([r["alias_u"] - r["alias_c"] for r in sel])
         lines.append(f"- {share}: mean ROI gain {gain:+.1f} dB (worst {worst:+.1f}), mean whole-frame loss {loss:.1f} dB, "
                      f"ring check CoNUS {ring:.1f} dB below uniform")
+    return lines
+
+
+def report(rows, all_curves, all_points):
+    lines = ["| photo | pixels | ROI PSNR CoNUS / uniform (gain) | ROI SSIM CoNUS / uniform | whole-frame loss | ring vs low-passed source: CoNUS / uniform |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['photo']} | {r['share']} | {r['roi_c']:.1f} / {r['roi_u']:.1f} ({r['roi_c'] - r['roi_u']:+.1f}) | "
+                     f"{r['ssim_c']:.3f} / {r['ssim_u']:.3f} | {r['frame_u'] - r['frame_c']:.1f} dB | {r['alias_c']:.1f} / {r['alias_u']:.1f} |")
+    lines.append("")
+    lines += summary(rows)
+    if FIT:
+        fitted = [dict(r["fitted"], photo=r["photo"], share=r["share"]) for r in rows]
+        lines += ["", f"Fitted to the decoder (`--fit {FIT}`), CoNUS against the uniform image fitted the same way "
+                  "(`uniform --fit`); 'vs plain': the fitted CoNUS against today's uniform image", "",
+                  "| photo | pixels | ROI PSNR CoNUS / uniform (gain) | ROI SSIM CoNUS / uniform | whole-frame loss | ring vs low-passed source: CoNUS / uniform | vs plain: gain, loss |",
+                  "|---|---|---|---|---|---|---|"]
+        for r, f in zip(rows, fitted):
+            lines.append(f"| {f['photo']} | {f['share']} | {f['roi_c']:.1f} / {f['roi_u']:.1f} ({f['roi_c'] - f['roi_u']:+.1f}) | "
+                         f"{f['ssim_c']:.3f} / {f['ssim_u']:.3f} | {f['frame_u'] - f['frame_c']:.1f} dB | "
+                         f"{f['alias_c']:.1f} / {f['alias_u']:.1f} | {f['roi_c'] - r['roi_u']:+.1f}, {r['frame_u'] - f['frame_c']:.1f} dB |")
+        lines.append("")
+        lines += summary(fitted)
     lines += ["", "Where the loss comes from at 1/16: error over uniform's by zone (distance from the regions in radii); "
               "'uniform at that density': the uniform image of the zone's mean density", "",
               "| photo | zone | share | mean density | median anisotropy | CoNUS | uniform at that density |", "|---|---|---|---|---|---|---|"]
@@ -347,16 +404,16 @@ def report(rows, all_curves, all_points):
             lines.append(f"| {r['photo']} | {z['zone']} | {100 * z['share']:.0f}% | {z['density']:.2f} | {z['anisotropy']:.2f} | "
                          f"{z['conus']:+.1f} dB | {z['ideal']:+.1f} dB |")
     lines += ["", "Gain against loss at 1/16 (mean over the photographs): method, setting: frame loss, ROI gain", ""]
-    for method in ("foci", "auto", "budget", "limited"):
+    for method in [m for m in METHODS if m in next(iter(all_points.values()))]:
         n = min(len(p[method]) for p in all_points.values())
         for i in range(n):
             setting = all_points[next(iter(all_points))][method][i][0]
             loss = np.mean([p[method][i][1] for p in all_points.values()])
             gain = np.mean([p[method][i][2] for p in all_points.values()])
             worst = min(p[method][i][2] for p in all_points.values())
-            name = {"foci": "k", "auto": "floor", "budget": "frame-loss", "limited": "max-anisotropy"}[method]
+            name = {"foci": "k", "auto": "floor", "budget": "frame-loss", "limited": "max-anisotropy"}[method.split("+")[0]]
             line = f"- {method} {name} {setting}: loss {loss:.2f} dB, gain {gain:+.2f} dB (worst photo {worst:+.2f})"
-            if method in ("budget", "limited"):
+            if method in ("budget", "limited", "budget+fit"):
                 p_loss = np.mean([p[method][i][3] for p in all_points.values()])
                 p_gain = np.mean([p[method][i][4] for p in all_points.values()])
                 floors = ", ".join(f"{p[method][i][5]:.2f}" for p in all_points.values())
@@ -377,10 +434,16 @@ def report(rows, all_curves, all_points):
 
 
 def main():
+    global FIT, FIT_HOLD
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", default=str(ROOT / "build" / "quality"))
     parser.add_argument("--quick", action="store_true", help="two photographs, fewer settings (a smoke run)")
+    parser.add_argument("--fit", type=int, default=FIT, help=f"iterations of the fitted variant (default {FIT})")
+    parser.add_argument("--no-fit", action="store_true", help="leave the fitted variant out")
+    parser.add_argument("--fit-hold", type=float, default=None, help="the fit's --fit-hold (default: the encoder's)")
     args = parser.parse_args()
+    FIT = 0 if args.no_fit else args.fit
+    FIT_HOLD = args.fit_hold
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for tool in ("cjxl", "djxl", "opj_compress", "opj_decompress"):

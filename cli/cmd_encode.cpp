@@ -27,6 +27,7 @@ struct EncodeOptions {
     double frameLoss = -1;  // dB; < 0: no budget (--min-density sets the floor)
     std::vector<std::string> foci;
     int grid = map_rules::kDefaultSide;
+    FitSetting fit;  // --fit iterations (0: the filtered encode alone), --fit-hold
     SourceOptions source;
     StorageOptions storage;
 };
@@ -89,14 +90,17 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
         built.map = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
     }
     const gl::Device device = deviceFor(o.storage.backend, gl::CpuPath::Available, "encoding");
-    format::ConusFile file = encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic);
+    std::string fitNote;
+    format::ConusFile file =
+        encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
     applyStorage(o.storage, file);
     Progress writing("write " + output);
     format::writeConusFile(output, file);
     writing.done();
     return "wrote " + output + ": " + std::to_string(size.width) + "x" + std::to_string(size.height) + " CoNUS image of a " +
            std::to_string(source.image.width) + "x" + std::to_string(source.image.height) + " source, " +
-           std::to_string(built.map->columns()) + "x" + std::to_string(built.map->rows()) + " sampling map";
+           std::to_string(built.map->columns()) + "x" + std::to_string(built.map->rows()) + " sampling map" +
+           (fitNote.empty() ? "" : "; " + fitNote);
 }
 
 int runEncode(const EncodeOptions& o) {
@@ -111,6 +115,7 @@ Command addEncodeCommand(CLI::App& root) {
         {"conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4",
          "conus encode photo.jpg -o photo.exr --size 1024x768 --importance faces",
          "conus encode scan.tif -o scan.exr --map painted.exr --float",
+         "conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4 --fit   # fitted to the decoder: sharper, costs more CPU",
          "conus encode shots/*.jpg --out-dir exr/ --jobs 2 --skip-existing --focus 0.5,0.5,0.1,4"});
     addBatchOptions(*command, options->batch, "source image ('-' reads standard input)", "output CoNUS file (.exr)", "{stem}.exr");
     command->add_option("--focus", options->foci,
@@ -137,6 +142,7 @@ Command addEncodeCommand(CLI::App& root) {
         ->check(CLI::IsMember({"density", "add"}));
     command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus and --importance (default " + std::to_string(map_rules::kDefaultSide) + ")")
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    addFitOption(*command, options->fit);
     addSourceOptions(*command, options->source);
     addStorageOptions(*command, options->storage);
     addQuietOption(*command);

@@ -17,6 +17,7 @@ struct UniformOptions {
     std::string input, output;
     SourceOptions source;
     StorageOptions storage;
+    FitSetting fit;
 };
 
 int runUniform(const UniformOptions& o) {
@@ -24,14 +25,15 @@ int runUniform(const UniformOptions& o) {
     const imageio::ImageFile source = readSource(o.input, o.source);
     const Size size = conusSize(o.storage, source.image);
     const gl::Device device = deviceFor(o.storage.backend, gl::CpuPath::Available, "encoding");
+    std::string fitNote;
     format::ConusFile file = encodeToConus(device, source.image, source.info.encoding,
-                                           codec::SamplingMap::identity(2, 2), size, std::nullopt);
+                                           codec::SamplingMap::identity(2, 2), size, std::nullopt, o.fit, &fitNote);
     applyStorage(o.storage, file);
     Progress writing("write " + o.output);
     format::writeConusFile(o.output, file);
     writing.done();
-    std::printf("wrote %s: %dx%d uniform image of a %dx%d source\n", o.output.c_str(), size.width, size.height,
-                source.image.width, source.image.height);
+    std::printf("wrote %s: %dx%d uniform image of a %dx%d source%s%s\n", o.output.c_str(), size.width, size.height,
+                source.image.width, source.image.height, fitNote.empty() ? "" : "; ", fitNote.c_str());
     return 0;
 }
 
@@ -39,11 +41,13 @@ CLI::App* declareUniform(CLI::App& root, UniformOptions& options) {
     CLI::App* command = addSubcommand(root, "uniform", "Encode with the identity map: the uniform image of the same pixel count (the baseline)",
         {"conus uniform photo.jpg -o uniform.exr                 # 1/16 of the pixels, like encode's default",
          "conus uniform photo.jpg -o uniform.exr --size 512x384",
-         "conus uniform photo.png -o same.exr --size 4000x3000   # at source size: an exact round trip"});
+         "conus uniform photo.png -o same.exr --size 4000x3000   # at source size: an exact round trip",
+         "conus uniform photo.jpg -o uniform.exr --fit           # fitted to its bilinear decode, like encode --fit"});
     command->add_option("input", options.input, "source image ('-' reads standard input)")->required();
     command->add_option("-o,--output", options.output, "output CoNUS file (.exr)")->required();
     addSourceOptions(*command, options.source);
     addStorageOptions(*command, options.storage);
+    addFitOption(*command, options.fit);
     return command;
 }
 

@@ -3,12 +3,14 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 
 #include "conus/core/atomic_file.h"
 
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
+#include "conus/codec/image/fit.h"
 #include "conus/renderers/gpu_image.h"
 #include "progress.h"
 
@@ -52,12 +54,52 @@ void checkConusOutput(const std::string& output, const std::string& input) {
     checkOutputPath(output, inputs);
 }
 
+void addFitOption(CLI::App& command, FitSetting& fit) {
+    CLI::Option* iterations =
+        command
+        .add_option("--fit", fit.iterations,
+                    "fit the CoNUS image to the decoder: N iterations of least squares (CGLS) from the filtered "
+                    "encode, so that the decoded view at the source's size comes closest to the source (default N: " +
+                        std::to_string(codec::kFitIterations) + "; write --fit=N or put --fit after the input)")
+        ->expected(0, 1)
+        ->default_str(std::to_string(codec::kFitIterations))
+        ->type_name("N")
+        ->check(CLI::Range(1, 100));
+    command
+        .add_option("--fit-hold", fit.hold,
+                    "with --fit: how strongly the fit keeps the encoder's low-pass along long, thin footprints (the "
+                    "focus rims, where undoing it brings back a radial comb); 0: the plain least squares, sharper and "
+                    "with more aliasing (default " + std::to_string(codec::kFitHoldLowPass).substr(0, 3) + ")")
+        ->check(CLI::Range(0.0, 1000.0))
+        ->needs(iterations);
+}
+
 format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,
-                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic) {
+                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
+                                const FitSetting& fit, std::string* fitNote) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                       std::to_string(size.width) + "x" + std::to_string(size.height));
     Image image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
+    if (fit.iterations > 0) {
+        Progress fitting("fit to the decoder (" + std::to_string(fit.iterations) + " iterations)");
+        codec::FitOptions options;
+        options.iterations = fit.iterations;
+        options.holdLowPass = fit.hold;
+        options.progress = fitting.callback();
+        const codec::FitResult r = codec::fitToDecoder(source, map, image, options);
+        fitting.done();
+        if (fitNote && !r.steps.empty()) {
+            // Overshoot at hard edges is kept, not clamped (the decoder interpolates it away): say how much.
+            char text[200];
+            std::snprintf(text, sizeof text,
+                          "fitted to the decoder: decoded PSNR %.2f -> %.2f dB in %d iterations; %lld values below 0 "
+                          "(lowest %.3g), kept",
+                          r.steps.front().psnr, r.steps.back().psnr, r.steps.back().iteration,
+                          static_cast<long long>(r.negatives), r.minimum);
+            *fitNote = text;
+        }
+    }
     return codec::makeImageFile(std::move(image), map, source.width, source.height, encoding, std::move(analytic));
 }
 

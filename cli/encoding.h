@@ -7,6 +7,7 @@
 
 #include "arguments.h"
 #include "backend.h"
+#include "conus/codec/image/fit.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 
@@ -28,10 +29,22 @@ void addStorageOptions(CLI::App& command, StorageOptions& options);
 // Resolves the CoNUS image size (checking it against the source) and the storage settings.
 Size conusSize(const StorageOptions& options, const Image& source);
 
+// Adds --fit [N] and --fit-hold H (encode and uniform alike, so that comparisons stay fair):
+// fit.iterations becomes the iteration count (codec::kFitIterations when no count is given); 0
+// when absent.
+// --fit-hold H: FitOptions::holdLowPass (codec::kFitHoldLowPass when absent).
+struct FitSetting {
+    int iterations = 0;
+    double hold = codec::kFitHoldLowPass;
+};
+void addFitOption(CLI::App& command, FitSetting& fit);
+
 // Encodes `source` through `map` at `size` (with progress) into a file model ready to write,
-// remembering the source's encoding.
+// remembering the source's encoding. fit.iterations > 0 then fits the image to the decoder with that many
+// iterations (codec/image/fit.h) and, when `fitNote` is given, says what the fit achieved there.
 format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,
-                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic);
+                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
+                                const FitSetting& fit = {}, std::string* fitNote = nullptr);
 
 // Applies the storage options to a file model. Without --half or --float, colour is stored as
 // float when the source had more precision than half keeps (16-bit integers, float), else half.

@@ -29,6 +29,7 @@
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
+#include "conus/codec/image/fit.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
@@ -218,6 +219,17 @@ void toDisplayOrder(Image& image) {
     image = std::move(sorted);
 }
 
+// fit > 0: the encoded image fitted to its decoder with that many iterations (fit.h).
+void fitTo(const Image& source, const codec::SamplingMap& map, Image& encoded, int fit,
+           double hold = codec::kFitHoldLowPass) {
+    if (fit < 0) throw Error(ErrorCode::InvalidArgument, "fit must be 0 (none) or a number of iterations");
+    if (fit == 0) return;
+    codec::FitOptions options;
+    options.iterations = fit;
+    options.holdLowPass = hold;
+    codec::fitToDecoder(source, map, encoded, options);
+}
+
 std::pair<int, int> sizeOr(const std::optional<std::pair<int, int>>& size, int w, int h) {
     return size ? *size : std::pair<int, int>{std::max(1, (w + 2) / 4), std::max(1, (h + 2) / 4)};
 }
@@ -387,7 +399,7 @@ PYBIND11_MODULE(_conus, m) {
         "encode",
         [](const py::array& pixels, std::optional<std::vector<std::tuple<double, double, double, double>>> foci,
            std::optional<std::pair<int, int>> size, std::shared_ptr<Map> map, std::optional<std::vector<std::string>> channels,
-           const std::string& backend) {
+           const std::string& backend, int fit, double fitHold) {
             Image source = fromArray(pixels, channels, "pixels");
             if (foci && map) throw Error(ErrorCode::InvalidArgument, "give foci or a map, not both");
             const double aspect = double(source.width) / source.height;
@@ -416,6 +428,7 @@ PYBIND11_MODULE(_conus, m) {
                     std::lock_guard<std::mutex> lock(g_deviceMutex);
                     encoded = gl::encodeImage(deviceFor(backend), source, map->map, options);
                 }
+                fitTo(source, map->map, encoded, fit, fitHold);
                 file->file = codec::makeImageFile(std::move(encoded), map->map, source.width, source.height, SourceEncoding{},
                                                   map->analytic);
             }
@@ -423,9 +436,12 @@ PYBIND11_MODULE(_conus, m) {
             return file;
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),
-        py::arg("channels") = py::none(), py::arg("backend") = "cpu",
+        py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = 0,
+        py::arg("fit_hold") = codec::kFitHoldLowPass,
         "Encode linear pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file;\n"
-        "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'");
+        "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'; fit = N > 0\n"
+        "fits the image to the decoder with N least-squares iterations (`conus encode --fit N`); fit_hold: its\n"
+        "damping where the encoder low-passed a long footprint axis (`--fit-hold`; 0: the plain least squares)");
     m.def(
         "decode",
         [](File& file, std::tuple<double, double, double, double> view, std::optional<std::pair<int, int>> size, const std::string& backend) {
@@ -456,15 +472,18 @@ PYBIND11_MODULE(_conus, m) {
         "A conventional frame of the rectangle view (u0, v0, u1, v1), at size (w, h) (default: the source's resolution)");
     m.def(
         "uniform",
-        [](const py::array& pixels, std::optional<std::pair<int, int>> size) {
+        [](const py::array& pixels, std::optional<std::pair<int, int>> size, int fit) {
             Image source = fromArray(pixels, std::nullopt, "pixels");
             const auto [w, h] = sizeOr(size, source.width, source.height);
             py::gil_scoped_release release;
             Image small = codec::areaDownsample(source, w, h);
+            fitTo(source, codec::SamplingMap::identity(2, 2), small, fit);
             py::gil_scoped_acquire acquire;
             return toArray(std::move(small));
         },
-        py::arg("pixels"), py::arg("size") = py::none(), "The uniform baseline: an area downsample to the same pixel count");
+        py::arg("pixels"), py::arg("size") = py::none(), py::arg("fit") = 0,
+        "The uniform baseline: an area downsample to the same pixel count; fit = N > 0 fits it to its bilinear\n"
+        "resize to the source's size (`conus uniform --fit N`)");
     m.def(
         "resize",
         [](const py::array& pixels, std::pair<int, int> size) {

@@ -85,6 +85,68 @@ TEST_F(Cli, UniformIsTheIdentityMap) {
     EXPECT_EQ(file.image.width, 64);
 }
 
+// encode --fit and uniform --fit: the decoded view at the source's size, read back with
+// OpenImageIO, comes closer to the (linear, float) source than without the fit.
+TEST_F(Cli, FitRoundTripBeatsThePlainEncode) {
+    constexpr int kW = 240, kH = 180;
+    std::vector<float> source(std::size_t(kW) * kH * 3);
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            const double u = (x + 0.5) / kW, v = (y + 0.5) / kH;
+            const double stripes = 0.5 + 0.4 * std::sin((x + 2 * y) * (0.08 + 0.3 * u));
+            const bool disc = std::hypot(u - 0.35, v - 0.4) < 0.12;
+            source[(y * kW + x) * 3 + 0] = float(disc ? 0.9 : 0.2 + 0.6 * stripes * v);
+            source[(y * kW + x) * 3 + 1] = float(0.1 + 0.7 * u * u);
+            source[(y * kW + x) * 3 + 2] = float(disc ? 0.1 : stripes);
+        }
+    const std::string in = path("in.exr");
+    {
+        auto output = OIIO::ImageOutput::create(in);
+        OIIO::ImageSpec spec(kW, kH, 3, OIIO::TypeDesc::FLOAT);
+        ASSERT_TRUE(output->open(in, spec));
+        ASSERT_TRUE(output->write_image(OIIO::TypeDesc::FLOAT, source.data()));
+        output->close();
+    }
+    const auto psnrOf = [&](const std::string& file) {
+        const ExrRead view = readExr(file);
+        EXPECT_EQ(view.width, kW);
+        EXPECT_EQ(view.height, kH);
+        double se = 0;
+        int c = 0;
+        for (const char* name : {"R", "G", "B"}) {
+            const std::vector<float>& values = view.channels.at(name);
+            for (std::size_t p = 0; p < values.size(); ++p) se += std::pow(values[p] - source[p * 3 + c], 2.0);
+            ++c;
+        }
+        return 10 * std::log10(1.0 / (se / (3.0 * kW * kH)));
+    };
+    const std::string common = " --size 60x45 --float --backend cpu";
+    const std::string foci = " --focus 0.35,0.4,0.1,4 --focus 0.75,0.65,0.07,3";
+    double db[4];
+    const std::string variants[4] = {"encode " + in + " -o " + path("plain.exr") + foci + common,
+                                     "encode " + in + " -o " + path("fit.exr") + foci + common + " --fit",
+                                     "uniform " + in + " -o " + path("uplain.exr") + common,
+                                     "uniform " + in + " -o " + path("ufit.exr") + common + " --fit=4"};
+    const char* names[4] = {"plain", "fit", "uplain", "ufit"};
+    for (int i = 0; i < 4; ++i) {
+        Result r = run(variants[i]);
+        ASSERT_EQ(r.exitCode, 0) << variants[i] << ": " << r.err;
+        EXPECT_EQ(r.out.find("fitted to the decoder") != std::string::npos, i % 2 == 1) << r.out;
+        r = run("decode " + path(std::string(names[i]) + ".exr") + " -o " + path(std::string(names[i]) + "-view.exr") +
+                " --backend cpu");
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        db[i] = psnrOf(path(std::string(names[i]) + "-view.exr"));
+    }
+    EXPECT_GT(db[1], db[0] + 0.2) << "encode " << db[0] << " dB, encode --fit " << db[1] << " dB";
+    EXPECT_GT(db[3], db[2] + 0.5) << "uniform " << db[2] << " dB, uniform --fit=4 " << db[3] << " dB";
+    // A count out of range is refused with a reason, and nothing is written.
+    const Result bad = run("encode " + in + " -o " + path("bad.exr") + foci + " --fit=0");
+    EXPECT_NE(bad.exitCode, 0);
+    EXPECT_NE(bad.err.find("--fit"), std::string::npos) << bad.err;
+    EXPECT_FALSE(fs::exists(path("bad.exr")));
+    EXPECT_TRUE(leftovers().empty());
+}
+
 TEST_F(Cli, EncodeTakesTheMapOfAnotherFile) {
     const std::string in = makePicture(200, 200);
     ASSERT_EQ(run("encode " + in + " -o " + path("a.exr") + " --size 50x50 --focus 0.5,0.5,0.1,3").exitCode, 0);

@@ -161,3 +161,29 @@ def test_gpu_encode_agrees_with_the_cpu_reference(asymmetric):
     f_cpu = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80))
     f_gl = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80), backend="egl")
     assert conus.psnr(f_gl.pixels, f_cpu.pixels) > 45.0
+
+
+def test_fit_brings_the_decoded_frame_closer_for_conus_and_uniform(tmp_path, asymmetric, conus_bin):
+    """encode(fit=N) and uniform(fit=N): the decoded frame at the source's size nearer the source
+    than without the fit; the fitted encode is what `conus encode --fit=N` writes."""
+    def mse(a, b):
+        return float(np.mean((a[..., :4] - b[..., :4]) ** 2))
+    plain, fitted = (conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=n) for n in (0, 3))
+    assert mse(conus.decode(fitted), asymmetric) < 0.9 * mse(conus.decode(plain), asymmetric)
+    small, small_fit = (conus.uniform(asymmetric, size=(60, 40), fit=n) for n in (0, 3))
+    assert mse(conus.resize(small_fit, size=(240, 160)), asymmetric) < 0.9 * mse(conus.resize(small, size=(240, 160)), asymmetric)
+    src = str(tmp_path / "src.exr")
+    conus.write_image(src, asymmetric)
+    pixels, channels = conus.read_image(src)
+    cli = str(tmp_path / "cli.exr")
+    run(conus_bin, "encode", src, "-o", cli, "--focus", ",".join(map(str, FOCUS)), "--size", "60x40", "--backend", "cpu",
+        "--fit=3", "--float", "-q")
+    ours = conus.encode(pixels, foci=[FOCUS], size=(60, 40), channels=channels, fit=3)
+    np.testing.assert_allclose(ours.pixels, conus.read(cli).pixels, atol=1e-4)
+    with pytest.raises(conus.Error):
+        conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=-1)
+    # fit_hold=0: the plain least squares, no damping toward the filtered encode: closer still.
+    unheld = conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=3, fit_hold=0.0)
+    assert mse(conus.decode(unheld), asymmetric) <= mse(conus.decode(fitted), asymmetric)
+    with pytest.raises(conus.Error):
+        conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=3, fit_hold=-1.0)

@@ -1,0 +1,71 @@
+// An encoder fitted to its decoder: the CoNUS image whose decoded view is closest to the source.
+//
+// The CPU decoder's whole-image view at the source's size (decodeImage, no pyramid) is linear in
+// the CoNUS pixels: view = D c, each output pixel one bilinear tap at Eq. 1 of its centre where
+// the CoNUS image is magnified, the decoder's average of up to kDecodeMaxTaps^2 bilinear taps
+// where it is minified (the same taps, exactly). fitToDecoder refines an encoded image c0 (the
+// EWA encode, encodeImage) toward the least-squares fit
+//     c* = argmin ||D c - s||^2 + sum_j h_j diag_j (c_j - c0_j)^2,   diag = diag(D^T D),
+// h_j = damping + holdLowPass * (share of pixel j's footprint the encoder low-passed, below),
+// by conjugate gradients on the normal equations (CGLS, Jacobi-preconditioned: a CoNUS pixel of
+// the context covers up to ~100 source pixels, one in a focus about one). The undamped fit is the
+// orthogonal projection of the source onto the decoder's reconstruction space: the L2-best image,
+// but sharper than any prefilter, so it keeps harmonics above the local rate that alias; the
+// damping per pixel (below) holds the ring's long footprints to their low-pass.
+//
+// Colour and alpha channels are fitted; a channel named "Z" (depth) is left as it was. Values are
+// not clamped: a fit overshoots at hard edges like any L2 projection (FitResult counts the values
+// below 0). CoNUS pixels no tap reaches keep their value. Memory: the CoNUS image a few times over
+// (no per-source-pixel storage: each pass walks Eq. 1 along the rows again). The same fit serves
+// the uniform baseline (the identity map: D is then resizeBilinear to the source's size).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "conus/codec/map/sampling_map.h"
+#include "conus/core/error.h"
+#include "conus/core/image.h"
+
+namespace conus::codec {
+
+// Default iterations: the decoded PSNR of astronaut and chelsea (two foci, 1/16) stops rising
+// after 2-3 (bench/README.md, "Fitted to the decoder": the PSNR per iteration). Damping
+// (0: none where the encoder kept the box filter) and hold: where the encoder low-passed a long
+// footprint axis (encode.h's rule against the radial comb), the damping grows by kFitHoldLowPass
+// times the share of that low-pass (the Gaussian's extent beyond the box, at most 1). Without it
+// the fit undoes that filter and the comb comes back (+13 dB in tests/codec/image/comb_test.cpp);
+// with 3 the ring aliases as much as the uniform image fitted the same way.
+inline constexpr int kFitIterations = 4;
+inline constexpr double kFitDamping = 0.0;
+inline constexpr double kFitHoldLowPass = 3.0;
+
+struct FitOptions {
+    int iterations = kFitIterations;  // 0 measures only
+    double damping = kFitDamping;     // >= 0, relative to each CoNUS pixel's own weight diag_j
+    double holdLowPass = kFitHoldLowPass;  // >= 0, added where the encoder low-passed a long axis
+    int threads = 0;
+    ProgressFn progress;
+};
+
+// The decoded view's error against the source over the fitted channels after `iteration`
+// iterations (0: the image given), and the minimized objective (its sum of squares plus the
+// damping term).
+struct FitStep {
+    int iteration = 0;
+    double rms = 0, psnr = 0;  // PSNR for a peak of 1 (linear light)
+    double objective = 0;
+};
+
+struct FitResult {
+    std::vector<FitStep> steps;   // iterations 0 .. the last one run
+    std::int64_t negatives = 0;   // fitted values below 0 in the result
+    float minimum = 0, maximum = 0;  // over the fitted channels of the result
+};
+
+// Fits `conus` (in place; the encode of `source` through `map`, same channels in the same order)
+// to the decoder's view at source.width x source.height. Throws conus::Error(InvalidArgument)
+// when the channels differ or options are out of range.
+FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus, const FitOptions& options = {});
+
+}  // namespace conus::codec

@@ -1,0 +1,200 @@
+// The encoder fitted to its decoder (fit.h): the operator it inverts is the decoder, its transpose
+// is the true adjoint, and the fit lowers the decoded view's error step by step below the EWA
+// encode's, on pictures with hard edges, texture and smooth shading through asymmetric foci.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "../../../codec/src/image/fit_pvt.h"
+#include "conus/codec/build/foci.h"
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/image/fit.h"
+#include "conus/codec/image/metrics.h"
+#include "error_code.h"
+#include "test_images.h"
+
+namespace conus::codec {
+namespace {
+
+// Two foci of different size and strength, off centre, on a non-square frame.
+SamplingMap twoFoci(double aspect) {
+    FociOptions options;
+    options.aspect = aspect;
+    options.columns = options.rows = 65;
+    const std::vector<Focus> foci = {{0.32, 0.4, 0.09, 4}, {0.71, 0.62, 0.06, 3}};
+    return buildFociMap(foci, options);
+}
+
+// A photo-like picture: smooth shading, a hard-edged disc and bar, a fine texture; each channel a
+// little different.
+Image picture(int w, int h, std::vector<std::string> channels) {
+    const Image grain = test::texture(std::max(w, h), 11);
+    Image im = makeImage(w, h, std::move(channels));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const double u = (x + 0.5) / w, v = (y + 0.5) / h;
+            for (int c = 0; c < im.channelCount(); ++c) {
+                double value = 0.35 + 0.2 * std::sin(3.0 * u + 2.0 * v + c) * std::cos(2.5 * v - c);
+                const double dx = u - 0.3 - 0.05 * c, dy = v - 0.42;
+                if (dx * dx + dy * dy < 0.01) value += 0.35;
+                if (u > 0.6 && u < 0.8 && v > 0.5 && v < 0.7) value -= 0.25;
+                value += 0.3 * (grain.at(x, y) - 0.5) * (1 + c % 2);
+                im.at(x, y, c) = static_cast<float>(value);
+            }
+        }
+    return im;
+}
+
+double dot(const Image& a, const Image& b) {
+    double sum = 0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) sum += double(a.pixels[i]) * b.pixels[i];
+    return sum;
+}
+
+DecodeOptions sourceView(const Image& source) {
+    DecodeOptions d;
+    d.width = source.width;
+    d.height = source.height;
+    return d;
+}
+
+// Magnified (the view finer than the CoNUS image everywhere) and minified in the foci (several
+// taps per output pixel there): the CoNUS size against a 300x200 view.
+struct Case {
+    int conusWidth, conusHeight, channels;
+};
+const Case kCases[] = {{75, 50, 3}, {240, 170, 1}, {150, 100, 4}};
+
+TEST(Fit, ForwardIsTheDecoder) {
+    const SamplingMap map = twoFoci(1.5);
+    for (const Case& c : kCases) {
+        std::vector<std::string> names = {"R", "G", "B", "A"};
+        names.resize(c.channels);
+        const Image sized = test::noise(c.conusWidth, c.conusHeight, names, 3);
+        DecodeOptions d;
+        d.width = 300;
+        d.height = 200;
+        const Image decoded = decodeImage(sized, map, d);
+        const Image forward = detail::fitForward(sized, map, 300, 200, 2);
+        EXPECT_LT(test::maxAbsDifference(decoded, forward), 2e-5f) << c.conusWidth << "x" << c.conusHeight;
+    }
+}
+
+TEST(Fit, AdjointIdentityThroughAFocusMap) {
+    const SamplingMap map = twoFoci(1.5);
+    for (const Case& c : kCases) {
+        std::vector<std::string> names = {"R", "G", "B", "A"};
+        names.resize(c.channels);
+        const Image x = test::noise(c.conusWidth, c.conusHeight, names, 5);
+        Image y = test::noise(300, 200, names, 6);
+        for (float& v : y.pixels) v -= 0.5f;  // signed, so that no sum is dominated by a mean
+        const Image dx = detail::fitForward(x, map, 300, 200, 3);
+        const Image dty = detail::fitAdjoint(y, map, c.conusWidth, c.conusHeight, 3);
+        const double lhs = dot(dx, y), rhs = dot(x, dty);
+        EXPECT_NEAR(lhs, rhs, 1e-5 * (std::abs(lhs) + std::abs(rhs)) + 1e-6)
+            << c.conusWidth << "x" << c.conusHeight << "x" << c.channels;
+        // Not a trivial identity: the splat moved mass (its total is the view's weighted total).
+        EXPECT_GT(std::abs(lhs), 1.0);
+        // The same sums whatever the thread count (bands are fixed, their sums added in order).
+        EXPECT_EQ(test::maxAbsDifference(dty, detail::fitAdjoint(y, map, c.conusWidth, c.conusHeight, 1)), 0.0f);
+    }
+}
+
+TEST(Fit, ResidualFallsAndBeatsTheEwaEncode) {
+    const Image source = picture(360, 240, {"R", "G", "B"});
+    const SamplingMap map = twoFoci(1.5);
+    EncodeOptions e;
+    e.width = 90;
+    e.height = 60;  // 1/16 of the pixels
+    const Image ewa = encodeImage(source, map, e);
+    const double before = psnr(decodeImage(ewa, map, sourceView(source)), source);
+
+    // The plain least-squares fit: its residual falls at every iteration.
+    Image fitted = ewa;
+    FitOptions f;
+    f.iterations = 10;
+    f.holdLowPass = 0;
+    const FitResult r = fitToDecoder(source, map, fitted, f);
+    ASSERT_EQ(r.steps.size(), 11u);
+    // Step 0 is the EWA image measured through the operator: the decoder's own PSNR.
+    EXPECT_NEAR(r.steps[0].psnr, before, 0.01);
+    for (std::size_t i = 1; i < r.steps.size(); ++i) {
+        EXPECT_LE(r.steps[i].rms, r.steps[i - 1].rms * (1 + 1e-6)) << "iteration " << i;
+        // Undamped, the objective is the residual's sum of squares.
+        const double squares = r.steps[i].rms * r.steps[i].rms * 360 * 240 * 3;
+        EXPECT_NEAR(r.steps[i].objective, squares, 1e-6 * squares);
+        std::printf("[ info ] fit iteration %zu: decoded PSNR %.2f dB\n", i, r.steps[i].psnr);
+    }
+    const double after = psnr(decodeImage(fitted, map, sourceView(source)), source);
+    EXPECT_NEAR(after, r.steps.back().psnr, 0.01);
+    std::printf("[ info ] EWA encode %.2f dB, fitted %.2f dB; %lld values below 0 (min %.3f)\n", before, after,
+                static_cast<long long>(r.negatives), r.minimum);
+    EXPECT_GT(after, before + 0.6);
+
+    // The default holds the long footprints toward the EWA image (and damping holds every pixel):
+    // the damped objective falls at every iteration, and the result lands between the two.
+    for (double damping : {0.0, 1.0}) {
+        Image held = ewa;
+        FitOptions d;
+        d.iterations = 10;
+        d.damping = damping;
+        const FitResult rd = fitToDecoder(source, map, held, d);
+        for (std::size_t i = 1; i < rd.steps.size(); ++i)
+            EXPECT_LE(rd.steps[i].objective, rd.steps[i - 1].objective * (1 + 1e-6)) << "damped iteration " << i;
+        const double between = psnr(decodeImage(held, map, sourceView(source)), source);
+        std::printf("[ info ] damping %g with the hold: %.2f dB\n", damping, between);
+        EXPECT_GT(between, before + 0.1);
+        EXPECT_LT(between, after);
+    }
+}
+
+TEST(Fit, UniformImageFittedToBilinear) {
+    const Image source = picture(320, 200, {"R", "G", "B"});
+    const SamplingMap identity = SamplingMap::identity(2, 2);
+    const Image area = areaDownsample(source, 80, 50);
+    Image fitted = area;
+    fitToDecoder(source, identity, fitted);
+    // The identity map's decoder is the bilinear resize the uniform baseline is shown with.
+    const double before = psnr(resizeBilinear(area, View{}, 320, 200), source);
+    const double after = psnr(resizeBilinear(fitted, View{}, 320, 200), source);
+    std::printf("[ info ] uniform: area %.2f dB, fitted %.2f dB\n", before, after);
+    EXPECT_GT(after, before + 0.5);
+}
+
+TEST(Fit, DepthStaysAndAlphaIsFitted) {
+    const Image source = picture(240, 160, {"R", "G", "B", "A", "Z"});
+    const SamplingMap map = twoFoci(1.5);
+    EncodeOptions e;
+    e.width = 60;
+    e.height = 40;
+    const Image ewa = encodeImage(source, map, e);
+    Image fitted = ewa;
+    fitToDecoder(source, map, fitted);
+    const int a = fitted.channelIndex("A"), z = fitted.channelIndex("Z");
+    double zChange = 0, aChange = 0;
+    for (std::size_t p = 0; p < fitted.pixels.size() / 5; ++p) {
+        zChange = std::max(zChange, double(std::abs(fitted.pixels[p * 5 + z] - ewa.pixels[p * 5 + z])));
+        aChange = std::max(aChange, double(std::abs(fitted.pixels[p * 5 + a] - ewa.pixels[p * 5 + a])));
+    }
+    EXPECT_EQ(zChange, 0.0);
+    EXPECT_GT(aChange, 1e-3);
+}
+
+TEST(Fit, RefusesMismatchedInput) {
+    const Image source = picture(120, 80, {"R", "G", "B"});
+    const SamplingMap map = twoFoci(1.5);
+    Image grey = test::noise(30, 20, {"Y"});
+    EXPECT_EQ(test::codeOf([&] { fitToDecoder(source, map, grey); }), ErrorCode::InvalidArgument);
+    Image rgb = test::noise(30, 20, {"R", "G", "B"});
+    FitOptions f;
+    f.iterations = -1;
+    EXPECT_EQ(test::codeOf([&] { fitToDecoder(source, map, rgb, f); }), ErrorCode::InvalidArgument);
+    f.iterations = 2;
+    f.damping = std::nan("");
+    EXPECT_EQ(test::codeOf([&] { fitToDecoder(source, map, rgb, f); }), ErrorCode::InvalidArgument);
+}
+
+}  // namespace
+}  // namespace conus::codec
