@@ -27,7 +27,7 @@ struct EncodeOptions {
     double frameLoss = -1;  // dB; < 0: no budget (--min-density sets the floor)
     std::vector<std::string> foci;
     int grid = map_rules::kDefaultSide;
-    FitSetting fit;  // --fit iterations (0: the filtered encode alone), --fit-hold
+    FitSetting fit;  // --fit, --fit-iterations, --fit-hold
     SourceOptions source;
     StorageOptions storage;
 };

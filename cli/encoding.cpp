@@ -55,23 +55,23 @@ void checkConusOutput(const std::string& output, const std::string& input) {
 }
 
 void addFitOption(CLI::App& command, FitSetting& fit) {
-    CLI::Option* iterations =
-        command
-        .add_option("--fit", fit.iterations,
-                    "fit the CoNUS image to the decoder: N iterations of least squares (CGLS) from the filtered "
-                    "encode, so that the decoded view at the source's size comes closest to the source (default N: " +
-                        std::to_string(codec::kFitIterations) + "; write --fit=N or put --fit after the input)")
-        ->expected(0, 1)
-        ->default_str(std::to_string(codec::kFitIterations))
+    CLI::Option* enabled = command.add_flag(
+        "--fit", fit.enabled,
+        "fit the CoNUS image to the decoder: least squares (CGLS) from the filtered encode, so that the decoded "
+        "view at the source's size comes closest to the source");
+    command
+        .add_option("--fit-iterations", fit.iterations, "with --fit: how many least-squares iterations")
+        ->capture_default_str()
         ->type_name("N")
-        ->check(CLI::Range(1, 100));
+        ->check(CLI::Range(1, 100))
+        ->needs(enabled);
     command
         .add_option("--fit-hold", fit.hold,
                     "with --fit: how strongly the fit keeps the encoder's low-pass along long, thin footprints (the "
                     "focus rims, where undoing it brings back a radial comb); 0: the plain least squares, sharper and "
                     "with more aliasing (default " + std::to_string(codec::kFitHoldLowPass).substr(0, 3) + ")")
         ->check(CLI::Range(0.0, 1000.0))
-        ->needs(iterations);
+        ->needs(enabled);
 }
 
 format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,
@@ -81,10 +81,10 @@ format::ConusFile encodeToConus(const gl::Device& device, const Image& source, c
                       std::to_string(size.width) + "x" + std::to_string(size.height));
     Image image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
-    if (fit.iterations > 0) {
-        Progress fitting("fit to the decoder (" + std::to_string(fit.iterations) + " iterations)");
+    if (fit.count() > 0) {
+        Progress fitting("fit to the decoder (" + std::to_string(fit.count()) + " iterations)");
         codec::FitOptions options;
-        options.iterations = fit.iterations;
+        options.iterations = fit.count();
         options.holdLowPass = fit.hold;
         options.progress = fitting.callback();
         const codec::FitResult r = codec::fitToDecoder(source, map, image, options);

@@ -29,13 +29,14 @@ void addStorageOptions(CLI::App& command, StorageOptions& options);
 // Resolves the CoNUS image size (checking it against the source) and the storage settings.
 Size conusSize(const StorageOptions& options, const Image& source);
 
-// Adds --fit [N] and --fit-hold H (encode and uniform alike, so that comparisons stay fair):
-// fit.iterations becomes the iteration count (codec::kFitIterations when no count is given); 0
-// when absent.
-// --fit-hold H: FitOptions::holdLowPass (codec::kFitHoldLowPass when absent).
+// Adds --fit, --fit-iterations N and --fit-hold H (encode and uniform alike, so that comparisons
+// stay fair). --fit is a plain flag (an optional count after it would take the input's name when
+// written first); --fit-iterations and --fit-hold need it.
 struct FitSetting {
-    int iterations = 0;
+    bool enabled = false;
+    int iterations = codec::kFitIterations;
     double hold = codec::kFitHoldLowPass;
+    int count() const { return enabled ? iterations : 0; }  // iterations to run; 0: the filtered encode alone
 };
 void addFitOption(CLI::App& command, FitSetting& fit);
 

@@ -440,7 +440,7 @@ PYBIND11_MODULE(_conus, m) {
         py::arg("fit_hold") = codec::kFitHoldLowPass,
         "Encode linear pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file;\n"
         "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'; fit = N > 0\n"
-        "fits the image to the decoder with N least-squares iterations (`conus encode --fit N`); fit_hold: its\n"
+        "fits the image to the decoder with N least-squares iterations (`conus encode --fit --fit-iterations N`); fit_hold: its\n"
         "damping where the encoder low-passed a long footprint axis (`--fit-hold`; 0: the plain least squares)");
     m.def(
         "decode",
@@ -483,7 +483,7 @@ PYBIND11_MODULE(_conus, m) {
         },
         py::arg("pixels"), py::arg("size") = py::none(), py::arg("fit") = 0,
         "The uniform baseline: an area downsample to the same pixel count; fit = N > 0 fits it to its bilinear\n"
-        "resize to the source's size (`conus uniform --fit N`)");
+        "resize to the source's size (`conus uniform --fit --fit-iterations N`)");
     m.def(
         "resize",
         [](const py::array& pixels, std::pair<int, int> size) {

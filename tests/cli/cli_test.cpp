@@ -126,7 +126,7 @@ TEST_F(Cli, FitRoundTripBeatsThePlainEncode) {
     const std::string variants[4] = {"encode " + in + " -o " + path("plain.exr") + foci + common,
                                      "encode " + in + " -o " + path("fit.exr") + foci + common + " --fit",
                                      "uniform " + in + " -o " + path("uplain.exr") + common,
-                                     "uniform " + in + " -o " + path("ufit.exr") + common + " --fit=4"};
+                                     "uniform " + in + " -o " + path("ufit.exr") + common + " --fit --fit-iterations 4"};
     const char* names[4] = {"plain", "fit", "uplain", "ufit"};
     for (int i = 0; i < 4; ++i) {
         Result r = run(variants[i]);
@@ -138,11 +138,11 @@ TEST_F(Cli, FitRoundTripBeatsThePlainEncode) {
         db[i] = psnrOf(path(std::string(names[i]) + "-view.exr"));
     }
     EXPECT_GT(db[1], db[0] + 0.2) << "encode " << db[0] << " dB, encode --fit " << db[1] << " dB";
-    EXPECT_GT(db[3], db[2] + 0.5) << "uniform " << db[2] << " dB, uniform --fit=4 " << db[3] << " dB";
+    EXPECT_GT(db[3], db[2] + 0.5) << "uniform " << db[2] << " dB, uniform --fit --fit-iterations 4 " << db[3] << " dB";
     // A count out of range is refused with a reason, and nothing is written.
-    const Result bad = run("encode " + in + " -o " + path("bad.exr") + foci + " --fit=0");
+    const Result bad = run("encode " + in + " -o " + path("bad.exr") + foci + " --fit --fit-iterations 0");
     EXPECT_NE(bad.exitCode, 0);
-    EXPECT_NE(bad.err.find("--fit"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("--fit-iterations"), std::string::npos) << bad.err;
     EXPECT_FALSE(fs::exists(path("bad.exr")));
     EXPECT_TRUE(leftovers().empty());
 }

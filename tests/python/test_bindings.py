@@ -165,7 +165,7 @@ def test_gpu_encode_agrees_with_the_cpu_reference(asymmetric):
 
 def test_fit_brings_the_decoded_frame_closer_for_conus_and_uniform(tmp_path, asymmetric, conus_bin):
     """encode(fit=N) and uniform(fit=N): the decoded frame at the source's size nearer the source
-    than without the fit; the fitted encode is what `conus encode --fit=N` writes."""
+    than without the fit; the fitted encode is what `conus encode --fit --fit-iterations N` writes."""
     def mse(a, b):
         return float(np.mean((a[..., :4] - b[..., :4]) ** 2))
     plain, fitted = (conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=n) for n in (0, 3))
@@ -177,7 +177,7 @@ def test_fit_brings_the_decoded_frame_closer_for_conus_and_uniform(tmp_path, asy
     pixels, channels = conus.read_image(src)
     cli = str(tmp_path / "cli.exr")
     run(conus_bin, "encode", src, "-o", cli, "--focus", ",".join(map(str, FOCUS)), "--size", "60x40", "--backend", "cpu",
-        "--fit=3", "--float", "-q")
+        "--fit", "--fit-iterations", "3", "--float", "-q")
     ours = conus.encode(pixels, foci=[FOCUS], size=(60, 40), channels=channels, fit=3)
     np.testing.assert_allclose(ours.pixels, conus.read(cli).pixels, atol=1e-4)
     with pytest.raises(conus.Error):
