@@ -53,7 +53,7 @@ struct FociOptions {
     double aspect = 1.0;          // image width / height: makes a focus circular in pixels
     FociComposition composition = FociComposition::Density;
     double maxAnisotropy = 0;     // density composition: DensityMapOptions::maxAnisotropy (0: none)
-    FociFalloff falloff;          // how each focus's density falls to the context's
+    FociFalloff falloff = {};     // how each focus's density falls to the context's (`= {}`: no -Wextra warning)
 };
 
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r outside (0, 1] or k outside
