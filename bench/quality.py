@@ -11,11 +11,15 @@ Everything is measured in linear light (the values the EXR holds) against the so
 - aliasing check in the context ring (r..2r): each decoded view against the source low-passed to
   the rate it was sampled at there (a Gaussian of sigma 0.5 / rate source pixels, the rate from
   the map's density), CoNUS and uniform alike: a comb or a staircase shows as error against it;
+  and against the source low-passed by each pixel's own footprint ellipse (a Gaussian of sigma
+  0.5 * spacing along the Jacobian's singular directions: what the sampling can represent there),
+  beside the uniform image at each ring pixel's own density against its own such reference;
 - equal bytes (1/16): the CoNUS and uniform images compressed with JPEG XL (cjxl) and JPEG 2000
   (opj_compress), against the full-resolution photograph compressed with either to the same
   bytes. OpenJPEG has no spatial region of interest (its -ROI upshifts a whole component), so the
   full-resolution JPEG 2000 at equal bytes stands for JPEG 2000's own ROI coding;
-- gain against loss: foci of k = 2..6 and automatic maps from ROI importance (1 in the discs, 0
+- gain against loss: foci of k = 2..6, foci of k = 4 with the transition's width and shape swept
+  (`--falloff`), and automatic maps from ROI importance (1 in the discs, 0
   elsewhere) with their context floor swept, or chosen by a whole-frame loss budget
   (Map.auto_for_frame_loss, `encode --frame-loss`), and with an anisotropy limit swept: the
   frontier each method reaches.
@@ -57,7 +61,10 @@ BUDGET_GRID, BUDGET_MAX_DENSITY = 129, 64.0
 ANISOTROPY_LIMITS = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0]  # --max-anisotropy swept, at the loosest budget
 FIT = 4  # --fit iterations (the default of `encode --fit`) of the fitted variant (0: --no-fit leaves it out)
 FIT_HOLD = None  # --fit-hold (None: the encoder's default)
-METHODS = ("foci", "auto", "budget", "limited", "foci+fit", "auto+fit", "budget+fit")
+METHODS = ("foci", "auto", "budget", "limited", "falloff", "foci+fit", "auto+fit", "budget+fit")
+# Foci of k = 4 with their transition's width and shape swept (`--falloff`; "2": the default).
+FALLOFFS = ["1.25", "1.5", "1.75", "2", "3", "1.5,log", "1.5,logr", "3,logr"]
+QUICK_FALLOFFS = ["1.5", "2", "3,logr"]
 
 
 def psnr(a, b, mask=None):
@@ -119,6 +126,67 @@ def lowpassed(source, rate):
     return out
 
 
+def footprint_sigmas(cmap, size, shape, mask):
+    """At each point of `mask`: the Gaussian of the sampling's own footprint, sigma_i = 0.5 *
+    spacing_i source pixels along the singular directions of F = diag(W, H) J^-1 diag(1/w, 1/h)
+    (J the map's Jacobian by central differences, (w, h) the CoNUS image's size): F takes a step of
+    one CoNUS pixel to source pixels. Returns (major sigma, minor sigma, unit major direction (x, y)),
+    the sigmas at least 0.5 (a rate of at most one sample per source pixel, as lowpassed())."""
+    h, w = shape[:2]
+    y, x = np.nonzero(mask)
+    p = np.stack([(x + 0.5) / w, (y + 0.5) / h], axis=-1)
+    e = 1e-4
+    du = (np.asarray(cmap.distort(p + [e, 0])) - np.asarray(cmap.distort(p - [e, 0]))) / (2 * e)
+    dv = (np.asarray(cmap.distort(p + [0, e])) - np.asarray(cmap.distort(p - [0, e]))) / (2 * e)
+    jac = np.stack([du, dv], axis=-1)  # rows: d(ud, vd); columns: d/du, d/dv
+    f = np.linalg.inv(jac) * [1.0 / size[0], 1.0 / size[1]]  # columns scaled: a CoNUS pixel in (u, v)
+    f = f * np.array([[w], [h]])  # rows scaled: (u, v) in source pixels
+    cov = 0.25 * f @ np.swapaxes(f, 1, 2)  # (0.5 F)(0.5 F)^T
+    a, b, c = cov[:, 0, 0], cov[:, 0, 1], cov[:, 1, 1]
+    mid, half = 0.5 * (a + c), np.sqrt(0.25 * (a - c) ** 2 + b * b)
+    major, minor = np.sqrt(mid + half), np.sqrt(np.maximum(mid - half, 0))
+    angle = 0.5 * np.arctan2(2 * b, a - c)
+    return np.maximum(major, 0.5), np.maximum(minor, 0.5), np.stack([np.cos(angle), np.sin(angle)], -1), (y, x)
+
+
+def lowpassed_footprint(source, major, minor, direction, where):
+    """The source low-passed at the points `where` (rows, columns) by each point's own elliptical
+    Gaussian: an isotropic Gaussian of the minor sigma (the nearest of a stack of blurs a quarter
+    octave apart), then a line Gaussian along the major direction for the rest of the major variance,
+    taps 1.5 sigma of the stack level apart (bilinear, so no tap skips detail the level keeps)."""
+    from scipy.ndimage import gaussian_filter, map_coordinates
+    ys, xs = where
+    levels = np.exp(np.arange(np.log(0.5), np.log(minor.max()) + 0.3, np.log(2) / 4))
+    index = np.clip(np.rint(np.log(minor / levels[0]) / (np.log(2) / 4)).astype(int), 0, len(levels) - 1)
+    out = np.zeros((len(ys), source.shape[2]), np.float64)
+    for i, s in enumerate(levels):
+        pick = np.nonzero(index == i)[0]
+        if not len(pick):
+            continue
+        line = np.sqrt(np.maximum(major[pick] ** 2 - s * s, 0))
+        step = 1.5 * s
+        taps = np.ceil(3 * line / step).astype(int)
+        # Blur only the box these points reach (their taps, and the blur's own reach beyond them).
+        reach = int(np.ceil(4 * s + 3 * line.max() + 2))
+        y0, y1 = max(0, ys[pick].min() - reach), min(source.shape[0], ys[pick].max() + reach + 1)
+        x0, x1 = max(0, xs[pick].min() - reach), min(source.shape[1], xs[pick].max() + reach + 1)
+        blurred = gaussian_filter(source[y0:y1, x0:x1], (s, s, 0))
+        acc = np.zeros((len(pick), source.shape[2]))
+        weight = np.zeros(len(pick))
+        for t in range(0, taps.max() + 1):
+            live = np.nonzero(taps >= t)[0]
+            for sign in ((1,) if t == 0 else (1, -1)):
+                d = sign * t * step
+                wgt = np.exp(-0.5 * (d / np.maximum(line[live], 1e-9)) ** 2) if t else np.ones(len(live))
+                cy = ys[pick[live]] - y0 + d * direction[pick[live], 1]
+                cx = xs[pick[live]] - x0 + d * direction[pick[live], 0]
+                for ch in range(source.shape[2]):
+                    acc[live, ch] += wgt * map_coordinates(blurred[..., ch], [cy, cx], order=1, mode="nearest")
+                weight[live] += wgt
+        out[pick] = acc / weight[:, None]
+    return out
+
+
 def codec_round_trip(pixels, tool, level, work):
     """8-bit sRGB of `pixels` compressed by tool ('jxl' distance, 'j2k' ratio); (linear, bytes)."""
     png, packed, back = work / "in.png", work / ("c." + tool), work / "back.png"
@@ -145,8 +213,11 @@ def view_of(file, w, h):
     return np.asarray(conus.decode(file, size=(w, h)))[..., :3]
 
 
-def encode_with(src, size, regions, k=K, map=None, fit=0):
+def encode_with(src, size, regions, k=K, map=None, fit=0, falloff=None):
     hold = {} if FIT_HOLD is None else {"fit_hold": FIT_HOLD}
+    if map is None and falloff is not None:
+        h, w = src.shape[:2]
+        map = conus.Map.foci([(u, v, r, k) for u, v, r in regions], aspect=w / h, falloff=falloff)
     if map is not None:
         return conus.encode(src, map=map, size=size, fit=fit, **hold)
     return conus.encode(src, foci=[(u, v, r, k) for u, v, r in regions], size=size, fit=fit, **hold)
@@ -173,17 +244,42 @@ def measure(name, src, regions, out, quick):
         rate = base * np.sqrt(np.asarray(cfile.map.density(points)))
         ring_ref_c = lowpassed(src, rate)
         ring_ref_u = lowpassed(src, np.full((h, w), base))
+        # The footprint's own ellipse as the reference: what each sampling can represent there.
+        major, minor, direction, where = footprint_sigmas(cfile.map, size, src.shape, ring)
+        fp_c = lowpassed_footprint(src, major, minor, direction, where)
+        identity = conus.Map.identity(2, 2)
+        umajor, uminor, udirection, _ = footprint_sigmas(identity, size, src.shape, ring)
+        fp_u = lowpassed_footprint(src, umajor, uminor, udirection, where)
+        # Uniform at each ring pixel's own density (the nearest of uniform images a quarter octave
+        # of rate apart), each against its own reference: what the local rate alone scores (a finer
+        # rate is held to a sharper reference, which holds more detail to miss).
+        local = np.asarray(cfile.map.density(points[where]))
+        step = np.log(2) / 4
+        level = np.rint(np.log(local) / (2 * step)).astype(int)
+        dview, fp_d = np.empty((len(local), 3)), np.empty((len(local), 3))
+        for lv in np.unique(level):
+            pick = np.nonzero(level == lv)[0]
+            scale = np.exp(lv * step)
+            dsize = (min(w, max(1, round(size[0] * scale))), min(h, max(1, round(size[1] * scale))))
+            view = np.asarray(conus.resize(conus.uniform(src, size=dsize), size=(w, h)))[..., :3]
+            dview[pick] = view[where[0][pick], where[1][pick]]
+            dmajor, dminor, ddirection, _ = footprint_sigmas(identity, dsize, src.shape, ring)
+            fp_d[pick] = lowpassed_footprint(src, dmajor[pick], dminor[pick], ddirection[pick], (where[0][pick], where[1][pick]))
+        dense = float(np.mean(local))
         rows.append(dict(photo=name, share=share,
                          roi_c=psnr(cview, src, roi), roi_u=psnr(uview, src, roi),
                          ssim_c=ssim(cview, src, roi), ssim_u=ssim(uview, src, roi),
                          frame_c=psnr(cview, src), frame_u=psnr(uview, src),
-                         alias_c=psnr(cview, ring_ref_c, ring), alias_u=psnr(uview, ring_ref_u, ring)))
+                         alias_c=psnr(cview, ring_ref_c, ring), alias_u=psnr(uview, ring_ref_u, ring),
+                         fp_c=psnr(cview[where], fp_c), fp_u=psnr(uview[where], fp_u), fp_d=psnr(dview, fp_d), ring_density=dense,
+                         ring_anisotropy=float(np.median(major / minor))))
         if FIT:
             fview, ufview = view_of(encode_with(src, size, regions, fit=FIT), w, h), uniform_view(src, size, FIT)
             rows[-1].update(fitted=dict(roi_c=psnr(fview, src, roi), roi_u=psnr(ufview, src, roi),
                                         ssim_c=ssim(fview, src, roi), ssim_u=ssim(ufview, src, roi),
                                         frame_c=psnr(fview, src), frame_u=psnr(ufview, src),
-                                        alias_c=psnr(fview, ring_ref_c, ring), alias_u=psnr(ufview, ring_ref_u, ring)))
+                                        alias_c=psnr(fview, ring_ref_c, ring), alias_u=psnr(ufview, ring_ref_u, ring),
+                                        fp_c=psnr(fview[where], fp_c), fp_u=psnr(ufview[where], fp_u), fp_d=psnr(dview, fp_d)))
             if share == "1/16":
                 write_png(out / f"{name}-conus-fit.png", srgb8(fview))
         if share == "1/16":
@@ -231,7 +327,7 @@ def frontier(name, src, regions, quick):
     uview = uniform_view(src, size)
     ref_roi, ref_frame = psnr(uview, src, roi), psnr(uview, src)
     importance = discs(src.shape, regions).astype(np.float32)
-    points = {"foci": [], "auto": [], "budget": [], "limited": []}
+    points = {"foci": [], "falloff": [], "auto": [], "budget": [], "limited": []}
     if FIT:
         # The fitted variants against the fitted uniform image: the same settings, each map once.
         ufview = uniform_view(src, size, FIT)
@@ -248,6 +344,18 @@ def frontier(name, src, regions, quick):
         view = view_of(encode_with(src, size, regions, k=k), w, h)
         points["foci"].append((k, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi))
         add_fitted("foci+fit", k, k=k)
+    # The transition's width and shape at k = 4: gain, loss, the map's largest anisotropy
+    # (MapMeasures) and the share of the CoNUS image's samples in the regions and in their rings.
+    ring = discs(src.shape, regions, 1.0, 2.0)
+    y, x = np.mgrid[0:h, 0:w]
+    pts = np.stack([(x + 0.5) / w, (y + 0.5) / h], axis=-1)
+    for falloff in (QUICK_FALLOFFS if quick else FALLOFFS):
+        cfile = encode_with(src, size, regions, falloff=falloff)
+        view = view_of(cfile, w, h)
+        density = np.asarray(cfile.map.density(pts))
+        points["falloff"].append((falloff, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi,
+                                  cfile.map.measures(w / h)["max_anisotropy"],
+                                  density[roi].sum() / density.sum(), density[ring].sum() / density.sum()))
     for floor in ([0.6, 0.3] if quick else [0.8, 0.6, 0.45, 0.3, 0.2]):
         try:
             m = conus.Map.auto(importance, min_density=floor, max_density=36.0)
@@ -342,10 +450,12 @@ def plots(out, all_curves, all_points):
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(7, 5))
     for method in [m for m in METHODS if m in next(iter(all_points.values()))]:
-        marker = {"foci": "o", "auto": "s", "budget": "^", "limited": "D"}[method.split("+")[0]]
+        marker = {"foci": "o", "falloff": "v", "auto": "s", "budget": "^", "limited": "D"}[method.split("+")[0]]
         xs = [np.mean([p[method][i][1] for p in all_points.values()]) for i in range(min(len(p[method]) for p in all_points.values()))]
         ys = [np.mean([p[method][i][2] for p in all_points.values()]) for i in range(len(xs))]
-        ax.plot(xs, ys, (":" if method.endswith("+fit") else "-") + marker, label={"foci": "one focus per region, k = 2..6", "auto": "automatic map from ROI importance, floor swept",
+        ax.plot(xs, ys, ("" if method == "falloff" else ":" if method.endswith("+fit") else "-") + marker, label={"foci": "one focus per region, k = 2..6",
+                                                "falloff": "k = 4, --falloff " + " ".join(QUICK_FALLOFFS if len(xs) == len(QUICK_FALLOFFS) else FALLOFFS),
+                                                "auto": "automatic map from ROI importance, floor swept",
                                                 "budget": f"automatic map, --frame-loss budget swept (max density {BUDGET_MAX_DENSITY:g}, grid {BUDGET_GRID})",
                                                 "limited": f"the same at {BUDGETS[-1]:g} dB, --max-anisotropy {ANISOTROPY_LIMITS[0]:g}..{ANISOTROPY_LIMITS[-1]:g} swept",
                                                 "foci+fit": f"foci, --fit {FIT} (against uniform --fit {FIT})",
@@ -371,17 +481,22 @@ def summary(rows):
         loss = np.mean([r["frame_u"] - r["frame_c"] for r in sel])
         worst = min(r["roi_c"] - r["roi_u"] for r in sel)
         ring = np.mean([r["alias_u"] - r["alias_c"] for r in sel])
+        ring_fp = np.mean([r["fp_u"] - r["fp_c"] for r in sel])
+        ring_d = np.mean([r["fp_d"] - r["fp_c"] for r in sel])
         lines.append(f"- {share}: mean ROI gain {gain:+.1f} dB (worst {worst:+.1f}), mean whole-frame loss {loss:.1f} dB, "
-                     f"ring check CoNUS {ring:.1f} dB below uniform")
+                     f"ring check CoNUS {ring:.1f} dB below uniform (isotropic reference), {ring_fp:.1f} dB (footprint reference), "
+                     f"{ring_d:.1f} dB below uniform at the local density")
     return lines
 
 
 def report(rows, all_curves, all_points):
-    lines = ["| photo | pixels | ROI PSNR CoNUS / uniform (gain) | ROI SSIM CoNUS / uniform | whole-frame loss | ring vs low-passed source: CoNUS / uniform |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| photo | pixels | ROI PSNR CoNUS / uniform (gain) | ROI SSIM CoNUS / uniform | whole-frame loss | ring vs low-passed source: CoNUS / uniform "
+             "| ring vs footprint-filtered source: CoNUS / uniform / uniform at the local density | ring's mean density, median footprint anisotropy |",
+             "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['photo']} | {r['share']} | {r['roi_c']:.1f} / {r['roi_u']:.1f} ({r['roi_c'] - r['roi_u']:+.1f}) | "
-                     f"{r['ssim_c']:.3f} / {r['ssim_u']:.3f} | {r['frame_u'] - r['frame_c']:.1f} dB | {r['alias_c']:.1f} / {r['alias_u']:.1f} |")
+                     f"{r['ssim_c']:.3f} / {r['ssim_u']:.3f} | {r['frame_u'] - r['frame_c']:.1f} dB | {r['alias_c']:.1f} / {r['alias_u']:.1f} | "
+                     f"{r['fp_c']:.1f} / {r['fp_u']:.1f} / {r['fp_d']:.1f} | {r['ring_density']:.2f}, {r['ring_anisotropy']:.2f} |")
     lines.append("")
     lines += summary(rows)
     if FIT:
@@ -411,8 +526,12 @@ def report(rows, all_curves, all_points):
             loss = np.mean([p[method][i][1] for p in all_points.values()])
             gain = np.mean([p[method][i][2] for p in all_points.values()])
             worst = min(p[method][i][2] for p in all_points.values())
-            name = {"foci": "k", "auto": "floor", "budget": "frame-loss", "limited": "max-anisotropy"}[method.split("+")[0]]
+            name = {"foci": "k", "falloff": "k 4, falloff", "auto": "floor", "budget": "frame-loss", "limited": "max-anisotropy"}[method.split("+")[0]]
             line = f"- {method} {name} {setting}: loss {loss:.2f} dB, gain {gain:+.2f} dB (worst photo {worst:+.2f})"
+            if method == "falloff":
+                line += "; max anisotropy " + ", ".join(f"{p[method][i][3]:.1f}" for p in all_points.values())
+                line += (f"; samples in the regions {100 * np.mean([p[method][i][4] for p in all_points.values()]):.1f}%, "
+                         f"in r..2r {100 * np.mean([p[method][i][5] for p in all_points.values()]):.1f}%")
             if method in ("budget", "limited", "budget+fit"):
                 p_loss = np.mean([p[method][i][3] for p in all_points.values()])
                 p_gain = np.mean([p[method][i][4] for p in all_points.values()])

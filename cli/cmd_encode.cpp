@@ -22,7 +22,7 @@ namespace {
 
 struct EncodeOptions {
     BatchOptions batch;
-    std::string mapFile, compose = "density", importance, method = "flow";
+    std::string mapFile, compose = "density", importance, method = "flow", falloff = "2";
     double minDensity = 0.25, maxDensity = 16, maxAnisotropy = 0;
     double frameLoss = -1;  // dB; < 0: no budget (--min-density sets the floor)
     std::vector<std::string> foci;
@@ -68,8 +68,10 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source) {
     fo.aspect = double(source.width) / source.height;
     fo.maxAnisotropy = o.maxAnisotropy;
     fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+    fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
-    BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo)), codec::toAnalytic(foci, fo.composition)};
+    BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo)),
+                   codec::toAnalytic(foci, fo.composition, fo.falloff)};
     codec::checkFociHeld(*built.map, foci, fo);  // the file must not record a focus its map ignores
     progress.done();
     return built;
@@ -140,6 +142,7 @@ Command addEncodeCommand(CLI::App& root) {
         ->check(CLI::IsMember({"flow", "separable"}));
     command->add_option("--compose", options->compose, "how several foci combine: density (default) | add")
         ->check(CLI::IsMember({"density", "add"}));
+    addFalloffOption(*command, options->falloff);
     command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus and --importance (default " + std::to_string(map_rules::kDefaultSide) + ")")
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addFitOption(*command, options->fit);

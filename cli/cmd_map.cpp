@@ -230,7 +230,7 @@ void runGround(const GroundOptions& o) {
 
 struct FociOptions {
     std::vector<std::string> foci;
-    std::string composition = "density";
+    std::string composition = "density", falloff = "2";
     int grid = map_rules::kDefaultSide;
     double aspect = 1.0, maxAnisotropy = 0;
     OutputOptions out;
@@ -241,6 +241,7 @@ void addFociOptions(CLI::App& command, FociOptions& o) {
     command.add_option("--focus", o.foci, "focus u,v,r,k (repeat for several)")->required();
     command.add_option("--compose", o.composition, "how several foci combine: density (default) | add")
         ->check(CLI::IsMember({"density", "add"}));
+    addFalloffOption(command, o.falloff);
     command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     command.add_option("--aspect", o.aspect, "image width / height, so foci are circular in pixels (default 1)");
     addOutputOptions(command, o.out);
@@ -253,11 +254,12 @@ void runFoci(const FociOptions& o) {
     fo.aspect = o.aspect;
     fo.maxAnisotropy = o.maxAnisotropy;
     fo.composition = o.composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+    fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
     const codec::SamplingMap map = codec::buildFociMap(list, fo);
     codec::checkFociHeld(map, list, fo);  // the file must not record a focus its map ignores
     progress.done();
-    writeMapFile(map, codec::toAnalytic(list, fo.composition), o.out, o.aspect);
+    writeMapFile(map, codec::toAnalytic(list, fo.composition, fo.falloff), o.out, o.aspect);
 }
 
 // ---- auto ----

@@ -57,6 +57,13 @@ void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy) {
         ->check(CLI::Range(1.0, 1e6));
 }
 
+void addFalloffOption(CLI::App& command, std::string& falloff) {
+    command.add_option("--falloff", falloff,
+                       "how a focus's density falls to the context's: WIDTH[,SHAPE], from r to WIDTH r (in (1, 8]), "
+                       "SHAPE density (smoothstep of the density, the default) | log (of its logarithm) | logr (of its "
+                       "logarithm over log radius); default 2,density");
+}
+
 void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDensity, const std::string& prefix) {
     command.add_option("--min-density", minDensity,
                        prefix + "density every map cell keeps (0..1, default 0.25), held to 5% or refused")

@@ -22,6 +22,8 @@ namespace conus::cli {
 // (0: none), and --min-density / --max-density for automatic maps.
 void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy);
 void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDensity, const std::string& prefix = "");
+// --falloff WIDTH[,SHAPE] for `map foci` and `encode --focus` (codec::parseFalloff; "2": the default).
+void addFalloffOption(CLI::App& command, std::string& falloff);
 
 // The builder's options from what `map auto` and `encode --importance` are given (method "flow"
 // or "separable").

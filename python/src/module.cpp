@@ -25,6 +25,7 @@
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/frame_budget.h"
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/map_measures.h"
 #include "conus/codec/build/springs.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/decode.h"
@@ -258,20 +259,24 @@ PYBIND11_MODULE(_conus, m) {
             py::arg("columns") = map_rules::kDefaultSide, py::arg("rows") = map_rules::kDefaultSide)
         .def_static(
             "foci",
-            [](const std::vector<std::tuple<double, double, double, double>>& foci, double aspect, int grid, const std::string& composition) {
+            [](const std::vector<std::tuple<double, double, double, double>>& foci, double aspect, int grid, const std::string& composition,
+               const std::string& falloff) {
                 const std::vector<codec::Focus> f = toFoci(foci);
                 codec::FociOptions options;
                 options.aspect = aspect;
                 options.columns = options.rows = grid;
+                options.falloff = codec::parseFalloff(falloff);
                 if (composition == "add") options.composition = codec::FociComposition::Add;
                 else if (composition != "density")
                     throw Error(ErrorCode::InvalidArgument, "composition must be 'density' or 'add', not '" + composition + "'");
                 py::gil_scoped_release release;
                 codec::SamplingMap map = codec::buildFociMap(f, options);
-                return std::make_shared<Map>(Map{std::move(map), codec::toAnalytic(f, options.composition)});
+                return std::make_shared<Map>(Map{std::move(map), codec::toAnalytic(f, options.composition, options.falloff)});
             },
             py::arg("foci"), py::arg("aspect") = 1.0, py::arg("grid") = map_rules::kDefaultSide, py::arg("composition") = "density",
-            "Circular foci (u, v, r, k): centre, radius as a fraction of the width, magnification")
+            py::arg("falloff") = "2",
+            "Circular foci (u, v, r, k): centre, radius as a fraction of the width, magnification; falloff as `map foci "
+            "--falloff` (\"2\": density smoothstepped from r to 2r; \"1.5,log\", \"3,logr\")")
         .def_static(
             "springs",
             [](const std::vector<std::tuple<double, double, double, double>>& strokes, int grid, int max_steps) {
@@ -285,17 +290,19 @@ PYBIND11_MODULE(_conus, m) {
             "The paper's mass-spring brush: strokes (u, v, radius, strength), relaxed until stable")
         .def_static(
             "auto",
-            [](const py::array& importance, int grid, double min_density, double max_density) {
+            [](const py::array& importance, int grid, double min_density, double max_density, double smoothing) {
                 Image image = fromArray(importance, std::nullopt, "importance");
                 codec::AutoMapOptions options;
                 options.columns = options.rows = grid;
                 options.minDensity = min_density;
                 options.maxDensity = max_density;
+                options.smoothing = smoothing;
                 py::gil_scoped_release release;
                 return std::make_shared<Map>(Map{codec::buildAutoMap(image, options), {}});
             },
             py::arg("importance"), py::arg("grid") = map_rules::kDefaultSide, py::arg("min_density") = 0.25,
-            py::arg("max_density") = 16.0, "A map whose density follows an importance image (H, W)")
+            py::arg("max_density") = 16.0, py::arg("smoothing") = codec::AutoMapOptions{}.smoothing,
+            "A map whose density follows an importance image (H, W), smoothed over `smoothing` of the width")
         .def_static(
             "auto_for_frame_loss",
             [](const py::array& importance, const py::array& source, std::pair<int, int> size, double frame_loss, int grid,
@@ -352,6 +359,20 @@ PYBIND11_MODULE(_conus, m) {
                  return py::object(both[py::make_tuple(py::ellipsis(), 0)]).cast<py::array>();
              },
              py::arg("points"), "Sampling density (area ratio) at undistorted points")
+        .def(
+            "measures",
+            [](const Map& self, double aspect) {
+                const codec::MapMeasures m = codec::measureMap(self.map, aspect);
+                py::dict d;
+                d["min_cell_density"] = m.minCellDensity;
+                d["max_cell_density"] = m.maxCellDensity;
+                d["max_anisotropy"] = m.maxAnisotropy;
+                d["most_anisotropic"] = py::make_tuple(m.mostAnisotropic.x, m.mostAnisotropic.y);
+                return d;
+            },
+            py::arg("aspect") = 1.0,
+            "What the map achieves on its own grid (as `conus info`): min/max cell density, the largest anisotropy of a "
+            "cell (its Jacobian's singular value ratio in pixels of an image of this width / height) and where")
         .def("__repr__", [](const Map& self) {
             return "<conus.Map " + std::to_string(self.map.columns()) + "x" + std::to_string(self.map.rows()) + " nodes" +
                    (self.analytic ? ", " + self.analytic->kind : std::string()) + ">";

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "conus/codec/image/metrics.h"
+#include "conus/codec/build/foci.h"
 #include "conus/codec/build/map_measures.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
@@ -341,6 +342,46 @@ TEST_F(Cli, AnisotropyIsLimitedReportedAndDrawn) {
     EXPECT_EQ(tight.exitCode, 2) << tight.out;  // a value that cannot be held: usage
     EXPECT_NE(tight.err.find("anisotropy limit 1.05"), std::string::npos) << tight.err;
     EXPECT_FALSE(fs::exists(path("t.exr")));
+}
+
+TEST_F(Cli, FocusFalloffIsBuiltRecordedAndChecked) {
+    // `--falloff` builds the map the codec builds for that transition, and the file records it.
+    const std::vector<conus::codec::Focus> foci{{0.45, 0.5, 0.1, 4}};
+    const Result r = run("map foci --focus 0.45,0.5,0.1,4 --aspect 1.5 --falloff 1.5,logr -o " + path("m.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const conus::format::ConusFile file = conus::format::readConusFile(path("m.exr"));
+    ASSERT_TRUE(file.analytic.has_value());
+    EXPECT_EQ(file.analytic->scalars.at("falloffWidth"), 1.5);
+    EXPECT_EQ(file.analytic->scalars.at("falloffShape"), 2.0);
+    conus::codec::FociOptions options;
+    options.aspect = 1.5;
+    options.falloff = {1.5, conus::codec::FociFalloffShape::LogRadius};
+    const auto built = conus::codec::buildFociMap(foci, options);
+    const auto read = conus::codec::SamplingMap::fromGrid(file.map);
+    ASSERT_EQ(read.nodes().size(), built.nodes().size());
+    double differs = 0, fromDefault = 0;
+    conus::codec::FociOptions defaults;
+    defaults.aspect = 1.5;
+    const auto plain = conus::codec::buildFociMap(foci, defaults);
+    for (std::size_t k = 0; k < built.nodes().size(); ++k) {
+        differs = std::max(differs, double(glm::length(read.nodes()[k] - built.nodes()[k])));
+        fromDefault = std::max(fromDefault, double(glm::length(read.nodes()[k] - plain.nodes()[k])));
+    }
+    EXPECT_LT(differs, 1e-6);
+    EXPECT_GT(fromDefault, 1e-3);  // the option changed the map
+    // encode --focus takes it too; the default leaves no trace in the file.
+    const std::string in = makePicture(240, 160);
+    ASSERT_EQ(run("encode " + in + " --focus 0.45,0.5,0.1,4 --falloff 3 -o " + path("e.exr") + " --size 60x40").exitCode, 0);
+    EXPECT_EQ(conus::format::readConusFile(path("e.exr")).analytic->scalars.at("falloffWidth"), 3.0);
+    ASSERT_EQ(run("encode " + in + " --focus 0.45,0.5,0.1,4 -o " + path("d.exr") + " --size 60x40").exitCode, 0);
+    EXPECT_TRUE(conus::format::readConusFile(path("d.exr")).analytic->scalars.empty());
+    // Bad falloffs: a usage error naming it, and no file.
+    for (const char* bad : {"1", "9", "2,cubic", "x"}) {
+        const Result b = run(std::string("map foci --focus 0.5,0.5,0.1,4 --falloff ") + bad + " -o " + path("b.exr"));
+        EXPECT_EQ(b.exitCode, 2) << bad << ": " << b.err;
+        EXPECT_NE(b.err.find("falloff"), std::string::npos) << b.err;
+        EXPECT_FALSE(fs::exists(path("b.exr")));
+    }
 }
 
 TEST_F(Cli, DensityBoundsAreHeldOrRefused) {

@@ -83,6 +83,24 @@ def test_maps_distort_undistort_and_density():
     np.testing.assert_allclose(rebuilt.distort(p), d, atol=1e-6)
 
 
+def test_foci_falloff_and_measures():
+    # A narrower transition (falloff 1.25) spends fewer samples on the ring r..2r than today's
+    # (2, density); a bad falloff is refused. measures() is what `conus info` reports.
+    grid = np.stack(np.meshgrid((np.arange(200) + 0.5) / 200, (np.arange(200) + 0.5) / 200), -1).reshape(-1, 2)
+    ring = np.hypot(grid[:, 0] - 0.4, (grid[:, 1] - 0.55) / 1.5) / 0.08
+    shares = {}
+    for falloff in ("2", "1.25", "1.5,logr"):
+        m = conus.Map.foci([(0.4, 0.55, 0.08, 4)], aspect=1.5, falloff=falloff)
+        d = m.density(grid)
+        shares[falloff] = d[(ring > 1) & (ring < 2)].sum() / d.sum()
+        measures = m.measures(1.5)
+        assert measures["max_anisotropy"] > 1.5 and measures["min_cell_density"] < 1 < measures["max_cell_density"]
+    assert shares["1.25"] < shares["2"] and shares["1.5,logr"] < shares["2"]
+    assert conus.Map.foci([(0.4, 0.55, 0.08, 4)], aspect=1.5, falloff="2").measures(1.5) == conus.Map.foci([(0.4, 0.55, 0.08, 4)], aspect=1.5).measures(1.5)
+    with pytest.raises(conus.Error, match="falloff"):
+        conus.Map.foci([(0.5, 0.5, 0.1, 4)], falloff="0.5")
+
+
 def test_auto_and_springs_maps_concentrate_where_asked():
     importance = np.zeros((64, 96), np.float32)
     importance[10:20, 60:80] = 1.0

@@ -23,6 +23,8 @@ constexpr double kSamplesPerRadius = 12.0;
 constexpr int kMinDensitySide = 256;
 constexpr int kMaxDensitySide = 512;
 constexpr int kMinShortSide = 32;
+// The widest focus falloff, in radii of the focus.
+constexpr double kMaxFalloffWidth = 8.0;
 // Add composition: the factor applied to all displacements while the sum folds.
 constexpr double kAddShrink = 0.9;
 
@@ -30,17 +32,32 @@ void checkOptions(const FociOptions& options) {
     if (!(options.aspect > 0.0) || !std::isfinite(options.aspect)) {
         throw Error(ErrorCode::InvalidArgument, "aspect " + numberText(options.aspect) + " is not finite and > 0");
     }
+    checkFalloff(options.falloff);
 }
 
-// Quintic smoothstep falloff: 1 inside the radius, 0 beyond twice it, C2 in between.
-double falloff(double s) {
-    if (s <= 1.0) return 1.0;
-    if (s >= 2.0) return 0.0;
-    const double x = 2.0 - s;  // 1 at s = 1, 0 at s = 2
+// Quintic smoothstep: 0 at x <= 0, 1 at x >= 1, C2 in between.
+double smoothstep(double x) {
+    if (x <= 0.0) return 0.0;
+    if (x >= 1.0) return 1.0;
     return x * x * x * (x * (x * 6.0 - 15.0) + 10.0);
 }
 
-DensityField sampleFociDensity(std::span<const Focus> foci, double aspect) {
+// The density of one focus of magnification k at s = distance / r (FociFalloff).
+double focusDensity(double s, double k, const FociFalloff& falloff) {
+    if (s <= 1.0) return k * k;
+    if (s >= falloff.width) return 1.0;
+    switch (falloff.shape) {
+        case FociFalloffShape::Density:
+            return 1.0 + (k * k - 1.0) * smoothstep((falloff.width - s) / (falloff.width - 1.0));
+        case FociFalloffShape::LogDensity:
+            return std::pow(k, 2.0 * smoothstep((falloff.width - s) / (falloff.width - 1.0)));
+        case FociFalloffShape::LogRadius:
+            return std::pow(k, 2.0 * smoothstep(std::log(falloff.width / s) / std::log(falloff.width)));
+    }
+    return 1.0;
+}
+
+DensityField sampleFociDensity(std::span<const Focus> foci, double aspect, const FociFalloff& falloff) {
     double rMin = 1.0;
     for (const Focus& f : foci) rMin = std::min(rMin, f.r);
     // Radius in u is r, in v it is r * aspect; sample pixel-isotropically (H = W / aspect).
@@ -55,7 +72,7 @@ DensityField sampleFociDensity(std::span<const Focus> foci, double aspect) {
     for (int y = 0; y < field.height; ++y)
         for (int x = 0; x < field.width; ++x)
             field.values[std::size_t(y) * field.width + x] =
-                static_cast<float>(fociDensity(foci, aspect, (x + 0.5) / field.width, (y + 0.5) / field.height));
+                static_cast<float>(fociDensity(foci, aspect, (x + 0.5) / field.width, (y + 0.5) / field.height, falloff));
     return field;
 }
 
@@ -64,7 +81,7 @@ SamplingMap buildDensityComposition(std::span<const Focus> foci, const FociOptio
     mapOptions.columns = options.columns;
     mapOptions.rows = options.rows;
     mapOptions.maxAnisotropy = options.maxAnisotropy;
-    return buildMapFromDensity(sampleFociDensity(foci, options.aspect), mapOptions);
+    return buildMapFromDensity(sampleFociDensity(foci, options.aspect, options.falloff), mapOptions);
 }
 
 SamplingMap buildAddComposition(std::span<const Focus> foci, const FociOptions& options) {
@@ -103,14 +120,47 @@ SamplingMap buildAddComposition(std::span<const Focus> foci, const FociOptions& 
 
 }  // namespace
 
-double fociDensity(std::span<const Focus> foci, double aspect, double u, double v) {
+double fociDensity(std::span<const Focus> foci, double aspect, double u, double v, const FociFalloff& falloff) {
     double density = 1.0;
     for (const Focus& f : foci) {
         const double dx = u - f.u, dy = (v - f.v) / aspect;
-        const double s = std::sqrt(dx * dx + dy * dy) / f.r;
-        density = std::max(density, 1.0 + (f.k * f.k - 1.0) * falloff(s));
+        density = std::max(density, focusDensity(std::sqrt(dx * dx + dy * dy) / f.r, f.k, falloff));
     }
     return density;
+}
+
+void checkFalloff(const FociFalloff& falloff) {
+    if (!(falloff.width > 1.0 && falloff.width <= kMaxFalloffWidth)) {
+        throw Error(ErrorCode::InvalidArgument, "focus falloff width " + numberText(falloff.width) + " is not in (1, " +
+                                                    numberText(kMaxFalloffWidth) + "] (radii of the focus)");
+    }
+}
+
+FociFalloff parseFalloff(const std::string& text) {
+    FociFalloff falloff;
+    const std::size_t comma = text.find(',');
+    const std::string width = text.substr(0, comma), shape = comma == std::string::npos ? "density" : text.substr(comma + 1);
+    char* end = nullptr;
+    errno = 0;
+    falloff.width = std::strtod(width.c_str(), &end);
+    if (width.empty() || end != width.c_str() + width.size() || errno == ERANGE) {
+        throw Error(ErrorCode::InvalidArgument, "falloff \"" + text + "\": width \"" + width + "\" is not a number");
+    }
+    if (shape == "density") falloff.shape = FociFalloffShape::Density;
+    else if (shape == "log") falloff.shape = FociFalloffShape::LogDensity;
+    else if (shape == "logr") falloff.shape = FociFalloffShape::LogRadius;
+    else throw Error(ErrorCode::InvalidArgument, "falloff \"" + text + "\": shape \"" + shape + "\" is not density, log or logr");
+    try {
+        checkFalloff(falloff);
+    } catch (const Error& e) {
+        throw Error(ErrorCode::InvalidArgument, "falloff \"" + text + "\": " + e.what());
+    }
+    return falloff;
+}
+
+std::string falloffText(const FociFalloff& falloff) {
+    static constexpr const char* kShapes[] = {"density", "log", "logr"};
+    return numberText(falloff.width) + "," + kShapes[static_cast<int>(falloff.shape)];
 }
 
 void checkFocus(const Focus& f) {
@@ -223,11 +273,15 @@ Focus parseFocus(const std::string& text) {
     return focus;
 }
 
-format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition composition) {
+format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition composition, const FociFalloff& falloff) {
     format::AnalyticMap analytic;
     analytic.kind = "foci";
     analytic.composition = composition == FociComposition::Add ? "add" : "density";
     for (const Focus& f : foci) analytic.foci.push_back({f.u, f.v, f.r, f.k});
+    if (falloff.width != FociFalloff{}.width || falloff.shape != FociFalloff{}.shape) {
+        analytic.scalars["falloffWidth"] = falloff.width;
+        analytic.scalars["falloffShape"] = static_cast<double>(falloff.shape);
+    }
     return analytic;
 }
 

@@ -46,6 +46,91 @@ TEST(Foci, DensityProfile) {
     EXPECT_DOUBLE_EQ(fociDensity(two, 1.0, 0.31, 0.5), 9.0);
 }
 
+const FociFalloff kFalloffs[] = {{2.0, FociFalloffShape::Density},    {1.25, FociFalloffShape::Density},
+                                  {1.5, FociFalloffShape::LogDensity},  {3.0, FociFalloffShape::Density},
+                                  {2.0, FociFalloffShape::LogRadius},   {3.0, FociFalloffShape::LogRadius}};
+
+TEST(Foci, FalloffProfiles) {
+    const Focus f{0.4, 0.5, 0.1, 4};
+    const std::vector<Focus> foci{f};
+    const double aspect = 16.0 / 9.0;
+    auto at = [&](double s, const FociFalloff& falloff) {  // along a diagonal, circular in pixels
+        const double c = std::cos(0.6), sn = std::sin(0.6);
+        return fociDensity(foci, aspect, f.u + s * f.r * c, f.v + s * f.r * sn * aspect, falloff);
+    };
+    for (const FociFalloff& falloff : kFalloffs) {
+        const std::string name = falloffText(falloff);
+        EXPECT_NEAR(at(0.999, falloff), 16.0, 1e-9) << name;
+        EXPECT_NEAR(at(falloff.width + 1e-6, falloff), 1.0, 1e-9) << name;
+        // Strictly falling through the transition, and continuous at both ends.
+        double last = at(1.0, falloff);
+        EXPECT_NEAR(last, 16.0, 1e-6) << name;
+        for (double s = 1.0 + 1e-3; s < falloff.width; s += 1e-3) {
+            const double d = at(s, falloff);
+            EXPECT_LT(d, last + 1e-12) << name << " s " << s;
+            EXPECT_LT(last - d, 0.5) << name << " s " << s;  // no jump
+            last = d;
+        }
+        EXPECT_NEAR(at(falloff.width - 1e-6, falloff), 1.0, 1e-6) << name;
+        // Half way: the density shape blends the density, the log shapes its logarithm (to k).
+        const double s = falloff.shape == FociFalloffShape::LogRadius ? std::sqrt(falloff.width) : 0.5 * (1 + falloff.width);
+        EXPECT_NEAR(at(s, falloff), falloff.shape == FociFalloffShape::Density ? 1 + 15.0 / 2 : 4.0, 1e-6) << name;
+    }
+    // At equal width a log blend is never denser than the density blend (k^(2t) <= 1 + (k^2-1) t).
+    for (double s = 1.0; s < 2.0; s += 0.01)
+        EXPECT_LE(at(s, {2.0, FociFalloffShape::LogDensity}), at(s, {2.0, FociFalloffShape::Density}) + 1e-12) << s;
+    // The default is the width 2 density blend: the same as no falloff given.
+    EXPECT_EQ(fociDensity(foci, aspect, 0.53, 0.52), fociDensity(foci, aspect, 0.53, 0.52, {2.0, FociFalloffShape::Density}));
+}
+
+// The share of all samples that a focus's transition ring (r..width r) holds, on the built map:
+// the ring's area after distortion (the integral of the map's density over it), sampled finely.
+// Against the same share of the target density (fociDensity), which the map follows.
+TEST(Foci, FalloffSetsTheTransitionsShareOfSamples) {
+    const std::vector<Focus> foci{{0.45, 0.55, 0.08, 4}};
+    const double aspect = 1.5;
+    constexpr int kSamples = 400;
+    struct Share {
+        double map, target;
+    };
+    auto ringShare = [&](const FociFalloff& falloff) {
+        FociOptions options;
+        options.aspect = aspect;
+        options.falloff = falloff;
+        const SamplingMap map = buildFociMap(foci, options);
+        expectValid(map);
+        double mapRing = 0, mapAll = 0, targetRing = 0, targetAll = 0;
+        for (int j = 0; j < kSamples; ++j)
+            for (int i = 0; i < kSamples; ++i) {
+                const double u = (i + 0.5) / kSamples, v = (j + 0.5) / kSamples;
+                const double du = u - foci[0].u, dv = (v - foci[0].v) / aspect;
+                const double s = std::sqrt(du * du + dv * dv) / foci[0].r;
+                const double d = map.density({u, v}), t = fociDensity(foci, aspect, u, v, falloff);
+                mapAll += d;
+                targetAll += t;
+                if (s > 1.0 && s < falloff.width) {
+                    mapRing += d;
+                    targetRing += t;
+                }
+            }
+        return Share{mapRing / mapAll, targetRing / targetAll};
+    };
+    std::vector<Share> shares;
+    for (const FociFalloff& falloff : kFalloffs) {
+        shares.push_back(ringShare(falloff));
+        // The map spends on the ring what its target asks, within 15% (a 65-node grid over a ring
+        // a few cells wide).
+        EXPECT_NEAR(shares.back().map, shares.back().target, 0.15 * shares.back().target) << falloffText(falloff);
+    }
+    // Wider rings hold more of the samples, log blends fewer than the density blend of their width.
+    const Share wide2 = shares[0], narrow = shares[1], log15 = shares[2], wide3 = shares[3], logr2 = shares[4], logr3 = shares[5];
+    EXPECT_LT(narrow.map, log15.map);
+    EXPECT_LT(log15.map, wide2.map);
+    EXPECT_LT(wide2.map, wide3.map);
+    EXPECT_LT(logr2.map, wide2.map);
+    EXPECT_LT(logr3.map, wide3.map);
+}
+
 TEST(Foci, SingleFocusMagnification) {
     for (double k : {2.0, 4.0}) {
         for (double aspect : {1.0, 16.0 / 9.0}) {
@@ -159,6 +244,38 @@ TEST(Foci, RejectsBadFoci) {
     FociOptions o;
     o.aspect = 0;
     EXPECT_EQ(code({0.5, 0.5, 0.1, 2}, o), ErrorCode::InvalidArgument);
+    for (double width : {1.0, 0.5, 8.5, std::nan("")}) {
+        FociOptions bad;
+        bad.falloff.width = width;
+        EXPECT_EQ(code({0.5, 0.5, 0.1, 2}, bad), ErrorCode::InvalidArgument) << width;
+    }
+}
+
+TEST(Foci, ParseFalloffAndRecordIt) {
+    EXPECT_EQ(parseFalloff("2").width, 2.0);
+    EXPECT_EQ(parseFalloff("2").shape, FociFalloffShape::Density);
+    EXPECT_EQ(parseFalloff("1.5,log").shape, FociFalloffShape::LogDensity);
+    EXPECT_EQ(parseFalloff("3,logr").shape, FociFalloffShape::LogRadius);
+    EXPECT_EQ(parseFalloff("3,logr").width, 3.0);
+    for (const FociFalloff& f : kFalloffs) {
+        EXPECT_EQ(parseFalloff(falloffText(f)).width, f.width);
+        EXPECT_EQ(parseFalloff(falloffText(f)).shape, f.shape);
+    }
+    for (const char* text : {"", "x", "1", "9", "nan", "2,", "2,cubic", "2x", "1.5,log,3"}) {
+        try {
+            parseFalloff(text);
+            ADD_FAILURE() << "accepted \"" << text << '"';
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+            EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+        }
+    }
+    // The file records a falloff other than the default (so the map can be rebuilt), and only then.
+    const std::vector<Focus> foci{{0.5, 0.5, 0.1, 3}};
+    EXPECT_TRUE(toAnalytic(foci, FociComposition::Density).scalars.empty());
+    const format::AnalyticMap a = toAnalytic(foci, FociComposition::Density, {1.5, FociFalloffShape::LogRadius});
+    EXPECT_EQ(a.scalars.at("falloffWidth"), 1.5);
+    EXPECT_EQ(a.scalars.at("falloffShape"), 2.0);
 }
 
 TEST(Foci, AGridTooCoarseForAFocusIsRefusedNamingOneThatHoldsIt) {

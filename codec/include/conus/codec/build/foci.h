@@ -1,7 +1,8 @@
 // Circular focus maps (spec/ "foci"): a focus u,v,r,k magnifies a disc of radius r (a fraction of
 // the image width, circular in pixels) so that the linear sampling rate at its centre is k times
 // the rate far from every focus. Density inside the disc is k^2 times the context density and
-// falls smoothly to it between r and 2r.
+// falls smoothly to it between r and w·r (the falloff: w = 2 and a smoothstep of the density by
+// default; FociFalloff).
 //
 // Two ways to build several foci:
 // - Density (default): one map from the joint density of all foci (density_map.h); the region
@@ -26,11 +27,33 @@ struct Focus {
 
 enum class FociComposition { Density, Add };
 
+// The transition from a focus's disc (density k^2) to the context (density 1), over the radii
+// s = distance / r in [1, width], with t = smoothstep(width - s over width - 1) (quintic, C2):
+// - Density: density 1 + (k^2 - 1) t (the default);
+// - LogDensity: density k^(2 t): the same ends, sparser in the outer part of the ring;
+// - LogRadius: density k^(2 t') with t' the smoothstep of log(width / s) over log(width): log
+//   density falls most steeply near the disc, as the least anisotropic radial focus does.
+enum class FociFalloffShape { Density, LogDensity, LogRadius };
+
+struct FociFalloff {
+    double width = 2.0;  // outer radius of the transition over r: in (1, 8]
+    FociFalloffShape shape = FociFalloffShape::Density;
+};
+
+// Throws conus::Error(InvalidArgument) for a width outside (1, 8] (NaN fails).
+void checkFalloff(const FociFalloff& falloff);
+// "2", "1.5,log", "3,logr" (a width, then optionally density | log | logr) -> FociFalloff; throws
+// conus::Error(InvalidArgument) with the reason.
+FociFalloff parseFalloff(const std::string& text);
+// The inverse of parseFalloff ("2,density" for the default).
+std::string falloffText(const FociFalloff& falloff);
+
 struct FociOptions {
     int columns = map_rules::kDefaultSide, rows = map_rules::kDefaultSide;  // grid of the built map
     double aspect = 1.0;          // image width / height: makes a focus circular in pixels
     FociComposition composition = FociComposition::Density;
     double maxAnisotropy = 0;     // density composition: DensityMapOptions::maxAnisotropy (0: none)
+    FociFalloff falloff = {};     // how each focus's density falls to the context's (`= {}`: no -Wextra warning)
 };
 
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r outside (0, 1] or k outside
@@ -51,12 +74,14 @@ std::vector<double> reachedMagnification(const SamplingMap& map, std::span<const
 void checkFociHeld(const SamplingMap& map, std::span<const Focus> foci, const FociOptions& options);
 
 // The target density (before normalization) of a set of foci at undistorted p.
-double fociDensity(std::span<const Focus> foci, double aspect, double u, double v);
+double fociDensity(std::span<const Focus> foci, double aspect, double u, double v, const FociFalloff& falloff = {});
 
 // "u,v,r,k" -> Focus; throws conus::Error(InvalidArgument) with the reason.
 Focus parseFocus(const std::string& text);
 
-// Analytic parameters for the file: kind "foci", the foci and how they were composed.
-format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition composition);
+// Analytic parameters for the file: kind "foci", the foci and how they were composed; a falloff
+// other than the default as the scalars falloffWidth and falloffShape (0 Density, 1 LogDensity,
+// 2 LogRadius; spec/ "Analytic-map parameters").
+format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition composition, const FociFalloff& falloff = {});
 
 }  // namespace conus::codec
