@@ -142,6 +142,11 @@ inline void tapBiased(const float* pixels, int width, int height, int c, double 
     const float* r0 = pixels + y0 * stride;
     const float* r1 = pixels + y1 * stride;
     const int o0 = x0 * channels, o1 = x1 * channels;
+    if constexpr (detail::kLanes<kC> && !kAccumulate) {
+        const float* last = pixels + (static_cast<std::size_t>(height) * width - 1) * kC;
+        detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(r0, r1, o0, o1, fx, fy, last));
+        return;
+    }
     for (int k = 0; k < channels; ++k) {
         const float top = r0[o0 + k] + fx * (r0[o1 + k] - r0[o0 + k]);
         const float bottom = r1[o0 + k] + fx * (r1[o1 + k] - r1[o0 + k]);
@@ -166,15 +171,17 @@ struct Level {
     const float* pixels;
     int width, height;
     float sx, sy, ox, oy;
+    const float* last;  // the last pixel (bilinearLanes)
 };
 
 std::vector<Level> pyramidLevels(const Image& conus, const ImagePyramid* pyramid) {
-    std::vector<Level> levels{{conus.pixels.data(), conus.width, conus.height, 1.0f, 1.0f, 0.0f, 0.0f}};
+    const auto last = [](const Image& im) { return im.pixels.data() + im.pixels.size() - im.channels.size(); };
+    std::vector<Level> levels{{conus.pixels.data(), conus.width, conus.height, 1.0f, 1.0f, 0.0f, 0.0f, last(conus)}};
     if (!pyramid) return levels;
     for (const Image& l : pyramid->levels) {
         const double sx = double(l.width) / conus.width, sy = double(l.height) / conus.height;
         levels.push_back({l.pixels.data(), l.width, l.height, float(sx), float(sy), float(0.5 - 0.5 * sx),
-                          float(0.5 - 0.5 * sy)});
+                          float(0.5 - 0.5 * sy), last(l)});
     }
     return levels;
 }
@@ -197,6 +204,18 @@ inline void levelTap(const Level& l, int c, float x, float y, float* out) {
     }
 }
 
+// levelTap with the pixel in lanes.
+template <int kC>
+inline detail::PixelLanes levelTapLanes(const Level& l, float x, float y) {
+    const int xi = static_cast<int>(x), yi = static_cast<int>(y);
+    const float fx = x - static_cast<float>(xi), fy = y - static_cast<float>(yi);
+    const std::size_t stride = static_cast<std::size_t>(l.width) * kC;
+    const float* r0 = l.pixels + static_cast<std::size_t>(std::max(yi - 1, 0)) * stride;
+    const float* r1 = l.pixels + static_cast<std::size_t>(std::min(yi, l.height - 1)) * stride;
+    return detail::bilinearLanes<kC>(r0, r1, static_cast<std::size_t>(std::max(xi - 1, 0)) * kC,
+                                     static_cast<std::size_t>(std::min(xi, l.width - 1)) * kC, fx, fy, l.last);
+}
+
 // One trilinear tap at biased level-0 coordinates (x, y) for a footprint whose longer edge
 // squared is rho2 CoNUS pixels squared: bilinear on the two levels around pyramidLevel, blended.
 // `scratch` holds a pixel's channels.
@@ -213,6 +232,21 @@ inline void trilinearTap(const Level* levels, int top, int c, float x, float y, 
     const Level& b = levels[l + 1];
     levelTap<kC>(b, channels, x * b.sx + b.ox, y * b.sy + b.oy, scratch);
     for (int k = 0; k < channels; ++k) out[k] += f * (scratch[k] - out[k]);
+}
+
+// trilinearTap with the pixel in lanes (the same floats).
+template <int kC>
+inline void trilinearTapLanes(const Level* levels, int top, float x, float y, float rho2, float* out) {
+    const float lambda = std::min(pyramidLevel(rho2), static_cast<float>(top));
+    const int l = static_cast<int>(lambda);
+    const float f = lambda - static_cast<float>(l);
+    const Level& a = levels[l];
+    detail::PixelLanes value = levelTapLanes<kC>(a, x * a.sx + a.ox, y * a.sy + a.oy);
+    if (f > 0.0f) {
+        const Level& b = levels[l + 1];
+        value = detail::lerpLanes(value, levelTapLanes<kC>(b, x * b.sx + b.ox, y * b.sy + b.oy), f);
+    }
+    detail::storeLanes<kC>(out, value);
 }
 
 // kPyramid: zoomed-out pixels take one trilinear tap from `levels` instead of the multi-tap
@@ -235,6 +269,7 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
     std::vector<float> dynamicScratch(kC > 0 ? 0 : channels);
     float* const scratch = kC > 0 ? fixedScratch : dynamicScratch.data();
     const float* pixels = src.pixels.data();
+    const float* const last = levels[0].last;
 
     for (int y = y0; y < y1; ++y) {
         const detail::CellRow row = detail::cellRow(m, view.v0 + (y + 0.5) / H * (view.v1 - view.v0));
@@ -274,6 +309,10 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
                         const float fy = static_cast<float>(fyp & 0xffffffff) * kFraction;
                         const float* p0 = pixels + (yi - 1) * stride + static_cast<std::size_t>(xi - 1) * channels;
                         const float* p1 = p0 + stride;
+                        if constexpr (detail::kLanes<kC>) {
+                            detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(p0, p1, 0, kC, fx, fy, last));
+                            continue;
+                        }
                         for (int c = 0; c < channels; ++c) {
                             const float top = p0[c] + fx * (p0[channels + c] - p0[c]);
                             const float bottom = p1[c] + fx * (p1[channels + c] - p1[c]);
@@ -299,8 +338,13 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
                 const int top = static_cast<int>(levels.size()) - 1;
                 for (int k = 0; k < count; ++k, px += sx, py += sy, out += channels) {
                     const float bxp = bx0 + static_cast<float>(k) * dbx, byp = by0 + static_cast<float>(k) * dby;
-                    trilinearTap<kC>(levels.data(), top, channels, static_cast<float>(px), static_cast<float>(py),
-                                     std::max(a2, bxp * bxp + byp * byp), out, scratch);
+                    const float rho2 = std::max(a2, bxp * bxp + byp * byp);
+                    if constexpr (detail::kLanes<kC>)
+                        trilinearTapLanes<kC>(levels.data(), top, static_cast<float>(px), static_cast<float>(py), rho2,
+                                              out);
+                    else
+                        trilinearTap<kC>(levels.data(), top, channels, static_cast<float>(px), static_cast<float>(py),
+                                         rho2, out, scratch);
                 }
                 return;
             }
@@ -369,6 +413,13 @@ void bilinearRows(const Image& src, Image& dst, const AxisTaps& tx, const AxisTa
         const float* r1 = src.pixels.data() + ty.i1[y] * stride;
         const float fy = ty.f[y];
         float* out = dst.pixels.data() + static_cast<std::size_t>(y) * dst.width * channels;
+        if constexpr (detail::kLanes<kC>) {
+            const float* last = src.pixels.data() + src.pixels.size() - kC;
+            for (int x = 0; x < dst.width; ++x, out += kC)
+                detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(r0, r1, std::size_t(tx.i0[x]) * kC,
+                                                                      std::size_t(tx.i1[x]) * kC, tx.f[x], fy, last));
+            continue;
+        }
         for (int x = 0; x < dst.width; ++x, out += channels) {
             const int o0 = tx.i0[x] * channels, o1 = tx.i1[x] * channels;
             const float fx = tx.f[x];
