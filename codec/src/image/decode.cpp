@@ -11,6 +11,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "conus/codec/image/decode.h"
@@ -628,6 +629,36 @@ float pyramidLevel(float rhoSquared) {
     const float t = mantissa - 1.0f;  // log2(1 + t) ~ t (1.3465553 - 0.3465553 t), exact at t = 0 and 1
     return std::max(0.0f, 0.5f * (static_cast<float>(exponent) + t * (1.3465553f - 0.3465553f * t)) -
                               static_cast<float>(kDecodePyramidBias));
+}
+
+bool viewZoomsOut(const Image& conus, const SamplingMap& map, const View& view, int width, int height) {
+    checkView(view, "viewZoomsOut");
+    detail::checkOutputSize(width, height, "viewZoomsOut");
+    const int n = map.columns(), m = map.rows();
+    // Output pixels per map cell along u and v; the cells the view covers (clamped like Eq. 1).
+    const double du = std::abs(view.u1 - view.u0) / width * (n - 1), dv = std::abs(view.v1 - view.v0) / height * (m - 1);
+    const auto cells = [](double a, double b, int count) {
+        const double lo = std::clamp(std::min(a, b), 0.0, 1.0), hi = std::clamp(std::max(a, b), 0.0, 1.0);
+        return std::pair{std::clamp(static_cast<int>(lo * count), 0, count - 1),
+                         std::clamp(static_cast<int>(hi * count), 0, count - 1)};
+    };
+    const auto [i0, i1] = cells(view.u0, view.u1, n - 1);
+    const auto [j0, j1] = cells(view.v0, view.v1, m - 1);
+    const glm::dvec2 scale(conus.width, conus.height);
+    double longest2 = 0;  // the longest footprint edge, squared: |a| and |b| are largest on a cell's edges
+    for (int j = j0; j <= j1 + 1; ++j)
+        for (int i = i0; i <= i1 + 1; ++i) {
+            const glm::dvec2 p = glm::dvec2(map.node(i, j)) * scale;
+            if (i <= i1) {
+                const glm::dvec2 a = (glm::dvec2(map.node(i + 1, j)) * scale - p) * du;
+                longest2 = std::max(longest2, a.x * a.x + a.y * a.y);
+            }
+            if (j <= j1) {
+                const glm::dvec2 b = (glm::dvec2(map.node(i, j + 1)) * scale - p) * dv;
+                longest2 = std::max(longest2, b.x * b.x + b.y * b.y);
+            }
+        }
+    return longest2 > kPyramidOneTap * kPyramidOneTap;
 }
 
 void checkPyramid(const Image& conus, const ImagePyramid& pyramid) {
