@@ -3,6 +3,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,7 @@
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
+#include "conus/codec/image/decode.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/build/map_measures.h"
@@ -73,6 +75,46 @@ TEST_F(Cli, EncodeWithFociThenValidateInfoDecode) {
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(imageSize(path("zoom2.exr")), std::make_pair(80, 60));  // the view at source resolution
     EXPECT_TRUE(leftovers().empty());
+}
+
+// A zoomed-out view goes through the image's pyramid (one trilinear tap per pixel), a magnified
+// one through the plain bilinear tap: the same floats as the codec's decoder each way.
+TEST_F(Cli, DecodeTakesThePyramidForAZoomedOutView) {
+    const std::string in = makePicture(320, 240);
+    ASSERT_EQ(run("encode " + in + " -o " + path("a.exr") + " --size 160x120 --focus 0.4,0.5,0.12,4 --float").exitCode, 0);
+    const auto file = conus::format::readConusFile(path("a.exr"));
+    const auto map = conus::codec::SamplingMap::fromGrid(file.map);
+    const conus::codec::ImagePyramid pyramid = conus::codec::buildPyramid(file.image);
+    const auto decoded = [&](const std::string& name) {
+        const ExrRead r = readExr(path(name));
+        std::vector<float> values;
+        for (std::size_t p = 0; p < static_cast<std::size_t>(r.width) * r.height; ++p)
+            for (const std::string& c : file.image.channels) values.push_back(r.channels.at(c).at(p));
+        return values;
+    };
+    const auto maxDifference = [](const std::vector<float>& a, const std::vector<float>& b) {
+        float worst = a.size() == b.size() ? 0.0f : INFINITY;
+        for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+        return worst;
+    };
+    conus::codec::DecodeOptions o;
+    o.width = 80;
+    o.height = 60;
+    Result r = run("decode " + path("a.exr") + " -o " + path("fit.exr") + " --size 80x60 --backend cpu");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::vector<float> fitted = decoded("fit.exr");
+    const conus::Image taps = conus::codec::decodeImage(file.image, map, o);
+    o.pyramid = &pyramid;
+    const conus::Image trilinear = conus::codec::decodeImage(file.image, map, o);
+    EXPECT_LT(maxDifference(fitted, trilinear.pixels), 1e-6f);
+    EXPECT_GT(maxDifference(fitted, taps.pixels), 1e-3f);  // not the multi-tap average
+
+    r = run("decode " + path("a.exr") + " -o " + path("zoom.exr") + " --view 0.1,0.1,0.3,0.3 --size 200x200 --backend cpu");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    o.view = {0.1, 0.1, 0.3, 0.3};
+    o.width = o.height = 200;
+    o.pyramid = nullptr;
+    EXPECT_LT(maxDifference(decoded("zoom.exr"), conus::codec::decodeImage(file.image, map, o).pixels), 1e-6f);
 }
 
 TEST_F(Cli, UniformIsTheIdentityMap) {

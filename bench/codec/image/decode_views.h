@@ -15,10 +15,8 @@ namespace conus::bench {
 
 // Hash noise: content does not change the cost of these kernels, and this is quick to build.
 inline Image hashImage(int side, unsigned seed) {
-    Image im;
-    im.width = im.height = side;
-    im.channels = {"R", "G", "B"};
-    im.pixels.resize(static_cast<std::size_t>(side) * side * 3);
+    // makeImage, as the EXR reader does: huge pages for a large image.
+    Image im = makeImage(side, side, {"R", "G", "B"});
     std::uint32_t h = seed * 2654435761u + 1;
     for (float& v : im.pixels) {
         h ^= h << 13;

@@ -9,7 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "conus/codec/image/decode.h"
@@ -142,6 +144,11 @@ inline void tapBiased(const float* pixels, int width, int height, int c, double 
     const float* r0 = pixels + y0 * stride;
     const float* r1 = pixels + y1 * stride;
     const int o0 = x0 * channels, o1 = x1 * channels;
+    if constexpr (detail::kLanes<kC> && !kAccumulate) {
+        const float* last = pixels + (static_cast<std::size_t>(height) * width - 1) * kC;
+        detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(r0, r1, o0, o1, fx, fy, last));
+        return;
+    }
     for (int k = 0; k < channels; ++k) {
         const float top = r0[o0 + k] + fx * (r0[o1 + k] - r0[o0 + k]);
         const float bottom = r1[o0 + k] + fx * (r1[o1 + k] - r1[o0 + k]);
@@ -166,15 +173,17 @@ struct Level {
     const float* pixels;
     int width, height;
     float sx, sy, ox, oy;
+    const float* last;  // the last pixel (bilinearLanes)
 };
 
 std::vector<Level> pyramidLevels(const Image& conus, const ImagePyramid* pyramid) {
-    std::vector<Level> levels{{conus.pixels.data(), conus.width, conus.height, 1.0f, 1.0f, 0.0f, 0.0f}};
+    const auto last = [](const Image& im) { return im.pixels.data() + im.pixels.size() - im.channels.size(); };
+    std::vector<Level> levels{{conus.pixels.data(), conus.width, conus.height, 1.0f, 1.0f, 0.0f, 0.0f, last(conus)}};
     if (!pyramid) return levels;
     for (const Image& l : pyramid->levels) {
         const double sx = double(l.width) / conus.width, sy = double(l.height) / conus.height;
         levels.push_back({l.pixels.data(), l.width, l.height, float(sx), float(sy), float(0.5 - 0.5 * sx),
-                          float(0.5 - 0.5 * sy)});
+                          float(0.5 - 0.5 * sy), last(l)});
     }
     return levels;
 }
@@ -197,6 +206,18 @@ inline void levelTap(const Level& l, int c, float x, float y, float* out) {
     }
 }
 
+// levelTap with the pixel in lanes.
+template <int kC>
+inline detail::PixelLanes levelTapLanes(const Level& l, float x, float y) {
+    const int xi = static_cast<int>(x), yi = static_cast<int>(y);
+    const float fx = x - static_cast<float>(xi), fy = y - static_cast<float>(yi);
+    const std::size_t stride = static_cast<std::size_t>(l.width) * kC;
+    const float* r0 = l.pixels + static_cast<std::size_t>(std::max(yi - 1, 0)) * stride;
+    const float* r1 = l.pixels + static_cast<std::size_t>(std::min(yi, l.height - 1)) * stride;
+    return detail::bilinearLanes<kC>(r0, r1, static_cast<std::size_t>(std::max(xi - 1, 0)) * kC,
+                                     static_cast<std::size_t>(std::min(xi, l.width - 1)) * kC, fx, fy, l.last);
+}
+
 // One trilinear tap at biased level-0 coordinates (x, y) for a footprint whose longer edge
 // squared is rho2 CoNUS pixels squared: bilinear on the two levels around pyramidLevel, blended.
 // `scratch` holds a pixel's channels.
@@ -213,6 +234,156 @@ inline void trilinearTap(const Level* levels, int top, int c, float x, float y, 
     const Level& b = levels[l + 1];
     levelTap<kC>(b, channels, x * b.sx + b.ox, y * b.sy + b.oy, scratch);
     for (int k = 0; k < channels; ++k) out[k] += f * (scratch[k] - out[k]);
+}
+
+// trilinearTap with the pixel in lanes (the same floats).
+template <int kC>
+inline void trilinearTapLanes(const Level* levels, int top, float x, float y, float rho2, float* out) {
+    const float lambda = std::min(pyramidLevel(rho2), static_cast<float>(top));
+    const int l = static_cast<int>(lambda);
+    const float f = lambda - static_cast<float>(l);
+    const Level& a = levels[l];
+    detail::PixelLanes value = levelTapLanes<kC>(a, x * a.sx + a.ox, y * a.sy + a.oy);
+    if (f > 0.0f) {
+        const Level& b = levels[l + 1];
+        value = detail::lerpLanes(value, levelTapLanes<kC>(b, x * b.sx + b.ox, y * b.sy + b.oy), f);
+    }
+    detail::storeLanes<kC>(out, value);
+}
+
+// The pyramid decode of a run of pixels in two passes, for 3 and 4 channels: the first plans
+// every pixel's taps (level, offsets, weights) four pixels at a time in vector lanes and touches
+// no image; the second only loads and blends. One pass per pixel was a chain of ~100 dependent
+// cycles (level, coordinates, addresses, then the loads) of which the core overlapped about two
+// pixels; split, the second pass has many pixels' loads in flight (bench/README.md, "Decode
+// speed"). The operations are trilinearTap's, lane by lane, so the results are the same floats.
+typedef std::int32_t IntLanes __attribute__((vector_size(16)));
+
+constexpr int kPlanBlock = 64;  // pixels planned at once (a multiple of 4)
+
+struct TapPlan {
+    alignas(16) std::int32_t offset[kPlanBlock];  // the top-left pixel, floats from the level's first
+    alignas(16) std::int32_t dx[kPlanBlock];      // to its right neighbour: channels, 0 at the edge
+    alignas(16) std::int32_t dy[kPlanBlock];      // to the one below: a row, 0 at the edge
+    alignas(16) float fx[kPlanBlock];
+    alignas(16) float fy[kPlanBlock];
+};
+struct PixelPlan {
+    TapPlan taps[2];                           // on levels `level` and `level` + 1
+    alignas(16) std::int32_t level[kPlanBlock];
+    alignas(16) float blend[kPlanBlock];       // trilinearTap's f: 0 takes the first tap alone
+};
+
+// Whether the levels' offsets fit the plan's 32-bit integers.
+bool plannable(const Level& level0, int channels) {
+    return static_cast<std::int64_t>(level0.width) * level0.height * channels < (std::int64_t{1} << 31);
+}
+
+// levelTap's arithmetic on four pixels of one level (x, y: biased level-0 coordinates).
+template <int kC>
+inline void planTaps(const Level& l, detail::PixelLanes x, detail::PixelLanes y, TapPlan& plan, int at) {
+    const detail::PixelLanes lx = x * l.sx + l.ox, ly = y * l.sy + l.oy;
+    const IntLanes xi = __builtin_convertvector(lx, IntLanes), yi = __builtin_convertvector(ly, IntLanes);
+    const detail::PixelLanes fx = lx - __builtin_convertvector(xi, detail::PixelLanes);
+    const detail::PixelLanes fy = ly - __builtin_convertvector(yi, detail::PixelLanes);
+    const IntLanes zero = {0, 0, 0, 0};
+    const IntLanes xm = xi - 1, ym = yi - 1, wLast = zero + (l.width - 1), hLast = zero + (l.height - 1);
+    const IntLanes x0 = xm > zero ? xm : zero, x1 = xi < wLast ? xi : wLast;
+    const IntLanes y0 = ym > zero ? ym : zero, y1 = yi < hLast ? yi : hLast;
+    const std::int32_t stride = l.width * kC;
+    // x1 - x0 and y1 - y0 are 0 or 1: the steps by masks, not multiplies (SSE2 has no 32-bit one).
+    const IntLanes offset = y0 * stride + x0 * kC, dx = (x0 - x1) & kC, dy = (y0 - y1) & stride;
+    std::memcpy(plan.offset + at, &offset, sizeof offset);
+    std::memcpy(plan.dx + at, &dx, sizeof dx);
+    std::memcpy(plan.dy + at, &dy, sizeof dy);
+    std::memcpy(plan.fx + at, &fx, sizeof fx);
+    std::memcpy(plan.fy + at, &fy, sizeof fy);
+}
+
+// pyramidLevel on four footprints (the same operations as the scalar one).
+inline detail::PixelLanes pyramidLevels(detail::PixelLanes rho2) {
+    IntLanes bits;
+    std::memcpy(&bits, &rho2, sizeof bits);
+    const IntLanes exponent = ((bits >> 23) & 0xff) - 127;
+    const IntLanes mantissaBits = (bits & 0x7fffff) | 0x3f800000;
+    detail::PixelLanes mantissa;
+    std::memcpy(&mantissa, &mantissaBits, sizeof mantissa);
+    const detail::PixelLanes t = mantissa - 1.0f;
+    const detail::PixelLanes zero = {0, 0, 0, 0};
+    const detail::PixelLanes lambda =
+        0.5f * (__builtin_convertvector(exponent, detail::PixelLanes) + t * (1.3465553f - 0.3465553f * t)) -
+        static_cast<float>(kDecodePyramidBias);
+    const detail::PixelLanes positive = zero < lambda ? lambda : zero;
+    return rho2 > 1.0f ? positive : zero;
+}
+
+// The footprint along a span: the longer of a (a2: its length squared, fixed) and
+// b = b0 + k db, k the pixel's index in the span, squared (as decodeRows has it).
+struct SpanFootprint {
+    float a2, bx0, by0, dbx, dby;
+};
+
+// Plans `count` (<= kPlanBlock) pixels at biased level-0 coordinates xs, ys (arrays padded to a
+// multiple of 4), pixels k0.. of a span.
+template <int kC>
+void planPixels(const Level* levels, int top, const float* xs, const float* ys, const SpanFootprint& fp, int k0,
+                int count, PixelPlan& plan) {
+    const detail::PixelLanes topLanes = {0, 0, 0, 0};
+    for (int at = 0; at < count; at += 4) {
+        detail::PixelLanes x, y;
+        std::memcpy(&x, xs + at, sizeof x);
+        std::memcpy(&y, ys + at, sizeof y);
+        const IntLanes kInt = IntLanes{0, 1, 2, 3} + (k0 + at);
+        const detail::PixelLanes k = __builtin_convertvector(kInt, detail::PixelLanes);
+        const detail::PixelLanes bx = fp.bx0 + k * fp.dbx, by = fp.by0 + k * fp.dby;
+        const detail::PixelLanes b2 = bx * bx + by * by;
+        const detail::PixelLanes r = fp.a2 < b2 ? b2 : topLanes + fp.a2;  // std::max(a2, b2)
+        const detail::PixelLanes level = pyramidLevels(r), topLevel = topLanes + static_cast<float>(top);
+        const detail::PixelLanes lambda = topLevel < level ? topLevel : level;  // std::min(level, top)
+        const IntLanes l = __builtin_convertvector(lambda, IntLanes);
+        const detail::PixelLanes f = lambda - __builtin_convertvector(l, detail::PixelLanes);
+        std::memcpy(plan.level + at, &l, sizeof l);
+        std::memcpy(plan.blend + at, &f, sizeof f);
+        if (l[0] == l[1] && l[0] == l[2] && l[0] == l[3]) {
+            planTaps<kC>(levels[l[0]], x, y, plan.taps[0], at);
+            if (l[0] < top) planTaps<kC>(levels[l[0] + 1], x, y, plan.taps[1], at);
+            continue;
+        }
+        // Lanes on different levels: each lane's levels in turn (the other lanes' entries are
+        // overwritten by their own).
+        for (int k = 0; k < 4; ++k) {
+            TapPlan scratch[2];
+            planTaps<kC>(levels[l[k]], x, y, scratch[0], 0);
+            const int taps = l[k] < top ? 2 : 1;
+            if (taps == 2) planTaps<kC>(levels[l[k] + 1], x, y, scratch[1], 0);
+            for (int t = 0; t < taps; ++t) {
+                plan.taps[t].offset[at + k] = scratch[t].offset[k];
+                plan.taps[t].dx[at + k] = scratch[t].dx[k];
+                plan.taps[t].dy[at + k] = scratch[t].dy[k];
+                plan.taps[t].fx[at + k] = scratch[t].fx[k];
+                plan.taps[t].fy[at + k] = scratch[t].fy[k];
+            }
+        }
+    }
+}
+
+template <int kC>
+inline detail::PixelLanes plannedTap(const Level& l, const TapPlan& plan, int k) {
+    const float* p0 = l.pixels + plan.offset[k];
+    const float* p1 = p0 + plan.dy[k];
+    return detail::bilinearLanes<kC>(p0, p1, 0, static_cast<std::size_t>(plan.dx[k]), plan.fx[k], plan.fy[k], l.last);
+}
+
+// The second pass: loads and blends only.
+template <int kC>
+void decodePlanned(const Level* levels, const PixelPlan& plan, int count, float* out) {
+    for (int k = 0; k < count; ++k, out += kC) {
+        const int l = plan.level[k];
+        detail::PixelLanes value = plannedTap<kC>(levels[l], plan.taps[0], k);
+        const float f = plan.blend[k];
+        if (f > 0.0f) value = detail::lerpLanes(value, plannedTap<kC>(levels[l + 1], plan.taps[1], k), f);
+        detail::storeLanes<kC>(out, value);
+    }
 }
 
 // kPyramid: zoomed-out pixels take one trilinear tap from `levels` instead of the multi-tap
@@ -235,6 +406,11 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
     std::vector<float> dynamicScratch(kC > 0 ? 0 : channels);
     float* const scratch = kC > 0 ? fixedScratch : dynamicScratch.data();
     const float* pixels = src.pixels.data();
+    const float* const last = levels[0].last;
+    // The planned pyramid decode's block (decodePlanned).
+    const bool planned = kPyramid && detail::kLanes<kC> && plannable(levels[0], channels);
+    std::unique_ptr<PixelPlan> plan(planned ? new PixelPlan : nullptr);
+    alignas(16) float blockX[kPlanBlock], blockY[kPlanBlock];
 
     for (int y = y0; y < y1; ++y) {
         const detail::CellRow row = detail::cellRow(m, view.v0 + (y + 0.5) / H * (view.v1 - view.v0));
@@ -274,6 +450,10 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
                         const float fy = static_cast<float>(fyp & 0xffffffff) * kFraction;
                         const float* p0 = pixels + (yi - 1) * stride + static_cast<std::size_t>(xi - 1) * channels;
                         const float* p1 = p0 + stride;
+                        if constexpr (detail::kLanes<kC>) {
+                            detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(p0, p1, 0, kC, fx, fy, last));
+                            continue;
+                        }
                         for (int c = 0; c < channels; ++c) {
                             const float top = p0[c] + fx * (p0[channels + c] - p0[c]);
                             const float bottom = p1[c] + fx * (p1[channels + c] - p1[c]);
@@ -297,10 +477,36 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
                 const float dbx = static_cast<float>(span.ds * (bx[i + 1] - bx[i]));
                 const float dby = static_cast<float>(span.ds * (by[i + 1] - by[i]));
                 const int top = static_cast<int>(levels.size()) - 1;
+                if constexpr (detail::kLanes<kC>) {
+                    if (planned) {
+                        // The inputs a block at a time (the positions stepped in double as below), then
+                        // its plan, then the taps.
+                        for (int k0 = 0; k0 < count; k0 += kPlanBlock) {
+                            const int n = std::min(kPlanBlock, count - k0);
+                            for (int k = 0; k < n; ++k, px += sx, py += sy) {
+                                blockX[k] = static_cast<float>(px);
+                                blockY[k] = static_cast<float>(py);
+                            }
+                            for (int k = n; k < ((n + 3) & ~3); ++k) {
+                                blockX[k] = blockX[n - 1];
+                                blockY[k] = blockY[n - 1];
+                            }
+                            planPixels<kC>(levels.data(), top, blockX, blockY, {a2, bx0, by0, dbx, dby}, k0, n, *plan);
+                            decodePlanned<kC>(levels.data(), *plan, n, out);
+                            out += static_cast<std::size_t>(n) * kC;
+                        }
+                        return;
+                    }
+                }
                 for (int k = 0; k < count; ++k, px += sx, py += sy, out += channels) {
                     const float bxp = bx0 + static_cast<float>(k) * dbx, byp = by0 + static_cast<float>(k) * dby;
-                    trilinearTap<kC>(levels.data(), top, channels, static_cast<float>(px), static_cast<float>(py),
-                                     std::max(a2, bxp * bxp + byp * byp), out, scratch);
+                    const float rho2 = std::max(a2, bxp * bxp + byp * byp);
+                    if constexpr (detail::kLanes<kC>)
+                        trilinearTapLanes<kC>(levels.data(), top, static_cast<float>(px), static_cast<float>(py), rho2,
+                                              out);
+                    else
+                        trilinearTap<kC>(levels.data(), top, channels, static_cast<float>(px), static_cast<float>(py),
+                                         rho2, out, scratch);
                 }
                 return;
             }
@@ -369,6 +575,13 @@ void bilinearRows(const Image& src, Image& dst, const AxisTaps& tx, const AxisTa
         const float* r1 = src.pixels.data() + ty.i1[y] * stride;
         const float fy = ty.f[y];
         float* out = dst.pixels.data() + static_cast<std::size_t>(y) * dst.width * channels;
+        if constexpr (detail::kLanes<kC>) {
+            const float* last = src.pixels.data() + src.pixels.size() - kC;
+            for (int x = 0; x < dst.width; ++x, out += kC)
+                detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(r0, r1, std::size_t(tx.i0[x]) * kC,
+                                                                      std::size_t(tx.i1[x]) * kC, tx.f[x], fy, last));
+            continue;
+        }
         for (int x = 0; x < dst.width; ++x, out += channels) {
             const int o0 = tx.i0[x] * channels, o1 = tx.i1[x] * channels;
             const float fx = tx.f[x];
@@ -416,6 +629,36 @@ float pyramidLevel(float rhoSquared) {
     const float t = mantissa - 1.0f;  // log2(1 + t) ~ t (1.3465553 - 0.3465553 t), exact at t = 0 and 1
     return std::max(0.0f, 0.5f * (static_cast<float>(exponent) + t * (1.3465553f - 0.3465553f * t)) -
                               static_cast<float>(kDecodePyramidBias));
+}
+
+bool viewZoomsOut(const Image& conus, const SamplingMap& map, const View& view, int width, int height) {
+    checkView(view, "viewZoomsOut");
+    detail::checkOutputSize(width, height, "viewZoomsOut");
+    const int n = map.columns(), m = map.rows();
+    // Output pixels per map cell along u and v; the cells the view covers (clamped like Eq. 1).
+    const double du = std::abs(view.u1 - view.u0) / width * (n - 1), dv = std::abs(view.v1 - view.v0) / height * (m - 1);
+    const auto cells = [](double a, double b, int count) {
+        const double lo = std::clamp(std::min(a, b), 0.0, 1.0), hi = std::clamp(std::max(a, b), 0.0, 1.0);
+        return std::pair{std::clamp(static_cast<int>(lo * count), 0, count - 1),
+                         std::clamp(static_cast<int>(hi * count), 0, count - 1)};
+    };
+    const auto [i0, i1] = cells(view.u0, view.u1, n - 1);
+    const auto [j0, j1] = cells(view.v0, view.v1, m - 1);
+    const glm::dvec2 scale(conus.width, conus.height);
+    double longest2 = 0;  // the longest footprint edge, squared: |a| and |b| are largest on a cell's edges
+    for (int j = j0; j <= j1 + 1; ++j)
+        for (int i = i0; i <= i1 + 1; ++i) {
+            const glm::dvec2 p = glm::dvec2(map.node(i, j)) * scale;
+            if (i <= i1) {
+                const glm::dvec2 a = (glm::dvec2(map.node(i + 1, j)) * scale - p) * du;
+                longest2 = std::max(longest2, a.x * a.x + a.y * a.y);
+            }
+            if (j <= j1) {
+                const glm::dvec2 b = (glm::dvec2(map.node(i, j + 1)) * scale - p) * dv;
+                longest2 = std::max(longest2, b.x * b.x + b.y * b.y);
+            }
+        }
+    return longest2 > kPyramidOneTap * kPyramidOneTap;
 }
 
 void checkPyramid(const Image& conus, const ImagePyramid& pyramid) {

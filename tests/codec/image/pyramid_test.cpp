@@ -71,6 +71,62 @@ TEST(Pyramid, MagnifiedPixelsAreTheBilinearTapUnchanged) {
               decodeImage(conus, map, viewOf(zoom, 300, 280)).pixels);
 }
 
+// Each channel alone (one channel: the scalar taps) against all of them together (three and
+// four: the pixel in vector lanes, the pyramid decode in planned blocks): the same floats, on
+// views that zoom out, magnify, reach past the image and mirror it, through odd-sized levels.
+TEST(Pyramid, VectorLanesGiveTheScalarDecode) {
+    const SamplingMap map = buildFociMap(std::vector<Focus>{{0.3, 0.35, 0.08, 4}, {0.7, 0.6, 0.06, 3}});
+    const View views[] = {{}, {0.18, 0.28, 0.42, 0.415}, {-0.2, -0.1, 1.3, 1.05}, {0.9, 0.95, 0.1, 0.05}};
+    for (const auto& names : {std::vector<std::string>{"R", "G", "B"}, std::vector<std::string>{"R", "G", "B", "A"}}) {
+        const Image conus = noise(301, 203, names, 11);
+        const ImagePyramid p = buildPyramid(conus);
+        std::vector<Image> planes;
+        std::vector<ImagePyramid> planePyramids;
+        for (std::size_t c = 0; c < names.size(); ++c) {
+            Image plane = makeImage(conus.width, conus.height, {"Y"});
+            for (std::size_t i = 0; i < plane.pixels.size(); ++i) plane.pixels[i] = conus.pixels[i * names.size() + c];
+            planePyramids.push_back(buildPyramid(plane));
+            planes.push_back(std::move(plane));
+        }
+        for (const View& view : views)
+            for (const bool pyramid : {false, true}) {
+                const Image all = decodeImage(conus, map, viewOf(view, 97, 61, pyramid ? &p : nullptr));
+                for (std::size_t c = 0; c < names.size(); ++c) {
+                    const Image one =
+                        decodeImage(planes[c], map, viewOf(view, 97, 61, pyramid ? &planePyramids[c] : nullptr));
+                    for (std::size_t i = 0; i < one.pixels.size(); ++i)
+                        ASSERT_NEAR(all.pixels[i * names.size() + c], one.pixels[i], 1e-6f)
+                            << names.size() << " channels, channel " << c << ", value " << i << ", pyramid " << pyramid;
+                }
+                const Image baseline = resizeBilinear(conus, view, 97, 61);
+                for (std::size_t c = 0; c < names.size(); ++c) {
+                    const Image one = resizeBilinear(planes[c], view, 97, 61);
+                    for (std::size_t i = 0; i < one.pixels.size(); ++i)
+                        ASSERT_NEAR(baseline.pixels[i * names.size() + c], one.pixels[i], 1e-6f) << "baseline";
+                }
+            }
+    }
+}
+
+TEST(Pyramid, ViewZoomsOutWhereSomeFootprintIsLongerThanOneTap) {
+    const Image conus = noise(256, 256, {"Y"});
+    const SamplingMap identity = SamplingMap::identity(9, 9);
+    EXPECT_FALSE(viewZoomsOut(conus, identity, {}, 256, 256));         // 1:1
+    EXPECT_FALSE(viewZoomsOut(conus, identity, {}, 190, 190));         // 1.35 pixels: still one tap
+    EXPECT_TRUE(viewZoomsOut(conus, identity, {}, 170, 256));          // 1.51 pixels along u
+    EXPECT_TRUE(viewZoomsOut(conus, identity, {0, 0, 0.5, 1}, 400, 100));  // along v
+    // A focus magnified 4x: its pixels are long in a fitted view whose context is magnified.
+    const SamplingMap focus = buildFociMap(std::vector<Focus>{{0.5, 0.5, 0.1, 4}});
+    EXPECT_TRUE(viewZoomsOut(conus, focus, {}, 256, 256));
+    EXPECT_FALSE(viewZoomsOut(conus, focus, {0.1, 0.1, 0.2, 0.2}, 256, 256));  // the context, zoomed in
+    // Where it says no, the pyramid changes nothing.
+    const ImagePyramid p = buildPyramid(conus);
+    const View zoom{0.1, 0.1, 0.2, 0.2};
+    EXPECT_EQ(decodeImage(conus, focus, viewOf(zoom, 256, 256, &p)).pixels,
+              decodeImage(conus, focus, viewOf(zoom, 256, 256)).pixels);
+    EXPECT_THROW(viewZoomsOut(conus, focus, {0, 0, 0, 1}, 10, 10), Error);
+}
+
 TEST(Pyramid, RejectsAPyramidOfAnotherImage) {
     const Image conus = noise(64, 48, {"Y"});
     const SamplingMap map = SamplingMap::identity(5, 5);

@@ -47,6 +47,12 @@ void checkPyramid(const Image& conus, const ImagePyramid& pyramid);
 inline constexpr double kDecodePyramidBias = 0.5;
 float pyramidLevel(float rhoSquared);
 
+// Whether some output pixel of `view` decoded at width x height has a footprint in `conus` longer
+// than the pyramid decode's one bilinear tap (2^kDecodePyramidBias CoNUS pixels): there a pyramid
+// changes the decode (and stops its aliasing); elsewhere the decode is the same with or without
+// one, so a caller may skip building it. Reads the map's cells the view covers.
+bool viewZoomsOut(const Image& conus, const SamplingMap& map, const View& view, int width, int height);
+
 struct DecodeOptions {
     View view;
     int width = 0, height = 0;  // output size
