@@ -6,7 +6,6 @@
 // footprint's major axis. A square footprint has no Gaussian: with the identity map and an integer
 // ratio the taps land exactly on source pixel centres, so the result is the exact area average.
 #include <array>
-#include <memory>
 #include <cmath>
 #include <cstring>
 #include <mutex>
@@ -53,8 +52,7 @@ AxisWeights areaWeights(int source, int target) {
 
 // Vertical pass into a row of source width, then the horizontal pass: each source value is read
 // once per output row it touches and the row buffer stays in cache.
-// A pixel array without its channel names: the pyramid's levels are not format::Images so they
-// are never zero-filled before being written.
+// A pixel array without its channel names.
 struct Plane {
     const float* data = nullptr;
     int width = 0, height = 0;
@@ -118,17 +116,19 @@ public:
         if (level == 0) return {m_source.pixels.data(), m_source.width, m_source.height};
         std::call_once(m_once[level], [&] {
             const Plane below = this->level(level - 1, threads);
-            m_levels[level].reset(new float[static_cast<std::size_t>(width(level)) * height(level) * m_channels]);
-            areaDownsamplePlane(below, m_levels[level].get(), width(level), height(level), m_channels, threads);
+            // A checked Image: zero-filled first, but in huge pages where large (core/image.cpp),
+            // which costs less than a 4 KiB page fault every 1024 floats of a new level.
+            m_levels[level] = makeImage(width(level), height(level), m_source.channels);
+            areaDownsamplePlane(below, m_levels[level].pixels.data(), width(level), height(level), m_channels, threads);
         });
-        return {m_levels[level].get(), width(level), height(level)};
+        return {m_levels[level].pixels.data(), width(level), height(level)};
     }
 
 private:
     const Image& m_source;
     int m_channels;
     std::vector<std::array<int, 2>> m_sizes;
-    std::array<std::unique_ptr<float[]>, kMaxLevels> m_levels;
+    std::array<Image, kMaxLevels> m_levels;
     std::array<std::once_flag, kMaxLevels> m_once;
 };
 
@@ -178,17 +178,6 @@ double footprintLevel(glm::dvec2 a, glm::dvec2 b, double minor, glm::dvec2 exten
     return std::log2(coarsest);
 }
 
-// The offsets o along `major` for which x - o * d lies in [-0.5, 0.5], intersected with [lo, hi].
-inline void narrowSlab(double x, double d, double& lo, double& hi) {
-    if (std::abs(d) < 1e-9) {
-        if (std::abs(x) > 0.5) hi = lo;
-        return;
-    }
-    const double o1 = (x - 0.5) / d, o2 = (x + 0.5) / d;
-    lo = std::max(lo, std::min(o1, o2));
-    hi = std::min(hi, std::max(o1, o2));
-}
-
 // Functions whose loops vectorize get a copy for x86-64-v3 (AVX2) besides the baseline one; the
 // loader picks one by the processor (an ifunc). Taken off where the toolchain may lack it.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__)
@@ -230,52 +219,51 @@ void boxRow(const TapGrid& g, int j, RowTaps& r) {
 }
 
 // A tap's weight is the Gaussian's mass over the offsets o along the major axis that keep the tap
-// in the unit box: the intersection of its column's slab (s) and its row's (t), cut at the reach.
-// erf is monotonic, so erf of the intersection's ends is the max / min of the slabs' erf: each
-// column's and each row's two erf are taken once per footprint, not two for every tap.
-struct GaussianColumns {
-    double lo[RowTaps::kMax], hi[RowTaps::kMax];         // the column's slab (lo > hi: empty)
+// in the unit box: the intersection of its column's slab (from s) and its row's (from t), within
+// the reach. erf is monotonic, so erf at the intersection's ends is the max / min of the slabs'
+// erf: each column's and each row's two erf are taken once per footprint, not two for every tap.
+struct Slabs {
+    double lo[RowTaps::kMax], hi[RowTaps::kMax];         // hi <= lo: empty
     double erfLo[RowTaps::kMax], erfHi[RowTaps::kMax];  // erf(k lo), erf(k hi)
 };
 
-// The columns' slabs: [(s - 0.5) / mx, (s + 0.5) / mx] (ordered), or, where the major axis runs
-// along t (mx ~ 0), the whole reach for a column of the unit box's width and nothing outside it.
-// Most of the encoder's arithmetic (two erf polynomials per column): on a processor with AVX2 a
-// second copy of it takes four columns at a time (CONUS_VECTOR_CLONES).
-CONUS_VECTOR_CLONES void gaussianColumns(const TapGrid& g, const FootprintFilter& filter, double k,
-                                         GaussianColumns& c) {
-    const double mx = filter.major.x;
-    if (std::abs(mx) >= 1e-9) {
-        const double inverse = 1.0 / mx;
-        for (int i = 0; i < g.ns; ++i) {
-            const double s = g.s0 + i * g.ds;
-            const double o1 = (s - 0.5) * inverse, o2 = (s + 0.5) * inverse;
-            c.lo[i] = o1 < o2 ? o1 : o2;  // (selects, not std::min/max: those kept the loop from vectorizing)
-            c.hi[i] = o1 < o2 ? o2 : o1;
+// The slabs of n grid lines at u = first + i * step: the offsets o for which u - o m lies in
+// [-0.5, 0.5] (m the major axis's component along u), within [-reach, reach]. Where m ~ 0 a line
+// within the unit box takes the whole reach and any other nothing. Most of the encoder's
+// arithmetic (two erf polynomials a line): on a processor with AVX2 a second copy of it takes
+// four lines at a time (CONUS_VECTOR_CLONES).
+CONUS_VECTOR_CLONES void gaussianSlabs(double first, double step, int n, double m, double reach, double k,
+                                       Slabs& out) {
+    // (Selects, not std::min/max: those kept the loops from vectorizing.)
+    if (std::abs(m) >= 1e-9) {
+        const double inverse = 1.0 / m;
+        for (int i = 0; i < n; ++i) {
+            const double u = first + i * step;
+            const double o1 = (u - 0.5) * inverse, o2 = (u + 0.5) * inverse;
+            const double lo = o1 < o2 ? o1 : o2, hi = o1 < o2 ? o2 : o1;
+            out.lo[i] = lo > -reach ? lo : -reach;
+            out.hi[i] = hi < reach ? hi : reach;
         }
     } else {
-        for (int i = 0; i < g.ns; ++i) {
-            const double inBox = std::abs(g.s0 + i * g.ds) <= 0.5 ? filter.reach : -filter.reach;
-            c.lo[i] = -inBox;
-            c.hi[i] = inBox;
+        for (int i = 0; i < n; ++i) {
+            out.lo[i] = -reach;
+            out.hi[i] = std::abs(first + i * step) <= 0.5 ? reach : -reach;
         }
     }
-    for (int i = 0; i < g.ns; ++i) {
-        c.erfLo[i] = detail::erfOnReach(c.lo[i] * k);
-        c.erfHi[i] = detail::erfOnReach(c.hi[i] * k);
+    for (int i = 0; i < n; ++i) {
+        out.erfLo[i] = detail::erfOnReach(out.lo[i] * k);
+        out.erfHi[i] = detail::erfOnReach(out.hi[i] * k);
     }
 }
 
-// Grid row j of the Gaussian filter: only the taps that can weigh anything (count 0 if none).
-// `k` is 1 / (sqrt(2) sigma).
-CONUS_VECTOR_CLONES void gaussianRow(const TapGrid& g, const FootprintFilter& filter, double k,
-                                     const GaussianColumns& c, int j, RowTaps& r) {
+// Grid row j of the Gaussian filter from the grid's column and row slabs: only the taps that can
+// weigh anything (count 0 if none).
+CONUS_VECTOR_CLONES void gaussianRow(const TapGrid& g, const FootprintFilter& filter, const Slabs& columns,
+                                     const Slabs& rows, int j, RowTaps& r) {
     r.count = 0;
-    const double t = g.t0 + j * g.dt;
-    // The row's slab along t, within the reach.
-    double rowLo = -filter.reach, rowHi = filter.reach;
-    narrowSlab(t, filter.major.y, rowLo, rowHi);
+    const double rowLo = rows.lo[j], rowHi = rows.hi[j];
     if (rowHi <= rowLo) return;
+    const double t = g.t0 + j * g.dt;
     const double rx = g.cx + g.bL.x * t, ry = g.cy + g.bL.y * t;
     const double mx = filter.major.x;
     // Only taps whose s slab meets the row's offsets weigh anything: s within 0.5 of
@@ -289,12 +277,13 @@ CONUS_VECTOR_CLONES void gaussianRow(const TapGrid& g, const FootprintFilter& fi
     }
     if (i1 <= i0) return;
     r.count = i1 - i0;
-    const double rowErfLo = detail::erfOnReach(rowLo * k), rowErfHi = detail::erfOnReach(rowHi * k);
+    const double rowErfLo = rows.erfLo[j], rowErfHi = rows.erfHi[j];
     for (int n = 0; n < r.count; ++n) {
         const int i = i0 + n;
-        const double lo = rowLo < c.lo[i] ? c.lo[i] : rowLo, hi = c.hi[i] < rowHi ? c.hi[i] : rowHi;
-        const double erfLo = rowErfLo < c.erfLo[i] ? c.erfLo[i] : rowErfLo;
-        const double erfHi = c.erfHi[i] < rowErfHi ? c.erfHi[i] : rowErfHi;
+        const double lo = rowLo < columns.lo[i] ? columns.lo[i] : rowLo;
+        const double hi = columns.hi[i] < rowHi ? columns.hi[i] : rowHi;
+        const double erfLo = rowErfLo < columns.erfLo[i] ? columns.erfLo[i] : rowErfLo;
+        const double erfHi = columns.erfHi[i] < rowErfHi ? columns.erfHi[i] : rowErfHi;
         r.weight[n] = hi > lo ? 0.5 * (erfHi - erfLo) : 0.0;
         const double s = g.s0 + i * g.ds;
         r.x[n] = rx + g.aL.x * s;
@@ -366,12 +355,15 @@ void filterOnLevel(Pyramid& pyramid, int level, int threads, int channels, const
     const bool inner = g.cx - ex >= 0 && g.cx + ex < img.width - 1 && g.cy - ey >= 0 && g.cy + ey < img.height - 1;
     const std::size_t stride = static_cast<std::size_t>(img.width) * channels;
     RowTaps r;
-    GaussianColumns columns;
-    if (!box) gaussianColumns(g, filter, k, columns);
+    Slabs columns, rows;
+    if (!box) {
+        gaussianSlabs(g.s0, g.ds, g.ns, filter.major.x, filter.reach, k, columns);
+        gaussianSlabs(g.t0, g.dt, g.nt, filter.major.y, filter.reach, k, rows);
+    }
     double total = 0;  // the sum of the weights taken
     const auto row = [&](int j) {
         if (box) boxRow(g, j, r);
-        else gaussianRow(g, filter, k, columns, j, r);
+        else gaussianRow(g, filter, columns, rows, j, r);
     };
     // All channels in one register where the footprint stays a row clear of the last one (the
     // four-float reads of the bottom row's texels stay inside the level).
