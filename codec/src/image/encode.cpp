@@ -179,7 +179,9 @@ double footprintLevel(glm::dvec2 a, glm::dvec2 b, double minor, glm::dvec2 exten
 }
 
 // Functions whose loops vectorize get a copy for x86-64-v3 (AVX2) besides the baseline one; the
-// loader picks one by the processor (an ifunc). Taken off where the toolchain may lack it.
+// loader picks one by the processor (an ifunc). That copy may fuse multiply-adds, so weights can
+// differ in their last bits from one processor to another (~1e-16). Taken off where the
+// toolchain may lack it.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__)
 #define CONUS_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
@@ -195,8 +197,8 @@ struct TapGrid {
 };
 
 // One grid row's taps, all worked out before any texel is read: each tap's arithmetic is then
-// independent of the others' and the loops vectorize (one tap at a time, every tap waited on a
-// division, two erf table reads and a branch).
+// independent of the others' and the loops vectorize (the loop this replaced took a tap at a time,
+// each waiting on two divisions, two erf table reads and a branch).
 struct RowTaps {
     static constexpr int kMax = 2 * kEncodeMaxAxisTaps;
     int count = 0;
