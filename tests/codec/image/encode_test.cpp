@@ -13,6 +13,7 @@
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
 #include "test_images.h"
+#include "../../../codec/src/image/encode_pvt.h"
 
 namespace conus::codec {
 namespace {
@@ -263,6 +264,125 @@ TEST(Encode, ThreadCountDoesNotChangeTheResult) {
     EXPECT_EQ(one.pixels, two.pixels);
     const Image a1 = areaDownsample(src, 100, 70, 1), a2 = areaDownsample(src, 100, 70, 2);
     EXPECT_EQ(a1.pixels, a2.pixels);
+}
+
+// The encoder's erf (a polynomial, so that a row of taps vectorizes) against the library's, over
+// the whole reach of the Gaussian and beyond it (held at the reach's value); non-decreasing,
+// which the encoder relies on when it takes erf at a slab's ends from its rows' and columns'.
+TEST(EncodeErf, MatchesTheLibraryOverTheReachAndNeverDecreases) {
+    const double reach = kEncodeGaussianReach / std::sqrt(2.0);
+    double worst = 0, previous = -2;
+    for (int i = -200000; i <= 200000; ++i) {
+        const double x = reach * i / 200000.0;
+        const double e = detail::erfOnReach(x);
+        worst = std::max(worst, std::abs(e - std::erf(x)));
+        EXPECT_GE(e, previous) << "at " << x;
+        previous = e;
+    }
+    EXPECT_LT(worst, 2e-9);
+    EXPECT_DOUBLE_EQ(detail::erfOnReach(3.0), detail::erfOnReach(reach));
+    EXPECT_DOUBLE_EQ(detail::erfOnReach(-1e300), -detail::erfOnReach(reach));
+}
+
+// encode.h's rule evaluated the plain way, in double, tap by tap over the whole grid with
+// clamp-to-edge bilinear reads and std::erf: what the encoder's row-at-a-time, vectorized path
+// (and its fallback at the borders and for other channel counts) must reproduce. The major axis
+// comes from the angle of [a b]'s right singular vector, the slabs from a direct intersection.
+double bilinearAt(const Image& im, int c, double x, double y) {
+    x = std::clamp(x, 0.0, im.width - 1.0);
+    y = std::clamp(y, 0.0, im.height - 1.0);
+    const int x0 = std::min(static_cast<int>(x), im.width - 2), y0 = std::min(static_cast<int>(y), im.height - 2);
+    const double fx = x - x0, fy = y - y0;
+    const auto v = [&](int i, int j) { return double(im.pixels[(std::size_t(j) * im.width + i) * im.channelCount() + c]); };
+    return (1 - fy) * ((1 - fx) * v(x0, y0) + fx * v(x0 + 1, y0)) + fy * ((1 - fx) * v(x0, y0 + 1) + fx * v(x0 + 1, y0 + 1));
+}
+
+Image encodeByTheRule(const Image& src, const SamplingMap& map, int W, int H, int& gaussianPixels) {
+    std::vector<Image> levels{src};
+    while (levels.back().width > 1 || levels.back().height > 1)
+        levels.push_back(areaDownsample(levels.back(), std::max(1, (levels.back().width + 1) / 2),
+                                        std::max(1, (levels.back().height + 1) / 2), 1));
+    const FootprintField field(map);
+    const double uniform = uniformSpacing(src.width, src.height, W, H);
+    const int channels = src.channelCount();
+    Image out = makeImage(W, H, src.channels);
+    gaussianPixels = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const glm::dvec2 p = map.undistort({(x + 0.5) / W, (y + 0.5) / H});
+            const glm::dmat2 J = field.inverseJacobian(p);
+            const glm::dvec2 a = J[0] / double(W) * glm::dvec2(src.width, src.height);
+            const glm::dvec2 b = J[1] / double(H) * glm::dvec2(src.width, src.height);
+            // [a b]^T [a b] = [[p q] [q r]]: its eigenvalues are the squared axes.
+            const double pp = glm::dot(a, a), q = glm::dot(a, b), r = glm::dot(b, b);
+            const double half = std::hypot(0.5 * (pp - r), q);
+            const double major = std::sqrt(0.5 * (pp + r) + half), minor = std::sqrt(std::max(0.0, 0.5 * (pp + r) - half));
+            const double angle = 0.5 * std::atan2(2 * q, pp - r);
+            const glm::dvec2 m(std::cos(angle), std::sin(angle));
+            const double ramp = major > 0 ? std::min(1 - kEncodeBoxAnisotropy * minor / major, 1 - uniform / major) : 0;
+            const double sigma = kEncodeAnisotropicSigma * std::max(0.0, ramp), reach = kEncodeGaussianReach * sigma;
+            const FootprintPlan plan = planFootprint(a, b, uniform);
+            const int top = static_cast<int>(levels.size()) - 1;
+            const int level = std::min(static_cast<int>(plan.level), top);
+            const double blend = level < top ? plan.level - level : 0.0;
+            if (sigma >= 1e-4) ++gaussianPixels;
+            std::vector<double> value[2];
+            for (int l = level; l <= std::min(level + 1, top); ++l) {
+                const Image& im = levels[l];
+                const glm::dvec2 scale(double(im.width) / src.width, double(im.height) / src.height);  // per axis
+                const glm::dvec2 aL = a * scale, bL = b * scale;
+                const int ns = std::clamp(static_cast<int>(std::ceil(glm::length(aL) * plan.extent.x - 1e-3)), 1, 128);
+                const int nt = std::clamp(static_cast<int>(std::ceil(glm::length(bL) * plan.extent.y - 1e-3)), 1, 128);
+                std::vector<double> sum(channels, 0.0);
+                double total = 0;
+                for (int j = 0; j < nt; ++j)
+                    for (int i = 0; i < ns; ++i) {
+                        const double s = (i + 0.5) * plan.extent.x / ns - 0.5 * plan.extent.x;
+                        const double t = (j + 0.5) * plan.extent.y / nt - 0.5 * plan.extent.y;
+                        double w = 1;
+                        if (sigma >= 1e-4) {  // the Gaussian's mass over o with (s,t) - o m in the unit box
+                            double lo = -reach, hi = reach;
+                            for (const auto& [u, mu] : {std::pair{s, m.x}, std::pair{t, m.y}}) {
+                                if (std::abs(mu) < 1e-9) {
+                                    if (std::abs(u) > 0.5) hi = lo;
+                                    continue;
+                                }
+                                lo = std::max(lo, std::min((u - 0.5) / mu, (u + 0.5) / mu));
+                                hi = std::min(hi, std::max((u - 0.5) / mu, (u + 0.5) / mu));
+                            }
+                            w = hi > lo ? 0.5 * (std::erf(hi / (std::sqrt(2.0) * sigma)) - std::erf(lo / (std::sqrt(2.0) * sigma))) : 0;
+                        }
+                        const glm::dvec2 tap = p * glm::dvec2(im.width, im.height) - 0.5 + aL * s + bL * t;
+                        for (int c = 0; c < channels; ++c) sum[c] += w * bilinearAt(im, c, tap.x, tap.y);
+                        total += w;
+                    }
+                for (double& v : sum) v /= total;
+                value[l - level] = sum;
+                if (!(blend > 0)) break;
+            }
+            for (int c = 0; c < channels; ++c)
+                out.pixels[(std::size_t(y) * W + x) * channels + c] = static_cast<float>(
+                    blend > 0 ? value[0][c] + blend * (value[1][c] - value[0][c]) : value[0][c]);
+        }
+    return out;
+}
+
+TEST(Encode, MatchesAPlainEvaluationOfTheFootprintRule) {
+    // A focus near the left edge (footprints clamped at the border) and one inside whose ring has
+    // long thin footprints (the Gaussian); 1, 3 (the vector path) and 5 channels (the general one).
+    const std::vector<Focus> foci = {{0.12, 0.45, 0.1, 4}, {0.62, 0.55, 0.12, 3}};
+    FociOptions options;
+    options.aspect = 330.0 / 250.0;
+    const SamplingMap map = buildFociMap(foci, options);
+    for (const auto& channels : {std::vector<std::string>{"Y"}, std::vector<std::string>{"R", "G", "B"},
+                                 std::vector<std::string>{"R", "G", "B", "A", "Z"}}) {
+        const Image src = noise(330, 250, channels, 5);
+        const Image enc = encodeImage(src, map, sized(110, 84, 2));
+        int gaussian = 0;
+        const Image reference = encodeByTheRule(src, map, 110, 84, gaussian);
+        EXPECT_GT(gaussian, 110 * 84 / 20) << "too few long footprints to test the Gaussian";
+        EXPECT_LT(maxAbsDifference(enc, reference), 2e-6f) << channels.size() << " channels";
+    }
 }
 
 TEST(Encode, ReportsProgressUpToOne) {
