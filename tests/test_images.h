@@ -60,4 +60,25 @@ inline float maxAbsDifference(const Image& a, const Image& b) {
     return worst;
 }
 
+// Photo-like: smooth shading, hard-edged shapes, fine texture and a little noise, per channel
+// slightly different.
+inline Image photoLike(int w, int h, std::vector<std::string> channels = {"R", "G", "B"}, unsigned seed = 7) {
+    Image im = makeImage(w, h, std::move(channels));
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> noise(-0.03f, 0.03f);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const double u = (x + 0.5) / w, v = (y + 0.5) / h;
+            for (int c = 0; c < im.channelCount(); ++c) {
+                double value = 0.35 + 0.25 * std::sin(3.0 * u + 2.0 * v + c) * std::cos(2.5 * v - c);
+                const double dx = u - 0.3 - 0.1 * c, dy = v - 0.55;
+                if (dx * dx + dy * dy < 0.04) value += 0.3;
+                if (u > 0.6 && u < 0.85 && v > 0.15 && v < 0.4) value -= 0.2;
+                value += 0.08 * std::sin(140.0 * u * (1 + v)) * std::sin(90.0 * v);
+                im.at(x, y, c) = static_cast<float>(value) + noise(rng);
+            }
+        }
+    return im;
+}
+
 }  // namespace conus::test

@@ -27,26 +27,6 @@ SamplingMap twoFoci(double aspect) {
     return buildFociMap(foci, options);
 }
 
-// A photo-like picture: smooth shading, a hard-edged disc and bar, a fine texture; each channel a
-// little different.
-Image picture(int w, int h, std::vector<std::string> channels) {
-    const Image grain = test::texture(std::max(w, h), 11);
-    Image im = makeImage(w, h, std::move(channels));
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const double u = (x + 0.5) / w, v = (y + 0.5) / h;
-            for (int c = 0; c < im.channelCount(); ++c) {
-                double value = 0.35 + 0.2 * std::sin(3.0 * u + 2.0 * v + c) * std::cos(2.5 * v - c);
-                const double dx = u - 0.3 - 0.05 * c, dy = v - 0.42;
-                if (dx * dx + dy * dy < 0.01) value += 0.35;
-                if (u > 0.6 && u < 0.8 && v > 0.5 && v < 0.7) value -= 0.25;
-                value += 0.3 * (grain.at(x, y) - 0.5) * (1 + c % 2);
-                im.at(x, y, c) = static_cast<float>(value);
-            }
-        }
-    return im;
-}
-
 double dot(const Image& a, const Image& b) {
     double sum = 0;
     for (std::size_t i = 0; i < a.pixels.size(); ++i) sum += double(a.pixels[i]) * b.pixels[i];
@@ -67,12 +47,17 @@ struct Case {
 };
 const Case kCases[] = {{75, 50, 3}, {240, 170, 1}, {150, 100, 4}};
 
+// Noise of the case's channel count (R, G, B, A in that order), w x h.
+Image caseNoise(const Case& c, int w, int h, unsigned seed) {
+    std::vector<std::string> names = {"R", "G", "B", "A"};
+    names.resize(c.channels);
+    return test::noise(w, h, names, seed);
+}
+
 TEST(Fit, ForwardIsTheDecoder) {
     const SamplingMap map = twoFoci(1.5);
     for (const Case& c : kCases) {
-        std::vector<std::string> names = {"R", "G", "B", "A"};
-        names.resize(c.channels);
-        const Image sized = test::noise(c.conusWidth, c.conusHeight, names, 3);
+        const Image sized = caseNoise(c, c.conusWidth, c.conusHeight, 3);
         DecodeOptions d;
         d.width = 300;
         d.height = 200;
@@ -85,10 +70,8 @@ TEST(Fit, ForwardIsTheDecoder) {
 TEST(Fit, AdjointIdentityThroughAFocusMap) {
     const SamplingMap map = twoFoci(1.5);
     for (const Case& c : kCases) {
-        std::vector<std::string> names = {"R", "G", "B", "A"};
-        names.resize(c.channels);
-        const Image x = test::noise(c.conusWidth, c.conusHeight, names, 5);
-        Image y = test::noise(300, 200, names, 6);
+        const Image x = caseNoise(c, c.conusWidth, c.conusHeight, 5);
+        Image y = caseNoise(c, 300, 200, 6);
         for (float& v : y.pixels) v -= 0.5f;  // signed, so that no sum is dominated by a mean
         const Image dx = detail::fitForward(x, map, 300, 200, 3);
         const Image dty = detail::fitAdjoint(y, map, c.conusWidth, c.conusHeight, 3);
@@ -103,7 +86,7 @@ TEST(Fit, AdjointIdentityThroughAFocusMap) {
 }
 
 TEST(Fit, ResidualFallsAndBeatsTheEwaEncode) {
-    const Image source = picture(360, 240, {"R", "G", "B"});
+    const Image source = test::photoLike(360, 240, {"R", "G", "B"});
     const SamplingMap map = twoFoci(1.5);
     EncodeOptions e;
     e.width = 90;
@@ -151,7 +134,7 @@ TEST(Fit, ResidualFallsAndBeatsTheEwaEncode) {
 }
 
 TEST(Fit, UniformImageFittedToBilinear) {
-    const Image source = picture(320, 200, {"R", "G", "B"});
+    const Image source = test::photoLike(320, 200, {"R", "G", "B"});
     const SamplingMap identity = SamplingMap::identity(2, 2);
     const Image area = areaDownsample(source, 80, 50);
     Image fitted = area;
@@ -164,7 +147,7 @@ TEST(Fit, UniformImageFittedToBilinear) {
 }
 
 TEST(Fit, DepthStaysAndAlphaIsFitted) {
-    const Image source = picture(240, 160, {"R", "G", "B", "A", "Z"});
+    const Image source = test::photoLike(240, 160, {"R", "G", "B", "A", "Z"});
     const SamplingMap map = twoFoci(1.5);
     EncodeOptions e;
     e.width = 60;
@@ -183,7 +166,7 @@ TEST(Fit, DepthStaysAndAlphaIsFitted) {
 }
 
 TEST(Fit, RefusesMismatchedInput) {
-    const Image source = picture(120, 80, {"R", "G", "B"});
+    const Image source = test::photoLike(120, 80, {"R", "G", "B"});
     const SamplingMap map = twoFoci(1.5);
     Image grey = test::noise(30, 20, {"Y"});
     EXPECT_EQ(test::codeOf([&] { fitToDecoder(source, map, grey); }), ErrorCode::InvalidArgument);
