@@ -61,10 +61,12 @@ BUDGET_GRID, BUDGET_MAX_DENSITY = 129, 64.0
 ANISOTROPY_LIMITS = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0]  # --max-anisotropy swept, at the loosest budget
 FIT = 4  # --fit iterations (the default of `encode --fit`) of the fitted variant (0: --no-fit leaves it out)
 FIT_HOLD = None  # --fit-hold (None: the encoder's default)
-METHODS = ("foci", "auto", "budget", "limited", "falloff", "foci+fit", "auto+fit", "budget+fit")
+METHODS = ("foci", "auto", "budget", "limited", "falloff", "foci+fit", "falloff+fit", "auto+fit", "budget+fit")
 # Foci of k = 4 with their transition's width and shape swept (`--falloff`; "2": the default).
 FALLOFFS = ["1.25", "1.5", "1.75", "2", "3", "1.5,log", "1.5,logr", "3,logr"]
 QUICK_FALLOFFS = ["1.5", "2", "3,logr"]
+# Narrower transitions with the fit (k = 4): the fit keeps their rims from combing (tests/codec/image/comb_test.cpp).
+FIT_FALLOFFS = ["1.75", "1.5"]
 
 
 def psnr(a, b, mask=None):
@@ -332,7 +334,7 @@ def frontier(name, src, regions, quick):
         # The fitted variants against the fitted uniform image: the same settings, each map once.
         ufview = uniform_view(src, size, FIT)
         fit_roi, fit_frame = psnr(ufview, src, roi), psnr(ufview, src)
-        points.update({"foci+fit": [], "auto+fit": [], "budget+fit": []})
+        points.update({"foci+fit": [], "falloff+fit": [], "auto+fit": [], "budget+fit": []})
 
         def add_fitted(method, setting, m=None, k=K, extra=()):
             view = view_of(encode_with(src, size, regions, k=k, map=m, fit=FIT), w, h)
@@ -356,6 +358,8 @@ def frontier(name, src, regions, quick):
         points["falloff"].append((falloff, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi,
                                   cfile.map.measures(w / h)["max_anisotropy"],
                                   density[roi].sum() / density.sum(), density[ring].sum() / density.sum()))
+    for falloff in FIT_FALLOFFS:
+        add_fitted("falloff+fit", falloff, m=conus.Map.foci([(u, v, r, K) for u, v, r in regions], aspect=w / h, falloff=falloff))
     for floor in ([0.6, 0.3] if quick else [0.8, 0.6, 0.45, 0.3, 0.2]):
         try:
             m = conus.Map.auto(importance, min_density=floor, max_density=36.0)
@@ -459,6 +463,7 @@ def plots(out, all_curves, all_points):
                                                 "budget": f"automatic map, --frame-loss budget swept (max density {BUDGET_MAX_DENSITY:g}, grid {BUDGET_GRID})",
                                                 "limited": f"the same at {BUDGETS[-1]:g} dB, --max-anisotropy {ANISOTROPY_LIMITS[0]:g}..{ANISOTROPY_LIMITS[-1]:g} swept",
                                                 "foci+fit": f"foci, --fit {FIT} (against uniform --fit {FIT})",
+                                                "falloff+fit": f"k = 4, --fit {FIT} --falloff " + " ".join(FIT_FALLOFFS),
                                                 "auto+fit": f"automatic map, floor swept, --fit {FIT}",
                                                 "budget+fit": f"automatic map, --frame-loss swept, --fit {FIT}"}[method])
     ax.axvline(2.5, color="grey", ls=":")
