@@ -98,19 +98,20 @@ std::string decodeOne(const DecodeCommandOptions& o, const std::string& input, c
     decode.view = view;
     decode.width = size.width;
     decode.height = size.height;
+    const bool depthImage = file.dataKind == format::DataKind::DepthImage && file.image.channelIndex("Z") >= 0;
+    // A zoomed-out view takes one trilinear tap from the image's pyramid per pixel (no aliasing,
+    // a fraction of the multi-tap average's work); a magnified one is the same without it.
+    const bool withPyramid = !depthImage && codec::viewZoomsOut(file.image, map, view, decode.width, decode.height);
     try {
-        codec::checkDecodeMemory(file.image, decode.width, decode.height);
+        codec::checkDecodeMemory(file.image, decode.width, decode.height, kMaxDecodeBytes, withPyramid);
     } catch (const Error& e) {
         throw Error(e.code(), std::string(e.what()) + "; give a smaller --size");
     }
     Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
     decode.progress = progress.callback();
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "decoding");
-    const bool depthImage = file.dataKind == format::DataKind::DepthImage && file.image.channelIndex("Z") >= 0;
-    // A zoomed-out view takes one trilinear tap from the image's pyramid per pixel (no aliasing,
-    // a fraction of the multi-tap average's work); a magnified one is the same without it.
     codec::ImagePyramid pyramid;
-    if (!depthImage && codec::viewZoomsOut(file.image, map, view, decode.width, decode.height)) {
+    if (withPyramid) {
         pyramid = codec::buildPyramid(file.image);
         decode.pyramid = &pyramid;
     }

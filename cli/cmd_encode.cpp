@@ -142,7 +142,7 @@ Command addEncodeCommand(CLI::App& root) {
         ->check(CLI::IsMember({"flow", "separable"}));
     command->add_option("--compose", options->compose, "how several foci combine: density (default) | add")
         ->check(CLI::IsMember({"density", "add"}));
-    addFalloffOption(*command, options->falloff);
+    addFalloffOption(*command, options->falloff)->needs("--focus");  // shapes foci only
     command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus and --importance (default " + std::to_string(map_rules::kDefaultSide) + ")")
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addFitOption(*command, options->fit);

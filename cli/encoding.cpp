@@ -58,7 +58,9 @@ void addFitOption(CLI::App& command, FitSetting& fit) {
     CLI::Option* enabled = command.add_flag(
         "--fit", fit.enabled,
         "fit the CoNUS image to the decoder: least squares (CGLS) from the filtered encode, so that the decoded "
-        "view at the source's size comes closest to the source");
+        "view at the source's size comes closest to the source (the decoder's bilinear and multi-tap paths; "
+        "zoomed-out views through the pyramid and the viewer reconstruct a little differently; colour and alpha "
+        "are fitted, unclamped)");
     command
         .add_option("--fit-iterations", fit.iterations, "with --fit: how many least-squares iterations")
         ->capture_default_str()

@@ -57,8 +57,8 @@ void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy) {
         ->check(CLI::Range(1.0, 1e6));
 }
 
-void addFalloffOption(CLI::App& command, std::string& falloff) {
-    command.add_option("--falloff", falloff,
+CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff) {
+    return command.add_option("--falloff", falloff,
                        "how a focus's density falls to the context's: WIDTH[,SHAPE], from r to WIDTH r (in (1, 8]), "
                        "SHAPE density (smoothstep of the density, the default) | log (of its logarithm) | logr (of its "
                        "logarithm over log radius); default 2,density");

@@ -14,6 +14,7 @@
 
 namespace CLI {
 class App;
+class Option;
 }
 
 namespace conus::cli {
@@ -23,7 +24,7 @@ namespace conus::cli {
 void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy);
 void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDensity, const std::string& prefix = "");
 // --falloff WIDTH[,SHAPE] for `map foci` and `encode --focus` (codec::parseFalloff; "2": the default).
-void addFalloffOption(CLI::App& command, std::string& falloff);
+CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff);
 
 // The builder's options from what `map auto` and `encode --importance` are given (method "flow"
 // or "separable").

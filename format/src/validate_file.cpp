@@ -158,6 +158,26 @@ void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationRepo
     }
 }
 
+// A foci map's transition: both falloff scalars or neither, the width in (1, kMaxFalloffWidth], the
+// shape one of the integers 0 .. kFalloffShapes - 1 (spec: Analytic-map parameters).
+void checkFalloffParams(const HeaderModel& m, ValidationReport& r) {
+    const auto width = m.params.find("falloffWidth"), shape = m.params.find("falloffShape");
+    const std::string prefix = specOf(&HeaderModel::params).name;
+    if ((width == m.params.end()) != (shape == m.params.end())) {
+        r.add(Rule::V12, prefix + "falloffWidth and " + prefix + "falloffShape come together; this part has only one");
+        return;
+    }
+    if (width == m.params.end()) return;
+    const double w = width->second.value, s = shape->second.value;
+    if (!(w > 1.0 && w <= map_rules::kMaxFalloffWidth)) {
+        r.add(Rule::V12, prefix + "falloffWidth = " + numberText(w, 9) + " is not in (1, " +
+                             numberText(map_rules::kMaxFalloffWidth, 9) + "]");
+    }
+    if (!(s >= 0 && s < map_rules::kFalloffShapes && s == std::floor(s))) {
+        r.add(Rule::V12, prefix + "falloffShape = " + numberText(s, 9) + " is not 0 (density), 1 (log) or 2 (logr)");
+    }
+}
+
 void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
     if (!m.mapKind.present) {
         if (m.foci.present || m.composition.present || !m.params.empty()) {
@@ -186,6 +206,7 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
         if (need(m, &HeaderModel::composition, r) && !oneOf(m.composition.value, {"density", "add"})) {
             r.add(Rule::V12, "composition `" + m.composition.value + "` is not density or add");
         }
+        checkFalloffParams(m, r);
     } else if (kind != "ground") {
         r.add(Rule::V12, "map kind `" + kind + "` is not foci or ground");
     }

@@ -556,7 +556,7 @@ Image decodeImageGpu(Context& context, const Image& conus, const codec::Sampling
                              const codec::DecodeOptions& options, GpuTimings* timings) {
     constexpr const char* kWhat = "decodeImageGpu";
     checkImage(conus, kWhat);
-    codec::checkDecodeMemory(conus, options.width, options.height);
+    codec::checkDecodeMemory(conus, options.width, options.height, kMaxDecodeBytes, options.pyramid != nullptr);
     if (options.pyramid) codec::checkPyramid(conus, *options.pyramid);
     const codec::View& view = options.view;
     if (!std::isfinite(view.u0) || !std::isfinite(view.u1) || !std::isfinite(view.v0) || !std::isfinite(view.v1) ||

@@ -424,6 +424,11 @@ TEST_F(Cli, FocusFalloffIsBuiltRecordedAndChecked) {
         EXPECT_NE(b.err.find("falloff"), std::string::npos) << b.err;
         EXPECT_FALSE(fs::exists(path("b.exr")));
     }
+    // encode's --falloff shapes foci only: without --focus it is refused, not dropped.
+    const Result alone = run("encode " + in + " --falloff 1.5 -o " + path("nofocus.exr") + " --size 60x40");
+    EXPECT_EQ(alone.exitCode, 2) << alone.err;
+    EXPECT_NE(alone.err.find("--focus"), std::string::npos) << alone.err;
+    EXPECT_FALSE(fs::exists(path("nofocus.exr")));
 }
 
 TEST_F(Cli, DensityBoundsAreHeldOrRefused) {

@@ -189,6 +189,20 @@ TEST_F(RuleTest, V12AnalyticMap) {
     EXPECT_TRUE(onlyRule(validateConusFile(f), 12));
     f.analytic = AnalyticMap{"ground", {}, "", {{"tilt", std::numeric_limits<double>::infinity()}}};
     EXPECT_TRUE(onlyRule(validateConusFile(f), 12));
+    // A focus's transition (--falloff): both scalars, the width in (1, 8], the shape 0, 1 or 2.
+    f.analytic = AnalyticMap{"foci", {{0.5, 0.5, 0.1, 2}}, "density", {{"falloffWidth", 1.75}, {"falloffShape", 2}}};
+    EXPECT_TRUE(validateConusFile(f).ok());
+    for (const auto& params : std::vector<std::map<std::string, double>>{{{"falloffWidth", 0.5}, {"falloffShape", 0}},
+                                                                         {{"falloffWidth", 20}, {"falloffShape", 0}},
+                                                                         {{"falloffWidth", 1.5}, {"falloffShape", 7}},
+                                                                         {{"falloffWidth", 1.5}, {"falloffShape", 1.5}},
+                                                                         {{"falloffWidth", 1.5}}}) {
+        f.analytic = AnalyticMap{"foci", {{0.5, 0.5, 0.1, 2}}, "density", params};
+        const ValidationReport report = validateConusFile(f);
+        EXPECT_TRUE(onlyRule(report, 12)) << params.begin()->second << " " << params.size();
+        ASSERT_FALSE(report.issues.empty());
+        EXPECT_NE(report.issues.front().message.find("falloff"), std::string::npos) << report.issues.front().message;
+    }
     EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) {
                              c.insert("conus:mapKind", Imf::StringAttribute("foci"));
                              c.insert("conus:foci", Imf::FloatVectorAttribute({0.5f, 0.5f, 0.1f, 2.0f, 0.3f}));

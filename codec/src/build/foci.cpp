@@ -24,7 +24,6 @@ constexpr int kMinDensitySide = 256;
 constexpr int kMaxDensitySide = 512;
 constexpr int kMinShortSide = 32;
 // The widest focus falloff, in radii of the focus.
-constexpr double kMaxFalloffWidth = 8.0;
 // Add composition: the factor applied to all displacements while the sum folds.
 constexpr double kAddShrink = 0.9;
 
@@ -130,9 +129,9 @@ double fociDensity(std::span<const Focus> foci, double aspect, double u, double 
 }
 
 void checkFalloff(const FociFalloff& falloff) {
-    if (!(falloff.width > 1.0 && falloff.width <= kMaxFalloffWidth)) {
+    if (!(falloff.width > 1.0 && falloff.width <= map_rules::kMaxFalloffWidth)) {
         throw Error(ErrorCode::InvalidArgument, "focus falloff width " + numberText(falloff.width) + " is not in (1, " +
-                                                    numberText(kMaxFalloffWidth) + "] (radii of the focus)");
+                                                    numberText(map_rules::kMaxFalloffWidth) + "] (radii of the focus)");
     }
 }
 

@@ -688,15 +688,17 @@ ImagePyramid buildPyramid(const Image& conus, int threads) {
     return pyramid;
 }
 
-void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes) {
+void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes, bool withPyramid) {
     const std::int64_t channels = conus.channelCount();
-    const std::int64_t bytes = (std::int64_t{conus.width} * conus.height + std::int64_t{width} * height) * channels *
+    const std::int64_t image = std::int64_t{conus.width} * conus.height;
+    const std::int64_t bytes = (image + (withPyramid ? image / 3 : 0) + std::int64_t{width} * height) * channels *
                                std::int64_t(sizeof(float));
     if (bytes > maxBytes) {
         throw Error(ErrorCode::LimitExceeded,
                     "decoding a " + std::to_string(conus.width) + "x" + std::to_string(conus.height) + " image to " +
                         std::to_string(width) + "x" + std::to_string(height) + " pixels of " + std::to_string(channels) +
-                        " channels takes " + std::to_string(bytes) + " bytes, beyond the decode memory limit of " +
+                        " channels" + (withPyramid ? std::string(" with its pyramid") : std::string()) + " takes " +
+                        std::to_string(bytes) + " bytes, beyond the decode memory limit of " +
                         std::to_string(maxBytes));
     }
 }
@@ -704,7 +706,7 @@ void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t m
 Image decodeImage(const Image& conus, const SamplingMap& map, const DecodeOptions& options) {
     checkImage(conus, "decodeImage");
     detail::checkOutputSize(options.width, options.height, "decodeImage");
-    checkDecodeMemory(conus, options.width, options.height);
+    checkDecodeMemory(conus, options.width, options.height, kMaxDecodeBytes, options.pyramid != nullptr);
     checkView(options.view, "decodeImage");
     if (options.pyramid) checkPyramid(conus, *options.pyramid);
     const std::vector<Level> levels = pyramidLevels(conus, options.pyramid);

@@ -370,7 +370,9 @@ void filterOnLevel(Pyramid& pyramid, int level, int threads, int channels, const
     // All channels in one register where the footprint stays a row clear of the last one (the
     // four-float reads of the bottom row's texels stay inside the level).
     if constexpr (kC > 0 && kC <= 4) {
-        if (inner && g.cy + ey < img.height - 2) {
+        // (One channel on a level two texels wide: the right texel's four floats would reach one
+        // past the level's last row, so that case takes the per-channel path.)
+        if (inner && g.cy + ey < img.height - 2 && (kC >= 2 || img.width >= 3)) {
             Float4 acc{0.0f, 0.0f, 0.0f, 0.0f};
             for (int j = 0; j < g.nt; ++j) {
                 row(j);

@@ -187,6 +187,11 @@ TEST(Decode, MemoryIsCheckedBeforeAllocating) {
     }
     EXPECT_NO_THROW(checkDecodeMemory(conus, 4096, 4096));
     EXPECT_THROW(checkDecodeMemory(conus, 64, 64, 1000), conus::Error);
+    // The pyramid's third of the image again counts: a limit the image and frame fit under, the
+    // image, its pyramid and the frame do not.
+    const std::int64_t plain = (std::int64_t{conus.width} * conus.height + 64 * 64) * conus.channelCount() * 4;
+    EXPECT_NO_THROW(checkDecodeMemory(conus, 64, 64, plain));
+    EXPECT_THROW(checkDecodeMemory(conus, 64, 64, plain, true), conus::Error);
 }
 
 }  // namespace
