@@ -6,6 +6,7 @@
 // image, so a magnified pixel costs the baseline's one bilinear tap plus a few integer adds. Where
 // the view is coarser than the CoNUS image (zoomed out, or a focus seen from afar) the pixel's
 // footprint, bounded per map cell, decides how many taps to average over it.
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -17,6 +18,7 @@
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "decode_pvt.h"
+#include "decode_simd_pvt.h"
 #include "conus/core/parallel.h"
 #include "resample_pvt.h"
 
@@ -281,7 +283,7 @@ bool plannable(const Level& level0, int channels) {
 
 // levelTap's arithmetic on four pixels of one level (x, y: biased level-0 coordinates).
 template <int kC>
-inline void planTaps(const Level& l, detail::PixelLanes x, detail::PixelLanes y, TapPlan& plan, int at) {
+[[gnu::always_inline]] inline void planTaps(const Level& l, detail::PixelLanes x, detail::PixelLanes y, TapPlan& plan, int at) {
     const detail::PixelLanes lx = x * l.sx + l.ox, ly = y * l.sy + l.oy;
     const IntLanes xi = __builtin_convertvector(lx, IntLanes), yi = __builtin_convertvector(ly, IntLanes);
     const detail::PixelLanes fx = lx - __builtin_convertvector(xi, detail::PixelLanes);
@@ -301,7 +303,7 @@ inline void planTaps(const Level& l, detail::PixelLanes x, detail::PixelLanes y,
 }
 
 // pyramidLevel on four footprints (the same operations as the scalar one).
-inline detail::PixelLanes pyramidLevels(detail::PixelLanes rho2) {
+[[gnu::always_inline]] inline detail::PixelLanes pyramidLevels(detail::PixelLanes rho2) {
     IntLanes bits;
     std::memcpy(&bits, &rho2, sizeof bits);
     const IntLanes exponent = ((bits >> 23) & 0xff) - 127;
@@ -326,7 +328,7 @@ struct SpanFootprint {
 // Plans `count` (<= kPlanBlock) pixels at biased level-0 coordinates xs, ys (arrays padded to a
 // multiple of 4), pixels k0.. of a span.
 template <int kC>
-void planPixels(const Level* levels, int top, const float* xs, const float* ys, const SpanFootprint& fp, int k0,
+[[gnu::always_inline]] inline void planPixels(const Level* levels, int top, const float* xs, const float* ys, const SpanFootprint& fp, int k0,
                 int count, PixelPlan& plan) {
     const detail::PixelLanes topLanes = {0, 0, 0, 0};
     for (int at = 0; at < count; at += 4) {
@@ -368,7 +370,7 @@ void planPixels(const Level* levels, int top, const float* xs, const float* ys, 
 }
 
 template <int kC>
-inline detail::PixelLanes plannedTap(const Level& l, const TapPlan& plan, int k) {
+[[gnu::always_inline]] inline detail::PixelLanes plannedTap(const Level& l, const TapPlan& plan, int k) {
     const float* p0 = l.pixels + plan.offset[k];
     const float* p1 = p0 + plan.dy[k];
     return detail::bilinearLanes<kC>(p0, p1, 0, static_cast<std::size_t>(plan.dx[k]), plan.fx[k], plan.fy[k], l.last);
@@ -376,7 +378,7 @@ inline detail::PixelLanes plannedTap(const Level& l, const TapPlan& plan, int k)
 
 // The second pass: loads and blends only.
 template <int kC>
-void decodePlanned(const Level* levels, const PixelPlan& plan, int count, float* out) {
+[[gnu::always_inline]] inline void decodePlanned(const Level* levels, const PixelPlan& plan, int count, float* out) {
     for (int k = 0; k < count; ++k, out += kC) {
         const int l = plan.level[k];
         detail::PixelLanes value = plannedTap<kC>(levels[l], plan.taps[0], k);
@@ -384,6 +386,62 @@ void decodePlanned(const Level* levels, const PixelPlan& plan, int count, float*
         if (f > 0.0f) value = detail::lerpLanes(value, plannedTap<kC>(levels[l + 1], plan.taps[1], k), f);
         detail::storeLanes<kC>(out, value);
     }
+}
+
+// A block of a span: its plan, then its taps (the arguments are planPixels's, then the output).
+template <int kC>
+[[gnu::always_inline]] inline void planAndDecode(const Level* levels, int top, const float* xs, const float* ys,
+                                                 const SpanFootprint& fp, int k0, int count, PixelPlan& plan,
+                                                 float* out) {
+    planPixels<kC>(levels, top, xs, ys, fp, k0, count, plan);
+    decodePlanned<kC>(levels, plan, count, out);
+}
+
+// planAndDecode in two copies, chosen once at run time: the baseline one and, where the compiler
+// can make it, one for AVX2 (with FMA and BMI2 it is x86-64-v3; the architecture is kept, so the
+// small inline helpers of resample_pvt.h still inline into it). The planner's clamps and selects are then single
+// instructions (SSE2 has no 32-bit min, max, blend or multiply), and the tap's addresses come out
+// sooner. Floating-point contraction is off for this file (codec/CMakeLists.txt), so the AVX2 copy
+// does the same operations in the same order: the same floats (Pyramid.Avx2DecodeMatchesBaseline).
+using BlockFn = void (*)(const Level*, int, const float*, const float*, const SpanFootprint&, int, int, PixelPlan&,
+                         float*);
+
+template <int kC>
+void planAndDecodeBaseline(const Level* levels, int top, const float* xs, const float* ys, const SpanFootprint& fp,
+                           int k0, int count, PixelPlan& plan, float* out) {
+    planAndDecode<kC>(levels, top, xs, ys, fp, k0, count, plan, out);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define CONUS_DECODE_AVX2 1
+template <int kC>
+[[gnu::target("avx2,fma,bmi,bmi2")]] void planAndDecodeAvx2(const Level* levels, int top, const float* xs,
+                                                          const float* ys, const SpanFootprint& fp, int k0, int count,
+                                                          PixelPlan& plan, float* out) {
+    planAndDecode<kC>(levels, top, xs, ys, fp, k0, count, plan, out);
+}
+#else
+#define CONUS_DECODE_AVX2 0
+#endif
+
+bool cpuHasAvx2() {
+#if CONUS_DECODE_AVX2
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi2");
+#else
+    return false;
+#endif
+}
+
+std::atomic<bool> g_forceBaseline{false};
+
+template <int kC>
+BlockFn chooseBlockFn() {
+#if CONUS_DECODE_AVX2
+    static const bool avx2 = cpuHasAvx2();
+    if (avx2 && !g_forceBaseline.load(std::memory_order_relaxed)) return &planAndDecodeAvx2<kC>;
+#endif
+    return &planAndDecodeBaseline<kC>;
 }
 
 // kPyramid: zoomed-out pixels take one trilinear tap from `levels` instead of the multi-tap
@@ -410,6 +468,8 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
     // The planned pyramid decode's block (decodePlanned).
     const bool planned = kPyramid && detail::kLanes<kC> && plannable(levels[0], channels);
     std::unique_ptr<PixelPlan> plan(planned ? new PixelPlan : nullptr);
+    [[maybe_unused]] BlockFn blockFn = nullptr;
+    if constexpr (detail::kLanes<kC>) blockFn = chooseBlockFn<kC>();
     alignas(16) float blockX[kPlanBlock], blockY[kPlanBlock];
 
     for (int y = y0; y < y1; ++y) {
@@ -491,8 +551,7 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
                                 blockX[k] = blockX[n - 1];
                                 blockY[k] = blockY[n - 1];
                             }
-                            planPixels<kC>(levels.data(), top, blockX, blockY, {a2, bx0, by0, dbx, dby}, k0, n, *plan);
-                            decodePlanned<kC>(levels.data(), *plan, n, out);
+                            blockFn(levels.data(), top, blockX, blockY, {a2, bx0, by0, dbx, dby}, k0, n, *plan, out);
                             out += static_cast<std::size_t>(n) * kC;
                         }
                         return;
@@ -616,6 +675,13 @@ void clearOutside(Image& out, const View& view) {
 }
 
 }  // namespace
+
+namespace detail {
+
+bool decodeAvx2Available() { return cpuHasAvx2(); }
+void forceBaselineDecode(bool baseline) { g_forceBaseline.store(baseline, std::memory_order_relaxed); }
+
+}  // namespace detail
 
 float pyramidLevel(float rhoSquared) {
     if (!(rhoSquared > 1.0f)) return 0.0f;  // magnified (or NaN): level 0
