@@ -254,12 +254,11 @@ inline void trilinearTapLanes(const Level* levels, int top, float x, float y, fl
 }
 
 // The pyramid decode of a run of pixels in two passes, for 3 and 4 channels: the first plans
-// every pixel's taps (level, offsets, weights) four pixels at a time in vector lanes and touches
+// every pixel's taps (level, offsets, weights) 4 or 8 pixels at a time in vector lanes and touches
 // no image; the second only loads and blends. One pass per pixel was a chain of ~100 dependent
 // cycles (level, coordinates, addresses, then the loads) of which the core overlapped about two
 // pixels; split, the second pass has many pixels' loads in flight (bench/README.md, "Decode
 // speed"). The operations are trilinearTap's, lane by lane, so the results are the same floats.
-typedef std::int32_t IntLanes __attribute__((vector_size(16)));
 // The planner's lanes: kN pixels at a time (4: an SSE2 register, the baseline copy; 8: an AVX2
 // register, the AVX2 copy). Lane by lane the same operations either way.
 template <int kN>
