@@ -6,6 +6,7 @@
 // image, so a magnified pixel costs the baseline's one bilinear tap plus a few integer adds. Where
 // the view is coarser than the CoNUS image (zoomed out, or a focus seen from afar) the pixel's
 // footprint, bounded per map cell, decides how many taps to average over it.
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -17,6 +18,7 @@
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "decode_pvt.h"
+#include "decode_simd_pvt.h"
 #include "conus/core/parallel.h"
 #include "resample_pvt.h"
 
@@ -252,12 +254,25 @@ inline void trilinearTapLanes(const Level* levels, int top, float x, float y, fl
 }
 
 // The pyramid decode of a run of pixels in two passes, for 3 and 4 channels: the first plans
-// every pixel's taps (level, offsets, weights) four pixels at a time in vector lanes and touches
+// every pixel's taps (level, offsets, weights) 4 or 8 pixels at a time in vector lanes and touches
 // no image; the second only loads and blends. One pass per pixel was a chain of ~100 dependent
 // cycles (level, coordinates, addresses, then the loads) of which the core overlapped about two
 // pixels; split, the second pass has many pixels' loads in flight (bench/README.md, "Decode
 // speed"). The operations are trilinearTap's, lane by lane, so the results are the same floats.
-typedef std::int32_t IntLanes __attribute__((vector_size(16)));
+// The planner's lanes: kN pixels at a time (4: an SSE2 register, the baseline copy; 8: an AVX2
+// register, the AVX2 copy). Lane by lane the same operations either way.
+template <int kN>
+struct PlanLanes;
+template <>
+struct PlanLanes<4> {
+    typedef float F __attribute__((vector_size(16)));
+    typedef std::int32_t I __attribute__((vector_size(16)));
+};
+template <>
+struct PlanLanes<8> {
+    typedef float F __attribute__((vector_size(32)));
+    typedef std::int32_t I __attribute__((vector_size(32)));
+};
 
 constexpr int kPlanBlock = 64;  // pixels planned at once (a multiple of 4)
 
@@ -280,19 +295,19 @@ bool plannable(const Level& level0, int channels) {
 }
 
 // levelTap's arithmetic on four pixels of one level (x, y: biased level-0 coordinates).
-template <int kC>
-inline void planTaps(const Level& l, detail::PixelLanes x, detail::PixelLanes y, TapPlan& plan, int at) {
-    const detail::PixelLanes lx = x * l.sx + l.ox, ly = y * l.sy + l.oy;
-    const IntLanes xi = __builtin_convertvector(lx, IntLanes), yi = __builtin_convertvector(ly, IntLanes);
-    const detail::PixelLanes fx = lx - __builtin_convertvector(xi, detail::PixelLanes);
-    const detail::PixelLanes fy = ly - __builtin_convertvector(yi, detail::PixelLanes);
-    const IntLanes zero = {0, 0, 0, 0};
-    const IntLanes xm = xi - 1, ym = yi - 1, wLast = zero + (l.width - 1), hLast = zero + (l.height - 1);
-    const IntLanes x0 = xm > zero ? xm : zero, x1 = xi < wLast ? xi : wLast;
-    const IntLanes y0 = ym > zero ? ym : zero, y1 = yi < hLast ? yi : hLast;
+template <int kC, int kN, typename F = typename PlanLanes<kN>::F, typename I = typename PlanLanes<kN>::I>
+[[gnu::always_inline]] inline void planTaps(const Level& l, F x, F y, TapPlan& plan, int at) {
+    const F lx = x * l.sx + l.ox, ly = y * l.sy + l.oy;
+    const I xi = __builtin_convertvector(lx, I), yi = __builtin_convertvector(ly, I);
+    const F fx = lx - __builtin_convertvector(xi, F);
+    const F fy = ly - __builtin_convertvector(yi, F);
+    const I zero = {};
+    const I xm = xi - 1, ym = yi - 1, wLast = zero + (l.width - 1), hLast = zero + (l.height - 1);
+    const I x0 = xm > zero ? xm : zero, x1 = xi < wLast ? xi : wLast;
+    const I y0 = ym > zero ? ym : zero, y1 = yi < hLast ? yi : hLast;
     const std::int32_t stride = l.width * kC;
     // x1 - x0 and y1 - y0 are 0 or 1: the steps by masks, not multiplies (SSE2 has no 32-bit one).
-    const IntLanes offset = y0 * stride + x0 * kC, dx = (x0 - x1) & kC, dy = (y0 - y1) & stride;
+    const I offset = y0 * stride + x0 * kC, dx = (x0 - x1) & kC, dy = (y0 - y1) & stride;
     std::memcpy(plan.offset + at, &offset, sizeof offset);
     std::memcpy(plan.dx + at, &dx, sizeof dx);
     std::memcpy(plan.dy + at, &dy, sizeof dy);
@@ -300,21 +315,23 @@ inline void planTaps(const Level& l, detail::PixelLanes x, detail::PixelLanes y,
     std::memcpy(plan.fy + at, &fy, sizeof fy);
 }
 
-// pyramidLevel on four footprints (the same operations as the scalar one).
-inline detail::PixelLanes pyramidLevels(detail::PixelLanes rho2) {
-    IntLanes bits;
+// pyramidLevel on a vector of footprints (the same operations as the scalar one; the result by
+// reference: a 32-byte vector returned by value changes the ABI without AVX, and GCC says so).
+template <typename F, typename I>
+[[gnu::always_inline]] inline void pyramidLevels(const F& rho2, F& out) {
+    I bits;
     std::memcpy(&bits, &rho2, sizeof bits);
-    const IntLanes exponent = ((bits >> 23) & 0xff) - 127;
-    const IntLanes mantissaBits = (bits & 0x7fffff) | 0x3f800000;
-    detail::PixelLanes mantissa;
+    const I exponent = ((bits >> 23) & 0xff) - 127;
+    const I mantissaBits = (bits & 0x7fffff) | 0x3f800000;
+    F mantissa;
     std::memcpy(&mantissa, &mantissaBits, sizeof mantissa);
-    const detail::PixelLanes t = mantissa - 1.0f;
-    const detail::PixelLanes zero = {0, 0, 0, 0};
-    const detail::PixelLanes lambda =
-        0.5f * (__builtin_convertvector(exponent, detail::PixelLanes) + t * (1.3465553f - 0.3465553f * t)) -
+    const F t = mantissa - 1.0f;
+    const F zero = {};
+    const F lambda =
+        0.5f * (__builtin_convertvector(exponent, F) + t * (1.3465553f - 0.3465553f * t)) -
         static_cast<float>(kDecodePyramidBias);
-    const detail::PixelLanes positive = zero < lambda ? lambda : zero;
-    return rho2 > 1.0f ? positive : zero;
+    const F positive = zero < lambda ? lambda : zero;
+    out = rho2 > 1.0f ? positive : zero;
 }
 
 // The footprint along a span: the longer of a (a2: its length squared, fixed) and
@@ -325,37 +342,44 @@ struct SpanFootprint {
 
 // Plans `count` (<= kPlanBlock) pixels at biased level-0 coordinates xs, ys (arrays padded to a
 // multiple of 4), pixels k0.. of a span.
-template <int kC>
-void planPixels(const Level* levels, int top, const float* xs, const float* ys, const SpanFootprint& fp, int k0,
+template <int kC, int kN>
+[[gnu::always_inline]] inline void planPixels(const Level* levels, int top, const float* xs, const float* ys, const SpanFootprint& fp, int k0,
                 int count, PixelPlan& plan) {
-    const detail::PixelLanes topLanes = {0, 0, 0, 0};
-    for (int at = 0; at < count; at += 4) {
-        detail::PixelLanes x, y;
+    using F = typename PlanLanes<kN>::F;
+    using I = typename PlanLanes<kN>::I;
+    const F topLanes = {};
+    for (int at = 0; at < count; at += kN) {
+        F x, y;
         std::memcpy(&x, xs + at, sizeof x);
         std::memcpy(&y, ys + at, sizeof y);
-        const IntLanes kInt = IntLanes{0, 1, 2, 3} + (k0 + at);
-        const detail::PixelLanes k = __builtin_convertvector(kInt, detail::PixelLanes);
-        const detail::PixelLanes bx = fp.bx0 + k * fp.dbx, by = fp.by0 + k * fp.dby;
-        const detail::PixelLanes b2 = bx * bx + by * by;
-        const detail::PixelLanes r = fp.a2 < b2 ? b2 : topLanes + fp.a2;  // std::max(a2, b2)
-        const detail::PixelLanes level = pyramidLevels(r), topLevel = topLanes + static_cast<float>(top);
-        const detail::PixelLanes lambda = topLevel < level ? topLevel : level;  // std::min(level, top)
-        const IntLanes l = __builtin_convertvector(lambda, IntLanes);
-        const detail::PixelLanes f = lambda - __builtin_convertvector(l, detail::PixelLanes);
+        I kInt;
+        for (int j = 0; j < kN; ++j) kInt[j] = k0 + at + j;
+        const F k = __builtin_convertvector(kInt, F);
+        const F bx = fp.bx0 + k * fp.dbx, by = fp.by0 + k * fp.dby;
+        const F b2 = bx * bx + by * by;
+        const F r = fp.a2 < b2 ? b2 : topLanes + fp.a2;  // std::max(a2, b2)
+        F level;
+        pyramidLevels<F, I>(r, level);
+        const F topLevel = topLanes + static_cast<float>(top);
+        const F lambda = topLevel < level ? topLevel : level;  // std::min(level, top)
+        const I l = __builtin_convertvector(lambda, I);
+        const F f = lambda - __builtin_convertvector(l, F);
         std::memcpy(plan.level + at, &l, sizeof l);
         std::memcpy(plan.blend + at, &f, sizeof f);
-        if (l[0] == l[1] && l[0] == l[2] && l[0] == l[3]) {
-            planTaps<kC>(levels[l[0]], x, y, plan.taps[0], at);
-            if (l[0] < top) planTaps<kC>(levels[l[0] + 1], x, y, plan.taps[1], at);
+        bool same = true;
+        for (int j = 1; j < kN; ++j) same = same && l[j] == l[0];
+        if (same) {
+            planTaps<kC, kN>(levels[l[0]], x, y, plan.taps[0], at);
+            if (l[0] < top) planTaps<kC, kN>(levels[l[0] + 1], x, y, plan.taps[1], at);
             continue;
         }
         // Lanes on different levels: each lane's levels in turn (the other lanes' entries are
         // overwritten by their own).
-        for (int k = 0; k < 4; ++k) {
+        for (int k = 0; k < kN; ++k) {
             TapPlan scratch[2];
-            planTaps<kC>(levels[l[k]], x, y, scratch[0], 0);
+            planTaps<kC, kN>(levels[l[k]], x, y, scratch[0], 0);
             const int taps = l[k] < top ? 2 : 1;
-            if (taps == 2) planTaps<kC>(levels[l[k] + 1], x, y, scratch[1], 0);
+            if (taps == 2) planTaps<kC, kN>(levels[l[k] + 1], x, y, scratch[1], 0);
             for (int t = 0; t < taps; ++t) {
                 plan.taps[t].offset[at + k] = scratch[t].offset[k];
                 plan.taps[t].dx[at + k] = scratch[t].dx[k];
@@ -368,7 +392,7 @@ void planPixels(const Level* levels, int top, const float* xs, const float* ys, 
 }
 
 template <int kC>
-inline detail::PixelLanes plannedTap(const Level& l, const TapPlan& plan, int k) {
+[[gnu::always_inline]] inline detail::PixelLanes plannedTap(const Level& l, const TapPlan& plan, int k) {
     const float* p0 = l.pixels + plan.offset[k];
     const float* p1 = p0 + plan.dy[k];
     return detail::bilinearLanes<kC>(p0, p1, 0, static_cast<std::size_t>(plan.dx[k]), plan.fx[k], plan.fy[k], l.last);
@@ -376,7 +400,7 @@ inline detail::PixelLanes plannedTap(const Level& l, const TapPlan& plan, int k)
 
 // The second pass: loads and blends only.
 template <int kC>
-void decodePlanned(const Level* levels, const PixelPlan& plan, int count, float* out) {
+[[gnu::always_inline]] inline void decodePlanned(const Level* levels, const PixelPlan& plan, int count, float* out) {
     for (int k = 0; k < count; ++k, out += kC) {
         const int l = plan.level[k];
         detail::PixelLanes value = plannedTap<kC>(levels[l], plan.taps[0], k);
@@ -384,6 +408,62 @@ void decodePlanned(const Level* levels, const PixelPlan& plan, int count, float*
         if (f > 0.0f) value = detail::lerpLanes(value, plannedTap<kC>(levels[l + 1], plan.taps[1], k), f);
         detail::storeLanes<kC>(out, value);
     }
+}
+
+// A block of a span: its plan, then its taps (the arguments are planPixels's, then the output).
+template <int kC, int kN>
+[[gnu::always_inline]] inline void planAndDecode(const Level* levels, int top, const float* xs, const float* ys,
+                                                 const SpanFootprint& fp, int k0, int count, PixelPlan& plan,
+                                                 float* out) {
+    planPixels<kC, kN>(levels, top, xs, ys, fp, k0, count, plan);
+    decodePlanned<kC>(levels, plan, count, out);
+}
+
+// planAndDecode in two copies, chosen once at run time: the baseline one and, where the compiler
+// can make it, one for AVX2 (with FMA and BMI2 it is x86-64-v3; the architecture is kept, so the
+// small inline helpers of resample_pvt.h still inline into it). The planner's clamps and selects are then single
+// instructions (SSE2 has no 32-bit min, max, blend or multiply), and the tap's addresses come out
+// sooner. Floating-point contraction is off for this file (codec/CMakeLists.txt), so the AVX2 copy
+// does the same operations in the same order: the same floats (Pyramid.Avx2DecodeMatchesBaseline).
+using BlockFn = void (*)(const Level*, int, const float*, const float*, const SpanFootprint&, int, int, PixelPlan&,
+                         float*);
+
+template <int kC>
+void planAndDecodeBaseline(const Level* levels, int top, const float* xs, const float* ys, const SpanFootprint& fp,
+                           int k0, int count, PixelPlan& plan, float* out) {
+    planAndDecode<kC, 4>(levels, top, xs, ys, fp, k0, count, plan, out);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define CONUS_DECODE_AVX2 1
+template <int kC>
+[[gnu::target("avx2,fma,bmi,bmi2")]] void planAndDecodeAvx2(const Level* levels, int top, const float* xs,
+                                                          const float* ys, const SpanFootprint& fp, int k0, int count,
+                                                          PixelPlan& plan, float* out) {
+    planAndDecode<kC, 8>(levels, top, xs, ys, fp, k0, count, plan, out);
+}
+#else
+#define CONUS_DECODE_AVX2 0
+#endif
+
+bool cpuHasAvx2() {
+#if CONUS_DECODE_AVX2
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi2");
+#else
+    return false;
+#endif
+}
+
+std::atomic<bool> g_forceBaseline{false};
+
+template <int kC>
+BlockFn chooseBlockFn() {
+#if CONUS_DECODE_AVX2
+    static const bool avx2 = cpuHasAvx2();
+    if (avx2 && !g_forceBaseline.load(std::memory_order_relaxed)) return &planAndDecodeAvx2<kC>;
+#endif
+    return &planAndDecodeBaseline<kC>;
 }
 
 // kPyramid: zoomed-out pixels take one trilinear tap from `levels` instead of the multi-tap
@@ -410,6 +490,8 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
     // The planned pyramid decode's block (decodePlanned).
     const bool planned = kPyramid && detail::kLanes<kC> && plannable(levels[0], channels);
     std::unique_ptr<PixelPlan> plan(planned ? new PixelPlan : nullptr);
+    [[maybe_unused]] BlockFn blockFn = nullptr;
+    if constexpr (detail::kLanes<kC>) blockFn = chooseBlockFn<kC>();
     alignas(16) float blockX[kPlanBlock], blockY[kPlanBlock];
 
     for (int y = y0; y < y1; ++y) {
@@ -487,12 +569,11 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
                                 blockX[k] = static_cast<float>(px);
                                 blockY[k] = static_cast<float>(py);
                             }
-                            for (int k = n; k < ((n + 3) & ~3); ++k) {
+                            for (int k = n; k < ((n + 7) & ~7); ++k) {
                                 blockX[k] = blockX[n - 1];
                                 blockY[k] = blockY[n - 1];
                             }
-                            planPixels<kC>(levels.data(), top, blockX, blockY, {a2, bx0, by0, dbx, dby}, k0, n, *plan);
-                            decodePlanned<kC>(levels.data(), *plan, n, out);
+                            blockFn(levels.data(), top, blockX, blockY, {a2, bx0, by0, dbx, dby}, k0, n, *plan, out);
                             out += static_cast<std::size_t>(n) * kC;
                         }
                         return;
@@ -616,6 +697,13 @@ void clearOutside(Image& out, const View& view) {
 }
 
 }  // namespace
+
+namespace detail {
+
+bool decodeAvx2Available() { return cpuHasAvx2(); }
+void forceBaselineDecode(bool baseline) { g_forceBaseline.store(baseline, std::memory_order_relaxed); }
+
+}  // namespace detail
 
 float pyramidLevel(float rhoSquared) {
     if (!(rhoSquared > 1.0f)) return 0.0f;  // magnified (or NaN): level 0

@@ -3,10 +3,12 @@
 // decode, must stay close to it, and must leave magnified pixels exactly as they were.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "../../../codec/src/image/decode_simd_pvt.h"
 #include "codec/image/decode_views.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/image/decode.h"
@@ -104,6 +106,31 @@ TEST(Pyramid, VectorLanesGiveTheScalarDecode) {
                     for (std::size_t i = 0; i < one.pixels.size(); ++i)
                         ASSERT_NEAR(baseline.pixels[i * names.size() + c], one.pixels[i], 1e-6f) << "baseline";
                 }
+            }
+    }
+}
+
+// The planned pyramid decode's AVX2 copy (where this processor has one) and its baseline copy give
+// the same floats, bit for bit, on zoomed-out views whose pixels span several levels.
+TEST(Pyramid, Avx2DecodeMatchesBaseline) {
+    const SamplingMap map = buildFociMap(std::vector<Focus>{{0.3, 0.35, 0.08, 4}, {0.7, 0.6, 0.06, 3}});
+    const View views[] = {{}, {-0.2, -0.1, 1.3, 1.05}, {0.9, 0.95, 0.1, 0.05}, {0.05, 0.6, 0.7, 0.9}};
+    std::printf("AVX2 copy of the planned decode: %s\n", detail::decodeAvx2Available() ? "yes" : "no (both baseline)");
+    for (const auto& names : {std::vector<std::string>{"R", "G", "B"}, std::vector<std::string>{"R", "G", "B", "A"}}) {
+        const Image conus = noise(613, 409, names, 23);
+        const ImagePyramid p = buildPyramid(conus);
+        for (const View& view : views)
+            for (const auto& [w, h] : {std::pair{131, 77}, std::pair{53, 90}}) {
+                detail::forceBaselineDecode(true);
+                const Image generic = decodeImage(conus, map, viewOf(view, w, h, &p));
+                detail::forceBaselineDecode(false);
+                const Image chosen = decodeImage(conus, map, viewOf(view, w, h, &p));
+                const Image multiTap = decodeImage(conus, map, viewOf(view, w, h, nullptr));
+                ASSERT_EQ(generic.pixels.size(), chosen.pixels.size());
+                EXPECT_EQ(0, std::memcmp(generic.pixels.data(), chosen.pixels.data(), generic.pixels.size() * sizeof(float)))
+                    << names.size() << " channels, " << w << "x" << h;
+                // The pyramid path ran: its pixels are not the multi-tap decode's.
+                EXPECT_NE(0, std::memcmp(generic.pixels.data(), multiTap.pixels.data(), generic.pixels.size() * sizeof(float)));
             }
     }
 }
