@@ -108,6 +108,8 @@ namespace {
 // A footprint longer than this (in CoNUS pixels) on either axis gets several taps.
 constexpr double kMultiTapThreshold = kDecodeMultiTap;
 constexpr int kMaxTapsPerAxis = kDecodeMaxTaps;
+using detail::length;
+using detail::tapsFor;
 // The pyramid decode's level is 0 (one bilinear tap) up to this footprint: 2^kDecodePyramidBias.
 const double kPyramidOneTap = std::exp2(kDecodePyramidBias);
 
@@ -117,12 +119,6 @@ void checkView(const View& v, const char* what) {
         throw Error(ErrorCode::InvalidArgument, std::string(what) + ": view (" + std::to_string(v.u0) + ", " +
                                                     std::to_string(v.v0) + ") - (" + std::to_string(v.u1) + ", " +
                                                     std::to_string(v.v1) + ") is empty or not finite");
-}
-
-// Taps per footprint axis: an axis up to the threshold is covered by one bilinear tap (its tent
-// spans two pixels), longer ones by ceil(length) taps at most a pixel apart.
-inline int tapsFor(double length) {
-    return length <= kMultiTapThreshold ? 1 : std::min(kMaxTapsPerAxis, static_cast<int>(std::ceil(length)));
 }
 
 constexpr detail::TapOffsets<kMaxTapsPerAxis> kTapOffsets;
@@ -160,7 +156,6 @@ inline void tapBiased(const float* pixels, int width, int height, int c, double 
     }
 }
 
-inline double length(double x, double y) { return std::sqrt(x * x + y * y); }
 
 // Whether every biased point in the box [xlo,xhi] x [ylo,yhi] has its 2x2 neighbourhood inside.
 inline bool interior(double xlo, double xhi, double ylo, double yhi, int width, int height) {

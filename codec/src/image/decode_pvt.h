@@ -5,6 +5,8 @@
 // column's cell and position in it depend only on u, so they are computed once per view.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -13,6 +15,15 @@
 #include "conus/codec/map/sampling_map.h"
 
 namespace conus::codec::detail {
+
+// The multi-tap footprint rule (decode.h), for the decoder and for the fit that models it: the
+// length of a footprint axis (written out: std::hypot rounds differently at the thresholds), and
+// its taps: up to kDecodeMultiTap CoNUS pixels one bilinear tap (its tent spans two pixels),
+// longer ceil(length) taps at most a pixel apart, at most kDecodeMaxTaps.
+inline double length(double x, double y) { return std::sqrt(x * x + y * y); }
+inline int tapsFor(double length) {
+    return length <= kDecodeMultiTap ? 1 : std::min(kDecodeMaxTaps, static_cast<int>(std::ceil(length)));
+}
 
 // Per output column of a view: map cell i and s = u(n-1) - i in [0,1], u clamped to [0,1] as
 // distort() does; inside is 0 where u was clamped (the point does not move with u there).

@@ -2,8 +2,8 @@
 // adjoint, shared by the fit and its test.
 //
 // DecoderTaps walks decode.cpp's decodeRows (without a pyramid) for the whole-image view: the same
-// row stepping of Eq. 1 (decode_pvt.h), the same footprint rule (kDecodeMultiTap, kDecodeMaxTaps,
-// the taps at TapOffsets), the same clamp to the image. It yields each output pixel's taps
+// row stepping of Eq. 1 (decode_pvt.h), the same footprint rule (decode_pvt.h's tapsFor, the taps
+// at TapOffsets), the same clamp to the image. It yields each output pixel's taps
 // instead of their value, so the fit can gather through them (D) and splat through them (D^T).
 // decode.cpp keeps its own loop, faster for its one job; tests/codec/image/fit_test.cpp checks
 // that the two agree on every pixel.
@@ -130,13 +130,6 @@ public:
     }
 
 private:
-    // decode.cpp's rule: an axis up to kDecodeMultiTap CoNUS pixels takes one tap, a longer one
-    // ceil(length), at most kDecodeMaxTaps.
-    static int tapsFor(double length) {
-        return length <= kDecodeMultiTap ? 1 : std::min(kDecodeMaxTaps, static_cast<int>(std::ceil(length)));
-    }
-    // As decode.cpp computes it (std::hypot rounds differently at the thresholds).
-    static double length(double x, double y) { return std::sqrt(x * x + y * y); }
     static constexpr TapOffsets<kDecodeMaxTaps> kOffsets{};
 
     const SamplingMap& m_map;
