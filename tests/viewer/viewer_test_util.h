@@ -88,14 +88,21 @@ inline std::string viewerBinary() { return std::string(CONUS_BIN_DIR) + "/conus-
 
 inline bool haveXvfb() { return std::system("command -v xvfb-run > /dev/null 2>&1") == 0; }
 
-// Runs a shell command, its output into `log`; returns the exit status.
+// Runs a shell command, its output into `log`; returns the exit status. A command under
+// xvfb-run that xvfb-run itself failed ("xvfb-run: error: ...": seen in parallel test runs as
+// "problem while cleaning up temporary directory", exit 5, after the command had run; two `-a`
+// servers starting at once race for a display) is run again, up to three times in all.
 inline int run(const std::string& command, std::string* log = nullptr) {
     const std::string logPath = (tempDir() / "run.log").string();
-    const int status = std::system((command + " > " + logPath + " 2>&1").c_str());
-    if (log) {
+    int status = 0;
+    std::string text;
+    for (int attempt = 0; attempt < 3; ++attempt) {
+        status = std::system((command + " > " + logPath + " 2>&1").c_str());
         std::ifstream in(logPath);
-        log->assign(std::istreambuf_iterator<char>(in), {});
+        text.assign(std::istreambuf_iterator<char>(in), {});
+        if (command.rfind("xvfb-run", 0) != 0 || text.find("xvfb-run: error:") == std::string::npos) break;
     }
+    if (log) *log = text;
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
