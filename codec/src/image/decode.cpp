@@ -3,7 +3,8 @@
 //
 // Eq. 1 is evaluated by the row stepping of decode_pvt.h, not by SamplingMap::distort: inside a
 // span the position advances by a constant step, in 32.32 fixed point where no tap can leave the
-// image, so a magnified pixel costs the baseline's one bilinear tap plus a few integer adds. Where
+// image (four pixels at a time in vector lanes), so a magnified pixel costs about the baseline's
+// one bilinear tap with its precomputed per-axis weights. Where
 // the view is coarser than the CoNUS image (zoomed out, or a focus seen from afar) the pixel's
 // footprint, bounded per map cell, decides how many taps to average over it.
 #include <atomic>
@@ -11,9 +12,14 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
@@ -123,10 +129,6 @@ void checkView(const View& v, const char* what) {
 
 constexpr detail::TapOffsets<kMaxTapsPerAxis> kTapOffsets;
 
-// Fixed point 32.32 for the stepped coordinates of interior spans: the integer part and the
-// weight come out of one add and two shifts instead of float-int round trips.
-constexpr double kFixedOne = 4294967296.0;
-
 // Bilinear at CoNUS pixel coordinates plus one, known to lie in [0.5, size + 0.5] (Eq. 1 keeps
 // every point inside the image): positive, so truncation is floor. kClamp = false when the whole
 // 2x2 neighbourhood is known to be inside the image. kAccumulate adds weight * value to out.
@@ -157,10 +159,149 @@ inline void tapBiased(const float* pixels, int width, int height, int c, double 
 }
 
 
+constexpr double kInteriorMargin = 1e-4;  // covers the fixed-point drift of the longest span
+
 // Whether every biased point in the box [xlo,xhi] x [ylo,yhi] has its 2x2 neighbourhood inside.
 inline bool interior(double xlo, double xhi, double ylo, double yhi, int width, int height) {
-    constexpr double kMargin = 1e-4;  // covers the fixed-point drift of the longest span
-    return xlo >= 1.0 + kMargin && xhi < width - kMargin && ylo >= 1.0 + kMargin && yhi < height - kMargin;
+    return xlo >= 1.0 + kInteriorMargin && xhi < width - kInteriorMargin && ylo >= 1.0 + kInteriorMargin &&
+           yhi < height - kInteriorMargin;
+}
+
+// Fixed point 32.32 for the stepped coordinates of interior spans: the integer part and the
+// weight come out of one add and two shifts instead of float-int round trips.
+constexpr double kFixedOne = 4294967296.0;
+
+// x in 32.32 fixed point, rounded half away from zero like std::llround (inline: a span's set-up
+// called llround four times); |x| is far below 2^31 here, so x * 2^32 + 0.5 is exact.
+inline std::int64_t toFixed(double x) {
+    const double scaled = x * kFixedOne;
+    return static_cast<std::int64_t>(scaled < 0.0 ? scaled - 0.5 : scaled + 0.5);
+}
+
+// A span's first biased position and its step per pixel, in 32.32 fixed point.
+struct FixedSteps {
+    std::int64_t x, y, sx, sy;
+};
+
+// bilinearLanes for a pixel whose 2x2 neighbourhood starts at p0 and whose 4-float reads all lie
+// inside the array: the same loads and operations without the check for the last pixel.
+template <int kC>
+[[gnu::always_inline]] inline detail::PixelLanes interiorTapAt(const float* p0, std::size_t stride, float fx,
+                                                               float fy) {
+    const detail::PixelLanes top = detail::lerpLanes(detail::loadLanes(p0), detail::loadLanes(p0 + kC), fx);
+    const detail::PixelLanes bottom =
+        detail::lerpLanes(detail::loadLanes(p0 + stride), detail::loadLanes(p0 + stride + kC), fx);
+    return detail::lerpLanes(top, bottom, fy);
+}
+
+// The weight of a 32.32 fixed-point coordinate: the top 24 bits of its fraction (exact in a
+// float, and the same in the scalar and the vector code below).
+inline float fixedWeight(std::int64_t x) {
+    return static_cast<float>(static_cast<std::int32_t>((x & 0xffffffff) >> 8)) * 0x1p-24f;
+}
+
+// Whether magnifyInteriorLanes can take a width x height image of `channels` channels: its
+// coordinates and row stride (in floats) below 2^15, so that the offsets come out of 16-bit
+// multiply-adds (images wider than 8191 pixels of 4 channels take magnifyInterior).
+inline bool lanesFit(int width, int height, int channels) {
+    return std::int64_t{width} * channels < 32767 && height < 32766;
+}
+
+// A magnified span whose 4-float reads all lie inside the array (3 or 4 channels, the taps' 2x2
+// neighbourhoods inside the image and, with 3 channels, above its last row): one bilinear tap a
+// pixel. The positions, weights and offsets of four pixels at a time come out of vector lanes
+// (two 32.32 coordinates a register, stepped exactly as the scalar loop steps them), so a pixel
+// costs little more than the baseline's tap with its precomputed per-axis weights; every pixel but
+// the span's last stores four lanes (the next pixel overwrites the fourth).
+template <int kC>
+[[gnu::always_inline]] inline void magnifyInteriorLanes(const float* pixels, std::size_t stride, FixedSteps p,
+                                                        int count, float* out) {
+    static_assert(detail::kLanes<kC>);
+    typedef std::int64_t Fixed2 __attribute__((vector_size(16)));
+    typedef std::int32_t Int4 __attribute__((vector_size(16)));
+    typedef std::uint32_t Uint4 __attribute__((vector_size(16)));
+    typedef float Float4 __attribute__((vector_size(16)));
+    // Biased coordinates: the 2x2 neighbourhood of (xi, yi) starts one pixel up and left. The
+    // caller checks lanesFit: xi, yi and the row stride fit 16 bits, the offsets 32.
+    const float* const origin = pixels - stride - kC;
+    const std::int32_t rowStride = static_cast<std::int32_t>(stride);
+    Fixed2 x01 = {p.x, p.x + p.sx}, x23 = {p.x + 2 * p.sx, p.x + 3 * p.sx};
+    Fixed2 y01 = {p.y, p.y + p.sy}, y23 = {p.y + 2 * p.sy, p.y + 3 * p.sy};
+    const std::int64_t sx4 = 4 * p.sx, sy4 = 4 * p.sy;
+    Float4 fx, fy;
+    Int4 offset;
+#if defined(__SSE2__)
+    const __m128i weights16 = _mm_set1_epi32(rowStride | kC << 16);
+#endif
+    // The next four pixels' weights and offsets (little-endian words of the coordinates: the
+    // fractions, then the integer parts).
+    const auto plan = [&] {
+        const Uint4 xw0 = reinterpret_cast<Uint4>(x01), xw1 = reinterpret_cast<Uint4>(x23);
+        const Uint4 yw0 = reinterpret_cast<Uint4>(y01), yw1 = reinterpret_cast<Uint4>(y23);
+        const Uint4 xFraction = __builtin_shufflevector(xw0, xw1, 0, 2, 4, 6);
+        const Uint4 yFraction = __builtin_shufflevector(yw0, yw1, 0, 2, 4, 6);
+        const Int4 xi = reinterpret_cast<Int4>(__builtin_shufflevector(xw0, xw1, 1, 3, 5, 7));
+        const Int4 yi = reinterpret_cast<Int4>(__builtin_shufflevector(yw0, yw1, 1, 3, 5, 7));
+        fx = __builtin_convertvector(reinterpret_cast<Int4>(xFraction >> 8), Float4) * 0x1p-24f;
+        fy = __builtin_convertvector(reinterpret_cast<Int4>(yFraction >> 8), Float4) * 0x1p-24f;
+#if defined(__SSE2__)
+        // yi * rowStride + xi * kC in one multiply-add of 16-bit halves.
+        offset = reinterpret_cast<Int4>(_mm_madd_epi16(reinterpret_cast<__m128i>(yi | (xi << 16)), weights16));
+#else
+        offset = yi * rowStride + xi * kC;
+#endif
+        x01 += sx4;
+        x23 += sx4;
+        y01 += sy4;
+        y23 += sy4;
+    };
+    const auto tap = [&](int j) { return interiorTapAt<kC>(origin + offset[j], stride, fx[j], fy[j]); };
+    int k = 0;
+    plan();
+    // Groups without the span's last pixel: four-lane stores. The next group is planned before
+    // this one's taps, so that its chain of shuffles and multiplies overlaps them.
+    for (; k + 4 < count; k += 4) {
+        const Float4 gx = fx, gy = fy;
+        const Int4 go = offset;
+        plan();
+        float* o = out + static_cast<std::size_t>(k) * kC;
+        for (int j = 0; j < 4; ++j) {
+            const detail::PixelLanes v = interiorTapAt<kC>(origin + go[j], stride, gx[j], gy[j]);
+            std::memcpy(o + j * kC, &v, sizeof v);
+        }
+    }
+    // The last one to four pixels, the span's last stored exactly.
+    for (int j = 0; k + j < count; ++j) {
+        const detail::PixelLanes v = tap(j);
+        float* o = out + static_cast<std::size_t>(k + j) * kC;
+        if (kC == 4 || k + j + 1 < count) std::memcpy(o, &v, sizeof v);
+        else detail::storeLanes<kC>(o, v);
+    }
+}
+
+// A magnified span whose taps are all inside the image, one pixel at a time (the channels in
+// lanes, with the check for the last pixel, or one by one): what magnifyInteriorLanes does
+// where it cannot.
+template <int kC>
+[[gnu::always_inline]] inline void magnifyInterior(const float* pixels, std::size_t stride, int c, const float* last,
+                                                   FixedSteps p, int count, float* out) {
+    const int channels = kC > 0 ? kC : c;
+    const float* const origin = pixels - stride - channels;
+    const std::ptrdiff_t rowStride = static_cast<std::ptrdiff_t>(stride);
+    for (int k = 0; k < count; ++k, p.x += p.sx, p.y += p.sy, out += channels) {
+        const float fx = fixedWeight(p.x), fy = fixedWeight(p.y);
+        const float* p0 = origin + (p.y >> 32) * rowStride + (p.x >> 32) * channels;
+        if constexpr (detail::kLanes<kC>) {
+            detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(p0, p0 + stride, 0, kC, fx, fy, last));
+        } else {
+            const float* p1 = p0 + stride;
+            for (int j = 0; j < channels; ++j) {
+                const float top = p0[j] + fx * (p0[channels + j] - p0[j]);
+                const float bottom = p1[j] + fx * (p1[channels + j] - p1[j]);
+                out[j] = top + fy * (bottom - top);
+            }
+        }
+    }
 }
 
 // The levels of a pyramid decode, level 0 first: a biased level-0 coordinate x (see tapBiased)
@@ -271,17 +412,30 @@ struct PlanLanes<8> {
 
 constexpr int kPlanBlock = 64;  // pixels planned at once (a multiple of 4)
 
+// The taps' rows are prefetched this many output rows ahead. Along an output row the taps follow
+// a curve through the CoNUS image that changes row every few pixels where the map bends it, so
+// the hardware's stream prefetch rarely locks on (the bilinear baseline reads two rows straight
+// through); the next rows' taps lie one footprint b further per output row, and the planner has b.
+// Measured on the codec_bench whole frame: 1 and 2 rows ahead alike, 0 (this block) little gain.
+constexpr float kPrefetchRows = 2.0f;
+
 struct TapPlan {
-    alignas(16) std::int32_t offset[kPlanBlock];  // the top-left pixel, floats from the level's first
-    alignas(16) std::int32_t dx[kPlanBlock];      // to its right neighbour: channels, 0 at the edge
-    alignas(16) std::int32_t dy[kPlanBlock];      // to the one below: a row, 0 at the edge
-    alignas(16) float fx[kPlanBlock];
-    alignas(16) float fy[kPlanBlock];
+    alignas(32) std::int32_t offset[kPlanBlock];  // the top-left pixel, floats from the level's first
+    alignas(32) std::int32_t dx[kPlanBlock];      // to its right neighbour: channels, 0 at the edge
+    alignas(32) std::int32_t dy[kPlanBlock];      // to the one below: a row, 0 at the edge
+    alignas(32) float fx[kPlanBlock];
+    alignas(32) float fy[kPlanBlock];
 };
 struct PixelPlan {
     TapPlan taps[2];                           // on levels `level` and `level` + 1
-    alignas(16) std::int32_t level[kPlanBlock];
-    alignas(16) float blend[kPlanBlock];       // trilinearTap's f: 0 takes the first tap alone
+    alignas(32) std::int32_t level[kPlanBlock];
+    alignas(32) float blend[kPlanBlock];  // trilinearTap's f: 0 takes the first tap alone
+    // Where the taps on level `uniform` will be kPrefetchRows output rows further down (prefetched).
+    alignas(32) std::int32_t ahead[kPlanBlock];
+    // The common block: every pixel on one level pair, every 2x2 neighbourhood inside both levels
+    // and above their last row: the level (taps hold offset, fx, fy only); else -1.
+    int uniform = -1;
+    bool oneTap = false;  // with `uniform`: every blend is 0 (or the level is the top), one tap each
 };
 
 // Whether the levels' offsets fit the plan's 32-bit integers.
@@ -290,8 +444,10 @@ bool plannable(const Level& level0, int channels) {
 }
 
 // levelTap's arithmetic on four pixels of one level (x, y: biased level-0 coordinates).
+// Returns the lanes whose 2x2 neighbourhood is inside the level and above its last row (so no
+// 4-float read of a 3-channel pixel overruns the array), by reference (see pyramidLevels).
 template <int kC, int kN, typename F = typename PlanLanes<kN>::F, typename I = typename PlanLanes<kN>::I>
-[[gnu::always_inline]] inline void planTaps(const Level& l, F x, F y, TapPlan& plan, int at) {
+[[gnu::always_inline]] inline void planTaps(const Level& l, F x, F y, TapPlan& plan, int at, I& inside) {
     const F lx = x * l.sx + l.ox, ly = y * l.sy + l.oy;
     const I xi = __builtin_convertvector(lx, I), yi = __builtin_convertvector(ly, I);
     const F fx = lx - __builtin_convertvector(xi, F);
@@ -308,6 +464,7 @@ template <int kC, int kN, typename F = typename PlanLanes<kN>::F, typename I = t
     std::memcpy(plan.dy + at, &dy, sizeof dy);
     std::memcpy(plan.fx + at, &fx, sizeof fx);
     std::memcpy(plan.fy + at, &fy, sizeof fy);
+    inside = (xi >= 1) & (xi <= wLast) & (yi >= 1) & (yi < hLast);
 }
 
 // pyramidLevel on a vector of footprints (the same operations as the scalar one; the result by
@@ -329,58 +486,168 @@ template <typename F, typename I>
     out = rho2 > 1.0f ? positive : zero;
 }
 
-// The footprint along a span: the longer of a (a2: its length squared, fixed) and
-// b = b0 + k db, k the pixel's index in the span, squared (as decodeRows has it).
-struct SpanFootprint {
+// A span's pixels, k = 0, 1, ... from its first: biased level-0 coordinates x0 + k sx, y0 + k sy
+// (float, so the scalar and the planned paths compute the same ones), and the footprint: the
+// longer of a (a2: its length squared, fixed) and b = b0 + k db, squared (as decodeRows has it).
+struct SpanInputs {
+    float x0, y0, sx, sy;
     float a2, bx0, by0, dbx, dby;
+    float xAt(int k) const { return x0 + static_cast<float>(k) * sx; }
+    float yAt(int k) const { return y0 + static_cast<float>(k) * sy; }
+    float rho2At(int k) const {
+        const float bx = bx0 + static_cast<float>(k) * dbx, by = by0 + static_cast<float>(k) * dby;
+        return std::max(a2, bx * bx + by * by);
+    }
 };
 
-// Plans `count` (<= kPlanBlock) pixels at biased level-0 coordinates xs, ys (arrays padded to a
-// multiple of 4), pixels k0.. of a span.
+// Whether every lane of a comparison's result is set.
+template <typename I>
+[[gnu::always_inline]] inline bool allLanes(const I& mask) {
+    std::uint64_t words[sizeof(I) / 8];
+    std::memcpy(words, &mask, sizeof mask);
+    std::uint64_t all = ~std::uint64_t{0};
+    for (const std::uint64_t w : words) all &= w;
+    return all == ~std::uint64_t{0};
+}
+
+// A level's constants in lanes, loaded once per block (the plan's stores could alias a Level).
+template <int kC, typename F, typename I>
+struct LevelLanes {
+    F sx, ox, sy, oy;
+    I wLast, hLast, stride;
+    explicit LevelLanes(const Level& l)
+        : sx(F{} + l.sx), ox(F{} + l.ox), sy(F{} + l.sy), oy(F{} + l.oy), wLast(I{} + (l.width - 1)),
+          hLast(I{} + (l.height - 1)), stride(I{} + l.width * kC) {}
+};
+
+// planTaps for a block expected to lie inside the level: the top-left pixel and the weights only
+// (the neighbours are a pixel and a row away), and the lanes for which that holds (`inside`, by
+// reference: see pyramidLevels).
+template <int kC, typename F, typename I>
+[[gnu::always_inline]] inline void planInteriorTaps(const LevelLanes<kC, F, I>& l, F x, F y, TapPlan& plan, int at,
+                                                    I& inside) {
+    const F lx = x * l.sx + l.ox, ly = y * l.sy + l.oy;
+    const I xi = __builtin_convertvector(lx, I), yi = __builtin_convertvector(ly, I);
+    const F fx = lx - __builtin_convertvector(xi, F);
+    const F fy = ly - __builtin_convertvector(yi, F);
+    const I offset = (yi - 1) * l.stride + (xi - 1) * kC;
+    std::memcpy(plan.offset + at, &offset, sizeof offset);
+    std::memcpy(plan.fx + at, &fx, sizeof fx);
+    std::memcpy(plan.fy + at, &fy, sizeof fy);
+    inside = (xi >= 1) & (xi <= l.wLast) & (yi >= 1) & (yi < l.hLast);
+}
+
+// The top-left pixel's offset on a level at biased level-0 coordinates (x, y), clamped into the
+// level, stored at `to`: for prefetching only.
+template <int kC, typename F, typename I>
+[[gnu::always_inline]] inline void clampedOffset(const LevelLanes<kC, F, I>& l, F x, F y, std::int32_t* to) {
+    const F lx = x * l.sx + l.ox, ly = y * l.sy + l.oy;
+    const F one = F{} + 1.0f, right = __builtin_convertvector(l.wLast, F), bottom = __builtin_convertvector(l.hLast, F);
+    // In float first: a position far outside would overflow the conversion.
+    const F cx = lx < one ? one : (lx > right ? right : lx), cy = ly < one ? one : (ly > bottom ? bottom : ly);
+    const I xi = __builtin_convertvector(cx, I), yi = __builtin_convertvector(cy, I);
+    const I offset = (yi - 1) * l.stride + (xi - 1) * kC;
+    std::memcpy(to, &offset, sizeof offset);
+}
+
+// Prefetches the rows of the taps recorded in plan.ahead (two pixels share most lines).
+template <int kC>
+[[gnu::always_inline]] inline void prefetchAhead(const float* pixels, std::size_t stride, const PixelPlan& plan,
+                                                 int count) {
+    for (int k = 0; k < count; k += 2) {
+        const float* p = pixels + plan.ahead[k];
+        __builtin_prefetch(p, 0, 2);
+        __builtin_prefetch(p + stride, 0, 2);
+    }
+}
+
+// Plans pixels k0 .. k0 + count - 1 (count <= kPlanBlock) of a span, kN at a time: each pixel's
+// level and blend and, while every pixel so far is on the first one's level (the common case:
+// the level changes slowly along a span), both levels' taps with the levels' constants fixed for
+// the block. A block that leaves its level or its levels' interior is planned again pixel group
+// by pixel group, each on its own levels and with the clamps.
 template <int kC, int kN>
-[[gnu::always_inline]] inline void planPixels(const Level* levels, int top, const float* xs, const float* ys, const SpanFootprint& fp, int k0,
-                int count, PixelPlan& plan) {
+[[gnu::always_inline]] inline void planPixels(const Level* levels, int top, const SpanInputs& in, int k0, int count,
+                                              PixelPlan& plan) {
     using F = typename PlanLanes<kN>::F;
     using I = typename PlanLanes<kN>::I;
-    const F topLanes = {};
+    const F zero = {};
+    I lane;
+    for (int j = 0; j < kN; ++j) lane[j] = j;
+    const F topLevel = zero + static_cast<float>(top);
+    I blended = lane != lane;  // lanes with a blend above 0 (the second tap counts)
+    const auto positions = [&](int at, F& x, F& y, F& k) {
+        k = __builtin_convertvector(lane + (k0 + at), F);
+        x = in.x0 + k * in.sx;
+        y = in.y0 + k * in.sy;
+    };
+    // The first group's levels decide the block's (a padding lane's level does not count).
+    int uniform = -1;
+    std::optional<LevelLanes<kC, F, I>> a, b;
+    bool interior = true;
     for (int at = 0; at < count; at += kN) {
-        F x, y;
-        std::memcpy(&x, xs + at, sizeof x);
-        std::memcpy(&y, ys + at, sizeof y);
-        I kInt;
-        for (int j = 0; j < kN; ++j) kInt[j] = k0 + at + j;
-        const F k = __builtin_convertvector(kInt, F);
-        const F bx = fp.bx0 + k * fp.dbx, by = fp.by0 + k * fp.dby;
+        F x, y, k;
+        positions(at, x, y, k);
+        const F bx = in.bx0 + k * in.dbx, by = in.by0 + k * in.dby;
         const F b2 = bx * bx + by * by;
-        const F r = fp.a2 < b2 ? b2 : topLanes + fp.a2;  // std::max(a2, b2)
+        const F r = in.a2 < b2 ? b2 : zero + in.a2;  // std::max(a2, b2)
         F level;
         pyramidLevels<F, I>(r, level);
-        const F topLevel = topLanes + static_cast<float>(top);
         const F lambda = topLevel < level ? topLevel : level;  // std::min(level, top)
         const I l = __builtin_convertvector(lambda, I);
         const F f = lambda - __builtin_convertvector(l, F);
         std::memcpy(plan.level + at, &l, sizeof l);
         std::memcpy(plan.blend + at, &f, sizeof f);
-        bool same = true;
-        for (int j = 1; j < kN; ++j) same = same && l[j] == l[0];
-        if (same) {
-            planTaps<kC, kN>(levels[l[0]], x, y, plan.taps[0], at);
-            if (l[0] < top) planTaps<kC, kN>(levels[l[0] + 1], x, y, plan.taps[1], at);
+        blended |= f > zero;
+        if (!interior) continue;
+        if (at == 0) {
+            uniform = l[0];
+            a.emplace(levels[uniform]);
+            if (uniform < top) b.emplace(levels[uniform + 1]);
+        }
+        const I padding = lane >= count - at;
+        if (!allLanes((l == uniform) | padding)) {
+            interior = false;
+            continue;
+        }
+        I inside, insideB;
+        planInteriorTaps<kC>(*a, x, y, plan.taps[0], at, inside);
+        clampedOffset<kC>(*a, x + kPrefetchRows * bx, y + kPrefetchRows * by, plan.ahead + at);
+        if (b) {
+            planInteriorTaps<kC>(*b, x, y, plan.taps[1], at, insideB);
+            inside &= insideB;
+        }
+        interior = allLanes(inside | padding);
+    }
+    if (interior) {
+        plan.uniform = uniform;
+        plan.oneTap = uniform == top || allLanes(blended == 0);
+        return;
+    }
+    plan.uniform = -1;
+    for (int at = 0; at < count; at += kN) {
+        F x, y, k;
+        positions(at, x, y, k);
+        I l, unused;
+        std::memcpy(&l, plan.level + at, sizeof l);
+        if (allLanes(l == l[0])) {
+            planTaps<kC, kN>(levels[l[0]], x, y, plan.taps[0], at, unused);
+            if (l[0] < top) planTaps<kC, kN>(levels[l[0] + 1], x, y, plan.taps[1], at, unused);
             continue;
         }
         // Lanes on different levels: each lane's levels in turn (the other lanes' entries are
         // overwritten by their own).
-        for (int k = 0; k < kN; ++k) {
+        for (int j = 0; j < kN; ++j) {
             TapPlan scratch[2];
-            planTaps<kC, kN>(levels[l[k]], x, y, scratch[0], 0);
-            const int taps = l[k] < top ? 2 : 1;
-            if (taps == 2) planTaps<kC, kN>(levels[l[k] + 1], x, y, scratch[1], 0);
+            planTaps<kC, kN>(levels[l[j]], x, y, scratch[0], 0, unused);
+            const int taps = l[j] < top ? 2 : 1;
+            if (taps == 2) planTaps<kC, kN>(levels[l[j] + 1], x, y, scratch[1], 0, unused);
             for (int t = 0; t < taps; ++t) {
-                plan.taps[t].offset[at + k] = scratch[t].offset[k];
-                plan.taps[t].dx[at + k] = scratch[t].dx[k];
-                plan.taps[t].dy[at + k] = scratch[t].dy[k];
-                plan.taps[t].fx[at + k] = scratch[t].fx[k];
-                plan.taps[t].fy[at + k] = scratch[t].fy[k];
+                plan.taps[t].offset[at + j] = scratch[t].offset[j];
+                plan.taps[t].dx[at + j] = scratch[t].dx[j];
+                plan.taps[t].dy[at + j] = scratch[t].dy[j];
+                plan.taps[t].fx[at + j] = scratch[t].fx[j];
+                plan.taps[t].fy[at + j] = scratch[t].fy[j];
             }
         }
     }
@@ -405,13 +672,52 @@ template <int kC>
     }
 }
 
+// plannedTap for a block whose neighbourhoods are all inside: the neighbours are a pixel and a
+// row away, so the same loads and operations without the per-pixel steps or the overrun check.
+template <int kC>
+[[gnu::always_inline]] inline detail::PixelLanes interiorTap(const float* pixels, std::size_t stride,
+                                                             const TapPlan& plan, int k) {
+    return interiorTapAt<kC>(pixels + plan.offset[k], stride, plan.fx[k], plan.fy[k]);
+}
+
+// decodePlanned for a block on one level pair, all inside (PixelPlan::uniform).
+template <int kC>
+[[gnu::always_inline]] inline void decodeInterior(const Level* levels, int top, const PixelPlan& plan, int count,
+                                                  float* out) {
+    const Level& a = levels[plan.uniform];
+    const std::size_t sa = static_cast<std::size_t>(a.width) * kC;
+    // The block's pixels are written in order, so all but its last may store four lanes.
+    const auto store = [&](int k, detail::PixelLanes v) {
+        if (kC == 4 || k + 1 < count) std::memcpy(out + static_cast<std::size_t>(k) * kC, &v, sizeof v);
+        else detail::storeLanes<kC>(out + static_cast<std::size_t>(k) * kC, v);
+    };
+    if (plan.oneTap) {
+        prefetchAhead<kC>(a.pixels, sa, plan, count);
+        for (int k = 0; k < count; ++k) store(k, interiorTap<kC>(a.pixels, sa, plan.taps[0], k));
+        return;
+    }
+    const Level& b = levels[plan.uniform + 1];
+    const std::size_t sb = static_cast<std::size_t>(b.width) * kC;
+    const float* const pa = a.pixels;  // locals: the stores to `out` cannot move them
+    const float* const pb = b.pixels;
+    const TapPlan& ta = plan.taps[0];
+    const TapPlan& tb = plan.taps[1];
+    prefetchAhead<kC>(pa, sa, plan, count);
+    for (int k = 0; k < count; ++k) {
+        const float f = plan.blend[k];
+        const detail::PixelLanes value = interiorTap<kC>(pa, sa, ta, k);
+        const detail::PixelLanes blended = detail::lerpLanes(value, interiorTap<kC>(pb, sb, tb, k), f);
+        store(k, f > 0.0f ? blended : value);
+    }
+}
+
 // A block of a span: its plan, then its taps (the arguments are planPixels's, then the output).
 template <int kC, int kN>
-[[gnu::always_inline]] inline void planAndDecode(const Level* levels, int top, const float* xs, const float* ys,
-                                                 const SpanFootprint& fp, int k0, int count, PixelPlan& plan,
-                                                 float* out) {
-    planPixels<kC, kN>(levels, top, xs, ys, fp, k0, count, plan);
-    decodePlanned<kC>(levels, plan, count, out);
+[[gnu::always_inline]] inline void planAndDecode(const Level* levels, int top, const SpanInputs& in, int k0, int count,
+                                                 PixelPlan& plan, float* out) {
+    planPixels<kC, kN>(levels, top, in, k0, count, plan);
+    if (plan.uniform >= 0) decodeInterior<kC>(levels, top, plan, count, out);
+    else decodePlanned<kC>(levels, plan, count, out);
 }
 
 // planAndDecode in two copies, chosen once at run time: the baseline one and, where the compiler
@@ -420,22 +726,20 @@ template <int kC, int kN>
 // instructions (SSE2 has no 32-bit min, max, blend or multiply), and the tap's addresses come out
 // sooner. Floating-point contraction is off for this file (codec/CMakeLists.txt), so the AVX2 copy
 // does the same operations in the same order: the same floats (Pyramid.Avx2DecodeMatchesBaseline).
-using BlockFn = void (*)(const Level*, int, const float*, const float*, const SpanFootprint&, int, int, PixelPlan&,
-                         float*);
+using BlockFn = void (*)(const Level*, int, const SpanInputs&, int, int, PixelPlan&, float*);
 
 template <int kC>
-void planAndDecodeBaseline(const Level* levels, int top, const float* xs, const float* ys, const SpanFootprint& fp,
-                           int k0, int count, PixelPlan& plan, float* out) {
-    planAndDecode<kC, 4>(levels, top, xs, ys, fp, k0, count, plan, out);
+void planAndDecodeBaseline(const Level* levels, int top, const SpanInputs& in, int k0, int count, PixelPlan& plan,
+                           float* out) {
+    planAndDecode<kC, 4>(levels, top, in, k0, count, plan, out);
 }
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define CONUS_DECODE_AVX2 1
 template <int kC>
-[[gnu::target("avx2,fma,bmi,bmi2")]] void planAndDecodeAvx2(const Level* levels, int top, const float* xs,
-                                                          const float* ys, const SpanFootprint& fp, int k0, int count,
-                                                          PixelPlan& plan, float* out) {
-    planAndDecode<kC, 8>(levels, top, xs, ys, fp, k0, count, plan, out);
+[[gnu::target("avx2,fma,bmi,bmi2")]] void planAndDecodeAvx2(const Level* levels, int top, const SpanInputs& in,
+                                                          int k0, int count, PixelPlan& plan, float* out) {
+    planAndDecode<kC, 8>(levels, top, in, k0, count, plan, out);
 }
 #else
 #define CONUS_DECODE_AVX2 0
@@ -452,11 +756,19 @@ bool cpuHasAvx2() {
 
 std::atomic<bool> g_forceBaseline{false};
 
+bool useAvx2() {
+#if CONUS_DECODE_AVX2
+    static const bool avx2 = cpuHasAvx2();
+    return avx2 && !g_forceBaseline.load(std::memory_order_relaxed);
+#else
+    return false;
+#endif
+}
+
 template <int kC>
 BlockFn chooseBlockFn() {
 #if CONUS_DECODE_AVX2
-    static const bool avx2 = cpuHasAvx2();
-    if (avx2 && !g_forceBaseline.load(std::memory_order_relaxed)) return &planAndDecodeAvx2<kC>;
+    if (useAvx2()) return &planAndDecodeAvx2<kC>;
 #endif
     return &planAndDecodeBaseline<kC>;
 }
@@ -482,12 +794,12 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
     float* const scratch = kC > 0 ? fixedScratch : dynamicScratch.data();
     const float* pixels = src.pixels.data();
     const float* const last = levels[0].last;
-    // The planned pyramid decode's block (decodePlanned).
+    const bool lanes = detail::kLanes<kC> && lanesFit(Wc, Hc, channels);
+    // The pyramid decode's planned blocks (3 and 4 channels).
     const bool planned = kPyramid && detail::kLanes<kC> && plannable(levels[0], channels);
     std::unique_ptr<PixelPlan> plan(planned ? new PixelPlan : nullptr);
     [[maybe_unused]] BlockFn blockFn = nullptr;
     if constexpr (detail::kLanes<kC>) blockFn = chooseBlockFn<kC>();
-    alignas(16) float blockX[kPlanBlock], blockY[kPlanBlock];
 
     for (int y = y0; y < y1; ++y) {
         const detail::CellRow row = detail::cellRow(m, view.v0 + (y + 0.5) / H * (view.v1 - view.v0));
@@ -513,30 +825,20 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
             const int i = span.cell;
             float* out = rowOut + static_cast<std::size_t>(span.x0) * channels;
             const int count = span.x1 - span.x0;
-            const double pxEnd = px + (count - 1) * sx, pyEnd = py + (count - 1) * sy;
             if (!multi[i]) {
                 // The common case (magnifying): one tap, the position stepped along the span.
-                if (interior(std::min(px, pxEnd), std::max(px, pxEnd), std::min(py, pyEnd), std::max(py, pyEnd),
-                             Wc, Hc)) {
-                    std::int64_t fxp = std::llround(px * kFixedOne), fyp = std::llround(py * kFixedOne);
-                    const std::int64_t fsx = std::llround(sx * kFixedOne), fsy = std::llround(sy * kFixedOne);
-                    constexpr float kFraction = 1.0f / 4294967296.0f;
-                    for (int k = 0; k < count; ++k, fxp += fsx, fyp += fsy, out += channels) {
-                        const int xi = static_cast<int>(fxp >> 32), yi = static_cast<int>(fyp >> 32);
-                        const float fx = static_cast<float>(fxp & 0xffffffff) * kFraction;
-                        const float fy = static_cast<float>(fyp & 0xffffffff) * kFraction;
-                        const float* p0 = pixels + (yi - 1) * stride + static_cast<std::size_t>(xi - 1) * channels;
-                        const float* p1 = p0 + stride;
-                        if constexpr (detail::kLanes<kC>) {
-                            detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(p0, p1, 0, kC, fx, fy, last));
-                            continue;
-                        }
-                        for (int c = 0; c < channels; ++c) {
-                            const float top = p0[c] + fx * (p0[channels + c] - p0[c]);
-                            const float bottom = p1[c] + fx * (p1[channels + c] - p1[c]);
-                            out[c] = top + fy * (bottom - top);
+                const double pxEnd = px + (count - 1) * sx, pyEnd = py + (count - 1) * sy;
+                const double ylo = std::min(py, pyEnd), yhi = std::max(py, pyEnd);
+                if (interior(std::min(px, pxEnd), std::max(px, pxEnd), ylo, yhi, Wc, Hc)) {
+                    const FixedSteps steps{toFixed(px), toFixed(py), toFixed(sx), toFixed(sy)};
+                    // Above the last row, no 4-float read of a 3-channel pixel passes the array's end.
+                    if constexpr (detail::kLanes<kC>) {
+                        if (lanes && (kC == 4 || yhi < Hc - 1 - kInteriorMargin)) {
+                            magnifyInteriorLanes<kC>(pixels, stride, steps, count, out);
+                            return;
                         }
                     }
+                    magnifyInterior<kC>(pixels, stride, channels, last, steps, count, out);
                 } else {
                     for (int k = 0; k < count; ++k, px += sx, py += sy, out += channels)
                         tapBiased<kC, true, false>(pixels, Wc, Hc, channels, px, py, 1.0f, out);
@@ -547,42 +849,33 @@ void decodeRows(const Image& src, const SamplingMap& map, const View& view, Imag
             const double axp = ax[i] * inside, ayp = ay[i] * inside;
             double s = span.s0;
             if constexpr (kPyramid) {
-                // b along the span, and the level's inputs in float as the GPU has them.
-                const float a2 = static_cast<float>(axp * axp + ayp * ayp);
-                const float bx0 = static_cast<float>(bx[i] + s * (bx[i + 1] - bx[i]));
-                const float by0 = static_cast<float>(by[i] + s * (by[i + 1] - by[i]));
-                const float dbx = static_cast<float>(span.ds * (bx[i + 1] - bx[i]));
-                const float dby = static_cast<float>(span.ds * (by[i + 1] - by[i]));
+                // The span's positions, and b along it, in float as the GPU has them.
+                const SpanInputs in{static_cast<float>(px),
+                                    static_cast<float>(py),
+                                    static_cast<float>(sx),
+                                    static_cast<float>(sy),
+                                    static_cast<float>(axp * axp + ayp * ayp),
+                                    static_cast<float>(bx[i] + s * (bx[i + 1] - bx[i])),
+                                    static_cast<float>(by[i] + s * (by[i + 1] - by[i])),
+                                    static_cast<float>(span.ds * (bx[i + 1] - bx[i])),
+                                    static_cast<float>(span.ds * (by[i + 1] - by[i]))};
                 const int top = static_cast<int>(levels.size()) - 1;
                 if constexpr (detail::kLanes<kC>) {
                     if (planned) {
-                        // The inputs a block at a time (the positions stepped in double as below), then
-                        // its plan, then the taps.
                         for (int k0 = 0; k0 < count; k0 += kPlanBlock) {
                             const int n = std::min(kPlanBlock, count - k0);
-                            for (int k = 0; k < n; ++k, px += sx, py += sy) {
-                                blockX[k] = static_cast<float>(px);
-                                blockY[k] = static_cast<float>(py);
-                            }
-                            for (int k = n; k < ((n + 7) & ~7); ++k) {
-                                blockX[k] = blockX[n - 1];
-                                blockY[k] = blockY[n - 1];
-                            }
-                            blockFn(levels.data(), top, blockX, blockY, {a2, bx0, by0, dbx, dby}, k0, n, *plan, out);
+                            blockFn(levels.data(), top, in, k0, n, *plan, out);
                             out += static_cast<std::size_t>(n) * kC;
                         }
                         return;
                     }
                 }
-                for (int k = 0; k < count; ++k, px += sx, py += sy, out += channels) {
-                    const float bxp = bx0 + static_cast<float>(k) * dbx, byp = by0 + static_cast<float>(k) * dby;
-                    const float rho2 = std::max(a2, bxp * bxp + byp * byp);
+                for (int k = 0; k < count; ++k, out += channels) {
                     if constexpr (detail::kLanes<kC>)
-                        trilinearTapLanes<kC>(levels.data(), top, static_cast<float>(px), static_cast<float>(py), rho2,
-                                              out);
+                        trilinearTapLanes<kC>(levels.data(), top, in.xAt(k), in.yAt(k), in.rho2At(k), out);
                     else
-                        trilinearTap<kC>(levels.data(), top, channels, static_cast<float>(px), static_cast<float>(py),
-                                         rho2, out, scratch);
+                        trilinearTap<kC>(levels.data(), top, channels, in.xAt(k), in.yAt(k), in.rho2At(k), out,
+                                         scratch);
                 }
                 return;
             }
@@ -652,8 +945,16 @@ void bilinearRows(const Image& src, Image& dst, const AxisTaps& tx, const AxisTa
         const float fy = ty.f[y];
         float* out = dst.pixels.data() + static_cast<std::size_t>(y) * dst.width * channels;
         if constexpr (detail::kLanes<kC>) {
+            // As the decoder's magnified spans: every pixel but the row's last stores four lanes (the
+            // next pixel overwrites the fourth).
             const float* last = src.pixels.data() + src.pixels.size() - kC;
-            for (int x = 0; x < dst.width; ++x, out += kC)
+            const int wide = kC == 4 ? dst.width : dst.width - 1;
+            for (int x = 0; x < wide; ++x, out += kC) {
+                const detail::PixelLanes v = detail::bilinearLanes<kC>(r0, r1, std::size_t(tx.i0[x]) * kC,
+                                                                       std::size_t(tx.i1[x]) * kC, tx.f[x], fy, last);
+                std::memcpy(out, &v, sizeof v);
+            }
+            for (int x = wide; x < dst.width; ++x, out += kC)
                 detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(r0, r1, std::size_t(tx.i0[x]) * kC,
                                                                       std::size_t(tx.i1[x]) * kC, tx.f[x], fy, last));
             continue;
@@ -670,24 +971,36 @@ void bilinearRows(const Image& src, Image& dst, const AxisTaps& tx, const AxisTa
     }
 }
 
+// The run [first, last) of the indices k < count whose centre a0 + (k + 0.5) / count * (a1 - a0)
+// lies in [0, 1]: one run, as the centres are monotone in k (empty: first == last).
+std::pair<int, int> insideRun(double a0, double a1, int count) {
+    const auto inside = [&](int k) {
+        const double a = a0 + (k + 0.5) / count * (a1 - a0);
+        return a >= 0.0 && a <= 1.0;
+    };
+    int first = 0;
+    while (first < count && !inside(first)) ++first;
+    int last = first;
+    while (last < count && inside(last)) ++last;
+    return {first, last};
+}
+
 // Pixels whose centre lies outside the image ([0,1]^2 undistorted) show the background, 0 in every
-// channel, instead of the edge pixels smeared outward.
+// channel, instead of the edge pixels smeared outward. Only those pixels are touched: a view
+// inside the image costs nothing here.
 void clearOutside(Image& out, const View& view) {
-    const std::size_t rowValues = static_cast<std::size_t>(out.width) * out.channels.size();
-    std::vector<char> columnOutside(out.width);
-    for (int x = 0; x < out.width; ++x) {
-        const double u = view.u0 + (x + 0.5) / out.width * (view.u1 - view.u0);
-        columnOutside[x] = !(u >= 0.0 && u <= 1.0);
-    }
+    const std::size_t c = out.channels.size();
+    const std::size_t rowValues = static_cast<std::size_t>(out.width) * c;
+    const auto [x0, x1] = insideRun(view.u0, view.u1, out.width);
+    const auto [y0, y1] = insideRun(view.v0, view.v1, out.height);
     for (int y = 0; y < out.height; ++y) {
         float* row = out.pixels.data() + y * rowValues;
-        const double v = view.v0 + (y + 0.5) / out.height * (view.v1 - view.v0);
-        if (!(v >= 0.0 && v <= 1.0)) {
+        if (y < y0 || y >= y1 || x0 == x1) {
             std::fill(row, row + rowValues, 0.0f);
             continue;
         }
-        for (int x = 0; x < out.width; ++x)
-            if (columnOutside[x]) std::fill_n(row + x * out.channels.size(), out.channels.size(), 0.0f);
+        std::fill(row, row + x0 * c, 0.0f);
+        std::fill(row + x1 * c, row + rowValues, 0.0f);
     }
 }
 

@@ -1,6 +1,7 @@
 // The pyramid decode (issue 10 item 6): a zoomed-out pixel takes one trilinear tap from the CoNUS
 // image's mip chain instead of up to 8x8 bilinear taps. It must not alias more than the multi-tap
 // decode, must stay close to it, and must leave magnified pixels exactly as they were.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -107,6 +108,52 @@ TEST(Pyramid, VectorLanesGiveTheScalarDecode) {
                         ASSERT_NEAR(baseline.pixels[i * names.size() + c], one.pixels[i], 1e-6f) << "baseline";
                 }
             }
+    }
+}
+
+// Magnified spans take four pixels at a time in vector lanes, their offsets from 16-bit
+// multiply-adds, where the image's row (in floats) and height fit 15 bits; a wider image takes the
+// pixel-at-a-time loop. Both give each channel's own decode, to the bit, and Eq. 1 tapped in
+// double precision (SamplingMap::distort, a bilinear tap) wherever the pixel takes one tap.
+TEST(Pyramid, MagnifiedSpansInLanesAndOneByOneAgree) {
+    const SamplingMap map = buildFociMap(std::vector<Focus>{{0.3, 0.5, 0.2, 3}});
+    constexpr int kW = 301, kH = 97, kRows = 40;
+    for (const int width : {257, 11000}) {  // 11000 x 3 floats a row: past the lanes' 15 bits
+        const Image conus = noise(width, kRows, {"R", "G", "B"}, 5);
+        Image plane = makeImage(conus.width, conus.height, {"Y"});
+        int checked = 0;
+        for (const int c : {0, 2}) {
+            for (std::size_t i = 0; i < plane.pixels.size(); ++i) plane.pixels[i] = conus.pixels[i * 3 + c];
+            for (const View& view : {View{0.1, 0.4, 0.104, 0.5}, View{0.5, 0.45, 0.497, 0.58}}) {  // magnified
+                const Image all = decodeImage(conus, map, viewOf(view, kW, kH));
+                const Image one = decodeImage(plane, map, viewOf(view, kW, kH));
+                for (std::size_t i = 0; i < one.pixels.size(); ++i)
+                    ASSERT_EQ(all.pixels[i * 3 + c], one.pixels[i]) << width << " wide, channel " << c << ", value " << i;
+                const glm::dvec2 scale(width, kRows);
+                for (int y = 1; y < kH; y += 8)
+                    for (int x = 2; x < kW; x += 13) {
+                        const glm::dvec2 p(view.u0 + (x + 0.5) / kW * (view.u1 - view.u0),
+                                           view.v0 + (y + 0.5) / kH * (view.v1 - view.v0));
+                        // The footprint: where the map's shear spreads a pixel over several CoNUS
+                        // pixels (a very wide image), the decoder averages taps instead.
+                        const glm::dmat2 jacobian = map.jacobian(p);
+                        const glm::dvec2 a = jacobian[0] * scale * ((view.u1 - view.u0) / kW);
+                        const glm::dvec2 b = jacobian[1] * scale * ((view.v1 - view.v0) / kH);
+                        if (std::max(glm::length(a), glm::length(b)) > 0.9 * kDecodeMultiTap) continue;
+                        const glm::dvec2 d = map.distort(p) * scale - 0.5;
+                        const int xi = static_cast<int>(std::floor(d.x)), yi = static_cast<int>(std::floor(d.y));
+                        const double fx = d.x - xi, fy = d.y - yi;
+                        const auto at = [&](int px, int py) {
+                            return double(plane.at(std::clamp(px, 0, width - 1), std::clamp(py, 0, kRows - 1)));
+                        };
+                        const double expected = (1 - fy) * ((1 - fx) * at(xi, yi) + fx * at(xi + 1, yi)) +
+                                                fy * ((1 - fx) * at(xi, yi + 1) + fx * at(xi + 1, yi + 1));
+                        EXPECT_NEAR(one.at(x, y), expected, 2e-5) << width << " wide at " << x << "," << y;
+                        ++checked;
+                    }
+            }
+        }
+        EXPECT_GT(checked, 100) << width << " wide: pixels held to Eq. 1";
     }
 }
 
