@@ -91,18 +91,23 @@ inline bool haveXvfb() { return std::system("command -v xvfb-run > /dev/null 2>&
 // Runs a shell command, its output into `log`; returns the exit status. A command under
 // xvfb-run that xvfb-run itself failed ("xvfb-run: error: ...": seen in parallel test runs as
 // "problem while cleaning up temporary directory", exit 5, after the command had run; two `-a`
-// servers starting at once race for a display) is run again, up to three times in all.
+// servers starting at once race for a display) is run again, up to three times in all, unless
+// the failed run's output holds a sanitizer's report; `log` gets every attempt's output.
 inline int run(const std::string& command, std::string* log = nullptr) {
     const std::string logPath = (tempDir() / "run.log").string();
     int status = 0;
-    std::string text;
+    std::string all;
     for (int attempt = 0; attempt < 3; ++attempt) {
         status = std::system((command + " > " + logPath + " 2>&1").c_str());
         std::ifstream in(logPath);
-        text.assign(std::istreambuf_iterator<char>(in), {});
-        if (command.rfind("xvfb-run", 0) != 0 || text.find("xvfb-run: error:") == std::string::npos) break;
+        const std::string text{std::istreambuf_iterator<char>(in), {}};
+        all += text;
+        const bool xvfbFailed = command.rfind("xvfb-run", 0) == 0 && text.find("xvfb-run: error:") != std::string::npos;
+        const bool sanitizer = text.find("Sanitizer") != std::string::npos || text.find("runtime error:") != std::string::npos;
+        if (!xvfbFailed || sanitizer) break;
+        all += "\n[run again: xvfb-run failed]\n";
     }
-    if (log) *log = text;
+    if (log) *log = all;
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 

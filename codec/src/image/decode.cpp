@@ -221,9 +221,9 @@ template <int kC>
     typedef std::int32_t Int4 __attribute__((vector_size(16)));
     typedef std::uint32_t Uint4 __attribute__((vector_size(16)));
     typedef float Float4 __attribute__((vector_size(16)));
-    // Biased coordinates: the 2x2 neighbourhood of (xi, yi) starts one pixel up and left. The
+    // Biased coordinates: the 2x2 neighbourhood of (xi, yi) starts at pixel (xi - 1, yi - 1). The
     // caller checks lanesFit: xi, yi and the row stride fit 16 bits, the offsets 32.
-    const float* const origin = pixels - stride - kC;
+    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the plan takes a coordinate's fraction from its low word");
     const std::int32_t rowStride = static_cast<std::int32_t>(stride);
     Fixed2 x01 = {p.x, p.x + p.sx}, x23 = {p.x + 2 * p.sx, p.x + 3 * p.sx};
     Fixed2 y01 = {p.y, p.y + p.sy}, y23 = {p.y + 2 * p.sy, p.y + 3 * p.sy};
@@ -240,12 +240,12 @@ template <int kC>
         const Uint4 yw0 = reinterpret_cast<Uint4>(y01), yw1 = reinterpret_cast<Uint4>(y23);
         const Uint4 xFraction = __builtin_shufflevector(xw0, xw1, 0, 2, 4, 6);
         const Uint4 yFraction = __builtin_shufflevector(yw0, yw1, 0, 2, 4, 6);
-        const Int4 xi = reinterpret_cast<Int4>(__builtin_shufflevector(xw0, xw1, 1, 3, 5, 7));
-        const Int4 yi = reinterpret_cast<Int4>(__builtin_shufflevector(yw0, yw1, 1, 3, 5, 7));
+        const Int4 xi = reinterpret_cast<Int4>(__builtin_shufflevector(xw0, xw1, 1, 3, 5, 7)) - 1;
+        const Int4 yi = reinterpret_cast<Int4>(__builtin_shufflevector(yw0, yw1, 1, 3, 5, 7)) - 1;
         fx = __builtin_convertvector(reinterpret_cast<Int4>(xFraction >> 8), Float4) * 0x1p-24f;
         fy = __builtin_convertvector(reinterpret_cast<Int4>(yFraction >> 8), Float4) * 0x1p-24f;
 #if defined(__SSE2__)
-        // yi * rowStride + xi * kC in one multiply-add of 16-bit halves.
+        // yi * rowStride + xi * kC (the neighbourhood's first pixel) in one multiply-add of 16-bit halves.
         offset = reinterpret_cast<Int4>(_mm_madd_epi16(reinterpret_cast<__m128i>(yi | (xi << 16)), weights16));
 #else
         offset = yi * rowStride + xi * kC;
@@ -255,7 +255,7 @@ template <int kC>
         y01 += sy4;
         y23 += sy4;
     };
-    const auto tap = [&](int j) { return interiorTapAt<kC>(origin + offset[j], stride, fx[j], fy[j]); };
+    const auto tap = [&](int j) { return interiorTapAt<kC>(pixels + offset[j], stride, fx[j], fy[j]); };
     int k = 0;
     plan();
     // Groups without the span's last pixel: four-lane stores. The next group is planned before
@@ -266,7 +266,7 @@ template <int kC>
         plan();
         float* o = out + static_cast<std::size_t>(k) * kC;
         for (int j = 0; j < 4; ++j) {
-            const detail::PixelLanes v = interiorTapAt<kC>(origin + go[j], stride, gx[j], gy[j]);
+            const detail::PixelLanes v = interiorTapAt<kC>(pixels + go[j], stride, gx[j], gy[j]);
             std::memcpy(o + j * kC, &v, sizeof v);
         }
     }
@@ -286,11 +286,10 @@ template <int kC>
 [[gnu::always_inline]] inline void magnifyInterior(const float* pixels, std::size_t stride, int c, const float* last,
                                                    FixedSteps p, int count, float* out) {
     const int channels = kC > 0 ? kC : c;
-    const float* const origin = pixels - stride - channels;
     const std::ptrdiff_t rowStride = static_cast<std::ptrdiff_t>(stride);
     for (int k = 0; k < count; ++k, p.x += p.sx, p.y += p.sy, out += channels) {
         const float fx = fixedWeight(p.x), fy = fixedWeight(p.y);
-        const float* p0 = origin + (p.y >> 32) * rowStride + (p.x >> 32) * channels;
+        const float* p0 = pixels + ((p.y >> 32) - 1) * rowStride + ((p.x >> 32) - 1) * channels;
         if constexpr (detail::kLanes<kC>) {
             detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(p0, p0 + stride, 0, kC, fx, fy, last));
         } else {
@@ -443,11 +442,9 @@ bool plannable(const Level& level0, int channels) {
     return static_cast<std::int64_t>(level0.width) * level0.height * channels < (std::int64_t{1} << 31);
 }
 
-// levelTap's arithmetic on four pixels of one level (x, y: biased level-0 coordinates).
-// Returns the lanes whose 2x2 neighbourhood is inside the level and above its last row (so no
-// 4-float read of a 3-channel pixel overruns the array), by reference (see pyramidLevels).
+// levelTap's arithmetic on kN pixels of one level (x, y: biased level-0 coordinates).
 template <int kC, int kN, typename F = typename PlanLanes<kN>::F, typename I = typename PlanLanes<kN>::I>
-[[gnu::always_inline]] inline void planTaps(const Level& l, F x, F y, TapPlan& plan, int at, I& inside) {
+[[gnu::always_inline]] inline void planTaps(const Level& l, F x, F y, TapPlan& plan, int at) {
     const F lx = x * l.sx + l.ox, ly = y * l.sy + l.oy;
     const I xi = __builtin_convertvector(lx, I), yi = __builtin_convertvector(ly, I);
     const F fx = lx - __builtin_convertvector(xi, F);
@@ -464,7 +461,6 @@ template <int kC, int kN, typename F = typename PlanLanes<kN>::F, typename I = t
     std::memcpy(plan.dy + at, &dy, sizeof dy);
     std::memcpy(plan.fx + at, &fx, sizeof fx);
     std::memcpy(plan.fy + at, &fy, sizeof fy);
-    inside = (xi >= 1) & (xi <= wLast) & (yi >= 1) & (yi < hLast);
 }
 
 // pyramidLevel on a vector of footprints (the same operations as the scalar one; the result by
@@ -628,20 +624,20 @@ template <int kC, int kN>
     for (int at = 0; at < count; at += kN) {
         F x, y, k;
         positions(at, x, y, k);
-        I l, unused;
+        I l;
         std::memcpy(&l, plan.level + at, sizeof l);
         if (allLanes(l == l[0])) {
-            planTaps<kC, kN>(levels[l[0]], x, y, plan.taps[0], at, unused);
-            if (l[0] < top) planTaps<kC, kN>(levels[l[0] + 1], x, y, plan.taps[1], at, unused);
+            planTaps<kC, kN>(levels[l[0]], x, y, plan.taps[0], at);
+            if (l[0] < top) planTaps<kC, kN>(levels[l[0] + 1], x, y, plan.taps[1], at);
             continue;
         }
         // Lanes on different levels: each lane's levels in turn (the other lanes' entries are
         // overwritten by their own).
         for (int j = 0; j < kN; ++j) {
             TapPlan scratch[2];
-            planTaps<kC, kN>(levels[l[j]], x, y, scratch[0], 0, unused);
+            planTaps<kC, kN>(levels[l[j]], x, y, scratch[0], 0);
             const int taps = l[j] < top ? 2 : 1;
-            if (taps == 2) planTaps<kC, kN>(levels[l[j] + 1], x, y, scratch[1], 0, unused);
+            if (taps == 2) planTaps<kC, kN>(levels[l[j] + 1], x, y, scratch[1], 0);
             for (int t = 0; t < taps; ++t) {
                 plan.taps[t].offset[at + j] = scratch[t].offset[j];
                 plan.taps[t].dx[at + j] = scratch[t].dx[j];
@@ -682,8 +678,7 @@ template <int kC>
 
 // decodePlanned for a block on one level pair, all inside (PixelPlan::uniform).
 template <int kC>
-[[gnu::always_inline]] inline void decodeInterior(const Level* levels, int top, const PixelPlan& plan, int count,
-                                                  float* out) {
+[[gnu::always_inline]] inline void decodeInterior(const Level* levels, const PixelPlan& plan, int count, float* out) {
     const Level& a = levels[plan.uniform];
     const std::size_t sa = static_cast<std::size_t>(a.width) * kC;
     // The block's pixels are written in order, so all but its last may store four lanes.
@@ -716,7 +711,7 @@ template <int kC, int kN>
 [[gnu::always_inline]] inline void planAndDecode(const Level* levels, int top, const SpanInputs& in, int k0, int count,
                                                  PixelPlan& plan, float* out) {
     planPixels<kC, kN>(levels, top, in, k0, count, plan);
-    if (plan.uniform >= 0) decodeInterior<kC>(levels, top, plan, count, out);
+    if (plan.uniform >= 0) decodeInterior<kC>(levels, plan, count, out);
     else decodePlanned<kC>(levels, plan, count, out);
 }
 

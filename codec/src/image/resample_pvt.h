@@ -84,7 +84,8 @@ inline void addBilinearInterior(const float* pixels, std::size_t stride, int c, 
 // extension: SSE2 on x86-64, NEON on ARM), so a bilinear tap is 4 loads and 9 vector operations
 // instead of 12 loads and 27 scalar ones. The operations are the scalar taps' own, lane by lane
 // and in the same order (a + t * (b - a)), so the results are the same floats; with 3 channels the
-// fourth lane holds whatever follows the pixel and is never stored.
+// fourth lane holds whatever follows the pixel: storeLanes leaves it out, and a loop that stores
+// all four lanes of a pixel does so only where the next pixel's store overwrites it.
 typedef float PixelLanes __attribute__((vector_size(16)));
 
 template <int kC>

@@ -124,7 +124,10 @@ TEST(Pyramid, MagnifiedSpansInLanesAndOneByOneAgree) {
         int checked = 0;
         for (const int c : {0, 2}) {
             for (std::size_t i = 0; i < plane.pixels.size(); ++i) plane.pixels[i] = conus.pixels[i * 3 + c];
-            for (const View& view : {View{0.1, 0.4, 0.104, 0.5}, View{0.5, 0.45, 0.497, 0.58}}) {  // magnified
+            // Magnified; the third over the bottom-right corner and past it (the last row, the
+            // edge spans, the last pixel), the fourth mirrored.
+            for (const View& view : {View{0.1, 0.4, 0.104, 0.5}, View{0.5, 0.45, 0.497, 0.58}, View{0.995, 0.9, 1.002, 1.03},
+                                     View{0.3, 1.0, 0.296, 0.93}}) {
                 const Image all = decodeImage(conus, map, viewOf(view, kW, kH));
                 const Image one = decodeImage(plane, map, viewOf(view, kW, kH));
                 for (std::size_t i = 0; i < one.pixels.size(); ++i)
@@ -134,6 +137,10 @@ TEST(Pyramid, MagnifiedSpansInLanesAndOneByOneAgree) {
                     for (int x = 2; x < kW; x += 13) {
                         const glm::dvec2 p(view.u0 + (x + 0.5) / kW * (view.u1 - view.u0),
                                            view.v0 + (y + 0.5) / kH * (view.v1 - view.v0));
+                        if (p.x < 0 || p.x > 1 || p.y < 0 || p.y > 1) {  // outside the image: the background
+                            EXPECT_EQ(one.at(x, y), 0.0f) << width << " wide at " << x << "," << y;
+                            continue;
+                        }
                         // The footprint: where the map's shear spreads a pixel over several CoNUS
                         // pixels (a very wide image), the decoder averages taps instead.
                         const glm::dmat2 jacobian = map.jacobian(p);

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -18,7 +19,8 @@ inline int threadCount(int requested) {
     return std::max(1u, std::thread::hardware_concurrency());
 }
 
-// Calls fn(y0, y1) for disjoint row ranges covering [0, rows). Rethrows the first exception.
+// Calls fn(y0, y1) for disjoint row ranges covering [0, rows). Rethrows the first exception. Where
+// the system gives fewer threads than asked, the rows are shared among those it gives.
 template <typename Fn>
 void parallelRows(int rows, int threads, Fn&& fn, int chunk = 8) {
     const int n = std::min(threadCount(threads), std::max(1, (rows + chunk - 1) / chunk));
@@ -39,7 +41,14 @@ void parallelRows(int rows, int threads, Fn&& fn, int chunk = 8) {
         }
     };
     std::vector<std::thread> pool;
-    for (int t = 1; t < n; ++t) pool.emplace_back(worker);
+    pool.reserve(n - 1);
+    for (int t = 1; t < n; ++t) {
+        try {
+            pool.emplace_back(worker);
+        } catch (const std::system_error&) {
+            break;  // no more threads to be had: the ones started and this one share the rows
+        }
+    }
     worker();
     for (auto& t : pool) t.join();
     if (error) std::rethrow_exception(error);
