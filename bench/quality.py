@@ -22,7 +22,8 @@ Everything is measured in linear light (the values the EXR holds) against the so
   (`--falloff`), and automatic maps from ROI importance (1 in the discs, 0
   elsewhere) with their context floor swept, or chosen by a whole-frame loss budget
   (Map.auto_for_frame_loss, `encode --frame-loss`), and with an anisotropy limit swept: the
-  frontier each method reaches.
+  frontier each method reaches; and automatic maps from the picture's own detail (`--importance
+  detail`: no region marked) under the same budgets, measured on the marked regions.
 - fitted to the decoder (`encode --fit`, `uniform --fit`; codec/image/fit.h): every measure above
   again with both images fitted, CoNUS against the fitted uniform image, and the gain-loss points of
   the foci, the automatic maps and the budgets with the fit.
@@ -61,7 +62,7 @@ BUDGET_GRID, BUDGET_MAX_DENSITY = 129, 64.0
 ANISOTROPY_LIMITS = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0]  # --max-anisotropy swept, at the loosest budget
 FIT = 4  # --fit iterations (the default of `encode --fit`) of the fitted variant (0: --no-fit leaves it out)
 FIT_HOLD = None  # --fit-hold (None: the encoder's default)
-METHODS = ("foci", "auto", "budget", "limited", "falloff", "foci+fit", "falloff+fit", "auto+fit", "budget+fit")
+METHODS = ("foci", "auto", "budget", "limited", "detail", "falloff", "foci+fit", "falloff+fit", "auto+fit", "budget+fit")
 # Foci of k = 4 with their transition's width and shape swept (`--falloff`; "2": the default).
 FALLOFFS = ["1.25", "1.5", "1.75", "2", "3", "1.5,log", "1.5,logr", "3,logr"]
 QUICK_FALLOFFS = ["1.5", "2", "3,logr"]
@@ -329,7 +330,7 @@ def frontier(name, src, regions, quick):
     uview = uniform_view(src, size)
     ref_roi, ref_frame = psnr(uview, src, roi), psnr(uview, src)
     importance = discs(src.shape, regions).astype(np.float32)
-    points = {"foci": [], "falloff": [], "auto": [], "budget": [], "limited": []}
+    points = {"foci": [], "falloff": [], "auto": [], "budget": [], "limited": [], "detail": []}
     if FIT:
         # The fitted variants against the fitted uniform image: the same settings, each map once.
         ufview = uniform_view(src, size, FIT)
@@ -378,6 +379,14 @@ def frontier(name, src, regions, quick):
         view = view_of(encode_with(src, size, regions, map=m), w, h)
         points["budget"].append((budget, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi, p_loss, p_gain, floor))
         add_fitted("budget+fit", budget, m=m, extra=(p_loss, p_gain, floor))
+    # The picture's own detail (`--importance detail`, conus.importance) instead of the marked
+    # regions, under the same budgets: what a user gets who marks nothing, measured on the regions.
+    own = np.asarray(conus.importance(src, "detail"))[..., 0]
+    for budget in ([1.0, 2.5] if quick else BUDGETS):
+        m, floor, p_loss, p_gain = conus.Map.auto_for_frame_loss(own, src, size, budget, grid=BUDGET_GRID,
+                                                                 max_density=BUDGET_MAX_DENSITY)
+        view = view_of(encode_with(src, size, regions, map=m), w, h)
+        points["detail"].append((budget, ref_frame - psnr(view, src), psnr(view, src, roi) - ref_roi, p_loss, p_gain, floor))
     # The same with an anisotropy limit (`--max-anisotropy`): the builder tempers the density until
     # every footprint is at most that elongated, which costs magnification but spares the context.
     for limit in ([4.0, 8.0] if quick else ANISOTROPY_LIMITS):
@@ -454,7 +463,7 @@ def plots(out, all_curves, all_points):
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(7, 5))
     for method in [m for m in METHODS if m in next(iter(all_points.values()))]:
-        marker = {"foci": "o", "falloff": "v", "auto": "s", "budget": "^", "limited": "D"}[method.split("+")[0]]
+        marker = {"foci": "o", "falloff": "v", "auto": "s", "budget": "^", "limited": "D", "detail": "x"}[method.split("+")[0]]
         xs = [np.mean([p[method][i][1] for p in all_points.values()]) for i in range(min(len(p[method]) for p in all_points.values()))]
         ys = [np.mean([p[method][i][2] for p in all_points.values()]) for i in range(len(xs))]
         ax.plot(xs, ys, ("" if method == "falloff" else ":" if method.endswith("+fit") else "-") + marker, label={"foci": "one focus per region, k = 2..6",
@@ -462,6 +471,7 @@ def plots(out, all_curves, all_points):
                                                 "auto": "automatic map from ROI importance, floor swept",
                                                 "budget": f"automatic map, --frame-loss budget swept (max density {BUDGET_MAX_DENSITY:g}, grid {BUDGET_GRID})",
                                                 "limited": f"the same at {BUDGETS[-1]:g} dB, --max-anisotropy {ANISOTROPY_LIMITS[0]:g}..{ANISOTROPY_LIMITS[-1]:g} swept",
+                                                "detail": "automatic map from --importance detail (no region marked), --frame-loss swept",
                                                 "foci+fit": f"foci, --fit {FIT} (against uniform --fit {FIT})",
                                                 "falloff+fit": f"k = 4, --fit {FIT} --falloff " + " ".join(FIT_FALLOFFS),
                                                 "auto+fit": f"automatic map, floor swept, --fit {FIT}",
@@ -531,13 +541,14 @@ def report(rows, all_curves, all_points):
             loss = np.mean([p[method][i][1] for p in all_points.values()])
             gain = np.mean([p[method][i][2] for p in all_points.values()])
             worst = min(p[method][i][2] for p in all_points.values())
-            name = {"foci": "k", "falloff": "k 4, falloff", "auto": "floor", "budget": "frame-loss", "limited": "max-anisotropy"}[method.split("+")[0]]
+            name = {"foci": "k", "falloff": "k 4, falloff", "auto": "floor", "budget": "frame-loss", "limited": "max-anisotropy",
+                    "detail": "frame-loss"}[method.split("+")[0]]
             line = f"- {method} {name} {setting}: loss {loss:.2f} dB, gain {gain:+.2f} dB (worst photo {worst:+.2f})"
             if method == "falloff":
                 line += "; max anisotropy " + ", ".join(f"{p[method][i][3]:.1f}" for p in all_points.values())
                 line += (f"; samples in the regions {100 * np.mean([p[method][i][4] for p in all_points.values()]):.1f}%, "
                          f"in r..2r {100 * np.mean([p[method][i][5] for p in all_points.values()]):.1f}%")
-            if method in ("budget", "limited", "budget+fit"):
+            if method in ("budget", "limited", "budget+fit", "detail"):
                 p_loss = np.mean([p[method][i][3] for p in all_points.values()])
                 p_gain = np.mean([p[method][i][4] for p in all_points.values()])
                 floors = ", ".join(f"{p[method][i][5]:.2f}" for p in all_points.values())

@@ -7,6 +7,7 @@
     g = conus.read("photo.exr")                                # .pixels .channels .map .attributes
     face = conus.decode(g, view=(0.36, 0.15, 0.52, 0.31), size=(512, 512))
     m = conus.Map.foci([(0.5, 0.5, 0.1, 4)]); m.undistort(m.distort(points))
+    m = conus.Map.auto(conus.importance(pixels, "detail", channels=channels))  # as --importance detail
 
 Pixels are linear light (sRGB pictures are linearized by read_image; see srgb_to_linear for
 arrays from elsewhere). Errors raise conus.Error, whose .rule names the spec rule broken.
@@ -14,11 +15,12 @@ Work past one machine: conus.dask.encode_files.
 """
 import numpy as _np
 
-from ._conus import (DEFAULT_MAP_SIDE, MAX_IMAGE_SIDE, MAX_MAP_SIDE, Error, File, Map, decode, encode, psnr,
-                     read, read_image, resize, uniform, write, write_image)
+from ._conus import (DEFAULT_MAP_SIDE, MAX_IMAGE_SIDE, MAX_MAP_SIDE, Error, File, Map, decode, encode, importance,
+                     psnr, read, read_image, resize, uniform, write, write_image)
 
-__all__ = ["Error", "File", "Map", "read", "write", "encode", "decode", "uniform", "resize", "psnr", "read_image",
-           "write_image", "srgb_to_linear", "linear_to_srgb", "MAX_IMAGE_SIDE", "MAX_MAP_SIDE", "DEFAULT_MAP_SIDE"]
+__all__ = ["Error", "File", "Map", "read", "write", "encode", "decode", "uniform", "resize", "psnr", "importance",
+           "read_image", "write_image", "srgb_to_linear", "linear_to_srgb", "MAX_IMAGE_SIDE", "MAX_MAP_SIDE",
+           "DEFAULT_MAP_SIDE"]
 __version__ = "1.0.0"
 
 

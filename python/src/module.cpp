@@ -521,6 +521,20 @@ PYBIND11_MODULE(_conus, m) {
         },
         py::arg("a"), py::arg("b"), py::arg("peak") = 1.0, "PSNR in dB of two images of the same shape");
     m.def(
+        "importance",
+        [](const py::array& pixels, const std::string& kind, std::optional<std::vector<std::string>> channels) {
+            Image image = fromArray(pixels, channels, "pixels");
+            if (kind != "detail") throw Error(ErrorCode::InvalidArgument, "importance: kind '" + kind + "' is not 'detail'");
+            py::gil_scoped_release release;
+            // As `--importance detail`: on the display-encoded picture (cli/importance.cpp).
+            Image out = codec::detailImportance(imageio::displayEncoded(image));
+            py::gil_scoped_acquire acquire;
+            return toArray(std::move(out));
+        },
+        py::arg("pixels"), py::arg("kind") = "detail", py::arg("channels") = py::none(),
+        "The picture's own importance for Map.auto, as `--importance detail`: the gradient magnitude of its\n"
+        "display-encoded luminance, (H', W', 1) at most 1024 px a side");
+    m.def(
         "read_image",
         [](const std::string& path) {
             imageio::ImageFile file;

@@ -112,6 +112,26 @@ def test_auto_and_springs_maps_concentrate_where_asked():
     assert inside > outside
 
 
+def test_detail_importance_is_the_sobel_of_what_a_display_shows(asymmetric):
+    from scipy import ndimage
+    detail = np.asarray(conus.importance(asymmetric, "detail", channels=["R", "G", "B", "A"]))
+    assert detail.shape == (160, 240, 1) and detail.dtype == np.float32
+    # The same by scipy: alpha divided out, sRGB-encoded, clamped, the mean of R, G, B, a Sobel
+    # gradient magnitude with the edges clamped.
+    colour = np.clip(asymmetric[..., :3] / asymmetric[..., 3:], 0, 1)
+    shown = conus.linear_to_srgb(colour).mean(axis=2)
+    expected = np.hypot(ndimage.sobel(shown, 1, mode="nearest"), ndimage.sobel(shown, 0, mode="nearest"))
+    assert np.allclose(detail[..., 0], expected, atol=2e-3)
+    # High on the red patch's right edge and the blue disc's rim, nothing inside either.
+    assert detail[10, 35, 0] > 0.3 and detail[115, 160, 0] > 0.5 and detail[95, 180, 0] > 0.5
+    assert detail[8, 10, 0] < 1e-6 and detail[115, 180, 0] < 1e-6
+    auto = conus.Map.auto(detail, grid=33)
+    rim, flat = auto.density(np.array([[160.5 / 240, 115.5 / 160], [10.5 / 240, 8.5 / 160]]))
+    assert rim > flat
+    with pytest.raises(conus.Error, match="kind"):
+        conus.importance(asymmetric, "saliency")
+
+
 def test_frame_loss_budget_sets_the_floor(asymmetric):
     h, w = asymmetric.shape[:2]
     importance = np.zeros((h, w), np.float32)
