@@ -461,7 +461,7 @@ def plots(out, all_curves, all_points):
     fig.tight_layout()
     fig.savefig(out / "rate-distortion.png", dpi=90)
     plt.close(fig)
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig, ax = plt.subplots(figsize=(11, 5))
     for method in [m for m in METHODS if m in next(iter(all_points.values()))]:
         marker = {"foci": "o", "falloff": "v", "auto": "s", "budget": "^", "limited": "D", "detail": "x"}[method.split("+")[0]]
         xs = [np.mean([p[method][i][1] for p in all_points.values()]) for i in range(min(len(p[method]) for p in all_points.values()))]
@@ -482,7 +482,7 @@ def plots(out, all_curves, all_points):
     ax.set_ylabel("mean ROI gain over uniform (dB)")
     ax.set_title("1/16 of the pixels, mean over the photographs")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.02, 0.5))  # beside the axes: the points stay visible
     fig.tight_layout()
     fig.savefig(out / "gain-loss.png", dpi=90)
     plt.close(fig)
