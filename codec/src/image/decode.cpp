@@ -272,10 +272,7 @@ template <int kC>
     }
     // The last one to four pixels, the span's last stored exactly.
     for (int j = 0; k + j < count; ++j) {
-        const detail::PixelLanes v = tap(j);
-        float* o = out + static_cast<std::size_t>(k + j) * kC;
-        if (kC == 4 || k + j + 1 < count) std::memcpy(o, &v, sizeof v);
-        else detail::storeLanes<kC>(o, v);
+        detail::storeLanesInRun<kC>(out + static_cast<std::size_t>(k + j) * kC, tap(j), k + j + 1 < count);
     }
 }
 
@@ -683,8 +680,7 @@ template <int kC>
     const std::size_t sa = static_cast<std::size_t>(a.width) * kC;
     // The block's pixels are written in order, so all but its last may store four lanes.
     const auto store = [&](int k, detail::PixelLanes v) {
-        if (kC == 4 || k + 1 < count) std::memcpy(out + static_cast<std::size_t>(k) * kC, &v, sizeof v);
-        else detail::storeLanes<kC>(out + static_cast<std::size_t>(k) * kC, v);
+        detail::storeLanesInRun<kC>(out + static_cast<std::size_t>(k) * kC, v, k + 1 < count);
     };
     if (plan.oneTap) {
         prefetchAhead<kC>(a.pixels, sa, plan, count);
@@ -751,19 +747,11 @@ bool cpuHasAvx2() {
 
 std::atomic<bool> g_forceBaseline{false};
 
-bool useAvx2() {
-#if CONUS_DECODE_AVX2
-    static const bool avx2 = cpuHasAvx2();
-    return avx2 && !g_forceBaseline.load(std::memory_order_relaxed);
-#else
-    return false;
-#endif
-}
-
 template <int kC>
 BlockFn chooseBlockFn() {
 #if CONUS_DECODE_AVX2
-    if (useAvx2()) return &planAndDecodeAvx2<kC>;
+    static const bool avx2 = cpuHasAvx2();
+    if (avx2 && !g_forceBaseline.load(std::memory_order_relaxed)) return &planAndDecodeAvx2<kC>;
 #endif
     return &planAndDecodeBaseline<kC>;
 }

@@ -108,6 +108,13 @@ template <int kC>
 inline void storeLanes(float* out, PixelLanes v) {
     std::memcpy(out, &v, kC * sizeof(float));
 }
+// storeLanes for a pixel of a run stored in order: all four lanes where the next pixel follows
+// (`followed`: its store overwrites the fourth), one 16-byte store instead of a 12-byte copy.
+template <int kC>
+inline void storeLanesInRun(float* out, PixelLanes v, bool followed) {
+    if (kC == 4 || followed) std::memcpy(out, &v, sizeof v);
+    else storeLanes<kC>(out, v);
+}
 inline PixelLanes lerpLanes(PixelLanes a, PixelLanes b, float t) { return a + t * (b - a); }
 
 // Bilinear between the pixels at r0 + o0, r0 + o1, r1 + o0 and r1 + o1 (r0 <= r1, o0 <= o1,
