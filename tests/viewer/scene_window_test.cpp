@@ -67,6 +67,7 @@ double meanDifference(const Image& a, const Image& b) {
 TEST(SceneWindow, MeshFramesAreTheEncodersAndFollowTheCommands) {
     ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";
     const std::string model = std::string(CONUS_SHARED_DATA) + "/meshes/spot.obj";
+    if (!fs::exists(model)) GTEST_SKIP() << "shared data not found: " << model;
     const codec::Focus focus{0.45, 0.4, 0.12, 3.0};
     const fs::path dir = test::tempDir();
     // The drag starts on the focus (the frame fills the window: uv = pixel / size) and ends far off.
@@ -117,6 +118,7 @@ TEST(SceneWindow, MeshFramesAreTheEncodersAndFollowTheCommands) {
 TEST(SceneWindow, MeshMaxEdgeSubdividesEachFrame) {
     ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";
     const std::string model = std::string(CONUS_SHARED_DATA) + "/meshes/suzanne.obj";
+    if (!fs::exists(model)) GTEST_SKIP() << "shared data not found: " << model;
     const codec::Focus focus{0.5, 0.45, 0.15, 4.0};
     const fs::path shot = test::tempDir() / "edge.png";
     const std::string log = runScript("--mesh " + model + " --focus 0.5,0.45,0.15,4 --max-edge 0.5", "screenshot " + shot.string() + "\n");
