@@ -1,7 +1,9 @@
-// Ray / depth-image intersection in GLSL: the twin of codec/src/depth/intersect.cpp, function for
-// function (clip in homogeneous coordinates, project, walk the projected segment distorting each
-// point with Equation 1, bisect). Include equation1.inc.glsl first. kIntersectDepthMargin is
-// injected from C++ (codec/depth/intersect.h).
+// Ray / depth-image intersection in GLSL: the twin of codec/src/depth/intersect.cpp and
+// depth_surface.cpp, function for function (clip in homogeneous coordinates, project, walk the
+// projected segment distorting each point with Equation 1, bisect; walls and hidden rays as
+// codec/depth/intersect.h says). Include equation1.inc.glsl first. kIntersectDepthMargin and
+// kSilhouetteStep are injected from C++. The depth texture is RG32F: the camera depth and the cell's discontinuity
+// flag (DepthImage::cellFlags, computed once on the CPU).
 struct DepthView {
     mat4 worldToNdc;  // the camera's worldToNdcMatrix (u, v = xy / w)
     mat4 ndcToWorld;  // its inverse, for unprojectDepth
@@ -10,6 +12,8 @@ struct DepthView {
     float near;
     bool perspective;
     float minDepth, maxDepth;  // the range of the stored camera depths
+    bool solid;                // DepthImage::solid
+    float jumpRelative, jumpAbsolute;  // DepthImage's jump threshold
 };
 
 struct DepthHit {
@@ -21,19 +25,45 @@ struct DepthHit {
     vec2 distorted;  // its place in the CoNUS image
     ivec2 texel;
     int steps;
+    bool hidden;  // the background carried on behind an occluder
     int face;  // the face of the clipped volume the ray entered through when steps == 0 (0..5), else -1
 };
 
-// Bilinear in the CoNUS image at pd, pixel centres at (i + 0.5) / size, clamped to the edge pixels:
-// exact weights (texelFetch), as DepthImage::sampleDepth computes them.
-float sampleDepth(sampler2D depths, vec2 pd) {
+// DepthImage::surfaceWeights: the four texels around pd (pixel centres at (i + 0.5) / size,
+// clamped to the edge pixels) and their bilinear weights, the far side of a flagged cell zeroed;
+// the texels' depths come back in d.
+void surfaceWeights(sampler2D depths, vec2 pd, out ivec2 t[4], out vec4 w, out vec4 d) {
     const ivec2 size = textureSize(depths, 0);
     const vec2 g = clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
     const ivec2 i0 = min(ivec2(g), size - 1), i1 = min(i0 + 1, size - 1);
     const vec2 f = g - vec2(i0);
-    const float top = mix(texelFetch(depths, i0, 0).r, texelFetch(depths, ivec2(i1.x, i0.y), 0).r, f.x);
-    const float bottom = mix(texelFetch(depths, ivec2(i0.x, i1.y), 0).r, texelFetch(depths, i1, 0).r, f.x);
-    return mix(top, bottom, f.y);
+    t[0] = i0;
+    t[1] = ivec2(i1.x, i0.y);
+    t[2] = ivec2(i0.x, i1.y);
+    t[3] = i1;
+    const vec2 a = texelFetch(depths, t[0], 0).rg;
+    d = vec4(a.r, texelFetch(depths, t[1], 0).r, texelFetch(depths, t[2], 0).r, texelFetch(depths, t[3], 0).r);
+    w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    if (a.g < 0.5) return;
+    const float middle = 0.5 * (min(min(d.x, d.y), min(d.z, d.w)) + max(max(d.x, d.y), max(d.z, d.w)));
+    const bool nearSide = d[(f.x < 0.5 ? 0 : 1) + (f.y < 0.5 ? 0 : 2)] <= middle;
+    for (int k = 0; k < 4; ++k)
+        if ((d[k] <= middle) != nearSide) w[k] = 0.0;
+}
+
+// Whether pd lies in a flagged cell (DepthImage::cellIndex's cell).
+bool flaggedCell(sampler2D depths, vec2 pd) {
+    const ivec2 size = textureSize(depths, 0);
+    const ivec2 i0 = min(ivec2(clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1))), size - 1);
+    return texelFetch(depths, i0, 0).g > 0.5;
+}
+
+// DepthImage::sampleDepth: the stored surface's depth at pd.
+float sampleDepth(sampler2D depths, vec2 pd) {
+    ivec2 t[4];
+    vec4 w, d;
+    surfaceWeights(depths, pd, t, w, d);
+    return dot(w, d) / (w.x + w.y + w.z + w.w);
 }
 
 // The world point at image point uv and camera depth `depth` (perspective or orthographic: depth is
@@ -58,12 +88,22 @@ vec3 clipFaceNormal(DepthView view, int face) {
     return -normalize(inward);
 }
 
+// The stored surface's depth at s along the projected segment, and where s lies in the CoNUS image.
+float surfaceAlong(sampler2D depths, sampler2D map, vec2 p0, vec2 along, float s, out MapPoint m) {
+    m = evalMap(map, p0 + along * s);
+    return sampleDepth(depths, m.pd);
+}
+
+// The ray's camera depth at s (perspective-correct).
+float rayDepth(float dw0, float dw1, float iw0, float iw1, float s) { return mix(dw0, dw1, s) / mix(iw0, iw1, s); }
+
 DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, vec3 origin, vec3 direction,
                              float stepTexels, int refinements, int maxSteps, float tMax) {
     DepthHit result;
     result.hit = false;
     result.steps = 0;
     result.face = -1;
+    result.hidden = false;
     // 1. Clip: u, v in [0,1] and depth in [lo, hi], each a + b t >= 0.
     const vec4 c0 = view.worldToNdc * vec4(origin, 1.0), cd = view.worldToNdc * vec4(direction, 0.0);
     const float z0 = dot(origin - view.eye, view.forward), zd = dot(direction, view.forward);
@@ -74,7 +114,7 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     float planes[12] = float[12](c0.x, cd.x, c0.w - c0.x, cd.w - cd.x, c0.y, cd.y, c0.w - c0.y, cd.w - cd.y, z0 - lo,
                                  zd, hi - z0, -zd);
     float tEnter = 0.0, tExit = tMax;
-    int entered = -1;
+    int entered = -1, exited = -1;
     for (int k = 0; k < 6; ++k) {
         const float a = planes[2 * k], b = planes[2 * k + 1];
         if (b == 0.0) {
@@ -87,8 +127,9 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
                 tEnter = t;
                 entered = k;
             }
-        } else {
-            tExit = min(tExit, t);
+        } else if (t < tExit) {
+            tExit = t;
+            exited = k;
         }
     }
     if (!(tEnter <= tExit)) return result;
@@ -105,30 +146,80 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     // 3. Walk near to far, each step stepTexels CoNUS pixels along the distorted curve.
     float before = 0.0, s = 0.0;
     int steps = 0;
-    MapPoint m = evalMap(map, p0);
-    float gap = sampleDepth(depths, m.pd) - (dw0 / iw0);
-    while (gap > 0.0) {
-        if (s >= 1.0 || steps >= maxSteps) return result;
-        const float speed = length((m.du * along.x + m.dv * along.y) * size);
-        before = s;
-        s = min(1.0, s + (speed > 0.0 ? stepTexels / speed : 1.0));
-        ++steps;
-        m = evalMap(map, p0 + along * s);
-        gap = sampleDepth(depths, m.pd) - mix(dw0, dw1, s) / mix(iw0, iw1, s);
+    bool hidden = false;
+    float hiddenDepth = 0.0;
+    MapPoint m, hiddenFrom;  // hiddenFrom: the last point in front of the surface
+    bool found = false;
+    if (surfaceAlong(depths, map, p0, along, 0.0, m) - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0) {
+        if (view.solid) {
+            found = true;
+        } else {
+            hidden = true;
+            hiddenDepth = rayDepth(dw0, dw1, iw0, iw1, 0.0);
+            hiddenFrom = m;
+        }
     }
-    // 4. Bisect between the last sample in front and the first behind.
-    if (steps > 0) {
+    while (!found) {
+        if (s >= 1.0 || steps >= maxSteps) {
+            if (!(hidden && s >= 1.0 && exited == 5)) return result;
+            // Hidden up to the farthest stored depth: the background where the ray went hidden.
+            m = hiddenFrom;
+            result.hidden = true;
+            break;
+        }
+        const float speed = length((m.du * along.x + m.dv * along.y) * size);
+        const bool fine = !view.solid && flaggedCell(depths, m.pd);
+        before = s;
+        s = min(1.0, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
+        ++steps;
+        float stored = surfaceAlong(depths, map, p0, along, s, m);
+        if (!fine && !view.solid && flaggedCell(depths, m.pd)) {  // a full step into a flagged cell: taken again, finely
+            s = min(1.0, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
+            stored = surfaceAlong(depths, map, p0, along, s, m);
+        }
+        const float gap = stored - rayDepth(dw0, dw1, iw0, iw1, s);
+        MapPoint q;
+        if (hidden) {
+            if (gap > 0.0) {
+                hidden = false;
+            } else if (stored >= hiddenDepth) {
+                float a = before, b = s;
+                for (int k = 0; k < refinements; ++k) {
+                    const float mid = 0.5 * (a + b);
+                    if (surfaceAlong(depths, map, p0, along, mid, q) >= hiddenDepth)
+                        b = mid;
+                    else
+                        a = mid;
+                }
+                s = b;
+                m = evalMap(map, p0 + along * s);
+                result.hidden = true;
+                found = true;
+            }
+            continue;
+        }
+        if (gap > 0.0) continue;
+        // 4. Bisect between the last sample in front and the first behind.
         float a = before, b = s;
         for (int k = 0; k < refinements; ++k) {
             const float mid = 0.5 * (a + b);
-            const MapPoint q = evalMap(map, p0 + along * mid);
-            if (sampleDepth(depths, q.pd) - mix(dw0, dw1, mid) / mix(iw0, iw1, mid) > 0.0)
+            if (surfaceAlong(depths, map, p0, along, mid, q) - rayDepth(dw0, dw1, iw0, iw1, mid) > 0.0)
                 a = mid;
             else
                 b = mid;
         }
-        s = 0.5 * (a + b);
-        m = evalMap(map, p0 + along * s);
+        const float sb = surfaceAlong(depths, map, p0, along, b, q);
+        MapPoint qa;
+        const float jump = surfaceAlong(depths, map, p0, along, a, qa) - sb;
+        if (view.solid || jump <= 0.5 * (view.jumpRelative * sb + view.jumpAbsolute)) {
+            s = 0.5 * (a + b);
+            m = evalMap(map, p0 + along * s);
+            found = true;
+        } else {
+            hidden = true;  // a wall: the ray passes behind an occluder's silhouette
+            hiddenDepth = rayDepth(dw0, dw1, iw0, iw1, b);
+            hiddenFrom = qa;
+        }
     }
     const float iw = mix(iw0, iw1, s);
     result.hit = true;

@@ -18,7 +18,7 @@ uniform float uTMax;
 layout(location = 0) out vec4 outHit;       // hit, t, depth, steps
 layout(location = 1) out vec4 outPosition;  // position, face
 layout(location = 2) out vec4 outPoints;    // point, distorted
-layout(location = 3) out vec4 outTexel;     // texel
+layout(location = 3) out vec4 outTexel;     // texel, hidden
 
 void main() {
     const ivec2 at = ivec2(gl_FragCoord.xy);
@@ -28,5 +28,5 @@ void main() {
     outHit = vec4(h.hit ? 1.0 : 0.0, h.t, h.depth, float(h.steps));
     outPosition = vec4(h.position, float(h.face));
     outPoints = vec4(h.point, h.distorted);
-    outTexel = vec4(vec2(h.texel), 0.0, 0.0);
+    outTexel = vec4(vec2(h.texel), h.hidden ? 1.0 : 0.0, 0.0);
 }

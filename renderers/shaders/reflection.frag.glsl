@@ -60,20 +60,21 @@ float hitReflector(vec3 origin, vec3 d, out vec3 normal) {
     return t;
 }
 
-// codec::reflectionColour: the face's colour at the hit's CoNUS position, bilinear over the
-// covered texels among the four around it (the far plane's texels carry no colour).
-vec3 reflectionColour(sampler2D colours, vec2 pd, ivec2 texel) {
-    const ivec2 size = textureSize(colours, 0);
-    const vec2 g = clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
-    const ivec2 i0 = min(ivec2(g), size - 1), i1 = min(i0 + 1, size - 1);
-    const vec2 f = g - vec2(i0);
-    const vec4 c00 = texelFetch(colours, i0, 0), c10 = texelFetch(colours, ivec2(i1.x, i0.y), 0);
-    const vec4 c01 = texelFetch(colours, ivec2(i0.x, i1.y), 0), c11 = texelFetch(colours, i1, 0);
-    const float w00 = (1.0 - f.x) * (1.0 - f.y) * c00.a, w10 = f.x * (1.0 - f.y) * c10.a;
-    const float w01 = (1.0 - f.x) * f.y * c01.a, w11 = f.x * f.y * c11.a;
-    const float w = w00 + w10 + w01 + w11;
-    if (!(w > 0.0)) return texelFetch(colours, texel, 0).rgb;
-    return (c00.rgb * w00 + c10.rgb * w10 + c01.rgb * w01 + c11.rgb * w11) / w;
+// codec::reflectionColour: the face's colour at the hit's CoNUS position, with the surface's own
+// weights (a silhouette's far side weighs nothing) times coverage (the far plane's texels carry none).
+vec3 reflectionColour(sampler2D depths, sampler2D colours, vec2 pd, ivec2 texel) {
+    ivec2 t[4];
+    vec4 w, d;
+    surfaceWeights(depths, pd, t, w, d);
+    vec3 sum = vec3(0.0);
+    float total = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        const vec4 c = texelFetch(colours, t[k], 0);
+        sum += c.rgb * (w[k] * c.a);
+        total += w[k] * c.a;
+    }
+    if (!(total > 0.0)) return texelFetch(colours, texel, 0).rgb;
+    return sum / total;
 }
 
 void main() {
@@ -98,10 +99,10 @@ void main() {
         const DepthHit h = intersectDepthImage(uDepths[f], uMaps[f], uViews[f], at, reflected, uStepTexels,
                                                uRefinements, uMaxSteps, best);
         if (!h.hit || (found && h.t >= best)) continue;
-        if (texelFetch(uColours[f], h.texel, 0).a < 0.5 || h.depth >= uFar[f] * (1.0 - 1e-4)) continue;
+        if (texelFetch(uColours[f], h.texel, 0).a < 0.5 || (!h.hidden && h.depth >= uFar[f] * (1.0 - 1e-4))) continue;
         found = true;
         best = h.t;
-        colour = reflectionColour(uColours[f], h.distorted, h.texel);
+        colour = reflectionColour(uDepths[f], uColours[f], h.distorted, h.texel);
     }
     outColour = vec4(colour, found ? 2.0 : 1.0);
 }

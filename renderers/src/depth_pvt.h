@@ -1,5 +1,6 @@
 // Private: a CoNUS depth image on the GPU, as intersect.inc.glsl reads it (relief and reflection
-// renderers): its textures (camera depths R32F, the map's nodes RG32F) and its DepthView uniforms;
+// renderers): its textures (camera depths and cell flags RG32F, the map's nodes RG32F) and its
+// DepthView uniforms;
 // and what both renderers' frames share: an RGBA32F target, one full-screen pass into it, and the
 // scene a DepthFrameRenderer keeps (depth_frames.h).
 #pragma once
@@ -50,8 +51,13 @@ struct DepthTextures {
                                                       "x" + std::to_string(image.height()) +
                                                       " exceeds GL_MAX_TEXTURE_SIZE " +
                                                       std::to_string(context.maxTextureSize()));
-        depths = floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(unit), image.width(), image.height(), 1,
-                              image.depths().data());
+        std::vector<float> depthsAndFlags(image.depths().size() * 2);
+        for (std::size_t i = 0; i < image.depths().size(); ++i) {
+            depthsAndFlags[2 * i] = image.depths()[i];
+            depthsAndFlags[2 * i + 1] = image.cellFlags()[i];
+        }
+        depths = floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(unit), image.width(), image.height(), 2,
+                              depthsAndFlags.data());
         const codec::SamplingMap& sampling = image.map();
         map = uploadMapTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(unit + 1), sampling.columns(), sampling.rows(),
                                glm::value_ptr(sampling.nodes().front()));
@@ -83,6 +89,9 @@ inline void setDepthView(const GladGLContext& gl, GLuint program, const codec::D
     gl.Uniform1i(at(".perspective"), camera.projection() == Projection::Perspective ? 1 : 0);
     gl.Uniform1f(at(".minDepth"), static_cast<float>(image.minDepth()));
     gl.Uniform1f(at(".maxDepth"), static_cast<float>(image.maxDepth()));
+    gl.Uniform1i(at(".solid"), image.solid() ? 1 : 0);
+    gl.Uniform1f(at(".jumpRelative"), static_cast<float>(image.jumpRelative()));
+    gl.Uniform1f(at(".jumpAbsolute"), static_cast<float>(image.jumpAbsolute()));
     gl.Uniform1i(gl.GetUniformLocation(program, depths.c_str()), textures.unit);
     gl.Uniform1i(gl.GetUniformLocation(program, map.c_str()), textures.unit + 1);
 }

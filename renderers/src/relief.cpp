@@ -100,6 +100,7 @@ std::vector<std::optional<codec::DepthHit>> intersectRays(Context& context, cons
         hit.point = glm::dvec2(out[2][i * 4], out[2][i * 4 + 1]);
         hit.distorted = glm::dvec2(out[2][i * 4 + 2], out[2][i * 4 + 3]);
         hit.texel = glm::ivec2(static_cast<int>(out[3][i * 4]), static_cast<int>(out[3][i * 4 + 1]));
+        hit.hidden = out[3][i * 4 + 2] > 0.5f;
         hits[i] = hit;
     }
     return hits;

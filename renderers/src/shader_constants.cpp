@@ -44,6 +44,7 @@ std::string constantsBlock() {
     s += "const float kMeshAmbient = " + glslFloat(codec::kAmbient) + ";\n";
     s += "const float kMeshGrey = " + glslFloat(codec::kDefaultAlbedo) + ";\n";
     s += "const float kIntersectDepthMargin = " + glslFloat(codec::kIntersectDepthMargin) + ";\n";
+    s += "const float kSilhouetteStep = " + glslFloat(codec::kSilhouetteStep) + ";\n";
     return s;
 }
 

@@ -15,7 +15,7 @@ inline constexpr int kViewMaxFoci = 16;          // focus outlines conus-view dr
 // kEncodeMaxAxisTaps, kEncodeAnisotropicSigma, kEncodeGaussianReach, kEncodeBoxAnisotropy
 // (codec/encode.h), kBackground, kMaxFoci (above), kInferno[6] (core/display.h), and the mesh
 // shading's kMeshAmbient, kMeshGrey (codec/mesh/shading.h: kAmbient, kDefaultAlbedo), and
-// kIntersectDepthMargin (codec/depth/intersect.h).
+// kIntersectDepthMargin and kSilhouetteStep (codec/depth/intersect.h).
 std::string withSharedConstants(const std::string& source);
 
 }  // namespace conus::gl

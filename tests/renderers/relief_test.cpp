@@ -64,7 +64,7 @@ void expectAgreement(Context& context, const DepthImage& image, const std::vecto
         const DepthHit& g = *gpu[i];
         if (glm::distance(c.position, g.position) > tolerance || std::abs(c.t - g.t) > tolerance ||
             glm::distance(c.point, g.point) > tolerance || glm::distance(c.distorted, g.distorted) > tolerance ||
-            std::abs(c.depth - g.depth) > tolerance || c.face != g.face ||
+            std::abs(c.depth - g.depth) > tolerance || c.face != g.face || c.hidden != g.hidden ||
             std::abs(c.steps - g.steps) > 2 + c.steps / 50 || glm::length(glm::dvec2(c.texel - g.texel)) > 1.5)
             ++disagreements;
     }
@@ -88,6 +88,20 @@ TEST_P(ReliefGl, GlslMatchesCpuOnAPerspectiveSphere) {
     std::vector<Ray> rays;
     for (int i = 0; i < 1000; ++i)
         rays.push_back(rayThrough({1.5, 1.0, -3.5}, {spread(rng), spread(rng), spread(rng) * 0.5}));
+    expectAgreement(context(), image, rays, {}, 1e-2);
+}
+
+// A scene's silhouettes (walls are no hits, hidden rays take the background) follow the same rule.
+TEST_P(ReliefGl, GlslMatchesCpuBesideAThinBoard) {
+    const DepthImage image = codec::test::boardImage(focusMap(0.5, 0.5, 0.1, 3.0), 128);
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<double> x(-0.6, 0.6), y(-0.6, 0.6);
+    std::vector<Ray> rays;
+    for (int i = 0; i < 1000; ++i) rays.push_back(rayThrough({1.2, 0.3, -3.0}, {x(rng), y(rng), codec::test::kWallZ}));
+    const auto gpu = intersectRays(context(), image, rays, {});
+    int hidden = 0;
+    for (const auto& h : gpu) hidden += h && h->hidden;
+    EXPECT_GT(hidden, 10);
     expectAgreement(context(), image, rays, {}, 1e-2);
 }
 

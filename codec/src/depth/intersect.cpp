@@ -18,6 +18,7 @@ struct Segment {
     glm::dvec2 p0, p1;
     double iw0, iw1, dw0, dw1, tw0, tw1;
     int face;  // the face the ray entered through (-1: it starts inside)
+    int exit;  // the face it leaves through (-1: cut short by tMax)
 
     glm::dvec2 point(double s) const { return p0 + (p1 - p0) * s; }
     double invW(double s) const { return iw0 + (iw1 - iw0) * s; }
@@ -41,7 +42,7 @@ std::optional<Segment> clipRay(const DepthImage& image, const Ray& ray, double t
     if (camera.projection() == Projection::Perspective) lo = std::max(lo, camera.near());
 
     double tEnter = 0.0, tExit = tMax;
-    int face = -1;
+    int face = -1, exit = -1;
     const double planes[6][2] = {{c0.x, cd.x},
                                  {c0.w - c0.x, cd.w - cd.x},
                                  {c0.y, cd.y},
@@ -60,8 +61,9 @@ std::optional<Segment> clipRay(const DepthImage& image, const Ray& ray, double t
                 tEnter = t;
                 face = k;
             }
-        } else {
-            tExit = std::min(tExit, t);
+        } else if (t < tExit) {
+            tExit = t;
+            exit = k;
         }
     }
     if (!(tEnter <= tExit)) return std::nullopt;
@@ -75,55 +77,13 @@ std::optional<Segment> clipRay(const DepthImage& image, const Ray& ray, double t
     };
     Segment segment{};
     segment.face = face;
+    segment.exit = exit;
     end(tEnter, segment.p0, segment.iw0, segment.dw0, segment.tw0);
     end(tExit, segment.p1, segment.iw1, segment.dw1, segment.tw1);
     return segment;
 }
 
 }  // namespace
-
-DepthImage::DepthImage(Camera camera, std::shared_ptr<const SamplingMap> map, int width, int height,
-                       std::vector<float> depths)
-    : m_camera(std::move(camera)), m_map(std::move(map)), m_width(width), m_height(height), m_depths(std::move(depths)) {
-    if (!m_map) m_map = std::make_shared<SamplingMap>(SamplingMap::identity(2, 2));
-    if (width < 1 || height < 1 || m_depths.size() != static_cast<std::size_t>(width) * height)
-        throw Error(ErrorCode::InvalidArgument, "DepthImage: " + std::to_string(m_depths.size()) + " depths for " +
-                                                    std::to_string(width) + "x" + std::to_string(height) + " pixels");
-    const auto [lo, hi] = std::minmax_element(m_depths.begin(), m_depths.end());
-    for (const float d : m_depths)
-        if (!std::isfinite(d)) throw Error(ErrorCode::InvalidArgument, "DepthImage: a depth is not finite");
-    m_minDepth = *lo;
-    m_maxDepth = *hi;
-}
-
-DepthImage DepthImage::fromFile(const format::ConusFile& file) {
-    if (!file.camera) throw Error(ErrorCode::InvalidArgument, "the file has no camera, so its depths have no place in space");
-    const int z = file.image.channelIndex("Z");
-    if (z < 0 || file.depth.kind == format::DepthKind::None)
-        throw Error(ErrorCode::InvalidArgument, "the file has no depth channel Z");
-    checkImage(file.image, "DepthImage::fromFile");
-    Camera camera = format::toCamera(*file.camera);
-    const bool height = file.depth.kind == format::DepthKind::Height;
-    const double base = height ? heightToDepth(camera, 0.0) : 0.0;
-    std::vector<float> depths(static_cast<std::size_t>(file.image.width) * file.image.height);
-    for (std::size_t i = 0; i < depths.size(); ++i) {
-        const float value = file.image.pixels[i * file.image.channels.size() + static_cast<std::size_t>(z)];
-        depths[i] = height ? static_cast<float>(base - value) : value;
-    }
-    return DepthImage(std::move(camera), std::make_shared<SamplingMap>(SamplingMap::fromGrid(file.map)),
-                      file.image.width, file.image.height, std::move(depths));
-}
-
-double DepthImage::sampleDepth(glm::dvec2 pd) const {
-    const double x = std::clamp(pd.x * m_width - 0.5, 0.0, m_width - 1.0);
-    const double y = std::clamp(pd.y * m_height - 0.5, 0.0, m_height - 1.0);
-    const int x0 = std::min(static_cast<int>(x), m_width - 1), y0 = std::min(static_cast<int>(y), m_height - 1);
-    const int x1 = std::min(x0 + 1, m_width - 1), y1 = std::min(y0 + 1, m_height - 1);
-    const double fx = x - x0, fy = y - y0;
-    const double top = depthAt(x0, y0) + (depthAt(x1, y0) - depthAt(x0, y0)) * fx;
-    const double bottom = depthAt(x0, y1) + (depthAt(x1, y1) - depthAt(x0, y1)) * fx;
-    return top + (bottom - top) * fy;
-}
 
 double heightToDepth(const Camera& camera, double height) {
     return glm::dot(-camera.eye(), camera.forward()) - height;
@@ -152,42 +112,96 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
     const SamplingMap& map = image.map();
     const glm::dvec2 size(image.width(), image.height());
     const glm::dvec2 along = segment.p1 - segment.p0;
-    // How far the surface lies in front of the ray at s (> 0: the ray is still in front).
-    const auto gap = [&](double s, glm::dvec2& pd) {
+    // The stored surface's depth at s (and where s lies in the CoNUS image).
+    const auto surface = [&](double s, glm::dvec2& pd) {
         pd = map.distort(segment.point(s));
-        return image.sampleDepth(pd) - segment.depth(s);
+        return image.sampleDepth(pd);
+    };
+    // Whether pd lies in a flagged cell: steps from or into one are kSilhouetteStep as long, so that
+    // a near surface a texel wide is not stepped over (a wall, unlike a skin, can be).
+    const bool solid = image.solid();  // no cell of a solid image is flagged
+    const auto flagged = [&](glm::dvec2 p) { return !solid && image.cellFlags()[image.cellIndex(p)] != 0; };
+    const auto hitAt = [&](double s, glm::dvec2 pd, int steps, bool hidden) {
+        DepthHit hit;
+        hit.t = segment.t(s);
+        hit.position = ray.origin + ray.direction * hit.t;
+        hit.depth = segment.depth(s);
+        hit.point = segment.point(s);
+        hit.distorted = pd;
+        hit.texel = glm::clamp(glm::ivec2(glm::floor(pd * size)), glm::ivec2(0), glm::ivec2(size) - 1);
+        hit.steps = steps;
+        hit.hidden = hidden;
+        hit.face = steps == 0 ? segment.face : -1;
+        return hit;
     };
 
     glm::dvec2 pd;
     double before = 0.0, s = 0.0;
     int steps = 0;
-    while (gap(s, pd) > 0.0) {
-        if (s >= 1.0 || steps >= options.maxSteps) return std::nullopt;
+    // Hidden: behind the surface of a scene, since the ray was at depth `hiddenDepth` (file comment).
+    bool hidden = false;
+    double hiddenDepth = 0.0;
+    glm::dvec2 hiddenFrom(0.0);  // the last point in front of the surface: the background's side
+    if (surface(0.0, pd) - segment.depth(0.0) <= 0.0) {
+        if (image.solid()) return hitAt(0.0, pd, 0, false);
+        hidden = true;
+        hiddenDepth = segment.depth(0.0);
+        hiddenFrom = pd;
+    }
+    for (;;) {
+        if (s >= 1.0 || steps >= options.maxSteps) {
+            // Hidden up to the farthest stored depth: behind the background, which takes the
+            // colour of where the ray went hidden.
+            if (hidden && s >= 1.0 && segment.exit == 5) return hitAt(1.0, hiddenFrom, steps, true);
+            return std::nullopt;
+        }
         // CoNUS pixels the curve covers per unit s here: |J (p1 - p0)| in pixels.
         const double speed = glm::length(map.jacobian(segment.point(s)) * along * size);
+        const auto advance = [&](double texels) { return std::min(1.0, before + (speed > 0.0 ? texels / speed : 1.0)); };
+        const bool fine = flagged(pd);
         before = s;
-        s = std::min(1.0, s + (speed > 0.0 ? options.stepTexels / speed : 1.0));
+        s = advance(options.stepTexels * (fine ? kSilhouetteStep : 1.0));
         ++steps;
-    }
-    if (steps > 0) {
+        double stored = surface(s, pd);
+        if (!fine && flagged(pd)) {  // a full step into a flagged cell: taken again, finely
+            s = advance(options.stepTexels * kSilhouetteStep);
+            stored = surface(s, pd);
+        }
+        const double gap = stored - segment.depth(s);
+        if (hidden) {
+            if (gap > 0.0) {
+                hidden = false;  // in front of the surface again
+            } else if (stored >= hiddenDepth) {
+                // Behind the background: where the stored surface first reaches hiddenDepth.
+                double a = before, b = s;
+                for (int k = 0; k < options.refinements; ++k) {
+                    const double m = 0.5 * (a + b);
+                    (surface(m, pd) >= hiddenDepth ? b : a) = m;
+                }
+                surface(b, pd);
+                return hitAt(b, pd, steps, true);
+            }
+            continue;
+        }
+        if (gap > 0.0) continue;
+        // A crossing between `before` (in front) and s (behind): bisect it.
         double a = before, b = s;
         for (int k = 0; k < options.refinements; ++k) {
             const double m = 0.5 * (a + b);
-            (gap(m, pd) > 0.0 ? a : b) = m;
+            (surface(m, pd) - segment.depth(m) > 0.0 ? a : b) = m;
         }
-        s = 0.5 * (a + b);
-        gap(s, pd);
+        glm::dvec2 pa, pb;
+        const double jump = surface(a, pa) - surface(b, pb);
+        if (image.solid() || jump <= 0.5 * (image.jumpRelative() * surface(b, pb) + image.jumpAbsolute())) {
+            const double mid = 0.5 * (a + b);
+            surface(mid, pd);
+            return hitAt(mid, pd, steps, false);
+        }
+        // A wall: the ray passes behind an occluder's silhouette.
+        hidden = true;
+        hiddenDepth = segment.depth(b);
+        hiddenFrom = pa;
     }
-    DepthHit hit;
-    hit.t = segment.t(s);
-    hit.position = ray.origin + ray.direction * hit.t;
-    hit.depth = segment.depth(s);
-    hit.point = segment.point(s);
-    hit.distorted = pd;
-    hit.texel = glm::clamp(glm::ivec2(glm::floor(pd * size)), glm::ivec2(0), glm::ivec2(size) - 1);
-    hit.steps = steps;
-    hit.face = steps == 0 ? segment.face : -1;
-    return hit;
 }
 
 }  // namespace conus::codec

@@ -38,10 +38,11 @@ AxisBox boundsOf(const Mesh& mesh) {
 bool finite(glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // A face's far plane lies where nothing was seen (coverage 0): a hit there, or one the bisection
-// leaves just short of it, is the sky, not a surface.
+// leaves just short of it, is the sky, not a surface. A hidden hit (intersect.h) lies on the
+// background carried on behind an occluder, wherever the ray ends: its texel alone says.
 bool onSky(const DepthHit& hit, const ReflectionFace& face) {
     return face.image.at(hit.texel.x, hit.texel.y, kMeshChannelA) < 0.5f ||
-           hit.depth >= face.depth.camera().far() * (1.0 - 1e-4);
+           (!hit.hidden && hit.depth >= face.depth.camera().far() * (1.0 - 1e-4));
 }
 
 }  // namespace
@@ -111,7 +112,7 @@ std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const Reflect
         const Image rgbaz = renderMeshReference(scene, Fpc(camera, map), o.size, o.size);
         std::vector<float> depths(static_cast<std::size_t>(o.size) * o.size);
         for (std::size_t i = 0; i < depths.size(); ++i) depths[i] = rgbaz.pixels[i * rgbaz.channels.size() + kMeshChannelZ];
-        faces.push_back({DepthImage(camera, map, o.size, o.size, std::move(depths)), rgbaz});
+        faces.push_back({DepthImage(camera, map, o.size, o.size, std::move(depths), false), rgbaz});
     }
     return faces;
 }
@@ -150,22 +151,22 @@ std::optional<ReflectorHit> hitReflector(const Reflector& r, const Ray& ray) {
 
 glm::vec3 reflectionColour(const ReflectionFace& face, const DepthHit& hit) {
     const Image& c = face.image;
-    const auto texel = [&](int x, int y) {
-        return glm::vec4(c.at(x, y, kMeshChannelR), c.at(x, y, kMeshChannelR + 1), c.at(x, y, kMeshChannelR + 2),
-                         c.at(x, y, kMeshChannelA));
+    const auto texel = [&](glm::ivec2 t) {
+        return glm::vec4(c.at(t.x, t.y, kMeshChannelR), c.at(t.x, t.y, kMeshChannelR + 1),
+                         c.at(t.x, t.y, kMeshChannelR + 2), c.at(t.x, t.y, kMeshChannelA));
     };
-    // As DepthImage::sampleDepth places the four (pixel centres at (i + 0.5) / size, clamped).
-    const glm::dvec2 size(c.width, c.height);
-    const glm::dvec2 g = glm::clamp(hit.distorted * size - 0.5, glm::dvec2(0.0), size - 1.0);
-    const glm::ivec2 i0 = glm::min(glm::ivec2(g), glm::ivec2(size) - 1), i1 = glm::min(i0 + 1, glm::ivec2(size) - 1);
-    const glm::dvec2 f = g - glm::dvec2(i0);
-    const glm::vec4 c00 = texel(i0.x, i0.y), c10 = texel(i1.x, i0.y), c01 = texel(i0.x, i1.y), c11 = texel(i1.x, i1.y);
-    const float fx = static_cast<float>(f.x), fy = static_cast<float>(f.y);
-    const float w00 = (1 - fx) * (1 - fy) * c00.a, w10 = fx * (1 - fy) * c10.a, w01 = (1 - fx) * fy * c01.a,
-                w11 = fx * fy * c11.a;
-    const float w = w00 + w10 + w01 + w11;
-    if (!(w > 0.0f)) return glm::vec3(texel(hit.texel.x, hit.texel.y));
-    return (glm::vec3(c00) * w00 + glm::vec3(c10) * w10 + glm::vec3(c01) * w01 + glm::vec3(c11) * w11) / w;
+    // The surface's own weights (a silhouette's far side weighs nothing), times coverage.
+    const DepthImage::Weights weights = face.depth.surfaceWeights(hit.distorted);
+    glm::vec3 sum(0.0f);
+    float w = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+        const glm::vec4 t = texel(weights.texel[k]);
+        const float wk = static_cast<float>(weights.weight[k]) * t.a;
+        sum += glm::vec3(t) * wk;
+        w += wk;
+    }
+    if (!(w > 0.0f)) return glm::vec3(texel(hit.texel));
+    return sum / w;
 }
 
 std::optional<ReflectionHit> traceReflection(const std::vector<ReflectionFace>& faces, const Ray& ray,

@@ -79,6 +79,34 @@ inline DepthImage sphereImage(std::shared_ptr<const SamplingMap> map, int size) 
     return DepthImage(camera, std::move(map), size, size, std::move(depths));
 }
 
+// A thin board (|x| <= kBoardHalf, |y| <= 2, in the plane z = 0, facing the camera) in front of the
+// wall z = kWallZ, seen by sphereCamera: the silhouette case of a depth image of a scene.
+inline constexpr double kBoardHalf = 0.04;
+
+inline std::optional<double> boardSceneHit(const Ray& ray) {
+    if (ray.direction.z != 0.0) {
+        const double t = -ray.origin.z / ray.direction.z;
+        const glm::dvec3 p = ray.origin + ray.direction * t;
+        if (t > 0.0 && std::abs(p.x) <= kBoardHalf && std::abs(p.y) <= 2.0) return t;
+    }
+    if (ray.direction.z > 0.0) return (kWallZ - ray.origin.z) / ray.direction.z;
+    return std::nullopt;
+}
+
+// The board scene's camera depths through `map`; `solid` as DepthImage takes it (a scene: false).
+inline DepthImage boardImage(std::shared_ptr<const SamplingMap> map, int size, bool solid = false) {
+    const Camera camera = sphereCamera();
+    std::vector<float> depths(static_cast<std::size_t>(size) * size);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const Ray ray = camera.ray(map->undistort({(x + 0.5) / size, (y + 0.5) / size}));
+            const double t = boardSceneHit(ray).value();
+            depths[static_cast<std::size_t>(y) * size + x] =
+                static_cast<float>(glm::dot(ray.origin + ray.direction * t - camera.eye(), camera.forward()));
+        }
+    return DepthImage(camera, std::move(map), size, size, std::move(depths), solid);
+}
+
 // A ray from `from` toward `to`.
 inline Ray rayThrough(glm::dvec3 from, glm::dvec3 to) { return {from, glm::normalize(to - from)}; }
 

@@ -100,6 +100,90 @@ TEST(Intersect, PerspectiveSphereFromAnotherViewpoint) {
     }
 }
 
+// A thin board in front of a far wall (a depth image of a scene): rays from elsewhere that pass
+// beside the board, over its silhouette in the image, hit the wall where it is, not the "skin"
+// between the board's depth and the wall's (the bilinear surface across the silhouette, which the
+// intersection hit before cells were split at discontinuities); rays at the board hit the board;
+// rays into the wall behind it, which the image never saw, hit the wall carried on behind it.
+TEST(Intersect, ThinBoardInFrontOfAFarWallHasNoSkin) {
+    for (const bool conus : {false, true}) {
+        const DepthImage image = test::boardImage(conus ? focusMap(0.5, 0.5, 0.1, 3.0) : identityMap(), 128);
+        const char* what = conus ? "CoNUS" : "identity";
+        const glm::dvec3 origin(1.2, 0.3, -3.0);
+        int crossings = 0;
+        for (int i = 0; i < 40; ++i) {
+            const double x = -0.5 + 0.38 * i / 39.0, y = -0.5 + 0.027 * i;
+            const Ray ray = rayThrough(origin, {x, y, test::kWallZ});
+            const auto truth = test::boardSceneHit(ray);
+            ASSERT_TRUE(truth);
+            // The ray passes the board's plane beside it and ends on the other side of its image:
+            // its projection crosses the board's image behind the board, the skin case.
+            const double t0 = -ray.origin.z / ray.direction.z;
+            const double u0 = image.camera().project(ray.origin + ray.direction * t0).x;
+            const double u1 = image.camera().project(ray.origin + ray.direction * *truth).x;
+            if ((u0 - 0.5) * (u1 - 0.5) < 0.0) ++crossings;
+            const auto hit = intersect(image, ray);
+            ASSERT_TRUE(hit) << what << " ray " << i;
+            EXPECT_NEAR(hit->position.z, test::kWallZ, 0.01) << what << " ray " << i;
+            EXPECT_NEAR(hit->t, *truth, 0.02) << what << " ray " << i;
+            EXPECT_FALSE(hit->hidden);
+            expectConsistent(image, ray, *hit);
+        }
+        EXPECT_GT(crossings, 30);
+        // At the board, over half a texel (0.028 here) inside its outline: a single layer keeps a
+        // silhouette to within half a texel.
+        for (int i = 0; i < 12; ++i) {
+            const Ray ray = rayThrough(origin, {-0.015 + 0.0025 * i, -0.4 + 0.07 * i, 0.0});
+            const auto hit = intersect(image, ray);
+            ASSERT_TRUE(hit) << what << " board ray " << i;
+            EXPECT_NEAR(hit->position.z, 0.0, 0.01) << what << " board ray " << i;
+            EXPECT_NEAR(hit->t, test::boardSceneHit(ray).value(), 0.01);
+        }
+        // Into the strip of wall the board hides from the camera: the background carried on.
+        const Ray behind = rayThrough(origin, {0.0, 0.1, test::kWallZ});
+        ASSERT_GT(std::abs(behind.origin.x + behind.direction.x * (-origin.z / behind.direction.z)), test::kBoardHalf);
+        const auto hidden = intersect(image, behind);
+        ASSERT_TRUE(hidden) << what;
+        EXPECT_TRUE(hidden->hidden);
+        EXPECT_NEAR(hidden->position.z, test::kWallZ, 0.01);
+        // The same depths as matter (a height field's rule): the board is solid to the wall, and
+        // the first ray that passes behind its silhouette hits its side.
+        const DepthImage solid = test::boardImage(conus ? focusMap(0.5, 0.5, 0.1, 3.0) : identityMap(), 128, true);
+        const auto side = intersect(solid, rayThrough(origin, {-0.3, 0.0, test::kWallZ}));
+        ASSERT_TRUE(side);
+        EXPECT_LT(side->position.z, 1.5);
+    }
+}
+
+// Cells are flagged where the depth jumps against its neighbours, not where it changes steadily:
+// a plane seen at a grazing angle has none, the board's silhouette columns have them.
+TEST(Intersect, DiscontinuityFlagsMarkSilhouettesOnly) {
+    const Camera camera = test::sphereCamera();
+    const int size = 64;
+    std::vector<float> floor(static_cast<std::size_t>(size) * size);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            // The plane y = -0.3 + 0.02 z, steeply foreshortened: 1/depth affine in the image.
+            const Ray ray = camera.ray({(x + 0.5) / size, (y + 0.5) / size});
+            const double t = (-0.3 - ray.origin.y + 0.02 * ray.origin.z) / (ray.direction.y - 0.02 * ray.direction.z);
+            floor[static_cast<std::size_t>(y) * size + x] =
+                static_cast<float>(t > 0 ? std::min(glm::dot(ray.direction * t, camera.forward()), 19.0) : 19.0);
+        }
+    const DepthImage plane(camera, identityMap(), size, size, floor, false);
+    int flaggedRows = 0;
+    for (int y = 0; y < size; ++y) {
+        bool any = false;
+        for (int x = 0; x < size; ++x) any = any || plane.cellFlags()[static_cast<std::size_t>(y) * size + x];
+        flaggedRows += any;
+    }
+    EXPECT_LE(flaggedRows, 1);  // at most the horizon, where the plane meets the far clip
+    const DepthImage board = test::boardImage(identityMap(), size);
+    int flagged = 0;
+    for (int x = 0; x < size; ++x) flagged += board.cellFlags()[static_cast<std::size_t>(size / 2) * size + x];
+    EXPECT_GE(flagged, 2);
+    EXPECT_LE(flagged, 4);
+}
+
 // A step: heights jump at x = 0.5. A focus on the edge holds it sharper than the identity at the
 // same texel count, so rays that hit the wall are placed better.
 TEST(Intersect, StepWallSharperWhereTheMapMagnifies) {

@@ -1,0 +1,160 @@
+// Reflections across silhouettes at the defaults a user gets (`bake reflection`: 128-texel faces,
+// a focus of k = 4 on the region of interest): a sphere mirror and a square plane mirror, each
+// reflecting a colour-ramped box, a thin pole and a wall behind them over a floor, where reflected
+// rays pass beside silhouettes with far surfaces behind (the case a single-layer depth image must
+// not bridge). BM_ReflectionSilhouettes reports the PSNR over the whole mirror against the traced
+// reference (the reflected rays against the mesh, Embree), and inside and outside the region of
+// interest (mirror pixels whose traced ray meets the box), for CoNUS faces and uniform faces of the
+// same texel count; with CONUS_BENCH_PICTURES set to a prefix it writes <prefix>-sphere.png and
+// <prefix>-plane.png (CoNUS | uniform | reference, the box enlarged below).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include "conus/codec/depth/reflection.h"
+#include "conus/imageio/image_file.h"
+
+namespace conus {
+namespace {
+
+constexpr int kFrame = 256;
+constexpr std::uint32_t kBoxTriangles = 12;
+const codec::AxisBox kBox{{0.4, -0.3, 1.5}, {1.0, 0.5, 2.2}};
+
+// An axis box of its own four-corner faces, coloured by `colour` at each corner.
+template <class Colour>
+void addBox(Mesh& m, glm::vec3 lo, glm::vec3 hi, Colour colour) {
+    const int faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    for (const auto& f : faces) {
+        const auto base = static_cast<std::uint32_t>(m.positions.size());
+        for (int c : f) {
+            const glm::vec3 p(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+            m.positions.push_back(p);
+            m.colours.push_back(colour(p));
+        }
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+}
+
+// A quad of four corners, each its own colour.
+void addQuad(Mesh& m, const std::array<glm::vec3, 4>& corners, const std::array<glm::vec3, 4>& colours) {
+    const auto base = static_cast<std::uint32_t>(m.positions.size());
+    for (int k = 0; k < 4; ++k) {
+        m.positions.push_back(corners[k]);
+        m.colours.push_back(colours[k]);
+    }
+    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+}
+
+Mesh room() {
+    Mesh m;
+    const glm::vec3 lo(kBox.lo), hi(kBox.hi);
+    addBox(m, lo, hi, [&](glm::vec3 p) {
+        return glm::vec3((p.x - lo.x) / (hi.x - lo.x), 0.25f + 0.5f * (p.y - lo.y) / (hi.y - lo.y), (p.z - lo.z) / (hi.z - lo.z));
+    });
+    // A pole beside the mirror, 0.08 wide: thin against the wall and the floor behind it.
+    addBox(m, {0.9f, -1.0f, 0.5f}, {0.98f, 0.9f, 0.58f}, [](glm::vec3 p) { return glm::vec3(0.85f, 0.3f + 0.3f * p.y, 0.2f); });
+    addQuad(m, {glm::vec3(-4, -1, -4), glm::vec3(-4, -1, 4), glm::vec3(4, -1, 4), glm::vec3(4, -1, -4)},
+            {glm::vec3(0.3f, 0.5f, 0.3f), glm::vec3(0.6f, 0.6f, 0.4f), glm::vec3(0.7f, 0.5f, 0.5f), glm::vec3(0.4f, 0.4f, 0.6f)});
+    addQuad(m, {glm::vec3(-4, -1, 4), glm::vec3(-4, 3, 4), glm::vec3(4, 3, 4), glm::vec3(4, -1, 4)},
+            {glm::vec3(0.2f, 0.3f, 0.7f), glm::vec3(0.8f, 0.8f, 0.9f), glm::vec3(0.9f, 0.7f, 0.3f), glm::vec3(0.3f, 0.6f, 0.3f)});
+    return m;
+}
+
+struct Scene {
+    codec::MeshScene scene{room()};
+    Camera camera = Camera::perspective({-0.8, 0.5, 3.0}, {0.0, 0.0, 0.0}, {0, 1, 0}, 22.0, 1.0, 0.1, 20.0);
+    std::vector<codec::ReflectionFace> faces[2];  // 0 uniform, 1 CoNUS, both at the defaults
+    Scene() {
+        codec::ReflectionBakeOptions bake;
+        bake.roi = kBox;
+        faces[1] = codec::bakeReflection(scene, bake);
+        bake.uniform = true;
+        faces[0] = codec::bakeReflection(scene, bake);
+    }
+};
+
+Scene& scene() {
+    static Scene s;
+    return s;
+}
+
+// Arg: 0 sphere mirror (radius 0.5), 1 plane mirror (side 1, facing +z), both at the origin.
+void BM_ReflectionSilhouettes(benchmark::State& state) {
+    Scene& s = scene();
+    codec::ReflectionFrameOptions options;
+    options.reflector.radius = 0.5;
+    if (state.range(0) == 1) {
+        options.reflector.kind = codec::Reflector::Kind::Plane;
+        options.reflector.normal = {0.0, 0.0, 1.0};
+    }
+    Image frames[2], truth;
+    for (auto _ : state) {
+        truth = codec::renderReflectionFrame(s.scene, nullptr, {0, 0, 0}, s.camera, kFrame, kFrame, options);
+        for (int k = 0; k < 2; ++k)
+            frames[k] = codec::renderReflectionFrame(s.scene, &s.faces[k], {0, 0, 0}, s.camera, kFrame, kFrame, options);
+    }
+    // Regions: 0 the box (ROI), 1 the rest of the mirror; 2 the whole mirror.
+    double squared[2][3] = {}, count[3] = {}, wrong[2] = {};
+    glm::ivec2 roiLo(kFrame), roiHi(0);
+    for (int y = 0; y < kFrame; ++y)
+        for (int x = 0; x < kFrame; ++x) {
+            if (truth.at(x, y, 3) == 0.0f) continue;
+            const auto mirror = codec::hitReflector(options.reflector, s.camera.ray({(x + 0.5) / kFrame, (y + 0.5) / kFrame}));
+            const auto hit = mirror ? s.scene.intersect(mirror->reflected, 1e-6) : std::nullopt;
+            const int region = hit && hit->triangle < kBoxTriangles ? 0 : 1;
+            if (region == 0) {
+                roiLo = glm::min(roiLo, glm::ivec2(x, y));
+                roiHi = glm::max(roiHi, glm::ivec2(x, y));
+            }
+            for (int k = 0; k < 2; ++k) {
+                double e = 0;
+                for (int c = 0; c < 3; ++c) {
+                    const double d = std::clamp(frames[k].at(x, y, c), 0.0f, 1.0f) - std::clamp(truth.at(x, y, c), 0.0f, 1.0f);
+                    e += d * d / 3.0;
+                }
+                squared[k][region] += e;
+                squared[k][2] += e;
+                wrong[k] += e > 0.01;  // more than 0.1 RMS off: a hit on the wrong surface
+            }
+            count[region] += 1;
+            count[2] += 1;
+        }
+    const auto psnr = [&](int k, int region) {
+        return 10.0 * std::log10(count[region] / std::max(squared[k][region], 1e-30));
+    };
+    state.counters["mirror_conus_dB"] = psnr(1, 2);
+    state.counters["mirror_uniform_dB"] = psnr(0, 2);
+    state.counters["roi_conus_dB"] = psnr(1, 0);
+    state.counters["roi_uniform_dB"] = psnr(0, 0);
+    state.counters["rest_conus_dB"] = psnr(1, 1);
+    state.counters["rest_uniform_dB"] = psnr(0, 1);
+    state.counters["roi_pixels"] = count[0];
+    state.counters["mirror_pixels"] = count[2];
+    state.counters["wrong_conus"] = wrong[1];
+    state.counters["wrong_uniform"] = wrong[0];
+    state.SetLabel(state.range(0) ? "plane mirror" : "sphere mirror");
+    if (const char* prefix = std::getenv("CONUS_BENCH_PICTURES")) {
+        constexpr int kZoom = 3, kCrop = kFrame / kZoom;
+        const glm::ivec2 corner = glm::clamp((roiLo + roiHi) / 2 - kCrop / 2, 0, kFrame - kCrop);
+        Image strip{3 * kFrame, 2 * kFrame, {"R", "G", "B"}, std::vector<float>(std::size_t(6) * kFrame * kFrame * 3)};
+        const Image* parts[3] = {&frames[1], &frames[0], &truth};
+        for (int p = 0; p < 3; ++p)
+            for (int y = 0; y < kFrame; ++y)
+                for (int x = 0; x < kFrame; ++x)
+                    for (int c = 0; c < 3; ++c) {
+                        strip.at(p * kFrame + x, y, c) = parts[p]->at(x, y, c);
+                        strip.at(p * kFrame + x, kFrame + y, c) = parts[p]->at(corner.x + x / kZoom, corner.y + y / kZoom, c);
+                    }
+        imageio::writeImageFile(std::string(prefix) + (state.range(0) ? "-plane.png" : "-sphere.png"), strip);
+    }
+}
+
+BENCHMARK(BM_ReflectionSilhouettes)->Arg(0)->Arg(1)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace conus
