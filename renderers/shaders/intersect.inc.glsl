@@ -2,8 +2,9 @@
 // depth_surface.cpp, function for function (clip in homogeneous coordinates, project, walk the
 // projected segment distorting each point with Equation 1, bisect; walls and hidden rays as
 // codec/depth/intersect.h says). Include equation1.inc.glsl first. kIntersectDepthMargin and
-// kSilhouetteStep are injected from C++. The depth texture is RG32F: the camera depth and the cell's discontinuity
-// flag (DepthImage::cellFlags, computed once on the CPU).
+// kSilhouetteStep are injected from C++. The depth texture is R32F; each depth's lowest mantissa
+// bit is its cell's discontinuity flag (DepthImage::cellFlags, computed once on the CPU;
+// renderers/src/depth_pvt.h).
 struct DepthView {
     mat4 worldToNdc;  // the camera's worldToNdcMatrix (u, v = xy / w)
     mat4 ndcToWorld;  // its inverse, for unprojectDepth
@@ -29,41 +30,54 @@ struct DepthHit {
     int face;  // the face of the clipped volume the ray entered through when steps == 0 (0..5), else -1
 };
 
+// The discontinuity flag a depth carries (always clear in a solid image).
+bool flagBit(float depth) { return (floatBitsToUint(depth) & 1u) != 0u; }
+
+// The far side of a flagged cell zeroed in the bilinear weights w of its depths d (x, y, z, w:
+// the texels at i0, (i1.x, i0.y), (i0.x, i1.y), i1), f the position in the cell: the texels on
+// the nearest texel's side of the cell's middle depth keep theirs.
+vec4 splitWeights(vec4 d, vec4 w, vec2 f) {
+    const float middle = 0.5 * (min(min(d.x, d.y), min(d.z, d.w)) + max(max(d.x, d.y), max(d.z, d.w)));
+    const float nearest = f.y < 0.5 ? (f.x < 0.5 ? d.x : d.y) : (f.x < 0.5 ? d.z : d.w);
+    return w * vec4(equal(lessThanEqual(d, vec4(middle)), bvec4(nearest <= middle)));
+}
+
 // DepthImage::surfaceWeights: the four texels around pd (pixel centres at (i + 0.5) / size,
-// clamped to the edge pixels) and their bilinear weights, the far side of a flagged cell zeroed;
-// the texels' depths come back in d.
-void surfaceWeights(sampler2D depths, vec2 pd, out ivec2 t[4], out vec4 w, out vec4 d) {
+// clamped to the edge pixels; corners i0 and i1) and their weights (x, y, z, w as splitWeights).
+vec4 surfaceWeights(sampler2D depths, vec2 pd, out ivec2 i0, out ivec2 i1) {
+    const ivec2 size = textureSize(depths, 0);
+    const vec2 g = clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
+    i0 = min(ivec2(g), size - 1);
+    i1 = min(i0 + 1, size - 1);
+    const vec2 f = g - vec2(i0);
+    const float a = texelFetch(depths, i0, 0).r;
+    const vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    if (!flagBit(a)) return w;
+    const vec4 d = vec4(a, texelFetch(depths, ivec2(i1.x, i0.y), 0).r, texelFetch(depths, ivec2(i0.x, i1.y), 0).r,
+                        texelFetch(depths, i1, 0).r);
+    return splitWeights(d, w, f);
+}
+
+// DepthImage::sampleDepth: the stored surface's depth at pd, plain bilinear in an unflagged cell
+// (exact weights, texelFetch); `flagged` says which.
+float sampleDepth(sampler2D depths, vec2 pd, out bool flagged) {
     const ivec2 size = textureSize(depths, 0);
     const vec2 g = clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
     const ivec2 i0 = min(ivec2(g), size - 1), i1 = min(i0 + 1, size - 1);
     const vec2 f = g - vec2(i0);
-    t[0] = i0;
-    t[1] = ivec2(i1.x, i0.y);
-    t[2] = ivec2(i0.x, i1.y);
-    t[3] = i1;
-    const vec2 a = texelFetch(depths, t[0], 0).rg;
-    d = vec4(a.r, texelFetch(depths, t[1], 0).r, texelFetch(depths, t[2], 0).r, texelFetch(depths, t[3], 0).r);
-    w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
-    if (a.g < 0.5) return;
-    const float middle = 0.5 * (min(min(d.x, d.y), min(d.z, d.w)) + max(max(d.x, d.y), max(d.z, d.w)));
-    const bool nearSide = d[(f.x < 0.5 ? 0 : 1) + (f.y < 0.5 ? 0 : 2)] <= middle;
-    for (int k = 0; k < 4; ++k)
-        if ((d[k] <= middle) != nearSide) w[k] = 0.0;
-}
-
-// Whether pd lies in a flagged cell (DepthImage::cellIndex's cell).
-bool flaggedCell(sampler2D depths, vec2 pd) {
-    const ivec2 size = textureSize(depths, 0);
-    const ivec2 i0 = min(ivec2(clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1))), size - 1);
-    return texelFetch(depths, i0, 0).g > 0.5;
-}
-
-// DepthImage::sampleDepth: the stored surface's depth at pd.
-float sampleDepth(sampler2D depths, vec2 pd) {
-    ivec2 t[4];
-    vec4 w, d;
-    surfaceWeights(depths, pd, t, w, d);
+    const float a = texelFetch(depths, i0, 0).r;
+    const float b = texelFetch(depths, ivec2(i1.x, i0.y), 0).r, c = texelFetch(depths, ivec2(i0.x, i1.y), 0).r;
+    const float e = texelFetch(depths, i1, 0).r;
+    flagged = flagBit(a);
+    if (!flagged) return mix(mix(a, b, f.x), mix(c, e, f.x), f.y);
+    const vec4 d = vec4(a, b, c, e);
+    const vec4 w = splitWeights(d, vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y), f);
     return dot(w, d) / (w.x + w.y + w.z + w.w);
+}
+
+float sampleDepth(sampler2D depths, vec2 pd) {
+    bool flagged;
+    return sampleDepth(depths, pd, flagged);
 }
 
 // The world point at image point uv and camera depth `depth` (perspective or orthographic: depth is
@@ -88,10 +102,16 @@ vec3 clipFaceNormal(DepthView view, int face) {
     return -normalize(inward);
 }
 
-// The stored surface's depth at s along the projected segment, and where s lies in the CoNUS image.
-float surfaceAlong(sampler2D depths, sampler2D map, vec2 p0, vec2 along, float s, out MapPoint m) {
+// The stored surface's depth at s along the projected segment, where s lies in the CoNUS image,
+// and whether its cell is flagged.
+float surfaceAlong(sampler2D depths, sampler2D map, vec2 p0, vec2 along, float s, out MapPoint m, out bool flagged) {
     m = evalMap(map, p0 + along * s);
-    return sampleDepth(depths, m.pd);
+    return sampleDepth(depths, m.pd, flagged);
+}
+
+float surfaceAlong(sampler2D depths, sampler2D map, vec2 p0, vec2 along, float s, out MapPoint m) {
+    bool flagged;
+    return surfaceAlong(depths, map, p0, along, s, m, flagged);
 }
 
 // The ray's camera depth at s (perspective-correct).
@@ -143,47 +163,59 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     const vec2 along = p1 - p0;
     const vec2 size = vec2(textureSize(depths, 0));
 
-    // 3. Walk near to far, each step stepTexels CoNUS pixels along the distorted curve.
+    // 3. Walk near to far, each step stepTexels CoNUS pixels along the distorted curve. The walk
+    // stops at an event; the bisections run after it, so that rays bisect together.
     float before = 0.0, s = 0.0;
     int steps = 0;
     bool hidden = false;
     float hiddenDepth = 0.0;
     MapPoint m, hiddenFrom;  // hiddenFrom: the last point in front of the surface
-    bool found = false;
-    if (surfaceAlong(depths, map, p0, along, 0.0, m) - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0) {
-        if (view.solid) {
-            found = true;
-        } else {
-            hidden = true;
-            hiddenDepth = rayDepth(dw0, dw1, iw0, iw1, 0.0);
-            hiddenFrom = m;
-        }
+    MapPoint q;
+    bool flagged;  // whether the sample at s lies in a flagged cell (never in a solid image)
+    const bool behind = surfaceAlong(depths, map, p0, along, 0.0, m, flagged) - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0;
+    if (behind && !view.solid) {
+        hidden = true;
+        hiddenDepth = rayDepth(dw0, dw1, iw0, iw1, 0.0);
+        hiddenFrom = m;
     }
-    while (!found) {
-        if (s >= 1.0 || steps >= maxSteps) {
-            if (!(hidden && s >= 1.0 && exited == 5)) return result;
-            // Hidden up to the farthest stored depth: the background where the ray went hidden.
-            m = hiddenFrom;
-            result.hidden = true;
-            break;
-        }
-        const float speed = length((m.du * along.x + m.dv * along.y) * size);
-        const bool fine = !view.solid && flaggedCell(depths, m.pd);
-        before = s;
-        s = min(1.0, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
-        ++steps;
-        float stored = surfaceAlong(depths, map, p0, along, s, m);
-        if (!fine && !view.solid && flaggedCell(depths, m.pd)) {  // a full step into a flagged cell: taken again, finely
-            s = min(1.0, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
-            stored = surfaceAlong(depths, map, p0, along, s, m);
-        }
-        const float gap = stored - rayDepth(dw0, dw1, iw0, iw1, s);
-        MapPoint q;
-        if (hidden) {
-            if (gap > 0.0) {
-                hidden = false;
-            } else if (stored >= hiddenDepth) {
-                float a = before, b = s;
+    if (!(behind && view.solid)) {  // a solid image entered behind its surface is hit where entered
+        for (;;) {
+            // The event: 1 a crossing, 2 behind the background while hidden, 0 the end.
+            int event = 0;
+            while (!(s >= 1.0 || steps >= maxSteps)) {
+                const float speed = length((m.du * along.x + m.dv * along.y) * size);
+                const bool fine = flagged;
+                before = s;
+                s = min(1.0, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
+                ++steps;
+                float stored = surfaceAlong(depths, map, p0, along, s, m, flagged);
+                if (!fine && flagged) {  // a full step into a flagged cell: taken again, finely
+                    s = min(1.0, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
+                    stored = surfaceAlong(depths, map, p0, along, s, m, flagged);
+                }
+                const float gap = stored - rayDepth(dw0, dw1, iw0, iw1, s);
+                if (hidden) {
+                    if (gap > 0.0) {
+                        hidden = false;  // in front of the surface again
+                    } else if (stored >= hiddenDepth) {
+                        event = 2;
+                        break;
+                    }
+                } else if (!(gap > 0.0)) {
+                    event = 1;
+                    break;
+                }
+            }
+            if (event == 0) {
+                // Hidden up to the farthest stored depth: the background where the ray went hidden.
+                if (!(hidden && s >= 1.0 && exited == 5)) return result;
+                m = hiddenFrom;
+                result.hidden = true;
+                break;
+            }
+            float a = before, b = s;
+            if (event == 2) {
+                // Behind the background: where the stored surface first reaches hiddenDepth.
                 for (int k = 0; k < refinements; ++k) {
                     const float mid = 0.5 * (a + b);
                     if (surfaceAlong(depths, map, p0, along, mid, q) >= hiddenDepth)
@@ -194,28 +226,28 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
                 s = b;
                 m = evalMap(map, p0 + along * s);
                 result.hidden = true;
-                found = true;
+                break;
             }
-            continue;
-        }
-        if (gap > 0.0) continue;
-        // 4. Bisect between the last sample in front and the first behind.
-        float a = before, b = s;
-        for (int k = 0; k < refinements; ++k) {
-            const float mid = 0.5 * (a + b);
-            if (surfaceAlong(depths, map, p0, along, mid, q) - rayDepth(dw0, dw1, iw0, iw1, mid) > 0.0)
-                a = mid;
-            else
-                b = mid;
-        }
-        const float sb = surfaceAlong(depths, map, p0, along, b, q);
-        MapPoint qa;
-        const float jump = surfaceAlong(depths, map, p0, along, a, qa) - sb;
-        if (view.solid || jump <= 0.5 * (view.jumpRelative * sb + view.jumpAbsolute)) {
-            s = 0.5 * (a + b);
-            m = evalMap(map, p0 + along * s);
-            found = true;
-        } else {
+            // 4. Bisect between the last sample in front and the first behind.
+            for (int k = 0; k < refinements; ++k) {
+                const float mid = 0.5 * (a + b);
+                if (surfaceAlong(depths, map, p0, along, mid, q) - rayDepth(dw0, dw1, iw0, iw1, mid) > 0.0)
+                    a = mid;
+                else
+                    b = mid;
+            }
+            if (view.solid) {
+                s = 0.5 * (a + b);
+                m = evalMap(map, p0 + along * s);
+                break;
+            }
+            const float sb = surfaceAlong(depths, map, p0, along, b, q);
+            MapPoint qa;
+            if (surfaceAlong(depths, map, p0, along, a, qa) - sb <= 0.5 * (view.jumpRelative * sb + view.jumpAbsolute)) {
+                s = 0.5 * (a + b);
+                m = evalMap(map, p0 + along * s);
+                break;
+            }
             hidden = true;  // a wall: the ray passes behind an occluder's silhouette
             hiddenDepth = rayDepth(dw0, dw1, iw0, iw1, b);
             hiddenFrom = qa;

@@ -63,18 +63,14 @@ float hitReflector(vec3 origin, vec3 d, out vec3 normal) {
 // codec::reflectionColour: the face's colour at the hit's CoNUS position, with the surface's own
 // weights (a silhouette's far side weighs nothing) times coverage (the far plane's texels carry none).
 vec3 reflectionColour(sampler2D depths, sampler2D colours, vec2 pd, ivec2 texel) {
-    ivec2 t[4];
-    vec4 w, d;
-    surfaceWeights(depths, pd, t, w, d);
-    vec3 sum = vec3(0.0);
-    float total = 0.0;
-    for (int k = 0; k < 4; ++k) {
-        const vec4 c = texelFetch(colours, t[k], 0);
-        sum += c.rgb * (w[k] * c.a);
-        total += w[k] * c.a;
-    }
+    ivec2 i0, i1;
+    const vec4 w = surfaceWeights(depths, pd, i0, i1);
+    const vec4 c00 = texelFetch(colours, i0, 0), c10 = texelFetch(colours, ivec2(i1.x, i0.y), 0);
+    const vec4 c01 = texelFetch(colours, ivec2(i0.x, i1.y), 0), c11 = texelFetch(colours, i1, 0);
+    const vec4 wc = w * vec4(c00.a, c10.a, c01.a, c11.a);
+    const float total = wc.x + wc.y + wc.z + wc.w;
     if (!(total > 0.0)) return texelFetch(colours, texel, 0).rgb;
-    return sum / total;
+    return (c00.rgb * wc.x + c10.rgb * wc.y + c01.rgb * wc.z + c11.rgb * wc.w) / total;
 }
 
 void main() {

@@ -90,9 +90,10 @@ struct ReflectorHit {
 // Where the eye ray meets the reflector's mirror side, and the reflected ray; nothing on a miss.
 std::optional<ReflectorHit> hitReflector(const Reflector& reflector, const Ray& ray);
 
-// The colour a hit on `face` takes: bilinear in the face's CoNUS image at the hit's distorted
-// position, over the covered texels among the four around it (the far plane's texels carry no
-// colour); the hit's own texel where none of the four weighs anything.
+// The colour a hit on `face` takes: the face's CoNUS image at the hit's distorted position with
+// the surface's own weights (DepthImage::surfaceWeights: bilinear, the far side of a silhouette
+// weighing nothing) times coverage (the far plane's texels carry no colour); the hit's own texel
+// where none of the four weighs anything.
 glm::vec3 reflectionColour(const ReflectionFace& face, const DepthHit& hit);
 
 struct ReflectionHit {
