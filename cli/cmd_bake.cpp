@@ -157,7 +157,7 @@ int runBakeReflection(const ReflectionBakeText& o) {
         options.roi = codec::AxisBox{lo, hi};
     }
     Progress loading("read " + o.scene);
-    const codec::MeshScene scene(sceneio::readMesh(o.scene));
+    const codec::MeshScene scene(sceneio::readMesh(o.scene, {.warn = warn}));
     loading.done();
     Progress baking("bake six " + std::to_string(o.size) + "x" + std::to_string(o.size) + " faces (Embree)");
     const auto faces = codec::bakeReflection(scene, options);

@@ -248,7 +248,7 @@ int runRender(const RenderOptions& r) {
     Progress loading("read " + o.model);
     Mesh mesh;
     if (o.model == kCity) mesh = city.emplace().meshAt(o.time);
-    else mesh = sceneio::readMesh(o.model);
+    else mesh = sceneio::readMesh(o.model, {.warn = warn});
     loading.done();
     const Camera camera =
         city && !cameraChoice.given ? cityCamera(*city, aspect) : meshCamera(cameraChoice, boundsOf(mesh), aspect);

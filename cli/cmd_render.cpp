@@ -104,7 +104,7 @@ int runRenderReflection(const ReflectionRenderText& o) {
     const glm::dvec3 centre = faces.front().depth.camera().eye();
     options.reflector.centre = o.at.empty() ? centre : parseVector3(o.at, "--at");
     Progress loading("read " + o.scene);
-    const codec::MeshScene scene(sceneio::readMesh(o.scene));
+    const codec::MeshScene scene(sceneio::readMesh(o.scene, {.warn = warn}));
     loading.done();
     const double aspect = double(size.width) / size.height;
     const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);

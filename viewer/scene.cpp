@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <vector>
 
@@ -25,6 +26,13 @@
 namespace conus::viewer {
 namespace {
 
+// A mesh file, what readMesh dropped said on stderr as the viewer's other messages are.
+Mesh readMeshFile(const std::string& path) {
+    return sceneio::readMesh(path, {.warn = [](const std::string& text) {
+                                 std::fprintf(stderr, "conus-view: warning: %s\n", text.c_str());
+                             }});
+}
+
 std::string fileName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
 
 template <class Points>
@@ -44,7 +52,7 @@ Image colourOf(const Image& frame) {
 class MeshView final : public Scene {
 public:
     MeshView(gl::Context& context, const std::string& path, double maxEdge)
-        : m_context(context), m_name(fileName(path) + " (mesh)"), m_mesh(sceneio::readMesh(path)),
+        : m_context(context), m_name(fileName(path) + " (mesh)"), m_mesh(readMeshFile(path)),
           m_bounds(sphereAround(m_mesh.positions)), m_maxEdge(maxEdge), m_renderer(context, m_mesh) {}
     std::string name() const override { return m_name; }
     glm::dvec3 centre() const override { return m_bounds.centre; }
@@ -160,7 +168,7 @@ private:
 class ReflectionView final : public Scene {
 public:
     ReflectionView(gl::Context& context, const Options& options)
-        : ReflectionView(context, options, sceneio::readMesh(options.reflectionScene)) {}
+        : ReflectionView(context, options, readMeshFile(options.reflectionScene)) {}
     ReflectionView(gl::Context& context, const Options& options, const Mesh& mesh)
         : m_name(fileName(options.scenePath) + " (reflection)"), m_bounds(sphereAround(mesh.positions)) {
         const std::vector<codec::ReflectionFace> conusFaces = faces(options.scenePath);

@@ -4,7 +4,9 @@
 // mesh is copied into one conus::Mesh, checking the caps before anything large is allocated.
 #include "conus/sceneio/mesh_file.h"
 
+#include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
+#include <assimp/LogStream.hpp>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -14,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -29,6 +32,15 @@ namespace fs = std::filesystem;
 [[noreturn]] void fail(ErrorCode code, const std::string& path, const std::string& why) {
     throw Error(code, "mesh '" + path + "': " + why);
 }
+
+// Assimp says some things only in its log: that it dropped faces whose indices point past their
+// mesh's vertices (glTF's importer does). While a file is read, its warnings and errors are kept
+// here; the logger is Assimp's one global, so reads take turns.
+struct AssimpLog : Assimp::LogStream {
+    std::string text;
+    void write(const char* message) override { text += message; }
+};
+std::mutex assimpLogMutex;
 
 // PLY headers declare their element counts up front and Assimp reserves memory for them before
 // reading a single vertex; a count no file of this size can hold (every element takes at least a
@@ -106,7 +118,19 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
                            aiProcess_PreTransformVertices | aiProcess_FlipUVs | aiProcess_ValidateDataStructure;
-    const aiScene* scene = importer.ReadFile(path, flags);
+    const aiScene* scene = nullptr;
+    AssimpLog log;
+    {
+        const std::lock_guard<std::mutex> lock(assimpLogMutex);
+        const bool created = Assimp::DefaultLogger::isNullLogger();
+        if (created) Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
+        Assimp::DefaultLogger::get()->attachStream(&log, Assimp::Logger::Warn | Assimp::Logger::Err);
+        scene = importer.ReadFile(path, flags);
+        Assimp::DefaultLogger::get()->detachStream(&log, Assimp::Logger::Warn | Assimp::Logger::Err);
+        if (created) Assimp::DefaultLogger::kill();
+    }
+    if (scene && log.text.find("out-of-range indices") != std::string::npos)
+        fail(ErrorCode::Corrupt, path, "a face indexes past its mesh's vertices");
     if (!scene) {
         std::string why = importer.GetErrorString();
         if (why.empty()) why = "Assimp could not read it";
@@ -140,6 +164,7 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
     Mesh out;
     out.positions.reserve(static_cast<std::size_t>(vertices));
     out.indices.reserve(static_cast<std::size_t>(triangles) * 3);
+    std::int64_t degenerate = 0;
     if (allNormals) out.normals.reserve(static_cast<std::size_t>(vertices));
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh& mesh = *scene->mMeshes[m];
@@ -166,9 +191,11 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
             if (!inRange) fail(ErrorCode::Corrupt, path, "a face indexes past its mesh's vertices");
             const std::uint32_t a = base + face.mIndices[0], b = base + face.mIndices[1], c = base + face.mIndices[2];
             // Degenerate triangles (a repeated corner or no area) are dropped: they cover nothing.
-            if (a == b || b == c || a == c) continue;
             const glm::vec3 n = glm::cross(out.positions[b] - out.positions[a], out.positions[c] - out.positions[a]);
-            if (!(glm::dot(n, n) > 0.0f)) continue;
+            if (a == b || b == c || a == c || !(glm::dot(n, n) > 0.0f)) {
+                ++degenerate;
+                continue;
+            }
             out.indices.insert(out.indices.end(), {a, b, c});
         }
     }
@@ -176,6 +203,9 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             fail(ErrorCode::Corrupt, path, "a vertex position is not finite");
     if (out.indices.empty()) fail(ErrorCode::Corrupt, path, "every triangle is degenerate (no area)");
+    if (degenerate > 0 && options.warn)
+        options.warn("mesh '" + path + "': dropped " + std::to_string(degenerate) + " of " + std::to_string(triangles) +
+                     " triangles, degenerate (a repeated corner or no area)");
 
     // The file's normals, unit; one unusable normal and they are all computed instead, so a
     // surface never mixes two rules.

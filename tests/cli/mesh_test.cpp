@@ -10,6 +10,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "cli/cli_fixture.h"
+#include "sceneio/test_meshes.h"
 #include "conus/format/container.h"
 
 namespace conus::test {
@@ -163,7 +164,9 @@ TEST_F(Mesh, BadInputIsOneLineAndNonZero) {
         {"mesh render " + obj + " -o " + path("x.exr") + " --camera 0,0,-5,0,0,-10,40", "behind"},
         {"mesh render city -o " + path("x.exr") + " --track 99", "cars"},
         {"mesh animate " + obj + " --out-dir " + path("d") + " --frames 2", "city"},
+        {"mesh render " + path("past.gltf") + " -o " + path("x.exr"), "indexes past"},
     };
+    test::writeGltfCube(path("past.gltf"), 9);
     for (const auto& c : cases) {
         const Result r = run(c.args + " -q");  // -q: only the error line
         EXPECT_NE(r.exitCode, 0) << c.args;
@@ -172,6 +175,11 @@ TEST_F(Mesh, BadInputIsOneLineAndNonZero) {
     }
     EXPECT_FALSE(fs::exists(path("x.exr")));
     EXPECT_TRUE(leftovers().empty());
+    // A degenerate triangle is dropped, and the warning says so even with -q.
+    writeText(path("flat.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n");
+    const Result r = run("mesh render " + path("flat.obj") + " -o " + path("flat.exr") + " --uniform --size 32x32 -q");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("dropped 1 of 2 triangles, degenerate"), std::string::npos) << r.err;
 }
 
 TEST_F(Mesh, AnimateWritesFramesAContactSheetAndAVideo) {

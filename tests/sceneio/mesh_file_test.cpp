@@ -253,6 +253,41 @@ TEST(ReadMesh, HostileFilesAreRefused) {
     errorOf(dir.file("huge.stl"));
 }
 
+// A glTF face that indexes past its vertices: Assimp drops it and says so only in its log; the
+// read refuses the file instead. The same cube with every index in range reads whole.
+TEST(ReadMesh, GltfIndicesPastTheVerticesAreRefused) {
+    TestDir dir("sceneio");
+    test::writeGltfCube(dir.file("cube.gltf"));
+    EXPECT_EQ(readMesh(dir.file("cube.gltf")).triangleCount(), 12u);
+    test::writeGltfCube(dir.file("past.gltf"), 9);
+    try {
+        readMesh(dir.file("past.gltf"));
+        ADD_FAILURE() << "read";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::Corrupt);
+        EXPECT_NE(std::string(e.what()).find("indexes past"), std::string::npos) << e.what();
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+    }
+    // Read again in range afterwards: nothing of the first read's log is left over.
+    EXPECT_EQ(readMesh(dir.file("cube.gltf")).triangleCount(), 12u);
+}
+
+// Degenerate triangles are dropped and the warning says how many of how many.
+TEST(ReadMesh, DroppedDegenerateTrianglesAreCounted) {
+    TestDir dir("sceneio");
+    test::writeText(dir.file("some.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\nf 2 3 3\nf 1 3 2\n");
+    std::vector<std::string> said;
+    MeshReadOptions options;
+    options.warn = [&](const std::string& text) { said.push_back(text); };
+    EXPECT_EQ(readMesh(dir.file("some.obj"), options).triangleCount(), 2u);
+    ASSERT_EQ(said.size(), 1u);
+    EXPECT_NE(said[0].find("dropped 2 of 4 triangles"), std::string::npos) << said[0];
+    said.clear();
+    test::writeText(dir.file("fine.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    readMesh(dir.file("fine.obj"), options);
+    EXPECT_TRUE(said.empty());
+}
+
 TEST(ReadMesh, CapsOnBytesAndTriangles) {
     TestDir dir("sceneio");
     const Mesh sphere = test::uvSphere({0, 0, 0}, 1.0f, 16, 32);

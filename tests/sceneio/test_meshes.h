@@ -98,4 +98,27 @@ inline void writeText(const std::string& path, const std::string& text) {
     ASSERT_TRUE(out.good()) << path;
 }
 
+// A glTF cube (eight corners, twelve triangles) at `path` with its buffer beside it (`<stem>.bin`);
+// `badIndex` >= 0: the sixth triangle's last corner becomes that index (past the eight vertices
+// for 8 and up).
+inline void writeGltfCube(const std::filesystem::path& path, int badIndex = -1) {
+    const float corners[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    std::uint16_t indices[36] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                 2, 3, 7, 2, 7, 6, 1, 2, 6, 1, 6, 5, 0, 4, 7, 0, 7, 3};
+    if (badIndex >= 0) indices[17] = static_cast<std::uint16_t>(badIndex);
+    std::string buffer(reinterpret_cast<const char*>(indices), sizeof indices);
+    buffer.append(reinterpret_cast<const char*>(corners), sizeof corners);
+    const std::string bin = path.stem().string() + ".bin";
+    writeText((path.parent_path() / bin).string(), buffer);
+    writeText(path.string(),
+              "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
+              " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 1}, \"indices\": 0}]}],\n"
+              " \"buffers\": [{\"byteLength\": 168, \"uri\": \"" + bin + "\"}],\n"
+              " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 72},\n"
+              "                 {\"buffer\": 0, \"byteOffset\": 72, \"byteLength\": 96}],\n"
+              " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5123, \"count\": 36, \"type\": \"SCALAR\"},\n"
+              "               {\"bufferView\": 1, \"componentType\": 5126, \"count\": 8, \"type\": \"VEC3\",\n"
+              "                \"min\": [0, 0, 0], \"max\": [1, 1, 1]}]}\n");
+}
+
 }  // namespace conus::test

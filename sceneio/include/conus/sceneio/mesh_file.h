@@ -9,12 +9,17 @@
 // textured material, read through imageio (linear light), when the file names one that exists.
 // Faces with fewer than three corners (points, lines) are dropped; polygons are triangulated.
 //
+// Degenerate triangles (a repeated corner or no area) are dropped, and MeshReadOptions::warn says
+// how many.
+//
 // Errors are one-line conus::Error naming the path: Io (missing, unreadable, or a format Assimp
-// does not know), Corrupt (Assimp refused the contents, or nothing but degenerate triangles),
+// does not know), Corrupt (Assimp refused the contents, a face indexes past its mesh's vertices,
+// a vertex is not finite, or nothing but degenerate triangles),
 // LimitExceeded (past the file-size or triangle cap, checked before the mesh is copied).
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "conus/core/mesh.h"
@@ -31,6 +36,8 @@ struct MeshReadOptions {
     std::int64_t maxTriangles = kMaxMeshTriangles;
     std::int64_t maxVertices = kMaxMeshVertices;
     bool readTexture = true;  // false: UVs are kept but no texture file is opened
+    // Told, in one line, what was dropped and how much (degenerate triangles); null: not told.
+    std::function<void(const std::string&)> warn;
 };
 
 // Reads the mesh file at `path`. The result always has normals, and holds at least one
