@@ -52,7 +52,9 @@ struct MeshOptions {
     int samples = 4, grid = map_rules::kDefaultSide;
     std::vector<int> track;
     double trackRadius = 0.05, trackK = 3;  // a car is small: a small, moderate focus keeps the context
-    std::string compose = "add";  // smooth from frame to frame (tests/renderers/mesh_sequence_test.cpp)
+    // animate: add, smooth from frame to frame (tests/renderers/mesh_sequence_test.cpp); render sets
+    // density, as encode, volume and map compose foci.
+    std::string compose = "add";
 };
 
 struct Bounds {
@@ -435,6 +437,7 @@ CLI::App* addRender(CLI::App& command, RenderOptions& r) {
         ->excludes("--map")
         ->excludes("--track");
     render->add_flag("--reference", r.reference, "the exact CPU reference (Embree ray casting) instead of the GPU");
+    r.mesh.compose = "density";
     addSharedOptions(*render, r.mesh, true);
     return render;
 }

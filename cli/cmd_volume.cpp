@@ -36,7 +36,7 @@ namespace conus::cli {
 namespace {
 
 struct VolumeOptions {
-    std::string volume, output, picture, sizeText = "512x512", cameraText, upText = "0,-1,0", tf = "bone",
+    std::string volume, output, picture, sizeText = "512x512", cameraText, upText = "0,-1,0", tf = codec::TransferFunction::kDefaultPreset,
                                          rangeText, backend = "auto", units = "voxel", mapFile;
     std::vector<std::string> foci;
     int grid = map_rules::kDefaultSide;

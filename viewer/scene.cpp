@@ -80,11 +80,12 @@ public:
           m_volume(options.scenePath.rfind("procedural:", 0) == 0 ? codec::proceduralVolume(options.scenePath)
                                                                   : sceneio::readVolume(options.scenePath)),
           m_presets(codec::TransferFunction::presetNames()) {
-        if (!options.transferFunction.empty()) {
-            const auto preset = std::find(m_presets.begin(), m_presets.end(), options.transferFunction);
-            if (preset != m_presets.end()) m_preset = static_cast<int>(preset - m_presets.begin());
-            else m_file = options.transferFunction;  // a file: T cycles on through the presets
-        }
+        // The command line's default preset when none is named, so both show a volume alike.
+        const std::string tf = options.transferFunction.empty() ? codec::TransferFunction::kDefaultPreset
+                                                                : options.transferFunction;
+        const auto preset = std::find(m_presets.begin(), m_presets.end(), tf);
+        if (preset != m_presets.end()) m_preset = static_cast<int>(preset - m_presets.begin());
+        else m_file = tf;  // a file: T cycles on through the presets
         m_renderer = std::make_unique<gl::VolumeRendererGpu>(context, m_volume, transferFunction());
     }
     std::string name() const override { return m_name; }

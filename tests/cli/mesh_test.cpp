@@ -125,6 +125,13 @@ TEST_F(Mesh, AFocusEnlargesTheModelAndUniformIsTheBaseline) {
     ASSERT_EQ(run("mesh render " + obj + " -o " + path("u.exr") + common + " --uniform").exitCode, 0);
     ASSERT_EQ(run("mesh render " + obj + " -o " + path("f.exr") + common + " --focus 0.5,0.5,0.15,4").exitCode, 0);
     EXPECT_GT(covered(readExr(path("f.exr"))), 2.0 * covered(readExr(path("u.exr"))));
+    // Foci compose by density, as encode, volume and map compose them.
+    ASSERT_EQ(run("mesh render " + obj + " -o " + path("two.exr") + common + " --focus 0.3,0.5,0.1,3 --focus 0.7,0.5,0.1,3")
+                  .exitCode,
+              0);
+    const format::ConusFile two = format::readConusFile(path("two.exr"));
+    ASSERT_TRUE(two.analytic);
+    EXPECT_EQ(two.analytic->composition, "density");
 }
 
 TEST_F(Mesh, DefaultCameraFramesTheModel) {
