@@ -65,7 +65,8 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("files", o.files, "CoNUS files (.exr); Tab / PageDown switch between them");
     app.add_option("--edit", o.edit, "paint a sampling map over IMAGE (PNG, JPEG, EXR, ...)");
     app.add_option("-o,--output", o.output, "--edit: base path for S (<base>.map.exr) and Ctrl-S (<base>.conus.exr)");
-    app.add_option("--screenshot", o.screenshot, "render the first file offscreen (no display needed) to a PNG and exit");
+    app.add_option("--screenshot", o.screenshot,
+                   "render the first file, or a 3-D mode's first frame, offscreen (no display needed) to a PNG and exit");
     app.add_option("--uniform", o.uniform,
                    "the first file's uniform baseline for U and W (a CoNUS file `conus uniform` wrote from the same source; "
                    "without it, the uniform image is resampled from the CoNUS data)");
@@ -127,8 +128,8 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
         }
         for (const std::string& text : foci) o.foci.push_back(parseFocus(text));
         if (o.sceneKind != SceneKind::None) {
-            if (!o.files.empty() || !o.edit.empty() || !o.screenshot.empty())
-                throw Error(ErrorCode::InvalidArgument, "a 3-D mode takes no CoNUS files, --edit or --screenshot (use --script's screenshot)");
+            if (!o.files.empty() || !o.edit.empty())
+                throw Error(ErrorCode::InvalidArgument, "a 3-D mode takes no CoNUS files or --edit");
             if (o.sceneKind == SceneKind::Reflection && o.reflectionScene.empty())
                 throw Error(ErrorCode::InvalidArgument, "--reflection needs --scene MESH (the mesh the asset was baked from)");
             if (!o.uniform.empty() && o.sceneKind != SceneKind::Relief && o.sceneKind != SceneKind::Reflection)
@@ -138,7 +139,8 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
             throw Error(ErrorCode::InvalidArgument, "no file given (conus-view FILE.exr, --edit IMAGE, --mesh, --volume, --relief or --reflection)");
         }
         if (!o.edit.empty() && !o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--edit takes no CoNUS files");
-        if (!o.screenshot.empty() && o.files.empty()) throw Error(ErrorCode::InvalidArgument, "--screenshot needs a CoNUS file");
+        if (!o.screenshot.empty() && o.files.empty() && o.sceneKind == SceneKind::None)
+            throw Error(ErrorCode::InvalidArgument, "--screenshot needs a CoNUS file or a 3-D mode");
         if (!o.uniform.empty() && o.files.empty() && o.sceneKind == SceneKind::None) throw Error(ErrorCode::InvalidArgument, "--uniform goes with a CoNUS file");
         if (o.benchmarkFrames < 0) throw Error(ErrorCode::InvalidArgument, "--benchmark-frames must be >= 0");
     } catch (const CLI::ParseError& e) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "conus/renderers/backend.h"
@@ -13,12 +14,47 @@
 #include "conus/imageio/image_file.h"
 #include "view_state.h"
 #include "overlay.h"
+#include "scene.h"
+#include "scene_state.h"
 
 namespace conus::viewer {
 
 constexpr int kDefaultMaxSide = 2048;
+constexpr int kSceneWidth = 640, kSceneHeight = 480;  // a 3-D mode's screenshot without --size
+
+namespace {
+
+// A 3-D mode's first frame, as its window shows it (the CoNUS frame through the sRGB curve): the
+// scene's home camera and the --focus foci (a baked asset's own maps).
+int sceneScreenshot(const Options& options) {
+    try {
+        const int width = options.width > 0 ? options.width : kSceneWidth;
+        const int height = options.height > 0 ? options.height : kSceneHeight;
+        const gl::Device device = gl::Device::choose(gl::parseBackend(options.backend), gl::CpuPath::None, "the viewer's screenshot");
+        gl::Context& context = device.context();
+        const std::unique_ptr<Scene> scene = openScene(options, context);
+        const SceneState state(scene->centre(), scene->radius(), options.foci, scene->home());
+        const double aspect = double(width) / height;
+        const codec::SamplingMap map = scene->throughMap() ? state.map(aspect) : codec::SamplingMap::identity(2, 2);
+        const Image frame = scene->render(state.camera(aspect), map, state.conus(), width, height);
+        Image rgb = makeImage(width, height, {"R", "G", "B"});
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x)
+                for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = frame.at(x, y, c);
+        imageio::writeImageFile(options.screenshot, rgb);
+        std::printf("wrote %s: %dx%d, the first frame of %s (%s)\n", options.screenshot.c_str(), width, height,
+                    scene->name().c_str(), context.renderer().c_str());
+        return 0;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "conus-view: %s\n", e.what());
+        return 1;
+    }
+}
+
+}  // namespace
 
 int runScreenshot(const Options& options) {
+    if (options.sceneKind != SceneKind::None) return sceneScreenshot(options);
     const Document doc = loadDocument(options.files.front());
     if (!doc.ok()) {
         std::fprintf(stderr, "conus-view: %s: %s\n", doc.path.c_str(), doc.error.c_str());

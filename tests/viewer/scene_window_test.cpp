@@ -137,6 +137,30 @@ TEST(SceneWindow, MeshMaxEdgeSubdividesEachFrame) {
     EXPECT_LT(compare(window, gl::renderMeshGpu(test::context(), fine, camera, map, kW, kH)).mean, 1.0 / 255);
 }
 
+// --screenshot in a 3-D mode: the first frame offscreen, no window, as the window would show it
+// (the GPU ray caster's frame for the scene state's camera and map, the default preset).
+TEST(SceneWindow, ScreenshotOfAVolumeIsItsFirstFrame) {
+    const std::string spec = "procedural:shepp-logan:48";
+    const fs::path shot = test::tempDir() / "volume-shot.png";
+    std::string log;
+    ASSERT_EQ(test::run(test::viewerBinary() + " --volume " + spec + " --focus 0.5,0.45,0.15,3 --screenshot " +
+                            shot.string() + " --size " + std::to_string(kW) + "x" + std::to_string(kH),
+                        &log),
+              0)
+        << log;
+    const Volume volume = codec::proceduralVolume(spec);
+    const SceneState state(0.5 * volume.extent(), 0.5 * glm::length(volume.extent()), {codec::Focus{0.5, 0.45, 0.15, 3.0}});
+    const double aspect = double(kW) / kH;
+    gl::VolumeRendererGpu renderer(test::context(), volume,
+                                   codec::TransferFunction::preset(codec::TransferFunction::kDefaultPreset));
+    const Image frame = renderer.render(Fpc(state.camera(aspect), std::make_shared<codec::SamplingMap>(state.map(aspect))),
+                                        kW, kH, {});
+    EXPECT_LT(compare(readPicture(shot), frame).mean, 1.0 / 255) << log;
+    // A mesh without a file: refused in one line.
+    std::string refused;
+    EXPECT_NE(test::run(test::viewerBinary() + " --mesh /nonexistent.obj --screenshot " + shot.string(), &refused), 0);
+}
+
 // T cycles the transfer function, U drops the map; each frame is the GPU ray caster's for the scene
 // state's camera and map (the volume box's sphere: centre extent / 2, radius |extent| / 2).
 TEST(SceneWindow, VolumeFramesAreTheRayCastersAndTCyclesTheLook) {
