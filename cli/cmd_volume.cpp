@@ -59,8 +59,11 @@ codec::TransferFunction loadTransferFunction(const std::string& text) {
     return codec::TransferFunction::preset(text);
 }
 
-Camera volumeCamera(const VolumeOptions& o, const Volume& volume, double aspect) {
-    if (o.cameraText.empty()) return codec::defaultVolumeCamera(volume, aspect);
+codec::VolumeRenderOptions renderOptions(const VolumeOptions& o);
+
+Camera volumeCamera(const VolumeOptions& o, const Volume& volume, const codec::TransferFunction& tf, double aspect) {
+    // What the transfer function shows fills the frame (a head, not the box around it).
+    if (o.cameraText.empty()) return codec::defaultVolumeCamera(volume, tf, codec::renderRange(volume, renderOptions(o)), aspect);
     const CameraText given = parseCamera(o.cameraText);
     const glm::dvec3 up = parseVector3(o.upText, "--up");
     const glm::dvec3 forward = given.target - given.eye;
@@ -127,7 +130,7 @@ Scene loadScene(const VolumeOptions& o, double aspect) {
     Progress loading("read " + o.volume);
     Volume volume = loadVolume(o.volume);
     loading.done();
-    const Camera camera = volumeCamera(o, volume, aspect);
+    const Camera camera = volumeCamera(o, volume, tf, aspect);
     return {std::move(tf), std::move(volume), camera};
 }
 

@@ -48,6 +48,30 @@ TEST_F(Volume, RenderWritesACameraDepthImage) {
     EXPECT_TRUE(leftovers().empty());
 }
 
+// The default camera frames what the transfer function shows: the phantom fills the uniform
+// frame's height, uncut (it sits in a larger box, which framed whole left it half the height and
+// 40% of the width).
+TEST_F(Volume, DefaultCameraFillsTheFrameWithTheHead) {
+    ASSERT_EQ(run("volume render procedural:shepp-logan:48 -o " + path("u.exr") + " --size 80x80 --uniform --backend cpu")
+                  .exitCode,
+              0);
+    const ExrRead exr = readExr(path("u.exr"));
+    const auto& a = exr.channels.at("A");
+    int top = 80, bottom = -1;
+    for (int y = 0; y < 80; ++y)
+        for (int x = 0; x < 80; ++x)
+            if (a[static_cast<std::size_t>(y) * 80 + x] > 0.5f) {
+                top = std::min(top, y);
+                bottom = std::max(bottom, y);
+            }
+    EXPECT_GT(bottom - top + 1, 0.9 * 80);
+    // Nothing at the frame's edge rows: the head is not cut.
+    for (int x = 0; x < 80; ++x) {
+        EXPECT_EQ(a[static_cast<std::size_t>(x)], 0.0f);
+        EXPECT_EQ(a[static_cast<std::size_t>(79) * 80 + x], 0.0f);
+    }
+}
+
 TEST_F(Volume, GpuAndCpuBackendsAgreeOnARawBrick) {
     // A uint16 brick with a bright off-centre blob and a ramp, written here.
     const int w = 24, h = 18, d = 20;

@@ -148,16 +148,61 @@ Image renderVolumeReference(const Volume& volume, const TransferFunction& tf, co
     return out;
 }
 
+namespace {
+
+const glm::dvec3 kToEye = glm::normalize(glm::dvec3(0.45, -0.35, -1.0));  // the view's fixed direction
+
+// Looks at `centre` from kToEye's direction, from `distance`, near and far bracketing the sphere
+// of `radius` about it.
+Camera viewFrom(glm::dvec3 centre, double distance, double radius, double aspect, double fovYDegrees) {
+    return Camera::perspective(centre + distance * kToEye, centre, {0.0, -1.0, 0.0}, fovYDegrees, aspect,
+                               std::max(distance - 1.05 * radius, 0.01 * distance), distance + 1.05 * radius);
+}
+
+double halfAngle(double fovYDegrees) { return 0.5 * fovYDegrees * kPi / 180.0; }
+
+}  // namespace
+
 Camera defaultVolumeCamera(const Volume& volume, double aspect, double fovYDegrees) {
     const glm::dvec3 centre = 0.5 * volume.extent();
     const double radius = std::max(0.5 * glm::length(volume.extent()), 1e-6);
     // The narrower of the two fields of view decides the distance that fits the bounding sphere.
-    const double halfY = 0.5 * fovYDegrees * kPi / 180.0;
-    const double halfX = std::atan(std::tan(halfY) * aspect);
-    const double distance = 1.02 * radius / std::sin(std::min(halfX, halfY));
-    const glm::dvec3 eye = centre + distance * glm::normalize(glm::dvec3(0.45, -0.35, -1.0));
-    return Camera::perspective(eye, centre, {0.0, -1.0, 0.0}, fovYDegrees, aspect,
-                               std::max(distance - 1.05 * radius, 0.01 * distance), distance + 1.05 * radius);
+    const double halfY = halfAngle(fovYDegrees), halfX = std::atan(std::tan(halfY) * aspect);
+    return viewFrom(centre, 1.02 * radius / std::sin(std::min(halfX, halfY)), radius, aspect, fovYDegrees);
+}
+
+Camera defaultVolumeCamera(const Volume& volume, const TransferFunction& tf, glm::vec2 range, double aspect,
+                           double fovYDegrees) {
+    const float scale = range.y > range.x ? 1.0f / (range.y - range.x) : 1.0f;
+    const auto shows = [&](int x, int y, int z) {
+        return tf.lookup(std::clamp((volume.at(x, y, z) - range.x) * scale, 0.0f, 1.0f)).a > 1.0f / 255.0f;
+    };
+    glm::ivec3 lo(volume.width, volume.height, volume.depth), hi(-1);
+    for (int z = 0; z < volume.depth; ++z)
+        for (int y = 0; y < volume.height; ++y)
+            for (int x = 0; x < volume.width; ++x)
+                if (shows(x, y, z)) {
+                    lo = glm::min(lo, glm::ivec3(x, y, z));
+                    hi = glm::max(hi, glm::ivec3(x, y, z));
+                }
+    if (hi.x < 0) return defaultVolumeCamera(volume, aspect, fovYDegrees);
+    // Look at the shown samples' box centre, from where every shown sample fits the frame.
+    const glm::dvec3 centre = 0.5 * glm::dvec3(lo + hi) * volume.spacing;
+    const double radius = std::max(0.5 * glm::length(glm::dvec3(hi - lo) * volume.spacing), 1e-6);
+    const double tanY = 0.95 * std::tan(halfAngle(fovYDegrees)), tanX = tanY * aspect;  // a small border
+    const glm::dvec3 forward = -kToEye, right = glm::normalize(glm::cross(forward, glm::dvec3(0.0, -1.0, 0.0)));
+    const glm::dvec3 up = glm::cross(right, forward);
+    double distance = 1.1 * radius;  // never inside the shown samples' sphere
+    for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+            for (int x = lo.x; x <= hi.x; ++x)
+                if (shows(x, y, z)) {
+                    const glm::dvec3 r = glm::dvec3(x, y, z) * volume.spacing - centre;
+                    const double along = glm::dot(r, forward);
+                    distance = std::max({distance, std::abs(glm::dot(r, right)) / tanX - along,
+                                         std::abs(glm::dot(r, up)) / tanY - along});
+                }
+    return viewFrom(centre, distance, radius, aspect, fovYDegrees);
 }
 
 }  // namespace conus::codec
