@@ -164,18 +164,18 @@ ScaleText parseScale(const std::string& text) {
     return r;
 }
 
-// The k-th input, moved and scaled as its --translate and --scale say.
-codec::SamplingMap composeInput(const ComposeOptions& o, std::size_t k, codec::SamplingMap map) {
+// The k-th input, moved and scaled as its --translate and --scale say; `aspect` its picture's.
+codec::SamplingMap composeInput(const ComposeOptions& o, std::size_t k, codec::SamplingMap map, double aspect) {
     if (k < o.translate.size()) {
         const auto [dx, dy] = parsePair(o.translate[k], "--translate");
-        codec::ComposeResult r = codec::translateMap(map, {dx, dy});
-        if (r.scale < 1.0) std::printf("%s: translated pattern scaled by %.4f to stay valid\n", o.inputs[k].c_str(), r.scale);
+        codec::ComposeResult r = codec::translateMap(map, {dx, dy}, aspect);
+        if (r.rebuilt) std::printf("%s: translated pattern built from its moved density\n", o.inputs[k].c_str());
         map = std::move(r.map);
     }
     if (k < o.scale.size()) {
         const ScaleText scale = parseScale(o.scale[k]);
-        codec::ComposeResult r = codec::scaleMap(map, scale.s, scale.centre);
-        if (r.scale < 1.0) std::printf("%s: scaled pattern's displacement scaled by %.4f to stay valid\n", o.inputs[k].c_str(), r.scale);
+        codec::ComposeResult r = codec::scaleMap(map, scale.s, scale.centre, aspect);
+        if (r.rebuilt) std::printf("%s: scaled pattern built from its scaled density\n", o.inputs[k].c_str());
         map = std::move(r.map);
     }
     return map;
@@ -187,21 +187,27 @@ void runCompose(const ComposeOptions& o) {
     }
     std::vector<codec::SamplingMap> maps;
     int grid = o.grid;
+    double aspect = 0;  // the first input's picture's, for the anisotropy bound
     for (std::size_t k = 0; k < o.inputs.size(); ++k) {
         const format::ConusFile file = format::readConusFile(o.inputs[k]);
         codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
         if (o.grid == 0) grid = std::max({grid, map.columns(), map.rows()});
-        maps.push_back(composeInput(o, k, std::move(map)));
+        if (aspect == 0) aspect = file.sourceWidth > 0 && file.sourceHeight > 0 ? double(file.sourceWidth) / file.sourceHeight : 1.0;
+        maps.push_back(composeInput(o, k, std::move(map), aspect));
     }
     std::vector<double> weights;
     if (!o.weights.empty()) {
         weights.assign(maps.size(), 1.0);
         std::copy(o.weights.begin(), o.weights.end(), weights.begin());
     }
-    const codec::ComposeResult sum = codec::addMaps(maps, grid, grid, weights);
-    std::printf("added %zu maps; displacement scale %.4f%s\n", maps.size(), sum.scale,
-                sum.scale < 1.0 ? " (the plain sum folds)" : "");
-    writeMapFile(sum.map, std::nullopt, o.out);
+    const codec::ComposeResult sum = codec::addMaps(maps, grid, grid, weights, aspect);
+    if (sum.rebuilt) {
+        std::printf("added %zu maps; the plain sum folds or starves a cell, so built from their summed density "
+                    "(anisotropy up to %.2f, bound %.2f)\n", maps.size(), sum.report.maxAnisotropy, sum.report.bound);
+    } else {
+        std::printf("added %zu maps\n", maps.size());
+    }
+    writeMapFile(sum.map, std::nullopt, o.out, aspect);
 }
 
 // ---- ground ----

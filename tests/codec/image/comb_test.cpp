@@ -124,8 +124,9 @@ TEST(Comb, FocusRingOfASiemensStarAliasesNoMoreThanUniform) {
                     u.fundamental);
         // Issue 10's target for the aliasing check in the ring: within 1 dB of uniform's.
         EXPECT_LT(dB(c.comb, u.comb), 1.0) << falloffText(falloff);
-        // The measure sees the comb: the pixel's box alone (the old filter) is well above it.
-        EXPECT_GT(dB(b.comb, u.comb), 3.0) << falloffText(falloff);
+        // The measure sees the comb: the pixel's box alone (the old filter) is well above it (less
+        // so since maps keep their anisotropy bounded: +2.9 dB with the widest ring).
+        EXPECT_GT(dB(b.comb, u.comb), 2.5) << falloffText(falloff);
         // And the filter removes the comb, not the star: the spokes keep most of their contrast
         // (energy at the star's own frequency at least a quarter of the uniform image's).
         EXPECT_GT(c.fundamental, 0.25 * u.fundamental) << falloffText(falloff);
