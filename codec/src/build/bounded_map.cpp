@@ -40,6 +40,8 @@ constexpr double kConformal = 0.01;
 // shape (a focus stays round) where the frame's shape would shear it.
 constexpr double kConformalGrowth = 1.5;
 constexpr double kDensity = 1.0;
+// The penalty on a corner's log density below DensityMapOptions::minDensity, per unit squared.
+constexpr double kFloor = 50.0;
 // The barrier starts at this share of the way from K = 1 to the bound (in c), and weighs this much.
 constexpr double kBarrierKnee = 0.8;
 constexpr double kBarrier = 1.0;
@@ -69,6 +71,7 @@ double conformalOf(double anisotropy) { return 0.5 * (anisotropy + 1.0 / anisotr
 struct Energy {
     const Level& level;
     double cMax = 0, cKnee = 0;
+    double floor = 0, logFloor = 0;  // DensityMapOptions::minDensity (0: none) and its log
 
     // One corner with Jacobian columns a = d/du, b = d/dv: its energy density in *e and gradient
     // in ga, gb; false when infeasible.
@@ -81,7 +84,12 @@ struct Energy {
         const double l = std::log(det) - logRho;
         double coefC = conformal;
         e = conformal * (c - 1.0) + kDensity * l * l;
-        const double coefDet = 2.0 * kDensity * l * inv;
+        double coefDet = 2.0 * kDensity * l * inv;
+        if (det < floor) {
+            const double under = logFloor - std::log(det);
+            e += kFloor * under * under;
+            coefDet -= 2.0 * kFloor * under * inv;
+        }
         if (c > cKnee) {
             const double t = c - cKnee, gap = cMax - c;
             e += kBarrier * t * t / gap;
@@ -343,7 +351,8 @@ SamplingMap buildBoundedMap(const DensityField& target, const DensityMapOptions&
     for (std::size_t l = 0; l < sides.size(); ++l) {
         const auto [n, m] = sides[l];
         const Level level = makeLevel(target, n, m, aspect);
-        const Energy energy{level, cMax, 1.0 + kBarrierKnee * (cMax - 1.0)};
+        const double floor = options.minDensity > 0 ? options.minDensity : 0.0;
+        const Energy energy{level, cMax, 1.0 + kBarrierKnee * (cMax - 1.0), floor, floor > 0 ? std::log(floor) : 0.0};
         x = l == 0 ? identityNodes(n, m, aspect) : prolong(x, previousN, previousM, n, m, aspect);
         // A prolongation across misaligned grids could leave the feasible set; start afresh then.
         if (!std::isfinite(energy(x, nullptr))) x = identityNodes(n, m, aspect);

@@ -48,6 +48,10 @@ struct DensityMapOptions {
     // Width / height of the picture, for the anisotropy in pixels; 0: the field's (fieldAspect),
     // which rounding of its sample counts may leave a little off.
     double aspect = 0;
+    // Bounded: the lowest density a cell should keep (the target normalized to mean 1), held by a
+    // steep penalty: where the target cannot be followed within the bound, the peaks give way
+    // instead of the context. 0: none.
+    double minDensity = 0;
 };
 
 // What the builder had to give up, measured on the map it returns.
