@@ -269,10 +269,12 @@ TEST(ConusView, WindowZoomKeepsTheFeatureUnderTheCursor) {
     // The inspector line for the marker: the white disc, undistorted (u,v) at the marker.
     EXPECT_NE(log.find("u,v=(0.3000,0.4000)"), std::string::npos) << log;
     // The disc is white; the encoder's footprint filter (its anisotropic low-pass, issue 10) blurs
-    // its edge a little into the pixel at its centre, so near 1 rather than a fixed value.
+    // its edge a little into the pixel at its centre, so near 1 rather than a fixed value (0.95:
+    // the disc lies in the focus's widened transition, where footprints are 2.5 times longer than
+    // wide).
     const std::size_t red = log.find("R=", log.find("u,v=(0.3000,0.4000)"));
     ASSERT_NE(red, std::string::npos) << log;
-    EXPECT_GT(std::stod(log.substr(red + 2, 8)), 0.97) << log;
+    EXPECT_GT(std::stod(log.substr(red + 2, 8)), 0.93) << log;
 }
 
 TEST(ConusView, WindowShowsAnInvalidFileAsAnErrorWithoutCrashing) {
