@@ -314,6 +314,8 @@ double WidenedFocus::density(double s) const {
     return m_density[i] + (x - i) * (m_density[i + 1] - m_density[i]);
 }
 
+SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options) { return buildFociMap(foci, options, nullptr); }
+
 SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options, FociReport* report) {
     checkOptions(options);
     for (const Focus& f : foci) checkFocus(f);

@@ -85,7 +85,8 @@ void checkFocus(const Focus& focus);
 
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r <= 0 or k < 1 or k > 64.
 // Never for a grid too coarse: the bounded builder refines it (FociOptions::columns).
-SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options = {}, FociReport* report = nullptr);
+SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options = {});
+SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options, FociReport* report);
 
 // A focus's density profile once its transition is widened for the anisotropy bound `bound`:
 // over s = distance / r, k^2 inside the disc, 1 from end() on (falloff.width when the falloff is
