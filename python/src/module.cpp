@@ -23,8 +23,9 @@
 #include <vector>
 
 #include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/frame_budget.h"
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/foci_budget.h"
+#include "conus/codec/build/frame_budget.h"
 #include "conus/codec/build/map_measures.h"
 #include "conus/codec/build/springs.h"
 #include "conus/codec/conus_file.h"
@@ -36,6 +37,7 @@
 #include "conus/format/container.h"
 #include "conus/imageio/image_file.h"
 #include "conus/renderers/gpu_image.h"
+#include "foci_budget_info.h"
 
 namespace py = pybind11;
 
@@ -152,6 +154,7 @@ struct Map {
 
 struct File {
     format::ConusFile file;
+    std::optional<py::dict> budget;  // what encode(foci=...)'s budget did (foci_budget.h); none otherwise
     std::shared_ptr<Map> map;  // built from file.map on first use
     std::shared_ptr<Map> samplingMap() {
         if (!map) map = std::make_shared<Map>(Map{codec::SamplingMap::fromGrid(file.map), file.analytic});
@@ -392,6 +395,12 @@ PYBIND11_MODULE(_conus, m) {
         .def_property_readonly("map", [](File& self) { return self.samplingMap(); })
         .def_property_readonly("attributes", [](const File& self) { return attributesOf(self.file); })
         .def_property_readonly("source_size", [](const File& self) { return py::make_tuple(self.file.sourceWidth, self.file.sourceHeight); })
+        .def_property_readonly(
+            "budget", [](const File& self) -> py::object { return self.budget ? py::object(*self.budget) : py::none(); },
+            "What encode(foci=...)'s budget did, or None: k_asked, k_given (each focus's), lowered, frame_loss (the\n"
+            "budget), predicted_frame_loss, predicted_roi_gain (dB), foci_share (of the CoNUS pixels),\n"
+            "context_downscale and uniform_downscale (the linear downscale the context and the uniform image are\n"
+            "sampled like), ask (the discs' pixels at k over all the pixels), grid_limited")
         .def("__repr__", [](const File& self) {
             const format::ConusFile& f = self.file;
             return "<conus.File " + std::to_string(f.image.width) + "x" + std::to_string(f.image.height) + " CoNUS image of a " +
@@ -420,22 +429,29 @@ PYBIND11_MODULE(_conus, m) {
         "encode",
         [](const py::array& pixels, std::optional<std::vector<std::tuple<double, double, double, double>>> foci,
            std::optional<std::pair<int, int>> size, std::shared_ptr<Map> map, std::optional<std::vector<std::string>> channels,
-           const std::string& backend, int fit, double fitHold) {
+           const std::string& backend, int fit, double fitHold, double frameLoss, bool exactK) {
             Image source = fromArray(pixels, channels, "pixels");
             if (foci && map) throw Error(ErrorCode::InvalidArgument, "give foci or a map, not both");
             const double aspect = double(source.width) / source.height;
+            const auto [w, h] = sizeOr(size, source.width, source.height);
+            std::optional<codec::FociBudget> budget;
             if (!map) {
                 if (foci && !foci->empty()) {
                     const std::vector<codec::Focus> f = toFoci(*foci);
                     codec::FociOptions options;
                     options.aspect = aspect;
-                    py::gil_scoped_release release;
-                    map = std::make_shared<Map>(Map{codec::buildFociMap(f, options), codec::toAnalytic(f, options.composition)});
+                    {
+                        // The budget of `conus encode --focus` (foci_budget.h): k lowered to hold frame_loss.
+                        py::gil_scoped_release release;
+                        const int side = 256;
+                        const codec::FrameErrorModel model(source, w, h, codec::fociImportance(f, aspect, side, std::max(1, int(side / aspect))));
+                        budget = codec::fociForFrameLoss(f, options, model, frameLoss, exactK);
+                    }
+                    map = std::make_shared<Map>(Map{budget->map, codec::toAnalytic(budget->given, options.composition)});
                 } else {
                     map = std::make_shared<Map>(Map{codec::SamplingMap::identity(2, 2), {}});
                 }
             }
-            const auto [w, h] = sizeOr(size, source.width, source.height);
             codec::EncodeOptions options;
             options.width = w;
             options.height = h;
@@ -454,15 +470,18 @@ PYBIND11_MODULE(_conus, m) {
                                                   map->analytic);
             }
             file->map = map;
+            if (budget) file->budget = budgetInfo(*budget, frameLoss, w, h, source.width, source.height, exactK);
             return file;
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),
-        py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = 0,
-        py::arg("fit_hold") = codec::kFitHoldLowPass,
+        py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = codec::kFitIterations,
+        py::arg("fit_hold") = codec::kFitHoldLowPass, py::arg("frame_loss") = codec::kDefaultFrameLoss, py::arg("exact_k") = false,
         "Encode linear pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file;\n"
-        "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'; fit = N > 0\n"
-        "fits the image to the decoder with N least-squares iterations (`conus encode --fit --fit-iterations N`); fit_hold: its\n"
-        "damping where the encoder low-passed a long footprint axis (`--fit-hold`; 0: the plain least squares)");
+        "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'. As `conus encode`:\n"
+        "foci hold a whole-frame loss budget (frame_loss dB, predicted) by lowering every k alike, with a\n"
+        "UserWarning that says so (exact_k=True keeps k; the File's .budget says what was given); fit = N\n"
+        "least-squares iterations fit the image to the decoder (default 4; 0: the filtered encode alone, `--fast`);\n"
+        "fit_hold: its damping where the encoder low-passed a long footprint axis (`--fit-hold`)");
     m.def(
         "decode",
         [](File& file, std::tuple<double, double, double, double> view, std::optional<std::pair<int, int>> size, const std::string& backend) {
