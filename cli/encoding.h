@@ -43,6 +43,7 @@ struct FitSetting {
 inline FitSetting defaultFit() {
     FitSetting fit;
     fit.enabled = true;
+    fit.iterations = codec::kDefaultEncodeFitIterations;
     return fit;
 }
 void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault = false);

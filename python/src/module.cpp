@@ -474,13 +474,13 @@ PYBIND11_MODULE(_conus, m) {
             return file;
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),
-        py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = codec::kFitIterations,
+        py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = codec::kDefaultEncodeFitIterations,
         py::arg("fit_hold") = codec::kFitHoldLowPass, py::arg("frame_loss") = codec::kDefaultFrameLoss, py::arg("exact_k") = false,
         "Encode linear pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file;\n"
         "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'. As `conus encode`:\n"
         "foci hold a whole-frame loss budget (frame_loss dB, predicted) by lowering every k alike, with a\n"
         "UserWarning that says so (exact_k=True keeps k; the File's .budget says what was given); fit = N\n"
-        "least-squares iterations fit the image to the decoder (default 4; 0: the filtered encode alone, `--fast`);\n"
+        "least-squares iterations fit the image to the decoder (default 2; 0: the filtered encode alone, `--fast`);\n"
         "fit_hold: its damping where the encoder low-passed a long footprint axis (`--fit-hold`)");
     m.def(
         "decode",
