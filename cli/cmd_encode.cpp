@@ -62,11 +62,11 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     }
     // The budget chooses the context floor; say what it achieved.
     const codec::FrameErrorModel model(source, size.width, size.height, importance);
-    codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions);
+    codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions, codec::kDefaultTileLoss);
     progress.done();
     if (!quiet())
-        std::printf("frame-loss budget %.2f dB: context floor %.3g; predicted whole-frame loss %.2f dB, ROI gain %+.2f dB%s\n",
-                    o.frameLoss, r.minDensity, r.predicted.frameLoss, r.predicted.roiGain,
+        std::printf("frame-loss budget %.2f dB (tiles %.2g dB): context floor %.3g; predicted whole-frame loss %.2f dB (tiles %.1f dB), ROI gain %+.2f dB%s\n",
+                    o.frameLoss, codec::kDefaultTileLoss, r.minDensity, r.predicted.frameLoss, r.predicted.tileLoss, r.predicted.roiGain,
                     r.budgetBinds ? "" : " (the lowest floor stays within the budget: raise --max-density for more)");
     return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt};
 }

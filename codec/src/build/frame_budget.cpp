@@ -205,7 +205,7 @@ FramePrediction FrameErrorModel::predict(const DensityField& field) const {
 }
 
 BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorModel& model, double frameLossDb,
-                                      AutoMapOptions options) {
+                                      AutoMapOptions options, double tileLossDb) {
     if (!(frameLossDb >= 0) || !std::isfinite(frameLossDb))
         invalid("the frame-loss budget " + std::to_string(frameLossDb) + " dB must be finite and >= 0");
     // A higher floor leaves the context more samples: the loss falls as the floor rises. Bisect in
@@ -219,16 +219,17 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         r.predicted = model.predict(r.map);
         return r;
     };
+    const auto within = [&](const BudgetResult& r) { return r.predicted.frameLoss <= frameLossDb && r.predicted.tileLoss <= tileLossDb; };
     BudgetResult low = build(kLowestFloor);
-    if (low.predicted.frameLoss <= frameLossDb) {
+    if (within(low)) {
         low.budgetBinds = false;
         return low;
     }
     BudgetResult high = build(kHighestFloor);
-    if (high.predicted.frameLoss > frameLossDb) return high;  // the closest to the budget there is
+    if (!within(high)) return high;  // the closest to the budget there is
     for (int i = 0; i < kBisectionSteps; ++i) {
         BudgetResult mid = build(std::sqrt(low.minDensity * high.minDensity));
-        (mid.predicted.frameLoss <= frameLossDb ? high : low) = std::move(mid);
+        (within(mid) ? high : low) = std::move(mid);
     }
     return high;
 }

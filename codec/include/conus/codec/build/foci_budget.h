@@ -23,10 +23,6 @@
 
 namespace conus::codec {
 
-// The budgets of the defaults (dB, predicted, against the uniform image): the whole frame's loss,
-// and the 95th percentile of the tiles' outside the foci.
-inline constexpr double kDefaultFrameLoss = 1.5;
-inline constexpr double kDefaultTileLoss = 4.0;
 // The least context density the defaults keep when no picture is given: half the linear rate of
 // the uniform image (the automatic maps' default floor).
 inline constexpr double kDefaultContextFloor = 0.25;

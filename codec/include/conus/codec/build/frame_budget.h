@@ -19,6 +19,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -28,6 +29,11 @@
 #include "conus/core/image.h"
 
 namespace conus::codec {
+
+// The budgets of the defaults (dB, predicted, against the uniform image of the same pixel count):
+// the whole frame's loss, and the 95th percentile of the tiles' outside the region of interest.
+inline constexpr double kDefaultFrameLoss = 1.5;
+inline constexpr double kDefaultTileLoss = 4.0;
 
 struct FramePrediction {
     double frameLoss = 0;  // dB
@@ -70,11 +76,12 @@ struct BudgetResult {
 
 // The automatic map (buildAutoMap with `options`, its minDensity replaced) with the lowest context
 // floor in [0.02, 0.99] (to 1.5%, by bisection, a map built for each try) whose own predicted
-// whole-frame loss stays within `frameLossDb`: the most ROI gain the budget allows. The map is built without refusing
+// whole-frame loss stays within `frameLossDb` and tile loss within `tileLossDb` (infinity: no tile
+// budget): the most ROI gain the budget allows. The map is built without refusing
 // density bounds (the budget, not the floor, is the promise). Throws conus::Error(InvalidArgument) for a budget that is not finite
 // and >= 0.
 BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorModel& model, double frameLossDb,
-                                      AutoMapOptions options = {});
+                                      AutoMapOptions options = {}, double tileLossDb = std::numeric_limits<double>::infinity());
 
 // The automatic map (buildAutoMap with `options`, its minDensity replaced) whose context floor,
 // among a few from 0.25 to 0.85, the model predicts loses least over the whole frame (the most
