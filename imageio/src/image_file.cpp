@@ -487,17 +487,7 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
     }
 
     info.nonFinite = tabled ? 0 : countNonFinite(image);  // every table value is finite
-    if (info.nonFinite > 0 && options.repair != NonFiniteRepair::Keep) {
-        OIIO::ImageBuf buffer(OIIO::ImageSpec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT),
-                              image.pixels.data());
-        const auto mode = options.repair == NonFiniteRepair::Black ? OIIO::ImageBufAlgo::NONFINITE_BLACK
-                                                                   : OIIO::ImageBufAlgo::NONFINITE_BOX3;
-        if (!OIIO::ImageBufAlgo::fixNonFinite(buffer, buffer, mode))
-            throw Error(ErrorCode::Io, shown + ": cannot repair non-finite values: " + buffer.geterror());
-        // Box3 leaves a value whose 3x3 neighbourhood holds nothing finite; those become 0.
-        for (float& v : image.pixels)
-            if (!std::isfinite(v)) v = 0.0f;
-    }
+    if (info.nonFinite > 0) repairNonFinite(image, options.repair, shown);
 
     // Colour: linear light with associated alpha, as OpenEXR has it (the tables did it already).
     if (encoding.transfer != Transfer::Raw && !tabled) {

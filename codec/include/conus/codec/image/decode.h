@@ -24,6 +24,10 @@ struct View {
     double u0 = 0, v0 = 0, u1 = 1, v1 = 1;  // undistorted rectangle; may extend past [0,1]^2 (background there)
 };
 
+// Refuses (InvalidArgument) a view that is empty or inverted (it needs u0 < u1 and v0 < v1), not
+// finite, or absurdly far from the image; `shown` is the view as the caller wrote it.
+void checkView(const View& view, const std::string& shown);
+
 // A mip chain of a CoNUS image for zoomed-out views: level k >= 1 is the exact area downsample
 // of level k-1 to half its size (rounded down, at least 1 pixel), down to 1x1. Level 0 is the
 // image itself and is not stored: levels[0] is level 1. Built once per image (a viewer keeps it
