@@ -2,10 +2,11 @@
 // (python/conus/__init__.py) re-exports it and adds the pure-Python helpers.
 //
 // Shared rules:
-// - Pixels are float32 numpy arrays of shape (height, width, channels), linear light, channels
-//   named by the file (R, G, B, A, Y, Z, ...). Arrays CoNUS returns own their memory without a
-//   copy (a capsule holds the C++ image); File.pixels and Map.nodes are views into the object
-//   they come from and keep it alive.
+// - Pixels CoNUS returns are float32 numpy arrays of shape (height, width, channels), linear light,
+//   channels named by the file (R, G, B, A, Y, Z, ...); what it takes follows arguments.h (float:
+//   linear light; uint8/uint16: display codes, as a PNG's). Returned arrays own their memory
+//   without a copy (a capsule holds the C++ image); File.pixels and Map.nodes are views into the
+//   object they come from and keep it alive.
 // - Every long call (read, write, encode, decode, building a map, distort/undistort of many
 //   points) releases the GIL.
 // - A conus::Error becomes conus.Error with .code ("corrupt", "limit-exceeded", ...), .rules (the
