@@ -561,12 +561,14 @@ PYBIND11_MODULE(_conus, m) {
         py::arg("path"), "Read an ordinary picture (PNG, JPEG, TIFF, EXR, ...) as linear float: (pixels, channels)");
     m.def(
         "write_image",
-        [](const std::string& path, py::object pixels, py::object channels, const std::string& colorspace) {
-            Image image = pixelsFrom(pixels, channelsFrom(channels), "pixels", rulesOf(colorspace, "keep"));
+        [](const std::string& path, py::object pixels, py::object channels, const std::string& colorspace,
+           const std::string& fixNonFinite) {
+            Image image = pixelsFrom(pixels, channelsFrom(channels), "pixels", rulesOf(colorspace, fixNonFinite));
             py::gil_scoped_release release;
             imageio::writeImageFile(path, image);
         },
         py::arg("path"), py::arg("pixels"), py::arg("channels") = py::none(), py::arg("colorspace") = "auto",
+        py::arg("fix_nonfinite") = "keep",
         "Write pixels (as for encode: float linear light, uint8/uint16 display codes) as an ordinary picture (8-bit\n"
         "sRGB for PNG/JPEG, half for EXR), atomically");
 }

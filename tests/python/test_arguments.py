@@ -116,7 +116,7 @@ def test_python_refuses_what_the_cli_refuses(tmp_path, asymmetric, conus_bin):
         conus.uniform(pixels, fit=-1)
 
 
-def test_nonfinite_pixels_warn_or_are_repaired_as_fix_nonfinite(asymmetric):
+def test_nonfinite_pixels_warn_or_are_repaired_as_fix_nonfinite(tmp_path, asymmetric):
     pixels = np.ascontiguousarray(asymmetric[..., :3]).copy()
     pixels[50, 60] = np.nan
     pixels[51, 60, 1] = np.inf
@@ -133,6 +133,10 @@ def test_nonfinite_pixels_warn_or_are_repaired_as_fix_nonfinite(asymmetric):
     np.testing.assert_allclose(box3[50, 60], asymmetric[50, 60, :3], atol=0.05)
     f = conus.encode(pixels, foci=[FOCUS], fix_nonfinite="box3")
     assert np.isfinite(f.pixels).all()
+    with pytest.warns(UserWarning, match="NaN or infinite values"):
+        conus.write_image(str(tmp_path / "nan.exr"), pixels)
+    conus.write_image(str(tmp_path / "fixed.exr"), pixels, fix_nonfinite="black")
+    assert np.isfinite(conus.read_image(str(tmp_path / "fixed.exr"))[0]).all()
 
 
 def test_a_map_made_for_another_aspect_warns(tmp_path, asymmetric, conus_bin):
