@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "conus/codec/image/decode.h"
+#include "conus/core/check.h"
 #include "conus/core/parallel.h"
 #include "decode_magnify_pvt.h"
 #include "decode_planned_pvt.h"
@@ -62,6 +63,7 @@ ViewColumns viewColumns(int mapColumns, double u0, double u1, int width) {
         span.x1 = x;
         c.spans.push_back(span);
     }
+    CONUS_DCHECK(!c.spans.empty() && c.spans.back().x1 == width);  // the spans tile the row
     return c;
 }
 

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <optional>
 
+#include "conus/core/check.h"
 #include "cpu_features_pvt.h"
 #include "decode_magnify_pvt.h"
 #include "decode_planned_pvt.h"
@@ -301,7 +302,10 @@ template <int kC>
 template <int kC, int kN>
 [[gnu::always_inline]] inline void planAndDecode(const Level* levels, int top, const SpanInputs& in, int k0, int count,
                                                  PixelPlan& plan, float* out) {
+    CONUS_DCHECK(count > 0 && count <= kPlanBlock);
     planPixels<kC, kN>(levels, top, in, k0, count, plan);
+    // decodeInterior blends level uniform + 1 unless every pixel takes one tap.
+    CONUS_DCHECK(plan.uniform < 0 || plan.oneTap || plan.uniform < top);
     if (plan.uniform >= 0) decodeInterior<kC>(levels, plan, count, out);
     else decodePlanned<kC>(levels, plan, count, out);
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "conus/codec/image/pyramid.h"
+#include "conus/core/check.h"
 #include "resample_pvt.h"
 
 namespace conus::codec::detail {
@@ -66,6 +67,7 @@ inline void trilinearTap(const Level* levels, int top, int c, float x, float y, 
     const float lambda = std::min(pyramidLevel(rho2), static_cast<float>(top));
     const int l = static_cast<int>(lambda);
     const float f = lambda - static_cast<float>(l);
+    CONUS_DCHECK(l >= 0 && l <= top && (f <= 0.0f || l < top));  // a blend reads level l + 1
     const Level& a = levels[l];
     levelTap<kC>(a, channels, x * a.sx + a.ox, y * a.sy + a.oy, out);
     if (f <= 0.0f) return;
@@ -80,6 +82,7 @@ inline void trilinearTapLanes(const Level* levels, int top, float x, float y, fl
     const float lambda = std::min(pyramidLevel(rho2), static_cast<float>(top));
     const int l = static_cast<int>(lambda);
     const float f = lambda - static_cast<float>(l);
+    CONUS_DCHECK(l >= 0 && l <= top && (f <= 0.0f || l < top));  // a blend reads level l + 1
     const Level& a = levels[l];
     PixelLanes value = levelTapLanes<kC>(a, x * a.sx + a.ox, y * a.sy + a.oy);
     if (f > 0.0f) {
