@@ -1,7 +1,7 @@
 // Private: the readable reference of the decode (decode.cpp), the one the GPU decoder and the
 // fit are held to: bilinear taps at biased CoNUS pixel coordinates and, for a zoomed-out pixel
 // without a pyramid, the average of na x nb taps over its footprint parallelogram (decode.h's
-// multi-tap rule). Scalar, one channel at a time, in double where the position is computed.
+// multi-tap rule). Positions in double, one tap at a time (a tap's channels in lanes at most).
 #pragma once
 
 #include <algorithm>
@@ -13,7 +13,7 @@
 
 namespace conus::codec::detail {
 
-constexpr TapOffsets<kDecodeMaxTaps> kTapOffsets;
+inline constexpr TapOffsets<kDecodeMaxTaps> kTapOffsets;
 
 // Bilinear at CoNUS pixel coordinates plus one, known to lie in [0.5, size + 0.5] (Eq. 1 keeps
 // every point inside the image): positive, so truncation is floor. kClamp = false when the whole
