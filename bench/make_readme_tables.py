@@ -100,7 +100,9 @@ def machine():
 
 def stamp(method):
     commit = run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"]).strip()
-    dirty = run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no"]).strip()
+    # The tables and plots this script writes do not count as a modified tree.
+    dirty = run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no", "--", ".",
+                 ":!bench/README.md", ":!bench/quality-plots"]).strip()
     when = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     return f"{when}, commit {commit}{' (modified)' if dirty else ''}, {machine()}; {method}."
 
