@@ -711,7 +711,7 @@ void writeImageFile(const std::string& path, const Image& image, const WriteOpti
     else if (written == Transfer::Linear) spec.attribute("oiio:ColorSpace", "Linear");
     if (integer && alpha >= 0) spec.attribute("oiio:UnassociatedAlpha", 1);
     if (target.formatName == "openexr") spec.attribute("compression", "zip");
-    // zlib level 4, not OpenImageIO's 6: a 1920x1080 photo view (bench/README.md, "Decode speed")
+    // zlib level 4, not OpenImageIO's 6: a 1920x1080 photo view (bench/notes/2026-11-24-decode-pyramid.md)
     // deflated at 6 took 0.6 s of CPU, a third of `conus decode`, for a file 4% smaller than at 4,
     // which takes 0.1 s; levels 1-3 save no more time and grow the file 6-11%.
     if (target.formatName == "png") spec.attribute("png:compressionLevel", 4);

@@ -431,7 +431,7 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
     const GladGLContext& gl = makeCurrentGl(d.context);
     if (!hasImage()) {
         gl.Viewport(0, 0, width, height);
-        gl.ClearColor(0.11f, 0.11f, 0.11f, 1.0f);
+        gl.ClearColor(kViewBackground, kViewBackground, kViewBackground, 1.0f);
         gl.Clear(GL_COLOR_BUFFER_BIT);
         return;
     }

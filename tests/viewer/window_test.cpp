@@ -268,7 +268,7 @@ TEST(ConusView, WindowZoomKeepsTheFeatureUnderTheCursor) {
     EXPECT_EQ(marker(grid).z, 0) << "density mode shows no picture";
     // The inspector line for the marker: the white disc, undistorted (u,v) at the marker.
     EXPECT_NE(log.find("u,v=(0.3000,0.4000)"), std::string::npos) << log;
-    // The disc is white; the encoder's footprint filter (its anisotropic low-pass, issue 10) blurs
+    // The disc is white; the encoder's footprint filter (its anisotropic low-pass) blurs
     // its edge a little into the pixel at its centre, so near 1 rather than a fixed value.
     const std::size_t red = log.find("R=", log.find("u,v=(0.3000,0.4000)"));
     ASSERT_NE(red, std::string::npos) << log;

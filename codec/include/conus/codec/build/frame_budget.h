@@ -1,5 +1,5 @@
 // What an automatic map costs the rest of the frame, predicted before encoding, and the context
-// floor chosen by a budget on it (`--frame-loss`, issue 10).
+// floor chosen by a budget on it (`--frame-loss`).
 //
 // The prediction: a picture sampled at linear rate s (samples per source pixel along each axis)
 // loses at each pixel about what the uniform image of that rate loses there, e(x, s) =
