@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# End-to-end speed of the `conus` program, next to `oiiotool` measured in the same run (issue 10,
-# item 7): start-up, a 4096^2 -> 1024^2 encode, a 1920x1080 decode to PNG and to EXR, the brush
+# End-to-end speed of the `conus` program, next to `oiiotool` measured in the same run:
+# start-up, a 4096^2 -> 1024^2 encode, a 1920x1080 decode to PNG and to EXR, the brush
 # (`map springs`) to its stable state, and the encode on one core vs two.
 #
 #   bench/end_to_end.sh [build-dir] [runs]      (defaults: build, 5)

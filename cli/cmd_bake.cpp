@@ -225,7 +225,7 @@ CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
     relief->add_option("--grid", o.grid, "sampling-map nodes per side")->capture_default_str();
     relief->add_option("--min-density", o.minDensity,
                        "with importance: density kept everywhere (the tablet: 0.7 gains 3.5 dB on the text for "
-                       "0.5 dB elsewhere, bench/README.md)")
+                       "0.5 dB elsewhere, bench/notes/2026-11-24-relief.md)")
         ->capture_default_str()
         ->check(finiteRange(0, 1));
     relief->add_option("--max-density", o.maxDensity, "with importance: cap on the density")

@@ -1,16 +1,19 @@
 // conus encode: a conventional image -> a CoNUS file, through foci, a map file, or importance.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <mutex>
 
+#include "arguments.h"
 #include "batch.h"
 #include "commands.h"
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/build/foci_budget.h"
 #include "conus/codec/build/frame_budget.h"
+#include "conus/codec/conus_file.h"
 #include "conus/core/limits.h"
 #include "conus/core/map_rules.h"
 #include "encoding.h"
@@ -46,8 +49,20 @@ struct BuiltMap {
     std::optional<format::AnalyticMap> analytic;
 };
 
-BuiltMap mapFromFile(const std::string& path) {
+BuiltMap mapFromFile(const std::string& path, const Image& source) {
     const format::ConusFile mapSource = format::readConusFile(path);
+    // Foci built for another aspect are ellipses on this picture.
+    if (const std::optional<double> aspect = codec::madeForAspect(mapSource)) {
+        const double here = double(source.width) / source.height;
+        if (std::abs(std::log(*aspect / here)) > 0.01) {
+            char text[320];
+            std::snprintf(text, sizeof text,
+                          "the map %s was made for pictures of aspect %.3g (width / height) and this one's is %.3g: its "
+                          "foci become ellipses (make it with `conus map foci --aspect %.3g`)",
+                          path.c_str(), *aspect, here, here);
+            warn(text);
+        }
+    }
     return {std::make_unique<codec::SamplingMap>(codec::SamplingMap::fromGrid(mapSource.map)), mapSource.analytic};
 }
 
@@ -122,7 +137,7 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     const Size size = conusSize(o.storage, source.image);
     BuiltMap built;
     std::string given;
-    if (!o.mapFile.empty()) built = mapFromFile(o.mapFile);
+    if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image);
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size);
     else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, &given);
     else built = mapFromOwnDetail(o, source.image, size, &given);
@@ -141,8 +156,11 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
 }
 
 int runEncode(EncodeOptions o) {
+    // Usage first, before any input is read.
     if (o.frameLossGiven && o.foci.empty() && o.importance.empty())
         throw Error(ErrorCode::InvalidArgument, "--frame-loss is the budget of --focus and --importance: give one of them");
+    parseFoci(o.foci);
+    if (!o.storage.sizeText.empty()) parseSize(o.storage.sizeText);
     if (o.fast) o.fit.enabled = false;
     return runConversions(o.batch, [&o](const Job& job) { return encodeOne(o, job.input, job.output); });
 }

@@ -70,12 +70,13 @@ void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticM
     format::writeConusFile(out.output, file);
     const DensityStats stats = densityStats(map);
     const codec::MapMeasures measures = codec::measureMap(map, aspect);
-    std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
+    if (!quiet())  // -q: silent on success
+        std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
                 map.rows(), stats.min, stats.max, measures.maxAnisotropy);
     if (!out.preview.empty()) {
         writeDrawing(out.preview,
                      densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr, aspect));
-        std::printf("wrote %s\n", out.preview.c_str());
+        if (!quiet()) std::printf("wrote %s\n", out.preview.c_str());
     }
 }
 
@@ -263,7 +264,9 @@ void runFoci(const FociOptions& o) {
     progress.done();
     const std::string said = describeFociBudget(budget, std::nullopt, o.exactK, o.grid, o.maxAnisotropy);
     if (!quiet()) std::printf("%s\n", said.c_str());
-    writeMapFile(budget.map, codec::toAnalytic(budget.given, fo.composition, fo.falloff), o.out, o.aspect);
+    std::optional<format::AnalyticMap> analytic = codec::toAnalytic(budget.given, fo.composition, fo.falloff);
+    analytic->scalars["aspect"] = o.aspect;  // so an encode of a picture of another aspect can warn
+    writeMapFile(budget.map, std::move(analytic), o.out, o.aspect);
 }
 
 // ---- auto ----

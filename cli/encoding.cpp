@@ -43,13 +43,11 @@ void applyStorage(const StorageOptions& options, format::ConusFile& file) {
 }
 
 void checkConusOutput(const std::string& output, const std::string& input) {
-    const std::filesystem::path path(output);
-    std::string extension = path.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
-    if (extension != ".exr")
-        throw Error(ErrorCode::InvalidArgument, "the output " + output +
-                                                    " must end in .exr: a CoNUS file is an OpenEXR file (for a picture of "
-                                                    "it, run `conus decode` on the .exr)");
+    try {
+        format::checkConusFileName(output);
+    } catch (const Error& e) {
+        throw Error(e.code(), std::string(e.what()) + " (for a picture of it, run `conus decode` on the .exr)");
+    }
     const std::string inputs[] = {input};
     checkOutputPath(output, inputs);
 }

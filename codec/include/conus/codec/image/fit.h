@@ -30,7 +30,7 @@
 namespace conus::codec {
 
 // Default iterations: the decoded PSNR of astronaut and chelsea (two foci, 1/16) stops rising
-// after 2-3 (bench/README.md, "Fitted to the decoder": the PSNR per iteration). Damping
+// after 2-3 (bench/notes/2026-11-24-quality-fit-to-decoder.md: the PSNR per iteration). Damping
 // (0: none where the encoder kept the box filter) and hold: where the encoder low-passed a long
 // footprint axis (encode.h's rule against the radial comb), the damping grows by kFitHoldLowPass
 // times the share of that low-pass (the Gaussian's extent beyond the box, at most 1). Without it
