@@ -70,12 +70,13 @@ void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticM
     format::writeConusFile(out.output, file);
     const DensityStats stats = densityStats(map);
     const codec::MapMeasures measures = codec::measureMap(map, aspect);
-    std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
+    if (!quiet())  // -q: silent on success
+        std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
                 map.rows(), stats.min, stats.max, measures.maxAnisotropy);
     if (!out.preview.empty()) {
         writeDrawing(out.preview,
                      densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr, aspect));
-        std::printf("wrote %s\n", out.preview.c_str());
+        if (!quiet()) std::printf("wrote %s\n", out.preview.c_str());
     }
 }
 
@@ -236,9 +237,10 @@ void runGround(const GroundOptions& o) {
 
 struct FociOptions {
     std::vector<std::string> foci;
-    std::string composition = "density", falloff = "2";
+    std::string composition = "density", falloff = kDefaultFalloff;
     int grid = map_rules::kDefaultSide;
     double aspect = 1.0, maxAnisotropy = 0;
+    bool exactK = false;
     OutputOptions out;
 };
 
@@ -250,6 +252,7 @@ void addFociOptions(CLI::App& command, FociOptions& o) {
     addFalloffOption(command, o.falloff);
     command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     command.add_option("--aspect", o.aspect, "image width / height, so foci are circular in pixels (default 1)");
+    addExactKOption(command, o.exactK);
     addOutputOptions(command, o.out);
 }
 
@@ -262,10 +265,14 @@ void runFoci(const FociOptions& o) {
     fo.composition = o.composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
-    const codec::SamplingMap map = codec::buildFociMap(list, fo);
-    codec::checkFociHeld(map, list, fo);  // the file must not record a focus its map ignores
+    // No picture to predict a loss on: the context keeps the default floor (foci_budget.h).
+    const codec::FociBudget budget = codec::fociForContextFloor(list, fo, codec::kDefaultContextFloor, o.exactK);
     progress.done();
-    writeMapFile(map, codec::toAnalytic(list, fo.composition, fo.falloff), o.out, o.aspect);
+    const std::string said = describeFociBudget(budget, std::nullopt, o.exactK, o.grid, o.maxAnisotropy);
+    if (!quiet()) std::printf("%s\n", said.c_str());
+    std::optional<format::AnalyticMap> analytic = codec::toAnalytic(budget.given, fo.composition, fo.falloff);
+    analytic->scalars["aspect"] = o.aspect;  // so an encode of a picture of another aspect can warn
+    writeMapFile(budget.map, std::move(analytic), o.out, o.aspect);
 }
 
 // ---- auto ----

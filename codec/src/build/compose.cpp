@@ -43,8 +43,8 @@ double ramp(double t) {
 constexpr double kRampSlope = 15.0 / 8.0;
 
 // A map's pattern placed in the output by the affine change q = a * p + b (per axis, a > 0): the
-// output's displacement is D(q) / a. Two cuts would leave it discontinuous (issue 10: "a visible
-// square seam and a dark slit"), so both are tapered:
+// output's displacement is D(q) / a. Two cuts would leave it discontinuous (a visible
+// square seam and a dark slit), so both are tapered:
 // - An edge of the pattern's square that falls inside the output (a pattern shrunk or moved in):
 //   D is tangential there but not zero (boundary nodes slide along their edge), and zero outside,
 //   so nodes on either side of the edge jumped apart, and the density stepped from the pattern's

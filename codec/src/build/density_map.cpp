@@ -1,4 +1,4 @@
-// Where issue 10's staircase came from: not the rasterized foci (their density is C2 and sampled
+// Where steps in a map's density come from: not the rasterized foci (their density is C2 and sampled
 // at >= 12 samples a radius) nor the Poisson solve's boundary (exact Neumann, zero normal flow),
 // but fitting the grid to the flow. Moser's flow is injective, but it shears: between two foci the
 // context divides between them, and along the divide the nodes' paths fan out so fast that

@@ -24,7 +24,6 @@ constexpr double kSamplesPerRadius = 12.0;
 constexpr int kMinDensitySide = 256;
 constexpr int kMaxDensitySide = 512;
 constexpr int kMinShortSide = 32;
-// The widest focus falloff, in radii of the focus.
 // Add composition: the factor applied to all displacements while the sum folds.
 constexpr double kAddShrink = 0.9;
 

@@ -168,7 +168,7 @@ double largestLogDensityJump(const SamplingMap& map, const std::function<bool(gl
 }
 
 TEST(Compose, ScaledAndMovedPatternsHaveNoSeam) {
-    // Issue 10: `map compose --scale` left a square seam and a dark slit. A focus map's
+    // `map compose --scale` once left a square seam and a dark slit. A focus map's
     // displacement reaches every edge (context is squeezed everywhere), so shrinking or moving it
     // puts its edge inside the frame (a seam), and enlarging or moving it cuts it at the frame's
     // edge (a slit: the old code folded there and scaled the whole pattern down to 0.1-0.2).

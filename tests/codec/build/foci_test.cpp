@@ -161,7 +161,7 @@ TEST(Foci, SingleFocusMagnification) {
 
 TEST(Foci, NearbyFociKeepTheirMagnification) {
     // The context squeezed between two foci shears under Moser's flow and folds on a 65x65 grid.
-    // Repairing the fold locally left steps (issue 10), so the builder tempers the density: the
+    // Repairing the fold locally left steps, so the builder tempers the density: the
     // foci keep most of their magnification, and more than half of their extra one.
     const std::vector<Focus> foci{{0.42, 0.31, 0.08, 4}, {0.7, 0.65, 0.1, 3}};
     const SamplingMap map = buildFociMap(foci, options(1.0));

@@ -72,7 +72,7 @@ TEST(MapMeasures, CellDensityOfAWarpedGridIsItsAreaRatio) {
     EXPECT_NEAR(measureMap(SamplingMap::identity(17, 17)).maxAnisotropy, 1.0, 1e-9);
 }
 
-const std::vector<Focus> kTwoFoci{{0.645, 0.62, 0.06, 4}, {0.49, 0.02, 0.05, 3}};  // issue 10's
+const std::vector<Focus> kTwoFoci{{0.645, 0.62, 0.06, 4}, {0.49, 0.02, 0.05, 3}};  // a staircase's repro
 
 // The transition shapes a focus can have (FociFalloff): the default, narrower, wider, log blends.
 const FociFalloff kFalloffs[] = {{2.0, FociFalloffShape::Density},
@@ -112,10 +112,10 @@ double largestLogCurvature(int n, int m, const std::function<double(int, int)>& 
 }
 
 TEST(MapMeasures, NoStepsInATwoFocusDensity) {
-    // Issue 10's repro: the density between the two foci came out as a staircase beside a channel
+    // The repro: the density between the two foci once came out as a staircase beside a channel
     // of almost no samples. The map follows the target (tempered, which only flattens it), so its
     // log cell density may bend no more sharply than the target's at the same cells, with 25% for
-    // the grid's fit; a step adds curvature (the repaired map of issue 10 measured 2.21 here, the
+    // the grid's fit; a step adds curvature (the locally repaired map measured 2.21 here, the
     // target 1.31, today's map 0.87). And no cell sparser than half the sparsest target density.
     // The same for every falloff shape.
     for (const FociFalloff& falloff : kFalloffs) {

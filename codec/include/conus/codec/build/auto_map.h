@@ -10,7 +10,7 @@
 //   density giving way where the importance rises too steeply for it), or Moser's flow.
 // - Separable: the baseline; u and v are warped independently by the cumulative marginals of rho,
 //   so density is the product of the marginals (bands through every hot spot).
-// Flow matches the target far better (tests and bench/README.md give the figures), so it is the
+// Flow matches the target far better (tests and bench/notes/2026-11-22-suite-figures.md give the figures), so it is the
 // default. Every result is a valid map; all-zero importance gives the identity.
 #pragma once
 
