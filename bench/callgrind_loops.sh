@@ -1,6 +1,6 @@
 #!/bin/bash
 # Instructions per iteration of Google Benchmark loops, by callgrind: the figure to compare two
-# builds on a shared machine, where wall clocks are noise (bench/README.md, "Restructuring check").
+# builds on a shared machine, where wall clocks are noise (bench/README.md, "Comparing two builds").
 #   bench/callgrind_loops.sh BINARY NAME...      NAME: a benchmark's full name, e.g. BM_Distort or
 #                                                BM_DecodeConusView/zoom:0/real_time
 # Each benchmark runs alone under callgrind, 3 repetitions of one iteration each; a profile is

@@ -1,10 +1,13 @@
 #!/usr/bin/python3
 """Quality of CoNUS against the uniform image of the same pixel count, on real photographs, in one
-command: `bench/quality.py [--out DIR] [--quick]`. Writes DIR/quality.md (the tables of
-bench/README.md) and DIR/*.png (rate-distortion and gain-loss plots), DIR defaulting to
-build/quality.
+command: `bench/quality.py [--out DIR] [--quick | --defaults-only]`. Writes DIR/quality.md (the
+tables of bench/README.md) and DIR/*.png (rate-distortion and gain-loss plots), DIR defaulting to
+build/quality. `--defaults-only`: only the targets table of the `conus` program's defaults on 8-bit
+sRGB pictures (quality_targets.py: DIR/targets.md and a contact sheet), in minutes.
 
-Everything is measured in linear light (the values the EXR holds) against the source:
+At 1/16 the 8-bit sRGB measures of quality_targets.py too (ROI and whole-frame PSNR and SSIM, the
+tile loss outside the regions). Everything else is measured in linear light (the values the EXR
+holds) against the source:
 - ROI PSNR and SSIM: inside each region of interest (a disc of radius r, a fraction of the width),
   CoNUS (one focus u,v,r,k per region, k = 4) against uniform, at 1/4, 1/16 and 1/64 of the pixels;
 - whole-frame loss: uniform's PSNR over the whole frame minus CoNUS's;
@@ -27,8 +30,10 @@ Everything is measured in linear light (the values the EXR holds) against the so
 - fitted to the decoder (`encode --fit`, `uniform --fit`; codec/image/fit.h): every measure above
   again with both images fitted, CoNUS against the fitted uniform image, and the gain-loss points of
   the foci, the automatic maps and the budgets with the fit.
-Photographs: Debian's python3-skimage (astronaut, chelsea, motorcycle) and mate-backgrounds
-(ladybird, dandelion, garden; reduced to 1280 px wide by an area filter to keep the run short).
+Photographs: Debian's python3-skimage (astronaut, chelsea, motorcycle), mate-backgrounds (ladybird,
+dandelion, garden) and lomiri-wallpapers-16.04 / -20.04 (seven more, quality_targets.UNSEEN), reduced
+to at most 1280 px wide by an area filter to keep the run short. The sweeps hold k exact
+(`exact_k=True`): they measure what each k gives.
 """
 import argparse
 import os
@@ -42,19 +47,10 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "build" / "python"))
 import conus  # noqa: E402  (the package built by cmake)
+from quality_targets import (ALL_PHOTOS as PHOTOS, MAX_WIDTH, defaults_only, discs, linear, read_png,  # noqa: E402
+                             scores, srgb8, write_png)
 
-SKIMAGE = pathlib.Path("/usr/lib/python3/dist-packages/skimage/data")
-MATE = pathlib.Path("/usr/share/backgrounds/mate/nature")
-# name, file, regions (u, v, r): r a fraction of the width.
-PHOTOS = [
-    ("astronaut", SKIMAGE / "astronaut.png", [(0.44, 0.23, 0.08), (0.33, 0.75, 0.06)]),
-    ("chelsea", SKIMAGE / "chelsea.png", [(0.37, 0.38, 0.07), (0.71, 0.45, 0.07)]),
-    ("motorcycle", SKIMAGE / "motorcycle_left.png", [(0.55, 0.62, 0.08), (0.72, 0.31, 0.05)]),
-    ("ladybird", MATE / "LadyBird.jpg", [(0.70, 0.50, 0.05)]),
-    ("dandelion", MATE / "TwoWings.jpg", [(0.50, 0.45, 0.07), (0.74, 0.40, 0.06)]),
-    ("garden", MATE / "Garden.jpg", [(0.55, 0.55, 0.09)]),
-]
-MAX_WIDTH = 1280
+# The photographs and their regions, and the 8-bit sRGB measures: quality_targets.py.
 FRACTIONS = [(2, "1/4"), (4, "1/16"), (8, "1/64")]  # side divisor, share of the pixels
 K = 4
 BUDGETS = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0]  # --frame-loss budgets swept (dB)
@@ -80,38 +76,6 @@ def ssim(a, b, mask):
     from skimage.metrics import structural_similarity
     _, full = structural_similarity(np.clip(a, 0, 1), np.clip(b, 0, 1), channel_axis=2, data_range=1.0, full=True)
     return float(full[mask].mean())
-
-
-def discs(shape, regions, inner=0.0, outer=1.0):
-    """Mask of the points within (inner*r, outer*r] of any region's centre (r in widths)."""
-    h, w = shape[:2]
-    y, x = np.mgrid[0:h, 0:w]
-    mask = np.zeros((h, w), bool)
-    for u, v, r in regions:
-        d = np.hypot(x + 0.5 - u * w, y + 0.5 - v * h) / (r * w)
-        mask |= (d > inner) & (d <= outer)
-    return mask
-
-
-def srgb8(linear):
-    c = np.clip(linear[..., :3], 0, 1)
-    s = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1 / 2.4) - 0.055)
-    return np.round(s * 255).astype(np.uint8)
-
-
-def linear(srgb):
-    s = srgb.astype(np.float32) / 255
-    return np.where(s <= 0.04045, s / 12.92, np.power((s + 0.055) / 1.055, 2.4)).astype(np.float32)
-
-
-def write_png(path, rgb8):
-    from PIL import Image
-    Image.fromarray(rgb8).save(path)
-
-
-def read_png(path):
-    from PIL import Image
-    return np.asarray(Image.open(path).convert("RGB"))
 
 
 def lowpassed(source, rate):
@@ -223,7 +187,7 @@ def encode_with(src, size, regions, k=K, map=None, fit=0, falloff=None):
         map = conus.Map.foci([(u, v, r, k) for u, v, r in regions], aspect=w / h, falloff=falloff)
     if map is not None:
         return conus.encode(src, map=map, size=size, fit=fit, **hold)
-    return conus.encode(src, foci=[(u, v, r, k) for u, v, r in regions], size=size, fit=fit, **hold)
+    return conus.encode(src, foci=[(u, v, r, k) for u, v, r in regions], size=size, fit=fit, exact_k=True, **hold)
 
 
 def uniform_view(src, size, fit=0):
@@ -288,6 +252,7 @@ def measure(name, src, regions, out, quick):
         if share == "1/16":
             write_png(out / f"{name}-conus.png", srgb8(cview))
             write_png(out / f"{name}-uniform.png", srgb8(uview))
+            rows[-1]["srgb"] = scores(srgb8(cview), srgb8(uview), srgb8(src), regions)
             rows[-1]["zones"] = zones(src, regions, cfile, cview, uview, size)
     return rows
 
@@ -514,6 +479,14 @@ def report(rows, all_curves, all_points):
                      f"{r['fp_c']:.1f} / {r['fp_u']:.1f} / {r['fp_d']:.1f} | {r['ring_density']:.2f}, {r['ring_anisotropy']:.2f} |")
     lines.append("")
     lines += summary(rows)
+    lines += ["", "8-bit sRGB at 1/16 (quality_targets.py's measures)", "",
+              "| photo | ROI gain (worst ROI) | ROI SSIM CoNUS / uniform | whole-frame loss | tile loss outside the regions: p95 / worst |",
+              "|---|---|---|---|---|"]
+    for r in rows:
+        if "srgb" in r:
+            g = r["srgb"]
+            lines.append(f"| {r['photo']} | {g['roi_gain']:+.2f} ({g['worst_roi']:+.2f}) | {g['roi_ssim'][0]:.3f} / {g['roi_ssim'][1]:.3f} | "
+                         f"{g['frame_loss']:.2f} dB | {g['tile95']:.2f} / {g['tile_worst']:.2f} dB |")
     if FIT:
         fitted = [dict(r["fitted"], photo=r["photo"], share=r["share"]) for r in rows]
         lines += ["", f"Fitted to the decoder (`--fit {FIT}`), CoNUS against the uniform image fitted the same way "
@@ -576,7 +549,18 @@ def main():
     parser.add_argument("--fit", type=int, default=FIT, help=f"iterations of the fitted variant (default {FIT})")
     parser.add_argument("--no-fit", action="store_true", help="leave the fitted variant out")
     parser.add_argument("--fit-hold", type=float, default=None, help="the fit's --fit-hold (default: the encoder's)")
+    parser.add_argument("--defaults-only", action="store_true",
+                        help="only the targets table of `conus encode`'s defaults, 8-bit sRGB (minutes)")
+    parser.add_argument("--encode-args", default="", help="with --defaults-only: more `conus encode` options (e.g. '--fast')")
+    parser.add_argument("--detail", action="store_true", help="with --defaults-only: `--importance detail` as a row too")
+    parser.add_argument("--photos", default="", help="with --defaults-only: a comma-separated subset of the photographs")
     args = parser.parse_args()
+    if args.defaults_only:
+        out = pathlib.Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        photos = [p for p in PHOTOS if not args.photos or p[0] in args.photos.split(",")]
+        defaults_only(conus, ROOT / "build" / "bin" / "conus", out, photos, args.encode_args.split(), args.detail)
+        return
     FIT = 0 if args.no_fit else args.fit
     FIT_HOLD = args.fit_hold
     out = pathlib.Path(args.out)
@@ -588,7 +572,8 @@ def main():
     rows, all_curves, all_points = [], {}, {}
     for name, path, regions in photos:
         if not path.exists():
-            sys.exit(f"bench/quality.py: {path} is missing (apt-get install python3-skimage mate-backgrounds)")
+            sys.exit(f"bench/quality.py: {path} is missing (apt-get install python3-skimage mate-backgrounds "
+                     "lomiri-wallpapers-16.04 lomiri-wallpapers-20.04)")
         print(f"== {name}", flush=True)
         src = load(path)
         rows += measure(name, src, regions, out, args.quick)

@@ -40,11 +40,8 @@ Size parseSize(const std::string& text) {
 codec::View parseView(const std::string& text) {
     const auto values = parseNumbers(text, ',');
     if (values.size() != 4) invalid("view '" + text + "' is not of the form u0,v0,u1,v1");
-    codec::View view{values[0], values[1], values[2], values[3]};
-    if (!(view.u0 < view.u1) || !(view.v0 < view.v1))
-        invalid("view '" + text + "' is empty: it needs u0 < u1 and v0 < v1");
-    if (std::abs(view.u0) > 1e3 || std::abs(view.u1) > 1e3 || std::abs(view.v0) > 1e3 || std::abs(view.v1) > 1e3)
-        invalid("view '" + text + "' is absurdly far from the image ([0,1] is the whole image)");
+    const codec::View view{values[0], values[1], values[2], values[3]};
+    codec::checkView(view, "'" + text + "'");
     return view;
 }
 

@@ -2,6 +2,9 @@
 
 #include <unistd.h>
 
+#include <csignal>
+#include <cstring>
+
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -64,6 +67,51 @@ std::string clock(double seconds) {
     else std::snprintf(text, sizeof text, "%ld:%02ld", s / 60, s % 60);
     return text;
 }
+
+// What an interrupted batch says (Ctrl-C, SIGTERM, SIGHUP): the handler may only write(2), so the
+// line is kept current in one of two buffers under the batch's mutex and the handler writes the
+// latest, then runs the handler it replaced (core's: remove the temporaries, die by the signal).
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+char g_note[2][320];
+std::atomic<int> g_latest{0};
+struct sigaction g_replaced[std::size(kSignals)];
+
+extern "C" void noteInterruption(int signal) {
+    const char* note = g_note[g_latest.load()];
+    [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, note, std::strlen(note));
+    for (std::size_t i = 0; i < std::size(kSignals); ++i)
+        if (kSignals[i] == signal && g_replaced[i].sa_handler != SIG_DFL && g_replaced[i].sa_handler != SIG_IGN &&
+            g_replaced[i].sa_handler != nullptr) {
+            g_replaced[i].sa_handler(signal);
+            return;
+        }
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+}
+
+// Under the batch's mutex: the note for `done` of `total` finished.
+void setInterruptionNote(const std::string& command, std::size_t done, std::size_t total) {
+    const int next = 1 - g_latest.load();
+    std::snprintf(g_note[next], sizeof g_note[next],
+                  "%sconus %s: interrupted: %zu done, %zu left (no partial output is left behind); run again with "
+                  "--skip-existing to finish\n",
+                  ::isatty(STDERR_FILENO) ? "\r\033[K" : "", command.c_str(), done, total - done);
+    g_latest = next;
+}
+
+class InterruptionNote {
+public:
+    InterruptionNote() {
+        struct sigaction action {};
+        action.sa_handler = &noteInterruption;
+        sigemptyset(&action.sa_mask);
+        action.sa_flags = SA_RESETHAND;
+        for (std::size_t i = 0; i < std::size(kSignals); ++i) ::sigaction(kSignals[i], &action, &g_replaced[i]);
+    }
+    ~InterruptionNote() {
+        for (std::size_t i = 0; i < std::size(kSignals); ++i) ::sigaction(kSignals[i], &g_replaced[i], nullptr);
+    }
+};
 
 }  // namespace
 
@@ -144,6 +192,9 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
         liveLine(line);
     };
 
+    setInterruptionNote(commandName(), 0, jobs.size());
+    const InterruptionNote interruption;
+
     auto worker = [&] {
         for (std::size_t i; !stop && (i = next++) < jobs.size();) {
             const Job& job = jobs[i];
@@ -178,11 +229,12 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
                 if (!userQuiet && !::isatty(STDERR_FILENO))  // a log keeps one line an item
                     report("[" + std::to_string(finished) + "/" + std::to_string(jobs.size()) + "] " + outcome);
             }
+            setInterruptionNote(commandName(), finished, jobs.size());
             show();
         }
     };
 
-    setQuiet(true);  // the items' stage lines: the batch reports instead
+    setQuiet(true);  // the items' stage lines: the batch reports instead; each warning once
     {
         std::vector<std::thread> threads;
         const int count = std::max(1, std::min<int>(options.jobs, int(jobs.size())));
@@ -191,6 +243,7 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
         for (std::thread& t : threads) t.join();
     }
     setQuiet(false);
+    reportRepeatedWarnings(jobs.size());
 
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::string summary = std::to_string(converted) + " converted, " + std::to_string(skipped) + " skipped (output exists), " +
@@ -198,7 +251,7 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
     if (stop) summary += ", " + std::to_string(jobs.size() - finished) + " not tried (--fail-fast)";
     summary += " in " + clock(elapsed);
     if (!userQuiet && ::isatty(STDERR_FILENO)) std::fprintf(stderr, "\r\033[K");
-    std::printf("%s\n", summary.c_str());
+    if (!userQuiet || failed > 0) std::printf("%s\n", summary.c_str());  // -q: silent on success
     for (const std::string& reason : reasons) std::printf("  failed: %s\n", reason.c_str());
     return failed > 0 ? 1 : 0;
 }
@@ -206,7 +259,8 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
 int runConversions(const BatchOptions& options, const std::function<std::string(const Job&)>& convert) {
     const std::vector<Job> jobs = planJobs(options);
     if (isBatch(options)) return runBatch(jobs, options, convert);
-    std::printf("%s\n", convert(jobs.front()).c_str());
+    const std::string line = convert(jobs.front());
+    if (!quiet()) std::printf("%s\n", line.c_str());
     return 0;
 }
 

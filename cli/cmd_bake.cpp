@@ -13,6 +13,8 @@
 #include "commands.h"
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/foci_budget.h"
+#include "conus/codec/build/frame_budget.h"
 #include "conus/codec/depth/heightfield.h"
 #include "conus/codec/depth/reflection.h"
 #include "conus/codec/depth/relief.h"
@@ -38,7 +40,7 @@ struct BakeOptions {
     std::string source, output, sizeText, colour, importance, text = kDefaultText, compression = "zip";
     std::string tabletSize = "1024x768";
     std::vector<std::string> foci;
-    bool uniform = false;
+    bool uniform = false, exactK = false;
     int grid = map_rules::kDefaultSide;
     double heightScale = 1.0, width = 1.0, minDensity = 0.7, maxDensity = 16.0;
 };
@@ -98,10 +100,19 @@ int runBakeRelief(const BakeOptions& o) {
             codec::FociOptions fo;
             fo.columns = fo.rows = o.grid;
             fo.aspect = double(source.heights.width) / source.heights.height;
-            map = codec::buildFociMap(foci, fo);
-            codec::checkFociHeld(*map, foci, fo);
-            analytic = codec::toAnalytic(foci, fo.composition);
-            how = plural(foci.size(), "focus", "foci") + " map";
+            fo.falloff = codec::parseFalloff(kDefaultFalloff);
+            // The budget of `encode --focus`, on the asset's colour: the rest of the field keeps its samples.
+            const int side = 256;
+            const codec::FrameErrorModel model(source.colour, size.width, size.height,
+                                               codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))));
+            codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, codec::kDefaultFrameLoss, o.exactK);
+            const std::string said = describeFociBudget(
+                budget, BudgetFrame{size.width, size.height, source.heights.width, source.heights.height, codec::kDefaultFrameLoss},
+                o.exactK, o.grid);
+            if (!quiet()) std::printf("%s\n", said.c_str());
+            map = std::move(budget.map);
+            analytic = codec::toAnalytic(budget.given, fo.composition, fo.falloff);
+            how = plural(foci.size(), "focus", "foci") + " map (k " + fociKText(budget.given) + ")";
         } else {
             codec::AutoMapOptions ao;
             ao.columns = ao.rows = o.grid;
@@ -204,6 +215,7 @@ CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
     relief->add_option("-o,--output", o.output, "relief asset (.exr)")->required();
     relief->add_option("--size", o.sizeText, "CoNUS image size WxH (default: a quarter of each side)");
     relief->add_option("--focus", o.foci, "focus u,v,r,k (repeatable): magnify these discs");
+    addExactKOption(*relief, o.exactK)->needs("--focus");
     relief->add_option("--importance", o.importance,
                        "detail (default) | faces | an importance image: where the samples go")
         ->excludes("--focus");
@@ -213,7 +225,7 @@ CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
     relief->add_option("--grid", o.grid, "sampling-map nodes per side")->capture_default_str();
     relief->add_option("--min-density", o.minDensity,
                        "with importance: density kept everywhere (the tablet: 0.7 gains 3.5 dB on the text for "
-                       "0.5 dB elsewhere, bench/README.md)")
+                       "0.5 dB elsewhere, bench/notes/2026-11-24-relief.md)")
         ->capture_default_str()
         ->check(finiteRange(0, 1));
     relief->add_option("--max-density", o.maxDensity, "with importance: cap on the density")

@@ -28,11 +28,39 @@ struct DecodeCommandOptions {
     PictureOptions picture;
 };
 
+// --size for a view of w x h source pixels: "512", "512x" and "x256" keep the view's aspect; "WxH"
+// is taken as given, with a warning when it stretches the view.
+Size sizeForView(const std::string& text, double w, double h) {
+    const std::size_t x = text.find('x');
+    const bool heightOnly = x == 0, widthOnly = x == std::string::npos || x + 1 == text.size();
+    if (!heightOnly && !widthOnly) {
+        const Size size = parseSize(text);
+        const double kept = size.width * h / w;  // the height that keeps the view's aspect
+        if (std::abs(kept - size.height) > std::max(1.0, 0.01 * size.height)) {
+            char note[256];
+            std::snprintf(note, sizeof note,
+                          "--size %s stretches the view (%.0fx%.0f source pixels, aspect %.3g) to aspect %.3g; --size %dx "
+                          "keeps its aspect",
+                          text.c_str(), w, h, w / h, double(size.width) / size.height, size.width);
+            warn(note);
+        }
+        return size;
+    }
+    const std::string side = heightOnly ? text.substr(1) : text.substr(0, x);
+    const Size given = parseSize(side + "x" + side);  // the one side's checks
+    const double other = heightOnly ? given.height * w / h : given.width * h / w;
+    if (other > kMaxImageSide)
+        throw Error(ErrorCode::InvalidArgument, "--size " + text + " would make the other side " + std::to_string(long(other)) +
+                                                    " pixels, past the limit of " + std::to_string(kMaxImageSide));
+    const int kept = std::max(1, static_cast<int>(std::lround(other)));
+    return heightOnly ? Size{kept, given.height} : Size{given.width, kept};
+}
+
 // The view at the source's resolution unless --size says otherwise.
 Size outputSize(const DecodeCommandOptions& o, const codec::View& view, const format::ConusFile& file) {
-    if (!o.sizeText.empty()) return parseSize(o.sizeText);
     const double w = std::round((view.u1 - view.u0) * file.sourceWidth);
     const double h = std::round((view.v1 - view.v0) * file.sourceHeight);
+    if (!o.sizeText.empty()) return sizeForView(o.sizeText, (view.u1 - view.u0) * file.sourceWidth, (view.v1 - view.v0) * file.sourceHeight);
     if (w > kMaxImageSide || h > kMaxImageSide || w * h > double(kMaxImagePixels))
         throw Error(ErrorCode::InvalidArgument, "the view at source resolution would be " + std::to_string(long(w)) + "x" +
                                                     std::to_string(long(h)) + " pixels, past the limits (" +
@@ -124,6 +152,12 @@ std::string decodeOne(const DecodeCommandOptions& o, const std::string& input, c
 }
 
 int runDecode(const DecodeCommandOptions& o) {
+    // Usage first, before any input is read.
+    if (!o.viewText.empty()) parseView(o.viewText);
+    if (const std::string& t = o.sizeText; !t.empty()) {
+        const std::size_t x = t.find('x');
+        parseSize(x == 0 ? t.substr(1) + "x1" : x == std::string::npos || x + 1 == t.size() ? t.substr(0, x) + "x1" : t);
+    }
     return runConversions(o.batch, [&o](const Job& job) { return decodeOne(o, job.input, job.output); });
 }
 
@@ -138,7 +172,8 @@ CLI::App* declareDecode(CLI::App& root, DecodeCommandOptions& options) {
                         "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image; "
                         "outside [0,1] shows the background)");
     command->add_option("--size", options.sizeText,
-                        "output size WxH (default: the view at the source's resolution)");
+                        "output size WxH; W, Wx or xH keep the view's aspect (default: the view at the source's "
+                        "resolution)");
     command->add_option("--camera", options.cameraText,
                         "height fields: render a 3-D frame from x,y,z,lx,ly,lz,fovDeg (eye, look-at, vertical fov; "
                         "world metres) instead of a 2-D view; 'viewer' is the ground map's own viewer");

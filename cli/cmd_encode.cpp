@@ -1,14 +1,19 @@
 // conus encode: a conventional image -> a CoNUS file, through foci, a map file, or importance.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 
+#include "arguments.h"
 #include "batch.h"
 #include "commands.h"
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/foci_budget.h"
 #include "conus/codec/build/frame_budget.h"
+#include "conus/codec/conus_file.h"
 #include "conus/core/limits.h"
 #include "conus/core/map_rules.h"
 #include "encoding.h"
@@ -22,23 +27,42 @@ namespace {
 
 struct EncodeOptions {
     BatchOptions batch;
-    std::string mapFile, compose = "density", importance, method = "flow", falloff = "2";
+    std::string mapFile, compose = "density", importance, method = "flow", falloff = kDefaultFalloff;
     double minDensity = 0.25, maxDensity = 16, maxAnisotropy = 0;
-    double frameLoss = -1;  // dB; < 0: no budget (--min-density sets the floor)
+    double frameLoss = codec::kDefaultFrameLoss;  // dB, predicted; --min-density instead sets an importance map's floor
+    bool floorGiven = false;  // --min-density: no budget for importance maps
+    bool frameLossGiven = false;
+    bool exactK = false;      // --exact-k: foci keep k as asked
+    bool fast = false;        // --fast: the filtered encode alone, no fit to the decoder
     std::vector<std::string> foci;
     int grid = map_rules::kDefaultSide;
-    FitSetting fit;  // --fit, --fit-iterations, --fit-hold
+    FitSetting fit = defaultFit();  // fitted by default; --fast leaves it out
     SourceOptions source;
     StorageOptions storage;
 };
+
+// The predicted tile loss (dB, frame_budget.h) the own-detail map keeps to when no focus is given.
+constexpr double kOwnDetailTileLoss = 2.0;
 
 struct BuiltMap {
     std::unique_ptr<codec::SamplingMap> map;
     std::optional<format::AnalyticMap> analytic;
 };
 
-BuiltMap mapFromFile(const std::string& path) {
+BuiltMap mapFromFile(const std::string& path, const Image& source) {
     const format::ConusFile mapSource = format::readConusFile(path);
+    // Foci built for another aspect are ellipses on this picture.
+    if (const std::optional<double> aspect = codec::madeForAspect(mapSource)) {
+        const double here = double(source.width) / source.height;
+        if (std::abs(std::log(*aspect / here)) > 0.01) {
+            char text[320];
+            std::snprintf(text, sizeof text,
+                          "the map %s was made for pictures of aspect %.3g (width / height) and this one's is %.3g: its "
+                          "foci become ellipses (make it with `conus map foci --aspect %.3g`)",
+                          path.c_str(), *aspect, here, here);
+            warn(text);
+        }
+    }
     return {std::make_unique<codec::SamplingMap>(codec::SamplingMap::fromGrid(mapSource.map)), mapSource.analytic};
 }
 
@@ -46,22 +70,25 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     Progress progress("build sampling map from " + o.importance + " importance");
     codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
     const Image importance = importanceFrom(o.importance, source);
-    if (o.frameLoss < 0) {
+    if (o.floorGiven) {
         BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildAutoMap(importance, autoOptions)), std::nullopt};
         progress.done();
         return built;
     }
     // The budget chooses the context floor; say what it achieved.
     const codec::FrameErrorModel model(source, size.width, size.height, importance);
-    codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions);
+    codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions, codec::kDefaultTileLoss);
     progress.done();
-    std::printf("frame-loss budget %.2f dB: context floor %.3g; predicted whole-frame loss %.2f dB, ROI gain %+.2f dB%s\n",
-                o.frameLoss, r.minDensity, r.predicted.frameLoss, r.predicted.roiGain,
-                r.budgetBinds ? "" : " (the lowest floor stays within the budget: raise --max-density for more)");
+    if (!quiet())
+        std::printf("frame-loss budget %.2f dB (tiles %.2g dB): context floor %.3g; predicted whole-frame loss %.2f dB (tiles %.1f dB), ROI gain %+.2f dB%s\n",
+                    o.frameLoss, codec::kDefaultTileLoss, r.minDensity, r.predicted.frameLoss, r.predicted.tileLoss, r.predicted.roiGain,
+                    r.budgetBinds ? "" : " (the lowest floor stays within the budget: raise --max-density for more)");
     return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt};
 }
 
-BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source) {
+// The foci's map under the frame-loss budget (foci_budget.h): says, before the work, what the foci
+// take and the k each got; `given` receives that k for the line that says what was written.
+BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& size, std::string* given) {
     const std::vector<codec::Focus> foci = parseFoci(o.foci);
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
@@ -70,11 +97,37 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source) {
     fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
-    BuiltMap built{std::make_unique<codec::SamplingMap>(codec::buildFociMap(foci, fo)),
-                   codec::toAnalytic(foci, fo.composition, fo.falloff)};
-    codec::checkFociHeld(*built.map, foci, fo);  // the file must not record a focus its map ignores
+    const int side = 256;
+    const codec::FrameErrorModel model(source, size.width, size.height,
+                                       codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))));
+    codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, o.frameLoss, o.exactK);
     progress.done();
-    return built;
+    const std::string said =
+        describeFociBudget(budget, BudgetFrame{size.width, size.height, source.width, source.height, o.frameLoss}, o.exactK, o.grid,
+                           o.maxAnisotropy);
+    if (!quiet()) std::printf("%s\n", said.c_str());
+    *given = "k " + fociKText(budget.given);
+    return {std::make_unique<codec::SamplingMap>(std::move(budget.map)), codec::toAnalytic(budget.given, fo.composition, fo.falloff)};
+}
+
+// No focus, map or importance: the samples follow the picture's own detail, with the context floor
+// the model predicts gains most over the whole frame (frame_budget.h), said once per batch.
+BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, std::string* given) {
+    Progress progress("build sampling map from the picture's detail");
+    const Image importance = importanceFrom("detail", source);
+    const codec::FrameErrorModel model(source, size.width, size.height, importance);
+    codec::BudgetResult r = codec::buildAutoMapForBestFrame(
+        importance, model, kOwnDetailTileLoss, autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method));
+    progress.done();
+    static std::once_flag once;  // once per batch, not per file
+    std::call_once(once, [] {
+        warn("no --focus, --map or --importance: the samples follow the picture's own detail (--importance detail, "
+             "the context floor chosen for the whole frame); `conus uniform` writes the uniform image");
+    });
+    char text[120];
+    std::snprintf(text, sizeof text, "detail, context floor %.2g, predicted whole-frame gain %+.1f dB", r.minDensity, -r.predicted.frameLoss);
+    *given = text;
+    return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt};
 }
 
 // One input to one output; returns the line that says what was written.
@@ -83,14 +136,11 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     const imageio::ImageFile source = readSource(input, o.source);
     const Size size = conusSize(o.storage, source.image);
     BuiltMap built;
-    if (!o.mapFile.empty()) built = mapFromFile(o.mapFile);
+    std::string given;
+    if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image);
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size);
-    else if (!o.foci.empty()) built = mapFromFoci(o, source.image);
-    else {
-        warn("no --focus, --map or --importance: writing the uniform image of the same pixel count (what `conus "
-             "uniform` makes)");
-        built.map = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
-    }
+    else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, &given);
+    else built = mapFromOwnDetail(o, source.image, size, &given);
     const gl::Device device = deviceFor(o.storage.backend, gl::CpuPath::Available, "encoding");
     std::string fitNote;
     format::ConusFile file =
@@ -102,10 +152,16 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     return "wrote " + output + ": " + std::to_string(size.width) + "x" + std::to_string(size.height) + " CoNUS image of a " +
            std::to_string(source.image.width) + "x" + std::to_string(source.image.height) + " source, " +
            std::to_string(built.map->columns()) + "x" + std::to_string(built.map->rows()) + " sampling map" +
-           (fitNote.empty() ? "" : "; " + fitNote);
+           (given.empty() ? "" : " (" + given + ")") + (fitNote.empty() ? "" : "; " + fitNote);
 }
 
-int runEncode(const EncodeOptions& o) {
+int runEncode(EncodeOptions o) {
+    // Usage first, before any input is read.
+    if (o.frameLossGiven && o.foci.empty() && o.importance.empty())
+        throw Error(ErrorCode::InvalidArgument, "--frame-loss is the budget of --focus and --importance: give one of them");
+    parseFoci(o.foci);
+    if (!o.storage.sizeText.empty()) parseSize(o.storage.sizeText);
+    if (o.fast) o.fit.enabled = false;
     return runConversions(o.batch, [&o](const Job& job) { return encodeOne(o, job.input, job.output); });
 }
 
@@ -117,7 +173,8 @@ Command addEncodeCommand(CLI::App& root) {
         {"conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4",
          "conus encode photo.jpg -o photo.exr --size 1024x768 --importance faces",
          "conus encode scan.tif -o scan.exr --map painted.exr --float",
-         "conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4 --fit   # fitted to the decoder: sharper, costs more CPU",
+         "conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4 --exact-k   # k as asked, whatever the frame loses",
+         "conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4 --fast      # not fitted to the decoder: faster, softer",
          "conus encode shots/*.jpg --out-dir exr/ --jobs 2 --skip-existing --focus 0.5,0.5,0.1,4"});
     addBatchOptions(*command, options->batch, "source image ('-' reads standard input)", "output CoNUS file (.exr)", "{stem}.exr");
     command->add_option("--focus", options->foci,
@@ -130,13 +187,13 @@ Command addEncodeCommand(CLI::App& root) {
         ->excludes("--focus")
         ->excludes("--map");
     addDensityBoundOptions(*command, options->minDensity, options->maxDensity, "with --importance: ");
-    command->add_option("--frame-loss", options->frameLoss,
-                        "with --importance: whole-frame loss budget in dB against the uniform image; chooses the "
-                        "lowest context floor whose predicted loss stays within it, and prints the predicted loss "
-                        "and ROI gain")
-        ->check(CLI::Range(0.0, 60.0))
-        ->needs("--importance")
-        ->excludes("--min-density");
+    command->get_option("--min-density")->each([options](const std::string&) { options->floorGiven = true; });
+    addFrameLossOption(*command, options->frameLoss,
+                       "foci get the largest k (every focus's lowered alike) and importance maps the lowest context "
+                       "floor whose predicted loss stays within it")
+        ->excludes("--min-density")
+        ->each([options](const std::string&) { options->frameLossGiven = true; });
+    addExactKOption(*command, options->exactK)->needs("--focus");
     addMaxAnisotropyOption(*command, options->maxAnisotropy);
     command->add_option("--method", options->method, "with --importance: flow (default) | separable")
         ->check(CLI::IsMember({"flow", "separable"}));
@@ -145,7 +202,11 @@ Command addEncodeCommand(CLI::App& root) {
     addFalloffOption(*command, options->falloff)->needs("--focus");  // shapes foci only
     command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus and --importance (default " + std::to_string(map_rules::kDefaultSide) + ")")
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
-    addFitOption(*command, options->fit);
+    addFitOption(*command, options->fit, true);
+    command->add_flag("--fast", options->fast, "the filtered encode alone, not fitted to the decoder: faster, softer")
+        ->excludes("--fit")
+        ->excludes("--fit-iterations")
+        ->excludes("--fit-hold");
     addSourceOptions(*command, options->source);
     addStorageOptions(*command, options->storage);
     addQuietOption(*command);

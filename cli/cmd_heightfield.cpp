@@ -49,10 +49,16 @@ Image demColour(const Dem& dem, const std::string& texture, glm::dvec2 extent, S
     return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
 }
 
-void printCamera(const Camera& c) {
+// The camera as given, or the ground map's own viewer as a --camera value to start from.
+void printCamera(const Camera& c, const std::string& given) {
+    if (quiet()) return;
+    if (!given.empty()) {
+        std::printf("camera %s\n", given.c_str());
+        return;
+    }
     const glm::dvec3 eye = c.eye(), look = eye + c.forward() * 1000.0;
-    std::printf("camera %.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f\n", eye.x, eye.y, eye.z, look.x, look.y, look.z,
-                c.verticalFovDegrees());
+    std::printf("camera %.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f (the ground map's viewer; look-at 1000 ahead)\n", eye.x, eye.y,
+                eye.z, look.x, look.y, look.z, c.verticalFovDegrees());
 }
 
 codec::GroundParams groundOf(const format::ConusFile& file, const std::string& name) {
@@ -83,7 +89,7 @@ Frame renderFrame(gl::Context& context, const format::ConusFile& file, const std
     Progress progress(stage);
     Image image = gl::renderTerrain(context, codec::undistortHeightField(file, extent), camera, size.width, size.height);
     progress.done();
-    printCamera(camera);
+    printCamera(camera, cameraText);
     return {std::move(image), camera, extent};
 }
 

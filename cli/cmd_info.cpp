@@ -255,6 +255,7 @@ Command addInfoCommand(CLI::App& root) {
                        "conus info --backends"});
     command->add_option("--density", options->densityPng,
                         "write the sampling density as a heat map with the sampling pattern over it (.png)");
+    addQuietOption(*command);  // progress only: the description is what info is for
     return {command, [options] { return runInfo(*options); }};
 }
 

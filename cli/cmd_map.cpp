@@ -70,12 +70,13 @@ void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticM
     format::writeConusFile(out.output, file);
     const DensityStats stats = densityStats(map);
     const codec::MapMeasures measures = codec::measureMap(map, aspect);
-    std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
+    if (!quiet())  // -q: silent on success
+        std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
                 map.rows(), stats.min, stats.max, measures.maxAnisotropy);
     if (!out.preview.empty()) {
         writeDrawing(out.preview,
                      densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr, aspect));
-        std::printf("wrote %s\n", out.preview.c_str());
+        if (!quiet()) std::printf("wrote %s\n", out.preview.c_str());
     }
 }
 
@@ -164,18 +165,18 @@ ScaleText parseScale(const std::string& text) {
     return r;
 }
 
-// The k-th input, moved and scaled as its --translate and --scale say.
-codec::SamplingMap composeInput(const ComposeOptions& o, std::size_t k, codec::SamplingMap map) {
+// The k-th input, moved and scaled as its --translate and --scale say; `aspect` its picture's.
+codec::SamplingMap composeInput(const ComposeOptions& o, std::size_t k, codec::SamplingMap map, double aspect) {
     if (k < o.translate.size()) {
         const auto [dx, dy] = parsePair(o.translate[k], "--translate");
-        codec::ComposeResult r = codec::translateMap(map, {dx, dy});
-        if (r.scale < 1.0) std::printf("%s: translated pattern scaled by %.4f to stay valid\n", o.inputs[k].c_str(), r.scale);
+        codec::ComposeResult r = codec::translateMap(map, {dx, dy}, aspect);
+        if (r.rebuilt) std::printf("%s: translated pattern built from its moved density\n", o.inputs[k].c_str());
         map = std::move(r.map);
     }
     if (k < o.scale.size()) {
         const ScaleText scale = parseScale(o.scale[k]);
-        codec::ComposeResult r = codec::scaleMap(map, scale.s, scale.centre);
-        if (r.scale < 1.0) std::printf("%s: scaled pattern's displacement scaled by %.4f to stay valid\n", o.inputs[k].c_str(), r.scale);
+        codec::ComposeResult r = codec::scaleMap(map, scale.s, scale.centre, aspect);
+        if (r.rebuilt) std::printf("%s: scaled pattern built from its scaled density\n", o.inputs[k].c_str());
         map = std::move(r.map);
     }
     return map;
@@ -187,21 +188,27 @@ void runCompose(const ComposeOptions& o) {
     }
     std::vector<codec::SamplingMap> maps;
     int grid = o.grid;
+    double aspect = 0;  // the first input's picture's, for the anisotropy bound
     for (std::size_t k = 0; k < o.inputs.size(); ++k) {
         const format::ConusFile file = format::readConusFile(o.inputs[k]);
         codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
         if (o.grid == 0) grid = std::max({grid, map.columns(), map.rows()});
-        maps.push_back(composeInput(o, k, std::move(map)));
+        if (aspect == 0) aspect = file.sourceWidth > 0 && file.sourceHeight > 0 ? double(file.sourceWidth) / file.sourceHeight : 1.0;
+        maps.push_back(composeInput(o, k, std::move(map), aspect));
     }
     std::vector<double> weights;
     if (!o.weights.empty()) {
         weights.assign(maps.size(), 1.0);
         std::copy(o.weights.begin(), o.weights.end(), weights.begin());
     }
-    const codec::ComposeResult sum = codec::addMaps(maps, grid, grid, weights);
-    std::printf("added %zu maps; displacement scale %.4f%s\n", maps.size(), sum.scale,
-                sum.scale < 1.0 ? " (the plain sum folds)" : "");
-    writeMapFile(sum.map, std::nullopt, o.out);
+    const codec::ComposeResult sum = codec::addMaps(maps, grid, grid, weights, aspect);
+    if (sum.rebuilt) {
+        std::printf("added %zu maps; the plain sum folds or starves a cell, so built from their summed density "
+                    "(anisotropy up to %.2f, bound %.2f)\n", maps.size(), sum.report.maxAnisotropy, sum.report.bound);
+    } else {
+        std::printf("added %zu maps\n", maps.size());
+    }
+    writeMapFile(sum.map, std::nullopt, o.out, aspect);
 }
 
 // ---- ground ----
@@ -230,9 +237,10 @@ void runGround(const GroundOptions& o) {
 
 struct FociOptions {
     std::vector<std::string> foci;
-    std::string composition = "density", falloff = "2";
+    std::string composition = "density", falloff = kDefaultFalloff;
     int grid = map_rules::kDefaultSide;
     double aspect = 1.0, maxAnisotropy = 0;
+    bool exactK = false;
     OutputOptions out;
 };
 
@@ -244,6 +252,7 @@ void addFociOptions(CLI::App& command, FociOptions& o) {
     addFalloffOption(command, o.falloff);
     command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     command.add_option("--aspect", o.aspect, "image width / height, so foci are circular in pixels (default 1)");
+    addExactKOption(command, o.exactK);
     addOutputOptions(command, o.out);
 }
 
@@ -256,10 +265,14 @@ void runFoci(const FociOptions& o) {
     fo.composition = o.composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
-    const codec::SamplingMap map = codec::buildFociMap(list, fo);
-    codec::checkFociHeld(map, list, fo);  // the file must not record a focus its map ignores
+    // No picture to predict a loss on: the context keeps the default floor (foci_budget.h).
+    const codec::FociBudget budget = codec::fociForContextFloor(list, fo, codec::kDefaultContextFloor, o.exactK);
     progress.done();
-    writeMapFile(map, codec::toAnalytic(list, fo.composition, fo.falloff), o.out, o.aspect);
+    const std::string said = describeFociBudget(budget, std::nullopt, o.exactK, o.grid, o.maxAnisotropy);
+    if (!quiet()) std::printf("%s\n", said.c_str());
+    std::optional<format::AnalyticMap> analytic = codec::toAnalytic(budget.given, fo.composition, fo.falloff);
+    analytic->scalars["aspect"] = o.aspect;  // so an encode of a picture of another aspect can warn
+    writeMapFile(budget.map, std::move(analytic), o.out, o.aspect);
 }
 
 // ---- auto ----

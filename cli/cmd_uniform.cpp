@@ -32,7 +32,8 @@ int runUniform(const UniformOptions& o) {
     Progress writing("write " + o.output);
     format::writeConusFile(o.output, file);
     writing.done();
-    std::printf("wrote %s: %dx%d uniform image of a %dx%d source%s%s\n", o.output.c_str(), size.width, size.height,
+    if (!quiet())  // -q: silent on success
+        std::printf("wrote %s: %dx%d uniform image of a %dx%d source%s%s\n", o.output.c_str(), size.width, size.height,
                 source.image.width, source.image.height, fitNote.empty() ? "" : "; ", fitNote.c_str());
     return 0;
 }

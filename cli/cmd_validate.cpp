@@ -5,7 +5,9 @@
 #include <memory>
 
 #include "commands.h"
+#include "conus/core/atomic_file.h"
 #include "conus/format/container.h"
+#include "progress.h"
 
 namespace conus::cli {
 
@@ -14,12 +16,15 @@ Command addValidateCommand(CLI::App& root) {
     CLI::App* command = root.add_subcommand(
         "validate", "Check a file against every rule of the CoNUS spec; exit 0 only if valid");
     command->add_option("input", *input, "file to check")->required();
+    addQuietOption(*command);
     setExamples(*command, {"conus validate photo.exr            # exit 0: valid; 1: every broken rule listed, one a line",
                        "conus validate photo.exr >/dev/null && echo ok"});
     return {command, [input] {
+                checkInputPath(*input, false);  // "no such file", not a broken rule
                 const format::ValidationReport report = format::validateConusFile(*input);
                 if (report.ok()) {
-                    std::printf("%s: valid CoNUS file (format version %d)\n", input->c_str(), format::kFormatVersion);
+                    if (!quiet())
+                        std::printf("%s: valid CoNUS file (format version %d)\n", input->c_str(), format::kFormatVersion);
                     return 0;
                 }
                 for (const auto& issue : report.issues)

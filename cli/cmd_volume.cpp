@@ -207,7 +207,7 @@ int runAnimate(const AnimateOptions& a) {
     const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "volume rendering");
     const codec::FociOptions fo = frameFociOptions(o.grid, o.compose, aspect);
     // On a GL device the volume and transfer function go up once for all frames (a 3-D texture
-    // upload per frame cost more than the frame itself on llvmpipe; bench/README.md "Volumes").
+    // upload per frame cost more than the frame itself on llvmpipe; bench/notes/2026-11-24-volumes.md).
     std::optional<gl::VolumeRendererGpu> gpu;
     if (device.onGpu()) gpu.emplace(device.context(), volume, tf);
     std::optional<codec::SamplingMap> previous;

@@ -43,37 +43,39 @@ void applyStorage(const StorageOptions& options, format::ConusFile& file) {
 }
 
 void checkConusOutput(const std::string& output, const std::string& input) {
-    const std::filesystem::path path(output);
-    std::string extension = path.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
-    if (extension != ".exr")
-        throw Error(ErrorCode::InvalidArgument, "the output " + output +
-                                                    " must end in .exr: a CoNUS file is an OpenEXR file (for a picture of "
-                                                    "it, run `conus decode` on the .exr)");
+    try {
+        format::checkConusFileName(output);
+    } catch (const Error& e) {
+        throw Error(e.code(), std::string(e.what()) + " (for a picture of it, run `conus decode` on the .exr)");
+    }
     const std::string inputs[] = {input};
     checkOutputPath(output, inputs);
 }
 
-void addFitOption(CLI::App& command, FitSetting& fit) {
+void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault) {
     CLI::Option* enabled = command.add_flag(
         "--fit", fit.enabled,
-        "fit the CoNUS image to the decoder: least squares (CGLS) from the filtered encode, so that the decoded "
-        "view at the source's size comes closest to the source (the decoder's bilinear and multi-tap paths; "
-        "zoomed-out views through the pyramid and the viewer reconstruct a little differently; colour and alpha "
-        "are fitted, unclamped)");
-    command
-        .add_option("--fit-iterations", fit.iterations, "with --fit: how many least-squares iterations")
-        ->capture_default_str()
-        ->type_name("N")
-        ->check(CLI::Range(1, 100))
-        ->needs(enabled);
-    command
-        .add_option("--fit-hold", fit.hold,
-                    "with --fit: how strongly the fit keeps the encoder's low-pass along long, thin footprints (the "
-                    "focus rims, where undoing it brings back a radial comb); 0: the plain least squares, sharper and "
-                    "with more aliasing (default " + std::to_string(codec::kFitHoldLowPass).substr(0, 3) + ")")
-        ->check(CLI::Range(0.0, 1000.0))
-        ->needs(enabled);
+        std::string(byDefault ? "(the default) " : "") +
+            "fit the CoNUS image to the decoder: least squares (CGLS) from the filtered encode, so that the decoded "
+            "view at the source's size comes closest to the source (the decoder's bilinear and multi-tap paths; "
+            "zoomed-out views through the pyramid and the viewer reconstruct a little differently; colour and alpha "
+            "are fitted, unclamped)");
+    const std::string with = byDefault ? "" : "with --fit: ";
+    CLI::Option* iterations = command.add_option("--fit-iterations", fit.iterations, with + "how many least-squares iterations")
+                                  ->capture_default_str()
+                                  ->type_name("N")
+                                  ->check(CLI::Range(1, 100));
+    CLI::Option* hold =
+        command
+            .add_option("--fit-hold", fit.hold,
+                        with + "how strongly the fit keeps the encoder's low-pass along long, thin footprints (the "
+                               "focus rims, where undoing it brings back a radial comb); 0: the plain least squares, sharper and "
+                               "with more aliasing (default " + std::to_string(codec::kFitHoldLowPass).substr(0, 3) + ")")
+            ->check(CLI::Range(0.0, 1000.0));
+    if (!byDefault) {
+        iterations->needs(enabled);
+        hold->needs(enabled);
+    }
 }
 
 format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,

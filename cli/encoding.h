@@ -30,7 +30,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options);
 Size conusSize(const StorageOptions& options, const Image& source);
 
 // Adds --fit, --fit-iterations N and --fit-hold H (encode and uniform alike, so that comparisons
-// stay fair). --fit is a plain flag (an optional count after it would take the input's name when
+// can be like for like). --fit is a plain flag (an optional count after it would take the input's name when
 // written first); --fit-iterations and --fit-hold need it.
 struct FitSetting {
     bool enabled = false;
@@ -38,7 +38,15 @@ struct FitSetting {
     double hold = codec::kFitHoldLowPass;
     int count() const { return enabled ? iterations : 0; }  // iterations to run; 0: the filtered encode alone
 };
-void addFitOption(CLI::App& command, FitSetting& fit);
+// `encode` fits by default (the sharpest picture it makes; --fast leaves the fit out): then --fit
+// only says so, and --fit-iterations and --fit-hold stand alone.
+inline FitSetting defaultFit() {
+    FitSetting fit;
+    fit.enabled = true;
+    fit.iterations = codec::kDefaultEncodeFitIterations;
+    return fit;
+}
+void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault = false);
 
 // Encodes `source` through `map` at `size` (with progress) into a file model ready to write,
 // remembering the source's encoding. fit.iterations > 0 then fits the image to the decoder with that many

@@ -54,7 +54,7 @@ Image detectFaceImportance(const Image& image) {
         throw Error(ErrorCode::Unsupported, std::string("face detection failed: ") + e.what());
     }
     if (faces.empty())
-        throw Error(ErrorCode::InvalidArgument, "no face found in the image; give --focus or an importance image");
+        throw Error(ErrorCode::Unsupported, "no face found in the image; give --focus or an importance image");
 
     // A soft disc over each face (a little larger than the detection box, which crops the hair).
     Image importance = makeImage(w, h, {"Y"});

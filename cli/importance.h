@@ -14,7 +14,7 @@ namespace conus::cli {
 Image importanceFrom(const std::string& source, const Image& image);
 
 // Importance that is high on each face found in `image` (display-encoded: imageio::displayEncoded) (a soft disc over every detection), zero
-// elsewhere; throws conus::Error(InvalidArgument) when no face is found. The detector (OpenCV,
+// elsewhere; throws conus::Error(Unsupported: it depends on the picture, exit 1) when no face is found. The detector (OpenCV,
 // faces.cpp) is a module loaded on the first call.
 Image faceImportance(const Image& image);
 

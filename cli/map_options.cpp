@@ -2,6 +2,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
+#include <cstdio>
+
 #include "conus/renderers/mesh_sequence.h"
 #include "progress.h"
 
@@ -50,6 +53,75 @@ FrameMap chooseFrameMap(bool uniform, const std::string& mapFile, const FociSour
     return {codec::SamplingMap::identity(2, 2), std::nullopt, true};
 }
 
+CLI::Option* addFrameLossOption(CLI::App& command, double& frameLoss, const std::string& what) {
+    return command
+        .add_option("--frame-loss", frameLoss,
+                    "whole-frame loss budget in dB against the uniform image of the same pixel count, predicted "
+                    "before the work: " + what + " (default " + numberText(codec::kDefaultFrameLoss) + ")")
+        ->check(CLI::Range(0.0, 60.0));
+}
+
+CLI::Option* addExactKOption(CLI::App& command, bool& exactK) {
+    return command.add_flag("--exact-k", exactK,
+                            "keep every focus's k as asked, even where the foci leave the context fewer samples than the "
+                            "budget allows (the budget is then only reported)");
+}
+
+std::string fociKText(const std::vector<codec::Focus>& foci) {
+    std::string out;
+    for (const codec::Focus& f : foci) out += (out.empty() ? "" : ", ") + numberText(std::round(f.k * 100) / 100);
+    return out;
+}
+
+namespace {
+
+std::string percent(double share) { return numberText(std::round(share * 1000) / 10) + "%"; }
+
+std::string oneIn(double downscale) { return "1/" + numberText(std::round(downscale * 10) / 10); }
+
+}  // namespace
+
+std::string describeFociBudget(const codec::FociBudget& b, const std::optional<BudgetFrame>& frame, bool exactK, int grid,
+                               double maxAnisotropy) {
+    std::string text;
+    if (b.askedShare.ask > 1.0)
+        text = "the foci ask " + numberText(std::round(b.askedShare.ask * 10) / 10) + "x the pixels there are at k " + fociKText(b.asked) + "; ";
+    if (b.lowered)
+        text += (frame ? "the loss budget (whole frame " + numberText(frame->frameLoss) + " dB, tiles " + numberText(codec::kDefaultTileLoss) + " dB)"
+                       : "the context floor (density " + numberText(codec::kDefaultContextFloor) + ")") +
+                " lowered k from " + fociKText(b.asked) + " to " + fociKText(b.given) + " (--exact-k keeps k); ";
+    const std::string pixels = frame ? std::to_string(frame->width) + "x" + std::to_string(frame->height) + " pixels" : "map's samples";
+    text += "foci take " + percent(b.share.share) + " of the " + pixels + (b.lowered ? "" : " at k " + fociKText(b.given));
+    if (frame) {
+        const double uniform = codec::contextDownscale({0, 1, 0}, frame->width, frame->height, frame->sourceWidth, frame->sourceHeight);
+        text += "; the context is sampled like a " + oneIn(codec::contextDownscale(b.share, frame->width, frame->height, frame->sourceWidth, frame->sourceHeight)) +
+                " downscale (the uniform image: " + oneIn(uniform) + ")";
+        char predicted[200];
+        std::snprintf(predicted, sizeof predicted, "; predicted whole-frame loss %.2f dB (tiles outside the foci: %.1f dB at the 95th percentile), ROI gain %+.1f dB",
+                      b.predicted.frameLoss, b.predicted.tileLoss, b.predicted.roiGain);
+        text += predicted;
+        if (exactK && (b.predicted.frameLoss > frame->frameLoss || b.predicted.tileLoss > codec::kDefaultTileLoss))
+            warn("--exact-k: the foci leave the context sampled like a " +
+                 oneIn(codec::contextDownscale(b.share, frame->width, frame->height, frame->sourceWidth, frame->sourceHeight)) +
+                 " downscale; predicted against the uniform image: the whole frame loses " +
+                 numberText(std::round(b.predicted.frameLoss * 10) / 10) + " dB, the tiles outside the foci " +
+                 numberText(std::round(b.predicted.tileLoss * 10) / 10) + " dB (the budget: " + numberText(frame->frameLoss) +
+                 " and " + numberText(codec::kDefaultTileLoss) + " dB)");
+    } else {
+        text += "; the context keeps density " + numberText(std::round(b.share.contextDensity * 1000) / 1000) + " (" +
+                numberText(std::round(std::sqrt(b.share.contextDensity) * 100) / 100) + "x the uniform image's linear rate)";
+        if (exactK && b.share.contextDensity < codec::kDefaultContextFloor)
+            warn("--exact-k: the foci leave the context density " + numberText(std::round(b.share.contextDensity * 1000) / 1000) +
+                 ", under the default floor " + numberText(codec::kDefaultContextFloor));
+    }
+    if (b.gridLimited)
+        warn("the map holds the foci only to k " + fociKText(b.given) + " (asked " + fociKText(b.asked) + ") on its " +
+             std::to_string(grid) + "x" + std::to_string(grid) + " grid" +
+             (maxAnisotropy > 0 ? " under --max-anisotropy " + numberText(maxAnisotropy) : std::string()) +
+             ": recorded so (a finer --grid or a wider focus holds more)");
+    return text;
+}
+
 void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy) {
     command.add_option("--max-anisotropy", maxAnisotropy,
                        "largest ratio of a CoNUS pixel's long to short side in the source (the Jacobian's singular "
@@ -61,7 +133,7 @@ CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff) {
     return command.add_option("--falloff", falloff,
                        "how a focus's density falls to the context's: WIDTH[,SHAPE], from r to WIDTH r (in (1, 8]), "
                        "SHAPE density (smoothstep of the density, the default) | log (of its logarithm) | logr (of its "
-                       "logarithm over log radius); default 2,density");
+                       "logarithm over log radius); default " + std::string(kDefaultFalloff) + ",density");
 }
 
 void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDensity, const std::string& prefix) {

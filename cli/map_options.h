@@ -9,6 +9,7 @@
 
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/foci_budget.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 
@@ -23,12 +24,33 @@ namespace conus::cli {
 // (0: none), and --min-density / --max-density for automatic maps.
 void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy);
 void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDensity, const std::string& prefix = "");
-// --falloff WIDTH[,SHAPE] for `map foci` and `encode --focus` (codec::parseFalloff; "2": the default).
+// The transition foci get unless --falloff says otherwise (codec::parseFalloff's text).
+inline constexpr const char* kDefaultFalloff = "2";
+// --falloff WIDTH[,SHAPE] for `map foci`, `encode --focus` and `bake relief --focus`.
 CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff);
+// "4, 3.1": the foci's k, as the budget lines say them.
+std::string fociKText(const std::vector<codec::Focus>& foci);
 
 // The builder's options from what `map auto` and `encode --importance` are given (method "flow"
 // or "separable").
 codec::AutoMapOptions autoMapOptions(int grid, double minDensity, double maxDensity, double maxAnisotropy, const std::string& method);
+
+// --frame-loss DB (the budget foci and importance maps hold by default) and --exact-k (foci keep
+// the k asked). `frameLoss` keeps its value when the option is not given; the option is returned.
+CLI::Option* addFrameLossOption(CLI::App& command, double& frameLoss, const std::string& what);
+CLI::Option* addExactKOption(CLI::App& command, bool& exactK);
+
+// The CoNUS and source sizes of an encode, for what a foci budget says (none for `map foci`).
+struct BudgetFrame {
+    int width = 0, height = 0, sourceWidth = 0, sourceHeight = 0;
+    double frameLoss = codec::kDefaultFrameLoss;
+};
+// What a foci budget did, in a line: the share of the pixels the foci take, what the context is
+// sampled like, the k each focus got and, when the budget lowered k, why. Warns (even when quiet)
+// where --exact-k left the context sparser than the budget, and where a grid held a focus only to
+// a lower k (recorded so).
+std::string describeFociBudget(const codec::FociBudget& budget, const std::optional<BudgetFrame>& frame, bool exactK, int grid,
+                               double maxAnisotropy = 0);
 
 // The foci of repeated --focus u,v,r,k options, in order.
 std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);

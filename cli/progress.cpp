@@ -1,13 +1,19 @@
 #include "progress.h"
 
+#include <time.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <exception>
+#include <fstream>
+#include <map>
 #include <mutex>
+#include <sstream>
 
 namespace conus::cli {
 namespace {
@@ -16,7 +22,27 @@ bool g_quiet = false;             // -q, read by CLI11
 std::atomic<bool> g_silenced{false};  // setQuiet: a batch runs its items quiet
 std::atomic<int> g_stages{0};
 std::string g_command;
+std::map<std::string, std::size_t> g_batchWarnings;  // a batch's warnings, and how many items gave each
 const auto g_started = std::chrono::steady_clock::now();
+double g_startUp = 0;       // seconds from the process's start to the command's
+double g_stageSeconds = 0;  // the finished stages', under g_printMutex
+
+// Seconds since the process started (the kernel's start time, 10 ms ticks): the loading of the
+// shared libraries included, which happens before any of our code runs.
+double sinceProcessStart() {
+    std::ifstream stat("/proc/self/stat");
+    std::string text;
+    std::getline(stat, text);
+    const std::size_t close = text.rfind(')');
+    timespec now{};
+    if (close != std::string::npos && ::clock_gettime(CLOCK_BOOTTIME, &now) == 0) {
+        std::istringstream fields(text.substr(close + 2));
+        std::string field;
+        for (int i = 3; i <= 22 && fields >> field; ++i)
+            if (i == 22) return now.tv_sec + now.tv_nsec * 1e-9 - std::stod(field) / double(::sysconf(_SC_CLK_TCK));
+    }
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - g_started).count();
+}
 }  // namespace
 
 void addQuietOption(CLI::App& command) {
@@ -70,23 +96,46 @@ void Progress::done() {
     if (m_finished) return;
     m_finished = true;
     ++g_stages;
-    if (quiet()) return;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
     std::lock_guard lock(g_printMutex);
+    g_stageSeconds += seconds;
+    if (quiet()) return;
     std::fprintf(stderr, "%sconus %s: %s done (%.2f s)\n", m_tty ? "\r" : "", g_command.c_str(), m_label.c_str(), seconds);
 }
 
-void beginCommand(const std::string& name) { g_command = name; }
+void beginCommand(const std::string& name) {
+    g_command = name;
+    g_startUp = sinceProcessStart();
+}
+
+const std::string& commandName() { return g_command; }
 
 void printTotal() {
     if (quiet() || g_stages < 2) return;
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - g_started).count();
-    std::fprintf(stderr, "conus %s: done in %.2f s (%d stages)\n", g_command.c_str(), seconds, g_stages.load());
+    const double total = sinceProcessStart();
+    std::lock_guard lock(g_printMutex);
+    // Rounded so that the parts add up to the total as printed.
+    const double whole = std::round(total * 100) / 100, staged = std::round(g_stageSeconds * 100) / 100,
+                 start = std::round(g_startUp * 100) / 100;
+    std::fprintf(stderr,
+                 "conus %s: done in %.2f s: %d stages %.2f s, start-up %.2f s, outside the stages %.2f s (loading "
+                 "OpenImageIO or GL on first use, choosing the backend)\n",
+                 g_command.c_str(), whole, g_stages.load(), staged, start, std::max(0.0, whole - staged - start));
 }
 
 void warn(const std::string& text) {
     std::lock_guard lock(g_printMutex);
-    std::fprintf(stderr, "conus %s: warning: %s\n", g_command.c_str(), text.c_str());
+    if (g_silenced && ++g_batchWarnings[text] > 1) return;
+    std::fprintf(stderr, "%sconus %s: warning: %s\n", ::isatty(STDERR_FILENO) ? "\r\033[K" : "", g_command.c_str(), text.c_str());
+}
+
+void reportRepeatedWarnings(std::size_t inputs) {
+    std::lock_guard lock(g_printMutex);
+    for (const auto& [text, count] : g_batchWarnings)
+        if (count > 1)
+            std::fprintf(stderr, "conus %s: the warning \"%.60s%s\" held for %zu of %zu inputs (printed once)\n",
+                         g_command.c_str(), text.c_str(), text.size() > 60 ? "..." : "", count, inputs);
+    g_batchWarnings.clear();
 }
 
 std::string plural(std::size_t n, const char* one, const char* many) {

@@ -43,12 +43,17 @@ void liveLine(const std::string& text);
 
 // The subcommand that runs, for the lines below (main.cpp sets it).
 void beginCommand(const std::string& name);
+const std::string& commandName();
 
-// "conus <command>: done in 2.41 s (4 stages)" once a command of several stages succeeded.
+// "conus <command>: done in 2.41 s: 4 stages 2.10 s, start-up 0.05 s, outside the stages 0.26 s" once
+// a command of several stages succeeded: the parts add up to the total, counted from the process's start.
 void printTotal();
 
-// "conus <command>: warning: <text>" on stderr, even when quiet.
+// "conus <command>: warning: <text>" on stderr, even when quiet. While a batch runs its items
+// (setQuiet(true)) a warning already given is not repeated; reportRepeatedWarnings says how many
+// of the batch's inputs each one held for.
 void warn(const std::string& text);
+void reportRepeatedWarnings(std::size_t inputs);
 
 // "N focus" / "N foci": counts said right.
 std::string plural(std::size_t n, const char* one, const char* many);

@@ -34,6 +34,16 @@ format::ConusFile makeDepthImageFile(Image image, const SamplingMap& map, const 
     return file;
 }
 
+std::optional<double> madeForAspect(const format::ConusFile& file) {
+    if (file.analytic)
+        if (const auto aspect = file.analytic->scalars.find("aspect"); aspect != file.analytic->scalars.end()) return aspect->second;
+    if (file.sourceWidth <= 0 || file.sourceHeight <= 0) return std::nullopt;
+    // A map file's source size is its grid's: it says nothing of the pictures.
+    if (file.sourceWidth == file.map.columns && file.sourceHeight == file.map.rows && file.image.width == file.map.columns)
+        return std::nullopt;
+    return double(file.sourceWidth) / file.sourceHeight;
+}
+
 format::ConusFile makeMapFile(const SamplingMap& map, std::optional<format::AnalyticMap> analytic) {
     format::ConusFile file;
     file.image = makeImage(map.columns(), map.rows(), {"Y"});

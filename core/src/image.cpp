@@ -24,7 +24,7 @@ namespace {
 
 // Large pixel arrays are first touched in 2 MiB pages where the kernel leaves that to the program
 // (transparent huge pages in "madvise" mode): a 4096^2 RGB float image is 48k page faults in 4 KiB
-// pages, which took 0.6 s of a `conus encode` in a virtual machine (bench/README.md "End to end"),
+// pages, which took 0.6 s of a `conus encode` in a virtual machine (bench/notes/2026-11-24-end-to-end.md),
 // and 96 in huge pages. Only the whole 2 MiB pages inside the array are advised; a hint, not a
 // requirement, so failure changes nothing.
 void adviseHugePages([[maybe_unused]] void* data, [[maybe_unused]] std::size_t bytes) {

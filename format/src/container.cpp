@@ -1,6 +1,10 @@
 // The public container entry points: validate, then write atomically; load, then throw or report.
 #include "conus/format/container.h"
 
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
 #include "conus/core/atomic_file.h"
 #include "conus/format/exr_check.h"
 #include "exr_io.h"
@@ -52,6 +56,13 @@ void writeConusFile(const std::string& path, const ConusFile& file) {
     AtomicFile out(path);
     detail::writeExrFile(out, file);
     out.commit();
+}
+
+void checkConusFileName(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (extension != ".exr")
+        throw Error(ErrorCode::InvalidArgument, "the output " + path + " must end in .exr: a CoNUS file is an OpenEXR file");
 }
 
 namespace {

@@ -589,7 +589,7 @@ void checkExr(const std::string& path, const Limits& limits) {
 
 // OpenEXR (de)compresses the line blocks of one writePixels/readPixels call on its global thread
 // pool, which is empty unless someone sizes it: one thread a core, once, unless the program set
-// its own. A 1024^2 zip write was a serial tail of `conus encode` (bench/README.md "End to end").
+// its own. A 1024^2 zip write was a serial tail of `conus encode` (bench/notes/2026-11-24-end-to-end.md).
 static void useExrThreads() {
     static std::once_flag once;
     std::call_once(once, [] {

@@ -207,6 +207,11 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
             r.add(Rule::V12, "composition `" + m.composition.value + "` is not density or add");
         }
         checkFalloffParams(m, r);
+        // The pictures' width / height a map file's foci were made for (spec: Analytic-map parameters).
+        if (const auto aspect = m.params.find("aspect");
+            aspect != m.params.end() && !(aspect->second.value >= 1.0 / 64 && aspect->second.value <= 64))
+            r.add(Rule::V12, std::string(specOf(&HeaderModel::params).name) + "aspect = " + numberText(aspect->second.value, 9) +
+                                 " is not a width / height in [1/64, 64]");
     } else if (kind != "ground") {
         r.add(Rule::V12, "map kind `" + kind + "` is not foci or ground");
     }

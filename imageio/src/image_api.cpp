@@ -29,6 +29,8 @@ void linearize(Image& image) { oiioFunctions().linearize(image); }
 
 Image displayEncoded(const Image& image) { return oiioFunctions().displayEncoded(image); }
 
+void repairNonFinite(Image& image, NonFiniteRepair repair) { oiioFunctions().repairNonFinite(image, repair, "an image"); }
+
 void drawText(Image& image, int x, int y, int size, const std::string& text, const float color[3]) {
     oiioFunctions().drawText(image, x, y, size, text, color);
 }

@@ -487,17 +487,7 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
     }
 
     info.nonFinite = tabled ? 0 : countNonFinite(image);  // every table value is finite
-    if (info.nonFinite > 0 && options.repair != NonFiniteRepair::Keep) {
-        OIIO::ImageBuf buffer(OIIO::ImageSpec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT),
-                              image.pixels.data());
-        const auto mode = options.repair == NonFiniteRepair::Black ? OIIO::ImageBufAlgo::NONFINITE_BLACK
-                                                                   : OIIO::ImageBufAlgo::NONFINITE_BOX3;
-        if (!OIIO::ImageBufAlgo::fixNonFinite(buffer, buffer, mode))
-            throw Error(ErrorCode::Io, shown + ": cannot repair non-finite values: " + buffer.geterror());
-        // Box3 leaves a value whose 3x3 neighbourhood holds nothing finite; those become 0.
-        for (float& v : image.pixels)
-            if (!std::isfinite(v)) v = 0.0f;
-    }
+    if (info.nonFinite > 0) repairNonFinite(image, options.repair, shown);
 
     // Colour: linear light with associated alpha, as OpenEXR has it (the tables did it already).
     if (encoding.transfer != Transfer::Raw && !tabled) {
@@ -721,7 +711,7 @@ void writeImageFile(const std::string& path, const Image& image, const WriteOpti
     else if (written == Transfer::Linear) spec.attribute("oiio:ColorSpace", "Linear");
     if (integer && alpha >= 0) spec.attribute("oiio:UnassociatedAlpha", 1);
     if (target.formatName == "openexr") spec.attribute("compression", "zip");
-    // zlib level 4, not OpenImageIO's 6: a 1920x1080 photo view (bench/README.md, "Decode speed")
+    // zlib level 4, not OpenImageIO's 6: a 1920x1080 photo view (bench/notes/2026-11-24-decode-pyramid.md)
     // deflated at 6 took 0.6 s of CPU, a third of `conus decode`, for a file 4% smaller than at 4,
     // which takes 0.1 s; levels 1-3 save no more time and grow the file 6-11%.
     if (target.formatName == "png") spec.attribute("png:compressionLevel", 4);

@@ -5,6 +5,7 @@ extern "C" __attribute__((visibility("default"))) const conus::imageio::OiioFunc
     using namespace conus::imageio;
     static const OiioFunctions functions{&oiio::readImageFile, &oiio::writeImageFile, &oiio::checkImageOutput,
                                          &oiio::sampleTypesOf, &oiio::linearize,      &oiio::displayEncoded,
+                                         &oiio::repairNonFinite,
                                          &oiio::drawText,      &oiio::renderTextPanel, &oiio::textWidth,
                                          &oiio::wrapText};
     return &functions;

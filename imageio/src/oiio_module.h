@@ -21,6 +21,7 @@ void checkImageOutput(const std::string& path, const WriteOptions& options);
 std::string sampleTypesOf(const std::string& path);
 void linearize(Image& image);
 Image displayEncoded(const Image& image);
+void repairNonFinite(Image& image, NonFiniteRepair repair, const std::string& shown);  // repair.cpp
 void drawText(Image& image, int x, int y, int size, const std::string& text, const float color[3]);
 Image renderTextPanel(const std::vector<std::string>& lines, const TextPanelStyle& style);
 int textWidth(const std::string& text, int fontSize);
@@ -34,6 +35,7 @@ struct OiioFunctions {
     decltype(&oiio::sampleTypesOf) sampleTypesOf;
     decltype(&oiio::linearize) linearize;
     decltype(&oiio::displayEncoded) displayEncoded;
+    decltype(&oiio::repairNonFinite) repairNonFinite;
     decltype(&oiio::drawText) drawText;
     decltype(&oiio::renderTextPanel) renderTextPanel;
     decltype(&oiio::textWidth) textWidth;

@@ -1,5 +1,5 @@
 // Private: plain PNG files read with libpng directly, without loading OpenImageIO (its ~260
-// libraries cost ~0.7 s of CPU and ~170 MiB before the first pixel; issue 10, item 7).
+// libraries cost ~0.7 s of CPU and ~170 MiB before the first pixel).
 #pragma once
 
 #include <optional>

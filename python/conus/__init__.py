@@ -9,14 +9,45 @@
     m = conus.Map.foci([(0.5, 0.5, 0.1, 4)]); m.undistort(m.distort(points))
     m = conus.Map.auto(conus.importance(pixels, "detail", channels=channels))  # as --importance detail
 
-Pixels are linear light (sRGB pictures are linearized by read_image; see srgb_to_linear for
-arrays from elsewhere). Errors raise conus.Error, whose .rule names the spec rule broken.
-Work past one machine: conus.dask.encode_files.
+Float pixels are linear light (read_image linearizes sRGB pictures); uint8 and uint16 arrays are
+display-encoded codes, converted as an 8- or 16-bit PNG is (colorspace= overrides). To save a
+decoded array with another library, encode it for display first: linear_to_srgb. Errors raise
+conus.Error, whose .rule names the spec rule broken; arguments of the wrong type raise a one-line
+TypeError. Work past one machine: conus.dask.encode_files.
 """
+import functools as _functools
+
 import numpy as _np
 
-from ._conus import (DEFAULT_MAP_SIDE, MAX_IMAGE_SIDE, MAX_MAP_SIDE, Error, File, Map, decode, encode, importance,
-                     psnr, read, read_image, resize, uniform, write, write_image)
+from . import _conus
+from ._conus import DEFAULT_MAP_SIDE, MAX_IMAGE_SIDE, MAX_MAP_SIDE, Error, File, Map
+
+
+def _one_line(function, name):
+    """`function` whose argument type errors (pybind11's many lines, the whole array among them)
+    become one line: what was given and the signature expected."""
+    @_functools.wraps(function)
+    def call(*args, **kwargs):
+        try:
+            return function(*args, **kwargs)
+        except TypeError as e:
+            lines = str(e).splitlines()
+            if not lines or "incompatible function arguments" not in lines[0]:
+                raise
+            expected = next((line.strip()[3:] for line in lines[1:] if line.strip().startswith("1. ")), "(...)")
+            expected = expected.replace("conus._conus.", "conus.")
+            given = ", ".join([type(a).__name__ for a in args] + [f"{k}={type(v).__name__}" for k, v in kwargs.items()])
+            raise TypeError(f"conus.{name}({given}): expected {name.split('.')[-1]}{expected}") from None
+    return call
+
+
+for _name in ("read", "write", "encode", "decode", "uniform", "resize", "psnr", "importance", "read_image", "write_image"):
+    globals()[_name] = _one_line(getattr(_conus, _name), _name)
+for _name in ("identity", "foci", "springs", "auto", "auto_for_frame_loss", "from_nodes"):
+    setattr(Map, _name, staticmethod(_one_line(getattr(Map, _name), "Map." + _name)))
+for _name in ("distort", "undistort", "density", "measures"):
+    setattr(Map, _name, _one_line(getattr(Map, _name), "Map." + _name))
+del _name
 
 __all__ = ["Error", "File", "Map", "read", "write", "encode", "decode", "uniform", "resize", "psnr", "importance",
            "read_image", "write_image", "srgb_to_linear", "linear_to_srgb", "MAX_IMAGE_SIDE", "MAX_MAP_SIDE",

@@ -2,10 +2,11 @@
 // (python/conus/__init__.py) re-exports it and adds the pure-Python helpers.
 //
 // Shared rules:
-// - Pixels are float32 numpy arrays of shape (height, width, channels), linear light, channels
-//   named by the file (R, G, B, A, Y, Z, ...). Arrays CoNUS returns own their memory without a
-//   copy (a capsule holds the C++ image); File.pixels and Map.nodes are views into the object
-//   they come from and keep it alive.
+// - Pixels CoNUS returns are float32 numpy arrays of shape (height, width, channels), linear light,
+//   channels named by the file (R, G, B, A, Y, Z, ...); what it takes follows arguments.h (float:
+//   linear light; uint8/uint16: display codes, as a PNG's). Returned arrays own their memory
+//   without a copy (a capsule holds the C++ image); File.pixels and Map.nodes are views into the
+//   object they come from and keep it alive.
 // - Every long call (read, write, encode, decode, building a map, distort/undistort of many
 //   points) releases the GIL.
 // - A conus::Error becomes conus.Error with .code ("corrupt", "limit-exceeded", ...), .rules (the
@@ -15,6 +16,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -23,8 +25,9 @@
 #include <vector>
 
 #include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/frame_budget.h"
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/foci_budget.h"
+#include "conus/codec/build/frame_budget.h"
 #include "conus/codec/build/map_measures.h"
 #include "conus/codec/build/springs.h"
 #include "conus/codec/conus_file.h"
@@ -36,6 +39,8 @@
 #include "conus/format/container.h"
 #include "conus/imageio/image_file.h"
 #include "conus/renderers/gpu_image.h"
+#include "arguments.h"
+#include "foci_budget_info.h"
 
 namespace py = pybind11;
 
@@ -84,40 +89,6 @@ py::array toArray(Image image) {
                               {py::ssize_t(held->width) * c * 4, c * 4, py::ssize_t(4)}, held->pixels.data(), owner);
 }
 
-std::vector<std::string> defaultChannels(py::ssize_t count) {
-    switch (count) {
-        case 1: return {"Y"};
-        case 2: return {"Y", "A"};
-        case 3: return {"R", "G", "B"};
-        case 4: return {"R", "G", "B", "A"};
-        default: {
-            std::vector<std::string> names;
-            for (py::ssize_t c = 0; c < count; ++c) names.push_back("C" + std::to_string(c));
-            return names;
-        }
-    }
-}
-
-// An (H, W) or (H, W, C) array of linear values as an Image (one copy, into the Image).
-Image fromArray(const py::array& input, std::optional<std::vector<std::string>> channels, const char* what) {
-    const FloatArray array = FloatArray::ensure(input);
-    if (!array) throw Error(ErrorCode::InvalidArgument, std::string(what) + " must be an array of numbers");
-    if (array.ndim() != 2 && array.ndim() != 3)
-        throw Error(ErrorCode::InvalidArgument, std::string(what) + " must have shape (height, width) or (height, width, channels), not " +
-                                                    std::to_string(array.ndim()) + " dimensions");
-    const py::ssize_t h = array.shape(0), w = array.shape(1), c = array.ndim() == 3 ? array.shape(2) : 1;
-    std::vector<std::string> names = channels ? *channels : defaultChannels(c);
-    if (py::ssize_t(names.size()) != c)
-        throw Error(ErrorCode::InvalidArgument, std::string(what) + " has " + std::to_string(c) + " channels but " +
-                                                    std::to_string(names.size()) + " names were given");
-    if (h > kMaxImageSide || w > kMaxImageSide)
-        throw Error(ErrorCode::LimitExceeded, std::string(what) + " of " + std::to_string(w) + "x" + std::to_string(h) +
-                                                  " pixels is beyond the limit of " + std::to_string(kMaxImageSide) + " a side");
-    Image image = makeImage(int(w), int(h), std::move(names));
-    std::copy(array.data(), array.data() + image.pixels.size(), image.pixels.begin());
-    return image;
-}
-
 // ---- points ------------------------------------------------------------------------------------
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
@@ -148,22 +119,19 @@ py::array mapPoints(const py::array& input, F&& f) {
 struct Map {
     codec::SamplingMap map;
     std::optional<format::AnalyticMap> analytic;  // when built from parameters
+    std::optional<double> aspect;                 // width / height of the pictures it was made for, when known
 };
 
 struct File {
     format::ConusFile file;
+    std::optional<py::dict> budget;  // what encode(foci=...)'s budget did (foci_budget.h); none otherwise
     std::shared_ptr<Map> map;  // built from file.map on first use
     std::shared_ptr<Map> samplingMap() {
-        if (!map) map = std::make_shared<Map>(Map{codec::SamplingMap::fromGrid(file.map), file.analytic});
+        if (!map)
+            map = std::make_shared<Map>(Map{codec::SamplingMap::fromGrid(file.map), file.analytic, codec::madeForAspect(file)});
         return map;
     }
 };
-
-std::vector<codec::Focus> toFoci(const std::vector<std::tuple<double, double, double, double>>& foci) {
-    std::vector<codec::Focus> out;
-    for (const auto& [u, v, r, k] : foci) out.push_back({u, v, r, k});
-    return out;
-}
 
 py::dict attributesOf(const format::ConusFile& f) {
     py::dict a;
@@ -223,7 +191,6 @@ void toDisplayOrder(Image& image) {
 // fit > 0: the encoded image fitted to its decoder with that many iterations (fit.h).
 void fitTo(const Image& source, const codec::SamplingMap& map, Image& encoded, int fit,
            double hold = codec::kFitHoldLowPass) {
-    if (fit < 0) throw Error(ErrorCode::InvalidArgument, "fit must be 0 (none) or a number of iterations");
     if (fit == 0) return;
     codec::FitOptions options;
     options.iterations = fit;
@@ -233,6 +200,28 @@ void fitTo(const Image& source, const codec::SamplingMap& map, Image& encoded, i
 
 std::pair<int, int> sizeOr(const std::optional<std::pair<int, int>>& size, int w, int h) {
     return size ? *size : std::pair<int, int>{std::max(1, (w + 2) / 4), std::max(1, (h + 2) / 4)};
+}
+
+// A map made for pictures of another aspect stretches its foci into ellipses: say so.
+void checkAspect(const Map& map, const Image& picture) {
+    const double aspect = double(picture.width) / picture.height;
+    if (!map.aspect || std::abs(std::log(*map.aspect / aspect)) < 0.01) return;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the map was made for pictures of aspect %.3g (width / height) and this one's is %.3g: its foci become "
+                  "ellipses (build it with aspect=%.3g)",
+                  *map.aspect, aspect, aspect);
+    warn(text);
+}
+
+// The pixel rules of an encode-like call (arguments.h).
+PixelRules rulesOf(const std::string& colorspace, const std::string& fixNonFinite) { return {colorspace, fixNonFinite}; }
+
+std::shared_ptr<Map> mapFrom(py::handle map) {
+    if (map.is_none()) return nullptr;
+    if (!py::isinstance<Map>(map))
+        throw py::type_error("map must be a conus.Map (conus.Map.foci(...), conus.read(path).map), not " + describe(map));
+    return map.cast<std::shared_ptr<Map>>();
 }
 
 }  // namespace
@@ -255,13 +244,12 @@ PYBIND11_MODULE(_conus, m) {
 
     py::class_<Map, std::shared_ptr<Map>>(m, "Map", "A sampling map: a grid of distorted node positions (Equation 1)")
         .def_static(
-            "identity", [](int columns, int rows) { return std::make_shared<Map>(Map{codec::SamplingMap::identity(columns, rows), {}}); },
+            "identity", [](int columns, int rows) { return std::make_shared<Map>(Map{codec::SamplingMap::identity(columns, rows), {}, std::nullopt}); },
             py::arg("columns") = map_rules::kDefaultSide, py::arg("rows") = map_rules::kDefaultSide)
         .def_static(
             "foci",
-            [](const std::vector<std::tuple<double, double, double, double>>& foci, double aspect, int grid, const std::string& composition,
-               const std::string& falloff) {
-                const std::vector<codec::Focus> f = toFoci(foci);
+            [](py::object foci, double aspect, int grid, const std::string& composition, const std::string& falloff) {
+                const std::vector<codec::Focus> f = fociFrom(foci);
                 codec::FociOptions options;
                 options.aspect = aspect;
                 options.columns = options.rows = grid;
@@ -271,12 +259,13 @@ PYBIND11_MODULE(_conus, m) {
                     throw Error(ErrorCode::InvalidArgument, "composition must be 'density' or 'add', not '" + composition + "'");
                 py::gil_scoped_release release;
                 codec::SamplingMap map = codec::buildFociMap(f, options);
-                return std::make_shared<Map>(Map{std::move(map), codec::toAnalytic(f, options.composition, options.falloff)});
+                return std::make_shared<Map>(Map{std::move(map), codec::toAnalytic(f, options.composition, options.falloff), aspect});
             },
             py::arg("foci"), py::arg("aspect") = 1.0, py::arg("grid") = map_rules::kDefaultSide, py::arg("composition") = "density",
             py::arg("falloff") = "2",
-            "Circular foci (u, v, r, k): centre, radius as a fraction of the width, magnification; falloff as `map foci "
-            "--falloff` (\"2\": density smoothstepped from r to 2r; \"1.5,log\", \"3,logr\")")
+            "Circular foci (u, v, r, k): centre, radius as a fraction of the width, magnification; aspect: the pictures' "
+            "width / height (encode warns on another); falloff as `map foci --falloff` (\"2\": density smoothstepped "
+            "from r to 2r; \"1.5,log\", \"3,logr\")")
         .def_static(
             "springs",
             [](const std::vector<std::tuple<double, double, double, double>>& strokes, int grid, int max_steps) {
@@ -284,21 +273,22 @@ PYBIND11_MODULE(_conus, m) {
                 for (const auto& [u, v, radius, strength] : strokes) system.addStroke({u, v, radius, strength});
                 py::gil_scoped_release release;
                 system.runUntilStable(max_steps);
-                return std::make_shared<Map>(Map{system.toMap(grid, grid), {}});
+                return std::make_shared<Map>(Map{system.toMap(grid, grid), {}, std::nullopt});
             },
             py::arg("strokes"), py::arg("grid") = map_rules::kDefaultSide, py::arg("max_steps") = 200000,
             "The paper's mass-spring brush: strokes (u, v, radius, strength), relaxed until stable")
         .def_static(
             "auto",
             [](const py::array& importance, int grid, double min_density, double max_density, double smoothing) {
-                Image image = fromArray(importance, std::nullopt, "importance");
+                Image image = dataFrom(importance, "importance");
+                const double aspect = double(image.width) / image.height;
                 codec::AutoMapOptions options;
                 options.columns = options.rows = grid;
                 options.minDensity = min_density;
                 options.maxDensity = max_density;
                 options.smoothing = smoothing;
                 py::gil_scoped_release release;
-                return std::make_shared<Map>(Map{codec::buildAutoMap(image, options), {}});
+                return std::make_shared<Map>(Map{codec::buildAutoMap(image, options), {}, aspect});
             },
             py::arg("importance"), py::arg("grid") = map_rules::kDefaultSide, py::arg("min_density") = 0.25,
             py::arg("max_density") = 16.0, py::arg("smoothing") = codec::AutoMapOptions{}.smoothing,
@@ -307,8 +297,8 @@ PYBIND11_MODULE(_conus, m) {
             "auto_for_frame_loss",
             [](const py::array& importance, const py::array& source, std::pair<int, int> size, double frame_loss, int grid,
                double max_density, double max_anisotropy) {
-                const Image image = fromArray(importance, std::nullopt, "importance");
-                const Image picture = fromArray(source, std::nullopt, "source");
+                const Image image = dataFrom(importance, "importance");
+                const Image picture = pixelsFrom(source, std::nullopt, "source");
                 codec::AutoMapOptions options;
                 options.columns = options.rows = grid;
                 options.maxDensity = max_density;
@@ -316,7 +306,8 @@ PYBIND11_MODULE(_conus, m) {
                 py::gil_scoped_release release;
                 const codec::FrameErrorModel model(picture, size.first, size.second, image);
                 codec::BudgetResult r = codec::buildAutoMapForFrameLoss(image, model, frame_loss, options);
-                return std::make_tuple(std::make_shared<Map>(Map{std::move(r.map), {}}), r.minDensity, r.predicted.frameLoss,
+                return std::make_tuple(std::make_shared<Map>(Map{std::move(r.map), {}, double(picture.width) / picture.height}),
+                                       r.minDensity, r.predicted.frameLoss,
                                        r.predicted.roiGain);
             },
             py::arg("importance"), py::arg("source"), py::arg("size"), py::arg("frame_loss"),
@@ -333,7 +324,7 @@ PYBIND11_MODULE(_conus, m) {
                 grid.rows = int(a.shape(0));
                 grid.columns = int(a.shape(1));
                 grid.xy.assign(a.data(), a.data() + a.size());
-                return std::make_shared<Map>(Map{codec::SamplingMap::fromGrid(grid), {}});
+                return std::make_shared<Map>(Map{codec::SamplingMap::fromGrid(grid), {}, std::nullopt});
             },
             py::arg("nodes"), "A map from its nodes' distorted positions, shape (rows, columns, 2); validated")
         .def_property_readonly("columns", [](const Map& self) { return self.map.columns(); })
@@ -392,6 +383,12 @@ PYBIND11_MODULE(_conus, m) {
         .def_property_readonly("map", [](File& self) { return self.samplingMap(); })
         .def_property_readonly("attributes", [](const File& self) { return attributesOf(self.file); })
         .def_property_readonly("source_size", [](const File& self) { return py::make_tuple(self.file.sourceWidth, self.file.sourceHeight); })
+        .def_property_readonly(
+            "budget", [](const File& self) -> py::object { return self.budget ? py::object(*self.budget) : py::none(); },
+            "What encode(foci=...)'s budget did, or None: k_asked, k_given (each focus's), lowered, frame_loss (the\n"
+            "budget), predicted_frame_loss, predicted_roi_gain (dB), foci_share (of the CoNUS pixels),\n"
+            "context_downscale and uniform_downscale (the linear downscale the context and the uniform image are\n"
+            "sampled like), ask (the discs' pixels at k over all the pixels), grid_limited")
         .def("__repr__", [](const File& self) {
             const format::ConusFile& f = self.file;
             return "<conus.File " + std::to_string(f.image.width) + "x" + std::to_string(f.image.height) + " CoNUS image of a " +
@@ -412,30 +409,47 @@ PYBIND11_MODULE(_conus, m) {
     m.def(
         "write",
         [](const std::string& path, const File& file) {
+            try {
+                format::checkConusFileName(path);
+            } catch (const Error& e) {
+                throw Error(e.code(), std::string(e.what()) + " (for a picture of it, conus.write_image(path, conus.decode(f)))");
+            }
             py::gil_scoped_release release;
             format::writeConusFile(path, file.file);
         },
         py::arg("path"), py::arg("file"), "Write a CoNUS file (validated first, written atomically)");
     m.def(
         "encode",
-        [](const py::array& pixels, std::optional<std::vector<std::tuple<double, double, double, double>>> foci,
-           std::optional<std::pair<int, int>> size, std::shared_ptr<Map> map, std::optional<std::vector<std::string>> channels,
-           const std::string& backend, int fit, double fitHold) {
-            Image source = fromArray(pixels, channels, "pixels");
-            if (foci && map) throw Error(ErrorCode::InvalidArgument, "give foci or a map, not both");
+        [](py::object pixels, py::object fociArgument, py::object sizeArgument, py::object mapArgument, py::object channels,
+           const std::string& backend, py::object fitArgument, double fitHold, double frameLoss, bool exactK,
+           const std::string& colorspace, const std::string& fixNonFinite) {
+            const std::vector<codec::Focus> foci = fociFrom(fociArgument);
+            const auto size = sizeFrom(sizeArgument);
+            std::shared_ptr<Map> map = mapFrom(mapArgument);
+            const int fit = iterationsFrom(fitArgument);
+            Image source = pixelsFrom(pixels, channelsFrom(channels), "pixels", rulesOf(colorspace, fixNonFinite));
+            if (!fociArgument.is_none() && map) throw Error(ErrorCode::InvalidArgument, "give foci or a map, not both");
+            if (map) checkAspect(*map, source);
             const double aspect = double(source.width) / source.height;
+            const auto [w, h] = sizeOr(size, source.width, source.height);
+            std::optional<codec::FociBudget> budget;
             if (!map) {
-                if (foci && !foci->empty()) {
-                    const std::vector<codec::Focus> f = toFoci(*foci);
+                if (!foci.empty()) {
+                    const std::vector<codec::Focus>& f = foci;
                     codec::FociOptions options;
                     options.aspect = aspect;
-                    py::gil_scoped_release release;
-                    map = std::make_shared<Map>(Map{codec::buildFociMap(f, options), codec::toAnalytic(f, options.composition)});
+                    {
+                        // The budget of `conus encode --focus` (foci_budget.h): k lowered to hold frame_loss.
+                        py::gil_scoped_release release;
+                        const int side = 256;
+                        const codec::FrameErrorModel model(source, w, h, codec::fociImportance(f, aspect, side, std::max(1, int(side / aspect))));
+                        budget = codec::fociForFrameLoss(f, options, model, frameLoss, exactK);
+                    }
+                    map = std::make_shared<Map>(Map{budget->map, codec::toAnalytic(budget->given, options.composition), aspect});
                 } else {
-                    map = std::make_shared<Map>(Map{codec::SamplingMap::identity(2, 2), {}});
+                    map = std::make_shared<Map>(Map{codec::SamplingMap::identity(2, 2), {}, std::nullopt});
                 }
             }
-            const auto [w, h] = sizeOr(size, source.width, source.height);
             codec::EncodeOptions options;
             options.width = w;
             options.height = h;
@@ -454,21 +468,33 @@ PYBIND11_MODULE(_conus, m) {
                                                   map->analytic);
             }
             file->map = map;
+            if (budget) file->budget = budgetInfo(*budget, frameLoss, w, h, source.width, source.height, exactK);
             return file;
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),
-        py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = 0,
-        py::arg("fit_hold") = codec::kFitHoldLowPass,
-        "Encode linear pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file;\n"
-        "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'; fit = N > 0\n"
-        "fits the image to the decoder with N least-squares iterations (`conus encode --fit --fit-iterations N`); fit_hold: its\n"
-        "damping where the encoder low-passed a long footprint axis (`--fit-hold`; 0: the plain least squares)");
+        py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = codec::kDefaultEncodeFitIterations,
+        py::arg("fit_hold") = codec::kFitHoldLowPass, py::arg("frame_loss") = codec::kDefaultFrameLoss, py::arg("exact_k") = false,
+        py::arg("colorspace") = "auto", py::arg("fix_nonfinite") = "keep",
+        "Encode pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file; float pixels are\n"
+        "linear light, uint8/uint16 display-encoded codes (colorspace= 'srgb' or 'linear' overrides; docs/python.md);\n"
+        "fix_nonfinite 'keep' (with a warning), 'black' or 'box3' as --fix-nonfinite;\n"
+        "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'. As `conus encode`:\n"
+        "foci hold a whole-frame loss budget (frame_loss dB, predicted) by lowering every k alike, with a\n"
+        "UserWarning that says so (exact_k=True keeps k; the File's .budget says what was given); fit = N\n"
+        "least-squares iterations fit the image to the decoder (default 2; 0: the filtered encode alone, `--fast`);\n"
+        "fit_hold: its damping where the encoder low-passed a long footprint axis (`--fit-hold`)");
     m.def(
         "decode",
-        [](File& file, std::tuple<double, double, double, double> view, std::optional<std::pair<int, int>> size, const std::string& backend) {
+        [](py::object fileArgument, py::object viewArgument, py::object sizeArgument, const std::string& backend) {
+            if (!py::isinstance<File>(fileArgument))
+                throw py::type_error("file must be a conus.File (from conus.read(path) or conus.encode(...)), not " +
+                                     describe(fileArgument));
+            File& file = fileArgument.cast<File&>();
+            const codec::View view = viewFrom(viewArgument);
+            const auto size = sizeFrom(sizeArgument);
             const auto [u0, v0, u1, v1] = view;
             codec::DecodeOptions options;
-            options.view = {u0, v0, u1, v1};
+            options.view = view;
             if (size) {
                 options.width = size->first;
                 options.height = size->second;
@@ -493,8 +519,11 @@ PYBIND11_MODULE(_conus, m) {
         "A conventional frame of the rectangle view (u0, v0, u1, v1), at size (w, h) (default: the source's resolution)");
     m.def(
         "uniform",
-        [](const py::array& pixels, std::optional<std::pair<int, int>> size, int fit) {
-            Image source = fromArray(pixels, std::nullopt, "pixels");
+        [](py::object pixels, py::object sizeArgument, py::object fitArgument, const std::string& colorspace,
+           const std::string& fixNonFinite) {
+            const auto size = sizeFrom(sizeArgument);
+            const int fit = iterationsFrom(fitArgument);
+            Image source = pixelsFrom(pixels, std::nullopt, "pixels", rulesOf(colorspace, fixNonFinite));
             const auto [w, h] = sizeOr(size, source.width, source.height);
             py::gil_scoped_release release;
             Image small = codec::areaDownsample(source, w, h);
@@ -502,13 +531,17 @@ PYBIND11_MODULE(_conus, m) {
             py::gil_scoped_acquire acquire;
             return toArray(std::move(small));
         },
-        py::arg("pixels"), py::arg("size") = py::none(), py::arg("fit") = 0,
-        "The uniform baseline: an area downsample to the same pixel count; fit = N > 0 fits it to its bilinear\n"
+        py::arg("pixels"), py::arg("size") = py::none(), py::arg("fit") = 0, py::arg("colorspace") = "auto",
+        py::arg("fix_nonfinite") = "keep",
+        "The uniform baseline (pixels as for encode): an area downsample to the same pixel count; fit = N > 0 fits it to its bilinear\n"
         "resize to the source's size (`conus uniform --fit --fit-iterations N`)");
     m.def(
         "resize",
-        [](const py::array& pixels, std::pair<int, int> size) {
-            Image source = fromArray(pixels, std::nullopt, "pixels");
+        [](py::object pixels, py::object sizeArgument) {
+            const auto given = sizeFrom(sizeArgument);
+            if (!given) throw py::type_error("size must be (width, height) in whole pixels, such as (512, 384), not None");
+            const std::pair<int, int> size = *given;
+            Image source = pixelsFrom(pixels, std::nullopt, "pixels");
             py::gil_scoped_release release;
             Image out = codec::resizeBilinear(source, {}, size.first, size.second);
             py::gil_scoped_acquire acquire;
@@ -516,14 +549,14 @@ PYBIND11_MODULE(_conus, m) {
         },
         py::arg("pixels"), py::arg("size"), "Bilinear resize (how a uniform image is shown at another size)");
     m.def(
-        "psnr", [](const py::array& a, const py::array& b, double peak) {
-            return codec::psnr(fromArray(a, std::nullopt, "a"), fromArray(b, std::nullopt, "b"), peak);
+        "psnr", [](py::object a, py::object b, double peak) {
+            return codec::psnr(pixelsFrom(a, std::nullopt, "a"), pixelsFrom(b, std::nullopt, "b"), peak);
         },
         py::arg("a"), py::arg("b"), py::arg("peak") = 1.0, "PSNR in dB of two images of the same shape");
     m.def(
         "importance",
-        [](const py::array& pixels, const std::string& kind, std::optional<std::vector<std::string>> channels) {
-            Image image = fromArray(pixels, channels, "pixels");
+        [](py::object pixels, const std::string& kind, py::object channels) {
+            Image image = pixelsFrom(pixels, channelsFrom(channels), "pixels");
             if (kind != "detail") throw Error(ErrorCode::InvalidArgument, "importance: kind '" + kind + "' is not 'detail'");
             py::gil_scoped_release release;
             // As `--importance detail`: on the display-encoded picture (cli/importance.cpp).
@@ -548,11 +581,14 @@ PYBIND11_MODULE(_conus, m) {
         py::arg("path"), "Read an ordinary picture (PNG, JPEG, TIFF, EXR, ...) as linear float: (pixels, channels)");
     m.def(
         "write_image",
-        [](const std::string& path, const py::array& pixels, std::optional<std::vector<std::string>> channels) {
-            Image image = fromArray(pixels, channels, "pixels");
+        [](const std::string& path, py::object pixels, py::object channels, const std::string& colorspace,
+           const std::string& fixNonFinite) {
+            Image image = pixelsFrom(pixels, channelsFrom(channels), "pixels", rulesOf(colorspace, fixNonFinite));
             py::gil_scoped_release release;
             imageio::writeImageFile(path, image);
         },
-        py::arg("path"), py::arg("pixels"), py::arg("channels") = py::none(),
-        "Write linear pixels as an ordinary picture (8-bit sRGB for PNG/JPEG, half for EXR), atomically");
+        py::arg("path"), py::arg("pixels"), py::arg("channels") = py::none(), py::arg("colorspace") = "auto",
+        py::arg("fix_nonfinite") = "keep",
+        "Write pixels (as for encode: float linear light, uint8/uint16 display codes) as an ordinary picture (8-bit\n"
+        "sRGB for PNG/JPEG, half for EXR), atomically");
 }

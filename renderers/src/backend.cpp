@@ -13,8 +13,8 @@ namespace {
 // Whether this machine has a device node a hardware GL driver could use: a DRM render node
 // (Mesa's hardware drivers, EGL surfaceless), NVIDIA's device, or WSL's GPU. Without one, any GL
 // context is a software rasterizer, which work with a CPU path leaves anyway: deciding that here
-// spares loading Mesa and LLVM (~0.2 s of CPU and ~80 MiB for `conus encode`, bench/README.md
-// "End to end") only to read GL_RENDERER.
+// spares loading Mesa and LLVM (~0.2 s of CPU and ~80 MiB for `conus encode`,
+// bench/notes/2026-11-24-end-to-end.md) only to read GL_RENDERER.
 bool mayHaveHardwareGpu() {
     std::error_code ec;
     for (const char* node : {"/dev/nvidiactl", "/dev/nvidia0", "/dev/dxg"})

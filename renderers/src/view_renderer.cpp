@@ -431,7 +431,7 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
     const GladGLContext& gl = makeCurrentGl(d.context);
     if (!hasImage()) {
         gl.Viewport(0, 0, width, height);
-        gl.ClearColor(0.11f, 0.11f, 0.11f, 1.0f);
+        gl.ClearColor(kViewBackground, kViewBackground, kViewBackground, 1.0f);
         gl.Clear(GL_COLOR_BUFFER_BIT);
         return;
     }
@@ -465,8 +465,9 @@ void ViewRenderer::draw(const codec::View& view, int width, int height, const Vi
     gl.Uniform1i(at("uBottomUp"), options.bottomUp ? 1 : 0);
     int every = options.gridEvery;
     if (every <= 0) {
-        // Window pixels per CoNUS pixel where the density is 1; coarser lines until they are legible.
-        const double perPixel = width / (std::abs(view.u1 - view.u0) * d.conusWidth);
+        // Window pixels per CoNUS pixel where the density is 1, over the densest part's linear
+        // magnification (the lines crowd together there); coarser lines until they are legible there.
+        const double perPixel = width / (std::abs(view.u1 - view.u0) * d.conusWidth) / std::exp(0.5 * std::max(0.0f, d.logDensityHi));
         every = 1;
         while (every * perPixel < kMinGridSpacing && every < d.conusWidth) every *= 2;
     }

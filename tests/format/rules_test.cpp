@@ -203,6 +203,16 @@ TEST_F(RuleTest, V12AnalyticMap) {
         ASSERT_FALSE(report.issues.empty());
         EXPECT_NE(report.issues.front().message.find("falloff"), std::string::npos) << report.issues.front().message;
     }
+    // The aspect a map file's foci were made for: a positive width / height.
+    f.analytic = AnalyticMap{"foci", {{0.5, 0.5, 0.1, 2}}, "density", {{"aspect", 1.5}}};
+    EXPECT_TRUE(validateConusFile(f).ok());
+    for (const double aspect : {0.0, -1.5, 1e-9}) {
+        f.analytic = AnalyticMap{"foci", {{0.5, 0.5, 0.1, 2}}, "density", {{"aspect", aspect}}};
+        const ValidationReport report = validateConusFile(f);
+        EXPECT_TRUE(onlyRule(report, 12)) << aspect;
+        ASSERT_FALSE(report.issues.empty());
+        EXPECT_NE(report.issues.front().message.find("aspect"), std::string::npos) << report.issues.front().message;
+    }
     EXPECT_TRUE(onlyRule(raw([](Imf::Header& c, Imf::Header&) {
                              c.insert("conus:mapKind", Imf::StringAttribute("foci"));
                              c.insert("conus:foci", Imf::FloatVectorAttribute({0.5f, 0.5f, 0.1f, 2.0f, 0.3f}));

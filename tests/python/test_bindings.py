@@ -16,7 +16,7 @@ def run(*args):
 
 
 def test_encode_write_read_round_trip(tmp_path, asymmetric, conus_bin):
-    f = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80))
+    f = conus.encode(asymmetric, foci=[FOCUS], size=(120, 80), exact_k=True)  # the focus as given, recorded
     assert f.pixels.shape == (80, 120, 4) and f.pixels.dtype == np.float32
     assert f.channels == ["R", "G", "B", "A"]
     path = str(tmp_path / "a.exr")
@@ -225,3 +225,42 @@ def test_fit_brings_the_decoded_frame_closer_for_conus_and_uniform(tmp_path, asy
     assert mse(conus.decode(unheld), asymmetric) <= mse(conus.decode(fitted), asymmetric)
     with pytest.raises(conus.Error):
         conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=3, fit_hold=-1.0)
+
+
+def test_encode_holds_the_frame_loss_budget(tmp_path, conus_bin):
+    """Two large foci on a detailed picture ask more pixels than there are: encode(foci=...) lowers
+    every k alike to hold the budget, warns, and says what it gave in File.budget, as `conus encode`
+    does (the same k in the same file); exact_k=True keeps k and warns what the frame pays."""
+    rng = np.random.default_rng(5)
+    h, w = 160, 240
+    y, x = np.mgrid[0:h, 0:w]
+    detail = (0.5 + 0.25 * np.sin(0.31 * x + 0.17 * y)[..., None] + 0.25 * rng.random((h, w, 3))).astype(np.float32)
+    foci = [(0.3, 0.4, 0.16, 4.0), (0.7, 0.55, 0.15, 4.0)]
+    with pytest.warns(UserWarning, match=r"the loss budget \(whole frame 1\.5 dB, tiles 4 dB\) lowered k from 4, 4 to "):
+        f = conus.encode(detail, foci=foci, size=(60, 40), fit=0)
+    b = f.budget
+    assert b["lowered"] and b["k_asked"] == [4.0, 4.0] and b["frame_loss"] == 1.5
+    assert 1.0 < b["k_given"][0] < 4.0 and b["k_given"][0] == pytest.approx(b["k_given"][1])
+    assert b["predicted_frame_loss"] <= 1.5 and b["predicted_tile_loss"] <= 4.0 and b["ask"] > 1.0
+    assert b["context_downscale"] > b["uniform_downscale"] == pytest.approx(4.0)
+    assert [focus[3] for focus in f.attributes["analytic"]["foci"]] == pytest.approx(b["k_given"])
+    # The binary gives the same k for the same picture.
+    src = str(tmp_path / "detail.exr")
+    conus.write_image(src, detail)
+    pixels, channels = conus.read_image(src)
+    cli = str(tmp_path / "cli.exr")
+    out = run(conus_bin, "encode", src, "-o", cli, "--size", "60x40", "--fast", *[a for fo in foci for a in ("--focus", ",".join(map(str, fo)))]).stdout
+    assert "lowered k from 4, 4 to" in out
+    with pytest.warns(UserWarning):
+        ours = conus.encode(pixels, foci=foci, size=(60, 40), channels=channels, fit=0)
+    theirs = [focus[3] for focus in conus.read(cli).attributes["analytic"]["foci"]]
+    assert [focus[3] for focus in ours.attributes["analytic"]["foci"]] == pytest.approx(theirs)
+    # exact_k keeps k, a looser budget gives more, and no foci means no budget.
+    with pytest.warns(UserWarning, match="exact_k"):
+        e = conus.encode(detail, foci=foci, size=(60, 40), fit=0, exact_k=True)
+    assert e.budget["k_given"] == [4.0, 4.0] and not e.budget["lowered"]
+    assert e.budget["predicted_frame_loss"] > 1.5 or e.budget["predicted_tile_loss"] > 4.0
+    with pytest.warns(UserWarning):
+        tight = conus.encode(detail, foci=foci, size=(60, 40), fit=0, frame_loss=0.1)
+    assert tight.budget["k_given"][0] < b["k_given"][0]
+    assert conus.encode(detail, size=(60, 40), fit=0).budget is None

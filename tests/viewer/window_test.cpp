@@ -268,11 +268,43 @@ TEST(ConusView, WindowZoomKeepsTheFeatureUnderTheCursor) {
     EXPECT_EQ(marker(grid).z, 0) << "density mode shows no picture";
     // The inspector line for the marker: the white disc, undistorted (u,v) at the marker.
     EXPECT_NE(log.find("u,v=(0.3000,0.4000)"), std::string::npos) << log;
-    // The disc is white; the encoder's footprint filter (its anisotropic low-pass, issue 10) blurs
-    // its edge a little into the pixel at its centre, so near 1 rather than a fixed value.
+    // The disc is white; the encoder's footprint filter (its anisotropic low-pass) blurs
+    // its edge a little into the pixel at its centre, so near 1 rather than a fixed value (0.95:
+    // the disc lies in the focus's widened transition, where footprints are 2.5 times longer than
+    // wide).
     const std::size_t red = log.find("R=", log.find("u,v=(0.3000,0.4000)"));
     ASSERT_NE(red, std::string::npos) << log;
-    EXPECT_GT(std::stod(log.substr(red + 2, 8)), 0.97) << log;
+    EXPECT_GT(std::stod(log.substr(red + 2, 8)), 0.93) << log;
+}
+
+// The raw mode's grid in a 960x650 window: the automatic lines at least ~6 pixels apart everywhere,
+// the focus included (spaced for density 1, they crowded together there into a moire).
+TEST(ConusView, WindowRawGridIsThinnedToWhatTheScreenShows) {
+    ASSERT_TRUE(test::haveXvfb()) << "install xvfb (scripts/packages.txt)";
+    const fs::path dir = test::tempDir();
+    test::writeText(dir / "raw.txt", "screenshot " + (dir / "raw.png").string() + "\nkey G\nscreenshot " +
+                                         (dir / "raw-grid.png").string() + "\n");
+    std::string log;
+    ASSERT_EQ(test::run(xvfb(test::conusPath() + " --mode raw --window 960x650 --script " + (dir / "raw.txt").string()), &log), 0)
+        << log;
+    const Image plain = readPng(dir / "raw.png"), grid = readPng(dir / "raw-grid.png");
+    ASSERT_EQ(plain.width, 960);
+    ASSERT_EQ(grid.height, 650);
+    constexpr int kTile = 48;
+    int drawn = 0;
+    double densest = 0;
+    for (int y0 = 0; y0 + kTile <= 650; y0 += kTile)
+        for (int x0 = 0; x0 + kTile <= 960; x0 += kTile) {
+            int lines = 0;
+            for (int y = y0; y < y0 + kTile; ++y)
+                for (int x = x0; x < x0 + kTile; ++x)
+                    lines += std::abs(plain.at(x, y, 1) - grid.at(x, y, 1)) > 1.5f / 255;
+            const double share = double(lines) / (kTile * kTile);
+            drawn += share > 0.05;
+            densest = std::max(densest, share);
+        }
+    EXPECT_GT(drawn, 100) << "the grid covers the picture";
+    EXPECT_LT(densest, 0.36) << "some tile is mostly grid lines";
 }
 
 TEST(ConusView, WindowShowsAnInvalidFileAsAnErrorWithoutCrashing) {

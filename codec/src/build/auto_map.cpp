@@ -187,6 +187,8 @@ SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options)
     mapOptions.columns = options.columns;
     mapOptions.rows = options.rows;
     mapOptions.maxAnisotropy = options.maxAnisotropy;
+    mapOptions.builder = options.builder;
+    mapOptions.minDensity = options.minDensity;  // the target's mean is 1 (importanceToDensity)
     // A grid cannot follow a steep rise exactly: the cells beside it come out denser or sparser than
     // the target. Each round divides the followed field by what the map achieved there (its cell
     // density at each sample) and rebuilds; the best map by its worst bound violation is kept.

@@ -1,5 +1,6 @@
 // Composition of sampling maps through their displacement fields, with one injectivity rule
-// (a global factor on all displacements, found by bisection).
+// (a global factor on all displacements, found by bisection), and a rebuild from the composed
+// density where that rule folds, starves a cell or passes the anisotropy bound (compose.h).
 #include "conus/codec/build/compose.h"
 
 #include <algorithm>
@@ -9,8 +10,10 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "conus/codec/build/map_measures.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
+#include "density_cells.h"
 
 namespace conus::codec {
 namespace {
@@ -40,8 +43,8 @@ double ramp(double t) {
 constexpr double kRampSlope = 15.0 / 8.0;
 
 // A map's pattern placed in the output by the affine change q = a * p + b (per axis, a > 0): the
-// output's displacement is D(q) / a. Two cuts would leave it discontinuous (issue 10: "a visible
-// square seam and a dark slit"), so both are tapered:
+// output's displacement is D(q) / a. Two cuts would leave it discontinuous (a visible
+// square seam and a dark slit), so both are tapered:
 // - An edge of the pattern's square that falls inside the output (a pattern shrunk or moved in):
 //   D is tangential there but not zero (boundary nodes slide along their edge), and zero outside,
 //   so nodes on either side of the edge jumped apart, and the density stepped from the pattern's
@@ -127,6 +130,44 @@ std::vector<glm::dvec2> resampleField(int columns, int rows, auto&& field) {
     return d;
 }
 
+// The target density on square samples for `aspect`, about four a cell of the output grid.
+DensityField sampleTarget(int columns, int rows, double aspect, auto&& density) {
+    DensityField field;
+    field.width = std::clamp(4 * (std::max(columns, rows) - 1), 64, 1024);
+    field.height = std::clamp(static_cast<int>(std::lround(field.width / aspect)), 16, 4096);
+    field.values.resize(std::size_t(field.width) * field.height);
+    for (int y = 0; y < field.height; ++y)
+        for (int x = 0; x < field.width; ++x)
+            field.values[std::size_t(y) * field.width + x] =
+                static_cast<float>(density(glm::dvec2((x + 0.5) / field.width, (y + 0.5) / field.height)));
+    return field;
+}
+
+// The density of `map` at q clamped to the unit square (a pattern's edge, continued).
+double densityAt(const SamplingMap& map, glm::dvec2 q) { return map.density(glm::clamp(q, 0.0, 1.0)); }
+
+void checkAspect(double aspect, const char* what) {
+    if (!(aspect > 0.0) || !std::isfinite(aspect))
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": aspect " + numberText(aspect) + " is not finite and > 0");
+}
+
+// The displacement rule's map when it holds the density floor and the anisotropy bound, else the
+// bounded builder's map of the target (compose.h).
+ComposeResult composeOrBuild(int columns, int rows, std::span<const glm::dvec2> displacement, const DensityField& target, double aspect) {
+    ComposeResult r = fitDisplacement(columns, rows, displacement);
+    const std::vector<double> cells = cellTargets(target, columns, rows);
+    const double lowest = *std::min_element(cells.begin(), cells.end());
+    const MapMeasures m = measureMap(r.map, aspect);
+    if (r.scale == 1.0 && m.minCellDensity >= 0.5 * lowest && m.maxAnisotropy <= map_rules::kMaxAnisotropy) return r;
+    DensityMapOptions options;
+    options.columns = columns;
+    options.rows = rows;
+    options.aspect = aspect;
+    ComposeResult built{SamplingMap::identity(2, 2), 1.0, true, {}};
+    built.map = buildMapFromDensity(target, options, &built.report);
+    return built;
+}
+
 }  // namespace
 
 bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes) {
@@ -155,28 +196,34 @@ ComposeResult fitDisplacement(int columns, int rows, std::span<const glm::dvec2>
     return {SamplingMap(columns, rows, std::move(nodes)), lo};
 }
 
-ComposeResult translateMap(const SamplingMap& map, glm::dvec2 offset) {
+ComposeResult translateMap(const SamplingMap& map, glm::dvec2 offset, double aspect) {
     if (!std::isfinite(offset.x) || !std::isfinite(offset.y)) {
         throw Error(ErrorCode::InvalidArgument, "translateMap: offset (" + numberText(offset.x) + ", " + numberText(offset.y) + ") is not finite");
     }
+    checkAspect(aspect, "translateMap");
     const auto d = placedDisplacement(map, {glm::dvec2(1.0), -offset});
-    return fitDisplacement(map.columns(), map.rows(), d);
+    const DensityField target = sampleTarget(map.columns(), map.rows(), aspect, [&](glm::dvec2 p) { return densityAt(map, p - offset); });
+    return composeOrBuild(map.columns(), map.rows(), d, target, aspect);
 }
 
-ComposeResult scaleMap(const SamplingMap& map, double factor, glm::dvec2 centre) {
+ComposeResult scaleMap(const SamplingMap& map, double factor, glm::dvec2 centre, double aspect) {
     if (!(factor > 0.0) || !std::isfinite(factor)) {
         throw Error(ErrorCode::InvalidArgument, "scaleMap: factor " + numberText(factor) + " is not finite and > 0");
     }
     if (!std::isfinite(centre.x) || !std::isfinite(centre.y)) {
         throw Error(ErrorCode::InvalidArgument, "scaleMap: centre (" + numberText(centre.x) + ", " + numberText(centre.y) + ") is not finite");
     }
+    checkAspect(aspect, "scaleMap");
     // q = centre + (p - centre) / factor
     const auto d = placedDisplacement(map, {glm::dvec2(1.0 / factor), centre - centre / factor});
-    return fitDisplacement(map.columns(), map.rows(), d);
+    const DensityField target =
+        sampleTarget(map.columns(), map.rows(), aspect, [&](glm::dvec2 p) { return densityAt(map, centre + (p - centre) / factor); });
+    return composeOrBuild(map.columns(), map.rows(), d, target, aspect);
 }
 
-ComposeResult addMaps(std::span<const SamplingMap> maps, int columns, int rows, std::span<const double> weights) {
+ComposeResult addMaps(std::span<const SamplingMap> maps, int columns, int rows, std::span<const double> weights, double aspect) {
     checkGrid(columns, rows, "addMaps");
+    checkAspect(aspect, "addMaps");
     if (!weights.empty() && weights.size() != maps.size()) {
         throw Error(ErrorCode::InvalidArgument, "addMaps: " + std::to_string(weights.size()) + " weights for " +
                                                     std::to_string(maps.size()) + " maps");
@@ -189,7 +236,18 @@ ComposeResult addMaps(std::span<const SamplingMap> maps, int columns, int rows, 
         for (std::size_t m = 0; m < maps.size(); ++m) sum += (weights.empty() ? 1.0 : weights[m]) * displacementAt(maps[m], p);
         return sum;
     });
-    return fitDisplacement(columns, rows, d);
+    // Each input's density relative to its context (its lowest, sampled where the target is).
+    std::vector<double> context(maps.size(), HUGE_VAL);
+    sampleTarget(columns, rows, aspect, [&](glm::dvec2 p) {
+        for (std::size_t m = 0; m < maps.size(); ++m) context[m] = std::min(context[m], maps[m].density(p));
+        return 1.0;
+    });
+    const DensityField target = sampleTarget(columns, rows, aspect, [&](glm::dvec2 p) {
+        double density = 1.0;
+        for (std::size_t m = 0; m < maps.size(); ++m) density += (weights.empty() ? 1.0 : weights[m]) * (maps[m].density(p) / context[m] - 1.0);
+        return std::max(density, kComposeFloor);
+    });
+    return composeOrBuild(columns, rows, d, target, aspect);
 }
 
 }  // namespace conus::codec

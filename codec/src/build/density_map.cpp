@@ -1,4 +1,4 @@
-// Where issue 10's staircase came from: not the rasterized foci (their density is C2 and sampled
+// Where steps in a map's density come from: not the rasterized foci (their density is C2 and sampled
 // at >= 12 samples a radius) nor the Poisson solve's boundary (exact Neumann, zero normal flow),
 // but fitting the grid to the flow. Moser's flow is injective, but it shears: between two foci the
 // context divides between them, and along the divide the nodes' paths fan out so fast that
@@ -20,6 +20,7 @@
 #include "conus/codec/build/density_map.h"
 
 #include "conus/codec/build/map_measures.h"
+#include "density_cells.h"
 
 #include <fftw3.h>
 
@@ -99,16 +100,15 @@ struct FlowField {
     std::vector<glm::dvec3> corners;
 };
 
-// Solves the 5-point Neumann Poisson problem lap(phi) = rho - 1 exactly (its eigenvectors are the
-// DCT-II basis), then differentiates phi on the faces and averages onto the corners.
-void solveFlowField(FlowField& field) {
-    const int w = field.width, h = field.height;
+// Solves the 5-point Neumann Poisson problem lap(phi) = rhs exactly on a w x h grid of square
+// samples of side 1/h (rhs of mean 0; its eigenvectors are the DCT-II basis); phi has mean 0.
+std::vector<double> solvePoisson(int w, int h, const std::vector<double>& rhs) {
     const std::size_t count = std::size_t(w) * h;
     FftwBuffer buffer(count);
     double* a = buffer.data();
     Dct2d forward(w, h, a, a, FFTW_REDFT10);
     Dct2d inverse(w, h, a, a, FFTW_REDFT01);
-    for (std::size_t k = 0; k < count; ++k) a[k] = field.rho[k] - 1.0;
+    for (std::size_t k = 0; k < count; ++k) a[k] = rhs[k];
     forward.run();
     // Square samples of side 1/h: the domain is [0, w/h] x [0, 1] in that metric.
     const double h2 = double(h) * h;
@@ -123,7 +123,16 @@ void solveFlowField(FlowField& field) {
         }
     }
     inverse.run();
-    const double* phi = a;
+    return std::vector<double>(a, a + count);
+}
+
+// The gradient of phi (in (u,v) units) and rho at the cell corners: phi differentiated on the
+// faces (staggered), averaged onto the corners; d phi/du is 0 on the left and right edges, d phi/dv
+// on the top and bottom ones.
+void gradientCorners(FlowField& field, const std::vector<double>& potential) {
+    const int w = field.width, h = field.height;
+    const double h2 = double(h) * h;
+    const double* phi = potential.data();
     // The gradient in the square metric, divided by the domain's extent (w/h, 1): velocities in (u,v).
     const double sx = h2 / w, sy = h;
     auto gxFace = [&](int i, int j) { return i > 0 && i < w ? (phi[std::size_t(j) * w + i] - phi[std::size_t(j) * w + i - 1]) * sx : 0.0; };
@@ -141,6 +150,13 @@ void solveFlowField(FlowField& field) {
             field.corners[std::size_t(j) * (w + 1) + i] = {gx, gy, r};
         }
     }
+}
+
+// Moser's velocity field: lap(phi) = rho - 1.
+void solveFlowField(FlowField& field) {
+    std::vector<double> rhs(field.rho.size());
+    for (std::size_t k = 0; k < rhs.size(); ++k) rhs[k] = field.rho[k] - 1.0;
+    gradientCorners(field, solvePoisson(field.width, field.height, rhs));
 }
 
 inline glm::dvec2 velocity(const FlowField& f, glm::dvec2 p, double t) {
@@ -231,6 +247,75 @@ void checkInput(const DensityField& target, const DensityMapOptions& options) {
 
 SamplingMap buildMapFromDensity(const DensityField& target, const DensityMapOptions& options, DensityMapReport* report) {
     checkInput(target, options);
+    switch (options.builder) {
+        case DensityBuilder::Flow: return buildFlowMap(target, options, report);
+        case DensityBuilder::Transport: return buildTransportMap(target, options, report);
+        case DensityBuilder::Bounded: break;
+    }
+    return buildBoundedMap(target, options, report);
+}
+
+SamplingMap buildTransportMap(const DensityField& target, const DensityMapOptions& options, DensityMapReport* report) {
+    constexpr int kIterations = 60;
+    const int w = target.width, h = target.height;
+    const std::size_t count = std::size_t(w) * h;
+    FlowField field;
+    field.width = w;
+    field.height = h;
+    field.rho.resize(count);
+    double sum = 0.0;
+    for (std::size_t k = 0; k < count; ++k) sum += field.rho[k] = target.values[k];
+    for (double& r : field.rho) r *= double(count) / sum;
+    // Benamou-Froese-Oberman: u = |x|^2 / 2 + psi, lap(u_next) = sqrt((u_xx - u_yy)^2 + 4 u_xy^2 + 4 rho)
+    // (the convex root of det D^2 u = rho), psi with zero normal derivative (edges stay on edges).
+    std::vector<double> psi(count, 0.0), rhs(count);
+    const double h2 = double(h) * h;
+    const auto at = [&](int i, int j) { return psi[std::size_t(std::clamp(j, 0, h - 1)) * w + std::clamp(i, 0, w - 1)]; };
+    for (int it = 0; it < kIterations; ++it) {
+        double mean = 0.0;
+        for (int j = 0; j < h; ++j)
+            for (int i = 0; i < w; ++i) {
+                const double c = at(i, j);
+                const double uxx = 1.0 + (at(i + 1, j) - 2.0 * c + at(i - 1, j)) * h2;
+                const double uyy = 1.0 + (at(i, j + 1) - 2.0 * c + at(i, j - 1)) * h2;
+                const double uxy = 0.25 * (at(i + 1, j + 1) - at(i + 1, j - 1) - at(i - 1, j + 1) + at(i - 1, j - 1)) * h2;
+                const double r = std::sqrt((uxx - uyy) * (uxx - uyy) + 4.0 * uxy * uxy + 4.0 * field.rho[std::size_t(j) * w + i]);
+                mean += rhs[std::size_t(j) * w + i] = r - 2.0;
+            }
+        mean /= double(count);
+        for (double& r : rhs) r -= mean;
+        psi = solvePoisson(w, h, rhs);
+    }
+    gradientCorners(field, psi);
+    const int n = options.columns, m = options.rows;
+    format::GridNodes grid;
+    grid.columns = n;
+    grid.rows = m;
+    grid.xy.resize(std::size_t(2) * n * m);
+    for (int j = 0; j < m; ++j)
+        for (int i = 0; i < n; ++i) {
+            const glm::dvec2 p(double(i) / (n - 1), double(j) / (m - 1));
+            glm::dvec2 q = clampUnit(p + velocity(field, p, 1.0));
+            if (i == 0) q.x = 0.0;
+            if (i == n - 1) q.x = 1.0;
+            if (j == 0) q.y = 0.0;
+            if (j == m - 1) q.y = 1.0;
+            grid.xy[2 * (std::size_t(j) * n + i)] = static_cast<float>(q.x);
+            grid.xy[2 * (std::size_t(j) * n + i) + 1] = static_cast<float>(q.y);
+        }
+    // The gradient of a convex potential is monotone, so its grid folds only where the grid cannot
+    // follow it; the identity is the answer then (the report shows it).
+    const bool valid = format::validateGrid(grid).ok();
+    SamplingMap map = valid ? SamplingMap::fromGrid(grid) : SamplingMap::identity(n, m);
+    if (report) {
+        *report = {};
+        report->gamma = valid ? 1.0 : 0.0;
+        compareWithTarget(map, target, buildAspect(target, options), *report);
+    }
+    return map;
+}
+
+SamplingMap buildFlowMap(const DensityField& target, const DensityMapOptions& options, DensityMapReport* report) {
     // Work with log(rho) relative to its maximum so that tempering rho^gamma cannot overflow.
     std::vector<double> logRho(target.values.size());
     double maxLog = -std::numeric_limits<double>::infinity();
@@ -242,7 +327,7 @@ SamplingMap buildMapFromDensity(const DensityField& target, const DensityMapOpti
     field.width = target.width;
     field.height = target.height;
     field.rho.resize(logRho.size());
-    const double aspect = fieldAspect(target);
+    const double aspect = buildAspect(target, options);
     bool anisotropyBound = false;
     auto attempt = [&](double gamma, format::GridNodes& grid) {
         double sum = 0.0;
@@ -262,8 +347,15 @@ SamplingMap buildMapFromDensity(const DensityField& target, const DensityMapOpti
         return true;
     };
     const auto finish = [&](format::GridNodes&& grid, double gamma) {
-        if (report) *report = {gamma, anisotropyBound};
-        return SamplingMap::fromGrid(grid);
+        SamplingMap map = SamplingMap::fromGrid(grid);
+        if (report) {
+            *report = {};
+            report->gamma = gamma;
+            report->anisotropyBound = anisotropyBound;
+            report->bound = options.maxAnisotropy;
+            compareWithTarget(map, target, aspect, *report);
+        }
+        return map;
     };
     format::GridNodes grid;
     if (attempt(1.0, grid)) return finish(std::move(grid), 1.0);

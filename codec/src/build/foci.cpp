@@ -11,6 +11,7 @@
 #include <string>
 
 #include "conus/codec/build/density_map.h"
+#include "conus/codec/build/map_measures.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
 
@@ -23,7 +24,6 @@ constexpr double kSamplesPerRadius = 12.0;
 constexpr int kMinDensitySide = 256;
 constexpr int kMaxDensitySide = 512;
 constexpr int kMinShortSide = 32;
-// The widest focus falloff, in radii of the focus.
 // Add composition: the factor applied to all displacements while the sum folds.
 constexpr double kAddShrink = 0.9;
 
@@ -56,7 +56,11 @@ double focusDensity(double s, double k, const FociFalloff& falloff) {
     return 1.0;
 }
 
-DensityField sampleFociDensity(std::span<const Focus> foci, double aspect, const FociFalloff& falloff) {
+// WidenedFocus's table step, and where the table ends (density 1 beyond), in radii.
+constexpr double kWidenedStep = 1.0 / 512.0;
+constexpr double kWidenedLimit = 64.0;
+
+DensityField sampleFociDensity(std::span<const Focus> foci, double aspect, const FociFalloff& falloff, double bound = 0) {
     double rMin = 1.0;
     for (const Focus& f : foci) rMin = std::min(rMin, f.r);
     // Radius in u is r, in v it is r * aspect; sample pixel-isotropically (H = W / aspect).
@@ -68,19 +72,104 @@ DensityField sampleFociDensity(std::span<const Focus> foci, double aspect, const
     field.width = std::max(kMinShortSide, static_cast<int>(std::lround(w * scale)));
     field.height = std::max(kMinShortSide, static_cast<int>(std::lround(h * scale)));
     field.values.resize(std::size_t(field.width) * field.height);
+    std::vector<WidenedFocus> profiles;
+    if (bound > 0)
+        for (const Focus& f : foci) profiles.emplace_back(f.k, falloff, bound);
     for (int y = 0; y < field.height; ++y)
-        for (int x = 0; x < field.width; ++x)
-            field.values[std::size_t(y) * field.width + x] =
-                static_cast<float>(fociDensity(foci, aspect, (x + 0.5) / field.width, (y + 0.5) / field.height, falloff));
+        for (int x = 0; x < field.width; ++x) {
+            const double u = (x + 0.5) / field.width, v = (y + 0.5) / field.height;
+            double density = 1.0;
+            if (bound > 0) {
+                for (std::size_t i = 0; i < foci.size(); ++i) {
+                    const double dx = u - foci[i].u, dy = (v - foci[i].v) / aspect;
+                    density = std::max(density, profiles[i].density(std::sqrt(dx * dx + dy * dy) / foci[i].r));
+                }
+            } else {
+                density = fociDensity(foci, aspect, u, v, falloff);
+            }
+            field.values[std::size_t(y) * field.width + x] = static_cast<float>(density);
+        }
     return field;
 }
 
-SamplingMap buildDensityComposition(std::span<const Focus> foci, const FociOptions& options) {
+double boundOf(const FociOptions& options) {
+    if (options.builder != DensityBuilder::Bounded) return options.maxAnisotropy;
+    return options.maxAnisotropy > 0 ? options.maxAnisotropy : map_rules::kMaxAnisotropy;
+}
+
+SamplingMap buildDensityComposition(std::span<const Focus> foci, const FociOptions& options, DensityMapReport* report = nullptr) {
     DensityMapOptions mapOptions;
     mapOptions.columns = options.columns;
     mapOptions.rows = options.rows;
     mapOptions.maxAnisotropy = options.maxAnisotropy;
-    return buildMapFromDensity(sampleFociDensity(foci, options.aspect, options.falloff), mapOptions);
+    mapOptions.builder = options.builder;
+    mapOptions.aspect = options.aspect;
+    const double widenFor = options.builder == DensityBuilder::Bounded ? boundOf(options) : 0.0;
+    return buildMapFromDensity(sampleFociDensity(foci, options.aspect, options.falloff, widenFor), mapOptions, report);
+}
+
+std::string focusText(const Focus& f) {
+    return numberText(f.u) + "," + numberText(f.v) + "," + numberText(f.r) + "," + numberText(f.k);
+}
+
+std::string rounded(double value) { return numberText(std::round(value * 100) / 100); }
+
+// A focus holds its k when it reaches three quarters of its extra magnification.
+bool heldWell(double reached, double k) { return reached >= 1.0 + 0.75 * (k - 1.0) - 1e-9; }
+
+// The bounded density composition, refining the grid while a focus smaller than a few of its
+// cells misses its k, with the report.
+SamplingMap buildBoundedFoci(std::span<const Focus> foci, const FociOptions& options, FociReport* report) {
+    // Refining helps only a focus this few cells wide; a larger one that misses is held back by
+    // the bound or by its neighbours, which a finer grid does not change.
+    constexpr double kSmallFocusCells = 4.0;
+    FociOptions o = options;
+    DensityMapReport densityReport;
+    SamplingMap map = buildDensityComposition(foci, o, &densityReport);
+    std::vector<double> reached = reachedMagnification(map, foci);
+    const auto needsFiner = [&](const FociOptions& at, const std::vector<double>& r) {
+        if (std::max(at.columns, at.rows) >= kMaxRefinedSide) return false;
+        for (std::size_t i = 0; i < foci.size(); ++i) {
+            const double cells = foci[i].r * std::min(at.columns - 1, int(std::lround((at.rows - 1) * options.aspect)));
+            if (!heldWell(r[i], foci[i].k) && cells < kSmallFocusCells) return true;
+        }
+        return false;
+    };
+    while (needsFiner(o, reached)) {
+        o.columns = std::min(2 * o.columns - 1, kMaxRefinedSide);
+        o.rows = std::min(2 * o.rows - 1, kMaxRefinedSide);
+        DensityMapReport finerReport;
+        SamplingMap finer = buildDensityComposition(foci, o, &finerReport);
+        map = std::move(finer);
+        densityReport = finerReport;
+        reached = reachedMagnification(map, foci);
+    }
+    if (!report) return map;
+    const double bound = boundOf(options);
+    *report = {};
+    report->columns = map.columns();
+    report->rows = map.rows();
+    report->bound = bound;
+    report->maxAnisotropy = densityReport.maxAnisotropy;
+    report->reached = reached;
+    if (map.columns() != options.columns || map.rows() != options.rows) {
+        report->notes.push_back("grid refined from " + std::to_string(options.columns) + "x" + std::to_string(options.rows) + " to " +
+                                std::to_string(map.columns()) + "x" + std::to_string(map.rows()) + " nodes for the smallest focus");
+    }
+    for (std::size_t i = 0; i < foci.size(); ++i) {
+        const double end = WidenedFocus(foci[i].k, options.falloff, bound).end();
+        report->transition.push_back(end);
+        if (end > options.falloff.width + 1e-9) {
+            report->notes.push_back("focus " + focusText(foci[i]) + ": transition widened from " + rounded(options.falloff.width) +
+                                    " to " + rounded(end) + " radii to keep anisotropy under " + rounded(bound));
+        }
+        if (!heldWell(reached[i], foci[i].k)) {
+            report->notes.push_back("focus " + focusText(foci[i]) + ": magnification " + rounded(reached[i]) + " of " +
+                                    rounded(foci[i].k) + " (the anisotropy bound " + rounded(bound) +
+                                    " and the frame's edges or neighbouring foci leave no more)");
+        }
+    }
+    return map;
 }
 
 SamplingMap buildAddComposition(std::span<const Focus> foci, const FociOptions& options) {
@@ -173,16 +262,79 @@ void checkFocus(const Focus& f) {
     }
 }
 
-SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options) {
+namespace {
+// The larger of the falloff's density and the bound's, joined smoothly (a p-norm of their excess
+// over the context's 1): never below either, and without the kink of a plain max, whose sudden
+// change of slope shows as a ring of aliasing in the encoded picture.
+double join(double base, double bounded) {
+    constexpr double kJoinPower = 4.0;
+    const double a = base - 1.0, b = std::max(bounded - 1.0, 0.0);
+    if (a <= 0.0) return 1.0 + b;
+    if (b <= 0.0) return base;
+    return 1.0 + std::pow(std::pow(a, kJoinPower) + std::pow(b, kJoinPower), 1.0 / kJoinPower);
+}
+}  // namespace
+
+WidenedFocus::WidenedFocus(double k, const FociFalloff& falloff, double bound) {
+    checkFalloff(falloff);
+    const double design = std::max(1.0 + 1e-3, kTransitionShare * bound);
+    const double step = kWidenedStep;
+    double mass = 0.0, s = 0.0, d = k * k;
+    m_density.push_back(d);
+    // M(s) = integral of 2 t d(t) dt by trapezoids; d(next) depends on M(next), so one
+    // fixed-point pass from the explicit guess (exact to the step's order).
+    while (true) {
+        const double next = s + step;
+        const double base = focusDensity(next, k, falloff);
+        if (next <= 1.0) {  // the disc: k^2 (its own anisotropy is 1)
+            mass += step * (s * d + next * base);
+            s = next;
+            d = base;
+            m_density.push_back(d);
+            continue;
+        }
+        // Capped at k^2, which the bound's density (at most k^2 / K) never needs.
+        double dNext = std::min(k * k, join(base, (mass + 2.0 * next * d * step) / (design * next * next)));
+        dNext = std::min(k * k, join(base, (mass + 0.5 * step * (2.0 * s * d + 2.0 * next * dNext)) / (design * next * next)));
+        mass += 0.5 * step * (2.0 * s * d + 2.0 * next * dNext);
+        s = next;
+        d = dNext;
+        m_density.push_back(d);
+        // A bound near 1 allows almost no change of density: the transition would never end.
+        if ((s >= falloff.width && d <= 1.0) || s >= kWidenedLimit) break;
+    }
+    m_end = s;
+}
+
+double WidenedFocus::density(double s) const {
+    const double x = s / kWidenedStep;
+    if (!(x < double(m_density.size() - 1))) return 1.0;
+    const std::size_t i = static_cast<std::size_t>(x);
+    return m_density[i] + (x - i) * (m_density[i + 1] - m_density[i]);
+}
+
+SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options) { return buildFociMap(foci, options, nullptr); }
+
+SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options, FociReport* report) {
     checkOptions(options);
     for (const Focus& f : foci) checkFocus(f);
     if (options.columns < 2 || options.rows < 2) {
         throw Error(ErrorCode::InvalidArgument, "foci map grid " + std::to_string(options.columns) + "x" +
                                                     std::to_string(options.rows) + " needs at least 2x2 nodes");
     }
-    if (foci.empty()) return SamplingMap::identity(options.columns, options.rows);
-    return options.composition == FociComposition::Add ? buildAddComposition(foci, options)
-                                                       : buildDensityComposition(foci, options);
+    if (foci.empty()) {
+        if (report) *report = {options.columns, options.rows, boundOf(options), 1.0, {}, {}, {}};
+        return SamplingMap::identity(options.columns, options.rows);
+    }
+    if (options.composition == FociComposition::Density && options.builder == DensityBuilder::Bounded)
+        return buildBoundedFoci(foci, options, report);
+    SamplingMap map = options.composition == FociComposition::Add ? buildAddComposition(foci, options)
+                                                                  : buildDensityComposition(foci, options);
+    if (report) {
+        *report = {map.columns(), map.rows(), boundOf(options), measureMap(map, options.aspect).maxAnisotropy,
+                   reachedMagnification(map, foci), std::vector<double>(foci.size(), options.falloff.width), {}};
+    }
+    return map;
 }
 
 std::vector<double> reachedMagnification(const SamplingMap& map, std::span<const Focus> foci) {

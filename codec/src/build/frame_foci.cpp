@@ -134,9 +134,29 @@ SamplingMap buildFrameFociMap(std::span<const Focus> foci, const FociOptions& op
             }
         }
 
+    // The anisotropy factor: the first s at which a cell's mean Jacobian, in pixels I + s S, reaches
+    // the bound K. With S's conformal part c and anticonformal part a (as vectors), K holds while
+    // |s a| <= q |(1, 0) + s c|, q = (K - 1) / (K + 1): a quadratic in s, positive at 0.
+    const double bound = options.maxAnisotropy > 0 ? options.maxAnisotropy : map_rules::kMaxAnisotropy;
+    const double q = (bound - 1.0) / (bound + 1.0);
+    double stretch = 1.0 / kAnisotropyMargin;
+    for (int j = 0; j + 1 < rows; ++j)
+        for (int i = 0; i + 1 < columns; ++i) {
+            const std::size_t n00 = at(i, j), n10 = at(i + 1, j), n01 = at(i, j + 1), n11 = at(i + 1, j + 1);
+            // Mean d shift / du and d shift / dv over the cell, then in pixels (x = aspect * u).
+            const double su_u = 0.5 * (shift[n10] - shift[n00] + shift[n11] - shift[n01]) / du;
+            const double sv_u = 0.5 * (shift[n10 + 1] - shift[n00 + 1] + shift[n11 + 1] - shift[n01 + 1]) / du;
+            const double su_v = 0.5 * (shift[n01] - shift[n00] + shift[n11] - shift[n10]) / dv;
+            const double sv_v = 0.5 * (shift[n01 + 1] - shift[n00 + 1] + shift[n11 + 1] - shift[n10 + 1]) / dv;
+            const double m00 = su_u, m01 = su_v * aspect, m10 = sv_u / aspect, m11 = sv_v;
+            const double cx = 0.5 * (m00 + m11), cy = 0.5 * (m10 - m01), ax = 0.5 * (m00 - m11), ay = 0.5 * (m10 + m01);
+            if (ax == 0.0 && ay == 0.0) continue;
+            stretch = std::min(stretch, firstRoot(q * q, 2.0 * q * q * cx, q * q * (cx * cx + cy * cy) - (ax * ax + ay * ay), stretch));
+        }
+
     // The nodes at s; single-precision rounding can still break a cell squeezed to V11's limit,
     // which the rules' own check catches, and a smaller s then mends.
-    double s = std::min(1.0, kFoldMargin * fold);
+    double s = std::min({1.0, kFoldMargin * fold, kAnisotropyMargin * stretch});
     std::vector<glm::vec2> nodes(count);
     for (int attempt = 0;; ++attempt) {
         for (std::size_t n = 0; n < count; ++n)

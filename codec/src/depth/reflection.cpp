@@ -75,7 +75,7 @@ std::optional<Focus> reflectionFocus(const Camera& face, const AxisBox& roi, dou
     // the one inscribed in the bounding square of the clipped projection (r half its larger side;
     // faces are square, r a fraction of the width): the corners lie in the fall-off. The bounding
     // disc instead (r half the diagonal) spreads the texels over 2x the area and reached a lower
-    // rate on the box, 1.8x against 2.2x at k = 3 (bench/README.md "Reflections").
+    // rate on the box, 1.8x against 2.2x at k = 3 (bench/notes/2026-11-24-reflections.md).
     const glm::dvec2 c = 0.5 * (lo + hi);
     const glm::dvec2 extent = hi - lo;
     const double r = std::clamp(0.5 * std::max(extent.x, extent.y), 0.02, 0.5);

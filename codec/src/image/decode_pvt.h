@@ -1,4 +1,5 @@
-// Private: the decoder's fast evaluation of Equation 1 along an output row, shared with its test.
+// Private: the decoder's fast evaluation of Equation 1 along an output row, shared with its test,
+// and the view rules the decoder and its bilinear baseline share.
 //
 // Along an output row v is fixed, so interpolating the two node rows of v's cell once gives one
 // distorted point per node column; inside a map cell Eq. 1 is then linear in u. Each output
@@ -70,6 +71,13 @@ inline void forEachSpan(const ViewColumns& cols, const RowNodes& nodes, Fn&& fn)
            span.ds * nodes.dy[i]);
     }
 }
+
+// Throws conus::Error(InvalidArgument) for an empty or non-finite view (`what` names the caller).
+void checkView(const View& v, const char* what);
+
+// Sets to 0 (the background) the pixels of `out` whose centre lies outside the image ([0,1]^2
+// undistorted), instead of the edge pixels smeared outward; touches only those pixels.
+void clearOutside(Image& out, const View& view);
 
 // Equation 1 at every output column of row `y` of a width x height view, by the stepping above
 // (normalized distorted coordinates). Tests compare it with SamplingMap::distort.

@@ -1,4 +1,4 @@
-// Which copy of the planned pyramid decode runs (decode.cpp): the baseline x86-64 one (SSE2), or
+// Which copy of the planned pyramid decode runs (decode_planned.cpp): the baseline x86-64 one (SSE2), or
 // one compiled for x86-64-v3 (AVX2) where the processor has it. Both give the same floats; the
 // switch lets the tests compare them on one machine.
 #pragma once

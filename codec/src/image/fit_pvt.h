@@ -1,11 +1,11 @@
 // Private: the decoder as a linear operator D (fit.h), a row of output pixels at a time, and its
 // adjoint, shared by the fit and its test.
 //
-// DecoderTaps walks decode.cpp's decodeRows (without a pyramid) for the whole-image view: the same
-// row stepping of Eq. 1 (decode_pvt.h), the same footprint rule (decode_pvt.h's tapsFor, the taps
-// at TapOffsets), the same clamp to the image. It yields each output pixel's taps
+// DecoderTaps walks the decoder's multi-tap reference (decode_reference_pvt.h) for the whole-image
+// view: the same row stepping of Eq. 1 (decode_pvt.h), the same footprint rule (decode_pvt.h's
+// tapsFor, the taps at TapOffsets), the same clamp to the image. It yields each output pixel's taps
 // instead of their value, so the fit can gather through them (D) and splat through them (D^T).
-// decode.cpp keeps its own loop, faster for its one job; tests/codec/image/fit_test.cpp checks
+// The decoder keeps its own loop, faster for its one job; tests/codec/image/fit_test.cpp checks
 // that the two agree on every pixel.
 #pragma once
 
@@ -20,8 +20,8 @@
 
 namespace conus::codec::detail {
 
-// One bilinear tap: CoNUS pixel coordinates plus one (pixel centres at 1, 2, ...; decode.cpp's
-// "biased" coordinates) and its weight.
+// One bilinear tap: CoNUS pixel coordinates plus one (pixel centres at 1, 2, ...; the decoder's
+// "biased" coordinates, tapBiased) and its weight.
 struct DecoderTap {
     double x = 0, y = 0;
     float weight = 1;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "conus/codec/build/map_measures.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
@@ -70,7 +71,11 @@ TEST(FrameFoci, IsolatedFocusMagnifiesByKAtItsCentre) {
                           {{0.5, 0.5, 0.08, 2.0}, map_rules::kDefaultSide, 1.5}};
     for (const Case& c : cases) {
         const Focus foci[] = {c.focus};
-        const SamplingMap map = buildFrameFociMap(foci, grid(c.side, c.aspect));
+        // The lens of k = 8 alone stretches its ring to 7.4, past the default bound (which would
+        // scale it, AnisotropyStaysUnderTheBound): a looser one leaves the lens whole here.
+        FociOptions options = grid(c.side, c.aspect);
+        options.maxAnisotropy = 12.0;
+        const SamplingMap map = buildFrameFociMap(foci, options);
         expectValid(map);
         const double reached = magnificationAt(map, {c.focus.u, c.focus.v});
         EXPECT_NEAR(reached, c.focus.k, 0.12 * c.focus.k) << c.focus.k;
@@ -112,6 +117,30 @@ TEST(FrameFoci, EightOverlappingFociGiveAValidMap) {
         expectValid(map);
         // The guard scaled the sum down, but every focus is still magnified.
         for (const Focus& f : foci) EXPECT_GT(magnificationAt(map, {f.u, f.v}), 1.2) << aspect;
+    }
+}
+
+TEST(FrameFoci, AnisotropyStaysUnderTheBound) {
+    // Lenses cut by the frame's edge, or overlapping, stretch cells: unscaled, these measured 10 to
+    // 18. The sum is scaled to the bound.
+    const std::vector<std::vector<Focus>> cases = {{{0.5, 0.5, 0.2, 4.0}},
+                                                   {{0.3, 0.4, 0.1, 4.0}, {0.4, 0.45, 0.1, 4.0}},
+                                                   {{0.3, 0.4, 0.1, 8.0}, {0.4, 0.45, 0.1, 8.0}},
+                                                   {{0.05, 0.9, 0.12, 6.0}}};
+    for (const auto& foci : cases) {
+        for (double aspect : {1.0, 16.0 / 9.0}) {
+            const SamplingMap map = buildFrameFociMap(foci, grid(map_rules::kDefaultSide, aspect));
+            expectValid(map);
+            EXPECT_LE(measureMap(map, aspect).maxAnisotropy, map_rules::kMaxAnisotropy) << foci.size() << " foci, aspect " << aspect;
+            // One factor scales every lens, so a lens cut by the edge costs its neighbours too;
+            // each still magnifies.
+            for (const Focus& f : foci) EXPECT_GT(magnificationAt(map, {f.u, f.v}), 1.3) << aspect;
+            // A looser bound scales less.
+            FociOptions loose = grid(map_rules::kDefaultSide, aspect);
+            loose.maxAnisotropy = 30.0;
+            EXPECT_GE(magnificationAt(buildFrameFociMap(foci, loose), {foci[0].u, foci[0].v}),
+                      magnificationAt(map, {foci[0].u, foci[0].v}) - 1e-6);
+        }
     }
 }
 

@@ -1,4 +1,4 @@
-// Issue 10's radial comb: thin features crossing the ring just outside a focus came out as a
+// The radial comb: thin features crossing the ring just outside a focus came out as a
 // starburst of streaks. Measured on a Siemens star: along any circle about its centre the star is a
 // square wave of kSpokes periods, so its intensity there holds energy only at multiples of kSpokes
 // cycles (and at 0). A low-pass filter of any width keeps it that way (it lowers the harmonics and
@@ -102,7 +102,7 @@ TEST(Comb, FocusRingOfASiemensStarAliasesNoMoreThanUniform) {
     const std::vector<double> radii = {200, 220, 240, 260, 280};
     const CircleSpectrum u = spectrum(uniform, radii);
     // The default focus, a narrower transition and a wider log-shaped one. Steeper rims comb more
-    // (1.5,logr: +3.7 dB, 1.25: +2.9 dB, 2,logr: +1.8 dB on this star; bench/README.md), so the
+    // (1.5,logr: +3.7 dB, 1.25: +2.9 dB, 2,logr: +1.8 dB on this star; bench/notes/2026-11-24-quality-ring-check.md), so the
     // narrowest that holds the target is what `--falloff` may offer as a default.
     for (const FociFalloff& falloff : {FociFalloff{}, FociFalloff{1.75, FociFalloffShape::Density},
                                        FociFalloff{3.0, FociFalloffShape::LogRadius}}) {
@@ -122,10 +122,11 @@ TEST(Comb, FocusRingOfASiemensStarAliasesNoMoreThanUniform) {
                     "(%+.2f dB), uniform %.3g; star fundamental: CoNUS %.3g, uniform %.3g\n",
                     falloffText(falloff).c_str(), c.comb, dB(c.comb, u.comb), b.comb, dB(b.comb, u.comb), u.comb, c.fundamental,
                     u.fundamental);
-        // Issue 10's target for the aliasing check in the ring: within 1 dB of uniform's.
+        // The target for the aliasing check in the ring: within 1 dB of uniform's.
         EXPECT_LT(dB(c.comb, u.comb), 1.0) << falloffText(falloff);
-        // The measure sees the comb: the pixel's box alone (the old filter) is well above it.
-        EXPECT_GT(dB(b.comb, u.comb), 3.0) << falloffText(falloff);
+        // The measure sees the comb: the pixel's box alone (the old filter) is well above it (less
+        // so since maps keep their anisotropy bounded: +2.9 dB with the widest ring).
+        EXPECT_GT(dB(b.comb, u.comb), 2.5) << falloffText(falloff);
         // And the filter removes the comb, not the star: the spokes keep most of their contrast
         // (energy at the star's own frequency at least a quarter of the uniform image's).
         EXPECT_GT(c.fundamental, 0.25 * u.fundamental) << falloffText(falloff);
@@ -154,7 +155,7 @@ TEST(Comb, FittedEncodeKeepsTheRingClean) {
     const auto dB = [](double x, double y) { return 10 * std::log10(x / y); };
 
     // The default focus, and the narrower transition that `--fit --falloff 1.75` pairs with on
-    // photographs (bench/README.md: the pair meets issue 10's frame-loss target at k = 4).
+    // photographs (bench/notes/2026-11-24-quality.md: the pair meets the frame-loss target at k = 4).
     for (const FociFalloff& falloff : {FociFalloff{}, FociFalloff{1.75, FociFalloffShape::Density}}) {
         FociOptions options;
         options.falloff = falloff;

@@ -1,4 +1,4 @@
-// The pyramid decode (issue 10 item 6): a zoomed-out pixel takes one trilinear tap from the CoNUS
+// The pyramid decode: a zoomed-out pixel takes one trilinear tap from the CoNUS
 // image's mip chain instead of up to 8x8 bilinear taps. It must not alias more than the multi-tap
 // decode, must stay close to it, and must leave magnified pixels exactly as they were.
 #include <algorithm>

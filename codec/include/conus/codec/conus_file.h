@@ -29,4 +29,8 @@ format::ConusFile makeDepthImageFile(Image image, const SamplingMap& map, const 
 
 format::ConusFile makeMapFile(const SamplingMap& map, std::optional<format::AnalyticMap> analytic = std::nullopt);
 
+// The width / height of the pictures a file's map was made for: a map file's `aspect` scalar, an
+// image file's source's; none when the file does not say (a map file without it).
+std::optional<double> madeForAspect(const format::ConusFile& file);
+
 }  // namespace conus::codec

@@ -1,7 +1,7 @@
 // From linear light to a display: exposure, an optional tone map for values above 1, and the
 // display's transfer curve. One definition for every place that shows linear data: `conus decode`
 // to PNG/JPEG (imageio applies exposure and tone map; OpenImageIO encodes sRGB) and the viewer
-// (its CPU path calls these; its shader mirrors them, renderers/shaders/display.glsl).
+// (its CPU path calls these; its shader mirrors them: `display` in renderers/shaders/view_frame.frag.glsl).
 #pragma once
 
 #include <array>

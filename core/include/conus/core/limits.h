@@ -2,7 +2,7 @@
 // a command line) against these, in 64-bit arithmetic, before it allocates; `conus info --limits`
 // prints them and spec/conus-format.md ("Limits") lists the same values. A caller may tighten them
 // through a Limits value (format::ReadLimits is this struct); the constants are the defaults.
-// Self-contained on purpose (no OpenEXR or other types): it moves to core/ in the restructuring.
+// Standard types only, so that every library, the CLI and the Python module can include it.
 #pragma once
 
 #include <array>

@@ -20,6 +20,11 @@ inline constexpr double kMaxFalloffWidth = 8.0;
 inline constexpr int kFalloffShapes = 3;
 // The grid the builders make when a user does not say (nodes per side).
 inline constexpr int kDefaultSide = 65;
+// The builders' default bound on anisotropy: the ratio of a cell's Jacobian singular values in
+// pixels (codec's map_measures.h). A CoNUS pixel's footprint is at most this elongated, so the
+// encode's filter and the decode's stretch stay local; foci reach their k by widening their
+// transition instead (codec/build/density_map.h, foci.h).
+inline constexpr double kMaxAnisotropy = 7.0;
 
 // The corners of cell (i,j) in its cyclic order: (i,j), (i+1,j), (i+1,j+1), (i,j+1).
 inline constexpr int kCornerDi[4] = {0, 1, 1, 0};

@@ -12,6 +12,8 @@
 #include <thread>
 #include <vector>
 
+#include "conus/core/check.h"
+
 namespace conus {
 
 inline int threadCount(int requested) {
@@ -23,6 +25,7 @@ inline int threadCount(int requested) {
 // the system gives fewer threads than asked, the rows are shared among those it gives.
 template <typename Fn>
 void parallelRows(int rows, int threads, Fn&& fn, int chunk = 8) {
+    CONUS_DCHECK_GE(chunk, 1);  // a chunk of 0 rows would hand out the same rows forever
     const int n = std::min(threadCount(threads), std::max(1, (rows + chunk - 1) / chunk));
     if (n <= 1) {
         fn(0, rows);

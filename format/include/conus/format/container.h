@@ -99,6 +99,10 @@ struct ConusFile {
 using ReadLimits = conus::Limits;
 
 void writeConusFile(const std::string& path, const ConusFile& file);
+// Refuses (InvalidArgument) an output name that does not end in .exr (any case): a CoNUS file is
+// an OpenEXR file, and a picture's extension would make readers expect a picture. The CLI and the
+// Python package call it before any work.
+void checkConusFileName(const std::string& path);
 ConusFile readConusFile(const std::string& path, const ReadLimits& limits = {});
 // Everything readConusFile reads but the CoNUS image's pixels (what `conus info` and `validate`
 // need): the image has its width, height and channels and no pixels. The same checks run, the

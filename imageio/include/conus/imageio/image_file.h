@@ -92,6 +92,9 @@ std::string sampleTypesOf(const std::string& path);
 // NaN and infinite values in `image`.
 std::int64_t countNonFinite(const Image& image);
 
+// Replaces the NaN and infinite values of an image in memory as reading with that repair does.
+void repairNonFinite(Image& image, NonFiniteRepair repair);
+
 // Converts an image of display-encoded sRGB values (a picture drawn in memory) to linear light
 // with associated alpha, as if it had been read from an 8-bit file.
 void linearize(Image& image);

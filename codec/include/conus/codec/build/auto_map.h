@@ -5,10 +5,12 @@
 // grid of at most 256 cells a side, and s chosen so that rho has mean 1 (the CoNUS image has as
 // many pixels as a uniform one): so `minDensity` is exactly the density context gets, and
 // `maxDensity` caps the magnification (density 16 = linear rate 4). Two methods build the map:
-// - Flow (default): a true 2-D map whose Jacobian determinant follows rho (density_map.h).
+// - Flow (default): a true 2-D map whose Jacobian determinant follows rho (density_map.h), built
+//   by `builder`: the bounded builder by default (every cell's anisotropy under the bound, the
+//   density giving way where the importance rises too steeply for it), or Moser's flow.
 // - Separable: the baseline; u and v are warped independently by the cumulative marginals of rho,
 //   so density is the product of the marginals (bands through every hot spot).
-// Flow matches the target far better (tests and bench/README.md give the figures), so it is the
+// Flow matches the target far better (tests and bench/notes/2026-11-22-suite-figures.md give the figures), so it is the
 // default. Every result is a valid map; all-zero importance gives the identity.
 #pragma once
 
@@ -27,7 +29,8 @@ struct AutoMapOptions {
     double maxDensity = 16.0;     // cap of the density (> 1)
     double smoothing = 0.01;      // blur radius as a fraction of the image width
     AutoMethod method = AutoMethod::Flow;
-    double maxAnisotropy = 0;     // flow: DensityMapOptions::maxAnisotropy (0: none)
+    double maxAnisotropy = 0;     // flow: DensityMapOptions::maxAnisotropy (0: the builder's default)
+    DensityBuilder builder = DensityBuilder::Bounded;  // flow: which 2-D builder
     bool refuseBounds = true;     // false: return the map closest to the bounds instead of refusing
 };
 

@@ -6,7 +6,9 @@
 //
 // Two ways to build several foci:
 // - Density (default): one map from the joint density of all foci (density_map.h); the region
-//   between foci is squeezed least.
+//   between foci is squeezed least. With the bounded builder (the default) each focus's
+//   transition is first widened where its falloff is too steep for the anisotropy bound (below),
+//   so the map reaches k with every cell's anisotropy under the bound.
 // - Add: the paper's composition: each focus's own map, displacement vectors added; if the sum
 //   folds, displacements are scaled down until every cell is valid.
 #pragma once
@@ -15,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "conus/codec/build/density_map.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/core/map_rules.h"
@@ -49,11 +52,31 @@ FociFalloff parseFalloff(const std::string& text);
 std::string falloffText(const FociFalloff& falloff);
 
 struct FociOptions {
-    int columns = map_rules::kDefaultSide, rows = map_rules::kDefaultSide;  // grid of the built map
+    // Grid of the built map; the bounded builder refines it (2n - 1 nodes a side, up to
+    // kMaxRefinedSide) while a focus smaller than a few cells misses its k (FociReport says so).
+    int columns = map_rules::kDefaultSide, rows = map_rules::kDefaultSide;
     double aspect = 1.0;          // image width / height: makes a focus circular in pixels
     FociComposition composition = FociComposition::Density;
-    double maxAnisotropy = 0;     // density composition: DensityMapOptions::maxAnisotropy (0: none)
+    // Density composition: DensityMapOptions::maxAnisotropy (0: the builder's default, which for
+    // the bounded builder is map_rules::kMaxAnisotropy and for Flow none).
+    double maxAnisotropy = 0;
     FociFalloff falloff = {};     // how each focus's density falls to the context's (`= {}`: no -Wextra warning)
+    DensityBuilder builder = DensityBuilder::Bounded;
+};
+
+// The largest grid the foci builder refines to on its own (nodes a side).
+inline constexpr int kMaxRefinedSide = 257;
+
+// What a foci map reached, and what gave way (bounded builder; Flow and Add fill what they can).
+struct FociReport {
+    int columns = 0, rows = 0;          // the grid built: finer than asked when a focus needed it
+    double bound = 0;                   // the anisotropy bound applied (0: none)
+    double maxAnisotropy = 1;           // the map's largest cell anisotropy, in pixels
+    std::vector<double> reached;        // per focus: reachedMagnification
+    std::vector<double> transition;     // per focus: where its widened transition ends, in radii
+    // One line per thing that gave way, with numbers (a transition widened, a grid refined, a k
+    // not reached); empty when the map is what was asked.
+    std::vector<std::string> notes;
 };
 
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r outside (0, 1] or k outside
@@ -61,7 +84,29 @@ struct FociOptions {
 void checkFocus(const Focus& focus);
 
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r <= 0 or k < 1 or k > 64.
+// Never for a grid too coarse: the bounded builder refines it (FociOptions::columns).
 SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options = {});
+SamplingMap buildFociMap(std::span<const Focus> foci, const FociOptions& options, FociReport* report);
+
+// A focus's density profile once its transition is widened for the anisotropy bound `bound`:
+// over s = distance / r, k^2 inside the disc, 1 from end() on (falloff.width when the falloff is
+// gentle enough). It is the smallest density above the falloff's for which the radial map of this
+// focus alone in the plane has anisotropy at most K = kTransitionShare * bound: the density mass
+// M(s) within s radii then obeys M(s) <= K s^2 d(s), i.e. d(s) = max(falloff density, M(s) / (K s^2)).
+// The share leaves room for the frame's edges and neighbouring foci. Tabulated once (512 steps a
+// radius, up to 64 radii: a bound near 1 allows almost no change of density, and its transition
+// is cut there); throws conus::Error(InvalidArgument) for a bad falloff.
+inline constexpr double kTransitionShare = 0.7;
+class WidenedFocus {
+public:
+    WidenedFocus(double k, const FociFalloff& falloff, double bound);
+    double end() const { return m_end; }
+    double density(double s) const;
+
+private:
+    std::vector<double> m_density;  // at s = i * kStep
+    double m_end = 1.0;
+};
 
 // The linear magnification `map` reaches at each focus centre: the square root of its density
 // there over its lowest density (which stands for "far from every focus"). 1 for the identity.
@@ -70,7 +115,9 @@ std::vector<double> reachedMagnification(const SamplingMap& map, std::span<const
 // Throws conus::Error(InvalidArgument) when `map` (built for `foci` with `options`) reaches less
 // than half of some focus's extra magnification (below 1 + (k - 1) / 2), naming the smallest grid
 // of 2^j + 1 nodes a side (up to 257) that does: a grid too coarse for a focus ignores it (a 2x2
-// grid is always the identity), and a file would record a focus its map does not have.
+// grid is always the identity), and a file would record a focus its map does not have. A map of
+// the bounded builder has refined its grid already, so this holds for it but in the extreme
+// (a focus under a cell of a 257-node grid).
 void checkFociHeld(const SamplingMap& map, std::span<const Focus> foci, const FociOptions& options);
 
 // The target density (before normalization) of a set of foci at undistorted p.

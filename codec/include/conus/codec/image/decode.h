@@ -1,13 +1,17 @@
-// CPU reference decoder: reconstructs a conventional frame from a CoNUS image. A view is a
+// The CPU decoder: reconstructs a conventional frame from a CoNUS image. A view is a
 // rectangle of the undistorted image plane rendered at width x height; each output pixel at (u,v)
 // takes the CoNUS image at SM(u,v) (Equation 1), bilinearly. Where the output is coarser than the
-// CoNUS image there (zoomed out), several taps over the pixel's footprint are averaged. Output
-// pixels whose centre lies outside the image show the background (0 in every channel).
+// CoNUS image there (zoomed out), several taps over the pixel's footprint are averaged, or one
+// trilinear tap is taken from the image's pyramid (pyramid.h). Output pixels whose centre lies
+// outside the image show the background (0 in every channel). The GPU decoder (renderers/) gives
+// the same frames and is tested against this one.
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
+#include "conus/codec/image/pyramid.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/error.h"
 #include "conus/core/image.h"
@@ -24,28 +28,9 @@ struct View {
     double u0 = 0, v0 = 0, u1 = 1, v1 = 1;  // undistorted rectangle; may extend past [0,1]^2 (background there)
 };
 
-// A mip chain of a CoNUS image for zoomed-out views: level k >= 1 is the exact area downsample
-// of level k-1 to half its size (rounded down, at least 1 pixel), down to 1x1. Level 0 is the
-// image itself and is not stored: levels[0] is level 1. Built once per image (a viewer keeps it
-// for every frame); GPU decoders upload the same levels as the texture's mip chain.
-struct ImagePyramid {
-    std::vector<Image> levels;
-};
-ImagePyramid buildPyramid(const Image& conus, int threads = 0);
-// Throws conus::Error(InvalidArgument) unless `pyramid` is buildPyramid's for an image of conus's
-// size and channels (decoders call it before they use one).
-void checkPyramid(const Image& conus, const ImagePyramid& pyramid);
-
-// The pyramid's level of detail for a footprint whose longer edge is rho CoNUS pixels:
-// lambda = max(0, log2(rho) - kDecodePyramidBias), 0 meaning level 0 alone (one bilinear tap),
-// with log2 by a quadratic in the mantissa (within 0.005 of the exact log2) that the GLSL twin
-// repeats. GL's own rule has no bias; a level-L texel is a 2^L box and bilinear adds a 2^L tent,
-// so that blurs about 1.7x wider than the multi-tap average over rho (a box of rho plus a tent of
-// 1), whose blur lambda = log2(rho) - 0.79 would match; at 0.5 a fitted zone plate keeps less
-// aliasing than the multi-tap decode (tests/codec/image/pyramid_test.cpp) and stays within
-// 33-37 dB of it, where GL's rule was 28-33 dB away. rhoSquared: rho^2.
-inline constexpr double kDecodePyramidBias = 0.5;
-float pyramidLevel(float rhoSquared);
+// Refuses (InvalidArgument) a view that is empty or inverted (it needs u0 < u1 and v0 < v1), not
+// finite, or absurdly far from the image; `shown` is the view as the caller wrote it.
+void checkView(const View& view, const std::string& shown);
 
 // Whether some output pixel of `view` decoded at width x height has a footprint in `conus` longer
 // than the pyramid decode's one bilinear tap (2^kDecodePyramidBias CoNUS pixels): there a pyramid

@@ -27,10 +27,10 @@ namespace conus::codec {
 // spacing of the uniform image of the same pixel count, sqrt(source area / CoNUS area) source pixels.
 // A footprint up to kEncodeBoxAnisotropy : 1 keeps the plain box (the exact area average; a pixel
 // grid with different ratios per axis is one); a long thin one is low-passed along its length, where
-// a box's side lobes alias into a radial comb once the decoder magnifies it (issue 10;
-// tests/codec/image/comb_test.cpp measures it). A major axis no longer than the uniform pixel
+// a box's side lobes alias into a radial comb once the decoder magnifies it
+// (tests/codec/image/comb_test.cpp measures it). A major axis no longer than the uniform pixel
 // also keeps the box: it aliases no more than the uniform image's own box filter does (the inner
-// ring of a focus, dense both ways; the Gaussian there cost 0.7 dB for nothing, bench/README.md).
+// ring of a focus, dense both ways; the Gaussian there cost 0.7 dB for nothing, bench/notes/2026-11-24-comb-at-focus-rims.md).
 // The pyramid level is the first where the minor axis is at most kEncodeMaxTaps texels and the
 // filter's extent along a and b at most kEncodeMaxAxisTaps: taps are at most a texel apart along
 // each edge, so a long axis takes many taps instead of being truncated (a longer one moves up a

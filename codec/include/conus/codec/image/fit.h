@@ -30,13 +30,16 @@
 namespace conus::codec {
 
 // Default iterations: the decoded PSNR of astronaut and chelsea (two foci, 1/16) stops rising
-// after 2-3 (bench/README.md, "Fitted to the decoder": the PSNR per iteration). Damping
+// after 2-3 (bench/notes/2026-11-24-quality-fit-to-decoder.md: the PSNR per iteration). Damping
 // (0: none where the encoder kept the box filter) and hold: where the encoder low-passed a long
 // footprint axis (encode.h's rule against the radial comb), the damping grows by kFitHoldLowPass
 // times the share of that low-pass (the Gaussian's extent beyond the box, at most 1). Without it
 // the fit undoes that filter and the comb comes back (+13 dB in tests/codec/image/comb_test.cpp);
 // with 3 the ring aliases as much as the uniform image fitted the same way.
 inline constexpr int kFitIterations = 4;
+// What `encode` (and conus.encode) runs by default: on the photographs of bench/quality.py the
+// third and fourth iterations add 0.01-0.05 dB and cost half the fit's time.
+inline constexpr int kDefaultEncodeFitIterations = 2;
 inline constexpr double kFitDamping = 0.0;
 inline constexpr double kFitHoldLowPass = 3.0;
 

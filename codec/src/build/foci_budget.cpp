@@ -1,0 +1,155 @@
+// The pixel budget of foci: their share of the samples, and the k a budget allows (foci_budget.h).
+#include "conus/codec/build/foci_budget.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "conus/core/error.h"
+
+namespace conus::codec {
+namespace {
+
+// Samples along the share grid's longer side, and at least this many across the smallest radius.
+constexpr int kShareSide = 512;
+constexpr double kShareSamplesPerRadius = 8.0;
+constexpr int kMaxShareSide = 2048;
+// Halvings of the exponent t of k^t: t to within 1/64 (k = 4: to within 2%).
+constexpr int kBisectionSteps = 6;
+
+bool inDisc(const Focus& f, double aspect, double u, double v) {
+    const double dx = u - f.u, dy = (v - f.v) / aspect;
+    return dx * dx + dy * dy <= f.r * f.r;
+}
+
+std::vector<Focus> powered(std::span<const Focus> foci, double t) {
+    std::vector<Focus> out(foci.begin(), foci.end());
+    for (Focus& f : out) f.k = std::pow(f.k, t);
+    return out;
+}
+
+// Each focus records what `map` reaches where that is below half its extra magnification (a grid
+// too coarse for it): the file must not record a magnification its map does not have.
+bool recordReached(const SamplingMap& map, std::vector<Focus>& foci) {
+    const std::vector<double> reached = reachedMagnification(map, foci);
+    bool limited = false;
+    for (std::size_t i = 0; i < foci.size(); ++i)
+        if (reached[i] < 1.0 + 0.5 * (foci[i].k - 1.0)) {
+            foci[i].k = std::clamp(reached[i], 1.0, foci[i].k);
+            limited = true;
+        }
+    return limited;
+}
+
+// The largest t in [0, 1] (to 1/64) for which holds(t); holds(0) is taken as true.
+double largestHolding(const std::function<bool(double)>& holds) {
+    if (holds(1.0)) return 1.0;
+    double lo = 0.0, hi = 1.0;
+    for (int i = 0; i < kBisectionSteps; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (holds(mid) ? lo : hi) = mid;
+    }
+    return lo;
+}
+
+}  // namespace
+
+FociShare fociShare(std::span<const Focus> foci, double aspect, const FociFalloff& falloff) {
+    FociShare out;
+    if (foci.empty()) return out;
+    double rMin = 1.0;
+    for (const Focus& f : foci) rMin = std::min(rMin, f.r);
+    // Pixel-isotropic samples (the width is `aspect` times the height), fine enough for every disc.
+    const int longSide = std::clamp(static_cast<int>(std::ceil(kShareSamplesPerRadius / rMin * std::max(1.0, 1.0 / aspect))),
+                                    kShareSide, kMaxShareSide);
+    const int w = aspect >= 1 ? longSide : std::max(8, static_cast<int>(std::lround(longSide * aspect)));
+    const int h = aspect >= 1 ? std::max(8, static_cast<int>(std::lround(longSide / aspect))) : longSide;
+    double total = 0, discs = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const double u = (x + 0.5) / w, v = (y + 0.5) / h;
+            const double d = fociDensity(foci, aspect, u, v, falloff);
+            total += d;
+            if (std::any_of(foci.begin(), foci.end(), [&](const Focus& f) { return inDisc(f, aspect, u, v); })) discs += d;
+        }
+    const double samples = double(w) * h;
+    out.contextDensity = samples / total;
+    out.share = discs / total;
+    out.ask = discs / samples;
+    return out;
+}
+
+double contextDownscale(const FociShare& share, int width, int height, int sourceWidth, int sourceHeight) {
+    const double rate = std::sqrt(double(width) * height / (double(sourceWidth) * sourceHeight) * share.contextDensity);
+    return 1.0 / std::max(rate, 1e-12);
+}
+
+Image fociImportance(std::span<const Focus> foci, double aspect, int width, int height) {
+    Image image = makeImage(width, height, {"Y"});
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const double u = (x + 0.5) / width, v = (y + 0.5) / height;
+            image.at(x, y) = std::any_of(foci.begin(), foci.end(), [&](const Focus& f) { return inDisc(f, aspect, u, v); }) ? 1.0f : 0.0f;
+        }
+    return image;
+}
+
+FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& options, const FrameErrorModel& model,
+                            double frameLossDb, bool exactK, double tileLossDb) {
+    if (!(frameLossDb >= 0) || !std::isfinite(frameLossDb))
+        throw Error(ErrorCode::InvalidArgument, "the frame-loss budget " + std::to_string(frameLossDb) + " dB must be finite and >= 0");
+    if (!(tileLossDb >= 0))  // NaN fails; infinity: no tile budget
+        throw Error(ErrorCode::InvalidArgument, "the tile-loss budget " + std::to_string(tileLossDb) + " dB must be >= 0");
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false};
+    // A lower k leaves the context more samples: the loss falls with t. Each try builds the map and
+    // predicts what it loses (its target alone predicts too little: stretched footprints lose along
+    // their long axis).
+    double bestT = -1;
+    const auto holds = [&](double t) {
+        std::vector<Focus> tried = powered(foci, t);
+        SamplingMap map = buildFociMap(tried, options);
+        const FramePrediction p = model.predict(map);
+        const bool ok = p.frameLoss <= frameLossDb && p.tileLoss <= tileLossDb;
+        if (ok && t > bestT) {
+            bestT = t;
+            out.given = std::move(tried);
+            out.map = std::move(map);
+            out.predicted = p;
+        }
+        return ok;
+    };
+    if (exactK) {
+        out.given = out.asked;
+        out.map = buildFociMap(out.given, options);
+        out.predicted = model.predict(out.map);
+    } else {
+        const double t = largestHolding(holds);
+        if (bestT < 0) {  // even the lowest t tried loses more: the identity (k = 1) holds any budget
+            out.given = powered(foci, t);
+            out.map = buildFociMap(out.given, options);
+            out.predicted = model.predict(out.map);
+        }
+        out.lowered = t < 1.0;
+    }
+    out.gridLimited = recordReached(out.map, out.given);
+    out.share = fociShare(out.given, options.aspect, options.falloff);
+    out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;
+    return out;
+}
+
+FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options, double floor, bool exactK) {
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false};
+    const double t = exactK ? 1.0 : largestHolding([&](double t) {
+        return fociShare(powered(foci, t), options.aspect, options.falloff).contextDensity >= floor;
+    });
+    out.given = powered(foci, t);
+    out.lowered = t < 1.0;
+    out.map = buildFociMap(out.given, options);
+    out.gridLimited = recordReached(out.map, out.given);
+    out.share = fociShare(out.given, options.aspect, options.falloff);
+    out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;
+    return out;
+}
+
+}  // namespace conus::codec

@@ -1,0 +1,58 @@
+// What encode(foci=...)'s budget did (codec/build/foci_budget.h), as File.budget shows it, and the
+// warning it gives. Included by module.cpp only.
+#pragma once
+
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "conus/codec/build/foci_budget.h"
+#include "conus/core/error.h"
+
+namespace conus::python {
+
+// The dict of File.budget; warns (UserWarning) when k was lowered, when exact_k left the frame
+// losing more than the budget, and when the grid held a focus only to a lower k.
+inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, int w, int h, int sourceW, int sourceH, bool exactK) {
+    std::vector<double> asked, given;
+    for (const codec::Focus& f : b.asked) asked.push_back(f.k);
+    for (const codec::Focus& f : b.given) given.push_back(f.k);
+    pybind11::dict d;
+    d["k_asked"] = asked;
+    d["k_given"] = given;
+    d["lowered"] = b.lowered;
+    d["grid_limited"] = b.gridLimited;
+    d["frame_loss"] = frameLoss;
+    d["predicted_frame_loss"] = b.predicted.frameLoss;
+    d["predicted_roi_gain"] = b.predicted.roiGain;
+    d["predicted_tile_loss"] = b.predicted.tileLoss;
+    d["foci_share"] = b.share.share;
+    d["ask"] = b.askedShare.ask;
+    d["context_downscale"] = codec::contextDownscale(b.share, w, h, sourceW, sourceH);
+    d["uniform_downscale"] = codec::contextDownscale({0, 1, 0}, w, h, sourceW, sourceH);
+    const auto list = [](const std::vector<double>& k) {
+        std::string out;
+        for (double v : k) out += (out.empty() ? "" : ", ") + numberText(std::round(v * 100) / 100);
+        return out;
+    };
+    std::string warning;
+    if (b.lowered)
+        warning = "conus.encode: the loss budget (whole frame " + numberText(frameLoss) + " dB, tiles " + numberText(codec::kDefaultTileLoss) +
+                  " dB) lowered k from " + list(asked) + " to " +
+                  list(given) + " (exact_k=True keeps k)";
+    else if (exactK && (b.predicted.frameLoss > frameLoss || b.predicted.tileLoss > codec::kDefaultTileLoss))
+        warning = "conus.encode: exact_k: predicted against the uniform image, the whole frame loses " +
+                  numberText(std::round(b.predicted.frameLoss * 10) / 10) + " dB, the tiles outside the foci " +
+                  numberText(std::round(b.predicted.tileLoss * 10) / 10) + " dB (the budget: " + numberText(frameLoss) + " and " +
+                  numberText(codec::kDefaultTileLoss) + " dB)";
+    if (b.gridLimited) warning += (warning.empty() ? "conus.encode: " : "; ") + std::string("the grid holds the foci only to k ") + list(given);
+    if (!warning.empty()) pybind11::module_::import("warnings").attr("warn")(warning, pybind11::module_::import("builtins").attr("UserWarning"), 2);
+    return d;
+}
+
+
+
+}  // namespace conus::python

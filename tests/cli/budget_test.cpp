@@ -1,0 +1,191 @@
+// What `conus encode` and `conus map foci` say about the pixel budget and the k each focus got,
+// through the real binary: the line before the work, the k the file records, --exact-k, and the
+// documented option combinations that once refused a grid as too coarse.
+#include <algorithm>
+#include <regex>
+
+#include "cli/cli_fixture.h"
+#include "conus/codec/map/sampling_map.h"
+#include "conus/format/container.h"
+
+namespace conus::test {
+namespace {
+
+using BudgetCli = Cli;
+
+// The k of each focus the file records (conus:foci), read back by the format library.
+std::vector<double> recordedK(const std::string& file) {
+    const format::ConusFile f = format::readConusFile(file);
+    std::vector<double> k;
+    if (f.analytic)
+        for (const auto& focus : f.analytic->foci) k.push_back(focus.k);
+    return k;
+}
+
+// The numbers after `prefix` in `text` ("k 2.6, 2.6" -> {2.6, 2.6}).
+std::vector<double> numbersAfter(const std::string& text, const std::string& prefix) {
+    const std::size_t at = text.find(prefix);
+    std::vector<double> out;
+    if (at == std::string::npos) return out;
+    const std::string rest = text.substr(at + prefix.size());
+    const std::regex number(R"(^\s*,?\s*([0-9]+(\.[0-9]+)?))");
+    std::smatch m;
+    std::string tail = rest;
+    while (std::regex_search(tail, m, number)) {
+        out.push_back(std::stod(m[1]));
+        tail = m.suffix();
+    }
+    return out;
+}
+
+TEST_F(BudgetCli, TwoLargeFociAreLoweredAndSaySo) {
+    const std::string picture = makePicture(360, 240);
+    const std::string foci = " --focus 0.3,0.4,0.16,4 --focus 0.7,0.55,0.15,4 --size 90x60";
+    const Result r = run("encode " + picture + foci + " -o " + path("held.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    // Before the work: what they ask, that the budget lowered k, what they take, the context's rate.
+    EXPECT_NE(r.out.find("the foci ask "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("x the pixels there are at k 4, 4"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("the loss budget (whole frame 1.5 dB, tiles 4 dB) lowered k from 4, 4 to "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("of the 90x60 pixels"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("the context is sampled like a 1/"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("(the uniform image: 1/4)"), std::string::npos) << r.out;
+    const std::vector<double> said = numbersAfter(r.out, "lowered k from 4, 4 to ");
+    ASSERT_EQ(said.size(), 2u) << r.out;
+    EXPECT_GT(said[0], 1.0);
+    EXPECT_LT(said[0], 4.0);
+    // The file records the k given, which the 'wrote' line repeats.
+    const std::vector<double> k = recordedK(path("held.exr"));
+    ASSERT_EQ(k.size(), 2u);
+    EXPECT_NEAR(k[0], said[0], 0.01);
+    EXPECT_NEAR(k[1], said[1], 0.01);
+    EXPECT_NE(r.out.find("sampling map (k "), std::string::npos) << r.out;
+
+    // --exact-k keeps k as asked and warns what the frame pays for it.
+    const Result exact = run("encode " + picture + foci + " --exact-k -o " + path("exact.exr"));
+    ASSERT_EQ(exact.exitCode, 0) << exact.err;
+    EXPECT_EQ(recordedK(path("exact.exr")), (std::vector<double>{4.0, 4.0}));
+    EXPECT_EQ(exact.out.find("lowered"), std::string::npos) << exact.out;
+    EXPECT_NE(exact.err.find("warning: --exact-k: the foci leave the context sampled like a 1/"), std::string::npos) << exact.err;
+
+    // A tighter whole-frame budget gives less: the k falls with it.
+    const Result tight = run("encode " + picture + foci + " --frame-loss 0.1 -o " + path("tight.exr"));
+    ASSERT_EQ(tight.exitCode, 0) << tight.err;
+    EXPECT_NE(tight.out.find("the loss budget (whole frame 0.1 dB, tiles 4 dB) lowered k"), std::string::npos) << tight.out;
+    EXPECT_LT(recordedK(path("tight.exr"))[0], k[0]);
+}
+
+TEST_F(BudgetCli, ASmallFocusKeepsItsK) {
+    const std::string picture = makePicture(320, 240);
+    const Result r = run("encode " + picture + " --focus 0.62,0.35,0.05,3 --size 80x60 --frame-loss 6 -o " + path("a.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.out.find("lowered"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("foci take "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("of the 80x60 pixels at k 3;"), std::string::npos) << r.out;
+    EXPECT_EQ(recordedK(path("a.exr")), std::vector<double>{3.0});
+    // --exact-k is about foci only.
+    EXPECT_EQ(run("encode " + picture + " --exact-k -o " + path("b.exr")).exitCode, 2);
+    EXPECT_FALSE(fs::exists(path("b.exr")));
+}
+
+TEST_F(BudgetCli, MapFociKeepsTheContextFloor) {
+    // No picture: the context keeps at least a quarter of the uniform density.
+    const std::string foci = " --focus 0.25,0.3,0.2,5 --focus 0.7,0.7,0.18,3";
+    const Result r = run("map foci" + foci + " -o " + path("m.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("the context floor (density 0.25) lowered k from 5, 3 to "), std::string::npos) << r.out;
+    const std::vector<double> k = recordedK(path("m.exr"));
+    ASSERT_EQ(k.size(), 2u);
+    EXPECT_LT(k[0], 5.0);
+    EXPECT_LT(k[1], 3.0);
+    EXPECT_NEAR(std::log(k[0]) / std::log(5.0), std::log(k[1]) / std::log(3.0), 0.01);  // the same power of each
+    const std::vector<double> density = numbersAfter(r.out, "the context keeps density ");
+    ASSERT_FALSE(density.empty()) << r.out;
+    EXPECT_GE(density[0], 0.25);
+    const Result exact = run("map foci" + foci + " --exact-k -o " + path("e.exr"));
+    ASSERT_EQ(exact.exitCode, 0) << exact.err;
+    EXPECT_EQ(recordedK(path("e.exr")), (std::vector<double>{5.0, 3.0}));
+    EXPECT_NE(exact.err.find("under the default floor 0.25"), std::string::npos) << exact.err;
+}
+
+TEST_F(BudgetCli, DocumentedCombinationsAreNotRefused) {
+    // Each of these once ended in "grid too coarse" or an anisotropy refusal; now each encodes and
+    // says what gave way.
+    const std::string picture = makePicture(384, 256);
+    const std::vector<std::string> combinations = {
+        "--focus 0.55,0.62,0.08,4 --focus 0.72,0.31,0.05,4 --fit --falloff 1.75",
+        "--focus 0.55,0.62,0.08,4 --focus 0.72,0.31,0.05,4 --falloff 1.5 --exact-k",
+        "--focus 0.4,0.4,0.07,4 --max-anisotropy 4",
+        "--focus 0.4,0.4,0.07,4 --max-anisotropy 8 --exact-k",
+        "--focus 0.5,0.5,0.1,4 --grid 3",
+        "--focus 0.1,0.9,0.06,6 --focus 0.92,0.08,0.05,6 --compose add",
+    };
+    int i = 0;
+    for (const std::string& options : combinations) {
+        const std::string out = path("c" + std::to_string(i++) + ".exr");
+        const Result r = run("encode " + picture + " " + options + " --size 96x64 -o " + out);
+        EXPECT_EQ(r.exitCode, 0) << options << ": " << r.err;
+        EXPECT_TRUE(fs::exists(out)) << options;
+        EXPECT_NE(r.out.find("foci take "), std::string::npos) << options << ": " << r.out;
+    }
+    // A grid too coarse to hold a focus records what it holds and says so.
+    const Result coarse = run("map foci --focus 0.5,0.5,0.1,4 --grid 2 -o " + path("g.exr"));
+    ASSERT_EQ(coarse.exitCode, 0) << coarse.err;
+    EXPECT_NE(coarse.err.find("the map holds the foci only to k 1 (asked 4) on its 2x2 grid"), std::string::npos) << coarse.err;
+    EXPECT_EQ(recordedK(path("g.exr")), std::vector<double>{1.0});
+}
+
+// A textured picture, finer on the right than on the left (noise of two grain sizes over slanted
+// waves) and flat in the bottom band: detail where a map can take samples from.
+std::string texturedPicture(const std::string& file, int width, int height) {
+    std::vector<unsigned char> pixels(static_cast<std::size_t>(width) * height * 3);
+    unsigned state = 12345;
+    const auto noise = [&state] {
+        state = state * 1664525u + 1013904223u;
+        return (state >> 8) / double(1u << 24);
+    };
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const bool flat = y > height * 3 / 4;
+                const double wave = 0.5 + 0.3 * std::sin(0.3 * x + 0.2 * y + c) * (x > width / 2 ? 1.0 : 0.3);
+                const double v = flat ? 0.4 + 0.1 * c : wave + (x > width / 2 ? 0.25 : 0.05) * (noise() - 0.5);
+                pixels[(std::size_t(y) * width + x) * 3 + c] = static_cast<unsigned char>(std::clamp(v, 0.0, 1.0) * 255);
+            }
+    auto output = OIIO::ImageOutput::create(file);
+    EXPECT_TRUE(output->open(file, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::UINT8)));
+    EXPECT_TRUE(output->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+    output->close();
+    return file;
+}
+
+TEST_F(BudgetCli, NoFocusFollowsTheDetailAndBeatsUniform) {
+    const std::string a = texturedPicture(path("a.png"), 320, 240), b = texturedPicture(path("b.png"), 240, 320);
+    // A batch of two: the note about the default is said once, not per file.
+    const Result batch = run("encode " + a + " " + b + " --out-dir " + path("out"));
+    ASSERT_EQ(batch.exitCode, 0) << batch.err;
+    std::size_t count = 0;
+    for (std::size_t at = batch.err.find("no --focus"); at != std::string::npos; at = batch.err.find("no --focus", at + 1)) ++count;
+    EXPECT_EQ(count, 1u) << batch.err;
+    EXPECT_NE(batch.err.find("the samples follow the picture's own detail"), std::string::npos) << batch.err;
+    ASSERT_EQ(run("uniform " + a + " -o " + path("u.exr")).exitCode, 0);
+    // Against `conus uniform`, both decoded at the source's size to 8-bit PNGs (what a user looks at).
+    ASSERT_EQ(run("decode " + path("out/a.exr") + " -o " + path("c.png") + " --backend cpu").exitCode, 0);
+    ASSERT_EQ(run("decode " + path("u.exr") + " -o " + path("uv.png") + " --backend cpu").exitCode, 0);
+    const ExrRead source = readExr(a), conus = readExr(path("c.png")), uniform = readExr(path("uv.png"));
+    ASSERT_EQ(conus.width, 320);
+    const auto psnr = [&source](const ExrRead& view) {
+        double se = 0;
+        std::size_t n = 0;
+        for (const char* c : {"R", "G", "B"})
+            for (std::size_t p = 0; p < source.channels.at(c).size(); ++p, ++n) se += std::pow(view.channels.at(c)[p] - source.channels.at(c)[p], 2);
+        return 10.0 * std::log10(1.0 / std::max(se / double(n), 1e-12));
+    };
+    EXPECT_GT(psnr(conus), psnr(uniform) + 0.5) << "detail " << psnr(conus) << " dB, uniform " << psnr(uniform) << " dB";
+    // The map is not the identity: it holds more samples on the fine right half than the flat band.
+    const auto map = codec::SamplingMap::fromGrid(format::readConusFile(path("out/a.exr")).map);
+    EXPECT_GT(map.density({0.75, 0.3}), 1.2 * map.density({0.25, 0.9}));
+}
+
+}  // namespace
+}  // namespace conus::test

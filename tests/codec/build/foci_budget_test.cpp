@@ -1,0 +1,169 @@
+// The pixel budget of foci: their share against the disc areas computed by hand, and the k a budget
+// gives (lowered alike, within the budget, as asked with exactK) against what an encode measures.
+#include "conus/codec/build/foci_budget.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/core/error.h"
+#include "../../test_images.h"
+
+namespace conus::codec {
+namespace {
+
+constexpr int kWidth = 384, kHeight = 256;
+
+// Fine detail everywhere (noise and slanted waves), so that every sample the context loses costs.
+Image picture() {
+    const Image n = test::noise(kWidth, kHeight, {"R", "G", "B"}, 11);
+    Image im = makeImage(kWidth, kHeight, {"R", "G", "B"});
+    for (int y = 0; y < kHeight; ++y)
+        for (int x = 0; x < kWidth; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const double wave = 0.5 + 0.5 * std::sin(0.23 * x + 0.11 * y + c);
+                im.pixels[(std::size_t(y) * kWidth + x) * 3 + c] =
+                    static_cast<float>(0.5 * n.pixels[(std::size_t(y) * kWidth + x) * 3 + c] + 0.5 * wave);
+            }
+    return im;
+}
+
+FociOptions optionsFor(double aspect) {
+    FociOptions o;
+    o.aspect = aspect;
+    return o;
+}
+
+TEST(FociShare, MatchesTheDiscAreas) {
+    const double aspect = 1.5;
+    // k = 1: the density is uniform, so the discs' share is their area (pi r^2 widths^2 over 1/aspect).
+    const std::vector<Focus> flat{{0.3, 0.4, 0.1, 1.0}};
+    const FociShare s = fociShare(flat, aspect);
+    const double area = std::numbers::pi * 0.01 * aspect;
+    EXPECT_NEAR(s.share, area, 0.02 * area);
+    EXPECT_NEAR(s.contextDensity, 1.0, 1e-9);
+    EXPECT_NEAR(s.ask, area, 0.02 * area);
+    // k = 4 on two separate discs of different sizes: they ask k^2 times their areas.
+    const std::vector<Focus> two{{0.25, 0.35, 0.12, 4.0}, {0.75, 0.6, 0.07, 4.0}};
+    const FociShare t = fociShare(two, aspect);
+    const double areas = std::numbers::pi * (0.12 * 0.12 + 0.07 * 0.07) * aspect;
+    EXPECT_NEAR(t.ask, 16 * areas, 0.03 * 16 * areas);
+    EXPECT_LT(t.contextDensity, 1.0);
+    EXPECT_GT(t.share, areas);  // magnified: more than their area
+    EXPECT_LT(t.share, t.ask);  // the context keeps some
+    // No foci: all to the context.
+    const FociShare none = fociShare({}, aspect);
+    EXPECT_EQ(none.share, 0.0);
+    EXPECT_EQ(none.contextDensity, 1.0);
+}
+
+TEST(FociShare, ContextDownscaleIsTheLinearRate) {
+    FociShare s;
+    s.contextDensity = 0.25;
+    // 1024^2 of 4096^2: the uniform image is a 1/4 downscale; a quarter of its density halves the rate.
+    EXPECT_NEAR(contextDownscale(s, 1024, 1024, 4096, 4096), 8.0, 1e-9);
+    s.contextDensity = 1.0;
+    EXPECT_NEAR(contextDownscale(s, 100, 50, 400, 200), 4.0, 1e-9);
+}
+
+TEST(FociBudget, LowersEveryKAlikeToHoldTheBudget) {
+    const Image source = picture();
+    const double aspect = double(kWidth) / kHeight;
+    // Two large foci at k = 4 ask more than the 96x64 image holds.
+    const std::vector<Focus> foci{{0.3, 0.4, 0.16, 4.0}, {0.68, 0.58, 0.15, 4.0}};
+    const FociOptions options = optionsFor(aspect);
+    const FrameErrorModel model(source, kWidth / 4, kHeight / 4, fociImportance(foci, aspect, 96, 64));
+    ASSERT_GT(fociShare(foci, aspect).ask, 1.0);
+
+    // A tight budget (0.3 dB), so that it binds on this picture whatever the builder.
+    constexpr double kBudget = 0.3;
+    const FociBudget exact = fociForFrameLoss(foci, options, model, kBudget, true);
+    EXPECT_FALSE(exact.lowered);
+    ASSERT_EQ(exact.given.size(), 2u);
+    EXPECT_EQ(exact.given[0].k, 4.0);
+    EXPECT_EQ(exact.given[1].k, 4.0);
+    EXPECT_GT(exact.predicted.frameLoss, kBudget);
+
+    const FociBudget held = fociForFrameLoss(foci, options, model, kBudget);
+    EXPECT_TRUE(held.lowered);
+    EXPECT_LE(held.predicted.frameLoss, kBudget);
+    EXPECT_LE(held.predicted.tileLoss, kDefaultTileLoss);
+    ASSERT_EQ(held.given.size(), 2u);
+    EXPECT_GT(held.given[0].k, 1.0);
+    EXPECT_LT(held.given[0].k, 4.0);
+    // The same power of each k: their ratio in log kept (both asked 4, so equal).
+    EXPECT_NEAR(held.given[0].k, held.given[1].k, 1e-12);
+    EXPECT_GT(held.share.contextDensity, exact.share.contextDensity);
+    EXPECT_GT(held.askedShare.ask, 1.0);
+    // The map built is the map of the k given: its magnification at the centres follows them.
+    const std::vector<double> reached = reachedMagnification(held.map, held.given);
+    EXPECT_NEAR(reached[0], held.given[0].k, 0.35 * held.given[0].k);
+
+    // Measured, not only predicted: the budget's map loses less over the frame than the exact one.
+    const auto measuredLoss = [&](const SamplingMap& map) {
+        EncodeOptions e;
+        e.width = kWidth / 4;
+        e.height = kHeight / 4;
+        DecodeOptions d;
+        d.width = kWidth;
+        d.height = kHeight;
+        const Image view = decodeImage(encodeImage(source, map, e), map, d);
+        const Image uniform = resizeBilinear(areaDownsample(source, e.width, e.height), {}, kWidth, kHeight);
+        double a = 0, b = 0;
+        for (std::size_t i = 0; i < source.pixels.size(); ++i) {
+            a += std::pow(view.pixels[i] - source.pixels[i], 2);
+            b += std::pow(uniform.pixels[i] - source.pixels[i], 2);
+        }
+        return 10 * std::log10(a / b);
+    };
+    const double heldLoss = measuredLoss(held.map), exactLoss = measuredLoss(exact.map);
+    EXPECT_LT(heldLoss, exactLoss - 0.3);
+    EXPECT_NEAR(heldLoss, held.predicted.frameLoss, 1.0);
+}
+
+TEST(FociBudget, KeepsKWhenTheFociFit) {
+    const Image source = picture();
+    const double aspect = double(kWidth) / kHeight;
+    const std::vector<Focus> foci{{0.7, 0.3, 0.05, 3.0}};
+    const FrameErrorModel model(source, kWidth / 4, kHeight / 4, fociImportance(foci, aspect, 96, 64));
+    const FociBudget loose = fociForFrameLoss(foci, optionsFor(aspect), model, 20.0);
+    EXPECT_FALSE(loose.lowered);
+    EXPECT_EQ(loose.given[0].k, 3.0);
+    EXPECT_LE(loose.predicted.frameLoss, 20.0);
+    EXPECT_THROW(fociForFrameLoss(foci, optionsFor(aspect), model, -1.0), Error);
+    EXPECT_THROW(fociForFrameLoss(foci, optionsFor(aspect), model, std::nan("")), Error);
+}
+
+TEST(FociBudget, WithoutAPictureTheContextKeepsItsFloor) {
+    const std::vector<Focus> foci{{0.2, 0.2, 0.2, 5.0}, {0.75, 0.7, 0.18, 3.0}};
+    const FociOptions options = optionsFor(1.0);
+    ASSERT_LT(fociShare(foci, 1.0).contextDensity, 0.25);
+    const FociBudget held = fociForContextFloor(foci, options, 0.25);
+    EXPECT_TRUE(held.lowered);
+    EXPECT_GE(held.share.contextDensity, 0.25);
+    EXPECT_LT(held.share.contextDensity, 0.35);  // lowered no further than needed (t to 1/64)
+    // Every k by the same power: log k_given / log k_asked alike.
+    EXPECT_NEAR(std::log(held.given[0].k) / std::log(5.0), std::log(held.given[1].k) / std::log(3.0), 1e-9);
+    const FociBudget exact = fociForContextFloor(foci, options, 0.25, true);
+    EXPECT_FALSE(exact.lowered);
+    EXPECT_EQ(exact.given[0].k, 5.0);
+    EXPECT_EQ(exact.given[1].k, 3.0);
+}
+
+TEST(FociBudget, AGridTooCoarseRecordsWhatItHolds) {
+    // A 2x2 grid is the identity: it holds no magnification, and the foci say so instead of refusing.
+    FociOptions options = optionsFor(1.0);
+    options.columns = options.rows = 2;
+    const std::vector<Focus> foci{{0.5, 0.5, 0.1, 4.0}};
+    const FociBudget b = fociForContextFloor(foci, options, 0.25);
+    EXPECT_TRUE(b.gridLimited);
+    EXPECT_NEAR(b.given[0].k, 1.0, 0.05);
+    EXPECT_EQ(b.asked[0].k, 4.0);
+}
+
+}  // namespace
+}  // namespace conus::codec
