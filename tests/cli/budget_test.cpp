@@ -128,11 +128,12 @@ TEST_F(BudgetCli, DocumentedCombinationsAreNotRefused) {
         EXPECT_TRUE(fs::exists(out)) << options;
         EXPECT_NE(r.out.find("foci take "), std::string::npos) << options << ": " << r.out;
     }
-    // A grid too coarse to hold a focus records what it holds and says so.
+    // A grid too coarse to hold a focus is refined until it does, and the file records that k.
     const Result coarse = run("map foci --focus 0.5,0.5,0.1,4 --grid 2 -o " + path("g.exr"));
     ASSERT_EQ(coarse.exitCode, 0) << coarse.err;
-    EXPECT_NE(coarse.err.find("the map holds the foci only to k 1 (asked 4) on its 2x2 grid"), std::string::npos) << coarse.err;
-    EXPECT_EQ(recordedK(path("g.exr")), std::vector<double>{1.0});
+    const std::vector<double> k = recordedK(path("g.exr"));
+    ASSERT_EQ(k.size(), 1u);
+    EXPECT_GT(k[0], 3.0);
 }
 
 // A textured picture, finer on the right than on the left (noise of two grain sizes over slanted

@@ -154,15 +154,18 @@ TEST(FociBudget, WithoutAPictureTheContextKeepsItsFloor) {
     EXPECT_EQ(exact.given[1].k, 3.0);
 }
 
-TEST(FociBudget, AGridTooCoarseRecordsWhatItHolds) {
-    // A 2x2 grid is the identity: it holds no magnification, and the foci say so instead of refusing.
+TEST(FociBudget, AGridTooCoarseIsRefinedToHoldTheFocus) {
+    // A 2x2 grid is the identity: the builder refines it until the focus holds, and the budget
+    // records the k the refined grid reaches (neither a refusal nor a focus the map ignores).
     FociOptions options = optionsFor(1.0);
     options.columns = options.rows = 2;
     const std::vector<Focus> foci{{0.5, 0.5, 0.1, 4.0}};
     const FociBudget b = fociForContextFloor(foci, options, 0.25);
-    EXPECT_TRUE(b.gridLimited);
-    EXPECT_NEAR(b.given[0].k, 1.0, 0.05);
+    EXPECT_GT(b.map.columns(), 2);
     EXPECT_EQ(b.asked[0].k, 4.0);
+    EXPECT_GT(b.given[0].k, 3.0);
+    // The builder refines until a focus reaches three quarters of its extra magnification.
+    EXPECT_GE(reachedMagnification(b.map, b.given)[0], 1 + 0.75 * (b.given[0].k - 1));
 }
 
 }  // namespace
