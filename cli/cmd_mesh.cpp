@@ -51,6 +51,7 @@ struct MeshOptions {
     double time = 0, maxEdge = 0.5;
     int samples = 4, grid = map_rules::kDefaultSide;
     std::vector<int> track;
+    std::vector<std::string> allowDirs;
     double trackRadius = 0.05, trackK = 3;  // a car is small: a small, moderate focus keeps the context
     std::string compose = "add";  // smooth from frame to frame (tests/renderers/mesh_sequence_test.cpp)
 };
@@ -248,7 +249,15 @@ int runRender(const RenderOptions& r) {
     Progress loading("read " + o.model);
     Mesh mesh;
     if (o.model == kCity) mesh = city.emplace().meshAt(o.time);
-    else mesh = sceneio::readMesh(o.model);
+    else {
+        sceneio::MeshReadOptions read;
+        read.allowedDirs = o.allowDirs;
+        sceneio::MeshReadReport report;
+        mesh = sceneio::readMesh(o.model, read, &report);
+        if (report.duplicateTriangles > 0)
+            warn(o.model + ": dropped " + std::to_string(report.duplicateTriangles) +
+                 " exact duplicate triangles (copies of another triangle's three corners)");
+    }
     loading.done();
     const Camera camera =
         city && !cameraChoice.given ? cityCamera(*city, aspect) : meshCamera(cameraChoice, boundsOf(mesh), aspect);
@@ -436,6 +445,7 @@ CLI::App* addRender(CLI::App& command, RenderOptions& r) {
         ->excludes("--track");
     render->add_flag("--reference", r.reference, "the exact CPU reference (Embree ray casting) instead of the GPU");
     addSharedOptions(*render, r.mesh, true);
+    addAllowDirOption(*render, r.mesh.allowDirs);
     return render;
 }
 

@@ -16,10 +16,10 @@ Work past one machine: conus.dask.encode_files.
 import numpy as _np
 
 from ._conus import (DEFAULT_MAP_SIDE, MAX_IMAGE_SIDE, MAX_MAP_SIDE, Error, File, Map, decode, encode, importance,
-                     psnr, read, read_image, resize, uniform, write, write_image)
+                     psnr, read, read_image, read_mesh, read_volume, resize, uniform, write, write_image)
 
 __all__ = ["Error", "File", "Map", "read", "write", "encode", "decode", "uniform", "resize", "psnr", "importance",
-           "read_image", "write_image", "srgb_to_linear", "linear_to_srgb", "MAX_IMAGE_SIDE", "MAX_MAP_SIDE",
+           "read_image", "write_image", "read_mesh", "read_volume", "srgb_to_linear", "linear_to_srgb", "MAX_IMAGE_SIDE", "MAX_MAP_SIDE",
            "DEFAULT_MAP_SIDE"]
 __version__ = "1.0.0"
 

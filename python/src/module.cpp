@@ -36,6 +36,7 @@
 #include "conus/format/container.h"
 #include "conus/imageio/image_file.h"
 #include "conus/renderers/gpu_image.h"
+#include "scene.h"
 
 namespace py = pybind11;
 
@@ -98,8 +99,18 @@ std::vector<std::string> defaultChannels(py::ssize_t count) {
     }
 }
 
+// Real numbers only: numpy's cast would drop a complex array's imaginary part and turn an object
+// array's items into numbers by any means they offer.
+void requireReal(const py::array& input, const std::string& what) {
+    const char kind = input.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b')
+        throw Error(ErrorCode::InvalidArgument, what + " must be an array of real numbers, not of dtype " +
+                                                    py::str(input.dtype()).cast<std::string>());
+}
+
 // An (H, W) or (H, W, C) array of linear values as an Image (one copy, into the Image).
 Image fromArray(const py::array& input, std::optional<std::vector<std::string>> channels, const char* what) {
+    requireReal(input, what);
     const FloatArray array = FloatArray::ensure(input);
     if (!array) throw Error(ErrorCode::InvalidArgument, std::string(what) + " must be an array of numbers");
     if (array.ndim() != 2 && array.ndim() != 3)
@@ -125,9 +136,14 @@ using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecas
 // f applied to every (u, v) of an (..., 2) array, without the GIL.
 template <class F>
 py::array mapPoints(const py::array& input, F&& f) {
+    requireReal(input, "points");
     const DoubleArray points = DoubleArray::ensure(input);
     if (!points || points.ndim() < 1 || points.shape(points.ndim() - 1) != 2)
         throw Error(ErrorCode::InvalidArgument, "points must be an array of shape (..., 2)");
+    for (py::ssize_t i = 0; i < points.size(); ++i)
+        if (!std::isfinite(points.data()[i]))
+            throw Error(ErrorCode::InvalidArgument, "points must be finite; point " + std::to_string(i / 2) + " holds " +
+                                                        numberText(points.data()[i]));
     DoubleArray out(std::vector<py::ssize_t>(points.shape(), points.shape() + points.ndim()));
     const double* in = points.data();
     double* o = out.mutable_data();
@@ -251,6 +267,7 @@ PYBIND11_MODULE(_conus, m) {
     py::register_exception_translator(&translateError);
     m.attr("MAX_IMAGE_SIDE") = kMaxImageSide;
     m.attr("MAX_MAP_SIDE") = kMaxMapSide;
+    addSceneReaders(m);
     m.attr("DEFAULT_MAP_SIDE") = map_rules::kDefaultSide;
 
     py::class_<Map, std::shared_ptr<Map>>(m, "Map", "A sampling map: a grid of distorted node positions (Equation 1)")
@@ -326,6 +343,7 @@ PYBIND11_MODULE(_conus, m) {
         .def_static(
             "from_nodes",
             [](const py::array& nodes) {
+                requireReal(nodes, "nodes");
                 const FloatArray a = FloatArray::ensure(nodes);
                 if (!a || a.ndim() != 3 || a.shape(2) != 2)
                     throw Error(ErrorCode::InvalidArgument, "nodes must have shape (rows, columns, 2)");

@@ -1067,16 +1067,19 @@ ImagePyramid buildPyramid(const Image& conus, int threads) {
     return pyramid;
 }
 
-void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes, bool withPyramid) {
+void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes, bool withPyramid,
+                       std::int64_t extraBytes) {
     const std::int64_t channels = conus.channelCount();
     const std::int64_t image = std::int64_t{conus.width} * conus.height;
     const std::int64_t bytes = (image + (withPyramid ? image / 3 : 0) + std::int64_t{width} * height) * channels *
-                               std::int64_t(sizeof(float));
+                                   std::int64_t(sizeof(float)) +
+                               extraBytes;
     if (bytes > maxBytes) {
         throw Error(ErrorCode::LimitExceeded,
                     "decoding a " + std::to_string(conus.width) + "x" + std::to_string(conus.height) + " image to " +
                         std::to_string(width) + "x" + std::to_string(height) + " pixels of " + std::to_string(channels) +
-                        " channels" + (withPyramid ? std::string(" with its pyramid") : std::string()) + " takes " +
+                        " channels" + (withPyramid ? std::string(" with its pyramid") : std::string()) +
+                        (extraBytes > 0 ? " and the picture writer's copies" : "") + " takes " +
                         std::to_string(bytes) + " bytes, beyond the decode memory limit of " +
                         std::to_string(maxBytes));
     }
@@ -1109,6 +1112,7 @@ Image decodeImage(const Image& conus, const SamplingMap& map, const DecodeOption
 Image resizeBilinear(const Image& image, const View& view, int width, int height, int threads) {
     checkImage(image, "resizeBilinear");
     detail::checkOutputSize(width, height, "resizeBilinear");
+    checkDecodeMemory(image, width, height);
     checkView(view, "resizeBilinear");
     Image out = detail::makeOutput(image, width, height);
     const AxisTaps tx = axisTaps(image.width, view.u0, view.u1, width);
