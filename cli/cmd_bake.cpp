@@ -85,6 +85,7 @@ int runBakeRelief(const BakeOptions& o) {
         size = {std::max(1, source.heights.width / 4), std::max(1, source.heights.height / 4)};
     else
         size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     if (size.width > source.heights.width || size.height > source.heights.height)
         throw Error(ErrorCode::InvalidArgument, "--size " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                                                     " is larger than the height field (" +

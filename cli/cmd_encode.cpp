@@ -9,6 +9,7 @@
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/build/frame_budget.h"
+#include "conus/codec/image/encode.h"
 #include "conus/core/limits.h"
 #include "conus/core/map_rules.h"
 #include "encoding.h"
@@ -82,6 +83,8 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     checkConusOutput(output, input);
     const imageio::ImageFile source = readSource(input, o.source);
     const Size size = conusSize(o.storage, source.image);
+    codec::checkEncodeMemory(source.image, size.width, size.height);  // before a map is built for it
+    if (!o.importance.empty() || !o.foci.empty()) checkGridForImage(o.grid, size.width, size.height);
     BuiltMap built;
     if (!o.mapFile.empty()) built = mapFromFile(o.mapFile);
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size);

@@ -241,6 +241,7 @@ int runRender(const RenderOptions& r) {
     const MeshOptions& o = r.mesh;
     checkConusOutput(r.output, o.model);
     const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     const CameraChoice cameraChoice = parseCameraOptions(o);
     if (!o.track.empty() && o.model != kCity)
         throw Error(ErrorCode::InvalidArgument, "--track follows the city's cars: give `city` as the model");
@@ -361,6 +362,7 @@ int runAnimate(const AnimateOptions& a) {
         throw Error(ErrorCode::InvalidArgument, "animate renders the procedural city: give `city` as the model, not '" + o.model + "'");
     if (o.track.empty()) warn("no --track: every frame is the uniform image (give --track 0,2 to follow cars)");
     const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     const CameraChoice cameraChoice = parseCameraOptions(o);
     const double aspect = double(size.width) / size.height;
     const std::filesystem::path dir(a.outDir);

@@ -137,6 +137,7 @@ int runRender(const VolumeOptions& o) {
     checkConusOutput(o.output, o.volume);
     checkCameraOptions(o);
     const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     const double aspect = double(size.width) / size.height;
     codec::VolumeRenderOptions options = renderOptions(o);
     const Scene scene = loadScene(o, aspect);
@@ -193,6 +194,7 @@ int runAnimate(const AnimateOptions& a) {
     const glm::dvec2 from = parsePoint(a.from, "--from"), to = parsePoint(a.to, "--to");
     checkCameraOptions(o);
     const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     const double aspect = double(size.width) / size.height;
     std::error_code ec;
     std::filesystem::create_directories(a.outDir, ec);

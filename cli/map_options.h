@@ -30,6 +30,11 @@ CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff);
 // or "separable").
 codec::AutoMapOptions autoMapOptions(int grid, double minDensity, double maxDensity, double maxAnisotropy, const std::string& method);
 
+// A map finer than the image it shapes adds nothing the image can show and costs a build in
+// proportion to its nodes (a minute at 4097 a side): --grid is refused (InvalidArgument) past
+// the larger of the default side and the image's longer side + 1.
+void checkGridForImage(int grid, int width, int height);
+
 // The foci of repeated --focus u,v,r,k options, in order.
 std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);
 

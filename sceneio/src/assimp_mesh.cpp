@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -114,6 +115,30 @@ void checkGltfUris(const std::string& path, const NamedFiles& named) {
     }
 }
 
+// A stream Assimp opened, registered with its IOSystem until it is deleted (Assimp's glTF
+// importer leaves a buffer's stream open when it throws on a lying byteLength; the IOSystem
+// deletes what is left when the importer is done).
+class TrackedStream : public Assimp::IOStream {
+public:
+    TrackedStream(Assimp::IOStream* stream, std::set<TrackedStream*>& open) : m_stream(stream), m_open(open) {
+        m_open.insert(this);
+    }
+    ~TrackedStream() override {
+        m_open.erase(this);
+        delete m_stream;
+    }
+    size_t Read(void* buffer, size_t size, size_t count) override { return m_stream->Read(buffer, size, count); }
+    size_t Write(const void* buffer, size_t size, size_t count) override { return m_stream->Write(buffer, size, count); }
+    aiReturn Seek(size_t offset, aiOrigin origin) override { return m_stream->Seek(offset, origin); }
+    size_t Tell() const override { return m_stream->Tell(); }
+    size_t FileSize() const override { return m_stream->FileSize(); }
+    void Flush() override { m_stream->Flush(); }
+
+private:
+    Assimp::IOStream* m_stream;
+    std::set<TrackedStream*>& m_open;
+};
+
 // Every file Assimp opens for the scene (glTF buffers, OBJ material libraries, ...) goes through
 // here: the scene file itself, or a name the policy of named_files.h allows. A name it refuses is
 // reported as missing to Assimp and remembered, so that the read fails with the policy's reason
@@ -121,6 +146,9 @@ void checkGltfUris(const std::string& path, const NamedFiles& named) {
 class PolicyIoSystem : public Assimp::DefaultIOSystem {
 public:
     PolicyIoSystem(std::string scene, const NamedFiles& named) : m_scene(std::move(scene)), m_named(named) {}
+    ~PolicyIoSystem() override {
+        while (!m_open.empty()) delete *m_open.begin();
+    }
 
     bool Exists(const char* file) const override {
         const std::string resolved = allowed(file);
@@ -129,8 +157,10 @@ public:
     Assimp::IOStream* Open(const char* file, const char* mode) override {
         if (std::strpbrk(mode, "wa+")) return nullptr;  // a reader writes nothing
         const std::string resolved = allowed(file);
-        return resolved.empty() ? nullptr : DefaultIOSystem::Open(resolved.c_str(), mode);
+        Assimp::IOStream* stream = resolved.empty() ? nullptr : DefaultIOSystem::Open(resolved.c_str(), mode);
+        return stream ? new TrackedStream(stream, m_open) : nullptr;
     }
+    void Close(Assimp::IOStream* stream) override { delete stream; }
     const std::string& refusal() const { return m_refusal; }
 
 private:
@@ -154,6 +184,7 @@ private:
     std::string m_scene;
     const NamedFiles& m_named;
     mutable std::string m_refusal;
+    std::set<TrackedStream*> m_open;
 };
 
 void checkFile(const std::string& path, const MeshReadOptions& options) {

@@ -172,6 +172,13 @@ TEST_F(SceneHostile, SizesAreCheckedBeforeAllocating) {
     r = run({"heightfield", "encode", "procedural:20000", "-o", path("t.exr")});
     expectRefused(r, "heightfield", "more than the limit of " + std::to_string(conus::kMaxDemSamples), 2);
     expectBounded(r, 400);
+    // A 4097-node map for a small image: a minute of building for nothing it can show.
+    r = run({"heightfield", "encode", "procedural:64", "-o", path("t.exr"), "--size", "32x32", "--grid", "4097"});
+    expectRefused(r, "heightfield", "--grid 4097 is finer than a 32x32 image can show; at most 65 nodes a side", 2);
+    expectBounded(r, 400);
+    r = run({"encode", path("small.ppm"), "-o", path("x.exr"), "--focus", "0.5,0.5,0.1,2", "--grid", "4097"});
+    expectRefused(r, "encode", "--grid 4097 is finer", 2);
+    expectBounded(r, 400);
 }
 
 TEST_F(SceneHostile, AFileThatValidatesAlsoDecodes) {
