@@ -1,5 +1,5 @@
 // A folder for the scene-reader harnesses: the input is written as `model.<ext>` inside
-// <tmp>/conus-fuzz-<name>-<pid>/model/, beside files it may name (a small data file, a material
+// /dev/shm (memory; the temporary folder where there is none)/conus-fuzz-<name>-<pid>/model/, beside files it may name (a small data file, a material
 // library, a texture) and traps it must not open: a FIFO (opening it blocks: a timeout), a symbolic
 // link out of the folder and a file outside it (../outside.bin). Made once per process.
 #pragma once
@@ -18,13 +18,14 @@ class SceneFixture {
 public:
     explicit SceneFixture(const std::string& name) {
         namespace fs = std::filesystem;
-        const fs::path root = fs::temp_directory_path() / ("conus-fuzz-" + name + "-" + std::to_string(::getpid()));
+        std::error_code ec;
+        const fs::path base = fs::is_directory("/dev/shm", ec) ? fs::path("/dev/shm") : fs::temp_directory_path();
+        const fs::path root = base / ("conus-fuzz-" + name + "-" + std::to_string(::getpid()));
         m_folder = (root / "model").string();
         fs::create_directories(m_folder);
         std::ofstream(root / "outside.bin") << std::string(4096, '\x01');
         std::ofstream(fs::path(m_folder) / "data.bin") << std::string(4096, '\x02');
         std::ofstream(fs::path(m_folder) / "m.mtl") << "newmtl a\nKd 1 0 0\nmap_Kd texture.png\n";
-        std::error_code ec;
         fs::create_symlink(root / "outside.bin", fs::path(m_folder) / "link.bin", ec);
         ::mkfifo((fs::path(m_folder) / "fifo.bin").c_str(), 0600);
     }
