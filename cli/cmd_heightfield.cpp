@@ -160,7 +160,7 @@ int runEncode(const EncodeOptions& o) {
     codec::HeightFieldOptions options;
     options.ground = groundFor(o, dem);
     const Size size = parseSize(o.sizeText);
-    checkGridForImage(o.grid, size.width, size.height);
+    checkGridForImage(o.grid, size.width, size.height, EncodeOptions{}.grid);
     options.width = size.width;
     options.height = size.height;
     options.mapGrid = o.grid;

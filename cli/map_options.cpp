@@ -79,8 +79,8 @@ void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDe
         ->check(CLI::Range(1.001, 4096.0));
 }
 
-void checkGridForImage(int grid, int width, int height) {
-    const int most = std::max(map_rules::kDefaultSide, std::max(width, height) + 1);
+void checkGridForImage(int grid, int width, int height, int defaultGrid) {
+    const int most = std::max(defaultGrid, 4 * std::max(width, height) + 1);
     if (grid > most)
         throw Error(ErrorCode::InvalidArgument, "--grid " + std::to_string(grid) + " is finer than a " + std::to_string(width) +
                                                     "x" + std::to_string(height) + " image can show; at most " +

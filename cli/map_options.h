@@ -10,6 +10,7 @@
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/map/sampling_map.h"
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 
 namespace CLI {
@@ -30,10 +31,10 @@ CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff);
 // or "separable").
 codec::AutoMapOptions autoMapOptions(int grid, double minDensity, double maxDensity, double maxAnisotropy, const std::string& method);
 
-// A map finer than the image it shapes adds nothing the image can show and costs a build in
+// A map much finer than the image it shapes adds nothing the image can show and costs a build in
 // proportion to its nodes (a minute at 4097 a side): --grid is refused (InvalidArgument) past
-// the larger of the default side and the image's longer side + 1.
-void checkGridForImage(int grid, int width, int height);
+// the larger of the command's default and 4 nodes a pixel along the image's longer side.
+void checkGridForImage(int grid, int width, int height, int defaultGrid = map_rules::kDefaultSide);
 
 // The foci of repeated --focus u,v,r,k options, in order.
 std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);

@@ -174,7 +174,7 @@ TEST_F(SceneHostile, SizesAreCheckedBeforeAllocating) {
     expectBounded(r, 400);
     // A 4097-node map for a small image: a minute of building for nothing it can show.
     r = run({"heightfield", "encode", "procedural:64", "-o", path("t.exr"), "--size", "32x32", "--grid", "4097"});
-    expectRefused(r, "heightfield", "--grid 4097 is finer than a 32x32 image can show; at most 65 nodes a side", 2);
+    expectRefused(r, "heightfield", "--grid 4097 is finer than a 32x32 image can show; at most 129 nodes a side", 2);
     expectBounded(r, 400);
     r = run({"encode", path("small.ppm"), "-o", path("x.exr"), "--focus", "0.5,0.5,0.1,2", "--grid", "4097"});
     expectRefused(r, "encode", "--grid 4097 is finer", 2);
@@ -291,6 +291,20 @@ TEST_F(SceneHostile, AReflectionAssetIsWrittenAsAWhole) {
     r = run({"bake", "reflection", path("scene.obj"), "--size", "8", "-o", path("asset")});
     expectRefused(r, "bake", "holds notes.txt", 2);
     EXPECT_TRUE(fs::exists(m_dir / "asset" / "notes.txt"));
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(SceneHostile, InfoListsTheSceneLimits) {
+    const conus::hostile::Outcome r = run({"info", "--limits", "--json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    for (const conus::LimitEntry& e : conus::limitTable()) EXPECT_EQ(j[e.name]["value"], e.value) << e.name;
+    EXPECT_EQ(j["demSamples"]["value"], conus::kMaxDemSamples);
+    EXPECT_EQ(j["volumeReadBytes"]["unit"], "bytes");
+    EXPECT_EQ(j["encodeBytes"]["value"], conus::kMaxEncodeBytes);
 }
 
 }  // namespace
