@@ -60,6 +60,8 @@ void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
             fail(ErrorCode::LimitExceeded, path, "its header declares " + numberText(double(count)) + " " + element +
                                                      " elements, more than the limit of " + std::to_string(cap));
     }
+    // Assimp's ASCII PLY reader loops forever on a header that never ends.
+    fail(ErrorCode::Corrupt, path, "its PLY header has no end_header line");
 }
 
 // A binary glTF's header and chunk lengths, which Assimp allocates by: each inside the file.

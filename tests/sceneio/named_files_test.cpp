@@ -155,6 +155,15 @@ TEST_F(NamedFilesTest, GlbChunkLengthsMustLieInsideTheFile) {
     EXPECT_TRUE(contains(refusal([&] { readMesh(path2); }).message, "header declares 1073741824 bytes"));
 }
 
+// Assimp's ASCII PLY reader looped forever on this 94-byte header (the mesh harness found it).
+TEST_F(NamedFilesTest, APlyHeaderWithoutAnEndIsRefused) {
+    const std::string path = scene("endless.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                                  "property float y\nprop0 0\n0 1 0\n3 0 1 2\n");
+    const Refusal r = refusal([&] { readMesh(path); });
+    EXPECT_EQ(r.code, ErrorCode::Corrupt) << r.message;
+    EXPECT_TRUE(contains(r.message, "no end_header")) << r.message;
+}
+
 TEST_F(NamedFilesTest, ExactDuplicateTrianglesAreDroppedAndCounted) {
     // One triangle in 50 copies (some reversed, some through repeated vertices) and one other.
     std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 5 5 5\n";
