@@ -45,7 +45,11 @@ namespace fs = std::filesystem;
 void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
-    if (!std::getline(in, line) || (line != "ply" && line != "ply\r" && line != "PLY" && line != "PLY\r")) return;
+    // Assimp takes any file that starts with the three letters for a PLY ("ply@" included).
+    if (!std::getline(in, line) || line.size() < 3) return;
+    std::string magic = line.substr(0, 3);
+    for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (magic != "ply") return;
     for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
         if (line.rfind("end_header", 0) == 0) return;
         std::istringstream words(line);

@@ -162,6 +162,8 @@ TEST_F(NamedFilesTest, APlyHeaderWithoutAnEndIsRefused) {
     const Refusal r = refusal([&] { readMesh(path); });
     EXPECT_EQ(r.code, ErrorCode::Corrupt) << r.message;
     EXPECT_TRUE(contains(r.message, "no end_header")) << r.message;
+    const std::string odd = scene("odd.ply", "ply@\nformat ascii 1.0\nelement vertex 3\nproperty float x\nprop0 0\n");
+    EXPECT_TRUE(contains(refusal([&] { readMesh(odd); }).message, "no end_header"));
 }
 
 TEST_F(NamedFilesTest, ExactDuplicateTrianglesAreDroppedAndCounted) {
