@@ -20,6 +20,7 @@
 #include <fstream>
 #include <iterator>
 #include <set>
+#include <stdexcept>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -29,6 +30,16 @@
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
 #include "conus/sceneio/named_files.h"
+
+// Debian's Assimp keeps its internal assertions, which abort the process (a hostile PLY reaches
+// one in the triangulation step). This definition takes the place of Assimp's own (the library
+// calls it through its PLT): the violation becomes an exception that readMesh turns into a
+// one-line conus::Error.
+namespace Assimp {
+void aiAssertViolation(const char* failed, const char* file, int line) {
+    throw std::runtime_error(std::string("Assimp's check failed: ") + failed + " (" + file + ":" + std::to_string(line) + ")");
+}
+}  // namespace Assimp
 
 namespace conus::sceneio {
 namespace {
@@ -298,7 +309,12 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options, MeshReadR
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
                            aiProcess_PreTransformVertices | aiProcess_FlipUVs | aiProcess_ValidateDataStructure;
-    const aiScene* scene = importer.ReadFile(path, flags);
+    const aiScene* scene = nullptr;
+    try {
+        scene = importer.ReadFile(path, flags);
+    } catch (const std::exception& e) {
+        fail(ErrorCode::Corrupt, path, e.what());
+    }
     if (!io->refusal().empty()) throw Error(ErrorCode::Io, io->refusal());
     if (!scene) {
         std::string why = importer.GetErrorString();
