@@ -62,11 +62,18 @@ void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
     for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (magic != "ply") return;
     for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
-        if (line.rfind("end_header", 0) == 0) return;
+        while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+        if (line == "end_header") return;
         std::istringstream words(line);
         std::string keyword, element;
         long double count = 0;
-        if (!(words >> keyword >> element >> count) || keyword != "element") continue;
+        // Assimp's ASCII reader loops forever on some malformed headers: only the spec's lines pass.
+        words >> keyword;
+        if (keyword != "format" && keyword != "element" && keyword != "property" && keyword != "comment" &&
+            keyword != "obj_info")
+            fail(ErrorCode::Corrupt, path, "its PLY header has a line that is not format, element, property, comment "
+                                           "or end_header");
+        if (!(words >> element >> count) || keyword != "element") continue;
         const std::int64_t cap = element == "vertex" ? options.maxVertices : element == "face" ? options.maxTriangles : -1;
         if (count > static_cast<long double>(bytes))
             fail(ErrorCode::Corrupt, path, "its header declares " + numberText(double(count)) + " " + element +
