@@ -79,4 +79,11 @@ format::Compression parseCompression(const std::string& text) {
     invalid("compression '" + text + "' is not one of " + format::nameList<format::Compression>());
 }
 
+void addAllowDirOption(CLI::App& command, std::vector<std::string>& dirs) {
+    command.add_option("--allow-dir", dirs,
+                       "a folder the files a scene file names (buffers, material libraries, data files) may also lie in; "
+                       "by default only the scene file's own folder (repeatable)")
+        ->check(CLI::ExistingDirectory);
+}
+
 }  // namespace conus::cli

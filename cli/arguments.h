@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
@@ -33,5 +34,9 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "
 // below `high`. CLI::Range lets NaN through (every comparison with NaN is false); this does not,
 // so a bad value is a usage error (exit 2) instead of a silent fallback.
 CLI::Validator finiteRange(double low, double high, bool lowIncluded = false);
+
+// --allow-dir DIR (repeatable): a folder, besides a scene file's own, that the files it names
+// (glTF buffers, material libraries, NRRD data files) may lie in (sceneio/named_files.h).
+void addAllowDirOption(CLI::App& command, std::vector<std::string>& dirs);
 
 }  // namespace conus::cli

@@ -19,6 +19,7 @@
 #include <mutex>
 #include <thread>
 
+#include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "progress.h"
 
@@ -27,15 +28,25 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A list is a regular file (a FIFO or /dev/zero could be read forever) or standard input, and at
+// most kMaxListBytes: a list that long names a million files.
+constexpr std::size_t kMaxListBytes = 64 << 20;
+
 std::vector<std::string> readList(const std::string& listFile) {
     std::ifstream file;
     if (listFile != "-") {
+        checkInputPath(listFile);
         file.open(listFile);
         if (!file) throw Error(ErrorCode::Io, "cannot read the list " + listFile);
     }
     std::istream& in = listFile == "-" ? std::cin : file;
     std::vector<std::string> inputs;
+    std::size_t bytes = 0;
     for (std::string line; std::getline(in, line);) {
+        bytes += line.size() + 1;
+        if (bytes > kMaxListBytes || line.size() > 4096)
+            throw Error(ErrorCode::LimitExceeded, "the list " + listFile + " is longer than " +
+                                                      std::to_string(kMaxListBytes) + " bytes or has a line of over 4096");
         while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
         const std::size_t start = line.find_first_not_of(" \t");
         if (start == std::string::npos || line[start] == '#') continue;  // blank lines and comments
@@ -153,7 +164,12 @@ std::vector<Job> planJobs(const BatchOptions& o) {
     std::vector<Job> jobs;
     std::map<std::string, std::string> seen;  // output -> the input that writes it
     for (std::size_t i = 0; i < inputs.size(); ++i) {
-        Job job{inputs[i], (fs::path(o.outDir) / outputName(o.name, inputs[i], i + 1)).string()};
+        // Outputs stay inside --out-dir: no absolute name, no ".." out of it.
+        const fs::path name = fs::path(outputName(o.name, inputs[i], i + 1)).lexically_normal();
+        if (name.empty() || name.is_absolute() || *name.begin() == ".." || name.has_root_name())
+            throw Error(ErrorCode::InvalidArgument, "--name '" + o.name + "' gives '" + name.string() +
+                                                        "', which is not a file name inside --out-dir");
+        Job job{inputs[i], (fs::path(o.outDir) / name).string()};
         const std::string key = fs::path(job.output).lexically_normal().string();
         if (auto [it, fresh] = seen.emplace(key, job.input); !fresh)
             throw Error(ErrorCode::InvalidArgument, job.input + " and " + it->second + " would both write " + job.output +
@@ -167,6 +183,7 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
     std::error_code ec;
     fs::create_directories(options.outDir, ec);
     if (ec) throw Error(ErrorCode::Io, "cannot make the folder " + options.outDir + ": " + ec.message());
+    removeStaleTemporaries(options.outDir);  // even when --skip-existing writes nothing
 
     const bool userQuiet = quiet();  // -q; the items below run quiet whatever it says
     const auto start = std::chrono::steady_clock::now();

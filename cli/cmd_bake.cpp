@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "arguments.h"
 #include "commands.h"
@@ -19,6 +21,7 @@
 #include "conus/codec/depth/reflection.h"
 #include "conus/codec/depth/relief.h"
 #include "conus/codec/image/encode.h"
+#include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
 #include "conus/imageio/text.h"
@@ -84,6 +87,7 @@ int runBakeRelief(const BakeOptions& o) {
         size = {std::max(1, source.heights.width / 4), std::max(1, source.heights.height / 4)};
     else
         size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     if (size.width > source.heights.width || size.height > source.heights.height)
         throw Error(ErrorCode::InvalidArgument, "--size " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                                                     " is larger than the height field (" +
@@ -148,12 +152,22 @@ int runBakeRelief(const BakeOptions& o) {
 
 struct ReflectionBakeText {
     std::string scene, outDir, centre = "0,0,0", roiMin, roiMax;
+    std::vector<std::string> allowDirs;
     int size = 128;
     double magnification = codec::ReflectionBakeOptions{}.magnification;
     bool uniform = false;
 };
 
+// The six faces' file names: the asset's folder holds these and nothing else.
+std::vector<std::string> faceFileNames() {
+    std::vector<std::string> names;
+    for (const char* face : codec::kCubeFaceNames) names.push_back(face + std::string(".exr"));
+    return names;
+}
+
 int runBakeReflection(const ReflectionBakeText& o) {
+    const std::vector<std::string> names = faceFileNames();
+    checkFolderOutput(o.outDir, names);
     codec::ReflectionBakeOptions options;
     options.centre = parseVector3(o.centre, "--center");
     options.size = o.size;
@@ -168,16 +182,20 @@ int runBakeReflection(const ReflectionBakeText& o) {
         options.roi = codec::AxisBox{lo, hi};
     }
     Progress loading("read " + o.scene);
-    const codec::MeshScene scene(sceneio::readMesh(o.scene, {.warn = warn}));
+    sceneio::MeshReadOptions read;
+    read.allowedDirs = o.allowDirs;
+    read.warn = warn;
+    const codec::MeshScene scene(sceneio::readMesh(o.scene, read));
     loading.done();
     Progress baking("bake six " + std::to_string(o.size) + "x" + std::to_string(o.size) + " faces (Embree)");
     const auto faces = codec::bakeReflection(scene, options);
     baking.done();
-    std::filesystem::create_directories(o.outDir);
-    for (int f = 0; f < codec::kCubeFaces; ++f) {
-        const std::string path = (std::filesystem::path(o.outDir) / (codec::kCubeFaceNames[f] + std::string(".exr"))).string();
-        format::writeConusFile(path, codec::reflectionFaceFile(faces[static_cast<std::size_t>(f)]));
-    }
+    // The six faces appear together or not at all (a full disk leaves the earlier asset whole).
+    writeFolderAtomically(o.outDir, names, [&](const std::string& folder) {
+        for (int f = 0; f < codec::kCubeFaces; ++f)
+            format::writeConusFile((std::filesystem::path(folder) / names[static_cast<std::size_t>(f)]).string(),
+                                   codec::reflectionFaceFile(faces[static_cast<std::size_t>(f)]));
+    });
     std::printf("wrote %s: six %dx%d CoNUS colour + depth faces from %g,%g,%g (%s)\n", o.outDir.c_str(), o.size, o.size,
                 options.centre.x, options.centre.y, options.centre.z,
                 o.uniform ? "uniform, the baseline" : "foci on the region of interest");
@@ -199,6 +217,7 @@ CLI::App* addBakeReflection(CLI::App& command, ReflectionBakeText& o) {
     reflection->add_option("--roi-min", o.roiMin, "region of interest, lowest corner x,y,z (default: the whole scene)");
     reflection->add_option("--roi-max", o.roiMax, "region of interest, highest corner x,y,z");
     reflection->add_flag("--uniform", o.uniform, "identity maps: the conventional asset of the same texel count");
+    addAllowDirOption(*reflection, o.allowDirs);
     return reflection;
 }
 

@@ -130,8 +130,12 @@ std::string decodeOne(const DecodeCommandOptions& o, const std::string& input, c
     // A zoomed-out view takes one trilinear tap from the image's pyramid per pixel (no aliasing,
     // a fraction of the multi-tap average's work); a magnified one is the same without it.
     const bool withPyramid = !depthImage && codec::viewZoomsOut(file.image, map, view, decode.width, decode.height);
+    // The picture writer holds the frame again: as float through the display transform and in the
+    // output's sample type (at most 4 bytes).
+    const std::int64_t writer = std::int64_t{decode.width} * decode.height * file.image.channelCount() *
+                                std::int64_t(sizeof(float) + 4);
     try {
-        codec::checkDecodeMemory(file.image, decode.width, decode.height, kMaxDecodeBytes, withPyramid);
+        codec::checkDecodeMemory(file.image, decode.width, decode.height, kMaxDecodeBytes, withPyramid, writer);
     } catch (const Error& e) {
         throw Error(e.code(), std::string(e.what()) + "; give a smaller --size");
     }

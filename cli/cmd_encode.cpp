@@ -14,6 +14,7 @@
 #include "conus/codec/build/foci_budget.h"
 #include "conus/codec/build/frame_budget.h"
 #include "conus/codec/conus_file.h"
+#include "conus/codec/image/encode.h"
 #include "conus/core/limits.h"
 #include "conus/core/map_rules.h"
 #include "encoding.h"
@@ -135,6 +136,8 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     checkConusOutput(output, input);
     const imageio::ImageFile source = readSource(input, o.source);
     const Size size = conusSize(o.storage, source.image);
+    codec::checkEncodeMemory(source.image, size.width, size.height);  // before a map is built for it
+    if (!o.importance.empty() || !o.foci.empty()) checkGridForImage(o.grid, size.width, size.height);
     BuiltMap built;
     std::string given;
     if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image);

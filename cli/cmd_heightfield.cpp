@@ -22,6 +22,7 @@
 #include "dem_io.h"
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
+#include "map_options.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -165,6 +166,7 @@ int runEncode(const EncodeOptions& o) {
     codec::HeightFieldOptions options;
     options.ground = groundFor(o, dem);
     const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height, EncodeOptions{}.grid);
     options.width = size.width;
     options.height = size.height;
     options.mapGrid = o.grid;

@@ -62,7 +62,7 @@ struct InfoOptions {
 
 // --verbose on an invalid file: every broken rule, one a line (as `conus validate`), then the error.
 void explainIfInvalid(const std::string& input) {
-    const format::ValidationReport report = format::validateConusFile(input);
+    const format::ValidationReport report = format::validateConusFile(input, {}, false);
     if (report.ok()) return;
     for (const auto& issue : report.issues)
         std::printf("%s: %s: %s\n", input.c_str(), format::label(issue.rule).c_str(), issue.message.c_str());

@@ -51,6 +51,7 @@ struct MeshOptions {
     double time = 0, maxEdge = 0.5;
     int samples = 4, grid = map_rules::kDefaultSide;
     std::vector<int> track;
+    std::vector<std::string> allowDirs;
     double trackRadius = 0.05, trackK = 3;  // a car is small: a small, moderate focus keeps the context
     // animate: add, smooth from frame to frame (tests/renderers/mesh_sequence_test.cpp); render sets
     // density, as encode, volume and map compose foci.
@@ -242,6 +243,7 @@ int runRender(const RenderOptions& r) {
     const MeshOptions& o = r.mesh;
     checkConusOutput(r.output, o.model);
     const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     const CameraChoice cameraChoice = parseCameraOptions(o);
     if (!o.track.empty() && o.model != kCity)
         throw Error(ErrorCode::InvalidArgument, "--track follows the city's cars: give `city` as the model");
@@ -250,7 +252,16 @@ int runRender(const RenderOptions& r) {
     Progress loading("read " + o.model);
     Mesh mesh;
     if (o.model == kCity) mesh = city.emplace().meshAt(o.time);
-    else mesh = sceneio::readMesh(o.model, {.warn = warn});
+    else {
+        sceneio::MeshReadOptions read;
+        read.allowedDirs = o.allowDirs;
+        read.warn = warn;
+        sceneio::MeshReadReport report;
+        mesh = sceneio::readMesh(o.model, read, &report);
+        if (report.duplicateTriangles > 0)
+            warn(o.model + ": dropped " + std::to_string(report.duplicateTriangles) +
+                 " exact duplicate triangles (copies of another triangle's three corners)");
+    }
     loading.done();
     const Camera camera =
         city && !cameraChoice.given ? cityCamera(*city, aspect) : meshCamera(cameraChoice, boundsOf(mesh), aspect);
@@ -354,6 +365,7 @@ int runAnimate(const AnimateOptions& a) {
         throw Error(ErrorCode::InvalidArgument, "animate renders the procedural city: give `city` as the model, not '" + o.model + "'");
     if (o.track.empty()) warn("no --track: every frame is the uniform image (give --track 0,2 to follow cars)");
     const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     const CameraChoice cameraChoice = parseCameraOptions(o);
     const double aspect = double(size.width) / size.height;
     const std::filesystem::path dir(a.outDir);
@@ -439,6 +451,7 @@ CLI::App* addRender(CLI::App& command, RenderOptions& r) {
     render->add_flag("--reference", r.reference, "the exact CPU reference (Embree ray casting) instead of the GPU");
     r.mesh.compose = "density";
     addSharedOptions(*render, r.mesh, true);
+    addAllowDirOption(*render, r.mesh.allowDirs);
     return render;
 }
 

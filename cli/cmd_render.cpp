@@ -77,6 +77,7 @@ int runRenderRelief(const RenderOptions& o) {
 struct ReflectionRenderText {
     std::string asset, scene, output, cameraText, sizeText = "640x480", reflector = "sphere", at, normal = "0,0,1",
                 backend = "auto";
+    std::vector<std::string> allowDirs;
     double radius = 0.5, step = 1.0;
     bool reference = false;
 };
@@ -104,7 +105,10 @@ int runRenderReflection(const ReflectionRenderText& o) {
     const glm::dvec3 centre = faces.front().depth.camera().eye();
     options.reflector.centre = o.at.empty() ? centre : parseVector3(o.at, "--at");
     Progress loading("read " + o.scene);
-    const codec::MeshScene scene(sceneio::readMesh(o.scene, {.warn = warn}));
+    sceneio::MeshReadOptions read;
+    read.allowedDirs = o.allowDirs;
+    read.warn = warn;
+    const codec::MeshScene scene(sceneio::readMesh(o.scene, read));
     loading.done();
     const double aspect = double(size.width) / size.height;
     const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);
@@ -134,6 +138,7 @@ CLI::App* addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
          "conus render reflection asset --scene scene.obj --reflector plane --normal 0,0,1 --radius 2 --camera 0,1,4,0,0,0,40 -o frame.png"});
     reflection->add_option("asset", o.asset, "folder from `conus bake reflection`")->required();
     reflection->add_option("--scene", o.scene, "the mesh file the asset was baked from (drawn behind)")->required();
+    addAllowDirOption(*reflection, o.allowDirs);
     reflection->add_option("-o,--output", o.output, "frame (.png, .exr, ...)")->required();
     reflection->add_option("--camera", o.cameraText, "x,y,z,lx,ly,lz,fovDeg")->required();
     reflection->add_option("--size", o.sizeText, "frame size WxH")->capture_default_str();

@@ -13,15 +13,19 @@ namespace conus::cli {
 
 Command addValidateCommand(CLI::App& root) {
     auto input = std::make_shared<std::string>();
+    auto headersOnly = std::make_shared<bool>(false);
     CLI::App* command = root.add_subcommand(
         "validate", "Check a file against every rule of the CoNUS spec; exit 0 only if valid");
     command->add_option("input", *input, "file to check")->required();
+    command->add_flag("--headers-only", *headersOnly,
+                      "check headers, the map and the chunk tables without decompressing the pixel data (faster; a "
+                      "file this passes may still fail to decode)");
     addQuietOption(*command);
     setExamples(*command, {"conus validate photo.exr            # exit 0: valid; 1: every broken rule listed, one a line",
                        "conus validate photo.exr >/dev/null && echo ok"});
-    return {command, [input] {
+    return {command, [input, headersOnly] {
                 checkInputPath(*input, false);  // "no such file", not a broken rule
-                const format::ValidationReport report = format::validateConusFile(*input);
+                const format::ValidationReport report = format::validateConusFile(*input, {}, !*headersOnly);
                 if (report.ok()) {
                     if (!quiet())
                         std::printf("%s: valid CoNUS file (format version %d)\n", input->c_str(), format::kFormatVersion);

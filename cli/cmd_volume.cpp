@@ -38,7 +38,7 @@ namespace {
 struct VolumeOptions {
     std::string volume, output, picture, sizeText = "512x512", cameraText, upText = "0,-1,0", tf = codec::TransferFunction::kDefaultPreset,
                                          rangeText, backend = "auto", units = "voxel", mapFile;
-    std::vector<std::string> foci;
+    std::vector<std::string> foci, allowDirs;
     int grid = map_rules::kDefaultSide;
     std::string compose = "density";
     double step = 0.5, depthOpacity = 0.5;
@@ -46,9 +46,11 @@ struct VolumeOptions {
 };
 
 // procedural:... through codec, every file form through sceneio.
-Volume loadVolume(const std::string& spec) {
+Volume loadVolume(const std::string& spec, const std::vector<std::string>& allowDirs) {
     if (spec.rfind("procedural:", 0) == 0) return codec::proceduralVolume(spec);
-    return sceneio::readVolume(spec);
+    sceneio::VolumeReadOptions read;
+    read.allowedDirs = allowDirs;
+    return sceneio::readVolume(spec, read);
 }
 
 // A preset's name, or the path of a transfer-function file (anything with a '/' or '.' or that exists).
@@ -128,7 +130,7 @@ struct Scene {
 Scene loadScene(const VolumeOptions& o, double aspect) {
     codec::TransferFunction tf = loadTransferFunction(o.tf);
     Progress loading("read " + o.volume);
-    Volume volume = loadVolume(o.volume);
+    Volume volume = loadVolume(o.volume, o.allowDirs);
     loading.done();
     const Camera camera = volumeCamera(o, volume, tf, aspect);
     return {std::move(tf), std::move(volume), camera};
@@ -138,6 +140,7 @@ int runRender(const VolumeOptions& o) {
     checkConusOutput(o.output, o.volume);
     checkCameraOptions(o);
     const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     const double aspect = double(size.width) / size.height;
     codec::VolumeRenderOptions options = renderOptions(o);
     const Scene scene = loadScene(o, aspect);
@@ -194,6 +197,7 @@ int runAnimate(const AnimateOptions& a) {
     const glm::dvec2 from = parsePoint(a.from, "--from"), to = parsePoint(a.to, "--to");
     checkCameraOptions(o);
     const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
     const double aspect = double(size.width) / size.height;
     std::error_code ec;
     std::filesystem::create_directories(a.outDir, ec);
@@ -284,6 +288,7 @@ Command addVolumeCommand(CLI::App& root) {
     render->add_flag("--uniform", o->uniform, "render the uniform image of the same pixel count (the baseline)");
     render->add_option("--units", o->units, "the volume's length unit, recorded as the depth's units")->capture_default_str();
     addBackendOption(*render, o->backend, gl::CpuPath::Available);
+    addAllowDirOption(*render, o->allowDirs);
     addQuietOption(*render);
 
     auto a = std::make_shared<AnimateOptions>();
@@ -306,6 +311,7 @@ Command addVolumeCommand(CLI::App& root) {
         ->capture_default_str()
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addBackendOption(*animate, a->volume.backend, gl::CpuPath::Available);
+    addAllowDirOption(*animate, a->volume.allowDirs);
     addQuietOption(*animate);
     return {volume, [o, a, render] { return render->parsed() ? runRender(*o) : runAnimate(*a); }};
 }

@@ -17,6 +17,7 @@
 
 #include "conus/codec/depth/heightfield.h"
 #include "conus/core/error.h"
+#include "conus/core/limits.h"
 #include "image_files.h"
 
 namespace conus::cli {
@@ -100,7 +101,9 @@ NpyHeader parseNpyHeader(const unsigned char* data, std::size_t available, const
         if (item.find_first_not_of(" \t") == std::string::npos && items.eof()) break;  // "(5,)": the trailing comma
         h.shape.push_back(dimension(item, shape, what));
         h.count *= h.shape.back();  // each factor <= 2^16 and the product is checked at each step: no overflow
-        if (h.count > kMaxImagePixels) fail(what, "shape (" + shape + ") holds more than " + std::to_string(kMaxImagePixels) + " values");
+        if (h.count > kMaxDemSamples)
+            throw Error(ErrorCode::LimitExceeded, what + ": shape (" + shape + ") holds more than the limit of " +
+                                                      std::to_string(kMaxDemSamples) + " height samples");
     }
     const std::string& d = h.dtype;
     if (d.size() < 3) fail(what, "dtype '" + d + "' is not supported");
@@ -187,6 +190,9 @@ std::map<std::string, NpyArray> readNpz(const std::string& path) {
     if (!archive) throw Error(ErrorCode::Io, path + ": cannot open as a .npz (zip) archive (libzip error " +
                                                  std::to_string(error) + ")");
     std::map<std::string, NpyArray> arrays;
+    // What all members may inflate to: the largest elevation model as int64 or float64, and headers.
+    constexpr std::uint64_t kMaxInflatedBytes = std::uint64_t(kMaxDemSamples) * 8 + 16 * (kMaxNpyHeaderBytes + 12);
+    std::uint64_t inflated = 0;
     const zip_int64_t entries = zip_get_num_entries(archive.get(), 0);
     for (zip_int64_t i = 0; i < entries; ++i) {
         zip_stat_t stat;
@@ -206,6 +212,11 @@ std::map<std::string, NpyArray> readNpz(const std::string& path) {
                                                 std::to_string(archiveSize) + "-byte archive; " +
                                                 (ratio == 1 ? std::string("stored data cannot expand")
                                                             : "deflate expands at most " + std::to_string(ratio) + " times"));
+        inflated += stat.size;
+        if (inflated > kMaxInflatedBytes)
+            throw Error(ErrorCode::LimitExceeded, what + ": the archive's arrays inflate to more than " +
+                                                      std::to_string(kMaxInflatedBytes) + " bytes, the limit for " +
+                                                      std::to_string(kMaxDemSamples) + " height samples");
         std::unique_ptr<zip_file_t, decltype(&zip_fclose)> file(zip_fopen_index(archive.get(), i, 0), &zip_fclose);
         if (!file) throw Error(ErrorCode::Io, what + ": cannot read the member");
         NpyArray array = readNpy(
@@ -221,10 +232,20 @@ std::map<std::string, NpyArray> readNpz(const std::string& path) {
     return arrays;
 }
 
+// Every height a file gives is a finite number (NaN or an overflow past float is bad data).
+void checkHeights(const Image& heights, const std::string& what) {
+    for (std::size_t i = 0; i < heights.pixels.size(); ++i)
+        if (!std::isfinite(heights.pixels[i]))
+            throw Error(ErrorCode::Corrupt, what + ": height at (" + std::to_string(i % heights.width) + ", " +
+                                                std::to_string(i / heights.width) + ") is " + numberText(heights.pixels[i]) +
+                                                " (times the height scale); every height must be finite");
+}
+
 Image toHeights(const NpyArray& a, double scale, const std::string& what) {
     if (a.header.shape.size() != 2) throw Error(ErrorCode::Corrupt, what + ": not a 2-D array");
     Image im = makeImage(static_cast<int>(a.header.shape[1]), static_cast<int>(a.header.shape[0]), {"Z"});
     values(a, im.pixels.size(), scale, im.pixels.data());
+    checkHeights(im, what);
     return im;
 }
 
@@ -245,12 +266,17 @@ Dem readDem(const std::string& source, double heightScale) {
     if (std::regex_match(source, m, std::regex("procedural(?::(\\d+))?(?::(\\d+))?"))) {
         codec::TerrainOptions options;
         if (m[1].matched) options.width = options.height = std::stoi(m[1].str().substr(0, 6));
+        if (std::int64_t{options.width} * options.height > kMaxDemSamples)
+            throw Error(ErrorCode::InvalidArgument, "procedural terrain " + std::to_string(options.width) + "x" +
+                                                        std::to_string(options.height) + " holds more than the limit of " +
+                                                        std::to_string(kMaxDemSamples) + " height samples");
         if (m[2].matched) options.seed = static_cast<std::uint32_t>(std::stoul(m[2].str().substr(0, 9)));
         dem.heights = codec::generateTerrain(options);
         if (heightScale != 1.0)
             for (float& h : dem.heights.pixels) h = static_cast<float>(h * heightScale);
         dem.description = "procedural terrain " + std::to_string(options.width) + "x" + std::to_string(options.height) +
                           " seed " + std::to_string(options.seed);
+        checkHeights(dem.heights, dem.description);
         return dem;
     }
     requireRegularFile(source);
@@ -275,6 +301,11 @@ Dem readDem(const std::string& source, double heightScale) {
             } else {
                 dem.cellMetres = {dx, dy};
             }
+            // A cell from a micrometre to a thousand kilometres; anything else is a damaged file.
+            if (!(dem.cellMetres.x >= 1e-6 && dem.cellMetres.x <= 1e6 && dem.cellMetres.y >= 1e-6 && dem.cellMetres.y <= 1e6))
+                throw Error(ErrorCode::Corrupt, source + ": spacing dx " + numberText(dx) + ", dy " + numberText(dy) +
+                                                    " gives cells of " + numberText(dem.cellMetres.x) + " x " +
+                                                    numberText(dem.cellMetres.y) + " m, outside [1e-6, 1e6] m");
         }
         dem.description = source + " " + it->first + " " + std::to_string(dem.heights.width) + "x" +
                           std::to_string(dem.heights.height) + " " + it->second.header.dtype;
@@ -296,6 +327,10 @@ Dem readDem(const std::string& source, double heightScale) {
         return dem;
     }
     const Image image = readData(source);
+    if (std::int64_t{image.width} * image.height > kMaxDemSamples)
+        throw Error(ErrorCode::LimitExceeded, source + ": " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                                                  " holds more than the limit of " + std::to_string(kMaxDemSamples) +
+                                                  " height samples");
     int channel = image.channelIndex("Z");
     if (channel < 0) channel = image.channelIndex("Y");
     if (channel < 0) channel = 0;  // a grey or RGB image: its first channel
@@ -303,6 +338,7 @@ Dem readDem(const std::string& source, double heightScale) {
     for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x)
             dem.heights.at(x, y) = static_cast<float>(image.at(x, y, channel) * heightScale);
+    checkHeights(dem.heights, source);
     dem.description = source + " " + std::to_string(image.width) + "x" + std::to_string(image.height) + " channel " +
                       image.channels[channel];
     return dem;

@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "arguments.h"
 #include "conus/core/atomic_file.h"
 #include "progress.h"
 
@@ -54,7 +55,7 @@ void addPictureOptions(CLI::App& command, PictureOptions& options) {
                        "sample type of the picture: 8, 16, half or float (default: the source's where the format holds it)")
         ->check(CLI::IsMember({"8", "16", "half", "float"}));
     command.add_option("--exposure", options.exposure, "exposure in stops (multiplies colour by 2^EV)")
-        ->check(CLI::Range(-64.0, 64.0));
+        ->check(finiteRange(-64.0, 64.0, true));
     command.add_option("--tonemap", options.toneMap,
                        "for 8/16-bit pictures of HDR data: none (default: values above 1 clip), reinhard, aces")
         ->check(CLI::IsMember({"none", "reinhard", "aces"}));

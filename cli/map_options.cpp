@@ -2,8 +2,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+
+#include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 
 #include "conus/renderers/mesh_sequence.h"
 #include "progress.h"
@@ -143,6 +148,14 @@ void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDe
     command.add_option("--max-density", maxDensity,
                        prefix + "cap on every map cell's density (default 16: 4x the linear rate), held to 5% or refused")
         ->check(CLI::Range(1.001, 4096.0));
+}
+
+void checkGridForImage(int grid, int width, int height, int defaultGrid) {
+    const int most = std::max(defaultGrid, 4 * std::max(width, height) + 1);
+    if (grid > most)
+        throw Error(ErrorCode::InvalidArgument, "--grid " + std::to_string(grid) + " is finer than a " + std::to_string(width) +
+                                                    "x" + std::to_string(height) + " image can show; at most " +
+                                                    std::to_string(most) + " nodes a side");
 }
 
 }  // namespace conus::cli

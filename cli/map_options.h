@@ -11,6 +11,7 @@
 #include "conus/codec/build/foci.h"
 #include "conus/codec/build/foci_budget.h"
 #include "conus/codec/map/sampling_map.h"
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 
 namespace CLI {
@@ -51,6 +52,11 @@ struct BudgetFrame {
 // a lower k (recorded so).
 std::string describeFociBudget(const codec::FociBudget& budget, const std::optional<BudgetFrame>& frame, bool exactK, int grid,
                                double maxAnisotropy = 0);
+
+// A map much finer than the image it shapes adds nothing the image can show and costs a build in
+// proportion to its nodes (a minute at 4097 a side): --grid is refused (InvalidArgument) past
+// the larger of the command's default and 4 nodes a pixel along the image's longer side.
+void checkGridForImage(int grid, int width, int height, int defaultGrid = map_rules::kDefaultSide);
 
 // The foci of repeated --focus u,v,r,k options, in order.
 std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);

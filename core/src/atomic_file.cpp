@@ -6,11 +6,18 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <csignal>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <regex>
+#include <set>
+#include <sstream>
 #include <system_error>
 
 #include "conus/core/error.h"
@@ -77,7 +84,105 @@ void checkReplaceable(const std::string& destination, const std::string& target,
                               " is not a regular file (a device, FIFO or socket); CoNUS writes regular files only");
 }
 
+// ---- stale temporaries -------------------------------------------------------------------------
+
+// ".<stem>.tmp-<pid>-<n><ext>": what the constructor below names a temporary.
+std::string temporaryName(const fs::path& target) {
+    return "." + target.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+           std::to_string(g_counter.fetch_add(1)) + target.extension().string();
+}
+
+// When process `pid` started, in seconds since the epoch; -1 when no such process runs.
+double processStart(long pid) {
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string text;
+    if (!std::getline(stat, text)) return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM ? 0.0 : -1.0;
+    // Field 22 (starttime, clock ticks after boot) follows the command name in parentheses.
+    const std::size_t close = text.rfind(')');
+    if (close == std::string::npos) return 0.0;
+    std::istringstream fields(text.substr(close + 2));
+    std::string field;
+    for (int i = 3; i < 22 && fields >> field;) ++i;
+    double ticks = 0;
+    if (!(fields >> ticks)) return 0.0;
+    std::ifstream boot("/proc/stat");
+    double bootTime = 0;
+    for (std::string line; std::getline(boot, line);)
+        if (line.rfind("btime ", 0) == 0) bootTime = std::stod(line.substr(6));
+    return bootTime + ticks / double(::sysconf(_SC_CLK_TCK));
+}
+
 }  // namespace
+
+void removeStaleTemporaries(const std::string& folder) {
+    static std::mutex mutex;
+    static std::set<std::string> done;
+    std::error_code ec;
+    const std::string key = fs::weakly_canonical(folder.empty() ? "." : folder, ec).string();
+    {
+        std::lock_guard lock(mutex);
+        if (!done.insert(key).second) return;
+    }
+    static const std::regex kName(R"(\..*\.tmp-([0-9]{1,9})-[0-9]{1,10}(\.[^.]*)?)");
+    fs::directory_iterator entries(folder.empty() ? "." : folder, ec);
+    if (ec) return;
+    for (; entries != fs::directory_iterator(); entries.increment(ec)) {
+        if (ec) return;
+        const std::string name = entries->path().filename().string();
+        std::smatch m;
+        if (name.empty() || name[0] != '.' || !std::regex_match(name, m, kName)) continue;
+        const long pid = std::stol(m[1].str());
+        if (pid == ::getpid()) continue;
+        struct stat st {};
+        if (::lstat(entries->path().c_str(), &st) != 0 || !(S_ISREG(st.st_mode) || S_ISDIR(st.st_mode))) continue;
+        const double started = processStart(pid);
+        if (started >= 0 && started <= double(st.st_mtime) + 1) continue;  // its process still runs
+        fs::remove_all(entries->path(), ec);
+    }
+}
+
+void checkFolderOutput(const std::string& folder, std::span<const std::string> names) {
+    std::error_code ec;
+    const fs::file_status status = fs::symlink_status(folder, ec);
+    if (!fs::exists(status)) return;
+    if (!fs::is_directory(status))
+        throw Error(ErrorCode::InvalidArgument, folder + " exists and is not a folder; give a new or an earlier output folder");
+    for (fs::directory_iterator it(folder, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (std::find(names.begin(), names.end(), name) == names.end())
+            throw Error(ErrorCode::InvalidArgument, folder + " holds " + name +
+                                                        ", which is not part of what is written there; give a new or empty folder");
+    }
+}
+
+void writeFolderAtomically(const std::string& folder, std::span<const std::string> names,
+                           const std::function<void(const std::string& temporaryFolder)>& write) {
+    checkFolderOutput(folder, names);
+    fs::path target = fs::path(folder).lexically_normal();
+    if (target.filename().empty()) target = target.parent_path();  // "asset/"
+    const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+    std::error_code ec;
+    if (!fs::is_directory(parent, ec))
+        throw Error(ErrorCode::InvalidArgument, folder + ": the folder " + parent.string() + " does not exist");
+    removeStaleTemporaries(parent.string());
+    const fs::path temporary = parent / temporaryName(target.filename());
+    if (!fs::create_directory(temporary, ec))
+        throw Error(ErrorCode::Io, "cannot write " + folder + ": " + (ec ? ec.message() : std::string("temporary exists")));
+    try {
+        write(temporary.string());
+        ::sync();  // the files inside are synced by their writers; the folder entries too
+        if (!fs::exists(target)) {
+            if (::rename(temporary.c_str(), target.c_str()) != 0) throw Error(ErrorCode::Io, "cannot write " + folder + ": " + errnoText(errno));
+        } else {
+            if (::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0)
+                throw Error(ErrorCode::Io, "cannot replace " + folder + ": " + errnoText(errno));
+            fs::remove_all(temporary, ec);  // the earlier set, now under the temporary name
+        }
+    } catch (...) {
+        fs::remove_all(temporary, ec);
+        throw;
+    }
+}
 
 // ---- AtomicFile --------------------------------------------------------------------------------
 
@@ -86,9 +191,8 @@ AtomicFile::AtomicFile(const std::string& destination) : m_destination(destinati
     checkReplaceable(m_destination, m_target, ErrorCode::Io);
     const fs::path target(m_target);
     const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-    m_temporary = (folder / ("." + target.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                             std::to_string(g_counter.fetch_add(1)) + target.extension().string()))
-                      .string();
+    removeStaleTemporaries(folder.string());
+    m_temporary = (folder / temporaryName(target)).string();
     // Registered before it exists, so a signal between open and registration leaves nothing.
     m_slot = registerTemporary(m_temporary);
     m_fd = ::open(m_temporary.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);

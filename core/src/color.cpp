@@ -1,5 +1,7 @@
 // Names of the colour enumerations, written once (spec/conus-format.md uses the same words).
 #include <array>
+#include <cstdint>
+#include <string>
 #include <utility>
 
 #include "conus/core/color.h"
@@ -58,6 +60,16 @@ int bitsOf(SampleType t) {
         case SampleType::Float: return 32;
     }
     return 32;
+}
+
+std::string iccProfileProblem(const std::string& bytes) {
+    if (bytes.size() < 132) return std::to_string(bytes.size()) + " bytes, shorter than an ICC header and tag count";
+    const auto byte = [&](std::size_t i) { return std::uint32_t(static_cast<unsigned char>(bytes[i])); };
+    const std::uint32_t declared = byte(0) << 24 | byte(1) << 16 | byte(2) << 8 | byte(3);
+    if (bytes.compare(36, 4, "acsp") != 0) return "no `acsp` signature at byte 36";
+    if (declared != bytes.size())
+        return "its header declares " + std::to_string(declared) + " bytes, it holds " + std::to_string(bytes.size());
+    return {};
 }
 
 }  // namespace conus

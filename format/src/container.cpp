@@ -80,10 +80,11 @@ ConusFile readConusFile(const std::string& path, const ReadLimits& limits) { ret
 
 ConusFile readConusHeader(const std::string& path, const ReadLimits& limits) { return load(path, limits, false); }
 
-ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits) {
-    // The rules concern headers, the map and the chunk tables, never pixel values: pixels are not read.
+ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits, bool readPixels) {
+    // The rules concern headers, the map and the chunk tables, never pixel values; reading the
+    // pixels finds damaged compressed data, which only a decompression can see.
     ConusFile file;
-    return detail::loadConusFile(path, limits, false, file).report;
+    return detail::loadConusFile(path, limits, readPixels, file).report;
 }
 
 void checkExrFile(const std::string& path, const Limits& limits) { detail::checkExr(path, limits); }

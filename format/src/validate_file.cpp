@@ -7,6 +7,7 @@
 #include <string>
 
 #include "conus/core/camera.h"
+#include "conus/core/color.h"
 #include "conus/core/map_rules.h"
 #include "header_model.h"
 
@@ -281,8 +282,13 @@ void checkColour(const HeaderModel& m, ValidationReport& r) {
     if (optional(m, &HeaderModel::chromaticities, r) &&
         !std::all_of(m.chromaticities.value.begin(), m.chromaticities.value.end(), [](float x) { return std::isfinite(x); }))
         r.add(Rule::V16, "chromaticities hold a non-finite value");
-    if (optional(m, &HeaderModel::iccProfile, r) && !base64Decode(m.iccProfile.value))
-        r.add(Rule::V16, std::string(kAttrIccProfile) + " is not base64 text (" + std::to_string(m.iccProfile.value.size()) + " characters)");
+    if (optional(m, &HeaderModel::iccProfile, r)) {
+        const auto bytes = base64Decode(m.iccProfile.value);
+        if (!bytes)
+            r.add(Rule::V16, std::string(kAttrIccProfile) + " is not base64 text (" + std::to_string(m.iccProfile.value.size()) + " characters)");
+        else if (const std::string why = iccProfileProblem(*bytes); !why.empty())
+            r.add(Rule::V16, std::string(kAttrIccProfile) + " is not an ICC profile: " + why);
+    }
 }
 
 void checkDisplayWindows(const HeaderModel& m, ValidationReport& r) {

@@ -171,6 +171,7 @@ void collectMetadata(const OIIO::ImageSpec& spec, bool oriented, SourceEncoding&
         icc && icc->type().basetype == OIIO::TypeDesc::UINT8 && icc->datasize() > 0) {
         const auto* bytes = static_cast<const char*>(icc->data());
         encoding.iccProfile.assign(bytes, bytes + icc->datasize());
+        if (!iccProfileProblem(encoding.iccProfile).empty()) encoding.iccProfile.clear();  // garbage is not carried
     }
 }
 

@@ -129,6 +129,7 @@ bool describe(const Png& p, Transfer& declared, SourceEncoding& encoding) {
     int compression = 0;
     if (png_get_iCCP(p.png, p.info, &profileName, &compression, &profile, &profileLength) && profile && profileLength)
         encoding.iccProfile.assign(reinterpret_cast<const char*>(profile), profileLength);
+    if (!iccProfileProblem(encoding.iccProfile).empty()) encoding.iccProfile.clear();  // garbage is not carried
     png_timep time = nullptr;
     if (png_get_tIME(p.png, p.info, &time) && time) {
         char date[64];

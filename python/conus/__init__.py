@@ -41,7 +41,8 @@ def _one_line(function, name):
     return call
 
 
-for _name in ("read", "write", "encode", "decode", "uniform", "resize", "psnr", "importance", "read_image", "write_image"):
+for _name in ("read", "write", "encode", "decode", "uniform", "resize", "psnr", "importance", "read_image", "write_image",
+              "read_mesh", "read_volume"):
     globals()[_name] = _one_line(getattr(_conus, _name), _name)
 for _name in ("identity", "foci", "springs", "auto", "auto_for_frame_loss", "from_nodes"):
     setattr(Map, _name, staticmethod(_one_line(getattr(Map, _name), "Map." + _name)))
@@ -50,7 +51,7 @@ for _name in ("distort", "undistort", "density", "measures"):
 del _name
 
 __all__ = ["Error", "File", "Map", "read", "write", "encode", "decode", "uniform", "resize", "psnr", "importance",
-           "read_image", "write_image", "srgb_to_linear", "linear_to_srgb", "MAX_IMAGE_SIDE", "MAX_MAP_SIDE",
+           "read_image", "write_image", "read_mesh", "read_volume", "srgb_to_linear", "linear_to_srgb", "MAX_IMAGE_SIDE", "MAX_MAP_SIDE",
            "DEFAULT_MAP_SIDE"]
 __version__ = "1.0.0"
 

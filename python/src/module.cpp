@@ -41,6 +41,7 @@
 #include "conus/renderers/gpu_image.h"
 #include "arguments.h"
 #include "foci_budget_info.h"
+#include "scene.h"
 
 namespace py = pybind11;
 
@@ -89,6 +90,15 @@ py::array toArray(Image image) {
                               {py::ssize_t(held->width) * c * 4, c * 4, py::ssize_t(4)}, held->pixels.data(), owner);
 }
 
+// Real numbers only: numpy's cast would drop a complex array's imaginary part and turn an object
+// array's items into numbers by any means they offer.
+void requireReal(const py::array& input, const std::string& what) {
+    const char kind = input.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b')
+        throw Error(ErrorCode::InvalidArgument, what + " must be an array of real numbers, not of dtype " +
+                                                    py::str(input.dtype()).cast<std::string>());
+}
+
 // ---- points ------------------------------------------------------------------------------------
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
@@ -96,9 +106,14 @@ using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecas
 // f applied to every (u, v) of an (..., 2) array, without the GIL.
 template <class F>
 py::array mapPoints(const py::array& input, F&& f) {
+    requireReal(input, "points");
     const DoubleArray points = DoubleArray::ensure(input);
     if (!points || points.ndim() < 1 || points.shape(points.ndim() - 1) != 2)
         throw Error(ErrorCode::InvalidArgument, "points must be an array of shape (..., 2)");
+    for (py::ssize_t i = 0; i < points.size(); ++i)
+        if (!std::isfinite(points.data()[i]))
+            throw Error(ErrorCode::InvalidArgument, "points must be finite; point " + std::to_string(i / 2) + " holds " +
+                                                        numberText(points.data()[i]));
     DoubleArray out(std::vector<py::ssize_t>(points.shape(), points.shape() + points.ndim()));
     const double* in = points.data();
     double* o = out.mutable_data();
@@ -240,6 +255,7 @@ PYBIND11_MODULE(_conus, m) {
     py::register_exception_translator(&translateError);
     m.attr("MAX_IMAGE_SIDE") = kMaxImageSide;
     m.attr("MAX_MAP_SIDE") = kMaxMapSide;
+    addSceneReaders(m);
     m.attr("DEFAULT_MAP_SIDE") = map_rules::kDefaultSide;
 
     py::class_<Map, std::shared_ptr<Map>>(m, "Map", "A sampling map: a grid of distorted node positions (Equation 1)")
@@ -317,6 +333,7 @@ PYBIND11_MODULE(_conus, m) {
         .def_static(
             "from_nodes",
             [](const py::array& nodes) {
+                requireReal(nodes, "nodes");
                 const FloatArray a = FloatArray::ensure(nodes);
                 if (!a || a.ndim() != 3 || a.shape(2) != 2)
                     throw Error(ErrorCode::InvalidArgument, "nodes must have shape (rows, columns, 2)");

@@ -633,6 +633,7 @@ Image decodeImageGpu(Context& context, const Image& conus, const codec::Sampling
 
 Image encodeImage(const Device& device, const Image& source, const codec::SamplingMap& map,
                           const codec::EncodeOptions& options) {
+    codec::checkEncodeMemory(source, options.width, options.height);
     return device.run([&] { return codec::encodeImage(source, map, options); },
                       [&](Context& context) { return encodeImageGpu(context, source, map, options); });
 }

@@ -81,6 +81,7 @@ Image VolumeRendererGpu::render(const Fpc& fpc, int width, int height, const cod
                                 GpuTimings* timings) {
     Impl& impl = *m_impl;
     codec::checkVolumeRenderOptions(width, height, options);  // the volume was checked on upload
+    codec::checkRaySteps(impl.volume, options.stepVoxels);
     Context& context = impl.context;
     if (width > context.textureLimit() || height > context.textureLimit())
         throw Error(ErrorCode::LimitExceeded, std::string(kWhat) + ": output " + std::to_string(width) + "x" +

@@ -5,6 +5,8 @@
 #include "conus/sceneio/mesh_file.h"
 
 #include <assimp/DefaultLogger.hpp>
+#include <assimp/DefaultIOSystem.h>
+#include <assimp/IOStream.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
 #include <assimp/material.h>
@@ -12,17 +14,35 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <iterator>
+#include <set>
+#include <stdexcept>
 #include <sstream>
 #include <string>
 #include <system_error>
+#include <utility>
+#include <vector>
 
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
+#include "conus/sceneio/named_files.h"
+
+// Debian's Assimp keeps its internal assertions, which abort the process (a hostile PLY reaches
+// one in the triangulation step). This definition takes the place of Assimp's own (the library
+// calls it through its PLT): the violation becomes an exception that readMesh turns into a
+// one-line conus::Error.
+namespace Assimp {
+void aiAssertViolation(const char* failed, const char* file, int line) {
+    throw std::runtime_error(std::string("Assimp's check failed: ") + failed + " (" + file + ":" + std::to_string(line) + ")");
+}
+}  // namespace Assimp
 
 namespace conus::sceneio {
 namespace {
@@ -48,13 +68,24 @@ std::mutex assimpLogMutex;
 void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
-    if (!std::getline(in, line) || (line != "ply" && line != "ply\r" && line != "PLY" && line != "PLY\r")) return;
+    // Assimp takes any file that starts with the three letters for a PLY ("ply@" included).
+    if (!std::getline(in, line) || line.size() < 3) return;
+    std::string magic = line.substr(0, 3);
+    for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (magic != "ply") return;
     for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
-        if (line.rfind("end_header", 0) == 0) return;
+        while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+        if (line == "end_header") return;
         std::istringstream words(line);
         std::string keyword, element;
         long double count = 0;
-        if (!(words >> keyword >> element >> count) || keyword != "element") continue;
+        // Assimp's ASCII reader loops forever on some malformed headers: only the spec's lines pass.
+        words >> keyword;
+        if (keyword != "format" && keyword != "element" && keyword != "property" && keyword != "comment" &&
+            keyword != "obj_info")
+            fail(ErrorCode::Corrupt, path, "its PLY header has a line that is not format, element, property, comment "
+                                           "or end_header");
+        if (!(words >> element >> count) || keyword != "element") continue;
         const std::int64_t cap = element == "vertex" ? options.maxVertices : element == "face" ? options.maxTriangles : -1;
         if (count > static_cast<long double>(bytes))
             fail(ErrorCode::Corrupt, path, "its header declares " + numberText(double(count)) + " " + element +
@@ -63,7 +94,134 @@ void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
             fail(ErrorCode::LimitExceeded, path, "its header declares " + numberText(double(count)) + " " + element +
                                                      " elements, more than the limit of " + std::to_string(cap));
     }
+    // Assimp's ASCII PLY reader loops forever on a header that never ends.
+    fail(ErrorCode::Corrupt, path, "its PLY header has no end_header line");
 }
+
+// A binary glTF's header and chunk lengths, which Assimp allocates by: each inside the file.
+void checkGlbLengths(const std::string& path, std::uintmax_t bytes) {
+    std::ifstream in(path, std::ios::binary);
+    unsigned char head[20] = {};
+    if (!in.read(reinterpret_cast<char*>(head), sizeof head) || std::memcmp(head, "glTF", 4) != 0) return;
+    const auto u32 = [](const unsigned char* p) {
+        return std::uint64_t(p[0]) | std::uint64_t(p[1]) << 8 | std::uint64_t(p[2]) << 16 | std::uint64_t(p[3]) << 24;
+    };
+    const std::uint64_t declared = u32(head + 8);
+    if (declared > bytes)
+        fail(ErrorCode::Corrupt, path, "its GLB header declares " + std::to_string(declared) + " bytes in a file of " +
+                                           std::to_string(bytes));
+    // Chunks follow the 12-byte header: a length, a type, then the data (padded to 4 bytes).
+    std::uint64_t at = 12;
+    for (int chunk = 0; at + 8 <= bytes && chunk < 1024; ++chunk) {
+        unsigned char c[8];
+        in.seekg(static_cast<std::streamoff>(at));
+        if (!in.read(reinterpret_cast<char*>(c), 8)) break;
+        const std::uint64_t length = u32(c);
+        if (length > bytes - at - 8)
+            fail(ErrorCode::Corrupt, path, "GLB chunk " + std::to_string(chunk) + " declares " + std::to_string(length) +
+                                               " bytes, past the end of the " + std::to_string(bytes) + "-byte file");
+        at += 8 + length;
+    }
+}
+
+// A .gltf names its buffers and images by URI: each that is not a data: URI is checked by the
+// policy before Assimp reads the file, so that an absolute or escaping name is refused in the
+// policy's words (the IOSystem below still guards every file Assimp actually opens).
+void checkGltfUris(const std::string& path, const NamedFiles& named) {
+    std::string ext = fs::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".gltf") return;
+    std::ifstream in(path, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto skipSpace = [&](std::size_t at) {
+        while (at < text.size() && std::isspace(static_cast<unsigned char>(text[at]))) ++at;
+        return at;
+    };
+    for (std::size_t at = 0; (at = text.find("\"uri\"", at)) != std::string::npos;) {
+        at = skipSpace(at + 5);
+        if (at >= text.size() || text[at] != ':') continue;
+        at = skipSpace(at + 1);
+        if (at >= text.size() || text[at] != '"') continue;
+        std::string uri;
+        for (++at; at < text.size() && text[at] != '"'; ++at) uri += text[at] == '\\' && at + 1 < text.size() ? text[++at] : text[at];
+        if (uri.rfind("data:", 0) == 0) continue;
+        std::error_code ec;
+        if (!fs::path(uri).is_absolute() && !fs::exists(fs::path(named.folder()) / uri, ec)) continue;  // Assimp says it is missing
+        named.resolve(uri);
+    }
+}
+
+// A stream Assimp opened, registered with its IOSystem until it is deleted (Assimp's glTF
+// importer leaves a buffer's stream open when it throws on a lying byteLength; the IOSystem
+// deletes what is left when the importer is done).
+class TrackedStream : public Assimp::IOStream {
+public:
+    TrackedStream(Assimp::IOStream* stream, std::set<TrackedStream*>& open) : m_stream(stream), m_open(open) {
+        m_open.insert(this);
+    }
+    ~TrackedStream() override {
+        m_open.erase(this);
+        delete m_stream;
+    }
+    size_t Read(void* buffer, size_t size, size_t count) override { return m_stream->Read(buffer, size, count); }
+    size_t Write(const void* buffer, size_t size, size_t count) override { return m_stream->Write(buffer, size, count); }
+    aiReturn Seek(size_t offset, aiOrigin origin) override { return m_stream->Seek(offset, origin); }
+    size_t Tell() const override { return m_stream->Tell(); }
+    size_t FileSize() const override { return m_stream->FileSize(); }
+    void Flush() override { m_stream->Flush(); }
+
+private:
+    Assimp::IOStream* m_stream;
+    std::set<TrackedStream*>& m_open;
+};
+
+// Every file Assimp opens for the scene (glTF buffers, OBJ material libraries, ...) goes through
+// here: the scene file itself, or a name the policy of named_files.h allows. A name it refuses is
+// reported as missing to Assimp and remembered, so that the read fails with the policy's reason
+// instead of going on without the file.
+class PolicyIoSystem : public Assimp::DefaultIOSystem {
+public:
+    PolicyIoSystem(std::string scene, const NamedFiles& named) : m_scene(std::move(scene)), m_named(named) {}
+    ~PolicyIoSystem() override {
+        while (!m_open.empty()) delete *m_open.begin();
+    }
+
+    bool Exists(const char* file) const override {
+        const std::string resolved = allowed(file);
+        return !resolved.empty() && DefaultIOSystem::Exists(resolved.c_str());
+    }
+    Assimp::IOStream* Open(const char* file, const char* mode) override {
+        if (std::strpbrk(mode, "wa+")) return nullptr;  // a reader writes nothing
+        const std::string resolved = allowed(file);
+        Assimp::IOStream* stream = resolved.empty() ? nullptr : DefaultIOSystem::Open(resolved.c_str(), mode);
+        return stream ? new TrackedStream(stream, m_open) : nullptr;
+    }
+    void Close(Assimp::IOStream* stream) override { delete stream; }
+    const std::string& refusal() const { return m_refusal; }
+
+private:
+    // The path to open, or "" (a missing file is simply missing; a refusal is remembered).
+    std::string allowed(const char* file) const {
+        if (file == m_scene) return m_scene;
+        std::error_code ec;
+        if (!fs::exists(file, ec)) return {};
+        try {
+            const std::string resolved = m_named.check(file);
+            if (static_cast<std::int64_t>(fs::file_size(resolved, ec)) > kMaxNamedFileBytes || ec)
+                throw Error(ErrorCode::LimitExceeded, "mesh '" + m_scene + "': names '" + file + "', larger than the limit of " +
+                                                          std::to_string(kMaxNamedFileBytes) + " bytes");
+            return resolved;
+        } catch (const Error& e) {
+            if (m_refusal.empty()) m_refusal = e.what();
+            return {};
+        }
+    }
+
+    std::string m_scene;
+    const NamedFiles& m_named;
+    mutable std::string m_refusal;
+    std::set<TrackedStream*> m_open;
+};
 
 void checkFile(const std::string& path, const MeshReadOptions& options) {
     std::error_code ec;
@@ -77,6 +235,7 @@ void checkFile(const std::string& path, const MeshReadOptions& options) {
         fail(ErrorCode::LimitExceeded, path, std::to_string(bytes) + " bytes, more than the limit of " +
                                                  std::to_string(options.maxFileBytes));
     checkPlyCounts(path, bytes, options);
+    checkGlbLengths(path, bytes);
 }
 
 // glTF states its vertex colours in linear light; the older formats (PLY, OBJ extensions, OFF)
@@ -88,7 +247,7 @@ bool coloursAreLinear(const std::string& path) {
 }
 
 // The base-colour texture file of the first material that names one on disk, or "".
-std::string textureFile(const aiScene& scene, const std::string& path) {
+std::string textureFile(const aiScene& scene, const NamedFiles& named) {
     for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
         const aiMesh& mesh = *scene.mMeshes[m];
         if (!mesh.HasTextureCoords(0) || mesh.mMaterialIndex >= scene.mNumMaterials) continue;
@@ -100,35 +259,93 @@ std::string textureFile(const aiScene& scene, const std::string& path) {
             if (file.empty() || file[0] == '*') continue;  // embedded textures are not read (yet)
             for (char& c : file)
                 if (c == '\\') c = '/';
-            const fs::path full = fs::path(path).parent_path() / file;
+            // A texture that is not there is left out; one the policy refuses refuses the mesh.
             std::error_code ec;
-            if (fs::is_regular_file(full, ec)) return full.string();
+            if (!fs::path(file).is_absolute() && !fs::exists(fs::path(named.folder()) / file, ec)) continue;
+            return named.resolve(file);
         }
     }
     return {};
 }
 
+// Drops exact duplicate triangles (the same three corner positions, in any order or orientation),
+// keeping the first; returns how many went. Equal positions are welded by sorting, so the work is
+// O(n log n) whatever the file holds.
+std::int64_t dropDuplicateTriangles(Mesh& mesh) {
+    const std::size_t vertices = mesh.positions.size(), triangles = mesh.indices.size() / 3;
+    const auto position = [&](std::uint32_t i) {
+        const glm::vec3& p = mesh.positions[i];
+        return std::array<float, 3>{p.x, p.y, p.z};
+    };
+    std::vector<std::uint32_t> order(vertices), weld(vertices);
+    for (std::size_t i = 0; i < vertices; ++i) order[i] = static_cast<std::uint32_t>(i);
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return position(a) < position(b); });
+    for (std::size_t k = 0; k < vertices; ++k)
+        weld[order[k]] = k > 0 && position(order[k]) == position(order[k - 1]) ? weld[order[k - 1]] : order[k];
+    struct Corners {
+        std::array<std::uint32_t, 3> welded;
+        std::uint32_t triangle;
+    };
+    std::vector<Corners> keys(triangles);
+    for (std::size_t t = 0; t < triangles; ++t) {
+        keys[t] = {{weld[mesh.indices[t * 3]], weld[mesh.indices[t * 3 + 1]], weld[mesh.indices[t * 3 + 2]]},
+                   static_cast<std::uint32_t>(t)};
+        std::sort(keys[t].welded.begin(), keys[t].welded.end());
+    }
+    std::sort(keys.begin(), keys.end(), [](const Corners& a, const Corners& b) {
+        return a.welded != b.welded ? a.welded < b.welded : a.triangle < b.triangle;
+    });
+    std::vector<bool> duplicate(triangles, false);
+    std::int64_t dropped = 0;
+    for (std::size_t k = 1; k < triangles; ++k)
+        if (keys[k].welded == keys[k - 1].welded) {
+            duplicate[keys[k].triangle] = true;
+            ++dropped;
+        }
+    if (dropped == 0) return 0;
+    std::size_t kept = 0;
+    for (std::size_t t = 0; t < triangles; ++t) {
+        if (duplicate[t]) continue;
+        for (int c = 0; c < 3; ++c) mesh.indices[kept * 3 + c] = mesh.indices[t * 3 + c];
+        ++kept;
+    }
+    mesh.indices.resize(kept * 3);
+    return dropped;
+}
+
 }  // namespace
 
-Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
+Mesh readMesh(const std::string& path, const MeshReadOptions& options, MeshReadReport* report) {
+    MeshReadReport counts;
     checkFile(path, options);
 
+    const NamedFiles named(path, options.allowedDirs, "mesh '" + path + "'");
+    checkGltfUris(path, named);
     Assimp::Importer importer;
+    auto* io = new PolicyIoSystem(path, named);
+    importer.SetIOHandler(io);  // the importer owns it
     // Points and lines are not surfaces: SortByPType drops them.
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
                            aiProcess_PreTransformVertices | aiProcess_FlipUVs | aiProcess_ValidateDataStructure;
     const aiScene* scene = nullptr;
     AssimpLog log;
+    std::string thrown;  // Assimp's own exceptions (its asserts among them), said after the logger is detached
     {
         const std::lock_guard<std::mutex> lock(assimpLogMutex);
         const bool created = Assimp::DefaultLogger::isNullLogger();
         if (created) Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
         Assimp::DefaultLogger::get()->attachStream(&log, Assimp::Logger::Warn | Assimp::Logger::Err);
-        scene = importer.ReadFile(path, flags);
+        try {
+            scene = importer.ReadFile(path, flags);
+        } catch (const std::exception& e) {
+            thrown = e.what();
+        }
         Assimp::DefaultLogger::get()->detachStream(&log, Assimp::Logger::Warn | Assimp::Logger::Err);
         if (created) Assimp::DefaultLogger::kill();
     }
+    if (!thrown.empty()) fail(ErrorCode::Corrupt, path, thrown);
+    if (!io->refusal().empty()) throw Error(ErrorCode::Io, io->refusal());
     if (scene && log.text.find("out-of-range indices") != std::string::npos)
         fail(ErrorCode::Corrupt, path, "a face indexes past its mesh's vertices");
     if (!scene) {
@@ -160,11 +377,10 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
         fail(ErrorCode::LimitExceeded, path, std::to_string(vertices) + " vertices, more than the limit of " +
                                                  std::to_string(options.maxVertices));
 
-    const std::string texturePath = options.readTexture ? textureFile(*scene, path) : std::string();
+    const std::string texturePath = options.readTexture ? textureFile(*scene, named) : std::string();
     Mesh out;
     out.positions.reserve(static_cast<std::size_t>(vertices));
     out.indices.reserve(static_cast<std::size_t>(triangles) * 3);
-    std::int64_t degenerate = 0;
     if (allNormals) out.normals.reserve(static_cast<std::size_t>(vertices));
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh& mesh = *scene->mMeshes[m];
@@ -193,7 +409,7 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
             // Degenerate triangles (a repeated corner or no area) are dropped: they cover nothing.
             const glm::vec3 n = glm::cross(out.positions[b] - out.positions[a], out.positions[c] - out.positions[a]);
             if (a == b || b == c || a == c || !(glm::dot(n, n) > 0.0f)) {
-                ++degenerate;
+                ++counts.degenerateTriangles;
                 continue;
             }
             out.indices.insert(out.indices.end(), {a, b, c});
@@ -203,9 +419,11 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             fail(ErrorCode::Corrupt, path, "a vertex position is not finite");
     if (out.indices.empty()) fail(ErrorCode::Corrupt, path, "every triangle is degenerate (no area)");
-    if (degenerate > 0 && options.warn)
-        options.warn("mesh '" + path + "': dropped " + std::to_string(degenerate) + " of " + std::to_string(triangles) +
-                     " triangles, degenerate (a repeated corner or no area)");
+    if (counts.degenerateTriangles > 0 && options.warn)
+        options.warn("mesh '" + path + "': dropped " + std::to_string(counts.degenerateTriangles) + " of " +
+                     std::to_string(triangles) + " triangles, degenerate (a repeated corner or no area)");
+    counts.duplicateTriangles = dropDuplicateTriangles(out);
+    if (report) *report = counts;
 
     // The file's normals, unit; one unusable normal and they are all computed instead, so a
     // surface never mixes two rules.

@@ -85,7 +85,7 @@ Volume readVdbVolume(const std::string& path, const VolumeReadOptions& options) 
                 for (int x = 0; x < volume.width; ++x)
                     volume.values[volume.index(x, y, z)] = accessor.getValue(origin.offsetBy(x, y, z));
     }, 1);
-    checkVolume(volume, what);
+    checkFileVolume(volume, what);
     return volume;
 }
 

@@ -56,11 +56,21 @@ void toHostOrder(std::vector<unsigned char>& bytes, std::size_t size, bool bigEn
 
 std::size_t sampleBytes(RawType type) { return type == RawType::UInt8 ? 1 : type == RawType::UInt16 ? 2 : 4; }
 
+// The file's bytes and the float samples, held together while converting.
+void checkReadBytes(const std::string& what, std::uint64_t voxels, std::size_t size) {
+    const std::uint64_t bytes = voxels * (size + sizeof(float));
+    if (bytes > std::uint64_t(kMaxVolumeReadBytes))
+        throw Error(ErrorCode::LimitExceeded, what + ": reading " + std::to_string(voxels) + " samples takes " +
+                                                  std::to_string(bytes) + " bytes, more than the limit of " +
+                                                  std::to_string(kMaxVolumeReadBytes));
+}
+
 }  // namespace
 
 Volume readRawVolume(const std::string& path, const RawLayout& layout, const VolumeReadOptions& options) {
     const std::string what = "raw volume '" + path + "'";
     checkDimensions(what, layout.width, layout.height, layout.depth, options.maxVoxels);
+    checkReadBytes(what, std::uint64_t(layout.width) * layout.height * layout.depth, sampleBytes(layout.type));
     const std::uintmax_t voxels = std::uintmax_t(layout.width) * layout.height * layout.depth;
     const std::size_t size = sampleBytes(layout.type);
     const std::uintmax_t expected = voxels * size;
@@ -89,7 +99,7 @@ Volume readRawVolume(const std::string& path, const RawLayout& layout, const Vol
             std::memcpy(&volume.values[i], &bytes[i * 4], 4);
         }
     }
-    checkVolume(volume, what);
+    checkFileVolume(volume, what);
     return volume;
 }
 
@@ -116,6 +126,7 @@ Volume readDenVolume(const std::string& path, const VolumeReadOptions& options) 
             : (std::uint32_t(header[61]) << 24 | std::uint32_t(header[60]) << 16 | std::uint32_t(header[59]) << 8 | header[58]);
     checkDimensions(what, width, height, depth, options.maxVoxels);
     const std::uintmax_t voxels = std::uintmax_t(width) * height * depth;
+    checkReadBytes(what, voxels, 1);
     if (length != voxels)
         throw Error(ErrorCode::Corrupt, what + ": the header's length " + std::to_string(length) + " is not " +
                                             std::to_string(width) + "x" + std::to_string(height) + "x" +

@@ -66,6 +66,19 @@ void checkDimensions(const std::string& what, std::int64_t width, std::int64_t h
                                                   std::to_string(maxVoxels));
 }
 
+void checkFileVolume(const Volume& volume, const std::string& what) {
+    try {
+        checkVolume(volume, what);
+    } catch (const Error& e) {
+        throw Error(e.code() == ErrorCode::InvalidArgument ? ErrorCode::Corrupt : e.code(), e.what());
+    }
+    const glm::dvec3 extent = volume.extent();
+    if (!(std::isfinite(extent.x) && std::isfinite(extent.y) && std::isfinite(extent.z)))
+        throw Error(ErrorCode::Corrupt, what + ": spacing " + numberText(volume.spacing.x) + "," +
+                                            numberText(volume.spacing.y) + "," + numberText(volume.spacing.z) +
+                                            " makes the volume's extent infinite");
+}
+
 RawSpec parseRawSpec(const std::string& spec) {
     const auto bad = [&](const std::string& why) {
         return Error(ErrorCode::InvalidArgument, "raw volume '" + spec + "': " + why +

@@ -286,16 +286,19 @@ bool viewZoomsOut(const Image& conus, const SamplingMap& map, const View& view, 
     return longest2 > kPyramidOneTap * kPyramidOneTap;
 }
 
-void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes, bool withPyramid) {
+void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes, bool withPyramid,
+                       std::int64_t extraBytes) {
     const std::int64_t channels = conus.channelCount();
     const std::int64_t image = std::int64_t{conus.width} * conus.height;
     const std::int64_t bytes = (image + (withPyramid ? image / 3 : 0) + std::int64_t{width} * height) * channels *
-                               std::int64_t(sizeof(float));
+                                   std::int64_t(sizeof(float)) +
+                               extraBytes;
     if (bytes > maxBytes) {
         throw Error(ErrorCode::LimitExceeded,
                     "decoding a " + std::to_string(conus.width) + "x" + std::to_string(conus.height) + " image to " +
                         std::to_string(width) + "x" + std::to_string(height) + " pixels of " + std::to_string(channels) +
-                        " channels" + (withPyramid ? std::string(" with its pyramid") : std::string()) + " takes " +
+                        " channels" + (withPyramid ? std::string(" with its pyramid") : std::string()) +
+                        (extraBytes > 0 ? " and the picture writer's copies" : "") + " takes " +
                         std::to_string(bytes) + " bytes, beyond the decode memory limit of " +
                         std::to_string(maxBytes));
     }

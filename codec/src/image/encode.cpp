@@ -479,9 +479,22 @@ glm::dmat2 FootprintField::inverseJacobian(glm::dvec2 p) const {
     return (at(0, 0) * (1 - s) + at(1, 0) * s) * (1 - t) + (at(0, 1) * (1 - s) + at(1, 1) * s) * t;
 }
 
+void checkEncodeMemory(const Image& source, int width, int height, std::int64_t maxBytes) {
+    const std::int64_t channels = source.channelCount();
+    const std::int64_t bytes =
+        (std::int64_t{source.width} * source.height + std::int64_t{width} * height) * channels * std::int64_t(sizeof(float));
+    if (bytes > maxBytes)
+        throw Error(ErrorCode::LimitExceeded, "encoding a " + std::to_string(source.width) + "x" + std::to_string(source.height) +
+                                                  " picture to " + std::to_string(width) + "x" + std::to_string(height) +
+                                                  " pixels of " + std::to_string(channels) + " channels takes " +
+                                                  std::to_string(bytes) + " bytes, beyond the encode memory limit of " +
+                                                  std::to_string(maxBytes) + "; give a smaller size");
+}
+
 Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options) {
     checkImage(source, "encodeImage");
     detail::checkOutputSize(options.width, options.height, "encodeImage");
+    checkEncodeMemory(source, options.width, options.height);
     Image out = detail::makeOutput(source, options.width, options.height);
     Pyramid pyramid(source);
     const FootprintField field(map);

@@ -79,6 +79,7 @@ void bilinearRows(const Image& src, Image& dst, const AxisTaps& tx, const AxisTa
 Image resizeBilinear(const Image& image, const View& view, int width, int height, int threads) {
     checkImage(image, "resizeBilinear");
     detail::checkOutputSize(width, height, "resizeBilinear");
+    checkDecodeMemory(image, width, height);
     detail::checkView(view, "resizeBilinear");
     Image out = detail::makeOutput(image, width, height);
     const AxisTaps tx = axisTaps(image.width, view.u0, view.u1, width);

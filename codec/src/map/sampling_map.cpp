@@ -265,6 +265,9 @@ SamplingMap SamplingMap::identity(int columns, int rows) {
         throw Error(ErrorCode::InvalidArgument,
                     "identity map of " + std::to_string(columns) + "x" + std::to_string(rows) + " nodes; need at least 2x2");
     }
+    if (columns > kMaxMapSide || rows > kMaxMapSide)
+        throw Error(ErrorCode::LimitExceeded, "identity map of " + std::to_string(columns) + "x" + std::to_string(rows) +
+                                                  " nodes; at most " + std::to_string(kMaxMapSide) + " a side");
     std::vector<glm::vec2> nodes(std::size_t(columns) * rows);
     for (int j = 0; j < rows; ++j)
         for (int i = 0; i < columns; ++i)

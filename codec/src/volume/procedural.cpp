@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "conus/core/error.h"
+#include "conus/core/limits.h"
 
 namespace conus::codec {
 namespace {
@@ -12,8 +14,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 Volume grid(int n, const char* what) {
-    if (n < 2 || n > 1024)
-        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": size " + std::to_string(n) + " is outside [2, 1024]");
+    if (n < 2 || n > 1024 || std::int64_t{n} * n * n > kMaxVolumeVoxels)
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": size " + std::to_string(n) +
+                                                    " is outside [2, 1024] or its n^3 samples pass the limit of " +
+                                                    std::to_string(kMaxVolumeVoxels));
     Volume v;
     v.width = v.height = v.depth = n;
     v.spacing = glm::dvec3(2.0 / (n - 1));

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "../image/resample_pvt.h"
+#include "conus/core/limits.h"
 #include "conus/core/parallel.h"
 
 namespace conus::codec {
@@ -71,6 +72,22 @@ void checkVolumeRenderOptions(int width, int height, const VolumeRenderOptions& 
                                                     numberText(options.rangeHi) + " is not lo <= hi");
 }
 
+void checkRaySteps(const Volume& volume, double stepVoxels) {
+    const double smallest = std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
+    const double steps = glm::length(volume.extent()) / (stepVoxels * smallest);
+    const double samples = double(volume.width) + volume.height + volume.depth;
+    const double cap = double(kMaxRayStepsPerSample) * samples;
+    if (steps <= cap) return;
+    // With an even spacing a step of at least 1/kMaxRayStepsPerSample always fits.
+    const bool stepTooSmall = stepVoxels < 1.0 / double(kMaxRayStepsPerSample);
+    throw Error(stepTooSmall ? ErrorCode::InvalidArgument : ErrorCode::LimitExceeded,
+                "volume render: a step of " + numberText(stepVoxels) + " voxels takes up to " + numberText(steps) +
+                    " steps per ray through a " + std::to_string(volume.width) + "x" + std::to_string(volume.height) +
+                    "x" + std::to_string(volume.depth) + " volume of spacing " + numberText(volume.spacing.x) + "," +
+                    numberText(volume.spacing.y) + "," + numberText(volume.spacing.z) + ", more than the limit of " +
+                    numberText(cap) + (stepTooSmall ? "; give a larger step" : " (the spacing is too uneven)"));
+}
+
 std::array<float, 5> castVolumeRay(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                                    glm::dvec2 uv, float jitter, glm::vec2 range, const VolumeRenderOptions& options,
                                    int* steps) {
@@ -130,6 +147,7 @@ Image renderVolumeReference(const Volume& volume, const TransferFunction& tf, co
                             const VolumeRenderOptions& options) {
     checkVolume(volume, "volume render");
     checkVolumeRenderOptions(width, height, options);
+    checkRaySteps(volume, options.stepVoxels);
     Image out = makeImage(width, height, {kVolumeChannels.begin(), kVolumeChannels.end()});
     const glm::vec2 range = renderRange(volume, options);
     const Distortion* distortion = fpc.distortion();

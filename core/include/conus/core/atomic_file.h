@@ -11,10 +11,13 @@
 // - Errors are conus::Error(Io) and name the destination the user gave, never the temporary file.
 // - A temporary file that is still open is removed when the process gets SIGINT, SIGTERM or SIGHUP,
 //   once the program has called removeTemporariesOnSignals() (libraries never install handlers).
+//   What SIGKILL or a power cut leaves is removed by the next write into the same folder: the
+//   first AtomicFile a process makes in a folder removes the temporaries of processes that are gone.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -69,6 +72,20 @@ void checkOutputPath(const std::string& output, std::span<const std::string> inp
 // Checks that `input` names a regular file that exists (not a directory, device or FIFO, which
 // could be read forever). "-" (standard input) is accepted when allowStdin. Throws conus::Error(Io).
 void checkInputPath(const std::string& input, bool allowStdin = false);
+
+// Removes (once per folder and process) the temporary files and folders of this naming in
+// `folder` whose process is gone: no process has that id, or the one that has it started after
+// the temporary was last written. Those of running processes are left alone.
+void removeStaleTemporaries(const std::string& folder);
+
+// Files that must appear together (a folder of them): `write` fills a temporary folder beside
+// `folder`, which then takes its place in one rename (an existing `folder` is exchanged with it
+// atomically, then removed). Any failure removes the temporary folder and leaves `folder` as it was.
+// An existing `folder` may hold only files named in `names` (a set this call replaces whole);
+// checkFolderOutput says so before any work, throwing conus::Error(InvalidArgument).
+void checkFolderOutput(const std::string& folder, std::span<const std::string> names);
+void writeFolderAtomically(const std::string& folder, std::span<const std::string> names,
+                           const std::function<void(const std::string& temporaryFolder)>& write);
 
 // Installs handlers for SIGINT, SIGTERM and SIGHUP that remove every open temporary file and
 // then end the process as the signal would have. Also ignores SIGXFSZ, so that a write past a

@@ -60,4 +60,10 @@ int bitsOf(SampleType sampleType);
 // DateTime, Artist, Copyright, ImageDescription and Orientation.
 bool isCarriedMetadata(std::string_view name);
 
+// Empty when `bytes` are an ICC profile as far as its header tells (ICC.1, 7.2: at least the
+// 128-byte header and a tag count, the header's size field, big-endian, equal to the byte count,
+// "acsp" at bytes 36..39); else why not. Readers drop a profile that is not one (a writer would
+// embed garbage), and the format refuses one (spec V16).
+std::string iccProfileProblem(const std::string& bytes);
+
 }  // namespace conus

@@ -31,8 +31,25 @@ inline constexpr std::int64_t kIndexBytesPerCell = 128;
 inline constexpr std::int64_t kIndexBytesBase = std::int64_t{64} << 10;
 inline constexpr std::int64_t kMaxIndexBytes = std::int64_t{512} << 20;
 
-// Memory for one decode: the CoNUS image's pixels as float plus the output frame's.
+// Memory for one decode: the CoNUS image's pixels as float plus the output frame's (and the
+// picture writer's copy of the frame, in `conus decode`).
 inline constexpr std::int64_t kMaxDecodeBytes = std::int64_t{8} << 30;
+// Memory for one encode: the source picture and the CoNUS image, as float.
+inline constexpr std::int64_t kMaxEncodeBytes = std::int64_t{8} << 30;
+
+// Scene files (sceneio, the height-field readers): what one file may make a reader hold.
+inline constexpr std::int64_t kMaxMeshFileBytes = std::int64_t{1} << 30;  // bytes of one mesh file
+inline constexpr std::int64_t kMaxMeshTriangles = std::int64_t{1} << 24;  // triangles after triangulation
+inline constexpr std::int64_t kMaxMeshVertices = std::int64_t{1} << 25;   // vertices after merging meshes
+inline constexpr std::int64_t kMaxNamedFileBytes = std::int64_t{1} << 30;  // one file a scene file names
+inline constexpr int kMaxVolumeSide = 1 << 14;                            // volume samples along one axis
+inline constexpr std::int64_t kMaxVolumeVoxels = std::int64_t{1} << 28;  // volume samples in all (1 GiB as float)
+// A volume read: its samples as float plus the reader's own decoded buffer of the file's type.
+inline constexpr std::int64_t kMaxVolumeReadBytes = std::int64_t{2} << 30;
+// Steps of one volume ray, per sample along the volume's sides (width + height + depth).
+inline constexpr std::int64_t kMaxRayStepsPerSample = 16;
+// Height samples of one elevation model (.npy, .npz, image, procedural).
+inline constexpr std::int64_t kMaxDemSamples = std::int64_t{1} << 26;
 
 // The caps a reader applies; a caller may lower any of them (never raise them past the constants:
 // the constants are also what the format's own rules allow).
@@ -53,7 +70,7 @@ struct LimitEntry {
     const char* meaning;  // one line
 };
 
-inline constexpr std::array<LimitEntry, 13> limitTable() {
+inline constexpr std::array<LimitEntry, 23> limitTable() {
     return {{
         {"imageSide", kMaxImageSide, "pixels", "width or height of any image (CoNUS image, source, decoded frame)"},
         {"imagePixels", kMaxImagePixels, "pixels", "width x height of any image"},
@@ -68,6 +85,16 @@ inline constexpr std::array<LimitEntry, 13> limitTable() {
         {"indexBytesBase", kIndexBytesBase, "bytes", "inverse-map index, fixed allowance"},
         {"indexBytes", kMaxIndexBytes, "bytes", "inverse-map index in all"},
         {"decodeBytes", kMaxDecodeBytes, "bytes", "one decode: CoNUS image as float plus the output frame"},
+        {"encodeBytes", kMaxEncodeBytes, "bytes", "one encode: the source picture and the CoNUS image as float"},
+        {"meshFileBytes", kMaxMeshFileBytes, "bytes", "one mesh file"},
+        {"meshTriangles", kMaxMeshTriangles, "triangles", "triangles of one mesh after triangulation"},
+        {"meshVertices", kMaxMeshVertices, "vertices", "vertices of one mesh after merging its parts"},
+        {"volumeSide", kMaxVolumeSide, "samples", "volume samples along one axis"},
+        {"volumeVoxels", kMaxVolumeVoxels, "samples", "volume samples in all"},
+        {"volumeReadBytes", kMaxVolumeReadBytes, "bytes", "one volume read: samples as float plus the reader's decoded buffer"},
+        {"rayStepsPerSample", kMaxRayStepsPerSample, "steps", "steps of one volume ray per sample of width + height + depth"},
+        {"demSamples", kMaxDemSamples, "samples", "height samples of one elevation model"},
+        {"namedFileBytes", kMaxNamedFileBytes, "bytes", "one file a scene file names (glTF buffer, material library, NRRD data file)"},
     }};
 }
 

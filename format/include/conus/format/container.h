@@ -109,8 +109,10 @@ ConusFile readConusFile(const std::string& path, const ReadLimits& limits = {});
 // chunk tables included, so a file this accepts does hold its pixel data's bytes.
 ConusFile readConusHeader(const std::string& path, const ReadLimits& limits = {});
 
-// Every violated rule of the file at `path` (never throws for bad content).
-ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits = {});
+// Every violated rule of the file at `path` (never throws for bad content). With `readPixels`
+// (the default) every chunk of pixel data is read and decompressed too, as readConusFile does, so
+// a file that validates also reads; without, headers, the map and the chunk tables only.
+ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits = {}, bool readPixels = true);
 // Every violated rule of an in-memory file (structure, attributes, map geometry).
 ValidationReport validateConusFile(const ConusFile& file);
 // The sampling-map rules alone (node count, finite values, boundary, strictly convex cells with

@@ -12,18 +12,21 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "conus/core/limits.h"
 #include "conus/core/volume.h"
 
 namespace conus::sceneio {
 
-// The default caps; a caller may lower them.
-inline constexpr int kMaxVolumeSide = 1 << 14;                            // samples along one axis
-inline constexpr std::int64_t kMaxVolumeVoxels = std::int64_t{1} << 28;  // samples in all (1 GiB as float)
+// The default caps (core/limits.h); a caller may lower them.
+using conus::kMaxVolumeSide;
+using conus::kMaxVolumeVoxels;
 
 struct VolumeReadOptions {
     std::int64_t maxVoxels = kMaxVolumeVoxels;
     std::string gridName;  // OpenVDB: the float grid to read ("" = the first float grid)
+    std::vector<std::string> allowedDirs;  // NRRD: folders besides the header's own its data files may lie in (named_files.h)
 };
 
 enum class RawType { UInt8, UInt16, Float32 };
@@ -36,6 +39,11 @@ struct RawLayout {
     bool bigEndian = false;  // byte order of uint16 and float32 samples
 };
 
+// core's checkVolume for a volume read from a file: its refusals (a side below 2, a spacing that
+// is not positive, a NaN sample) are bad data, Corrupt, not InvalidArgument; and the extent
+// (sides times spacing) must be finite.
+void checkFileVolume(const Volume& volume, const std::string& what);
+
 // Throws conus::Error(InvalidArgument) for a side below 2; LimitExceeded for a side past
 // kMaxVolumeSide or more than maxVoxels samples.
 void checkDimensions(const std::string& what, std::int64_t width, std::int64_t height, std::int64_t depth,
@@ -45,7 +53,7 @@ void checkDimensions(const std::string& what, std::int64_t width, std::int64_t h
 Volume readRawVolume(const std::string& path, const RawLayout& layout, const VolumeReadOptions& options = {});
 // VolPack's density file (.den): a 62-byte header (either byte order) and 8-bit samples.
 Volume readDenVolume(const std::string& path, const VolumeReadOptions& options = {});
-// NRRD (.nrrd, .nhdr with its data file) through teem: 3-D, any scalar type (converted to float),
+// NRRD (.nrrd, .nhdr with its data files, which follow named_files.h) through teem: 3-D, any scalar type (converted to float),
 // spacing from the header's spacings or space directions when present.
 Volume readNrrdVolume(const std::string& path, const VolumeReadOptions& options = {});
 // OpenVDB (.vdb): a float grid, sparse or dense, densified over its active bounding box (the

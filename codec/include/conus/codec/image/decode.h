@@ -53,10 +53,11 @@ struct DecodeOptions {
 // Throws conus::Error(LimitExceeded) when decoding `conus` (only its size and channels are read)
 // to a width x height frame would hold more than `maxBytes` of pixels, the CoNUS image's and the
 // frame's together, as float (limits.h: kMaxDecodeBytes), plus a third of the image again for its
-// pyramid when `withPyramid`. decodeImage checks this before it allocates; other decoders (the GPU
+// pyramid when `withPyramid`, plus `extraBytes` the caller holds beside them (a picture writer's
+// copies of the frame). decodeImage checks this before it allocates; other decoders (the GPU
 // one) and `conus decode` (before it builds the pyramid) call it too.
 void checkDecodeMemory(const Image& conus, int width, int height, std::int64_t maxBytes = kMaxDecodeBytes,
-                       bool withPyramid = false);
+                       bool withPyramid = false, std::int64_t extraBytes = 0);
 
 Image decodeImage(const Image& conus, const SamplingMap& map, const DecodeOptions& options);
 

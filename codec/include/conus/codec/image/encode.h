@@ -14,6 +14,7 @@
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/error.h"
 #include "conus/core/image.h"
+#include "conus/core/limits.h"
 
 namespace conus::codec {
 
@@ -77,6 +78,11 @@ struct EncodeOptions {
     int threads = 0;
     ProgressFn progress;
 };
+
+// Throws conus::Error(LimitExceeded) when encoding `source` (its size and channels) to a width x
+// height CoNUS image would hold more than `maxBytes` of pixels as float, the source's and the
+// CoNUS image's together (limits.h: kMaxEncodeBytes). Every encoder calls it before allocating.
+void checkEncodeMemory(const Image& source, int width, int height, std::int64_t maxBytes = kMaxEncodeBytes);
 
 Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options);
 

@@ -11,7 +11,7 @@
 
 namespace conus::codec {
 
-// Throws conus::Error(InvalidArgument) for n outside [2, 1024].
+// Throws conus::Error(InvalidArgument) for n outside [2, 1024] or n^3 past kMaxVolumeVoxels (n <= 645).
 Volume marschnerLobb(int n = 64);
 Volume sheppLogan3d(int n = 64);
 

@@ -56,6 +56,12 @@ float pixelJitter(int x, int y);
 // renderer calls it, after checkVolume (core/volume.h).
 void checkVolumeRenderOptions(int width, int height, const VolumeRenderOptions& options);
 
+// A ray's steps are bounded by the volume's size: at most kMaxRayStepsPerSample times
+// width + height + depth across the box's diagonal. A step too small for that is refused with
+// InvalidArgument (give a larger step); a spacing so uneven that a usual step exceeds it
+// (the step follows the smallest spacing) with LimitExceeded. Every renderer calls it.
+void checkRaySteps(const Volume& volume, double stepVoxels);
+
 Image renderVolumeReference(const Volume& volume, const TransferFunction& tf, const Fpc& fpc, int width, int height,
                             const VolumeRenderOptions& options = {});
 

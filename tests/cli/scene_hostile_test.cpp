@@ -1,0 +1,310 @@
+// The scene readers and the budgets through the real `conus` binary: the reproducers of
+// ../shared/data/hostile/scene (files a model names outside its folder, devices and FIFOs behind a
+// name, lying lengths and compression bombs, work without end, files that validate but do not
+// decode) and the smaller items found with them. Each is refused with one line and the right exit
+// code (1 bad data, 2 usage), or done within a second and bounded memory.
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include "hostile_fixture.h"
+
+namespace {
+
+using namespace conus::hostile;
+
+class SceneHostile : public Hostile {
+protected:
+    static std::string scene(const std::string& name) {
+        return (fs::path(CONUS_SHARED_DATA) / "hostile" / "scene" / name).string();
+    }
+    void write(const std::string& name, const std::string& text) const {
+        std::ofstream(m_dir / name, std::ios::binary) << text;
+    }
+    // A glTF whose one buffer is `uri`: a triangle when the buffer holds three float32 corners.
+    void writeGltf(const std::string& name, const std::string& uri) const {
+        write(name, R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "scene": 0, "nodes": [{"mesh": 0}],
+ "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}], "buffers": [{"uri": ")" + uri + R"(", "byteLength": 36}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}]})");
+    }
+    void writeTriangleBuffer(const fs::path& file) const {
+        const float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(p), sizeof p);
+    }
+};
+
+TEST_F(SceneHostile, AGltfNamingAFileOutsideItsFolderIsRefused) {
+    const struct {
+        const char* file;
+        const char* reason;
+    } cases[] = {{"gltf_passwd.gltf", "an absolute path"}, {"gltf_dotdot.gltf", "outside its folder"}};
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.file);
+        const std::string file = scene(c.file);
+        CONUS_REQUIRE(file);
+        Outcome r = run({"mesh", "render", file, "-o", path("x.exr"), "--size", "32x32"});
+        expectRefused(r, "mesh", c.reason);
+        EXPECT_TRUE(contains(r.err, "/etc/passwd")) << r.err;
+        expectBounded(r, 400);
+        r = run({"bake", "reflection", file, "--size", "8", "-o", path("asset")});
+        expectRefused(r, "bake", c.reason);
+        EXPECT_FALSE(fs::exists(path("x.exr")) || fs::exists(path("asset")));
+    }
+}
+
+TEST_F(SceneHostile, LinksFifosAndDevicesBehindAGltfNameAreRefused) {
+    fs::create_directories(m_dir / "elsewhere");
+    writeTriangleBuffer(m_dir / "elsewhere" / "tri.bin");
+    fs::create_symlink("/etc/passwd", m_dir / "passwd.bin");
+    ASSERT_EQ(::mkfifo(path("fifo.bin").c_str(), 0600), 0);
+    const struct {
+        const char* uri;
+        const char* reason;
+    } cases[] = {{"passwd.bin", "outside its folder"}, {"fifo.bin", "not a regular file"}, {"/dev/zero", "an absolute path"}};
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.uri);
+        writeGltf("m.gltf", c.uri);
+        const Outcome r = run({"mesh", "render", path("m.gltf"), "-o", path("x.exr"), "--size", "32x32"});
+        expectRefused(r, "mesh", c.reason);
+        expectBounded(r, 400);
+    }
+    // --allow-dir lets the same buffer read from the folder it names.
+    writeGltf("far.gltf", "elsewhere/tri.bin");
+    EXPECT_EQ(run({"mesh", "render", path("far.gltf"), "-o", path("x.exr"), "--size", "32x32"}).exitCode, 0);
+    // A link out of the model's folder into another one the user allows.
+    writeGltf("link.gltf", "link.bin");
+    fs::create_directories(m_dir / "model");
+    fs::rename(m_dir / "link.gltf", m_dir / "model" / "link.gltf");
+    fs::create_symlink(m_dir / "elsewhere" / "tri.bin", m_dir / "model" / "link.bin");
+    Outcome r = run({"mesh", "render", path("model/link.gltf"), "-o", path("y.exr"), "--size", "32x32"});
+    expectRefused(r, "mesh", "outside its folder");
+    r = run({"mesh", "render", path("model/link.gltf"), "-o", path("y.exr"), "--size", "32x32", "--allow-dir",
+             path("elsewhere")});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+}
+
+TEST_F(SceneHostile, AnNrrdDataFileOutsideItsFolderOrADeviceOrFifoIsRefused) {
+    for (const char* name : {"det_passwd.nhdr", "det_devzero.nhdr"}) {
+        SCOPED_TRACE(name);
+        const std::string file = scene(name);
+        CONUS_REQUIRE(file);
+        const Outcome r = run({"volume", "render", file, "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+        expectRefused(r, "volume", "an absolute path");
+        expectBounded(r, 400);
+    }
+    ASSERT_EQ(::mkfifo(path("fifo.raw").c_str(), 0600), 0);
+    write("fifo.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\ndata file: fifo.raw\n");
+    Outcome r = run({"volume", "render", path("fifo.nhdr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+    expectRefused(r, "volume", "not a regular file");  // teem would block on it forever
+    expectBounded(r, 400);
+    // A data file in another folder reads once that folder is allowed.
+    fs::create_directories(m_dir / "data");
+    std::string samples(64, '\0');
+    for (int i = 0; i < 64; ++i) samples[std::size_t(i)] = char(i * 4);
+    std::ofstream(m_dir / "data" / "cube.raw", std::ios::binary) << samples;
+    fs::create_directories(m_dir / "headers");
+    write("headers/cube.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\ndata file: ../data/cube.raw\n");
+    r = run({"volume", "render", path("headers/cube.nhdr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+    expectRefused(r, "volume", "outside its folder");
+    r = run({"volume", "render", path("headers/cube.nhdr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu",
+             "--allow-dir", path("data")});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+}
+
+TEST_F(SceneHostile, AGlbChunkLengthPastTheFileIsRefusedAtOnce) {
+    const std::string file = scene("glb_jsonlen.glb");
+    CONUS_REQUIRE(file);
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"mesh", "render", file, "-o", path("x.exr"), "--size", "32x32"},
+          std::vector<std::string>{"bake", "reflection", file, "--size", "8", "-o", path("asset")}}) {
+        const Outcome r = run(args);
+        expectRefused(r, args[0], "its GLB header declares 4294967295 bytes in a file of 400");
+        expectBounded(r, 400);
+    }
+}
+
+TEST_F(SceneHostile, AnNpzBombIsRefusedBeforeInflating) {
+    const std::string file = scene("npz_bomb_1GiB.npz");
+    CONUS_REQUIRE(file);
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"heightfield", "encode", file, "-o", path("t.exr"), "--size", "32x32"},
+          std::vector<std::string>{"bake", "relief", file, "-o", path("r.exr"), "--size", "32x32"}}) {
+        const Outcome r = run(args);
+        expectRefused(r, args[0], "the limit for " + std::to_string(conus::kMaxDemSamples) + " height samples");
+        expectBounded(r, 400);
+    }
+}
+
+TEST_F(SceneHostile, CoincidentTrianglesAreMergedSoARenderStaysFast) {
+    const std::string file = scene("coincident_20k.obj");
+    CONUS_REQUIRE(file);
+    const Outcome r = run({"mesh", "render", file, "-o", path("x.exr"), "--size", "128x128"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, "dropped 19999 exact duplicate triangles")) << r.err;
+    expectBounded(r, 700);
+}
+
+TEST_F(SceneHostile, AVolumeRayTakesStepsBoundedByTheVolume) {
+    Outcome r = run({"volume", "render", "procedural:shepp-logan:32", "-o", path("v.exr"), "--size", "16x16", "--backend",
+                     "cpu", "--step", "1e-6", "--uniform"});
+    expectRefused(r, "volume", "give a larger step", 2);
+    expectBounded(r, 400);
+    r = run({"volume", "render", "procedural:shepp-logan:700", "-o", path("v.exr"), "--size", "16x16"});
+    expectRefused(r, "volume", "pass the limit of " + std::to_string(conus::kMaxVolumeVoxels), 2);
+    expectBounded(r, 400);
+}
+
+TEST_F(SceneHostile, ListsThatAreNotRegularFilesAreRefused) {
+    Outcome r = run({"encode", "--list", "/dev/zero", "--out-dir", path("out")});
+    expectRefused(r, "encode", "not a regular file");
+    expectBounded(r, 400);
+    ASSERT_EQ(::mkfifo(path("list.fifo").c_str(), 0600), 0);
+    r = run({"encode", "--list", path("list.fifo"), "--out-dir", path("out")});
+    expectRefused(r, "encode", "not a regular file");
+    expectBounded(r, 400);
+}
+
+TEST_F(SceneHostile, SizesAreCheckedBeforeAllocating) {
+    write("small.ppm", "P3\n2 2\n255\n0 50 100 150 200 250\n10 20 30 40 50 60\n");
+    Outcome r = run({"encode", path("small.ppm"), "-o", path("x.exr"), "--size", "32768x32768", "--focus", "0.5,0.5,0.1,2"});
+    expectRefused(r, "encode", "beyond the encode memory limit of " + std::to_string(conus::kMaxEncodeBytes));
+    expectBounded(r, 400);
+    r = run({"heightfield", "encode", "procedural:20000", "-o", path("t.exr")});
+    expectRefused(r, "heightfield", "more than the limit of " + std::to_string(conus::kMaxDemSamples), 2);
+    expectBounded(r, 400);
+    // A 4097-node map for a small image: a minute of building for nothing it can show.
+    r = run({"heightfield", "encode", "procedural:64", "-o", path("t.exr"), "--size", "32x32", "--grid", "4097"});
+    expectRefused(r, "heightfield", "--grid 4097 is finer than a 32x32 image can show; at most 129 nodes a side", 2);
+    expectBounded(r, 400);
+    r = run({"encode", path("small.ppm"), "-o", path("x.exr"), "--focus", "0.5,0.5,0.1,2", "--grid", "4097"});
+    expectRefused(r, "encode", "--grid 4097 is finer", 2);
+    expectBounded(r, 400);
+}
+
+TEST_F(SceneHostile, AFileThatValidatesAlsoDecodes) {
+    // The source size alone makes the default frame pass the decode budget.
+    const std::string big = scene("valid-sourceSize-32768x16000.exr");
+    CONUS_REQUIRE(big);
+    Outcome r = run({"decode", big, "-o", path("x.png")});
+    expectRefused(r, "decode", "give a smaller --size");
+    expectBounded(r, 400);
+    EXPECT_FALSE(fs::exists(path("x.png")));
+    r = run({"decode", big, "-o", path("x.png"), "--size", "64x32"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    // A garbage ICC profile: refused by validate (V16) and so by decode, one line each.
+    const std::string icc = scene("valid-bad-icc-multiline.exr");
+    r = run({"validate", icc});
+    expectRefused(r, "validate", "not a valid CoNUS file");
+    EXPECT_TRUE(contains(r.out, ": V16: ") && contains(r.out, "not an ICC profile")) << r.out;
+    r = run({"decode", icc, "-o", path("y.png")});
+    expectRefused(r, "decode", "V16");
+}
+
+TEST_F(SceneHostile, DamagedPixelDataFailsValidate) {
+    // A zip-compressed file with one byte of its last image chunk flipped (its compressed pixels:
+    // the chunks of a noisy 64x64 picture are several KB, the map's chunk after them a few dozen
+    // bytes). The headers and chunk tables still pass; only a decompression sees the damage.
+    std::string pgm = "P2\n64 64\n255\n";
+    std::uint32_t state = 12345;
+    for (int i = 0; i < 64 * 64; ++i) {
+        state = state * 1664525u + 1013904223u;  // noise: chunks that do not compress
+        pgm += std::to_string(state >> 24) + " ";
+    }
+    write("p.pgm", pgm);
+    const Outcome made = run({"uniform", path("p.pgm"), "-o", path("u.exr"), "--size", "64x64", "--compression", "zip"});
+    ASSERT_EQ(made.exitCode, 0) << made.err;
+    std::ifstream in(m_dir / "u.exr", std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GT(bytes.size(), 4000u);
+    bytes[bytes.size() - 1000] = char(bytes[bytes.size() - 1000] ^ 0x5a);
+    std::ofstream(m_dir / "damaged.exr", std::ios::binary) << bytes;
+    Outcome r = run({"validate", path("damaged.exr"), "--headers-only"});
+    EXPECT_EQ(r.exitCode, 0) << r.out << r.err;
+    r = run({"validate", path("damaged.exr")});
+    expectRefused(r, "validate", "not a valid CoNUS file");
+    EXPECT_TRUE(contains(r.out, ": V1: damaged OpenEXR data")) << r.out;
+    EXPECT_NE(run({"decode", path("damaged.exr"), "-o", path("d.png")}).exitCode, 0);
+}
+
+TEST_F(SceneHostile, SmallerItemsHaveTheirExitCodes) {
+    Outcome r = run({"decode", "x.exr", "-o", path("x.png"), "--exposure", "nan"});
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    write("a.pgm", "P2\n2 2\n255\n0 1 2 3\n");
+    write("b.pgm", "P2\n2 2\n255\n3 2 1 0\n");
+    r = run({"encode", path("a.pgm"), path("b.pgm"), "--out-dir", path("out"), "--name", "/tmp/escape-{stem}.exr"});
+    expectRefused(r, "encode", "not a file name inside --out-dir", 2);
+    r = run({"encode", path("a.pgm"), path("b.pgm"), "--out-dir", path("out"), "--name", "../{stem}.exr"});
+    expectRefused(r, "encode", "not a file name inside --out-dir", 2);
+    EXPECT_FALSE(fs::exists("/tmp/escape-a.exr") || fs::exists(path("a.exr")));
+    // Bad data in a file is exit 1: NaN heights, absurd spacings, a zero-length NRRD direction.
+    std::string npy("\x93NUMPY\x01\x00", 8);
+    std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }";
+    header.resize(118, ' ');
+    header += '\n';
+    npy += char(header.size() & 0xff);
+    npy += char(header.size() >> 8);
+    const float heights[6] = {1, 2, std::nanf(""), 4, 5, 6};
+    npy += header + std::string(reinterpret_cast<const char*>(heights), sizeof heights);
+    write("nan.npy", npy);
+    r = run({"heightfield", "encode", path("nan.npy"), "-o", path("t.exr"), "--size", "16x16"});
+    expectRefused(r, "heightfield", "every height must be finite");
+    write("zero.nrrd", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\nspace dimension: 3\n"
+                       "space directions: (0,0,0) (0,1,0) (0,0,1)\n\n" + std::string(64, '\1'));
+    r = run({"volume", "render", path("zero.nrrd"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_EQ(errorLines(r.err).size(), 1u) << r.err;
+}
+
+// What SIGKILL leaves (a temporary of a process that is gone) is removed by the next write into
+// the folder; the temporary of a process that still runs stays.
+TEST_F(SceneHostile, StaleTemporariesAreRemovedByTheNextRun) {
+    const pid_t child = ::fork();
+    if (child == 0) ::_exit(0);
+    ::waitpid(child, nullptr, 0);  // its id now names no process
+    const std::string stale = ".u.tmp-" + std::to_string(child) + "-0.exr";
+    const std::string live = ".u.tmp-" + std::to_string(::getpid()) + "-0.exr";
+    write(stale, "half a file");
+    write(live, "being written");
+    write("a.pgm", "P2\n2 2\n255\n0 1 2 3\n");
+    ASSERT_EQ(run({"uniform", path("a.pgm"), "-o", path("u.exr"), "--size", "2x2"}).exitCode, 0);
+    EXPECT_FALSE(fs::exists(m_dir / stale));
+    EXPECT_TRUE(fs::exists(m_dir / live));
+}
+
+// The six faces of a reflection asset appear together: an earlier asset is replaced whole, and a
+// folder holding anything else is refused before any work.
+TEST_F(SceneHostile, AReflectionAssetIsWrittenAsAWhole) {
+    write("scene.obj", "v -5 -1 -5\nv 5 -1 -5\nv 5 -1 5\nv -5 -1 5\nf 1 2 3 4\n");
+    Outcome r = run({"bake", "reflection", path("scene.obj"), "--size", "8", "-o", path("asset")});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto firstTime = fs::last_write_time(m_dir / "asset" / "px.exr");
+    r = run({"bake", "reflection", path("scene.obj"), "--size", "16", "-o", path("asset")});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(m_dir / "asset")) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"nx.exr", "ny.exr", "nz.exr", "px.exr", "py.exr", "pz.exr"}));
+    EXPECT_GE(fs::last_write_time(m_dir / "asset" / "px.exr"), firstTime);
+    for (const auto& e : fs::directory_iterator(m_dir))
+        EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+    write("asset/notes.txt", "mine");
+    r = run({"bake", "reflection", path("scene.obj"), "--size", "8", "-o", path("asset")});
+    expectRefused(r, "bake", "holds notes.txt", 2);
+    EXPECT_TRUE(fs::exists(m_dir / "asset" / "notes.txt"));
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(SceneHostile, InfoListsTheSceneLimits) {
+    const conus::hostile::Outcome r = run({"info", "--limits", "--json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    for (const conus::LimitEntry& e : conus::limitTable()) EXPECT_EQ(j[e.name]["value"], e.value) << e.name;
+    EXPECT_EQ(j["demSamples"]["value"], conus::kMaxDemSamples);
+    EXPECT_EQ(j["volumeReadBytes"]["unit"], "bytes");
+    EXPECT_EQ(j["encodeBytes"]["value"], conus::kMaxEncodeBytes);
+}
+
+}  // namespace

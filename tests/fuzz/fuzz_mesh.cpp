@@ -1,0 +1,62 @@
+// Fuzz harness: the mesh reader (sceneio::readMesh, Assimp behind it) on arbitrary bytes, written
+// as a file whose extension follows its content (glTF, GLB, PLY, STL, OFF, OBJ; else the first
+// byte picks one) in a folder with files it may name and traps it must not open (scene_fixture.h).
+// A mesh that reads must satisfy checkMesh, stay within the caps given, and hold no exact
+// duplicate triangle; anything else must be a one-line conus::Error.
+#include <algorithm>
+#include <array>
+#include <set>
+#include <string>
+
+#include "conus/core/error.h"
+#include "conus/sceneio/mesh_file.h"
+#include "fuzz.h"
+#include "scene_fixture.h"
+
+namespace {
+
+std::string extensionOf(const std::uint8_t* data, std::size_t size) {
+    if (startsWith(data, size, "glTF")) return "glb";
+    if (startsWith(data, size, "{")) return "gltf";
+    if (startsWith(data, size, "ply")) return "ply";
+    if (startsWith(data, size, "solid")) return "stl";
+    if (startsWith(data, size, "OFF")) return "off";
+    if (startsWith(data, size, "v ") || startsWith(data, size, "#") || startsWith(data, size, "mtllib")) return "obj";
+    static const char* kAny[] = {"obj", "ply", "stl", "gltf", "glb", "off"};
+    return size == 0 ? "obj" : kAny[data[0] % 6];
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    static const SceneFixture fixture("mesh");
+    const std::string path = fixture.write(extensionOf(data, size), data, size);
+    conus::sceneio::MeshReadOptions options;
+    options.maxFileBytes = 1 << 16;
+    options.maxTriangles = 1 << 16;
+    options.maxVertices = 1 << 17;
+    try {
+        const conus::Mesh mesh = conus::sceneio::readMesh(path, options);
+        conus::checkMesh(mesh, "fuzzed mesh");
+        CONUS_FUZZ_CHECK(mesh.indices.size() / 3 <= std::size_t(options.maxTriangles), "triangle cap");
+        CONUS_FUZZ_CHECK(!mesh.indices.empty(), "a mesh that reads has a triangle");
+        std::set<std::array<float, 9>> seen;
+        for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+            std::array<std::array<float, 3>, 3> corners;
+            for (int c = 0; c < 3; ++c) {
+                const glm::vec3& p = mesh.positions[mesh.indices[t + c]];
+                corners[c] = {p.x, p.y, p.z};
+            }
+            std::sort(corners.begin(), corners.end());
+            std::array<float, 9> key;
+            for (int c = 0; c < 9; ++c) key[c] = corners[c / 3][c % 3];
+            CONUS_FUZZ_CHECK(seen.insert(key).second, "no exact duplicate triangle survives");
+        }
+    } catch (const conus::Error& e) {
+        CONUS_FUZZ_CHECK(isOneLine(e.what()), "an error is one line");
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "non-CoNUS exception: %s\n", e.what());
+        CONUS_FUZZ_CHECK(false, "the reader throws only conus::Error");
+    }
+    return 0;
+}
