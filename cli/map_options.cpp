@@ -124,6 +124,7 @@ std::string describeFociBudget(const codec::FociBudget& b, const std::optional<B
              std::to_string(grid) + "x" + std::to_string(grid) + " grid" +
              (maxAnisotropy > 0 ? " under --max-anisotropy " + numberText(maxAnisotropy) : std::string()) +
              ": recorded so (a finer --grid or a wider focus holds more)");
+    for (const std::string& note : b.builderNotes) text += "\n" + note;  // what the anisotropy bound cost
     return text;
 }
 

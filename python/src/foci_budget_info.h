@@ -25,6 +25,7 @@ inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, i
     d["k_given"] = given;
     d["lowered"] = b.lowered;
     d["grid_limited"] = b.gridLimited;
+    d["builder_notes"] = b.builderNotes;  // what the anisotropy bound cost (a transition widened, a grid refined)
     d["frame_loss"] = frameLoss;
     d["predicted_frame_loss"] = b.predicted.frameLoss;
     d["predicted_roi_gain"] = b.predicted.roiGain;

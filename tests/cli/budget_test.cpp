@@ -106,6 +106,8 @@ TEST_F(BudgetCli, MapFociKeepsTheContextFloor) {
     ASSERT_EQ(exact.exitCode, 0) << exact.err;
     EXPECT_EQ(recordedK(path("e.exr")), (std::vector<double>{5.0, 3.0}));
     EXPECT_NE(exact.err.find("under the default floor 0.25"), std::string::npos) << exact.err;
+    // What the anisotropy bound cost the k = 5 focus is said, with numbers.
+    EXPECT_NE(exact.out.find("focus 0.25,0.3,0.2,5: transition widened from 2 to "), std::string::npos) << exact.out;
 }
 
 TEST_F(BudgetCli, DocumentedCombinationsAreNotRefused) {

@@ -200,6 +200,7 @@ TEST_F(Hostile, AFocusTheGridCannotHoldGetsAFinerGrid) {
     EXPECT_GT(map.columns(), 2);
     const std::vector<conus::codec::Focus> focus{{0.5, 0.5, 0.1, 4}};
     EXPECT_GT(conus::codec::reachedMagnification(map, focus)[0], 3.25);
+    EXPECT_NE(r.out.find("grid refined from 2x2 to "), std::string::npos) << r.out;
 }
 
 TEST_F(Hostile, InfoPrintsTheLimits) {

@@ -259,6 +259,8 @@ def test_encode_holds_the_frame_loss_budget(tmp_path, conus_bin):
     with pytest.warns(UserWarning, match="exact_k"):
         e = conus.encode(detail, foci=foci, size=(60, 40), fit=0, exact_k=True)
     assert e.budget["k_given"] == [4.0, 4.0] and not e.budget["lowered"]
+    # What the anisotropy bound cost each k = 4 focus, as the CLI prints it.
+    assert any(n.startswith("focus 0.3,0.4,0.16,4: transition widened from 2 to ") for n in e.budget["builder_notes"])
     assert e.budget["predicted_frame_loss"] > 1.5 or e.budget["predicted_tile_loss"] > 4.0
     with pytest.warns(UserWarning):
         tight = conus.encode(detail, foci=foci, size=(60, 40), fit=0, frame_loss=0.1)

@@ -275,7 +275,7 @@ TEST(ReadMesh, GltfIndicesPastTheVerticesAreRefused) {
 // Degenerate triangles are dropped and the warning says how many of how many.
 TEST(ReadMesh, DroppedDegenerateTrianglesAreCounted) {
     TestDir dir("sceneio");
-    test::writeText(dir.file("some.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\nf 2 3 3\nf 1 3 2\n");
+    test::writeText(dir.file("some.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\nf 2 3 3\nf 1 4 3\n");
     std::vector<std::string> said;
     MeshReadOptions options;
     options.warn = [&](const std::string& text) { said.push_back(text); };

@@ -101,33 +101,39 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         throw Error(ErrorCode::InvalidArgument, "the frame-loss budget " + std::to_string(frameLossDb) + " dB must be finite and >= 0");
     if (!(tileLossDb >= 0))  // NaN fails; infinity: no tile budget
         throw Error(ErrorCode::InvalidArgument, "the tile-loss budget " + std::to_string(tileLossDb) + " dB must be >= 0");
-    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false};
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false, {}};
     // A lower k leaves the context more samples: the loss falls with t. Each try builds the map and
     // predicts what it loses (its target alone predicts too little: stretched footprints lose along
     // their long axis).
     double bestT = -1;
     const auto holds = [&](double t) {
         std::vector<Focus> tried = powered(foci, t);
-        SamplingMap map = buildFociMap(tried, options);
+        FociReport report;
+        SamplingMap map = buildFociMap(tried, options, &report);
         const FramePrediction p = model.predict(map);
         const bool ok = p.frameLoss <= frameLossDb && p.tileLoss <= tileLossDb;
         if (ok && t > bestT) {
             bestT = t;
             out.given = std::move(tried);
             out.map = std::move(map);
+            out.builderNotes = std::move(report.notes);
             out.predicted = p;
         }
         return ok;
     };
     if (exactK) {
         out.given = out.asked;
-        out.map = buildFociMap(out.given, options);
+        FociReport report;
+        out.map = buildFociMap(out.given, options, &report);
+        out.builderNotes = std::move(report.notes);
         out.predicted = model.predict(out.map);
     } else {
         const double t = largestHolding(holds);
         if (bestT < 0) {  // even the lowest t tried loses more: the identity (k = 1) holds any budget
             out.given = powered(foci, t);
-            out.map = buildFociMap(out.given, options);
+            FociReport report;
+            out.map = buildFociMap(out.given, options, &report);
+            out.builderNotes = std::move(report.notes);
             out.predicted = model.predict(out.map);
         }
         out.lowered = t < 1.0;
@@ -139,13 +145,15 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
 }
 
 FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options, double floor, bool exactK) {
-    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false};
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false, {}};
     const double t = exactK ? 1.0 : largestHolding([&](double t) {
         return fociShare(powered(foci, t), options.aspect, options.falloff).contextDensity >= floor;
     });
     out.given = powered(foci, t);
     out.lowered = t < 1.0;
-    out.map = buildFociMap(out.given, options);
+    FociReport report;
+    out.map = buildFociMap(out.given, options, &report);
+    out.builderNotes = std::move(report.notes);
     out.gridLimited = recordReached(out.map, out.given);
     out.share = fociShare(out.given, options.aspect, options.falloff);
     out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;

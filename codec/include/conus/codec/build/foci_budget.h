@@ -15,6 +15,7 @@
 #pragma once
 
 #include <span>
+#include <string>
 #include <vector>
 
 #include "conus/codec/build/foci.h"
@@ -49,6 +50,9 @@ struct FociBudget {
     FramePrediction predicted;        // with a picture; zeros without
     bool lowered = false;             // the budget lowered k
     bool gridLimited = false;         // the grid held less than half a focus's extra magnification
+    // What the builder gave way on to keep the anisotropy bound (FociReport::notes: a transition
+    // widened, a grid refined, a k not reached), one line each with numbers.
+    std::vector<std::string> builderNotes;
 };
 
 // An importance image that is 1 on the foci's discs and 0 elsewhere (w x h), the region a
