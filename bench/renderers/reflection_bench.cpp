@@ -20,6 +20,7 @@
 #include "conus/codec/depth/reflection.h"
 #include "conus/imageio/image_file.h"
 #include "conus/renderers/reflection.h"
+#include "reflection_scoring.h"
 
 namespace conus {
 namespace {
@@ -114,38 +115,14 @@ void BM_ReflectionQuality(benchmark::State& state) {
                                                      kFrame, options);
     }
     // ROI: reflector pixels whose traced reflected ray meets the box.
-    double squared[2][2] = {}, count[2] = {}, wrong[2] = {};
-    glm::ivec2 roiLo(kFrame), roiHi(0);
-    for (int y = 0; y < kFrame; ++y)
-        for (int x = 0; x < kFrame; ++x) {
-            if (truth.at(x, y, 3) == 0.0f) continue;
-            const auto mirror = codec::hitReflector(options.reflector, s.camera.ray({(x + 0.5) / kFrame, (y + 0.5) / kFrame}));
-            const auto hit = mirror ? s.scene.intersect(mirror->reflected, 1e-6) : std::nullopt;
-            const int region = hit && hit->triangle < kBoxTriangles ? 0 : 1;
-            if (region == 0) {
-                roiLo = glm::min(roiLo, glm::ivec2(x, y));
-                roiHi = glm::max(roiHi, glm::ivec2(x, y));
-            }
-            for (int k = 0; k < 2; ++k) {
-                double e = 0;
-                for (int c = 0; c < 3; ++c) {
-                    const double d = std::clamp(frames[k].at(x, y, c), 0.0f, 1.0f) - std::clamp(truth.at(x, y, c), 0.0f, 1.0f);
-                    e += d * d / 3.0;
-                }
-                squared[k][region] += e;
-                // A pixel off by more than 0.1 RMS: a hit on the wrong surface (the silhouettes).
-                if (region == 0) wrong[k] += e > 0.01;
-            }
-            count[region] += 1;
-        }
-    auto psnr = [&](int k, int region) { return 10.0 * std::log10(count[region] / std::max(squared[k][region], 1e-30)); };
-    state.counters["roi_conus_dB"] = psnr(1, 0);
-    state.counters["roi_conventional_dB"] = psnr(0, 0);
-    state.counters["rest_conus_dB"] = psnr(1, 1);
-    state.counters["rest_conventional_dB"] = psnr(0, 1);
-    state.counters["roi_pixels"] = count[0];
-    state.counters["roi_wrong_conus"] = wrong[1];
-    state.counters["roi_wrong_conventional"] = wrong[0];
+    const bench::MirrorScore score = bench::scoreMirror(frames, truth, s.scene, options.reflector, s.camera, kFrame, kBoxTriangles);
+    state.counters["roi_conus_dB"] = score.psnr(1, {0});
+    state.counters["roi_conventional_dB"] = score.psnr(0, {0});
+    state.counters["rest_conus_dB"] = score.psnr(1, {1});
+    state.counters["rest_conventional_dB"] = score.psnr(0, {1});
+    state.counters["roi_pixels"] = score.count[0];
+    state.counters["roi_wrong_conus"] = score.wrong[1][0];
+    state.counters["roi_wrong_conventional"] = score.wrong[0][0];
     // What the focus achieves: the +z face's linear sampling rate at the box's centre, against the
     // conventional face's (the map's Jacobian determinant, square-rooted).
     const codec::DepthImage& front = s.faces[1][4].depth;
@@ -154,20 +131,7 @@ void BM_ReflectionQuality(benchmark::State& state) {
     const char* picture = std::getenv("CONUS_BENCH_PICTURE");
     if (picture && state.range(0) == static_cast<int>(codec::ReflectionBakeOptions{}.magnification) &&
         state.range(1) == 10) {
-        // Top: the frames; below: the box, kZoom times enlarged (nearest), around the ROI's centre.
-        constexpr int kZoom = 4, kCrop = kFrame / kZoom;
-        const glm::ivec2 corner = glm::clamp((roiLo + roiHi) / 2 - kCrop / 2, 0, kFrame - kCrop);
-        Image strip{3 * kFrame, 2 * kFrame, {"R", "G", "B"}, std::vector<float>(std::size_t(6) * kFrame * kFrame * 3)};
-        const Image* parts[3] = {&frames[1], &frames[0], &truth};
-        for (int p = 0; p < 3; ++p)
-            for (int y = 0; y < kFrame; ++y)
-                for (int x = 0; x < kFrame; ++x)
-                    for (int c = 0; c < 3; ++c) {
-                        strip.at(p * kFrame + x, y, c) = parts[p]->at(x, y, c);
-                        strip.at(p * kFrame + x, kFrame + y, c) =
-                            parts[p]->at(corner.x + x / kZoom, corner.y + y / kZoom, c);
-                    }
-        imageio::writeImageFile(picture, strip);
+        bench::writeMirrorStrip(picture, frames, truth, score, kFrame, 4);
     }
 }
 

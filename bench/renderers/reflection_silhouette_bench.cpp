@@ -17,6 +17,7 @@
 
 #include "conus/codec/depth/reflection.h"
 #include "conus/imageio/image_file.h"
+#include "reflection_scoring.h"
 
 namespace conus {
 namespace {
@@ -98,59 +99,21 @@ void BM_ReflectionSilhouettes(benchmark::State& state) {
         for (int k = 0; k < 2; ++k)
             frames[k] = codec::renderReflectionFrame(s.scene, &s.faces[k], {0, 0, 0}, s.camera, kFrame, kFrame, options);
     }
-    // Regions: 0 the box (ROI), 1 the rest of the mirror; 2 the whole mirror.
-    double squared[2][3] = {}, count[3] = {}, wrong[2] = {};
-    glm::ivec2 roiLo(kFrame), roiHi(0);
-    for (int y = 0; y < kFrame; ++y)
-        for (int x = 0; x < kFrame; ++x) {
-            if (truth.at(x, y, 3) == 0.0f) continue;
-            const auto mirror = codec::hitReflector(options.reflector, s.camera.ray({(x + 0.5) / kFrame, (y + 0.5) / kFrame}));
-            const auto hit = mirror ? s.scene.intersect(mirror->reflected, 1e-6) : std::nullopt;
-            const int region = hit && hit->triangle < kBoxTriangles ? 0 : 1;
-            if (region == 0) {
-                roiLo = glm::min(roiLo, glm::ivec2(x, y));
-                roiHi = glm::max(roiHi, glm::ivec2(x, y));
-            }
-            for (int k = 0; k < 2; ++k) {
-                double e = 0;
-                for (int c = 0; c < 3; ++c) {
-                    const double d = std::clamp(frames[k].at(x, y, c), 0.0f, 1.0f) - std::clamp(truth.at(x, y, c), 0.0f, 1.0f);
-                    e += d * d / 3.0;
-                }
-                squared[k][region] += e;
-                squared[k][2] += e;
-                wrong[k] += e > 0.01;  // more than 0.1 RMS off: a hit on the wrong surface
-            }
-            count[region] += 1;
-            count[2] += 1;
-        }
-    const auto psnr = [&](int k, int region) {
-        return 10.0 * std::log10(count[region] / std::max(squared[k][region], 1e-30));
-    };
-    state.counters["mirror_conus_dB"] = psnr(1, 2);
-    state.counters["mirror_uniform_dB"] = psnr(0, 2);
-    state.counters["roi_conus_dB"] = psnr(1, 0);
-    state.counters["roi_uniform_dB"] = psnr(0, 0);
-    state.counters["rest_conus_dB"] = psnr(1, 1);
-    state.counters["rest_uniform_dB"] = psnr(0, 1);
-    state.counters["roi_pixels"] = count[0];
-    state.counters["mirror_pixels"] = count[2];
-    state.counters["wrong_conus"] = wrong[1];
-    state.counters["wrong_uniform"] = wrong[0];
+    // Regions: 0 the box (ROI), 1 the rest of the mirror; both: the whole mirror.
+    const bench::MirrorScore score = bench::scoreMirror(frames, truth, s.scene, options.reflector, s.camera, kFrame, kBoxTriangles);
+    state.counters["mirror_conus_dB"] = score.psnr(1, {0, 1});
+    state.counters["mirror_uniform_dB"] = score.psnr(0, {0, 1});
+    state.counters["roi_conus_dB"] = score.psnr(1, {0});
+    state.counters["roi_uniform_dB"] = score.psnr(0, {0});
+    state.counters["rest_conus_dB"] = score.psnr(1, {1});
+    state.counters["rest_uniform_dB"] = score.psnr(0, {1});
+    state.counters["roi_pixels"] = score.count[0];
+    state.counters["mirror_pixels"] = score.count[0] + score.count[1];
+    state.counters["wrong_conus"] = score.wrong[1][0] + score.wrong[1][1];
+    state.counters["wrong_uniform"] = score.wrong[0][0] + score.wrong[0][1];
     state.SetLabel(state.range(0) ? "plane mirror" : "sphere mirror");
     if (const char* prefix = std::getenv("CONUS_BENCH_PICTURES")) {
-        constexpr int kZoom = 3, kCrop = kFrame / kZoom;
-        const glm::ivec2 corner = glm::clamp((roiLo + roiHi) / 2 - kCrop / 2, 0, kFrame - kCrop);
-        Image strip{3 * kFrame, 2 * kFrame, {"R", "G", "B"}, std::vector<float>(std::size_t(6) * kFrame * kFrame * 3)};
-        const Image* parts[3] = {&frames[1], &frames[0], &truth};
-        for (int p = 0; p < 3; ++p)
-            for (int y = 0; y < kFrame; ++y)
-                for (int x = 0; x < kFrame; ++x)
-                    for (int c = 0; c < 3; ++c) {
-                        strip.at(p * kFrame + x, y, c) = parts[p]->at(x, y, c);
-                        strip.at(p * kFrame + x, kFrame + y, c) = parts[p]->at(corner.x + x / kZoom, corner.y + y / kZoom, c);
-                    }
-        imageio::writeImageFile(std::string(prefix) + (state.range(0) ? "-plane.png" : "-sphere.png"), strip);
+        bench::writeMirrorStrip(std::string(prefix) + (state.range(0) ? "-plane.png" : "-sphere.png"), frames, truth, score, kFrame, 3);
     }
 }
 
