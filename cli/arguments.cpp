@@ -45,22 +45,6 @@ codec::View parseView(const std::string& text) {
     return view;
 }
 
-CLI::Validator finiteRange(double low, double high, bool lowIncluded) {
-    std::ostringstream range;
-    range << (lowIncluded ? "[" : "(") << low << ", " << high << ")";
-    const std::string description = "a finite number in " + range.str();
-    return CLI::Validator(
-        [=](std::string& text) -> std::string {
-            char* end = nullptr;
-            const double value = std::strtod(text.c_str(), &end);
-            const bool aboveLow = lowIncluded ? value >= low : value > low;
-            if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value) || !aboveLow || !(value < high))
-                return "'" + text + "' is not " + description;
-            return {};
-        },
-        description);
-}
-
 CameraText parseCamera(const std::string& text) {
     const auto v = parseNumbers(text, ',');
     if (v.size() != 7 || text.back() == ',') invalid("camera '" + text + "' needs 7 values x,y,z,lx,ly,lz,fovDeg");
@@ -77,13 +61,6 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what) {
 format::Compression parseCompression(const std::string& text) {
     if (const auto compression = format::parseName<format::Compression>(text)) return *compression;
     invalid("compression '" + text + "' is not one of " + format::nameList<format::Compression>());
-}
-
-void addAllowDirOption(CLI::App& command, std::vector<std::string>& dirs) {
-    command.add_option("--allow-dir", dirs,
-                       "a folder the files a scene file names (buffers, material libraries, data files) may also lie in; "
-                       "by default only the scene file's own folder (repeatable)")
-        ->check(CLI::ExistingDirectory);
 }
 
 }  // namespace conus::cli

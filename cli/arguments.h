@@ -10,6 +10,7 @@
 
 #include "conus/codec/image/decode.h"
 #include "conus/format/container.h"
+#include "option_checks.h"
 
 namespace conus::cli {
 
@@ -30,13 +31,5 @@ struct CameraText {
 CameraText parseCamera(const std::string& text);
 glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "x,y,z", all finite
 
-// A CLI11 check for a number option: finite, above `low` (or equal to it when `lowIncluded`) and
-// below `high`. CLI::Range lets NaN through (every comparison with NaN is false); this does not,
-// so a bad value is a usage error (exit 2) instead of a silent fallback.
-CLI::Validator finiteRange(double low, double high, bool lowIncluded = false);
-
-// --allow-dir DIR (repeatable): a folder, besides a scene file's own, that the files it names
-// (glTF buffers, material libraries, NRRD data files) may lie in (sceneio/named_files.h).
-void addAllowDirOption(CLI::App& command, std::vector<std::string>& dirs);
 
 }  // namespace conus::cli

@@ -24,6 +24,7 @@
 #include "image_files.h"
 #include "importance.h"
 #include "map_options.h"
+#include "option_checks.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -197,7 +198,7 @@ CLI::App* declareDemo(CLI::App& root, DemoOptions& options) {
     command->add_option("--out", options.out, "folder for the pictures and files (default demo-out)");
     command->add_option("--size", options.size, "side of the built-in picture (default 4096)")
         ->check(CLI::Range(256, 8192));
-    command->add_option("--k", options.k, "magnification of both foci (default 4)")->check(CLI::Range(1.0, 8.0));
+    command->add_option("--k", options.k, "magnification of both foci (default 4)")->check(finiteRange(1.0, 8.0, true, true));
     command->add_option("--input", options.input,
                         "run the same comparison on your own picture instead of the built-in one");
     command->add_option("--focus", options.foci, "with --input: focus u,v,r,k (repeatable; default: the centre)");

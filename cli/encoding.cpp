@@ -71,7 +71,7 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault) {
                         with + "how strongly the fit keeps the encoder's low-pass along long, thin footprints (the "
                                "focus rims, where undoing it brings back a radial comb); 0: the plain least squares, sharper and "
                                "with more aliasing (default " + std::to_string(codec::kFitHoldLowPass).substr(0, 3) + ")")
-            ->check(CLI::Range(0.0, 1000.0));
+            ->check(finiteRange(0.0, 1000.0, true, true));
     if (!byDefault) {
         iterations->needs(enabled);
         hold->needs(enabled);

@@ -1,4 +1,5 @@
 #include "map_options.h"
+#include "option_checks.h"
 
 #include <CLI/CLI.hpp>
 
@@ -63,7 +64,7 @@ CLI::Option* addFrameLossOption(CLI::App& command, double& frameLoss, const std:
         .add_option("--frame-loss", frameLoss,
                     "whole-frame loss budget in dB against the uniform image of the same pixel count, predicted "
                     "before the work: " + what + " (default " + numberText(codec::kDefaultFrameLoss) + ")")
-        ->check(CLI::Range(0.0, 60.0));
+        ->check(finiteRange(0.0, 60.0, true, true));
 }
 
 CLI::Option* addExactKOption(CLI::App& command, bool& exactK) {
@@ -132,7 +133,7 @@ void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy) {
     command.add_option("--max-anisotropy", maxAnisotropy,
                        "largest ratio of a CoNUS pixel's long to short side in the source (the Jacobian's singular "
                        "values; >= 1, default: no limit); a tight limit costs magnification")
-        ->check(CLI::Range(1.0, 1e6));
+        ->check(finiteRange(1.0, 1e6, true, true));
 }
 
 CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff) {
@@ -145,10 +146,10 @@ CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff) {
 void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDensity, const std::string& prefix) {
     command.add_option("--min-density", minDensity,
                        prefix + "density every map cell keeps (0..1, default 0.25), held to 5% or refused")
-        ->check(CLI::Range(0.001, 0.999));
+        ->check(finiteRange(0.001, 0.999, true, true));
     command.add_option("--max-density", maxDensity,
                        prefix + "cap on every map cell's density (default 16: 4x the linear rate), held to 5% or refused")
-        ->check(CLI::Range(1.001, 4096.0));
+        ->check(finiteRange(1.001, 4096.0, true, true));
 }
 
 void checkGridForImage(int grid, int width, int height, int defaultGrid) {

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "../cli/option_checks.h"
 #include "conus/core/error.h"
 
 namespace conus::viewer {
@@ -76,12 +77,13 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("--reflection", reflection,
                    "3-D mode: orbit a reflection asset folder (`conus bake reflection`) with --scene; --uniform: its conventional twin");
     app.add_option("--scene", o.reflectionScene, "--reflection: the mesh the asset was baked from");
-    app.add_option("--radius", o.reflectorRadius, "--reflection: the mirror sphere's radius")->capture_default_str()->check(CLI::PositiveNumber);
+    cli::addAllowDirOption(app, o.allowDirs);
+    app.add_option("--radius", o.reflectorRadius, "--reflection: the mirror sphere's radius")->capture_default_str()->check(cli::finiteRange(0.0, 1e9));
     app.add_option("--max-edge", o.maxEdge,
                    "--mesh: split triangles each CoNUS frame until no projected edge spans more than this many map cells "
                    "(straight edges follow Eq. 1's curves; costs a CPU subdivision and an upload a frame; 0: never)")
         ->capture_default_str()
-        ->check(CLI::Range(0.0, 1e6));
+        ->check(cli::finiteRange(0.0, 1e6, true, true));
     app.add_option("--tf", o.transferFunction, "--volume: transfer function preset or file (T cycles the presets)");
     app.add_option("--focus", foci, "3-D modes: a focus u,v,r,k (repeat for more; N adds one at the cursor)");
     app.add_option("--view", view, "undistorted rectangle u0,v0,u1,v1 to show");
@@ -91,12 +93,12 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_flag("--grid", o.display.grid, "draw the CoNUS pixel grid");
     app.add_option("--grid-every", o.display.gridEvery, "draw every n-th grid line (0: automatic)");
     app.add_flag("--outlines", o.display.outlines, "draw the focus outlines");
-    app.add_option("--exposure", o.display.exposure, "exposure in stops");
+    app.add_option("--exposure", o.display.exposure, "exposure in stops")->check(cli::finiteRange(-64.0, 64.0, true, true));
     app.add_option("--tonemap", toneMap, "tone map for HDR values: none (default), reinhard, aces")
         ->check(CLI::IsMember({"none", "reinhard", "aces"}));
     app.add_option("--gamma", o.display.gamma,
                    "display curve: 0 (default) the sRGB curve for linear data, else a display gamma (1: linear)")
-        ->check(CLI::Range(0.0, 10.0));
+        ->check(cli::finiteRange(0.0, 10.0, true, true));
     app.add_option("--decode", decode,
                    "where the reconstructed frame is decoded: gpu (shader), cpu (codec::decodeImage each frame, "
                    "uploaded), auto (gpu, except on a software rasterizer (llvmpipe, softpipe, swrast) where the view is not zoomed out: cpu, the faster there)")
@@ -144,7 +146,12 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
         if (!o.uniform.empty() && o.files.empty() && o.sceneKind == SceneKind::None) throw Error(ErrorCode::InvalidArgument, "--uniform goes with a CoNUS file");
         if (o.benchmarkFrames < 0) throw Error(ErrorCode::InvalidArgument, "--benchmark-frames must be >= 0");
     } catch (const CLI::ParseError& e) {
-        *exitCode = app.exit(e);
+        if (e.get_exit_code() == 0) {  // --help
+            *exitCode = app.exit(e);
+            return std::nullopt;
+        }
+        std::fprintf(stderr, "conus-view: %s (see --help)\n", oneLine(e.what()).c_str());  // as conus says a usage error
+        *exitCode = 2;
         return std::nullopt;
     } catch (const Error& e) {
         std::fprintf(stderr, "conus-view: %s\n", e.what());

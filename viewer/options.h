@@ -35,6 +35,7 @@ struct Options {
     SceneKind sceneKind = SceneKind::None;
     std::string scenePath;
     std::string reflectionScene;         // --scene: the mesh a reflection asset was baked from
+    std::vector<std::string> allowDirs;  // --allow-dir: folders a scene file may also name files in
     double reflectorRadius = 0.5;        // --radius: the mirror sphere of --reflection
     std::string transferFunction;        // --tf: a volume's transfer function preset or file
     double maxEdge = 0;                  // --max-edge: --mesh subdivides each CoNUS frame's mesh (0: never)

@@ -26,11 +26,21 @@
 namespace conus::viewer {
 namespace {
 
-// A mesh file, what readMesh dropped said on stderr as the viewer's other messages are.
-Mesh readMeshFile(const std::string& path) {
+// A mesh file, what readMesh dropped said on stderr as the viewer's other messages are; the files it
+// names may lie in its folder or in --allow-dir's.
+Mesh readMeshFile(const std::string& path, const std::vector<std::string>& allowDirs) {
     return sceneio::readMesh(path, {.warn = [](const std::string& text) {
-                                 std::fprintf(stderr, "conus-view: warning: %s\n", text.c_str());
-                             }});
+                                        std::fprintf(stderr, "conus-view: warning: %s\n", text.c_str());
+                                    },
+                                    .allowedDirs = allowDirs});
+}
+
+// A volume file (or procedural: spec); an NRRD's data files may lie in its folder or in --allow-dir's.
+Volume readVolumeFile(const Options& options) {
+    if (options.scenePath.rfind("procedural:", 0) == 0) return codec::proceduralVolume(options.scenePath);
+    sceneio::VolumeReadOptions read;
+    read.allowedDirs = options.allowDirs;
+    return sceneio::readVolume(options.scenePath, read);
 }
 
 std::string fileName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
@@ -51,8 +61,8 @@ Image colourOf(const Image& frame) {
 
 class MeshView final : public Scene {
 public:
-    MeshView(gl::Context& context, const std::string& path, double maxEdge)
-        : m_context(context), m_name(fileName(path) + " (mesh)"), m_mesh(readMeshFile(path)),
+    MeshView(gl::Context& context, const std::string& path, const std::vector<std::string>& allowDirs, double maxEdge)
+        : m_context(context), m_name(fileName(path) + " (mesh)"), m_mesh(readMeshFile(path, allowDirs)),
           m_bounds(sphereAround(m_mesh.positions)), m_maxEdge(maxEdge), m_renderer(context, m_mesh) {}
     std::string name() const override { return m_name; }
     glm::dvec3 centre() const override { return m_bounds.centre; }
@@ -77,8 +87,7 @@ class VolumeView final : public Scene {
 public:
     VolumeView(gl::Context& context, const Options& options)
         : m_name(fileName(options.scenePath) + " (volume)"),
-          m_volume(options.scenePath.rfind("procedural:", 0) == 0 ? codec::proceduralVolume(options.scenePath)
-                                                                  : sceneio::readVolume(options.scenePath)),
+          m_volume(readVolumeFile(options)),
           m_presets(codec::TransferFunction::presetNames()) {
         // The command line's default preset when none is named, so both show a volume alike.
         const std::string tf = options.transferFunction.empty() ? codec::TransferFunction::kDefaultPreset
@@ -169,7 +178,7 @@ private:
 class ReflectionView final : public Scene {
 public:
     ReflectionView(gl::Context& context, const Options& options)
-        : ReflectionView(context, options, readMeshFile(options.reflectionScene)) {}
+        : ReflectionView(context, options, readMeshFile(options.reflectionScene, options.allowDirs)) {}
     ReflectionView(gl::Context& context, const Options& options, const Mesh& mesh)
         : m_name(fileName(options.scenePath) + " (reflection)"), m_bounds(sphereAround(mesh.positions)) {
         const std::vector<codec::ReflectionFace> conusFaces = faces(options.scenePath);
@@ -222,7 +231,7 @@ private:
 
 std::unique_ptr<Scene> openScene(const Options& options, gl::Context& context) {
     switch (options.sceneKind) {
-    case SceneKind::Mesh: return std::make_unique<MeshView>(context, options.scenePath, options.maxEdge);
+    case SceneKind::Mesh: return std::make_unique<MeshView>(context, options.scenePath, options.allowDirs, options.maxEdge);
     case SceneKind::Volume: return std::make_unique<VolumeView>(context, options);
     case SceneKind::Relief: return std::make_unique<ReliefView>(context, options);
     case SceneKind::Reflection: return std::make_unique<ReflectionView>(context, options);

@@ -66,11 +66,13 @@ protected:
     }
     void TearDown() override { fs::remove_all(m_dir); }
 
-    // Runs conus with `args` (no shell), stdin from /dev/null, measuring wall time and peak memory
-    // of that one child (wait4), killed after 60 s so a hang fails instead of blocking the suite.
-    Outcome run(const std::vector<std::string>& args) {
+    // Runs conus (or another of the built tools) with `args` (no shell), stdin from /dev/null,
+    // measuring wall time and peak memory of that one child (wait4), killed after 60 s so a hang
+    // fails instead of blocking the suite.
+    Outcome run(const std::vector<std::string>& args) { return runTool("conus", args); }
+    Outcome runTool(const std::string& tool, const std::vector<std::string>& args) {
         const std::string out = (m_dir / "stdout.txt").string(), err = (m_dir / "stderr.txt").string();
-        std::vector<std::string> all{"timeout", "60", std::string(CONUS_BIN_DIR) + "/conus"};
+        std::vector<std::string> all{"timeout", "60", std::string(CONUS_BIN_DIR) + "/" + tool};
         all.insert(all.end(), args.begin(), args.end());
         std::vector<char*> argv;
         for (std::string& a : all) argv.push_back(a.data());
@@ -85,7 +87,7 @@ protected:
         pid_t pid = 0;
         if (posix_spawnp(&pid, "timeout", &actions, nullptr, argv.data(), environ) != 0) {
             posix_spawn_file_actions_destroy(&actions);
-            ADD_FAILURE() << "cannot start conus";
+            ADD_FAILURE() << "cannot start " << tool;
             return r;
         }
         int status = 0;

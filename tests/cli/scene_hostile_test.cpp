@@ -83,6 +83,51 @@ TEST_F(SceneHostile, LinksFifosAndDevicesBehindAGltfNameAreRefused) {
     EXPECT_EQ(r.exitCode, 0) << r.err;
 }
 
+// conus-view reads scene files by the same policy, with the same --allow-dir.
+TEST_F(SceneHostile, TheViewerKeepsAModelInsideItsFolderToo) {
+    fs::create_directories(m_dir / "model");
+    fs::create_directories(m_dir / "elsewhere");
+    writeTriangleBuffer(m_dir / "elsewhere" / "tri.bin");
+    writeGltf("model/far.gltf", "../elsewhere/tri.bin");
+    const std::vector<std::string> view{"--mesh", path("model/far.gltf"), "--screenshot", path("far.png"), "--size", "32x32"};
+    Outcome r = runTool("conus-view", view);
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    ASSERT_EQ(errorLines(r.err).size(), 1u) << r.err;
+    EXPECT_TRUE(contains(r.err, "outside its folder")) << r.err;
+    EXPECT_FALSE(fs::exists(path("far.png")));
+    std::vector<std::string> allowed = view;
+    allowed.insert(allowed.end(), {"--allow-dir", path("elsewhere")});
+    r = runTool("conus-view", allowed);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(fs::exists(path("far.png")));
+}
+
+// A number option that is not a finite number in its range is a usage error in either tool: one
+// line, exit 2 (CLI11's own range checks let NaN through).
+TEST_F(SceneHostile, NotANumberIsAUsageErrorInEveryNumberOption) {
+    write("a.pgm", "P2\n2 2\n255\n0 1 2 3\n");
+    const std::vector<std::vector<std::string>> conusRuns{
+        {"encode", path("a.pgm"), "-o", path("a.exr"), "--frame-loss", "nan"},
+        {"encode", path("a.pgm"), "-o", path("a.exr"), "--focus", "0.5,0.5,0.1,4", "--max-anisotropy", "nan"},
+        {"encode", path("a.pgm"), "-o", path("a.exr"), "--fit-hold", "inf"},
+        {"demo", "--out", path("demo"), "--k", "nan"}};
+    for (const auto& args : conusRuns) {
+        SCOPED_TRACE(args[0] + " " + args[args.size() - 2]);
+        const Outcome r = run(args);
+        EXPECT_EQ(r.exitCode, 2) << r.err;
+        EXPECT_EQ(errorLines(r.err).size(), 1u) << r.err;
+        EXPECT_TRUE(contains(r.err, "not a finite number")) << r.err;
+    }
+    for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
+             {"--exposure", "nan"}, {"--gamma", "nan"}, {"--max-edge", "-inf"}, {"--radius", "nan"}}) {
+        SCOPED_TRACE(option);
+        const Outcome r = runTool("conus-view", {"--volume", "procedural:shepp-logan:16", "--screenshot", path("v.png"), option, value});
+        EXPECT_EQ(r.exitCode, 2) << r.err;
+        EXPECT_EQ(errorLines(r.err).size(), 1u) << r.err;
+        EXPECT_TRUE(contains(r.err, "conus-view: " + option)) << r.err;
+    }
+}
+
 TEST_F(SceneHostile, AnNrrdDataFileOutsideItsFolderOrADeviceOrFifoIsRefused) {
     for (const char* name : {"det_passwd.nhdr", "det_devzero.nhdr"}) {
         SCOPED_TRACE(name);
