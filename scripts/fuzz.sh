@@ -10,6 +10,7 @@
 # A unit slower than CONUS_FUZZ_TIMEOUT seconds (default 30) is a finding. Every input runs in well
 # under a second on an idle core; a lower limit reports false timeouts when the machine is busy (a
 # build beside a niced fuzzer starved it past 10 s while the same inputs replay in 0.8 s).
+# CONUS_FUZZ_RUNS=N stops each harness after N executions instead (SECONDS still bounds it).
 # Usage: scripts/fuzz.sh [SECONDS] [HARNESS...]   e.g. scripts/fuzz.sh 1800 container
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -45,7 +46,7 @@ for name in "${harnesses[@]}"; do
   echo "fuzz: $name for ${seconds} s (log: $log)"
   set +e
   "build-fuzz/bin/fuzz_$name" -max_total_time="$seconds" -dict=tests/fuzz/conus.dict -timeout="${CONUS_FUZZ_TIMEOUT:-30}" -rss_limit_mb=2048 -max_len=16384 \
-    -print_final_stats=1 -artifact_prefix="build-fuzz/artifacts/$name-" "${corpora[@]}" >"$log" 2>&1
+    -print_final_stats=1 -runs="${CONUS_FUZZ_RUNS:--1}" -artifact_prefix="build-fuzz/artifacts/$name-" "${corpora[@]}" >"$log" 2>&1
   rc=$?
   set -e
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
