@@ -97,7 +97,7 @@ Frame renderFrame(gl::Context& context, const format::ConusFile& file, const std
 // ---- encode ----
 
 struct EncodeOptions {
-    std::string dem, output, sizeText = "512x512", colour, compression = "zip";
+    std::string dem, output, sizeText = "512x512", colour, compression = "zip", rows = "terrain";
     double eyeHeight = 150, near = 200, far = 0, fov = 0, heightScale = 1;  // far, fov: 0 until given
     int grid = 129;
 };
@@ -133,6 +133,12 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
         }
     });
     encode.add_option("--grid", o.grid, "sampling-map nodes per side stored in the file")->capture_default_str();
+    encode.add_option("--rows", o.rows,
+                      "how the map spends rows on depth: terrain (in proportion to the screen rows each band of the "
+                      "terrain covers for the map's viewer, within the DEM's resolution) or planar (the paper's "
+                      "perspective ground plane, which starves far mountains)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"terrain", "planar"}));
     encode.add_option("--height-scale", o.heightScale, "multiplies the DEM's values (to metres)")
         ->capture_default_str();
     encode.add_option("--colour,--color", o.colour, "colour texture (default: a ramp by height and slope)");
@@ -170,6 +176,7 @@ int runEncode(const EncodeOptions& o) {
     options.width = size.width;
     options.height = size.height;
     options.mapGrid = o.grid;
+    options.fitRows = o.rows == "terrain";
     const glm::dvec2 extent = codec::fieldExtent(options.ground);
     SourceEncoding encoding;
     const Image colour = demColour(dem, o.colour, extent, &encoding);
@@ -180,11 +187,12 @@ int runEncode(const EncodeOptions& o) {
     file.compression = parseCompression(o.compression);
     file.sourceEncoding = encoding;
     format::writeConusFile(o.output, file);
+    const bool fitted = file.analytic && !file.analytic->groundRows.empty();
     std::printf("wrote %s: %dx%d CoNUS height field of %s; field %.0f x %.0f m (eye %g m, near %g m, "
-                "far %g m, fov %.2f deg); heights %.1f..%.1f m\n",
+                "far %g m, fov %.2f deg; %s rows); heights %.1f..%.1f m\n",
                 o.output.c_str(), file.image.width, file.image.height, dem.description.c_str(), extent.x, extent.y,
                 options.ground.eyeHeight, options.ground.near, options.ground.far, options.ground.fovDegrees,
-                file.depth.near, file.depth.far);
+                fitted ? "terrain" : "planar", file.depth.near, file.depth.far);
     return 0;
 }
 

@@ -470,6 +470,7 @@ void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
         const std::vector<float>& f = m.foci.value;
         for (std::size_t i = 0; i + 3 < f.size(); i += 4) a.foci.push_back({f[i], f[i + 1], f[i + 2], f[i + 3]});
         a.composition = m.composition.value;
+        a.groundRows = m.groundRows.value;
         for (const auto& [name, attr] : m.params) a.scalars[name] = attr.value;
         out.analytic = std::move(a);
     }

@@ -58,6 +58,7 @@ HeaderModel modelOf(const ConusFile& file) {
             m.foci = attr(std::move(f));
         }
         if (a.kind == "foci" || !a.composition.empty()) m.composition = attr(a.composition);
+        if (!a.groundRows.empty()) m.groundRows = attr(a.groundRows);
         for (const auto& [name, value] : a.scalars) m.params[name] = attr(value);
     }
     if (file.camera) {

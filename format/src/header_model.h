@@ -91,6 +91,7 @@ struct HeaderModel {
     Attr<std::string> dataKind;
     Attr<std::string> mapKind;
     Attr<std::vector<float>> foci;
+    Attr<std::vector<float>> groundRows;
     Attr<std::string> composition;
     std::map<std::string, Attr<double>> params;  // conus:param:<name>, keyed by <name>
     Attr<std::array<float, 16>> worldToCamera, worldToNDC;
@@ -139,6 +140,7 @@ inline constexpr const char* kAttrDataKind = "conus:dataKind";
 inline constexpr const char* kAttrMapKind = "conus:mapKind";
 inline constexpr const char* kAttrFoci = "conus:foci";
 inline constexpr const char* kAttrComposition = "conus:composition";
+inline constexpr const char* kAttrGroundRows = "conus:groundRows";
 inline constexpr const char* kAttrParamPrefix = "conus:param:";
 inline constexpr const char* kAttrProjection = "conus:projection";
 inline constexpr const char* kAttrDepthKind = "conus:depthKind";
@@ -163,6 +165,7 @@ inline constexpr AttributeSpec kAttributes[] = {
     {kAttrMapKind, PartKind::Conus, Rule::V12, &HeaderModel::mapKind},
     {kAttrFoci, PartKind::Conus, Rule::V12, &HeaderModel::foci},
     {kAttrComposition, PartKind::Conus, Rule::V12, &HeaderModel::composition},
+    {kAttrGroundRows, PartKind::Conus, Rule::V12, &HeaderModel::groundRows},
     {kAttrParamPrefix, PartKind::Conus, Rule::V12, &HeaderModel::params},
     // The camera (V13).
     {kAttrWorldToCamera, PartKind::Conus, Rule::V13, &HeaderModel::worldToCamera},

@@ -179,9 +179,33 @@ void checkFalloffParams(const HeaderModel& m, ValidationReport& r) {
     }
 }
 
+// A ground map's row profile: v_d at K + 1 evenly spaced rows, from 0 to 1, strictly increasing.
+void checkGroundRows(const HeaderModel& m, const std::string& kind, ValidationReport& r) {
+    if (!m.groundRows.present) return;
+    if (!need(m, &HeaderModel::groundRows, r)) return;
+    const std::vector<float>& rows = m.groundRows.value;
+    if (kind != "ground") {
+        r.add(Rule::V12, std::string(kAttrGroundRows) + " belongs to a ground map, not to `" + kind + "`");
+        return;
+    }
+    if (rows.size() < 2 || rows.size() > std::size_t(map_rules::kMaxGroundRows)) {
+        r.add(Rule::V12, std::string(kAttrGroundRows) + " has " + std::to_string(rows.size()) + " values; 2 to " +
+                             std::to_string(map_rules::kMaxGroundRows));
+        return;
+    }
+    if (rows.front() != 0.0f || rows.back() != 1.0f)
+        r.add(Rule::V12, std::string(kAttrGroundRows) + " runs from " + numberText(rows.front(), 9) + " to " +
+                             numberText(rows.back(), 9) + ", not from 0 to 1");
+    for (std::size_t k = 1; k < rows.size(); ++k)
+        if (!(rows[k] > rows[k - 1])) {  // NaN fails too
+            r.add(Rule::V12, std::string(kAttrGroundRows) + " is not strictly increasing at value " + std::to_string(k));
+            break;
+        }
+}
+
 void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
     if (!m.mapKind.present) {
-        if (m.foci.present || m.composition.present || !m.params.empty()) {
+        if (m.foci.present || m.composition.present || m.groundRows.present || !m.params.empty()) {
             r.add(Rule::V12, std::string("analytic map parameters without ") + kAttrMapKind);
         }
         return;
@@ -216,6 +240,7 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
     } else if (kind != "ground") {
         r.add(Rule::V12, "map kind `" + kind + "` is not foci or ground");
     }
+    checkGroundRows(m, kind, r);
     const AttributeSpec& params = specOf(&HeaderModel::params);
     for (const auto& [name, a] : m.params) {
         const std::string full = params.name + name;

@@ -1,5 +1,5 @@
-// The perspective ground-plane map: rows by a pitched pinhole camera, columns by normalized
-// viewing angle; both invert in closed form.
+// The perspective ground-plane map: rows by a pitched pinhole camera (or a given profile), columns
+// by normalized viewing angle; both invert exactly.
 #include "conus/codec/build/ground_map.h"
 
 #include <algorithm>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec {
 namespace {
@@ -36,6 +37,22 @@ struct Geometry {
     double groundZ(double v) const { return nearZ + (1.0 - v) * (farZ - nearZ); }
 };
 
+// The profile's v_d at v, and its inverse (both piecewise linear, strictly increasing).
+double profileRow(const std::vector<double>& rows, double v) {
+    const int segments = static_cast<int>(rows.size()) - 1;
+    const double t = v * segments;
+    const int k = std::clamp(static_cast<int>(t), 0, segments - 1);
+    return rows[std::size_t(k)] + (t - k) * (rows[std::size_t(k) + 1] - rows[std::size_t(k)]);
+}
+
+double profileInverse(const std::vector<double>& rows, double vd) {
+    const int segments = static_cast<int>(rows.size()) - 1;
+    const auto next = std::upper_bound(rows.begin() + 1, rows.end() - 1, vd);
+    const int k = static_cast<int>(next - rows.begin()) - 1;
+    const double a = rows[std::size_t(k)], b = rows[std::size_t(k) + 1];
+    return (k + std::clamp((vd - a) / (b - a), 0.0, 1.0)) / segments;
+}
+
 }  // namespace
 
 void checkGroundParams(const GroundParams& p) {
@@ -48,15 +65,30 @@ void checkGroundParams(const GroundParams& p) {
     if (!(p.fovDegrees > 0.0 && p.fovDegrees < kMaxFov)) {
         throw Error(ErrorCode::InvalidArgument, "ground map: field of view " + numberText(p.fovDegrees) + " degrees is not in (0, 170)");
     }
+    if (p.rows.empty()) return;
+    if (p.rows.size() < 2 || p.rows.size() > std::size_t(map_rules::kMaxGroundRows))
+        throw Error(ErrorCode::InvalidArgument, "ground map: a row profile of " + std::to_string(p.rows.size()) +
+                                                    " values is outside [2, " + std::to_string(map_rules::kMaxGroundRows) + "]");
+    if (p.rows.front() != 0.0 || p.rows.back() != 1.0)
+        throw Error(ErrorCode::InvalidArgument, "ground map: the row profile must run from 0 to 1");
+    for (std::size_t k = 1; k < p.rows.size(); ++k)
+        if (!(p.rows[k] > p.rows[k - 1]))  // NaN fails too
+            throw Error(ErrorCode::InvalidArgument, "ground map: the row profile is not strictly increasing at value " +
+                                                        std::to_string(k));
 }
 
 glm::dvec2 groundDistort(const GroundParams& params, glm::dvec2 p) {
     const Geometry g(params);
     const double u = std::clamp(p.x, 0.0, 1.0), v = std::clamp(p.y, 0.0, 1.0);
     const double z = g.groundZ(v);
-    // Rows: image row of the ground point in the pitched camera.
-    const double beta = std::atan2(g.h, z) - g.pitch;
-    double vd = 0.5 + 0.5 * std::tan(beta) / g.tanPhi;
+    // Rows: image row of the ground point in the pitched camera, or the profile's.
+    double vd = 0.0;
+    if (params.rows.empty()) {
+        const double beta = std::atan2(g.h, z) - g.pitch;
+        vd = 0.5 + 0.5 * std::tan(beta) / g.tanPhi;
+    } else {
+        vd = profileRow(params.rows, v);
+    }
     // Columns: viewing angle over the angle of the field's edge at this depth.
     const double a = g.halfWidth / g.zCam(z);
     double ud = 0.5 + 0.5 * std::atan((2.0 * u - 1.0) * a) / std::atan(a);
@@ -69,9 +101,15 @@ glm::dvec2 groundDistort(const GroundParams& params, glm::dvec2 p) {
 glm::dvec2 groundUndistort(const GroundParams& params, glm::dvec2 pd) {
     const Geometry g(params);
     const double ud = std::clamp(pd.x, 0.0, 1.0), vd = std::clamp(pd.y, 0.0, 1.0);
-    const double alpha = g.pitch + std::atan((2.0 * vd - 1.0) * g.tanPhi);
-    const double z = g.h * std::cos(alpha) / std::sin(alpha);
-    double v = 1.0 - (z - g.nearZ) / (g.farZ - g.nearZ);
+    double v = 0.0, z = 0.0;
+    if (params.rows.empty()) {
+        const double alpha = g.pitch + std::atan((2.0 * vd - 1.0) * g.tanPhi);
+        z = g.h * std::cos(alpha) / std::sin(alpha);
+        v = 1.0 - (z - g.nearZ) / (g.farZ - g.nearZ);
+    } else {
+        v = profileInverse(params.rows, vd);
+        z = g.groundZ(v);
+    }
     const double a = g.halfWidth / g.zCam(z);
     double u = 0.5 + 0.5 * std::tan((2.0 * ud - 1.0) * std::atan(a)) / a;
     if (vd == 0.0 || vd == 1.0) v = vd;
@@ -101,6 +139,7 @@ format::AnalyticMap toAnalytic(const GroundParams& params) {
     format::AnalyticMap a;
     a.kind = "ground";
     a.scalars = {{"eyeHeight", params.eyeHeight}, {"near", params.near}, {"far", params.far}, {"fovDegrees", params.fovDegrees}};
+    a.groundRows.assign(params.rows.begin(), params.rows.end());
     return a;
 }
 
@@ -120,6 +159,7 @@ GroundParams groundFromAnalytic(const format::AnalyticMap& analytic) {
     p.near = get("near");
     p.far = get("far");
     p.fovDegrees = get("fovDegrees");
+    p.rows.assign(analytic.groundRows.begin(), analytic.groundRows.end());
     checkGroundParams(p);
     return p;
 }

@@ -254,8 +254,10 @@ format::ConusFile encodeHeightField(const Image& heights, const Image& colour,
 
     // Sample through a grid as fine as the image: a sample then sits where the analytic inverse
     // puts it (the piecewise-bilinear error of a coarse grid would shift the mesh's vertices).
+    GroundParams ground = options.ground;
+    if (options.fitRows && ground.rows.empty()) ground.rows = groundRowsForTerrain(heights, ground, options.height);
     const int fine = std::clamp(std::max(options.width, options.height) + 1, options.mapGrid, kMaxMapSide);
-    const SamplingMap sampling = buildGroundMap(options.ground, fine, fine);
+    const SamplingMap sampling = buildGroundMap(ground, fine, fine);
     EncodeOptions encode;
     encode.width = options.width;
     encode.height = options.height;
@@ -268,8 +270,8 @@ format::ConusFile encodeHeightField(const Image& heights, const Image& colour,
     file.sourceWidth = heights.width;
     file.sourceHeight = heights.height;
     file.dataKind = format::DataKind::HeightField;
-    file.map = buildGroundMap(options.ground, options.mapGrid, options.mapGrid).toGrid();
-    file.analytic = toAnalytic(options.ground);
+    file.map = buildGroundMap(ground, options.mapGrid, options.mapGrid).toGrid();
+    file.analytic = toAnalytic(ground);
     file.depth = heightDepth(file.image, options.units);
     return file;
 }

@@ -14,6 +14,8 @@ namespace conus::map_rules {
 inline constexpr double kMinCornerCross = 1e-12;
 // V12: a focus magnifies by k in [1, kMaxMagnification].
 inline constexpr double kMaxMagnification = 64.0;
+// V12: a ground map's row profile (conus:groundRows) holds 2 to kMaxGroundRows values.
+inline constexpr int kMaxGroundRows = 4097;
 // V12: a focus's transition (conus:param:falloffWidth) ends at w radii, w in (1, kMaxFalloffWidth];
 // its shape (conus:param:falloffShape) is an integer in [0, kFalloffShapes): density, log, logr.
 inline constexpr double kMaxFalloffWidth = 8.0;

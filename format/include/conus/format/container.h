@@ -57,6 +57,7 @@ struct AnalyticMap {
     std::vector<FocusParams> foci;          // kind "foci"
     std::string composition;                // kind "foci": "density" or "add"
     std::map<std::string, double> scalars;  // other kinds' named parameters
+    std::vector<float> groundRows;          // kind "ground": the row profile, if any (conus:groundRows)
 };
 
 // The camera as the file records it (rule V13): EXR's standard matrices and conus:projection, as

@@ -12,9 +12,15 @@
 // - Columns: within a row, the viewing angle atan(x / z_cam) normalized by the angle of the field's
 //   edge, so each row covers the full width (boundary to boundary) and, near the viewer, spends
 //   more samples on the centre line. z_cam is the ground point's depth along the camera axis.
-// The map sends the unit square onto itself, each edge onto itself, is injective, and has the
-// exact closed-form inverse groundUndistort. Density is > 1 near the viewer and < 1 far away.
+// - Rows given as a profile instead (`rows`, what the height-field encoder fits to a terrain, see
+//   groundRowsForTerrain): v_d is the piecewise-linear function through (k / K, rows[k]); the
+//   columns are unchanged. A terrain's mountains stand up into the view where the plane lies flat,
+//   so the planar rows starve the far field.
+// The map sends the unit square onto itself, each edge onto itself, is injective, and has an exact
+// inverse groundUndistort (closed form, or per segment of the profile).
 #pragma once
+
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -28,6 +34,9 @@ struct GroundParams {
     double near = 0.0;        // >= 0, distance of the field's bottom edge (v = 1)
     double far = 1.0;         // > near, distance of the field's top edge (v = 0)
     double fovDegrees = 60.0;  // in (0, 170): horizontal field of view at the far edge
+    // Empty: the planar pinhole rows. Else v_d at v = k / K for k = 0..K (K >= 1, at most
+    // map_rules::kMaxGroundRows): 0 first, 1 last, strictly increasing.
+    std::vector<double> rows;
 };
 
 // Throws conus::Error(InvalidArgument) naming the parameter out of range.
@@ -41,7 +50,8 @@ glm::dvec2 groundUndistort(const GroundParams& params, glm::dvec2 pd);
 // The map on a columns x rows grid (each node = groundDistort of its undistorted position).
 SamplingMap buildGroundMap(const GroundParams& params, int columns, int rows);
 
-// Analytic parameters for the file: kind "ground", scalars eyeHeight, near, far, fovDegrees.
+// Analytic parameters for the file: kind "ground", scalars eyeHeight, near, far, fovDegrees, and
+// the row profile when there is one.
 format::AnalyticMap toAnalytic(const GroundParams& params);
 // Throws conus::Error(InvalidArgument) for another kind or a missing / out-of-range scalar.
 GroundParams groundFromAnalytic(const format::AnalyticMap& analytic);

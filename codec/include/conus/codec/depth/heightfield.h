@@ -61,8 +61,17 @@ glm::dvec2 fieldExtent(const GroundParams& params);
 // throws conus::Error(InvalidArgument) when no fov in (0, 170) does.
 double fovForFieldWidth(double eyeHeight, double near, double far, double width);
 
+// The ground map's rows for a terrain (GroundParams::rows): each band of depth gets rows in
+// proportion to the screen rows it covers for the ground map's viewer (eyeHeight above the DEM at
+// the middle of the near edge), its hidden parts left out (a horizon sweep along 128 rays), at most
+// the DEM's own row rate and at least a quarter of the uniform rate. The planar rows give a band
+// of mountains far away the few rows that flat ground would cover there. Empty when the DEM has
+// nothing to see (the planar rows then stay).
+std::vector<double> groundRowsForTerrain(const Image& heights, const GroundParams& ground, int imageRows);
+
 struct HeightFieldOptions {
-    GroundParams ground;
+    GroundParams ground;         // with no row profile: fitted to the terrain when fitRows
+    bool fitRows = true;         // the rows by groundRowsForTerrain (false: the planar pinhole rows)
     int width = 0, height = 0;  // CoNUS image size
     int mapGrid = 129;          // nodes per side of the map stored in the file
     std::string units = "m";
