@@ -111,7 +111,8 @@ TEST(HeightFieldEncode, ZIsFilteredHeight) {
 
 TEST(HeightFieldMesh, VerticesOnUndistortedGround) {
     const format::ConusFile file = encodeSmall(128, 48);
-    const GroundParams ground = testGround();
+    const GroundParams ground = groundFromAnalytic(*file.analytic);  // with the rows fitted to the terrain
+    ASSERT_FALSE(ground.rows.empty());
     const glm::dvec2 extent = fieldExtent(ground);
     const Mesh mesh = undistortHeightField(file);
     const int w = file.image.width, h = file.image.height, nx = w + 2, ny = h + 2;
@@ -174,6 +175,71 @@ TEST(HeightFieldMesh, DenserNearSparserFar) {
     const int farConus = within(conus, 4000, 1e9), farUniform = within(uniform, 4000, 1e9);
     EXPECT_GT(nearConus, 3 * nearUniform) << nearConus << " vs " << nearUniform;
     EXPECT_LT(farConus, farUniform) << farConus << " vs " << farUniform;
+}
+
+// A plain near the viewer and a ridge far away: the planar rows give the ridge the few rows flat
+// ground would cover there; the fitted rows give it the rows it covers on screen.
+TEST(HeightFieldRows, AFarRidgeGetsTheRowsItCoversOnScreen) {
+    Image dem = makeImage(64, 256, {"Z"});
+    for (int y = 0; y < dem.height; ++y)
+        for (int x = 0; x < dem.width; ++x) dem.at(x, y, 0) = y < 64 ? 600.0f * std::sin(3.14159f * y / 64) : 0.0f;
+    const GroundParams ground = testGround();
+    const std::vector<double> rows = groundRowsForTerrain(dem, ground, 64);
+    ASSERT_GE(rows.size(), 2u);
+    GroundParams fitted = ground;
+    fitted.rows = rows;
+    EXPECT_NO_THROW(checkGroundParams(fitted));
+    // The far quarter (v < 0.25, the ridge, its back hidden) holds several times the rows planar
+    // gives it, and a good share of the image.
+    const double planarFar = groundDistort(ground, {0.5, 0.25}).y, fittedFar = groundDistort(fitted, {0.5, 0.25}).y;
+    EXPECT_GT(fittedFar, 0.15);
+    EXPECT_GT(fittedFar, 4 * planarFar) << fittedFar << " vs " << planarFar;
+    // No band is sampled finer than the DEM's own rows (256 over 64 CoNUS rows: 4x) or coarser
+    // than a quarter of uniform.
+    for (std::size_t k = 1; k < rows.size(); ++k) {
+        const double density = (rows[k] - rows[k - 1]) * double(rows.size() - 1);
+        EXPECT_LE(density, 4.0 * 1.001) << k;
+        EXPECT_GE(density, 0.25 * 0.999) << k;
+    }
+    // The map is exactly invertible and never folds.
+    for (double v = 0; v <= 1.0; v += 1.0 / 97)
+        for (double u = 0; u <= 1.0; u += 1.0 / 13) {
+            const glm::dvec2 back = groundUndistort(fitted, groundDistort(fitted, {u, v}));
+            EXPECT_NEAR(back.x, u, 1e-9);
+            EXPECT_NEAR(back.y, v, 1e-9);
+        }
+    EXPECT_TRUE(format::validateGrid(buildGroundMap(fitted, 65, 65).toGrid()).ok());
+}
+
+TEST(HeightFieldRows, TheProfileTravelsInTheFileAndBadProfilesAreRefused) {
+    const format::ConusFile file = encodeSmall(256, 64);
+    ASSERT_TRUE(file.analytic && !file.analytic->groundRows.empty());
+    const std::string path = (std::filesystem::temp_directory_path() / "conus_heightfield_rows_test.exr").string();
+    format::writeConusFile(path, file);
+    const format::ConusFile read = format::readConusFile(path);
+    std::filesystem::remove(path);
+    ASSERT_TRUE(read.analytic.has_value());
+    EXPECT_EQ(read.analytic->groundRows, file.analytic->groundRows);
+    EXPECT_EQ(groundFromAnalytic(*read.analytic).rows, groundFromAnalytic(*file.analytic).rows);
+
+    format::ConusFile bad = file;
+    std::swap(bad.analytic->groundRows[3], bad.analytic->groundRows[4]);
+    EXPECT_FALSE(format::validateConusFile(bad).ok());
+    EXPECT_THROW(groundFromAnalytic(*bad.analytic), Error);
+    bad = file;
+    bad.analytic->groundRows.back() = 0.9f;
+    EXPECT_FALSE(format::validateConusFile(bad).ok());
+    bad = file;
+    bad.analytic->kind = "foci";
+    EXPECT_NE(format::validateConusFile(bad).str().find("conus:groundRows belongs to a ground map"), std::string::npos);
+
+    // The planar rows when asked: no profile in the file.
+    const Image dem = generateTerrain(smallTerrain(128));
+    HeightFieldOptions options;
+    options.ground = testGround();
+    options.width = options.height = 32;
+    options.fitRows = false;
+    EXPECT_TRUE(encodeHeightField(dem, terrainColours(dem, fieldExtent(testGround())), options).analytic->groundRows.empty());
 }
 
 TEST(HeightFieldExtent, FovForWidthInvertsFieldExtent) {

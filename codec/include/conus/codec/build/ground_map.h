@@ -36,7 +36,7 @@ struct GroundParams {
     double fovDegrees = 60.0;  // in (0, 170): horizontal field of view at the far edge
     // Empty: the planar pinhole rows. Else v_d at v = k / K for k = 0..K (K >= 1, at most
     // map_rules::kMaxGroundRows): 0 first, 1 last, strictly increasing.
-    std::vector<double> rows;
+    std::vector<double> rows{};
 };
 
 // Throws conus::Error(InvalidArgument) naming the parameter out of range.
