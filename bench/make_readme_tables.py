@@ -191,7 +191,7 @@ def viewer_table(build, frames=20):
 def quality_table(build):
     out_dir = Path(build) / "quality"
     env = dict(os.environ, PYTHONPATH=str(Path(build).resolve() / "python"))
-    run([sys.executable, str(BENCH / "quality.py"), "--out", str(out_dir)], env=env)
+    run([str(BENCH / "quality.py"), "--out", str(out_dir)], env=env)
     report = (out_dir / "quality.md").read_text()
     plots = BENCH / "quality-plots"
     plots.mkdir(exist_ok=True)
@@ -270,7 +270,7 @@ def run_quality_defaults(build):
     sheet); copies the sheet to bench/quality-plots/."""
     out_dir = Path(build) / "quality"
     env = dict(os.environ, PYTHONPATH=str(Path(build).resolve() / "python"))
-    run([sys.executable, str(BENCH / "quality.py"), "--defaults-only", "--out", str(out_dir)], env=env)
+    run([str(BENCH / "quality.py"), "--defaults-only", "--out", str(out_dir)], env=env)
     shutil.copy(out_dir / "contact-sheet.png", BENCH / "quality-plots" / "contact-sheet-defaults.png")
     return json.loads((out_dir / "targets.json").read_text())
 
