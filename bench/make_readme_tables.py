@@ -267,11 +267,11 @@ def reflections_table(result):
 
 def run_quality_defaults(build):
     """Runs `bench/quality.py --defaults-only` (it writes build/quality/targets.json and the contact
-    sheet); copies the sheet to bench/quality-plots/."""
+    sheets); copies the 600 px wide sheet to bench/quality-plots/."""
     out_dir = Path(build) / "quality"
     env = dict(os.environ, PYTHONPATH=str(Path(build).resolve() / "python"))
     run([str(BENCH / "quality.py"), "--defaults-only", "--out", str(out_dir)], env=env)
-    shutil.copy(out_dir / "contact-sheet.png", BENCH / "quality-plots" / "contact-sheet-defaults.png")
+    shutil.copy(out_dir / "contact-sheet-600.png", BENCH / "quality-plots" / "contact-sheet-defaults.png")
     return json.loads((out_dir / "targets.json").read_text())
 
 

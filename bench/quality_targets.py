@@ -233,7 +233,8 @@ def table(results):
 
 
 def contact_sheet(out, names):
-    """All the per-photo sheets in one PNG (each scaled to 1200 px wide)."""
+    """All the per-photo sheets in one PNG (each scaled to 1200 px wide), and a half-size copy
+    (contact-sheet-600.png, the one bench/README.md shows)."""
     from PIL import Image
     tiles = []
     for name in names:
@@ -247,6 +248,7 @@ def contact_sheet(out, names):
         sheet.paste(t, (0, y))
         y += t.height + 8
     sheet.save(out / "contact-sheet.png")
+    sheet.resize((600, round(sheet.height / 2)), Image.BOX).save(out / "contact-sheet-600.png")
 
 
 def defaults_only(conus, binary, out, photos=ALL_PHOTOS, extra_args=(), detail=False):
