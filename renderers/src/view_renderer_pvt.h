@@ -48,7 +48,6 @@ struct ViewRenderer::Impl {
     // The handles delete their objects after this body, with the context current.
     ~Impl() { makeCurrentGl(context); }
 
-
     // Whether draw() decodes on the CPU: DecodePath resolved for this context and zoom.
     bool cpuDecode(const ViewOptions& options, const codec::View& view, int width) const;
     // The CPU path's display table for these settings; kept while they stay the same.
