@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Regenerates the tables of bench/README.md from a run of the suites.
 
-    bench/make_readme_tables.py [--build DIR] [--repetitions N] [--instructions] SUITE...
-    SUITE: codec, oiio, renderers, end-to-end, viewer, quality, or all
+    bench/make_readme_tables.py [--build DIR] [--repetitions N] [--instructions] [--from-results] SUITE...
+    SUITE: codec, oiio, renderers, reflections, end-to-end, viewer, quality-defaults, quality, or all
 
 Each suite's table sits between `<!-- table:SUITE -->` and `<!-- /table -->` in bench/README.md;
 this script rewrites that block only, stamped with the date, the commit, the machine and the
@@ -15,18 +15,23 @@ bench/callgrind_loops.sh, the same on a loaded machine as on an idle one). `end-
 bench/end_to_end.sh and keeps its table; `viewer` times conus-view under Xvfb on a 2048² CoNUS
 image of a photograph, both decode paths; `quality` runs bench/quality.py, keeps the headline of
 its report and copies the report and its plots to bench/quality-plots/.
+
+`reflections` and `quality-defaults` write a result file first (build/bench-results/reflections.json:
+renderers_bench's JSON with the run's stamp; build/quality/targets.json from `bench/quality.py
+--defaults-only`) and make the table from it; `--from-results` makes their tables from the files
+of an earlier run without running anything.
 """
 import argparse
-import datetime
 import json
 import os
-import platform
 import re
 import shutil
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from run_stamp import run_stamp, stamp_line
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
@@ -85,26 +90,8 @@ def run(cmd, **kw):
     return result.stdout
 
 
-def machine():
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    load = os.getloadavg()[0]
-    return f"{cpu}, {os.cpu_count()} cores, load {load:.1f}"
-
-
 def stamp(method):
-    commit = run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"]).strip()
-    # The tables and plots this script writes do not count as a modified tree.
-    dirty = run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no", "--", ".",
-                 ":!bench/README.md", ":!bench/quality-plots"]).strip()
-    when = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    return f"{when}, commit {commit}{' (modified)' if dirty else ''}, {machine()}; {method}."
+    return stamp_line(run_stamp(), method)
 
 
 def wall_medians(binary, names, repetitions):
@@ -204,7 +191,7 @@ def viewer_table(build, frames=20):
 def quality_table(build):
     out_dir = Path(build) / "quality"
     env = dict(os.environ, PYTHONPATH=str(Path(build).resolve() / "python"))
-    run([sys.executable, str(BENCH / "quality.py"), "--out", str(out_dir)], env=env)
+    run([str(BENCH / "quality.py"), "--out", str(out_dir)], env=env)
     report = (out_dir / "quality.md").read_text()
     plots = BENCH / "quality-plots"
     plots.mkdir(exist_ok=True)
@@ -217,6 +204,123 @@ def quality_table(build):
                      ["", "The whole report: [quality-plots/quality.md](quality-plots/quality.md)."])
 
 
+RESULTS = "bench-results"  # under the build folder
+
+# renderers_bench's reflection benchmarks: the two mirrors' quality (deterministic, run once) and
+# CoNUS / uniform cost pairs (medians of interleaved repetitions), each with its target.
+MIRRORS = [("sphere", "BM_ReflectionSilhouettes/0"), ("plane", "BM_ReflectionSilhouettes/1")]
+REFLECTION_COSTS = [
+    ("intersection, CPU `codec::intersect` (relief asset)", "BM_IntersectCpu", "1.05x"),
+    ("intersection, GLSL `gl::intersectRays` (relief asset)", "BM_IntersectGlsl", "1.05x"),
+    ("reflection frame, CPU `renderReflectionFrame`", "BM_ReflectionFrame", ""),
+    ("reflection frame, GLSL `ReflectionRenderer::draw`", "BM_ReflectionFrameGl", ""),
+]
+
+
+def run_reflections(build, repetitions):
+    """Runs the reflection benchmarks and writes build/bench-results/reflections.json."""
+    binary = str(Path(build) / "bin" / "renderers_bench")
+    stamp = run_stamp()
+    quality = json.loads(run([binary, "--benchmark_filter=^BM_ReflectionSilhouettes/", "--benchmark_format=json"]))
+    costs = "|".join(name for _, name, _ in REFLECTION_COSTS)
+    cost = json.loads(run([binary, f"--benchmark_filter=^({costs})/[01](/|$)", f"--benchmark_repetitions={repetitions}",
+                           "--benchmark_enable_random_interleaving=true", "--benchmark_report_aggregates_only=true",
+                           "--benchmark_format=json"]))
+    result = {"stamp": stamp, "repetitions": repetitions, "quality": quality["benchmarks"], "cost": cost["benchmarks"]}
+    path = Path(build) / RESULTS / "reflections.json"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(result, indent=1))
+    return result
+
+
+def reflections_table(result):
+    quality = {b["run_name"].split("/iterations")[0]: b for b in result["quality"]}
+    lines = [stamp_line(result["stamp"], "PSNR against the traced reference (deterministic); cost: wall clock, medians "
+                        f"of {result['repetitions']} interleaved repetitions"), "",
+             "| mirror | whole mirror: CoNUS / uniform | ROI (box): CoNUS / uniform | rest: CoNUS / uniform | targets |",
+             "|---|---|---|---|---|"]
+    for mirror, name in MIRRORS:
+        b = quality.get(name)
+        if b is None:
+            lines.append(f"| {mirror} | `{name}` not run | | | |")
+            continue
+        whole, roi, rest = ((b[f"{part}_conus_dB"], b[f"{part}_uniform_dB"]) for part in ("mirror", "roi", "rest"))
+        met = [("mirror >= 30 dB", whole[0] >= 30), ("ROI >= +2 dB", roi[0] - roi[1] >= 2), ("rest >= uniform", rest[0] >= rest[1])]
+        lines.append(f"| {mirror} | **{whole[0]:.1f} / {whole[1]:.1f} dB** | **{roi[0]:.1f} / {roi[1]:.1f} dB "
+                     f"({roi[0] - roi[1]:+.1f})** | {rest[0]:.1f} / {rest[1]:.1f} dB ({rest[0] - rest[1]:+.1f}) | "
+                     + ", ".join(f"{what} ({'met' if ok else '**not met**'})" for what, ok in met) + " |")
+    scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
+    medians = {b["run_name"].replace("/real_time", ""): b["real_time"] * scale[b["time_unit"]] for b in result["cost"]
+               if b.get("aggregate_name") == "median"}
+    lines += ["", "| cost | CoNUS (`/1`) | uniform (`/0`, same run) | CoNUS / uniform | target |", "|---|---|---|---|---|"]
+    for what, name, target in REFLECTION_COSTS:
+        conus, uniform = medians.get(f"{name}/1"), medians.get(f"{name}/0")
+        if conus is None or uniform is None:
+            lines.append(f"| {what} | `{name}` not run | | | {target} |")
+            continue
+        ratio = conus / uniform
+        mark = (" (met)" if ratio <= float(target.rstrip("x")) else " (**not met**)") if target else ""
+        lines.append(f"| {what} | `{name}/1` {fmt_value(conus, False)} | `{name}/0` {fmt_value(uniform, False)} | "
+                     f"**{ratio:.3g}x** | {target}{mark} |")
+    return "\n".join(lines)
+
+
+def run_quality_defaults(build):
+    """Runs `bench/quality.py --defaults-only` (it writes build/quality/targets.json and the contact
+    sheets); copies the 600 px wide sheet to bench/quality-plots/."""
+    out_dir = Path(build) / "quality"
+    env = dict(os.environ, PYTHONPATH=str(Path(build).resolve() / "python"))
+    run([str(BENCH / "quality.py"), "--defaults-only", "--out", str(out_dir)], env=env)
+    shutil.copy(out_dir / "contact-sheet-600.png", BENCH / "quality-plots" / "contact-sheet-defaults.png")
+    return json.loads((out_dir / "targets.json").read_text())
+
+
+# Targets of the defaults, per method of quality_targets.py: (mean ROI gain, worst ROI, frame loss
+# on every photo, tile loss p95 on every photo); with no focus: (mean frame gain, tiles).
+DEFAULT_TARGETS = {"foci": (7.0, 2.0, 2.0, 4.0), "importance": (8.0, 2.0, 2.0, 4.0)}
+NO_FOCUS_TARGETS = (1.5, 3.0)
+METHOD_LABELS = {"foci": "`--focus u,v,r,4` per region", "importance": "`--importance roi.png`",
+                 "no focus": "nothing (the picture's own detail)", "detail": "`--importance detail`"}
+
+
+def quality_defaults_table(result):
+    results = result["results"]
+    lines = [stamp_line(result["stamp"], f"`bench/quality.py --defaults-only` ({result['seconds'] / 60:.0f} min), "
+                        f"{len(results)} photographs, 8-bit sRGB; against `conus uniform` and, in brackets, against "
+                        "`uniform --fit` (deterministic)"), "",
+             "| with the defaults | mean ROI gain (worst ROI) | whole-frame loss, mean (worst photo) "
+             "| tile loss p95, worst photo | targets |", "|---|---|---|---|---|"]
+    for method in next(iter(results.values())):
+        rows = [r[method] for r in results.values() if "refused" not in r[method]]
+        refused = len(results) - len(rows)
+        label = METHOD_LABELS.get(method, method) + (f" (refused on {refused})" if refused else "")
+        if not rows:
+            lines.append(f"| {label} | | | | |")
+            continue
+        fit = [r["vs_fit"] for r in rows]
+        mean = lambda rs, k: sum(r[k] for r in rs) / len(rs)
+        gain, worst = mean(rows, "roi_gain"), min(r["worst_roi"] for r in rows)
+        loss, loss_worst = mean(rows, "frame_loss"), max(r["frame_loss"] for r in rows)
+        tiles = max(r["tile95"] for r in rows)
+        frame = (f"{loss:+.2f} dB ({loss_worst:+.2f}) [{mean(fit, 'frame_loss'):+.2f} "
+                 f"({max(r['frame_loss'] for r in fit):+.2f})]")
+        tile_cell = f"{tiles:.2f} dB [{max(r['tile95'] for r in fit):.2f}]"
+        if method in DEFAULT_TARGETS:
+            g, w, l, tl = DEFAULT_TARGETS[method]
+            met = [(f"ROI >= +{g:g}", gain >= g), (f"no ROI < +{w:g}", worst >= w), (f"loss <= {l:g}", loss_worst <= l),
+                   (f"tiles <= {tl:g}", tiles <= tl)]
+            roi = f"{gain:+.2f} dB ({worst:+.2f}) [{mean(fit, 'roi_gain'):+.2f}]"
+        else:
+            g, tl = NO_FOCUS_TARGETS
+            met = [(f"gain >= +{g:g}", -loss >= g), (f"tiles <= {tl:g}", tiles <= tl)]
+            roi = ""
+        lines.append(f"| {label} | {roi} | {frame} | {tile_cell} | "
+                     + ", ".join(f"{what} ({'met' if ok else '**not met**'})" for what, ok in met) + " |")
+    lines += ["", "The rows per photograph: build/quality/targets.md; the contact sheet (source | default encode | "
+              "uniform): [quality-plots/contact-sheet-defaults.png](quality-plots/contact-sheet-defaults.png)."]
+    return "\n".join(lines)
+
+
 def replace_block(text, suite, body):
     pattern = re.compile(rf"(<!-- table:{re.escape(suite)} -->\n).*?(<!-- /table -->)", re.S)
     if not pattern.search(text):
@@ -226,22 +330,35 @@ def replace_block(text, suite, body):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("suites", nargs="+", choices=[*SUITES, "end-to-end", "viewer", "quality", "all"])
+    names = [*SUITES, "reflections", "end-to-end", "viewer", "quality-defaults", "quality"]
+    parser.add_argument("suites", nargs="+", choices=[*names, "all"])
     parser.add_argument("--build", default=str(ROOT / "build"))
     parser.add_argument("--repetitions", type=int, default=7)
     parser.add_argument("--instructions", action="store_true", help="callgrind instruction counts (codec only)")
+    parser.add_argument("--from-results", action="store_true",
+                        help="reflections, quality-defaults: the tables from the result files of an earlier run")
     args = parser.parse_args()
-    suites = [*SUITES, "end-to-end", "viewer", "quality"] if "all" in args.suites else args.suites
+    suites = names if "all" in args.suites else args.suites
     if args.instructions and set(suites) - {"codec"}:
         sys.exit("make_readme_tables.py: --instructions counts codec_bench only (valgrind stops at llvmpipe and libhwy)")
+    if args.from_results and set(suites) - {"reflections", "quality-defaults"}:
+        sys.exit("make_readme_tables.py: --from-results remakes the reflections and quality-defaults tables only")
     text = README.read_text()
     for suite in suites:
         if suite in SUITES:
             body = benchmark_table(args.build, suite, args.repetitions, args.instructions)
+        elif suite == "reflections":
+            saved = Path(args.build) / RESULTS / "reflections.json"
+            body = reflections_table(json.loads(saved.read_text()) if args.from_results
+                                     else run_reflections(args.build, min(args.repetitions, 5)))
         elif suite == "end-to-end":
             body = end_to_end_table(args.build, min(args.repetitions, 5))
         elif suite == "viewer":
             body = viewer_table(args.build)
+        elif suite == "quality-defaults":
+            saved = Path(args.build) / "quality" / "targets.json"
+            body = quality_defaults_table(json.loads(saved.read_text()) if args.from_results
+                                          else run_quality_defaults(args.build))
         else:
             body = quality_table(args.build)
         text = replace_block(text, suite, body)

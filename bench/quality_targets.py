@@ -12,8 +12,11 @@ decoded to the source's size by the CPU decoder, the uniform one by a bilinear r
 - tiles outside the regions: tiles of max(W, H) / 32 px that touch no region, each with loss
   10 log10((mse_conus + e) / (mse_uniform + e)), e = (2/255)^2 (values in [0, 1]): the 95th
   percentile and the worst.
-A contact sheet per photograph (source | default encode | uniform, whole frames) goes to DIR.
+A contact sheet per photograph (source | default encode | uniform, whole frames) goes to DIR, and
+every row with the run's stamp (date, commit, machine) to DIR/targets.json, from which
+bench/make_readme_tables.py makes the README's table.
 """
+import json
 import pathlib
 import re
 import subprocess
@@ -21,6 +24,8 @@ import tempfile
 import time
 
 import numpy as np
+
+from run_stamp import run_stamp
 
 SKIMAGE = pathlib.Path("/usr/lib/python3/dist-packages/skimage/data")
 MATE = pathlib.Path("/usr/share/backgrounds/mate/nature")
@@ -228,7 +233,8 @@ def table(results):
 
 
 def contact_sheet(out, names):
-    """All the per-photo sheets in one PNG (each scaled to 1200 px wide)."""
+    """All the per-photo sheets in one PNG (each scaled to 1200 px wide), and a half-size copy
+    (contact-sheet-600.png, the one bench/README.md shows)."""
     from PIL import Image
     tiles = []
     for name in names:
@@ -242,9 +248,11 @@ def contact_sheet(out, names):
         sheet.paste(t, (0, y))
         y += t.height + 8
     sheet.save(out / "contact-sheet.png")
+    sheet.resize((600, round(sheet.height / 2)), Image.BOX).save(out / "contact-sheet-600.png")
 
 
 def defaults_only(conus, binary, out, photos=ALL_PHOTOS, extra_args=(), detail=False):
+    stamp, start = run_stamp(), time.monotonic()
     results = {}
     for name, path, regions in photos:
         if not path.exists():
@@ -254,7 +262,9 @@ def defaults_only(conus, binary, out, photos=ALL_PHOTOS, extra_args=(), detail=F
         results[name] = measure_photo(conus, binary, name, path, regions, out, extra_args, detail)
     text = table(results)
     (out / "targets.md").write_text(text)
+    (out / "targets.json").write_text(json.dumps({"stamp": stamp, "seconds": time.monotonic() - start,
+                                                  "encode_args": list(map(str, extra_args)), "results": results}, indent=1))
     contact_sheet(out, [n for n, _, _ in photos])
     print(text)
-    print(f"wrote {out / 'targets.md'}, {out / 'contact-sheet.png'}")
+    print(f"wrote {out / 'targets.md'}, {out / 'targets.json'}, {out / 'contact-sheet.png'}")
     return results

@@ -14,7 +14,8 @@
 namespace conus::imageio {
 
 namespace oiio {
-// The implementations (image_file.cpp, text.cpp); same meaning as the public functions.
+// The implementations (image_read.cpp, image_write.cpp, image_colour.cpp, text.cpp); same meaning
+// as the public functions.
 ImageFile readImageFile(const std::string& path, const ReadOptions& options);
 void writeImageFile(const std::string& path, const Image& image, const WriteOptions& options);
 void checkImageOutput(const std::string& path, const WriteOptions& options);

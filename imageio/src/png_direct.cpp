@@ -1,5 +1,5 @@
 // Plain PNG files through libpng, without OpenImageIO (png_direct.h says which files and why).
-// What the file's chunks become follows OpenImageIO 2.4's PNG reader, as image_file.cpp then
+// What the file's chunks become follows OpenImageIO 2.4's PNG reader, as image_read.cpp then
 // keeps it (tests/imageio/png_direct_test.cpp compares the two paths on the same files).
 #include "png_direct.h"
 
@@ -182,7 +182,7 @@ std::optional<ImageFile> readPngDirect(const std::string& path, const ReadOption
     const std::uint32_t width = png_get_image_width(p.png, p.info), height = png_get_image_height(p.png, p.info);
     const int depth = png_get_bit_depth(p.png, p.info), channels = png_get_channels(p.png, p.info);
 
-    // The OpenImageIO path's limits (image_file.cpp); past any of them it words the refusal.
+    // The OpenImageIO path's limits (image_read.cpp); past any of them it words the refusal.
     const std::int64_t pixels = std::int64_t{width} * height;
     const Limits& limits = options.limits;
     constexpr std::uintmax_t kMaxExpansion = 4096;

@@ -1,5 +1,5 @@
-// conus-view's drawing: one full-screen pass of view_frame.frag.glsl into the bound framebuffer,
-// or (where the backend rule prefers the CPU) codec's decoder per frame, uploaded and blitted.
+// conus-view's drawing: the uploads, one full-screen pass of view_frame.frag.glsl into the bound
+// framebuffer (or, where the backend rule prefers the CPU, view_cpu_frame.cpp's frame), overlays.
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -23,36 +23,13 @@
 #include "embedded_shaders.h"
 #include "gl_objects.h"
 #include "shader_constants.h"
+#include "view_renderer_pvt.h"
 
 namespace conus::gl {
 namespace {
 
-// An exposed linear value on the display, 0..255: tone map, then the sRGB curve or a gamma.
-std::uint8_t displayByte(float exposed, float invGamma, ToneMap toneMap) {
-    const float x = exposeAndToneMap(exposed, 1.0f, toneMap);
-    const double v = invGamma == 0.0f ? linearToSrgbDisplay(x) : std::pow(static_cast<double>(std::max(x, 0.0f)), static_cast<double>(invGamma));
-    return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
-}
-
-// 0 selects the sRGB curve (ViewOptions::gamma 0); a gamma below 0.05 is held there.
-float inverseGamma(const ViewOptions& options) {
-    return options.gamma == 0.0 ? 0.0f : static_cast<float>(1.0 / std::max(options.gamma, 0.05));
-}
-
 constexpr int kDensitySamples = 128;     // per side, for the heat map's log-density range
 constexpr double kMinGridSpacing = 6.0;  // pixels between automatic grid lines (at density 1)
-
-// The 8-bit display table of the CPU path: a display value for every float in [2^-32, 1) by its
-// top 12 mantissa bits (131072 buckets, relative width 2^-12); 0 below, 255 at 1 and above.
-constexpr std::uint32_t kLutLowBits = 0x2f800000u;  // 2^-32
-constexpr int kLutShift = 11;
-constexpr std::size_t kLutSize = (0x3f800000u - kLutLowBits) >> kLutShift;
-
-std::uint32_t floatBits(float f) {
-    std::uint32_t b;
-    std::memcpy(&b, &f, sizeof b);
-    return b;
-}
 
 // The display channels as R,G,B (the shader writes alpha 1 whatever the image's alpha).
 Image displayRgb(const Image& rgba) {
@@ -143,210 +120,43 @@ std::array<int, 4> imageBox(const codec::View& view, int width, int height, bool
 
 }  // namespace
 
-struct ViewRenderer::Impl {
-    Context& context;
-    GlHandle conus, map, uniform;
-    bool conusHalf = false;  // conus is RGBA16F; conusFloat, its RGBA32F twin, made when first needed
-    GlHandle conusFloat;
-    // The CPU decode path: the display channels and the map on the CPU, the frame texture (RGBA8
-    // for a window, RGBA32F when rendering to a float target) and a framebuffer to blit it from.
-    Image rgb;
-    codec::ImagePyramid rgbPyramid;  // rgb's mip chain: zoomed-out pixels take one trilinear tap
-    std::optional<codec::SamplingMap> cpuMap;
-    GlHandle frameTexture, frameFramebuffer;
-    int frameWidth = 0, frameHeight = 0;
-    GLenum frameFormat = 0;
-    bool floatTarget = false;  // renderToImage: exact float values, no 8-bit rounding
-    std::vector<std::uint8_t> frameBytes;
-    std::vector<float> frameFloats;
-    std::vector<std::uint8_t> lut;
-    float lutExposure = -1, lutInvGamma = -1;
-    ToneMap lutToneMap = ToneMap::None;
-    int conusWidth = 0, conusHeight = 0;
-    double sourceWidth = 1, sourceHeight = 1;
-    std::vector<float> foci;  // u, v, r per focus
-    float logDensityLo = 0, logDensityHi = 0;
-    Image uniformImage;
-    GlHandle overlays[ViewRenderer::kOverlaySlots];
-    int overlayWidth[ViewRenderer::kOverlaySlots] = {}, overlayHeight[ViewRenderer::kOverlaySlots] = {};
-
-    explicit Impl(Context& c) : context(c) {}
-    // The handles delete their objects after this body, with the context current.
-    ~Impl() { makeCurrentGl(context); }
-
-    bool cpuDecode(const ViewOptions& options, const codec::View& view, int width) const {
-        if (options.mode != ViewMode::Reconstructed || !cpuMap) return false;
-        switch (options.decode) {
-        case DecodePath::Cpu: return true;
-        case DecodePath::Gpu: return false;
-        case DecodePath::Auto: break;
-        }
-        const bool minified = std::abs(view.u1 - view.u0) * conusWidth > width;
-        return !minified && prefersCpu(context);
-    }
-
-    void buildLut(float exposure, float invGamma, ToneMap toneMap) {
-        if (lut.size() == kLutSize && exposure == lutExposure && invGamma == lutInvGamma && toneMap == lutToneMap) return;
-        lut.resize(kLutSize);
-        for (std::size_t i = 0; i < kLutSize; ++i) {
-            const std::uint32_t lo = kLutLowBits + (static_cast<std::uint32_t>(i) << kLutShift);
-            const std::uint32_t mid = lo + (1u << (kLutShift - 1));
-            float x;
-            std::memcpy(&x, &mid, sizeof x);
-            lut[i] = displayByte(x, invGamma, toneMap);  // indexed by the exposed value
-        }
-        lutExposure = exposure;
-        lutInvGamma = invGamma;
-        lutToneMap = toneMap;
-    }
-
-    // The frame decoded by codec::decodeImage into the frame texture, top row first (or bottom row
-    // first for a window), display values, background outside [0,1]^2 as the shader has it.
-    void decodeFrame(const codec::View& view, int width, int height, const ViewOptions& options) {
-        codec::DecodeOptions decode;
-        decode.view = view;
-        decode.width = width;
-        decode.height = height;
-        decode.pyramid = &rgbPyramid;
-        const Image frame = codec::decodeImage(rgb, *cpuMap, decode);
-        const float exposure = static_cast<float>(std::exp2(options.exposure));
-        const float invGamma = inverseGamma(options);
-        // Which columns / rows are inside [0,1]^2 at the pixel centres (gl_FragCoord in the shader).
-        std::vector<std::uint8_t> colInside(width), rowInside(height);
-        const double su = (view.u1 - view.u0) / width, sv = (view.v1 - view.v0) / height;
-        for (int x = 0; x < width; ++x) {
-            const double u = view.u0 + (x + 0.5) * su;
-            colInside[x] = u >= 0.0 && u <= 1.0;
-        }
-        for (int y = 0; y < height; ++y) {
-            const double v = view.v0 + (y + 0.5) * sv;
-            rowInside[y] = v >= 0.0 && v <= 1.0;
-        }
-        const bool flip = options.bottomUp;
-        const std::size_t count = static_cast<std::size_t>(width) * height * 4;
-        if (floatTarget) {
-            frameFloats.resize(count);
-            parallelRows(height, 0, [&](int y0, int y1) {
-                for (int y = y0; y < y1; ++y) {
-                    float* out = frameFloats.data() + static_cast<std::size_t>(flip ? height - 1 - y : y) * width * 4;
-                    const float* in = frame.pixels.data() + static_cast<std::size_t>(y) * width * 3;
-                    for (int x = 0; x < width; ++x, out += 4, in += 3) {
-                        for (int c = 0; c < 3; ++c) {
-                            const float t = exposeAndToneMap(in[c], exposure, options.toneMap);
-                            out[c] = rowInside[y] && colInside[x]
-                                         ? (invGamma == 0.0f ? linearToSrgbDisplay(t) : std::pow(std::max(t, 0.0f), invGamma))
-                                         : kViewBackground;
-                        }
-                        out[3] = 1.0f;
-                    }
-                }
-            });
-        } else {
-            buildLut(exposure, invGamma, options.toneMap);
-            frameBytes.resize(count);
-            const std::uint8_t background = static_cast<std::uint8_t>(std::lround(kViewBackground * 255.0f));
-            const std::uint8_t* table = lut.data();
-            parallelRows(height, 0, [&](int y0, int y1) {
-                for (int y = y0; y < y1; ++y) {
-                    std::uint8_t* out = frameBytes.data() + static_cast<std::size_t>(flip ? height - 1 - y : y) * width * 4;
-                    const float* in = frame.pixels.data() + static_cast<std::size_t>(y) * width * 3;
-                    for (int x = 0; x < width; ++x, out += 4, in += 3) {
-                        if (!rowInside[y] || !colInside[x]) {
-                            out[0] = out[1] = out[2] = background;
-                        } else {
-                            for (int c = 0; c < 3; ++c) {
-                                const float f = in[c] * exposure;
-                                const std::uint32_t b = floatBits(f);
-                                // The table spans [2^-32, 1); above 1 only a tone map keeps values apart.
-                                out[c] = !(f >= 0x1p-32f)                      ? 0
-                                         : f < 1.0f                            ? table[(b - kLutLowBits) >> kLutShift]
-                                         : options.toneMap == ToneMap::None    ? 255
-                                                                               : displayByte(f, invGamma, options.toneMap);
-                            }
-                        }
-                        out[3] = 255;
-                    }
-                }
-            });
-        }
-
+GLuint ViewRenderer::Impl::conusTexture(const ViewOptions& options) {
+    if (!conusHalf || (options.mode != ViewMode::Raw && options.exposure <= kHalfTextureMaxExposure)) return conus.id();
+    if (!conusFloat) {
         const GladGLContext& gl = makeCurrentGl(context);
-        const GLenum format = floatTarget ? GL_RGBA32F : GL_RGBA8;
-        if (!frameTexture || frameWidth != width || frameHeight != height || frameFormat != format) {
-            frameTexture = makeTexture(gl);
-            gl.ActiveTexture(GL_TEXTURE0);
-            gl.BindTexture(GL_TEXTURE_2D, frameTexture.id());
-            gl.TexStorage2D(GL_TEXTURE_2D, 1, format, width, height);
-            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-            gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-            if (!frameFramebuffer) frameFramebuffer = makeFramebuffer(gl);
-            GLint readBinding = 0;
-            gl.GetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readBinding);
-            gl.BindFramebuffer(GL_READ_FRAMEBUFFER, frameFramebuffer.id());
-            gl.FramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, frameTexture.id(), 0);
-            gl.BindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readBinding));
-            frameWidth = width;
-            frameHeight = height;
-            frameFormat = format;
+        conusFloat = uploadMipmapped(gl, GL_RGBA32F, GL_RGB, rgb, rgbPyramid);
+        checkGl(gl, "ViewRenderer: float texture upload");
+    }
+    return conusFloat.id();
+}
+
+GLuint ViewRenderer::Impl::program(const ViewOptions& options, bool overlayOnly) {
+    const int mode = static_cast<int>(options.mode);
+    const std::string key = "view_frame/" + std::to_string(mode) + (options.grid ? "g" : "") + (options.outlines ? "o" : "") +
+                            (overlayOnly ? "v" : "");
+    std::string source = shaders::kShaderViewFrameFrag;
+    const std::size_t eol = source.find('\n') + 1;
+    source.insert(eol, "#define VIEW_MODE " + std::to_string(mode) + "\n#define VIEW_GRID " + (options.grid ? "1" : "0") +
+                           "\n#define VIEW_OUTLINES " + (options.outlines ? "1" : "0") + "\n#define VIEW_OVERLAY " +
+                           (overlayOnly ? "1" : "0") + "\n");
+    return cachedProgram(context, key, shaders::kShaderFullscreenVert, source.c_str());
+}
+
+void ViewRenderer::Impl::uploadMap(const codec::SamplingMap& m) {
+    const GladGLContext& gl = makeCurrentGl(context);
+    map = uploadMapTexture(gl, GL_TEXTURE1, m.columns(), m.rows(), &m.nodes().front().x);
+    checkGl(gl, "ViewRenderer: map upload");
+    double lo = 1e300, hi = -1e300;
+    for (int j = 0; j < kDensitySamples; ++j)
+        for (int i = 0; i < kDensitySamples; ++i) {
+            const double d = std::log(std::max(
+                m.density({(i + 0.5) / kDensitySamples, (j + 0.5) / kDensitySamples}), 1e-12));
+            lo = std::min(lo, d);
+            hi = std::max(hi, d);
         }
-        gl.ActiveTexture(GL_TEXTURE0);
-        gl.BindTexture(GL_TEXTURE_2D, frameTexture.id());
-        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
-        if (floatTarget) gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RGBA, GL_FLOAT, frameFloats.data());
-        else gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, frameBytes.data());
-        // Copied into the bound draw framebuffer; the read binding is left as it was (the viewer
-        // reads its back buffer for screenshots).
-        GLint readBinding = 0;
-        gl.GetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readBinding);
-        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, frameFramebuffer.id());
-        gl.BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readBinding));
-        checkGl(gl, "ViewRenderer::draw (CPU decode)");
-    }
-
-    // The CoNUS texture for these options: the half one for the decoded frame unless the exposure
-    // needs float; the raw mode shows the CoNUS image's own values, so float.
-    GLuint conusTexture(const ViewOptions& options) {
-        if (!conusHalf || (options.mode != ViewMode::Raw && options.exposure <= kHalfTextureMaxExposure)) return conus.id();
-        if (!conusFloat) {
-            const GladGLContext& gl = makeCurrentGl(context);
-            conusFloat = uploadMipmapped(gl, GL_RGBA32F, GL_RGB, rgb, rgbPyramid);
-            checkGl(gl, "ViewRenderer: float texture upload");
-        }
-        return conusFloat.id();
-    }
-
-    // The program for a mode and overlays: view_frame.frag.glsl with its VIEW_* switches defined
-    // after the #version line (compiled once per combination, cached by the context).
-    // overlayOnly: the overlays alone, premultiplied, to blend over a frame already drawn.
-    GLuint program(const ViewOptions& options, bool overlayOnly = false) {
-        const int mode = static_cast<int>(options.mode);
-        const std::string key = "view_frame/" + std::to_string(mode) + (options.grid ? "g" : "") + (options.outlines ? "o" : "") +
-                                (overlayOnly ? "v" : "");
-        std::string source = shaders::kShaderViewFrameFrag;
-        const std::size_t eol = source.find('\n') + 1;
-        source.insert(eol, "#define VIEW_MODE " + std::to_string(mode) + "\n#define VIEW_GRID " + (options.grid ? "1" : "0") +
-                               "\n#define VIEW_OUTLINES " + (options.outlines ? "1" : "0") + "\n#define VIEW_OVERLAY " +
-                               (overlayOnly ? "1" : "0") + "\n");
-        return cachedProgram(context, key, shaders::kShaderFullscreenVert, source.c_str());
-    }
-
-    void uploadMap(const codec::SamplingMap& m) {
-        const GladGLContext& gl = makeCurrentGl(context);
-        map = uploadMapTexture(gl, GL_TEXTURE1, m.columns(), m.rows(), &m.nodes().front().x);
-        checkGl(gl, "ViewRenderer: map upload");
-        double lo = 1e300, hi = -1e300;
-        for (int j = 0; j < kDensitySamples; ++j)
-            for (int i = 0; i < kDensitySamples; ++i) {
-                const double d = std::log(std::max(
-                    m.density({(i + 0.5) / kDensitySamples, (j + 0.5) / kDensitySamples}), 1e-12));
-                lo = std::min(lo, d);
-                hi = std::max(hi, d);
-            }
-        logDensityLo = static_cast<float>(lo);
-        logDensityHi = static_cast<float>(hi);
-    }
-};
+    logDensityLo = static_cast<float>(lo);
+    logDensityHi = static_cast<float>(hi);
+}
 
 ViewRenderer::ViewRenderer(Context& context) : m_impl(std::make_unique<Impl>(context)) {
     // Compile now, so a broken driver fails at start-up rather than at the first frame.

@@ -139,7 +139,7 @@ TEST_F(ImageFileTest, SrgbIsConvertedThroughOpenImageIoAndRawIsNot) {
     for (std::size_t i = 0; i < before.pixels.size(); ++i) EXPECT_NEAR(shown.pixels[i], before.pixels[i], 1e-5);
 }
 
-// 8- and 16-bit files without alpha are read through per-value tables (image_file.cpp) instead of
+// 8- and 16-bit files without alpha are read through per-value tables (image_read.cpp) instead of
 // converting a float copy in place: every pixel must equal what OpenImageIO's own float read and
 // colour conversion give, to the bit, across several strips of rows and every sample value.
 // TIFF: plain PNGs are read with libpng instead (png_direct_test.cpp compares those paths).

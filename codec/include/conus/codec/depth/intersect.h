@@ -20,8 +20,9 @@
 // What lies behind the stored surface depends on the image. Solid images (height fields, relief):
 // the matter under the surface is solid, so the bilinear surface between a near and a far sample
 // is the best estimate of the wall between them (split walls measured worse on the tablet's
-// engraved text, bench/README.md), a wall is hit like any surface, and a ray that enters the
-// clipped volume already behind the surface hits where it enters (the side walls of a relief box).
+// engraved text, bench/notes/2026-11-27-reflection-silhouettes.md), a wall is hit like any
+// surface, and a ray that enters the clipped volume already behind the surface hits where it
+// enters (the side walls of a relief box).
 //
 // Images of scenes (camera depth: reflections, mesh renders) know nothing behind a silhouette, and
 // the bilinear surface across one is a "skin" no ray may hit (the false intersections of distance
