@@ -29,7 +29,6 @@
 #include "dem_io.h"
 #include "encoding.h"
 #include "image_files.h"
-#include "importance.h"
 #include "map_options.h"
 #include "progress.h"
 
