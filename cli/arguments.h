@@ -10,6 +10,7 @@
 
 #include "conus/codec/image/decode.h"
 #include "conus/format/container.h"
+#include "conus/sceneio/dem_file.h"
 
 namespace conus::cli {
 
@@ -29,6 +30,10 @@ struct CameraText {
 };
 CameraText parseCamera(const std::string& text);
 glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "x,y,z", all finite
+
+// The elevation model a DEM argument names: procedural[:SIZE[:SEED]] (codec's terrain, SIZE x SIZE
+// samples) or a file (sceneio::readDem), its heights times `heightScale`.
+sceneio::Dem demFrom(const std::string& source, double heightScale);
 
 // A CLI11 check for a number option: finite, above `low` (or equal to it when `lowIncluded`) and
 // below `high`. CLI::Range lets NaN through (every comparison with NaN is false); this does not,
