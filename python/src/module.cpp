@@ -1,5 +1,7 @@
 // `import conus`: the toolkit over numpy (pybind11). The compiled part, conus._conus; the package
-// (python/conus/__init__.py) re-exports it and adds the pure-Python helpers.
+// (python/conus/__init__.py) re-exports it and adds the pure-Python helpers. Here: errors, File,
+// read, write, encode, decode and the image calls; maps.cpp: Map and importance; scene.cpp: the
+// scene readers; arguments.cpp: what users pass.
 //
 // Shared rules:
 // - Pixels CoNUS returns are float32 numpy arrays of shape (height, width, channels), linear light,
