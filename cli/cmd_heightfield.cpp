@@ -30,7 +30,8 @@ namespace {
 
 // The DEM's colour in linear light: a texture (resized down to the DEM when larger), else the
 // height/slope ramp (drawn as display colours). `encoding` receives what the colour came from.
-Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding = nullptr) {
+Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent,
+                SourceEncoding* encoding = nullptr) {
     if (texture.empty()) {
         Image ramp = codec::terrainColours(dem.heights, extent);
         imageio::linearize(ramp);
@@ -208,7 +209,8 @@ CLI::App* addRender(CLI::App& command, RenderOptions& o) {
 }
 
 // The DEM resampled uniformly to columns x rows, rendered as `frame` was.
-Image renderUniform(gl::Context& context, const sceneio::Dem& dem, const Image& colour, int columns, int rows, const Frame& frame) {
+Image renderUniform(gl::Context& context, const sceneio::Dem& dem, const Image& colour, int columns, int rows,
+                    const Frame& frame) {
     const format::ConusFile field = codec::uniformHeightField(dem.heights, colour, columns, rows);
     return gl::renderTerrain(context, codec::undistortHeightField(field, frame.extent), frame.camera, frame.image.width,
                              frame.image.height);

@@ -75,7 +75,8 @@ struct TerrainView {
 
 // The ground map's own viewer of `file` (viewerCamera, standing on the height at the middle of the
 // near edge), or `view` with that viewer's clip distances. `aspect` is the frame's width / height.
-Camera heightFieldCamera(const format::ConusFile& file, double aspect, const std::optional<TerrainView>& view = std::nullopt);
+Camera heightFieldCamera(const format::ConusFile& file, double aspect,
+                         const std::optional<TerrainView>& view = std::nullopt);
 
 // A frame of the CoNUS height field `file`: undistorted to a mesh over the field's extent
 // (codec::undistortHeightField) and rendered from `camera` (renderTerrain).
