@@ -1,11 +1,15 @@
 #include "arguments.h"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <regex>
 #include <sstream>
 #include <vector>
 
+#include "conus/codec/depth/heightfield.h"
 #include "conus/core/error.h"
+#include "conus/core/limits.h"
 
 namespace conus::cli {
 namespace {
@@ -61,6 +65,22 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what) {
 format::Compression parseCompression(const std::string& text) {
     if (const auto compression = format::parseName<format::Compression>(text)) return *compression;
     invalid("compression '" + text + "' is not one of " + format::nameList<format::Compression>());
+}
+
+sceneio::Dem demFrom(const std::string& source, double heightScale) {
+    std::smatch m;
+    if (!std::regex_match(source, m, std::regex("procedural(?::(\\d+))?(?::(\\d+))?")))
+        return sceneio::readDem(source, heightScale);
+    codec::TerrainOptions options;
+    if (m[1].matched) options.width = options.height = std::stoi(m[1].str().substr(0, 6));
+    if (std::int64_t{options.width} * options.height > kMaxDemSamples)
+        throw Error(ErrorCode::InvalidArgument, "procedural terrain " + std::to_string(options.width) + "x" +
+                                                    std::to_string(options.height) + " holds more than the limit of " +
+                                                    std::to_string(kMaxDemSamples) + " height samples");
+    if (m[2].matched) options.seed = static_cast<std::uint32_t>(std::stoul(m[2].str().substr(0, 9)));
+    return sceneio::demFromHeights(codec::generateTerrain(options), heightScale,
+                                   "procedural terrain " + std::to_string(options.width) + "x" +
+                                       std::to_string(options.height) + " seed " + std::to_string(options.seed));
 }
 
 }  // namespace conus::cli

@@ -10,6 +10,7 @@
 
 #include "conus/codec/image/decode.h"
 #include "conus/format/container.h"
+#include "conus/sceneio/dem_file.h"
 #include "option_checks.h"
 
 namespace conus::cli {
@@ -31,5 +32,8 @@ struct CameraText {
 CameraText parseCamera(const std::string& text);
 glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "x,y,z", all finite
 
+// The elevation model a DEM argument names: procedural[:SIZE[:SEED]] (codec's terrain, SIZE x SIZE
+// samples) or a file (sceneio::readDem), its heights times `heightScale`.
+sceneio::Dem demFrom(const std::string& source, double heightScale);
 
 }  // namespace conus::cli

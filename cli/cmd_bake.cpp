@@ -26,10 +26,8 @@
 #include "conus/imageio/image_file.h"
 #include "conus/imageio/text.h"
 #include "conus/sceneio/mesh_file.h"
-#include "dem_io.h"
 #include "encoding.h"
 #include "image_files.h"
-#include "importance.h"
 #include "map_options.h"
 #include "progress.h"
 
@@ -63,7 +61,7 @@ Source readReliefSource(const BakeOptions& o) {
         return {std::move(made.heights), std::move(made.colour), made.extent,
                 "engraved tablet " + o.tabletSize + " \"" + o.text + "\""};
     }
-    Dem dem = readDem(o.source, o.heightScale);
+    sceneio::Dem dem = demFrom(o.source, o.heightScale);
     const glm::dvec2 extent(o.width, o.width * dem.heights.height / dem.heights.width);
     Image colour;
     if (o.colour.empty()) {

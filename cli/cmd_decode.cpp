@@ -114,8 +114,8 @@ std::string decodeOne(const DecodeCommandOptions& o, const std::string& input, c
     if (!o.cameraText.empty()) {
         // A height field seen from a camera: undistort to a mesh and render it.
         const Size size = parseSize(o.sizeText.empty() ? "960x540" : o.sizeText);
-        const Image frame = renderHeightFieldFrame(file, o.cameraText == "viewer" ? "" : o.cameraText, size.width,
-                                                           size.height, o.backend);
+        const Image frame = heightFieldFrame(file, o.cameraText == "viewer" ? "" : o.cameraText, size.width, size.height,
+                                             o.backend);
         writePicture(output, frame, writeOptionsOf(o.picture, nullptr));
         return "wrote " + output + ": " + std::to_string(frame.width) + "x" + std::to_string(frame.height) +
                " frame of the height field";

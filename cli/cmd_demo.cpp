@@ -22,7 +22,6 @@
 #include "encoding.h"
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
-#include "importance.h"
 #include "map_options.h"
 #include "option_checks.h"
 #include "pictures.h"

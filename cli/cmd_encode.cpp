@@ -19,7 +19,6 @@
 #include "conus/core/map_rules.h"
 #include "encoding.h"
 #include "image_files.h"
-#include "importance.h"
 #include "map_options.h"
 #include "progress.h"
 
@@ -41,9 +40,6 @@ struct EncodeOptions {
     SourceOptions source;
     StorageOptions storage;
 };
-
-// The predicted tile loss (dB, frame_budget.h) the own-detail map keeps to when no focus is given.
-constexpr double kOwnDetailTileLoss = 2.0;
 
 struct BuiltMap {
     std::unique_ptr<codec::SamplingMap> map;
@@ -115,10 +111,8 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
 // the model predicts gains most over the whole frame (frame_budget.h), said once per batch.
 BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, std::string* given) {
     Progress progress("build sampling map from the picture's detail");
-    const Image importance = importanceFrom("detail", source);
-    const codec::FrameErrorModel model(source, size.width, size.height, importance);
-    codec::BudgetResult r = codec::buildAutoMapForBestFrame(
-        importance, model, kOwnDetailTileLoss, autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method));
+    codec::BudgetResult r = codec::buildOwnDetailMap(source, importanceFrom("detail", source), size.width, size.height,
+                                                     autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method));
     progress.done();
     static std::once_flag once;  // once per batch, not per file
     std::call_once(once, [] {

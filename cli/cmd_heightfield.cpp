@@ -19,7 +19,6 @@
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 #include "conus/renderers/terrain.h"
-#include "dem_io.h"
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
 #include "map_options.h"
@@ -31,7 +30,8 @@ namespace {
 
 // The DEM's colour in linear light: a texture (resized down to the DEM when larger), else the
 // height/slope ramp (drawn as display colours). `encoding` receives what the colour came from.
-Image demColour(const Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding = nullptr) {
+Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent,
+                SourceEncoding* encoding = nullptr) {
     if (texture.empty()) {
         Image ramp = codec::terrainColours(dem.heights, extent);
         imageio::linearize(ramp);
@@ -62,18 +62,11 @@ void printCamera(const Camera& c, const std::string& given) {
                 eye.z, look.x, look.y, look.z, c.verticalFovDegrees());
 }
 
-codec::GroundParams groundOf(const format::ConusFile& file, const std::string& name) {
-    if (file.dataKind != format::DataKind::HeightField || !file.analytic || file.analytic->kind != "ground")
-        throw Error(ErrorCode::InvalidArgument, name + " is not a CoNUS height field with ground-map parameters");
-    return codec::groundFromAnalytic(*file.analytic);
-}
-
-// The ground map's own viewer, or the one the text names (with the viewer's clip distances).
-Camera terrainCamera(const format::ConusFile& file, const std::string& cameraText, double aspect) {
-    const Camera viewer = gl::viewerCamera(groundOf(file, "the file"), codec::heightAt(file, {0.5, 1.0}), aspect);
-    if (cameraText.empty()) return viewer;
+// The camera --camera names (empty: the ground map's own viewer).
+std::optional<gl::TerrainView> terrainView(const std::string& cameraText) {
+    if (cameraText.empty()) return std::nullopt;
     const CameraText given = parseCamera(cameraText);
-    return Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, viewer.near(), viewer.far());
+    return gl::TerrainView{given.eye, given.target, given.fovYDegrees};
 }
 
 // A frame of the height field `file` (called `name` in messages) seen from `cameraText`.
@@ -85,10 +78,10 @@ struct Frame {
 
 Frame renderFrame(gl::Context& context, const format::ConusFile& file, const std::string& name,
                   const std::string& cameraText, Size size, const std::string& stage) {
-    const glm::dvec2 extent = codec::fieldExtent(groundOf(file, name));
-    const Camera camera = terrainCamera(file, cameraText, double(size.width) / size.height);
+    const glm::dvec2 extent = codec::fieldExtent(gl::heightFieldGround(file, name));
+    const Camera camera = gl::heightFieldCamera(file, double(size.width) / size.height, terrainView(cameraText));
     Progress progress(stage);
-    Image image = gl::renderTerrain(context, codec::undistortHeightField(file, extent), camera, size.width, size.height);
+    Image image = gl::renderHeightFieldFrame(context, file, camera, size.width, size.height);
     progress.done();
     printCamera(camera, cameraText);
     return {std::move(image), camera, extent};
@@ -153,7 +146,7 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
 
 // The ground map: the options as given, the DEM's own size in metres where the user left
 // --far or --fov out and the file knows its spacing, else the defaults.
-codec::GroundParams groundFor(const EncodeOptions& o, const Dem& dem) {
+codec::GroundParams groundFor(const EncodeOptions& o, const sceneio::Dem& dem) {
     const glm::dvec2 demMetres(dem.cellMetres.x * dem.heights.width, dem.cellMetres.y * dem.heights.height);
     codec::GroundParams ground;
     ground.eyeHeight = o.eyeHeight;
@@ -167,7 +160,7 @@ codec::GroundParams groundFor(const EncodeOptions& o, const Dem& dem) {
 
 int runEncode(const EncodeOptions& o) {
     Progress loading("read " + o.dem);
-    const Dem dem = readDem(o.dem, o.heightScale);
+    const sceneio::Dem dem = demFrom(o.dem, o.heightScale);
     loading.done();
     codec::HeightFieldOptions options;
     options.ground = groundFor(o, dem);
@@ -224,7 +217,8 @@ CLI::App* addRender(CLI::App& command, RenderOptions& o) {
 }
 
 // The DEM resampled uniformly to columns x rows, rendered as `frame` was.
-Image renderUniform(gl::Context& context, const Dem& dem, const Image& colour, int columns, int rows, const Frame& frame) {
+Image renderUniform(gl::Context& context, const sceneio::Dem& dem, const Image& colour, int columns, int rows,
+                    const Frame& frame) {
     const format::ConusFile field = codec::uniformHeightField(dem.heights, colour, columns, rows);
     return gl::renderTerrain(context, codec::undistortHeightField(field, frame.extent), frame.camera, frame.image.width,
                              frame.image.height);
@@ -233,7 +227,7 @@ Image renderUniform(gl::Context& context, const Dem& dem, const Image& colour, i
 // --compare: full resolution | CoNUS | uniform of the CoNUS image's sample count, with PSNRs.
 void writeComparison(gl::Context& context, const RenderOptions& o, const format::ConusFile& file, const Frame& frame) {
     Progress comparing("render full resolution and uniform");
-    const Dem dem = readDem(o.compare, o.heightScale);
+    const sceneio::Dem dem = demFrom(o.compare, o.heightScale);
     const Image colour = demColour(dem, o.colour, frame.extent);
     const Image full = renderUniform(context, dem, colour, dem.heights.width, dem.heights.height, frame);
     const Image uniform = renderUniform(context, dem, colour, file.image.width, file.image.height, frame);
@@ -265,8 +259,8 @@ int runRender(const RenderOptions& o) {
 
 }  // namespace
 
-Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
-                                     int height, const std::string& backendName) {
+Image heightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width, int height,
+                       const std::string& backendName) {
     const gl::Device device = deviceFor(backendName, gl::CpuPath::None, "terrain rendering");
     return renderFrame(device.context(), file, "the file", cameraText, {width, height},
                        "undistort the height field and render " + std::to_string(width) + "x" + std::to_string(height))

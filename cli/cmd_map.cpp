@@ -28,7 +28,6 @@
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
 #include "encoding.h"
-#include "importance.h"
 #include "map_options.h"
 #include "pictures.h"
 #include "progress.h"

@@ -11,7 +11,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -27,6 +26,7 @@
 #include "conus/codec/mesh/city.h"
 #include "conus/codec/mesh/subdivide.h"
 #include "conus/core/atomic_file.h"
+#include "conus/core/camera.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
@@ -42,7 +42,6 @@
 namespace conus::cli {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr const char* kCity = "city";
 
 // What render and animate share.
@@ -58,36 +57,6 @@ struct MeshOptions {
     std::string compose = "add";
 };
 
-struct Bounds {
-    glm::dvec3 lo{std::numeric_limits<double>::max()}, hi{std::numeric_limits<double>::lowest()};
-};
-
-Bounds boundsOf(const Mesh& mesh) {
-    Bounds b;
-    for (const glm::vec3& p : mesh.positions) {
-        b.lo = glm::min(b.lo, glm::dvec3(p));
-        b.hi = glm::max(b.hi, glm::dvec3(p));
-    }
-    return b;
-}
-
-// The clip range that holds the whole box: its corners' depths along the view axis, a little wider.
-void clipRange(const Bounds& b, glm::dvec3 eye, glm::dvec3 forward, double& near, double& far) {
-    double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
-    for (int corner = 0; corner < 8; ++corner) {
-        const glm::dvec3 p((corner & 1) ? b.hi.x : b.lo.x, (corner & 2) ? b.hi.y : b.lo.y, (corner & 4) ? b.hi.z : b.lo.z);
-        const double depth = glm::dot(p - eye, forward);
-        lo = std::min(lo, depth);
-        hi = std::max(hi, depth);
-    }
-    if (!(hi > 0))
-        throw Error(ErrorCode::InvalidArgument, "the model lies entirely behind the camera (look toward it with --camera)");
-    far = hi * 1.02 + 1e-6;
-    near = std::max(lo * 0.98, far * 1e-4);
-}
-
-// --camera (with --up), or one that frames the model's bounding box: looking at its centre from
-// the front right and above (+x, +y, +z), far enough that the bounding sphere fits both fields of view.
 // --camera and --up as given (checked before any work).
 struct CameraChoice {
     std::optional<CameraText> given;
@@ -102,42 +71,9 @@ CameraChoice parseCameraOptions(const MeshOptions& o) {
     return choice;
 }
 
-// Looking at the box's centre from `direction` (toward the eye), far enough that the box's
-// bounding sphere fits both fields of view.
-Camera framingCamera(const Bounds& b, glm::dvec3 direction, glm::dvec3 up, double aspect) {
-    const double fovY = 40.0;
-    const glm::dvec3 centre = 0.5 * (b.lo + b.hi);
-    const double radius = std::max(0.5 * glm::length(b.hi - b.lo), 1e-6);
-    const double halfY = 0.5 * fovY * kPi / 180.0, halfX = std::atan(std::tan(halfY) * aspect);
-    direction = glm::normalize(direction);
-    if (glm::length(glm::cross(direction, glm::normalize(up))) < 1e-6) direction = glm::normalize(glm::dvec3(1.0, 0.0, 0.2));
-    // The sphere always fits; then move closer until the box's corners (not the sphere) span 90%
-    // of the frame (a few steps: the image size of the box scales about as 1 / distance).
-    double distance = 1.05 * radius / std::sin(std::min(halfX, halfY));
-    const auto at = [&](double d) {
-        const glm::dvec3 eye = centre + direction * d;
-        double near = 0, far = 0;
-        clipRange(b, eye, -direction, near, far);
-        return Camera::perspective(eye, centre, up, fovY, aspect, near, far);
-    };
-    for (int step = 0; step < 4; ++step) {
-        const Camera camera = at(distance);
-        double extent = 0;
-        for (int corner = 0; corner < 8; ++corner) {
-            const glm::dvec3 p = camera.project({(corner & 1) ? b.hi.x : b.lo.x, (corner & 2) ? b.hi.y : b.lo.y,
-                                                 (corner & 4) ? b.hi.z : b.lo.z});
-            extent = std::max({extent, std::abs(p.x - 0.5), std::abs(p.y - 0.5)});
-        }
-        const double scale = std::clamp(extent / 0.45, 0.5, 1.0);
-        if (scale > 0.98) break;
-        distance = std::max(distance * scale, radius * 1.05);  // never inside the bounding sphere
-    }
-    return at(distance);
-}
-
 // --camera (with --up), or one that frames the model's bounding box from the front right and
 // above (+x, +y, +z).
-Camera meshCamera(const CameraChoice& choice, const Bounds& b, double aspect) {
+Camera meshCamera(const CameraChoice& choice, const AxisBox& b, double aspect) {
     const glm::dvec3 up = choice.up;
     if (!choice.given) return framingCamera(b, {0.55, 0.45, 1.0}, up, aspect);
     const CameraText& given = *choice.given;
@@ -145,14 +81,15 @@ Camera meshCamera(const CameraChoice& choice, const Bounds& b, double aspect) {
     if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
         throw Error(ErrorCode::InvalidArgument,
                     "--camera: the eye must differ from the look-at point and not look along --up");
-    double near = 0, far = 0;
-    clipRange(b, given.eye, glm::normalize(forward), near, far);
-    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, near, far);
+    const std::optional<ClipRange> clip = clipRangeFor(b, given.eye, glm::normalize(forward));
+    if (!clip)
+        throw Error(ErrorCode::InvalidArgument, "the model lies entirely behind the camera (look toward it with --camera)");
+    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, clip->near, clip->far);
 }
 
 // The whole city from high above its front edge, steep enough that buildings hide few streets.
 Camera cityCamera(const codec::CityScene& city, double aspect) {
-    Bounds b;
+    AxisBox b;
     b.lo = {-city.halfExtentX(), 0.0, -city.halfExtentZ()};
     b.hi = {city.halfExtentX(), city.maxHeight(), city.halfExtentZ()};
     return framingCamera(b, {0.15, 1.3, 1.0}, {0, 1, 0}, aspect);

@@ -21,6 +21,7 @@
 #include "conus/codec/volume/procedural.h"
 #include "conus/codec/volume/raycast.h"
 #include "conus/codec/volume/transfer_function.h"
+#include "conus/core/camera.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
 #include "conus/renderers/mesh_sequence.h"
@@ -73,17 +74,10 @@ Camera volumeCamera(const VolumeOptions& o, const Volume& volume, const codec::T
         throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText +
                                                     "': the eye must differ from the look-at point and not look along --up");
     // Near and far bracket the volume's box along the view axis.
-    const glm::dvec3 axis = glm::normalize(forward), extent = volume.extent();
-    double lo = 1e300, hi = -1e300;
-    for (int corner = 0; corner < 8; ++corner) {
-        const glm::dvec3 p((corner & 1) ? extent.x : 0.0, (corner & 2) ? extent.y : 0.0, (corner & 4) ? extent.z : 0.0);
-        lo = std::min(lo, glm::dot(p - given.eye, axis));
-        hi = std::max(hi, glm::dot(p - given.eye, axis));
-    }
-    if (!(hi > 0))
+    const std::optional<ClipRange> clip = clipRangeFor(AxisBox{glm::dvec3(0.0), volume.extent()}, given.eye, glm::normalize(forward));
+    if (!clip)
         throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText + "': the volume lies entirely behind the camera");
-    const double far = hi * 1.02 + 1e-6;
-    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, std::max(lo * 0.98, far * 1e-4), far);
+    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, clip->near, clip->far);
 }
 
 // "a,b": two finite numbers.

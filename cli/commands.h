@@ -61,9 +61,10 @@ Command addCommandGroup(CLI::App& parent, const std::string& name, const std::st
 CONUS_CLI_COMMANDS(CONUS_CLI_DECLARE_COMMAND)
 #undef CONUS_CLI_DECLARE_COMMAND
 
-// A frame of a CoNUS height field from a camera "x,y,z,lx,ly,lz,fovDeg" (empty: the ground map's
-// own viewer), rendered with GL: what `decode` does for height fields and `heightfield render` does.
-Image renderHeightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width,
-                                     int height, const std::string& backendName);
+// `decode --camera` of a height field as `heightfield render` does it (cmd_heightfield.cpp): the
+// backend chosen, the frame (gl::renderHeightFieldFrame) from a camera "x,y,z,lx,ly,lz,fovDeg"
+// (empty: the ground map's own viewer) as a progress stage, the camera said.
+Image heightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width, int height,
+                       const std::string& backendName);
 
 }  // namespace conus::cli

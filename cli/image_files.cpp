@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "arguments.h"
+#include "conus/codec/build/importance.h"
 #include "conus/core/atomic_file.h"
 #include "progress.h"
 
@@ -48,6 +49,13 @@ Image readData(const std::string& path) {
     imageio::ReadOptions read;
     read.colorspace = Transfer::Raw;
     return imageio::readImageFile(path, read).image;
+}
+
+Image importanceFrom(const std::string& source, const Image& picture) {
+    const std::optional<codec::ImportanceRule> rule = codec::parseImportanceRule(source);
+    if (!rule) return readData(source);
+    if (picture.empty()) throw Error(ErrorCode::InvalidArgument, "'" + source + "' importance needs an input image");
+    return codec::ruleImportance(*rule, imageio::displayEncoded(picture));
 }
 
 void addPictureOptions(CLI::App& command, PictureOptions& options) {

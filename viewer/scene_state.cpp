@@ -6,6 +6,7 @@
 
 #include "conus/codec/build/frame_foci.h"
 #include "conus/codec/conus_file.h"
+#include "conus/core/bounds.h"
 
 namespace conus::viewer {
 namespace {
@@ -111,13 +112,9 @@ void SceneState::scaleFocusRadius(double factor) {
 }
 
 BoundingSphere boundingSphere(const std::vector<glm::dvec3>& points) {
-    glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
-    for (const glm::dvec3& p : points) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
     if (points.empty()) return {};
-    return {0.5 * (lo + hi), std::max(1e-6, 0.5 * glm::length(hi - lo))};
+    const AxisBox box = boundsOf(std::span<const glm::dvec3>(points));
+    return {box.centre(), std::max(1e-6, 0.5 * glm::length(box.hi - box.lo))};
 }
 
 format::ConusFile sceneFrameFile(Image image, const codec::SamplingMap& map, const Camera& camera,

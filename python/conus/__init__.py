@@ -7,7 +7,8 @@
     g = conus.read("photo.exr")                                # .pixels .channels .map .attributes
     face = conus.decode(g, view=(0.36, 0.15, 0.52, 0.31), size=(512, 512))
     m = conus.Map.foci([(0.5, 0.5, 0.1, 4)]); m.undistort(m.distort(points))
-    m = conus.Map.auto(conus.importance(pixels, "detail", channels=channels))  # as --importance detail
+    m = conus.Map.auto(conus.importance(pixels, "faces", channels=channels))  # as --importance faces
+    f = conus.encode(pixels)   # as `conus encode` with no focus: the samples follow the picture's detail
 
 Float pixels are linear light (read_image linearizes sRGB pictures); uint8 and uint16 arrays are
 display-encoded codes, converted as an 8- or 16-bit PNG is (colorspace= overrides). To save a

@@ -226,6 +226,21 @@ int iterationsFrom(py::handle fit) {
     return int(n);
 }
 
+void requireReal(const py::array& input, const std::string& what) {
+    const char kind = input.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b')
+        throw Error(ErrorCode::InvalidArgument, what + " must be an array of real numbers, not of dtype " +
+                                                    py::str(input.dtype()).cast<std::string>());
+}
+
+py::array toArray(Image image) {
+    auto* held = new Image(std::move(image));
+    py::capsule owner(held, [](void* p) { delete static_cast<Image*>(p); });
+    const py::ssize_t c = held->channelCount();
+    return py::array_t<float>({py::ssize_t(held->height), py::ssize_t(held->width), c},
+                              {py::ssize_t(held->width) * c * 4, c * 4, py::ssize_t(4)}, held->pixels.data(), owner);
+}
+
 void warn(const std::string& text) {
     if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) < 0) throw py::error_already_set();
 }

@@ -1,6 +1,6 @@
 // What Python users pass, converted with one-line messages: the arrays (pixels and data), foci,
-// channel names, sizes, views and counts. Type mistakes raise TypeError, bad values conus.Error
-// (invalid-argument), each naming the argument and what it should be.
+// channel names, sizes, views and counts; and the arrays CoNUS hands back. Type mistakes raise
+// TypeError, bad values conus.Error (invalid-argument), each naming the argument and what it should be.
 //
 // The rule for pixel arrays (docs/python.md): float arrays are linear light; uint8 and uint16
 // arrays are display-encoded codes, converted as an 8- or 16-bit PNG is (sRGB to linear light,
@@ -8,6 +8,7 @@
 // NaN and infinite values are kept with a warning, or repaired as --fix-nonfinite does.
 #pragma once
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include <optional>
@@ -45,6 +46,13 @@ std::optional<std::vector<std::string>> channelsFrom(py::handle channels);
 std::optional<std::pair<int, int>> sizeFrom(py::handle size, const char* what = "size");
 codec::View viewFrom(py::handle view);
 int iterationsFrom(py::handle fit);
+
+// Real numbers only: numpy's cast would drop a complex array's imaginary part and turn an object
+// array's items into numbers by any means they offer.
+void requireReal(const py::array& input, const std::string& what);
+
+// The image as an array that owns it: no copy of the pixels (a capsule holds the C++ image).
+py::array toArray(Image image);
 
 // Warns (Python's warnings, a UserWarning) with `text`; raises if warnings are errors.
 void warn(const std::string& text);

@@ -1,5 +1,7 @@
 // `import conus`: the toolkit over numpy (pybind11). The compiled part, conus._conus; the package
-// (python/conus/__init__.py) re-exports it and adds the pure-Python helpers.
+// (python/conus/__init__.py) re-exports it and adds the pure-Python helpers. Here: errors, File,
+// read, write, encode, decode and the image calls; maps.cpp: Map and importance; scene.cpp: the
+// scene readers; arguments.cpp: what users pass.
 //
 // Shared rules:
 // - Pixels CoNUS returns are float32 numpy arrays of shape (height, width, channels), linear light,
@@ -24,12 +26,10 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
 #include "conus/codec/build/foci_budget.h"
 #include "conus/codec/build/frame_budget.h"
-#include "conus/codec/build/map_measures.h"
-#include "conus/codec/build/springs.h"
+#include "conus/codec/build/importance.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
@@ -41,6 +41,7 @@
 #include "conus/renderers/gpu_image.h"
 #include "arguments.h"
 #include "foci_budget_info.h"
+#include "maps.h"
 #include "scene.h"
 
 namespace py = pybind11;
@@ -77,65 +78,7 @@ void translateError(std::exception_ptr p) {
     }
 }
 
-// ---- numpy <-> Image ---------------------------------------------------------------------------
-
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-
-// The image as an array that owns it: no copy of the pixels.
-py::array toArray(Image image) {
-    auto* held = new Image(std::move(image));
-    py::capsule owner(held, [](void* p) { delete static_cast<Image*>(p); });
-    const py::ssize_t c = held->channelCount();
-    return py::array_t<float>({py::ssize_t(held->height), py::ssize_t(held->width), c},
-                              {py::ssize_t(held->width) * c * 4, c * 4, py::ssize_t(4)}, held->pixels.data(), owner);
-}
-
-// Real numbers only: numpy's cast would drop a complex array's imaginary part and turn an object
-// array's items into numbers by any means they offer.
-void requireReal(const py::array& input, const std::string& what) {
-    const char kind = input.dtype().kind();
-    if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b')
-        throw Error(ErrorCode::InvalidArgument, what + " must be an array of real numbers, not of dtype " +
-                                                    py::str(input.dtype()).cast<std::string>());
-}
-
-// ---- points ------------------------------------------------------------------------------------
-
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-// f applied to every (u, v) of an (..., 2) array, without the GIL.
-template <class F>
-py::array mapPoints(const py::array& input, F&& f) {
-    requireReal(input, "points");
-    const DoubleArray points = DoubleArray::ensure(input);
-    if (!points || points.ndim() < 1 || points.shape(points.ndim() - 1) != 2)
-        throw Error(ErrorCode::InvalidArgument, "points must be an array of shape (..., 2)");
-    for (py::ssize_t i = 0; i < points.size(); ++i)
-        if (!std::isfinite(points.data()[i]))
-            throw Error(ErrorCode::InvalidArgument, "points must be finite; point " + std::to_string(i / 2) + " holds " +
-                                                        numberText(points.data()[i]));
-    DoubleArray out(std::vector<py::ssize_t>(points.shape(), points.shape() + points.ndim()));
-    const double* in = points.data();
-    double* o = out.mutable_data();
-    const py::ssize_t n = points.size() / 2;
-    {
-        py::gil_scoped_release release;
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const glm::dvec2 q = f(glm::dvec2(in[2 * i], in[2 * i + 1]));
-            o[2 * i] = q.x;
-            o[2 * i + 1] = q.y;
-        }
-    }
-    return out;
-}
-
 // ---- the objects -------------------------------------------------------------------------------
-
-struct Map {
-    codec::SamplingMap map;
-    std::optional<format::AnalyticMap> analytic;  // when built from parameters
-    std::optional<double> aspect;                 // width / height of the pictures it was made for, when known
-};
 
 struct File {
     format::ConusFile file;
@@ -258,133 +201,7 @@ PYBIND11_MODULE(_conus, m) {
     addSceneReaders(m);
     m.attr("DEFAULT_MAP_SIDE") = map_rules::kDefaultSide;
 
-    py::class_<Map, std::shared_ptr<Map>>(m, "Map", "A sampling map: a grid of distorted node positions (Equation 1)")
-        .def_static(
-            "identity", [](int columns, int rows) { return std::make_shared<Map>(Map{codec::SamplingMap::identity(columns, rows), {}, std::nullopt}); },
-            py::arg("columns") = map_rules::kDefaultSide, py::arg("rows") = map_rules::kDefaultSide)
-        .def_static(
-            "foci",
-            [](py::object foci, double aspect, int grid, const std::string& composition, const std::string& falloff) {
-                const std::vector<codec::Focus> f = fociFrom(foci);
-                codec::FociOptions options;
-                options.aspect = aspect;
-                options.columns = options.rows = grid;
-                options.falloff = codec::parseFalloff(falloff);
-                if (composition == "add") options.composition = codec::FociComposition::Add;
-                else if (composition != "density")
-                    throw Error(ErrorCode::InvalidArgument, "composition must be 'density' or 'add', not '" + composition + "'");
-                py::gil_scoped_release release;
-                codec::SamplingMap map = codec::buildFociMap(f, options);
-                return std::make_shared<Map>(Map{std::move(map), codec::toAnalytic(f, options.composition, options.falloff), aspect});
-            },
-            py::arg("foci"), py::arg("aspect") = 1.0, py::arg("grid") = map_rules::kDefaultSide, py::arg("composition") = "density",
-            py::arg("falloff") = "2",
-            "Circular foci (u, v, r, k): centre, radius as a fraction of the width, magnification; aspect: the pictures' "
-            "width / height (encode warns on another); falloff as `map foci --falloff` (\"2\": density smoothstepped "
-            "from r to 2r; \"1.5,log\", \"3,logr\")")
-        .def_static(
-            "springs",
-            [](const std::vector<std::tuple<double, double, double, double>>& strokes, int grid, int max_steps) {
-                codec::SpringSystem system(grid, grid);
-                for (const auto& [u, v, radius, strength] : strokes) system.addStroke({u, v, radius, strength});
-                py::gil_scoped_release release;
-                system.runUntilStable(max_steps);
-                return std::make_shared<Map>(Map{system.toMap(grid, grid), {}, std::nullopt});
-            },
-            py::arg("strokes"), py::arg("grid") = map_rules::kDefaultSide, py::arg("max_steps") = 200000,
-            "The paper's mass-spring brush: strokes (u, v, radius, strength), relaxed until stable")
-        .def_static(
-            "auto",
-            [](const py::array& importance, int grid, double min_density, double max_density, double smoothing) {
-                Image image = dataFrom(importance, "importance");
-                const double aspect = double(image.width) / image.height;
-                codec::AutoMapOptions options;
-                options.columns = options.rows = grid;
-                options.minDensity = min_density;
-                options.maxDensity = max_density;
-                options.smoothing = smoothing;
-                py::gil_scoped_release release;
-                return std::make_shared<Map>(Map{codec::buildAutoMap(image, options), {}, aspect});
-            },
-            py::arg("importance"), py::arg("grid") = map_rules::kDefaultSide, py::arg("min_density") = 0.25,
-            py::arg("max_density") = 16.0, py::arg("smoothing") = codec::AutoMapOptions{}.smoothing,
-            "A map whose density follows an importance image (H, W), smoothed over `smoothing` of the width")
-        .def_static(
-            "auto_for_frame_loss",
-            [](const py::array& importance, const py::array& source, std::pair<int, int> size, double frame_loss, int grid,
-               double max_density, double max_anisotropy) {
-                const Image image = dataFrom(importance, "importance");
-                const Image picture = pixelsFrom(source, std::nullopt, "source");
-                codec::AutoMapOptions options;
-                options.columns = options.rows = grid;
-                options.maxDensity = max_density;
-                options.maxAnisotropy = max_anisotropy;
-                py::gil_scoped_release release;
-                const codec::FrameErrorModel model(picture, size.first, size.second, image);
-                codec::BudgetResult r = codec::buildAutoMapForFrameLoss(image, model, frame_loss, options);
-                return std::make_tuple(std::make_shared<Map>(Map{std::move(r.map), {}, double(picture.width) / picture.height}),
-                                       r.minDensity, r.predicted.frameLoss,
-                                       r.predicted.roiGain);
-            },
-            py::arg("importance"), py::arg("source"), py::arg("size"), py::arg("frame_loss"),
-            py::arg("grid") = map_rules::kDefaultSide, py::arg("max_density") = 16.0, py::arg("max_anisotropy") = 0.0,
-            "The automatic map (max_anisotropy: 0 none, else as --max-anisotropy) with the lowest context floor whose predicted whole-frame loss against the uniform "
-            "image of `size` (width, height) stays within `frame_loss` dB: (map, floor, predicted loss, predicted ROI gain)")
-        .def_static(
-            "from_nodes",
-            [](const py::array& nodes) {
-                requireReal(nodes, "nodes");
-                const FloatArray a = FloatArray::ensure(nodes);
-                if (!a || a.ndim() != 3 || a.shape(2) != 2)
-                    throw Error(ErrorCode::InvalidArgument, "nodes must have shape (rows, columns, 2)");
-                format::GridNodes grid;
-                grid.rows = int(a.shape(0));
-                grid.columns = int(a.shape(1));
-                grid.xy.assign(a.data(), a.data() + a.size());
-                return std::make_shared<Map>(Map{codec::SamplingMap::fromGrid(grid), {}, std::nullopt});
-            },
-            py::arg("nodes"), "A map from its nodes' distorted positions, shape (rows, columns, 2); validated")
-        .def_property_readonly("columns", [](const Map& self) { return self.map.columns(); })
-        .def_property_readonly("rows", [](const Map& self) { return self.map.rows(); })
-        .def_property_readonly(
-            "nodes",
-            [](py::object self) {
-                const Map& map = self.cast<const Map&>();
-                py::array_t<float> view({py::ssize_t(map.map.rows()), py::ssize_t(map.map.columns()), py::ssize_t(2)},
-                                        reinterpret_cast<const float*>(map.map.nodes().data()), self);
-                py::detail::array_proxy(view.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-                return view;
-            },
-            "The nodes' distorted positions, (rows, columns, 2), a read-only view")
-        .def("distort", [](const Map& self, const py::array& p) { return mapPoints(p, [&](glm::dvec2 q) { return self.map.distort(q); }); },
-             py::arg("points"), "Equation 1 on an (..., 2) array of undistorted (u, v)")
-        .def("undistort",
-             [](const Map& self, const py::array& p) { return mapPoints(p, [&](glm::dvec2 q) { return self.map.undistort(q); }); },
-             py::arg("points"), "The exact inverse of distort on an (..., 2) array")
-        .def("density",
-             [](const Map& self, const py::array& p) {
-                 py::array both = mapPoints(p, [&](glm::dvec2 q) { return glm::dvec2(self.map.density(q), 0.0); });
-                 return py::object(both[py::make_tuple(py::ellipsis(), 0)]).cast<py::array>();
-             },
-             py::arg("points"), "Sampling density (area ratio) at undistorted points")
-        .def(
-            "measures",
-            [](const Map& self, double aspect) {
-                const codec::MapMeasures m = codec::measureMap(self.map, aspect);
-                py::dict d;
-                d["min_cell_density"] = m.minCellDensity;
-                d["max_cell_density"] = m.maxCellDensity;
-                d["max_anisotropy"] = m.maxAnisotropy;
-                d["most_anisotropic"] = py::make_tuple(m.mostAnisotropic.x, m.mostAnisotropic.y);
-                return d;
-            },
-            py::arg("aspect") = 1.0,
-            "What the map achieves on its own grid (as `conus info`): min/max cell density, the largest anisotropy of a "
-            "cell (its Jacobian's singular value ratio in pixels of an image of this width / height) and where")
-        .def("__repr__", [](const Map& self) {
-            return "<conus.Map " + std::to_string(self.map.columns()) + "x" + std::to_string(self.map.rows()) + " nodes" +
-                   (self.analytic ? ", " + self.analytic->kind : std::string()) + ">";
-        });
+    addMaps(m);
 
     py::class_<File, std::shared_ptr<File>>(m, "File", "A CoNUS file in memory: the CoNUS image, its map and attributes")
         .def_property_readonly(
@@ -449,6 +266,7 @@ PYBIND11_MODULE(_conus, m) {
             if (map) checkAspect(*map, source);
             const double aspect = double(source.width) / source.height;
             const auto [w, h] = sizeOr(size, source.width, source.height);
+            codec::checkEncodeMemory(source, w, h);  // before a map is built for it
             std::optional<codec::FociBudget> budget;
             if (!map) {
                 if (!foci.empty()) {
@@ -464,7 +282,13 @@ PYBIND11_MODULE(_conus, m) {
                     }
                     map = std::make_shared<Map>(Map{budget->map, codec::toAnalytic(budget->given, options.composition), aspect});
                 } else {
-                    map = std::make_shared<Map>(Map{codec::SamplingMap::identity(2, 2), {}, std::nullopt});
+                    // As `conus encode` with no focus, map or importance: the picture's own detail.
+                    warn("conus.encode: no foci or map: the samples follow the picture's own detail (conus.importance(pixels, "
+                         "'detail'), the context floor chosen for the whole frame); conus.uniform makes the uniform image");
+                    py::gil_scoped_release release;
+                    codec::BudgetResult own = codec::buildOwnDetailMap(
+                        source, pictureImportance(codec::ImportanceRule::Detail, source), w, h);
+                    map = std::make_shared<Map>(Map{std::move(own.map), {}, aspect});
                 }
             }
             codec::EncodeOptions options;
@@ -497,7 +321,8 @@ PYBIND11_MODULE(_conus, m) {
         "fix_nonfinite 'keep' (with a warning), 'black' or 'box3' as --fix-nonfinite;\n"
         "size (w, h) defaults to a quarter of each side; backend 'cpu', 'auto', 'egl' or 'osmesa'. As `conus encode`:\n"
         "foci hold a whole-frame loss budget (frame_loss dB, predicted) by lowering every k alike, with a\n"
-        "UserWarning that says so (exact_k=True keeps k; the File's .budget says what was given); fit = N\n"
+        "UserWarning that says so (exact_k=True keeps k; the File's .budget says what was given); with neither\n"
+        "foci nor a map the samples follow the picture's own detail (with a UserWarning); fit = N\n"
         "least-squares iterations fit the image to the decoder (default 2; 0: the filtered encode alone, `--fast`);\n"
         "fit_hold: its damping where the encoder low-passed a long footprint axis (`--fit-hold`)");
     m.def(
@@ -570,20 +395,6 @@ PYBIND11_MODULE(_conus, m) {
             return codec::psnr(pixelsFrom(a, std::nullopt, "a"), pixelsFrom(b, std::nullopt, "b"), peak);
         },
         py::arg("a"), py::arg("b"), py::arg("peak") = 1.0, "PSNR in dB of two images of the same shape");
-    m.def(
-        "importance",
-        [](py::object pixels, const std::string& kind, py::object channels) {
-            Image image = pixelsFrom(pixels, channelsFrom(channels), "pixels");
-            if (kind != "detail") throw Error(ErrorCode::InvalidArgument, "importance: kind '" + kind + "' is not 'detail'");
-            py::gil_scoped_release release;
-            // As `--importance detail`: on the display-encoded picture (cli/importance.cpp).
-            Image out = codec::detailImportance(imageio::displayEncoded(image));
-            py::gil_scoped_acquire acquire;
-            return toArray(std::move(out));
-        },
-        py::arg("pixels"), py::arg("kind") = "detail", py::arg("channels") = py::none(),
-        "The picture's own importance for Map.auto, as `--importance detail`: the gradient magnitude of its\n"
-        "display-encoded luminance, (H', W', 1) at most 1024 px a side");
     m.def(
         "read_image",
         [](const std::string& path) {

@@ -188,4 +188,21 @@ Image renderTerrain(Context& context, const Mesh& mesh, const Camera& camera, in
     return renderer.render(camera, width, height);
 }
 
+codec::GroundParams heightFieldGround(const format::ConusFile& file, const std::string& name) {
+    if (file.dataKind != format::DataKind::HeightField || !file.analytic || file.analytic->kind != "ground")
+        throw Error(ErrorCode::InvalidArgument, name + " is not a CoNUS height field with ground-map parameters");
+    return codec::groundFromAnalytic(*file.analytic);
+}
+
+Camera heightFieldCamera(const format::ConusFile& file, double aspect, const std::optional<TerrainView>& view) {
+    const Camera viewer = viewerCamera(heightFieldGround(file), codec::heightAt(file, {0.5, 1.0}), aspect);
+    if (!view) return viewer;
+    return Camera::perspective(view->eye, view->target, {0, 1, 0}, view->fovYDegrees, aspect, viewer.near(), viewer.far());
+}
+
+Image renderHeightFieldFrame(Context& context, const format::ConusFile& file, const Camera& camera, int width, int height) {
+    const glm::dvec2 extent = codec::fieldExtent(heightFieldGround(file));
+    return renderTerrain(context, codec::undistortHeightField(file, extent), camera, width, height);
+}
+
 }  // namespace conus::gl

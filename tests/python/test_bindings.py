@@ -132,6 +132,55 @@ def test_detail_importance_is_the_sobel_of_what_a_display_shows(asymmetric):
         conus.importance(asymmetric, "saliency")
 
 
+ASTRONAUT = "/usr/lib/python3/dist-packages/skimage/data/astronaut.png"  # python3-skimage (scripts/packages.txt)
+
+
+def test_faces_importance_is_the_clis(tmp_path, conus_bin):
+    """conus.importance(pixels, "faces") finds the astronaut's face through the library the CLI uses:
+    Map.auto of it has the nodes of `conus map auto --importance faces`; a picture without a face is
+    refused, as the CLI refuses it (exit 1)."""
+    pixels, channels = conus.read_image(ASTRONAUT)
+    faces = np.asarray(conus.importance(pixels, "faces", channels=channels))
+    h, w = faces.shape[:2]
+    assert faces.shape[2] == 1 and faces.dtype == np.float32
+    # The face is around (0.44, 0.23); the flag at the left edge and the suit are nothing.
+    assert faces[int(0.23 * h), int(0.44 * w), 0] == 1.0
+    assert faces[int(0.6 * h), int(0.1 * w), 0] == 0.0 and faces[int(0.85 * h), int(0.8 * w), 0] == 0.0
+    ours = conus.Map.auto(faces)
+    cli = str(tmp_path / "faces.exr")
+    run(conus_bin, "map", "auto", "--importance", "faces", "--image", ASTRONAUT, "-o", cli)
+    np.testing.assert_array_equal(ours.nodes, conus.read(cli).map.nodes)
+    face, suit = ours.density(np.array([[0.44, 0.23], [0.8, 0.85]]))
+    assert face > 3 * suit
+    flat = np.full((64, 96, 3), 0.4, np.float32)
+    with pytest.raises(conus.Error, match="no face found") as e:
+        conus.importance(flat, "faces")
+    assert e.value.code == "unsupported"
+    with pytest.raises(conus.Error, match="'detail' or 'faces'"):
+        conus.importance(flat, "saliency")
+
+
+def test_encode_without_foci_follows_the_pictures_detail_as_the_cli_does(tmp_path, conus_bin):
+    """No foci and no map: the map of the picture's own detail, as `conus encode` makes it (the same
+    nodes), so a detailed corner gets more samples than the flat rest; a UserWarning says so."""
+    h, w = 160, 240
+    picture = np.full((h, w, 3), 0.4, np.float32)
+    rng = np.random.default_rng(3)
+    picture[:50, 170:] = rng.random((50, 70, 3)).astype(np.float32)  # detail in the top-right corner only
+    src = str(tmp_path / "src.exr")
+    conus.write_image(src, picture)
+    pixels, channels = conus.read_image(src)
+    with pytest.warns(UserWarning, match="own detail"):
+        ours = conus.encode(pixels, channels=channels, size=(60, 40), fit=0)
+    corner, flat = ours.map.density(np.array([[205 / w, 25 / h], [60 / w, 110 / h]]))
+    assert corner > 2 * flat
+    assert ours.budget is None and ours.attributes.get("analytic") is None
+    cli = str(tmp_path / "cli.exr")
+    out = run(conus_bin, "encode", src, "-o", cli, "--size", "60x40", "--fast", "--backend", "cpu")
+    assert "detail, context floor" in out.stdout
+    np.testing.assert_array_equal(ours.map.nodes, conus.read(cli).map.nodes)
+
+
 def test_frame_loss_budget_sets_the_floor(asymmetric):
     h, w = asymmetric.shape[:2]
     importance = np.zeros((h, w), np.float32)

@@ -224,6 +224,7 @@ SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options)
     return std::move(*best);
 }
 
+// importance.h's detail rule, here beside importanceToDensity for the luminance they share.
 Image detailImportance(const Image& image) {
     if (image.empty()) invalid("the image is empty");
     const double scale = std::min(1.0, 1024.0 / std::max(image.width, image.height));

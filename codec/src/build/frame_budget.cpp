@@ -255,4 +255,9 @@ BudgetResult buildAutoMapForBestFrame(const Image& importance, const FrameErrorM
     return std::move(*best);
 }
 
+BudgetResult buildOwnDetailMap(const Image& source, const Image& detail, int width, int height, const AutoMapOptions& options) {
+    const FrameErrorModel model(source, width, height, detail);
+    return buildAutoMapForBestFrame(detail, model, kOwnDetailTileLoss, options);
+}
+
 }  // namespace conus::codec

@@ -10,6 +10,7 @@
 #include "conus/codec/mesh/shading.h"
 #include "conus/core/error.h"
 #include "conus/core/fpc.h"
+#include "conus/core/mesh.h"
 #include "conus/core/parallel.h"
 
 namespace conus::codec {
@@ -25,15 +26,6 @@ constexpr std::array<std::array<double, 6>, kCubeFaces> kFaceAxes{{
     {0, 0, 1, 0, 1, 0},
     {0, 0, -1, 0, 1, 0},
 }};
-
-AxisBox boundsOf(const Mesh& mesh) {
-    AxisBox box{glm::dvec3(std::numeric_limits<double>::max()), glm::dvec3(std::numeric_limits<double>::lowest())};
-    for (const glm::vec3& p : mesh.positions) {
-        box.lo = glm::min(box.lo, glm::dvec3(p));
-        box.hi = glm::max(box.hi, glm::dvec3(p));
-    }
-    return box;
-}
 
 bool finite(glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 

@@ -17,6 +17,8 @@
 
 #include <glm/glm.hpp>
 
+#include "conus/core/bounds.h"
+
 namespace conus {
 
 enum class Projection { Perspective, Orthographic };
@@ -72,5 +74,22 @@ private:
     Projection m_projection = Projection::Perspective;
     double m_near = 0.1, m_far = 1000.0;
 };
+
+// ---- Framing a scene ----
+
+struct ClipRange {
+    double near = 0, far = 0;
+};
+
+// The clip distances that hold all of `box` seen from `eye` looking along unit `forward`: its
+// corners' depths widened a little (far 2% past the farthest, near 2% short of the nearest but at
+// least far / 10^4, so depth keeps its precision). std::nullopt when the box lies entirely behind
+// the eye.
+std::optional<ClipRange> clipRangeFor(const AxisBox& box, glm::dvec3 eye, glm::dvec3 forward);
+
+// A perspective camera looking at the box's centre from `direction` (toward the eye; one along
+// `up` is replaced by (1, 0, 0.2)), as close as keeps the box's corners within 90% of the frame
+// and never inside its bounding sphere, clipped by clipRangeFor: a default view of a scene.
+Camera framingCamera(const AxisBox& box, glm::dvec3 direction, glm::dvec3 up, double aspect, double fovYDegrees = 40.0);
 
 }  // namespace conus

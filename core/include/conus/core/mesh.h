@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "conus/core/bounds.h"
 #include "conus/core/image.h"
 
 namespace conus {
@@ -33,5 +34,8 @@ void checkMesh(const Mesh& mesh, const char* what);
 // (unnormalized, so area-weighted) face normals of its triangles, counter-clockwise = outside.
 // A vertex no non-degenerate triangle touches gets (0, 0, 1).
 void computeVertexNormals(Mesh& mesh);
+
+// The box around the mesh's positions (bounds.h).
+inline AxisBox boundsOf(const Mesh& mesh) { return boundsOf(std::span<const glm::vec3>(mesh.positions)); }
 
 }  // namespace conus

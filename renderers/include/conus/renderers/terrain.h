@@ -11,6 +11,8 @@
 #pragma once
 
 #include <memory>
+#include <optional>
+#include <string>
 
 #include <glm/glm.hpp>
 
@@ -18,6 +20,7 @@
 #include "conus/core/camera.h"
 #include "conus/codec/depth/heightfield.h"
 #include "conus/core/image.h"
+#include "conus/format/container.h"
 #include "conus/renderers/context.h"
 
 namespace conus::gl {
@@ -57,5 +60,26 @@ private:
 // One frame: upload, draw, read back.
 Image renderTerrain(Context& context, const Mesh& mesh, const Camera& camera, int width,
                             int height, const TerrainLook& look = {});
+
+// ---- Frames of a CoNUS height field (`conus heightfield render`, `conus decode --camera`) ----
+
+// The ground map of a CoNUS height field, from its analytic parameters; throws
+// conus::Error(InvalidArgument), naming the file as `name`, unless `file` is a height field with them.
+codec::GroundParams heightFieldGround(const format::ConusFile& file, const std::string& name = "the file");
+
+// Where a frame is seen from: the eye, the point it looks at, the vertical field of view (degrees).
+struct TerrainView {
+    glm::dvec3 eye{0.0}, target{0.0};
+    double fovYDegrees = 50;
+};
+
+// The ground map's own viewer of `file` (viewerCamera, standing on the height at the middle of the
+// near edge), or `view` with that viewer's clip distances. `aspect` is the frame's width / height.
+Camera heightFieldCamera(const format::ConusFile& file, double aspect,
+                         const std::optional<TerrainView>& view = std::nullopt);
+
+// A frame of the CoNUS height field `file`: undistorted to a mesh over the field's extent
+// (codec::undistortHeightField) and rendered from `camera` (renderTerrain).
+Image renderHeightFieldFrame(Context& context, const format::ConusFile& file, const Camera& camera, int width, int height);
 
 }  // namespace conus::gl

@@ -15,6 +15,7 @@
 #pragma once
 
 #include "conus/codec/build/density_map.h"
+#include "conus/codec/build/importance.h"  // importance from the picture itself
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/image.h"
 #include "conus/core/map_rules.h"
@@ -47,10 +48,6 @@ DensityField importanceToDensity(const Image& importance, const AutoMapOptions& 
 // (InvalidArgument) naming the bounds this importance and grid can reach when it cannot.
 SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options = {});
 SamplingMap buildSeparableMap(const DensityField& target, int columns, int rows);
-
-// Local detail of an image: gradient magnitude of its luminance (one channel "Y"), computed at
-// most 1024 px a side; an importance source for `--importance detail`.
-Image detailImportance(const Image& image);
 
 // Pearson correlation between the density a map achieves and a target field (both sampled at the
 // field's cell centres): 1 means the map follows the target exactly (up to scale).

@@ -91,4 +91,14 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
 BudgetResult buildAutoMapForBestFrame(const Image& importance, const FrameErrorModel& model, double tileLossDb,
                                       AutoMapOptions options = {});
 
+// The predicted tile loss (dB) the map of the picture's own detail keeps to.
+inline constexpr double kOwnDetailTileLoss = 2.0;
+
+// What `conus encode` and Python's conus.encode make when given no focus, map or importance: the
+// samples follow the picture's own detail (`detail`: importance.h's detail rule on `source` as a
+// display shows it), the context floor buildAutoMapForBestFrame's within kOwnDetailTileLoss for a
+// CoNUS image of width x height.
+BudgetResult buildOwnDetailMap(const Image& source, const Image& detail, int width, int height,
+                               const AutoMapOptions& options = {});
+
 }  // namespace conus::codec

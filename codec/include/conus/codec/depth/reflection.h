@@ -23,6 +23,7 @@
 #include "conus/codec/build/foci.h"
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/mesh/raycast.h"
+#include "conus/core/bounds.h"
 #include "conus/core/image.h"
 
 namespace conus::codec {
@@ -48,9 +49,7 @@ struct ReflectionFace {
 format::ConusFile reflectionFaceFile(const ReflectionFace& face);
 ReflectionFace reflectionFaceFromFile(const format::ConusFile& file);
 
-struct AxisBox {
-    glm::dvec3 lo{0.0}, hi{0.0};
-};
+using conus::AxisBox;  // core/bounds.h
 
 struct ReflectionBakeOptions {
     glm::dvec3 centre{0.0};      // the reflector's centre (the faces' common eye)

@@ -1,6 +1,6 @@
 // DEM readers: the .npy header parser and the .npz (zip) archive access live here, the only
-// files of cli/ that touch libzip.
-#include "dem_io.h"
+// file that touches libzip.
+#include "conus/sceneio/dem_file.h"
 
 #include <zip.h>
 
@@ -15,12 +15,11 @@
 #include <sstream>
 #include <vector>
 
-#include "conus/codec/depth/heightfield.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
-#include "image_files.h"
+#include "conus/imageio/image_file.h"
 
-namespace conus::cli {
+namespace conus::sceneio {
 namespace {
 
 // A .npy header never needs more than this (NumPy writes a few hundred bytes); a larger one is
@@ -256,29 +255,27 @@ bool endsWith(const std::string& s, const std::string& suffix) {
     return tail == suffix;
 }
 
-}  // namespace
-
-Dem readDem(const std::string& source, double heightScale) {
+void checkHeightScale(double heightScale) {
     if (!(std::isfinite(heightScale) && heightScale != 0.0))
         throw Error(ErrorCode::InvalidArgument, "height scale " + std::to_string(heightScale) + " must be finite and non-zero");
+}
+
+}  // namespace
+
+Dem demFromHeights(Image heights, double heightScale, std::string description) {
+    checkHeightScale(heightScale);
     Dem dem;
-    std::smatch m;
-    if (std::regex_match(source, m, std::regex("procedural(?::(\\d+))?(?::(\\d+))?"))) {
-        codec::TerrainOptions options;
-        if (m[1].matched) options.width = options.height = std::stoi(m[1].str().substr(0, 6));
-        if (std::int64_t{options.width} * options.height > kMaxDemSamples)
-            throw Error(ErrorCode::InvalidArgument, "procedural terrain " + std::to_string(options.width) + "x" +
-                                                        std::to_string(options.height) + " holds more than the limit of " +
-                                                        std::to_string(kMaxDemSamples) + " height samples");
-        if (m[2].matched) options.seed = static_cast<std::uint32_t>(std::stoul(m[2].str().substr(0, 9)));
-        dem.heights = codec::generateTerrain(options);
-        if (heightScale != 1.0)
-            for (float& h : dem.heights.pixels) h = static_cast<float>(h * heightScale);
-        dem.description = "procedural terrain " + std::to_string(options.width) + "x" + std::to_string(options.height) +
-                          " seed " + std::to_string(options.seed);
-        checkHeights(dem.heights, dem.description);
-        return dem;
-    }
+    dem.heights = std::move(heights);
+    if (heightScale != 1.0)
+        for (float& h : dem.heights.pixels) h = static_cast<float>(h * heightScale);
+    dem.description = std::move(description);
+    checkHeights(dem.heights, dem.description);
+    return dem;
+}
+
+Dem readDem(const std::string& source, double heightScale) {
+    checkHeightScale(heightScale);
+    Dem dem;
     requireRegularFile(source);
     if (endsWith(source, ".npz")) {
         const auto arrays = readNpz(source);
@@ -326,7 +323,9 @@ Dem readDem(const std::string& source, double heightScale) {
                           " " + a.header.dtype;
         return dem;
     }
-    const Image image = readData(source);
+    imageio::ReadOptions raw;  // data: values as they are, never converted
+    raw.colorspace = Transfer::Raw;
+    const Image image = imageio::readImageFile(source, raw).image;
     if (std::int64_t{image.width} * image.height > kMaxDemSamples)
         throw Error(ErrorCode::LimitExceeded, source + ": " + std::to_string(image.width) + "x" + std::to_string(image.height) +
                                                   " holds more than the limit of " + std::to_string(kMaxDemSamples) +
@@ -344,4 +343,4 @@ Dem readDem(const std::string& source, double heightScale) {
     return dem;
 }
 
-}  // namespace conus::cli
+}  // namespace conus::sceneio

@@ -1,7 +1,7 @@
-// Face detection for `--importance faces`: OpenCV's Haar cascade (Debian's opencv-data). The only
-// file of cli/ that includes OpenCV; its exceptions become conus::Error here. Built as the module
-// libconus_faces (cli/CMakeLists.txt), which `conus` loads only when asked for faces: OpenCV's
-// detectors and their dnn stack no longer load with every command.
+// Face detection for the `faces` importance rule (importance.h): OpenCV's Haar cascade (Debian's
+// opencv-data). The only file that includes OpenCV; its exceptions become conus::Error here. Built
+// as the module libconus_faces (codec/CMakeLists.txt), loaded only when faces are asked for:
+// OpenCV's detectors and their dnn stack stay out of every other process.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -11,9 +11,9 @@
 #include <opencv2/objdetect.hpp>
 
 #include "conus/core/error.h"
-#include "importance.h"
+#include "conus/codec/build/importance.h"
 
-namespace conus::cli {
+namespace conus::codec {
 namespace {
 
 // Where Debian's opencv-data puts the frontal-face cascade.
@@ -71,9 +71,9 @@ Image detectFaceImportance(const Image& image) {
 }
 
 }  // namespace
-}  // namespace conus::cli
+}  // namespace conus::codec
 
 // The module's one exported symbol (importance.cpp loads it).
-extern "C" __attribute__((visibility("default"))) conus::cli::FaceImportanceFunction conusFaceImportance() {
-    return &conus::cli::detectFaceImportance;
+extern "C" __attribute__((visibility("default"))) conus::codec::FaceImportanceFunction conusFaceImportance() {
+    return &conus::codec::detectFaceImportance;
 }
