@@ -2,7 +2,7 @@
 """Regenerates the tables of bench/README.md from a run of the suites.
 
     bench/make_readme_tables.py [--build DIR] [--repetitions N] [--instructions] [--from-results] SUITE...
-    SUITE: codec, oiio, renderers, reflections, end-to-end, viewer, quality-defaults, quality, or all
+    SUITE: codec, oiio, renderers, reflections, terrain, end-to-end, viewer, quality-defaults, quality, or all
 
 Each suite's table sits between `<!-- table:SUITE -->` and `<!-- /table -->` in bench/README.md;
 this script rewrites that block only, stamped with the date, the commit, the machine and the
@@ -16,10 +16,11 @@ bench/end_to_end.sh and keeps its table; `viewer` times conus-view under Xvfb on
 image of a photograph, both decode paths; `quality` runs bench/quality.py, keeps the headline of
 its report and copies the report and its plots to bench/quality-plots/.
 
-`reflections` and `quality-defaults` write a result file first (build/bench-results/reflections.json:
-renderers_bench's JSON with the run's stamp; build/quality/targets.json from `bench/quality.py
---defaults-only`) and make the table from it; `--from-results` makes their tables from the files
-of an earlier run without running anything.
+`reflections`, `terrain` and `quality-defaults` write a result file first
+(build/bench-results/reflections.json: renderers_bench's JSON with the run's stamp;
+build/bench-results/terrain.json from bench/terrain_gain.py; build/quality/targets.json from
+`bench/quality.py --defaults-only`) and make the table from it; `--from-results` makes their tables
+from the files of an earlier run without running anything.
 """
 import argparse
 import json
@@ -31,6 +32,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+import terrain_gain
 from run_stamp import run_stamp, stamp_line
 
 BENCH = Path(__file__).resolve().parent
@@ -330,19 +332,19 @@ def replace_block(text, suite, body):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    names = [*SUITES, "reflections", "end-to-end", "viewer", "quality-defaults", "quality"]
+    names = [*SUITES, "reflections", "terrain", "end-to-end", "viewer", "quality-defaults", "quality"]
     parser.add_argument("suites", nargs="+", choices=[*names, "all"])
     parser.add_argument("--build", default=str(ROOT / "build"))
     parser.add_argument("--repetitions", type=int, default=7)
     parser.add_argument("--instructions", action="store_true", help="callgrind instruction counts (codec only)")
     parser.add_argument("--from-results", action="store_true",
-                        help="reflections, quality-defaults: the tables from the result files of an earlier run")
+                        help="reflections, terrain, quality-defaults: the tables from the result files of an earlier run")
     args = parser.parse_args()
     suites = names if "all" in args.suites else args.suites
     if args.instructions and set(suites) - {"codec"}:
         sys.exit("make_readme_tables.py: --instructions counts codec_bench only (valgrind stops at llvmpipe and libhwy)")
-    if args.from_results and set(suites) - {"reflections", "quality-defaults"}:
-        sys.exit("make_readme_tables.py: --from-results remakes the reflections and quality-defaults tables only")
+    if args.from_results and set(suites) - {"reflections", "terrain", "quality-defaults"}:
+        sys.exit("make_readme_tables.py: --from-results remakes the reflections, terrain and quality-defaults tables only")
     text = README.read_text()
     for suite in suites:
         if suite in SUITES:
@@ -351,6 +353,13 @@ def main():
             saved = Path(args.build) / RESULTS / "reflections.json"
             body = reflections_table(json.loads(saved.read_text()) if args.from_results
                                      else run_reflections(args.build, min(args.repetitions, 5)))
+        elif suite == "terrain":
+            saved = Path(args.build) / RESULTS / "terrain.json"
+            if not args.from_results:
+                run([sys.executable, str(BENCH / "terrain_gain.py"), "--conus", str(Path(args.build) / "bin" / "conus"),
+                     "--out", str(saved.parent)])
+                shutil.copy(saved.parent / "terrain-7-terrain-viewer.png", BENCH / "img" / "terrain-compare.png")
+            body = terrain_gain.table(json.loads(saved.read_text()))
         elif suite == "end-to-end":
             body = end_to_end_table(args.build, min(args.repetitions, 5))
         elif suite == "viewer":

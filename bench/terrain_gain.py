@@ -6,19 +6,22 @@ For each procedural seed, `conus heightfield encode` (the default terrain-fitted
 `--rows planar` for the paper's flat ground plane), then `conus heightfield render --compare` from
 the map's own viewer and from cameras moved back along the viewing direction, up, and sideways.
 Wall clock does not matter here; each row is a PSNR difference (CoNUS - uniform, dB, the frame
-against the full-resolution DEM's) measured in the same run. Writes build/bench-results/terrain.json,
-a Markdown table on stdout, and the compare pictures of the viewer pose next to the JSON.
+against the full-resolution DEM's) measured in the same run. Writes build/bench-results/terrain.json
+(stamped as bench/run_stamp.py stamps), a Markdown table on stdout (make_readme_tables.py terrain puts
+it in bench/README.md), and the compare pictures of the viewer pose (full | CoNUS | uniform) next to
+the JSON.
 
     bench/terrain_gain.py [--conus build/bin/conus] [--seeds 1,7,11] [--dem-size 1024] [--size 256x256]
 """
 import argparse
-import datetime
 import json
 import os
-import platform
 import re
 import subprocess
 import sys
+import time
+
+from run_stamp import run_stamp, stamp_line
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -55,6 +58,7 @@ def main():
     parser.add_argument("--out", default=os.path.join(ROOT, "build", "bench-results"))
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
+    stamp, start = run_stamp(), time.time()
     rows = []
     for seed in [int(s) for s in args.seeds.split(",")]:
         dem = f"procedural:{args.dem_size}:{seed}"
@@ -63,7 +67,8 @@ def main():
             run([args.conus, "heightfield", "encode", dem, "-o", exr, "--size", args.size, "--rows", kind, "-q"])
             viewer = None
             for name, back, up, sideways in POSES:
-                picture = os.path.join(args.out, f"terrain-{seed}-{kind}.png")
+                pose = "viewer" if name == "viewer" else "moved"
+                picture = os.path.join(args.out, f"terrain-{seed}-{kind}-{pose}.png")
                 command = [args.conus, "heightfield", "render", exr, "--compare", dem, "--size", args.frame, "-o", picture]
                 if viewer is not None:
                     command += ["--camera", ",".join(f"{x:.2f}" for x in moved(viewer, back, up, sideways))]
@@ -75,9 +80,9 @@ def main():
                              "gain_db": round(conus_db - uniform_db, 2)})
                 print(f"seed {seed} {kind:7s} {name:16s} CoNUS {conus_db:6.2f} dB  uniform {uniform_db:6.2f} dB  "
                       f"gain {conus_db - uniform_db:+.2f}", file=sys.stderr, flush=True)
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-    result = {"date": datetime.date.today().isoformat(), "commit": commit, "machine": platform.processor() or platform.machine(),
-              "method": f"PSNR of a {args.frame} frame against the full-resolution DEM's; {args.dem_size}^2 DEM, {args.size} height fields",
+    result = {"stamp": stamp, "seconds": time.time() - start, "seeds": args.seeds,
+              "method": f"PSNR of a {args.frame} frame against the full-resolution DEM's, {args.dem_size}² procedural DEMs "
+                        f"(seeds {args.seeds}), {args.size} height fields (deterministic)",
               "rows": rows}
     with open(os.path.join(args.out, "terrain.json"), "w") as f:
         json.dump(result, f, indent=1)
@@ -85,14 +90,17 @@ def main():
 
 
 def table(result):
+    """The README block: the stamp, then the gain (least .. most over the seeds) per pose."""
     poses = [p[0] for p in POSES]
-    lines = ["| rows | " + " | ".join(poses) + " |", "|---|" + "---|" * len(poses)]
+    lines = [stamp_line(result["stamp"], result["method"]), "",
+             "| gain over uniform, dB (least .. most) | " + " | ".join(poses) + " |", "|---|" + "---|" * len(poses)]
     for kind in ("terrain", "planar"):
         cells = []
         for pose in poses:
             gains = [r["gain_db"] for r in result["rows"] if r["rows"] == kind and r["pose"] == pose]
             cells.append(f"{min(gains):+.2f} .. {max(gains):+.2f}" if gains else "")
-        lines.append(f"| {kind} | " + " | ".join(cells) + " |")
+        label = "`--rows terrain` (default)" if kind == "terrain" else "`--rows planar` (the paper's ground plane)"
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 

@@ -98,6 +98,42 @@ void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
     fail(ErrorCode::Corrupt, path, "its PLY header has no end_header line");
 }
 
+// OFF files declare their vertex and face counts in the first line after the keyword, and Assimp
+// allocates the faces by the count before reading one (a 139-byte file asked for 61 GB): a count no
+// file of this size can hold (a vertex takes at least 6 bytes, a face 8) or one past the caps is
+// refused here.
+void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
+    std::ifstream in(path, std::ios::binary);
+    std::string token;
+    std::vector<std::string> tokens;
+    for (std::string line; tokens.size() < 4 && std::getline(in, line) && in.tellg() < 65536;) {
+        std::istringstream words(line.substr(0, line.find('#')));
+        while (tokens.size() < 4 && words >> token) tokens.push_back(token);
+    }
+    std::string ext = fs::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const bool keyword = !tokens.empty() && tokens[0].size() >= 3 && tokens[0].compare(tokens[0].size() - 3, 3, "OFF") == 0;
+    if (!keyword && ext != ".off") return;
+    const std::size_t first = keyword ? 1 : 0;
+    if (tokens.size() < first + 2) return;  // Assimp refuses what has no counts
+    long double counts[2] = {0, 0};
+    for (int i = 0; i < 2; ++i) {
+        std::istringstream number(tokens[first + std::size_t(i)]);
+        if (!(number >> counts[i])) return;  // not a count: Assimp refuses it itself
+    }
+    const char* names[2] = {"vertices", "faces"};
+    const long double leastBytes[2] = {6, 8};
+    const std::int64_t caps[2] = {options.maxVertices, options.maxTriangles};
+    for (int i = 0; i < 2; ++i) {
+        if (counts[i] * leastBytes[i] > static_cast<long double>(bytes))
+            fail(ErrorCode::Corrupt, path, "its OFF header declares " + numberText(double(counts[i])) + " " + names[i] +
+                                               " in a file of " + std::to_string(bytes) + " bytes");
+        if (counts[i] > static_cast<long double>(caps[i]))
+            fail(ErrorCode::LimitExceeded, path, "its OFF header declares " + numberText(double(counts[i])) + " " +
+                                                     names[i] + ", more than the limit of " + std::to_string(caps[i]));
+    }
+}
+
 // A binary glTF's header and chunk lengths, which Assimp allocates by: each inside the file.
 void checkGlbLengths(const std::string& path, std::uintmax_t bytes) {
     std::ifstream in(path, std::ios::binary);
@@ -235,6 +271,7 @@ void checkFile(const std::string& path, const MeshReadOptions& options) {
         fail(ErrorCode::LimitExceeded, path, std::to_string(bytes) + " bytes, more than the limit of " +
                                                  std::to_string(options.maxFileBytes));
     checkPlyCounts(path, bytes, options);
+    checkOffCounts(path, bytes, options);
     checkGlbLengths(path, bytes);
 }
 

@@ -168,6 +168,18 @@ TEST_F(SceneHostile, AGlbChunkLengthPastTheFileIsRefusedAtOnce) {
     }
 }
 
+// An OFF header's face count, which Assimp allocates by before reading a face (a fuzzer's 139-byte
+// file asked for 61 GB), is checked against the file's size and the caps first.
+TEST_F(SceneHostile, AnOffFaceCountPastTheFileIsRefusedAtOnce) {
+    const std::string file = (fs::path(CONUS_FUZZ_CORPUS) / "mesh" / "found-off-face-count.off").string();
+    Outcome r = run({"mesh", "render", file, "-o", path("x.exr"), "--size", "32x32"});
+    expectRefused(r, "mesh", "its OFF header declares");
+    expectBounded(r, 400);
+    write("big.off", "OFF\n3 2000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    r = run({"mesh", "render", path("big.off"), "-o", path("x.exr"), "--size", "32x32"});
+    expectRefused(r, "mesh", "faces in a file of");
+}
+
 TEST_F(SceneHostile, AnNpzBombIsRefusedBeforeInflating) {
     const std::string file = scene("npz_bomb_1GiB.npz");
     CONUS_REQUIRE(file);
