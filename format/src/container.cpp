@@ -67,7 +67,7 @@ void checkConusFileName(const std::string& path) {
 
 namespace {
 
-ConusFile load(const std::string& path, const ReadLimits& limits, bool readPixels) {
+ConusFile load(const std::string& path, const Limits& limits, bool readPixels) {
     ConusFile file;
     const detail::LoadResult result = detail::loadConusFile(path, limits, readPixels, file);
     if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.summary(), result.report.ruleNumbers());
@@ -76,11 +76,11 @@ ConusFile load(const std::string& path, const ReadLimits& limits, bool readPixel
 
 }  // namespace
 
-ConusFile readConusFile(const std::string& path, const ReadLimits& limits) { return load(path, limits, true); }
+ConusFile readConusFile(const std::string& path, const Limits& limits) { return load(path, limits, true); }
 
-ConusFile readConusHeader(const std::string& path, const ReadLimits& limits) { return load(path, limits, false); }
+ConusFile readConusHeader(const std::string& path, const Limits& limits) { return load(path, limits, false); }
 
-ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits, bool readPixels) {
+ValidationReport validateConusFile(const std::string& path, const Limits& limits, bool readPixels) {
     // The rules concern headers, the map and the chunk tables, never pixel values; reading the
     // pixels finds damaged compressed data, which only a decompression can see.
     ConusFile file;

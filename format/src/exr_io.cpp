@@ -597,7 +597,7 @@ static void useExrThreads() {
     });
 }
 
-LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool readPixels, ConusFile& out) {
+LoadResult loadConusFile(const std::string& path, const Limits& limits, bool readPixels, ConusFile& out) {
     useExrThreads();
     LoadResult result;
     ValidationReport& r = result.report;

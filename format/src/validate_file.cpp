@@ -80,7 +80,7 @@ void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport&
     }
 }
 
-void checkChannels(const PartModel& part, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
+void checkChannels(const PartModel& part, const Limits& limits, ValidationReport& r, HeaderCheck& hc) {
     const auto n = static_cast<std::int64_t>(part.channels.size());
     if (n < 1 || n > kMaxChannels) {
         r.add(Rule::V3, "part `conus` has " + std::to_string(n) + " channels; 1 to " + std::to_string(kMaxChannels) + " allowed");
@@ -101,7 +101,7 @@ void checkChannels(const PartModel& part, const ReadLimits& limits, ValidationRe
     }
 }
 
-void checkWindows(const PartModel& part, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
+void checkWindows(const PartModel& part, const Limits& limits, ValidationReport& r, HeaderCheck& hc) {
     const Box& dw = part.dataWindow;
     if (!(dw == part.displayWindow) || dw.minX != 0 || dw.minY != 0) {
         r.add(Rule::V4, "part `conus` dataWindow " + boxStr(dw) + " must equal displayWindow " + boxStr(part.displayWindow) +
@@ -130,7 +130,7 @@ void checkSourceAndKind(const HeaderModel& m, ValidationReport& r) {
     }
 }
 
-void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
+void checkMapPart(const HeaderModel& m, const Limits& limits, ValidationReport& r, HeaderCheck& hc) {
     const PartSlot& slot = m.slot(PartKind::SamplingMap);
     if (slot.count != 1) {
         r.add(Rule::V7, std::to_string(slot.count) + " parts are named `samplingmap`; exactly one is required");
@@ -302,7 +302,7 @@ void checkDisplayWindows(const HeaderModel& m, ValidationReport& r) {
 
 }  // namespace
 
-HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r) {
+HeaderCheck checkHeaderRules(const HeaderModel& m, const Limits& limits, ValidationReport& r) {
     HeaderCheck hc;
     if (m.slot(PartKind::Conus).index < 0) {
         r.add(Rule::V2, "not a CoNUS file: no part named `conus` among " + std::to_string(m.parts.size()) + " part(s)");
@@ -329,7 +329,7 @@ HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, Val
 ValidationReport validateConusFile(const ConusFile& file) {
     ValidationReport report;
     const detail::HeaderModel model = detail::modelOf(file);
-    detail::checkHeaderRules(model, ReadLimits{}, report);
+    detail::checkHeaderRules(model, Limits{}, report);
     // The in-memory image must hold what its header promises (V4 covers the pixel array).
     const Image& im = file.image;
     if (im.width >= 1 && im.height >= 1 &&
