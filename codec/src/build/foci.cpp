@@ -202,7 +202,7 @@ SamplingMap buildAddComposition(std::span<const Focus> foci, const FociOptions& 
                 grid.xy[2 * k] = static_cast<float>(p.x);
                 grid.xy[2 * k + 1] = static_cast<float>(p.y);
             }
-        if (scale == 0.0 || format::validateGrid(grid).ok()) return SamplingMap::fromGrid(grid);
+        if (scale == 0.0 || map_rules::isValidGrid(grid.columns, grid.rows, grid.xy)) return SamplingMap::fromGrid(grid);
     }
 }
 

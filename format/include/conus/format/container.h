@@ -113,7 +113,8 @@ ValidationReport validateConusFile(const std::string& path, const Limits& limits
 // Every violated rule of an in-memory file (structure, attributes, map geometry).
 ValidationReport validateConusFile(const ConusFile& file);
 // The sampling-map rules alone (node count, finite values, boundary, strictly convex cells with
-// the identity's orientation). Used by codec::SamplingMap so the rules live in one place.
+// the identity's orientation), rule by rule in words; whether a grid is valid is decided by
+// core/map_rules.h's isValidGrid, which this agrees with.
 ValidationReport validateGrid(const GridNodes& grid);
 
 const char* toString(PixelType);
