@@ -74,11 +74,6 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what) {
     return {v[0], v[1], v[2]};
 }
 
-format::Compression parseCompression(const std::string& text) {
-    if (const auto compression = format::parseName<format::Compression>(text)) return *compression;
-    invalid("compression '" + text + "' is not one of " + format::nameList<format::Compression>());
-}
-
 void addAllowDirOption(CLI::App& command, std::vector<std::string>& dirs) {
     command.add_option("--allow-dir", dirs,
                        "a folder the files a scene file names (buffers, material libraries, data files) may also lie in; "

@@ -19,7 +19,6 @@ struct Size {
 
 Size parseSize(const std::string& text);        // "1024x768"; each side in [1, 65536]
 codec::View parseView(const std::string& text);  // "u0,v0,u1,v1" with u0 < u1, v0 < v1, all finite
-format::Compression parseCompression(const std::string& text);  // zip | piz | dwaa | none
 
 // "x,y,z,lx,ly,lz,fovDeg": eye, look-at point, vertical field of view in degrees (what
 // `heightfield render` and `mesh render` take as --camera).

@@ -138,7 +138,7 @@ int runBakeRelief(const BakeOptions& o) {
     format::ConusFile file = codec::bakeRelief(source.heights, source.colour, map ? &*map : nullptr, options);
     baking.done();
     file.analytic = analytic;
-    file.compression = parseCompression(o.compression);
+    file.compression = parseEnum<format::Compression>(o.compression);
     Progress writing("write " + o.output);
     format::writeConusFile(o.output, file);
     writing.done();
@@ -262,7 +262,7 @@ CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
     relief->add_option("--colour,--color", o.colour, "colour image (default: a ramp by height and slope)");
     relief->add_option("--compression", o.compression, "zip | piz | dwaa | none")
         ->capture_default_str()
-        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
+        ->check(CLI::IsMember(enumNames<format::Compression>()));
     return relief;
 }
 

@@ -63,7 +63,7 @@ void printCamera(const Camera& c, const std::string& given) {
 }
 
 codec::GroundParams groundOf(const format::ConusFile& file, const std::string& name) {
-    if (file.dataKind != format::DataKind::HeightField || !file.analytic || file.analytic->kind != "ground")
+    if (file.dataKind != format::DataKind::HeightField || !file.analytic || !file.analytic->is(format::MapKind::Ground))
         throw Error(ErrorCode::InvalidArgument, name + " is not a CoNUS height field with ground-map parameters");
     return codec::groundFromAnalytic(*file.analytic);
 }
@@ -138,7 +138,7 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
     encode.add_option("--colour,--color", o.colour, "colour texture (default: a ramp by height and slope)");
     encode.add_option("--compression", o.compression, "zip | piz | dwaa | none")
         ->capture_default_str()
-        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
+        ->check(CLI::IsMember(enumNames<format::Compression>()));
     setExamples(encode, {"conus heightfield encode procedural -o terrain.exr",
                        "conus heightfield encode dem.tif --height-scale 800 -o terrain.exr --size 1024x1024 --eye-height 150",
                        "conus heightfield encode jacksboro_fault_dem.npz --colour ortho.png -o terrain.exr"});
@@ -177,7 +177,7 @@ int runEncode(const EncodeOptions& o) {
     options.progress = progress.callback();
     format::ConusFile file = codec::encodeHeightField(dem.heights, colour, options);
     progress.done();
-    file.compression = parseCompression(o.compression);
+    file.compression = parseEnum<format::Compression>(o.compression);
     file.sourceEncoding = encoding;
     format::writeConusFile(o.output, file);
     std::printf("wrote %s: %dx%d CoNUS height field of %s; field %.0f x %.0f m (eye %g m, near %g m, "
@@ -191,7 +191,7 @@ int runEncode(const EncodeOptions& o) {
 // ---- render ----
 
 struct RenderOptions {
-    std::string input, frame, cameraText, frameSize = "960x540", compare, backend = "auto", colour;
+    std::string input, frame, cameraText, frameSize = "960x540", compare, backend = enumName(gl::Backend::Auto), colour;
     double heightScale = 1;
 };
 

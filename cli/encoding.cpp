@@ -25,7 +25,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
         ->excludes(half);
     command.add_option("--compression", options.compression, "zip | piz | dwaa | none")
         ->default_val("zip")
-        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
+        ->check(CLI::IsMember(enumNames<format::Compression>()));
     addBackendOption(command, options.backend);
 }
 
@@ -39,7 +39,7 @@ void applyStorage(const StorageOptions& options, format::ConusFile& file) {
     const std::optional<SampleType> source = file.sourceEncoding.sampleType;
     const bool precise = source && *source != SampleType::Uint8 && *source != SampleType::Half;
     file.pixelType = options.full || (precise && !options.half) ? format::PixelType::Float : format::PixelType::Half;
-    file.compression = parseCompression(options.compression);
+    file.compression = parseEnum<format::Compression>(options.compression);
 }
 
 void checkConusOutput(const std::string& output, const std::string& input) {

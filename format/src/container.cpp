@@ -26,8 +26,8 @@ bool onlyMapRules(const ValidationReport& r) {
 namespace detail {
 
 CameraCheck describeCamera(const CameraAttributes& a) {
-    const std::optional<Projection> projection = parseProjection(a.projection);
-    if (!projection) return {std::nullopt, "projection `" + a.projection + "` is not perspective or orthographic"};
+    const std::optional<Projection> projection = tryParseEnum<Projection>(a.projection);
+    if (!projection) return {std::nullopt, "projection `" + a.projection + "` is not one of " + enumChoices<Projection>()};
     try {
         return {Camera::fromMatrices(a.worldToCamera, a.worldToNDC, *projection), {}};
     } catch (const Error& e) {
@@ -44,7 +44,7 @@ conus::Camera toCamera(const CameraAttributes& attributes) {
 }
 
 CameraAttributes toAttributes(const conus::Camera& camera) {
-    return {toString(camera.projection()), camera.worldToCamera(), camera.worldToNDC()};
+    return {enumName(camera.projection()), camera.worldToCamera(), camera.worldToNDC()};
 }
 
 void writeConusFile(const std::string& path, const ConusFile& file) {

@@ -57,10 +57,6 @@ bool optional(const HeaderModel& m, AttrMember<T> member, ValidationReport& r) {
     return (m.*member).present && need(m, member, r);
 }
 
-bool oneOf(const std::string& s, std::initializer_list<const char*> allowed) {
-    return std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return s == a; });
-}
-
 void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport& r) {
     if (const int n = m.slot(PartKind::Conus).count; n > 1) r.add(Rule::V2, std::to_string(n) + " parts are named `conus`; exactly one is allowed");
     if (part.type != "scanlineimage" && part.type != "tiledimage") {
@@ -125,8 +121,8 @@ void checkSourceAndKind(const HeaderModel& m, ValidationReport& r) {
                          std::to_string(kMaxImageSide) + "]");
         }
     }
-    if (need(m, &HeaderModel::dataKind, r) && !parseName<DataKind>(m.dataKind.value)) {
-        r.add(Rule::V6, "data kind `" + m.dataKind.value + "` is not one of image, heightfield, depthimage");
+    if (need(m, &HeaderModel::dataKind, r) && !tryParseEnum<DataKind>(m.dataKind.value)) {
+        r.add(Rule::V6, "data kind `" + m.dataKind.value + "` is not one of " + enumChoices<DataKind>());
     }
 }
 
@@ -159,6 +155,14 @@ void checkMapPart(const HeaderModel& m, const Limits& limits, ValidationReport& 
     }
 }
 
+// "0 (density), 1 (log), 2 (logr)": the falloff shapes as the file numbers them.
+std::string shapeNumbers() {
+    std::string list;
+    for (const auto& [shape, name] : kEnumNameTable<FociFalloffShape>.names)
+        list.append(list.empty() ? "" : ", ").append(std::to_string(static_cast<int>(shape))).append(" (").append(name).append(")");
+    return list;
+}
+
 // A foci map's transition: both falloff scalars or neither, the width in (1, kMaxFalloffWidth], the
 // shape one of the integers 0 .. kFalloffShapes - 1 (spec: Analytic-map parameters).
 void checkFalloffParams(const HeaderModel& m, ValidationReport& r) {
@@ -175,7 +179,7 @@ void checkFalloffParams(const HeaderModel& m, ValidationReport& r) {
                              numberText(map_rules::kMaxFalloffWidth, 9) + "]");
     }
     if (!(s >= 0 && s < map_rules::kFalloffShapes && s == std::floor(s))) {
-        r.add(Rule::V12, prefix + "falloffShape = " + numberText(s, 9) + " is not 0 (density), 1 (log) or 2 (logr)");
+        r.add(Rule::V12, prefix + "falloffShape = " + numberText(s, 9) + " is not one of " + shapeNumbers());
     }
 }
 
@@ -188,7 +192,7 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
     }
     if (!need(m, &HeaderModel::mapKind, r)) return;
     const std::string& kind = m.mapKind.value;
-    if (kind == "foci") {
+    if (kind == enumName(MapKind::Foci)) {
         if (need(m, &HeaderModel::foci, r)) {
             const std::vector<float>& f = m.foci.value;
             if (f.empty() || f.size() % 4 != 0) {
@@ -204,8 +208,8 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
                 }
             }
         }
-        if (need(m, &HeaderModel::composition, r) && !oneOf(m.composition.value, {"density", "add"})) {
-            r.add(Rule::V12, "composition `" + m.composition.value + "` is not density or add");
+        if (need(m, &HeaderModel::composition, r) && !tryParseEnum<FociComposition>(m.composition.value)) {
+            r.add(Rule::V12, "composition `" + m.composition.value + "` is not one of " + enumChoices<FociComposition>());
         }
         checkFalloffParams(m, r);
         // The pictures' width / height a map file's foci were made for (spec: Analytic-map parameters).
@@ -213,8 +217,8 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
             aspect != m.params.end() && !(aspect->second.value >= 1.0 / 64 && aspect->second.value <= 64))
             r.add(Rule::V12, std::string(specOf(&HeaderModel::params).name) + "aspect = " + numberText(aspect->second.value, 9) +
                                  " is not a width / height in [1/64, 64]");
-    } else if (kind != "ground") {
-        r.add(Rule::V12, "map kind `" + kind + "` is not foci or ground");
+    } else if (!tryParseEnum<MapKind>(kind)) {
+        r.add(Rule::V12, "map kind `" + kind + "` is not one of " + enumChoices<MapKind>());
     }
     const AttributeSpec& params = specOf(&HeaderModel::params);
     for (const auto& [name, a] : m.params) {
@@ -233,8 +237,8 @@ void checkCamera(const HeaderModel& m, ValidationReport& r) {
             r.add(Rule::V13, std::string(specOf(matrix).name) + " has a non-finite element");
         }
     }
-    if (need(m, &HeaderModel::projection, r) && !parseProjection(m.projection.value)) {
-        r.add(Rule::V13, "projection `" + m.projection.value + "` is not perspective or orthographic");
+    if (need(m, &HeaderModel::projection, r) && !tryParseEnum<Projection>(m.projection.value)) {
+        r.add(Rule::V13, "projection `" + m.projection.value + "` is not one of " + enumChoices<Projection>());
     } else if (!r.violates(Rule::V13)) {
         const CameraCheck check = describeCamera(CameraAttributes{m.projection.value, m.worldToCamera.value, m.worldToNDC.value});
         if (!check.problem.empty()) r.add(Rule::V13, check.problem);
@@ -245,8 +249,8 @@ void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r
     std::string kind = "none";  // absent means no depth
     if (optional(m, &HeaderModel::depthKind, r)) {
         kind = m.depthKind.value;
-        if (!parseName<DepthKind>(kind)) {
-            r.add(Rule::V14, "depth kind `" + kind + "` is not none, cameraDepth or height");
+        if (!tryParseEnum<DepthKind>(kind)) {
+            r.add(Rule::V14, "depth kind `" + kind + "` is not one of " + enumChoices<DepthKind>());
             return;
         }
     }
@@ -275,10 +279,10 @@ void checkDepthImage(const HeaderModel& m, ValidationReport& r) {
 }
 
 void checkColour(const HeaderModel& m, ValidationReport& r) {
-    if (optional(m, &HeaderModel::sourceTransfer, r) && !parseTransfer(m.sourceTransfer.value))
-        r.add(Rule::V16, "source transfer `" + m.sourceTransfer.value + "` is not linear, srgb or raw");
-    if (optional(m, &HeaderModel::sourceSampleType, r) && !parseSampleType(m.sourceSampleType.value))
-        r.add(Rule::V16, "source sample type `" + m.sourceSampleType.value + "` is not uint8, uint16, uint32, half or float");
+    if (optional(m, &HeaderModel::sourceTransfer, r) && !tryParseEnum<Transfer>(m.sourceTransfer.value))
+        r.add(Rule::V16, "source transfer `" + m.sourceTransfer.value + "` is not one of " + enumChoices<Transfer>());
+    if (optional(m, &HeaderModel::sourceSampleType, r) && !tryParseEnum<SampleType>(m.sourceSampleType.value))
+        r.add(Rule::V16, "source sample type `" + m.sourceSampleType.value + "` is not one of " + enumChoices<SampleType>());
     if (optional(m, &HeaderModel::chromaticities, r) &&
         !std::all_of(m.chromaticities.value.begin(), m.chromaticities.value.end(), [](float x) { return std::isfinite(x); }))
         r.add(Rule::V16, "chromaticities hold a non-finite value");

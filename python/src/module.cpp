@@ -151,12 +151,12 @@ struct File {
 py::dict attributesOf(const format::ConusFile& f) {
     py::dict a;
     a["source_size"] = py::make_tuple(f.sourceWidth, f.sourceHeight);
-    a["data_kind"] = format::toString(f.dataKind);
-    a["pixel_type"] = format::toString(f.pixelType);
-    a["compression"] = format::toString(f.compression);
+    a["data_kind"] = enumName(f.dataKind);
+    a["pixel_type"] = enumName(f.pixelType);
+    a["compression"] = enumName(f.compression);
     a["software"] = f.software;
-    a["transfer"] = toString(f.sourceEncoding.transfer);
-    if (f.sourceEncoding.sampleType) a["source_sample_type"] = toString(*f.sourceEncoding.sampleType);
+    a["transfer"] = enumName(f.sourceEncoding.transfer);
+    if (f.sourceEncoding.sampleType) a["source_sample_type"] = enumName(*f.sourceEncoding.sampleType);
     if (f.analytic) {
         py::dict analytic;
         analytic["kind"] = f.analytic->kind;
@@ -169,7 +169,7 @@ py::dict attributesOf(const format::ConusFile& f) {
     }
     if (f.depth.kind != format::DepthKind::None) {
         py::dict depth;
-        depth["kind"] = format::toString(f.depth.kind);
+        depth["kind"] = enumName(f.depth.kind);
         depth["units"] = f.depth.units;
         depth["near"] = f.depth.near;
         depth["far"] = f.depth.far;
@@ -185,7 +185,7 @@ const gl::Device& deviceFor(const std::string& backend) {
     static std::map<std::string, gl::Device> devices;
     auto it = devices.find(backend);
     if (it == devices.end())
-        it = devices.emplace(backend, gl::Device::choose(gl::parseBackend(backend), gl::CpuPath::Available, "image encode")).first;
+        it = devices.emplace(backend, gl::Device::choose(enumArgument<gl::Backend>(backend, "backend"), gl::CpuPath::Available, "image encode")).first;
     return it->second;
 }
 
@@ -270,14 +270,12 @@ PYBIND11_MODULE(_conus, m) {
                 options.aspect = aspect;
                 options.columns = options.rows = grid;
                 options.falloff = codec::parseFalloff(falloff);
-                if (composition == "add") options.composition = codec::FociComposition::Add;
-                else if (composition != "density")
-                    throw Error(ErrorCode::InvalidArgument, "composition must be 'density' or 'add', not '" + composition + "'");
+                options.composition = enumArgument<codec::FociComposition>(composition, "composition");
                 py::gil_scoped_release release;
                 codec::SamplingMap map = codec::buildFociMap(f, options);
                 return std::make_shared<Map>(Map{std::move(map), codec::toAnalytic(f, options.composition, options.falloff), aspect});
             },
-            py::arg("foci"), py::arg("aspect") = 1.0, py::arg("grid") = map_rules::kDefaultSide, py::arg("composition") = "density",
+            py::arg("foci"), py::arg("aspect") = 1.0, py::arg("grid") = map_rules::kDefaultSide, py::arg("composition") = enumName(codec::FociComposition::Density),
             py::arg("falloff") = "2",
             "Circular foci (u, v, r, k): centre, radius as a fraction of the width, magnification; aspect: the pictures' "
             "width / height (encode warns on another); falloff as `map foci --falloff` (\"2\": density smoothstepped "
@@ -474,7 +472,7 @@ PYBIND11_MODULE(_conus, m) {
             {
                 py::gil_scoped_release release;
                 Image encoded;
-                if (backend == "cpu") {
+                if (enumArgument<gl::Backend>(backend, "backend") == gl::Backend::Cpu) {
                     encoded = codec::encodeImage(source, map->map, options);
                 } else {
                     std::lock_guard<std::mutex> lock(g_deviceMutex);
@@ -523,7 +521,7 @@ PYBIND11_MODULE(_conus, m) {
             Image frame;
             {
                 py::gil_scoped_release release;
-                if (backend == "cpu") {
+                if (enumArgument<gl::Backend>(backend, "backend") == gl::Backend::Cpu) {
                     frame = codec::decodeImage(file.file.image, map->map, options);
                 } else {
                     std::lock_guard<std::mutex> lock(g_deviceMutex);

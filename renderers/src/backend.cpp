@@ -67,7 +67,7 @@ Context& Device::context() const {
 
 std::string Device::describe() const {
     if (!m_context) return "cpu";
-    return backendName(m_context->backend()) + ": " + m_context->renderer();
+    return std::string(enumName(m_context->backend())) + ": " + m_context->renderer();
 }
 
 }  // namespace conus::gl

@@ -126,10 +126,10 @@ TEST(Container, CompressionModes) {
     TempDir dir;
     for (Compression c : {Compression::None, Compression::Zip, Compression::Piz, Compression::Dwaa}) {
         for (PixelType t : {PixelType::Half, PixelType::Float}) {
-            SCOPED_TRACE(std::string(toString(c)) + " " + toString(t));
+            SCOPED_TRACE(std::string(enumName(c)) + " " + enumName(t));
             ConusFile f = validFile(t);
             f.compression = c;
-            const std::string path = dir.file(std::string(toString(c)) + toString(t) + ".exr");
+            const std::string path = dir.file(std::string(enumName(c)) + enumName(t) + ".exr");
             writeConusFile(path, f);
             const ConusFile g = readConusFile(path);
             EXPECT_EQ(g.compression, c);

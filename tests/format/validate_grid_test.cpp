@@ -180,10 +180,10 @@ TEST(Image, MakeImageAndChannelIndex) {
 }
 
 TEST(ToString, Names) {
-    EXPECT_STREQ(toString(PixelType::Half), "half");
-    EXPECT_STREQ(toString(Compression::Dwaa), "dwaa");
-    EXPECT_STREQ(toString(DataKind::HeightField), "heightfield");
-    EXPECT_STREQ(toString(DepthKind::CameraDepth), "cameraDepth");
+    EXPECT_STREQ(enumName(PixelType::Half), "half");
+    EXPECT_STREQ(enumName(Compression::Dwaa), "dwaa");
+    EXPECT_STREQ(enumName(DataKind::HeightField), "heightfield");
+    EXPECT_STREQ(enumName(DepthKind::CameraDepth), "cameraDepth");
 }
 
 }  // namespace

@@ -238,7 +238,7 @@ TEST(ViewRenderer, SrgbCurveAndToneMapsAgreeWithCoreOnBothPaths) {
             for (int x = 0; x < 64; x += 7)
                 for (int c = 0; c < 3; ++c) {
                     const float want = linearToSrgbDisplay(exposeAndToneMap(base.at(x, 20, c), 4.0f, toneMap));
-                    EXPECT_NEAR(shown.at(x, 20, c), want, 2e-3) << toString(toneMap) << (path == gl::DecodePath::Cpu ? " cpu" : " gpu");
+                    EXPECT_NEAR(shown.at(x, 20, c), want, 2e-3) << enumName(toneMap) << (path == gl::DecodePath::Cpu ? " cpu" : " gpu");
                 }
         }
     }

@@ -53,10 +53,12 @@ struct FocusParams {
 // How a map was built, kept so the same map can be rebuilt and shown (focus outlines, ground
 // plane). The grid in `samplingmap` is always the authority for decoding.
 struct AnalyticMap {
-    std::string kind;                       // "foci" or "ground" (spec/ lists the kinds)
+    std::string kind;                       // a MapKind's name (names.h; spec/ lists the kinds)
     std::vector<FocusParams> foci;          // kind "foci"
-    std::string composition;                // kind "foci": "density" or "add"
+    std::string composition;                // kind "foci": a FociComposition's name (names.h)
     std::map<std::string, double> scalars;  // other kinds' named parameters
+
+    bool is(MapKind k) const { return kind == enumName(k); }
 };
 
 // The camera as the file records it (rule V13): EXR's standard matrices and conus:projection, as
@@ -116,10 +118,5 @@ ValidationReport validateConusFile(const ConusFile& file);
 // the identity's orientation), rule by rule in words; whether a grid is valid is decided by
 // core/map_rules.h's isValidGrid, which this agrees with.
 ValidationReport validateGrid(const GridNodes& grid);
-
-const char* toString(PixelType);
-const char* toString(Compression);
-const char* toString(DataKind);
-const char* toString(DepthKind);
 
 }  // namespace conus::format
