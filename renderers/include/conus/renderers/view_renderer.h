@@ -25,6 +25,9 @@
 
 namespace conus::gl {
 
+// The grey conus-view draws around the image, in every channel (its shader gets it as kBackground).
+inline constexpr float kViewBackground = 0.11f;
+
 enum class ViewMode {
     Reconstructed,  // the conventional frame decoded from the CoNUS image (default)
     Raw,            // the CoNUS image itself, stretched over the view's undistorted rectangle
