@@ -74,6 +74,12 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what) {
     return {v[0], v[1], v[2]};
 }
 
+CLI::Option* addCompressionOption(CLI::App& command, std::string& compression) {
+    return command.add_option("--compression", compression, "how the file's pixels are compressed (dwaa: lossy)")
+        ->default_val(enumName(format::Compression::Zip))
+        ->check(CLI::IsMember(enumNames<format::Compression>()));
+}
+
 void addAllowDirOption(CLI::App& command, std::vector<std::string>& dirs) {
     command.add_option("--allow-dir", dirs,
                        "a folder the files a scene file names (buffers, material libraries, data files) may also lie in; "

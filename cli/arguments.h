@@ -34,6 +34,9 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "
 // so a bad value is a usage error (exit 2) instead of a silent fallback.
 CLI::Validator finiteRange(double low, double high, bool lowIncluded = false);
 
+// --compression (format::Compression's names; default zip) for the commands that write a CoNUS file.
+CLI::Option* addCompressionOption(CLI::App& command, std::string& compression);
+
 // --allow-dir DIR (repeatable): a folder, besides a scene file's own, that the files it names
 // (glTF buffers, material libraries, NRRD data files) may lie in (sceneio/named_files.h).
 void addAllowDirOption(CLI::App& command, std::vector<std::string>& dirs);

@@ -23,9 +23,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
     command.add_flag("--float", options.full,
                      "store colour channels as 32-bit float (default for 16-bit and float sources)")
         ->excludes(half);
-    command.add_option("--compression", options.compression, "zip | piz | dwaa | none")
-        ->default_val("zip")
-        ->check(CLI::IsMember(enumNames<format::Compression>()));
+    addCompressionOption(command, options.compression);
     addBackendOption(command, options.backend);
 }
 

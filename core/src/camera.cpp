@@ -96,7 +96,7 @@ Camera Camera::fromMatrices(const std::array<float, 16>& worldToCamera, const st
     const glm::dmat4 k = n * glm::inverse(c);
     const bool perspective = std::abs(k[2][3]) > 1e-12;  // w' depends on depth
     if (perspective != (projection == Projection::Perspective))
-        invalid(std::string("the matrices describe a ") + (perspective ? "perspective" : "orthographic") + " camera, not " +
+        invalid(std::string("the matrices describe a ") + enumName(perspective ? Projection::Perspective : Projection::Orthographic) + " camera, not " +
                 enumName(projection));
     // The clip depths where z'/w' is 0 and 1, when the matrix maps depth that way; else unbounded.
     double near = perspective ? 0.0 : -1e300, far = 1e300;

@@ -268,14 +268,15 @@ void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r
 
 // V17: a depth image's Z means something only through its camera (cameraDepth along its axis).
 void checkDepthImage(const HeaderModel& m, ValidationReport& r) {
-    if (!m.dataKind.present || m.dataKind.value != "depthimage") return;
+    if (!m.dataKind.present || m.dataKind.value != enumName(DataKind::DepthImage)) return;
     std::string missing;
     if (!m.worldToCamera.present) missing += kAttrWorldToCamera;
     if (!m.worldToNDC.present) missing += std::string(missing.empty() ? "" : ", ") + kAttrWorldToNDC;
     if (!m.projection.present) missing += std::string(missing.empty() ? "" : ", ") + kAttrProjection;
     if (!missing.empty()) r.add(Rule::V17, "a depth image needs its camera; missing " + missing);
-    const std::string kind = m.depthKind.present ? m.depthKind.value : "none";
-    if (kind != "cameraDepth") r.add(Rule::V17, "a depth image's conus:depthKind is " + kind + ", not cameraDepth");
+    const std::string kind = m.depthKind.present ? m.depthKind.value : enumName(DepthKind::None);
+    if (kind != enumName(DepthKind::CameraDepth))
+        r.add(Rule::V17, "a depth image's conus:depthKind is " + kind + ", not " + enumName(DepthKind::CameraDepth));
 }
 
 void checkColour(const HeaderModel& m, ValidationReport& r) {

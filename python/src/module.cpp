@@ -487,9 +487,9 @@ PYBIND11_MODULE(_conus, m) {
             return file;
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),
-        py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = codec::kDefaultEncodeFitIterations,
+        py::arg("channels") = py::none(), py::arg("backend") = enumName(gl::Backend::Cpu), py::arg("fit") = codec::kDefaultEncodeFitIterations,
         py::arg("fit_hold") = codec::kFitHoldLowPass, py::arg("frame_loss") = codec::kDefaultFrameLoss, py::arg("exact_k") = false,
-        py::arg("colorspace") = "auto", py::arg("fix_nonfinite") = "keep",
+        py::arg("colorspace") = kAutoColorspace, py::arg("fix_nonfinite") = enumName(imageio::NonFiniteRepair::Keep),
         "Encode pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file; float pixels are\n"
         "linear light, uint8/uint16 display-encoded codes (colorspace= 'srgb' or 'linear' overrides; docs/python.md);\n"
         "fix_nonfinite 'keep' (with a warning), 'black' or 'box3' as --fix-nonfinite;\n"
@@ -530,7 +530,7 @@ PYBIND11_MODULE(_conus, m) {
             }
             return toArray(std::move(frame));
         },
-        py::arg("file"), py::arg("view") = std::make_tuple(0.0, 0.0, 1.0, 1.0), py::arg("size") = py::none(), py::arg("backend") = "cpu",
+        py::arg("file"), py::arg("view") = std::make_tuple(0.0, 0.0, 1.0, 1.0), py::arg("size") = py::none(), py::arg("backend") = enumName(gl::Backend::Cpu),
         "A conventional frame of the rectangle view (u0, v0, u1, v1), at size (w, h) (default: the source's resolution)");
     m.def(
         "uniform",
@@ -546,8 +546,8 @@ PYBIND11_MODULE(_conus, m) {
             py::gil_scoped_acquire acquire;
             return toArray(std::move(small));
         },
-        py::arg("pixels"), py::arg("size") = py::none(), py::arg("fit") = 0, py::arg("colorspace") = "auto",
-        py::arg("fix_nonfinite") = "keep",
+        py::arg("pixels"), py::arg("size") = py::none(), py::arg("fit") = 0, py::arg("colorspace") = kAutoColorspace,
+        py::arg("fix_nonfinite") = enumName(imageio::NonFiniteRepair::Keep),
         "The uniform baseline (pixels as for encode): an area downsample to the same pixel count; fit = N > 0 fits it to its bilinear\n"
         "resize to the source's size (`conus uniform --fit --fit-iterations N`)");
     m.def(
@@ -602,8 +602,8 @@ PYBIND11_MODULE(_conus, m) {
             py::gil_scoped_release release;
             imageio::writeImageFile(path, image);
         },
-        py::arg("path"), py::arg("pixels"), py::arg("channels") = py::none(), py::arg("colorspace") = "auto",
-        py::arg("fix_nonfinite") = "keep",
+        py::arg("path"), py::arg("pixels"), py::arg("channels") = py::none(), py::arg("colorspace") = kAutoColorspace,
+        py::arg("fix_nonfinite") = enumName(imageio::NonFiniteRepair::Keep),
         "Write pixels (as for encode: float linear light, uint8/uint16 display codes) as an ordinary picture (8-bit\n"
         "sRGB for PNG/JPEG, half for EXR), atomically");
 }

@@ -66,7 +66,7 @@ Context& Device::context() const {
 }
 
 std::string Device::describe() const {
-    if (!m_context) return "cpu";
+    if (!m_context) return enumName(Backend::Cpu);
     return std::string(enumName(m_context->backend())) + ": " + m_context->renderer();
 }
 

@@ -64,7 +64,7 @@ struct AnalyticMap {
 // The camera as the file records it (rule V13): EXR's standard matrices and conus:projection, as
 // read, so that the validator can report on them. toCamera() gives the camera model they describe.
 struct CameraAttributes {
-    std::string projection = "perspective";  // "perspective" or "orthographic"
+    std::string projection = enumName(Projection::Perspective);  // a Projection's name
     std::array<float, 16> worldToCamera{};    // row-major, as EXR's standard attribute (M44f)
     std::array<float, 16> worldToNDC{};
 };
