@@ -62,9 +62,10 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what) {
     return {v[0], v[1], v[2]};
 }
 
-format::Compression parseCompression(const std::string& text) {
-    if (const auto compression = format::parseName<format::Compression>(text)) return *compression;
-    invalid("compression '" + text + "' is not one of " + format::nameList<format::Compression>());
+CLI::Option* addCompressionOption(CLI::App& command, std::string& compression) {
+    return command.add_option("--compression", compression, "how the file's pixels are compressed (dwaa: lossy)")
+        ->default_val(enumName(format::Compression::Zip))
+        ->check(CLI::IsMember(enumNames<format::Compression>()));
 }
 
 sceneio::Dem demFrom(const std::string& source, double heightScale) {

@@ -21,7 +21,6 @@ struct Size {
 
 Size parseSize(const std::string& text);        // "1024x768"; each side in [1, 65536]
 codec::View parseView(const std::string& text);  // "u0,v0,u1,v1" with u0 < u1, v0 < v1, all finite
-format::Compression parseCompression(const std::string& text);  // zip | piz | dwaa | none
 
 // "x,y,z,lx,ly,lz,fovDeg": eye, look-at point, vertical field of view in degrees (what
 // `heightfield render` and `mesh render` take as --camera).
@@ -35,5 +34,8 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "
 // The elevation model a DEM argument names: procedural[:SIZE[:SEED]] (codec's terrain, SIZE x SIZE
 // samples) or a file (sceneio::readDem), its heights times `heightScale`.
 sceneio::Dem demFrom(const std::string& source, double heightScale);
+
+// --compression (format::Compression's names; default zip) for the commands that write a CoNUS file.
+CLI::Option* addCompressionOption(CLI::App& command, std::string& compression);
 
 }  // namespace conus::cli

@@ -1,4 +1,4 @@
-// `--backend auto|egl|osmesa|cpu` on every command that renders. The choice itself is made in one
+// `--backend` (gl::Backend's names) on every command that renders. The choice itself is made in one
 // place, conus::gl::Device::choose (renderers/backend.h); this file only parses the option.
 #pragma once
 

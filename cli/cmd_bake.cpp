@@ -38,7 +38,7 @@ constexpr const char* kTabletSource = "tablet";
 constexpr const char* kDefaultText = "CoNUS|FLEXIBLE PINHOLE|CAMERA";
 
 struct BakeOptions {
-    std::string source, output, sizeText, colour, importance, text = kDefaultText, compression = "zip";
+    std::string source, output, sizeText, colour, importance, text = kDefaultText, compression = enumName(format::Compression::Zip);
     std::string tabletSize = "1024x768";
     std::vector<std::string> foci;
     bool uniform = false, exactK = false;
@@ -136,7 +136,7 @@ int runBakeRelief(const BakeOptions& o) {
     format::ConusFile file = codec::bakeRelief(source.heights, source.colour, map ? &*map : nullptr, options);
     baking.done();
     file.analytic = analytic;
-    file.compression = parseCompression(o.compression);
+    file.compression = parseEnum<format::Compression>(o.compression);
     Progress writing("write " + o.output);
     format::writeConusFile(o.output, file);
     writing.done();
@@ -258,9 +258,7 @@ CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
         ->capture_default_str()
         ->check(finiteRange(0, 1e9));
     relief->add_option("--colour,--color", o.colour, "colour image (default: a ramp by height and slope)");
-    relief->add_option("--compression", o.compression, "zip | piz | dwaa | none")
-        ->capture_default_str()
-        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
+    addCompressionOption(*relief, o.compression);
     return relief;
 }
 

@@ -24,7 +24,7 @@ namespace {
 
 struct DecodeCommandOptions {
     BatchOptions batch;
-    std::string viewText, sizeText, cameraText, backend = "auto";
+    std::string viewText, sizeText, cameraText, backend = enumName(gl::Backend::Auto);
     PictureOptions picture;
 };
 

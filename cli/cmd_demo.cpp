@@ -51,7 +51,7 @@ codec::Focus hottestRegion(const Image& importance, int width, int height) {
 }
 
 struct DemoOptions {
-    std::string out = "demo-out", input, importance, backend = "auto";
+    std::string out = "demo-out", input, importance, backend = enumName(gl::Backend::Auto);
     std::vector<std::string> foci;
     int size = 4096;
     double k = 4;

@@ -27,7 +27,8 @@ namespace {
 
 struct EncodeOptions {
     BatchOptions batch;
-    std::string mapFile, compose = "density", importance, method = "flow", falloff = kDefaultFalloff;
+    std::string mapFile, compose = enumName(format::FociComposition::Density), importance,
+        method = enumName(codec::AutoMethod::Flow), falloff = kDefaultFalloff;
     double minDensity = 0.25, maxDensity = 16, maxAnisotropy = 0;
     double frameLoss = codec::kDefaultFrameLoss;  // dB, predicted; --min-density instead sets an importance map's floor
     bool floorGiven = false;  // --min-density: no budget for importance maps
@@ -91,7 +92,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     fo.columns = fo.rows = o.grid;
     fo.aspect = double(source.width) / source.height;
     fo.maxAnisotropy = o.maxAnisotropy;
-    fo.composition = o.compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+    fo.composition = parseEnum<format::FociComposition>(o.compose);
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
     const int side = 256;
@@ -192,10 +193,10 @@ Command addEncodeCommand(CLI::App& root) {
         ->each([options](const std::string&) { options->frameLossGiven = true; });
     addExactKOption(*command, options->exactK)->needs("--focus");
     addMaxAnisotropyOption(*command, options->maxAnisotropy);
-    command->add_option("--method", options->method, "with --importance: flow (default) | separable")
-        ->check(CLI::IsMember({"flow", "separable"}));
-    command->add_option("--compose", options->compose, "how several foci combine: density (default) | add")
-        ->check(CLI::IsMember({"density", "add"}));
+    command->add_option("--method", options->method, "with --importance: how the map follows it")
+        ->capture_default_str()
+        ->check(CLI::IsMember(enumNames<codec::AutoMethod>()));
+    addComposeOption(*command, options->compose);
     addFalloffOption(*command, options->falloff)->needs("--focus");  // shapes foci only
     command->add_option("--grid", options->grid, "sampling-map nodes per side for --focus and --importance (default " + std::to_string(map_rules::kDefaultSide) + ")")
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));

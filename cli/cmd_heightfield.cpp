@@ -90,7 +90,7 @@ Frame renderFrame(gl::Context& context, const format::ConusFile& file, const std
 // ---- encode ----
 
 struct EncodeOptions {
-    std::string dem, output, sizeText = "512x512", colour, compression = "zip", rows = "terrain";
+    std::string dem, output, sizeText = "512x512", colour, compression = enumName(format::Compression::Zip), rows = "terrain";
     double eyeHeight = 150, near = 200, far = 0, fov = 0, heightScale = 1;  // far, fov: 0 until given
     int grid = 129;
 };
@@ -135,9 +135,7 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
     encode.add_option("--height-scale", o.heightScale, "multiplies the DEM's values (to metres)")
         ->capture_default_str();
     encode.add_option("--colour,--color", o.colour, "colour texture (default: a ramp by height and slope)");
-    encode.add_option("--compression", o.compression, "zip | piz | dwaa | none")
-        ->capture_default_str()
-        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
+    addCompressionOption(encode, o.compression);
     setExamples(encode, {"conus heightfield encode procedural -o terrain.exr",
                        "conus heightfield encode dem.tif --height-scale 800 -o terrain.exr --size 1024x1024 --eye-height 150",
                        "conus heightfield encode jacksboro_fault_dem.npz --colour ortho.png -o terrain.exr"});
@@ -177,7 +175,7 @@ int runEncode(const EncodeOptions& o) {
     options.progress = progress.callback();
     format::ConusFile file = codec::encodeHeightField(dem.heights, colour, options);
     progress.done();
-    file.compression = parseCompression(o.compression);
+    file.compression = parseEnum<format::Compression>(o.compression);
     file.sourceEncoding = encoding;
     format::writeConusFile(o.output, file);
     const bool fitted = file.analytic && !file.analytic->groundRows.empty();
@@ -192,7 +190,7 @@ int runEncode(const EncodeOptions& o) {
 // ---- render ----
 
 struct RenderOptions {
-    std::string input, frame, cameraText, frameSize = "960x540", compare, backend = "auto", colour;
+    std::string input, frame, cameraText, frameSize = "960x540", compare, backend = enumName(gl::Backend::Auto), colour;
     double heightScale = 1;
 };
 

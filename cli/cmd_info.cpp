@@ -26,7 +26,7 @@ int printBackends(bool json) {
     if (json) {
         nlohmann::ordered_json j = nlohmann::ordered_json::array();
         for (const auto& s : statuses)
-            j.push_back({{"backend", gl::backendName(s.backend)},
+            j.push_back({{"backend", enumName(s.backend)},
                          {"works", s.works},
                          {"renderer", s.renderer},
                          {"version", s.version},
@@ -35,7 +35,7 @@ int printBackends(bool json) {
         return 0;
     }
     for (const auto& s : statuses) {
-        std::printf("%-7s %-10s %s\n", gl::backendName(s.backend).c_str(), s.works ? "works" : "unavailable",
+        std::printf("%-7s %-10s %s\n", enumName(s.backend), s.works ? "works" : "unavailable",
                     s.works ? (s.renderer + (s.version.empty() ? "" : " (" + s.version + ")")).c_str() : "");
         if (!s.reason.empty()) std::printf("        %s\n", s.reason.c_str());
     }
@@ -97,12 +97,12 @@ nlohmann::ordered_json toJson(const std::string& input, const FileFacts& f) {
     nlohmann::ordered_json j;
     j["file"] = input;
     j["formatVersion"] = format::kFormatVersion;
-    j["dataKind"] = format::toString(file.dataKind);
+    j["dataKind"] = enumName(file.dataKind);
     j["image"] = {{"width", file.image.width},
                   {"height", file.image.height},
                   {"channels", f.channels},
-                  {"pixelType", format::toString(file.pixelType)},
-                  {"compression", format::toString(file.compression)}};
+                  {"pixelType", enumName(file.pixelType)},
+                  {"compression", enumName(file.compression)}};
     j["source"] = {{"width", file.sourceWidth}, {"height", file.sourceHeight}};
     j["pixelRatio"] = f.pixelRatio;
     j["samplingMap"] = {{"columns", f.map.columns()},
@@ -114,7 +114,7 @@ nlohmann::ordered_json toJson(const std::string& input, const FileFacts& f) {
                         {"mostAnisotropicAt", {f.measures.mostAnisotropic.x, f.measures.mostAnisotropic.y}}};
     if (file.analytic) {
         nlohmann::ordered_json a{{"kind", file.analytic->kind}};
-        if (file.analytic->kind == "foci") {
+        if (file.analytic->is(format::MapKind::Foci)) {
             a["composition"] = file.analytic->composition;
             for (const auto& focus : file.analytic->foci)
                 a["foci"].push_back({{"u", focus.u}, {"v", focus.v}, {"r", focus.r}, {"k", focus.k}});
@@ -132,14 +132,14 @@ nlohmann::ordered_json toJson(const std::string& input, const FileFacts& f) {
         if (f.camera->projection() == Projection::Perspective) j["camera"]["verticalFov"] = f.camera->verticalFovDegrees();
     }
     if (file.depth.kind != format::DepthKind::None)
-        j["depth"] = {{"kind", format::toString(file.depth.kind)},
+        j["depth"] = {{"kind", enumName(file.depth.kind)},
                       {"units", file.depth.units},
                       {"near", file.depth.near},
                       {"far", file.depth.far}};
     if (!file.software.empty()) j["software"] = file.software;
     const SourceEncoding& encoding = file.sourceEncoding;
-    nlohmann::ordered_json colour{{"sourceTransfer", toString(encoding.transfer)}};
-    if (encoding.sampleType) colour["sourceSampleType"] = toString(*encoding.sampleType);
+    nlohmann::ordered_json colour{{"sourceTransfer", enumName(encoding.transfer)}};
+    if (encoding.sampleType) colour["sourceSampleType"] = enumName(*encoding.sampleType);
     if (encoding.chromaticities) colour["chromaticities"] = *encoding.chromaticities;
     colour["iccProfileBytes"] = encoding.iccProfile.size();
     for (const MetadataItem& item : encoding.metadata)
@@ -151,7 +151,7 @@ nlohmann::ordered_json toJson(const std::string& input, const FileFacts& f) {
 void printColour(const SourceEncoding& encoding, bool verbose) {
     std::printf("  colour        %s%s%s\n",
                 encoding.transfer == Transfer::Raw ? "raw data (never converted)" : "linear light, associated alpha",
-                encoding.sampleType ? (std::string("; source ") + toString(encoding.transfer) + " " + toString(*encoding.sampleType)).c_str()
+                encoding.sampleType ? (std::string("; source ") + enumName(encoding.transfer) + " " + enumName(*encoding.sampleType)).c_str()
                                     : "",
                 encoding.iccProfile.empty() ? "" : (", ICC profile of " + std::to_string(encoding.iccProfile.size()) + " bytes").c_str());
     if (!verbose) return;
@@ -168,11 +168,11 @@ void printColour(const SourceEncoding& encoding, bool verbose) {
 void printText(const InfoOptions& o, const FileFacts& f) {
     const format::ConusFile& file = f.file;
     std::printf("%s: CoNUS file, format version %d, data kind %s\n", o.input.c_str(), format::kFormatVersion,
-                format::toString(file.dataKind));
+                enumName(file.dataKind));
     std::string channelList;
     for (const auto& c : f.channels) channelList += (channelList.empty() ? "" : ",") + c;
     std::printf("  CoNUS image   %d x %d, channels %s, %s, %s compression\n", file.image.width, file.image.height,
-                channelList.c_str(), format::toString(file.pixelType), format::toString(file.compression));
+                channelList.c_str(), enumName(file.pixelType), enumName(file.compression));
     printColour(file.sourceEncoding, o.verbose);
     std::printf("  source        %d x %d (CoNUS image holds %.2f%% of its pixels)\n", file.sourceWidth, file.sourceHeight,
                 100.0 * f.pixelRatio);
@@ -182,7 +182,7 @@ void printText(const InfoOptions& o, const FileFacts& f) {
                 f.measures.maxAnisotropy, f.measures.mostAnisotropic.x, f.measures.mostAnisotropic.y);
     if (file.analytic) {
         std::printf("  analytic map  %s", file.analytic->kind.c_str());
-        if (file.analytic->kind == "foci") {
+        if (file.analytic->is(format::MapKind::Foci)) {
             std::printf(" (%s composition)", file.analytic->composition.c_str());
             for (const auto& focus : file.analytic->foci)
                 std::printf("\n    focus u=%g v=%g r=%g k=%g", focus.u, focus.v, focus.r, focus.k);
@@ -192,13 +192,13 @@ void printText(const InfoOptions& o, const FileFacts& f) {
     }
     if (f.camera) {
         const glm::dvec3 eye = f.camera->eye(), forward = f.camera->forward();
-        std::printf("  camera        %s, eye (%g, %g, %g), looking along (%.4g, %.4g, %.4g)", toString(f.camera->projection()),
+        std::printf("  camera        %s, eye (%g, %g, %g), looking along (%.4g, %.4g, %.4g)", enumName(f.camera->projection()),
                     eye.x, eye.y, eye.z, forward.x, forward.y, forward.z);
         if (f.camera->projection() == Projection::Perspective) std::printf(", vertical fov %.4g deg", f.camera->verticalFovDegrees());
         std::printf("\n");
     }
     if (file.depth.kind != format::DepthKind::None)
-        std::printf("  depth         %s in [%g, %g] %s\n", format::toString(file.depth.kind), file.depth.near, file.depth.far,
+        std::printf("  depth         %s in [%g, %g] %s\n", enumName(file.depth.kind), file.depth.near, file.depth.far,
                     file.depth.units.c_str());
     if (!o.densityPng.empty()) std::printf("  density       written to %s\n", o.densityPng.c_str());
 }

@@ -236,7 +236,7 @@ void runGround(const GroundOptions& o) {
 
 struct FociOptions {
     std::vector<std::string> foci;
-    std::string composition = "density", falloff = kDefaultFalloff;
+    std::string composition = enumName(format::FociComposition::Density), falloff = kDefaultFalloff;
     int grid = map_rules::kDefaultSide;
     double aspect = 1.0, maxAnisotropy = 0;
     bool exactK = false;
@@ -246,8 +246,7 @@ struct FociOptions {
 void addFociOptions(CLI::App& command, FociOptions& o) {
     addMaxAnisotropyOption(command, o.maxAnisotropy);
     command.add_option("--focus", o.foci, "focus u,v,r,k (repeat for several)")->required();
-    command.add_option("--compose", o.composition, "how several foci combine: density (default) | add")
-        ->check(CLI::IsMember({"density", "add"}));
+    addComposeOption(command, o.composition);
     addFalloffOption(command, o.falloff);
     command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     command.add_option("--aspect", o.aspect, "image width / height, so foci are circular in pixels (default 1)");
@@ -261,7 +260,7 @@ void runFoci(const FociOptions& o) {
     fo.columns = fo.rows = o.grid;
     fo.aspect = o.aspect;
     fo.maxAnisotropy = o.maxAnisotropy;
-    fo.composition = o.composition == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+    fo.composition = parseEnum<format::FociComposition>(o.composition);
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(list.size(), "focus", "foci") + ")");
     // No picture to predict a loss on: the context keeps the default floor (foci_budget.h).
@@ -277,7 +276,7 @@ void runFoci(const FociOptions& o) {
 // ---- auto ----
 
 struct AutoOptions {
-    std::string importance, image, method = "flow";
+    std::string importance, image, method = enumName(codec::AutoMethod::Flow);
     double minDensity = 0.25, maxDensity = 16, maxAnisotropy = 0;
     int grid = map_rules::kDefaultSide;
     OutputOptions out;
@@ -291,8 +290,9 @@ void addAutoOptions(CLI::App& command, AutoOptions& o) {
         ->required();
     command.add_option("--image", o.image, "the picture that 'detail' and 'faces' look at");
     addDensityBoundOptions(command, o.minDensity, o.maxDensity);
-    command.add_option("--method", o.method, "flow (2-D, default) | separable (baseline)")
-        ->check(CLI::IsMember({"flow", "separable"}));
+    command.add_option("--method", o.method, "how the map follows the importance: 2-D flow, or separable (the baseline)")
+        ->capture_default_str()
+        ->check(CLI::IsMember(enumNames<codec::AutoMethod>()));
     command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addOutputOptions(command, o.out);
 }

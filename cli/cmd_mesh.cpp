@@ -46,7 +46,7 @@ constexpr const char* kCity = "city";
 
 // What render and animate share.
 struct MeshOptions {
-    std::string model, sizeText = "512x512", cameraText, upText = "0,1,0", backend = "auto", units = "m";
+    std::string model, sizeText = "512x512", cameraText, upText = "0,1,0", backend = enumName(gl::Backend::Auto), units = "m";
     double time = 0, maxEdge = 0.5;
     int samples = 4, grid = map_rules::kDefaultSide;
     std::vector<int> track;
@@ -54,7 +54,7 @@ struct MeshOptions {
     double trackRadius = 0.05, trackK = 3;  // a car is small: a small, moderate focus keeps the context
     // animate: add, smooth from frame to frame (tests/renderers/mesh_sequence_test.cpp); render sets
     // density, as encode, volume and map compose foci.
-    std::string compose = "add";
+    std::string compose = enumName(format::FociComposition::Add);
 };
 
 // --camera and --up as given (checked before any work).
@@ -149,9 +149,7 @@ void addSharedOptions(CLI::App& command, MeshOptions& o, bool withCamera) {
     command.add_option("--track-k", o.trackK, "--track: each focus's magnification")
         ->capture_default_str()
         ->check(finiteRange(1, map_rules::kMaxMagnification, true));
-    command.add_option("--compose", o.compose, "how foci combine: density | add")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"density", "add"}));
+    addComposeOption(command, o.compose);
     command.add_option("--grid", o.grid, "sampling-map nodes per side for --focus and --track")
         ->capture_default_str()
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
@@ -386,7 +384,7 @@ CLI::App* addRender(CLI::App& command, RenderOptions& r) {
         ->excludes("--map")
         ->excludes("--track");
     render->add_flag("--reference", r.reference, "the exact CPU reference (Embree ray casting) instead of the GPU");
-    r.mesh.compose = "density";
+    r.mesh.compose = enumName(format::FociComposition::Density);
     addSharedOptions(*render, r.mesh, true);
     addAllowDirOption(*render, r.mesh.allowDirs);
     return render;

@@ -26,7 +26,7 @@ namespace conus::cli {
 namespace {
 
 struct RenderOptions {
-    std::string input, output, cameraText, sizeText = "960x720", lightText = "-0.4,0.8,-0.45", backend = "auto";
+    std::string input, output, cameraText, sizeText = "960x720", lightText = "-0.4,0.8,-0.45", backend = enumName(gl::Backend::Auto);
     bool shadows = false;
     double step = 1.0;
 };
@@ -75,8 +75,8 @@ int runRenderRelief(const RenderOptions& o) {
 // --- reflection -------------------------------------------------------------------------------
 
 struct ReflectionRenderText {
-    std::string asset, scene, output, cameraText, sizeText = "640x480", reflector = "sphere", at, normal = "0,0,1",
-                backend = "auto";
+    std::string asset, scene, output, cameraText, sizeText = "640x480", at, normal = "0,0,1", backend = enumName(gl::Backend::Auto);
+    std::string reflector = enumName(codec::Reflector::Kind::Sphere);
     std::vector<std::string> allowDirs;
     double radius = 0.5, step = 1.0;
     bool reference = false;
@@ -89,7 +89,7 @@ int runRenderReflection(const ReflectionRenderText& o) {
     if (o.cameraText.empty()) throw Error(ErrorCode::InvalidArgument, "--camera is required (x,y,z,lx,ly,lz,fovDeg)");
     const CameraText given = parseCamera(o.cameraText);
     codec::ReflectionFrameOptions options;
-    options.reflector.kind = o.reflector == "plane" ? codec::Reflector::Kind::Plane : codec::Reflector::Kind::Sphere;
+    options.reflector.kind = parseEnum<codec::Reflector::Kind>(o.reflector);
     options.reflector.radius = o.radius;
     options.reflector.normal = parseVector3(o.normal, "--normal");
     if (!(glm::length(options.reflector.normal) > 0)) throw Error(ErrorCode::InvalidArgument, "--normal is the zero vector");
@@ -142,7 +142,9 @@ CLI::App* addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
     reflection->add_option("-o,--output", o.output, "frame (.png, .exr, ...)")->required();
     reflection->add_option("--camera", o.cameraText, "x,y,z,lx,ly,lz,fovDeg")->required();
     reflection->add_option("--size", o.sizeText, "frame size WxH")->capture_default_str();
-    reflection->add_option("--reflector", o.reflector, "sphere | plane")->capture_default_str()->check(CLI::IsMember({"sphere", "plane"}));
+    reflection->add_option("--reflector", o.reflector, "the mirror's shape")
+        ->capture_default_str()
+        ->check(CLI::IsMember(enumNames<codec::Reflector::Kind>()));
     reflection->add_option("--at", o.at, "the reflector's centre x,y,z (default: the asset's centre)");
     reflection->add_option("--radius", o.radius, "sphere radius, or half the plane mirror's side")
         ->capture_default_str()

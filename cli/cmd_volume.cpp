@@ -38,10 +38,10 @@ namespace {
 
 struct VolumeOptions {
     std::string volume, output, picture, sizeText = "512x512", cameraText, upText = "0,-1,0", tf = codec::TransferFunction::kDefaultPreset,
-                                         rangeText, backend = "auto", units = "voxel", mapFile;
+                                         rangeText, backend = enumName(gl::Backend::Auto), units = "voxel", mapFile;
     std::vector<std::string> foci, allowDirs;
     int grid = map_rules::kDefaultSide;
-    std::string compose = "density";
+    std::string compose = enumName(format::FociComposition::Density);
     double step = 0.5, depthOpacity = 0.5;
     bool uniform = false, noJitter = false;
 };
@@ -248,8 +248,8 @@ Command addVolumeCommand(CLI::App& root) {
          "conus volume render brain.den -o brain.exr --tf bone --size 640x480 --uniform  # the uniform baseline",
          "conus volume render raw:256x256x128:uint16:0.8:ct.raw -o ct.exr --tf grey --range 0,4095  # a raw brick"});
     render->add_option("volume", o->volume,
-                       "file.vdb | file.nrrd | file.nhdr | file.den | raw:WxHxD:uint8|uint16|float32[:spacing]:path | "
-                       "procedural:marschner-lobb[:n] | procedural:shepp-logan[:n]")
+                       "file.vdb | file.nrrd | file.nhdr | file.den | " + sceneio::rawVolumeForm() +
+                           " | procedural:marschner-lobb[:n] | procedural:shepp-logan[:n]")
         ->required();
     render->add_option("-o,--output", o->output, "the CoNUS file to write (.exr)")->required();
     render->add_option("--picture", o->picture, "also write the CoNUS image's colour as a picture (PNG)");
@@ -276,9 +276,7 @@ Command addVolumeCommand(CLI::App& root) {
     render->add_option("--grid", o->grid, "sampling-map nodes per side for --focus")
         ->capture_default_str()
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
-    render->add_option("--compose", o->compose, "how foci combine: density | add")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"density", "add"}));
+    addComposeOption(*render, o->compose);
     render->add_flag("--uniform", o->uniform, "render the uniform image of the same pixel count (the baseline)");
     render->add_option("--units", o->units, "the volume's length unit, recorded as the depth's units")->capture_default_str();
     addBackendOption(*render, o->backend, gl::CpuPath::Available);

@@ -23,9 +23,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
     command.add_flag("--float", options.full,
                      "store colour channels as 32-bit float (default for 16-bit and float sources)")
         ->excludes(half);
-    command.add_option("--compression", options.compression, "zip | piz | dwaa | none")
-        ->default_val("zip")
-        ->check(CLI::IsMember(format::namesOf<format::Compression>()));
+    addCompressionOption(command, options.compression);
     addBackendOption(command, options.backend);
 }
 
@@ -39,7 +37,7 @@ void applyStorage(const StorageOptions& options, format::ConusFile& file) {
     const std::optional<SampleType> source = file.sourceEncoding.sampleType;
     const bool precise = source && *source != SampleType::Uint8 && *source != SampleType::Half;
     file.pixelType = options.full || (precise && !options.half) ? format::PixelType::Float : format::PixelType::Half;
-    file.compression = parseCompression(options.compression);
+    file.compression = parseEnum<format::Compression>(options.compression);
 }
 
 void checkConusOutput(const std::string& output, const std::string& input) {

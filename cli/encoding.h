@@ -20,8 +20,8 @@ namespace conus::cli {
 struct StorageOptions {
     std::string sizeText;  // "WxH"; empty: a quarter of each source side (1/16 of the pixels)
     bool half = false, full = false;  // neither: float for 16-bit and float sources, else half
-    std::string compression = "zip";
-    std::string backend = "auto";
+    std::string compression = enumName(format::Compression::Zip);
+    std::string backend = enumName(gl::Backend::Auto);
 };
 
 void addStorageOptions(CLI::App& command, StorageOptions& options);

@@ -10,26 +10,29 @@
 namespace conus::cli {
 
 void addSourceOptions(CLI::App& command, SourceOptions& options) {
+    std::vector<std::string> colorspaces{kFromTheFile};
+    for (const std::string& name : enumNames<Transfer>()) colorspaces.push_back(name);
     command.add_option("--input-colorspace", options.colorspace,
-                       "what the input's values are: auto (default: 8/16-bit files sRGB, float files linear), "
-                       "srgb, linear, or raw (data, never converted)")
-        ->check(CLI::IsMember({"auto", "srgb", "linear", "raw"}));
+                       "what the input's values are; " + std::string(kFromTheFile) + ": 8/16-bit files " +
+                           enumName(Transfer::Srgb) + ", float files " + enumName(Transfer::Linear) + "; " +
+                           enumName(Transfer::Raw) + ": data, never converted")
+        ->capture_default_str()
+        ->check(CLI::IsMember(colorspaces));
     command.add_flag("--no-auto-orient", options.noAutoOrient,
                      "keep the stored frame instead of applying the EXIF orientation");
     command.add_option("--fix-nonfinite", options.fixNonFinite,
-                       "NaN/Inf in the input: keep (default, with a warning), black (0) or box3 (mean of finite neighbours)")
-        ->check(CLI::IsMember({"keep", "black", "box3"}));
+                       "NaN/Inf in the input: kept with a warning, made 0, or the mean of their finite neighbours")
+        ->capture_default_str()
+        ->check(CLI::IsMember(enumNames<imageio::NonFiniteRepair>()));
     command.add_option("--part", options.part, "the part of a multi-part input to read, by name or index (default: the first)");
 }
 
 imageio::ImageFile readSource(const std::string& path, const SourceOptions& options) {
     imageio::ReadOptions read;
-    if (options.colorspace != "auto") read.colorspace = parseTransfer(options.colorspace);
+    if (options.colorspace != kFromTheFile) read.colorspace = parseEnum<Transfer>(options.colorspace);
     read.autoOrient = !options.noAutoOrient;
     read.part = options.part;
-    read.repair = options.fixNonFinite == "black"  ? imageio::NonFiniteRepair::Black
-                  : options.fixNonFinite == "box3" ? imageio::NonFiniteRepair::Box3
-                                                   : imageio::NonFiniteRepair::Keep;
+    read.repair = parseEnum<imageio::NonFiniteRepair>(options.fixNonFinite);
     Progress progress("read " + path);
     imageio::ImageFile file = imageio::readImageFile(path, read);
     progress.done();
@@ -40,7 +43,8 @@ imageio::ImageFile readSource(const std::string& path, const SourceOptions& opti
     if (info.nonFinite > 0)
         warn(path + " holds " + plural(static_cast<std::size_t>(info.nonFinite), "NaN or infinite value", "NaN or infinite values") +
              (read.repair == imageio::NonFiniteRepair::Keep
-                  ? "; filtering spreads them to their neighbours (repair with --fix-nonfinite box3|black)"
+                  ? "; filtering spreads them to their neighbours (repair with --fix-nonfinite " +
+                        std::string(enumName(imageio::NonFiniteRepair::Box3)) + "|" + enumName(imageio::NonFiniteRepair::Black) + ")"
                   : "; repaired (--fix-nonfinite " + options.fixNonFinite + ")"));
     return file;
 }
@@ -65,15 +69,16 @@ void addPictureOptions(CLI::App& command, PictureOptions& options) {
     command.add_option("--exposure", options.exposure, "exposure in stops (multiplies colour by 2^EV)")
         ->check(finiteRange(-64.0, 64.0, true));
     command.add_option("--tonemap", options.toneMap,
-                       "for 8/16-bit pictures of HDR data: none (default: values above 1 clip), reinhard, aces")
-        ->check(CLI::IsMember({"none", "reinhard", "aces"}));
+                       "for 8/16-bit pictures of HDR data (" + std::string(enumName(ToneMap::None)) + ": values above 1 clip)")
+        ->capture_default_str()
+        ->check(CLI::IsMember(enumNames<ToneMap>()));
 }
 
 imageio::WriteOptions writeOptionsOf(const PictureOptions& options, const SourceEncoding* source) {
     imageio::WriteOptions write;
     write.source = source;
     write.display.exposure = options.exposure;
-    write.display.toneMap = parseToneMap(options.toneMap).value_or(ToneMap::None);
+    write.display.toneMap = parseEnum<ToneMap>(options.toneMap);
     if (options.bits == "8") write.sampleType = SampleType::Uint8;
     else if (options.bits == "16") write.sampleType = SampleType::Uint16;
     else if (options.bits == "half") write.sampleType = SampleType::Half;
@@ -89,7 +94,7 @@ void checkPictureOutput(const std::string& path, const imageio::WriteOptions& op
     if (options.display.toneMap != ToneMap::None && options.sampleType &&
         (*options.sampleType == SampleType::Half || *options.sampleType == SampleType::Float))
         throw Error(ErrorCode::InvalidArgument,
-                    "--tonemap is for 8/16-bit pictures; a " + std::string(toString(*options.sampleType)) +
+                    "--tonemap is for 8/16-bit pictures; a " + std::string(enumName(*options.sampleType)) +
                         " picture keeps the linear values (use --exposure alone)");
 }
 

@@ -14,10 +14,13 @@ class App;
 
 namespace conus::cli {
 
+// --input-colorspace's value that takes the colour space from the file.
+inline constexpr const char* kFromTheFile = "auto";
+
 struct SourceOptions {
-    std::string colorspace = "auto";  // auto | srgb | linear | raw
+    std::string colorspace = kFromTheFile;  // or a Transfer's name
     bool noAutoOrient = false;
-    std::string fixNonFinite = "keep";  // keep | black | box3
+    std::string fixNonFinite = enumName(imageio::NonFiniteRepair::Keep);
     std::string part;                   // a part of a multi-part file, by name or index
 };
 
@@ -39,7 +42,7 @@ Image importanceFrom(const std::string& source, const Image& picture);
 struct PictureOptions {
     std::string bits;  // "", 8, 16, half, float
     double exposure = 0;
-    std::string toneMap = "none";
+    std::string toneMap = enumName(ToneMap::None);
 };
 
 // --bits, --exposure and --tonemap.

@@ -22,7 +22,7 @@ codec::AutoMapOptions autoMapOptions(int grid, double minDensity, double maxDens
     options.minDensity = minDensity;
     options.maxDensity = maxDensity;
     options.maxAnisotropy = maxAnisotropy;
-    options.method = method == "separable" ? codec::AutoMethod::Separable : codec::AutoMethod::Flow;
+    options.method = parseEnum<codec::AutoMethod>(method);
     return options;
 }
 
@@ -36,7 +36,7 @@ codec::FociOptions frameFociOptions(int grid, const std::string& compose, double
     codec::FociOptions options;
     options.columns = options.rows = grid;
     options.aspect = aspect;
-    options.composition = compose == "add" ? codec::FociComposition::Add : codec::FociComposition::Density;
+    options.composition = parseEnum<format::FociComposition>(compose);
     return options;
 }
 
@@ -139,8 +139,15 @@ void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy) {
 CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff) {
     return command.add_option("--falloff", falloff,
                        "how a focus's density falls to the context's: WIDTH[,SHAPE], from r to WIDTH r (in (1, 8]), "
-                       "SHAPE density (smoothstep of the density, the default) | log (of its logarithm) | logr (of its "
-                       "logarithm over log radius); default " + std::string(kDefaultFalloff) + ",density");
+                       "SHAPE one of " + enumChoices<format::FociFalloffShape>() + " (a smoothstep of the density, of its "
+                       "logarithm, of its logarithm over log radius); default " + std::string(kDefaultFalloff) + "," +
+                       enumName(codec::FociFalloff{}.shape));
+}
+
+CLI::Option* addComposeOption(CLI::App& command, std::string& compose) {
+    return command.add_option("--compose", compose, "how several foci combine")
+        ->capture_default_str()
+        ->check(CLI::IsMember(enumNames<format::FociComposition>()));
 }
 
 void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDensity, const std::string& prefix) {

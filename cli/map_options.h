@@ -29,11 +29,14 @@ void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDe
 inline constexpr const char* kDefaultFalloff = "2";
 // --falloff WIDTH[,SHAPE] for `map foci`, `encode --focus` and `bake relief --focus`.
 CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff);
+// --compose: how several foci combine (format::FociComposition's names), for `map foci`, `encode`,
+// `mesh` and `volume render`.
+CLI::Option* addComposeOption(CLI::App& command, std::string& compose);
 // "4, 3.1": the foci's k, as the budget lines say them.
 std::string fociKText(const std::vector<codec::Focus>& foci);
 
-// The builder's options from what `map auto` and `encode --importance` are given (method "flow"
-// or "separable").
+// The builder's options from what `map auto` and `encode --importance` are given (method: an
+// AutoMethod's name).
 codec::AutoMapOptions autoMapOptions(int grid, double minDensity, double maxDensity, double maxAnisotropy, const std::string& method);
 
 // --frame-loss DB (the budget foci and importance maps hold by default) and --exact-k (foci keep
@@ -61,7 +64,7 @@ void checkGridForImage(int grid, int width, int height, int defaultGrid = map_ru
 // The foci of repeated --focus u,v,r,k options, in order.
 std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);
 
-// The foci builder's options for a frame of `aspect` from --grid and --compose ("add" or "density").
+// The foci builder's options for a frame of `aspect` from --grid and --compose (a FociComposition's name).
 codec::FociOptions frameFociOptions(int grid, const std::string& compose, double aspect);
 
 // The sampling map of a rendered CoNUS frame, and the analytic form written beside its grid.

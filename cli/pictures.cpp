@@ -96,7 +96,7 @@ Image densityPicture(const codec::SamplingMap& map, int width, int height, int l
         blend(picture, cx + d, cy + d, cyan, 1.0f);
         blend(picture, cx + d, cy - d, cyan, 1.0f);
     }
-    if (analytic && analytic->kind == "foci") {
+    if (analytic && analytic->is(format::MapKind::Foci)) {
         for (const auto& f : analytic->foci) {
             // r is a fraction of the image width, circular in pixels.
             const double radius = f.r * width;

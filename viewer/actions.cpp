@@ -39,7 +39,7 @@ const std::vector<Binding> kViewBindings = {
     {"E", true, false, Action::ExposureDown, "E / Shift-E exposure +/- 0.5 stop; 0 resets"},
     {"0", false, false, Action::ResetExposure, ""},
     {"L", false, false, Action::ToggleGamma, "L          linear output (no curve) / the sRGB display curve"},
-    {"T", false, false, Action::NextToneMap, "T          tone map for HDR values: none, reinhard, aces"},
+    {"T", false, false, Action::NextToneMap, "T          next tone map for HDR values (--tonemap's choices)"},
     {"Tab", false, false, Action::NextFile, "Tab, PgDn  next file; Shift-Tab, PgUp previous"},
     {"PageDown", false, false, Action::NextFile, ""},
     {"Tab", true, false, Action::PreviousFile, ""},
@@ -155,24 +155,6 @@ std::string helpText(KeyTable table) {
     if (table == KeyTable::Scene) add(kSceneBindings, false);
     add(kViewBindings, table == KeyTable::Scene);
     return text;
-}
-
-gl::ViewMode parseMode(const std::string& name) {
-    for (gl::ViewMode m : {gl::ViewMode::Reconstructed, gl::ViewMode::Raw, gl::ViewMode::Uniform, gl::ViewMode::Wipe,
-                           gl::ViewMode::Density})
-        if (name == modeName(m)) return m;
-    throw Error(ErrorCode::InvalidArgument, "--mode \"" + name + "\" is not reconstructed, raw, uniform, wipe or density");
-}
-
-const char* modeName(gl::ViewMode mode) {
-    switch (mode) {
-    case gl::ViewMode::Reconstructed: return "reconstructed";
-    case gl::ViewMode::Raw: return "raw";
-    case gl::ViewMode::Uniform: return "uniform";
-    case gl::ViewMode::Wipe: return "wipe";
-    case gl::ViewMode::Density: return "density";
-    }
-    return "?";
 }
 
 }  // namespace conus::viewer

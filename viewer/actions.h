@@ -70,10 +70,4 @@ Action actionFor(const KeyChord& chord, KeyTable table);
 // One line per key of the table in use.
 std::string helpText(KeyTable table);
 
-// The display modes by name: "reconstructed|raw|uniform|wipe|density" -> ViewMode;
-// conus::Error(InvalidArgument) otherwise. ("z", the depth picture, is options.cpp's: the depth
-// picture is an image the viewer makes, shown in any of these modes.)
-gl::ViewMode parseMode(const std::string& name);
-const char* modeName(gl::ViewMode mode);
-
 }  // namespace conus::viewer

@@ -131,7 +131,7 @@ private:
         std::printf("benchmark: %d frames at %dx%d (%s, %dx%d CoNUS image, %s mode, %s decode): %.2f frames/s, %.1f ms/frame; %s\n",
                     frames, fw, fh, doc ? std::filesystem::path(doc->path).filename().string().c_str() : "-",
                     doc && doc->ok() ? doc->file->image.width : 0, doc && doc->ok() ? doc->file->image.height : 0,
-                    modeName(m_controller.display().mode), renderer.decodesOnCpu(m_controller.display(), m_controller.state().view(), fw) ? "CPU" : "GPU",
+                    enumName(m_controller.display().mode), renderer.decodesOnCpu(m_controller.display(), m_controller.state().view(), fw) ? "CPU" : "GPU",
                     frames / seconds, 1000.0 * seconds / n, m_window->context().renderer().c_str());
         return m_controller.exitCode();
     }

@@ -166,8 +166,8 @@ std::string Controller::summary(const char* separator) const {
         if (m_sceneThroughMap && m_scene->conus())
             text += " (" + std::to_string(m_scene->foci().size()) + (m_scene->foci().size() == 1 ? " focus)" : " foci)");
         if (!m_sceneLook.empty()) text += sep + m_sceneLook;
-        if (m_depthPicture) text += sep + "z";
-        return text + sep + modeName(m_display.mode);
+        if (m_depthPicture) text += sep + kDepthPictureMode;
+        return text + sep + enumName(m_display.mode);
     }
     const Document* doc = current();
     if (!doc) return {};
@@ -177,10 +177,10 @@ std::string Controller::summary(const char* separator) const {
     char zoom[32];
     std::snprintf(zoom, sizeof zoom, "zoom %.3g", m_state.zoom());
     if (m_depthPicture && !hasDepth(*doc->file)) text += sep + "no Z channel";
-    else if (m_depthPicture) text += sep + "z";
-    text += sep + modeName(m_display.mode) + sep + zoom;
+    else if (m_depthPicture) text += sep + kDepthPictureMode;
+    text += sep + enumName(m_display.mode) + sep + zoom;
     if (m_display.exposure != 0) text += sep + "ev " + std::to_string(m_display.exposure).substr(0, 4);
-    if (m_display.toneMap != ToneMap::None) text += sep + toString(m_display.toneMap);
+    if (m_display.toneMap != ToneMap::None) text += sep + enumName(m_display.toneMap);
     if (m_display.gamma == 1.0) text += sep + "linear";
     return text;
 }

@@ -12,6 +12,9 @@
 
 namespace conus::viewer {
 
+// --mode's value that shows a depth image's Z as a picture (beside the gl::ViewMode names).
+inline constexpr const char* kDepthPictureMode = "z";
+
 // The 3-D modes (scene.h): what is rendered live instead of CoNUS files being viewed.
 enum class SceneKind { None, Mesh, Volume, Relief, Reflection };
 
@@ -27,7 +30,7 @@ struct Options {
     gl::ViewOptions display;             // --mode, --grid, --outlines, --exposure, --tonemap, --gamma
     std::string script;                  // --script CMDS.txt
     int benchmarkFrames = 0;             // --benchmark-frames N
-    std::string backend = "auto";        // --backend for --screenshot (egl, osmesa)
+    std::string backend = enumName(gl::Backend::Auto);  // --backend for --screenshot
     bool helpOverlay = false;            // --help-overlay: start with the key list (H) shown
     bool statusBar = false;              // --status-bar: start with the status bar (B) shown
     // 3-D modes: --mesh FILE, --volume SPEC, --relief ASSET or --reflection DIR (with --scene MESH);

@@ -122,8 +122,8 @@ format::ConusFile sceneFrameFile(Image image, const codec::SamplingMap& map, con
     std::optional<format::AnalyticMap> analytic;
     if (!foci.empty()) {
         analytic.emplace();
-        analytic->kind = "foci";
-        analytic->composition = "add";
+        analytic->kind = enumName(format::MapKind::Foci);
+        analytic->composition = enumName(format::FociComposition::Add);
         for (const codec::Focus& f : foci) analytic->foci.push_back({f.u, f.v, f.r, f.k});
     }
     if (image.channelIndex("Z") >= 0) return codec::makeDepthImageFile(std::move(image), map, camera, "world", std::move(analytic));

@@ -30,7 +30,7 @@ int sceneScreenshot(const Options& options) {
     try {
         const int width = options.width > 0 ? options.width : kSceneWidth;
         const int height = options.height > 0 ? options.height : kSceneHeight;
-        const gl::Device device = gl::Device::choose(gl::parseBackend(options.backend), gl::CpuPath::None, "the viewer's screenshot");
+        const gl::Device device = gl::Device::choose(parseEnum<gl::Backend>(options.backend), gl::CpuPath::None, "the viewer's screenshot");
         gl::Context& context = device.context();
         const std::unique_ptr<Scene> scene = openScene(options, context);
         const SceneState state(scene->centre(), scene->radius(), options.foci, scene->home());
@@ -76,7 +76,7 @@ int runScreenshot(const Options& options) {
             width = std::max(1, static_cast<int>(std::lround(w * scale)));
             height = std::max(1, static_cast<int>(std::lround(h * scale)));
         }
-        const gl::Device device = gl::Device::choose(gl::parseBackend(options.backend), gl::CpuPath::None, "the viewer's screenshot");
+        const gl::Device device = gl::Device::choose(parseEnum<gl::Backend>(options.backend), gl::CpuPath::None, "the viewer's screenshot");
         gl::Context& context = device.context();
         gl::ViewRenderer renderer(context);
         const bool depth = options.depthPicture && hasDepth(*doc.file);
@@ -91,7 +91,7 @@ int runScreenshot(const Options& options) {
         if (options.statusBar) {
             char text[160];
             std::snprintf(text, sizeof text, "%s | %s | %dx%d", std::filesystem::path(doc.path).filename().string().c_str(),
-                          depth ? "z" : modeName(options.display.mode), width, height);
+                          depth ? kDepthPictureMode : enumName(options.display.mode), width, height);
             const Image bar = statusPanel(text, width);
             renderer.setOverlay(kStatusSlot, bar);
             overlays.push_back({kStatusSlot, 0, height - bar.height});
@@ -101,7 +101,7 @@ int runScreenshot(const Options& options) {
         write.meaning = imageio::PixelMeaning::Display;  // the framebuffer: already what the screen shows
         imageio::writeImageFile(options.screenshot, frame, write);
         std::printf("wrote %s: %dx%d, %s view of %s (%s)\n", options.screenshot.c_str(), width, height,
-                    depth ? "z" : modeName(options.display.mode), doc.path.c_str(), context.renderer().c_str());
+                    depth ? kDepthPictureMode : enumName(options.display.mode), doc.path.c_str(), context.renderer().c_str());
         return 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "conus-view: %s\n", e.what());

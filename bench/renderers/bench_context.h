@@ -14,7 +14,7 @@ namespace conus::bench {
 // A new context on that backend; throws conus::Error when it cannot start.
 inline std::unique_ptr<gl::Context> createBenchContext() {
     const char* backend = std::getenv("CONUS_BACKEND");
-    return gl::Context::create(gl::parseBackend(backend ? backend : "auto"));
+    return gl::Context::create(backend ? parseEnum<gl::Backend>(backend) : gl::Backend::Auto);
 }
 
 // One context shared by the GPU rows that can skip, made on first use; null when no backend

@@ -91,7 +91,7 @@ void BM_ReflectionFrameGl(benchmark::State& state) {
     Setup& s = setup(static_cast<int>(codec::ReflectionBakeOptions{}.magnification));
     static std::unique_ptr<gl::Context> context = [] {
         const char* backend = std::getenv("CONUS_BACKEND");
-        return gl::Context::create(gl::parseBackend(backend ? backend : "auto"));
+        return gl::Context::create(backend ? parseEnum<gl::Backend>(backend) : gl::Backend::Auto);
     }();
     gl::ReflectionRenderer renderer(*context, s.scene.mesh(), s.faces[state.range(0)], s.options);
     renderer.draw(s.camera, kFrame, kFrame);  // compiles the program

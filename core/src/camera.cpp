@@ -50,14 +50,6 @@ glm::dmat4 lookAt(glm::dvec3 eye, glm::dvec3 target, glm::dvec3 up) {
 
 }  // namespace
 
-const char* toString(Projection p) { return p == Projection::Perspective ? "perspective" : "orthographic"; }
-
-std::optional<Projection> parseProjection(std::string_view text) {
-    if (text == "perspective") return Projection::Perspective;
-    if (text == "orthographic") return Projection::Orthographic;
-    return std::nullopt;
-}
-
 Camera::Camera(const glm::dmat4& worldToCamera, const glm::dmat4& cameraToNdc, Projection projection, double near, double far)
     : m_worldToCamera(worldToCamera), m_cameraToWorld(glm::inverse(worldToCamera)), m_cameraToNdc(cameraToNdc),
       m_projection(projection), m_near(near), m_far(far) {}
@@ -104,8 +96,8 @@ Camera Camera::fromMatrices(const std::array<float, 16>& worldToCamera, const st
     const glm::dmat4 k = n * glm::inverse(c);
     const bool perspective = std::abs(k[2][3]) > 1e-12;  // w' depends on depth
     if (perspective != (projection == Projection::Perspective))
-        invalid(std::string("the matrices describe a ") + (perspective ? "perspective" : "orthographic") + " camera, not " +
-                toString(projection));
+        invalid(std::string("the matrices describe a ") + enumName(perspective ? Projection::Perspective : Projection::Orthographic) + " camera, not " +
+                enumName(projection));
     // The clip depths where z'/w' is 0 and 1, when the matrix maps depth that way; else unbounded.
     double near = perspective ? 0.0 : -1e300, far = 1e300;
     if (perspective && std::abs(k[2][2]) > 1e-12 && k[2][3] > 0) {

@@ -1,4 +1,4 @@
-// Names of the colour enumerations, written once (spec/conus-format.md uses the same words).
+// Colour facts that are not names: which metadata travels, bits per sample, what an ICC profile header holds.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -8,40 +8,6 @@
 #include "conus/core/display.h"
 
 namespace conus {
-namespace {
-
-constexpr std::array<std::pair<Transfer, const char*>, 3> kTransfers{
-    {{Transfer::Linear, "linear"}, {Transfer::Srgb, "srgb"}, {Transfer::Raw, "raw"}}};
-constexpr std::array<std::pair<SampleType, const char*>, 5> kSampleTypes{{{SampleType::Uint8, "uint8"},
-                                                                          {SampleType::Uint16, "uint16"},
-                                                                          {SampleType::Uint32, "uint32"},
-                                                                          {SampleType::Half, "half"},
-                                                                          {SampleType::Float, "float"}}};
-constexpr std::array<std::pair<ToneMap, const char*>, 3> kToneMaps{
-    {{ToneMap::None, "none"}, {ToneMap::Reinhard, "reinhard"}, {ToneMap::Aces, "aces"}}};
-
-template <class E, std::size_t N>
-const char* nameOf(const std::array<std::pair<E, const char*>, N>& table, E value) {
-    for (const auto& [v, name] : table)
-        if (v == value) return name;
-    return "unknown";
-}
-
-template <class E, std::size_t N>
-std::optional<E> valueOf(const std::array<std::pair<E, const char*>, N>& table, std::string_view text) {
-    for (const auto& [v, name] : table)
-        if (text == name) return v;
-    return std::nullopt;
-}
-
-}  // namespace
-
-const char* toString(Transfer t) { return nameOf(kTransfers, t); }
-const char* toString(SampleType t) { return nameOf(kSampleTypes, t); }
-const char* toString(ToneMap t) { return nameOf(kToneMaps, t); }
-std::optional<Transfer> parseTransfer(std::string_view text) { return valueOf(kTransfers, text); }
-std::optional<SampleType> parseSampleType(std::string_view text) { return valueOf(kSampleTypes, text); }
-std::optional<ToneMap> parseToneMap(std::string_view text) { return valueOf(kToneMaps, text); }
 
 bool isCarriedMetadata(std::string_view name) {
     for (std::string_view prefix : {"Exif:", "GPS:", "IPTC:"})

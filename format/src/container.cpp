@@ -26,8 +26,8 @@ bool onlyMapRules(const ValidationReport& r) {
 namespace detail {
 
 CameraCheck describeCamera(const CameraAttributes& a) {
-    const std::optional<Projection> projection = parseProjection(a.projection);
-    if (!projection) return {std::nullopt, "projection `" + a.projection + "` is not perspective or orthographic"};
+    const std::optional<Projection> projection = tryParseEnum<Projection>(a.projection);
+    if (!projection) return {std::nullopt, "projection `" + a.projection + "` is not one of " + enumChoices<Projection>()};
     try {
         return {Camera::fromMatrices(a.worldToCamera, a.worldToNDC, *projection), {}};
     } catch (const Error& e) {
@@ -44,7 +44,7 @@ conus::Camera toCamera(const CameraAttributes& attributes) {
 }
 
 CameraAttributes toAttributes(const conus::Camera& camera) {
-    return {toString(camera.projection()), camera.worldToCamera(), camera.worldToNDC()};
+    return {enumName(camera.projection()), camera.worldToCamera(), camera.worldToNDC()};
 }
 
 void writeConusFile(const std::string& path, const ConusFile& file) {
@@ -67,7 +67,7 @@ void checkConusFileName(const std::string& path) {
 
 namespace {
 
-ConusFile load(const std::string& path, const ReadLimits& limits, bool readPixels) {
+ConusFile load(const std::string& path, const Limits& limits, bool readPixels) {
     ConusFile file;
     const detail::LoadResult result = detail::loadConusFile(path, limits, readPixels, file);
     if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.summary(), result.report.ruleNumbers());
@@ -76,11 +76,11 @@ ConusFile load(const std::string& path, const ReadLimits& limits, bool readPixel
 
 }  // namespace
 
-ConusFile readConusFile(const std::string& path, const ReadLimits& limits) { return load(path, limits, true); }
+ConusFile readConusFile(const std::string& path, const Limits& limits) { return load(path, limits, true); }
 
-ConusFile readConusHeader(const std::string& path, const ReadLimits& limits) { return load(path, limits, false); }
+ConusFile readConusHeader(const std::string& path, const Limits& limits) { return load(path, limits, false); }
 
-ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits, bool readPixels) {
+ValidationReport validateConusFile(const std::string& path, const Limits& limits, bool readPixels) {
     // The rules concern headers, the map and the chunk tables, never pixel values; reading the
     // pixels finds damaged compressed data, which only a decompression can see.
     ConusFile file;

@@ -230,7 +230,7 @@ void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
     out.compression = part.compression;
     out.sourceWidth = m.sourceSize.value[0];
     out.sourceHeight = m.sourceSize.value[1];
-    out.dataKind = parseName<DataKind>(m.dataKind.value).value_or(DataKind::Image);
+    out.dataKind = tryParseEnum<DataKind>(m.dataKind.value).value_or(DataKind::Image);
     if (m.mapKind.ok()) {
         AnalyticMap a;
         a.kind = m.mapKind.value;
@@ -242,15 +242,15 @@ void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
         out.analytic = std::move(a);
     }
     if (m.projection.ok()) out.camera = CameraAttributes{m.projection.value, m.worldToCamera.value, m.worldToNDC.value};
-    out.depth.kind = m.depthKind.ok() ? parseName<DepthKind>(m.depthKind.value).value_or(DepthKind::None) : DepthKind::None;
+    out.depth.kind = m.depthKind.ok() ? tryParseEnum<DepthKind>(m.depthKind.value).value_or(DepthKind::None) : DepthKind::None;
     if (out.depth.kind != DepthKind::None) {
         out.depth.near = m.depthRange.value[0];
         out.depth.far = m.depthRange.value[1];
     }
     out.depth.units = m.depthUnits.value;
     SourceEncoding& e = out.sourceEncoding;
-    if (m.sourceTransfer.ok()) e.transfer = parseTransfer(m.sourceTransfer.value).value_or(Transfer::Linear);
-    if (m.sourceSampleType.ok()) e.sampleType = parseSampleType(m.sourceSampleType.value);
+    if (m.sourceTransfer.ok()) e.transfer = tryParseEnum<Transfer>(m.sourceTransfer.value).value_or(Transfer::Linear);
+    if (m.sourceSampleType.ok()) e.sampleType = tryParseEnum<SampleType>(m.sourceSampleType.value);
     if (m.chromaticities.ok()) e.chromaticities = m.chromaticities.value;
     if (m.iccProfile.ok()) e.iccProfile = base64Decode(m.iccProfile.value).value_or(std::string());
     for (auto it = h.begin(); it != h.end(); ++it) {

@@ -23,7 +23,7 @@
 
 namespace conus::format::detail {
 
-LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool readPixels, ConusFile& out) {
+LoadResult loadConusFile(const std::string& path, const Limits& limits, bool readPixels, ConusFile& out) {
     useExrThreads();
     LoadResult result;
     ValidationReport& r = result.report;

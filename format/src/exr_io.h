@@ -18,7 +18,7 @@ struct LoadResult {
 // and, when `readPixels`, the image, and checks the map rules. Never throws for bad content: every
 // problem lands in the report. `out` is filled only when the report is ok; without `readPixels`
 // its image has width, height and channels but no pixels.
-LoadResult loadConusFile(const std::string& path, const ReadLimits& limits, bool readPixels, ConusFile& out);
+LoadResult loadConusFile(const std::string& path, const Limits& limits, bool readPixels, ConusFile& out);
 
 // conus::format::checkExrFile (exr_check.h).
 void checkExr(const std::string& path, const Limits& limits);

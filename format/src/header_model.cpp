@@ -45,19 +45,19 @@ HeaderModel modelOf(const ConusFile& file) {
 
     m.version = attr(kFormatVersion);
     m.sourceSize = attr(std::array<int, 2>{file.sourceWidth, file.sourceHeight});
-    m.dataKind = attr(std::string(toString(file.dataKind)));
+    m.dataKind = attr(std::string(enumName(file.dataKind)));
     m.software = attr(file.software.empty() ? std::string(kSoftwareName) : file.software);
     if (file.analytic) {
         const AnalyticMap& a = *file.analytic;
         m.mapKind = attr(a.kind);
-        if (a.kind == "foci" || !a.foci.empty()) {
+        if (a.is(MapKind::Foci) || !a.foci.empty()) {
             std::vector<float> f;
             for (const FocusParams& p : a.foci) {
                 f.insert(f.end(), {float(p.u), float(p.v), float(p.r), float(p.k)});
             }
             m.foci = attr(std::move(f));
         }
-        if (a.kind == "foci" || !a.composition.empty()) m.composition = attr(a.composition);
+        if (a.is(MapKind::Foci) || !a.composition.empty()) m.composition = attr(a.composition);
         if (!a.groundRows.empty()) m.groundRows = attr(a.groundRows);
         for (const auto& [name, value] : a.scalars) m.params[name] = attr(value);
     }
@@ -66,12 +66,12 @@ HeaderModel modelOf(const ConusFile& file) {
         m.worldToNDC = attr(file.camera->worldToNDC);
         m.projection = attr(file.camera->projection);
     }
-    m.depthKind = attr(std::string(toString(file.depth.kind)));
+    m.depthKind = attr(std::string(enumName(file.depth.kind)));
     if (file.depth.kind != DepthKind::None) m.depthRange = attr(std::array<float, 2>{file.depth.near, file.depth.far});
     if (!file.depth.units.empty()) m.depthUnits = attr(file.depth.units);
     const SourceEncoding& e = file.sourceEncoding;
-    m.sourceTransfer = attr(std::string(toString(e.transfer)));
-    if (e.sampleType) m.sourceSampleType = attr(std::string(toString(*e.sampleType)));
+    m.sourceTransfer = attr(std::string(enumName(e.transfer)));
+    if (e.sampleType) m.sourceSampleType = attr(std::string(enumName(*e.sampleType)));
     if (e.chromaticities) m.chromaticities = attr(*e.chromaticities);
     if (!e.iccProfile.empty()) m.iccProfile = attr(base64Encode(e.iccProfile));
     return m;

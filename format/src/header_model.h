@@ -195,7 +195,7 @@ constexpr const AttributeSpec& specOf(Member member) {
 // Which rule a failure maps to is part of the report; this says how readConusFile should throw.
 struct HeaderCheck {
     bool notConus = false;       // readable EXR without a `conus` part
-    bool limitExceeded = false;  // a size beyond ReadLimits
+    bool limitExceeded = false;  // a size beyond Limits
 };
 
 // The camera the attributes describe, or what is wrong with them (V13's geometric half: known
@@ -207,7 +207,7 @@ struct CameraCheck {
 CameraCheck describeCamera(const CameraAttributes& attributes);
 
 // Runs V2..V7 (shape only for V7) and V12..V15 on the model, appending to `report`.
-HeaderCheck checkHeaderRules(const HeaderModel& model, const ReadLimits& limits, ValidationReport& report);
+HeaderCheck checkHeaderRules(const HeaderModel& model, const Limits& limits, ValidationReport& report);
 
 // The header an in-memory file is written with (header_model.cpp).
 HeaderModel modelOf(const ConusFile& file);

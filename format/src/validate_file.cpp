@@ -57,10 +57,6 @@ bool optional(const HeaderModel& m, AttrMember<T> member, ValidationReport& r) {
     return (m.*member).present && need(m, member, r);
 }
 
-bool oneOf(const std::string& s, std::initializer_list<const char*> allowed) {
-    return std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return s == a; });
-}
-
 void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport& r) {
     if (const int n = m.slot(PartKind::Conus).count; n > 1) r.add(Rule::V2, std::to_string(n) + " parts are named `conus`; exactly one is allowed");
     if (part.type != "scanlineimage" && part.type != "tiledimage") {
@@ -80,7 +76,7 @@ void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport&
     }
 }
 
-void checkChannels(const PartModel& part, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
+void checkChannels(const PartModel& part, const Limits& limits, ValidationReport& r, HeaderCheck& hc) {
     const auto n = static_cast<std::int64_t>(part.channels.size());
     if (n < 1 || n > kMaxChannels) {
         r.add(Rule::V3, "part `conus` has " + std::to_string(n) + " channels; 1 to " + std::to_string(kMaxChannels) + " allowed");
@@ -101,7 +97,7 @@ void checkChannels(const PartModel& part, const ReadLimits& limits, ValidationRe
     }
 }
 
-void checkWindows(const PartModel& part, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
+void checkWindows(const PartModel& part, const Limits& limits, ValidationReport& r, HeaderCheck& hc) {
     const Box& dw = part.dataWindow;
     if (!(dw == part.displayWindow) || dw.minX != 0 || dw.minY != 0) {
         r.add(Rule::V4, "part `conus` dataWindow " + boxStr(dw) + " must equal displayWindow " + boxStr(part.displayWindow) +
@@ -125,12 +121,12 @@ void checkSourceAndKind(const HeaderModel& m, ValidationReport& r) {
                          std::to_string(kMaxImageSide) + "]");
         }
     }
-    if (need(m, &HeaderModel::dataKind, r) && !parseName<DataKind>(m.dataKind.value)) {
-        r.add(Rule::V6, "data kind `" + m.dataKind.value + "` is not one of image, heightfield, depthimage");
+    if (need(m, &HeaderModel::dataKind, r) && !tryParseEnum<DataKind>(m.dataKind.value)) {
+        r.add(Rule::V6, "data kind `" + m.dataKind.value + "` is not one of " + enumChoices<DataKind>());
     }
 }
 
-void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r, HeaderCheck& hc) {
+void checkMapPart(const HeaderModel& m, const Limits& limits, ValidationReport& r, HeaderCheck& hc) {
     const PartSlot& slot = m.slot(PartKind::SamplingMap);
     if (slot.count != 1) {
         r.add(Rule::V7, std::to_string(slot.count) + " parts are named `samplingmap`; exactly one is required");
@@ -159,6 +155,14 @@ void checkMapPart(const HeaderModel& m, const ReadLimits& limits, ValidationRepo
     }
 }
 
+// "0 (density), 1 (log), 2 (logr)": the falloff shapes as the file numbers them.
+std::string shapeNumbers() {
+    std::string list;
+    for (const auto& [shape, name] : kEnumNameTable<FociFalloffShape>.names)
+        list.append(list.empty() ? "" : ", ").append(std::to_string(static_cast<int>(shape))).append(" (").append(name).append(")");
+    return list;
+}
+
 // A foci map's transition: both falloff scalars or neither, the width in (1, kMaxFalloffWidth], the
 // shape one of the integers 0 .. kFalloffShapes - 1 (spec: Analytic-map parameters).
 void checkFalloffParams(const HeaderModel& m, ValidationReport& r) {
@@ -175,7 +179,7 @@ void checkFalloffParams(const HeaderModel& m, ValidationReport& r) {
                              numberText(map_rules::kMaxFalloffWidth, 9) + "]");
     }
     if (!(s >= 0 && s < map_rules::kFalloffShapes && s == std::floor(s))) {
-        r.add(Rule::V12, prefix + "falloffShape = " + numberText(s, 9) + " is not 0 (density), 1 (log) or 2 (logr)");
+        r.add(Rule::V12, prefix + "falloffShape = " + numberText(s, 9) + " is not one of " + shapeNumbers());
     }
 }
 
@@ -212,7 +216,7 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
     }
     if (!need(m, &HeaderModel::mapKind, r)) return;
     const std::string& kind = m.mapKind.value;
-    if (kind == "foci") {
+    if (kind == enumName(MapKind::Foci)) {
         if (need(m, &HeaderModel::foci, r)) {
             const std::vector<float>& f = m.foci.value;
             if (f.empty() || f.size() % 4 != 0) {
@@ -228,8 +232,8 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
                 }
             }
         }
-        if (need(m, &HeaderModel::composition, r) && !oneOf(m.composition.value, {"density", "add"})) {
-            r.add(Rule::V12, "composition `" + m.composition.value + "` is not density or add");
+        if (need(m, &HeaderModel::composition, r) && !tryParseEnum<FociComposition>(m.composition.value)) {
+            r.add(Rule::V12, "composition `" + m.composition.value + "` is not one of " + enumChoices<FociComposition>());
         }
         checkFalloffParams(m, r);
         // The pictures' width / height a map file's foci were made for (spec: Analytic-map parameters).
@@ -237,8 +241,8 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
             aspect != m.params.end() && !(aspect->second.value >= 1.0 / 64 && aspect->second.value <= 64))
             r.add(Rule::V12, std::string(specOf(&HeaderModel::params).name) + "aspect = " + numberText(aspect->second.value, 9) +
                                  " is not a width / height in [1/64, 64]");
-    } else if (kind != "ground") {
-        r.add(Rule::V12, "map kind `" + kind + "` is not foci or ground");
+    } else if (!tryParseEnum<MapKind>(kind)) {
+        r.add(Rule::V12, "map kind `" + kind + "` is not one of " + enumChoices<MapKind>());
     }
     checkGroundRows(m, kind, r);
     const AttributeSpec& params = specOf(&HeaderModel::params);
@@ -258,8 +262,8 @@ void checkCamera(const HeaderModel& m, ValidationReport& r) {
             r.add(Rule::V13, std::string(specOf(matrix).name) + " has a non-finite element");
         }
     }
-    if (need(m, &HeaderModel::projection, r) && !parseProjection(m.projection.value)) {
-        r.add(Rule::V13, "projection `" + m.projection.value + "` is not perspective or orthographic");
+    if (need(m, &HeaderModel::projection, r) && !tryParseEnum<Projection>(m.projection.value)) {
+        r.add(Rule::V13, "projection `" + m.projection.value + "` is not one of " + enumChoices<Projection>());
     } else if (!r.violates(Rule::V13)) {
         const CameraCheck check = describeCamera(CameraAttributes{m.projection.value, m.worldToCamera.value, m.worldToNDC.value});
         if (!check.problem.empty()) r.add(Rule::V13, check.problem);
@@ -270,8 +274,8 @@ void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r
     std::string kind = "none";  // absent means no depth
     if (optional(m, &HeaderModel::depthKind, r)) {
         kind = m.depthKind.value;
-        if (!parseName<DepthKind>(kind)) {
-            r.add(Rule::V14, "depth kind `" + kind + "` is not none, cameraDepth or height");
+        if (!tryParseEnum<DepthKind>(kind)) {
+            r.add(Rule::V14, "depth kind `" + kind + "` is not one of " + enumChoices<DepthKind>());
             return;
         }
     }
@@ -289,21 +293,22 @@ void checkDepth(const HeaderModel& m, const PartModel& part, ValidationReport& r
 
 // V17: a depth image's Z means something only through its camera (cameraDepth along its axis).
 void checkDepthImage(const HeaderModel& m, ValidationReport& r) {
-    if (!m.dataKind.present || m.dataKind.value != "depthimage") return;
+    if (!m.dataKind.present || m.dataKind.value != enumName(DataKind::DepthImage)) return;
     std::string missing;
     if (!m.worldToCamera.present) missing += kAttrWorldToCamera;
     if (!m.worldToNDC.present) missing += std::string(missing.empty() ? "" : ", ") + kAttrWorldToNDC;
     if (!m.projection.present) missing += std::string(missing.empty() ? "" : ", ") + kAttrProjection;
     if (!missing.empty()) r.add(Rule::V17, "a depth image needs its camera; missing " + missing);
-    const std::string kind = m.depthKind.present ? m.depthKind.value : "none";
-    if (kind != "cameraDepth") r.add(Rule::V17, "a depth image's conus:depthKind is " + kind + ", not cameraDepth");
+    const std::string kind = m.depthKind.present ? m.depthKind.value : enumName(DepthKind::None);
+    if (kind != enumName(DepthKind::CameraDepth))
+        r.add(Rule::V17, "a depth image's conus:depthKind is " + kind + ", not " + enumName(DepthKind::CameraDepth));
 }
 
 void checkColour(const HeaderModel& m, ValidationReport& r) {
-    if (optional(m, &HeaderModel::sourceTransfer, r) && !parseTransfer(m.sourceTransfer.value))
-        r.add(Rule::V16, "source transfer `" + m.sourceTransfer.value + "` is not linear, srgb or raw");
-    if (optional(m, &HeaderModel::sourceSampleType, r) && !parseSampleType(m.sourceSampleType.value))
-        r.add(Rule::V16, "source sample type `" + m.sourceSampleType.value + "` is not uint8, uint16, uint32, half or float");
+    if (optional(m, &HeaderModel::sourceTransfer, r) && !tryParseEnum<Transfer>(m.sourceTransfer.value))
+        r.add(Rule::V16, "source transfer `" + m.sourceTransfer.value + "` is not one of " + enumChoices<Transfer>());
+    if (optional(m, &HeaderModel::sourceSampleType, r) && !tryParseEnum<SampleType>(m.sourceSampleType.value))
+        r.add(Rule::V16, "source sample type `" + m.sourceSampleType.value + "` is not one of " + enumChoices<SampleType>());
     if (optional(m, &HeaderModel::chromaticities, r) &&
         !std::all_of(m.chromaticities.value.begin(), m.chromaticities.value.end(), [](float x) { return std::isfinite(x); }))
         r.add(Rule::V16, "chromaticities hold a non-finite value");
@@ -327,7 +332,7 @@ void checkDisplayWindows(const HeaderModel& m, ValidationReport& r) {
 
 }  // namespace
 
-HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, ValidationReport& r) {
+HeaderCheck checkHeaderRules(const HeaderModel& m, const Limits& limits, ValidationReport& r) {
     HeaderCheck hc;
     if (m.slot(PartKind::Conus).index < 0) {
         r.add(Rule::V2, "not a CoNUS file: no part named `conus` among " + std::to_string(m.parts.size()) + " part(s)");
@@ -354,7 +359,7 @@ HeaderCheck checkHeaderRules(const HeaderModel& m, const ReadLimits& limits, Val
 ValidationReport validateConusFile(const ConusFile& file) {
     ValidationReport report;
     const detail::HeaderModel model = detail::modelOf(file);
-    detail::checkHeaderRules(model, ReadLimits{}, report);
+    detail::checkHeaderRules(model, Limits{}, report);
     // The in-memory image must hold what its header promises (V4 covers the pixel array).
     const Image& im = file.image;
     if (im.width >= 1 && im.height >= 1 &&

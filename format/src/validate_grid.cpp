@@ -1,6 +1,5 @@
-// The sampling-map rules V7..V11 (spec/conus-format.md) in words: the tests themselves are
-// core/map_rules.h, which codec's builders call too.
-#include <cmath>
+// The sampling-map rules V7..V11 (spec/conus-format.md) in words. Whether a grid is valid is
+// core/map_rules.h's isValidGrid, the question codec asks too; this only says what is broken.
 #include <cstdio>
 #include <string>
 
@@ -49,7 +48,8 @@ ValidationReport validateGrid(const GridNodes& grid) {
     ValidationReport report;
     const int n = grid.columns;
     const int m = grid.rows;
-    if (n < kMinMapSide || n > kMaxMapSide || m < kMinMapSide || m > kMaxMapSide) {
+    if (map_rules::isValidGrid(n, m, grid.xy)) return report;
+    if (!map_rules::sidesInRange(n, m)) {
         report.add(Rule::V7, "map grid is " + std::to_string(n) + "x" + std::to_string(m) + " nodes; columns and rows must be in [" +
                           std::to_string(kMinMapSide) + ", " + std::to_string(kMaxMapSide) + "]");
         return report;  // nothing below can be indexed safely
@@ -70,7 +70,7 @@ ValidationReport validateGrid(const GridNodes& grid) {
         for (int j = 0; j < m; ++j) {
             for (int i = 0; i < n; ++i) {
                 const double u = view.u(i, j), v = view.v(i, j);
-                if (!std::isfinite(u) || !std::isfinite(v)) {
+                if (!map_rules::nodeFinite(view, i, j)) {
                     v8.add("node " + node(i, j) + " is not finite: (" + numberText(u, 9) + ", " + numberText(v, 9) + ")");
                     allFinite = false;
                     continue;
@@ -78,8 +78,9 @@ ValidationReport validateGrid(const GridNodes& grid) {
                 if (!map_rules::nodeInside(view, i, j)) {
                     v9.add("node " + node(i, j) + " = (" + numberText(u, 9) + ", " + numberText(v, 9) + ") is outside [0,1]^2");
                 }
-                // Exact comparisons: boundary nodes must sit on their edge so the CoNUS image covers
-                // exactly the conventional field of view.
+                // Boundary nodes sit exactly on their edge, so the CoNUS image covers exactly the
+                // conventional field of view; the message names the edge.
+                if (map_rules::nodeOnItsEdge(view, i, j)) continue;
                 if (i == 0 && u != 0.0) v10.add("left-column node " + node(i, j) + " has u = " + numberText(u, 9) + ", must be 0");
                 if (i == n - 1 && u != 1.0) v10.add("right-column node " + node(i, j) + " has u = " + numberText(u, 9) + ", must be 1");
                 if (j == 0 && v != 0.0) v10.add("top-row node " + node(i, j) + " has v = " + numberText(v, 9) + ", must be 0");

@@ -1,4 +1,4 @@
-// ValidationReport helpers and the toString functions of the header model.
+// ValidationReport helpers.
 #include <algorithm>
 
 #include "conus/format/container.h"
@@ -58,10 +58,5 @@ std::string ValidationReport::summary() const {
         out += " (and " + std::to_string(more) + " more problem" + (more == 1 ? "" : "s") + "; `conus validate` lists them)";
     return out;
 }
-
-const char* toString(PixelType t) { return nameOf(t); }
-const char* toString(Compression c) { return nameOf(c); }
-const char* toString(DataKind k) { return nameOf(k); }
-const char* toString(DepthKind k) { return nameOf(k); }
 
 }  // namespace conus::format

@@ -60,7 +60,7 @@ OIIO::TypeDesc typeDescOf(SampleType t) {
 std::string joinTypes(const std::vector<SampleType>& types) {
     std::string s;
     for (std::size_t i = 0; i < types.size(); ++i)
-        s += std::string(i == 0 ? "" : i + 1 == types.size() ? " or " : ", ") + toString(types[i]);
+        s += std::string(i == 0 ? "" : i + 1 == types.size() ? " or " : ", ") + enumName(types[i]);
     return s;
 }
 
@@ -148,7 +148,7 @@ Target targetFor(const std::string& path, const WriteOptions& options) {
     if (options.sampleType) {
         if (!holds(*options.sampleType))
             throw Error(ErrorCode::InvalidArgument, path + ": " + t.formatName + " holds " + joinTypes(t.traits.sampleTypes) +
-                                                        " samples, not " + toString(*options.sampleType));
+                                                        " samples, not " + enumName(*options.sampleType));
         t.sampleType = *options.sampleType;
         return t;
     }

@@ -28,6 +28,17 @@ bool isWhole(py::handle value) { return !py::isinstance<py::bool_>(value) && PyI
 
 [[noreturn]] void invalid(const std::string& text) { throw Error(ErrorCode::InvalidArgument, text); }
 
+}  // namespace
+
+std::string quotedChoices(const std::vector<std::string>& names) {
+    std::string list;
+    for (std::size_t i = 0; i < names.size(); ++i)
+        list.append(i == 0 ? "" : i + 1 == names.size() ? " or " : ", ").append("'").append(names[i]).append("'");
+    return list;
+}
+
+namespace {
+
 std::string shape(const py::array& a) {
     std::ostringstream text;
     text << '(';
@@ -113,10 +124,11 @@ std::string describe(py::handle value) {
 
 Image pixelsFrom(py::handle pixels, const std::optional<std::vector<std::string>>& channels, const char* what,
                  const PixelRules& rules) {
-    if (rules.colorspace != "auto" && rules.colorspace != "srgb" && rules.colorspace != "linear")
-        invalid("colorspace must be 'auto', 'srgb' or 'linear', not '" + rules.colorspace + "'");
-    if (rules.fixNonFinite != "keep" && rules.fixNonFinite != "black" && rules.fixNonFinite != "box3")
-        invalid("fix_nonfinite must be 'keep', 'black' or 'box3', not '" + rules.fixNonFinite + "'");
+    const std::vector<std::string> colorspaces{kAutoColorspace, enumName(Transfer::Srgb), enumName(Transfer::Linear)};
+    if (std::find(colorspaces.begin(), colorspaces.end(), rules.colorspace) == colorspaces.end())
+        invalid("colorspace must be " + quotedChoices(colorspaces) + ", not '" + rules.colorspace + "'");
+    const imageio::NonFiniteRepair repair = enumArgument<imageio::NonFiniteRepair>(rules.fixNonFinite, "fix_nonfinite");
+    const bool autoColorspace = rules.colorspace == kAutoColorspace;
     const py::array array = asArray(pixels, what, "; read a picture file with conus.read_image");
     const float scale = codeScale(array);
     const bool codes = scale > 0.0f;
@@ -125,16 +137,15 @@ Image pixelsFrom(py::handle pixels, const std::optional<std::vector<std::string>
                              ": give float linear light, or uint8 / uint16 display-encoded codes (as an 8- or 16-bit PNG "
                              "holds)");
     Image image = toImage(array, channels, what, codes ? scale : 1.0f);
-    if (rules.colorspace == "srgb" || (codes && rules.colorspace == "auto")) imageio::linearize(image);
+    if (rules.colorspace == enumName(Transfer::Srgb) || (codes && autoColorspace)) imageio::linearize(image);
     if (codes) return image;
     if (const std::int64_t bad = imageio::countNonFinite(image); bad > 0) {
         const std::string count = std::to_string(bad) + (bad == 1 ? " NaN or infinite value" : " NaN or infinite values");
-        if (rules.fixNonFinite == "keep") {
-            warn(std::string(what) + " hold " + count +
-                 "; filtering spreads them to their neighbours (repair with fix_nonfinite='box3' or 'black')");
+        if (repair == imageio::NonFiniteRepair::Keep) {
+            warn(std::string(what) + " hold " + count + "; filtering spreads them to their neighbours (repair with fix_nonfinite=" +
+                 quotedChoices(enumNames({imageio::NonFiniteRepair::Box3, imageio::NonFiniteRepair::Black})) + ")");
         } else {
-            imageio::repairNonFinite(image, rules.fixNonFinite == "black" ? imageio::NonFiniteRepair::Black
-                                                                          : imageio::NonFiniteRepair::Box3);
+            imageio::repairNonFinite(image, repair);
         }
     }
     return image;

@@ -18,7 +18,10 @@
 
 #include "conus/codec/build/foci.h"
 #include "conus/codec/image/decode.h"
+#include "conus/core/enum_names.h"
+#include "conus/core/error.h"
 #include "conus/core/image.h"
+#include "conus/imageio/image_file.h"
 
 namespace conus::python {
 
@@ -30,9 +33,24 @@ std::vector<std::string> defaultChannelNames(int count);
 // "the str 'photo.png'", "a tuple of 3", "an array of shape (4, 5)": what was given, for messages.
 std::string describe(py::handle value);
 
+// "'a', 'b' or 'c'": the names an argument accepts, for its one-line error.
+std::string quotedChoices(const std::vector<std::string>& names);
+
+// The value of E named `text` (core/enum_names.h), for the argument `argument`; else conus.Error
+// "argument must be 'a', 'b' or 'c', not 'x'".
+template <class E>
+E enumArgument(const std::string& text, const char* argument) {
+    if (const std::optional<E> value = tryParseEnum<E>(text)) return *value;
+    throw Error(ErrorCode::InvalidArgument,
+                std::string(argument) + " must be " + quotedChoices(enumNames<E>()) + ", not '" + text + "'");
+}
+
+// colorspace= "auto" (the rule above) or a display-referred Transfer (srgb, linear); fix_nonfinite=
+// a NonFiniteRepair.
+inline constexpr const char* kAutoColorspace = "auto";
 struct PixelRules {
-    std::string colorspace = "auto";  // auto | srgb | linear
-    std::string fixNonFinite = "keep";  // keep | black | box3
+    std::string colorspace = kAutoColorspace;
+    std::string fixNonFinite = enumName(imageio::NonFiniteRepair::Keep);
 };
 
 // A picture: (H, W) or (H, W, C) of linear light after the rule above.

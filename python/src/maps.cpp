@@ -84,14 +84,12 @@ void addMaps(py::module_& m) {
                 options.aspect = aspect;
                 options.columns = options.rows = grid;
                 options.falloff = codec::parseFalloff(falloff);
-                if (composition == "add") options.composition = codec::FociComposition::Add;
-                else if (composition != "density")
-                    throw Error(ErrorCode::InvalidArgument, "composition must be 'density' or 'add', not '" + composition + "'");
+                options.composition = enumArgument<codec::FociComposition>(composition, "composition");
                 py::gil_scoped_release release;
                 codec::SamplingMap map = codec::buildFociMap(f, options);
                 return std::make_shared<Map>(Map{std::move(map), codec::toAnalytic(f, options.composition, options.falloff), aspect});
             },
-            py::arg("foci"), py::arg("aspect") = 1.0, py::arg("grid") = map_rules::kDefaultSide, py::arg("composition") = "density",
+            py::arg("foci"), py::arg("aspect") = 1.0, py::arg("grid") = map_rules::kDefaultSide, py::arg("composition") = enumName(codec::FociComposition::Density),
             py::arg("falloff") = "2",
             "Circular foci (u, v, r, k): centre, radius as a fraction of the width, magnification; aspect: the pictures' "
             "width / height (encode warns on another); falloff as `map foci --falloff` (\"2\": density smoothstepped "

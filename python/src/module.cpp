@@ -94,12 +94,12 @@ struct File {
 py::dict attributesOf(const format::ConusFile& f) {
     py::dict a;
     a["source_size"] = py::make_tuple(f.sourceWidth, f.sourceHeight);
-    a["data_kind"] = format::toString(f.dataKind);
-    a["pixel_type"] = format::toString(f.pixelType);
-    a["compression"] = format::toString(f.compression);
+    a["data_kind"] = enumName(f.dataKind);
+    a["pixel_type"] = enumName(f.pixelType);
+    a["compression"] = enumName(f.compression);
     a["software"] = f.software;
-    a["transfer"] = toString(f.sourceEncoding.transfer);
-    if (f.sourceEncoding.sampleType) a["source_sample_type"] = toString(*f.sourceEncoding.sampleType);
+    a["transfer"] = enumName(f.sourceEncoding.transfer);
+    if (f.sourceEncoding.sampleType) a["source_sample_type"] = enumName(*f.sourceEncoding.sampleType);
     if (f.analytic) {
         py::dict analytic;
         analytic["kind"] = f.analytic->kind;
@@ -112,7 +112,7 @@ py::dict attributesOf(const format::ConusFile& f) {
     }
     if (f.depth.kind != format::DepthKind::None) {
         py::dict depth;
-        depth["kind"] = format::toString(f.depth.kind);
+        depth["kind"] = enumName(f.depth.kind);
         depth["units"] = f.depth.units;
         depth["near"] = f.depth.near;
         depth["far"] = f.depth.far;
@@ -128,7 +128,7 @@ const gl::Device& deviceFor(const std::string& backend) {
     static std::map<std::string, gl::Device> devices;
     auto it = devices.find(backend);
     if (it == devices.end())
-        it = devices.emplace(backend, gl::Device::choose(gl::parseBackend(backend), gl::CpuPath::Available, "image encode")).first;
+        it = devices.emplace(backend, gl::Device::choose(enumArgument<gl::Backend>(backend, "backend"), gl::CpuPath::Available, "image encode")).first;
     return it->second;
 }
 
@@ -298,7 +298,7 @@ PYBIND11_MODULE(_conus, m) {
             {
                 py::gil_scoped_release release;
                 Image encoded;
-                if (backend == "cpu") {
+                if (enumArgument<gl::Backend>(backend, "backend") == gl::Backend::Cpu) {
                     encoded = codec::encodeImage(source, map->map, options);
                 } else {
                     std::lock_guard<std::mutex> lock(g_deviceMutex);
@@ -313,9 +313,9 @@ PYBIND11_MODULE(_conus, m) {
             return file;
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),
-        py::arg("channels") = py::none(), py::arg("backend") = "cpu", py::arg("fit") = codec::kDefaultEncodeFitIterations,
+        py::arg("channels") = py::none(), py::arg("backend") = enumName(gl::Backend::Cpu), py::arg("fit") = codec::kDefaultEncodeFitIterations,
         py::arg("fit_hold") = codec::kFitHoldLowPass, py::arg("frame_loss") = codec::kDefaultFrameLoss, py::arg("exact_k") = false,
-        py::arg("colorspace") = "auto", py::arg("fix_nonfinite") = "keep",
+        py::arg("colorspace") = kAutoColorspace, py::arg("fix_nonfinite") = enumName(imageio::NonFiniteRepair::Keep),
         "Encode pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file; float pixels are\n"
         "linear light, uint8/uint16 display-encoded codes (colorspace= 'srgb' or 'linear' overrides; docs/python.md);\n"
         "fix_nonfinite 'keep' (with a warning), 'black' or 'box3' as --fix-nonfinite;\n"
@@ -348,7 +348,7 @@ PYBIND11_MODULE(_conus, m) {
             Image frame;
             {
                 py::gil_scoped_release release;
-                if (backend == "cpu") {
+                if (enumArgument<gl::Backend>(backend, "backend") == gl::Backend::Cpu) {
                     frame = codec::decodeImage(file.file.image, map->map, options);
                 } else {
                     std::lock_guard<std::mutex> lock(g_deviceMutex);
@@ -357,7 +357,7 @@ PYBIND11_MODULE(_conus, m) {
             }
             return toArray(std::move(frame));
         },
-        py::arg("file"), py::arg("view") = std::make_tuple(0.0, 0.0, 1.0, 1.0), py::arg("size") = py::none(), py::arg("backend") = "cpu",
+        py::arg("file"), py::arg("view") = std::make_tuple(0.0, 0.0, 1.0, 1.0), py::arg("size") = py::none(), py::arg("backend") = enumName(gl::Backend::Cpu),
         "A conventional frame of the rectangle view (u0, v0, u1, v1), at size (w, h) (default: the source's resolution)");
     m.def(
         "uniform",
@@ -373,8 +373,8 @@ PYBIND11_MODULE(_conus, m) {
             py::gil_scoped_acquire acquire;
             return toArray(std::move(small));
         },
-        py::arg("pixels"), py::arg("size") = py::none(), py::arg("fit") = 0, py::arg("colorspace") = "auto",
-        py::arg("fix_nonfinite") = "keep",
+        py::arg("pixels"), py::arg("size") = py::none(), py::arg("fit") = 0, py::arg("colorspace") = kAutoColorspace,
+        py::arg("fix_nonfinite") = enumName(imageio::NonFiniteRepair::Keep),
         "The uniform baseline (pixels as for encode): an area downsample to the same pixel count; fit = N > 0 fits it to its bilinear\n"
         "resize to the source's size (`conus uniform --fit --fit-iterations N`)");
     m.def(
@@ -415,8 +415,8 @@ PYBIND11_MODULE(_conus, m) {
             py::gil_scoped_release release;
             imageio::writeImageFile(path, image);
         },
-        py::arg("path"), py::arg("pixels"), py::arg("channels") = py::none(), py::arg("colorspace") = "auto",
-        py::arg("fix_nonfinite") = "keep",
+        py::arg("path"), py::arg("pixels"), py::arg("channels") = py::none(), py::arg("colorspace") = kAutoColorspace,
+        py::arg("fix_nonfinite") = enumName(imageio::NonFiniteRepair::Keep),
         "Write pixels (as for encode: float linear light, uint8/uint16 display codes) as an ordinary picture (8-bit\n"
         "sRGB for PNG/JPEG, half for EXR), atomically");
 }

@@ -66,8 +66,8 @@ Context& Device::context() const {
 }
 
 std::string Device::describe() const {
-    if (!m_context) return "cpu";
-    return backendName(m_context->backend()) + ": " + m_context->renderer();
+    if (!m_context) return enumName(Backend::Cpu);
+    return std::string(enumName(m_context->backend())) + ": " + m_context->renderer();
 }
 
 }  // namespace conus::gl

@@ -42,7 +42,7 @@ std::string loadGl(Context::Impl& impl) {
 
 // One backend: a current context with GL 4.5 loaded, or nullptr and the reason.
 std::unique_ptr<Context::Impl> tryBackend(Backend backend, std::string& reason) {
-    if (disabledByEnvironment(backendName(backend))) {
+    if (disabledByEnvironment(enumName(backend))) {
         reason = "disabled by CONUS_GL_DISABLE";
         return nullptr;
     }
@@ -100,24 +100,6 @@ Context::Impl::~Impl() {
     if (tCurrent == platform.get()) tCurrent = nullptr;
 }
 
-Backend parseBackend(const std::string& name) {
-    std::string lower(name);
-    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-    for (Backend b : {Backend::Auto, Backend::Egl, Backend::OsMesa, Backend::Cpu})
-        if (lower == backendName(b)) return b;
-    throw Error(ErrorCode::InvalidArgument, "unknown backend '" + name + "' (expected auto, egl, osmesa or cpu)");
-}
-
-std::string backendName(Backend backend) {
-    switch (backend) {
-    case Backend::Auto: return "auto";
-    case Backend::Egl: return "egl";
-    case Backend::OsMesa: return "osmesa";
-    case Backend::Cpu: return "cpu";
-    }
-    return "unknown";
-}
-
 std::vector<BackendStatus> probeBackends() {
     std::vector<BackendStatus> out;
     for (Backend b : {Backend::Egl, Backend::OsMesa}) {
@@ -150,7 +132,7 @@ std::unique_ptr<Context> Context::create(Backend backend) {
     for (Backend b : order) {
         std::string reason;
         if (auto impl = tryBackend(b, reason)) return std::make_unique<Context>(std::move(impl));
-        reasons += std::string(reasons.empty() ? "" : "; ") + backendName(b) + ": " + reason;
+        reasons += std::string(reasons.empty() ? "" : "; ") + enumName(b) + ": " + reason;
     }
     throw Error(ErrorCode::Unsupported, "no OpenGL 4.5 context (" + reasons + ")");
 }

@@ -5,15 +5,16 @@
 
 #include <string>
 
+#include "conus/renderers/view_renderer.h"  // kViewBackground (GLSL: kBackground)
+
 namespace conus::gl {
 
-inline constexpr float kViewBackground = 0.11f;  // grey around the image in conus-view (GLSL: kBackground)
 inline constexpr int kViewMaxFoci = 16;          // focus outlines conus-view draws (GLSL: kMaxFoci)
 
 // `source` with the shared constants declared after its first line (#version):
 // kDecodeMultiTap, kDecodeMaxTaps, kDecodePyramidBias (codec/decode.h), kEncodeMaxTaps, kEncodeTapTolerance,
 // kEncodeMaxAxisTaps, kEncodeAnisotropicSigma, kEncodeGaussianReach, kEncodeBoxAnisotropy
-// (codec/encode.h), kBackground, kMaxFoci (above), kInferno[6] (core/display.h), and the mesh
+// (codec/encode.h), kBackground (view_renderer.h), kMaxFoci (above), kInferno[6] (core/display.h), and the mesh
 // shading's kMeshAmbient, kMeshGrey (codec/mesh/shading.h: kAmbient, kDefaultAlbedo), and
 // kIntersectDepthMargin and kSilhouetteStep (codec/depth/intersect.h).
 std::string withSharedConstants(const std::string& source);

@@ -220,7 +220,7 @@ void ViewRenderer::setImage(const format::ConusFile& file) {
     d.sourceWidth = file.sourceWidth > 0 ? file.sourceWidth : rgba.width;
     d.sourceHeight = file.sourceHeight > 0 ? file.sourceHeight : rgba.height;
     d.foci.clear();
-    if (file.analytic && file.analytic->kind == "foci")
+    if (file.analytic && file.analytic->is(format::MapKind::Foci))
         for (const auto& f : file.analytic->foci) {
             if (static_cast<int>(d.foci.size()) / 3 >= kViewMaxFoci) break;
             d.foci.insert(d.foci.end(), {float(f.u), float(f.v), float(f.r)});

@@ -79,10 +79,15 @@ void checkFileVolume(const Volume& volume, const std::string& what) {
                                             " makes the volume's extent infinite");
 }
 
+std::string rawVolumeForm() {
+    std::string types;
+    for (const std::string& name : enumNames<RawType>()) types.append(types.empty() ? "" : "|").append(name);
+    return "raw:WxHxD:" + types + "[:spacing]:path";
+}
+
 RawSpec parseRawSpec(const std::string& spec) {
     const auto bad = [&](const std::string& why) {
-        return Error(ErrorCode::InvalidArgument, "raw volume '" + spec + "': " + why +
-                                                     " (expected raw:WxHxD:uint8|uint16|float32[:spacing]:path)");
+        return Error(ErrorCode::InvalidArgument, "raw volume '" + spec + "': " + why + " (expected " + rawVolumeForm() + ")");
     };
     if (spec.rfind("raw:", 0) != 0) throw bad("does not start with 'raw:'");
     // The path is everything after the third (or fourth, with a spacing) colon: it may hold colons.
@@ -105,10 +110,8 @@ RawSpec parseRawSpec(const std::string& spec) {
         out.layout.bigEndian = true;
         type.resize(type.size() - 3);
     }
-    if (type == "uint8") out.layout.type = RawType::UInt8;
-    else if (type == "uint16") out.layout.type = RawType::UInt16;
-    else if (type == "float32") out.layout.type = RawType::Float32;
-    else throw bad("type '" + fields[1] + "' is not uint8, uint16 or float32");
+    if (const std::optional<RawType> parsed = tryParseEnum<RawType>(type)) out.layout.type = *parsed;
+    else throw bad("type '" + fields[1] + "' is not one of " + enumChoices<RawType>());
     std::size_t pathField = 2;
     // A spacing field is numbers and commas; a path rarely is, and "./" disambiguates one that is.
     if (fields.size() >= 4 && !fields[2].empty() &&
@@ -135,8 +138,7 @@ Volume readVolume(const std::string& spec, const VolumeReadOptions& options) {
     if (ext == ".nrrd" || ext == ".nhdr") return readNrrdVolume(spec, options);
     if (ext == ".vdb") return readVdbVolume(spec, options);
     throw Error(ErrorCode::Unsupported, "volume '" + spec +
-                                            "': unknown form; read are .vdb, .nrrd, .nhdr, .den and "
-                                            "raw:WxHxD:uint8|uint16|float32[:spacing]:path");
+                                            "': unknown form; read are .vdb, .nrrd, .nhdr, .den and " + rawVolumeForm());
 }
 
 }  // namespace conus::sceneio

@@ -126,10 +126,10 @@ TEST(Container, CompressionModes) {
     TempDir dir;
     for (Compression c : {Compression::None, Compression::Zip, Compression::Piz, Compression::Dwaa}) {
         for (PixelType t : {PixelType::Half, PixelType::Float}) {
-            SCOPED_TRACE(std::string(toString(c)) + " " + toString(t));
+            SCOPED_TRACE(std::string(enumName(c)) + " " + enumName(t));
             ConusFile f = validFile(t);
             f.compression = c;
-            const std::string path = dir.file(std::string(toString(c)) + toString(t) + ".exr");
+            const std::string path = dir.file(std::string(enumName(c)) + enumName(t) + ".exr");
             writeConusFile(path, f);
             const ConusFile g = readConusFile(path);
             EXPECT_EQ(g.compression, c);
@@ -236,17 +236,17 @@ TEST(Container, MissingFileIsIo) {
     EXPECT_FALSE(validateConusFile(dir.file("nothing.exr")).ok());
 }
 
-TEST(Container, ReadLimitsAreEnforced) {
+TEST(Container, LimitsAreEnforced) {
     TempDir dir;
     writeConusFile(dir.file("x.exr"), validFile());
-    ReadLimits small;
+    Limits small;
     small.maxPixels = 47;  // the image has 48
     const Error e = errorFrom([&] { readConusFile(dir.file("x.exr"), small); });
     EXPECT_EQ(e.code(), ErrorCode::LimitExceeded) << e.what();
-    ReadLimits mapLimit;
+    Limits mapLimit;
     mapLimit.maxMapSide = 4;
     EXPECT_TRUE(validateConusFile(dir.file("x.exr"), mapLimit).violates(Rule::V7));
-    ReadLimits channelLimit;
+    Limits channelLimit;
     channelLimit.maxChannels = 3;
     EXPECT_TRUE(validateConusFile(dir.file("x.exr"), channelLimit).violates(Rule::V3));
 }

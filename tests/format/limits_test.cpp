@@ -65,8 +65,8 @@ Refusal refusal(Read read) {
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-TEST(Limits, ReadLimitsDefaultToTheStatedCapsAndTheTableListsEach) {
-    const ReadLimits limits;
+TEST(Limits, LimitsDefaultToTheStatedCapsAndTheTableListsEach) {
+    const Limits limits;
     EXPECT_EQ(limits.maxPixels, kMaxImagePixels);
     EXPECT_EQ(limits.maxMapSide, kMaxMapSide);
     EXPECT_EQ(limits.maxChannels, kMaxChannels);
@@ -137,7 +137,7 @@ TEST(Limits, AHeaderBeyondTheCapIsRefused) {
 TEST(Limits, ACallerMayTightenThem) {
     TempDir dir;
     writeConusFile(dir.file("a.exr"), validFile());  // 8x6, 4 float channels: 768 bytes of pixels
-    ReadLimits small;
+    Limits small;
     small.maxDecodeBytes = 700;
     Refusal r = refusal([&] { readConusFile(dir.file("a.exr"), small); });
     EXPECT_EQ(r.code, ErrorCode::LimitExceeded) << r.message;
@@ -148,7 +148,7 @@ TEST(Limits, ACallerMayTightenThem) {
     ConusFile f = validFile();
     f.software = std::string(200, 's');
     writeConusFile(dir.file("b.exr"), f);
-    ReadLimits attributes;
+    Limits attributes;
     attributes.maxAttributeBytes = 100;  // `software` holds 200, every other attribute less than 100
     r = refusal([&] { readConusFile(dir.file("b.exr"), attributes); });
     EXPECT_EQ(r.code, ErrorCode::LimitExceeded) << r.message;
@@ -222,7 +222,7 @@ TEST(Hostile, ADeclaredWindowWithoutItsDataIsRefusedBeforeAllocating) {
         EXPECT_TRUE(oneLine(r.message));
         EXPECT_LT(r.seconds, kSecond);
     }
-    ReadLimits generous;  // the chunk table refuses it even when memory would allow it
+    Limits generous;  // the chunk table refuses it even when memory would allow it
     generous.maxDecodeBytes = std::int64_t{1} << 40;
     const Refusal r = refusal([&] { readConusFile(hostile("dw_32768x32768_rgb_dwab.exr"), generous); });
     EXPECT_TRUE(contains(r.message, "expands at most")) << r.message;

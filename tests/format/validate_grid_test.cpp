@@ -3,7 +3,9 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 
+#include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "test_files.h"
 
@@ -19,6 +21,37 @@ float& v(GridNodes& g, int i, int j) { return g.xy[2 * (std::size_t(j) * g.colum
 void expectOnly(const ValidationReport& r, int rule) {
     ASSERT_FALSE(r.ok());
     for (const Issue& issue : r.issues) EXPECT_EQ(number(issue.rule), rule) << r.str();
+}
+
+// core/map_rules.h decides and the validator words: both give the same answer on grids broken in
+// every way (random moves of growing size, NaN, nodes off their edge, a wrong count, sides outside V7).
+TEST(ValidateGrid, AgreesWithTheCoreRule) {
+    std::mt19937 rng(20261127);
+    int valid = 0, invalid = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+        const int n = 2 + trial % 7, m = 2 + (trial * 5) % 9;
+        GridNodes g = identityGrid(n, m);
+        const float size = 0.02f * float(trial % 20) / float(n);
+        std::uniform_real_distribution<float> move(-size, size);
+        for (int j = 1; j + 1 < m; ++j)
+            for (int i = 1; i + 1 < n; ++i) u(g, i, j) += move(rng), v(g, i, j) += move(rng);
+        std::uniform_int_distribution<int> node(0, n * m - 1);
+        switch (trial % 10) {
+            case 7: g.xy[2 * std::size_t(node(rng)) + 1] = std::numeric_limits<float>::quiet_NaN(); break;
+            case 8: u(g, 0, m - 1) = 1e-4f; break;
+            case 9: g.xy.pop_back(); break;
+            default: break;
+        }
+        const bool rule = map_rules::isValidGrid(g.columns, g.rows, g.xy);
+        EXPECT_EQ(rule, validateGrid(g).ok()) << "trial " << trial << ": " << validateGrid(g).str();
+        (rule ? valid : invalid) += 1;
+    }
+    EXPECT_GT(valid, 50);
+    EXPECT_GT(invalid, 50);
+    GridNodes wide = identityGrid(2, 2);
+    wide.columns = kMaxMapSide + 1;
+    EXPECT_FALSE(map_rules::isValidGrid(wide.columns, wide.rows, wide.xy));
+    EXPECT_FALSE(validateGrid(wide).ok());
 }
 
 TEST(ValidateGrid, IdentityIsValid) {
@@ -147,10 +180,10 @@ TEST(Image, MakeImageAndChannelIndex) {
 }
 
 TEST(ToString, Names) {
-    EXPECT_STREQ(toString(PixelType::Half), "half");
-    EXPECT_STREQ(toString(Compression::Dwaa), "dwaa");
-    EXPECT_STREQ(toString(DataKind::HeightField), "heightfield");
-    EXPECT_STREQ(toString(DepthKind::CameraDepth), "cameraDepth");
+    EXPECT_STREQ(enumName(PixelType::Half), "half");
+    EXPECT_STREQ(enumName(Compression::Dwaa), "dwaa");
+    EXPECT_STREQ(enumName(DataKind::HeightField), "heightfield");
+    EXPECT_STREQ(enumName(DepthKind::CameraDepth), "cameraDepth");
 }
 
 }  // namespace

@@ -46,7 +46,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     static MemoryFile file;
     file.assign(data, size);
     // Small enough that every run stays fast; the reader's checks are the same at any limit.
-    format::ReadLimits limits;
+    conus::Limits limits;
     limits.maxDecodeBytes = std::int64_t{64} << 20;
 
     format::ValidationReport report;

@@ -35,18 +35,18 @@ private:
 using conus::test::codeOf;
 
 TEST(ParseBackend, AcceptsEveryNameInAnyCase) {
-    EXPECT_EQ(parseBackend("auto"), Backend::Auto);
-    EXPECT_EQ(parseBackend("egl"), Backend::Egl);
-    EXPECT_EQ(parseBackend("OSMesa"), Backend::OsMesa);
-    EXPECT_EQ(parseBackend("CPU"), Backend::Cpu);
+    EXPECT_EQ(parseEnum<Backend>("auto"), Backend::Auto);
+    EXPECT_EQ(parseEnum<Backend>("egl"), Backend::Egl);
+    EXPECT_EQ(parseEnum<Backend>("OSMesa"), Backend::OsMesa);
+    EXPECT_EQ(parseEnum<Backend>("CPU"), Backend::Cpu);
     for (Backend b : {Backend::Auto, Backend::Egl, Backend::OsMesa, Backend::Cpu})
-        EXPECT_EQ(parseBackend(backendName(b)), b);
+        EXPECT_EQ(parseEnum<Backend>(enumName(b)), b);
 }
 
 TEST(ParseBackend, RejectsUnknownNamesListingTheValidOnes) {
     for (const char* bad : {"vulkan", "", "egl ", "gl"}) {
         std::string message;
-        EXPECT_EQ(codeOf([&] { parseBackend(bad); }, &message), ErrorCode::InvalidArgument) << bad;
+        EXPECT_EQ(codeOf([&] { parseEnum<Backend>(bad); }, &message), ErrorCode::InvalidArgument) << bad;
         EXPECT_NE(message.find("osmesa"), std::string::npos) << message;
     }
 }
@@ -65,9 +65,9 @@ TEST(Context, ProbeFindsEglAndOsMesaWorking) {
     EXPECT_EQ(statuses[1].backend, Backend::OsMesa);
     EXPECT_EQ(statuses[2].backend, Backend::Cpu);
     for (const BackendStatus& s : statuses) {
-        std::printf("    %-6s works=%d renderer='%s' version='%s' (%s)\n", backendName(s.backend).c_str(), s.works,
+        std::printf("    %-6s works=%d renderer='%s' version='%s' (%s)\n", enumName(s.backend), s.works,
                     s.renderer.c_str(), s.version.c_str(), s.reason.c_str());
-        EXPECT_TRUE(s.works) << backendName(s.backend) << ": " << s.reason;
+        EXPECT_TRUE(s.works) << enumName(s.backend) << ": " << s.reason;
     }
     // OSMesa is always Mesa's software rasterizer; EGL is too unless it found a hardware device.
     EXPECT_NE(statuses[1].renderer.find("llvmpipe"), std::string::npos) << statuses[1].renderer;

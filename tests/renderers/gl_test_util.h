@@ -26,7 +26,7 @@ inline Context& contextFor(Backend backend) {
     return *slot;
 }
 
-inline std::string paramName(const ::testing::TestParamInfo<Backend>& info) { return backendName(info.param); }
+inline std::string paramName(const ::testing::TestParamInfo<Backend>& info) { return enumName(info.param); }
 
 
 using conus::test::photoLike;

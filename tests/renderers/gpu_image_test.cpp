@@ -91,7 +91,7 @@ protected:
         EXPECT_EQ(gpu.channels, source.channels);
         const double psnr = codec::psnr(cpu, gpu);
         std::printf("    encode %dx%d -> %dx%d, map %dx%d, %s: PSNR %.2f dB\n", source.width, source.height, w, h,
-                    map.columns(), map.rows(), backendName(GetParam()).c_str(), psnr);
+                    map.columns(), map.rows(), enumName(GetParam()), psnr);
         return psnr;
     }
 
@@ -101,7 +101,7 @@ protected:
         EXPECT_EQ(gpu.channels, conus.channels);
         const double psnr = codec::psnr(cpu, gpu);
         std::printf("    decode %dx%d view (%.2f,%.2f)-(%.2f,%.2f) -> %dx%d, %s: PSNR %.2f dB\n", conus.width,
-                    conus.height, view.u0, view.v0, view.u1, view.v1, w, h, backendName(GetParam()).c_str(), psnr);
+                    conus.height, view.u0, view.v0, view.u1, view.v1, w, h, enumName(GetParam()), psnr);
         return psnr;
     }
 };
@@ -258,7 +258,7 @@ TEST_P(GpuImage, PyramidDecodeMatchesCpu) {
                 ASSERT_EQ(gpu.channels, conus.channels);
                 const double psnr = codec::psnr(cpu, gpu);
                 std::printf("    pyramid decode (%.2f,%.2f)-(%.2f,%.2f) -> %dx%d, %s: PSNR %.2f dB\n", view.u0, view.v0,
-                            view.u1, view.v1, w, w * 3 / 4, backendName(GetParam()).c_str(), psnr);
+                            view.u1, view.v1, w, w * 3 / 4, enumName(GetParam()), psnr);
                 EXPECT_GE(psnr, kDecodePsnr);
             }
         }
@@ -357,7 +357,7 @@ TEST_P(GpuImage, EncodeTilesSourcesOverTheLimit) {
         const double vsCpu = codec::psnr(cpu, tiled), vsUntiled = codec::psnr(untiled, tiled);
         std::printf("    tiled encode 700x500 -> %dx%d (%s), limit 512, %s: PSNR %.2f dB vs CPU, %.2f dB vs untiled "
                     "GPU (largest difference %.2g), untiled vs CPU %.2f dB\n",
-                    c.width, c.height, c.name, backendName(GetParam()).c_str(), vsCpu, vsUntiled, worst,
+                    c.width, c.height, c.name, enumName(GetParam()), vsCpu, vsUntiled, worst,
                     codec::psnr(cpu, untiled));
         EXPECT_GE(vsCpu, kEncodePsnr);
         EXPECT_GE(vsUntiled, 60.0);

@@ -8,8 +8,6 @@
 #include <sstream>
 #include <string>
 
-#include <glm/gtc/type_ptr.hpp>
-
 #include "conus/codec/build/map_measures.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
@@ -170,11 +168,6 @@ ComposeResult composeOrBuild(int columns, int rows, std::span<const glm::dvec2> 
 
 }  // namespace
 
-bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes) {
-    if (columns < 2 || rows < 2 || nodes.size() != std::size_t(columns) * rows) return false;
-    return map_rules::isValidGrid({columns, rows, glm::value_ptr(nodes.front())});
-}
-
 ComposeResult fitDisplacement(int columns, int rows, std::span<const glm::dvec2> displacement) {
     checkGrid(columns, rows, "fitDisplacement");
     if (displacement.size() != std::size_t(columns) * rows) {
@@ -184,13 +177,13 @@ ComposeResult fitDisplacement(int columns, int rows, std::span<const glm::dvec2>
     }
     std::vector<glm::vec2> nodes;
     placeNodes(columns, rows, displacement, 1.0, nodes);
-    if (isValidGrid(columns, rows, nodes)) return {SamplingMap(columns, rows, std::move(nodes)), 1.0};
+    if (map_rules::isValidGrid(columns, rows, nodes)) return {SamplingMap(columns, rows, std::move(nodes)), 1.0};
     // Invariant: lo is valid (0 is the identity), hi is not.
     double lo = 0.0, hi = 1.0;
     for (int it = 0; it < kBisectionSteps; ++it) {
         const double mid = 0.5 * (lo + hi);
         placeNodes(columns, rows, displacement, mid, nodes);
-        (isValidGrid(columns, rows, nodes) ? lo : hi) = mid;
+        (map_rules::isValidGrid(columns, rows, nodes) ? lo : hi) = mid;
     }
     placeNodes(columns, rows, displacement, lo, nodes);
     return {SamplingMap(columns, rows, std::move(nodes)), lo};

@@ -305,7 +305,7 @@ SamplingMap buildTransportMap(const DensityField& target, const DensityMapOption
         }
     // The gradient of a convex potential is monotone, so its grid folds only where the grid cannot
     // follow it; the identity is the answer then (the report shows it).
-    const bool valid = format::validateGrid(grid).ok();
+    const bool valid = map_rules::isValidGrid(grid.columns, grid.rows, grid.xy);
     SamplingMap map = valid ? SamplingMap::fromGrid(grid) : SamplingMap::identity(n, m);
     if (report) {
         *report = {};
@@ -338,7 +338,7 @@ SamplingMap buildFlowMap(const DensityField& target, const DensityMapOptions& op
         grid = integrateNodes(field, options);
         // Folded, or a cell much sparser than the sparsest density asked for: the grid could not
         // follow the flow here (see the top of this file); a weaker density is tried.
-        if (!format::validateGrid(grid).ok()) return false;
+        if (!map_rules::isValidGrid(grid.columns, grid.rows, grid.xy)) return false;
         if (minCellDensityOf(grid) < kMinDensityShare * *std::min_element(field.rho.begin(), field.rho.end())) return false;
         if (options.maxAnisotropy > 0 && measureMap(SamplingMap::fromGrid(grid), aspect).maxAnisotropy > options.maxAnisotropy) {
             anisotropyBound = true;

@@ -202,7 +202,7 @@ SamplingMap buildAddComposition(std::span<const Focus> foci, const FociOptions& 
                 grid.xy[2 * k] = static_cast<float>(p.x);
                 grid.xy[2 * k + 1] = static_cast<float>(p.y);
             }
-        if (scale == 0.0 || format::validateGrid(grid).ok()) return SamplingMap::fromGrid(grid);
+        if (scale == 0.0 || map_rules::isValidGrid(grid.columns, grid.rows, grid.xy)) return SamplingMap::fromGrid(grid);
     }
 }
 
@@ -227,17 +227,16 @@ void checkFalloff(const FociFalloff& falloff) {
 FociFalloff parseFalloff(const std::string& text) {
     FociFalloff falloff;
     const std::size_t comma = text.find(',');
-    const std::string width = text.substr(0, comma), shape = comma == std::string::npos ? "density" : text.substr(comma + 1);
+    const std::string width = text.substr(0, comma);
+    const std::string shape = comma == std::string::npos ? enumName(FociFalloff{}.shape) : text.substr(comma + 1);
     char* end = nullptr;
     errno = 0;
     falloff.width = std::strtod(width.c_str(), &end);
     if (width.empty() || end != width.c_str() + width.size() || errno == ERANGE) {
         throw Error(ErrorCode::InvalidArgument, "falloff \"" + text + "\": width \"" + width + "\" is not a number");
     }
-    if (shape == "density") falloff.shape = FociFalloffShape::Density;
-    else if (shape == "log") falloff.shape = FociFalloffShape::LogDensity;
-    else if (shape == "logr") falloff.shape = FociFalloffShape::LogRadius;
-    else throw Error(ErrorCode::InvalidArgument, "falloff \"" + text + "\": shape \"" + shape + "\" is not density, log or logr");
+    if (const std::optional<FociFalloffShape> parsed = tryParseEnum<FociFalloffShape>(shape)) falloff.shape = *parsed;
+    else throw Error(ErrorCode::InvalidArgument, "falloff \"" + text + "\": shape \"" + shape + "\" is not one of " + enumChoices<FociFalloffShape>());
     try {
         checkFalloff(falloff);
     } catch (const Error& e) {
@@ -247,8 +246,7 @@ FociFalloff parseFalloff(const std::string& text) {
 }
 
 std::string falloffText(const FociFalloff& falloff) {
-    static constexpr const char* kShapes[] = {"density", "log", "logr"};
-    return numberText(falloff.width) + "," + kShapes[static_cast<int>(falloff.shape)];
+    return numberText(falloff.width) + "," + enumName(falloff.shape);
 }
 
 void checkFocus(const Focus& f) {
@@ -426,8 +424,8 @@ Focus parseFocus(const std::string& text) {
 
 format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition composition, const FociFalloff& falloff) {
     format::AnalyticMap analytic;
-    analytic.kind = "foci";
-    analytic.composition = composition == FociComposition::Add ? "add" : "density";
+    analytic.kind = enumName(format::MapKind::Foci);
+    analytic.composition = enumName(composition);
     for (const Focus& f : foci) analytic.foci.push_back({f.u, f.v, f.r, f.k});
     if (falloff.width != FociFalloff{}.width || falloff.shape != FociFalloff{}.shape) {
         analytic.scalars["falloffWidth"] = falloff.width;

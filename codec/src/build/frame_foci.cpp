@@ -162,8 +162,7 @@ SamplingMap buildFrameFociMap(std::span<const Focus> foci, const FociOptions& op
         for (std::size_t n = 0; n < count; ++n)
             nodes[n] = glm::vec2(static_cast<float>(std::clamp(base[2 * n] + s * shift[2 * n], 0.0, 1.0)),
                                  static_cast<float>(std::clamp(base[2 * n + 1] + s * shift[2 * n + 1], 0.0, 1.0)));
-        const map_rules::GridView view{columns, rows, &nodes[0].x};
-        if (map_rules::isValidGrid(view) || attempt == 64) break;
+        if (map_rules::isValidGrid(columns, rows, nodes) || attempt == 64) break;
         s *= 0.5;
     }
     return SamplingMap(columns, rows, std::move(nodes));

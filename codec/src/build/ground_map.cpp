@@ -137,14 +137,14 @@ SamplingMap buildGroundMap(const GroundParams& params, int columns, int rows) {
 format::AnalyticMap toAnalytic(const GroundParams& params) {
     checkGroundParams(params);
     format::AnalyticMap a;
-    a.kind = "ground";
+    a.kind = enumName(format::MapKind::Ground);
     a.scalars = {{"eyeHeight", params.eyeHeight}, {"near", params.near}, {"far", params.far}, {"fovDegrees", params.fovDegrees}};
     a.groundRows.assign(params.rows.begin(), params.rows.end());
     return a;
 }
 
 GroundParams groundFromAnalytic(const format::AnalyticMap& analytic) {
-    if (analytic.kind != "ground") {
+    if (!analytic.is(format::MapKind::Ground)) {
         throw Error(ErrorCode::InvalidArgument, "analytic map of kind \"" + analytic.kind + "\" is not a ground map");
     }
     auto get = [&](const char* name) {

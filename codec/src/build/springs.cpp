@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "conus/codec/build/compose.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec {
 namespace {
@@ -544,7 +545,7 @@ SamplingMap SpringSystem::toMap(int columns, int rows, double* scale) const {
     if (scale) *scale = 1.0;
     if (columns == m_columns && rows == m_rows) {
         std::vector<glm::vec2> nodes = positions();
-        if (isValidGrid(columns, rows, nodes)) return SamplingMap(columns, rows, std::move(nodes));
+        if (map_rules::isValidGrid(columns, rows, nodes)) return SamplingMap(columns, rows, std::move(nodes));
     }
     if (columns < 2 || rows < 2 || columns > kMaxMapSide || rows > kMaxMapSide) {
         fail("spring map of " + std::to_string(columns) + "x" + std::to_string(rows) + " nodes; each side must be in [2, " +

@@ -325,7 +325,7 @@ Mesh undistortHeightField(const format::ConusFile& file, glm::dvec2 extent) {
 
     std::optional<GroundParams> ground;
     std::optional<SamplingMap> grid;
-    if (file.analytic && file.analytic->kind == "ground")
+    if (file.analytic && file.analytic->is(format::MapKind::Ground))
         ground = groundFromAnalytic(*file.analytic);
     else
         grid = SamplingMap::fromGrid(file.map);
@@ -363,7 +363,7 @@ Mesh undistortHeightField(const format::ConusFile& file, glm::dvec2 extent) {
 }
 
 Mesh undistortHeightField(const format::ConusFile& file) {
-    if (!file.analytic || file.analytic->kind != "ground")
+    if (!file.analytic || !file.analytic->is(format::MapKind::Ground))
         throw Error(ErrorCode::InvalidArgument,
                     "undistortHeightField: the file has no ground-map parameters to size the field; give its extent");
     return undistortHeightField(file, fieldExtent(groundFromAnalytic(*file.analytic)));
@@ -374,7 +374,7 @@ double heightAt(const format::ConusFile& file, glm::dvec2 p) {
     checkImage(image, "heightAt");
     const int z = image.channelIndex("Z");
     if (z < 0) throw Error(ErrorCode::InvalidArgument, "heightAt: the CoNUS image has no Z channel");
-    const glm::dvec2 pd = file.analytic && file.analytic->kind == "ground"
+    const glm::dvec2 pd = file.analytic && file.analytic->is(format::MapKind::Ground)
                               ? groundDistort(groundFromAnalytic(*file.analytic), p)
                               : SamplingMap::fromGrid(file.map).distort(p);
     const double fx = std::clamp(pd.x * image.width - 0.5, 0.0, image.width - 1.0);

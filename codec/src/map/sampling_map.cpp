@@ -11,6 +11,7 @@
 #include <string>
 
 #include "conus/core/error.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::codec {
 namespace {
@@ -249,8 +250,10 @@ inline const SamplingMap::Index& SamplingMap::index() const {
 std::size_t SamplingMap::indexBytes() const { return index().bytes(); }
 
 SamplingMap::SamplingMap(int columns, int rows, std::vector<glm::vec2> nodes) {
-    const format::ValidationReport report = format::validateGrid(makeGrid(columns, rows, nodes));
-    if (!report.ok()) throw Error(ErrorCode::InvalidMap, report.str(), report.ruleNumbers());
+    if (!map_rules::isValidGrid(columns, rows, nodes)) {
+        const format::ValidationReport report = format::validateGrid(makeGrid(columns, rows, nodes));
+        throw Error(ErrorCode::InvalidMap, report.str(), report.ruleNumbers());
+    }
     m_columns = columns;
     m_rows = rows;
     m_nodes = std::move(nodes);

@@ -217,13 +217,13 @@ TEST(Compose, ScaledAndMovedPatternsHaveNoSeam) {
 
 TEST(Compose, ValidityCheckAgreesWithValidator) {
     std::vector<glm::vec2> nodes = SamplingMap::identity(4, 4).nodes();
-    EXPECT_TRUE(isValidGrid(4, 4, nodes));
+    EXPECT_TRUE(map_rules::isValidGrid(4, 4, nodes));
     nodes[5] = nodes[6];  // collapse an edge
-    EXPECT_FALSE(isValidGrid(4, 4, nodes));
+    EXPECT_FALSE(map_rules::isValidGrid(4, 4, nodes));
     nodes = SamplingMap::identity(4, 4).nodes();
     nodes[1].y = 1e-3f;  // top node off its edge
-    EXPECT_FALSE(isValidGrid(4, 4, nodes));
-    EXPECT_FALSE(isValidGrid(4, 5, nodes));
+    EXPECT_FALSE(map_rules::isValidGrid(4, 4, nodes));
+    EXPECT_FALSE(map_rules::isValidGrid(4, 5, nodes));
 }
 
 }  // namespace

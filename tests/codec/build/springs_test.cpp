@@ -25,7 +25,7 @@ void expectValid(const SamplingMap& map) {
 
 void expectValidPositions(const SpringSystem& system) {
     const std::vector<glm::vec2> p = system.positions();
-    ASSERT_TRUE(isValidGrid(system.columns(), system.rows(), p));
+    ASSERT_TRUE(map_rules::isValidGrid(system.columns(), system.rows(), p));
     format::GridNodes grid{system.columns(), system.rows(), {}};
     for (const glm::vec2& q : p) grid.xy.insert(grid.xy.end(), {q.x, q.y});
     const format::ValidationReport report = format::validateGrid(grid);

@@ -14,16 +14,20 @@
 #include <array>
 #include <optional>
 #include <string_view>
+#include <utility>
 
 #include <glm/glm.hpp>
 
 #include "conus/core/bounds.h"
+#include "conus/core/enum_names.h"
 
 namespace conus {
 
 enum class Projection { Perspective, Orthographic };
-const char* toString(Projection projection);  // "perspective", "orthographic"
-std::optional<Projection> parseProjection(std::string_view text);
+constexpr auto enumNameTable(Projection) {
+    return makeEnumNameTable<Projection>(
+        "projection", {{Projection::Perspective, "perspective"}, {Projection::Orthographic, "orthographic"}});
+}
 
 struct Ray {
     glm::dvec3 origin{0.0};

@@ -10,8 +10,11 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
+
+#include "conus/core/enum_names.h"
 
 namespace conus {
 
@@ -24,6 +27,15 @@ enum class Transfer {
 
 // The sample type a file stored, which a round trip restores.
 enum class SampleType { Uint8, Uint16, Uint32, Half, Float };
+
+constexpr auto enumNameTable(Transfer) {
+    return makeEnumNameTable<Transfer>(
+        "colour space", {{Transfer::Linear, "linear"}, {Transfer::Srgb, "srgb"}, {Transfer::Raw, "raw"}});
+}
+constexpr auto enumNameTable(SampleType) {
+    return makeEnumNameTable<SampleType>("sample type", {{SampleType::Uint8, "uint8"}, {SampleType::Uint16, "uint16"}, {SampleType::Uint32, "uint32"},
+                                                         {SampleType::Half, "half"}, {SampleType::Float, "float"}});
+}
 
 // A metadata item carried from a source file into a CoNUS file and back out on decode (EXIF,
 // camera make and model, ...), under the name OpenImageIO gives it ("Make", "Exif:FNumber").
@@ -48,10 +60,6 @@ struct SourceEncoding {
 // sRGB's primaries and white point (ITU-R BT.709, D65), the chromaticities of sRGB sources.
 inline constexpr std::array<float, 8> kRec709Chromaticities{0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
 
-const char* toString(Transfer transfer);      // "linear", "srgb", "raw"
-const char* toString(SampleType sampleType);  // "uint8", "uint16", "uint32", "half", "float"
-std::optional<Transfer> parseTransfer(std::string_view text);
-std::optional<SampleType> parseSampleType(std::string_view text);
 // Bits per sample of a type: 8, 16, 32, 16, 32.
 int bitsOf(SampleType sampleType);
 

@@ -8,6 +8,9 @@
 #include <cmath>
 #include <optional>
 #include <string_view>
+#include <utility>
+
+#include "conus/core/enum_names.h"
 
 namespace conus {
 
@@ -16,6 +19,11 @@ enum class ToneMap {
     Reinhard,  // x / (1 + x) per channel: every value fits, highlights compress
     Aces,      // Narkowicz's fit of the ACES filmic curve per channel: contrasty, saturates to white
 };
+
+constexpr auto enumNameTable(ToneMap) {
+    return makeEnumNameTable<ToneMap>(
+        "tone map", {{ToneMap::None, "none"}, {ToneMap::Reinhard, "reinhard"}, {ToneMap::Aces, "aces"}});
+}
 
 struct DisplayOptions {
     double exposure = 0.0;  // stops: values are multiplied by 2^exposure first
@@ -31,9 +39,6 @@ inline constexpr std::array<std::array<float, 3>, 6> kInfernoRamp{{{0.001f, 0.00
                                                                    {0.865f, 0.317f, 0.226f},
                                                                    {0.988f, 0.645f, 0.040f},
                                                                    {0.988f, 0.998f, 0.645f}}};
-
-const char* toString(ToneMap toneMap);  // "none", "reinhard", "aces"
-std::optional<ToneMap> parseToneMap(std::string_view text);
 
 // Exposure then tone map, for a linear colour value (not alpha, not data). NaN stays NaN.
 inline float exposeAndToneMap(float linear, float gain, ToneMap toneMap) {

@@ -1,7 +1,7 @@
 // The resource limits of CoNUS, stated once. Every reader checks a size that comes from a file (or
 // a command line) against these, in 64-bit arithmetic, before it allocates; `conus info --limits`
 // prints them and spec/conus-format.md ("Limits") lists the same values. A caller may tighten them
-// through a Limits value (format::ReadLimits is this struct); the constants are the defaults.
+// through a Limits value; the constants are the defaults.
 // Standard types only, so that every library, the CLI and the Python module can include it.
 #pragma once
 

@@ -1,11 +1,17 @@
 // The sampling-map rules of spec/conus-format.md, written once: the grid's node count (V7), finite
 // nodes (V8) inside [0,1]^2 (V9), boundary nodes exactly on their edge (V10) and strictly convex
-// cells with the identity's orientation (V11); the focus parameters (V12). format's validator
-// reports on them in words; codec's builders (compose, density, springs) test them here, with the
-// same arithmetic and the same margin, so what a builder accepts the validator accepts.
+// cells with the identity's orientation (V11); the focus parameters (V12). isValidGrid is the one
+// question "is this grid a valid map?": codec's builders and SamplingMap ask it, and format's
+// validator asks it too before it words each broken rule, so what one accepts the other accepts.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
+#include <span>
+
+#include <glm/vec2.hpp>
+
+#include "conus/core/limits.h"
 
 namespace conus::map_rules {
 
@@ -58,6 +64,14 @@ inline int firstBadCorner(const GridView& g, int i, int j) {
     return -1;
 }
 
+// V7's size: columns and rows in [kMinMapSide, kMaxMapSide].
+inline bool sidesInRange(int columns, int rows) {
+    return columns >= kMinMapSide && columns <= kMaxMapSide && rows >= kMinMapSide && rows <= kMaxMapSide;
+}
+
+// V8 for node (i,j).
+inline bool nodeFinite(const GridView& g, int i, int j) { return std::isfinite(g.u(i, j)) && std::isfinite(g.v(i, j)); }
+
 // V9 and V10 for node (i,j), assuming it is finite.
 inline bool nodeInside(const GridView& g, int i, int j) {
     const double u = g.u(i, j), v = g.v(i, j);
@@ -69,8 +83,11 @@ inline bool nodeOnItsEdge(const GridView& g, int i, int j) {
              (j == g.rows - 1 && v != 1.0));
 }
 
-// V8..V11 together, without messages (format::validateGrid says what is wrong): what a builder
-// asks of a grid it made. Does not check V7's size limits, only that the grid has cells.
+// V7's size and V8..V11 together, without messages (format::validateGrid says what is wrong).
 bool isValidGrid(const GridView& g);
+// The same for nodes as floats (u, v interleaved: format::GridNodes) or as glm::vec2 (codec's
+// maps): false too when there are not columns x rows nodes.
+bool isValidGrid(int columns, int rows, std::span<const float> uv);
+bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes);
 
 }  // namespace conus::map_rules

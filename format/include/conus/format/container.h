@@ -6,7 +6,7 @@
 // Rules shared by the functions below:
 // - writeConusFile validates first and writes nothing for an invalid file; it writes through
 //   conus::AtomicFile (core/atomic_file.h), so no half-written file is ever left.
-// - readConusFile reads regular files only. It checks every size against ReadLimits (limits.h)
+// - readConusFile reads regular files only. It checks every size against conus::Limits (limits.h)
 //   before allocating, and the chunk tables against the file's size before committing memory for
 //   pixels; it throws conus::Error: NotConus for an EXR without a `conus` part, Corrupt for a
 //   damaged file or a broken V-rule, LimitExceeded for sizes beyond the limits, Io when the file
@@ -53,17 +53,19 @@ struct FocusParams {
 // How a map was built, kept so the same map can be rebuilt and shown (focus outlines, ground
 // plane). The grid in `samplingmap` is always the authority for decoding.
 struct AnalyticMap {
-    std::string kind;                       // "foci" or "ground" (spec/ lists the kinds)
+    std::string kind;                       // a MapKind's name (names.h; spec/ lists the kinds)
     std::vector<FocusParams> foci;          // kind "foci"
-    std::string composition;                // kind "foci": "density" or "add"
+    std::string composition;                // kind "foci": a FociComposition's name (names.h)
     std::map<std::string, double> scalars;  // other kinds' named parameters
     std::vector<float> groundRows;          // kind "ground": the row profile, if any (conus:groundRows)
+
+    bool is(MapKind k) const { return kind == enumName(k); }
 };
 
 // The camera as the file records it (rule V13): EXR's standard matrices and conus:projection, as
 // read, so that the validator can report on them. toCamera() gives the camera model they describe.
 struct CameraAttributes {
-    std::string projection = "perspective";  // "perspective" or "orthographic"
+    std::string projection = enumName(Projection::Perspective);  // a Projection's name
     std::array<float, 16> worldToCamera{};    // row-major, as EXR's standard attribute (M44f)
     std::array<float, 16> worldToNDC{};
 };
@@ -96,33 +98,26 @@ struct ConusFile {
     std::string software;  // free text; the writer fills "conus <version>" when empty
 };
 
-// The caps readConusFile checks before allocating (limits.h; a caller may lower them).
-using ReadLimits = conus::Limits;
-
 void writeConusFile(const std::string& path, const ConusFile& file);
 // Refuses (InvalidArgument) an output name that does not end in .exr (any case): a CoNUS file is
 // an OpenEXR file, and a picture's extension would make readers expect a picture. The CLI and the
 // Python package call it before any work.
 void checkConusFileName(const std::string& path);
-ConusFile readConusFile(const std::string& path, const ReadLimits& limits = {});
+ConusFile readConusFile(const std::string& path, const Limits& limits = {});
 // Everything readConusFile reads but the CoNUS image's pixels (what `conus info` and `validate`
 // need): the image has its width, height and channels and no pixels. The same checks run, the
 // chunk tables included, so a file this accepts does hold its pixel data's bytes.
-ConusFile readConusHeader(const std::string& path, const ReadLimits& limits = {});
+ConusFile readConusHeader(const std::string& path, const Limits& limits = {});
 
 // Every violated rule of the file at `path` (never throws for bad content). With `readPixels`
 // (the default) every chunk of pixel data is read and decompressed too, as readConusFile does, so
 // a file that validates also reads; without, headers, the map and the chunk tables only.
-ValidationReport validateConusFile(const std::string& path, const ReadLimits& limits = {}, bool readPixels = true);
+ValidationReport validateConusFile(const std::string& path, const Limits& limits = {}, bool readPixels = true);
 // Every violated rule of an in-memory file (structure, attributes, map geometry).
 ValidationReport validateConusFile(const ConusFile& file);
 // The sampling-map rules alone (node count, finite values, boundary, strictly convex cells with
-// the identity's orientation). Used by codec::SamplingMap so the rules live in one place.
+// the identity's orientation), rule by rule in words; whether a grid is valid is decided by
+// core/map_rules.h's isValidGrid, which this agrees with.
 ValidationReport validateGrid(const GridNodes& grid);
-
-const char* toString(PixelType);
-const char* toString(Compression);
-const char* toString(DataKind);
-const char* toString(DepthKind);
 
 }  // namespace conus::format

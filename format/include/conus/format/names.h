@@ -1,12 +1,12 @@
-// The names the container writes for its enumerations, each written once: the writer, the reader,
-// the validator's "one of" checks and the command line's choices all come from these tables.
+// The container's enumerations and the names it writes for them (spec/conus-format.md), each
+// written once in its table (core/enum_names.h): the writer, the reader, the
+// validator's "one of" checks and the command line's choices all come from these tables.
 #pragma once
 
-#include <optional>
-#include <string>
-#include <string_view>
 #include <utility>
-#include <vector>
+
+#include "conus/core/enum_names.h"
+#include "conus/core/map_rules.h"
 
 namespace conus::format {
 
@@ -14,58 +14,37 @@ enum class PixelType { Half, Float };         // storage type of the image chann
 enum class Compression { None, Zip, Piz, Dwaa };
 enum class DataKind { Image, HeightField, DepthImage };
 enum class DepthKind { None, CameraDepth, Height };  // what a `Z` channel holds
+// How a map was built (conus:mapKind): foci, or the perspective ground plane.
+enum class MapKind { Foci, Ground };
+// How a foci map's foci combine (conus:composition) and the shape of a focus's transition
+// (conus:param:falloffShape, stored as the value's number); codec/build/foci.h builds each.
+enum class FociComposition { Density, Add };
+enum class FociFalloffShape { Density, LogDensity, LogRadius };
 
-template <class E>
-struct EnumNames;  // `table`: each value with its name, in the order choices are listed
-
-template <>
-struct EnumNames<PixelType> {
-    static constexpr std::pair<PixelType, const char*> table[] = {{PixelType::Half, "half"}, {PixelType::Float, "float"}};
-};
-template <>
-struct EnumNames<Compression> {
-    static constexpr std::pair<Compression, const char*> table[] = {
-        {Compression::Zip, "zip"}, {Compression::Piz, "piz"}, {Compression::Dwaa, "dwaa"}, {Compression::None, "none"}};
-};
-template <>
-struct EnumNames<DataKind> {
-    static constexpr std::pair<DataKind, const char*> table[] = {
-        {DataKind::Image, "image"}, {DataKind::HeightField, "heightfield"}, {DataKind::DepthImage, "depthimage"}};
-};
-template <>
-struct EnumNames<DepthKind> {
-    static constexpr std::pair<DepthKind, const char*> table[] = {
-        {DepthKind::None, "none"}, {DepthKind::CameraDepth, "cameraDepth"}, {DepthKind::Height, "height"}};
-};
-
-template <class E>
-const char* nameOf(E value) {
-    for (const auto& [v, name] : EnumNames<E>::table)
-        if (v == value) return name;
-    return "unknown";
+constexpr auto enumNameTable(PixelType) {
+    return makeEnumNameTable<PixelType>("pixel type", {{PixelType::Half, "half"}, {PixelType::Float, "float"}});
 }
-
-template <class E>
-std::optional<E> parseName(std::string_view text) {
-    for (const auto& [v, name] : EnumNames<E>::table)
-        if (text == name) return v;
-    return std::nullopt;
+constexpr auto enumNameTable(Compression) {
+    return makeEnumNameTable<Compression>("compression", {{Compression::Zip, "zip"}, {Compression::Piz, "piz"},
+                                                          {Compression::Dwaa, "dwaa"}, {Compression::None, "none"}});
 }
-
-// Every name, in table order ("zip", "piz", ...): for "one of" checks and command-line choices.
-template <class E>
-std::vector<std::string> namesOf() {
-    std::vector<std::string> names;
-    for (const auto& entry : EnumNames<E>::table) names.emplace_back(entry.second);
-    return names;
+constexpr auto enumNameTable(DataKind) {
+    return makeEnumNameTable<DataKind>(
+        "data kind", {{DataKind::Image, "image"}, {DataKind::HeightField, "heightfield"}, {DataKind::DepthImage, "depthimage"}});
 }
-
-// "zip, piz, dwaa, none": for messages.
-template <class E>
-std::string nameList() {
-    std::string list;
-    for (const auto& entry : EnumNames<E>::table) list.append(list.empty() ? "" : ", ").append(entry.second);
-    return list;
+constexpr auto enumNameTable(DepthKind) {
+    return makeEnumNameTable<DepthKind>(
+        "depth kind", {{DepthKind::None, "none"}, {DepthKind::CameraDepth, "cameraDepth"}, {DepthKind::Height, "height"}});
 }
+constexpr auto enumNameTable(MapKind) { return makeEnumNameTable<MapKind>("map kind", {{MapKind::Foci, "foci"}, {MapKind::Ground, "ground"}}); }
+constexpr auto enumNameTable(FociComposition) {
+    return makeEnumNameTable<FociComposition>(
+        "composition", {{FociComposition::Density, "density"}, {FociComposition::Add, "add"}});
+}
+constexpr auto enumNameTable(FociFalloffShape) {
+    return makeEnumNameTable<FociFalloffShape>("falloff shape", {{FociFalloffShape::Density, "density"}, {FociFalloffShape::LogDensity, "log"},
+                                                                 {FociFalloffShape::LogRadius, "logr"}});
+}
+static_assert(kEnumNameTable<FociFalloffShape>.names.size() == map_rules::kFalloffShapes);
 
 }  // namespace conus::format

@@ -18,9 +18,11 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "conus/core/color.h"
 #include "conus/core/display.h"
+#include "conus/core/enum_names.h"
 #include "conus/core/image.h"
 #include "conus/core/limits.h"
 
@@ -32,6 +34,11 @@ enum class NonFiniteRepair {
     Black,  // replace them by 0
     Box3,   // replace them by the average of their finite 3x3 neighbours (oiiotool --fixnan box3)
 };
+
+constexpr auto enumNameTable(NonFiniteRepair) {
+    return makeEnumNameTable<NonFiniteRepair>("non-finite repair", {{NonFiniteRepair::Keep, "keep"}, {NonFiniteRepair::Black, "black"},
+                                                                    {NonFiniteRepair::Box3, "box3"}});
+}
 
 struct ReadOptions {
     std::optional<Transfer> colorspace;  // absent: from the file (float: linear; integer: sRGB unless tagged linear)

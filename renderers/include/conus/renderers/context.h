@@ -16,7 +16,10 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "conus/core/enum_names.h"
 
 namespace conus::gl {
 
@@ -30,11 +33,12 @@ enum class Backend {
     Cpu,     // no GL: the CPU reference in conus::codec; has no Context
 };
 
-// "auto", "egl", "osmesa", "cpu" (any case) -> Backend; anything else throws
-// conus::Error(InvalidArgument) listing the accepted names.
-Backend parseBackend(const std::string& name);
-// The lower-case name parseBackend accepts.
-std::string backendName(Backend backend);
+// Backends are named in any case (parseEnum<gl::Backend>("OSMesa")); a bad name throws
+// conus::Error(InvalidArgument) listing these.
+constexpr auto enumNameTable(Backend) {
+    return makeEnumNameTable<Backend>(
+        "backend", {{Backend::Auto, "auto"}, {Backend::Egl, "egl"}, {Backend::OsMesa, "osmesa"}, {Backend::Cpu, "cpu"}}, true);
+}
 
 struct BackendStatus {
     Backend backend = Backend::Cpu;

@@ -13,15 +13,20 @@
 #include "conus/core/display.h"
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "conus/codec/image/decode.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
+#include "conus/core/enum_names.h"
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"
 
 namespace conus::gl {
+
+// The grey conus-view draws around the image, in every channel (its shader gets it as kBackground).
+inline constexpr float kViewBackground = 0.11f;
 
 enum class ViewMode {
     Reconstructed,  // the conventional frame decoded from the CoNUS image (default)
@@ -43,6 +48,15 @@ enum class ViewMode {
 // trilinear tap from the mip chain per pixel in the shader, which measured faster on llvmpipe than
 // the CPU decoder (bench/README.md, Viewer). Other modes always use the GPU.
 enum class DecodePath { Auto, Gpu, Cpu };
+
+constexpr auto enumNameTable(ViewMode) {
+    return makeEnumNameTable<ViewMode>("view mode", {{ViewMode::Reconstructed, "reconstructed"}, {ViewMode::Raw, "raw"}, {ViewMode::Uniform, "uniform"},
+                                                     {ViewMode::Wipe, "wipe"}, {ViewMode::Density, "density"}});
+}
+constexpr auto enumNameTable(DecodePath) {
+    return makeEnumNameTable<DecodePath>(
+        "decode path", {{DecodePath::Auto, "auto"}, {DecodePath::Gpu, "gpu"}, {DecodePath::Cpu, "cpu"}});
+}
 
 struct ViewOptions {
     ViewMode mode = ViewMode::Reconstructed;

@@ -12,8 +12,10 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "conus/core/enum_names.h"
 #include "conus/core/limits.h"
 #include "conus/core/volume.h"
 
@@ -30,6 +32,11 @@ struct VolumeReadOptions {
 };
 
 enum class RawType { UInt8, UInt16, Float32 };
+
+constexpr auto enumNameTable(RawType) {
+    return makeEnumNameTable<RawType>(
+        "raw sample type", {{RawType::UInt8, "uint8"}, {RawType::UInt16, "uint16"}, {RawType::Float32, "float32"}});
+}
 
 // A raw brick's layout: what the command line says, since the file says nothing.
 struct RawLayout {
@@ -64,8 +71,11 @@ Volume readVdbVolume(const std::string& path, const VolumeReadOptions& options =
 // through a temporary renamed over `path`: for conversions and tests.
 void writeVdbVolume(const std::string& path, const Volume& volume, float background = 0.0f);
 
-// "raw:WxHxD:uint8|uint16|float32[:spacing]:path" (spacing "s" or "sx,sy,sz") -> path and layout.
-// Throws conus::Error(InvalidArgument) naming what is malformed.
+// "raw:WxHxD:uint8|uint16|float32[:spacing]:path": the raw form with RawType's names, for messages and help.
+std::string rawVolumeForm();
+
+// rawVolumeForm() (spacing "s" or "sx,sy,sz") -> path and layout. Throws
+// conus::Error(InvalidArgument) naming what is malformed.
 struct RawSpec {
     std::string path;
     RawLayout layout;

@@ -18,11 +18,15 @@
 #include "conus/codec/build/importance.h"  // importance from the picture itself
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/image.h"
+#include "conus/core/enum_names.h"
 #include "conus/core/map_rules.h"
 
 namespace conus::codec {
 
 enum class AutoMethod { Flow, Separable };
+constexpr auto enumNameTable(AutoMethod) {
+    return makeEnumNameTable<AutoMethod>("method", {{AutoMethod::Flow, "flow"}, {AutoMethod::Separable, "separable"}});
+}
 
 struct AutoMapOptions {
     int columns = map_rules::kDefaultSide, rows = map_rules::kDefaultSide;  // map grid

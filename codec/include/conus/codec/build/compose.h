@@ -45,10 +45,6 @@ struct ComposeResult {
     DensityMapReport report = {};  // of the rebuild: what the builder held
 };
 
-// True when `nodes` (columns x rows, row-major) form a valid map (rules V8..V11): the test of
-// core/map_rules.h, which format::validateGrid words.
-bool isValidGrid(int columns, int rows, std::span<const glm::vec2> nodes);
-
 // The shared rule above: node (i,j) = p + scale * displacement[j*columns+i]. Throws
 // conus::Error(InvalidArgument) for a grid smaller than 2x2 or a span of the wrong size.
 ComposeResult fitDisplacement(int columns, int rows, std::span<const glm::dvec2> displacement);

@@ -28,7 +28,10 @@ struct Focus {
     double u = 0.5, v = 0.5, r = 0.1, k = 2;
 };
 
-enum class FociComposition { Density, Add };
+// The composition and the falloff shape are the container's enumerations (format/names.h), which
+// records them.
+using format::FociComposition;
+using format::FociFalloffShape;
 
 // The transition from a focus's disc (density k^2) to the context (density 1), over the radii
 // s = distance / r in [1, width], with t = smoothstep(width - s over width - 1) (quintic, C2):
@@ -36,8 +39,6 @@ enum class FociComposition { Density, Add };
 // - LogDensity: density k^(2 t): the same ends, sparser in the outer part of the ring;
 // - LogRadius: density k^(2 t') with t' the smoothstep of log(width / s) over log(width): log
 //   density falls most steeply near the disc, as the least anisotropic radial focus does.
-enum class FociFalloffShape { Density, LogDensity, LogRadius };
-
 struct FociFalloff {
     double width = 2.0;  // outer radius of the transition over r: in (1, 8]
     FociFalloffShape shape = FociFalloffShape::Density;

@@ -24,6 +24,7 @@
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/core/bounds.h"
+#include "conus/core/enum_names.h"
 #include "conus/core/image.h"
 
 namespace conus::codec {
@@ -126,5 +127,10 @@ struct ReflectionFrameOptions {
 // showing the sky, 2 the reflector showing the scene.
 Image renderReflectionFrame(const MeshScene& scene, const std::vector<ReflectionFace>* faces, glm::dvec3 centre,
                             const Camera& camera, int width, int height, const ReflectionFrameOptions& options);
+
+constexpr auto enumNameTable(Reflector::Kind) {
+    return makeEnumNameTable<Reflector::Kind>(
+        "reflector", {{Reflector::Kind::Sphere, "sphere"}, {Reflector::Kind::Plane, "plane"}});
+}
 
 }  // namespace conus::codec

@@ -3,9 +3,9 @@
 // location. distort() is the paper's Equation 1 (bilinear interpolation of the nodes); undistort()
 // is its exact inverse, O(1) per lookup through a bucket grid over the distorted plane.
 //
-// A SamplingMap is always valid: the constructor checks every rule of format::validateGrid (finite
-// nodes in [0,1]^2, boundary nodes on their edge, corners fixed, every cell strictly convex with
-// the identity's orientation) and throws conus::Error(InvalidMap) naming the rules it breaks.
+// A SamplingMap is always valid: the constructor asks core/map_rules.h's isValidGrid (V7..V11:
+// finite nodes in [0,1]^2, boundary nodes on their edge, every cell strictly convex with the
+// identity's orientation) and throws conus::Error(InvalidMap) with format::validateGrid's words.
 // Coordinates are normalized: u right, v down, origin top-left. Points outside [0,1]^2 are clamped.
 #pragma once
 
