@@ -57,7 +57,7 @@ struct AnalyticMap {
     std::vector<FocusParams> foci;          // kind "foci"
     std::string composition;                // kind "foci": a FociComposition's name (names.h)
     std::map<std::string, double> scalars;  // other kinds' named parameters
-    std::vector<float> groundRows;          // kind "ground": the row profile, if any (conus:groundRows)
+    std::vector<float> groundRows{};        // kind "ground": the row profile, if any (conus:groundRows)
 
     bool is(MapKind k) const { return kind == enumName(k); }
 };

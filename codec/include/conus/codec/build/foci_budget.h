@@ -52,7 +52,7 @@ struct FociBudget {
     bool gridLimited = false;         // the grid held less than half a focus's extra magnification
     // What the builder gave way on to keep the anisotropy bound (FociReport::notes: a transition
     // widened, a grid refined, a k not reached), one line each with numbers.
-    std::vector<std::string> builderNotes;
+    std::vector<std::string> builderNotes{};
 };
 
 // An importance image that is 1 on the foci's discs and 0 elsewhere (w x h), the region a
