@@ -213,7 +213,7 @@ RESULTS = "bench-results"  # under the build folder
 MIRRORS = [("sphere", "BM_ReflectionSilhouettes/0"), ("plane", "BM_ReflectionSilhouettes/1")]
 REFLECTION_COSTS = [
     ("intersection, CPU `codec::intersect` (relief asset)", "BM_IntersectCpu", "1.05x"),
-    ("intersection, GLSL `gl::intersectRays` (relief asset)", "BM_IntersectGlsl", "1.05x"),
+    ("intersection, GLSL `renderers::intersectRays` (relief asset)", "BM_IntersectGlsl", "1.05x"),
     ("reflection frame, CPU `renderReflectionFrame`", "BM_ReflectionFrame", ""),
     ("reflection frame, GLSL `ReflectionRenderer::draw`", "BM_ReflectionFrameGl", ""),
 ]

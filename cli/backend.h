@@ -1,5 +1,5 @@
-// `--backend` (gl::Backend's names) on every command that renders. The choice itself is made in one
-// place, conus::gl::Device::choose (renderers/backend.h); this file only parses the option.
+// `--backend` (renderers::Backend's names) on every command that renders. The choice itself is made in one
+// place, conus::renderers::Device::choose (renderers/backend.h); this file only parses the option.
 #pragma once
 
 #include <string>
@@ -13,9 +13,9 @@ class App;
 namespace conus::cli {
 
 // Work without a CPU path offers auto, egl and osmesa only.
-void addBackendOption(CLI::App& command, std::string& backend, gl::CpuPath cpuPath = gl::CpuPath::Available);
+void addBackendOption(CLI::App& command, std::string& backend, renderers::CpuPath cpuPath = renderers::CpuPath::Available);
 
 // The device for `work` from the option's value.
-gl::Device deviceFor(const std::string& backend, gl::CpuPath cpuPath, const std::string& work);
+renderers::Device deviceFor(const std::string& backend, renderers::CpuPath cpuPath, const std::string& work);
 
 }  // namespace conus::cli

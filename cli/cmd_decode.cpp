@@ -24,7 +24,7 @@ namespace {
 
 struct DecodeCommandOptions {
     BatchOptions batch;
-    std::string viewText, sizeText, cameraText, backend = enumName(gl::Backend::Auto);
+    std::string viewText, sizeText, cameraText, backend = enumName(renderers::Backend::Auto);
     PictureOptions picture;
 };
 
@@ -71,7 +71,7 @@ Size outputSize(const DecodeCommandOptions& o, const codec::View& view, const fo
 
 // A depth image's view: colour and coverage bilinear on `device`, Z nearest (depth_image.h: a
 // mean across a silhouette would be a depth on neither surface); Z outside the image is the far.
-Image decodeDepthImage(const gl::Device& device, const format::ConusFile& file, const codec::SamplingMap& map,
+Image decodeDepthImage(const renderers::Device& device, const format::ConusFile& file, const codec::SamplingMap& map,
                        const codec::DecodeOptions& decode) {
     const Image& conus = file.image;
     const int z = conus.channelIndex("Z");
@@ -85,7 +85,7 @@ Image decodeDepthImage(const gl::Device& device, const format::ConusFile& file, 
         for (std::size_t p = 0; p < n; ++p)
             for (std::size_t c = 0, k = 0; c < from; ++c)
                 if (static_cast<int>(c) != z) colour.pixels[p * names.size() + k++] = conus.pixels[p * from + c];
-        frame = gl::decodeImage(device, colour, map, decode);
+        frame = renderers::decodeImage(device, colour, map, decode);
     }
     const Image depth = codec::decodeDepthNearest(conus, map, decode, file.depth.far);
     names.push_back("Z");
@@ -141,13 +141,13 @@ std::string decodeOne(const DecodeCommandOptions& o, const std::string& input, c
     }
     Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
     decode.progress = progress.callback();
-    const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "decoding");
+    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Available, "decoding");
     codec::ImagePyramid pyramid;
     if (withPyramid) {
         pyramid = codec::buildPyramid(file.image);
         decode.pyramid = &pyramid;
     }
-    const Image frame = depthImage ? decodeDepthImage(device, file, map, decode) : gl::decodeImage(device, file.image, map, decode);
+    const Image frame = depthImage ? decodeDepthImage(device, file, map, decode) : renderers::decodeImage(device, file.image, map, decode);
     progress.done();
     writePicture(output, frame, write);
     char line[256];

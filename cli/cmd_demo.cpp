@@ -51,7 +51,7 @@ codec::Focus hottestRegion(const Image& importance, int width, int height) {
 }
 
 struct DemoOptions {
-    std::string out = "demo-out", input, importance, backend = enumName(gl::Backend::Auto);
+    std::string out = "demo-out", input, importance, backend = enumName(renderers::Backend::Auto);
     std::vector<std::string> foci;
     int size = 4096;
     double k = 4;
@@ -143,7 +143,7 @@ int runDemo(const DemoOptions& o) {
     const int w = source.image.width, h = source.image.height;
 
     const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
-    const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "the demo");
+    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Available, "the demo");
     const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
     const format::ConusFile conus = encodeToConus(device, source.image, source.encoding, map, size, built.analytic);
     const format::ConusFile uniform = encodeToConus(device, source.image, source.encoding, identity, size, std::nullopt);
@@ -172,8 +172,8 @@ int runDemo(const DemoOptions& o) {
         decode.width = v.width;
         decode.height = v.height;
         const Image reference = codec::crop(source.image, v.x0, v.y0, v.width, v.height);
-        const Image fromConus = gl::decodeImage(device, conus.image, map, decode);
-        const Image fromUniform = gl::decodeImage(device, uniform.image, identity, decode);
+        const Image fromConus = renderers::decodeImage(device, conus.image, map, decode);
+        const Image fromUniform = renderers::decodeImage(device, uniform.image, identity, decode);
         const double a = codec::psnr(reference, fromConus), b = codec::psnr(reference, fromUniform);
         std::printf("%-22s %9.2f dB %11.2f dB %+7.2f\n", v.label.c_str(), a, b, a - b);
         std::vector<Image> strip{reference, fromConus, fromUniform};

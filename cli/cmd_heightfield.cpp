@@ -63,10 +63,10 @@ void printCamera(const Camera& c, const std::string& given) {
 }
 
 // The camera --camera names (empty: the ground map's own viewer).
-std::optional<gl::TerrainView> terrainView(const std::string& cameraText) {
+std::optional<renderers::TerrainView> terrainView(const std::string& cameraText) {
     if (cameraText.empty()) return std::nullopt;
     const CameraText given = parseCamera(cameraText);
-    return gl::TerrainView{given.eye, given.target, given.fovYDegrees};
+    return renderers::TerrainView{given.eye, given.target, given.fovYDegrees};
 }
 
 // A frame of the height field `file` (called `name` in messages) seen from `cameraText`.
@@ -76,12 +76,12 @@ struct Frame {
     glm::dvec2 extent;  // the field's size on the ground
 };
 
-Frame renderFrame(gl::Context& context, const format::ConusFile& file, const std::string& name,
+Frame renderFrame(renderers::Context& context, const format::ConusFile& file, const std::string& name,
                   const std::string& cameraText, Size size, const std::string& stage) {
-    const glm::dvec2 extent = codec::fieldExtent(gl::heightFieldGround(file, name));
-    const Camera camera = gl::heightFieldCamera(file, double(size.width) / size.height, terrainView(cameraText));
+    const glm::dvec2 extent = codec::fieldExtent(renderers::heightFieldGround(file, name));
+    const Camera camera = renderers::heightFieldCamera(file, double(size.width) / size.height, terrainView(cameraText));
     Progress progress(stage);
-    Image image = gl::renderHeightFieldFrame(context, file, camera, size.width, size.height);
+    Image image = renderers::renderHeightFieldFrame(context, file, camera, size.width, size.height);
     progress.done();
     printCamera(camera, cameraText);
     return {std::move(image), camera, extent};
@@ -190,7 +190,7 @@ int runEncode(const EncodeOptions& o) {
 // ---- render ----
 
 struct RenderOptions {
-    std::string input, frame, cameraText, frameSize = "960x540", compare, backend = enumName(gl::Backend::Auto), colour;
+    std::string input, frame, cameraText, frameSize = "960x540", compare, backend = enumName(renderers::Backend::Auto), colour;
     double heightScale = 1;
 };
 
@@ -207,7 +207,7 @@ CLI::App* addRender(CLI::App& command, RenderOptions& o) {
                       "field of the same sample count, side by side (full | CoNUS | uniform), with PSNRs");
     render.add_option("--height-scale", o.heightScale, "as given to encode (for --compare)")->capture_default_str();
     render.add_option("--colour,--color", o.colour, "as given to encode (for --compare)");
-    addBackendOption(render, o.backend, gl::CpuPath::None);
+    addBackendOption(render, o.backend, renderers::CpuPath::None);
     setExamples(render, {"conus heightfield render terrain.exr -o frame.png",
                        "conus heightfield render terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720",
                        "conus heightfield render terrain.exr -o compare.png --compare procedural"});
@@ -215,15 +215,15 @@ CLI::App* addRender(CLI::App& command, RenderOptions& o) {
 }
 
 // The DEM resampled uniformly to columns x rows, rendered as `frame` was.
-Image renderUniform(gl::Context& context, const sceneio::Dem& dem, const Image& colour, int columns, int rows,
+Image renderUniform(renderers::Context& context, const sceneio::Dem& dem, const Image& colour, int columns, int rows,
                     const Frame& frame) {
     const format::ConusFile field = codec::uniformHeightField(dem.heights, colour, columns, rows);
-    return gl::renderTerrain(context, codec::undistortHeightField(field, frame.extent), frame.camera, frame.image.width,
+    return renderers::renderTerrain(context, codec::undistortHeightField(field, frame.extent), frame.camera, frame.image.width,
                              frame.image.height);
 }
 
 // --compare: full resolution | CoNUS | uniform of the CoNUS image's sample count, with PSNRs.
-void writeComparison(gl::Context& context, const RenderOptions& o, const format::ConusFile& file, const Frame& frame) {
+void writeComparison(renderers::Context& context, const RenderOptions& o, const format::ConusFile& file, const Frame& frame) {
     Progress comparing("render full resolution and uniform");
     const sceneio::Dem dem = demFrom(o.compare, o.heightScale);
     const Image colour = demColour(dem, o.colour, frame.extent);
@@ -242,8 +242,8 @@ void writeComparison(gl::Context& context, const RenderOptions& o, const format:
 int runRender(const RenderOptions& o) {
     const format::ConusFile file = format::readConusFile(o.input);
     const Size size = parseSize(o.frameSize);
-    const gl::Device device = deviceFor(o.backend, gl::CpuPath::None, "terrain rendering");
-    gl::Context& context = device.context();
+    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::None, "terrain rendering");
+    renderers::Context& context = device.context();
     const Frame frame = renderFrame(context, file, o.input, o.cameraText, size, "undistort and render");
     if (!o.compare.empty()) {
         writeComparison(context, o, file, frame);
@@ -259,7 +259,7 @@ int runRender(const RenderOptions& o) {
 
 Image heightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width, int height,
                        const std::string& backendName) {
-    const gl::Device device = deviceFor(backendName, gl::CpuPath::None, "terrain rendering");
+    const renderers::Device device = deviceFor(backendName, renderers::CpuPath::None, "terrain rendering");
     return renderFrame(device.context(), file, "the file", cameraText, {width, height},
                        "undistort the height field and render " + std::to_string(width) + "x" + std::to_string(height))
         .image;

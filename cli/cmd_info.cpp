@@ -22,7 +22,7 @@ namespace conus::cli {
 namespace {
 
 int printBackends(bool json) {
-    const std::vector<gl::BackendStatus> statuses = gl::probeBackends();
+    const std::vector<renderers::BackendStatus> statuses = renderers::probeBackends();
     if (json) {
         nlohmann::ordered_json j = nlohmann::ordered_json::array();
         for (const auto& s : statuses)

@@ -46,7 +46,7 @@ constexpr const char* kCity = "city";
 
 // What render and animate share.
 struct MeshOptions {
-    std::string model, sizeText = "512x512", cameraText, upText = "0,1,0", backend = enumName(gl::Backend::Auto), units = "m";
+    std::string model, sizeText = "512x512", cameraText, upText = "0,1,0", backend = enumName(renderers::Backend::Auto), units = "m";
     double time = 0, maxEdge = 0.5;
     int samples = 4, grid = map_rules::kDefaultSide;
     std::vector<int> track;
@@ -113,9 +113,9 @@ std::vector<glm::dvec3> carCentres(const codec::CityScene& city, const std::vect
 }
 
 // Renders one frame on `device`: on a GPU the mesh is first subdivided for the map (--max-edge).
-Image renderFrame(const gl::Device& device, const Mesh& mesh, const Camera& camera, const codec::SamplingMap& map,
+Image renderFrame(const renderers::Device& device, const Mesh& mesh, const Camera& camera, const codec::SamplingMap& map,
                   Size size, const MeshOptions& o, bool report) {
-    gl::MeshRenderOptions options;
+    renderers::MeshRenderOptions options;
     options.samples = o.samples;
     if (device.onGpu() && o.maxEdge > 0) {
         const double before = codec::longestProjectedEdge(mesh, camera, map);
@@ -124,14 +124,14 @@ Image renderFrame(const gl::Device& device, const Mesh& mesh, const Camera& came
             std::printf("subdivided %zu -> %zu triangles: longest projected edge %.3g -> %.3g map cells (--max-edge %g)\n",
                         mesh.triangleCount(), fine.triangleCount(), before,
                         codec::longestProjectedEdge(fine, camera, map), o.maxEdge);
-        return gl::renderMesh(device, fine, camera, map, size.width, size.height, options);
+        return renderers::renderMesh(device, fine, camera, map, size.width, size.height, options);
     }
-    return gl::renderMesh(device, mesh, camera, map, size.width, size.height, options);
+    return renderers::renderMesh(device, mesh, camera, map, size.width, size.height, options);
 }
 
-gl::Device meshDevice(const MeshOptions& o, bool reference) {
-    if (reference) return gl::Device::cpu();
-    return deviceFor(o.backend, gl::CpuPath::Available, "mesh rendering");
+renderers::Device meshDevice(const MeshOptions& o, bool reference) {
+    if (reference) return renderers::Device::cpu();
+    return deviceFor(o.backend, renderers::CpuPath::Available, "mesh rendering");
 }
 
 void addSharedOptions(CLI::App& command, MeshOptions& o, bool withCamera) {
@@ -162,7 +162,7 @@ void addSharedOptions(CLI::App& command, MeshOptions& o, bool withCamera) {
         ->capture_default_str()
         ->check(CLI::Range(1, 64));
     command.add_option("--units", o.units, "the model's length unit, recorded as the depth's units")->capture_default_str();
-    addBackendOption(command, o.backend, gl::CpuPath::Available);
+    addBackendOption(command, o.backend, renderers::CpuPath::Available);
 }
 
 // --- render -----------------------------------------------------------------------------------
@@ -205,7 +205,7 @@ int runRender(const RenderOptions& r) {
         std::vector<codec::Focus> given = parseFoci(r.foci);
         if (city) {
             const auto centres = carCentres(*city, o.track, o.time);
-            const auto tracked = gl::trackedFoci(camera, centres, aspect, {o.trackRadius, o.trackK});
+            const auto tracked = renderers::trackedFoci(camera, centres, aspect, {o.trackRadius, o.trackK});
             given.insert(given.end(), tracked.begin(), tracked.end());
         }
         return given;
@@ -214,7 +214,7 @@ int runRender(const RenderOptions& r) {
                                            "--focus, --map or --track");
     const codec::SamplingMap& map = chosen.map;
 
-    const gl::Device device = meshDevice(o, r.reference);
+    const renderers::Device device = meshDevice(o, r.reference);
     Progress rendering("render " + std::to_string(mesh.triangleCount()) + " triangles at " + o.sizeText + " (" +
                        device.describe() + ")");
     const Image image = renderFrame(device, mesh, camera, map, size, o, !quiet());
@@ -312,7 +312,7 @@ int runAnimate(const AnimateOptions& a) {
     const Camera camera =
         cameraChoice.given ? meshCamera(cameraChoice, boundsOf(city.meshAt(o.time)), aspect) : cityCamera(city, aspect);
     const codec::FociOptions fo = frameFociOptions(o.grid, o.compose, aspect);
-    const gl::Device device = meshDevice(o, false);
+    const renderers::Device device = meshDevice(o, false);
     printCamera(camera);
 
     std::vector<Image> tiles;
@@ -324,9 +324,9 @@ int runAnimate(const AnimateOptions& a) {
     Progress rendering("render " + std::to_string(a.frames) + " frames at " + o.sizeText + " (" + device.describe() + ")");
     for (int i = 0; i < a.frames; ++i) {
         const double t = o.time + i / a.fps;
-        const auto foci = gl::trackedFoci(camera, carCentres(city, o.track, t), aspect, {o.trackRadius, o.trackK});
-        codec::SamplingMap map = gl::frameMap(foci, fo);
-        if (previous) largestStep = std::max(largestStep, gl::largestNodeStep(*previous, map));
+        const auto foci = renderers::trackedFoci(camera, carCentres(city, o.track, t), aspect, {o.trackRadius, o.trackK});
+        codec::SamplingMap map = renderers::frameMap(foci, fo);
+        if (previous) largestStep = std::max(largestStep, renderers::largestNodeStep(*previous, map));
         const Image image = renderFrame(device, city.meshAt(t), camera, map, size, o, false);
         char name[32];
         std::snprintf(name, sizeof name, "frame_%04d", i);

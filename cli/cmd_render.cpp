@@ -26,7 +26,7 @@ namespace conus::cli {
 namespace {
 
 struct RenderOptions {
-    std::string input, output, cameraText, sizeText = "960x720", lightText = "-0.4,0.8,-0.45", backend = enumName(gl::Backend::Auto);
+    std::string input, output, cameraText, sizeText = "960x720", lightText = "-0.4,0.8,-0.45", backend = enumName(renderers::Backend::Auto);
     bool shadows = false;
     double step = 1.0;
 };
@@ -55,13 +55,13 @@ int runRenderRelief(const RenderOptions& o) {
     if (given)
         camera = Camera::perspective(given->eye, given->target, {0, 1, 0}, given->fovYDegrees, aspect, camera.near(),
                                      camera.far());
-    gl::ReliefLook look;
+    renderers::ReliefLook look;
     look.shadows = o.shadows;
     look.towardLight = glm::vec3(towardLight);
     look.intersect.stepTexels = o.step;
-    const gl::Device device = deviceFor(o.backend, gl::CpuPath::None, "relief rendering");
+    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::None, "relief rendering");
     Progress progress("render " + std::to_string(size.width) + "x" + std::to_string(size.height));
-    gl::ReliefRenderer renderer(device.context(), asset, file.image, look);
+    renderers::ReliefRenderer renderer(device.context(), asset, file.image, look);
     const Image frame = renderer.render(camera, size.width, size.height);
     progress.done();
     writePicture(o.output, frame, write);
@@ -75,7 +75,7 @@ int runRenderRelief(const RenderOptions& o) {
 // --- reflection -------------------------------------------------------------------------------
 
 struct ReflectionRenderText {
-    std::string asset, scene, output, cameraText, sizeText = "640x480", at, normal = "0,0,1", backend = enumName(gl::Backend::Auto);
+    std::string asset, scene, output, cameraText, sizeText = "640x480", at, normal = "0,0,1", backend = enumName(renderers::Backend::Auto);
     std::string reflector = enumName(codec::Reflector::Kind::Sphere);
     std::vector<std::string> allowDirs;
     double radius = 0.5, step = 1.0;
@@ -113,13 +113,13 @@ int runRenderReflection(const ReflectionRenderText& o) {
     const double aspect = double(size.width) / size.height;
     const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);
     // The ground truth traces the mesh itself: the CPU only.
-    const gl::Device device =
-        o.reference ? gl::Device::cpu() : deviceFor(o.backend, gl::CpuPath::Available, "reflection rendering");
+    const renderers::Device device =
+        o.reference ? renderers::Device::cpu() : deviceFor(o.backend, renderers::CpuPath::Available, "reflection rendering");
     Progress rendering("render " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                        (o.reference ? " (reflections traced against the mesh)" : " (reflections from the faces)"));
     Image frame = o.reference
                       ? codec::renderReflectionFrame(scene, nullptr, centre, camera, size.width, size.height, options)
-                      : gl::renderReflection(device, scene, faces, camera, size.width, size.height, options);
+                      : renderers::renderReflection(device, scene, faces, camera, size.width, size.height, options);
     rendering.done();
     Image rgb{frame.width, frame.height, {"R", "G", "B"}, {}};
     rgb.pixels.reserve(static_cast<std::size_t>(frame.width) * frame.height * 3);
@@ -173,7 +173,7 @@ CLI::App* addRenderRelief(CLI::App& command, RenderOptions& o) {
     relief->add_option("--step", o.step, "linear-search step in CoNUS pixels")
         ->capture_default_str()
         ->check(finiteRange(0, 64));
-    addBackendOption(*relief, o.backend, gl::CpuPath::None);
+    addBackendOption(*relief, o.backend, renderers::CpuPath::None);
     return relief;
 }
 

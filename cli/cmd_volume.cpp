@@ -38,7 +38,7 @@ namespace {
 
 struct VolumeOptions {
     std::string volume, output, picture, sizeText = "512x512", cameraText, upText = "0,-1,0", tf = codec::TransferFunction::kDefaultPreset,
-                                         rangeText, backend = enumName(gl::Backend::Auto), units = "voxel", mapFile;
+                                         rangeText, backend = enumName(renderers::Backend::Auto), units = "voxel", mapFile;
     std::vector<std::string> foci, allowDirs;
     int grid = map_rules::kDefaultSide;
     std::string compose = enumName(format::FociComposition::Density);
@@ -148,11 +148,11 @@ int runRender(const VolumeOptions& o) {
     const codec::SamplingMap& map = chosen.map;
     const Fpc fpc(camera, chosen.identity ? nullptr : std::make_shared<codec::SamplingMap>(map));
 
-    const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "volume rendering");
+    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Available, "volume rendering");
     Progress rendering("render " + std::to_string(volume.width) + "x" + std::to_string(volume.height) + "x" +
                        std::to_string(volume.depth) + " volume at " + o.sizeText + " (" + device.describe() + ")");
     options.progress = rendering.callback();
-    const Image image = gl::renderVolume(device, volume, tf, fpc, size.width, size.height, options);
+    const Image image = renderers::renderVolume(device, volume, tf, fpc, size.width, size.height, options);
     rendering.done();
     Progress writing("write " + o.output);
     format::writeConusFile(o.output, codec::makeDepthImageFile(image, map, camera, o.units, chosen.analytic));
@@ -202,11 +202,11 @@ int runAnimate(const AnimateOptions& a) {
     const Volume& volume = scene.volume;
     const Camera& camera = scene.camera;
     const codec::TransferFunction& tf = scene.tf;
-    const gl::Device device = deviceFor(o.backend, gl::CpuPath::Available, "volume rendering");
+    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Available, "volume rendering");
     const codec::FociOptions fo = frameFociOptions(o.grid, o.compose, aspect);
     // On a GL device the volume and transfer function go up once for all frames (a 3-D texture
     // upload per frame cost more than the frame itself on llvmpipe; bench/notes/2026-11-24-volumes.md).
-    std::optional<gl::VolumeRendererGpu> gpu;
+    std::optional<renderers::VolumeRendererGpu> gpu;
     if (device.onGpu()) gpu.emplace(device.context(), volume, tf);
     std::optional<codec::SamplingMap> previous;
     double largest = 0;
@@ -215,8 +215,8 @@ int runAnimate(const AnimateOptions& a) {
         const double t = a.frames > 1 ? double(f) / (a.frames - 1) : 0.0;
         const glm::dvec2 centre = glm::mix(from, to, t);
         const std::vector<codec::Focus> foci{{centre.x, centre.y, a.radius, a.k}};
-        codec::SamplingMap map = gl::frameMap(foci, fo);
-        if (previous) largest = std::max(largest, gl::largestNodeStep(*previous, map));
+        codec::SamplingMap map = renderers::frameMap(foci, fo);
+        if (previous) largest = std::max(largest, renderers::largestNodeStep(*previous, map));
         const Fpc fpc(camera, std::make_shared<codec::SamplingMap>(map));
         const Image image = gpu ? gpu->render(fpc, size.width, size.height, options)
                                 : codec::renderVolumeReference(volume, tf, fpc, size.width, size.height, options);
@@ -279,7 +279,7 @@ Command addVolumeCommand(CLI::App& root) {
     addComposeOption(*render, o->compose);
     render->add_flag("--uniform", o->uniform, "render the uniform image of the same pixel count (the baseline)");
     render->add_option("--units", o->units, "the volume's length unit, recorded as the depth's units")->capture_default_str();
-    addBackendOption(*render, o->backend, gl::CpuPath::Available);
+    addBackendOption(*render, o->backend, renderers::CpuPath::Available);
     addAllowDirOption(*render, o->allowDirs);
     addQuietOption(*render);
 
@@ -302,7 +302,7 @@ Command addVolumeCommand(CLI::App& root) {
     animate->add_option("--grid", a->volume.grid, "sampling-map nodes per side")
         ->capture_default_str()
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
-    addBackendOption(*animate, a->volume.backend, gl::CpuPath::Available);
+    addBackendOption(*animate, a->volume.backend, renderers::CpuPath::Available);
     addAllowDirOption(*animate, a->volume.allowDirs);
     addQuietOption(*animate);
     return {volume, [o, a, render] { return render->parsed() ? runRender(*o) : runAnimate(*a); }};

@@ -62,7 +62,7 @@ CONUS_CLI_COMMANDS(CONUS_CLI_DECLARE_COMMAND)
 #undef CONUS_CLI_DECLARE_COMMAND
 
 // `decode --camera` of a height field as `heightfield render` does it (cmd_heightfield.cpp): the
-// backend chosen, the frame (gl::renderHeightFieldFrame) from a camera "x,y,z,lx,ly,lz,fovDeg"
+// backend chosen, the frame (renderers::renderHeightFieldFrame) from a camera "x,y,z,lx,ly,lz,fovDeg"
 // (empty: the ground map's own viewer) as a progress stage, the camera said.
 Image heightFieldFrame(const format::ConusFile& file, const std::string& cameraText, int width, int height,
                        const std::string& backendName);

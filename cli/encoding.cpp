@@ -76,12 +76,12 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault) {
     }
 }
 
-format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,
+format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
                                 const FitSetting& fit, std::string* fitNote) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                       std::to_string(size.width) + "x" + std::to_string(size.height));
-    Image image = gl::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
+    Image image = renderers::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
     if (fit.count() > 0) {
         Progress fitting("fit to the decoder (" + std::to_string(fit.count()) + " iterations)");

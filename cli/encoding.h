@@ -21,7 +21,7 @@ struct StorageOptions {
     std::string sizeText;  // "WxH"; empty: a quarter of each source side (1/16 of the pixels)
     bool half = false, full = false;  // neither: float for 16-bit and float sources, else half
     std::string compression = enumName(format::Compression::Zip);
-    std::string backend = enumName(gl::Backend::Auto);
+    std::string backend = enumName(renderers::Backend::Auto);
 };
 
 void addStorageOptions(CLI::App& command, StorageOptions& options);
@@ -51,7 +51,7 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault = false);
 // Encodes `source` through `map` at `size` (with progress) into a file model ready to write,
 // remembering the source's encoding. fit.iterations > 0 then fits the image to the decoder with that many
 // iterations (codec/image/fit.h) and, when `fitNote` is given, says what the fit achieved there.
-format::ConusFile encodeToConus(const gl::Device& device, const Image& source, const SourceEncoding& encoding,
+format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
                                 const FitSetting& fit = {}, std::string* fitNote = nullptr);
 

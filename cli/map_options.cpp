@@ -50,7 +50,7 @@ FrameMap chooseFrameMap(bool uniform, const std::string& mapFile, const FociSour
     if (fociSource) {
         const std::vector<codec::Focus> foci = fociSource();
         Progress building("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
-        FrameMap chosen{gl::frameMap(foci, options), std::nullopt, false};
+        FrameMap chosen{renderers::frameMap(foci, options), std::nullopt, false};
         if (!foci.empty()) chosen.analytic = codec::toAnalytic(foci, options.composition);
         building.done();
         return chosen;

@@ -105,7 +105,7 @@ private:
             frame();
         }
         for (int k = 0; k < kBenchmarkWarmup; ++k) frame();
-        gl::ViewRenderer& renderer = m_drawing->renderer();
+        renderers::ViewRenderer& renderer = m_drawing->renderer();
         renderer.finish();
         const auto [fw, fh] = m_window->framebufferSize();
         const int frames = m_options.benchmarkFrames;

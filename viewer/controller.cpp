@@ -39,7 +39,7 @@ bool Controller::load() {
         }
         // The source, shown raw (it is undistorted), with the live map's grid over it.
         m_state.setImageSize(m_editor->source().width, m_editor->source().height);
-        m_display.mode = gl::ViewMode::Raw;
+        m_display.mode = renderers::ViewMode::Raw;
         m_display.grid = true;
         if (m_display.gridEvery == 0) m_display.gridEvery = std::max(1, m_editor->source().width / 64);
         ++m_imageVersion;
@@ -66,7 +66,7 @@ void Controller::startScene(glm::dvec3 centre, double radius, std::string name, 
     m_sceneName = std::move(name);
     m_sceneThroughMap = throughMap;
     m_sceneLook = std::move(look);
-    m_display.mode = gl::ViewMode::Raw;  // the CoNUS image itself: the paper's focus-plus-context display
+    m_display.mode = renderers::ViewMode::Raw;  // the CoNUS image itself: the paper's focus-plus-context display
     const glm::ivec2 size = sceneFrameSize();
     m_state.setImageSize(size.x, size.y);
     std::printf("conus-view: %s%s%s; H lists the keys\n", m_sceneName.c_str(), m_sceneLook.empty() ? "" : ", ",
@@ -99,7 +99,7 @@ std::string Controller::probeAt(glm::dvec2 pixel) const {
     if (m_scene) {
         if (!m_sceneFrame) return {};
         // Raw shows the CoNUS image itself: the cursor is at a distorted position.
-        const glm::dvec2 uv = m_display.mode == gl::ViewMode::Raw
+        const glm::dvec2 uv = m_display.mode == renderers::ViewMode::Raw
                                   ? m_sceneMap->undistort(glm::clamp(shown, glm::dvec2(0.0), glm::dvec2(1.0)))
                                   : shown;
         return formatProbe(probe(*m_sceneFrame, *m_sceneMap, uv));
@@ -238,7 +238,7 @@ void Controller::button(MouseButton button, bool press, Modifiers modifiers) {
         else m_orbiting = true;
     } else if (button == MouseButton::Left && m_editor && !modifiers.ctrl) {
         m_editor->press(m_state.windowToImage(m_cursor));  // undistorted: the source is shown undistorted
-    } else if (button == MouseButton::Left && modifiers.shift && m_display.mode == gl::ViewMode::Wipe) {
+    } else if (button == MouseButton::Left && modifiers.shift && m_display.mode == renderers::ViewMode::Wipe) {
         m_wiping = true;
         m_display.wipeX = std::clamp(m_cursor.x / m_state.windowWidth(), 0.0, 1.0);
     } else {
@@ -317,12 +317,12 @@ void Controller::doAction(Action action) {
     case Action::PanRight: m_state.pan({-panStep.x, 0}); break;
     case Action::PanUp: m_state.pan({0, panStep.y}); break;
     case Action::PanDown: m_state.pan({0, -panStep.y}); break;
-    case Action::ModeReconstructed: m_display.mode = gl::ViewMode::Reconstructed; break;
-    case Action::ModeRaw: m_display.mode = gl::ViewMode::Raw; break;
-    case Action::ModeUniform: m_display.mode = gl::ViewMode::Uniform; break;
-    case Action::ModeWipe: m_display.mode = gl::ViewMode::Wipe; break;
+    case Action::ModeReconstructed: m_display.mode = renderers::ViewMode::Reconstructed; break;
+    case Action::ModeRaw: m_display.mode = renderers::ViewMode::Raw; break;
+    case Action::ModeUniform: m_display.mode = renderers::ViewMode::Uniform; break;
+    case Action::ModeWipe: m_display.mode = renderers::ViewMode::Wipe; break;
     case Action::ModeDensity:
-        m_display.mode = m_display.mode == gl::ViewMode::Density && editing() ? gl::ViewMode::Raw : gl::ViewMode::Density;
+        m_display.mode = m_display.mode == renderers::ViewMode::Density && editing() ? renderers::ViewMode::Raw : renderers::ViewMode::Density;
         break;
     case Action::ToggleDepth:
         m_depthPicture = !m_depthPicture;

@@ -42,7 +42,7 @@ public:
 
     // What a frame shows.
     const ViewState& state() const { return m_state; }
-    const gl::ViewOptions& display() const { return m_display; }
+    const renderers::ViewOptions& display() const { return m_display; }
     bool editing() const { return m_editor.has_value(); }
     KeyTable keyTable() const { return m_scene ? KeyTable::Scene : editing() ? KeyTable::Edit : KeyTable::View; }
 
@@ -109,7 +109,7 @@ private:
     bool m_orbiting = false;
     std::string m_editorMessage;
     ViewState m_state;
-    gl::ViewOptions m_display;
+    renderers::ViewOptions m_display;
     glm::dvec2 m_cursor{0.0};
     bool m_panning = false, m_wiping = false;
     std::string m_probe;

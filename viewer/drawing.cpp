@@ -42,7 +42,7 @@ Image displayRgba(const Image& frame) {
 
 }  // namespace
 
-Drawing::Drawing(gl::Context& context) : m_renderer(context) {}
+Drawing::Drawing(renderers::Context& context) : m_renderer(context) {}
 
 void Drawing::setUniform(const std::string& path, Image uniform) {
     m_uniformPath = path;
@@ -84,10 +84,10 @@ void Drawing::renderScene(Controller& controller) {
 // whole frame) nobody would look at. Any other display goes through setImage as a file would.
 bool Drawing::showsSceneDirectly(const Controller& controller, int fw, int fh) {
     const format::ConusFile* frame = controller.sceneFrame();
-    const gl::ViewOptions& o = controller.display();
+    const renderers::ViewOptions& o = controller.display();
     const codec::View v = controller.state().view();
     constexpr double kExact = 1e-9;
-    return frame && frame->image.width == fw && frame->image.height == fh && o.mode == gl::ViewMode::Raw && !o.grid &&
+    return frame && frame->image.width == fw && frame->image.height == fh && o.mode == renderers::ViewMode::Raw && !o.grid &&
            !o.outlines && o.exposure == 0 && o.toneMap == ToneMap::None && o.gamma == 0 && !controller.depthPicture() &&
            std::abs(v.u0) < kExact && std::abs(v.v0) < kExact && std::abs(v.u1 - 1) < kExact && std::abs(v.v1 - 1) < kExact;
 }

@@ -12,14 +12,14 @@ namespace conus::viewer {
 
 class Drawing {
 public:
-    explicit Drawing(gl::Context& context);
+    explicit Drawing(renderers::Context& context);
 
     // Draws into the bound framebuffer (fw x fh): uploads the image or map first when the
     // controller's versions moved.
     void frame(Controller& controller, int fw, int fh);
     // The frame just drawn, display values, top row first.
     Image readFramebuffer(int fw, int fh) { return m_renderer.readFramebuffer(fw, fh); }
-    gl::ViewRenderer& renderer() { return m_renderer; }
+    renderers::ViewRenderer& renderer() { return m_renderer; }
     // Shows `uniform` as the uniform image whenever the file at `path` is shown (--uniform).
     void setUniform(const std::string& path, Image uniform);
     // The 3-D modes: the scene frames are rendered from (owned by the caller, outliving the drawing's use).
@@ -38,13 +38,13 @@ private:
     template <class Make>
     bool prepareOverlay(int slot, const std::string& key, Make make);
 
-    gl::ViewRenderer m_renderer;
+    renderers::ViewRenderer m_renderer;
     int m_imageVersion = -1, m_mapVersion = -1;
     bool m_shown = false;  // the renderer holds an image
     std::string m_uniformPath;  // --uniform: the file it belongs to, and the image
     Image m_uniform;
-    std::string m_overlayKey[gl::ViewRenderer::kOverlaySlots];
-    int m_overlayHeight[gl::ViewRenderer::kOverlaySlots] = {};
+    std::string m_overlayKey[renderers::ViewRenderer::kOverlaySlots];
+    int m_overlayHeight[renderers::ViewRenderer::kOverlaySlots] = {};
     bool m_textBroken = false;
     Scene* m_scene = nullptr;
     int m_sceneVersion = -1, m_looksSeen = 0;

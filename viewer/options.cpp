@@ -59,8 +59,8 @@ codec::Focus parseFocus(const std::string& text) {
 
 std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     Options o;
-    std::string view, size, window = "1280x800", mode = enumName(gl::ViewMode::Reconstructed);
-    std::string decode = enumName(gl::DecodePath::Auto), toneMap = enumName(ToneMap::None);
+    std::string view, size, window = "1280x800", mode = enumName(renderers::ViewMode::Reconstructed);
+    std::string decode = enumName(renderers::DecodePath::Auto), toneMap = enumName(ToneMap::None);
     std::string mesh, volume, relief, reflection;
     std::vector<std::string> foci;
     CLI::App app(kDescription, "conus-view");
@@ -90,7 +90,7 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("--view", view, "undistorted rectangle u0,v0,u1,v1 to show");
     app.add_option("--size", size, "WxH of --screenshot, or of the CoNUS image --edit encodes");
     app.add_option("--window", window, "window size WxH")->capture_default_str();
-    app.add_option("--mode", mode, "one of " + enumChoices<gl::ViewMode>() + ", or " + kDepthPictureMode + " (a depth image's Z as a picture)")
+    app.add_option("--mode", mode, "one of " + enumChoices<renderers::ViewMode>() + ", or " + kDepthPictureMode + " (a depth image's Z as a picture)")
         ->capture_default_str();
     app.add_flag("--grid", o.display.grid, "draw the CoNUS pixel grid");
     app.add_option("--grid-every", o.display.gridEvery, "draw every n-th grid line (0: automatic)");
@@ -106,7 +106,7 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
                    "where the reconstructed frame is decoded: the shader, or codec::decodeImage each frame, uploaded; "
                    "auto: the shader, except on a software rasterizer (llvmpipe, softpipe, swrast) where the view is not "
                    "zoomed out: the CPU, the faster there")
-        ->check(CLI::IsMember(enumNames<gl::DecodePath>()))
+        ->check(CLI::IsMember(enumNames<renderers::DecodePath>()))
         ->capture_default_str();
     app.add_option("--script", o.script, "run window commands from a file, then exit (see viewer/script.h)");
     app.add_option("--benchmark-frames", o.benchmarkFrames, "draw N frames, print frames/s and exit");
@@ -114,19 +114,19 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_flag("--status-bar", o.statusBar, "show the status bar (B): file, mode, zoom, the pixel under the cursor");
     app.add_option("--backend", o.backend, "--screenshot's GL backend")
         ->capture_default_str()
-        ->check(CLI::IsMember(enumNames({gl::Backend::Auto, gl::Backend::Egl, gl::Backend::OsMesa}), CLI::ignore_case));
+        ->check(CLI::IsMember(enumNames({renderers::Backend::Auto, renderers::Backend::Egl, renderers::Backend::OsMesa}), CLI::ignore_case));
     try {
         app.parse(argc, argv);
         if (!view.empty()) o.view = parseView(view);
         if (!size.empty()) std::tie(o.width, o.height) = parseSize(size, "--size");
         std::tie(o.windowWidth, o.windowHeight) = parseSize(window, "--window");
         o.depthPicture = mode == kDepthPictureMode;
-        const std::optional<gl::ViewMode> viewMode = tryParseEnum<gl::ViewMode>(mode);
+        const std::optional<renderers::ViewMode> viewMode = tryParseEnum<renderers::ViewMode>(mode);
         if (!o.depthPicture && !viewMode)
-            throw Error(ErrorCode::InvalidArgument, "--mode '" + mode + "' is not one of " + enumChoices<gl::ViewMode>() + ", " + kDepthPictureMode);
-        o.display.mode = viewMode.value_or(gl::ViewMode::Reconstructed);
+            throw Error(ErrorCode::InvalidArgument, "--mode '" + mode + "' is not one of " + enumChoices<renderers::ViewMode>() + ", " + kDepthPictureMode);
+        o.display.mode = viewMode.value_or(renderers::ViewMode::Reconstructed);
         o.display.toneMap = parseEnum<ToneMap>(toneMap);
-        o.display.decode = parseEnum<gl::DecodePath>(decode);
+        o.display.decode = parseEnum<renderers::DecodePath>(decode);
         const std::pair<SceneKind, const std::string*> scenes[] = {
             {SceneKind::Mesh, &mesh}, {SceneKind::Volume, &volume}, {SceneKind::Relief, &relief}, {SceneKind::Reflection, &reflection}};
         for (const auto& [kind, path] : scenes) {

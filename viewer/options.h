@@ -12,7 +12,7 @@
 
 namespace conus::viewer {
 
-// --mode's value that shows a depth image's Z as a picture (beside the gl::ViewMode names).
+// --mode's value that shows a depth image's Z as a picture (beside the renderers::ViewMode names).
 inline constexpr const char* kDepthPictureMode = "z";
 
 // The 3-D modes (scene.h): what is rendered live instead of CoNUS files being viewed.
@@ -27,10 +27,10 @@ struct Options {
     std::optional<codec::View> view;     // --view u0,v0,u1,v1
     int width = 0, height = 0;           // --size: screenshot size, or the editor's encode size
     int windowWidth = 1280, windowHeight = 800;
-    gl::ViewOptions display;             // --mode, --grid, --outlines, --exposure, --tonemap, --gamma
+    renderers::ViewOptions display;             // --mode, --grid, --outlines, --exposure, --tonemap, --gamma
     std::string script;                  // --script CMDS.txt
     int benchmarkFrames = 0;             // --benchmark-frames N
-    std::string backend = enumName(gl::Backend::Auto);  // --backend for --screenshot
+    std::string backend = enumName(renderers::Backend::Auto);  // --backend for --screenshot
     bool helpOverlay = false;            // --help-overlay: start with the key list (H) shown
     bool statusBar = false;              // --status-bar: start with the status bar (B) shown
     // 3-D modes: --mesh FILE, --volume SPEC, --relief ASSET or --reflection DIR (with --scene MESH);

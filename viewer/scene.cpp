@@ -61,7 +61,7 @@ Image colourOf(const Image& frame) {
 
 class MeshView final : public Scene {
 public:
-    MeshView(gl::Context& context, const std::string& path, const std::vector<std::string>& allowDirs, double maxEdge)
+    MeshView(renderers::Context& context, const std::string& path, const std::vector<std::string>& allowDirs, double maxEdge)
         : m_context(context), m_name(fileName(path) + " (mesh)"), m_mesh(readMeshFile(path, allowDirs)),
           m_bounds(sphereAround(m_mesh.positions)), m_maxEdge(maxEdge), m_renderer(context, m_mesh) {}
     std::string name() const override { return m_name; }
@@ -70,22 +70,22 @@ public:
     Image render(const Camera& camera, const codec::SamplingMap& map, bool conus, int width, int height) override {
         // --max-edge: this frame's subdivision (the camera and the map decide it), uploaded for this frame.
         if (m_maxEdge > 0 && conus)
-            return gl::renderMeshGpu(m_context, codec::subdivideForMap(m_mesh, camera, map, m_maxEdge), camera, map, width, height);
+            return renderers::renderMeshGpu(m_context, codec::subdivideForMap(m_mesh, camera, map, m_maxEdge), camera, map, width, height);
         return m_renderer.render(camera, map, width, height);
     }
 
 private:
-    gl::Context& m_context;
+    renderers::Context& m_context;
     std::string m_name;
     Mesh m_mesh;
     BoundingSphere m_bounds;
     double m_maxEdge;
-    gl::MeshRenderer m_renderer;
+    renderers::MeshRenderer m_renderer;
 };
 
 class VolumeView final : public Scene {
 public:
-    VolumeView(gl::Context& context, const Options& options)
+    VolumeView(renderers::Context& context, const Options& options)
         : m_name(fileName(options.scenePath) + " (volume)"),
           m_volume(readVolumeFile(options)),
           m_presets(codec::TransferFunction::presetNames()) {
@@ -95,7 +95,7 @@ public:
         const auto preset = std::find(m_presets.begin(), m_presets.end(), tf);
         if (preset != m_presets.end()) m_preset = static_cast<int>(preset - m_presets.begin());
         else m_file = tf;  // a file: T cycles on through the presets
-        m_renderer = std::make_unique<gl::VolumeRendererGpu>(context, m_volume, transferFunction());
+        m_renderer = std::make_unique<renderers::VolumeRendererGpu>(context, m_volume, transferFunction());
     }
     std::string name() const override { return m_name; }
     glm::dvec3 centre() const override { return 0.5 * m_volume.extent(); }
@@ -122,13 +122,13 @@ private:
     std::vector<std::string> m_presets;
     int m_preset = 0;
     std::string m_file;
-    std::unique_ptr<gl::VolumeRendererGpu> m_renderer;
+    std::unique_ptr<renderers::VolumeRendererGpu> m_renderer;
 };
 
 // A baked relief asset and, when given, its conventional twin (--uniform).
 class ReliefView final : public Scene {
 public:
-    ReliefView(gl::Context& context, const Options& options) : m_name(fileName(options.scenePath) + " (relief)") {
+    ReliefView(renderers::Context& context, const Options& options) : m_name(fileName(options.scenePath) + " (relief)") {
         m_conus = open(context, options.scenePath);
         if (!options.uniform.empty()) m_uniform = open(context, options.uniform);
     }
@@ -150,7 +150,7 @@ public:
     }
 
 private:
-    std::unique_ptr<gl::ReliefRenderer> open(gl::Context& context, const std::string& path) {
+    std::unique_ptr<renderers::ReliefRenderer> open(renderers::Context& context, const std::string& path) {
         const format::ConusFile file = format::readConusFile(path);
         if (file.dataKind != format::DataKind::HeightField || file.depth.kind != format::DepthKind::Height)
             throw Error(ErrorCode::Unsupported, path + " is not a relief asset (make one with `conus bake relief`)");
@@ -164,31 +164,31 @@ private:
             m_bounds = sphereAround(corners);
             m_bounded = true;
         }
-        return std::make_unique<gl::ReliefRenderer>(context, asset, file.image);
+        return std::make_unique<renderers::ReliefRenderer>(context, asset, file.image);
     }
     std::string m_name;
     BoundingSphere m_bounds;
     bool m_bounded = false;
-    std::unique_ptr<gl::ReliefRenderer> m_conus, m_uniform;
+    std::unique_ptr<renderers::ReliefRenderer> m_conus, m_uniform;
 };
 
 // A baked reflection asset (six faces) and the scene it was baked from, drawn on the GPU
-// (gl::ReflectionRenderer, the GLSL twin of codec::renderReflectionFrame): a mirror sphere at the
+// (renderers::ReflectionRenderer, the GLSL twin of codec::renderReflectionFrame): a mirror sphere at the
 // asset's centre whose reflected rays intersect the faces.
 class ReflectionView final : public Scene {
 public:
-    ReflectionView(gl::Context& context, const Options& options)
+    ReflectionView(renderers::Context& context, const Options& options)
         : ReflectionView(context, options, readMeshFile(options.reflectionScene, options.allowDirs)) {}
-    ReflectionView(gl::Context& context, const Options& options, const Mesh& mesh)
+    ReflectionView(renderers::Context& context, const Options& options, const Mesh& mesh)
         : m_name(fileName(options.scenePath) + " (reflection)"), m_bounds(sphereAround(mesh.positions)) {
         const std::vector<codec::ReflectionFace> conusFaces = faces(options.scenePath);
         m_centre = conusFaces.front().depth.camera().eye();
         m_options.reflector.kind = codec::Reflector::Kind::Sphere;
         m_options.reflector.centre = m_centre;
         m_options.reflector.radius = options.reflectorRadius;
-        m_conus = std::make_unique<gl::ReflectionRenderer>(context, mesh, conusFaces, m_options);
+        m_conus = std::make_unique<renderers::ReflectionRenderer>(context, mesh, conusFaces, m_options);
         if (!options.uniform.empty())
-            m_uniform = std::make_unique<gl::ReflectionRenderer>(context, mesh, faces(options.uniform), m_options);
+            m_uniform = std::make_unique<renderers::ReflectionRenderer>(context, mesh, faces(options.uniform), m_options);
     }
     std::string name() const override { return m_name; }
     glm::dvec3 centre() const override { return m_centre; }
@@ -224,12 +224,12 @@ private:
     BoundingSphere m_bounds;
     glm::dvec3 m_centre{0.0};
     codec::ReflectionFrameOptions m_options;
-    std::unique_ptr<gl::ReflectionRenderer> m_conus, m_uniform;
+    std::unique_ptr<renderers::ReflectionRenderer> m_conus, m_uniform;
 };
 
 }  // namespace
 
-std::unique_ptr<Scene> openScene(const Options& options, gl::Context& context) {
+std::unique_ptr<Scene> openScene(const Options& options, renderers::Context& context) {
     switch (options.sceneKind) {
     case SceneKind::Mesh: return std::make_unique<MeshView>(context, options.scenePath, options.allowDirs, options.maxEdge);
     case SceneKind::Volume: return std::make_unique<VolumeView>(context, options);

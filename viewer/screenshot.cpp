@@ -30,8 +30,8 @@ int sceneScreenshot(const Options& options) {
     try {
         const int width = options.width > 0 ? options.width : kSceneWidth;
         const int height = options.height > 0 ? options.height : kSceneHeight;
-        const gl::Device device = gl::Device::choose(parseEnum<gl::Backend>(options.backend), gl::CpuPath::None, "the viewer's screenshot");
-        gl::Context& context = device.context();
+        const renderers::Device device = renderers::Device::choose(parseEnum<renderers::Backend>(options.backend), renderers::CpuPath::None, "the viewer's screenshot");
+        renderers::Context& context = device.context();
         const std::unique_ptr<Scene> scene = openScene(options, context);
         const SceneState state(scene->centre(), scene->radius(), options.foci, scene->home());
         const double aspect = double(width) / height;
@@ -76,14 +76,14 @@ int runScreenshot(const Options& options) {
             width = std::max(1, static_cast<int>(std::lround(w * scale)));
             height = std::max(1, static_cast<int>(std::lround(h * scale)));
         }
-        const gl::Device device = gl::Device::choose(parseEnum<gl::Backend>(options.backend), gl::CpuPath::None, "the viewer's screenshot");
-        gl::Context& context = device.context();
-        gl::ViewRenderer renderer(context);
+        const renderers::Device device = renderers::Device::choose(parseEnum<renderers::Backend>(options.backend), renderers::CpuPath::None, "the viewer's screenshot");
+        renderers::Context& context = device.context();
+        renderers::ViewRenderer renderer(context);
         const bool depth = options.depthPicture && hasDepth(*doc.file);
         if (options.depthPicture && !depth) std::fprintf(stderr, "conus-view: %s has no Z channel: showing its colour\n", doc.path.c_str());
         renderer.setImage(depth ? depthPicture(*doc.file) : *doc.file);
         if (!options.uniform.empty()) renderer.setUniform(uniformBaseline(options.uniform));
-        std::vector<gl::OverlayPlacement> overlays;
+        std::vector<renderers::OverlayPlacement> overlays;
         if (options.helpOverlay) {
             renderer.setOverlay(kHelpSlot, helpPanel(KeyTable::View));
             overlays.push_back({kHelpSlot, kOverlayMargin, kOverlayMargin});

@@ -81,7 +81,7 @@ Window::Window(int width, int height, bool vsync, InputSink& input) : m_input(in
         if (const auto chord = chordOf(key, mods)) windowOf(w).m_input.key(*chord);
     });
     try {
-        m_context = gl::adoptCurrentContext(glfwGetProcAddress);
+        m_context = renderers::adoptCurrentContext(glfwGetProcAddress);
     } catch (...) {
         glfwDestroyWindow(m_window);
         glfwTerminate();

@@ -24,7 +24,7 @@ public:
     Window(const Window&) = delete;
     Window& operator=(const Window&) = delete;
 
-    gl::Context& context() { return *m_context; }
+    renderers::Context& context() { return *m_context; }
     std::pair<int, int> framebufferSize() const;
     void setTitle(const std::string& title);
     void swap();
@@ -37,7 +37,7 @@ private:
     glm::dvec2 framebufferScale() const;
     GLFWwindow* m_window = nullptr;
     InputSink& m_input;
-    std::unique_ptr<gl::Context> m_context;
+    std::unique_ptr<renderers::Context> m_context;
 };
 
 }  // namespace conus::viewer

@@ -12,15 +12,15 @@
 namespace conus::bench {
 
 // A new context on that backend; throws conus::Error when it cannot start.
-inline std::unique_ptr<gl::Context> createBenchContext() {
+inline std::unique_ptr<renderers::Context> createBenchContext() {
     const char* backend = std::getenv("CONUS_BACKEND");
-    return gl::Context::create(backend ? parseEnum<gl::Backend>(backend) : gl::Backend::Auto);
+    return renderers::Context::create(backend ? parseEnum<renderers::Backend>(backend) : renderers::Backend::Auto);
 }
 
 // One context shared by the GPU rows that can skip, made on first use; null when no backend
 // works (those rows then skip with "no GL backend").
-inline gl::Context* sharedBenchContext() {
-    static const std::unique_ptr<gl::Context> context = []() -> std::unique_ptr<gl::Context> {
+inline renderers::Context* sharedBenchContext() {
+    static const std::unique_ptr<renderers::Context> context = []() -> std::unique_ptr<renderers::Context> {
         try {
             return createBenchContext();
         } catch (const Error&) {

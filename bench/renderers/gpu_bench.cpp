@@ -52,9 +52,9 @@ const Image& decodeSource() {
 }
 
 // Null when no GL backend works (the GPU rows then skip).
-gl::Context* context() { return bench::sharedBenchContext(); }
+renderers::Context* context() { return bench::sharedBenchContext(); }
 
-void reportTimings(benchmark::State& state, const gl::GpuTimings& sum) {
+void reportTimings(benchmark::State& state, const renderers::GpuTimings& sum) {
     const auto avg = benchmark::Counter::kAvgIterations;
     state.counters["upload_ms"] = benchmark::Counter(sum.uploadMs, avg);
     state.counters["draw_ms"] = benchmark::Counter(sum.drawMs, avg);
@@ -88,7 +88,7 @@ template <class Run>
 void timeGpu(benchmark::State& state, Run run) {
     if (!context()) return state.SkipWithError("no GL backend");
     run(nullptr);
-    gl::GpuTimings sum, t;
+    renderers::GpuTimings sum, t;
     for (auto _ : state) {
         benchmark::DoNotOptimize(run(&t));
         sum.uploadMs += t.uploadMs;
@@ -100,7 +100,7 @@ void timeGpu(benchmark::State& state, Run run) {
 
 void BM_EncodeGpu(benchmark::State& state) {
     const Image& source = encodeSource();
-    timeGpu(state, [&](gl::GpuTimings* t) { return gl::encodeImageGpu(*context(), source, focusMap(), encodeOptions(), t); });
+    timeGpu(state, [&](renderers::GpuTimings* t) { return renderers::encodeImageGpu(*context(), source, focusMap(), encodeOptions(), t); });
 }
 
 Image decodeInput() {
@@ -122,7 +122,7 @@ void BM_DecodeCpu(benchmark::State& state) {
 
 void BM_DecodeGpu(benchmark::State& state) {
     const Image& conus = conusImage();
-    timeGpu(state, [&](gl::GpuTimings* t) { return gl::decodeImageGpu(*context(), conus, focusMap(), decodeOptions(), t); });
+    timeGpu(state, [&](renderers::GpuTimings* t) { return renderers::decodeImageGpu(*context(), conus, focusMap(), decodeOptions(), t); });
 }
 
 BENCHMARK(BM_EncodeCpu)->UseRealTime()->Unit(benchmark::kMillisecond);

@@ -32,8 +32,8 @@ struct Data {
     Mesh mesh, fine;
     Camera camera = Camera::perspective({30, 110, 160}, {0, 0, -10}, {0, 1, 0}, 50.0, kAspect, 1.0, 600.0);
     std::unique_ptr<codec::SamplingMap> map, identity;
-    std::unique_ptr<gl::Context> context;
-    std::unique_ptr<gl::MeshRenderer> renderer, fineRenderer;
+    std::unique_ptr<renderers::Context> context;
+    std::unique_ptr<renderers::MeshRenderer> renderer, fineRenderer;
 };
 
 Data& data() {
@@ -43,12 +43,12 @@ Data& data() {
         const std::vector<glm::dvec3> cars{d->city.carCentre(0, 0.0), d->city.carCentre(2, 0.0)};
         codec::FociOptions fo;
         fo.aspect = kAspect;
-        d->map = std::make_unique<codec::SamplingMap>(gl::frameMap(gl::trackedFoci(d->camera, cars, kAspect), fo));
+        d->map = std::make_unique<codec::SamplingMap>(renderers::frameMap(renderers::trackedFoci(d->camera, cars, kAspect), fo));
         d->identity = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
         d->fine = codec::subdivideForMap(d->mesh, d->camera, *d->map, 0.5);
         d->context = bench::createBenchContext();
-        d->renderer = std::make_unique<gl::MeshRenderer>(*d->context, d->mesh);
-        d->fineRenderer = std::make_unique<gl::MeshRenderer>(*d->context, d->fine);
+        d->renderer = std::make_unique<renderers::MeshRenderer>(*d->context, d->mesh);
+        d->fineRenderer = std::make_unique<renderers::MeshRenderer>(*d->context, d->fine);
         // Warm up: shader compilation and the framebuffers belong to no frame.
         d->renderer->render(d->camera, *d->map, kWidth, kHeight);
         return d;
@@ -63,7 +63,7 @@ void setCounters(benchmark::State& state, const Mesh& mesh) {
 }
 
 // Draw + resolve + readback of `renderer`, which holds `mesh` already uploaded: the frame loop's cost.
-void renderFrames(benchmark::State& state, gl::MeshRenderer& renderer, const Mesh& mesh, const codec::SamplingMap& map) {
+void renderFrames(benchmark::State& state, renderers::MeshRenderer& renderer, const Mesh& mesh, const codec::SamplingMap& map) {
     const Data& d = data();
     for (auto _ : state) benchmark::DoNotOptimize(renderer.render(d.camera, map, kWidth, kHeight));
     setCounters(state, mesh);
@@ -79,7 +79,7 @@ void BM_GpuDrawOnly(benchmark::State& state) {
     const codec::SamplingMap& map = state.range(0) ? *d.map : *d.identity;
     double ms = 0;
     for (auto _ : state) {
-        gl::GpuTimings timings;
+        renderers::GpuTimings timings;
         benchmark::DoNotOptimize(d.renderer->render(d.camera, map, kWidth, kHeight, {}, &timings));
         ms += timings.drawMs;
     }
@@ -92,7 +92,7 @@ void BM_GpuConusOverConventionalPaired(benchmark::State& state) {
     Data& d = data();
     const bool drawOnly = state.range(0) != 0;
     const auto timeOne = [&](const codec::SamplingMap& map) {
-        gl::GpuTimings timings;
+        renderers::GpuTimings timings;
         const auto start = std::chrono::steady_clock::now();
         benchmark::DoNotOptimize(d.renderer->render(d.camera, map, kWidth, kHeight, {}, &timings));
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -125,7 +125,7 @@ void fociFrame(benchmark::State& state, codec::FociComposition composition) {
     codec::FociOptions options;
     options.aspect = kAspect;
     options.composition = composition;
-    for (auto _ : state) benchmark::DoNotOptimize(gl::frameMap(foci, options));
+    for (auto _ : state) benchmark::DoNotOptimize(renderers::frameMap(foci, options));
 }
 void BM_FociFrameDensity(benchmark::State& state) { fociFrame(state, codec::FociComposition::Density); }
 void BM_FociFrameAdd(benchmark::State& state) { fociFrame(state, codec::FociComposition::Add); }

@@ -5,7 +5,7 @@
 // region of interest (reflector pixels showing the box) and over the rest of the reflector, and
 // writes bench/img/reflection.png (CoNUS | conventional | truth) when CONUS_BENCH_PICTURE names a
 // path. BM_ReflectionFrame times the CPU frame with either set of faces (the ratio is the cost);
-// BM_ReflectionFrameGl the GLSL frame (gl::ReflectionRenderer::draw: the scene behind, its upload
+// BM_ReflectionFrameGl the GLSL frame (renderers::ReflectionRenderer::draw: the scene behind, its upload
 // and the reflection pass) on the context CONUS_BACKEND names (default auto).
 #include <benchmark/benchmark.h>
 
@@ -89,11 +89,11 @@ void BM_ReflectionFrame(benchmark::State& state) {
 
 void BM_ReflectionFrameGl(benchmark::State& state) {
     Setup& s = setup(static_cast<int>(codec::ReflectionBakeOptions{}.magnification));
-    static std::unique_ptr<gl::Context> context = [] {
+    static std::unique_ptr<renderers::Context> context = [] {
         const char* backend = std::getenv("CONUS_BACKEND");
-        return gl::Context::create(backend ? parseEnum<gl::Backend>(backend) : gl::Backend::Auto);
+        return renderers::Context::create(backend ? parseEnum<renderers::Backend>(backend) : renderers::Backend::Auto);
     }();
-    gl::ReflectionRenderer renderer(*context, s.scene.mesh(), s.faces[state.range(0)], s.options);
+    renderers::ReflectionRenderer renderer(*context, s.scene.mesh(), s.faces[state.range(0)], s.options);
     renderer.draw(s.camera, kFrame, kFrame);  // compiles the program
     const auto start = std::chrono::steady_clock::now();
     for (auto _ : state) renderer.draw(s.camera, kFrame, kFrame);

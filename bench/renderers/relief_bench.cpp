@@ -31,7 +31,7 @@ constexpr double kContextDensity = 0.7;            // `bake relief`'s default --
 struct Asset {
     format::ConusFile file;
     std::optional<codec::DepthImage> image;
-    std::unique_ptr<gl::ReliefRenderer> renderer;
+    std::unique_ptr<renderers::ReliefRenderer> renderer;
 };
 
 struct Data {
@@ -39,7 +39,7 @@ struct Data {
     Image ink;
     Asset conus, conventional, full;
     std::vector<Ray> rays;
-    std::unique_ptr<gl::Context> context;
+    std::unique_ptr<renderers::Context> context;
 };
 
 void load(Data& d, Asset& asset, const codec::SamplingMap* map, int width, int height) {
@@ -49,7 +49,7 @@ void load(Data& d, Asset& asset, const codec::SamplingMap* map, int width, int h
     options.extent = d.tablet.extent;
     asset.file = codec::bakeRelief(d.tablet.heights, d.tablet.colour, map, options);
     asset.image.emplace(codec::DepthImage::fromFile(asset.file));
-    asset.renderer = std::make_unique<gl::ReliefRenderer>(*d.context, *asset.image, asset.file.image);
+    asset.renderer = std::make_unique<renderers::ReliefRenderer>(*d.context, *asset.image, asset.file.image);
 }
 
 Data& data() {
@@ -91,7 +91,7 @@ void BM_IntersectCpu(benchmark::State& state) {
 void BM_IntersectGlsl(benchmark::State& state) {
     Data& d = data();
     const Asset& asset = assetOf(state);
-    for (auto _ : state) benchmark::DoNotOptimize(gl::intersectRays(*d.context, *asset.image, d.rays));
+    for (auto _ : state) benchmark::DoNotOptimize(renderers::intersectRays(*d.context, *asset.image, d.rays));
     state.SetItemsProcessed(state.iterations() * static_cast<long>(d.rays.size()));
     state.SetLabel(state.range(0) ? "CoNUS" : "conventional");
 }
@@ -124,9 +124,9 @@ void BM_Quality(benchmark::State& state) {
     }
     // The ROI: where the frame shows the engraved strokes (the full-resolution tablet drawn with
     // its ink as colour, unlit).
-    gl::ReliefLook unlit;
+    renderers::ReliefLook unlit;
     unlit.ambient = 1.0f;
-    gl::ReliefRenderer maskRenderer(*d.context, *d.full.image, d.ink, unlit);
+    renderers::ReliefRenderer maskRenderer(*d.context, *d.full.image, d.ink, unlit);
     const Image mask = maskRenderer.render(camera, kFrameWidth, kFrameHeight);
     state.counters["roi_conus_dB"] = codec::maskedPsnr(frames[1], frames[0], mask, true);
     state.counters["roi_conventional_dB"] = codec::maskedPsnr(frames[2], frames[0], mask, true);

@@ -22,7 +22,7 @@ struct Data {
     Image dem, colour;
     format::ConusFile conus, uniform;
     Mesh conusMesh, uniformMesh;
-    std::unique_ptr<gl::Context> context;
+    std::unique_ptr<renderers::Context> context;
 };
 
 Data& data() {
@@ -68,8 +68,8 @@ void BM_UndistortUniform(benchmark::State& state) {
 }
 void renderFrames(benchmark::State& state, const Mesh& mesh) {
     Data& d = data();
-    gl::TerrainRenderer renderer(*d.context, mesh);
-    const Camera camera = gl::viewerCamera(kGround, d.dem.at(kDem / 2, kDem - 1), double(kFrameWidth) / kFrameHeight);
+    renderers::TerrainRenderer renderer(*d.context, mesh);
+    const Camera camera = renderers::viewerCamera(kGround, d.dem.at(kDem / 2, kDem - 1), double(kFrameWidth) / kFrameHeight);
     for (auto _ : state) benchmark::DoNotOptimize(renderer.render(camera, kFrameWidth, kFrameHeight));
     state.counters["frames/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
     state.SetLabel(d.context->renderer());

@@ -67,7 +67,7 @@ Fpc fpc(bool conus, int width, int height, bool filled = false) {
 }
 
 // Null when no GL backend works (the GPU rows then skip).
-gl::Context* context() { return bench::sharedBenchContext(); }
+renderers::Context* context() { return bench::sharedBenchContext(); }
 
 double hitFraction(const Image& image) {
     double hits = 0;
@@ -120,10 +120,10 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
 void runGpu(benchmark::State& state, bool conus, bool filled = false) {
     if (!context()) return state.SkipWithError("no GL backend");
     const int w = 512, h = 512;
-    gl::VolumeRendererGpu renderer(*context(), volume(), transfer());
+    renderers::VolumeRendererGpu renderer(*context(), volume(), transfer());
     const Fpc f = fpc(conus, w, h, filled);
     Image last = renderer.render(f, w, h, {});  // compile the shader outside the timing
-    gl::GpuTimings sum, t;
+    renderers::GpuTimings sum, t;
     const auto start = std::chrono::steady_clock::now();
     for (auto _ : state) {
         last = renderer.render(f, w, h, {}, &t);
@@ -159,7 +159,7 @@ void BM_VolumeGpuConusOverConventionalPaired(benchmark::State& state) {
     if (!context()) return state.SkipWithError("no GL backend");
     const bool filled = state.range(0) != 0;
     const int w = 512, h = 512;
-    gl::VolumeRendererGpu renderer(*context(), volume(), transfer());
+    renderers::VolumeRendererGpu renderer(*context(), volume(), transfer());
     const Fpc conventional = fpc(false, w, h, filled), conus = fpc(true, w, h, filled);
     renderer.render(conus, w, h, {});  // compile the shader outside the timing
     const auto timeOne = [&](const Fpc& f) {

@@ -124,11 +124,11 @@ py::dict attributesOf(const format::ConusFile& f) {
 // One GL context per backend for the process, used by one call at a time.
 std::mutex g_deviceMutex;
 
-const gl::Device& deviceFor(const std::string& backend) {
-    static std::map<std::string, gl::Device> devices;
+const renderers::Device& deviceFor(const std::string& backend) {
+    static std::map<std::string, renderers::Device> devices;
     auto it = devices.find(backend);
     if (it == devices.end())
-        it = devices.emplace(backend, gl::Device::choose(enumArgument<gl::Backend>(backend, "backend"), gl::CpuPath::Available, "image encode")).first;
+        it = devices.emplace(backend, renderers::Device::choose(enumArgument<renderers::Backend>(backend, "backend"), renderers::CpuPath::Available, "image encode")).first;
     return it->second;
 }
 
@@ -298,11 +298,11 @@ PYBIND11_MODULE(_conus, m) {
             {
                 py::gil_scoped_release release;
                 Image encoded;
-                if (enumArgument<gl::Backend>(backend, "backend") == gl::Backend::Cpu) {
+                if (enumArgument<renderers::Backend>(backend, "backend") == renderers::Backend::Cpu) {
                     encoded = codec::encodeImage(source, map->map, options);
                 } else {
                     std::lock_guard<std::mutex> lock(g_deviceMutex);
-                    encoded = gl::encodeImage(deviceFor(backend), source, map->map, options);
+                    encoded = renderers::encodeImage(deviceFor(backend), source, map->map, options);
                 }
                 fitTo(source, map->map, encoded, fit, fitHold);
                 file->file = codec::makeImageFile(std::move(encoded), map->map, source.width, source.height, SourceEncoding{},
@@ -313,7 +313,7 @@ PYBIND11_MODULE(_conus, m) {
             return file;
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),
-        py::arg("channels") = py::none(), py::arg("backend") = enumName(gl::Backend::Cpu), py::arg("fit") = codec::kDefaultEncodeFitIterations,
+        py::arg("channels") = py::none(), py::arg("backend") = enumName(renderers::Backend::Cpu), py::arg("fit") = codec::kDefaultEncodeFitIterations,
         py::arg("fit_hold") = codec::kFitHoldLowPass, py::arg("frame_loss") = codec::kDefaultFrameLoss, py::arg("exact_k") = false,
         py::arg("colorspace") = kAutoColorspace, py::arg("fix_nonfinite") = enumName(imageio::NonFiniteRepair::Keep),
         "Encode pixels (H, W) or (H, W, C) through foci [(u, v, r, k)] or a Map into a CoNUS file; float pixels are\n"
@@ -348,16 +348,16 @@ PYBIND11_MODULE(_conus, m) {
             Image frame;
             {
                 py::gil_scoped_release release;
-                if (enumArgument<gl::Backend>(backend, "backend") == gl::Backend::Cpu) {
+                if (enumArgument<renderers::Backend>(backend, "backend") == renderers::Backend::Cpu) {
                     frame = codec::decodeImage(file.file.image, map->map, options);
                 } else {
                     std::lock_guard<std::mutex> lock(g_deviceMutex);
-                    frame = gl::decodeImage(deviceFor(backend), file.file.image, map->map, options);
+                    frame = renderers::decodeImage(deviceFor(backend), file.file.image, map->map, options);
                 }
             }
             return toArray(std::move(frame));
         },
-        py::arg("file"), py::arg("view") = std::make_tuple(0.0, 0.0, 1.0, 1.0), py::arg("size") = py::none(), py::arg("backend") = enumName(gl::Backend::Cpu),
+        py::arg("file"), py::arg("view") = std::make_tuple(0.0, 0.0, 1.0, 1.0), py::arg("size") = py::none(), py::arg("backend") = enumName(renderers::Backend::Cpu),
         "A conventional frame of the rectangle view (u0, v0, u1, v1), at size (w, h) (default: the source's resolution)");
     m.def(
         "uniform",

@@ -3,7 +3,7 @@
 # as a raw string literal; <Name> is the file name in PascalCase (encode.frag.glsl -> EncodeFrag).
 # A line `#include "x.inc.glsl"` is replaced by that file's text (from the same folder), so shared
 # GLSL (Equation 1) is written once; *.inc.glsl files are only included, never embedded alone.
-set(_text "// Generated from renderers/shaders/*.glsl by embed_shaders.cmake; do not edit.\n#pragma once\n\nnamespace conus::gl::shaders {\n")
+set(_text "// Generated from renderers/shaders/*.glsl by embed_shaders.cmake; do not edit.\n#pragma once\n\nnamespace conus::renderers::shaders {\n")
 foreach(_path IN LISTS SHADERS)
   get_filename_component(_file "${_path}" NAME)
   if(_file MATCHES "\\.inc\\.glsl$")
@@ -34,5 +34,5 @@ foreach(_path IN LISTS SHADERS)
   endif()
   string(APPEND _text "\n// ${_file}\ninline constexpr const char kShader${_name}[] = R\"glsl(${_source})glsl\";\n")
 endforeach()
-string(APPEND _text "\n}  // namespace conus::gl::shaders\n")
+string(APPEND _text "\n}  // namespace conus::renderers::shaders\n")
 file(WRITE "${OUTPUT}" "${_text}")

@@ -6,7 +6,7 @@
 
 #include "conus/core/error.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 namespace {
 
@@ -70,4 +70,4 @@ std::string Device::describe() const {
     return std::string(enumName(m_context->backend())) + ": " + m_context->renderer();
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

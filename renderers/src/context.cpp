@@ -9,7 +9,7 @@
 #include "shader_constants.h"
 #include "conus/core/error.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 // Platforms differ in dispatch; the one bound last on this thread is released before another.
@@ -230,4 +230,4 @@ GLuint cachedProgram(Context& context, const std::string& key, const char* verte
     return program;
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -13,7 +13,7 @@
 
 #include "context_pvt.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 bool hasExtension(const char* list, const char* name) {
@@ -172,4 +172,4 @@ std::unique_ptr<Platform> createEglPlatform(std::string& reason) {
     return nullptr;
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

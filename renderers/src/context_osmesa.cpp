@@ -20,7 +20,7 @@
 #endif
 #include <GL/osmesa.h>
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 // The OSMesa entry points this backend calls, resolved once from the library.
@@ -101,4 +101,4 @@ std::unique_ptr<Platform> createOsMesaPlatform(std::string& reason) {
     return platform;
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

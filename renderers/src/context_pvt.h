@@ -10,7 +10,7 @@
 
 #include "conus/renderers/context.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // One backend's native context, already current on the calling thread when returned.
 class Platform {
@@ -49,4 +49,4 @@ const GladGLContext& makeCurrentGl(Context& context);
 // the GLSL log when it does not compile.
 GLuint cachedProgram(Context& context, const std::string& key, const char* vertex, const char* fragment);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -5,7 +5,7 @@
 #include "depth_pvt.h"
 #include "frame_pvt.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 DepthFrameRenderer::DepthFrameRenderer(std::unique_ptr<Scene> scene) : m_scene(std::move(scene)) {}
 
@@ -27,4 +27,4 @@ Image DepthFrameRenderer::render(const Camera& camera, int width, int height) {
     return frame;
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -18,7 +18,7 @@
 #include "context_pvt.h"
 #include "gl_objects.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // A float texture of `channels` channels from interleaved data, nearest (or linear) filtering,
 // clamped. Leaves it bound on `unit`.
@@ -168,4 +168,4 @@ struct DepthFrameRenderer::Scene {
     FrameTarget target;
 };
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -11,7 +11,7 @@
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 constexpr int kMaxFrameSide = 16384;
 
@@ -39,4 +39,4 @@ inline Image readRgbFrame(const GladGLContext& gl, int width, int height) {
     return readFrame(gl, width, height, {"R", "G", "B"});
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

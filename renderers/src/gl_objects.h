@@ -12,7 +12,7 @@
 
 #include "conus/core/error.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // The Gen/Delete pair of glGen*/glDelete* share one signature; the handle keeps its Delete. An
 // empty handle (default) holds nothing; moving hands the object over, assigning deletes the old one.
@@ -149,4 +149,4 @@ inline void uploadIndexedMesh(const GladGLContext& gl, GLuint vertexArray, GLuin
                   indices.data(), GL_STATIC_DRAW);
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

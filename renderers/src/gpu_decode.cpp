@@ -13,7 +13,7 @@
 #include "gl_objects.h"
 #include "gpu_pass.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 Image decodeImageGpu(Context& context, const Image& conus, const codec::SamplingMap& map,
                              const codec::DecodeOptions& options, GpuTimings* timings) {
@@ -100,4 +100,4 @@ Image decodeImage(const Device& device, const Image& conus, const codec::Samplin
                       [&](Context& context) { return decodeImageGpu(context, conus, map, options); });
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -15,7 +15,7 @@
 #include "gpu_encode_plan.h"
 #include "gpu_pass.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 void setLinearClamp(const GladGLContext& gl) {
@@ -263,4 +263,4 @@ Image encodeImage(const Device& device, const Image& source, const codec::Sampli
                       [&](Context& context) { return encodeImageGpu(context, source, map, options); });
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -9,7 +9,7 @@
 #include "conus/codec/image/encode.h"
 #include "conus/core/error.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 // Positions along one axis of the map at which the mesh has vertices: every node, plus `splits[i]`
@@ -207,4 +207,4 @@ std::vector<GLuint> tileIndices(const Mesh& mesh, const std::array<float, 4>& co
     return out;
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -10,7 +10,7 @@
 
 #include "conus/codec/map/sampling_map.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 constexpr int kVertexFloats = 8;
 
@@ -63,4 +63,4 @@ std::array<float, 4> tileCore(const Tile& tile, int width, int height);
 // The mesh's triangles whose undistorted bounding box meets the tile's core.
 std::vector<GLuint> tileIndices(const Mesh& mesh, const std::array<float, 4>& core);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

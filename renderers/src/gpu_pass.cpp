@@ -4,7 +4,7 @@
 #include "context_pvt.h"
 #include "conus/core/error.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 std::string limitDescription(const Context& context, int limit) {
@@ -48,4 +48,4 @@ void readBack(const GladGLContext& gl, Image& out, int first, int count) {
         for (int c = 0; c < count; ++c) out.pixels[i * channels + first + c] = buffer[i * count + c];
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

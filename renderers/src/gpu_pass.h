@@ -14,7 +14,7 @@
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 constexpr int kChannelsPerPass = 4;
 
@@ -53,4 +53,4 @@ private:
 // Reads the bound framebuffer's first `count` channels into channels [first, first + count).
 void readBack(const GladGLContext& gl, Image& out, int first, int count);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -21,7 +21,7 @@
 #include "frame_pvt.h"
 #include "gl_objects.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 constexpr const char* kWhat = "renderMesh";
@@ -314,4 +314,4 @@ Image renderMesh(const Device& device, const Mesh& mesh, const Camera& camera, c
         [&](Context& context) { return renderMeshGpu(context, mesh, camera, map, width, height, options); });
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -7,7 +7,7 @@
 #include "conus/codec/build/frame_foci.h"
 #include "conus/core/error.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 std::vector<codec::Focus> trackedFoci(const Camera& camera, std::span<const glm::dvec3> points, double aspect,
                                       const TrackOptions& options) {
@@ -48,4 +48,4 @@ double largestNodeStep(const codec::SamplingMap& from, const codec::SamplingMap&
     return largest;
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -18,7 +18,7 @@
 #include "frame_pvt.h"
 #include "gl_objects.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 constexpr const char* kWhat = "reflection";
@@ -172,4 +172,4 @@ Image renderReflection(const Device& device, const codec::MeshScene& scene,
         });
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

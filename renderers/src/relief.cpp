@@ -17,7 +17,7 @@
 #include "frame_pvt.h"
 #include "gl_objects.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 constexpr const char* kWhat = "relief";
@@ -175,4 +175,4 @@ ReliefRenderer::ReliefRenderer(Context& context, const codec::DepthImage& image,
                                const ReliefLook& look)
     : DepthFrameRenderer(reliefScene(context, image, colour, look)) {}
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

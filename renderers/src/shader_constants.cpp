@@ -9,7 +9,7 @@
 #include "conus/codec/volume/raycast.h"
 #include "conus/core/display.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 // Exact decimal text of a float (9 significant digits round-trip it).
@@ -57,4 +57,4 @@ std::string withSharedConstants(const std::string& source) {
     return source.substr(0, eol + 1) + block + source.substr(eol + 1);
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -7,7 +7,7 @@
 
 #include "conus/renderers/view_renderer.h"  // kViewBackground (GLSL: kBackground)
 
-namespace conus::gl {
+namespace conus::renderers {
 
 inline constexpr int kViewMaxFoci = 16;          // focus outlines conus-view draws (GLSL: kMaxFoci)
 
@@ -19,4 +19,4 @@ inline constexpr int kViewMaxFoci = 16;          // focus outlines conus-view dr
 // kIntersectDepthMargin and kSilhouetteStep (codec/depth/intersect.h).
 std::string withSharedConstants(const std::string& source);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

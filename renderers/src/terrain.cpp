@@ -22,7 +22,7 @@
 #include "frame_pvt.h"
 #include "gl_objects.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 constexpr const char* kWhat = "renderTerrain";
@@ -205,4 +205,4 @@ Image renderHeightFieldFrame(Context& context, const format::ConusFile& file, co
     return renderTerrain(context, codec::undistortHeightField(file, extent), camera, width, height);
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

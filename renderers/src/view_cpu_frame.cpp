@@ -12,7 +12,7 @@
 #include "shader_constants.h"
 #include "view_renderer_pvt.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 
@@ -170,4 +170,4 @@ void ViewRenderer::Impl::decodeFrame(const codec::View& view, int width, int hei
     checkGl(gl, "ViewRenderer::draw (CPU decode)");
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

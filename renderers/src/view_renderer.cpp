@@ -25,7 +25,7 @@
 #include "shader_constants.h"
 #include "view_renderer_pvt.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 constexpr int kDensitySamples = 128;     // per side, for the heat map's log-density range
@@ -419,4 +419,4 @@ void ViewRenderer::drawOverlay(int slot, int x, int y, int width, int height, bo
 
 void ViewRenderer::finish() { makeCurrentGl(m_impl->context).Finish(); }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

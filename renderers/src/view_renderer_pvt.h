@@ -12,7 +12,7 @@
 #include "conus/renderers/view_renderer.h"
 #include "gl_objects.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // 0 selects the sRGB curve (ViewOptions::gamma 0); a gamma below 0.05 is held there.
 float inverseGamma(const ViewOptions& options);
@@ -66,4 +66,4 @@ struct ViewRenderer::Impl {
     void uploadMap(const codec::SamplingMap& m);
 };
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -15,7 +15,7 @@
 #include "embedded_shaders.h"
 #include "gl_objects.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 constexpr const char* kWhat = "renderVolumeGpu";
@@ -209,4 +209,4 @@ Image renderVolume(const Device& device, const Volume& volume, const codec::Tran
                       });
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

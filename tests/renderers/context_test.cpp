@@ -12,7 +12,7 @@
 #include "gl_test_util.h"
 #include "error_code.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 // Sets an environment variable for one scope.
@@ -203,4 +203,4 @@ TEST(Device, RunTakesThePathOfTheDevice) {
     EXPECT_EQ(codeOf([&] { cpu.context(); }), ErrorCode::InvalidArgument);
 }
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -15,7 +15,7 @@
 #include "conus/renderers/context.h"
 #include "test_images.h"
 
-namespace conus::gl::test {
+namespace conus::renderers::test {
 
 // Both backends must work on CI machines (Mesa's EGL and OSMesa): a missing one fails, never skips.
 inline Context& contextFor(Backend backend) {
@@ -57,4 +57,4 @@ inline codec::SamplingMap randomFociMap(unsigned seed) {
     return codec::buildFociMap(foci, options);
 }
 
-}  // namespace conus::gl::test
+}  // namespace conus::renderers::test

@@ -19,7 +19,7 @@
 #include "conus/core/error.h"
 #include "gl_test_util.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 using test::contextFor;
@@ -392,4 +392,4 @@ TEST_P(GpuImage, DecodeRefusesImagesOverTheLimit) {
 INSTANTIATE_TEST_SUITE_P(Backends, GpuImage, ::testing::Values(Backend::Egl, Backend::OsMesa), test::paramName);
 
 }  // namespace
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -17,7 +17,7 @@
 #include "gl_test_util.h"
 #include "mesh_test_util.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 constexpr int kSide = 192;
@@ -120,4 +120,4 @@ TEST(MeshSubdivision, ACoarseBoxUnderAStrongFocusNeedsIt) {
 }
 
 }  // namespace
-}  // namespace conus::gl
+}  // namespace conus::renderers

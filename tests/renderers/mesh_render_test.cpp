@@ -11,7 +11,7 @@
 #include "gl_test_util.h"
 #include "mesh_test_util.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 using test::contextFor;
@@ -156,4 +156,4 @@ TEST_P(MeshRender, NormalsAreComputedWhenAbsent) {
 INSTANTIATE_TEST_SUITE_P(MeshGl, MeshRender, ::testing::Values(Backend::Egl, Backend::OsMesa), test::paramName);
 
 }  // namespace
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -11,7 +11,7 @@
 
 #include "conus/core/error.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 Camera camera(double aspect) {
@@ -108,4 +108,4 @@ TEST(FrameMaps, NoFociIsTheIdentityOfTheGrid) {
 }
 
 }  // namespace
-}  // namespace conus::gl
+}  // namespace conus::renderers

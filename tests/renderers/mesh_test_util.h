@@ -16,7 +16,7 @@
 #include "conus/core/image.h"
 #include "conus/core/mesh.h"
 
-namespace conus::gl::test {
+namespace conus::renderers::test {
 
 struct Sphere {
     glm::dvec3 centre{0.0};
@@ -162,4 +162,4 @@ inline DepthError depthError(const Image& a, const Image& b) {
     return e;
 }
 
-}  // namespace conus::gl::test
+}  // namespace conus::renderers::test

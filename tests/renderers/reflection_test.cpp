@@ -9,7 +9,7 @@
 #include "conus/core/error.h"
 #include "renderers/gl_test_util.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 const glm::vec3 kBoxLo(0.4f, -0.3f, 1.5f), kBoxHi(1.0f, 0.5f, 2.2f);
@@ -129,4 +129,4 @@ TEST_P(ReflectionGl, BadInputIsRefused) {
 INSTANTIATE_TEST_SUITE_P(Backends, ReflectionGl, ::testing::Values(Backend::Egl, Backend::OsMesa), test::paramName);
 
 }  // namespace
-}  // namespace conus::gl
+}  // namespace conus::renderers

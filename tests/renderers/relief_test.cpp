@@ -9,7 +9,7 @@
 #include "conus/core/error.h"
 #include "renderers/gl_test_util.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 using codec::DepthHit;
@@ -127,4 +127,4 @@ TEST_P(ReliefGl, BadInputIsRefused) {
 INSTANTIATE_TEST_SUITE_P(Backends, ReliefGl, ::testing::Values(Backend::Egl, Backend::OsMesa), test::paramName);
 
 }  // namespace
-}  // namespace conus::gl
+}  // namespace conus::renderers

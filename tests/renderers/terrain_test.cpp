@@ -16,7 +16,7 @@
 #include "conus/core/error.h"
 #include "gl_test_util.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 using test::contextFor;
@@ -160,4 +160,4 @@ TEST(TerrainRealDem, JacksboroThroughTheCli) {
 }
 
 }  // namespace
-}  // namespace conus::gl
+}  // namespace conus::renderers

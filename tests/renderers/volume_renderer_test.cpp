@@ -19,7 +19,7 @@
 #include "conus/sceneio/volume_file.h"
 #include "gl_test_util.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 namespace {
 
 using test::contextFor;
@@ -136,4 +136,4 @@ TEST_P(VolumeGpu, DeviceRunsTheGpuPathAndTheCpuPath) {
 INSTANTIATE_TEST_SUITE_P(Backends, VolumeGpu, ::testing::Values(Backend::Egl, Backend::OsMesa), test::paramName);
 
 }  // namespace
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -36,7 +36,7 @@ TEST(Controller, WheelZoomsAboutTheCursorAndKeysChangeTheDisplay) {
     EXPECT_NEAR(after.x, before.x, 1e-9);
     EXPECT_NEAR(after.y, before.y, 1e-9);
     c.key({"D"});
-    EXPECT_EQ(c.display().mode, gl::ViewMode::Density);
+    EXPECT_EQ(c.display().mode, renderers::ViewMode::Density);
     c.key({"T"});
     EXPECT_EQ(c.display().toneMap, ToneMap::Reinhard);
     c.key({"E", true});

@@ -75,7 +75,7 @@ protected:
 TEST_F(SceneController, DragOnAFocusMovesItElsewhereOrbits) {
     ASSERT_NE(c.scene(), nullptr);
     EXPECT_EQ(c.keyTable(), KeyTable::Scene);
-    EXPECT_EQ(c.display().mode, gl::ViewMode::Raw) << "the CoNUS image itself";
+    EXPECT_EQ(c.display().mode, renderers::ViewMode::Raw) << "the CoNUS image itself";
     EXPECT_EQ(c.sceneFrameSize(), glm::ivec2(kW, kH));
 
     // A drag from the focus takes it to where the drag ends; the camera stays.

@@ -90,7 +90,7 @@ TEST(SceneWindow, MeshFramesAreTheEncodersAndFollowTheCommands) {
     const BoundingSphere sphere = boundingSphere(std::vector<glm::dvec3>(mesh.positions.begin(), mesh.positions.end()));
     SceneState state(sphere.centre, sphere.radius, {focus});
     const double aspect = double(kW) / kH;
-    gl::MeshRenderer renderer(test::context(), mesh);
+    renderers::MeshRenderer renderer(test::context(), mesh);
     const Image conus = renderer.render(state.camera(aspect), state.map(aspect), kW, kH);
     const Image conventional = renderer.render(state.camera(aspect), codec::SamplingMap::identity(2, 2), kW, kH);
     state.rotate(40, 10);
@@ -134,7 +134,7 @@ TEST(SceneWindow, MeshMaxEdgeSubdividesEachFrame) {
     const codec::SamplingMap map = state.map(aspect);
     const Mesh fine = codec::subdivideForMap(mesh, camera, map, 0.5);
     ASSERT_GT(fine.triangleCount(), mesh.triangleCount()) << "the focus makes some edges long";
-    EXPECT_LT(compare(window, gl::renderMeshGpu(test::context(), fine, camera, map, kW, kH)).mean, 1.0 / 255);
+    EXPECT_LT(compare(window, renderers::renderMeshGpu(test::context(), fine, camera, map, kW, kH)).mean, 1.0 / 255);
 }
 
 // --screenshot in a 3-D mode: the first frame offscreen, no window, as the window would show it
@@ -151,7 +151,7 @@ TEST(SceneWindow, ScreenshotOfAVolumeIsItsFirstFrame) {
     const Volume volume = codec::proceduralVolume(spec);
     const SceneState state(0.5 * volume.extent(), 0.5 * glm::length(volume.extent()), {codec::Focus{0.5, 0.45, 0.15, 3.0}});
     const double aspect = double(kW) / kH;
-    gl::VolumeRendererGpu renderer(test::context(), volume,
+    renderers::VolumeRendererGpu renderer(test::context(), volume,
                                    codec::TransferFunction::preset(codec::TransferFunction::kDefaultPreset));
     const Image frame = renderer.render(Fpc(state.camera(aspect), std::make_shared<codec::SamplingMap>(state.map(aspect))),
                                         kW, kH, {});
@@ -183,7 +183,7 @@ TEST(SceneWindow, VolumeFramesAreTheRayCastersAndTCyclesTheLook) {
     const auto at = std::find(presets.begin(), presets.end(), codec::TransferFunction::kDefaultPreset);
     ASSERT_NE(at, presets.end());
     const std::size_t first = static_cast<std::size_t>(at - presets.begin());
-    gl::VolumeRendererGpu renderer(test::context(), volume, codec::TransferFunction::preset(presets[first]));
+    renderers::VolumeRendererGpu renderer(test::context(), volume, codec::TransferFunction::preset(presets[first]));
     const auto render = [&](const codec::SamplingMap& map) {
         return renderer.render(Fpc(state.camera(aspect), std::make_shared<codec::SamplingMap>(map)), kW, kH, {});
     };

@@ -11,13 +11,13 @@
 namespace conus::viewer {
 namespace {
 
-using gl::ViewMode;
-using gl::ViewOptions;
+using renderers::ViewMode;
+using renderers::ViewOptions;
 
 struct Fixture {
     format::ConusFile file = test::conusFile();
     codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
-    gl::ViewRenderer renderer{test::context()};
+    renderers::ViewRenderer renderer{test::context()};
     Fixture() { renderer.setImage(file); }
 };
 
@@ -78,23 +78,23 @@ TEST(ViewRenderer, CpuDecodeMatchesTheShader) {
             o.grid = overlays;
             o.gridEvery = 5;
             o.outlines = overlays;
-            o.decode = gl::DecodePath::Gpu;
+            o.decode = renderers::DecodePath::Gpu;
             EXPECT_FALSE(f.renderer.decodesOnCpu(o, view, 240));
             const Image gpu = f.renderer.renderToImage(view, 240, 180, o);
-            o.decode = gl::DecodePath::Cpu;
+            o.decode = renderers::DecodePath::Cpu;
             EXPECT_TRUE(f.renderer.decodesOnCpu(o, view, 240));
             const Image cpu = f.renderer.renderToImage(view, 240, 180, o);
             EXPECT_GT(psnrRgb(gpu, cpu), overlays ? 40.0 : 50.0) << view.u0 << "," << view.v0 << " overlays " << overlays;
             // Same background outside [0,1]^2, same alpha.
             EXPECT_EQ(gpu.at(0, 0, 3), cpu.at(0, 0, 3));
             if (view.u0 < 0) {
-                EXPECT_FLOAT_EQ(cpu.at(1, 1, 0), gl::kViewBackground);
+                EXPECT_FLOAT_EQ(cpu.at(1, 1, 0), renderers::kViewBackground);
             }
         }
     }
     // Other modes never decode on the CPU.
     ViewOptions raw = linear(ViewMode::Raw);
-    raw.decode = gl::DecodePath::Cpu;
+    raw.decode = renderers::DecodePath::Cpu;
     EXPECT_FALSE(f.renderer.decodesOnCpu(raw, codec::View{}, 240));
 }
 
@@ -103,9 +103,9 @@ TEST(ViewRenderer, CpuDecodeMatchesTheShader) {
 TEST(ViewRenderer, AutoDecodeFollowsTheRasterizerAndTheZoom) {
     Fixture& f = fixture();
     ViewOptions o;
-    o.decode = gl::DecodePath::Auto;
+    o.decode = renderers::DecodePath::Auto;
     const int across = f.file.image.width;  // target pixels across the whole image: 1:1
-    const bool software = gl::prefersCpu(test::context());
+    const bool software = renderers::prefersCpu(test::context());
     EXPECT_EQ(f.renderer.decodesOnCpu(o, codec::View{}, across), software);
     EXPECT_EQ(f.renderer.decodesOnCpu(o, codec::View{0.2, 0.2, 0.4, 0.4}, across), software);  // magnified
     EXPECT_FALSE(f.renderer.decodesOnCpu(o, codec::View{}, across / 2));                      // minified
@@ -138,7 +138,7 @@ TEST(ViewRenderer, WipeSplitsReconstructedAndUniform) {
     wipe.wipeX = 0.5;
     const Image w = f.renderer.renderToImage({}, 200, 150, wipe);
     ViewOptions shader = linear();
-    shader.decode = gl::DecodePath::Gpu;  // the wipe is drawn by the shader (pixel for pixel; the CPU path is within 50 dB)
+    shader.decode = renderers::DecodePath::Gpu;  // the wipe is drawn by the shader (pixel for pixel; the CPU path is within 50 dB)
     const Image r = f.renderer.renderToImage({}, 200, 150, shader);
     const Image u = f.renderer.renderToImage({}, 200, 150, linear(ViewMode::Uniform));
     for (int y = 0; y < 150; y += 3) {
@@ -232,13 +232,13 @@ TEST(ViewRenderer, SrgbCurveAndToneMapsAgreeWithCoreOnBothPaths) {
         ViewOptions o;  // gamma 0: the sRGB curve
         o.exposure = 2.0;  // pushes the bright parts above 1
         o.toneMap = toneMap;
-        for (gl::DecodePath path : {gl::DecodePath::Gpu, gl::DecodePath::Cpu}) {
+        for (renderers::DecodePath path : {renderers::DecodePath::Gpu, renderers::DecodePath::Cpu}) {
             o.decode = path;
             const Image shown = f.renderer.renderToImage({}, 64, 48, o);
             for (int x = 0; x < 64; x += 7)
                 for (int c = 0; c < 3; ++c) {
                     const float want = linearToSrgbDisplay(exposeAndToneMap(base.at(x, 20, c), 4.0f, toneMap));
-                    EXPECT_NEAR(shown.at(x, 20, c), want, 2e-3) << enumName(toneMap) << (path == gl::DecodePath::Cpu ? " cpu" : " gpu");
+                    EXPECT_NEAR(shown.at(x, 20, c), want, 2e-3) << enumName(toneMap) << (path == renderers::DecodePath::Cpu ? " cpu" : " gpu");
                 }
         }
     }
@@ -252,14 +252,14 @@ TEST(ViewRenderer, DimImagesAtHighExposureMatchTheCpuDecode) {
     for (const int stops : {12, 20}) {
         format::ConusFile file = test::conusFile();
         for (float& x : file.image.pixels) x = std::ldexp(x, -stops);
-        gl::ViewRenderer renderer{test::context()};
+        renderers::ViewRenderer renderer{test::context()};
         renderer.setImage(file);
         ViewOptions o = linear();
         o.exposure = stops;
         for (const codec::View& view : {codec::View{}, codec::View{0.1, 0.15, 0.9, 0.8}}) {
-            o.decode = gl::DecodePath::Gpu;
+            o.decode = renderers::DecodePath::Gpu;
             const Image gpu = renderer.renderToImage(view, 160, 120, o);
-            o.decode = gl::DecodePath::Cpu;
+            o.decode = renderers::DecodePath::Cpu;
             const Image cpu = renderer.renderToImage(view, 160, 120, o);
             EXPECT_GT(psnrRgb(gpu, cpu), 50.0) << stops << " stops";
             EXPECT_GT(gpu.at(80, 60, 0) + gpu.at(80, 60, 1), 0.05f) << "the picture, not black";
@@ -270,8 +270,8 @@ TEST(ViewRenderer, DimImagesAtHighExposureMatchTheCpuDecode) {
 TEST(ViewRenderer, OutsideTheImageIsBackground) {
     Fixture& f = fixture();
     const Image im = f.renderer.renderToImage({-1.0, -1.0, 2.0, 2.0}, 90, 90, linear());
-    EXPECT_NEAR(im.at(5, 5, 0), gl::kViewBackground, 1e-6);
-    EXPECT_NE(im.at(45, 45, 0), gl::kViewBackground);
+    EXPECT_NEAR(im.at(5, 5, 0), renderers::kViewBackground, 1e-6);
+    EXPECT_NE(im.at(45, 45, 0), renderers::kViewBackground);
 }
 
 TEST(ViewRenderer, OverlayBlendsOverTheFrameInItsRectangleOnly) {

@@ -78,9 +78,9 @@ inline const std::string& conusPath() {
     return path;
 }
 
-inline gl::Context& context() {
+inline renderers::Context& context() {
     // Never destroyed: Mesa's exit handlers may run before static destructors.
-    static gl::Context* c = gl::Context::create().release();
+    static renderers::Context* c = renderers::Context::create().release();
     return *c;
 }
 

@@ -16,7 +16,7 @@
 
 #include "conus/renderers/context.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 enum class CpuPath { Available, None };
 
@@ -51,4 +51,4 @@ bool isSoftwareRasterizer(const std::string& renderer);
 // Whether work that has a CPU path should take it rather than run on this context: the rule above.
 bool prefersCpu(const Context& context);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

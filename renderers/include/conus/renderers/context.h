@@ -21,7 +21,7 @@
 
 #include "conus/core/enum_names.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // The environment variable that lowers Context::textureLimit.
 inline constexpr const char* kTextureLimitVariable = "CONUS_GL_MAX_TEXTURE";
@@ -33,7 +33,7 @@ enum class Backend {
     Cpu,     // no GL: the CPU reference in conus::codec; has no Context
 };
 
-// Backends are named in any case (parseEnum<gl::Backend>("OSMesa")); a bad name throws
+// Backends are named in any case (parseEnum<renderers::Backend>("OSMesa")); a bad name throws
 // conus::Error(InvalidArgument) listing these.
 constexpr auto enumNameTable(Backend) {
     return makeEnumNameTable<Backend>(
@@ -94,4 +94,4 @@ using GetProcFn = ProcAddress (*)(const char* name);
 // conus::Error(Unsupported) when GL 4.5 core cannot be loaded.
 std::unique_ptr<Context> adoptCurrentContext(GetProcFn getProc);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

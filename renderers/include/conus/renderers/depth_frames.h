@@ -12,7 +12,7 @@
 #include "conus/core/camera.h"
 #include "conus/core/image.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 class DepthFrameRenderer {
 public:
@@ -36,4 +36,4 @@ private:
     std::unique_ptr<Scene> m_scene;
 };
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -38,7 +38,7 @@
 #include "conus/renderers/backend.h"
 #include "conus/renderers/context.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // Where the time of one call went, in milliseconds; each phase ends with glFinish, so the phases
 // add up to the call (minus CPU-side argument checks). Upload includes building the source pyramid
@@ -59,4 +59,4 @@ Image encodeImage(const Device& device, const Image& source, const codec::Sampli
 Image decodeImage(const Device& device, const Image& conus, const codec::SamplingMap& map,
                           const codec::DecodeOptions& options);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

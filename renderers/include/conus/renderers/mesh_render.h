@@ -30,7 +30,7 @@
 #include "conus/renderers/context.h"
 #include "conus/renderers/gpu_image.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 struct MeshRenderOptions {
     int samples = 4;  // multisampling per pixel (1: one sample at the centre); the driver's maximum caps it
@@ -64,4 +64,4 @@ Image renderMeshGpu(Context& context, const Mesh& mesh, const Camera& camera, co
 Image renderMesh(const Device& device, const Mesh& mesh, const Camera& camera, const codec::SamplingMap& map,
                  int width, int height, const MeshRenderOptions& options = {});
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

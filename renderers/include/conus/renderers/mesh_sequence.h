@@ -19,7 +19,7 @@
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/camera.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 struct TrackOptions {
     double radius = 0.08;  // each focus's radius, a fraction of the image width
@@ -39,4 +39,4 @@ codec::SamplingMap frameMap(std::span<const codec::Focus> foci, const codec::Foc
 // The largest distance any node moved between two maps of the same grid (normalized units).
 double largestNodeStep(const codec::SamplingMap& from, const codec::SamplingMap& to);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -17,7 +17,7 @@
 #include "conus/renderers/context.h"
 #include "conus/renderers/depth_frames.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // Keeps an asset (exactly six faces) and its scene uploaded (a frame is two draws: the scene
 // behind, then the reflection pass); render() gives channels R, G, B, M as
@@ -34,4 +34,4 @@ Image renderReflection(const Device& device, const codec::MeshScene& scene,
                        const std::vector<codec::ReflectionFace>& faces, const Camera& camera, int width, int height,
                        const codec::ReflectionFrameOptions& options);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -20,7 +20,7 @@
 #include "conus/renderers/context.h"
 #include "conus/renderers/depth_frames.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // codec::intersect for each ray, on the GPU (float precision): for tests of the GLSL against the
 // CPU reference and for benchmarks.
@@ -44,4 +44,4 @@ public:
     ReliefRenderer(Context& context, const codec::DepthImage& image, const Image& colour, const ReliefLook& look = {});
 };
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

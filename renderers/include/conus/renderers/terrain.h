@@ -23,7 +23,7 @@
 #include "conus/format/container.h"
 #include "conus/renderers/context.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 struct TerrainLook {
     glm::vec3 sky{0.62f, 0.74f, 0.88f};
@@ -82,4 +82,4 @@ Camera heightFieldCamera(const format::ConusFile& file, double aspect,
 // (codec::undistortHeightField) and rendered from `camera` (renderTerrain).
 Image renderHeightFieldFrame(Context& context, const format::ConusFile& file, const Camera& camera, int width, int height);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

@@ -23,7 +23,7 @@
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // The grey conus-view draws around the image, in every channel (its shader gets it as kBackground).
 inline constexpr float kViewBackground = 0.11f;
@@ -43,7 +43,7 @@ enum class ViewMode {
 // uploaded and copied into the target, overlays drawn over it by a second pass; on a software
 // rasterizer (llvmpipe) the multithreaded incremental CPU decoder is several times faster than the
 // shader at 1:1 and magnified. Auto: Gpu, except where the backend rule of backend.h
-// (gl::prefersCpu: GL_RENDERER names a software rasterizer) holds and the view is not minified
+// (renderers::prefersCpu: GL_RENDERER names a software rasterizer) holds and the view is not minified
 // (at most one CoNUS pixel across per target pixel, on average): a minified view takes one
 // trilinear tap from the mip chain per pixel in the shader, which measured faster on llvmpipe than
 // the CPU decoder (bench/README.md, Viewer). Other modes always use the GPU.
@@ -138,4 +138,4 @@ private:
     std::unique_ptr<Impl> m_impl;
 };
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

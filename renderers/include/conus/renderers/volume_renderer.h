@@ -32,7 +32,7 @@
 #include "conus/renderers/context.h"
 #include "conus/renderers/gpu_image.h"
 
-namespace conus::gl {
+namespace conus::renderers {
 
 // A volume and a transfer function uploaded once, rendered any number of times (the viewer, the
 // benchmarks, animations). Holds GL objects of `context`: destroy it before the context.
@@ -57,4 +57,4 @@ private:
 Image renderVolume(const Device& device, const Volume& volume, const codec::TransferFunction& tf, const Fpc& fpc,
                    int width, int height, const codec::VolumeRenderOptions& options);
 
-}  // namespace conus::gl
+}  // namespace conus::renderers

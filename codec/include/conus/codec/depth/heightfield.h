@@ -3,7 +3,7 @@
 // ground_map.h, so that the sampling rate falls with the distance from a viewer standing at the
 // middle of the field's bottom edge. The server encodes (encodeHeightField); the client undistorts
 // the CoNUS image back into a 3-D triangle mesh (undistortHeightField) and renders frames near the
-// viewer (conus::gl::renderTerrain). A uniform height field of the same sample count is the baseline.
+// viewer (conus::renderers::renderTerrain). A uniform height field of the same sample count is the baseline.
 //
 // World frame of every Mesh (metres): x to the right (x = u * width), y up (y = height above the
 // base plane), z toward the viewer (z = v * depth): the far edge (v = 0) lies at z = 0, the near
