@@ -16,6 +16,8 @@
 #include "conus/codec/image/encode.h"
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/foci_budget.h"
+#include "conus/codec/build/frame_budget.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/renderers/gpu_image.h"
 #include "demo_picture.h"
@@ -91,22 +93,33 @@ struct DemoMap {
     std::optional<format::AnalyticMap> analytic;
 };
 
-// From importance (its hottest region becomes the view when no focus names one), else the foci.
-DemoMap demoMap(const DemoOptions& o, DemoSource& source) {
+// From importance (its hottest region becomes the view when no focus names one), else the foci;
+// under encode's default frame-loss budget, so the demo shows what `conus encode` gives.
+DemoMap demoMap(const DemoOptions& o, DemoSource& source, const Size& size) {
     Progress building("build the sampling map");
     DemoMap m;
     const int w = source.image.width, h = source.image.height;
+    std::string said;
     if (!o.importance.empty()) {
         const Image importance = importanceFrom(o.importance, source.image);
-        m.map = codec::buildAutoMap(importance, {});
+        const codec::FrameErrorModel model(source.image, size.width, size.height, importance);
+        m.map = codec::buildAutoMapForFrameLoss(importance, model, codec::kDefaultFrameLoss, {}, codec::kDefaultTileLoss).map;
         if (o.foci.empty()) source.foci = {hottestRegion(importance, w, h)};
     } else {
         codec::FociOptions fociOptions;
         fociOptions.aspect = double(w) / h;
-        m.map = codec::buildFociMap(source.foci, fociOptions);
-        m.analytic = codec::toAnalytic(source.foci, fociOptions.composition);
+        const int side = 256;
+        const codec::FrameErrorModel model(
+            source.image, size.width, size.height,
+            codec::fociImportance(source.foci, fociOptions.aspect, side, std::max(1, static_cast<int>(side / fociOptions.aspect))));
+        codec::FociBudget budget = codec::fociForFrameLoss(source.foci, fociOptions, model);
+        said = describeFociBudget(budget, BudgetFrame{size.width, size.height, w, h}, false, fociOptions.columns);
+        source.foci = budget.given;
+        m.map = std::move(budget.map);
+        m.analytic = codec::toAnalytic(source.foci, fociOptions.composition, fociOptions.falloff);
     }
     building.done();
+    if (!said.empty() && !quiet()) std::printf("%s\n", said.c_str());
     return m;
 }
 
@@ -138,11 +151,11 @@ int runDemo(const DemoOptions& o) {
     fs::create_directories(o.out);
     const fs::path out(o.out);
     DemoSource source = demoSource(o);
-    const DemoMap built = demoMap(o, source);
-    const codec::SamplingMap& map = *built.map;
     const int w = source.image.width, h = source.image.height;
-
     const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
+    const DemoMap built = demoMap(o, source, size);
+    const codec::SamplingMap& map = *built.map;
+
     const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Available, "the demo");
     const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
     const format::ConusFile conus = encodeToConus(device, source.image, source.encoding, map, size, built.analytic);
