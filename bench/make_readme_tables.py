@@ -53,7 +53,7 @@ CODEC = [
      "BM_DecodeBaselineBilinear/zoom:0/real_time", ""),
     ("build the 2048² image's pyramid (once per image)", "BM_BuildPyramid/real_time",
      "BM_DecodeBaselineBilinear/zoom:0/real_time", ""),
-    ("automatic map from 4096² importance, flow", "BM_AutoMapFlow4096/real_time",
+    ("automatic map from 4096² importance, the default (bounded) builder", "BM_AutoMapFlow4096/real_time",
      "BM_AutoMapSeparable4096/real_time", ""),
     ("mass-spring 256², one step", "BM_SpringStep256", "BM_SpringBaselinePass256", ""),
     ("mass-spring 256², 3 strokes to the stable state", "BM_SpringTimeToStable256/1",
