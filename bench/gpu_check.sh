@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The GL checks and figures for a machine with a GPU, in one run: the renderers' tests (GL output
+# against the CPU reference and analytic expectations), `conus demo` through EGL and through the CPU
+# (the same pictures, the same PSNR), and renderers_bench's GPU / CPU pairs as JSON (medians of
+# interleaved repetitions, so that every ratio is read off one run on one machine).
+# Usage: bench/gpu_check.sh BIN_DIR OUT_DIR [REPETITIONS]
+#   BIN_DIR holds renderers_tests, renderers_bench and conus (build/bin); OUT_DIR receives
+#   machine.txt, renderers_tests.txt, demo-egl.txt, demo-cpu.txt, demo-egl.png and renderers_bench.json.
+# Figures from such runs: bench/notes/ (the GPU named in machine.txt).
+set -uo pipefail
+bin=${1:?usage: bench/gpu_check.sh BIN_DIR OUT_DIR [REPETITIONS]}
+out=${2:?usage: bench/gpu_check.sh BIN_DIR OUT_DIR [REPETITIONS]}
+repetitions=${3:-5}
+limit=${CONUS_GPU_CHECK_STAGE_SECONDS:-900}  # each stage's wall-clock limit
+mkdir -p "$out"
+status=0
+
+{
+  date -u
+  nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader 2>/dev/null || echo "no nvidia-smi"
+  echo "cores: $(nproc)"
+} >"$out/machine.txt"
+cat "$out/machine.txt"
+
+echo "== renderers_tests"
+timeout "$limit" "$bin/renderers_tests" --gtest_brief=1 >"$out/renderers_tests.txt" 2>&1 || status=1
+tail -5 "$out/renderers_tests.txt"
+
+demo=$(mktemp -d)
+for backend in egl cpu; do
+  echo "== conus demo --backend $backend"
+  timeout "$limit" "$bin/conus" demo --backend "$backend" --out "$demo/$backend" >"$out/demo-$backend.txt" 2>&1 || status=1
+  tail -4 "$out/demo-$backend.txt"
+done
+cp "$demo/egl/view-frame.png" "$out/demo-egl.png" 2>/dev/null
+rm -rf "$demo"
+
+# Each GPU figure beside its baseline: conventional beside CoNUS, CPU beside GL.
+pairs='BM_(Encode|Decode)(Gpu|Cpu)|BM_Gpu(Conventional|Conus|ConusSubdivided)|BM_GpuConusOverConventionalPaired/.*'
+pairs+='|BM_Volume(Gpu|Cpu)(Conventional|Conus)(Filled)?|BM_VolumeGpuConusOverConventionalPaired/.*'
+pairs+='|BM_Intersect(Cpu|Glsl)/[01]|BM_ReflectionFrame(Gl)?/[01]|BM_ReliefFrame/[01]|BM_Render(Conus|Uniform)'
+echo "== renderers_bench ($repetitions repetitions)"
+timeout "$limit" "$bin/renderers_bench" --benchmark_filter="^($pairs)(/real_time)?\$" --benchmark_repetitions="$repetitions" \
+  --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
+  --benchmark_format=json >"$out/renderers_bench.json" 2>"$out/renderers_bench.err" || status=1
+# The mirrors' quality against the traced reference (deterministic; on this GPU's GL).
+timeout "$limit" "$bin/renderers_bench" --benchmark_filter='^BM_ReflectionSilhouettes/' --benchmark_format=json \
+  >"$out/reflection_quality.json" 2>>"$out/renderers_bench.err" || status=1
+tail -3 "$out/renderers_bench.err"
+exit $status
