@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
 # The GL checks and figures for a machine with a GPU, in one run: the renderers' tests (GL output
 # against the CPU reference and analytic expectations), `conus demo` through EGL and through the CPU
-# (the same pictures, the same PSNR), and renderers_bench's GPU / CPU pairs as JSON (medians of
-# interleaved repetitions, so that every ratio is read off one run on one machine).
+# (the same pictures, the same PSNR), `conus encode` and `decode` of the demo's 4096x4096 picture
+# timed on each backend, and renderers_bench's GPU / CPU pairs as JSON (medians of interleaved
+# repetitions of at least a second each, so that the GPU's clocks have risen and every ratio is read
+# off one run on one machine).
 # Usage: bench/gpu_check.sh BIN_DIR OUT_DIR [REPETITIONS]
 #   BIN_DIR holds renderers_tests, renderers_bench and conus (build/bin); OUT_DIR receives
-#   machine.txt, renderers_tests.txt, demo-egl.txt, demo-cpu.txt, demo-egl.png and renderers_bench.json.
+#   machine.txt, renderers_tests.txt, cli.txt, demo-egl.png, renderers_bench.json (+ .err) and
+#   reflection_quality.json. CONUS_GPU_CHECK_TESTS is a gtest filter for the tests (default all);
+#   CONUS_GPU_CHECK_STAGE_SECONDS bounds each stage (default 900).
 # Figures from such runs: bench/notes/ (the GPU named in machine.txt).
 set -uo pipefail
 bin=${1:?usage: bench/gpu_check.sh BIN_DIR OUT_DIR [REPETITIONS]}
@@ -23,16 +27,26 @@ status=0
 cat "$out/machine.txt"
 
 echo "== renderers_tests"
-timeout "$limit" "$bin/renderers_tests" --gtest_brief=1 >"$out/renderers_tests.txt" 2>&1 || status=1
+timeout "$limit" "$bin/renderers_tests" --gtest_brief=1 --gtest_filter="${CONUS_GPU_CHECK_TESTS:-*}" >"$out/renderers_tests.txt" 2>&1 || status=1
 tail -5 "$out/renderers_tests.txt"
 
 demo=$(mktemp -d)
 for backend in egl cpu; do
-  echo "== conus demo --backend $backend"
-  timeout "$limit" "$bin/conus" demo --backend "$backend" --out "$demo/$backend" >"$out/demo-$backend.txt" 2>&1 || status=1
-  tail -4 "$out/demo-$backend.txt"
+  echo "== conus demo --backend $backend" | tee -a "$out/cli.txt"
+  timeout "$limit" "$bin/conus" demo --backend "$backend" --out "$demo/$backend" >>"$out/cli.txt" 2>&1 || status=1
+  tail -4 "$out/cli.txt"
 done
 cp "$demo/egl/view-frame.png" "$out/demo-egl.png" 2>/dev/null
+# The user's commands, wall clock: encode 4096x4096 -> 1024x1024 through a focus, decode a 2048x2048 frame.
+for backend in egl cpu egl cpu; do
+  for step in encode decode; do
+    if [ $step = encode ]; then args=(encode "$demo/egl/source.png" --focus 0.3,0.3,0.1,4 -o "$demo/t-$backend.exr")
+    else args=(decode "$demo/t-$backend.exr" --size 2048x2048 -o "$demo/t-$backend.png"); fi
+    start=$(date +%s%N)
+    timeout "$limit" "$bin/conus" "${args[@]}" --backend "$backend" -q >>"$out/cli.txt" 2>&1 || status=1
+    echo "time conus $step --backend $backend: $((($(date +%s%N) - start) / 1000000)) ms" | tee -a "$out/cli.txt"
+  done
+done
 rm -rf "$demo"
 
 # Each GPU figure beside its baseline: conventional beside CoNUS, CPU beside GL.
@@ -41,7 +55,7 @@ pairs+='|BM_Volume(Gpu|Cpu)(Conventional|Conus)(Filled)?|BM_VolumeGpuConusOverCo
 pairs+='|BM_Intersect(Cpu|Glsl)/[01]|BM_ReflectionFrame(Gl)?/[01]|BM_ReliefFrame/[01]|BM_Render(Conus|Uniform)'
 echo "== renderers_bench ($repetitions repetitions)"
 timeout "$limit" "$bin/renderers_bench" --benchmark_filter="^($pairs)(/real_time)?\$" --benchmark_repetitions="$repetitions" \
-  --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
+  --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true --benchmark_min_time=1 \
   --benchmark_format=json >"$out/renderers_bench.json" 2>"$out/renderers_bench.err" || status=1
 # The mirrors' quality against the traced reference (deterministic; on this GPU's GL).
 timeout "$limit" "$bin/renderers_bench" --benchmark_filter='^BM_ReflectionSilhouettes/' --benchmark_format=json \
