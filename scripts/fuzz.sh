@@ -15,27 +15,34 @@
 # harnesses then run several times faster where a reader allocates large buffers (Assimp's OBJ
 # importer fills 16 MB per file, and ASan maps and faults those pages in afresh every time). The
 # corpus, logs and findings stay in build-fuzz/, shared with the full build.
+# CONUS_FUZZ_FORK=N runs N processes per harness (libFuzzer's -fork) on a machine with the cores.
+# CONUS_FUZZ_BUILD=0 runs the harnesses already built, installing and building nothing (a copy of
+# the build tree on a machine without the compilers).
 # Usage: scripts/fuzz.sh [SECONDS] [HARNESS...]   e.g. scripts/fuzz.sh 1800 container
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift $(($# > 0 ? 1 : 0))
 
-# clang and its sanitizer and libFuzzer runtimes: a fast no-op when present.
-scripts/install-packages.sh fuzz clang-14 libclang-rt-14-dev
-
-launcher=()
-if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 sanitizers="${CONUS_FUZZ_SANITIZERS:-address,undefined}"
 build=build-fuzz
 suffix=
 if [ "$sanitizers" != "address,undefined" ]; then suffix="-${sanitizers//,/-}"; build="build-fuzz$suffix"; fi
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang-14 \
-  -DCMAKE_CXX_COMPILER=clang++-14 -DCONUS_FUZZ=ON -DCONUS_FUZZ_SANITIZERS="$sanitizers" "${launcher[@]}" >/dev/null
 harnesses=("$@")
-targets=()
-for name in "${harnesses[@]}"; do targets+=(--target "fuzz_$name"); done  # only the harnesses asked for
-cmake --build "$build" --parallel "${CONUS_FUZZ_JOBS:-$(nproc)}" "${targets[@]}"
+if [ "${CONUS_FUZZ_BUILD:-1}" != 0 ]; then
+  # clang and its sanitizer and libFuzzer runtimes: a fast no-op when present.
+  scripts/install-packages.sh fuzz clang-14 libclang-rt-14-dev
+
+  launcher=()
+  if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang-14 \
+    -DCMAKE_CXX_COMPILER=clang++-14 -DCONUS_FUZZ=ON -DCONUS_FUZZ_SANITIZERS="$sanitizers" "${launcher[@]}" >/dev/null
+  targets=()
+  for name in "${harnesses[@]}"; do targets+=(--target "fuzz_$name"); done  # only the harnesses asked for
+  cmake --build "$build" --parallel "${CONUS_FUZZ_JOBS:-$(nproc)}" "${targets[@]}"
+fi
+fork=()
+if [ -n "${CONUS_FUZZ_FORK:-}" ]; then fork=(-fork="$CONUS_FUZZ_FORK"); fi
 
 if ((${#harnesses[@]} == 0)); then
   for binary in "$build"/bin/fuzz_*; do harnesses+=("$(basename "$binary" | sed 's/^fuzz_//')"); done
@@ -56,11 +63,17 @@ for name in "${harnesses[@]}"; do
   echo "fuzz: $name for ${seconds} s, -fsanitize=$sanitizers (log: $log)"
   set +e
   "$build/bin/fuzz_$name" -max_total_time="$seconds" -dict=tests/fuzz/conus.dict -timeout="${CONUS_FUZZ_TIMEOUT:-30}" -rss_limit_mb=2048 -max_len=16384 \
-    -print_final_stats=1 -runs="${CONUS_FUZZ_RUNS:--1}" -artifact_prefix="build-fuzz/artifacts/$name-" "${corpora[@]}" >"$log" 2>&1
+    -print_final_stats=1 -runs="${CONUS_FUZZ_RUNS:--1}" "${fork[@]}" -artifact_prefix="build-fuzz/artifacts/$name-" "${corpora[@]}" >"$log" 2>&1
   rc=$?
   set -e
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+  if ((${#fork[@]})); then  # fork mode prints no final stats: its last status line counts them all
+    last=$(grep -E '^#[0-9]+: cov:' "$log" | tail -1)
+    execs=$(sed -n 's/^#\([0-9]*\):.*/\1/p' <<<"$last")
+    secs=$(sed -n 's/.* time: \([0-9]*\)s.*/\1/p' <<<"$last")
+    rate=$((${execs:-0} / (${secs:-0} > 0 ? ${secs:-1} : 1)))
+  fi
   execs=${execs:-0}
   total=$((total + execs))
   if [ "$rc" -ne 0 ]; then
