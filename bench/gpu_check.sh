@@ -9,7 +9,8 @@
 #   BIN_DIR holds renderers_tests, renderers_bench and conus (build/bin); OUT_DIR receives
 #   machine.txt, renderers_tests.txt, cli.txt, demo-egl.png, renderers_bench.json (+ .err) and
 #   reflection_quality.json. CONUS_GPU_CHECK_TESTS is a gtest filter for the tests (default all);
-#   CONUS_GPU_CHECK_STAGE_SECONDS bounds each stage (default 900).
+#   CONUS_GPU_CHECK_STAGE_SECONDS bounds each stage (default 900); CONUS_GPU_CHECK_MIN_TIME is each
+#   benchmark repetition's least time in seconds (default 1).
 # Figures from such runs: bench/notes/ (the GPU named in machine.txt).
 set -uo pipefail
 bin=${1:?usage: bench/gpu_check.sh BIN_DIR OUT_DIR [REPETITIONS]}
@@ -55,7 +56,7 @@ pairs+='|BM_Volume(Gpu|Cpu)(Conventional|Conus)(Filled)?|BM_VolumeGpuConusOverCo
 pairs+='|BM_Intersect(Cpu|Glsl)/[01]|BM_ReflectionFrame(Gl)?/[01]|BM_ReliefFrame/[01]|BM_Render(Conus|Uniform)'
 echo "== renderers_bench ($repetitions repetitions)"
 timeout "$limit" "$bin/renderers_bench" --benchmark_filter="^($pairs)(/real_time)?\$" --benchmark_repetitions="$repetitions" \
-  --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true --benchmark_min_time=1 \
+  --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true --benchmark_min_time="${CONUS_GPU_CHECK_MIN_TIME:-1}" \
   --benchmark_format=json >"$out/renderers_bench.json" 2>"$out/renderers_bench.err" || status=1
 # The mirrors' quality against the traced reference (deterministic; on this GPU's GL).
 timeout "$limit" "$bin/renderers_bench" --benchmark_filter='^BM_ReflectionSilhouettes/' --benchmark_format=json \
