@@ -66,14 +66,30 @@ std::mutex assimpLogMutex;
 // reading a single vertex; a count no file of this size can hold (every element takes at least a
 // byte) or one past the caps is refused here, before Assimp sees the file.
 void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
+    // Assimp reads a PLY header as lines ended by any of \n \r \0 \f, skips empty ones, and takes
+    // a file whose first line starts with the three letters ("ply@" included) whatever its name:
+    // a .glb or .gltf its own importer refuses is tried as a PLY. The header is read the same way.
+    constexpr std::size_t kHeaderBytes = 1 << 20;
     std::ifstream in(path, std::ios::binary);
+    std::string head(static_cast<std::size_t>(std::min<std::uintmax_t>(bytes, kHeaderBytes)), '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(std::max<std::streamsize>(0, in.gcount())));
+    const auto lineEnd = [](char c) { return c == '\n' || c == '\r' || c == '\0' || c == '\f'; };
+    std::size_t at = 0;
+    const auto nextLine = [&](std::string& line) {
+        while (at < head.size() && lineEnd(head[at])) ++at;
+        if (at >= head.size()) return false;
+        const std::size_t start = at;
+        while (at < head.size() && !lineEnd(head[at])) ++at;
+        line.assign(head, start, at - start);
+        return true;
+    };
     std::string line;
-    // Assimp takes any file that starts with the three letters for a PLY ("ply@" included).
-    if (!std::getline(in, line) || line.size() < 3) return;
+    if (!nextLine(line) || line.size() < 3) return;
     std::string magic = line.substr(0, 3);
     for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (magic != "ply") return;
-    for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
+    for (int n = 0; n < 10000 && nextLine(line); ++n) {
         while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
         if (line == "end_header") return;
         std::istringstream words(line);
