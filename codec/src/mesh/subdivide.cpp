@@ -19,6 +19,7 @@ struct Projected {
     std::vector<glm::dvec2> uv;
     std::vector<char> measurable;
     glm::dvec2 pixels{1, 1};  // the image's size, for lengths in pixels
+    std::vector<char> unchanged;  // per triangle: the last pass kept it as it was
 };
 
 Projected projectAll(const Mesh& mesh, const Camera& camera) {
@@ -164,22 +165,16 @@ int longestEdge(const Mesh& mesh, const Projected& projected, const std::uint32_
 // triangles across those, until none is missing: longest-edge bisection then needs no other
 // pattern, and its triangles neither thin out nor loop.
 void closeOverLongestEdges(const Mesh& mesh, const Projected& projected, EdgeSplits& split) {
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> across;
     const std::size_t triangles = mesh.triangleCount();
-    for (std::size_t t = 0; t < triangles; ++t)
-        for (int e = 0; e < 3; ++e) across[edgeKey(mesh.indices[t * 3 + e], mesh.indices[t * 3 + (e + 1) % 3])].push_back(std::uint32_t(t));
-    std::vector<std::uint32_t> pending;
-    for (const auto& [key, id] : split)
-        if (const auto it = across.find(key); it != across.end()) pending.insert(pending.end(), it->second.begin(), it->second.end());
-    while (!pending.empty()) {
-        const std::size_t t = pending.back();
-        pending.pop_back();
-        const std::uint32_t* v = &mesh.indices[t * 3];
-        const int r = longestEdge(mesh, projected, v);
-        const std::uint64_t key = edgeKey(v[r], v[(r + 1) % 3]);
-        if (!split.emplace(key, 0).second) continue;
-        const auto& others = across.at(key);
-        pending.insert(pending.end(), others.begin(), others.end());
+    for (bool added = true; added;) {  // sweeps until none is added: as many as the longest chain
+        added = false;
+        for (std::size_t t = 0; t < triangles; ++t) {
+            const std::uint32_t* v = &mesh.indices[t * 3];
+            if (!split.count(edgeKey(v[0], v[1])) && !split.count(edgeKey(v[1], v[2])) && !split.count(edgeKey(v[2], v[0])))
+                continue;
+            const int r = longestEdge(mesh, projected, v);
+            added |= split.emplace(edgeKey(v[r], v[(r + 1) % 3]), 0).second;
+        }
     }
 }
 
@@ -228,6 +223,7 @@ void splitEdges(Mesh& mesh, Projected& projected, const Camera& camera, EdgeSpli
 
     std::vector<std::uint32_t> indices;
     indices.reserve(std::size_t(total) * 3);
+    projected.unchanged.assign(std::size_t(total), 0);
     auto emit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) { indices.insert(indices.end(), {a, b, c}); };
     for (std::size_t t = 0; t < triangles; ++t) {
         const std::uint32_t v[3] = {mesh.indices[t * 3], mesh.indices[t * 3 + 1], mesh.indices[t * 3 + 2]};
@@ -253,7 +249,10 @@ void splitEdges(Mesh& mesh, Projected& projected, const Camera& camera, EdgeSpli
             continue;
         }
         switch (mask) {
-            case 0: emit(v[0], v[1], v[2]); break;
+            case 0:
+                projected.unchanged[indices.size() / 3] = 1;
+                emit(v[0], v[1], v[2]);
+                break;
             case 7: {  // all three: four triangles
                 const std::uint32_t m0 = mid(0), m1 = mid(1), m2 = mid(2);
                 emit(v[0], m0, m2);
@@ -304,6 +303,7 @@ Mesh subdivide(const Mesh& input, const Camera& camera, const SubdivideOptions& 
     if (mesh.normals.empty()) computeVertexNormals(mesh);
     Projected projected = projectAll(mesh, camera);
     projected.pixels = pixels;
+    projected.unchanged.assign(mesh.triangleCount(), 0);
     for (;;) {
         EdgeSplits split;
         choose(mesh, projected, split);
@@ -353,10 +353,11 @@ Mesh subdivideForBend(const Mesh& input, const Camera& camera, const SamplingMap
     if (!(maxBend > 0) || !std::isfinite(maxBend))
         throw Error(ErrorCode::InvalidArgument, "subdivideForBend: the largest bend must be > 0 pixels, got " + numberText(maxBend));
     const BendMeter meter(map, width, height);
-    std::unordered_map<std::uint64_t, bool> bent;  // each edge measured once, whichever triangle asks
+    // Each edge measured once, whichever triangle asks in whichever pass; a triangle the last pass
+    // kept is not measured again.
+    std::unordered_map<std::uint64_t, bool> bent;
     return subdivide(input, camera, options, "following the map to " + numberText(maxBend) + " pixels", {width, height}, true,
                      [&](const Mesh& mesh, const Projected& projected, EdgeSplits& split) {
-        bent.clear();
         // An edge shorter than the bound is never split: its image cannot stray much further.
         auto isBent = [&](std::uint32_t a, std::uint32_t b) {
             if (!projected.measurable[a] || !projected.measurable[b]) return false;
@@ -368,6 +369,7 @@ Mesh subdivideForBend(const Mesh& input, const Camera& camera, const SamplingMap
             return it->second;
         };
         for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+            if (projected.unchanged[t / 3]) continue;
             const std::uint32_t v[3] = {mesh.indices[t], mesh.indices[t + 1], mesh.indices[t + 2]};
             bool any = false;
             for (int e = 0; e < 3; ++e)

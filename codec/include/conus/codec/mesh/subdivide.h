@@ -25,7 +25,7 @@
 namespace conus::codec {
 
 inline constexpr std::int64_t kMaxSubdividedTriangles = std::int64_t{1} << 24;
-inline constexpr double kDefaultMaxBend = 0.5;   // CoNUS pixels: `conus mesh render`'s --max-bend
+inline constexpr double kDefaultMaxBend = 0.25;  // CoNUS pixels: `conus mesh render`'s --max-bend
 
 struct SubdivideOptions {
     std::int64_t maxTriangles = kMaxSubdividedTriangles;  // cap on the result
