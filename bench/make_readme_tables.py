@@ -2,7 +2,8 @@
 """Regenerates the tables of bench/README.md from a run of the suites.
 
     bench/make_readme_tables.py [--build DIR] [--repetitions N] [--instructions] [--from-results] SUITE...
-    SUITE: codec, oiio, renderers, reflections, terrain, end-to-end, viewer, quality-defaults, quality, or all
+    SUITE: codec, oiio, renderers, subdivision, reflections, terrain, end-to-end, viewer, quality-defaults, quality,
+           or all
 
 Each suite's table sits between `<!-- table:SUITE -->` and `<!-- /table -->` in bench/README.md;
 this script rewrites that block only, stamped with the date, the commit, the machine and the
@@ -16,8 +17,8 @@ bench/end_to_end.sh and keeps its table; `viewer` times conus-view under Xvfb on
 image of a photograph, both decode paths; `quality` runs bench/quality.py, keeps the headline of
 its report and copies the report and its plots to bench/quality-plots/.
 
-`reflections`, `terrain` and `quality-defaults` write a result file first
-(build/bench-results/reflections.json: renderers_bench's JSON with the run's stamp;
+`subdivision`, `reflections`, `terrain` and `quality-defaults` write a result file first
+(build/bench-results/subdivision.json and reflections.json: renderers_bench's JSON with the run's stamp;
 build/bench-results/terrain.json from bench/terrain_gain.py; build/quality/targets.json from
 `bench/quality.py --defaults-only`) and make the table from it; `--from-results` makes their tables
 from the files of an earlier run without running anything.
@@ -267,6 +268,49 @@ def reflections_table(result):
     return "\n".join(lines)
 
 
+# The city's CoNUS render (renderers_bench, two tracked foci) as built, subdivided where the map
+# bends (the default) and everywhere (--max-edge 0.5): (label, timed benchmark, counter suffix of
+# BM_SubdivisionQuality).
+SUBDIVISIONS = [("as built (`--max-bend 0`)", "BM_GpuConus/real_time", "none"),
+                ("where the map bends (`--max-bend 0.25`, the default)", "BM_GpuConusBend/real_time", "bend"),
+                ("everywhere (`--max-edge 0.5`)", "BM_GpuConusSubdivided/real_time", "edge")]
+
+
+def run_subdivision(build, repetitions):
+    """Times the three renders and scores them; writes build/bench-results/subdivision.json."""
+    binary = str(Path(build) / "bin" / "renderers_bench")
+    stamp = run_stamp()
+    quality = json.loads(run([binary, "--benchmark_filter=^BM_SubdivisionQuality", "--benchmark_format=json"]))
+    times = wall_medians(binary, [name for _, name, _ in SUBDIVISIONS], repetitions)
+    result = {"stamp": stamp, "repetitions": repetitions, "quality": quality["benchmarks"][0], "times": times}
+    path = Path(build) / RESULTS / "subdivision.json"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(result, indent=1))
+    return result
+
+
+def subdivision_table(result):
+    q, times = result["quality"], result["times"]
+    base = {"triangles": q["triangles_none"], "time": times["BM_GpuConus/real_time"]}
+    old = {"triangles": q["triangles_edge"], "time": times["BM_GpuConusSubdivided/real_time"]}
+    lines = [stamp_line(result["stamp"], "triangles and PSNR (RGB) against the Embree reference (deterministic); frame "
+                        f"time: wall clock, medians of {result['repetitions']} interleaved repetitions"), "",
+             "| the city's CoNUS render, split | triangles (/ as built, / everywhere) | frame time "
+             "(/ as built, / everywhere) | PSNR against Embree | targets |", "|---|---|---|---|---|"]
+    for label, name, key in SUBDIVISIONS:
+        triangles, ms, psnr = q[f"triangles_{key}"], times[name], q[f"psnr_{key}"]
+        cells = [f"{triangles:,.0f} ({triangles / base['triangles']:.3g}x, {triangles / old['triangles']:.3g}x)",
+                 f"`{name.split('/')[0]}` {fmt_value(ms, False)} ({ms / base['time']:.3g}x, {ms / old['time']:.3g}x)",
+                 f"**{psnr:.2f} dB**"]
+        met = ""
+        if key == "bend":
+            checks = [("triangles <= 1.5x", triangles / base["triangles"] <= 1.5), ("time <= 1.5x", ms / base["time"] <= 1.5),
+                      (">= 40 dB", psnr >= 40)]
+            met = ", ".join(f"{what} ({'met' if ok else '**not met**'})" for what, ok in checks)
+        lines.append(f"| {label} | " + " | ".join(cells) + f" | {met} |")
+    return "\n".join(lines)
+
+
 def run_quality_defaults(build):
     """Runs `bench/quality.py --defaults-only` (it writes build/quality/targets.json and the contact
     sheets); copies the 600 px wide sheet to bench/quality-plots/."""
@@ -332,23 +376,29 @@ def replace_block(text, suite, body):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    names = [*SUITES, "reflections", "terrain", "end-to-end", "viewer", "quality-defaults", "quality"]
+    names = [*SUITES, "subdivision", "reflections", "terrain", "end-to-end", "viewer", "quality-defaults", "quality"]
     parser.add_argument("suites", nargs="+", choices=[*names, "all"])
     parser.add_argument("--build", default=str(ROOT / "build"))
     parser.add_argument("--repetitions", type=int, default=7)
     parser.add_argument("--instructions", action="store_true", help="callgrind instruction counts (codec only)")
     parser.add_argument("--from-results", action="store_true",
-                        help="reflections, terrain, quality-defaults: the tables from the result files of an earlier run")
+                        help="subdivision, reflections, terrain, quality-defaults: the tables from the result files of an "
+                        "earlier run")
     args = parser.parse_args()
     suites = names if "all" in args.suites else args.suites
     if args.instructions and set(suites) - {"codec"}:
         sys.exit("make_readme_tables.py: --instructions counts codec_bench only (valgrind stops at llvmpipe and libhwy)")
-    if args.from_results and set(suites) - {"reflections", "terrain", "quality-defaults"}:
-        sys.exit("make_readme_tables.py: --from-results remakes the reflections, terrain and quality-defaults tables only")
+    if args.from_results and set(suites) - {"subdivision", "reflections", "terrain", "quality-defaults"}:
+        sys.exit("make_readme_tables.py: --from-results remakes the subdivision, reflections, terrain and quality-defaults "
+                 "tables only")
     text = README.read_text()
     for suite in suites:
         if suite in SUITES:
             body = benchmark_table(args.build, suite, args.repetitions, args.instructions)
+        elif suite == "subdivision":
+            saved = Path(args.build) / RESULTS / "subdivision.json"
+            body = subdivision_table(json.loads(saved.read_text()) if args.from_results
+                                     else run_subdivision(args.build, min(args.repetitions, 5)))
         elif suite == "reflections":
             saved = Path(args.build) / RESULTS / "reflections.json"
             body = reflections_table(json.loads(saved.read_text()) if args.from_results

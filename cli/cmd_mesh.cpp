@@ -47,7 +47,7 @@ constexpr const char* kCity = "city";
 // What render and animate share.
 struct MeshOptions {
     std::string model, sizeText = "512x512", cameraText, upText = "0,1,0", backend = enumName(renderers::Backend::Auto), units = "m";
-    double time = 0, maxEdge = 0.5;
+    double time = 0, maxEdge = 0, maxBend = codec::kDefaultMaxBend;
     int samples = 4, grid = map_rules::kDefaultSide;
     std::vector<int> track;
     std::vector<std::string> allowDirs;
@@ -112,7 +112,8 @@ std::vector<glm::dvec3> carCentres(const codec::CityScene& city, const std::vect
     return centres;
 }
 
-// Renders one frame on `device`: on a GPU the mesh is first subdivided for the map (--max-edge).
+// Renders one frame on `device`: on a GPU the mesh is first subdivided for the map, where it bends
+// (--max-bend) or everywhere (--max-edge).
 Image renderFrame(const renderers::Device& device, const Mesh& mesh, const Camera& camera, const codec::SamplingMap& map,
                   Size size, const MeshOptions& o, bool report) {
     renderers::MeshRenderOptions options;
@@ -124,6 +125,15 @@ Image renderFrame(const renderers::Device& device, const Mesh& mesh, const Camer
             std::printf("subdivided %zu -> %zu triangles: longest projected edge %.3g -> %.3g map cells (--max-edge %g)\n",
                         mesh.triangleCount(), fine.triangleCount(), before,
                         codec::longestProjectedEdge(fine, camera, map), o.maxEdge);
+        return renderers::renderMesh(device, fine, camera, map, size.width, size.height, options);
+    }
+    if (device.onGpu() && o.maxBend > 0) {
+        Mesh fine = codec::subdivideForBend(mesh, camera, map, size.width, size.height, o.maxBend);
+        if (report)
+            std::printf("subdivided %zu -> %zu triangles where the map bends: largest bend %.3g -> %.3g pixels (--max-bend %g)\n",
+                        mesh.triangleCount(), fine.triangleCount(),
+                        codec::measureBend(mesh, camera, map, size.width, size.height).largest(),
+                        codec::measureBend(fine, camera, map, size.width, size.height).largest(), o.maxBend);
         return renderers::renderMesh(device, fine, camera, map, size.width, size.height, options);
     }
     return renderers::renderMesh(device, mesh, camera, map, size.width, size.height, options);
@@ -153,9 +163,14 @@ void addSharedOptions(CLI::App& command, MeshOptions& o, bool withCamera) {
     command.add_option("--grid", o.grid, "sampling-map nodes per side for --focus and --track")
         ->capture_default_str()
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
+    command.add_option("--max-bend", o.maxBend,
+                       "GPU: split triangles where Equation 1 bends an edge or a triangle's inside more than this many "
+                       "CoNUS pixels away from the straight lines the rasterizer draws (0: no subdivision)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e6, true));
     command.add_option("--max-edge", o.maxEdge,
-                       "GPU: split triangles until no projected edge spans more than this many map cells, so the "
-                       "straight edges follow Equation 1's curves (0: no subdivision)")
+                       "GPU: instead of --max-bend, split every triangle until no projected edge spans more than this "
+                       "many map cells (0: off)")
         ->capture_default_str()
         ->check(finiteRange(0, 1e6, true));
     command.add_option("--samples", o.samples, "samples a pixel (multisampling; the reference takes round(sqrt)^2 rays)")
@@ -370,7 +385,7 @@ CLI::App* addRender(CLI::App& command, RenderOptions& r) {
     CLI::App* render = addSubcommand(
         command, "render", "Render a mesh (OBJ, PLY, STL, glTF, ... or `city`) as a CoNUS colour + depth image",
         {"conus mesh render bunny.ply -o bunny.exr --focus 0.45,0.4,0.1,4",
-         "conus mesh render model.obj -o model.exr --size 1024x1024 --camera 0,1,3,0,0,0,40 --max-edge 0.25",
+         "conus mesh render model.obj -o model.exr --size 1024x1024 --camera 0,1,3,0,0,0,40 --max-bend 0.1",
          "conus mesh render city -o city.exr --track 0,2 --time 3.5 --reference"});
     render->add_option("model", r.mesh.model, "mesh file (anything Assimp reads) or `city` (the procedural city)")->required();
     render->add_option("-o,--output", r.output, "CoNUS file (.exr): R, G, B, A (coverage), Z (camera depth)")->required();

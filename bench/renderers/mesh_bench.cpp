@@ -1,7 +1,8 @@
 // The GPU mesh encoder on the procedural city (paper section 6) at 1024 x 576, on the GL backend of
 // CONUS_BACKEND (default auto): the CoNUS render (two tracked foci) next to the conventional render
 // of the same mesh at the same size (the identity map: the paper measured no cost for the vertex
-// distortion), the cost of subdividing for --max-edge, the Embree reference at the same size (rays
+// distortion), the mesh subdivided where the map bends (--max-bend, the default) and everywhere
+// (--max-edge 0.5), their cost and PSNR against the Embree reference, that reference (rays
 // a second), and per-frame map construction from 1..8 foci on a 65 x 65 grid, both compositions
 // (the animation builds one every frame). GPU and Embree times are wall-clock (the work runs on
 // other threads). Read ratios within one run (bench/README.md).
@@ -10,9 +11,11 @@
 #include <chrono>
 #include <cstdlib>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "bench_context.h"
+#include "conus/codec/image/metrics.h"
 #include "conus/codec/mesh/city.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/codec/mesh/subdivide.h"
@@ -29,11 +32,11 @@ constexpr double kAspect = double(kWidth) / kHeight;
 
 struct Data {
     codec::CityScene city;
-    Mesh mesh, fine;
+    Mesh mesh, fine, bend;  // as built; --max-edge 0.5; --max-bend's default
     Camera camera = Camera::perspective({30, 110, 160}, {0, 0, -10}, {0, 1, 0}, 50.0, kAspect, 1.0, 600.0);
     std::unique_ptr<codec::SamplingMap> map, identity;
     std::unique_ptr<renderers::Context> context;
-    std::unique_ptr<renderers::MeshRenderer> renderer, fineRenderer;
+    std::unique_ptr<renderers::MeshRenderer> renderer, fineRenderer, bendRenderer;
 };
 
 Data& data() {
@@ -46,9 +49,11 @@ Data& data() {
         d->map = std::make_unique<codec::SamplingMap>(renderers::frameMap(renderers::trackedFoci(d->camera, cars, kAspect), fo));
         d->identity = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
         d->fine = codec::subdivideForMap(d->mesh, d->camera, *d->map, 0.5);
+        d->bend = codec::subdivideForBend(d->mesh, d->camera, *d->map, kWidth, kHeight, codec::kDefaultMaxBend);
         d->context = bench::createBenchContext();
         d->renderer = std::make_unique<renderers::MeshRenderer>(*d->context, d->mesh);
         d->fineRenderer = std::make_unique<renderers::MeshRenderer>(*d->context, d->fine);
+        d->bendRenderer = std::make_unique<renderers::MeshRenderer>(*d->context, d->bend);
         // Warm up: shader compilation and the framebuffers belong to no frame.
         d->renderer->render(d->camera, *d->map, kWidth, kHeight);
         return d;
@@ -73,6 +78,7 @@ void BM_GpuConus(benchmark::State& state) { renderFrames(state, *data().renderer
 void BM_GpuConusSubdivided(benchmark::State& state) {
     renderFrames(state, *data().fineRenderer, data().fine, *data().map);
 }
+void BM_GpuConusBend(benchmark::State& state) { renderFrames(state, *data().bendRenderer, data().bend, *data().map); }
 // Only the draw (no readback): where the vertex distortion's cost would show.
 void BM_GpuDrawOnly(benchmark::State& state) {
     Data& d = data();
@@ -106,6 +112,32 @@ void BM_Subdivide(benchmark::State& state) {
     for (auto _ : state) benchmark::DoNotOptimize(codec::subdivideForMap(d.mesh, d.camera, *d.map, 0.5));
     state.counters["triangles out"] = static_cast<double>(d.fine.triangleCount());
 }
+void BM_SubdivideBend(benchmark::State& state) {
+    Data& d = data();
+    for (auto _ : state)
+        benchmark::DoNotOptimize(codec::subdivideForBend(d.mesh, d.camera, *d.map, kWidth, kHeight, codec::kDefaultMaxBend));
+    state.counters["triangles out"] = static_cast<double>(d.bend.triangleCount());
+}
+// Deterministic, run once: each CoNUS render's triangles and PSNR (RGB) against the Embree
+// reference (4 rays a pixel against 4x MSAA): as built, where the map bends, everywhere.
+void BM_SubdivisionQuality(benchmark::State& state) {
+    Data& d = data();
+    const codec::MeshScene scene(d.mesh);
+    codec::ReferenceOptions options;
+    options.samplesPerPixel = 4;
+    const Image reference =
+        codec::renderMeshReference(scene, Fpc(d.camera, std::make_shared<codec::SamplingMap>(*d.map)), kWidth, kHeight, options);
+    const struct {
+        const char* name;
+        renderers::MeshRenderer& renderer;
+        const Mesh& mesh;
+    } renders[] = {{"none", *d.renderer, d.mesh}, {"bend", *d.bendRenderer, d.bend}, {"edge", *d.fineRenderer, d.fine}};
+    for (auto _ : state)
+        for (const auto& r : renders) {
+            state.counters[std::string("psnr_") + r.name] = codec::psnr(r.renderer.render(d.camera, *d.map, kWidth, kHeight), reference);
+            state.counters[std::string("triangles_") + r.name] = static_cast<double>(r.mesh.triangleCount());
+        }
+}
 void BM_EmbreeReference(benchmark::State& state) {
     Data& d = data();
     static const codec::MeshScene scene(d.mesh);
@@ -133,9 +165,12 @@ void BM_FociFrameAdd(benchmark::State& state) { fociFrame(state, codec::FociComp
 BENCHMARK(BM_GpuConventional)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuConus)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuConusSubdivided)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GpuConusBend)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuDrawOnly)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuConusOverConventionalPaired)->Arg(0)->Arg(1)->Iterations(41)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Subdivide)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SubdivideBend)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SubdivisionQuality)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EmbreeReference)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FociFrameDensity)->Arg(1)->Arg(2)->Arg(8)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FociFrameAdd)->Arg(1)->Arg(2)->Arg(8)->Unit(benchmark::kMillisecond);

@@ -1,6 +1,7 @@
 // `conus mesh render|animate` through the real binary; outputs read back with OpenImageIO.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -42,7 +43,7 @@ TEST_F(Mesh, RenderWritesACameraDepthImageThatOpenImageIoReads) {
                          " --size 96x64 --focus 0.35,0.4,0.12,3 --backend egl --camera 0.4,0.6,3,0.1,0,0,40");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("wrote"), std::string::npos);
-    EXPECT_NE(r.out.find("subdivided"), std::string::npos);  // the GPU path splits long edges by default
+    EXPECT_NE(r.out.find("subdivided"), std::string::npos);  // the GPU path splits where the map bends by default
     const ExrRead exr = readExr(path("cube.exr"));
     ASSERT_NO_FATAL_FAILURE(expectCameraDepthImage(exr, 96, 64));
     EXPECT_EQ(exr.spec.get_string_attribute("conus:projection"), "perspective");
@@ -157,6 +158,42 @@ TEST_F(Mesh, CityWithTrackedCars) {
     const ExrRead exr = readExr(path("c.exr"));
     EXPECT_EQ(exr.width, 128);
     EXPECT_EQ(exr.spec.get_string_attribute("conus:mapKind"), "foci");
+}
+
+// The triangles before and after of the line "subdivided A -> B triangles ..." (0, 0 when absent).
+std::pair<long, long> subdivided(const std::string& out) {
+    long before = 0, after = 0;
+    const std::size_t at = out.find("subdivided ");
+    if (at != std::string::npos) std::sscanf(out.c_str() + at, "subdivided %ld -> %ld", &before, &after);
+    return {before, after};
+}
+
+// The city through two tracked cars at the default size, as `conus mesh render` draws it by default
+// (split where the map bends), against the Embree reference, beside no subdivision and the uniform
+// split to half a map cell (--max-edge 0.5).
+TEST_F(Mesh, TheCityFollowsTheMapWhereItBends) {
+    const std::string city = "mesh render city --track 0,2 --time 1 -o ";
+    const Result bend = run(city + path("bend.exr") + " --backend egl");
+    ASSERT_EQ(bend.exitCode, 0) << bend.err;
+    EXPECT_NE(bend.out.find("where the map bends"), std::string::npos) << bend.out;
+    const Result none = run(city + path("none.exr") + " --backend egl --max-bend 0");
+    ASSERT_EQ(none.exitCode, 0) << none.err;
+    EXPECT_EQ(none.out.find("subdivided"), std::string::npos);
+    const Result edge = run(city + path("edge.exr") + " --backend egl --max-edge 0.5");
+    ASSERT_EQ(edge.exitCode, 0) << edge.err;
+    ASSERT_EQ(run(city + path("ref.exr") + " --reference").exitCode, 0);
+    const ExrRead ref = readExr(path("ref.exr"));
+    const double psnrBend = psnrRgb(readExr(path("bend.exr")), ref), psnrNone = psnrRgb(readExr(path("none.exr")), ref),
+                 psnrEdge = psnrRgb(readExr(path("edge.exr")), ref);
+    const auto [before, afterBend] = subdivided(bend.out);
+    const long afterEdge = subdivided(edge.out).second;
+    std::printf("city: none %ld triangles %.2f dB; bend %ld %.2f dB; --max-edge 0.5 %ld %.2f dB\n", before, psnrNone,
+                afterBend, psnrBend, afterEdge, psnrEdge);
+    EXPECT_EQ(before, 878);
+    EXPECT_GE(psnrBend, 40.0);
+    EXPECT_LT(psnrNone, 25.0);  // the ground's straight inside covers the buildings
+    EXPECT_GT(psnrEdge, psnrBend - 1.0);
+    EXPECT_LT(afterBend, afterEdge / 2);  // the same picture from under half the triangles
 }
 
 TEST_F(Mesh, BadInputIsOneLineAndNonZero) {

@@ -110,6 +110,7 @@ TEST_F(SceneHostile, NotANumberIsAUsageErrorInEveryNumberOption) {
         {"encode", path("a.pgm"), "-o", path("a.exr"), "--frame-loss", "nan"},
         {"encode", path("a.pgm"), "-o", path("a.exr"), "--focus", "0.5,0.5,0.1,4", "--max-anisotropy", "nan"},
         {"encode", path("a.pgm"), "-o", path("a.exr"), "--fit-hold", "inf"},
+        {"mesh", "render", "city", "-o", path("c.exr"), "--max-bend", "nan"},
         {"demo", "--out", path("demo"), "--k", "nan"}};
     for (const auto& args : conusRuns) {
         SCOPED_TRACE(args[0] + " " + args[args.size() - 2]);
