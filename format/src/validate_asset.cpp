@@ -2,6 +2,7 @@
 // each face first checked as a file of its own; and the in-memory asset's headers and validator.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -19,7 +20,10 @@ constexpr double kTolerance = 1e-4;
 
 std::string faceName(int f) { return kCubeFaceNames[f]; }
 
-std::string vectorText(glm::dvec3 v) { return "(" + numberText(v.x, 6) + ", " + numberText(v.y, 6) + ", " + numberText(v.z, 6) + ")"; }
+std::string vectorText(glm::dvec3 v) {
+    v += 0.0;  // -0 reads as 0
+    return "(" + numberText(v.x, 6) + ", " + numberText(v.y, 6) + ", " + numberText(v.z, 6) + ")";
+}
 
 // V18: what each face holds; the faces square and of one size.
 void checkFaces(const AssetModel& faces, ValidationReport& r) {
@@ -141,6 +145,20 @@ HeaderCheck checkAssetRules(const AssetModel& faces, const Limits& limits, Valid
     glm::dvec3 centre(0.0);
     glm::dmat3 axes(1.0);
     if (!checkFrame(faces[0], centre, axes, r)) return hc;
+    // Faces that share an eye elsewhere than the centre: the frame's centre is what is wrong, said once.
+    std::optional<glm::dvec3> eye;
+    for (const HeaderModel& m : faces) {
+        const CameraCheck check = describeCamera(CameraAttributes{m.projection.value, m.worldToCamera.value, m.worldToNDC.value});
+        if (!check.camera || (eye && glm::distance(*eye, check.camera->eye()) > kTolerance * (1.0 + glm::length(*eye)))) {
+            eye.reset();
+            break;
+        }
+        eye = check.camera->eye();
+    }
+    if (eye && glm::distance(*eye, centre) > kTolerance * (1.0 + glm::length(centre))) {
+        r.add(Rule::V19, std::string(kAttrCubeCentre) + " " + vectorText(centre) + " is not the faces' eye " + vectorText(*eye));
+        return hc;
+    }
     for (int f = 0; f < kCubeFaceCount; ++f) checkFaceCamera(f, faces[static_cast<std::size_t>(f)], centre, axes, r);
     return hc;
 }

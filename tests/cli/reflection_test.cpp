@@ -168,6 +168,26 @@ TEST_F(ReflectionCli, AFolderOfFacesIsRefusedSayingWhatToDo) {
     EXPECT_NE(r.err.find("a reflection asset is one OpenEXR file; give a name ending in .exr"), std::string::npos) << r.err;
 }
 
+// A bake whose write fails midway (a file-size limit) leaves the earlier asset as it was and no
+// temporary file.
+TEST_F(ReflectionCli, AWriteCutShortLeavesTheEarlierAssetWhole) {
+    const std::string scene = path("scene.obj"), asset = path("asset.exr");
+    writeScene(scene);
+    ASSERT_EQ(run("bake reflection " + scene + " --size 16 -q -o " + asset).exitCode, 0);
+    const auto before = fs::file_size(asset);
+    const std::string command = "bash -c 'ulimit -f 100; " + std::string(CONUS_BIN_DIR) + "/conus bake reflection " + scene +
+                                " --size 256 -q -o " + asset + "' >/dev/null 2>" + path("err.txt");
+    const int status = std::system(command.c_str());
+    std::ifstream in(path("err.txt"));
+    const std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(WEXITSTATUS(status), 1) << err;
+    EXPECT_NE(err.find("cannot write " + asset), std::string::npos) << err;
+    EXPECT_EQ(fs::file_size(asset), before);
+    EXPECT_EQ(run("validate -q " + asset).exitCode, 0);
+    for (const auto& e : fs::directory_iterator(fs::path(asset).parent_path()))
+        EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+}
+
 TEST_F(ReflectionCli, BadInputIsOneLineAndNonZero) {
     const std::string scene = path("scene.obj");
     writeScene(scene);

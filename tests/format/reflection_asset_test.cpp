@@ -125,7 +125,15 @@ TEST_F(ReflectionAsset, ABadFrameOrFaceIsRefusedInMemoryAndNothingIsWritten) {
     a.frame.centre[0] += 0.5f;  // the faces' eyes are elsewhere
     const ValidationReport moved = validateReflectionAsset(a);
     EXPECT_TRUE(only(moved, {Rule::V19}));
-    EXPECT_NE(moved.str().find("not at the cube's centre"), std::string::npos) << moved.str();
+    EXPECT_EQ(moved.issues.size(), 1u) << moved.str();
+    EXPECT_NE(moved.str().find("conus:cubeCentre (1, -0.25, 2) is not the faces' eye (0.5, -0.25, 2)"), std::string::npos) << moved.str();
+    a = validAsset();
+    a.faces[3].camera = toAttributes(Camera::perspective(kCentre + glm::dvec3(0, 0.5, 0), kCentre + glm::dvec3(0, -0.5, 0),
+                                                         {0, 0, 1}, 90.0, 1.0, 0.01, 10.0));  // one face's eye moved
+    const ValidationReport oneMoved = validateReflectionAsset(a);
+    EXPECT_TRUE(only(oneMoved, {Rule::V19}));
+    EXPECT_NE(oneMoved.str().find("face ny's camera has its eye at (0.5, 0.25, 2), not at the cube's centre"), std::string::npos)
+        << oneMoved.str();
     a = validAsset();
     a.frame.axes = {1, 0, 0, 0, 1, 0, 0, 0.5f, 1};
     EXPECT_TRUE(only(validateReflectionAsset(a), {Rule::V19}));
