@@ -92,8 +92,7 @@ TEST_F(ReflectionCli, OneFileBakesValidatesDescribesAndRenders) {
     ASSERT_EQ(run("render reflection " + conus + common + " --backend cpu -o " + path("conus.png")).exitCode, 0);
     ASSERT_EQ(run("render reflection " + uniform + common + " --backend cpu -o " + path("uniform.png")).exitCode, 0);
     ASSERT_EQ(run("render reflection " + conus + common + " --reference -o " + path("truth.png")).exitCode, 0);
-    // The faces approximate the traced reflection: the six files of the folder form gave 38.4 dB
-    // here (the same faces, so the same picture).
+    // The faces approximate the traced reflection: 38.4 dB on this scene at these sizes.
     const double conusPsnr = psnr(path("conus.png"), path("truth.png"));
     EXPECT_GT(conusPsnr, 38.0);
     EXPECT_LT(conusPsnr, 60.0);
