@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,8 +20,8 @@
 #include "conus/codec/depth/reflection.h"
 #include "conus/codec/depth/relief.h"
 #include "conus/codec/image/encode.h"
-#include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
+#include "conus/format/reflection_asset.h"
 #include "conus/imageio/image_file.h"
 #include "conus/imageio/text.h"
 #include "conus/sceneio/mesh_file.h"
@@ -149,23 +148,21 @@ int runBakeRelief(const BakeOptions& o) {
 // --- reflection -------------------------------------------------------------------------------
 
 struct ReflectionBakeText {
-    std::string scene, outDir, centre = "0,0,0", roiMin, roiMax;
+    std::string scene, output, centre = "0,0,0", roiMin, roiMax;
     std::vector<std::string> allowDirs;
     int size = 128;
     double magnification = codec::ReflectionBakeOptions{}.magnification;
     bool uniform = false;
 };
 
-// The six faces' file names: the asset's folder holds these and nothing else.
-std::vector<std::string> faceFileNames() {
-    std::vector<std::string> names;
-    for (const char* face : codec::kCubeFaceNames) names.push_back(face + std::string(".exr"));
-    return names;
-}
-
 int runBakeReflection(const ReflectionBakeText& o) {
-    const std::vector<std::string> names = faceFileNames();
-    checkFolderOutput(o.outDir, names);
+    try {
+        format::checkConusFileName(o.output);
+    } catch (const Error&) {
+        throw Error(ErrorCode::InvalidArgument,
+                    "-o " + o.output + ": a reflection asset is one OpenEXR file; give a name ending in .exr (-o asset.exr)");
+    }
+    checkConusOutput(o.output, o.scene);
     codec::ReflectionBakeOptions options;
     options.centre = parseVector3(o.centre, "--center");
     options.size = o.size;
@@ -188,14 +185,12 @@ int runBakeReflection(const ReflectionBakeText& o) {
     Progress baking("bake six " + std::to_string(o.size) + "x" + std::to_string(o.size) + " faces (Embree)");
     const auto faces = codec::bakeReflection(scene, options);
     baking.done();
-    // The six faces appear together or not at all (a full disk leaves the earlier asset whole).
-    writeFolderAtomically(o.outDir, names, [&](const std::string& folder) {
-        for (int f = 0; f < codec::kCubeFaces; ++f)
-            format::writeConusFile((std::filesystem::path(folder) / names[static_cast<std::size_t>(f)]).string(),
-                                   codec::reflectionFaceFile(faces[static_cast<std::size_t>(f)]));
-    });
-    std::printf("wrote %s: six %dx%d CoNUS colour + depth faces from %g,%g,%g (%s)\n", o.outDir.c_str(), o.size, o.size,
-                options.centre.x, options.centre.y, options.centre.z,
+    // One file, written through a temporary and renamed: a failed bake leaves the earlier asset whole.
+    Progress writing("write " + o.output);
+    format::writeReflectionAsset(o.output, codec::reflectionAssetFile(faces));
+    writing.done();
+    std::printf("wrote %s: reflection asset of six %dx%d CoNUS colour + depth faces from %g,%g,%g (%s)\n", o.output.c_str(),
+                o.size, o.size, options.centre.x, options.centre.y, options.centre.z,
                 o.uniform ? "uniform, the baseline" : "foci on the region of interest");
     return 0;
 }
@@ -203,10 +198,11 @@ int runBakeReflection(const ReflectionBakeText& o) {
 CLI::App* addBakeReflection(CLI::App& command, ReflectionBakeText& o) {
     CLI::App* reflection = addSubcommand(
         command, "reflection",
-        "A mesh seen from a reflector's centre -> six CoNUS colour + depth faces (a reflection asset)",
-        {"conus bake reflection scene.obj --center 0,0.5,0 -o asset", "conus bake reflection scene.obj --uniform -o asset-uniform"});
+        "A mesh seen from a reflector's centre -> a reflection asset: one .exr of six CoNUS colour + depth faces",
+        {"conus bake reflection scene.obj --center 0,0.5,0 -o asset.exr",
+         "conus bake reflection scene.obj --uniform -o asset-uniform.exr"});
     reflection->add_option("scene", o.scene, "mesh file (.obj, .ply, .gltf, ...)")->required();
-    reflection->add_option("-o,--output", o.outDir, "folder for the six faces (px nx py ny pz nz .exr)")->required();
+    reflection->add_option("-o,--output", o.output, "reflection asset (.exr: the six faces and the cube's frame)")->required();
     reflection->add_option("--center,--centre", o.centre, "the reflector's centre x,y,z")->capture_default_str();
     reflection->add_option("--size", o.size, "texels a face side")->capture_default_str()->check(CLI::Range(8, 4096));
     reflection->add_option("--magnification", o.magnification, "linear magnification of the region of interest")

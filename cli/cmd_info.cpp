@@ -10,6 +10,7 @@
 #include "conus/codec/build/map_measures.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
+#include "conus/format/reflection_asset.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
 #include "conus/renderers/context.h"
@@ -81,8 +82,7 @@ struct FileFacts {
     double pixelRatio = 0;  // CoNUS pixels over source pixels
 };
 
-FileFacts readFacts(const std::string& input) {
-    format::ConusFile file = format::readConusHeader(input);
+FileFacts factsOf(format::ConusFile file) {
     codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
     const DensityStats stats = densityStats(map);
     const codec::MapMeasures measures = codec::measureMap(map, double(file.sourceWidth) / file.sourceHeight);
@@ -92,11 +92,16 @@ FileFacts readFacts(const std::string& input) {
     return {std::move(file), std::move(channels), std::move(map), stats, measures, camera, ratio};
 }
 
+FileFacts readFacts(const std::string& input) { return factsOf(format::readConusHeader(input)); }
+
+// A file's facts (an asset's face has no "file" or "formatVersion" of its own: `input` empty).
 nlohmann::ordered_json toJson(const std::string& input, const FileFacts& f) {
     const format::ConusFile& file = f.file;
     nlohmann::ordered_json j;
-    j["file"] = input;
-    j["formatVersion"] = format::kFormatVersion;
+    if (!input.empty()) {
+        j["file"] = input;
+        j["formatVersion"] = format::kFormatVersion;
+    }
     j["dataKind"] = enumName(file.dataKind);
     j["image"] = {{"width", file.image.width},
                   {"height", file.image.height},
@@ -215,11 +220,56 @@ void writeDensityPicture(const std::string& path, const FileFacts& f) {
                                       double(file.sourceWidth) / file.sourceHeight));
 }
 
+// A reflection asset: its frame, then each face in a line (JSON: each face as a file's facts).
+int printReflectionAsset(const InfoOptions& o) {
+    if (!o.densityPng.empty())
+        throw Error(ErrorCode::InvalidArgument, "--density draws one image's map; " + o.input + " is a reflection asset of six faces");
+    const format::ReflectionAssetFile asset = format::readReflectionAssetHeader(o.input);
+    const auto& c = asset.frame.centre;
+    const auto& a = asset.frame.axes;
+    std::vector<FileFacts> faces;
+    for (const format::ConusFile& face : asset.faces) faces.push_back(factsOf(face));
+    if (o.json) {
+        nlohmann::ordered_json j;
+        j["file"] = o.input;
+        j["formatVersion"] = format::kFormatVersion;
+        j["kind"] = "reflectionAsset";
+        j["cubeFrame"] = {{"centre", c}, {"axes", {{a[0], a[1], a[2]}, {a[3], a[4], a[5]}, {a[6], a[7], a[8]}}}};
+        for (std::size_t f = 0; f < faces.size(); ++f) {
+            nlohmann::ordered_json face{{"name", format::kCubeFaceNames[f]}};
+            face.update(toJson("", faces[f]));
+            j["faces"].push_back(face);
+        }
+        std::printf("%s\n", j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
+        return 0;
+    }
+    const format::ConusFile& first = faces.front().file;
+    std::string channelList;
+    for (const auto& name : faces.front().channels) channelList += (channelList.empty() ? "" : ",") + name;
+    std::printf("%s: CoNUS reflection asset, format version %d: six %d x %d faces, channels %s, %s, %s compression\n",
+                o.input.c_str(), format::kFormatVersion, first.image.width, first.image.height, channelList.c_str(),
+                enumName(first.pixelType), enumName(first.compression));
+    std::printf("  cube frame    centre (%g, %g, %g); axes +x (%g, %g, %g), +y (%g, %g, %g), +z (%g, %g, %g)\n", c[0], c[1], c[2],
+                a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], a[8]);
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+        const FileFacts& face = faces[f];
+        const glm::dvec3 forward = (face.camera ? face.camera->forward() : glm::dvec3(0.0)) + 0.0;  // no -0
+        std::printf("  face %s       looking along (%.4g, %.4g, %.4g); map %d x %d nodes, density %.3f..%.3f", format::kCubeFaceNames[f],
+                    forward.x, forward.y, forward.z, face.map.columns(), face.map.rows(), face.stats.min, face.stats.max);
+        if (face.file.analytic && face.file.analytic->is(format::MapKind::Foci))
+            for (const auto& focus : face.file.analytic->foci)
+                std::printf("; focus u=%.3g v=%.3g r=%.3g k=%.3g", focus.u, focus.v, focus.r, focus.k);
+        std::printf("; depth [%g, %g] %s\n", face.file.depth.near, face.file.depth.far, face.file.depth.units.c_str());
+    }
+    return 0;
+}
+
 int runInfo(const InfoOptions& o) {
     if (o.backends) return printBackends(o.json);
     if (o.limits) return printLimits(o.json);
     if (o.input.empty()) throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends, --limits)");
     if (o.verbose) explainIfInvalid(o.input);
+    if (format::isReflectionAsset(o.input)) return printReflectionAsset(o);
     const FileFacts facts = readFacts(o.input);
     nlohmann::ordered_json j = toJson(o.input, facts);
     if (!o.densityPng.empty()) {
@@ -240,8 +290,8 @@ int runInfo(const InfoOptions& o) {
 
 Command addInfoCommand(CLI::App& root) {
     auto options = std::make_shared<InfoOptions>();
-    CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth");
-    command->add_option("input", options->input, "CoNUS file (.exr)");
+    CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth (a reflection asset: its frame and six faces)");
+    command->add_option("input", options->input, "CoNUS file or reflection asset (.exr)");
     command->add_flag("--backends", options->backends,
                       "list the rendering backends (EGL, OSMesa, CPU): whether each works, its GL_RENDERER, why not");
     command->add_flag("--limits", options->limits,
@@ -252,6 +302,7 @@ Command addInfoCommand(CLI::App& root) {
                       "also list the source's metadata; for an invalid file, every broken rule (as `conus validate`)");
     setExamples(*command, {"conus info photo.exr",
                        "conus info photo.exr --json --density density.png",
+                       "conus info asset.exr                # a reflection asset: the cube's frame and its six faces",
                        "conus info --backends"});
     command->add_option("--density", options->densityPng,
                         "write the sampling density as a heat map with the sampling pattern over it (.png)");

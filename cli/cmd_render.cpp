@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -85,7 +84,7 @@ struct ReflectionRenderText {
 int runRenderReflection(const ReflectionRenderText& o) {
     const Size size = parseSize(o.sizeText);
     const imageio::WriteOptions write = writeOptionsOf({}, nullptr);
-    checkPictureOutput(o.output, write, {o.scene});
+    checkPictureOutput(o.output, write, {o.scene, o.asset});
     if (o.cameraText.empty()) throw Error(ErrorCode::InvalidArgument, "--camera is required (x,y,z,lx,ly,lz,fovDeg)");
     const CameraText given = parseCamera(o.cameraText);
     codec::ReflectionFrameOptions options;
@@ -95,13 +94,7 @@ int runRenderReflection(const ReflectionRenderText& o) {
     if (!(glm::length(options.reflector.normal) > 0)) throw Error(ErrorCode::InvalidArgument, "--normal is the zero vector");
     options.reflector.normal = glm::normalize(options.reflector.normal);
     options.intersect.stepTexels = o.step;
-    std::vector<codec::ReflectionFace> faces;
-    for (int f = 0; f < codec::kCubeFaces; ++f) {
-        const std::string path = (std::filesystem::path(o.asset) / (codec::kCubeFaceNames[f] + std::string(".exr"))).string();
-        if (!std::filesystem::is_regular_file(path))
-            throw Error(ErrorCode::Io, o.asset + " is not a reflection asset: it has no " + path + " (make one with `conus bake reflection`)");
-        faces.push_back(codec::reflectionFaceFromFile(format::readConusFile(path)));
-    }
+    const std::vector<codec::ReflectionFace> faces = codec::readReflectionFaces(o.asset);
     const glm::dvec3 centre = faces.front().depth.camera().eye();
     options.reflector.centre = o.at.empty() ? centre : parseVector3(o.at, "--at");
     Progress loading("read " + o.scene);
@@ -134,9 +127,9 @@ int runRenderReflection(const ReflectionRenderText& o) {
 CLI::App* addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
     CLI::App* reflection = addSubcommand(
         command, "reflection", "A specular reflector whose reflected rays intersect a reflection asset's faces",
-        {"conus render reflection asset --scene scene.obj --camera 0,1,4,0,0,0,40 -o frame.png",
-         "conus render reflection asset --scene scene.obj --reflector plane --normal 0,0,1 --radius 2 --camera 0,1,4,0,0,0,40 -o frame.png"});
-    reflection->add_option("asset", o.asset, "folder from `conus bake reflection`")->required();
+        {"conus render reflection asset.exr --scene scene.obj --camera 0,1,4,0,0,0,40 -o frame.png",
+         "conus render reflection asset.exr --scene scene.obj --reflector plane --normal 0,0,1 --radius 2 --camera 0,1,4,0,0,0,40 -o frame.png"});
+    reflection->add_option("asset", o.asset, "reflection asset (.exr, from `conus bake reflection`)")->required();
     reflection->add_option("--scene", o.scene, "the mesh file the asset was baked from (drawn behind)")->required();
     addAllowDirOption(*reflection, o.allowDirs);
     reflection->add_option("-o,--output", o.output, "frame (.png, .exr, ...)")->required();

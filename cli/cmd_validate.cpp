@@ -7,6 +7,7 @@
 #include "commands.h"
 #include "conus/core/atomic_file.h"
 #include "conus/format/container.h"
+#include "conus/format/reflection_asset.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -22,13 +23,15 @@ Command addValidateCommand(CLI::App& root) {
                       "file this passes may still fail to decode)");
     addQuietOption(*command);
     setExamples(*command, {"conus validate photo.exr            # exit 0: valid; 1: every broken rule listed, one a line",
-                       "conus validate photo.exr >/dev/null && echo ok"});
+                       "conus validate photo.exr >/dev/null && echo ok",
+                       "conus validate asset.exr            # a reflection asset: each face, then the cube's frame"});
     return {command, [input, headersOnly] {
                 checkInputPath(*input, false);  // "no such file", not a broken rule
                 const format::ValidationReport report = format::validateConusFile(*input, {}, !*headersOnly);
                 if (report.ok()) {
                     if (!quiet())
-                        std::printf("%s: valid CoNUS file (format version %d)\n", input->c_str(), format::kFormatVersion);
+                        std::printf("%s: valid CoNUS %s (format version %d)\n", input->c_str(),
+                                    format::isReflectionAsset(*input) ? "reflection asset, six faces" : "file", format::kFormatVersion);
                     return 0;
                 }
                 for (const auto& issue : report.issues)

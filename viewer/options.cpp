@@ -76,7 +76,7 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("--volume", volume, "3-D mode: ray-cast this volume live (.den, .nrrd, .vdb, raw:..., procedural:...)");
     app.add_option("--relief", relief, "3-D mode: orbit a relief asset (`conus bake relief`); --uniform: its conventional twin");
     app.add_option("--reflection", reflection,
-                   "3-D mode: orbit a reflection asset folder (`conus bake reflection`) with --scene; --uniform: its conventional twin");
+                   "3-D mode: orbit a reflection asset (.exr from `conus bake reflection`) with --scene; --uniform: its conventional twin");
     app.add_option("--scene", o.reflectionScene, "--reflection: the mesh the asset was baked from");
     cli::addAllowDirOption(app, o.allowDirs);
     app.add_option("--radius", o.reflectorRadius, "--reflection: the mirror sphere's radius")->capture_default_str()->check(cli::finiteRange(0.0, 1e9));

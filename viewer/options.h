@@ -33,7 +33,7 @@ struct Options {
     std::string backend = enumName(renderers::Backend::Auto);  // --backend for --screenshot
     bool helpOverlay = false;            // --help-overlay: start with the key list (H) shown
     bool statusBar = false;              // --status-bar: start with the status bar (B) shown
-    // 3-D modes: --mesh FILE, --volume SPEC, --relief ASSET or --reflection DIR (with --scene MESH);
+    // 3-D modes: --mesh FILE, --volume SPEC, --relief ASSET or --reflection ASSET (with --scene MESH);
     // --uniform is then the conventional asset of a relief or reflection; --size the frame's size.
     SceneKind sceneKind = SceneKind::None;
     std::string scenePath;

@@ -181,14 +181,14 @@ public:
         : ReflectionView(context, options, readMeshFile(options.reflectionScene, options.allowDirs)) {}
     ReflectionView(renderers::Context& context, const Options& options, const Mesh& mesh)
         : m_name(fileName(options.scenePath) + " (reflection)"), m_bounds(sphereAround(mesh.positions)) {
-        const std::vector<codec::ReflectionFace> conusFaces = faces(options.scenePath);
+        const std::vector<codec::ReflectionFace> conusFaces = codec::readReflectionFaces(options.scenePath);
         m_centre = conusFaces.front().depth.camera().eye();
         m_options.reflector.kind = codec::Reflector::Kind::Sphere;
         m_options.reflector.centre = m_centre;
         m_options.reflector.radius = options.reflectorRadius;
         m_conus = std::make_unique<renderers::ReflectionRenderer>(context, mesh, conusFaces, m_options);
         if (!options.uniform.empty())
-            m_uniform = std::make_unique<renderers::ReflectionRenderer>(context, mesh, faces(options.uniform), m_options);
+            m_uniform = std::make_unique<renderers::ReflectionRenderer>(context, mesh, codec::readReflectionFaces(options.uniform), m_options);
     }
     std::string name() const override { return m_name; }
     glm::dvec3 centre() const override { return m_centre; }
@@ -209,17 +209,6 @@ public:
     }
 
 private:
-    static std::vector<codec::ReflectionFace> faces(const std::string& folder) {
-        std::vector<codec::ReflectionFace> faces;
-        for (const char* face : codec::kCubeFaceNames) {
-            const std::string path = (std::filesystem::path(folder) / (std::string(face) + ".exr")).string();
-            if (!std::filesystem::is_regular_file(path))
-                throw Error(ErrorCode::Io, folder + " is not a reflection asset: it has no " + path +
-                                               " (make one with `conus bake reflection`)");
-            faces.push_back(codec::reflectionFaceFromFile(format::readConusFile(path)));
-        }
-        return faces;
-    }
     std::string m_name;
     BoundingSphere m_bounds;
     glm::dvec3 m_centre{0.0};

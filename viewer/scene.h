@@ -4,7 +4,7 @@
 //   --mesh FILE       renderers/mesh_render's GPU mesh encoder (Equation 1 in the vertex shader)
 //   --volume SPEC     renderers/volume_renderer's GPU CoNUS ray casting; T cycles the presets
 //   --relief ASSET    renderers/relief: relief texture mapping of a baked CoNUS height field
-//   --reflection DIR  the GLSL reflection renderer (renderers::ReflectionRenderer) over a baked asset
+//   --reflection ASSET  the GLSL reflection renderer (renderers::ReflectionRenderer) over a baked asset
 // Meshes and volumes are rendered through the map (the foci are live); relief and reflection assets
 // hold their map already (baked), so their frames are conventional and C swaps the CoNUS asset for
 // the conventional one (--uniform).

@@ -141,49 +141,6 @@ void removeStaleTemporaries(const std::string& folder) {
     }
 }
 
-void checkFolderOutput(const std::string& folder, std::span<const std::string> names) {
-    std::error_code ec;
-    const fs::file_status status = fs::symlink_status(folder, ec);
-    if (!fs::exists(status)) return;
-    if (!fs::is_directory(status))
-        throw Error(ErrorCode::InvalidArgument, folder + " exists and is not a folder; give a new or an earlier output folder");
-    for (fs::directory_iterator it(folder, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
-        const std::string name = it->path().filename().string();
-        if (std::find(names.begin(), names.end(), name) == names.end())
-            throw Error(ErrorCode::InvalidArgument, folder + " holds " + name +
-                                                        ", which is not part of what is written there; give a new or empty folder");
-    }
-}
-
-void writeFolderAtomically(const std::string& folder, std::span<const std::string> names,
-                           const std::function<void(const std::string& temporaryFolder)>& write) {
-    checkFolderOutput(folder, names);
-    fs::path target = fs::path(folder).lexically_normal();
-    if (target.filename().empty()) target = target.parent_path();  // "asset/"
-    const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-    std::error_code ec;
-    if (!fs::is_directory(parent, ec))
-        throw Error(ErrorCode::InvalidArgument, folder + ": the folder " + parent.string() + " does not exist");
-    removeStaleTemporaries(parent.string());
-    const fs::path temporary = parent / temporaryName(target.filename());
-    if (!fs::create_directory(temporary, ec))
-        throw Error(ErrorCode::Io, "cannot write " + folder + ": " + (ec ? ec.message() : std::string("temporary exists")));
-    try {
-        write(temporary.string());
-        ::sync();  // the files inside are synced by their writers; the folder entries too
-        if (!fs::exists(target)) {
-            if (::rename(temporary.c_str(), target.c_str()) != 0) throw Error(ErrorCode::Io, "cannot write " + folder + ": " + errnoText(errno));
-        } else {
-            if (::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0)
-                throw Error(ErrorCode::Io, "cannot replace " + folder + ": " + errnoText(errno));
-            fs::remove_all(temporary, ec);  // the earlier set, now under the temporary name
-        }
-    } catch (...) {
-        fs::remove_all(temporary, ec);
-        throw;
-    }
-}
-
 // ---- AtomicFile --------------------------------------------------------------------------------
 
 AtomicFile::AtomicFile(const std::string& destination) : m_destination(destination), m_target(targetOf(destination)) {

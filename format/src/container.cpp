@@ -7,6 +7,7 @@
 
 #include "conus/core/atomic_file.h"
 #include "conus/format/exr_check.h"
+#include "conus/format/reflection_asset.h"
 #include "exr_io.h"
 #include "header_model.h"
 
@@ -47,15 +48,28 @@ CameraAttributes toAttributes(const conus::Camera& camera) {
     return {enumName(camera.projection()), camera.worldToCamera(), camera.worldToNDC()};
 }
 
-void writeConusFile(const std::string& path, const ConusFile& file) {
-    const ValidationReport report = validateConusFile(file);
+namespace {
+
+// Validates `what`, then writes it through an AtomicFile: nothing under `path` unless all of it.
+template <class File>
+void writeValid(const std::string& path, const File& what, const ValidationReport& report, const char* kind) {
     if (!report.ok()) {
         throw Error(onlyMapRules(report) ? ErrorCode::InvalidMap : ErrorCode::Corrupt,
-                    "refusing to write invalid CoNUS file " + path + ": " + report.summary(), report.ruleNumbers());
+                    std::string("refusing to write invalid ") + kind + " " + path + ": " + report.summary(), report.ruleNumbers());
     }
     AtomicFile out(path);
-    detail::writeExrFile(out, file);
+    detail::writeExrFile(out, what);
     out.commit();
+}
+
+}  // namespace
+
+void writeConusFile(const std::string& path, const ConusFile& file) {
+    writeValid(path, file, validateConusFile(file), "CoNUS file");
+}
+
+void writeReflectionAsset(const std::string& path, const ReflectionAssetFile& asset) {
+    writeValid(path, asset, validateReflectionAsset(asset), "reflection asset");
 }
 
 void checkConusFileName(const std::string& path) {
@@ -74,17 +88,31 @@ ConusFile load(const std::string& path, const Limits& limits, bool readPixels) {
     return file;
 }
 
+ReflectionAssetFile loadAsset(const std::string& path, const Limits& limits, bool readPixels) {
+    ReflectionAssetFile asset;
+    const detail::LoadResult result = detail::loadReflectionAsset(path, limits, readPixels, asset);
+    if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.summary(), result.report.ruleNumbers());
+    return asset;
+}
+
 }  // namespace
 
 ConusFile readConusFile(const std::string& path, const Limits& limits) { return load(path, limits, true); }
 
 ConusFile readConusHeader(const std::string& path, const Limits& limits) { return load(path, limits, false); }
 
+ReflectionAssetFile readReflectionAsset(const std::string& path, const Limits& limits) { return loadAsset(path, limits, true); }
+
+ReflectionAssetFile readReflectionAssetHeader(const std::string& path, const Limits& limits) {
+    return loadAsset(path, limits, false);
+}
+
+bool isReflectionAsset(const std::string& path) { return detail::hasReflectionLayout(path); }
+
 ValidationReport validateConusFile(const std::string& path, const Limits& limits, bool readPixels) {
     // The rules concern headers, the map and the chunk tables, never pixel values; reading the
     // pixels finds damaged compressed data, which only a decompression can see.
-    ConusFile file;
-    return detail::loadConusFile(path, limits, readPixels, file).report;
+    return detail::validateFile(path, limits, readPixels).report;
 }
 
 void checkExrFile(const std::string& path, const Limits& limits) { detail::checkExr(path, limits); }

@@ -114,6 +114,29 @@ struct ExrAttribute<std::array<float, 8>> {  // red, green, blue, white: x, y ea
     }
 };
 
+template <>
+struct ExrAttribute<std::array<float, 3>> {
+    using Type = Imf::V3fAttribute;
+    static std::array<float, 3> from(const Imath::V3f& v) { return {v.x, v.y, v.z}; }
+    static Type to(const std::array<float, 3>& v) { return Type(Imath::V3f(v[0], v[1], v[2])); }
+};
+template <>
+struct ExrAttribute<std::array<float, 9>> {  // row-major, as Imath stores a matrix
+    using Type = Imf::M33fAttribute;
+    static std::array<float, 9> from(const Imath::M33f& m) {
+        std::array<float, 9> a{};
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) a[r * 3 + c] = m[r][c];
+        return a;
+    }
+    static Type to(const std::array<float, 9>& a) {
+        Imath::M33f m;
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) m[r][c] = a[r * 3 + c];
+        return Type(m);
+    }
+};
+
 template <class T>
 Attr<T> readAttr(const Imf::Attribute& attribute) {
     Attr<T> a;
@@ -206,13 +229,14 @@ Imf::Header exrHeader(const PartModel& p) {
     return h;
 }
 
-HeaderModel modelOf(const Imf::MultiPartInputFile& file) {
+HeaderModel modelOf(const Imf::MultiPartInputFile& file, const std::string& suffix) {
     HeaderModel m;
+    m.suffix = suffix;
     for (int i = 0; i < file.parts(); ++i) {
         m.parts.push_back(partOf(file.header(i)));
         for (const PartSpec& spec : kParts) {
             PartSlot& slot = m.slot(spec.kind);
-            if (m.parts.back().name == spec.name && slot.count++ == 0) slot.index = i;
+            if (m.parts.back().name == m.partName(spec.kind) && slot.count++ == 0) slot.index = i;
         }
     }
     for (const PartSpec& spec : kParts) {

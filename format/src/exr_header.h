@@ -10,8 +10,9 @@
 
 namespace conus::format::detail {
 
-// The parts of `file` and every attribute of the parts kParts names.
-HeaderModel modelOf(const Imf::MultiPartInputFile& file);
+// The parts of `file` and every attribute of the parts kParts names, each name followed by
+// `suffix` (HeaderModel::partName).
+HeaderModel modelOf(const Imf::MultiPartInputFile& file, const std::string& suffix = "");
 
 // The header of one part as the writer writes it (its attributes come separately).
 Imf::Header exrHeader(const PartModel& p);

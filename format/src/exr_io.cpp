@@ -1,7 +1,8 @@
-// Reading and writing a CoNUS file through OpenEXR: the screen before OpenEXR's C++ library reads
-// (exr_screen.h), the header rules on the model of the headers (exr_header.h), then the parts'
-// pixels (exr_parts.h). OpenEXR's exceptions (Iex::BaseExc derives from std::exception) are caught
-// here and turned into report issues or conus::Error, so nothing from OpenEXR escapes format/.
+// Reading and writing a CoNUS file (one image, or a reflection asset's six) through OpenEXR: the
+// screen before OpenEXR's C++ library reads (exr_screen.h), the header rules on the model of the
+// headers (exr_header.h), then the parts' pixels (exr_parts.h). OpenEXR's exceptions (Iex::BaseExc
+// derives from std::exception) are caught here and turned into report issues or conus::Error, so
+// nothing from OpenEXR escapes format/.
 #include "exr_io.h"
 
 #include <ImfHeader.h>
@@ -10,9 +11,12 @@
 #include <ImfIntAttribute.h>
 #include <ImfStringAttribute.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
+#include <span>
 #include <system_error>
 #include <variant>
 
@@ -22,72 +26,156 @@
 #include "header_model.h"
 
 namespace conus::format::detail {
+namespace {
 
-LoadResult loadConusFile(const std::string& path, const Limits& limits, bool readPixels, ConusFile& out) {
-    useExrThreads();
+enum class Layout { Image, ReflectionAsset };
+
+LoadResult refusal(const Problem& problem) {
     LoadResult result;
-    ValidationReport& r = result.report;
-    auto refuse = [&](const Problem& problem) {
-        r.add(problem.rule, problem.message);
-        result.code = problem.code;
-        return result;
-    };
-    // A FIFO never ends and a device may not either: only regular files are read.
+    result.report.add(problem.rule, problem.message);
+    result.code = problem.code;
+    return result;
+}
+
+// A regular file (a FIFO never ends and a device may not either) that passes the screen
+// (exr_screen.h); its size and the C core's context for the chunk checks.
+Problem screen(const std::string& path, const Limits& limits, std::uintmax_t& size, std::unique_ptr<CoreFile>& core) {
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);
-    if (ec || !std::filesystem::exists(status)) {
-        return refuse({Rule::V1, ErrorCode::Io, "cannot open " + path + ": " + (ec ? ec.message() : std::string("no such file"))});
+    if (ec || !std::filesystem::exists(status))
+        return {Rule::V1, ErrorCode::Io, "cannot open " + path + ": " + (ec ? ec.message() : std::string("no such file"))};
+    if (!std::filesystem::is_regular_file(status)) return {Rule::V1, ErrorCode::Io, "cannot read " + path + ": not a regular file"};
+    size = std::filesystem::file_size(path, ec);
+    if (ec || !std::ifstream(path, std::ios::binary))
+        return {Rule::V1, ErrorCode::Io, "cannot open " + path + (ec ? ": " + ec.message() : std::string())};
+    return checkHeaders(path, size, limits, core);
+}
+
+bool hasPart(const HeaderModel& m, const std::string& name) {
+    return std::any_of(m.parts.begin(), m.parts.end(), [&](const PartModel& p) { return p.name == name; });
+}
+
+// A file without a `conus` part whose parts include the first face's is a reflection asset.
+Layout layoutOf(const HeaderModel& single) {
+    return single.slot(PartKind::Conus).index < 0 && hasPart(single, kConusPartName + faceSuffix(0)) ? Layout::ReflectionAsset
+                                                                                                   : Layout::Image;
+}
+
+ErrorCode codeOf(const HeaderCheck& hc) {
+    return hc.notConus ? ErrorCode::NotConus : hc.limitExceeded ? ErrorCode::LimitExceeded : ErrorCode::Corrupt;
+}
+
+// The image's pixels as float, counted against the decode memory limit.
+std::int64_t imageBytes(const HeaderModel& m) {
+    const PartModel& part = m.part(PartKind::Conus);
+    return part.dataWindow.width() * part.dataWindow.height() * std::int64_t(part.channels.size()) * std::int64_t(sizeof(float));
+}
+
+// After the header rules passed: the chunk tables of the image's two parts.
+Problem checkImageChunks(const CoreFile& core, const HeaderModel& m, std::uintmax_t size) {
+    for (const PartSpec& spec : kParts)
+        if (Problem problem = checkChunks(core.ctx(), m.slot(spec.kind).index, size); !problem.message.empty()) return problem;
+    return {};
+}
+
+// One image's metadata, map and (with `readPixels`) pixels; map rule issues land in `r`.
+ConusFile readImage(Imf::MultiPartInputFile& file, const HeaderModel& m, bool readPixels, ValidationReport& r) {
+    ConusFile loaded;
+    const PartModel& part = m.part(PartKind::Conus);
+    fillMetadata(m, file.header(m.slot(PartKind::Conus).index), loaded);
+    if (readPixels) {
+        readImagePart(file, m.slot(PartKind::Conus).index, part, loaded.image);
+    } else {
+        loaded.image.width = int(part.dataWindow.width());
+        loaded.image.height = int(part.dataWindow.height());
+        for (const ChannelModel& c : part.channels) loaded.image.channels.push_back(c.name);
     }
-    if (!std::filesystem::is_regular_file(status)) return refuse({Rule::V1, ErrorCode::Io, "cannot read " + path + ": not a regular file"});
-    const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec || !std::ifstream(path, std::ios::binary)) {
-        return refuse({Rule::V1, ErrorCode::Io, "cannot open " + path + (ec ? ": " + ec.message() : std::string())});
-    }
-    std::unique_ptr<CoreFile> opened;
-    if (Problem problem = checkHeaders(path, size, limits, opened); !problem.message.empty()) return refuse(problem);
-    const CoreFile& core = *opened;
+    readMapPart(file, m.slot(PartKind::SamplingMap).index, m.part(PartKind::SamplingMap), loaded.map);
+    const ValidationReport grid = validateGrid(loaded.map);
+    for (const Issue& issue : grid.issues)
+        r.add(issue.rule, m.suffix.empty() ? issue.message : "face " + m.suffix.substr(1) + ": " + issue.message, issue.count);
+    return loaded;
+}
+
+Problem decodeLimit(std::int64_t bytes, const std::string& what, const Limits& limits) {
+    if (bytes <= limits.maxDecodeBytes) return {};
+    return {Rule::V4, ErrorCode::LimitExceeded,
+            what + " floats takes " + std::to_string(bytes) + " bytes, beyond the decode memory limit of " +
+                std::to_string(limits.maxDecodeBytes)};
+}
+
+// Reads the file at `path` as `want` (either layout when empty) into `single` or `asset`.
+LoadResult load(const std::string& path, const Limits& limits, bool readPixels, std::optional<Layout> want, ConusFile* single,
+                ReflectionAssetFile* asset) {
+    useExrThreads();
+    std::uintmax_t size = 0;
+    std::unique_ptr<CoreFile> core;
+    if (Problem problem = screen(path, limits, size, core); !problem.message.empty()) return refusal(problem);
+    LoadResult result;
+    ValidationReport& r = result.report;
     try {
         Imf::MultiPartInputFile file(path.c_str());
         const HeaderModel model = modelOf(file);
-        const HeaderCheck hc = checkHeaderRules(model, limits, r);
-        if (!r.ok()) {
-            result.code = hc.notConus ? ErrorCode::NotConus : hc.limitExceeded ? ErrorCode::LimitExceeded : ErrorCode::Corrupt;
+        const Layout layout = layoutOf(model);
+        if (want && *want != layout) {
+            return refusal(layout == Layout::ReflectionAsset
+                               ? Problem{Rule::V2, ErrorCode::NotConus,
+                                         "a reflection asset (six cube faces), not one CoNUS image: `conus info`, `conus render "
+                                         "reflection` and `conus-view --reflection` read it"}
+                               : Problem{Rule::V18, ErrorCode::NotConus,
+                                         "not a reflection asset (no part `" + std::string(kConusPartName) + faceSuffix(0) +
+                                             "`); make one with `conus bake reflection SCENE -o asset.exr`"});
+        }
+        if (layout == Layout::Image) {
+            const HeaderCheck hc = checkHeaderRules(model, limits, r);
+            if (!r.ok()) {
+                result.code = codeOf(hc);
+                return result;
+            }
+            // Headers passed every rule, so every size below is within limits; the chunk tables must
+            // still show that the pixels are in the file before memory is committed for them.
+            const PartModel& part = model.part(PartKind::Conus);
+            if (readPixels)
+                if (Problem p = decodeLimit(imageBytes(model), "image of " + std::to_string(part.dataWindow.width()) + "x" +
+                                                                   std::to_string(part.dataWindow.height()) + "x" +
+                                                                   std::to_string(part.channels.size()),
+                                            limits);
+                    !p.message.empty())
+                    return refusal(p);
+            if (Problem p = checkImageChunks(*core, model, size); !p.message.empty()) return refusal(p);
+            ConusFile loaded = readImage(file, model, readPixels, r);
+            if (!r.ok()) {
+                result.code = ErrorCode::InvalidMap;
+                return result;
+            }
+            if (single) *single = std::move(loaded);
             return result;
         }
-        // Headers passed every rule, so every size below is within limits; the chunk tables must
-        // still show that the pixels are in the file before memory is committed for them.
-        const PartModel& part = model.part(PartKind::Conus);
+        AssetModel faces;
+        for (int f = 0; f < kCubeFaceCount; ++f) faces[static_cast<std::size_t>(f)] = modelOf(file, faceSuffix(f));
+        const HeaderCheck hc = checkAssetRules(faces, limits, r);
+        if (!r.ok()) {
+            result.code = codeOf(hc);
+            return result;
+        }
         if (readPixels) {
-            const std::int64_t bytes = part.dataWindow.width() * part.dataWindow.height() *
-                                       std::int64_t(part.channels.size()) * std::int64_t(sizeof(float));
-            if (bytes > limits.maxDecodeBytes) {
-                return refuse({Rule::V4, ErrorCode::LimitExceeded,
-                               "image of " + std::to_string(part.dataWindow.width()) + "x" + std::to_string(part.dataWindow.height()) +
-                                   "x" + std::to_string(part.channels.size()) + " floats takes " + std::to_string(bytes) +
-                                   " bytes, beyond the decode memory limit of " + std::to_string(limits.maxDecodeBytes)});
-            }
+            std::int64_t bytes = 0;
+            for (const HeaderModel& m : faces) bytes += imageBytes(m);
+            if (Problem p = decodeLimit(bytes, "six faces of " + std::to_string(faces[0].part(PartKind::Conus).dataWindow.width()) + "x" +
+                                                         std::to_string(faces[0].part(PartKind::Conus).dataWindow.height()) + "x" +
+                                                         std::to_string(faces[0].part(PartKind::Conus).channels.size()),
+                                        limits); !p.message.empty()) return refusal(p);
         }
-        for (const PartSpec& spec : kParts) {
-            const int p = model.slot(spec.kind).index;
-            if (Problem problem = checkChunks(core.ctx(), p, size); !problem.message.empty()) return refuse(problem);
-        }
-        ConusFile loaded;
-        fillMetadata(model, file.header(model.slot(PartKind::Conus).index), loaded);
-        if (readPixels) {
-            readImagePart(file, model.slot(PartKind::Conus).index, part, loaded.image);
-        } else {
-            loaded.image.width = int(part.dataWindow.width());
-            loaded.image.height = int(part.dataWindow.height());
-            for (const ChannelModel& c : part.channels) loaded.image.channels.push_back(c.name);
-        }
-        readMapPart(file, model.slot(PartKind::SamplingMap).index, model.part(PartKind::SamplingMap), loaded.map);
-        const ValidationReport grid = validateGrid(loaded.map);
-        r.issues.insert(r.issues.end(), grid.issues.begin(), grid.issues.end());
+        for (const HeaderModel& m : faces)
+            if (Problem p = checkImageChunks(*core, m, size); !p.message.empty()) return refusal(p);
+        ReflectionAssetFile loaded;
+        for (std::size_t f = 0; f < faces.size(); ++f) loaded.faces[f] = readImage(file, faces[f], readPixels, r);
         if (!r.ok()) {
             result.code = ErrorCode::InvalidMap;
             return result;
         }
-        out = std::move(loaded);
+        loaded.frame = {faces[0].cubeCentre.value, faces[0].cubeAxes.value};
+        if (asset) *asset = std::move(loaded);
     } catch (const std::exception& e) {
         r.add(Rule::V1, std::string("damaged OpenEXR data: ") + e.what());
         result.code = ErrorCode::Corrupt;
@@ -95,33 +183,79 @@ LoadResult loadConusFile(const std::string& path, const Limits& limits, bool rea
     return result;
 }
 
-void writeExrFile(AtomicFile& out, const ConusFile& file) {
+// The images of a file into `out`: image k's two parts after image k-1's, `models[k]` naming them.
+void writeImages(AtomicFile& out, std::span<const HeaderModel> models, std::span<const ConusFile* const> files) {
     useExrThreads();
-    const Image& im = file.image;
     const std::string& path = out.destination();
     AtomicOStream stream(out);
     try {
         // The parts and attributes the validator checked (header_model.cpp), then the source's
-        // metadata, which only the `conus` part carries.
-        const HeaderModel model = modelOf(file);
+        // metadata, which only an image part carries.
         std::vector<Imf::Header> headers;
-        for (const PartModel& part : model.parts) headers.push_back(exrHeader(part));
-        for (const PartSpec& spec : kParts) writeAttributes(model, spec.kind, headers[model.slot(spec.kind).index]);
-        Imf::Header& conus = headers[model.slot(PartKind::Conus).index];
-        for (const MetadataItem& item : file.sourceEncoding.metadata) {
-            if (!isCarriedMetadata(item.name)) continue;  // never let an item overwrite a CoNUS attribute
-            if (const auto* v = std::get_if<std::string>(&item.value)) conus.insert(item.name, Imf::StringAttribute(*v));
-            else if (const auto* i = std::get_if<int>(&item.value)) conus.insert(item.name, Imf::IntAttribute(*i));
-            else if (const auto* f = std::get_if<float>(&item.value)) conus.insert(item.name, Imf::FloatAttribute(*f));
-            else if (const auto* d = std::get_if<double>(&item.value)) conus.insert(item.name, Imf::DoubleAttribute(*d));
+        for (std::size_t k = 0; k < models.size(); ++k) {
+            const HeaderModel& model = models[k];
+            const std::size_t first = headers.size();
+            for (const PartModel& part : model.parts) headers.push_back(exrHeader(part));
+            for (const PartSpec& spec : kParts) writeAttributes(model, spec.kind, headers[first + model.slot(spec.kind).index]);
+            Imf::Header& conus = headers[first + model.slot(PartKind::Conus).index];
+            for (const MetadataItem& item : files[k]->sourceEncoding.metadata) {
+                if (!isCarriedMetadata(item.name)) continue;  // never let an item overwrite a CoNUS attribute
+                if (const auto* v = std::get_if<std::string>(&item.value)) conus.insert(item.name, Imf::StringAttribute(*v));
+                else if (const auto* i = std::get_if<int>(&item.value)) conus.insert(item.name, Imf::IntAttribute(*i));
+                else if (const auto* f = std::get_if<float>(&item.value)) conus.insert(item.name, Imf::FloatAttribute(*f));
+                else if (const auto* d = std::get_if<double>(&item.value)) conus.insert(item.name, Imf::DoubleAttribute(*d));
+            }
         }
         Imf::MultiPartOutputFile exr(stream, headers.data(), int(headers.size()));
-        writeImagePart(exr, model.slot(PartKind::Conus).index, im, file.pixelType);
-        writeMapPart(exr, model.slot(PartKind::SamplingMap).index, file.map);
+        int first = 0;
+        for (std::size_t k = 0; k < models.size(); ++k) {
+            writeImagePart(exr, first + models[k].slot(PartKind::Conus).index, files[k]->image, files[k]->pixelType);
+            writeMapPart(exr, first + models[k].slot(PartKind::SamplingMap).index, files[k]->map);
+            first += int(models[k].parts.size());
+        }
     } catch (const std::exception& e) {
         throw Error(ErrorCode::Io, stream.failure().empty() ? "cannot write " + path + ": " + e.what() : stream.failure());
     }
     if (!stream.failure().empty()) throw Error(ErrorCode::Io, stream.failure());
+}
+
+}  // namespace
+
+LoadResult loadConusFile(const std::string& path, const Limits& limits, bool readPixels, ConusFile& out) {
+    return load(path, limits, readPixels, Layout::Image, &out, nullptr);
+}
+
+LoadResult loadReflectionAsset(const std::string& path, const Limits& limits, bool readPixels, ReflectionAssetFile& out) {
+    return load(path, limits, readPixels, Layout::ReflectionAsset, nullptr, &out);
+}
+
+LoadResult validateFile(const std::string& path, const Limits& limits, bool readPixels) {
+    return load(path, limits, readPixels, std::nullopt, nullptr, nullptr);
+}
+
+bool hasReflectionLayout(const std::string& path) {
+    std::uintmax_t size = 0;
+    std::unique_ptr<CoreFile> core;
+    if (!screen(path, {}, size, core).message.empty()) return false;
+    try {
+        Imf::MultiPartInputFile file(path.c_str());
+        return layoutOf(modelOf(file)) == Layout::ReflectionAsset;
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+void writeExrFile(AtomicFile& out, const ConusFile& file) {
+    const HeaderModel model = modelOf(file);
+    const ConusFile* files[] = {&file};
+    writeImages(out, std::span(&model, 1), files);
+}
+
+void writeExrFile(AtomicFile& out, const ReflectionAssetFile& asset) {
+    const AssetModel models = modelOf(asset);
+    std::array<const ConusFile*, kCubeFaceCount> files{};
+    for (std::size_t f = 0; f < files.size(); ++f) files[f] = &asset.faces[f];
+    writeImages(out, models, files);
 }
 
 }  // namespace conus::format::detail

@@ -1,6 +1,6 @@
 // Private to format/: the pixels of one part of a multipart EXR, read and written by its index, and
-// the stream that writes such a file through an AtomicFile (exr_parts.cpp). A container of several
-// images and maps (the CoNUS file now; more parts per file next) is assembled from these.
+// the stream that writes such a file through an AtomicFile (exr_parts.cpp). A container of images
+// and maps (a CoNUS file's one, a reflection asset's six) is assembled from these (exr_io.cpp).
 #pragma once
 
 #include <cstdint>

@@ -17,11 +17,14 @@ Attr<T> attr(T value) {
 
 }  // namespace
 
-HeaderModel modelOf(const ConusFile& file) {
+std::string HeaderModel::partName(PartKind kind) const { return kParts[static_cast<std::size_t>(kind)].name + suffix; }
+
+HeaderModel modelOf(const ConusFile& file, const std::string& suffix) {
     HeaderModel m;
+    m.suffix = suffix;
     const Image& im = file.image;
     PartModel conus;
-    conus.name = kConusPartName;
+    conus.name = m.partName(PartKind::Conus);
     conus.type = "scanlineimage";
     conus.compression = file.compression;
     for (const std::string& name : im.channels) {
@@ -33,7 +36,7 @@ HeaderModel modelOf(const ConusFile& file) {
     // Every part shares the displayWindow (OpenEXR requires it); the map's dataWindow is its grid.
     // The map is always stored losslessly (DWAA would quantize the node positions).
     PartModel map;
-    map.name = kMapPartName;
+    map.name = m.partName(PartKind::SamplingMap);
     map.type = "scanlineimage";
     map.compression = file.compression == Compression::None ? Compression::None : Compression::Zip;
     map.channels = {{kMapChannelU, ChannelType::Float, 1, 1}, {kMapChannelV, ChannelType::Float, 1, 1}};

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "conus/format/container.h"
+#include "conus/format/reflection_asset.h"
 
 namespace conus::format::detail {
 
@@ -103,6 +104,14 @@ struct HeaderModel {
     // Colour (V16).
     Attr<std::string> sourceTransfer, sourceSampleType, iccProfile;
     Attr<std::array<float, 8>> chromaticities;
+    // A reflection asset's cube frame (V19), on its first face's image part.
+    Attr<std::array<float, 3>> cubeCentre;
+    Attr<std::array<float, 9>> cubeAxes;  // row-major: rows the cube's +x, +y, +z in world space
+
+    // The name of the part of `kind` this model describes: kParts' name plus `suffix` (".px" for a
+    // reflection asset's +x face, empty for a single image).
+    std::string suffix;
+    std::string partName(PartKind kind) const;
 };
 
 // ---- The attributes CoNUS reads and writes, as data ----------------------------------------------
@@ -117,11 +126,12 @@ using AttrMember = Attr<T> HeaderModel::*;
 using ParamsMember = std::map<std::string, Attr<double>> HeaderModel::*;
 using AttrField = std::variant<AttrMember<int>, AttrMember<std::string>, AttrMember<std::array<int, 2>>,
                                AttrMember<std::array<float, 2>>, AttrMember<std::vector<float>>,
-                               AttrMember<std::array<float, 16>>, AttrMember<std::array<float, 8>>, ParamsMember>;
+                               AttrMember<std::array<float, 16>>, AttrMember<std::array<float, 8>>, ParamsMember,
+                               AttrMember<std::array<float, 3>>, AttrMember<std::array<float, 9>>>;
 
 // The EXR type of each of AttrField's alternatives, in its order, as messages and the spec name it.
 inline constexpr const char* kAttrTypeNames[] = {"int", "string", "v2i", "v2f", "floatvector", "m44f", "chromaticities",
-                                                 "double or float"};
+                                                 "double or float", "v3f", "m33f"};
 static_assert(std::size(kAttrTypeNames) == std::variant_size_v<AttrField>);
 
 struct AttributeSpec {
@@ -153,6 +163,8 @@ inline constexpr const char* kAttrSourceTransfer = "conus:sourceTransfer";
 inline constexpr const char* kAttrSourceSampleType = "conus:sourceSampleType";
 inline constexpr const char* kAttrIccProfile = "conus:iccProfile";  // base64
 inline constexpr const char* kAttrChromaticities = "chromaticities";
+inline constexpr const char* kAttrCubeCentre = "conus:cubeCentre";
+inline constexpr const char* kAttrCubeAxes = "conus:cubeAxes";
 inline constexpr const char* kMapChannelU = "ud";
 inline constexpr const char* kMapChannelV = "vd";
 
@@ -182,6 +194,9 @@ inline constexpr AttributeSpec kAttributes[] = {
     {kAttrSourceSampleType, PartKind::Conus, Rule::V16, &HeaderModel::sourceSampleType},
     {kAttrIccProfile, PartKind::Conus, Rule::V16, &HeaderModel::iccProfile},
     {kAttrChromaticities, PartKind::Conus, Rule::V16, &HeaderModel::chromaticities},
+    // A reflection asset's cube frame (V19).
+    {kAttrCubeCentre, PartKind::Conus, Rule::V19, &HeaderModel::cubeCentre},
+    {kAttrCubeAxes, PartKind::Conus, Rule::V19, &HeaderModel::cubeAxes},
 };
 
 // The row of the attribute `member` holds.
@@ -209,8 +224,21 @@ CameraCheck describeCamera(const CameraAttributes& attributes);
 // Runs V2..V7 (shape only for V7) and V12..V15 on the model, appending to `report`.
 HeaderCheck checkHeaderRules(const HeaderModel& model, const Limits& limits, ValidationReport& report);
 
-// The header an in-memory file is written with (header_model.cpp).
-HeaderModel modelOf(const ConusFile& file);
+// An in-memory file's pixel array against its size (V4) and its map's rules (V8..V11; V7 unless
+// the headers said it), each message after `prefix` (validate_file.cpp).
+void checkPixelsAndMap(const ConusFile& file, const std::string& prefix, ValidationReport& report);
+
+// The header an in-memory file is written with (header_model.cpp); `suffix` names its parts.
+HeaderModel modelOf(const ConusFile& file, const std::string& suffix = "");
+
+// A reflection asset's headers: one model per face, each naming its parts with faceSuffix(face).
+using AssetModel = std::array<HeaderModel, kCubeFaceCount>;
+inline std::string faceSuffix(int face) { return std::string(".") + kCubeFaceNames[face]; }
+// Each present face's header rules (V2..V17, its issues prefixed "face px: "), then V18 and V19
+// (validate_asset.cpp).
+HeaderCheck checkAssetRules(const AssetModel& faces, const Limits& limits, ValidationReport& report);
+// The headers an in-memory asset is written with: each face's modelOf, the frame on the first.
+AssetModel modelOf(const ReflectionAssetFile& asset);
 
 // Base64 (RFC 4648) for the ICC profile, which OpenEXR 3.1 has no byte-array attribute for.
 std::string base64Encode(const std::string& bytes);

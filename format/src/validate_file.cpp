@@ -58,13 +58,13 @@ bool optional(const HeaderModel& m, AttrMember<T> member, ValidationReport& r) {
 }
 
 void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport& r) {
-    if (const int n = m.slot(PartKind::Conus).count; n > 1) r.add(Rule::V2, std::to_string(n) + " parts are named `conus`; exactly one is allowed");
+    if (const int n = m.slot(PartKind::Conus).count; n > 1) r.add(Rule::V2, std::to_string(n) + " parts are named `" + m.partName(PartKind::Conus) + "`; exactly one is allowed");
     if (part.type != "scanlineimage" && part.type != "tiledimage") {
-        r.add(Rule::V2, "part `conus` has type `" + part.type + "`, expected scanlineimage or tiledimage");
+        r.add(Rule::V2, "part `" + part.name + "` has type `" + part.type + "`, expected scanlineimage or tiledimage");
     }
     if (part.type == "tiledimage" &&
         (part.tileWidth < 1 || part.tileHeight < 1 || part.tileWidth * part.tileHeight > kMaxTilePixels)) {
-        r.add(Rule::V2, "part `conus` has tiles of " + std::to_string(part.tileWidth) + "x" + std::to_string(part.tileHeight) +
+        r.add(Rule::V2, "part `" + part.name + "` has tiles of " + std::to_string(part.tileWidth) + "x" + std::to_string(part.tileHeight) +
                      " pixels; at most " + std::to_string(kMaxTilePixels) + " pixels a tile are read");
     }
     if (!need(m, &HeaderModel::version, r)) return;
@@ -79,9 +79,9 @@ void checkVersion(const HeaderModel& m, const PartModel& part, ValidationReport&
 void checkChannels(const PartModel& part, const Limits& limits, ValidationReport& r, HeaderCheck& hc) {
     const auto n = static_cast<std::int64_t>(part.channels.size());
     if (n < 1 || n > kMaxChannels) {
-        r.add(Rule::V3, "part `conus` has " + std::to_string(n) + " channels; 1 to " + std::to_string(kMaxChannels) + " allowed");
+        r.add(Rule::V3, "part `" + part.name + "` has " + std::to_string(n) + " channels; 1 to " + std::to_string(kMaxChannels) + " allowed");
     } else if (n > limits.maxChannels) {
-        r.add(Rule::V3, "part `conus` has " + std::to_string(n) + " channels, beyond the reader's limit of " +
+        r.add(Rule::V3, "part `" + part.name + "` has " + std::to_string(n) + " channels, beyond the reader's limit of " +
                      std::to_string(limits.maxChannels));
         hc.limitExceeded = true;
     }
@@ -100,7 +100,7 @@ void checkChannels(const PartModel& part, const Limits& limits, ValidationReport
 void checkWindows(const PartModel& part, const Limits& limits, ValidationReport& r, HeaderCheck& hc) {
     const Box& dw = part.dataWindow;
     if (!(dw == part.displayWindow) || dw.minX != 0 || dw.minY != 0) {
-        r.add(Rule::V4, "part `conus` dataWindow " + boxStr(dw) + " must equal displayWindow " + boxStr(part.displayWindow) +
+        r.add(Rule::V4, "part `" + part.name + "` dataWindow " + boxStr(dw) + " must equal displayWindow " + boxStr(part.displayWindow) +
                      " with origin (0, 0)");
     }
     const std::int64_t w = dw.width(), h = dw.height();
@@ -129,11 +129,11 @@ void checkSourceAndKind(const HeaderModel& m, ValidationReport& r) {
 void checkMapPart(const HeaderModel& m, const Limits& limits, ValidationReport& r, HeaderCheck& hc) {
     const PartSlot& slot = m.slot(PartKind::SamplingMap);
     if (slot.count != 1) {
-        r.add(Rule::V7, std::to_string(slot.count) + " parts are named `samplingmap`; exactly one is required");
+        r.add(Rule::V7, std::to_string(slot.count) + " parts are named `" + m.partName(PartKind::SamplingMap) + "`; exactly one is required");
         if (slot.index < 0) return;
     }
     const PartModel& p = m.part(PartKind::SamplingMap);
-    if (p.type != "scanlineimage") r.add(Rule::V7, "part `samplingmap` has type `" + p.type + "`, expected scanlineimage");
+    if (p.type != "scanlineimage") r.add(Rule::V7, "part `" + p.name + "` has type `" + p.type + "`, expected scanlineimage");
     const bool channelsOk = p.channels.size() == 2 && p.channels[0].name == kMapChannelU && p.channels[1].name == kMapChannelV &&
                             std::all_of(p.channels.begin(), p.channels.end(), [](const ChannelModel& c) {
                                 return c.type == ChannelType::Float && c.xSampling == 1 && c.ySampling == 1;
@@ -141,12 +141,12 @@ void checkMapPart(const HeaderModel& m, const Limits& limits, ValidationReport& 
     if (!channelsOk) {
         std::string list;
         for (const ChannelModel& c : p.channels) list += (list.empty() ? "" : ", ") + c.name + ":" + typeName(c.type);
-        r.add(Rule::V7, "part `samplingmap` has channels {" + list + "}; exactly FLOAT `ud` and `vd` expected");
+        r.add(Rule::V7, "part `" + p.name + "` has channels {" + list + "}; exactly FLOAT `ud` and `vd` expected");
     }
     const Box& dw = p.dataWindow;
     const std::int64_t n = dw.width(), rows = dw.height();
     if (dw.minX != 0 || dw.minY != 0 || n < kMinMapSide || rows < kMinMapSide || n > kMaxMapSide || rows > kMaxMapSide) {
-        r.add(Rule::V7, "part `samplingmap` dataWindow " + boxStr(dw) + " must be (0, 0) - (columns-1, rows-1) with columns and rows in [" +
+        r.add(Rule::V7, "part `" + p.name + "` dataWindow " + boxStr(dw) + " must be (0, 0) - (columns-1, rows-1) with columns and rows in [" +
                      std::to_string(kMinMapSide) + ", " + std::to_string(kMaxMapSide) + "]");
     } else if (n > limits.maxMapSide || rows > limits.maxMapSide) {
         r.add(Rule::V7, "sampling map of " + std::to_string(n) + "x" + std::to_string(rows) + " nodes exceeds the reader's limit of " +
@@ -356,22 +356,30 @@ HeaderCheck checkHeaderRules(const HeaderModel& m, const Limits& limits, Validat
 
 }  // namespace detail
 
-ValidationReport validateConusFile(const ConusFile& file) {
-    ValidationReport report;
-    const detail::HeaderModel model = detail::modelOf(file);
-    detail::checkHeaderRules(model, Limits{}, report);
+namespace detail {
+
+void checkPixelsAndMap(const ConusFile& file, const std::string& prefix, ValidationReport& report) {
     // The in-memory image must hold what its header promises (V4 covers the pixel array).
     const Image& im = file.image;
     if (im.width >= 1 && im.height >= 1 &&
         im.pixels.size() != std::size_t(im.width) * std::size_t(im.height) * im.channels.size()) {
-        report.add(Rule::V4, "image holds " + std::to_string(im.pixels.size()) + " values; " + std::to_string(im.width) + "x" +
-                          std::to_string(im.height) + "x" + std::to_string(im.channels.size()) + " expected");
+        report.add(Rule::V4, prefix + "image holds " + std::to_string(im.pixels.size()) + " values; " + std::to_string(im.width) +
+                                 "x" + std::to_string(im.height) + "x" + std::to_string(im.channels.size()) + " expected");
     }
     const ValidationReport grid = validateGrid(file.map);
     // V7's shape was already reported from the header model; keep the grid's own messages otherwise.
     for (const Issue& issue : grid.issues) {
-        if (issue.rule != Rule::V7 || !report.violates(Rule::V7)) report.issues.push_back(issue);
+        if (issue.rule != Rule::V7 || !report.violates(Rule::V7)) report.add(issue.rule, prefix + issue.message, issue.count);
     }
+}
+
+}  // namespace detail
+
+ValidationReport validateConusFile(const ConusFile& file) {
+    ValidationReport report;
+    const detail::HeaderModel model = detail::modelOf(file);
+    detail::checkHeaderRules(model, Limits{}, report);
+    detail::checkPixelsAndMap(file, "", report);
     return report;
 }
 

@@ -1,5 +1,6 @@
 // Every rule V1..V17 of spec/conus-format.md, each broken once: in memory where a ConusFile can
-// express the fault, else as a malformed file written with OpenEXR directly.
+// express the fault, else as a malformed file written with OpenEXR directly. (A reflection
+// asset's V18 and V19: reflection_asset_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <ImfChannelList.h>

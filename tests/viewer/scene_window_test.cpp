@@ -246,7 +246,7 @@ TEST(SceneWindow, BadScenesFailClearly) {
         bool window;
     } cases[] = {
         {"--mesh a.obj --volume b", "give one of --mesh", 2, false},
-        {"--reflection folder", "needs --scene", 2, false},
+        {"--reflection asset.exr", "needs --scene", 2, false},
         {"--mesh a.obj --focus 2,0,0.1,2", "outside [0,1]^2", 2, false},
         {"--mesh a.obj --uniform b.obj", "--uniform in a 3-D mode", 2, false},
         {"--mesh /nonexistent/model.obj", "no such file", 1, true},
@@ -297,12 +297,12 @@ TEST(SceneWindow, ReflectionAssetToggleChangesTheMirrorOnly) {
     for (const char* flag : {"", " --uniform"})
         ASSERT_EQ(test::run(conus + " bake reflection " + room + " --center 0,0,0 --size 32 -q --roi-min 1.5,-1,-0.5 " +
                                 "--roi-max 2.5,0.5,0.5 --magnification 4 -o " +
-                                (dir / (std::string("mirror") + (*flag ? "-u" : ""))).string() + flag,
+                                (dir / (std::string("mirror") + (*flag ? "-u" : "") + ".exr")).string() + flag,
                             &log),
                   0)
             << log;
     const std::string script = "screenshot " + (dir / "f1.png").string() + "\nkey U\nscreenshot " + (dir / "f2.png").string() + "\n";
-    log = runScript("--reflection " + (dir / "mirror").string() + " --uniform " + (dir / "mirror-u").string() + " --scene " + room, script);
+    log = runScript("--reflection " + (dir / "mirror.exr").string() + " --uniform " + (dir / "mirror-u.exr").string() + " --scene " + room, script);
     const Image f1 = readPicture(dir / "f1.png"), f2 = readPicture(dir / "f2.png");
     ASSERT_EQ(f2.width, kW) << log;
     // The mirror sphere (radius 0.5 at the origin) is the frame's centre, a third of its height.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <string>
@@ -15,17 +16,6 @@
 
 namespace conus::codec {
 namespace {
-
-// Forward and up of each face: the usual cube-map layout, any fixed one would do as every face
-// carries its own camera.
-constexpr std::array<std::array<double, 6>, kCubeFaces> kFaceAxes{{
-    {1, 0, 0, 0, 1, 0},
-    {-1, 0, 0, 0, 1, 0},
-    {0, 1, 0, 0, 0, -1},
-    {0, -1, 0, 0, 0, 1},
-    {0, 0, 1, 0, 1, 0},
-    {0, 0, -1, 0, 1, 0},
-}};
 
 bool finite(glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -43,7 +33,7 @@ Camera cubeFaceCamera(glm::dvec3 centre, int face, double near, double far) {
     if (face < 0 || face >= kCubeFaces) throw Error(ErrorCode::InvalidArgument, "cube face " + std::to_string(face) + " is not 0..5");
     if (!finite(centre) || !(near > 0) || !(far > near) || !std::isfinite(far))
         throw Error(ErrorCode::InvalidArgument, "cube face camera: needs a finite centre and 0 < near < far");
-    const auto& a = kFaceAxes[static_cast<std::size_t>(face)];
+    const auto& a = format::kCubeFaceAxes[static_cast<std::size_t>(face)];
     const glm::dvec3 forward(a[0], a[1], a[2]), up(a[3], a[4], a[5]);
     return Camera::perspective(centre, centre + forward, up, 90.0, 1.0, near, far);
 }
@@ -174,16 +164,10 @@ std::optional<ReflectionHit> traceReflection(const std::vector<ReflectionFace>& 
     return best;
 }
 
-format::ConusFile reflectionFaceFile(const ReflectionFace& face) {
-    return makeDepthImageFile(face.image, face.depth.map(), face.depth.camera(), "world");
-}
+namespace {
 
-ReflectionFace reflectionFaceFromFile(const format::ConusFile& file) {
+ReflectionFace faceFromFile(const format::ConusFile& file) {
     const std::vector<std::string> names = meshChannelNames();
-    if (file.dataKind != format::DataKind::DepthImage || file.depth.kind != format::DepthKind::CameraDepth ||
-        file.image.channelIndex("R") < 0 || file.image.channelIndex("G") < 0 || file.image.channelIndex("B") < 0)
-        throw Error(ErrorCode::InvalidArgument,
-                    "not a reflection face (a camera-depth image with R, G, B and Z; make them with `conus bake reflection`)");
     DepthImage depth = DepthImage::fromFile(file);
     // The file keeps channels in its own (EXR: alphabetical) order; faces hold the mesh render's.
     Image image{file.image.width, file.image.height, names, std::vector<float>(file.image.pixels.size() / file.image.channels.size() * names.size())};
@@ -194,6 +178,34 @@ ReflectionFace reflectionFaceFromFile(const format::ConusFile& file) {
                 image.at(x, y, static_cast<int>(c)) = from < 0 ? 1.0f : file.image.at(x, y, from);
     }
     return {std::move(depth), std::move(image)};
+}
+
+}  // namespace
+
+format::ReflectionAssetFile reflectionAssetFile(const std::vector<ReflectionFace>& faces) {
+    if (faces.size() != static_cast<std::size_t>(kCubeFaces))
+        throw Error(ErrorCode::InvalidArgument, "a reflection asset has six faces, not " + std::to_string(faces.size()));
+    format::ReflectionAssetFile asset;
+    const glm::dvec3 centre = faces.front().depth.camera().eye();
+    // + 0 turns the -0 an inverted matrix gives into 0 (the file and `conus info` show it).
+    asset.frame.centre = {static_cast<float>(centre.x) + 0.0f, static_cast<float>(centre.y) + 0.0f, static_cast<float>(centre.z) + 0.0f};
+    for (std::size_t f = 0; f < faces.size(); ++f)
+        asset.faces[f] = makeDepthImageFile(faces[f].image, faces[f].depth.map(), faces[f].depth.camera(), "world");
+    return asset;
+}
+
+std::vector<ReflectionFace> reflectionFaces(const format::ReflectionAssetFile& asset) {
+    std::vector<ReflectionFace> faces;
+    for (const format::ConusFile& file : asset.faces) faces.push_back(faceFromFile(file));
+    return faces;
+}
+
+std::vector<ReflectionFace> readReflectionFaces(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw Error(ErrorCode::Unsupported, path + " is a folder, not a reflection asset: an asset is one .exr file "
+                                                   "(`conus bake reflection SCENE -o asset.exr` bakes one)");
+    return reflectionFaces(format::readReflectionAsset(path));
 }
 
 std::optional<glm::vec3> traceReflectionReference(const MeshScene& scene, const Ray& ray, glm::dvec3 centre) {

@@ -9,6 +9,7 @@
 #include "conus/codec/mesh/shading.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
+#include "conus/format/reflection_asset.h"
 #include "test_dir.h"
 
 namespace conus::codec {
@@ -231,27 +232,32 @@ TEST(Reflection, BadBakeOptionsAreRefused) {
     EXPECT_THROW(bakeReflection(scene, o), Error);
 }
 
-TEST(Reflection, FacesValidateAndRoundTripThroughFiles) {
+TEST(Reflection, FacesRoundTripThroughOneAssetFile) {
     const auto faces = bakeBox(32, false);
     conus::test::TestDir dir("reflection");
+    const std::string path = dir.file("asset.exr");
+    format::writeReflectionAsset(path, reflectionAssetFile(faces));
+    EXPECT_TRUE(format::validateConusFile(path).ok()) << format::validateConusFile(path).str();
+    const std::vector<ReflectionFace> back = readReflectionFaces(path);
+    ASSERT_EQ(back.size(), faces.size());
     for (std::size_t f = 0; f < faces.size(); ++f) {
-        const std::string path = dir.file("face" + std::to_string(f) + ".exr");
-        format::writeConusFile(path, reflectionFaceFile(faces[f]));
-        EXPECT_TRUE(format::validateConusFile(path).ok()) << path;
-        const ReflectionFace back = reflectionFaceFromFile(format::readConusFile(path));
-        EXPECT_EQ(back.depth.depths(), faces[f].depth.depths());
-        EXPECT_EQ(back.image.pixels, faces[f].image.pixels);
-        EXPECT_EQ(back.depth.map().nodes(), faces[f].depth.map().nodes());
+        SCOPED_TRACE(kCubeFaceNames[f]);
+        EXPECT_EQ(back[f].depth.depths(), faces[f].depth.depths());
+        EXPECT_EQ(back[f].image.channels, faces[f].image.channels);
+        EXPECT_EQ(back[f].image.pixels, faces[f].image.pixels);
+        EXPECT_EQ(back[f].depth.map().nodes(), faces[f].depth.map().nodes());
         const glm::dvec3 p(0.7, 0.1, 1.8);
-        const glm::dvec3 a = back.depth.camera().project(p), b = faces[f].depth.camera().project(p);
+        const glm::dvec3 a = back[f].depth.camera().project(p), b = faces[f].depth.camera().project(p);
         EXPECT_NEAR(glm::distance(a, b), 0.0, 1e-4);
     }
     // The +z face sees the box, so its map is not the identity; -z sees nothing of it.
     EXPECT_GT(faces[4].depth.map().columns(), 2);
     EXPECT_EQ(faces[5].depth.map().columns(), 2);
-    format::ConusFile notAFace = reflectionFaceFile(faces[0]);
-    notAFace.depth.kind = format::DepthKind::Height;
-    EXPECT_THROW(reflectionFaceFromFile(notAFace), Error);
+    // The frame is the faces' eye and the world's axes.
+    const format::ReflectionAssetFile asset = format::readReflectionAsset(path);
+    EXPECT_EQ(asset.frame.centre, (std::array<float, 3>{0, 0, 0}));
+    EXPECT_EQ(asset.frame.axes, (std::array<float, 9>{1, 0, 0, 0, 1, 0, 0, 0, 1}));
+    EXPECT_THROW(reflectionAssetFile({faces[0]}), Error);
 }
 
 // Mean squared RGB error of `a` against `truth` over the pixels `inRegion` picks.

@@ -78,15 +78,6 @@ void checkInputPath(const std::string& input, bool allowStdin = false);
 // the temporary was last written. Those of running processes are left alone.
 void removeStaleTemporaries(const std::string& folder);
 
-// Files that must appear together (a folder of them): `write` fills a temporary folder beside
-// `folder`, which then takes its place in one rename (an existing `folder` is exchanged with it
-// atomically, then removed). Any failure removes the temporary folder and leaves `folder` as it was.
-// An existing `folder` may hold only files named in `names` (a set this call replaces whole);
-// checkFolderOutput says so before any work, throwing conus::Error(InvalidArgument).
-void checkFolderOutput(const std::string& folder, std::span<const std::string> names);
-void writeFolderAtomically(const std::string& folder, std::span<const std::string> names,
-                           const std::function<void(const std::string& temporaryFolder)>& write);
-
 // Installs handlers for SIGINT, SIGTERM and SIGHUP that remove every open temporary file and
 // then end the process as the signal would have. Also ignores SIGXFSZ, so that a write past a
 // file-size limit fails with an error instead of killing the process mid-file.

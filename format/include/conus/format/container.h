@@ -109,7 +109,8 @@ ConusFile readConusFile(const std::string& path, const Limits& limits = {});
 // chunk tables included, so a file this accepts does hold its pixel data's bytes.
 ConusFile readConusHeader(const std::string& path, const Limits& limits = {});
 
-// Every violated rule of the file at `path` (never throws for bad content). With `readPixels`
+// Every violated rule of the file at `path`, one CoNUS image or a reflection asset
+// (reflection_asset.h), never throwing for bad content. With `readPixels`
 // (the default) every chunk of pixel data is read and decompressed too, as readConusFile does, so
 // a file that validates also reads; without, headers, the map and the chunk tables only.
 ValidationReport validateConusFile(const std::string& path, const Limits& limits = {}, bool readPixels = true);

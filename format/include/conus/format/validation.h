@@ -10,7 +10,7 @@ namespace conus::format {
 
 // The rules of spec/conus-format.md by number (Rule::V7 is V7); Unreadable: the file could not be
 // read at all, so no rule could be checked.
-enum class Rule : int { Unreadable = 0, V1, V2, V3, V4, V5, V6, V7, V8, V9, V10, V11, V12, V13, V14, V15, V16, V17 };
+enum class Rule : int { Unreadable = 0, V1, V2, V3, V4, V5, V6, V7, V8, V9, V10, V11, V12, V13, V14, V15, V16, V17, V18, V19 };
 inline constexpr int number(Rule rule) { return static_cast<int>(rule); }
 // "V7", or "error" for Unreadable: how messages name a rule.
 std::string label(Rule rule);

@@ -6,8 +6,8 @@
 // every direction a sphere reflects with no face wider than 90 degrees, where a perspective
 // image's texels stay within a factor 3^(3/2) of each other in solid angle; fewer, wider faces
 // would spend their texels unevenly before any map does. Each face is an ordinary CoNUS depth
-// image (camera, map, Z = camera depth, the far plane where nothing was seen), so a face file
-// needs no format change.
+// image (camera, map, Z = camera depth, the far plane where nothing was seen); the asset is one
+// file of the six with the cube's frame (format/reflection_asset.h).
 //
 // The faces' maps favour what the reflector shows most: a focus on the projection of a region of
 // interest (by default the scene's bounding box; in practice the object nearest the reflector) in
@@ -26,15 +26,17 @@
 #include "conus/core/bounds.h"
 #include "conus/core/enum_names.h"
 #include "conus/core/image.h"
+#include "conus/format/reflection_asset.h"
 
 namespace conus::codec {
 
-inline constexpr int kCubeFaces = 6;
-// The faces' names, in order (the files `conus bake reflection` writes).
-inline constexpr const char* kCubeFaceNames[kCubeFaces] = {"px", "nx", "py", "ny", "pz", "nz"};
+// The faces, in order, as the asset file names them (+x, -x, +y, -y, +z, -z).
+inline constexpr int kCubeFaces = format::kCubeFaceCount;
+using format::kCubeFaceNames;
 
-// The camera of cube face `face` (0..5: +x, -x, +y, -y, +z, -z) at `centre`: 90 degrees, square,
-// depths in [near, far]. Throws conus::Error(InvalidArgument) for a face outside 0..5 or bad clips.
+// The camera of cube face `face` (0..5: +x, -x, +y, -y, +z, -z) at `centre`, the world's axes as
+// the cube's (format::kCubeFaceAxes): 90 degrees, square, depths in [near, far]. Throws
+// conus::Error(InvalidArgument) for a face outside 0..5 or bad clips.
 Camera cubeFaceCamera(glm::dvec3 centre, int face, double near, double far);
 
 // One face: its depth image (what rays intersect) and the mesh render it came from (R, G, B, A, Z
@@ -44,11 +46,14 @@ struct ReflectionFace {
     Image image;
 };
 
-// A face as an ordinary CoNUS depth image file (codec/conus_file.h's makeDepthImageFile, units
-// "world"), and back. fromFile throws conus::Error(InvalidArgument) for a file that is not a
-// camera-depth image with R, G, B and Z channels.
-format::ConusFile reflectionFaceFile(const ReflectionFace& face);
-ReflectionFace reflectionFaceFromFile(const format::ConusFile& file);
+// The six faces as one asset file's contents (each face codec/conus_file.h's makeDepthImageFile,
+// units "world"; the frame the first face's eye and the world's axes), and back. Throws
+// conus::Error(InvalidArgument) for other than six faces.
+format::ReflectionAssetFile reflectionAssetFile(const std::vector<ReflectionFace>& faces);
+std::vector<ReflectionFace> reflectionFaces(const format::ReflectionAssetFile& asset);
+// The faces of the asset file at `path` (format::readReflectionAsset). A folder (of face files,
+// say) is refused with conus::Error(Unsupported) saying how to bake the one file.
+std::vector<ReflectionFace> readReflectionFaces(const std::string& path);
 
 using conus::AxisBox;  // core/bounds.h
 
