@@ -62,34 +62,44 @@ struct AssimpLog : Assimp::LogStream {
 };
 std::mutex assimpLogMutex;
 
+// Assimp's text importers (PLY headers, OBJ, MTL) end a line at any of \n \r \0 \f and skip empty
+// lines; the checks below read files the same way. The first `limit` bytes of `path`, in lines.
+class AssimpLines {
+public:
+    AssimpLines(const std::string& path, std::uintmax_t limit) {
+        std::ifstream in(path, std::ios::binary);
+        m_text.resize(static_cast<std::size_t>(limit));
+        in.read(m_text.data(), static_cast<std::streamsize>(m_text.size()));
+        m_text.resize(static_cast<std::size_t>(std::max<std::streamsize>(0, in.gcount())));
+    }
+    bool next(std::string& line) {
+        const auto end = [](char c) { return c == '\n' || c == '\r' || c == '\0' || c == '\f'; };
+        while (m_at < m_text.size() && end(m_text[m_at])) ++m_at;
+        if (m_at >= m_text.size()) return false;
+        const std::size_t start = m_at;
+        while (m_at < m_text.size() && !end(m_text[m_at])) ++m_at;
+        line.assign(m_text, start, m_at - start);
+        return true;
+    }
+
+private:
+    std::string m_text;
+    std::size_t m_at = 0;
+};
+
 // PLY headers declare their element counts up front and Assimp reserves memory for them before
 // reading a single vertex; a count no file of this size can hold (every element takes at least a
 // byte) or one past the caps is refused here, before Assimp sees the file.
 void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
-    // Assimp reads a PLY header as lines ended by any of \n \r \0 \f, skips empty ones, and takes
-    // a file whose first line starts with the three letters ("ply@" included) whatever its name:
-    // a .glb or .gltf its own importer refuses is tried as a PLY. The header is read the same way.
-    constexpr std::size_t kHeaderBytes = 1 << 20;
-    std::ifstream in(path, std::ios::binary);
-    std::string head(static_cast<std::size_t>(std::min<std::uintmax_t>(bytes, kHeaderBytes)), '\0');
-    in.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(std::max<std::streamsize>(0, in.gcount())));
-    const auto lineEnd = [](char c) { return c == '\n' || c == '\r' || c == '\0' || c == '\f'; };
-    std::size_t at = 0;
-    const auto nextLine = [&](std::string& line) {
-        while (at < head.size() && lineEnd(head[at])) ++at;
-        if (at >= head.size()) return false;
-        const std::size_t start = at;
-        while (at < head.size() && !lineEnd(head[at])) ++at;
-        line.assign(head, start, at - start);
-        return true;
-    };
+    // Assimp takes a file whose first line starts with the three letters ("ply@" included) as a
+    // PLY whatever its name: a .glb or .gltf its own importer refuses is tried as one.
+    AssimpLines lines(path, std::min<std::uintmax_t>(bytes, 1 << 20));
     std::string line;
-    if (!nextLine(line) || line.size() < 3) return;
+    if (!lines.next(line) || line.size() < 3) return;
     std::string magic = line.substr(0, 3);
     for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (magic != "ply") return;
-    for (int n = 0; n < 10000 && nextLine(line); ++n) {
+    for (int n = 0; n < 10000 && lines.next(line); ++n) {
         while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
         if (line == "end_header") return;
         std::istringstream words(line);
@@ -147,6 +157,37 @@ void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
         if (counts[i] > static_cast<long double>(caps[i]))
             fail(ErrorCode::LimitExceeded, path, "its OFF header declares " + numberText(double(counts[i])) + " " +
                                                      names[i] + ", more than the limit of " + std::to_string(caps[i]));
+    }
+}
+
+// An OBJ's material libraries (its `mtllib` lines): Assimp's MTL reader dereferences the material
+// being defined, and dies on a statement before the library's first `newmtl` (`map_d x.png` in a
+// library, or an OBJ naming itself). Such a library is refused before Assimp reads the OBJ.
+void checkMaterialLibraries(const std::string& path, std::uintmax_t bytes) {
+    AssimpLines obj(path, bytes);
+    const auto trimmed = [](std::string text) {
+        const auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+        while (!text.empty() && space(text.back())) text.pop_back();
+        std::size_t first = 0;
+        while (first < text.size() && space(text[first])) ++first;
+        return text.substr(first);
+    };
+    for (std::string line; obj.next(line);) {
+        line = trimmed(line);
+        if (line.rfind("mtllib", 0) != 0 || line.size() < 7 || !std::isspace(static_cast<unsigned char>(line[6]))) continue;
+        const fs::path named(trimmed(line.substr(7)));
+        const fs::path library = named.is_absolute() ? named : fs::path(path).parent_path() / named;
+        std::error_code ec;
+        if (!fs::is_regular_file(library, ec)) continue;  // missing: Assimp goes on without it; elsewhere: the policy says
+        AssimpLines mtl(library.string(), std::min<std::uintmax_t>(fs::file_size(library, ec), kMaxNamedFileBytes));
+        for (std::string statement; mtl.next(statement);) {
+            statement = trimmed(statement);
+            if (statement.empty() || statement[0] == '#') continue;
+            if (statement.rfind("newmtl", 0) == 0) break;
+            fail(ErrorCode::Corrupt, path, "its material library '" + named.string() + "' has '" +
+                                               statement.substr(0, std::min<std::size_t>(statement.find(' '), 24)) +
+                                               "' before its first newmtl");
+        }
     }
 }
 
@@ -289,6 +330,7 @@ void checkFile(const std::string& path, const MeshReadOptions& options) {
     checkPlyCounts(path, bytes, options);
     checkOffCounts(path, bytes, options);
     checkGlbLengths(path, bytes);
+    checkMaterialLibraries(path, bytes);
 }
 
 // glTF states its vertex colours in linear light; the older formats (PLY, OBJ extensions, OFF)

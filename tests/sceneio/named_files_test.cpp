@@ -185,6 +185,22 @@ TEST_F(NamedFilesTest, APlyHeaderBehindLineEndsIsCheckedWhateverTheName) {
     EXPECT_EQ(readMesh(scene("fine.ply", fine)).indices.size(), 3u);
 }
 
+// Assimp's MTL reader died (SIGSEGV) on a statement before a library's first newmtl, whether the
+// library was a .mtl or the OBJ itself (the mesh harness found the second on a GPU machine's cores).
+TEST_F(NamedFilesTest, AMaterialLibraryWithAStatementBeforeNewmtlIsRefused) {
+    const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    scene("early.mtl", "# made by hand\n\nmap_d x.png\nnewmtl red\n");
+    Refusal r = refusal([&] { readMesh(scene("early.obj", "mtllib early.mtl\n" + triangle)); });
+    EXPECT_EQ(r.code, ErrorCode::Corrupt) << r.message;
+    EXPECT_TRUE(contains(r.message, "material library 'early.mtl' has 'map_d' before its first newmtl")) << r.message;
+    r = refusal([&] { readMesh(scene("self.obj", std::string("mtllib self.obj") + '\0' + "map_d\n" + triangle)); });
+    EXPECT_TRUE(contains(r.message, "material library 'self.obj' has 'mtllib' before its first newmtl")) << r.message;
+    // Comments and blank lines may come first; a missing library is Assimp's to go on without.
+    scene("good.mtl", "# made by hand\r\n\r\nnewmtl red\nKd 1 0 0\nmap_d x.png\n");
+    EXPECT_EQ(readMesh(scene("good.obj", "mtllib good.mtl\n" + triangle)).indices.size(), 3u);
+    EXPECT_EQ(readMesh(scene("gone.obj", "mtllib gone.mtl\n" + triangle)).indices.size(), 3u);
+}
+
 TEST_F(NamedFilesTest, ExactDuplicateTrianglesAreDroppedAndCounted) {
     // One triangle in 50 copies (some reversed, some through repeated vertices) and one other.
     std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 5 5 5\n";
