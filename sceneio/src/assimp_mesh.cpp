@@ -90,6 +90,20 @@ private:
 // PLY headers declare their element counts up front and Assimp reserves memory for them before
 // reading a single vertex; a count no file of this size can hold (every element takes at least a
 // byte) or one past the caps is refused here, before Assimp sees the file.
+// A PLY header's format and property lines as the spec has them: Assimp's reader loops on a list
+// whose type it does not know, and on a format it does not know.
+void checkPlyLine(const std::string& path, const std::string& keyword, std::istringstream& words) {
+    static const std::set<std::string> kTypes = {"char",  "uchar",  "short", "ushort", "int",    "uint",
+                                                 "float", "double", "int8",  "uint8",  "int16",  "uint16",
+                                                 "int32", "uint32", "float32", "float64"};
+    std::string a, b, c, d;
+    words >> a >> b >> c >> d;
+    const bool ok = keyword == "format"
+                        ? (a == "ascii" || a == "binary_little_endian" || a == "binary_big_endian") && b == "1.0" && c.empty()
+                        : a == "list" ? kTypes.count(b) && kTypes.count(c) && !d.empty() : kTypes.count(a) && !b.empty() && c.empty();
+    if (!ok) fail(ErrorCode::Corrupt, path, "its PLY header has a " + keyword + " line the format does not define");
+}
+
 void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
     // Assimp takes a file whose first line starts with the three letters ("ply@" included) as a
     // PLY whatever its name: a .glb or .gltf its own importer refuses is tried as one.
@@ -111,6 +125,7 @@ void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
             keyword != "obj_info")
             fail(ErrorCode::Corrupt, path, "its PLY header has a line that is not format, element, property, comment "
                                            "or end_header");
+        if (keyword == "format" || keyword == "property") checkPlyLine(path, keyword, words);
         if (!(words >> element >> count) || keyword != "element") continue;
         const std::int64_t cap = element == "vertex" ? options.maxVertices : element == "face" ? options.maxTriangles : -1;
         if (count > static_cast<long double>(bytes))

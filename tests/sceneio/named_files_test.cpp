@@ -178,6 +178,12 @@ TEST_F(NamedFilesTest, APlyHeaderBehindLineEndsIsCheckedWhateverTheName) {
         EXPECT_EQ(r.code, ErrorCode::Corrupt) << name << ": " << r.message;
         EXPECT_TRUE(contains(r.message, "its PLY header has a line that is not")) << name << ": " << r.message;
     }
+    // A list of a type the format does not define held Assimp's reader too; so would a format 2.0.
+    const std::string list = "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar\xf0\x90 vertex_indices\n"
+                             "end_header\n8 0 0\n";
+    EXPECT_TRUE(contains(refusal([&] { readMesh(scene("list.ply", list)); }).message, "a property line the format"));
+    const std::string format = "ply\nformat ascii 2.0\nelement vertex 1\nproperty float x\nend_header\n0\n";
+    EXPECT_TRUE(contains(refusal([&] { readMesh(scene("format.ply", format)); }).message, "a format line the format"));
     // A whole header with \r\n line ends still reads.
     const std::string fine = "ply\r\nformat ascii 1.0\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\n"
                              "property float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\n"
