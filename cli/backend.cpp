@@ -12,7 +12,10 @@ void addBackendOption(CLI::App& command, std::string& backend, renderers::CpuPat
             ->check(CLI::IsMember(enumNames({renderers::Backend::Auto, renderers::Backend::Egl, renderers::Backend::OsMesa}), CLI::ignore_case));
         return;
     }
-    command.add_option("--backend", backend, "what runs the work; " + automatic + ": a GPU when there is one, else the CPU")
+    const std::string rule = cpuPath == renderers::CpuPath::Faster
+                                 ? ": the CPU (measured faster than a GPU at this work; egl and osmesa ask for GL)"
+                                 : ": a GPU when there is one, else the CPU";
+    command.add_option("--backend", backend, "what runs the work; " + automatic + rule)
         ->default_val(automatic)
         ->check(CLI::IsMember(enumNames<renderers::Backend>(), CLI::ignore_case));
 }

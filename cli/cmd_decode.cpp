@@ -141,7 +141,7 @@ std::string decodeOne(const DecodeCommandOptions& o, const std::string& input, c
     }
     Progress progress("decode " + std::to_string(decode.width) + "x" + std::to_string(decode.height));
     decode.progress = progress.callback();
-    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Available, "decoding");
+    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Faster, "decoding");
     codec::ImagePyramid pyramid;
     if (withPyramid) {
         pyramid = codec::buildPyramid(file.image);
@@ -182,7 +182,7 @@ CLI::App* declareDecode(CLI::App& root, DecodeCommandOptions& options) {
                         "height fields: render a 3-D frame from x,y,z,lx,ly,lz,fovDeg (eye, look-at, vertical fov; "
                         "world metres) instead of a 2-D view; 'viewer' is the ground map's own viewer");
     addPictureOptions(*command, options.picture);
-    addBackendOption(*command, options.backend);
+    addBackendOption(*command, options.backend, renderers::CpuPath::Faster);
     return command;
 }
 

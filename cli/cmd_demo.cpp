@@ -156,7 +156,7 @@ int runDemo(const DemoOptions& o) {
     const DemoMap built = demoMap(o, source, size);
     const codec::SamplingMap& map = *built.map;
 
-    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Available, "the demo");
+    const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Faster, "the demo");
     const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
     const format::ConusFile conus = encodeToConus(device, source.image, source.encoding, map, size, built.analytic);
     const format::ConusFile uniform = encodeToConus(device, source.image, source.encoding, identity, size, std::nullopt);
@@ -217,7 +217,7 @@ CLI::App* declareDemo(CLI::App& root, DemoOptions& options) {
     command->add_option("--importance", options.importance,
                         "with --input: build the map automatically from importance (a file, 'detail' or 'faces') "
                         "instead of foci; --focus then only names the views to compare");
-    addBackendOption(*command, options.backend);
+    addBackendOption(*command, options.backend, renderers::CpuPath::Faster);
     return command;
 }
 

@@ -139,7 +139,7 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size);
     else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, &given);
     else built = mapFromOwnDetail(o, source.image, size, &given);
-    const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Available, "encoding");
+    const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Faster, "encoding");
     std::string fitNote;
     format::ConusFile file =
         encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);

@@ -24,7 +24,7 @@ int runUniform(const UniformOptions& o) {
     checkConusOutput(o.output, o.input);
     const imageio::ImageFile source = readSource(o.input, o.source);
     const Size size = conusSize(o.storage, source.image);
-    const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Available, "encoding");
+    const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Faster, "encoding");
     std::string fitNote;
     format::ConusFile file = encodeToConus(device, source.image, source.info.encoding,
                                            codec::SamplingMap::identity(2, 2), size, std::nullopt, o.fit, &fitNote);

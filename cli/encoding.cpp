@@ -24,7 +24,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
                      "store colour channels as 32-bit float (default for 16-bit and float sources)")
         ->excludes(half);
     addCompressionOption(command, options.compression);
-    addBackendOption(command, options.backend);
+    addBackendOption(command, options.backend, renderers::CpuPath::Faster);
 }
 
 Size conusSize(const StorageOptions& options, const Image& source) {

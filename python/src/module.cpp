@@ -128,7 +128,7 @@ const renderers::Device& deviceFor(const std::string& backend) {
     static std::map<std::string, renderers::Device> devices;
     auto it = devices.find(backend);
     if (it == devices.end())
-        it = devices.emplace(backend, renderers::Device::choose(enumArgument<renderers::Backend>(backend, "backend"), renderers::CpuPath::Available, "image encode")).first;
+        it = devices.emplace(backend, renderers::Device::choose(enumArgument<renderers::Backend>(backend, "backend"), renderers::CpuPath::Faster, "image encode and decode")).first;
     return it->second;
 }
 

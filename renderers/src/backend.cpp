@@ -40,6 +40,7 @@ Device Device::choose(Backend requested, CpuPath cpuPath, const std::string& wor
             throw Error(ErrorCode::InvalidArgument, work + " needs GL (it has no CPU path): use --backend auto, egl or osmesa");
         return cpu();
     }
+    if (requested == Backend::Auto && cpuPath == CpuPath::Faster) return cpu();
     if (requested != Backend::Auto || cpuPath == CpuPath::None)
         return on(Context::create(requested));  // asked for by name, or GL is the only way: its failure is an error
     if (!mayHaveHardwareGpu()) return cpu();

@@ -188,6 +188,10 @@ TEST(Device, TheOneDispatchChoosesByTheOrderedListAndTheSoftwareRule) {
     const Device automatic = Device::choose(Backend::Auto, CpuPath::Available, "encoding");
     EXPECT_EQ(automatic.onGpu(), !prefersCpu(needsGl.context()));
     EXPECT_EQ(automatic.describe() == "cpu", !automatic.onGpu());
+    // auto where the CPU path measured faster than any GPU (image encode, decode): the CPU, with GL
+    // working beside it; GL by name still GL.
+    EXPECT_FALSE(Device::choose(Backend::Auto, CpuPath::Faster, "decoding").onGpu());
+    EXPECT_EQ(Device::choose(Backend::OsMesa, CpuPath::Faster, "decoding").backend(), Backend::OsMesa);
     // No GL at all: auto falls back to the CPU where it can, and says why where it cannot.
     ScopedEnv off("CONUS_GL_DISABLE", "egl,osmesa");
     EXPECT_FALSE(Device::choose(Backend::Auto, CpuPath::Available, "encoding").onGpu());

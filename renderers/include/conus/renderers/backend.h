@@ -1,10 +1,13 @@
 // Where work runs, decided in one place.
 //
 // The ordered list: EGL (hardware devices first, then Mesa's software device, then surfaceless),
-// then OSMesa, then the CPU reference in conus::codec. `auto` takes the first that works, with one
-// rule: on a software rasterizer (llvmpipe, softpipe, swrast), work that has a CPU path runs there
-// instead, since the CPU reference measured several times faster (bench/README.md). Work without
-// a CPU path (terrain rendering) needs GL on any rasterizer, and asking for the CPU is refused.
+// then OSMesa, then the CPU reference in conus::codec. `auto` takes the first that works, with two
+// rules: on a software rasterizer (llvmpipe, softpipe, swrast), work that has a CPU path runs there
+// instead, since the CPU reference measured several times faster (bench/README.md); and work whose
+// CPU path measured faster than a hardware GPU too (image encode and decode: the upload of a
+// host-resident image costs more than the CPU's whole pass, bench/notes/2026-11-27-gpu-h200.md)
+// runs on the CPU unless GL is asked for by name. Work without a CPU path (terrain rendering)
+// needs GL on any rasterizer, and asking for the CPU is refused.
 //
 // A GPU path and its CPU reference are registered once, where the work is declared, through
 // Device::run (gpu_image.h's encodeImage / decodeImage are the pattern to follow).
@@ -18,7 +21,9 @@
 
 namespace conus::renderers {
 
-enum class CpuPath { Available, None };
+// Available: `auto` takes a hardware GPU when there is one. Faster: `auto` takes the CPU (GL only
+// by name). None: GL only.
+enum class CpuPath { Available, Faster, None };
 
 class Device {
 public:
