@@ -175,35 +175,51 @@ void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
     }
 }
 
-// An OBJ's material libraries (its `mtllib` lines): Assimp's MTL reader dereferences the material
-// being defined, and dies on a statement before the library's first `newmtl` (`map_d x.png` in a
-// library, or an OBJ naming itself). Such a library is refused before Assimp reads the OBJ.
-void checkMaterialLibraries(const std::string& path, std::uintmax_t bytes) {
+std::string trimmed(std::string text) {
+    const auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+    while (!text.empty() && space(text.back())) text.pop_back();
+    std::size_t first = 0;
+    while (first < text.size() && space(text[first])) ++first;
+    return text.substr(first);
+}
+
+// Assimp's MTL reader dereferences the material being defined, and dies (SIGSEGV) on a statement
+// before a library's first `newmtl`. The first such statement's keyword in `library`, or "".
+std::string statementBeforeNewmtl(const fs::path& library) {
+    std::error_code ec;
+    if (!fs::is_regular_file(library, ec)) return {};
+    AssimpLines mtl(library.string(), std::min<std::uintmax_t>(fs::file_size(library, ec), kMaxNamedFileBytes));
+    for (std::string statement; mtl.next(statement);) {
+        statement = trimmed(statement);
+        if (statement.empty() || statement[0] == '#') continue;
+        if (statement.rfind("newmtl", 0) == 0) return {};
+        return statement.substr(0, std::min<std::size_t>(statement.find(' '), 24));
+    }
+    return {};
+}
+
+std::string materialRefusal(const std::string& path, const std::string& named, const std::string& statement) {
+    return "mesh '" + path + "': its material library '" + named + "' has '" + statement + "' before its first newmtl";
+}
+
+// An OBJ's material libraries (its `mtllib` lines), as Assimp joins them to the scene's folder
+// ("./" for none) as strings ("/m.mtl" is inside the folder): a library with a statement before
+// its first newmtl is refused before Assimp reads the OBJ (an OBJ naming itself included). Every
+// other file Assimp opens while such an OBJ is read is checked the same way (PolicyIoSystem).
+// Whether the scene names material libraries at all.
+bool checkMaterialLibraries(const std::string& path, std::uintmax_t bytes) {
+    const std::string folder = path.substr(0, path.find_last_of("\\/") + 1);
     AssimpLines obj(path, bytes);
-    const auto trimmed = [](std::string text) {
-        const auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
-        while (!text.empty() && space(text.back())) text.pop_back();
-        std::size_t first = 0;
-        while (first < text.size() && space(text[first])) ++first;
-        return text.substr(first);
-    };
+    bool names = false;
     for (std::string line; obj.next(line);) {
         line = trimmed(line);
         if (line.rfind("mtllib", 0) != 0 || line.size() < 7 || !std::isspace(static_cast<unsigned char>(line[6]))) continue;
-        const fs::path named(trimmed(line.substr(7)));
-        const fs::path library = named.is_absolute() ? named : fs::path(path).parent_path() / named;
-        std::error_code ec;
-        if (!fs::is_regular_file(library, ec)) continue;  // missing: Assimp goes on without it; elsewhere: the policy says
-        AssimpLines mtl(library.string(), std::min<std::uintmax_t>(fs::file_size(library, ec), kMaxNamedFileBytes));
-        for (std::string statement; mtl.next(statement);) {
-            statement = trimmed(statement);
-            if (statement.empty() || statement[0] == '#') continue;
-            if (statement.rfind("newmtl", 0) == 0) break;
-            fail(ErrorCode::Corrupt, path, "its material library '" + named.string() + "' has '" +
-                                               statement.substr(0, std::min<std::size_t>(statement.find(' '), 24)) +
-                                               "' before its first newmtl");
-        }
+        names = true;
+        const std::string named = trimmed(line.substr(7));
+        const std::string statement = statementBeforeNewmtl((folder.empty() ? std::string("./") : folder) + named);
+        if (!statement.empty()) throw Error(ErrorCode::Corrupt, materialRefusal(path, named, statement));
     }
+    return names;
 }
 
 // A binary glTF's header and chunk lengths, which Assimp allocates by: each inside the file.
@@ -289,7 +305,8 @@ private:
 // instead of going on without the file.
 class PolicyIoSystem : public Assimp::DefaultIOSystem {
 public:
-    PolicyIoSystem(std::string scene, const NamedFiles& named) : m_scene(std::move(scene)), m_named(named) {}
+    PolicyIoSystem(std::string scene, const NamedFiles& named, bool materialLibraries)
+        : m_scene(std::move(scene)), m_named(named), m_materialLibraries(materialLibraries) {}
     ~PolicyIoSystem() override {
         while (!m_open.empty()) delete *m_open.begin();
     }
@@ -306,6 +323,7 @@ public:
     }
     void Close(Assimp::IOStream* stream) override { delete stream; }
     const std::string& refusal() const { return m_refusal; }
+    ErrorCode refusalCode() const { return m_refusalCode; }
 
 private:
     // The path to open, or "" (a missing file is simply missing; a refusal is remembered).
@@ -318,20 +336,30 @@ private:
             if (static_cast<std::int64_t>(fs::file_size(resolved, ec)) > kMaxNamedFileBytes || ec)
                 throw Error(ErrorCode::LimitExceeded, "mesh '" + m_scene + "': names '" + file + "', larger than the limit of " +
                                                           std::to_string(kMaxNamedFileBytes) + " bytes");
+            // A scene that names material libraries is read as an OBJ: what Assimp opens for it
+            // (a library, or its fallback) is a library to Assimp's MTL reader.
+            const std::string statement = m_materialLibraries ? statementBeforeNewmtl(resolved) : std::string();
+            if (!statement.empty()) throw Error(ErrorCode::Corrupt, materialRefusal(m_scene, file, statement));
             return resolved;
         } catch (const Error& e) {
-            if (m_refusal.empty()) m_refusal = e.what();
+            if (m_refusal.empty()) {
+                m_refusal = e.what();
+                m_refusalCode = e.code();
+            }
             return {};
         }
     }
 
     std::string m_scene;
     const NamedFiles& m_named;
+    bool m_materialLibraries;
     mutable std::string m_refusal;
+    mutable ErrorCode m_refusalCode = ErrorCode::Io;
     std::set<TrackedStream*> m_open;
 };
 
-void checkFile(const std::string& path, const MeshReadOptions& options) {
+// Returns whether the scene names material libraries (checkMaterialLibraries).
+bool checkFile(const std::string& path, const MeshReadOptions& options) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);
     if (ec || !fs::exists(status)) fail(ErrorCode::Io, path, "no such file");
@@ -345,7 +373,7 @@ void checkFile(const std::string& path, const MeshReadOptions& options) {
     checkPlyCounts(path, bytes, options);
     checkOffCounts(path, bytes, options);
     checkGlbLengths(path, bytes);
-    checkMaterialLibraries(path, bytes);
+    return checkMaterialLibraries(path, bytes);
 }
 
 // glTF states its vertex colours in linear light; the older formats (PLY, OBJ extensions, OFF)
@@ -427,12 +455,12 @@ std::int64_t dropDuplicateTriangles(Mesh& mesh) {
 
 Mesh readMesh(const std::string& path, const MeshReadOptions& options, MeshReadReport* report) {
     MeshReadReport counts;
-    checkFile(path, options);
+    const bool materialLibraries = checkFile(path, options);
 
     const NamedFiles named(path, options.allowedDirs, "mesh '" + path + "'");
     checkGltfUris(path, named);
     Assimp::Importer importer;
-    auto* io = new PolicyIoSystem(path, named);
+    auto* io = new PolicyIoSystem(path, named, materialLibraries);
     importer.SetIOHandler(io);  // the importer owns it
     // Points and lines are not surfaces: SortByPType drops them.
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -455,7 +483,7 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options, MeshReadR
         if (created) Assimp::DefaultLogger::kill();
     }
     if (!thrown.empty()) fail(ErrorCode::Corrupt, path, thrown);
-    if (!io->refusal().empty()) throw Error(ErrorCode::Io, io->refusal());
+    if (!io->refusal().empty()) throw Error(io->refusalCode(), io->refusal());
     if (scene && log.text.find("out-of-range indices") != std::string::npos)
         fail(ErrorCode::Corrupt, path, "a face indexes past its mesh's vertices");
     if (!scene) {
