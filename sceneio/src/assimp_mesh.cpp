@@ -87,9 +87,6 @@ private:
     std::size_t m_at = 0;
 };
 
-// PLY headers declare their element counts up front and Assimp reserves memory for them before
-// reading a single vertex; a count no file of this size can hold (every element takes at least a
-// byte) or one past the caps is refused here, before Assimp sees the file.
 // A PLY header's format and property lines as the spec has them: Assimp's reader loops on a list
 // whose type it does not know, and on a format it does not know.
 void checkPlyLine(const std::string& path, const std::string& keyword, std::istringstream& words) {
@@ -104,6 +101,9 @@ void checkPlyLine(const std::string& path, const std::string& keyword, std::istr
     if (!ok) fail(ErrorCode::Corrupt, path, "its PLY header has a " + keyword + " line the format does not define");
 }
 
+// PLY headers declare their element counts up front and Assimp reserves memory for them before
+// reading a single vertex; a count no file of this size can hold (every element takes at least a
+// byte) or one past the caps is refused here, before Assimp sees the file.
 void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
     // Assimp takes a file whose first line starts with the three letters ("ply@" included) as a
     // PLY whatever its name: a .glb or .gltf its own importer refuses is tried as one.
@@ -206,7 +206,7 @@ std::string materialRefusal(const std::string& path, const std::string& named, c
 // ("./" for none) as strings ("/m.mtl" is inside the folder): a library with a statement before
 // its first newmtl is refused before Assimp reads the OBJ (an OBJ naming itself included). Every
 // other file Assimp opens while such an OBJ is read is checked the same way (PolicyIoSystem).
-// Whether the scene names material libraries at all.
+// Returns whether the scene names material libraries at all.
 bool checkMaterialLibraries(const std::string& path, std::uintmax_t bytes) {
     const std::string folder = path.substr(0, path.find_last_of("\\/") + 1);
     AssimpLines obj(path, bytes);
