@@ -63,28 +63,28 @@ struct AssimpLog : Assimp::LogStream {
 std::mutex assimpLogMutex;
 
 // Assimp's text importers (PLY headers, OBJ, MTL) end a line at any of \n \r \0 \f and skip empty
-// lines; the checks below read files the same way. The first `limit` bytes of `path`, in lines.
+// lines; the checks below read files the same way: the first `limit` bytes of `path`, a line at a
+// time, streamed (a check that stops at its first statement reads no further).
 class AssimpLines {
 public:
-    AssimpLines(const std::string& path, std::uintmax_t limit) {
-        std::ifstream in(path, std::ios::binary);
-        m_text.resize(static_cast<std::size_t>(limit));
-        in.read(m_text.data(), static_cast<std::streamsize>(m_text.size()));
-        m_text.resize(static_cast<std::size_t>(std::max<std::streamsize>(0, in.gcount())));
-    }
+    AssimpLines(const std::string& path, std::uintmax_t limit) : m_in(path, std::ios::binary), m_left(limit) {}
     bool next(std::string& line) {
-        const auto end = [](char c) { return c == '\n' || c == '\r' || c == '\0' || c == '\f'; };
-        while (m_at < m_text.size() && end(m_text[m_at])) ++m_at;
-        if (m_at >= m_text.size()) return false;
-        const std::size_t start = m_at;
-        while (m_at < m_text.size() && !end(m_text[m_at])) ++m_at;
-        line.assign(m_text, start, m_at - start);
-        return true;
+        const auto end = [](int c) { return c == '\n' || c == '\r' || c == '\0' || c == '\f'; };
+        line.clear();
+        for (int c; m_left > 0 && (c = m_in.rdbuf()->sbumpc()) != std::ifstream::traits_type::eof(); --m_left) {
+            if (!end(c)) {
+                line += static_cast<char>(c);
+            } else if (!line.empty()) {
+                --m_left;
+                return true;
+            }
+        }
+        return !line.empty();
     }
 
 private:
-    std::string m_text;
-    std::size_t m_at = 0;
+    std::ifstream m_in;
+    std::uintmax_t m_left;
 };
 
 // A PLY header's format and property lines as the spec has them: Assimp's reader loops on a list
