@@ -101,11 +101,11 @@ int runBakeRelief(const BakeOptions& o) {
             codec::FociOptions fo;
             fo.columns = fo.rows = o.grid;
             fo.aspect = double(source.heights.width) / source.heights.height;
-            fo.falloff = codec::parseFalloff(kDefaultFalloff);
             // The budget of `encode --focus`, on the asset's colour: the rest of the field keeps its samples.
             const int side = 256;
             const codec::FrameErrorModel model(source.colour, size.width, size.height,
-                                               codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))));
+                                               codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))),
+                                               codec::FrameModelOptions{codec::ErrorSpace::Display, 0});  // the asset is not fitted
             codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, codec::kDefaultFrameLoss, o.exactK);
             const std::string said = describeFociBudget(
                 budget, BudgetFrame{size.width, size.height, source.heights.width, source.heights.height, codec::kDefaultFrameLoss},

@@ -93,6 +93,9 @@ struct DemoMap {
     std::optional<format::AnalyticMap> analytic;
 };
 
+// The demo encodes without the fit, and so do its budget's trials.
+constexpr codec::FrameModelOptions kDemoTrials{codec::ErrorSpace::Display, 0};
+
 // From importance (its hottest region becomes the view when no focus names one), else the foci;
 // under encode's default frame-loss budget, so the demo shows what `conus encode` gives.
 DemoMap demoMap(const DemoOptions& o, DemoSource& source, const Size& size) {
@@ -102,16 +105,21 @@ DemoMap demoMap(const DemoOptions& o, DemoSource& source, const Size& size) {
     std::string said;
     if (!o.importance.empty()) {
         const Image importance = importanceFrom(o.importance, source.image);
-        const codec::FrameErrorModel model(source.image, size.width, size.height, importance);
+        const codec::FrameErrorModel model(source.image, size.width, size.height, importance, kDemoTrials);
         m.map = codec::buildAutoMapForFrameLoss(importance, model, codec::kDefaultFrameLoss, {}, codec::kDefaultTileLoss).map;
         if (o.foci.empty()) source.foci = {hottestRegion(importance, w, h)};
     } else {
         codec::FociOptions fociOptions;
         fociOptions.aspect = double(w) / h;
+        // As `encode`: away from the foci the samples follow the picture's own detail.
+        const codec::DensityField context =
+            codec::ownDetailContext(source.image, importanceFrom("detail", source.image), size.width, size.height, {}, kDemoTrials);
+        fociOptions.context = &context;
         const int side = 256;
         const codec::FrameErrorModel model(
             source.image, size.width, size.height,
-            codec::fociImportance(source.foci, fociOptions.aspect, side, std::max(1, static_cast<int>(side / fociOptions.aspect))));
+            codec::fociImportance(source.foci, fociOptions.aspect, side, std::max(1, static_cast<int>(side / fociOptions.aspect))),
+            kDemoTrials);
         codec::FociBudget budget = codec::fociForFrameLoss(source.foci, fociOptions, model);
         said = describeFociBudget(budget, BudgetFrame{size.width, size.height, w, h}, false, fociOptions.columns);
         source.foci = budget.given;

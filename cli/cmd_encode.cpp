@@ -28,7 +28,7 @@ namespace {
 struct EncodeOptions {
     BatchOptions batch;
     std::string mapFile, compose = enumName(format::FociComposition::Density), importance,
-        method = enumName(codec::AutoMethod::Flow), falloff = kDefaultFalloff;
+        method = enumName(codec::AutoMethod::Flow), falloff = defaultFalloffText();
     double minDensity = 0.25, maxDensity = 16, maxAnisotropy = 0;
     double frameLoss = codec::kDefaultFrameLoss;  // dB, predicted; --min-density instead sets an importance map's floor
     bool floorGiven = false;  // --min-density: no budget for importance maps
@@ -64,7 +64,7 @@ BuiltMap mapFromFile(const std::string& path, const Image& source) {
     return {std::make_unique<codec::SamplingMap>(codec::SamplingMap::fromGrid(mapSource.map)), mapSource.analytic};
 }
 
-BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size) {
+BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials) {
     Progress progress("build sampling map from " + o.importance + " importance");
     codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
     const Image importance = importanceFrom(o.importance, source);
@@ -73,8 +73,15 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
         progress.done();
         return built;
     }
-    // The budget chooses the context floor; say what it achieved.
-    const codec::FrameErrorModel model(source, size.width, size.height, importance);
+    // The budget chooses the context floor; say what it achieved. Apart from the importance the
+    // samples follow the picture's own detail, as with no importance at all (`detail` is that already).
+    codec::DensityField context;
+    if (o.importance != "detail") {
+        context = codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height,
+                                          autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method), trials);
+        autoOptions.context = &context;
+    }
+    const codec::FrameErrorModel model(source, size.width, size.height, importance, trials);
     codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions, codec::kDefaultTileLoss);
     progress.done();
     if (!quiet())
@@ -86,7 +93,7 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
 
 // The foci's map under the frame-loss budget (foci_budget.h): says, before the work, what the foci
 // take and the k each got; `given` receives that k for the line that says what was written.
-BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& size, std::string* given) {
+BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials, std::string* given) {
     const std::vector<codec::Focus> foci = parseFoci(o.foci);
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
@@ -95,9 +102,14 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     fo.composition = parseEnum<format::FociComposition>(o.compose);
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
+    // Away from the foci the samples follow the picture's own detail, as with no focus at all.
+    const codec::DensityField context =
+        codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height,
+                                autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method), trials);
+    fo.context = &context;
     const int side = 256;
     const codec::FrameErrorModel model(source, size.width, size.height,
-                                       codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))));
+                                       codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))), trials);
     codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, o.frameLoss, o.exactK);
     progress.done();
     const std::string said =
@@ -110,10 +122,10 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
 
 // No focus, map or importance: the samples follow the picture's own detail, with the context floor
 // the model predicts gains most over the whole frame (frame_budget.h), said once per batch.
-BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, std::string* given) {
+BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials, std::string* given) {
     Progress progress("build sampling map from the picture's detail");
     codec::BudgetResult r = codec::buildOwnDetailMap(source, importanceFrom("detail", source), size.width, size.height,
-                                                     autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method));
+                                                     autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method), trials);
     progress.done();
     static std::once_flag once;  // once per batch, not per file
     std::call_once(once, [] {
@@ -135,10 +147,14 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     if (!o.importance.empty() || !o.foci.empty()) checkGridForImage(o.grid, size.width, size.height);
     BuiltMap built;
     std::string given;
+    // The budgets' trial encodes are this encode's, measured on what a user sees: colour through the
+    // display's curve, raw data as stored.
+    const codec::FrameModelOptions trials{
+        source.info.encoding.transfer == Transfer::Raw ? codec::ErrorSpace::Linear : codec::ErrorSpace::Display, o.fit.count(), o.fit.hold};
     if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image);
-    else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size);
-    else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, &given);
-    else built = mapFromOwnDetail(o, source.image, size, &given);
+    else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, trials);
+    else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, trials, &given);
+    else built = mapFromOwnDetail(o, source.image, size, trials, &given);
     const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Faster, "encoding");
     std::string fitNote;
     format::ConusFile file =

@@ -236,7 +236,7 @@ void runGround(const GroundOptions& o) {
 
 struct FociOptions {
     std::vector<std::string> foci;
-    std::string composition = enumName(format::FociComposition::Density), falloff = kDefaultFalloff;
+    std::string composition = enumName(format::FociComposition::Density), falloff = defaultFalloffText();
     int grid = map_rules::kDefaultSide;
     double aspect = 1.0, maxAnisotropy = 0;
     bool exactK = false;

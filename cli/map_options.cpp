@@ -37,6 +37,9 @@ codec::FociOptions frameFociOptions(int grid, const std::string& compose, double
     options.columns = options.rows = grid;
     options.aspect = aspect;
     options.composition = parseEnum<format::FociComposition>(compose);
+    // The rendered frames keep the r..2r ring: the narrow default was measured on photographs
+    // (bench/notes/2026-11-27-narrow-transitions.md), not on renders, whose figures are the ring's.
+    options.falloff = codec::kFormatFalloff;
     return options;
 }
 
@@ -136,12 +139,13 @@ void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy) {
         ->check(finiteRange(1.0, 1e6, true, true));
 }
 
+std::string defaultFalloffText() { return codec::falloffText(codec::FociFalloff{}); }
+
 CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff) {
     return command.add_option("--falloff", falloff,
                        "how a focus's density falls to the context's: WIDTH[,SHAPE], from r to WIDTH r (in (1, 8]), "
                        "SHAPE one of " + enumChoices<format::FociFalloffShape>() + " (a smoothstep of the density, of its "
-                       "logarithm, of its logarithm over log radius); default " + std::string(kDefaultFalloff) + "," +
-                       enumName(codec::FociFalloff{}.shape));
+                       "logarithm, of its logarithm over log radius); default " + defaultFalloffText());
 }
 
 CLI::Option* addComposeOption(CLI::App& command, std::string& compose) {

@@ -25,8 +25,8 @@ namespace conus::cli {
 // (0: none), and --min-density / --max-density for automatic maps.
 void addMaxAnisotropyOption(CLI::App& command, double& maxAnisotropy);
 void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDensity, const std::string& prefix = "");
-// The transition foci get unless --falloff says otherwise (codec::parseFalloff's text).
-inline constexpr const char* kDefaultFalloff = "2";
+// The transition foci get unless --falloff says otherwise (codec::parseFalloff's text of codec::FociFalloff{}).
+std::string defaultFalloffText();
 // --falloff WIDTH[,SHAPE] for `map foci`, `encode --focus` and `bake relief --focus`.
 CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff);
 // --compose: how several foci combine (format::FociComposition's names), for `map foci`, `encode`,
@@ -64,7 +64,8 @@ void checkGridForImage(int grid, int width, int height, int defaultGrid = map_ru
 // The foci of repeated --focus u,v,r,k options, in order.
 std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);
 
-// The foci builder's options for a frame of `aspect` from --grid and --compose (a FociComposition's name).
+// The foci builder's options for a rendered frame of `aspect` from --grid and --compose (a FociComposition's name),
+// with the r..2r ring (codec::kFormatFalloff).
 codec::FociOptions frameFociOptions(int grid, const std::string& compose, double aspect);
 
 // The sampling map of a rendered CoNUS frame, and the analytic form written beside its grid.

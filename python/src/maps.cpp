@@ -90,10 +90,10 @@ void addMaps(py::module_& m) {
                 return std::make_shared<Map>(Map{std::move(map), codec::toAnalytic(f, options.composition, options.falloff), aspect});
             },
             py::arg("foci"), py::arg("aspect") = 1.0, py::arg("grid") = map_rules::kDefaultSide, py::arg("composition") = enumName(codec::FociComposition::Density),
-            py::arg("falloff") = "2",
+            py::arg("falloff") = codec::falloffText(codec::FociFalloff{}),
             "Circular foci (u, v, r, k): centre, radius as a fraction of the width, magnification; aspect: the pictures' "
-            "width / height (encode warns on another); falloff as `map foci --falloff` (\"2\": density smoothstepped "
-            "from r to 2r; \"1.5,log\", \"3,logr\")")
+            "width / height (encode warns on another); falloff as `map foci --falloff` (\"1.25\", the default: density "
+            "smoothstepped from r to 1.25 r, widened where the anisotropy bound needs; \"2\", \"1.5,log\", \"3,logr\")")
         .def_static(
             "springs",
             [](const std::vector<std::tuple<double, double, double, double>>& strokes, int grid, int max_steps) {
@@ -140,8 +140,9 @@ void addMaps(py::module_& m) {
             },
             py::arg("importance"), py::arg("source"), py::arg("size"), py::arg("frame_loss"),
             py::arg("grid") = map_rules::kDefaultSide, py::arg("max_density") = 16.0, py::arg("max_anisotropy") = 0.0,
-            "The automatic map (max_anisotropy: 0 none, else as --max-anisotropy) with the lowest context floor whose predicted whole-frame loss against the uniform "
-            "image of `size` (width, height) stays within `frame_loss` dB: (map, floor, predicted loss, predicted ROI gain)")
+            "The automatic map (max_anisotropy: 0 none, else as --max-anisotropy) with the lowest context floor whose whole-frame loss against the uniform "
+            "image of `size` (width, height), measured on a trial encode fitted as encode's default, stays within `frame_loss` dB: (map, floor, "
+            "predicted loss, predicted ROI gain)")
         .def_static(
             "from_nodes",
             [](const py::array& nodes) {

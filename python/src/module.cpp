@@ -268,17 +268,26 @@ PYBIND11_MODULE(_conus, m) {
             const auto [w, h] = sizeOr(size, source.width, source.height);
             codec::checkEncodeMemory(source, w, h);  // before a map is built for it
             std::optional<codec::FociBudget> budget;
+            // The budgets' trial encodes are this encode's, on what a display shows (data as stored).
+            const codec::FrameModelOptions trials{colorspace == enumName(Transfer::Raw) ? codec::ErrorSpace::Linear : codec::ErrorSpace::Display,
+                                                  fit, fitHold};
             if (!map) {
                 if (!foci.empty()) {
                     const std::vector<codec::Focus>& f = foci;
                     codec::FociOptions options;
                     options.aspect = aspect;
                     {
-                        // The budget of `conus encode --focus` (foci_budget.h): k lowered to hold frame_loss.
+                        // The budget of `conus encode --focus` (foci_budget.h): k lowered to hold frame_loss,
+                        // the foci on the context the picture's own detail asks for.
                         py::gil_scoped_release release;
+                        const codec::DensityField context = codec::ownDetailContext(
+                            source, pictureImportance(codec::ImportanceRule::Detail, source), w, h, {}, trials);
+                        options.context = &context;
                         const int side = 256;
-                        const codec::FrameErrorModel model(source, w, h, codec::fociImportance(f, aspect, side, std::max(1, int(side / aspect))));
+                        const codec::FrameErrorModel model(source, w, h, codec::fociImportance(f, aspect, side, std::max(1, int(side / aspect))),
+                                                           trials);
                         budget = codec::fociForFrameLoss(f, options, model, frameLoss, exactK);
+                        options.context = nullptr;  // the field ends with this block
                     }
                     map = std::make_shared<Map>(Map{budget->map, codec::toAnalytic(budget->given, options.composition), aspect});
                 } else {
@@ -287,7 +296,7 @@ PYBIND11_MODULE(_conus, m) {
                          "'detail'), the context floor chosen for the whole frame); conus.uniform makes the uniform image");
                     py::gil_scoped_release release;
                     codec::BudgetResult own = codec::buildOwnDetailMap(
-                        source, pictureImportance(codec::ImportanceRule::Detail, source), w, h);
+                        source, pictureImportance(codec::ImportanceRule::Detail, source), w, h, {}, trials);
                     map = std::make_shared<Map>(Map{std::move(own.map), {}, aspect});
                 }
             }

@@ -415,12 +415,15 @@ TEST_F(Cli, FocusFalloffIsBuiltRecordedAndChecked) {
     }
     EXPECT_LT(differs, 1e-6);
     EXPECT_GT(fromDefault, 1e-3);  // the option changed the map
-    // encode --focus takes it too; the default leaves no trace in the file.
+    // encode --focus takes it too; the default (1.25) is recorded as well, and only the format's own
+    // r..2r leaves no trace in the file.
     const std::string in = makePicture(240, 160);
     ASSERT_EQ(run("encode " + in + " --focus 0.45,0.5,0.1,4 --falloff 3 -o " + path("e.exr") + " --size 60x40").exitCode, 0);
     EXPECT_EQ(conus::format::readConusFile(path("e.exr")).analytic->scalars.at("falloffWidth"), 3.0);
     ASSERT_EQ(run("encode " + in + " --focus 0.45,0.5,0.1,4 -o " + path("d.exr") + " --size 60x40").exitCode, 0);
-    EXPECT_TRUE(conus::format::readConusFile(path("d.exr")).analytic->scalars.empty());
+    EXPECT_EQ(conus::format::readConusFile(path("d.exr")).analytic->scalars.at("falloffWidth"), 1.25);
+    ASSERT_EQ(run("encode " + in + " --focus 0.45,0.5,0.1,4 --falloff 2 -o " + path("f.exr") + " --size 60x40").exitCode, 0);
+    EXPECT_TRUE(conus::format::readConusFile(path("f.exr")).analytic->scalars.empty());
     // Bad falloffs: a usage error naming it, and no file.
     for (const char* bad : {"1", "9", "2,cubic", "x"}) {
         const Result b = run(std::string("map foci --focus 0.5,0.5,0.1,4 --falloff ") + bad + " -o " + path("b.exr"));

@@ -94,19 +94,33 @@ DensityField importanceToDensity(const Image& importance, const AutoMapOptions& 
     const double cell = std::max(double(gw) / std::max(1, options.columns - 1), double(gh) / std::max(1, options.rows - 1));
     blur(field, gw, gh, static_cast<int>(std::lround(std::max(options.smoothing * gw, 0.5 * cell))));
 
+    // The context at each cell, normalized to mean 1 over them (1 everywhere without one).
+    std::vector<double> context(field.size(), 1.0);
+    if (options.context) {
+        const DensityField& c = *options.context;
+        double sum = 0;
+        for (int y = 0; y < gh; ++y)
+            for (int x = 0; x < gw; ++x) {
+                const int cx = std::clamp(static_cast<int>((x + 0.5) / gw * c.width), 0, c.width - 1);
+                const int cy = std::clamp(static_cast<int>((y + 0.5) / gh * c.height), 0, c.height - 1);
+                sum += context[std::size_t(y) * gw + x] = c.values[std::size_t(cy) * c.width + cx];
+            }
+        for (double& v : context) v *= double(context.size()) / sum;
+    }
+
     DensityField out;
     out.width = gw;
     out.height = gh;
-    out.values.assign(field.size(), 1.0f);
+    out.values.assign(context.begin(), context.end());
     const double peak = *std::max_element(field.begin(), field.end());
-    if (!(peak > 0)) return out;  // no importance anywhere: uniform
+    if (!(peak > 0)) return out;  // no importance anywhere: the context alone
 
     // s such that mean(clamp(s I, floor, max)) == 1; the mean grows monotonically with s and with
     // the floor. When even saturating every important cell at maxDensity leaves the mean below 1
     // (importance on a few cells), the context gets more than the floor instead.
     auto meanFor = [&](double s, double floor) {
         double sum = 0;
-        for (double v : field) sum += std::clamp(s * v, floor, options.maxDensity);
+        for (std::size_t i = 0; i < field.size(); ++i) sum += context[i] * std::clamp(s * field[i], floor, options.maxDensity);
         return sum / field.size();
     };
     double smallest = peak;
@@ -130,7 +144,7 @@ DensityField importanceToDensity(const Image& importance, const AutoMapOptions& 
         s = hi;
     }
     for (std::size_t i = 0; i < field.size(); ++i)
-        out.values[i] = static_cast<float>(std::clamp(s * field[i], floor, options.maxDensity));
+        out.values[i] = static_cast<float>(context[i] * std::clamp(s * field[i], floor, options.maxDensity));
     return out;
 }
 
@@ -189,6 +203,12 @@ SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options)
     mapOptions.maxAnisotropy = options.maxAnisotropy;
     mapOptions.builder = options.builder;
     mapOptions.minDensity = options.minDensity;  // the target's mean is 1 (importanceToDensity)
+    if (options.context) {
+        // The bounds hold on the importance's factor, which the target already holds: one round,
+        // the builder's floor the target's lowest density.
+        mapOptions.minDensity = *std::min_element(target.values.begin(), target.values.end());
+        return buildMapFromDensity(target, mapOptions);
+    }
     // A grid cannot follow a steep rise exactly: the cells beside it come out denser or sparser than
     // the target. Each round divides the followed field by what the map achieved there (its cell
     // density at each sample) and rebuilds; the best map by its worst bound violation is kept.

@@ -60,7 +60,8 @@ double focusDensity(double s, double k, const FociFalloff& falloff) {
 constexpr double kWidenedStep = 1.0 / 512.0;
 constexpr double kWidenedLimit = 64.0;
 
-DensityField sampleFociDensity(std::span<const Focus> foci, double aspect, const FociFalloff& falloff, double bound = 0) {
+DensityField sampleFociDensity(std::span<const Focus> foci, double aspect, const FociFalloff& falloff, double bound = 0,
+                               const DensityField* context = nullptr) {
     double rMin = 1.0;
     for (const Focus& f : foci) rMin = std::min(rMin, f.r);
     // Radius in u is r, in v it is r * aspect; sample pixel-isotropically (H = W / aspect).
@@ -87,6 +88,13 @@ DensityField sampleFociDensity(std::span<const Focus> foci, double aspect, const
             } else {
                 density = fociDensity(foci, aspect, u, v, falloff);
             }
+            // The foci multiply the context: k times its rate there (a focus on detail gets more
+            // than one on a flat sky, which a higher rate would not show).
+            if (context) {
+                const int cx = std::clamp(static_cast<int>(u * context->width), 0, context->width - 1);
+                const int cy = std::clamp(static_cast<int>(v * context->height), 0, context->height - 1);
+                density *= context->values[std::size_t(cy) * context->width + cx];
+            }
             field.values[std::size_t(y) * field.width + x] = static_cast<float>(density);
         }
     return field;
@@ -105,7 +113,7 @@ SamplingMap buildDensityComposition(std::span<const Focus> foci, const FociOptio
     mapOptions.builder = options.builder;
     mapOptions.aspect = options.aspect;
     const double widenFor = options.builder == DensityBuilder::Bounded ? boundOf(options) : 0.0;
-    return buildMapFromDensity(sampleFociDensity(foci, options.aspect, options.falloff, widenFor), mapOptions, report);
+    return buildMapFromDensity(sampleFociDensity(foci, options.aspect, options.falloff, widenFor, options.context), mapOptions, report);
 }
 
 std::string focusText(const Focus& f) {
@@ -427,7 +435,7 @@ format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition comp
     analytic.kind = enumName(format::MapKind::Foci);
     analytic.composition = enumName(composition);
     for (const Focus& f : foci) analytic.foci.push_back({f.u, f.v, f.r, f.k});
-    if (falloff.width != FociFalloff{}.width || falloff.shape != FociFalloff{}.shape) {
+    if (falloff.width != kFormatFalloff.width || falloff.shape != kFormatFalloff.shape) {
         analytic.scalars["falloffWidth"] = falloff.width;
         analytic.scalars["falloffShape"] = static_cast<double>(falloff.shape);
     }

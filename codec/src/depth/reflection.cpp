@@ -87,6 +87,7 @@ std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const Reflect
         if (focus) {
             FociOptions foci;
             foci.aspect = 1.0;
+            foci.falloff = kFormatFalloff;  // the r..2r ring: the faces' figures were measured with it (a narrow one: -0.8 dB)
             map = std::make_shared<SamplingMap>(buildFociMap(std::span<const Focus>(&*focus, 1), foci));
         } else {
             map = std::make_shared<SamplingMap>(SamplingMap::identity(2, 2));

@@ -8,6 +8,9 @@
 #include <numbers>
 #include <vector>
 
+#include "conus/codec/build/auto_map.h"
+#include "conus/codec/build/frame_budget.h"
+#include "conus/codec/build/importance.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/core/error.h"
@@ -166,6 +169,112 @@ TEST(FociBudget, AGridTooCoarseIsRefinedToHoldTheFocus) {
     EXPECT_GT(b.given[0].k, 3.0);
     // The builder refines until a focus reaches three quarters of its extra magnification.
     EXPECT_GE(reachedMagnification(b.map, b.given)[0], 1 + 0.75 * (b.given[0].k - 1));
+}
+
+// Waves 12-13 source pixels long (held at the uniform image's quarter rate, lost below it) on the
+// left quarter and in a disc on the right, flat grey elsewhere: a frame whose detail the uniform
+// context spreads its samples over evenly.
+Image halfTextured() {
+    Image im = makeImage(kWidth, kHeight, {"R", "G", "B"});
+    for (int y = 0; y < kHeight; ++y)
+        for (int x = 0; x < kWidth; ++x) {
+            const bool disc = std::hypot(x - 0.75 * kWidth, y - 0.5 * kHeight) < 0.12 * kWidth;
+            const double edge = std::clamp((0.25 * kWidth - x) / 24.0 + 0.5, 0.0, 1.0);  // the textured quarter fades out
+            for (int c = 0; c < 3; ++c) {
+                const double waves = 0.5 + 0.2 * std::sin(0.5 * x + 0.2 * y + c) + 0.2 * std::sin(0.15 * x - 0.45 * y);
+                const double grey = 0.3 + 0.05 * c;
+                im.pixels[(std::size_t(y) * kWidth + x) * 3 + c] = static_cast<float>(disc ? waves : grey + edge * (waves - grey));
+            }
+        }
+    return im;
+}
+
+struct Budgets {
+    FociBudget plain, detailed;
+};
+
+// The foci's budget on a uniform context and on `context` (null: the picture's own detail,
+// ownDetailContext), unfitted.
+Budgets budgetsFor(const Image& source, const std::vector<Focus>& foci, DensityField& context, bool given = false) {
+    const int w = source.width / 4, h = source.height / 4;
+    const double aspect = double(source.width) / source.height;
+    const FrameModelOptions trials{ErrorSpace::Display, 0};
+    const FrameErrorModel model(source, w, h, fociImportance(foci, aspect, 96, 64), trials);
+    if (!given) context = ownDetailContext(source, detailImportance(source), w, h, {}, trials);
+    FociOptions options = optionsFor(aspect);
+    FociBudget plain = fociForFrameLoss(foci, options, model, kDefaultFrameLoss);
+    options.context = &context;
+    Budgets b{std::move(plain), fociForFrameLoss(foci, options, model, kDefaultFrameLoss)};
+    std::printf("k given: uniform context %.2f (tile loss %.2f dB, ROI gain %+.2f dB), detail context %.2f (%.2f dB, %+.2f dB)\n",
+                b.plain.given[0].k, b.plain.predicted.tileLoss, b.plain.predicted.roiGain, b.detailed.given[0].k,
+                b.detailed.predicted.tileLoss, b.detailed.predicted.roiGain);
+    return b;
+}
+
+// The foci multiply the context: the textured part away from the focus gets more samples than the
+// flat rest, and the budget, spent where the picture shows it, gives the focus (on the texture) more
+// in its region than the uniform context can; its k, relative to the denser context there, is lower.
+TEST(FociBudget, AContextFollowingTheDetailGivesTheFocusMore) {
+    // Twice the density on the textured quarter, half of it on the flat rest.
+    DensityField context;
+    context.width = 8;
+    context.height = 1;
+    context.values = {2, 2, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
+    const Budgets b = budgetsFor(halfTextured(), {{0.12, 0.5, 0.08, 6.0}}, context, true);
+    EXPECT_LT(b.plain.given[0].k, 6.0);  // the uniform context's budget binds
+    EXPECT_LE(b.detailed.predicted.tileLoss, kDefaultTileLoss);
+    EXPECT_LE(b.detailed.predicted.frameLoss, kDefaultFrameLoss);
+    EXPECT_GT(b.detailed.predicted.roiGain, b.plain.predicted.roiGain + 1.0);
+    EXPECT_GT(b.detailed.map.density({0.2, 0.15}), 2.0 * b.detailed.map.density({0.95, 0.08}));
+    EXPECT_NEAR(b.plain.map.density({0.2, 0.15}) / b.plain.map.density({0.95, 0.08}), 1.0, 0.2);
+}
+
+// Where the context gives the focus less (fine noise everywhere but a smooth focus, which the
+// context starves), the uniform context's map is kept: the context never costs the regions more
+// than the margin that keeps the choice stable.
+TEST(FociBudget, AContextThatGivesLessIsNotTaken) {
+    Image source = halfTextured();
+    const Image n = test::noise(kWidth, kHeight, {"R", "G", "B"}, 5);
+    for (int y = 0; y < kHeight; ++y)
+        for (int x = 0; x < kWidth; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const std::size_t i = (std::size_t(y) * kWidth + x) * 3 + c;
+                const bool focus = std::hypot(x - 0.25 * kWidth, y - 0.5 * kHeight) < 0.12 * kWidth;
+                source.pixels[i] = focus ? static_cast<float>(0.3 + 0.1 * std::sin(0.2 * x)) : n.pixels[i];
+            }
+    DensityField context;
+    const Budgets b = budgetsFor(source, {{0.25, 0.5, 0.12, 6.0}}, context);
+    EXPECT_GE(b.detailed.predicted.roiGain, b.plain.predicted.roiGain - kContextMarginDb);
+    EXPECT_LE(b.detailed.predicted.tileLoss, kDefaultTileLoss + 1e-9);
+}
+
+// An importance map on a context: the density is the context times the importance's factor
+// (clamped to [floor, max]), with mean 1.
+TEST(FociBudget, ImportanceOnAContextMultipliesIt) {
+    Image importance = makeImage(64, 64, {"Y"});
+    for (int y = 20; y < 30; ++y)
+        for (int x = 10; x < 20; ++x) importance.at(x, y) = 1.0f;
+    DensityField context;
+    context.width = 2;
+    context.height = 1;
+    context.values = {1.5f, 0.5f};
+    AutoMapOptions options;
+    options.smoothing = 0;
+    const DensityField plain = importanceToDensity(importance, options);
+    options.context = &context;
+    const DensityField on = importanceToDensity(importance, options);
+    ASSERT_EQ(on.values.size(), plain.values.size());
+    double mean = 0;
+    for (float v : on.values) mean += v;
+    EXPECT_NEAR(mean / on.values.size(), 1.0, 1e-3);
+    // Away from the region: the floor times the context, three times denser on the left.
+    const auto at = [&](const DensityField& f, double u, double v) {
+        return f.values[std::size_t(v * f.height) * f.width + std::size_t(u * f.width)];
+    };
+    EXPECT_NEAR(at(on, 0.05, 0.9) / at(on, 0.9, 0.9), 3.0, 1e-3);
+    EXPECT_NEAR(at(plain, 0.05, 0.9) / at(plain, 0.9, 0.9), 1.0, 1e-6);
+    // In the region (left half): the importance's factor over the floor, times 1.5.
+    EXPECT_GT(at(on, 0.22, 0.38) / at(on, 0.05, 0.9), 4.0);
 }
 
 }  // namespace

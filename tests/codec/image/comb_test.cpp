@@ -101,10 +101,11 @@ TEST(Comb, FocusRingOfASiemensStarAliasesNoMoreThanUniform) {
     // 26 to 37 source pixels is 6.5 to 9 uniform pixels), so its comb is near its floor.
     const std::vector<double> radii = {200, 220, 240, 260, 280};
     const CircleSpectrum u = spectrum(uniform, radii);
-    // The default focus, a narrower transition and a wider log-shaped one. Steeper rims comb more
-    // (1.5,logr: +3.7 dB, 1.25: +2.9 dB, 2,logr: +1.8 dB on this star; bench/notes/2026-11-24-quality-ring-check.md), so the
-    // narrowest that holds the target is what `--falloff` may offer as a default.
-    for (const FociFalloff& falloff : {FociFalloff{}, FociFalloff{1.75, FociFalloffShape::Density},
+    // The default focus (1.25), the files' old default (2), one between and a wide log-shaped one. With
+    // maps whose anisotropy was unbounded, steeper rims combed more (1.25: +2.9 dB on this star,
+    // bench/notes/2026-11-24-quality-ring-check.md); the bounded builder widens a rim too steep for
+    // its bound, and the narrow default now combs least (bench/notes/2026-11-27-narrow-transitions.md).
+    for (const FociFalloff& falloff : {FociFalloff{}, kFormatFalloff, FociFalloff{1.75, FociFalloffShape::Density},
                                        FociFalloff{3.0, FociFalloffShape::LogRadius}}) {
         FociOptions options;
         options.falloff = falloff;
@@ -154,9 +155,8 @@ TEST(Comb, FittedEncodeKeepsTheRingClean) {
     const CircleSpectrum fu = spectrum(resizeBilinear(uniform, View{}, kSource, kSource), radii);
     const auto dB = [](double x, double y) { return 10 * std::log10(x / y); };
 
-    // The default focus, and the narrower transition that `--fit --falloff 1.75` pairs with on
-    // photographs (bench/notes/2026-11-24-quality.md: the pair meets the frame-loss target at k = 4).
-    for (const FociFalloff& falloff : {FociFalloff{}, FociFalloff{1.75, FociFalloffShape::Density}}) {
+    // The default focus (1.25), the files' old default (2) and one between.
+    for (const FociFalloff& falloff : {FociFalloff{}, kFormatFalloff, FociFalloff{1.75, FociFalloffShape::Density}}) {
         FociOptions options;
         options.falloff = falloff;
         const SamplingMap map = buildFociMap(foci, options);

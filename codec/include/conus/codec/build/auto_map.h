@@ -37,6 +37,11 @@ struct AutoMapOptions {
     double maxAnisotropy = 0;     // flow: DensityMapOptions::maxAnisotropy (0: the builder's default)
     DensityBuilder builder = DensityBuilder::Bounded;  // flow: which 2-D builder
     bool refuseBounds = true;     // false: return the map closest to the bounds instead of refusing
+    // The density the frame has apart from the importance (> 0, any size, about 1 on average; under
+    // `encode` the picture's own detail, frame_budget.h's ownDetailContext), which the importance's
+    // density multiplies: minDensity and maxDensity then bound that factor, not the cells, which
+    // are not pushed towards them. Null: 1 everywhere.
+    const DensityField* context = nullptr;
 };
 
 // How far the achieved cell density (map_measures.h) may stray outside [minDensity, maxDensity]:

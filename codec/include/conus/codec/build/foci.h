@@ -35,21 +35,28 @@ using format::FociFalloffShape;
 
 // The transition from a focus's disc (density k^2) to the context (density 1), over the radii
 // s = distance / r in [1, width], with t = smoothstep(width - s over width - 1) (quintic, C2):
-// - Density: density 1 + (k^2 - 1) t (the default);
+// - Density: density 1 + (k^2 - 1) t (the default shape);
 // - LogDensity: density k^(2 t): the same ends, sparser in the outer part of the ring;
 // - LogRadius: density k^(2 t') with t' the smoothstep of log(width / s) over log(width): log
 //   density falls most steeply near the disc, as the least anisotropic radial focus does.
+// The default width is narrow: the bounded builder widens a transition only as far as its
+// anisotropy bound needs, and a narrow ring costs the context fewer samples than the old 2 r, so
+// the same budget gives the focus more k at less loss outside it, with a ring that combs no more
+// than the uniform image (bench/notes/2026-11-27-narrow-transitions.md; tests/codec/image/comb_test.cpp).
 struct FociFalloff {
-    double width = 2.0;  // outer radius of the transition over r: in (1, 8]
+    double width = 1.25;  // outer radius of the transition over r: in (1, 8]
     FociFalloffShape shape = FociFalloffShape::Density;
 };
+// What a file's foci without the falloff scalars had (spec/ "Analytic-map parameters"): r..2r, the
+// density smoothstepped. Older writers' default; toAnalytic leaves the scalars out only for it.
+inline constexpr FociFalloff kFormatFalloff{2.0, FociFalloffShape::Density};
 
 // Throws conus::Error(InvalidArgument) for a width outside (1, 8] (NaN fails).
 void checkFalloff(const FociFalloff& falloff);
 // "2", "1.5,log", "3,logr" (a width, then optionally density | log | logr) -> FociFalloff; throws
 // conus::Error(InvalidArgument) with the reason.
 FociFalloff parseFalloff(const std::string& text);
-// The inverse of parseFalloff ("2,density" for the default).
+// The inverse of parseFalloff ("1.25,density" for the default).
 std::string falloffText(const FociFalloff& falloff);
 
 struct FociOptions {
@@ -63,6 +70,11 @@ struct FociOptions {
     double maxAnisotropy = 0;
     FociFalloff falloff = {};     // how each focus's density falls to the context's (`= {}`: no -Wextra warning)
     DensityBuilder builder = DensityBuilder::Bounded;
+    // Density composition: the density the frame has away from the foci (> 0, any size, about 1
+    // on average; under `encode` the picture's own detail, frame_budget.h's ownDetailContext),
+    // which the foci's profiles multiply: a focus is k times the context's linear rate where it
+    // lies. Null: 1 everywhere.
+    const DensityField* context = nullptr;
 };
 
 // The largest grid the foci builder refines to on its own (nodes a side).
@@ -128,7 +140,7 @@ double fociDensity(std::span<const Focus> foci, double aspect, double u, double 
 Focus parseFocus(const std::string& text);
 
 // Analytic parameters for the file: kind "foci", the foci and how they were composed; a falloff
-// other than the default as the scalars falloffWidth and falloffShape (0 Density, 1 LogDensity,
+// other than kFormatFalloff as the scalars falloffWidth and falloffShape (0 Density, 1 LogDensity,
 // 2 LogRadius; spec/ "Analytic-map parameters").
 format::AnalyticMap toAnalytic(std::span<const Focus> foci, FociComposition composition, const FociFalloff& falloff = {});
 

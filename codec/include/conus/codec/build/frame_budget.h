@@ -1,30 +1,28 @@
-// What a map costs the rest of the frame, predicted before encoding, and the context floor chosen
-// by a budget on it (`--frame-loss`; foci_budget.h lowers the foci's k by the same prediction).
+// What a map costs the rest of the frame, predicted before the real encode, and the context floor
+// chosen by a budget on it (`--frame-loss`; foci_budget.h lowers the foci's k by the same prediction).
 //
-// The prediction: a picture sampled at linear rate s (samples per source pixel along each axis)
-// loses at each pixel about what the uniform image of that rate loses there, e(x, s) =
-// |source - bilinear(area(source, s))|^2 (mean over channels). The model holds e at rates half an
-// octave apart and interpolates in log rate; e = 0 at s >= 1. A map of density d samples at
-// s0 sqrt(d), s0 the rate of the uniform image of the CoNUS pixel count; a map samples at s0 times
-// its Jacobian's singular values along its footprint's axes, and loses the mean of the two. Then
-//   whole-frame loss = 10 log10((mean_x e(x, s0 sqrt d) + f) / (mean_x e(x, s0) + f))   (dB, > 0: CoNUS worse)
-//   ROI gain        = 10 log10(mean_R e(x, s0) / mean_R e(x, s0 sqrt d))     (R: importance >= half its peak)
-//   tile loss       = the same as the frame's over each tile of max(W, H) / 32 touching no part of R,
-//                     at the 95th percentile; f = (1.5/255)^2, about bench/quality.py's floor (2/255)^2 of
-//                     8-bit sRGB near mid-grey, in linear light
-// e is measured on the source reduced to at most 1024 px a side (or twice the CoNUS side) and
-// pooled into blocks of at most 256 a side, where the map's rates are taken at each block's centre.
-// Otherwise it takes the encode and decode to be the area downsample and bilinear of the uniform
-// image (bench/quality.py sets it beside measured figures).
+// The prediction is a trial: the picture, reduced to at most 1024 px a side, is encoded through the
+// map at the same relative size, fitted as the encode will fit it, decoded at its own size by the
+// CPU decoder, and compared with the uniform image of the same pixel count (area downsample,
+// bilinear resize) on the values a user looks at: colour through the display's sRGB curve (D),
+// data as stored. With e_c and e_u the per-pixel squared errors of the two (mean over channels),
+//   whole-frame loss = 10 log10((mean e_c + f) / (mean e_u + f))   (dB, > 0: CoNUS worse)
+//   ROI gain        = 10 log10(mean_R e_u / mean_R e_c)           (R: importance >= half its peak)
+//   tile loss       = the frame's loss over each tile of max(W, H) / 32 touching no part of R, at
+//                     the 95th percentile; f = (2/255)^2, bench/quality.py's floor on 8-bit sRGB
+//                     ((1.5/255)^2 for data)
+// which are bench/quality.py's measures, on the reduced picture. (A model of the errors at each
+// sampling rate, the uniform image's at the map's local rates, was 1-6 dB pessimistic about tiles:
+// it missed the fit, the encoder's filter and how little an anisotropic footprint loses across its
+// short axis; bench/notes/2026-11-27-narrow-transitions.md.)
 #pragma once
 
-#include <functional>
 #include <limits>
 #include <vector>
 
-#include <glm/glm.hpp>
-
 #include "conus/codec/build/auto_map.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/image/fit.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/image.h"
 
@@ -41,30 +39,39 @@ struct FramePrediction {
     double tileLoss = 0;   // dB: the 95th percentile over tiles of max(W, H) / 32 touching no region
 };
 
+// Where the trials take their errors: on colour as a display shows it (sRGB; alpha and other
+// channels as stored), or on the values as stored (data: heights, depth, raw input).
+enum class ErrorSpace { Display, Linear };
+
+struct FrameModelOptions {
+    ErrorSpace space = ErrorSpace::Display;
+    int fitIterations = kDefaultEncodeFitIterations;  // the encode's fit (0: the filtered encode alone, `--fast`)
+    double fitHold = kFitHoldLowPass;
+};
+
 class FrameErrorModel {
 public:
     // `source` the picture, (width, height) the CoNUS image size (at most the source's), `importance`
     // any size (its region R is where it reaches half its peak; empty: R is the whole frame). Throws
     // conus::Error(InvalidArgument) on an empty source or a size outside 1..source size.
-    FrameErrorModel(const Image& source, int width, int height, const Image& importance);
+    FrameErrorModel(const Image& source, int width, int height, const Image& importance, const FrameModelOptions& options = {});
 
-    // For a density at undistorted p in [0,1]^2 (density(p) > 0).
-    FramePrediction predict(const std::function<double(double u, double v)>& density) const;
+    // The losses and gain of encoding through `map`, measured on a trial encode (about 60 ms at 1024 px).
     FramePrediction predict(const SamplingMap& map) const;
-    FramePrediction predict(const DensityField& field) const;
-    // For the linear rates along two axes at p, relative to the uniform image's (a density d is
-    // sqrt(d) along both; a map's are its Jacobian's singular values in pixels).
-    FramePrediction predictAxes(const std::function<glm::dvec2(double u, double v)>& scales) const;
 
 private:
-    int m_width = 0, m_height = 0;  // of the pooled blocks (at most 256 a side)
-    double m_aspect = 1;            // the source's width over its height
-    double m_baseRate = 1;          // s0, in pixels of the grid the errors are measured on
-    std::vector<double> m_logRates;                // ascending, the last one log(1) = 0
-    std::vector<std::vector<float>> m_error;       // per rate, per block: the sum of its pixels' errors
-    std::vector<std::vector<float>> m_roiError;    // the same over the region's pixels only
-    std::vector<float> m_count;                    // pixels per block
-    std::vector<unsigned char> m_roiAny;           // the block holds a pixel of the region
+    std::vector<float> shownValues(const Image& image) const;  // D on the colour channels
+    std::vector<float> errors(const Image& view) const;        // per pixel, against the picture
+    FramePrediction measure(const std::vector<float>& mapped) const;
+
+    FrameModelOptions m_options;
+    Image m_picture;                    // the source, at most 1024 px a side
+    int m_conusWidth = 1, m_conusHeight = 1;  // the CoNUS size at the picture's scale
+    double m_floor = 0;                 // f, of the space the errors are taken in
+    std::vector<bool> m_shown;          // per channel: through D
+    std::vector<float> m_reference;     // the picture's values as shown
+    std::vector<float> m_uniformError;  // per pixel: the uniform image's
+    std::vector<unsigned char> m_roi;   // per pixel: in R
 };
 
 struct BudgetResult {
@@ -91,6 +98,11 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
 BudgetResult buildAutoMapForBestFrame(const Image& importance, const FrameErrorModel& model, double tileLossDb,
                                       AutoMapOptions options = {});
 
+// How much more ROI gain (predicted, dB) a budget's map on a uniform context must give to be kept
+// over the one on the picture's own detail (FociOptions::context, AutoMapOptions::context): a
+// margin, so that a picture and its 8-bit rounding choose alike.
+inline constexpr double kContextMarginDb = 0.5;
+
 // The predicted tile loss (dB) the map of the picture's own detail keeps to.
 inline constexpr double kOwnDetailTileLoss = 2.0;
 
@@ -99,6 +111,12 @@ inline constexpr double kOwnDetailTileLoss = 2.0;
 // display shows it), the context floor buildAutoMapForBestFrame's within kOwnDetailTileLoss for a
 // CoNUS image of width x height.
 BudgetResult buildOwnDetailMap(const Image& source, const Image& detail, int width, int height,
-                               const AutoMapOptions& options = {});
+                               const AutoMapOptions& options = {}, const FrameModelOptions& model = {});
+
+// The density the picture's own detail asks for (importanceToDensity of `detail` at the context
+// floor buildOwnDetailMap chooses): the context that `encode`'s foci multiply (FociOptions::context),
+// so that the frame outside them is sampled as the no-focus default would sample it.
+DensityField ownDetailContext(const Image& source, const Image& detail, int width, int height,
+                              const AutoMapOptions& options = {}, const FrameModelOptions& model = {});
 
 }  // namespace conus::codec
