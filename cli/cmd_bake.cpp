@@ -33,6 +33,11 @@
 namespace conus::cli {
 namespace {
 
+// The loss (dB) a relief asset's focus may cost the field outside it, against the uniform asset, on
+// the budget's trial (which encodes the colour as `encode` does): the baked tablet then loses 0.75 dB
+// outside its focus, within the 1 dB a relief read all over can spare (bench/notes/2026-11-27-narrow-transitions.md).
+constexpr double kReliefRestLoss = 0.6;
+
 constexpr const char* kTabletSource = "tablet";
 constexpr const char* kDefaultText = "CoNUS|FLEXIBLE PINHOLE|CAMERA";
 
@@ -106,9 +111,11 @@ int runBakeRelief(const BakeOptions& o) {
             const codec::FrameErrorModel model(source.colour, size.width, size.height,
                                                codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))),
                                                codec::FrameModelOptions{codec::ErrorSpace::Display, 0});  // the asset is not fitted
-            codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, codec::kDefaultFrameLoss, o.exactK);
+            // And the field outside the focus within 1 dB of the uniform asset: a relief is read all over.
+            codec::FociBudget budget =
+                codec::fociForFrameLoss(foci, fo, model, codec::kDefaultFrameLoss, o.exactK, codec::kDefaultTileLoss, kReliefRestLoss);
             const std::string said = describeFociBudget(
-                budget, BudgetFrame{size.width, size.height, source.heights.width, source.heights.height, codec::kDefaultFrameLoss},
+                budget, BudgetFrame{size.width, size.height, source.heights.width, source.heights.height, codec::kDefaultFrameLoss, kReliefRestLoss},
                 o.exactK, o.grid);
             if (!quiet()) std::printf("%s\n", said.c_str());
             map = std::move(budget.map);

@@ -96,7 +96,8 @@ std::string describeFociBudget(const codec::FociBudget& b, const std::optional<B
     if (b.askedShare.ask > 1.0)
         text = "the foci ask " + numberText(std::round(b.askedShare.ask * 10) / 10) + "x the pixels there are at k " + fociKText(b.asked) + "; ";
     if (b.lowered)
-        text += (frame ? "the loss budget (whole frame " + numberText(frame->frameLoss) + " dB, tiles " + numberText(codec::kDefaultTileLoss) + " dB)"
+        text += (frame ? "the loss budget (whole frame " + numberText(frame->frameLoss) + " dB, tiles " + numberText(codec::kDefaultTileLoss) + " dB" +
+                             (std::isfinite(frame->restLoss) ? ", outside the foci " + numberText(frame->restLoss) + " dB" : "") + ")"
                        : "the context floor (density " + numberText(codec::kDefaultContextFloor) + ")") +
                 " lowered k from " + fociKText(b.asked) + " to " + fociKText(b.given) + " (--exact-k keeps k); ";
     const std::string pixels = frame ? std::to_string(frame->width) + "x" + std::to_string(frame->height) + " pixels" : "map's samples";

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,7 @@ CLI::Option* addExactKOption(CLI::App& command, bool& exactK);
 struct BudgetFrame {
     int width = 0, height = 0, sourceWidth = 0, sourceHeight = 0;
     double frameLoss = codec::kDefaultFrameLoss;
+    double restLoss = std::numeric_limits<double>::infinity();  // outside the foci (finite: said)
 };
 // What a foci budget did, in a line: the share of the pixels the foci take, what the context is
 // sampled like, the k each focus got and, when the budget lowered k, why. Warns (even when quiet)

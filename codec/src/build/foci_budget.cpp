@@ -96,7 +96,7 @@ Image fociImportance(std::span<const Focus> foci, double aspect, int width, int 
 }
 
 FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& options, const FrameErrorModel& model,
-                            double frameLossDb, bool exactK, double tileLossDb) {
+                            double frameLossDb, bool exactK, double tileLossDb, double restLossDb) {
     if (!(frameLossDb >= 0) || !std::isfinite(frameLossDb))
         throw Error(ErrorCode::InvalidArgument, "the frame-loss budget " + std::to_string(frameLossDb) + " dB must be finite and >= 0");
     if (!(tileLossDb >= 0))  // NaN fails; infinity: no tile budget
@@ -111,7 +111,7 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         FociReport report;
         SamplingMap map = buildFociMap(tried, options, &report);
         const FramePrediction p = model.predict(map);
-        const bool ok = p.frameLoss <= frameLossDb && p.tileLoss <= tileLossDb;
+        const bool ok = p.frameLoss <= frameLossDb && p.tileLoss <= tileLossDb && p.restLoss <= restLossDb;
         if (ok && t > bestT) {
             bestT = t;
             out.given = std::move(tried);
@@ -135,7 +135,7 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
             // loses the budget), the foci on a uniform context give more in the regions: keep that.
             FociOptions uniform = options;
             uniform.context = nullptr;
-            FociBudget plain = fociForFrameLoss(foci, uniform, model, frameLossDb, exactK, tileLossDb);
+            FociBudget plain = fociForFrameLoss(foci, uniform, model, frameLossDb, exactK, tileLossDb, restLossDb);
             if (bestT < 0 || plain.predicted.roiGain > out.predicted.roiGain + kContextMarginDb) return plain;
         }
         if (bestT < 0) {  // even the lowest t tried loses more: the identity (k = 1) holds any budget

@@ -126,17 +126,19 @@ FramePrediction FrameErrorModel::predict(const SamplingMap& map) const {
 FramePrediction FrameErrorModel::measure(const std::vector<float>& mapped) const {
     const int w = m_picture.width, h = m_picture.height;
     const auto db = [](double a, double b) { return 10.0 * std::log10(std::max(a, 1e-30) / std::max(b, 1e-30)); };
-    double frameUniform = 0, frameMapped = 0, roiUniform = 0, roiMapped = 0;
+    double frameUniform = 0, frameMapped = 0, roiUniform = 0, roiMapped = 0, roiCount = 0;
     for (std::size_t p = 0; p < mapped.size(); ++p) {
         frameUniform += m_uniformError[p];
         frameMapped += mapped[p];
         if (m_roi[p]) {
             roiUniform += m_uniformError[p];
             roiMapped += mapped[p];
+            roiCount += 1;
         }
     }
-    const double n = double(mapped.size());
-    FramePrediction out{db(frameMapped / n + m_floor, frameUniform / n + m_floor), db(roiUniform, roiMapped), 0.0};
+    const double n = double(mapped.size()), rest = std::max(1.0, n - roiCount);
+    FramePrediction out{db(frameMapped / n + m_floor, frameUniform / n + m_floor), db(roiUniform, roiMapped), 0.0,
+                        db((frameMapped - roiMapped) / rest + m_floor, (frameUniform - roiUniform) / rest + m_floor)};
     // Tiles of max(W, H) / 32 touching no region: the loss at the 95th percentile.
     const int tile = std::max(1, std::max(w, h) / kTilesPerSide);
     std::vector<double> losses;

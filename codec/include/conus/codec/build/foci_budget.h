@@ -14,6 +14,7 @@
 // The foci then record the k they were given. An explicit choice (`--exact-k`) keeps k as asked.
 #pragma once
 
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -60,12 +61,13 @@ struct FociBudget {
 Image fociImportance(std::span<const Focus> foci, double aspect, int width, int height);
 
 // The map of `foci` (buildFociMap with `options`) with k lowered to hold `frameLossDb` of predicted
-// whole-frame loss and `tileLossDb` of tile loss (model: the picture at the CoNUS size, its region
-// fociImportance), or as asked when `exactK`; then each focus records what the map reaches where that is below half its extra
-// magnification. Throws what buildFociMap throws, and conus::Error(InvalidArgument) for a budget
-// that is not finite and >= 0.
+// whole-frame loss, `tileLossDb` of tile loss and `restLossDb` of loss outside the foci (model: the
+// picture at the CoNUS size, its region fociImportance), or as asked when `exactK`; then each focus
+// records what the map reaches where that is below half its extra magnification. Throws what
+// buildFociMap throws, and conus::Error(InvalidArgument) for a budget that is not finite and >= 0.
 FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& options, const FrameErrorModel& model,
-                            double frameLossDb = kDefaultFrameLoss, bool exactK = false, double tileLossDb = kDefaultTileLoss);
+                            double frameLossDb = kDefaultFrameLoss, bool exactK = false, double tileLossDb = kDefaultTileLoss,
+                            double restLossDb = std::numeric_limits<double>::infinity());
 // The same without a picture: k lowered until the context's target density is at least `floor`.
 FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options,
                                double floor = kDefaultContextFloor, bool exactK = false);

@@ -8,6 +8,7 @@
 // data as stored. With e_c and e_u the per-pixel squared errors of the two (mean over channels),
 //   whole-frame loss = 10 log10((mean e_c + f) / (mean e_u + f))   (dB, > 0: CoNUS worse)
 //   ROI gain        = 10 log10(mean_R e_u / mean_R e_c)           (R: importance >= half its peak)
+//   rest loss       = the frame's loss over the pixels outside R
 //   tile loss       = the frame's loss over each tile of max(W, H) / 32 touching no part of R, at
 //                     the 95th percentile; f = (2/255)^2, bench/quality.py's floor on 8-bit sRGB
 //                     ((1.5/255)^2 for data)
@@ -37,6 +38,7 @@ struct FramePrediction {
     double frameLoss = 0;  // dB
     double roiGain = 0;    // dB
     double tileLoss = 0;   // dB: the 95th percentile over tiles of max(W, H) / 32 touching no region
+    double restLoss = 0;   // dB: over every pixel outside the region, as the whole frame's (f added)
 };
 
 // Where the trials take their errors: on colour as a display shows it (sRGB; alpha and other
