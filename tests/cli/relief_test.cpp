@@ -3,6 +3,8 @@
 #include <OpenImageIO/imagebufalgo.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 #include "cli/cli_fixture.h"
 #include "conus/format/container.h"
@@ -80,6 +82,41 @@ TEST_F(ReliefCli, BakeValidatesAndRenders) {
               0);
     EXPECT_GT(meanAndSpread(path("above.png")).first, 0.25);
     EXPECT_TRUE(leftovers().empty());
+}
+
+// PSNR (dB) of picture a against the reference r, over the pixels whose (u, v) `in` accepts.
+template <class Mask>
+double psnrWhere(const std::string& a, const std::string& r, Mask in) {
+    OIIO::ImageBuf x(a), y(r);
+    EXPECT_TRUE(x.read(0, 0, true, OIIO::TypeDesc::FLOAT) && y.read(0, 0, true, OIIO::TypeDesc::FLOAT)) << a << ", " << r;
+    const OIIO::ROI roi = x.roi();
+    double sum = 0, count = 0;
+    for (OIIO::ImageBuf::ConstIterator<float> i(x), j(y); !i.done(); ++i, ++j) {
+        if (!in((i.x() + 0.5) / roi.width(), (i.y() + 0.5) / roi.height())) continue;
+        for (int c = 0; c < std::min(3, roi.nchannels()); ++c) sum += (i[c] - j[c]) * (i[c] - j[c]);
+        count += std::min(3, roi.nchannels());
+    }
+    return 10 * std::log10(1.0 / std::max(sum / count, 1e-12));
+}
+
+// A focus on a relief: the budget lowers k so that the tablet outside the focus stays within 1 dB
+// of the uniform asset (the target), says so, and the focus still gains.
+TEST_F(ReliefCli, AFocusKeepsTheRestOfTheTablet) {
+    const std::string args = " --tablet-size 512x384 --text 'CoNUS|RELIEF'";
+    Result r = run("bake relief tablet" + args + " --size 128x96 --focus 0.5,0.3,0.12,3 -o " + path("f.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("outside the foci 0.6 dB) lowered k from 3 to "), std::string::npos) << r.out;
+    ASSERT_EQ(run("bake relief tablet" + args + " --size 128x96 --uniform -o " + path("u.exr")).exitCode, 0);
+    ASSERT_EQ(run("bake relief tablet" + args + " --uniform --size 512x384 -o " + path("ref.exr")).exitCode, 0);
+    for (const char* name : {"f", "u", "ref"})
+        ASSERT_EQ(run(std::string("decode ") + path(std::string(name) + ".exr") + " -o " + path(std::string(name) + ".png") + " --size 512x384 -q").exitCode, 0);
+    const auto outside = [](double u, double v) { return std::hypot(u - 0.5, (v - 0.3) * 0.75) > 0.12; };
+    const auto inside = [&](double u, double v) { return !outside(u, v); };
+    const double rest = psnrWhere(path("f.png"), path("ref.png"), outside) - psnrWhere(path("u.png"), path("ref.png"), outside);
+    const double focus = psnrWhere(path("f.png"), path("ref.png"), inside) - psnrWhere(path("u.png"), path("ref.png"), inside);
+    std::printf("relief with a focus against the uniform asset: focus %+.2f dB, the rest %+.2f dB\n", focus, rest);
+    EXPECT_GT(rest, -1.0);
+    EXPECT_GT(focus, 1.0);
 }
 
 TEST_F(ReliefCli, BadInputFailsWithOneLine) {
