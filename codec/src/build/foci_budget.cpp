@@ -132,11 +132,12 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         if (options.context) {
             // A context that follows the picture usually lets the foci keep more k; where it does
             // not (a focus on a softer part of the picture than the rest, or a context that alone
-            // loses the budget), the foci on a uniform context give more in the regions: keep that.
+            // loses the budget), or where it crowds a few tiles (small features on a flat ground),
+            // the foci on a uniform context are kept (keepsContext).
             FociOptions uniform = options;
             uniform.context = nullptr;
             FociBudget plain = fociForFrameLoss(foci, uniform, model, frameLossDb, exactK, tileLossDb, restLossDb);
-            if (bestT < 0 || plain.predicted.roiGain > out.predicted.roiGain + kContextMarginDb) return plain;
+            if (bestT < 0 || !keepsContext(out.predicted, plain.predicted)) return plain;
         }
         if (bestT < 0) {  // even the lowest t tried loses more: the identity (k = 1) holds any budget
             out.given = powered(foci, t);

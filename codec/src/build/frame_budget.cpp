@@ -27,6 +27,7 @@ constexpr int kTilesPerSide = 32;
 constexpr double kDisplayFloor = (2.0 / 255.0) * (2.0 / 255.0);
 constexpr double kLinearFloor = (1.5 / 255.0) * (1.5 / 255.0);
 constexpr double kTilePercentile = 0.95;
+constexpr double kWorstTilesPercentile = 0.99;
 constexpr double kLowestFloor = 0.02, kHighestFloor = 0.99;
 // Halvings of log floor: the floor to within a factor of (0.99 / 0.02)^(1/256), 1.5%.
 constexpr int kBisectionSteps = 8;
@@ -160,6 +161,9 @@ FramePrediction FrameErrorModel::measure(const std::vector<float>& mapped) const
         const std::size_t at = std::min(losses.size() - 1, static_cast<std::size_t>(kTilePercentile * double(losses.size())));
         std::nth_element(losses.begin(), losses.begin() + static_cast<std::ptrdiff_t>(at), losses.end());
         out.tileLoss = losses[at];
+        const std::size_t at99 = std::min(losses.size() - 1, static_cast<std::size_t>(kWorstTilesPercentile * double(losses.size())));
+        std::nth_element(losses.begin(), losses.begin() + static_cast<std::ptrdiff_t>(at99), losses.end());
+        out.tileLoss99 = losses[at99];
     }
     return out;
 }
@@ -198,11 +202,10 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
     if (options.context) {
         // As for foci (foci_budget.cpp): where the context that follows the picture gives the region
         // less (a region softer than the rest, whose factor the max density caps; a context that
-        // alone loses the budget), the uniform context's map is kept.
+        // alone loses the budget) or crowds a few tiles (keepsContext), the uniform context's map is kept.
         options.context = nullptr;
         BudgetResult plain = search();
-        if ((within(plain) && !within(chosen)) ||
-            (within(plain) == within(chosen) && plain.predicted.roiGain > chosen.predicted.roiGain + kContextMarginDb))
+        if ((within(plain) && !within(chosen)) || (within(plain) == within(chosen) && !keepsContext(chosen.predicted, plain.predicted)))
             return plain;
     }
     return chosen;

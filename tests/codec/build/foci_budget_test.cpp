@@ -248,6 +248,20 @@ TEST(FociBudget, AContextThatGivesLessIsNotTaken) {
     EXPECT_LE(b.detailed.predicted.tileLoss, kDefaultTileLoss + 1e-9);
 }
 
+// The rule that keeps the context: the regions may give up at most the margin, and the worst few
+// tiles (the 99th percentile) may lose at most kContextWorstTileDb more.
+TEST(FociBudget, TheContextIsKeptOnlyWhereItCostsNoRegionOrTile) {
+    FramePrediction context, uniform;
+    context.roiGain = 6.0, context.tileLoss99 = 5.0;
+    uniform.roiGain = 6.4, uniform.tileLoss99 = 4.0;
+    EXPECT_TRUE(keepsContext(context, uniform));
+    uniform.roiGain = context.roiGain + kContextMarginDb + 0.01;
+    EXPECT_FALSE(keepsContext(context, uniform));
+    uniform.roiGain = 6.0;
+    context.tileLoss99 = uniform.tileLoss99 + kContextWorstTileDb + 0.01;
+    EXPECT_FALSE(keepsContext(context, uniform));
+}
+
 // An importance map on a context: the density is the context times the importance's factor
 // (clamped to [floor, max]), with mean 1.
 TEST(FociBudget, ImportanceOnAContextMultipliesIt) {

@@ -39,6 +39,7 @@ struct FramePrediction {
     double roiGain = 0;    // dB
     double tileLoss = 0;   // dB: the 95th percentile over tiles of max(W, H) / 32 touching no region
     double restLoss = 0;   // dB: over every pixel outside the region, as the whole frame's (f added)
+    double tileLoss99 = 0; // dB: those tiles' loss at the 99th percentile (their worst few)
 };
 
 // Where the trials take their errors: on colour as a display shows it (sRGB; alpha and other
@@ -104,6 +105,15 @@ BudgetResult buildAutoMapForBestFrame(const Image& importance, const FrameErrorM
 // over the one on the picture's own detail (FociOptions::context, AutoMapOptions::context): a
 // margin, so that a picture and its 8-bit rounding choose alike.
 inline constexpr double kContextMarginDb = 0.5;
+// And how much more its worst few tiles (tileLoss99) may lose than the uniform context's: a context
+// that follows the picture can crowd small isolated features (text, small objects on a flat ground)
+// into a few tiles that lose much, which the 95th percentile does not see. (The single worst tile
+// is too noisy a judge: on the photographs it refused contexts that the bench measured better.)
+inline constexpr double kContextWorstTileDb = 1.5;
+// Whether the budget's map on the picture's own detail is kept over the one on a uniform context.
+inline bool keepsContext(const FramePrediction& context, const FramePrediction& uniform) {
+    return context.roiGain + kContextMarginDb >= uniform.roiGain && context.tileLoss99 <= uniform.tileLoss99 + kContextWorstTileDb;
+}
 
 // The predicted tile loss (dB) the map of the picture's own detail keeps to.
 inline constexpr double kOwnDetailTileLoss = 2.0;
