@@ -204,7 +204,7 @@ Command addEncodeCommand(CLI::App& root) {
     command->get_option("--min-density")->each([options](const std::string&) { options->floorGiven = true; });
     addFrameLossOption(*command, options->frameLoss,
                        "foci get the largest k (every focus's lowered alike) and importance maps the lowest context "
-                       "floor whose predicted loss stays within it")
+                       "floor whose loss stays within it")
         ->excludes("--min-density")
         ->each([options](const std::string&) { options->frameLossGiven = true; });
     addExactKOption(*command, options->exactK)->needs("--focus");

@@ -65,8 +65,9 @@ FrameMap chooseFrameMap(bool uniform, const std::string& mapFile, const FociSour
 CLI::Option* addFrameLossOption(CLI::App& command, double& frameLoss, const std::string& what) {
     return command
         .add_option("--frame-loss", frameLoss,
-                    "whole-frame loss budget in dB against the uniform image of the same pixel count, predicted "
-                    "before the work: " + what + " (default " + numberText(codec::kDefaultFrameLoss) + ")")
+                    "whole-frame loss budget in dB against the uniform image of the same pixel count, measured "
+                    "before the work by trial encodes of the picture at 1024 px: " + what + " (default " +
+                    numberText(codec::kDefaultFrameLoss) + ")")
         ->check(finiteRange(0.0, 60.0, true, true));
 }
 
