@@ -64,6 +64,15 @@ BuiltMap mapFromFile(const std::string& path, const Image& source) {
     return {std::make_unique<codec::SamplingMap>(codec::SamplingMap::fromGrid(mapSource.map)), mapSource.analytic};
 }
 
+// The options of the map of the picture's own detail: what `encode` makes with no focus, and the
+// context foci and importance maps sit on.
+codec::AutoMapOptions ownDetailOptions(const EncodeOptions& o) { return autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method); }
+
+// The density the picture's own detail asks for (codec::ownDetailContext), this encode's trials choosing its floor.
+codec::DensityField ownDetailContext(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials) {
+    return codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), trials);
+}
+
 BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials) {
     Progress progress("build sampling map from " + o.importance + " importance");
     codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
@@ -77,8 +86,7 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     // samples follow the picture's own detail, as with no importance at all (`detail` is that already).
     codec::DensityField context;
     if (o.importance != "detail") {
-        context = codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height,
-                                          autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method), trials);
+        context = ownDetailContext(o, source, size, trials);
         autoOptions.context = &context;
     }
     const codec::FrameErrorModel model(source, size.width, size.height, importance, trials);
@@ -103,9 +111,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
     // Away from the foci the samples follow the picture's own detail, as with no focus at all.
-    const codec::DensityField context =
-        codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height,
-                                autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method), trials);
+    const codec::DensityField context = ownDetailContext(o, source, size, trials);
     fo.context = &context;
     const int side = 256;
     const codec::FrameErrorModel model(source, size.width, size.height,
@@ -124,8 +130,8 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
 // the model predicts gains most over the whole frame (frame_budget.h), said once per batch.
 BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials, std::string* given) {
     Progress progress("build sampling map from the picture's detail");
-    codec::BudgetResult r = codec::buildOwnDetailMap(source, importanceFrom("detail", source), size.width, size.height,
-                                                     autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method), trials);
+    codec::BudgetResult r =
+        codec::buildOwnDetailMap(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), trials);
     progress.done();
     static std::once_flag once;  // once per batch, not per file
     std::call_once(once, [] {

@@ -97,14 +97,9 @@ DensityField importanceToDensity(const Image& importance, const AutoMapOptions& 
     // The context at each cell, normalized to mean 1 over them (1 everywhere without one).
     std::vector<double> context(field.size(), 1.0);
     if (options.context) {
-        const DensityField& c = *options.context;
         double sum = 0;
         for (int y = 0; y < gh; ++y)
-            for (int x = 0; x < gw; ++x) {
-                const int cx = std::clamp(static_cast<int>((x + 0.5) / gw * c.width), 0, c.width - 1);
-                const int cy = std::clamp(static_cast<int>((y + 0.5) / gh * c.height), 0, c.height - 1);
-                sum += context[std::size_t(y) * gw + x] = c.values[std::size_t(cy) * c.width + cx];
-            }
+            for (int x = 0; x < gw; ++x) sum += context[std::size_t(y) * gw + x] = densityAt(*options.context, (x + 0.5) / gw, (y + 0.5) / gh);
         for (double& v : context) v *= double(context.size()) / sum;
     }
 

@@ -90,11 +90,7 @@ DensityField sampleFociDensity(std::span<const Focus> foci, double aspect, const
             }
             // The foci multiply the context: k times its rate there (a focus on detail gets more
             // than one on a flat sky, which a higher rate would not show).
-            if (context) {
-                const int cx = std::clamp(static_cast<int>(u * context->width), 0, context->width - 1);
-                const int cy = std::clamp(static_cast<int>(v * context->height), 0, context->height - 1);
-                density *= context->values[std::size_t(cy) * context->width + cx];
-            }
+            if (context) density *= densityAt(*context, u, v);
             field.values[std::size_t(y) * field.width + x] = static_cast<float>(density);
         }
     return field;

@@ -22,6 +22,7 @@
 //   nothing bounds its anisotropy. For comparison only (bench/notes).
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "conus/codec/map/sampling_map.h"
@@ -33,6 +34,13 @@ struct DensityField {
     int width = 0, height = 0;   // samples over [0,1]^2, cell-centred like pixels
     std::vector<float> values;   // > 0 everywhere, finite
 };
+
+// The field's sample whose cell holds p = (u, v) in [0,1]^2 (nearest; outside, the border's).
+inline float densityAt(const DensityField& field, double u, double v) {
+    const int x = std::clamp(static_cast<int>(u * field.width), 0, field.width - 1);
+    const int y = std::clamp(static_cast<int>(v * field.height), 0, field.height - 1);
+    return field.values[std::size_t(y) * field.width + x];
+}
 
 enum class DensityBuilder { Bounded, Flow, Transport };
 
