@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -47,7 +48,7 @@ constexpr const char* kCity = "city";
 // What render and animate share.
 struct MeshOptions {
     std::string model, sizeText = "512x512", cameraText, upText = "0,1,0", backend = enumName(renderers::Backend::Auto), units = "m";
-    double time = 0, maxEdge = 0, maxBend = codec::kDefaultMaxBend;
+    double time = 0, maxEdge = 0, maxBend = renderers::kDefaultMaxBend;
     int samples = 4, grid = map_rules::kDefaultSide;
     std::vector<int> track;
     std::vector<std::string> allowDirs;
@@ -112,31 +113,30 @@ std::vector<glm::dvec3> carCentres(const codec::CityScene& city, const std::vect
     return centres;
 }
 
-// Renders one frame on `device`: on a GPU the mesh is first subdivided for the map, where it bends
-// (--max-bend) or everywhere (--max-edge).
+// Renders one frame on `device`. On a GPU the tessellation stages split triangles where the map
+// bends them (--max-bend), unless --max-edge splits every triangle on the CPU first.
 Image renderFrame(const renderers::Device& device, const Mesh& mesh, const Camera& camera, const codec::SamplingMap& map,
                   Size size, const MeshOptions& o, bool report) {
     renderers::MeshRenderOptions options;
     options.samples = o.samples;
-    if (device.onGpu() && o.maxEdge > 0) {
+    options.maxBend = o.maxEdge > 0 ? 0.0 : o.maxBend;
+    if (!device.onGpu()) return renderers::renderMesh(device, mesh, camera, map, size.width, size.height, options);
+    std::optional<Mesh> fine;
+    if (o.maxEdge > 0) {
         const double before = codec::longestProjectedEdge(mesh, camera, map);
-        Mesh fine = codec::subdivideForMap(mesh, camera, map, o.maxEdge);
+        fine = codec::subdivideForMap(mesh, camera, map, o.maxEdge);
         if (report)
             std::printf("subdivided %zu -> %zu triangles: longest projected edge %.3g -> %.3g map cells (--max-edge %g)\n",
-                        mesh.triangleCount(), fine.triangleCount(), before,
-                        codec::longestProjectedEdge(fine, camera, map), o.maxEdge);
-        return renderers::renderMesh(device, fine, camera, map, size.width, size.height, options);
+                        mesh.triangleCount(), fine->triangleCount(), before,
+                        codec::longestProjectedEdge(*fine, camera, map), o.maxEdge);
     }
-    if (device.onGpu() && o.maxBend > 0) {
-        Mesh fine = codec::subdivideForBend(mesh, camera, map, size.width, size.height, o.maxBend);
-        if (report)
-            std::printf("subdivided %zu -> %zu triangles where the map bends: largest bend %.3g -> %.3g pixels (--max-bend %g)\n",
-                        mesh.triangleCount(), fine.triangleCount(),
-                        codec::measureBend(mesh, camera, map, size.width, size.height).largest(),
-                        codec::measureBend(fine, camera, map, size.width, size.height).largest(), o.maxBend);
-        return renderers::renderMesh(device, fine, camera, map, size.width, size.height, options);
-    }
-    return renderers::renderMesh(device, mesh, camera, map, size.width, size.height, options);
+    renderers::MeshRenderer renderer(device.context(), fine ? *fine : mesh);
+    std::int64_t drawn = 0;
+    Image image = renderer.render(camera, map, size.width, size.height, options, nullptr, &drawn);
+    if (report && options.maxBend > 0)
+        std::printf("drew %zu triangles as %lld, split on the GPU where the map bends them more than %g pixels (--max-bend)\n",
+                    mesh.triangleCount(), static_cast<long long>(drawn), options.maxBend);
+    return image;
 }
 
 renderers::Device meshDevice(const MeshOptions& o, bool reference) {
@@ -164,13 +164,13 @@ void addSharedOptions(CLI::App& command, MeshOptions& o, bool withCamera) {
         ->capture_default_str()
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
     command.add_option("--max-bend", o.maxBend,
-                       "GPU: split triangles where Equation 1 bends an edge or a triangle's inside more than this many "
-                       "CoNUS pixels away from the straight lines the rasterizer draws (0: no subdivision)")
+                       "GPU: split triangles (tessellation shaders) where Equation 1 bends an edge or a triangle's inside "
+                       "more than this many CoNUS pixels away from the straight lines the rasterizer draws (0: no split)")
         ->capture_default_str()
         ->check(finiteRange(0, 1e6, true));
     command.add_option("--max-edge", o.maxEdge,
-                       "GPU: instead of --max-bend, split every triangle until no projected edge spans more than this "
-                       "many map cells (0: off)")
+                       "GPU: instead of --max-bend, split every triangle on the CPU until no projected edge spans more than "
+                       "this many map cells (0: off)")
         ->capture_default_str()
         ->check(finiteRange(0, 1e6, true));
     command.add_option("--samples", o.samples, "samples a pixel (multisampling; the reference takes round(sqrt)^2 rays)")

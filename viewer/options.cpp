@@ -81,8 +81,8 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     cli::addAllowDirOption(app, o.allowDirs);
     app.add_option("--radius", o.reflectorRadius, "--reflection: the mirror sphere's radius")->capture_default_str()->check(cli::finiteRange(0.0, 1e9));
     app.add_option("--max-edge", o.maxEdge,
-                   "--mesh: split triangles each CoNUS frame until no projected edge spans more than this many map cells "
-                   "(straight edges follow Eq. 1's curves; costs a CPU subdivision and an upload a frame; 0: never)")
+                   "--mesh: instead of splitting on the GPU where the map bends, split triangles each CoNUS frame until no "
+                   "projected edge spans more than this many map cells (a CPU subdivision and an upload a frame; 0: never)")
         ->capture_default_str()
         ->check(cli::finiteRange(0.0, 1e6, true, true));
     app.add_option("--tf", o.transferFunction, "--volume: transfer function preset or file (T cycles the presets)");

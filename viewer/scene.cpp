@@ -68,9 +68,14 @@ public:
     glm::dvec3 centre() const override { return m_bounds.centre; }
     double radius() const override { return m_bounds.radius; }
     Image render(const Camera& camera, const codec::SamplingMap& map, bool conus, int width, int height) override {
-        // --max-edge: this frame's subdivision (the camera and the map decide it), uploaded for this frame.
-        if (m_maxEdge > 0 && conus)
-            return renderers::renderMeshGpu(m_context, codec::subdivideForMap(m_mesh, camera, map, m_maxEdge), camera, map, width, height);
+        // --max-edge: this frame's subdivision (the camera and the map decide it), uploaded for this
+        // frame and drawn as it is; otherwise the renderer splits where the map bends (tessellation).
+        if (m_maxEdge > 0 && conus) {
+            renderers::MeshRenderOptions asSplit;
+            asSplit.maxBend = 0;
+            return renderers::renderMeshGpu(m_context, codec::subdivideForMap(m_mesh, camera, map, m_maxEdge), camera, map,
+                                            width, height, asSplit);
+        }
         return m_renderer.render(camera, map, width, height);
     }
 

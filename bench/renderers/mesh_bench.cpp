@@ -1,14 +1,16 @@
 // The GPU mesh encoder on the procedural city (paper section 6) at 1024 x 576, on the GL backend of
 // CONUS_BACKEND (default auto): the CoNUS render (two tracked foci) next to the conventional render
 // of the same mesh at the same size (the identity map: the paper measured no cost for the vertex
-// distortion), the mesh subdivided where the map bends (--max-bend, the default) and everywhere
-// (--max-edge 0.5), their cost and PSNR against the Embree reference, that reference (rays
+// distortion; both drawn as built), the mesh split where the map bends (the tessellation stages,
+// --max-bend, the default) and everywhere on the CPU (--max-edge 0.5), their cost and PSNR against
+// the Embree reference, that reference (rays
 // a second), and per-frame map construction from 1..8 foci on a 65 x 65 grid, both compositions
 // (the animation builds one every frame). GPU and Embree times are wall-clock (the work runs on
 // other threads). Read ratios within one run (bench/README.md).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -32,12 +34,20 @@ constexpr double kAspect = double(kWidth) / kHeight;
 
 struct Data {
     codec::CityScene city;
-    Mesh mesh, fine, bend;  // as built; --max-edge 0.5; --max-bend's default
+    Mesh mesh, fine;  // as built; --max-edge 0.5
     Camera camera = Camera::perspective({30, 110, 160}, {0, 0, -10}, {0, 1, 0}, 50.0, kAspect, 1.0, 600.0);
     std::unique_ptr<codec::SamplingMap> map, identity;
     std::unique_ptr<renderers::Context> context;
-    std::unique_ptr<renderers::MeshRenderer> renderer, fineRenderer, bendRenderer;
+    std::unique_ptr<renderers::MeshRenderer> renderer, fineRenderer;
+    std::int64_t bendTriangles = 0;  // what the tessellation stages draw at the default --max-bend
 };
+
+// The mesh drawn as it is (no tessellation), as the paper drew it.
+renderers::MeshRenderOptions asBuilt() {
+    renderers::MeshRenderOptions options;
+    options.maxBend = 0;
+    return options;
+}
 
 Data& data() {
     static Data* d = [] {
@@ -49,36 +59,42 @@ Data& data() {
         d->map = std::make_unique<codec::SamplingMap>(renderers::frameMap(renderers::trackedFoci(d->camera, cars, kAspect), fo));
         d->identity = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
         d->fine = codec::subdivideForMap(d->mesh, d->camera, *d->map, 0.5);
-        d->bend = codec::subdivideForBend(d->mesh, d->camera, *d->map, kWidth, kHeight, codec::kDefaultMaxBend);
         d->context = bench::createBenchContext();
         d->renderer = std::make_unique<renderers::MeshRenderer>(*d->context, d->mesh);
         d->fineRenderer = std::make_unique<renderers::MeshRenderer>(*d->context, d->fine);
-        d->bendRenderer = std::make_unique<renderers::MeshRenderer>(*d->context, d->bend);
         // Warm up: shader compilation and the framebuffers belong to no frame.
-        d->renderer->render(d->camera, *d->map, kWidth, kHeight);
+        d->renderer->render(d->camera, *d->map, kWidth, kHeight, asBuilt());
+        d->renderer->render(d->camera, *d->map, kWidth, kHeight, {}, nullptr, &d->bendTriangles);
         return d;
     }();
     return *d;
 }
 
-void setCounters(benchmark::State& state, const Mesh& mesh) {
-    state.counters["triangles"] = static_cast<double>(mesh.triangleCount());
+void setCounters(benchmark::State& state, double triangles) {
+    state.counters["triangles"] = triangles;
     state.counters["pixels/s"] =
         benchmark::Counter(double(kWidth) * kHeight, benchmark::Counter::kIsIterationInvariantRate);
 }
 
-// Draw + resolve + readback of `renderer`, which holds `mesh` already uploaded: the frame loop's cost.
-void renderFrames(benchmark::State& state, renderers::MeshRenderer& renderer, const Mesh& mesh, const codec::SamplingMap& map) {
+// Draw + resolve + readback of `renderer`, which holds its mesh already uploaded: the frame loop's cost.
+void renderFrames(benchmark::State& state, renderers::MeshRenderer& renderer, const codec::SamplingMap& map,
+                  const renderers::MeshRenderOptions& options, double triangles) {
     const Data& d = data();
-    for (auto _ : state) benchmark::DoNotOptimize(renderer.render(d.camera, map, kWidth, kHeight));
-    setCounters(state, mesh);
+    for (auto _ : state) benchmark::DoNotOptimize(renderer.render(d.camera, map, kWidth, kHeight, options));
+    setCounters(state, triangles);
 }
-void BM_GpuConventional(benchmark::State& state) { renderFrames(state, *data().renderer, data().mesh, *data().identity); }
-void BM_GpuConus(benchmark::State& state) { renderFrames(state, *data().renderer, data().mesh, *data().map); }
+void BM_GpuConventional(benchmark::State& state) {
+    renderFrames(state, *data().renderer, *data().identity, asBuilt(), double(data().mesh.triangleCount()));
+}
+void BM_GpuConus(benchmark::State& state) {
+    renderFrames(state, *data().renderer, *data().map, asBuilt(), double(data().mesh.triangleCount()));
+}
 void BM_GpuConusSubdivided(benchmark::State& state) {
-    renderFrames(state, *data().fineRenderer, data().fine, *data().map);
+    renderFrames(state, *data().fineRenderer, *data().map, asBuilt(), double(data().fine.triangleCount()));
 }
-void BM_GpuConusBend(benchmark::State& state) { renderFrames(state, *data().bendRenderer, data().bend, *data().map); }
+void BM_GpuConusBend(benchmark::State& state) {
+    renderFrames(state, *data().renderer, *data().map, {}, double(data().bendTriangles));
+}
 // Only the draw (no readback): where the vertex distortion's cost would show.
 void BM_GpuDrawOnly(benchmark::State& state) {
     Data& d = data();
@@ -86,7 +102,7 @@ void BM_GpuDrawOnly(benchmark::State& state) {
     double ms = 0;
     for (auto _ : state) {
         renderers::GpuTimings timings;
-        benchmark::DoNotOptimize(d.renderer->render(d.camera, map, kWidth, kHeight, {}, &timings));
+        benchmark::DoNotOptimize(d.renderer->render(d.camera, map, kWidth, kHeight, asBuilt(), &timings));
         ms += timings.drawMs;
     }
     state.counters["drawMs"] = ms / static_cast<double>(state.iterations());
@@ -100,7 +116,7 @@ void BM_GpuConusOverConventionalPaired(benchmark::State& state) {
     const auto timeOne = [&](const codec::SamplingMap& map) {
         renderers::GpuTimings timings;
         const auto start = std::chrono::steady_clock::now();
-        benchmark::DoNotOptimize(d.renderer->render(d.camera, map, kWidth, kHeight, {}, &timings));
+        benchmark::DoNotOptimize(d.renderer->render(d.camera, map, kWidth, kHeight, asBuilt(), &timings));
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         return drawOnly ? timings.drawMs : ms;
     };
@@ -111,12 +127,6 @@ void BM_Subdivide(benchmark::State& state) {
     Data& d = data();
     for (auto _ : state) benchmark::DoNotOptimize(codec::subdivideForMap(d.mesh, d.camera, *d.map, 0.5));
     state.counters["triangles out"] = static_cast<double>(d.fine.triangleCount());
-}
-void BM_SubdivideBend(benchmark::State& state) {
-    Data& d = data();
-    for (auto _ : state)
-        benchmark::DoNotOptimize(codec::subdivideForBend(d.mesh, d.camera, *d.map, kWidth, kHeight, codec::kDefaultMaxBend));
-    state.counters["triangles out"] = static_cast<double>(d.bend.triangleCount());
 }
 // Deterministic, run once: each CoNUS render's triangles and PSNR (RGB) against the Embree
 // reference (4 rays a pixel against 4x MSAA): as built, where the map bends, everywhere.
@@ -130,12 +140,14 @@ void BM_SubdivisionQuality(benchmark::State& state) {
     const struct {
         const char* name;
         renderers::MeshRenderer& renderer;
-        const Mesh& mesh;
-    } renders[] = {{"none", *d.renderer, d.mesh}, {"bend", *d.bendRenderer, d.bend}, {"edge", *d.fineRenderer, d.fine}};
+        renderers::MeshRenderOptions options;
+    } renders[] = {{"none", *d.renderer, asBuilt()}, {"bend", *d.renderer, {}}, {"edge", *d.fineRenderer, asBuilt()}};
     for (auto _ : state)
         for (const auto& r : renders) {
-            state.counters[std::string("psnr_") + r.name] = codec::psnr(r.renderer.render(d.camera, *d.map, kWidth, kHeight), reference);
-            state.counters[std::string("triangles_") + r.name] = static_cast<double>(r.mesh.triangleCount());
+            std::int64_t triangles = 0;
+            state.counters[std::string("psnr_") + r.name] =
+                codec::psnr(r.renderer.render(d.camera, *d.map, kWidth, kHeight, r.options, nullptr, &triangles), reference);
+            state.counters[std::string("triangles_") + r.name] = static_cast<double>(triangles);
         }
 }
 void BM_EmbreeReference(benchmark::State& state) {
@@ -169,7 +181,6 @@ BENCHMARK(BM_GpuConusBend)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuDrawOnly)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuConusOverConventionalPaired)->Arg(0)->Arg(1)->Iterations(41)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Subdivide)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_SubdivideBend)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SubdivisionQuality)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EmbreeReference)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FociFrameDensity)->Arg(1)->Arg(2)->Arg(8)->Unit(benchmark::kMillisecond);

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <sstream>
+#include <vector>
 
 #include "context_pvt.h"
 #include "shader_constants.h"
@@ -206,28 +207,30 @@ GLuint compileShader(const GladGLContext& gl, GLenum type, const char* source, c
 
 }  // namespace
 
-GLuint cachedProgram(Context& context, const std::string& key, const char* vertex, const char* fragment) {
+GLuint cachedProgram(Context& context, const std::string& key, std::initializer_list<ShaderStage> stages) {
     Context::Impl& impl = context.impl();
     if (auto it = impl.programs.find(key); it != impl.programs.end()) return it->second;
     const GladGLContext& gl = impl.gl;
-    const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, withSharedConstants(vertex).c_str(), key);
-    GLuint fs = 0;
+    std::vector<GLuint> shaders;
     try {
-        fs = compileShader(gl, GL_FRAGMENT_SHADER, withSharedConstants(fragment).c_str(), key);
+        for (const ShaderStage& stage : stages)
+            shaders.push_back(compileShader(gl, stage.type, withSharedConstants(stage.source).c_str(), key));
     } catch (...) {
-        gl.DeleteShader(vs);
+        for (GLuint shader : shaders) gl.DeleteShader(shader);
         throw;
     }
     const GLuint program = gl.CreateProgram();
-    gl.AttachShader(program, vs);
-    gl.AttachShader(program, fs);
+    for (GLuint shader : shaders) gl.AttachShader(program, shader);
     gl.LinkProgram(program);
-    gl.DeleteShader(vs);
-    gl.DeleteShader(fs);
+    for (GLuint shader : shaders) gl.DeleteShader(shader);
     throwUnlessBuilt(program, GL_LINK_STATUS, gl.GetProgramiv, gl.GetProgramInfoLog, gl.DeleteProgram,
                      "GLSL link failed (" + key + ")");
     impl.programs.emplace(key, program);
     return program;
+}
+
+GLuint cachedProgram(Context& context, const std::string& key, const char* vertex, const char* fragment) {
+    return cachedProgram(context, key, {{GL_VERTEX_SHADER, vertex}, {GL_FRAGMENT_SHADER, fragment}});
 }
 
 }  // namespace conus::renderers

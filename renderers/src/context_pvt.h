@@ -2,6 +2,7 @@
 // was found; context_*_missing.cpp stands in otherwise) and the state a Context holds.
 #pragma once
 
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <string>
@@ -48,5 +49,11 @@ const GladGLContext& makeCurrentGl(Context& context);
 // A linked program from the cache, compiled on first use; throws conus::Error(Unsupported) with
 // the GLSL log when it does not compile.
 GLuint cachedProgram(Context& context, const std::string& key, const char* vertex, const char* fragment);
+// The same for any stages (tessellation's between the vertex and the fragment shader).
+struct ShaderStage {
+    GLenum type;  // GL_VERTEX_SHADER, GL_TESS_CONTROL_SHADER, ...
+    const char* source;
+};
+GLuint cachedProgram(Context& context, const std::string& key, std::initializer_list<ShaderStage> stages);
 
 }  // namespace conus::renderers

@@ -52,6 +52,7 @@ inline GlHandle makeTexture(const GladGLContext& gl) { return {gl.GenTextures, g
 inline GlHandle makeBuffer(const GladGLContext& gl) { return {gl.GenBuffers, gl.DeleteBuffers}; }
 inline GlHandle makeFramebuffer(const GladGLContext& gl) { return {gl.GenFramebuffers, gl.DeleteFramebuffers}; }
 inline GlHandle makeVertexArray(const GladGLContext& gl) { return {gl.GenVertexArrays, gl.DeleteVertexArrays}; }
+inline GlHandle makeQuery(const GladGLContext& gl) { return {gl.GenQueries, gl.DeleteQueries}; }
 
 // The sampling map's nodes as an RG32F texture on `unit`, read exactly (texelFetch, nearest) by
 // Equation 1 in GLSL (equation1.inc.glsl). Leaves the texture bound on that unit.

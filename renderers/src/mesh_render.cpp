@@ -27,6 +27,8 @@ namespace {
 constexpr const char* kWhat = "renderMesh";
 constexpr GLuint kAttributes = 4;     // position, normal, colour, uv
 constexpr GLsizei kFloatsPerVertex = 11;
+// A triangle patch at mesh.tesc.glsl's largest level (64) makes 3 * 32 * 33 + 1 = 3169 vertices.
+constexpr GLsizei kSoftwarePatchesPerDraw = 65535 / 3169;
 
 enum class Albedo : GLint { VertexColour = 0, Texture = 1, Grey = 2 };
 
@@ -70,11 +72,25 @@ GlHandle makeFramebufferOf(const GladGLContext& gl, GLenum textarget, GLuint col
     return framebuffer;
 }
 
+// Whether Equation 1 is affine for `map` (every node where its corners' affine map puts it, as for
+// the identity): straight edges stay straight and nothing needs splitting.
+bool isAffine(const codec::SamplingMap& map) {
+    const int columns = map.columns(), rows = map.rows();
+    const auto node = [&](int i, int j) { return glm::dvec2(map.nodes()[static_cast<std::size_t>(j) * columns + i]); };
+    const glm::dvec2 origin = node(0, 0), across = node(columns - 1, 0) - origin, down = node(0, rows - 1) - origin;
+    for (int j = 0; j < rows; ++j)
+        for (int i = 0; i < columns; ++i) {
+            const glm::dvec2 affine = origin + across * (double(i) / (columns - 1)) + down * (double(j) / (rows - 1));
+            if (glm::length(node(i, j) - affine) > 1e-7) return false;
+        }
+    return true;
+}
+
 }  // namespace
 
 struct MeshRenderer::Impl {
     Context& context;
-    GlHandle vertexArray, vertexBuffer, indexBuffer, texture;
+    GlHandle vertexArray, vertexBuffer, indexBuffer, texture, primitivesQuery;
     GLsizei indexCount = 0;
     Albedo albedo = Albedo::Grey;
     // Targets, kept between frames of one size and sample count.
@@ -83,7 +99,8 @@ struct MeshRenderer::Impl {
     std::optional<GlHandle> colour, depth, resolveFramebuffer;               // samples > 1 only
 
     Impl(Context& c, const GladGLContext& gl)
-        : context(c), vertexArray(makeVertexArray(gl)), vertexBuffer(makeBuffer(gl)), indexBuffer(makeBuffer(gl)) {}
+        : context(c), vertexArray(makeVertexArray(gl)), vertexBuffer(makeBuffer(gl)), indexBuffer(makeBuffer(gl)),
+          primitivesQuery(makeQuery(gl)) {}
 
     void ensureTargets(const GladGLContext& gl, int w, int h, int wantedSamples) {
         GLint maxSamples = 1;
@@ -184,15 +201,25 @@ MeshRenderer::~MeshRenderer() {
 }
 
 Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, int width, int height,
-                           const MeshRenderOptions& options, GpuTimings* timings) {
+                           const MeshRenderOptions& options, GpuTimings* timings, std::int64_t* trianglesDrawn) {
     Context& context = m_impl->context;
     checkFrame(context, width, height, kWhat);
     if (options.samples < 1)
         throw Error(ErrorCode::InvalidArgument,
                     std::string(kWhat) + ": samples " + std::to_string(options.samples) + " is below 1");
+    if (!(options.maxBend >= 0 && std::isfinite(options.maxBend)))
+        throw Error(ErrorCode::InvalidArgument,
+                    std::string(kWhat) + ": the largest bend " + std::to_string(options.maxBend) + " is not a finite pixel count >= 0");
     const GladGLContext& gl = makeCurrentGl(context);
     auto phase = std::chrono::steady_clock::now();
-    const GLuint program = cachedProgram(context, "mesh", shaders::kShaderMeshVert, shaders::kShaderMeshFrag);
+    const bool tessellate = options.maxBend > 0 && !isAffine(map);
+    const GLuint program =
+        tessellate ? cachedProgram(context, "mesh_tessellated",
+                                   {{GL_VERTEX_SHADER, shaders::kShaderMeshPatchVert},
+                                    {GL_TESS_CONTROL_SHADER, shaders::kShaderMeshTesc},
+                                    {GL_TESS_EVALUATION_SHADER, shaders::kShaderMeshTese},
+                                    {GL_FRAGMENT_SHADER, shaders::kShaderMeshFrag}})
+                   : cachedProgram(context, "mesh", shaders::kShaderMeshVert, shaders::kShaderMeshFrag);
     m_impl->ensureTargets(gl, width, height, options.samples);
     Impl& impl = *m_impl;
 
@@ -236,13 +263,33 @@ Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, 
     gl.Uniform1i(gl.GetUniformLocation(program, "uPerspective"), camera.projection() == Projection::Perspective);
     gl.Uniform3fv(gl.GetUniformLocation(program, "uEye"), 1, glm::value_ptr(eye));
     gl.Uniform3fv(gl.GetUniformLocation(program, "uForward"), 1, glm::value_ptr(forward));
+    gl.Uniform2f(gl.GetUniformLocation(program, "uPixels"), static_cast<float>(width), static_cast<float>(height));
+    gl.Uniform1f(gl.GetUniformLocation(program, "uMaxBend"), static_cast<float>(options.maxBend));
     if (impl.texture) {
         gl.ActiveTexture(GL_TEXTURE1);
         gl.BindTexture(GL_TEXTURE_2D, impl.texture.id());
         gl.ActiveTexture(GL_TEXTURE0);
     }
     gl.BindVertexArray(impl.vertexArray.id());
-    gl.DrawElements(GL_TRIANGLES, impl.indexCount, GL_UNSIGNED_INT, nullptr);
+    if (trianglesDrawn) gl.BeginQuery(GL_PRIMITIVES_GENERATED, impl.primitivesQuery.id());
+    if (tessellate) {
+        gl.PatchParameteri(GL_PATCH_VERTICES, 3);
+        // Mesa's software rasterizers number the vertices of one draw in 16 bits, tessellated ones
+        // included, so a draw there holds no more patches than can make 65535 vertices at the
+        // largest level; elsewhere one draw holds them all.
+        const GLsizei perDraw = isSoftwareRasterizer(context.renderer()) ? 3 * kSoftwarePatchesPerDraw : impl.indexCount;
+        for (GLsizei first = 0; first < impl.indexCount; first += perDraw)
+            gl.DrawElements(GL_PATCHES, std::min(perDraw, impl.indexCount - first), GL_UNSIGNED_INT,
+                            reinterpret_cast<const void*>(static_cast<std::uintptr_t>(first) * sizeof(GLuint)));
+    } else {
+        gl.DrawElements(GL_TRIANGLES, impl.indexCount, GL_UNSIGNED_INT, nullptr);
+    }
+    if (trianglesDrawn) {
+        gl.EndQuery(GL_PRIMITIVES_GENERATED);
+        GLuint64 generated = 0;
+        gl.GetQueryObjectui64v(impl.primitivesQuery.id(), GL_QUERY_RESULT, &generated);
+        *trianglesDrawn = static_cast<std::int64_t>(generated);
+    }
     gl.BindVertexArray(0);
     gl.Disable(GL_DEPTH_TEST);
     checkGl(gl, kWhat);

@@ -55,12 +55,13 @@ double depthRange(const Image& reference) {
     return hi - lo;
 }
 
-// `mesh` through one focus, rendered on the GPU as it is and subdivided for the map, each compared
+// `mesh` through one focus, rendered on the GPU as it is, subdivided for the map on the CPU (both
+// drawn without tessellation) and split by the tessellation stages (the default), each compared
 // with the Embree reference.
 struct SubdivisionRun {
     Image reference;
     Mesh fine;  // the subdivided mesh
-    Comparison coarse, split;
+    Comparison coarse, split, tessellated;
 };
 
 SubdivisionRun renderWithAndWithoutSubdivision(const Mesh& mesh, const Camera& camera, const codec::Focus& focus) {
@@ -71,6 +72,8 @@ SubdivisionRun renderWithAndWithoutSubdivision(const Mesh& mesh, const Camera& c
     Context& context = test::contextFor(Backend::Egl);
     MeshRenderOptions options;
     options.samples = 1;  // the pixel centre, like the reference's one ray
+    run.tessellated = compare(renderMeshGpu(context, mesh, camera, *map, kSide, kSide, options), run.reference);
+    options.maxBend = 0;
     run.fine = codec::subdivideForMap(mesh, camera, *map, 0.5);
     run.coarse = compare(renderMeshGpu(context, mesh, camera, *map, kSide, kSide, options), run.reference);
     run.split = compare(renderMeshGpu(context, run.fine, camera, *map, kSide, kSide, options), run.reference);
@@ -85,13 +88,18 @@ TEST_P(MeshModels, GpuMatchesTheEmbreeReferenceWithSubdivision) {
     const Mesh mesh = sceneio::readMesh(file.string());
     const Camera camera = framing(mesh);
     // A strong focus a little off the model's centre.
-    const auto [reference, fine, coarse, split] = renderWithAndWithoutSubdivision(mesh, camera, {0.42, 0.45, 0.12, 4.0});
+    const auto [reference, fine, coarse, split, tessellated] =
+        renderWithAndWithoutSubdivision(mesh, camera, {0.42, 0.45, 0.12, 4.0});
     const double range = depthRange(reference);
-    std::printf("%s: %zu -> %zu triangles; PSNR %.2f dB -> %.2f dB; depth error p99 %.3g%% -> %.3g%% of the range\n",
-                GetParam().c_str(), mesh.triangleCount(), fine.triangleCount(), coarse.psnr, split.psnr,
-                100 * coarse.depth.p99 / range, 100 * split.depth.p99 / range);
+    std::printf("%s: %zu -> %zu triangles; PSNR %.2f dB -> %.2f dB (tessellated %.2f dB); depth error p99 %.3g%% -> "
+                "%.3g%% (%.3g%%) of the range\n",
+                GetParam().c_str(), mesh.triangleCount(), fine.triangleCount(), coarse.psnr, split.psnr, tessellated.psnr,
+                100 * coarse.depth.p99 / range, 100 * split.depth.p99 / range, 100 * tessellated.depth.p99 / range);
     EXPECT_GE(split.psnr, 35.0);
     EXPECT_LT(split.depth.p99, 0.01 * range);
+    EXPECT_GE(tessellated.psnr, 35.0);
+    EXPECT_GE(tessellated.psnr, coarse.psnr - 0.01);  // small triangles stay whole
+    EXPECT_LT(tessellated.depth.p99, 0.01 * range);
     EXPECT_GT(split.depth.pixels, kSide * kSide / 10);
 }
 
@@ -105,18 +113,23 @@ INSTANTIATE_TEST_SUITE_P(SharedData, MeshModels,
                          });
 
 // A big box seen up close through a strong focus: its long edges and faces cross many map cells,
-// so without subdivision the straight edges miss Equation 1's curves; with it they follow them.
+// so without subdivision the straight edges miss Equation 1's curves; split on the CPU or by the
+// tessellation stages they follow them.
 TEST(MeshSubdivision, ACoarseBoxUnderAStrongFocusNeedsIt) {
     Mesh box;
     test::appendBox(box, {-2.0, -1.0, -2.0}, {2.0, 1.2, 1.5});
     const Camera camera = Camera::perspective({2.5, 2.0, 5.0}, {0.0, 0.0, 0.0}, {0, 1, 0}, 55.0, 1.0, 1.0, 20.0);
-    const auto [reference, fine, coarse, split] = renderWithAndWithoutSubdivision(box, camera, {0.45, 0.5, 0.15, 6.0});
+    const auto [reference, fine, coarse, split, tessellated] =
+        renderWithAndWithoutSubdivision(box, camera, {0.45, 0.5, 0.15, 6.0});
     ASSERT_GT(fine.triangleCount(), 20 * box.triangleCount());
-    std::printf("box: %zu -> %zu triangles; PSNR %.2f dB -> %.2f dB; depth error mean %.4g -> %.4g\n",
-                box.triangleCount(), fine.triangleCount(), coarse.psnr, split.psnr, coarse.depth.mean, split.depth.mean);
-    EXPECT_GE(split.psnr, 35.0);
-    EXPECT_GT(split.psnr, coarse.psnr + 6.0);  // measurably better: a quarter of the error energy
-    EXPECT_LT(split.depth.mean, 0.5 * coarse.depth.mean);
+    std::printf("box: %zu -> %zu triangles; PSNR %.2f dB -> %.2f dB (tessellated %.2f dB); depth error mean %.4g -> %.4g (%.4g)\n",
+                box.triangleCount(), fine.triangleCount(), coarse.psnr, split.psnr, tessellated.psnr, coarse.depth.mean,
+                split.depth.mean, tessellated.depth.mean);
+    for (const Comparison& followed : {split, tessellated}) {
+        EXPECT_GE(followed.psnr, 35.0);
+        EXPECT_GT(followed.psnr, coarse.psnr + 6.0);  // measurably better: a quarter of the error energy
+        EXPECT_LT(followed.depth.mean, 0.5 * coarse.depth.mean);
+    }
 }
 
 }  // namespace

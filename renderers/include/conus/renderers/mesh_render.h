@@ -1,9 +1,12 @@
 // The GPU mesh encoder (paper section 3.2, "Geometry data"): a conus::Mesh seen through a
 // flexible pinhole camera (a Camera and a sampling map) rendered as a CoNUS colour + depth image.
-// The vertex shader projects each vertex with the camera and moves it by Equation 1
-// (equation1.inc.glsl: the map's nodes fetched exactly, manual bilinear weights); the rasterizer
-// joins the distorted vertices with straight edges, which is why long edges are subdivided first
-// (codec/mesh/subdivide.h, `conus mesh render --max-edge`); shading is codec/mesh/shading.h's.
+// Each vertex is projected with the camera and moved by Equation 1 (equation1.inc.glsl: the map's
+// nodes fetched exactly, manual bilinear weights). The rasterizer joins distorted vertices with
+// straight edges and affine insides while the map bends both, so the tessellation stages split
+// each triangle where the map bends its picture by more than options.maxBend pixels
+// (mesh.tesc.glsl; nothing is split for an affine map such as the identity); the mesh uploaded
+// stays as it is. codec/mesh/subdivide.h's uniform split (`--max-edge`) is the CPU alternative.
+// Shading is codec/mesh/shading.h's.
 // The CPU path is codec's Embree reference (codec/mesh/raycast.h), which casts each CoNUS pixel's
 // exact ray; renderMesh(Device, ...) registers both.
 //
@@ -21,6 +24,7 @@
 // thread.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 
 #include "conus/codec/map/sampling_map.h"
@@ -32,8 +36,13 @@
 
 namespace conus::renderers {
 
+inline constexpr double kDefaultMaxBend = 0.5;   // CoNUS pixels: `conus mesh render`'s --max-bend
+
 struct MeshRenderOptions {
     int samples = 4;  // multisampling per pixel (1: one sample at the centre); the driver's maximum caps it
+    // Split triangles on the GPU until the map bends no edge or inside more than this many CoNUS
+    // pixels away from what the rasterizer draws (0: draw the triangles as they are).
+    double maxBend = kDefaultMaxBend;
 };
 
 // Keeps a mesh uploaded, so that frames of one mesh (another camera, another map) cost only the draw
@@ -46,9 +55,12 @@ public:
     MeshRenderer& operator=(const MeshRenderer&) = delete;
 
     // The camera's aspect should be width / height (else the picture is stretched). `timings`, if
-    // given, receives the phases (upload: the map; draw; readback).
+    // given, receives the phases (upload: the map; draw; readback); `trianglesDrawn` the triangles
+    // the rasterizer was given (after the split). Throws InvalidArgument for samples < 1 or a
+    // negative or non-finite maxBend.
     Image render(const Camera& camera, const codec::SamplingMap& map, int width, int height,
-                 const MeshRenderOptions& options = {}, GpuTimings* timings = nullptr);
+                 const MeshRenderOptions& options = {}, GpuTimings* timings = nullptr,
+                 std::int64_t* trianglesDrawn = nullptr);
 
 private:
     struct Impl;
