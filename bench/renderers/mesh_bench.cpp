@@ -123,6 +123,18 @@ void BM_GpuConusOverConventionalPaired(benchmark::State& state) {
     bench::pairedRatio(state, [&] { return timeOne(*d.identity); }, [&] { return timeOne(*d.map); });
     state.SetLabel(drawOnly ? "draw only" : "draw + resolve + readback");
 }
+// The default (split where the map bends, tessellation) over the mesh as built, both through the
+// CoNUS map, timed in interleaved pairs: what following the map costs a frame.
+void BM_GpuBendOverAsBuiltPaired(benchmark::State& state) {
+    Data& d = data();
+    const auto timeOne = [&](const renderers::MeshRenderOptions& options) {
+        const auto start = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(d.renderer->render(d.camera, *d.map, kWidth, kHeight, options));
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    };
+    bench::pairedRatio(state, [&] { return timeOne(asBuilt()); }, [&] { return timeOne({}); });
+    state.counters["triangles"] = static_cast<double>(d.bendTriangles);
+}
 void BM_Subdivide(benchmark::State& state) {
     Data& d = data();
     for (auto _ : state) benchmark::DoNotOptimize(codec::subdivideForMap(d.mesh, d.camera, *d.map, 0.5));
@@ -180,6 +192,7 @@ BENCHMARK(BM_GpuConusSubdivided)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuConusBend)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuDrawOnly)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GpuConusOverConventionalPaired)->Arg(0)->Arg(1)->Iterations(41)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GpuBendOverAsBuiltPaired)->Iterations(41)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Subdivide)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SubdivisionQuality)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EmbreeReference)->UseRealTime()->Unit(benchmark::kMillisecond);

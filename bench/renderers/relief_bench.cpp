@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "bench_context.h"
+#include "paired.h"
 #include "conus/codec/build/auto_map.h"
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/depth/relief.h"
@@ -26,6 +27,7 @@ constexpr int kTabletWidth = 1024, kTabletHeight = 768;  // the full-resolution 
 constexpr int kAssetWidth = 256, kAssetHeight = 192;     // both assets: 1/16 of its texels
 constexpr int kFrameWidth = 640, kFrameHeight = 480;
 constexpr int kRayWidth = 320, kRayHeight = 240;  // eye rays for the intersection benchmarks
+constexpr int kManyRays = 4;                       // the paired GLSL walk: 4 x 4 rays a pixel of those
 constexpr double kContextDensity = 0.7;            // `bake relief`'s default --min-density
 
 struct Asset {
@@ -38,7 +40,7 @@ struct Data {
     codec::Tablet tablet;
     Image ink;
     Asset conus, conventional, full;
-    std::vector<Ray> rays;
+    std::vector<Ray> rays, manyRays;
     std::unique_ptr<renderers::Context> context;
 };
 
@@ -69,6 +71,9 @@ Data& data() {
         const Camera camera = codec::defaultReliefView(*d->conus.image, double(kRayWidth) / kRayHeight);
         for (int y = 0; y < kRayHeight; ++y)
             for (int x = 0; x < kRayWidth; ++x) d->rays.push_back(camera.ray({(x + 0.5) / kRayWidth, (y + 0.5) / kRayHeight}));
+        const int wide = kManyRays * kRayWidth, high = kManyRays * kRayHeight;
+        for (int y = 0; y < high; ++y)
+            for (int x = 0; x < wide; ++x) d->manyRays.push_back(camera.ray({(x + 0.5) / wide, (y + 0.5) / high}));
         return d;
     }();
     return *d;
@@ -94,6 +99,29 @@ void BM_IntersectGlsl(benchmark::State& state) {
     for (auto _ : state) benchmark::DoNotOptimize(renderers::intersectRays(*d.context, *asset.image, d.rays));
     state.SetItemsProcessed(state.iterations() * static_cast<long>(d.rays.size()));
     state.SetLabel(state.range(0) ? "CoNUS" : "conventional");
+}
+
+// CoNUS over conventional in interleaved pairs (paired.h), where a fast GPU's clocks and a loaded
+// machine would otherwise swap the sides of separate runs. Arg 0: the GLSL walk of the 320 x 240
+// rays (with their upload and readback); 1: of 1280 x 960 rays, where the walk outweighs the
+// transfers; 2: the relief frame's draw (640 x 480, waited for).
+void BM_ReliefPaired(benchmark::State& state) {
+    Data& d = data();
+    const auto milliseconds = [](auto&& work) {
+        const auto start = std::chrono::steady_clock::now();
+        work();
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    };
+    const auto timeOne = [&](Asset& asset) {
+        if (state.range(0) == 2) {
+            const Camera camera = codec::defaultReliefView(*asset.image, double(kFrameWidth) / kFrameHeight);
+            return milliseconds([&] { asset.renderer->draw(camera, kFrameWidth, kFrameHeight); });
+        }
+        const std::vector<Ray>& rays = state.range(0) ? d.manyRays : d.rays;
+        return milliseconds([&] { benchmark::DoNotOptimize(renderers::intersectRays(*d.context, *asset.image, rays)); });
+    };
+    bench::pairedRatio(state, [&] { return timeOne(d.conventional); }, [&] { return timeOne(d.conus); });
+    state.SetLabel(state.range(0) == 2 ? "relief frame" : state.range(0) ? "GLSL walk, 1280x960 rays" : "GLSL walk, 320x240 rays");
 }
 
 void BM_ReliefFrame(benchmark::State& state) {
@@ -138,6 +166,7 @@ BENCHMARK(BM_IntersectCpu)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // GL work runs on llvmpipe's own threads (or the GPU): wall-clock time is what counts there.
 BENCHMARK(BM_IntersectGlsl)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReliefFrame)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReliefPaired)->Arg(0)->Arg(1)->Arg(2)->Iterations(61)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Quality)->Arg(25)->Arg(50)->Arg(70)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
