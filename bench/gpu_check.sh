@@ -54,6 +54,7 @@ rm -rf "$demo"
 pairs='BM_(Encode|Decode)(Gpu|Cpu)|BM_Gpu(Conventional|Conus|ConusSubdivided)|BM_GpuConusOverConventionalPaired/.*'
 pairs+='|BM_Volume(Gpu|Cpu)(Conventional|Conus)(Filled)?|BM_VolumeGpuConusOverConventionalPaired/.*'
 pairs+='|BM_Intersect(Cpu|Glsl)/[01]|BM_ReflectionFrame(Gl)?/[01]|BM_ReliefFrame/[01]|BM_Render(Conus|Uniform)'
+pairs+='|BM_GpuConusBend|BM_ReliefPaired/.*|BM_GpuBendOverAsBuiltPaired.*|BM_SubdivisionQuality.*'
 echo "== renderers_bench ($repetitions repetitions)"
 timeout "$limit" "$bin/renderers_bench" --benchmark_filter="^($pairs)(/real_time)?\$" --benchmark_repetitions="$repetitions" \
   --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true --benchmark_min_time="${CONUS_GPU_CHECK_MIN_TIME:-1}" \

@@ -104,7 +104,8 @@ void BM_IntersectGlsl(benchmark::State& state) {
 // CoNUS over conventional in interleaved pairs (paired.h), where a fast GPU's clocks and a loaded
 // machine would otherwise swap the sides of separate runs. Arg 0: the GLSL walk of the 320 x 240
 // rays (with their upload and readback); 1: of 1280 x 960 rays, where the walk outweighs the
-// transfers; 2: the relief frame's draw (640 x 480, waited for).
+// transfers; 2: the relief frame's draw (640 x 480, waited for); 3: codec::intersect of the
+// 320 x 240 rays on the CPU (one thread).
 void BM_ReliefPaired(benchmark::State& state) {
     Data& d = data();
     const auto milliseconds = [](auto&& work) {
@@ -117,11 +118,16 @@ void BM_ReliefPaired(benchmark::State& state) {
             const Camera camera = codec::defaultReliefView(*asset.image, double(kFrameWidth) / kFrameHeight);
             return milliseconds([&] { asset.renderer->draw(camera, kFrameWidth, kFrameHeight); });
         }
+        if (state.range(0) == 3)
+            return milliseconds([&] {
+                for (const Ray& ray : d.rays) benchmark::DoNotOptimize(codec::intersect(*asset.image, ray));
+            });
         const std::vector<Ray>& rays = state.range(0) ? d.manyRays : d.rays;
         return milliseconds([&] { benchmark::DoNotOptimize(renderers::intersectRays(*d.context, *asset.image, rays)); });
     };
     bench::pairedRatio(state, [&] { return timeOne(d.conventional); }, [&] { return timeOne(d.conus); });
-    state.SetLabel(state.range(0) == 2 ? "relief frame" : state.range(0) ? "GLSL walk, 1280x960 rays" : "GLSL walk, 320x240 rays");
+    const char* labels[] = {"GLSL walk, 320x240 rays", "GLSL walk, 1280x960 rays", "relief frame", "CPU walk, 320x240 rays"};
+    state.SetLabel(labels[state.range(0)]);
 }
 
 void BM_ReliefFrame(benchmark::State& state) {
@@ -166,7 +172,7 @@ BENCHMARK(BM_IntersectCpu)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // GL work runs on llvmpipe's own threads (or the GPU): wall-clock time is what counts there.
 BENCHMARK(BM_IntersectGlsl)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReliefFrame)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_ReliefPaired)->Arg(0)->Arg(1)->Arg(2)->Iterations(61)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReliefPaired)->DenseRange(0, 3)->Iterations(61)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Quality)->Arg(25)->Arg(50)->Arg(70)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
