@@ -8,23 +8,14 @@ in vec3 tWorld[];
 in vec3 tNormal[];
 in vec3 tColour[];
 in vec2 tUv[];
-uniform vec4 uDepthRow;  // camera depth = dot(uDepthRow, (p, 1)): worldToCamera's z row
-out vec3 vWorld;
-out vec3 vNormal;
-out vec3 vColour;
-out vec2 vUv;
-out float vDepth;
 
 #include "equation1.inc.glsl"
 #include "mesh_project.inc.glsl"
+#include "mesh_vertex.inc.glsl"
 
 void main() {
     const vec3 b = gl_TessCoord;
     precise vec3 world = b.x * tWorld[0] + b.y * tWorld[1] + b.z * tWorld[2];
-    vWorld = world;
-    vNormal = b.x * tNormal[0] + b.y * tNormal[1] + b.z * tNormal[2];
-    vColour = b.x * tColour[0] + b.y * tColour[1] + b.z * tColour[2];
-    vUv = b.x * tUv[0] + b.y * tUv[1] + b.z * tUv[2];
-    vDepth = dot(uDepthRow, vec4(world, 1.0));
-    gl_Position = fpcClipPosition(world);
+    emitVertex(world, b.x * tNormal[0] + b.y * tNormal[1] + b.z * tNormal[2],
+               b.x * tColour[0] + b.y * tColour[1] + b.z * tColour[2], b.x * tUv[0] + b.y * tUv[1] + b.z * tUv[2]);
 }

@@ -6,21 +6,11 @@ layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
 layout(location = 2) in vec3 aColour;
 layout(location = 3) in vec2 aUv;
-uniform vec4 uDepthRow;       // camera depth = dot(uDepthRow, (p, 1)): worldToCamera's z row
-out vec3 vWorld;
-out vec3 vNormal;
-out vec3 vColour;
-out vec2 vUv;
-out float vDepth;
 
 #include "equation1.inc.glsl"
 #include "mesh_project.inc.glsl"
+#include "mesh_vertex.inc.glsl"
 
 void main() {
-    vWorld = aPosition;
-    vNormal = aNormal;
-    vColour = aColour;
-    vUv = aUv;
-    vDepth = dot(uDepthRow, vec4(aPosition, 1.0));
-    gl_Position = fpcClipPosition(aPosition);
+    emitVertex(aPosition, aNormal, aColour, aUv);
 }
