@@ -80,6 +80,11 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     app.add_option("--scene", o.reflectionScene, "--reflection: the mesh the asset was baked from");
     cli::addAllowDirOption(app, o.allowDirs);
     app.add_option("--radius", o.reflectorRadius, "--reflection: the mirror sphere's radius")->capture_default_str()->check(cli::finiteRange(0.0, 1e9));
+    app.add_option("--max-bend", o.maxBend,
+                   "--mesh: split triangles on the GPU where Equation 1 bends an edge or a triangle's inside more than "
+                   "this many CoNUS pixels away from the straight lines the rasterizer draws (0: draw them as they are)")
+        ->capture_default_str()
+        ->check(cli::finiteRange(0.0, 1e6, true, true));
     app.add_option("--max-edge", o.maxEdge,
                    "--mesh: instead of splitting on the GPU where the map bends, split triangles each CoNUS frame until no "
                    "projected edge spans more than this many map cells (a CPU subdivision and an upload a frame; 0: never)")

@@ -8,6 +8,7 @@
 #include "conus/codec/build/foci.h"
 #include "conus/codec/image/decode.h"
 #include "actions.h"
+#include "conus/renderers/mesh_render.h"
 #include "conus/renderers/view_renderer.h"
 
 namespace conus::viewer {
@@ -42,6 +43,7 @@ struct Options {
     double reflectorRadius = 0.5;        // --radius: the mirror sphere of --reflection
     std::string transferFunction;        // --tf: a volume's transfer function preset or file
     double maxEdge = 0;                  // --max-edge: --mesh subdivides each CoNUS frame's mesh (0: never)
+    double maxBend = renderers::kDefaultMaxBend;  // --max-bend: --mesh's GPU split where the map bends (0: none)
     std::vector<codec::Focus> foci;      // --focus u,v,r,k (repeated): the 3-D modes' first foci
     bool depthPicture = false;           // --mode z: a depth image's Z as a picture (key Z)
 };

@@ -61,9 +61,12 @@ Image colourOf(const Image& frame) {
 
 class MeshView final : public Scene {
 public:
-    MeshView(renderers::Context& context, const std::string& path, const std::vector<std::string>& allowDirs, double maxEdge)
+    MeshView(renderers::Context& context, const std::string& path, const std::vector<std::string>& allowDirs, double maxEdge,
+             double maxBend)
         : m_context(context), m_name(fileName(path) + " (mesh)"), m_mesh(readMeshFile(path, allowDirs)),
-          m_bounds(sphereAround(m_mesh.positions)), m_maxEdge(maxEdge), m_renderer(context, m_mesh) {}
+          m_bounds(sphereAround(m_mesh.positions)), m_maxEdge(maxEdge), m_renderer(context, m_mesh) {
+        m_options.maxBend = maxBend;
+    }
     std::string name() const override { return m_name; }
     glm::dvec3 centre() const override { return m_bounds.centre; }
     double radius() const override { return m_bounds.radius; }
@@ -76,7 +79,7 @@ public:
             return renderers::renderMeshGpu(m_context, codec::subdivideForMap(m_mesh, camera, map, m_maxEdge), camera, map,
                                             width, height, asSplit);
         }
-        return m_renderer.render(camera, map, width, height);
+        return m_renderer.render(camera, map, width, height, m_options);
     }
 
 private:
@@ -85,6 +88,7 @@ private:
     Mesh m_mesh;
     BoundingSphere m_bounds;
     double m_maxEdge;
+    renderers::MeshRenderOptions m_options;
     renderers::MeshRenderer m_renderer;
 };
 
@@ -225,7 +229,8 @@ private:
 
 std::unique_ptr<Scene> openScene(const Options& options, renderers::Context& context) {
     switch (options.sceneKind) {
-    case SceneKind::Mesh: return std::make_unique<MeshView>(context, options.scenePath, options.allowDirs, options.maxEdge);
+    case SceneKind::Mesh: return std::make_unique<MeshView>(context, options.scenePath, options.allowDirs, options.maxEdge,
+                                                                  options.maxBend);
     case SceneKind::Volume: return std::make_unique<VolumeView>(context, options);
     case SceneKind::Relief: return std::make_unique<ReliefView>(context, options);
     case SceneKind::Reflection: return std::make_unique<ReflectionView>(context, options);

@@ -134,7 +134,32 @@ TEST(SceneWindow, MeshMaxEdgeSubdividesEachFrame) {
     const codec::SamplingMap map = state.map(aspect);
     const Mesh fine = codec::subdivideForMap(mesh, camera, map, 0.5);
     ASSERT_GT(fine.triangleCount(), mesh.triangleCount()) << "the focus makes some edges long";
-    EXPECT_LT(compare(window, renderers::renderMeshGpu(test::context(), fine, camera, map, kW, kH)).mean, 1.0 / 255);
+    renderers::MeshRenderOptions asSplit;
+    asSplit.maxBend = 0;
+    EXPECT_LT(compare(window, renderers::renderMeshGpu(test::context(), fine, camera, map, kW, kH, asSplit)).mean, 1.0 / 255);
+}
+
+// --max-bend 0: the mesh drawn as it is through the map, not the default's split frame.
+TEST(SceneWindow, MeshMaxBendZeroDrawsTheMeshAsItIs) {
+    ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";
+    const std::string model = std::string(CONUS_SHARED_DATA) + "/meshes/suzanne.obj";
+    if (!fs::exists(model)) GTEST_SKIP() << "shared data not found: " << model;
+    const codec::Focus focus{0.5, 0.45, 0.15, 4.0};
+    const fs::path shot = test::tempDir() / "straight.png";
+    const std::string log = runScript("--mesh " + model + " --focus 0.5,0.45,0.15,4 --max-bend 0", "screenshot " + shot.string() + "\n");
+    const Image window = readPicture(shot);
+    ASSERT_EQ(window.width, kW) << log;
+    const Mesh mesh = sceneio::readMesh(model);
+    const BoundingSphere sphere = boundingSphere(std::vector<glm::dvec3>(mesh.positions.begin(), mesh.positions.end()));
+    const SceneState state(sphere.centre, sphere.radius, {focus});
+    const double aspect = double(kW) / kH;
+    renderers::MeshRenderer renderer(test::context(), mesh);
+    renderers::MeshRenderOptions straight;
+    straight.maxBend = 0;
+    const Image asBuilt = renderer.render(state.camera(aspect), state.map(aspect), kW, kH, straight);
+    const Image split = renderer.render(state.camera(aspect), state.map(aspect), kW, kH);
+    EXPECT_LT(compare(window, asBuilt).mean, 1.0 / 255);
+    EXPECT_GT(compare(asBuilt, split).worst, 8.0 / 255) << "the focus bends suzanne's long edges";
 }
 
 // --screenshot in a 3-D mode: the first frame offscreen, no window, as the window would show it
