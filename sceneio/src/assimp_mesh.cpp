@@ -33,6 +33,7 @@
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
 #include "conus/sceneio/named_files.h"
+#include "extension_pvt.h"
 
 // Debian's Assimp keeps its internal assertions, which abort the process (a hostile PLY reaches
 // one in the triangulation step). This definition takes the place of Assimp's own (the library
@@ -151,8 +152,7 @@ void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
         std::istringstream words(line.substr(0, line.find('#')));
         while (tokens.size() < 4 && words >> token) tokens.push_back(token);
     }
-    std::string ext = fs::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowerExtension(path);
     const bool keyword = !tokens.empty() && tokens[0].size() >= 3 && tokens[0].compare(tokens[0].size() - 3, 3, "OFF") == 0;
     if (!keyword && ext != ".off") return;
     const std::size_t first = keyword ? 1 : 0;
@@ -252,8 +252,7 @@ void checkGlbLengths(const std::string& path, std::uintmax_t bytes) {
 // policy before Assimp reads the file, so that an absolute or escaping name is refused in the
 // policy's words (the IOSystem below still guards every file Assimp actually opens).
 void checkGltfUris(const std::string& path, const NamedFiles& named) {
-    std::string ext = fs::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowerExtension(path);
     if (ext != ".gltf") return;
     std::ifstream in(path, std::ios::binary);
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -379,8 +378,7 @@ bool checkFile(const std::string& path, const MeshReadOptions& options) {
 // glTF states its vertex colours in linear light; the older formats (PLY, OBJ extensions, OFF)
 // store the display values their authors picked, i.e. sRGB.
 bool coloursAreLinear(const std::string& path) {
-    std::string ext = fs::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowerExtension(path);
     return ext == ".gltf" || ext == ".glb";
 }
 

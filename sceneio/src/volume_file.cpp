@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "conus/core/error.h"
+#include "extension_pvt.h"
 
 namespace conus::sceneio {
 namespace {
@@ -38,12 +39,6 @@ double positiveNumber(const std::string& text, const std::string& spec) {
         throw Error(ErrorCode::InvalidArgument, "raw volume '" + spec + "': spacing '" + text +
                                                     "' is not a positive number");
     return value;
-}
-
-std::string lowerExtension(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext;
 }
 
 }  // namespace
