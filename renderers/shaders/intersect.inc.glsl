@@ -117,6 +117,36 @@ float surfaceAlong(sampler2D depths, sampler2D map, vec2 p0, vec2 along, float s
 // The ray's camera depth at s (perspective-correct).
 float rayDepth(float dw0, float dw1, float iw0, float iw1, float s) { return mix(dw0, dw1, s) / mix(iw0, iw1, s); }
 
+// Clips the ray (c0 + cd t in clip coordinates, camera depth z0 + zd t) to u, v in [0,1] and depth
+// in [lo, hi], each a + b t >= 0: false when nothing is left.
+bool clipDepthRay(vec4 c0, vec4 cd, float z0, float zd, float lo, float hi, float tMax, out float tEnter, out float tExit,
+                  out int entered, out int exited) {
+    float planes[12] = float[12](c0.x, cd.x, c0.w - c0.x, cd.w - cd.x, c0.y, cd.y, c0.w - c0.y, cd.w - cd.y, z0 - lo,
+                                 zd, hi - z0, -zd);
+    tEnter = 0.0;
+    tExit = tMax;
+    entered = -1;
+    exited = -1;
+    for (int k = 0; k < 6; ++k) {
+        const float a = planes[2 * k], b = planes[2 * k + 1];
+        if (b == 0.0) {
+            if (a < 0.0) return false;
+            continue;
+        }
+        const float t = -a / b;
+        if (b > 0.0) {
+            if (t > tEnter) {
+                tEnter = t;
+                entered = k;
+            }
+        } else if (t < tExit) {
+            tExit = t;
+            exited = k;
+        }
+    }
+    return tEnter <= tExit;
+}
+
 DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, vec3 origin, vec3 direction,
                              float stepTexels, int refinements, int maxSteps, float tMax) {
     DepthHit result;
@@ -131,28 +161,32 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     float lo = view.minDepth - margin;
     const float hi = view.maxDepth + margin;
     if (view.perspective) lo = max(lo, view.near);
-    float planes[12] = float[12](c0.x, cd.x, c0.w - c0.x, cd.w - cd.x, c0.y, cd.y, c0.w - c0.y, cd.w - cd.y, z0 - lo,
-                                 zd, hi - z0, -zd);
-    float tEnter = 0.0, tExit = tMax;
-    int entered = -1, exited = -1;
-    for (int k = 0; k < 6; ++k) {
-        const float a = planes[2 * k], b = planes[2 * k + 1];
-        if (b == 0.0) {
-            if (a < 0.0) return result;
-            continue;
-        }
-        const float t = -a / b;
-        if (b > 0.0) {
-            if (t > tEnter) {
-                tEnter = t;
-                entered = k;
+    float tEnter, tExit;
+    int entered, exited;
+    if (!view.solid) {
+        // A scene's surface that goes on across the side the ray enters through, less than a jump
+        // in front of it: met there (the clip reaches a jump further for this test).
+        const float jump = view.jumpRelative * view.maxDepth + view.jumpAbsolute;
+        if (clipDepthRay(c0, cd, z0, zd, lo, hi + jump, tMax, tEnter, tExit, entered, exited) && entered >= 0 &&
+            entered < 4) {
+            const vec4 ca = c0 + cd * tEnter;
+            const vec2 pe = clamp(ca.xy / ca.w, 0.0, 1.0);
+            const MapPoint me = evalMap(map, pe);
+            const float stored = sampleDepth(depths, me.pd), depth = z0 + zd * tEnter;
+            if (stored - depth <= 0.0 && depth - stored <= view.jumpRelative * stored + view.jumpAbsolute) {
+                result.hit = true;
+                result.t = tEnter;
+                result.position = origin + direction * tEnter;
+                result.depth = depth;
+                result.point = pe;
+                result.distorted = me.pd;
+                result.texel = clamp(ivec2(floor(me.pd * vec2(textureSize(depths, 0)))), ivec2(0), textureSize(depths, 0) - 1);
+                result.face = entered;
+                return result;
             }
-        } else if (t < tExit) {
-            tExit = t;
-            exited = k;
         }
     }
-    if (!(tEnter <= tExit)) return result;
+    if (!clipDepthRay(c0, cd, z0, zd, lo, hi, tMax, tEnter, tExit, entered, exited)) return result;
 
     // 2. Project the ends; 1/w, depth/w and t/w are linear along the projected segment.
     const vec4 ca = c0 + cd * tEnter, cb = c0 + cd * tExit;

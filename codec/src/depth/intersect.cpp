@@ -26,9 +26,9 @@ struct Segment {
     double t(double s) const { return (tw0 + (tw1 - tw0) * s) / invW(s); }
 };
 
-// Clips `ray` to u, v in [0,1] and depth in [lo, hi] (each a half-space a + b t >= 0 in
+// Clips `ray` to u, v in [0,1] and depth in [lo, hi + beyond] (each a half-space a + b t >= 0 in
 // homogeneous clip coordinates, where perspective and orthographic cameras are alike).
-std::optional<Segment> clipRay(const DepthImage& image, const Ray& ray, double tMax) {
+std::optional<Segment> clipRay(const DepthImage& image, const Ray& ray, double tMax, double beyond = 0.0) {
     const Camera& camera = image.camera();
     const glm::dmat4 m = camera.worldToNdcMatrix();
     const glm::dvec4 c0 = m * glm::dvec4(ray.origin, 1.0), cd = m * glm::dvec4(ray.direction, 0.0);
@@ -38,7 +38,7 @@ std::optional<Segment> clipRay(const DepthImage& image, const Ray& ray, double t
     // in front of a perspective eye's near plane nothing projects.
     const double margin = kIntersectDepthMargin * (1.0 + std::max(std::abs(image.minDepth()), std::abs(image.maxDepth())));
     double lo = image.minDepth() - margin;
-    const double hi = image.maxDepth() + margin;
+    const double hi = image.maxDepth() + margin + beyond;
     if (camera.projection() == Projection::Perspective) lo = std::max(lo, camera.near());
 
     double tEnter = 0.0, tExit = tMax;
@@ -105,7 +105,43 @@ void checkRay(const Ray& ray) {
                                                     std::to_string(length) + ")");
 }
 
+namespace {
+
+// The hit at s along `segment` (pd: where s lies in the CoNUS image).
+DepthHit hitOn(const DepthImage& image, const Segment& segment, const Ray& ray, double s, glm::dvec2 pd, int steps, bool hidden) {
+    const glm::dvec2 size(image.width(), image.height());
+    DepthHit hit;
+    hit.t = segment.t(s);
+    hit.position = ray.origin + ray.direction * hit.t;
+    hit.depth = segment.depth(s);
+    hit.point = segment.point(s);
+    hit.distorted = pd;
+    hit.texel = glm::clamp(glm::ivec2(glm::floor(pd * size)), glm::ivec2(0), glm::ivec2(size) - 1);
+    hit.steps = steps;
+    hit.hidden = hidden;
+    hit.face = steps == 0 ? segment.face : -1;
+    return hit;
+}
+
+// A scene's surface that goes on across the side of the view volume the ray enters through (a
+// floor seen by two cube faces): the ray, entering behind it by less than a jump (continuous with
+// it by the image's own measure), met it there. The clip reaches a jump beyond the data's depth
+// range for this test alone.
+std::optional<DepthHit> acrossSide(const DepthImage& image, const Ray& ray, double tMax) {
+    const double jump = image.jumpRelative() * image.maxDepth() + image.jumpAbsolute();
+    const std::optional<Segment> wide = clipRay(image, ray, tMax, jump);
+    if (!wide || wide->face < 0 || wide->face > 3) return std::nullopt;
+    const glm::dvec2 pd = image.map().distort(wide->point(0.0));
+    const double stored = image.sampleDepth(pd), depth = wide->depth(0.0);
+    if (stored - depth > 0.0 || depth - stored > image.jumpRelative() * stored + image.jumpAbsolute()) return std::nullopt;
+    return hitOn(image, *wide, ray, 0.0, pd, 0, false);
+}
+
+}  // namespace
+
 std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options) {
+    if (!image.solid())
+        if (auto hit = acrossSide(image, ray, options.tMax)) return hit;
     const std::optional<Segment> clipped = clipRay(image, ray, options.tMax);
     if (!clipped) return std::nullopt;
     const Segment& segment = *clipped;
@@ -121,19 +157,7 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
     // a near surface a texel wide is not stepped over (a wall, unlike a skin, can be).
     const bool solid = image.solid();  // no cell of a solid image is flagged
     const auto flagged = [&](glm::dvec2 p) { return !solid && image.cellFlags()[image.cellIndex(p)] != 0; };
-    const auto hitAt = [&](double s, glm::dvec2 pd, int steps, bool hidden) {
-        DepthHit hit;
-        hit.t = segment.t(s);
-        hit.position = ray.origin + ray.direction * hit.t;
-        hit.depth = segment.depth(s);
-        hit.point = segment.point(s);
-        hit.distorted = pd;
-        hit.texel = glm::clamp(glm::ivec2(glm::floor(pd * size)), glm::ivec2(0), glm::ivec2(size) - 1);
-        hit.steps = steps;
-        hit.hidden = hidden;
-        hit.face = steps == 0 ? segment.face : -1;
-        return hit;
-    };
+    const auto hitAt = [&](double s, glm::dvec2 pd, int steps, bool hidden) { return hitOn(image, segment, ray, s, pd, steps, hidden); };
 
     glm::dvec2 pd;
     double before = 0.0, s = 0.0;
