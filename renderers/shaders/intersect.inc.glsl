@@ -117,20 +117,30 @@ float surfaceAlong(sampler2D depths, sampler2D map, vec2 p0, vec2 along, float s
 // The ray's camera depth at s (perspective-correct).
 float rayDepth(float dw0, float dw1, float iw0, float iw1, float s) { return mix(dw0, dw1, s) / mix(iw0, iw1, s); }
 
-// Clips the ray (c0 + cd t in clip coordinates, camera depth z0 + zd t) to u, v in [0,1] and depth
-// in [lo, hi], each a + b t >= 0: false when nothing is left.
-bool clipDepthRay(vec4 c0, vec4 cd, float z0, float zd, float lo, float hi, float tMax, out float tEnter, out float tExit,
-                  out int entered, out int exited) {
+DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, vec3 origin, vec3 direction,
+                             float stepTexels, int refinements, int maxSteps, float tMax) {
+    DepthHit result;
+    result.hit = false;
+    result.steps = 0;
+    result.face = -1;
+    result.hidden = false;
+    // 1. Clip: u, v in [0,1] and depth in [lo, hi], each a + b t >= 0.
+    const vec4 c0 = view.worldToNdc * vec4(origin, 1.0), cd = view.worldToNdc * vec4(direction, 0.0);
+    const float z0 = dot(origin - view.eye, view.forward), zd = dot(direction, view.forward);
+    const float margin = kIntersectDepthMargin * (1.0 + max(abs(view.minDepth), abs(view.maxDepth)));
+    float lo = view.minDepth - margin;
+    const float range = view.maxDepth + margin;
+    // a scene's clip reaches a jump further for rays going away from the eye; the walk ends at range
+    const float hi = range + (view.solid || !(zd > 0.0) ? 0.0 : view.jumpRelative * view.maxDepth + view.jumpAbsolute);
+    if (view.perspective) lo = max(lo, view.near);
     float planes[12] = float[12](c0.x, cd.x, c0.w - c0.x, cd.w - cd.x, c0.y, cd.y, c0.w - c0.y, cd.w - cd.y, z0 - lo,
                                  zd, hi - z0, -zd);
-    tEnter = 0.0;
-    tExit = tMax;
-    entered = -1;
-    exited = -1;
+    float tEnter = 0.0, tExit = tMax;
+    int entered = -1, exited = -1;
     for (int k = 0; k < 6; ++k) {
         const float a = planes[2 * k], b = planes[2 * k + 1];
         if (b == 0.0) {
-            if (a < 0.0) return false;
+            if (a < 0.0) return result;
             continue;
         }
         const float t = -a / b;
@@ -144,49 +154,7 @@ bool clipDepthRay(vec4 c0, vec4 cd, float z0, float zd, float lo, float hi, floa
             exited = k;
         }
     }
-    return tEnter <= tExit;
-}
-
-DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, vec3 origin, vec3 direction,
-                             float stepTexels, int refinements, int maxSteps, float tMax) {
-    DepthHit result;
-    result.hit = false;
-    result.steps = 0;
-    result.face = -1;
-    result.hidden = false;
-    // 1. Clip: u, v in [0,1] and depth in [lo, hi], each a + b t >= 0.
-    const vec4 c0 = view.worldToNdc * vec4(origin, 1.0), cd = view.worldToNdc * vec4(direction, 0.0);
-    const float z0 = dot(origin - view.eye, view.forward), zd = dot(direction, view.forward);
-    const float margin = kIntersectDepthMargin * (1.0 + max(abs(view.minDepth), abs(view.maxDepth)));
-    float lo = view.minDepth - margin;
-    const float hi = view.maxDepth + margin;
-    if (view.perspective) lo = max(lo, view.near);
-    float tEnter, tExit;
-    int entered, exited;
-    if (!view.solid) {
-        // A scene's surface that goes on across the side the ray enters through, less than a jump
-        // in front of it: met there (the clip reaches a jump further for this test).
-        const float jump = view.jumpRelative * view.maxDepth + view.jumpAbsolute;
-        if (clipDepthRay(c0, cd, z0, zd, lo, hi + jump, tMax, tEnter, tExit, entered, exited) && entered >= 0 &&
-            entered < 4) {
-            const vec4 ca = c0 + cd * tEnter;
-            const vec2 pe = clamp(ca.xy / ca.w, 0.0, 1.0);
-            const MapPoint me = evalMap(map, pe);
-            const float stored = sampleDepth(depths, me.pd), depth = z0 + zd * tEnter;
-            if (stored - depth <= 0.0 && depth - stored <= view.jumpRelative * stored + view.jumpAbsolute) {
-                result.hit = true;
-                result.t = tEnter;
-                result.position = origin + direction * tEnter;
-                result.depth = depth;
-                result.point = pe;
-                result.distorted = me.pd;
-                result.texel = clamp(ivec2(floor(me.pd * vec2(textureSize(depths, 0)))), ivec2(0), textureSize(depths, 0) - 1);
-                result.face = entered;
-                return result;
-            }
-        }
-    }
-    if (!clipDepthRay(c0, cd, z0, zd, lo, hi, tMax, tEnter, tExit, entered, exited)) return result;
+    if (!(tEnter <= tExit)) return result;
 
     // 2. Project the ends; 1/w, depth/w and t/w are linear along the projected segment.
     const vec4 ca = c0 + cd * tEnter, cb = c0 + cd * tExit;
@@ -196,6 +164,13 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     const float tw0 = tEnter * iw0, tw1 = tExit * iw1;
     const vec2 along = p1 - p0;
     const vec2 size = vec2(textureSize(depths, 0));
+    float end = 1.0;  // where the walk ends (Segment::end)
+    bool endsAtRange = exited == 5;
+    if (hi > range && rayDepth(dw0, dw1, iw0, iw1, 1.0) > range) {
+        const float den = (dw1 - dw0) - range * (iw1 - iw0);
+        end = den != 0.0 ? clamp((range * iw0 - dw0) / den, 0.0, 1.0) : 1.0;
+        endsAtRange = true;
+    }
 
     // 3. Walk near to far, each step stepTexels CoNUS pixels along the distorted curve. The walk
     // stops at an event; the bisections run after it, so that rays bisect together.
@@ -206,25 +181,30 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     MapPoint m, hiddenFrom;  // hiddenFrom: the last point in front of the surface
     MapPoint q;
     bool flagged;  // whether the sample at s lies in a flagged cell (never in a solid image)
-    const bool behind = surfaceAlong(depths, map, p0, along, 0.0, m, flagged) - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0;
-    if (behind && !view.solid) {
+    const float entry = surfaceAlong(depths, map, p0, along, 0.0, m, flagged);
+    const bool behind = entry - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0;
+    // Through a side, behind a scene's surface by less than a jump: met where it enters.
+    const bool acrossSide = behind && !view.solid && entered >= 0 && entered < 4 &&
+                            rayDepth(dw0, dw1, iw0, iw1, 0.0) - entry <= view.jumpRelative * entry + view.jumpAbsolute;
+    if (behind && !view.solid && !acrossSide) {
+        if (end <= 0.0) return result;  // entered beyond the data's depth range
         hidden = true;
         hiddenDepth = rayDepth(dw0, dw1, iw0, iw1, 0.0);
         hiddenFrom = m;
     }
-    if (!(behind && view.solid)) {  // a solid image entered behind its surface is hit where entered
+    if (!(behind && (view.solid || acrossSide))) {  // else hit where entered: a solid image, or a surface across the side
         for (;;) {
             // The event: 1 a crossing, 2 behind the background while hidden, 0 the end.
             int event = 0;
-            while (!(s >= 1.0 || steps >= maxSteps)) {
+            while (!(s >= end || steps >= maxSteps)) {
                 const float speed = length((m.du * along.x + m.dv * along.y) * size);
                 const bool fine = flagged;
                 before = s;
-                s = min(1.0, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
+                s = min(end, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
                 ++steps;
                 float stored = surfaceAlong(depths, map, p0, along, s, m, flagged);
                 if (!fine && flagged) {  // a full step into a flagged cell: taken again, finely
-                    s = min(1.0, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
+                    s = min(end, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
                     stored = surfaceAlong(depths, map, p0, along, s, m, flagged);
                 }
                 const float gap = stored - rayDepth(dw0, dw1, iw0, iw1, s);
@@ -242,9 +222,10 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
             }
             if (event == 0) {
                 // Hidden up to the farthest stored depth: the background where the ray went hidden.
-                if (!(hidden && s >= 1.0 && exited == 5)) return result;
+                if (!(hidden && s >= end && endsAtRange)) return result;
                 m = hiddenFrom;
                 result.hidden = true;
+                s = end;
                 break;
             }
             float a = before, b = s;
