@@ -129,7 +129,9 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     const float z0 = dot(origin - view.eye, view.forward), zd = dot(direction, view.forward);
     const float margin = kIntersectDepthMargin * (1.0 + max(abs(view.minDepth), abs(view.maxDepth)));
     float lo = view.minDepth - margin;
-    const float hi = view.maxDepth + margin;
+    const float range = view.maxDepth + margin;
+    // a scene's clip reaches a jump further for rays going away from the eye; the walk ends at range
+    const float hi = range + (view.solid || !(zd > 0.0) ? 0.0 : view.jumpRelative * view.maxDepth + view.jumpAbsolute);
     if (view.perspective) lo = max(lo, view.near);
     float planes[12] = float[12](c0.x, cd.x, c0.w - c0.x, cd.w - cd.x, c0.y, cd.y, c0.w - c0.y, cd.w - cd.y, z0 - lo,
                                  zd, hi - z0, -zd);
@@ -162,6 +164,13 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     const float tw0 = tEnter * iw0, tw1 = tExit * iw1;
     const vec2 along = p1 - p0;
     const vec2 size = vec2(textureSize(depths, 0));
+    float end = 1.0;  // where the walk ends (Segment::end)
+    bool endsAtRange = exited == 5;
+    if (hi > range && rayDepth(dw0, dw1, iw0, iw1, 1.0) > range) {
+        const float den = (dw1 - dw0) - range * (iw1 - iw0);
+        end = den != 0.0 ? clamp((range * iw0 - dw0) / den, 0.0, 1.0) : 1.0;
+        endsAtRange = true;
+    }
 
     // 3. Walk near to far, each step stepTexels CoNUS pixels along the distorted curve. The walk
     // stops at an event; the bisections run after it, so that rays bisect together.
@@ -172,25 +181,30 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     MapPoint m, hiddenFrom;  // hiddenFrom: the last point in front of the surface
     MapPoint q;
     bool flagged;  // whether the sample at s lies in a flagged cell (never in a solid image)
-    const bool behind = surfaceAlong(depths, map, p0, along, 0.0, m, flagged) - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0;
-    if (behind && !view.solid) {
+    const float entry = surfaceAlong(depths, map, p0, along, 0.0, m, flagged);
+    const bool behind = entry - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0;
+    // Through a side, behind a scene's surface by less than a jump: met where it enters.
+    const bool acrossSide = behind && !view.solid && entered >= 0 && entered < 4 &&
+                            rayDepth(dw0, dw1, iw0, iw1, 0.0) - entry <= view.jumpRelative * entry + view.jumpAbsolute;
+    if (behind && !view.solid && !acrossSide) {
+        if (end <= 0.0) return result;  // entered beyond the data's depth range
         hidden = true;
         hiddenDepth = rayDepth(dw0, dw1, iw0, iw1, 0.0);
         hiddenFrom = m;
     }
-    if (!(behind && view.solid)) {  // a solid image entered behind its surface is hit where entered
+    if (!(behind && (view.solid || acrossSide))) {  // else hit where entered: a solid image, or a surface across the side
         for (;;) {
             // The event: 1 a crossing, 2 behind the background while hidden, 0 the end.
             int event = 0;
-            while (!(s >= 1.0 || steps >= maxSteps)) {
+            while (!(s >= end || steps >= maxSteps)) {
                 const float speed = length((m.du * along.x + m.dv * along.y) * size);
                 const bool fine = flagged;
                 before = s;
-                s = min(1.0, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
+                s = min(end, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
                 ++steps;
                 float stored = surfaceAlong(depths, map, p0, along, s, m, flagged);
                 if (!fine && flagged) {  // a full step into a flagged cell: taken again, finely
-                    s = min(1.0, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
+                    s = min(end, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
                     stored = surfaceAlong(depths, map, p0, along, s, m, flagged);
                 }
                 const float gap = stored - rayDepth(dw0, dw1, iw0, iw1, s);
@@ -208,9 +222,10 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
             }
             if (event == 0) {
                 // Hidden up to the farthest stored depth: the background where the ray went hidden.
-                if (!(hidden && s >= 1.0 && exited == 5)) return result;
+                if (!(hidden && s >= end && endsAtRange)) return result;
                 m = hiddenFrom;
                 result.hidden = true;
+                s = end;
                 break;
             }
             float a = before, b = s;

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "codec/depth/intersect_scenes.h"
+#include "codec/mesh/mesh_test_scenes.h"
+#include "conus/codec/depth/reflection.h"
 #include "conus/core/error.h"
 #include "renderers/gl_test_util.h"
 
@@ -103,6 +105,27 @@ TEST_P(ReliefGl, GlslMatchesCpuBesideAThinBoard) {
     for (const auto& h : gpu) hidden += h && h->hidden;
     EXPECT_GT(hidden, 10);
     expectAgreement(context(), image, rays, {}, 1e-2);
+}
+
+// A scene's surface across the side a ray enters through (a floor seen by two cube faces): hit
+// where the ray enters, in both twins.
+TEST_P(ReliefGl, GlslMatchesCpuWhereAFloorCrossesAFaceSide) {
+    const codec::MeshScene mesh(codec::test::rampedBoxAndFloor({0.4f, -0.3f, 1.5f}, {1.0f, 0.5f, 2.2f}));
+    codec::ReflectionBakeOptions bake;
+    bake.size = 64;
+    const auto faces = codec::bakeReflection(mesh, bake);
+    const DepthImage& below = faces[3].depth;  // -y: the floor meets +z's and -x's faces at its sides
+    std::vector<Ray> rays;
+    for (int i = 0; i < 200; ++i) {
+        const double across = -0.7 + 1.4 * (i % 20) / 19.0, off = -0.01 + 0.02 * (i / 20) / 9.0;
+        rays.push_back(rayThrough({0.07, 0.25, 0.1}, {across, -1.0, 1.0 + off}));
+        rays.push_back(rayThrough({0.07, 0.25, 0.1}, {-1.0 - off, -1.0, across}));
+    }
+    int acrossSide = 0;
+    for (const auto& ray : rays)
+        if (const auto hit = codec::intersect(below, ray); hit && hit->steps == 0 && hit->face >= 0 && hit->face < 4) ++acrossSide;
+    EXPECT_GT(acrossSide, 40);
+    expectAgreement(context(), below, rays, {}, 1e-2);
 }
 
 TEST_P(ReliefGl, FinerStepsAndShortRaysAgreeToo) {

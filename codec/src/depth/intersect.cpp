@@ -19,6 +19,10 @@ struct Segment {
     double iw0, iw1, dw0, dw1, tw0, tw1;
     int face;  // the face the ray entered through (-1: it starts inside)
     int exit;  // the face it leaves through (-1: cut short by tMax)
+    // Where the walk ends and whether that is the data's farthest depth (a scene's clip reaches a
+    // jump beyond it, for a ray entering through a side just behind the surface; intersect.h).
+    double end;
+    bool endsAtRange;
 
     glm::dvec2 point(double s) const { return p0 + (p1 - p0) * s; }
     double invW(double s) const { return iw0 + (iw1 - iw0) * s; }
@@ -35,10 +39,12 @@ std::optional<Segment> clipRay(const DepthImage& image, const Ray& ray, double t
     const glm::dvec3 forward = camera.forward();
     const double z0 = glm::dot(ray.origin - camera.eye(), forward), zd = glm::dot(ray.direction, forward);
     // The data's depth range, a hair wider so a surface exactly at its extreme is still reached;
-    // in front of a perspective eye's near plane nothing projects.
+    // in front of a perspective eye's near plane nothing projects. A scene's reaches a jump further
+    // for rays going away from the eye (the walk still ends at the range: Segment::end).
     const double margin = kIntersectDepthMargin * (1.0 + std::max(std::abs(image.minDepth()), std::abs(image.maxDepth())));
     double lo = image.minDepth() - margin;
-    const double hi = image.maxDepth() + margin;
+    const double range = image.maxDepth() + margin;
+    const double hi = range + (image.solid() || !(zd > 0.0) ? 0.0 : image.jumpRelative() * image.maxDepth() + image.jumpAbsolute());
     if (camera.projection() == Projection::Perspective) lo = std::max(lo, camera.near());
 
     double tEnter = 0.0, tExit = tMax;
@@ -80,6 +86,13 @@ std::optional<Segment> clipRay(const DepthImage& image, const Ray& ray, double t
     segment.exit = exit;
     end(tEnter, segment.p0, segment.iw0, segment.dw0, segment.tw0);
     end(tExit, segment.p1, segment.iw1, segment.dw1, segment.tw1);
+    segment.end = 1.0;
+    segment.endsAtRange = exit == 5;
+    if (hi > range && segment.depth(1.0) > range) {  // where the ray's depth reaches the range
+        const double den = (segment.dw1 - segment.dw0) - range * (segment.iw1 - segment.iw0);
+        segment.end = den != 0.0 ? std::clamp((range * segment.iw0 - segment.dw0) / den, 0.0, 1.0) : 1.0;
+        segment.endsAtRange = true;
+    }
     return segment;
 }
 
@@ -142,22 +155,28 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
     bool hidden = false;
     double hiddenDepth = 0.0;
     glm::dvec2 hiddenFrom(0.0);  // the last point in front of the surface: the background's side
-    if (surface(0.0, pd) - segment.depth(0.0) <= 0.0) {
+    if (const double entry = surface(0.0, pd); entry - segment.depth(0.0) <= 0.0) {
         if (image.solid()) return hitAt(0.0, pd, 0, false);
+        // Through a side, behind a scene's surface by less than a jump (continuous with it by the
+        // image's own measure): the surface goes on across the edge, and the ray met it there.
+        if (segment.face >= 0 && segment.face < 4 &&
+            segment.depth(0.0) - entry <= image.jumpRelative() * entry + image.jumpAbsolute())
+            return hitAt(0.0, pd, 0, false);
+        if (segment.end <= 0.0) return std::nullopt;  // entered beyond the data's depth range
         hidden = true;
         hiddenDepth = segment.depth(0.0);
         hiddenFrom = pd;
     }
     for (;;) {
-        if (s >= 1.0 || steps >= options.maxSteps) {
+        if (s >= segment.end || steps >= options.maxSteps) {
             // Hidden up to the farthest stored depth: behind the background, which takes the
             // colour of where the ray went hidden.
-            if (hidden && s >= 1.0 && segment.exit == 5) return hitAt(1.0, hiddenFrom, steps, true);
+            if (hidden && s >= segment.end && segment.endsAtRange) return hitAt(segment.end, hiddenFrom, steps, true);
             return std::nullopt;
         }
         // CoNUS pixels the curve covers per unit s here: |J (p1 - p0)| in pixels.
         const double speed = glm::length(map.jacobian(segment.point(s)) * along * size);
-        const auto advance = [&](double texels) { return std::min(1.0, before + (speed > 0.0 ? texels / speed : 1.0)); };
+        const auto advance = [&](double texels) { return std::min(segment.end, before + (speed > 0.0 ? texels / speed : 1.0)); };
         const bool fine = flagged(pd);
         before = s;
         s = advance(options.stepTexels * (fine ? kSilhouetteStep : 1.0));

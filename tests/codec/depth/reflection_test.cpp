@@ -315,5 +315,38 @@ TEST(Reflection, FramesMatchTheTracedReferenceAndCoNUSBeatsUniform) {
     EXPECT_LT(conusError, uniformError);
 }
 
+// The floor goes on across the seams of the cube faces that see it (+z and -y meet where its
+// points lie as far down as ahead, z = 1 at y = -1; -x and -y at x = -1). A ray that meets it
+// within 0.01 of a seam, in the strip between a face's last texel centres and its edge, enters the
+// next face just behind the floor: it hits there, in the CoNUS faces (larger texels at the +z
+// face's edge, where the focus took them) and the uniform ones alike, rather than showing the sky.
+TEST(Reflection, FloorAcrossAFaceSeamIsHitNotMissed) {
+    const MeshScene mesh(test::rampedBoxAndFloor(glm::vec3(kBoxLo), glm::vec3(kBoxHi)));
+    ReflectionBakeOptions bake;
+    bake.size = 64;
+    bake.roi = AxisBox{kBoxLo, kBoxHi};
+    const auto conusFaces = bakeReflection(mesh, bake);
+    bake.uniform = true;
+    const auto uniformFaces = bakeReflection(mesh, bake);
+    for (const auto* faces : {&conusFaces, &uniformFaces}) {
+        int rays = 0;
+        for (int i = 0; i < 41; ++i)
+            for (int j = 0; j < 31; ++j) {
+                const double across = -0.7 + 1.4 * i / 40.0, off = -0.01 + 0.02 * j / 30.0;
+                for (const glm::dvec3 target : {glm::dvec3(across, -1.0, 1.0 + off), glm::dvec3(-1.0 - off, -1.0, across)}) {
+                    const glm::dvec3 from(0.07, 0.25, 0.1);  // near the centre, above it
+                    const auto hit = traceReflection(*faces, Ray{from, glm::normalize(target - from)});
+                    ASSERT_TRUE(hit) << (faces == &conusFaces ? "CoNUS" : "uniform") << " to " << target.x << ", " << target.z;
+                    // Near the target, on the floor or less than a jump (5% of the depth, about 1)
+                    // behind it, where the ray entered the next face.
+                    EXPECT_NEAR(hit->hit.position.y, -1.0, 0.06);
+                    EXPECT_LT(glm::distance(hit->hit.position, target), 0.08);
+                    ++rays;
+                }
+            }
+        EXPECT_EQ(rays, 41 * 31 * 2);
+    }
+}
+
 }  // namespace
 }  // namespace conus::codec

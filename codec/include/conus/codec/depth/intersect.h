@@ -42,7 +42,10 @@
 // background carried on behind the occluder (the nearest honest guess; the true surface is not in
 // the image). A ray still hidden where it leaves the data's depth range hits the background where
 // it went hidden; one that leaves through the image's side hits nothing here (a reflection then
-// takes another face, or the sky). Depth images of scenes that store the far plane where nothing
+// takes another face, or the sky). A ray that enters a scene's image through a side less than a
+// jump behind the stored surface hits where it enters: the surface goes on across the image's
+// edge (a floor seen by two cube faces), where between the last texel centres and the edge the
+// depth is the last texel's, and the ray would otherwise pass both images. Depth images of scenes that store the far plane where nothing
 // was seen never hit there, since the clipped ray never goes beyond the largest stored depth.
 //
 // Height fields (depth kind `height`, orthographic camera looking down at the base plane): the
