@@ -10,7 +10,7 @@ struct DepthView {
     mat4 ndcToWorld;  // its inverse, for unprojectDepth
     vec3 eye;
     vec3 forward;
-    float near;
+    float near, far;
     bool perspective;
     float minDepth, maxDepth;  // the range of the stored camera depths
     bool solid;                // DepthImage::solid
@@ -183,8 +183,10 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     bool flagged;  // whether the sample at s lies in a flagged cell (never in a solid image)
     const float entry = surfaceAlong(depths, map, p0, along, 0.0, m, flagged);
     const bool behind = entry - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0;
-    // Through a side, behind a scene's surface by less than a jump: met where it enters.
+    // Through a side, behind a scene's surface by less than a jump, short of the far plane (where a
+    // scene saw nothing): met where it enters.
     const bool acrossSide = behind && !view.solid && entered >= 0 && entered < 4 &&
+                            entry < view.far * (1.0 - kSideRuleFarMargin) &&
                             rayDepth(dw0, dw1, iw0, iw1, 0.0) - entry <= view.jumpRelative * entry + view.jumpAbsolute;
     if (behind && !view.solid && !acrossSide) {
         if (end <= 0.0) return result;  // entered beyond the data's depth range

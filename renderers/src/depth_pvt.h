@@ -98,6 +98,7 @@ inline void setDepthView(const GladGLContext& gl, GLuint program, const codec::D
     gl.Uniform3f(at(".eye"), eye.x, eye.y, eye.z);
     gl.Uniform3f(at(".forward"), forward.x, forward.y, forward.z);
     gl.Uniform1f(at(".near"), static_cast<float>(camera.near()));
+    gl.Uniform1f(at(".far"), static_cast<float>(camera.far()));
     gl.Uniform1i(at(".perspective"), camera.projection() == Projection::Perspective ? 1 : 0);
     gl.Uniform1f(at(".minDepth"), static_cast<float>(image.minDepth()));
     gl.Uniform1f(at(".maxDepth"), static_cast<float>(image.maxDepth()));

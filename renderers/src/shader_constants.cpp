@@ -45,6 +45,8 @@ std::string constantsBlock() {
     s += "const float kMeshGrey = " + glslFloat(codec::kDefaultAlbedo) + ";\n";
     s += "const float kIntersectDepthMargin = " + glslFloat(codec::kIntersectDepthMargin) + ";\n";
     s += "const float kSilhouetteStep = " + glslFloat(codec::kSilhouetteStep) + ";\n";
+    s += "const float kSideRuleFarMargin = " + glslFloat(codec::kSideRuleFarMargin) + ";\n";
+    s += "const float kMeshMaxTessLevel = " + glslFloat(kMeshMaxTessLevel) + ";\n";
     return s;
 }
 

@@ -128,6 +128,12 @@ TEST_P(ReliefGl, GlslMatchesCpuWhereAFloorCrossesAFaceSide) {
     expectAgreement(context(), below, rays, {}, 1e-2);
 }
 
+TEST_P(ReliefGl, GlslFindsNothingPastAScenesFarPlaneEither) {
+    const DepthImage image = codec::test::skyImage(focusMap(0.3, 0.6, 0.1, 3.0), 96);
+    const auto gpu = intersectRays(context(), image, codec::test::raysPastTheFarPlane());
+    for (const auto& hit : gpu) EXPECT_FALSE(hit);
+}
+
 TEST_P(ReliefGl, FinerStepsAndShortRaysAgreeToo) {
     const DepthImage image = heightImage(hills, focusMap(0.7, 0.3, 0.1, 3.0), 64);
     codec::IntersectOptions options;

@@ -158,8 +158,9 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
     if (const double entry = surface(0.0, pd); entry - segment.depth(0.0) <= 0.0) {
         if (image.solid()) return hitAt(0.0, pd, 0, false);
         // Through a side, behind a scene's surface by less than a jump (continuous with it by the
-        // image's own measure): the surface goes on across the edge, and the ray met it there.
-        if (segment.face >= 0 && segment.face < 4 &&
+        // image's own measure): the surface goes on across the edge, and the ray met it there. Not
+        // at the camera's far plane, which is where a scene's image saw nothing.
+        if (segment.face >= 0 && segment.face < 4 && entry < image.camera().far() * (1.0 - kSideRuleFarMargin) &&
             segment.depth(0.0) - entry <= image.jumpRelative() * entry + image.jumpAbsolute())
             return hitAt(0.0, pd, 0, false);
         if (segment.end <= 0.0) return std::nullopt;  // entered beyond the data's depth range

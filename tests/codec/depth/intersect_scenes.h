@@ -107,6 +107,30 @@ inline DepthImage boardImage(std::shared_ptr<const SamplingMap> map, int size, b
     return DepthImage(camera, std::move(map), size, size, std::move(depths), solid);
 }
 
+// A scene's image that saw nothing but a square of wall at depth 6 in its middle: every other
+// texel holds the far plane (20), as a mesh render stores what it did not see.
+inline DepthImage skyImage(std::shared_ptr<const SamplingMap> map, int size) {
+    const Camera camera = sphereCamera();
+    std::vector<float> depths(static_cast<std::size_t>(size) * size, static_cast<float>(camera.far()));
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const glm::dvec2 uv = map->undistort({(x + 0.5) / size, (y + 0.5) / size});
+            if (std::abs(uv.x - 0.5) < 0.15 && std::abs(uv.y - 0.5) < 0.15) depths[static_cast<std::size_t>(y) * size + x] = 6.0f;
+        }
+    return DepthImage(camera, std::move(map), size, size, std::move(depths), false);
+}
+
+// Rays that enter skyImage's frustum through its side a little past the far plane (within a jump
+// of it) and go on away from the eye.
+inline std::vector<Ray> raysPastTheFarPlane() {
+    std::vector<Ray> rays;
+    for (int i = 0; i < 24; ++i) {
+        const double depth = 20.1 + 0.03 * i, y = -3.0 + 0.25 * i;  // the eye is at z = -5, looking along +z
+        rays.push_back({{12.0, y, -5.0 + depth}, glm::normalize(glm::dvec3(-1.0, 0.0, 0.02))});
+    }
+    return rays;
+}
+
 // A ray from `from` toward `to`.
 inline Ray rayThrough(glm::dvec3 from, glm::dvec3 to) { return {from, glm::normalize(to - from)}; }
 

@@ -155,6 +155,22 @@ TEST(Intersect, ThinBoardInFrontOfAFarWallHasNoSkin) {
     }
 }
 
+// The far plane of a scene's image is where it saw nothing: a ray entering through the image's
+// side within a jump behind it is not taken to meet a surface there (a floor across a cube face's
+// side is; Reflection.FloorAcrossAFaceSeamIsHitNotMissed).
+TEST(Intersect, NothingSeenIsNotContinuedAcrossTheSide) {
+    for (const bool conus : {false, true}) {
+        const DepthImage image = test::skyImage(conus ? focusMap(0.3, 0.6, 0.1, 3.0) : identityMap(), 96);
+        int enteringThroughASide = 0;
+        for (const Ray& ray : test::raysPastTheFarPlane()) {
+            const glm::dvec3 p = image.camera().project(ray.origin);
+            if (p.x > 1.0 || p.x < 0.0) ++enteringThroughASide;
+            EXPECT_FALSE(intersect(image, ray)) << (conus ? "CoNUS" : "identity") << " ray from " << ray.origin.y;
+        }
+        EXPECT_EQ(enteringThroughASide, 24);
+    }
+}
+
 // Cells are flagged where the depth jumps against its neighbours, not where it changes steadily:
 // a plane seen at a grazing angle has none, the board's silhouette columns have them.
 TEST(Intersect, DiscontinuityFlagsMarkSilhouettesOnly) {

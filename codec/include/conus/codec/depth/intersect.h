@@ -45,8 +45,10 @@
 // takes another face, or the sky). A ray that enters a scene's image through a side less than a
 // jump behind the stored surface hits where it enters: the surface goes on across the image's
 // edge (a floor seen by two cube faces), where between the last texel centres and the edge the
-// depth is the last texel's, and the ray would otherwise pass both images. Depth images of scenes that store the far plane where nothing
-// was seen never hit there, since the clipped ray never goes beyond the largest stored depth.
+// depth is the last texel's, and the ray would otherwise pass both images; not where the stored
+// surface is at the camera's far plane (within kSideRuleFarMargin of it), which is where depth
+// images of scenes store nothing seen. Those never hit there: the walk ends at the largest stored
+// depth.
 //
 // Height fields (depth kind `height`, orthographic camera looking down at the base plane): the
 // base plane is the plane through the world origin facing the camera, and height h lies h above
@@ -137,6 +139,10 @@ double heightToDepth(const Camera& camera, double height);
 // The clip's depth range is widened by this fraction of (1 + its largest magnitude), so that a
 // surface exactly at the range's end is still reached despite rounding (GLSL: same constant).
 inline constexpr double kIntersectDepthMargin = 1e-5;
+// A stored surface within this fraction of the camera's far plane is not continued across an
+// image's side (the file comment; GLSL: same constant): a scene's image stores the far plane
+// where it saw nothing.
+inline constexpr double kSideRuleFarMargin = 1e-4;
 
 struct IntersectOptions {
     double stepTexels = 1.0;  // linear-search step, in CoNUS pixels along the projected curve
