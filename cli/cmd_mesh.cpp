@@ -132,8 +132,8 @@ Image renderFrame(const renderers::Device& device, const Mesh& mesh, const Camer
     }
     renderers::MeshRenderer renderer(device.context(), fine ? *fine : mesh);
     std::int64_t drawn = 0;
-    Image image = renderer.render(camera, map, size.width, size.height, options, nullptr, &drawn);
-    if (report && options.maxBend > 0)
+    Image image = renderer.render(camera, map, size.width, size.height, options, nullptr, report ? &drawn : nullptr);
+    if (report && drawn > static_cast<std::int64_t>(mesh.triangleCount()))
         std::printf("drew %zu triangles as %lld, split on the GPU where the map bends them more than %g pixels (--max-bend)\n",
                     mesh.triangleCount(), static_cast<long long>(drawn), options.maxBend);
     return image;

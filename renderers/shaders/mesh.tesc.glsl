@@ -6,8 +6,9 @@
 // triangle's (world) barycentric coordinates, so a piece of parameter length h strays from the
 // picture by about |H''| h^2 / (8 w) pixels. H'' comes from second differences of H sampled along
 // each edge and over a lattice inside; each edge and the inside get the fewest equal segments that
-// keep the error within uMaxBend pixels (up to kMaxLevel). An edge's level depends on its two ends
-// only, taken in one order, so the two triangles that share it split it alike: no cracks.
+// keep the error within uMaxBend pixels (up to kMeshMaxTessLevel). An edge's level depends on its
+// two ends only, taken in one order, and its arithmetic is `precise`, so the two triangles that
+// share it split it alike: no cracks.
 // Edges with an end at or in front of a perspective camera's near plane are not split, nor the
 // insides of triangles with such a corner (the rasterizer clips them; Equation 1 has no position
 // for a point behind the eye).
@@ -27,7 +28,6 @@ uniform bool uPerspective;
 #include "equation1.inc.glsl"
 #include "mesh_project.inc.glsl"
 
-const float kMaxLevel = 64.0;           // GL_MAX_TESS_GEN_LEVEL's least value
 const int kEdgeSamples = 64;            // intervals along an edge, at most (one every 4 pixels below that)
 const int kInsideSamples = 16;          // lattice intervals a side inside, at most (one every 8 pixels)
 const float kPixelsPerEdgeSample = 4.0, kPixelsPerInsideSample = 8.0;
@@ -36,8 +36,9 @@ vec3 lattice[(kInsideSamples + 1) * (kInsideSamples + 2) / 2];
 
 // H (xy) and w (z) of a world point.
 vec3 homogeneousPixels(vec3 world) {
-    const vec4 ndc = uWorldToNdc * vec4(world, 1.0);
-    return vec3(distortedUv(ndc) * uPixels * ndc.w, ndc.w);
+    precise const vec4 ndc = uWorldToNdc * vec4(world, 1.0);
+    precise const vec3 h = vec3(distortedUv(ndc) * uPixels * ndc.w, ndc.w);
+    return h;
 }
 
 bool measurable(vec3 world) {
@@ -48,7 +49,8 @@ bool measurable(vec3 world) {
 // Equal segments that keep the error within uMaxBend, from the largest |second difference| / w
 // of samples `intervals` to the unit parameter.
 float segmentsFor(float secondDifference, int intervals) {
-    return clamp(ceil(float(intervals) * sqrt(secondDifference / (8.0 * uMaxBend))), 1.0, kMaxLevel);
+    if (!(secondDifference > 0.0)) return 1.0;
+    return clamp(ceil(float(intervals) * sqrt(secondDifference / (8.0 * uMaxBend))), 1.0, kMeshMaxTessLevel);
 }
 
 float edgeLevel(vec3 a, vec3 b) {
@@ -58,13 +60,13 @@ float edgeLevel(vec3 a, vec3 b) {
         a = b;
         b = t;
     }
-    const vec3 ha = homogeneousPixels(a), hb = homogeneousPixels(b);
-    const float span = distance(ha.xy / ha.z, hb.xy / hb.z);
+    precise const vec3 ha = homogeneousPixels(a), hb = homogeneousPixels(b);
+    precise const float span = distance(ha.xy / ha.z, hb.xy / hb.z);
     const int intervals = int(clamp(ceil(span / kPixelsPerEdgeSample), 2.0, float(kEdgeSamples)));
-    float worst = 0.0;
-    vec3 previous = ha, current = homogeneousPixels(mix(a, b, 1.0 / float(intervals)));
+    precise float worst = 0.0;
+    precise vec3 previous = ha, current = homogeneousPixels(mix(a, b, 1.0 / float(intervals)));
     for (int j = 1; j < intervals; ++j) {
-        const vec3 next = j + 1 == intervals ? hb : homogeneousPixels(mix(a, b, float(j + 1) / float(intervals)));
+        precise const vec3 next = j + 1 == intervals ? hb : homogeneousPixels(mix(a, b, float(j + 1) / float(intervals)));
         worst = max(worst, length(previous.xy - 2.0 * current.xy + next.xy) / current.z);
         previous = current;
         current = next;

@@ -20,6 +20,7 @@
 #include "embedded_shaders.h"
 #include "frame_pvt.h"
 #include "gl_objects.h"
+#include "shader_constants.h"
 
 namespace conus::renderers {
 namespace {
@@ -27,8 +28,10 @@ namespace {
 constexpr const char* kWhat = "renderMesh";
 constexpr GLuint kAttributes = 4;     // position, normal, colour, uv
 constexpr GLsizei kFloatsPerVertex = 11;
-// A triangle patch at mesh.tesc.glsl's largest level (64) makes 3 * 32 * 33 + 1 = 3169 vertices.
-constexpr GLsizei kSoftwarePatchesPerDraw = 65535 / 3169;
+// A triangle patch at the largest level L (even) makes 3 (L/2) (L/2 + 1) + 1 vertices: 3169 at 64.
+constexpr GLsizei kMaxPatchVertices = 3 * (kMeshMaxTessLevel / 2) * (kMeshMaxTessLevel / 2 + 1) + 1;
+constexpr GLsizei kSoftwarePatchesPerDraw = 65535 / kMaxPatchVertices;
+static_assert(kMeshMaxTessLevel % 2 == 0 && kSoftwarePatchesPerDraw >= 1);
 
 enum class Albedo : GLint { VertexColour = 0, Texture = 1, Grey = 2 };
 
@@ -70,6 +73,15 @@ GlHandle makeFramebufferOf(const GladGLContext& gl, GLenum textarget, GLuint col
     if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         throw Error(ErrorCode::Unsupported, std::string(kWhat) + ": the driver cannot render to " + what);
     return framebuffer;
+}
+
+void checkOptions(const MeshRenderOptions& options) {
+    if (options.samples < 1)
+        throw Error(ErrorCode::InvalidArgument,
+                    std::string(kWhat) + ": samples " + std::to_string(options.samples) + " is below 1");
+    if (!(options.maxBend >= 0 && std::isfinite(options.maxBend)))
+        throw Error(ErrorCode::InvalidArgument,
+                    std::string(kWhat) + ": the largest bend " + std::to_string(options.maxBend) + " is not a finite pixel count >= 0");
 }
 
 // Whether Equation 1 is affine for `map` (every node where its corners' affine map puts it, as for
@@ -204,12 +216,7 @@ Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, 
                            const MeshRenderOptions& options, GpuTimings* timings, std::int64_t* trianglesDrawn) {
     Context& context = m_impl->context;
     checkFrame(context, width, height, kWhat);
-    if (options.samples < 1)
-        throw Error(ErrorCode::InvalidArgument,
-                    std::string(kWhat) + ": samples " + std::to_string(options.samples) + " is below 1");
-    if (!(options.maxBend >= 0 && std::isfinite(options.maxBend)))
-        throw Error(ErrorCode::InvalidArgument,
-                    std::string(kWhat) + ": the largest bend " + std::to_string(options.maxBend) + " is not a finite pixel count >= 0");
+    checkOptions(options);
     const GladGLContext& gl = makeCurrentGl(context);
     auto phase = std::chrono::steady_clock::now();
     const bool tessellate = options.maxBend > 0 && !isAffine(map);
@@ -264,7 +271,8 @@ Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, 
     gl.Uniform3fv(gl.GetUniformLocation(program, "uEye"), 1, glm::value_ptr(eye));
     gl.Uniform3fv(gl.GetUniformLocation(program, "uForward"), 1, glm::value_ptr(forward));
     gl.Uniform2f(gl.GetUniformLocation(program, "uPixels"), static_cast<float>(width), static_cast<float>(height));
-    gl.Uniform1f(gl.GetUniformLocation(program, "uMaxBend"), static_cast<float>(options.maxBend));
+    // At least a millionth of a pixel: a bound that rounds to float 0 would make 0 / 0 levels.
+    gl.Uniform1f(gl.GetUniformLocation(program, "uMaxBend"), static_cast<float>(std::max(options.maxBend, 1e-6)));
     if (impl.texture) {
         gl.ActiveTexture(GL_TEXTURE1);
         gl.BindTexture(GL_TEXTURE_2D, impl.texture.id());
@@ -349,6 +357,7 @@ Image renderMeshGpu(Context& context, const Mesh& mesh, const Camera& camera, co
 
 Image renderMesh(const Device& device, const Mesh& mesh, const Camera& camera, const codec::SamplingMap& map,
                  int width, int height, const MeshRenderOptions& options) {
+    checkOptions(options);
     return device.run(
         [&] {
             codec::ReferenceOptions reference;

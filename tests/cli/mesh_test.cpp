@@ -198,8 +198,10 @@ TEST_F(Mesh, TheCityFollowsTheMapWhereItBends) {
     EXPECT_GE(psnrBend, 40.0);
     EXPECT_LT(psnrNone, 25.0);  // the ground's straight inside covers the buildings
     EXPECT_GT(psnrEdge, psnrBend - 1.0);
-    // The same picture from the 878 triangles uploaded, where --max-edge uploads its split mesh.
+    // The same picture from the 878 triangles uploaded, where --max-edge uploads its split mesh,
+    // and under half the triangles drawn.
     EXPECT_GT(afterEdge, 100 * before);
+    EXPECT_LT(drawn, afterEdge / 2);
 }
 
 TEST_F(Mesh, BadInputIsOneLineAndNonZero) {

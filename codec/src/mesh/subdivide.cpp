@@ -160,21 +160,6 @@ void splitEdges(Mesh& mesh, Projected& projected, const Camera& camera, EdgeSpli
     mesh.indices = std::move(indices);
 }
 
-// Splits in passes until `choose` (which fills the edges of one pass) names none.
-template <class Choose>
-Mesh subdivide(const Mesh& input, const Camera& camera, const SubdivideOptions& options, const std::string& bound,
-               Choose choose) {
-    Mesh mesh = input;
-    if (mesh.normals.empty()) computeVertexNormals(mesh);
-    Projected projected = projectAll(mesh, camera);
-    for (;;) {
-        EdgeSplits split;
-        choose(mesh, projected, split);
-        if (split.empty()) return mesh;
-        splitEdges(mesh, projected, camera, split, options, bound);
-    }
-}
-
 }  // namespace
 
 Mesh subdivideForMap(const Mesh& input, const Camera& camera, const SamplingMap& map, double maxEdge,
@@ -183,14 +168,21 @@ Mesh subdivideForMap(const Mesh& input, const Camera& camera, const SamplingMap&
     if (!(maxEdge > 0) || !std::isfinite(maxEdge))
         throw Error(ErrorCode::InvalidArgument, "subdivideForMap: the longest edge must be > 0 cells, got " + numberText(maxEdge));
     const glm::dvec2 cells = cellsOf(map);
-    return subdivide(input, camera, options, "splitting edges to " + numberText(maxEdge) + " cells",
-                     [&](const Mesh& mesh, const Projected& projected, EdgeSplits& split) {
-                         for (std::size_t t = 0; t < mesh.indices.size(); t += 3)
-                             for (int e = 0; e < 3; ++e) {
-                                 const std::uint32_t a = mesh.indices[t + e], b = mesh.indices[t + (e + 1) % 3];
-                                 if (cellLength(projected, a, b, cells) > maxEdge) split.emplace(edgeKey(a, b), 0);
-                             }
-                     });
+    const std::string bound = "splitting edges to " + numberText(maxEdge) + " cells";
+    Mesh mesh = input;
+    if (mesh.normals.empty()) computeVertexNormals(mesh);
+    Projected projected = projectAll(mesh, camera);
+    // Passes until no edge is too long.
+    for (;;) {
+        EdgeSplits split;
+        for (std::size_t t = 0; t < mesh.indices.size(); t += 3)
+            for (int e = 0; e < 3; ++e) {
+                const std::uint32_t a = mesh.indices[t + e], b = mesh.indices[t + (e + 1) % 3];
+                if (cellLength(projected, a, b, cells) > maxEdge) split.emplace(edgeKey(a, b), 0);
+            }
+        if (split.empty()) return mesh;
+        splitEdges(mesh, projected, camera, split, options, bound);
+    }
 }
 
 }  // namespace conus::codec
