@@ -116,49 +116,53 @@ TEST(SceneWindow, MeshFramesAreTheEncodersAndFollowTheCommands) {
     EXPECT_GT(brightest, 1.6) << "the nearest surface is the ramp's bright end";
 }
 
+const std::string kSuzanne = std::string(CONUS_SHARED_DATA) + "/meshes/suzanne.obj";
+
+// The window's screenshot of suzanne through one focus (`options` after --mesh and --focus), with
+// the mesh and the camera and map the window starts from.
+struct SuzanneFrame {
+    Image window;
+    std::string log;
+    Mesh mesh;
+    Camera camera;
+    codec::SamplingMap map;
+};
+
+SuzanneFrame suzanneFrame(const std::string& options, const std::string& shotName) {
+    const fs::path shot = test::tempDir() / shotName;
+    std::string log = runScript("--mesh " + kSuzanne + " --focus 0.5,0.45,0.15,4 " + options, "screenshot " + shot.string() + "\n");
+    Mesh mesh = sceneio::readMesh(kSuzanne);
+    const BoundingSphere sphere = boundingSphere(std::vector<glm::dvec3>(mesh.positions.begin(), mesh.positions.end()));
+    const SceneState state(sphere.centre, sphere.radius, {codec::Focus{0.5, 0.45, 0.15, 4.0}});
+    const double aspect = double(kW) / kH;
+    return {readPicture(shot), std::move(log), std::move(mesh), state.camera(aspect), state.map(aspect)};
+}
+
 // --max-edge: each CoNUS frame is the encoder's of the mesh subdivided for that frame's camera and map.
 TEST(SceneWindow, MeshMaxEdgeSubdividesEachFrame) {
     ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";
-    const std::string model = std::string(CONUS_SHARED_DATA) + "/meshes/suzanne.obj";
-    if (!fs::exists(model)) GTEST_SKIP() << "shared data not found: " << model;
-    const codec::Focus focus{0.5, 0.45, 0.15, 4.0};
-    const fs::path shot = test::tempDir() / "edge.png";
-    const std::string log = runScript("--mesh " + model + " --focus 0.5,0.45,0.15,4 --max-edge 0.5", "screenshot " + shot.string() + "\n");
-    const Image window = readPicture(shot);
-    ASSERT_EQ(window.width, kW) << log;
-    const Mesh mesh = sceneio::readMesh(model);
-    const BoundingSphere sphere = boundingSphere(std::vector<glm::dvec3>(mesh.positions.begin(), mesh.positions.end()));
-    const SceneState state(sphere.centre, sphere.radius, {focus});
-    const double aspect = double(kW) / kH;
-    const Camera camera = state.camera(aspect);
-    const codec::SamplingMap map = state.map(aspect);
-    const Mesh fine = codec::subdivideForMap(mesh, camera, map, 0.5);
-    ASSERT_GT(fine.triangleCount(), mesh.triangleCount()) << "the focus makes some edges long";
+    if (!fs::exists(kSuzanne)) GTEST_SKIP() << "shared data not found: " << kSuzanne;
+    const SuzanneFrame f = suzanneFrame("--max-edge 0.5", "edge.png");
+    ASSERT_EQ(f.window.width, kW) << f.log;
+    const Mesh fine = codec::subdivideForMap(f.mesh, f.camera, f.map, 0.5);
+    ASSERT_GT(fine.triangleCount(), f.mesh.triangleCount()) << "the focus makes some edges long";
     renderers::MeshRenderOptions asSplit;
     asSplit.maxBend = 0;
-    EXPECT_LT(compare(window, renderers::renderMeshGpu(test::context(), fine, camera, map, kW, kH, asSplit)).mean, 1.0 / 255);
+    EXPECT_LT(compare(f.window, renderers::renderMeshGpu(test::context(), fine, f.camera, f.map, kW, kH, asSplit)).mean, 1.0 / 255);
 }
 
 // --max-bend 0: the mesh drawn as it is through the map, not the default's split frame.
 TEST(SceneWindow, MeshMaxBendZeroDrawsTheMeshAsItIs) {
     ASSERT_TRUE(test::haveXvfb()) << "xvfb-run is needed (package xvfb)";
-    const std::string model = std::string(CONUS_SHARED_DATA) + "/meshes/suzanne.obj";
-    if (!fs::exists(model)) GTEST_SKIP() << "shared data not found: " << model;
-    const codec::Focus focus{0.5, 0.45, 0.15, 4.0};
-    const fs::path shot = test::tempDir() / "straight.png";
-    const std::string log = runScript("--mesh " + model + " --focus 0.5,0.45,0.15,4 --max-bend 0", "screenshot " + shot.string() + "\n");
-    const Image window = readPicture(shot);
-    ASSERT_EQ(window.width, kW) << log;
-    const Mesh mesh = sceneio::readMesh(model);
-    const BoundingSphere sphere = boundingSphere(std::vector<glm::dvec3>(mesh.positions.begin(), mesh.positions.end()));
-    const SceneState state(sphere.centre, sphere.radius, {focus});
-    const double aspect = double(kW) / kH;
-    renderers::MeshRenderer renderer(test::context(), mesh);
+    if (!fs::exists(kSuzanne)) GTEST_SKIP() << "shared data not found: " << kSuzanne;
+    const SuzanneFrame f = suzanneFrame("--max-bend 0", "straight.png");
+    ASSERT_EQ(f.window.width, kW) << f.log;
+    renderers::MeshRenderer renderer(test::context(), f.mesh);
     renderers::MeshRenderOptions straight;
     straight.maxBend = 0;
-    const Image asBuilt = renderer.render(state.camera(aspect), state.map(aspect), kW, kH, straight);
-    const Image split = renderer.render(state.camera(aspect), state.map(aspect), kW, kH);
-    EXPECT_LT(compare(window, asBuilt).mean, 1.0 / 255);
+    const Image asBuilt = renderer.render(f.camera, f.map, kW, kH, straight);
+    const Image split = renderer.render(f.camera, f.map, kW, kH);
+    EXPECT_LT(compare(f.window, asBuilt).mean, 1.0 / 255);
     EXPECT_GT(compare(asBuilt, split).worst, 8.0 / 255) << "the focus bends suzanne's long edges";
 }
 

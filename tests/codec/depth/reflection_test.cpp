@@ -274,6 +274,16 @@ double meanSquaredError(const Image& a, const Image& truth, Pick inRegion) {
     return n ? sum / (3.0 * n) : 0.0;
 }
 
+// CoNUS faces (the bake's defaults, a focus on the box) and uniform faces of 64 texels a side.
+std::pair<std::vector<ReflectionFace>, std::vector<ReflectionFace>> bakeBoth(const MeshScene& mesh) {
+    ReflectionBakeOptions bake;
+    bake.size = 64;
+    bake.roi = AxisBox{kBoxLo, kBoxHi};
+    auto conus = bakeReflection(mesh, bake);
+    bake.uniform = true;
+    return {std::move(conus), bakeReflection(mesh, bake)};
+}
+
 TEST(Reflection, FramesMatchTheTracedReferenceAndCoNUSBeatsUniform) {
     // The box and a floor, a sphere mirror between them and the camera.
     const Mesh scene = test::rampedBoxAndFloor(glm::vec3(kBoxLo), glm::vec3(kBoxHi));
@@ -285,12 +295,7 @@ TEST(Reflection, FramesMatchTheTracedReferenceAndCoNUSBeatsUniform) {
     const Image truth = renderReflectionFrame(mesh, nullptr, o.reflector.centre, camera, 96, 96, o);
     // 64-texel faces: the box is a few texels across in the uniform ones. (At 32, with about 100
     // pixels on the box, one pixel either side of its outline decides the comparison.)
-    ReflectionBakeOptions bake;
-    bake.size = 64;
-    bake.roi = AxisBox{kBoxLo, kBoxHi};
-    const auto conusFaces = bakeReflection(mesh, bake);
-    bake.uniform = true;
-    const auto uniformFaces = bakeReflection(mesh, bake);
+    const auto [conusFaces, uniformFaces] = bakeBoth(mesh);
     const Image conus = renderReflectionFrame(mesh, &conusFaces, o.reflector.centre, camera, 96, 96, o);
     const Image uniform = renderReflectionFrame(mesh, &uniformFaces, o.reflector.centre, camera, 96, 96, o);
     // The region of interest: reflector pixels whose traced reflected ray meets the box (its 12
@@ -322,12 +327,7 @@ TEST(Reflection, FramesMatchTheTracedReferenceAndCoNUSBeatsUniform) {
 // face's edge, where the focus took them) and the uniform ones alike, rather than showing the sky.
 TEST(Reflection, FloorAcrossAFaceSeamIsHitNotMissed) {
     const MeshScene mesh(test::rampedBoxAndFloor(glm::vec3(kBoxLo), glm::vec3(kBoxHi)));
-    ReflectionBakeOptions bake;
-    bake.size = 64;
-    bake.roi = AxisBox{kBoxLo, kBoxHi};
-    const auto conusFaces = bakeReflection(mesh, bake);
-    bake.uniform = true;
-    const auto uniformFaces = bakeReflection(mesh, bake);
+    const auto [conusFaces, uniformFaces] = bakeBoth(mesh);
     for (const auto* faces : {&conusFaces, &uniformFaces}) {
         for (int i = 0; i < 41; ++i)
             for (int j = 0; j < 31; ++j) {
