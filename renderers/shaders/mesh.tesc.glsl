@@ -98,12 +98,31 @@ float insideLevel(float longestEdge) {
     return segmentsFor(worst, m);
 }
 
+// Whether the three corners lie beyond one plane of the view volume (0 <= x, y, z <= w in the
+// projection's clip coordinates), so the whole triangle does. Equation 1 keeps the frame's edges
+// on themselves (spec V10) and mesh_project continues the map outside by translation, so nothing
+// beyond a side before the map lands inside after it: the patch is dropped before it is split.
+bool outsideTheFrustum() {
+    ivec3 below = ivec3(0), above = ivec3(0);  // corners beyond each plane
+    for (int k = 0; k < 3; ++k) {
+        const vec4 c = uWorldToNdc * vec4(pWorld[k], 1.0);
+        below += ivec3(lessThan(c.xyz, vec3(0.0)));
+        above += ivec3(greaterThan(c.xyz, vec3(c.w)));
+    }
+    return any(equal(below, ivec3(3))) || any(equal(above, ivec3(3)));
+}
+
 void main() {
     tWorld[gl_InvocationID] = pWorld[gl_InvocationID];
     tNormal[gl_InvocationID] = pNormal[gl_InvocationID];
     tColour[gl_InvocationID] = pColour[gl_InvocationID];
     tUv[gl_InvocationID] = pUv[gl_InvocationID];
     if (gl_InvocationID != 0) return;
+    if (outsideTheFrustum()) {
+        gl_TessLevelOuter[0] = gl_TessLevelOuter[1] = gl_TessLevelOuter[2] = 0.0;
+        gl_TessLevelInner[0] = 0.0;
+        return;
+    }
     // Outer level k belongs to the edge opposite corner k (the edge where gl_TessCoord[k] is 0).
     gl_TessLevelOuter[0] = edgeLevel(pWorld[1], pWorld[2]);
     gl_TessLevelOuter[1] = edgeLevel(pWorld[2], pWorld[0]);

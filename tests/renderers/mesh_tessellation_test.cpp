@@ -121,6 +121,25 @@ TEST_P(MeshTessellation, AnAffineMapDrawsTheMeshAsItIs) {
     EXPECT_LT(codec::meanSquaredError(identity, asBuilt), 1e-12);  // rounding in Equation 1 alone
 }
 
+// A triangle wholly beyond one side of the view volume is dropped before it is split: a second
+// floor off to the side of the frame adds no triangle drawn and changes no pixel.
+TEST_P(MeshTessellation, DropsTrianglesOutsideTheFrame) {
+    const Mesh floor = floorGrid();
+    Mesh twoFloors = floor;
+    const auto first = static_cast<std::uint32_t>(floor.positions.size());
+    for (std::size_t i = 0; i < floor.positions.size(); ++i) {
+        twoFloors.positions.push_back(floor.positions[i] + glm::vec3(200.0f, 0.0f, 0.0f));
+        twoFloors.colours.push_back(floor.colours[i]);
+    }
+    for (const std::uint32_t index : floor.indices) twoFloors.indices.push_back(first + index);
+    std::int64_t one = 0, two = 0;
+    const Image alone = MeshRenderer(contextFor(GetParam()), floor).render(floorCamera(), bentMap(), kWidth, kHeight, {}, nullptr, &one);
+    const Image beside = MeshRenderer(contextFor(GetParam()), twoFloors).render(floorCamera(), bentMap(), kWidth, kHeight, {}, nullptr, &two);
+    EXPECT_GT(one, static_cast<std::int64_t>(floor.triangleCount()));  // the floor in view is split
+    EXPECT_EQ(two, one);
+    EXPECT_EQ(codec::meanSquaredError(alone, beside), 0.0);
+}
+
 TEST_P(MeshTessellation, BadBoundsAreRefused) {
     MeshRenderer renderer(contextFor(GetParam()), floorGrid());
     for (const double bad : {-0.5, std::nan(""), HUGE_VAL})
