@@ -42,14 +42,20 @@ vec4 splitWeights(vec4 d, vec4 w, vec2 f) {
     return w * vec4(equal(lessThanEqual(d, vec4(middle)), bvec4(nearest <= middle)));
 }
 
-// DepthImage::surfaceWeights: the four texels around pd (pixel centres at (i + 0.5) / size,
-// clamped to the edge pixels; corners i0 and i1) and their weights (x, y, z, w as splitWeights).
-vec4 surfaceWeights(sampler2D depths, vec2 pd, out ivec2 i0, out ivec2 i1) {
-    const ivec2 size = textureSize(depths, 0);
-    const vec2 g = clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
-    i0 = min(ivec2(g), size - 1);
+// DepthImage's cellAt: the cell of four texels around pd (pixel centres at (i + 0.5) / size; corners
+// i0 and i1) and pd's place in it, past [0, 1] within half a texel of the image's side (the last
+// cell's step carried on to the side).
+vec2 cellAt(ivec2 size, vec2 pd, out ivec2 i0, out ivec2 i1) {
+    const vec2 g = pd * vec2(size) - 0.5;
+    i0 = clamp(ivec2(floor(g)), ivec2(0), max(size - 2, ivec2(0)));
     i1 = min(i0 + 1, size - 1);
-    const vec2 f = g - vec2(i0);
+    return mix(vec2(0.0), clamp(g - vec2(i0), -0.5, 1.5), greaterThan(i1, i0));
+}
+
+// DepthImage::surfaceWeights: the four texels around pd and their weights (x, y, z, w as
+// splitWeights), which do not extrapolate.
+vec4 surfaceWeights(sampler2D depths, vec2 pd, out ivec2 i0, out ivec2 i1) {
+    const vec2 f = clamp(cellAt(textureSize(depths, 0), pd, i0, i1), 0.0, 1.0);
     const float a = texelFetch(depths, i0, 0).r;
     const vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
     if (!flagBit(a)) return w;
@@ -59,19 +65,18 @@ vec4 surfaceWeights(sampler2D depths, vec2 pd, out ivec2 i0, out ivec2 i1) {
 }
 
 // DepthImage::sampleDepth: the stored surface's depth at pd, plain bilinear in an unflagged cell
-// (exact weights, texelFetch); `flagged` says which.
+// (exact weights, texelFetch; extrapolated at the image's side); `flagged` says which.
 float sampleDepth(sampler2D depths, vec2 pd, out bool flagged) {
-    const ivec2 size = textureSize(depths, 0);
-    const vec2 g = clamp(pd * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
-    const ivec2 i0 = min(ivec2(g), size - 1), i1 = min(i0 + 1, size - 1);
-    const vec2 f = g - vec2(i0);
+    ivec2 i0, i1;
+    const vec2 f = cellAt(textureSize(depths, 0), pd, i0, i1);
     const float a = texelFetch(depths, i0, 0).r;
     const float b = texelFetch(depths, ivec2(i1.x, i0.y), 0).r, c = texelFetch(depths, ivec2(i0.x, i1.y), 0).r;
     const float e = texelFetch(depths, i1, 0).r;
     flagged = flagBit(a);
     if (!flagged) return mix(mix(a, b, f.x), mix(c, e, f.x), f.y);
+    const vec2 fc = clamp(f, 0.0, 1.0);
     const vec4 d = vec4(a, b, c, e);
-    const vec4 w = splitWeights(d, vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y), f);
+    const vec4 w = splitWeights(d, vec4((1.0 - fc.x) * (1.0 - fc.y), fc.x * (1.0 - fc.y), (1.0 - fc.x) * fc.y, fc.x * fc.y), fc);
     return dot(w, d) / (w.x + w.y + w.z + w.w);
 }
 

@@ -93,6 +93,14 @@ TEST_P(ReliefGl, GlslMatchesCpuOnAPerspectiveSphere) {
     expectAgreement(context(), image, rays, {}, 1e-2);
 }
 
+// Between the last texel centres and the side the surface goes on at its last step, in both twins.
+TEST_P(ReliefGl, GlslMatchesCpuInTheSideStrips) {
+    for (const bool conus : {false, true}) {
+        const DepthImage image = heightImage(codec::test::steepPlane, conus ? focusMap(0.3, 0.65, 0.15, 4.0) : identityMap(), 64);
+        expectAgreement(context(), image, codec::test::raysIntoTheSideStrips(64, 8, 500), {}, 2e-3);
+    }
+}
+
 // A scene's silhouettes (walls are no hits, hidden rays take the background) follow the same rule.
 TEST_P(ReliefGl, GlslMatchesCpuBesideAThinBoard) {
     const DepthImage image = codec::test::boardImage(focusMap(0.5, 0.5, 0.1, 3.0), 128);

@@ -37,9 +37,6 @@ DepthImage::DepthImage(Camera camera, std::shared_ptr<const SamplingMap> map, in
                                                     std::to_string(width) + "x" + std::to_string(height) + " pixels");
     for (const float d : m_depths)
         if (!std::isfinite(d)) throw Error(ErrorCode::InvalidArgument, "DepthImage: a depth is not finite");
-    const auto [lo, hi] = std::minmax_element(m_depths.begin(), m_depths.end());
-    m_minDepth = *lo;
-    m_maxDepth = *hi;
 
     const bool perspective = m_camera.projection() == Projection::Perspective;
     if (perspective) {
@@ -50,7 +47,28 @@ DepthImage::DepthImage(Camera camera, std::shared_ptr<const SamplingMap> map, in
     }
     // Solid images keep the bilinear surface everywhere (intersect.h): no cell is flagged.
     m_flags.assign(m_depths.size(), 0);
-    if (solid) return;
+    if (!solid) flagCells();
+    // The range the surface spans: the samples', and where it is carried on to the image's sides
+    // (sampleDepth; extremes at the sides' points level with texel centres, and the corners).
+    const auto [lo, hi] = std::minmax_element(m_depths.begin(), m_depths.end());
+    m_minDepth = *lo;
+    m_maxDepth = *hi;
+    const auto include = [&](double u, double v) {
+        const double depth = sampleDepth({u, v});
+        m_minDepth = std::min(m_minDepth, depth);
+        m_maxDepth = std::max(m_maxDepth, depth);
+    };
+    for (int x = 0; x < width; ++x)
+        for (const double v : {0.0, 1.0}) include((x + 0.5) / width, v);
+    for (int y = 0; y < height; ++y)
+        for (const double u : {0.0, 1.0}) include(u, (y + 0.5) / height);
+    for (const double u : {0.0, 1.0})
+        for (const double v : {0.0, 1.0}) include(u, v);
+}
+
+void DepthImage::flagCells() {
+    const int width = m_width, height = m_height;
+    const bool perspective = m_camera.projection() == Projection::Perspective;
     // Edge flags first (right: x to x + 1; down: y to y + 1), then each cell from its four edges.
     const auto d = [&](int x, int y) -> const float* {
         return x < 0 || y < 0 || x >= width || y >= height ? nullptr : &m_depths[static_cast<std::size_t>(y) * width + x];
@@ -93,22 +111,37 @@ DepthImage DepthImage::fromFile(const format::ConusFile& file) {
                       file.image.width, file.image.height, std::move(depths), height);
 }
 
+namespace {
+
+// The cell of four texels around pd (pixel centres at (i + 0.5) / size): its top-left texel
+// (x0, y0), the texel across (x1, y1), and pd's place in it. Within half a texel of the image's
+// side the cell is the last one and f runs past [0, 1] (down to -0.5 or up to 1.5), so the
+// surface is carried on to the side by its last step instead of stopping flat at the last texel.
+struct Cell {
+    int x0, y0, x1, y1;
+    double fx, fy;
+};
+Cell cellAt(glm::dvec2 pd, int width, int height) {
+    const double x = pd.x * width - 0.5, y = pd.y * height - 0.5;
+    const int x0 = std::clamp(static_cast<int>(std::floor(x)), 0, std::max(width - 2, 0));
+    const int y0 = std::clamp(static_cast<int>(std::floor(y)), 0, std::max(height - 2, 0));
+    const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
+    return {x0, y0, x1, y1, x1 > x0 ? std::clamp(x - x0, -0.5, 1.5) : 0.0, y1 > y0 ? std::clamp(y - y0, -0.5, 1.5) : 0.0};
+}
+
+}  // namespace
+
 std::size_t DepthImage::cellIndex(glm::dvec2 pd) const {
-    const double x = std::clamp(pd.x * m_width - 0.5, 0.0, m_width - 1.0);
-    const double y = std::clamp(pd.y * m_height - 0.5, 0.0, m_height - 1.0);
-    return static_cast<std::size_t>(std::min(static_cast<int>(y), m_height - 1)) * m_width +
-           std::min(static_cast<int>(x), m_width - 1);
+    const Cell c = cellAt(pd, m_width, m_height);
+    return static_cast<std::size_t>(c.y0) * m_width + c.x0;
 }
 
 DepthImage::Weights DepthImage::surfaceWeights(glm::dvec2 pd) const {
-    const double x = std::clamp(pd.x * m_width - 0.5, 0.0, m_width - 1.0);
-    const double y = std::clamp(pd.y * m_height - 0.5, 0.0, m_height - 1.0);
-    const int x0 = std::min(static_cast<int>(x), m_width - 1), y0 = std::min(static_cast<int>(y), m_height - 1);
-    const int x1 = std::min(x0 + 1, m_width - 1), y1 = std::min(y0 + 1, m_height - 1);
-    const double fx = x - x0, fy = y - y0;
-    Weights w{{{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}},
+    const Cell c = cellAt(pd, m_width, m_height);
+    const double fx = std::clamp(c.fx, 0.0, 1.0), fy = std::clamp(c.fy, 0.0, 1.0);  // colours do not extrapolate
+    Weights w{{{c.x0, c.y0}, {c.x1, c.y0}, {c.x0, c.y1}, {c.x1, c.y1}},
               {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy}};
-    if (!m_flags[static_cast<std::size_t>(y0) * m_width + x0]) return w;
+    if (!m_flags[static_cast<std::size_t>(c.y0) * m_width + c.x0]) return w;
     // A flagged cell: keep the texels on the nearest texel's side of the cell's middle depth.
     double d[4], lo = 1e300, hi = -1e300;
     for (int k = 0; k < 4; ++k) {
@@ -124,16 +157,13 @@ DepthImage::Weights DepthImage::surfaceWeights(glm::dvec2 pd) const {
 }
 
 double DepthImage::sampleDepth(glm::dvec2 pd) const {
-    const double x = std::clamp(pd.x * m_width - 0.5, 0.0, m_width - 1.0);
-    const double y = std::clamp(pd.y * m_height - 0.5, 0.0, m_height - 1.0);
-    const int x0 = std::min(static_cast<int>(x), m_width - 1), y0 = std::min(static_cast<int>(y), m_height - 1);
-    // The common case first, as cheap as plain bilinear: an unflagged cell.
-    if (!m_flags[static_cast<std::size_t>(y0) * m_width + x0]) {
-        const int x1 = std::min(x0 + 1, m_width - 1), y1 = std::min(y0 + 1, m_height - 1);
-        const double fx = x - x0, fy = y - y0;
-        const double top = depthAt(x0, y0) + (depthAt(x1, y0) - depthAt(x0, y0)) * fx;
-        const double bottom = depthAt(x0, y1) + (depthAt(x1, y1) - depthAt(x0, y1)) * fx;
-        return top + (bottom - top) * fy;
+    const Cell c = cellAt(pd, m_width, m_height);
+    // The common case first, as cheap as plain bilinear: an unflagged cell, extrapolated within
+    // half a texel of the image's side (cellAt).
+    if (!m_flags[static_cast<std::size_t>(c.y0) * m_width + c.x0]) {
+        const double top = depthAt(c.x0, c.y0) + (depthAt(c.x1, c.y0) - depthAt(c.x0, c.y0)) * c.fx;
+        const double bottom = depthAt(c.x0, c.y1) + (depthAt(c.x1, c.y1) - depthAt(c.x0, c.y1)) * c.fx;
+        return top + (bottom - top) * c.fy;
     }
     const Weights w = surfaceWeights(pd);
     double sum = 0.0, weight = 0.0;

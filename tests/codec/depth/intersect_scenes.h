@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <random>
 #include <vector>
 
 #include "conus/codec/build/foci.h"
@@ -133,6 +134,25 @@ inline std::vector<Ray> raysPastTheFarPlane() {
 
 // A ray from `from` toward `to`.
 inline Ray rayThrough(glm::dvec3 from, glm::dvec3 to) { return {from, glm::normalize(to - from)}; }
+
+// A steep plane of heights, and rays from above toward points on it within half a texel of a
+// side (or a corner) of a height image `size` texels a side: between the last texel centres and
+// the side, where the surface goes on at its last step.
+inline double steepPlane(double x, double z) { return 0.3 + 0.5 * x - 0.4 * z; }
+inline std::vector<Ray> raysIntoTheSideStrips(int size, unsigned seed, int count) {
+    const double strip = 0.5 / size;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> inStrip(0.05 * strip, 0.95 * strip), along(0.05, 0.95), tilt(-0.4, 0.4);
+    std::vector<Ray> rays;
+    while (static_cast<int>(rays.size()) < count) {
+        const double a = inStrip(rng), b = along(rng);
+        for (const glm::dvec2 t : {glm::dvec2(a, b), glm::dvec2(1.0 - a, b), glm::dvec2(b, a), glm::dvec2(b, 1.0 - a), glm::dvec2(a, 1.0 - a)}) {
+            const glm::dvec3 target(t.x, steepPlane(t.x, t.y), t.y);
+            rays.push_back(rayThrough(target + glm::dvec3(tilt(rng), 1.2, tilt(rng)), target));
+        }
+    }
+    return rays;
+}
 
 // The first t where the ray is at or below height(x, z) inside the unit box (heights in [0, top]):
 // dense marching on the true function, then bisection.

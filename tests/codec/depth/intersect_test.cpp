@@ -67,6 +67,26 @@ TEST(Intersect, TiltedPlaneMatchesClosedForm) {
     }
 }
 
+// Between the last texel centres and the image's side the surface goes on at its last step: a
+// steep plane is met where it is there too, not at the edge texel's height (half a texel's rise
+// off), and the depth range reaches the side.
+TEST(Intersect, TiltedPlaneReachesTheImagesSides) {
+    constexpr int kSize = 64;
+    const DepthImage image = heightImage(test::steepPlane, identityMap(), kSize);
+    const Camera& camera = image.camera();
+    EXPECT_NEAR(image.maxDepth(), heightToDepth(camera, test::steepPlane(0.0, 1.0)), 1e-6);  // the lowest corner
+    EXPECT_NEAR(image.minDepth(), heightToDepth(camera, test::steepPlane(1.0, 0.0)), 1e-6);  // the highest
+    for (const Ray& ray : test::raysIntoTheSideStrips(kSize, 5, 400)) {
+        // Closed form: origin.y + t d.y = steepPlane(origin + t d).
+        const double num = test::steepPlane(ray.origin.x, ray.origin.z) - ray.origin.y;
+        const double truth = num / (ray.direction.y - 0.5 * ray.direction.x + 0.4 * ray.direction.z);
+        const auto hit = intersect(image, ray);
+        ASSERT_TRUE(hit) << "ray from " << ray.origin.x << ", " << ray.origin.z;
+        EXPECT_NEAR(hit->t, truth, 2e-4) << "ray from " << ray.origin.x << ", " << ray.origin.z;
+        expectConsistent(image, ray, *hit);
+    }
+}
+
 // A sphere in front of a wall, seen by a perspective camera; rays from elsewhere (as reflected
 // rays would come) must find the sphere where it truly is.
 TEST(Intersect, PerspectiveSphereFromAnotherViewpoint) {

@@ -44,10 +44,9 @@
 // it went hidden; one that leaves through the image's side hits nothing here (a reflection then
 // takes another face, or the sky). A ray that enters a scene's image through a side less than a
 // jump behind the stored surface hits where it enters: the surface goes on across the image's
-// edge (a floor seen by two cube faces), where between the last texel centres and the edge the
-// depth is the last texel's, and the ray would otherwise pass both images; not where the stored
-// surface is at the camera's far plane (within kSideRuleFarMargin of it), which is where depth
-// images of scenes store nothing seen. Those never hit there: the walk ends at the largest stored
+// edge (a floor seen by two cube faces), and the ray would otherwise pass both images; not where
+// the stored surface is at the camera's far plane (within kSideRuleFarMargin of it), which is
+// where depth images of scenes store nothing seen. Those never hit there: the walk ends at the largest stored
 // depth.
 //
 // Height fields (depth kind `height`, orthographic camera looking down at the base plane): the
@@ -100,11 +99,13 @@ public:
     const std::vector<float>& depths() const { return m_depths; }
     float depthAt(int x, int y) const { return m_depths[static_cast<std::size_t>(y) * m_width + x]; }
     // The surface's depth at distorted position pd: bilinear in the CoNUS image (pixel centres at
-    // (i + 0.5) / width, clamped to the edge pixels), split in flagged cells (file comment): what
-    // the linear search compares the ray with.
+    // (i + 0.5) / width; between the last centres and the image's side, the last cell's step
+    // carried on, so a surface reaches the side at its own slope), split in flagged cells (file
+    // comment): what the linear search compares the ray with.
     double sampleDepth(glm::dvec2 pd) const;
     // The four texels around pd and their weights in sampleDepth (zero for the far side of a
-    // flagged cell); the colour a hit takes uses the same weights.
+    // flagged cell; at the side, the edge texels' without extrapolation); the colour a hit takes
+    // uses the same weights.
     struct Weights {
         glm::ivec2 texel[4];
         double weight[4];
@@ -112,6 +113,7 @@ public:
     Weights surfaceWeights(glm::dvec2 pd) const;
     // The index (y * width + x) of the cell around pd: its top-left texel, as surfaceWeights finds it.
     std::size_t cellIndex(glm::dvec2 pd) const;
+    // The range of depths the surface spans (sampleDepth's, the sides' included).
     double minDepth() const { return m_minDepth; }
     double maxDepth() const { return m_maxDepth; }
     bool solid() const { return m_solid; }
@@ -123,6 +125,8 @@ public:
     double jumpAbsolute() const { return m_jumpAbsolute; }
 
 private:
+    void flagCells();  // m_flags of a scene's image (file comment)
+
     Camera m_camera;
     std::shared_ptr<const SamplingMap> m_map;
     int m_width = 0, m_height = 0;
