@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -25,6 +26,53 @@ bool finite(glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && s
 bool onSky(const DepthHit& hit, const ReflectionFace& face) {
     return face.image.at(hit.texel.x, hit.texel.y, kMeshChannelA) < 0.5f ||
            (!hit.hidden && hit.depth >= face.depth.camera().far() * (1.0 - 1e-4));
+}
+
+// The context a face's focus multiplies, from a uniform render of the face: a reflected ray meets
+// the wrong surface mostly beside an outline against the sky (nothing is stored behind it), and the
+// sky itself needs few texels. Texels within kOutlineBand of such an outline get kOutlineDensity,
+// the sky beyond kSkyDensity, surfaces 1 (bench/notes/2026-11-27-reflection-rest.md: the band buys
+// the rest of the mirror what the focus takes from it; the sky's saving alone does not).
+constexpr int kOutlineBand = 4;          // texels of the face, either side of the outline
+constexpr float kOutlineDensity = 6.0f;
+constexpr float kSkyDensity = 0.5f;
+
+// Running maximum of `values` over a window of kOutlineBand either side, along rows (step 1) or
+// columns (step w); the window clamps at the border.
+std::vector<std::uint8_t> windowMax(const std::vector<std::uint8_t>& values, int w, int h, bool columns) {
+    std::vector<std::uint8_t> out(values.size());
+    const int n = columns ? h : w, lines = columns ? w : h;
+    for (int line = 0; line < lines; ++line)
+        for (int i = 0; i < n; ++i) {
+            std::uint8_t m = 0;
+            for (int j = std::max(0, i - kOutlineBand); j <= std::min(n - 1, i + kOutlineBand); ++j)
+                m = std::max(m, values[columns ? std::size_t(j) * w + line : std::size_t(line) * w + j]);
+            out[columns ? std::size_t(i) * w + line : std::size_t(line) * w + i] = m;
+        }
+    return out;
+}
+
+// Nothing when the face sees no outline (all surface or all sky): the focus alone then.
+std::optional<DensityField> outlineContext(const Image& uniform) {
+    const int w = uniform.width, h = uniform.height;
+    std::vector<std::uint8_t> seen(std::size_t(w) * h), unseen(seen.size());
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            seen[std::size_t(y) * w + x] = uniform.at(x, y, kMeshChannelA) >= 0.5f;
+            unseen[std::size_t(y) * w + x] = !seen[std::size_t(y) * w + x];
+        }
+    // A texel lies in the band when its (2 kOutlineBand + 1)^2 window holds both.
+    const std::vector<std::uint8_t> anySeen = windowMax(windowMax(seen, w, h, false), w, h, true);
+    const std::vector<std::uint8_t> anyUnseen = windowMax(windowMax(unseen, w, h, false), w, h, true);
+    DensityField field{w, h, std::vector<float>(seen.size())};
+    bool outline = false;
+    for (std::size_t i = 0; i < seen.size(); ++i) {
+        const bool band = anySeen[i] && anyUnseen[i];
+        outline = outline || band;
+        field.values[i] = band ? kOutlineDensity : seen[i] ? 1.0f : kSkyDensity;
+    }
+    if (!outline) return std::nullopt;
+    return field;
 }
 
 }  // namespace
@@ -79,18 +127,22 @@ std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const Reflect
 
     std::vector<ReflectionFace> faces;
     faces.reserve(kCubeFaces);
+    const std::shared_ptr<const SamplingMap> identity = std::make_shared<SamplingMap>(SamplingMap::identity(2, 2));
     for (int f = 0; f < kCubeFaces; ++f) {
         const Camera camera = cubeFaceCamera(o.centre, f, o.near, far);
-        std::shared_ptr<const SamplingMap> map;
+        std::shared_ptr<const SamplingMap> map = identity;
         std::optional<Focus> focus;
         if (!o.uniform) focus = reflectionFocus(camera, roi, o.magnification);
+        // A face without a focus keeps the identity: its context gives no texels to the focus, and
+        // a map bent by the outline band alone moves straight outlines off its texel rows (the pole
+        // of the bench's +x face: -1 dB, bench/notes/2026-11-27-reflection-rest.md).
         if (focus) {
+            const std::optional<DensityField> context = outlineContext(renderMeshReference(scene, Fpc(camera, identity), o.size, o.size));
             FociOptions foci;
             foci.aspect = 1.0;
             foci.falloff = kFormatFalloff;  // the r..2r ring: the faces' figures were measured with it (a narrow one: -0.8 dB)
+            foci.context = context ? &*context : nullptr;
             map = std::make_shared<SamplingMap>(buildFociMap(std::span<const Focus>(&*focus, 1), foci));
-        } else {
-            map = std::make_shared<SamplingMap>(SamplingMap::identity(2, 2));
         }
         const Image rgbaz = renderMeshReference(scene, Fpc(camera, map), o.size, o.size);
         std::vector<float> depths(static_cast<std::size_t>(o.size) * o.size);

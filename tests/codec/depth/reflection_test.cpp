@@ -188,6 +188,55 @@ TEST(Reflection, FocusIsTheDiscInscribedInTheProjectedBoxsSquare) {
     EXPECT_LT(focus->r, 0.5 * glm::length(hi - lo));  // not the bounding disc
 }
 
+// The box before a wall whose top edge crosses the +z face with sky above: the face that holds the
+// focus spends the sky's texels on the wall's outline against it (where reflected rays pass beside
+// an edge with nothing stored behind it), not on the sky, unlike a focus over a flat context.
+TEST(Reflection, FocusedFaceSpendsTheSkysTexelsOnItsOutline) {
+    Mesh scene = flatBox(glm::vec3(kBoxLo), glm::vec3(kBoxHi));
+    const Mesh wall = flatBox({-6.0f, -2.0f, 4.0f}, {6.0f, 1.5f, 4.3f});
+    const auto base = static_cast<std::uint32_t>(scene.positions.size());
+    scene.positions.insert(scene.positions.end(), wall.positions.begin(), wall.positions.end());
+    scene.normals.insert(scene.normals.end(), wall.normals.begin(), wall.normals.end());
+    for (std::uint32_t i : wall.indices) scene.indices.push_back(base + i);
+    ReflectionBakeOptions bake;
+    bake.size = 128;
+    bake.roi = AxisBox{kBoxLo, kBoxHi};
+    const std::vector<ReflectionFace> faces = bakeReflection(MeshScene(scene), bake);
+
+    const Camera& front = faces[4].depth.camera();  // +z: the box, the wall and the sky
+    FociOptions flat;
+    flat.aspect = 1.0;
+    flat.falloff = kFormatFalloff;
+    const Focus focus = *reflectionFocus(front, *bake.roi, bake.magnification);
+    const SamplingMap focusOnly = buildFociMap(std::span<const Focus>(&focus, 1), flat);
+    const SamplingMap& map = faces[4].depth.map();
+    // The wall's top edge on the side away from the focus (u > 0.5), and the sky well above it:
+    // the outline's texels are finer across it (d v_d / d v) and denser, the sky's sparser.
+    double outline = 0, outlineFlat = 0, sky = 0, skyFlat = 0;
+    for (double x : {-3.0, -2.0, -1.0}) {
+        SCOPED_TRACE(x);
+        const glm::dvec2 edge(front.project({x, 1.5, 4.0})), above(front.project({x, 3.2, 4.0}));
+        EXPECT_GT(map.jacobian(edge)[1][1], 1.35 * focusOnly.jacobian(edge)[1][1]);
+        EXPECT_GT(map.jacobian(edge)[1][1], 1.5);
+        outline += map.density(edge);
+        outlineFlat += focusOnly.density(edge);
+        sky += map.density(above);
+        skyFlat += focusOnly.density(above);
+    }
+    EXPECT_GT(outline, 1.4 * outlineFlat);
+    EXPECT_LT(sky, 0.7 * skyFlat);
+    EXPECT_GT(reachedMagnification(map, std::span<const Focus>(&focus, 1))[0], 3.0);
+    // The +x and -x faces see the wall's ends against the sky but not the box: they keep the identity.
+    for (int f : {0, 1}) {
+        const Image& image = faces[f].image;
+        float seen = 0, sky = 1;
+        for (std::size_t i = kMeshChannelA; i < image.pixels.size(); i += image.channels.size())
+            seen = std::max(seen, image.pixels[i]), sky = std::min(sky, image.pixels[i]);
+        EXPECT_EQ(seen - sky, 1.0f);
+        EXPECT_EQ(faces[f].depth.map().columns(), 2);
+    }
+}
+
 // The hit's colour: bilinear between texel centres over the covered texels only.
 TEST(Reflection, HitColourIsBilinearOverCoveredTexels) {
     ReflectionFace face = bakeBox(16, true)[0];

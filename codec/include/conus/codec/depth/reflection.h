@@ -11,7 +11,9 @@
 //
 // The faces' maps favour what the reflector shows most: a focus on the projection of a region of
 // interest (by default the scene's bounding box; in practice the object nearest the reflector) in
-// every face that sees it. The uniform baseline has the identity map and the same texel count.
+// every face that sees it, over a context that gives the face's outlines against the sky more
+// texels and the sky fewer (what a uniform render of the face sees); the other faces keep the
+// identity. The uniform baseline has the identity map and the same texel count.
 #pragma once
 
 #include <array>
@@ -72,7 +74,8 @@ struct ReflectionBakeOptions {
 std::optional<Focus> reflectionFocus(const Camera& face, const AxisBox& roi, double magnification);
 
 // The six faces of `scene` from options.centre, each rendered by the Embree reference (one exact
-// ray per CoNUS pixel: depths of one surface, never a mean across a silhouette). Throws
+// ray per CoNUS pixel: depths of one surface, never a mean across a silhouette); a face with a
+// focus is rendered uniform first, for its context. Throws
 // conus::Error(InvalidArgument) for a size outside [8, 4096], a magnification outside [1, 16], a
 // non-finite centre, or a centre inside no free space (a near clip at or beyond the far one).
 std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const ReflectionBakeOptions& options);
