@@ -161,6 +161,7 @@ void BM_SubdivisionQuality(benchmark::State& state) {
                 codec::psnr(r.renderer.render(d.camera, *d.map, kWidth, kHeight, r.options, nullptr, &triangles), reference);
             state.counters[std::string("triangles_") + r.name] = static_cast<double>(triangles);
         }
+    state.SetLabel(d.context->renderer());  // the GL the frame times of this run are read on
 }
 void BM_EmbreeReference(benchmark::State& state) {
     Data& d = data();

@@ -46,8 +46,8 @@
 // jump behind the stored surface hits where it enters: the surface goes on across the image's
 // edge (a floor seen by two cube faces), and the ray would otherwise pass both images; not where
 // the stored surface is at the camera's far plane (within kSideRuleFarMargin of it), which is
-// where depth images of scenes store nothing seen. Those never hit there: the walk ends at the largest stored
-// depth.
+// where depth images of scenes store nothing seen. Those never hit there: the walk ends at the
+// largest stored depth.
 //
 // Height fields (depth kind `height`, orthographic camera looking down at the base plane): the
 // base plane is the plane through the world origin facing the camera, and height h lies h above
