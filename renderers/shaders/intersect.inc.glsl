@@ -42,7 +42,7 @@ vec4 splitWeights(vec4 d, vec4 w, vec2 f) {
     return w * vec4(equal(lessThanEqual(d, vec4(middle)), bvec4(nearest <= middle)));
 }
 
-// DepthImage's cellAt: the cell of four texels around pd (pixel centres at (i + 0.5) / size; corners
+// depth_surface.cpp's cellAt: the cell of four texels around pd (pixel centres at (i + 0.5) / size; corners
 // i0 and i1) and pd's place in it, past [0, 1] within half a texel of the image's side (the last
 // cell's step carried on to the side).
 vec2 cellAt(ivec2 size, vec2 pd, out ivec2 i0, out ivec2 i1) {
@@ -65,24 +65,30 @@ vec4 surfaceWeights(sampler2D depths, vec2 pd, out ivec2 i0, out ivec2 i1) {
 }
 
 // DepthImage::sampleDepth: the stored surface's depth at pd, plain bilinear in an unflagged cell
-// (exact weights, texelFetch; extrapolated at the image's side); `flagged` says which.
-float sampleDepth(sampler2D depths, vec2 pd, out bool flagged) {
+// (exact weights, texelFetch; carried on to the image's side, in 1/depth for a perspective
+// image); `flagged` says which.
+float sampleDepth(sampler2D depths, DepthView view, vec2 pd, out bool flagged) {
     ivec2 i0, i1;
     const vec2 f = cellAt(textureSize(depths, 0), pd, i0, i1);
     const float a = texelFetch(depths, i0, 0).r;
     const float b = texelFetch(depths, ivec2(i1.x, i0.y), 0).r, c = texelFetch(depths, ivec2(i0.x, i1.y), 0).r;
     const float e = texelFetch(depths, i1, 0).r;
     flagged = flagBit(a);
-    if (!flagged) return mix(mix(a, b, f.x), mix(c, e, f.x), f.y);
+    if (!flagged) {
+        if (f == clamp(f, 0.0, 1.0) || !view.perspective) return mix(mix(a, b, f.x), mix(c, e, f.x), f.y);
+        const float q = mix(mix(1.0 / a, 1.0 / b, f.x), mix(1.0 / c, 1.0 / e, f.x), f.y);
+        return 1.0 / clamp(q, 1.0 / view.far, 1.0 / view.near);
+    }
     const vec2 fc = clamp(f, 0.0, 1.0);
     const vec4 d = vec4(a, b, c, e);
-    const vec4 w = splitWeights(d, vec4((1.0 - fc.x) * (1.0 - fc.y), fc.x * (1.0 - fc.y), (1.0 - fc.x) * fc.y, fc.x * fc.y), fc);
+    const vec4 bilinear = vec4((1.0 - fc.x) * (1.0 - fc.y), fc.x * (1.0 - fc.y), (1.0 - fc.x) * fc.y, fc.x * fc.y);
+    const vec4 w = splitWeights(d, bilinear, fc);
     return dot(w, d) / (w.x + w.y + w.z + w.w);
 }
 
-float sampleDepth(sampler2D depths, vec2 pd) {
+float sampleDepth(sampler2D depths, DepthView view, vec2 pd) {
     bool flagged;
-    return sampleDepth(depths, pd, flagged);
+    return sampleDepth(depths, view, pd, flagged);
 }
 
 // The world point at image point uv and camera depth `depth` (perspective or orthographic: depth is
@@ -109,14 +115,15 @@ vec3 clipFaceNormal(DepthView view, int face) {
 
 // The stored surface's depth at s along the projected segment, where s lies in the CoNUS image,
 // and whether its cell is flagged.
-float surfaceAlong(sampler2D depths, sampler2D map, vec2 p0, vec2 along, float s, out MapPoint m, out bool flagged) {
+float surfaceAlong(sampler2D depths, DepthView view, sampler2D map, vec2 p0, vec2 along, float s, out MapPoint m,
+                   out bool flagged) {
     m = evalMap(map, p0 + along * s);
-    return sampleDepth(depths, m.pd, flagged);
+    return sampleDepth(depths, view, m.pd, flagged);
 }
 
-float surfaceAlong(sampler2D depths, sampler2D map, vec2 p0, vec2 along, float s, out MapPoint m) {
+float surfaceAlong(sampler2D depths, DepthView view, sampler2D map, vec2 p0, vec2 along, float s, out MapPoint m) {
     bool flagged;
-    return surfaceAlong(depths, map, p0, along, s, m, flagged);
+    return surfaceAlong(depths, view, map, p0, along, s, m, flagged);
 }
 
 // The ray's camera depth at s (perspective-correct).
@@ -186,7 +193,7 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     MapPoint m, hiddenFrom;  // hiddenFrom: the last point in front of the surface
     MapPoint q;
     bool flagged;  // whether the sample at s lies in a flagged cell (never in a solid image)
-    const float entry = surfaceAlong(depths, map, p0, along, 0.0, m, flagged);
+    const float entry = surfaceAlong(depths, view, map, p0, along, 0.0, m, flagged);
     const bool behind = entry - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0;
     // Through a side, behind a scene's surface by less than a jump, short of the far plane (where a
     // scene saw nothing): met where it enters.
@@ -209,10 +216,10 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
                 before = s;
                 s = min(end, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
                 ++steps;
-                float stored = surfaceAlong(depths, map, p0, along, s, m, flagged);
+                float stored = surfaceAlong(depths, view, map, p0, along, s, m, flagged);
                 if (!fine && flagged) {  // a full step into a flagged cell: taken again, finely
                     s = min(end, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
-                    stored = surfaceAlong(depths, map, p0, along, s, m, flagged);
+                    stored = surfaceAlong(depths, view, map, p0, along, s, m, flagged);
                 }
                 const float gap = stored - rayDepth(dw0, dw1, iw0, iw1, s);
                 if (hidden) {
@@ -240,7 +247,7 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
                 // Behind the background: where the stored surface first reaches hiddenDepth.
                 for (int k = 0; k < refinements; ++k) {
                     const float mid = 0.5 * (a + b);
-                    if (surfaceAlong(depths, map, p0, along, mid, q) >= hiddenDepth)
+                    if (surfaceAlong(depths, view, map, p0, along, mid, q) >= hiddenDepth)
                         b = mid;
                     else
                         a = mid;
@@ -253,7 +260,7 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
             // 4. Bisect between the last sample in front and the first behind.
             for (int k = 0; k < refinements; ++k) {
                 const float mid = 0.5 * (a + b);
-                if (surfaceAlong(depths, map, p0, along, mid, q) - rayDepth(dw0, dw1, iw0, iw1, mid) > 0.0)
+                if (surfaceAlong(depths, view, map, p0, along, mid, q) - rayDepth(dw0, dw1, iw0, iw1, mid) > 0.0)
                     a = mid;
                 else
                     b = mid;
@@ -263,9 +270,9 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
                 m = evalMap(map, p0 + along * s);
                 break;
             }
-            const float sb = surfaceAlong(depths, map, p0, along, b, q);
+            const float sb = surfaceAlong(depths, view, map, p0, along, b, q);
             MapPoint qa;
-            if (surfaceAlong(depths, map, p0, along, a, qa) - sb <= 0.5 * (view.jumpRelative * sb + view.jumpAbsolute)) {
+            if (surfaceAlong(depths, view, map, p0, along, a, qa) - sb <= 0.5 * (view.jumpRelative * sb + view.jumpAbsolute)) {
                 s = 0.5 * (a + b);
                 m = evalMap(map, p0 + along * s);
                 break;

@@ -28,7 +28,7 @@ vec3 worldAt(vec2 uv, float ndcZ) {
 }
 
 // The stored surface's world point at undistorted image point p.
-vec3 surfaceAt(vec2 p) { return unprojectDepth(uView, p, sampleDepth(uDepths, evalMap(uMap, p).pd)); }
+vec3 surfaceAt(vec2 p) { return unprojectDepth(uView, p, sampleDepth(uDepths, uView, evalMap(uMap, p).pd)); }
 
 void main() {
     // GL's window row 0 is the frame's top row (the readback is top row first).

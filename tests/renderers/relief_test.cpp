@@ -96,8 +96,17 @@ TEST_P(ReliefGl, GlslMatchesCpuOnAPerspectiveSphere) {
 // Between the last texel centres and the side the surface goes on at its last step, in both twins.
 TEST_P(ReliefGl, GlslMatchesCpuInTheSideStrips) {
     for (const bool conus : {false, true}) {
-        const DepthImage image = heightImage(codec::test::steepPlane, conus ? focusMap(0.3, 0.65, 0.15, 4.0) : identityMap(), 64);
+        const auto map = conus ? focusMap(0.3, 0.65, 0.15, 4.0) : identityMap();
+        const DepthImage image = heightImage(codec::test::steepPlane, map, 64);
         expectAgreement(context(), image, codec::test::raysIntoTheSideStrips(64, 8, 500), {}, 2e-3);
+    }
+}
+
+TEST_P(ReliefGl, GlslMatchesCpuInAPerspectiveImagesSideStrips) {
+    for (const bool conus : {false, true}) {
+        const auto map = conus ? focusMap(0.3, 0.6, 0.15, 3.0) : identityMap();
+        const DepthImage image = codec::test::tiltedWallImage(map, 64);
+        expectAgreement(context(), image, codec::test::raysIntoTheWallsSideStrips(64, 9, 500), {}, 2e-3);
     }
 }
 

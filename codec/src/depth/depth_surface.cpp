@@ -115,18 +115,22 @@ namespace {
 
 // The cell of four texels around pd (pixel centres at (i + 0.5) / size): its top-left texel
 // (x0, y0), the texel across (x1, y1), and pd's place in it. Within half a texel of the image's
-// side the cell is the last one and f runs past [0, 1] (down to -0.5 or up to 1.5), so the
-// surface is carried on to the side by its last step instead of stopping flat at the last texel.
+// side the cell is the last one and f runs past [0, 1] (down to -0.5 or up to 1.5), so an
+// unflagged cell's surface is carried on to the side (sampleDepth) instead of stopping flat at the
+// last texel.
 struct Cell {
     int x0, y0, x1, y1;
     double fx, fy;
 };
 Cell cellAt(glm::dvec2 pd, int width, int height) {
-    const double x = pd.x * width - 0.5, y = pd.y * height - 0.5;
+    // Clamped before the conversion to int (fmin and fmax also take a NaN to a side).
+    const double x = std::fmax(-1.0, std::fmin(pd.x * width - 0.5, double(width)));
+    const double y = std::fmax(-1.0, std::fmin(pd.y * height - 0.5, double(height)));
     const int x0 = std::clamp(static_cast<int>(std::floor(x)), 0, std::max(width - 2, 0));
     const int y0 = std::clamp(static_cast<int>(std::floor(y)), 0, std::max(height - 2, 0));
     const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
-    return {x0, y0, x1, y1, x1 > x0 ? std::clamp(x - x0, -0.5, 1.5) : 0.0, y1 > y0 ? std::clamp(y - y0, -0.5, 1.5) : 0.0};
+    return {x0, y0, x1, y1, x1 > x0 ? std::clamp(x - x0, -0.5, 1.5) : 0.0,
+            y1 > y0 ? std::clamp(y - y0, -0.5, 1.5) : 0.0};
 }
 
 }  // namespace
@@ -158,12 +162,21 @@ DepthImage::Weights DepthImage::surfaceWeights(glm::dvec2 pd) const {
 
 double DepthImage::sampleDepth(glm::dvec2 pd) const {
     const Cell c = cellAt(pd, m_width, m_height);
-    // The common case first, as cheap as plain bilinear: an unflagged cell, extrapolated within
-    // half a texel of the image's side (cellAt).
+    // The common case first, as cheap as plain bilinear: an unflagged cell.
     if (!m_flags[static_cast<std::size_t>(c.y0) * m_width + c.x0]) {
-        const double top = depthAt(c.x0, c.y0) + (depthAt(c.x1, c.y0) - depthAt(c.x0, c.y0)) * c.fx;
-        const double bottom = depthAt(c.x0, c.y1) + (depthAt(c.x1, c.y1) - depthAt(c.x0, c.y1)) * c.fx;
-        return top + (bottom - top) * c.fy;
+        const auto bilinear = [&](const auto& value) {
+            const double top = value(c.x0, c.y0) + (value(c.x1, c.y0) - value(c.x0, c.y0)) * c.fx;
+            const double bottom = value(c.x0, c.y1) + (value(c.x1, c.y1) - value(c.x0, c.y1)) * c.fx;
+            return top + (bottom - top) * c.fy;
+        };
+        const bool inside = c.fx >= 0.0 && c.fx <= 1.0 && c.fy >= 0.0 && c.fy <= 1.0;
+        if (inside || m_camera.projection() != Projection::Perspective)
+            return bilinear([&](int x, int y) { return double(depthAt(x, y)); });
+        // Between the last centres and a perspective image's side: 1/depth carried on (a plane's
+        // is affine in the image, so a floor reaches the side where it truly is), kept within
+        // the camera's near and far planes.
+        const double q = bilinear([&](int x, int y) { return 1.0 / double(depthAt(x, y)); });
+        return 1.0 / std::clamp(q, 1.0 / m_camera.far(), 1.0 / m_camera.near());
     }
     const Weights w = surfaceWeights(pd);
     double sum = 0.0, weight = 0.0;

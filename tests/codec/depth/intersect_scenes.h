@@ -139,6 +139,10 @@ inline Ray rayThrough(glm::dvec3 from, glm::dvec3 to) { return {from, glm::norma
 // side (or a corner) of a height image `size` texels a side: between the last texel centres and
 // the side, where the surface goes on at its last step.
 inline double steepPlane(double x, double z) { return 0.3 + 0.5 * x - 0.4 * z; }
+// Points a from a side (a inside the strip) and b along it: on each of the four sides and a corner.
+inline std::vector<glm::dvec2> sideStripPoints(double a, double b) {
+    return {{a, b}, {1.0 - a, b}, {b, a}, {b, 1.0 - a}, {a, 1.0 - a}};
+}
 inline std::vector<Ray> raysIntoTheSideStrips(int size, unsigned seed, int count) {
     const double strip = 0.5 / size;
     std::mt19937 rng(seed);
@@ -146,11 +150,51 @@ inline std::vector<Ray> raysIntoTheSideStrips(int size, unsigned seed, int count
     std::vector<Ray> rays;
     while (static_cast<int>(rays.size()) < count) {
         const double a = inStrip(rng), b = along(rng);
-        for (const glm::dvec2 t : {glm::dvec2(a, b), glm::dvec2(1.0 - a, b), glm::dvec2(b, a), glm::dvec2(b, 1.0 - a), glm::dvec2(a, 1.0 - a)}) {
+        for (const glm::dvec2 t : sideStripPoints(a, b)) {
             const glm::dvec3 target(t.x, steepPlane(t.x, t.y), t.y);
             rays.push_back(rayThrough(target + glm::dvec3(tilt(rng), 1.2, tilt(rng)), target));
         }
     }
+    return rays;
+}
+
+// A wall tilted toward sphereCamera, filling its view, as a scene's image (not solid): the same
+// strips seen in perspective, where a plane's 1/depth is affine in the image.
+inline const glm::dvec3 kTiltedWallPoint{0.0, 0.0, 2.0};
+inline glm::dvec3 tiltedWallNormal() { return glm::normalize(glm::dvec3(0.3, 0.4, -1.0)); }
+inline std::optional<double> tiltedWallHit(const Ray& ray) {
+    const double facing = glm::dot(ray.direction, tiltedWallNormal());
+    if (facing == 0.0) return std::nullopt;
+    const double t = glm::dot(kTiltedWallPoint - ray.origin, tiltedWallNormal()) / facing;
+    return t > 0.0 ? std::optional<double>(t) : std::nullopt;
+}
+inline DepthImage tiltedWallImage(std::shared_ptr<const SamplingMap> map, int size) {
+    const Camera camera = sphereCamera();
+    std::vector<float> depths(static_cast<std::size_t>(size) * size);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const Ray ray = camera.ray(map->undistort({(x + 0.5) / size, (y + 0.5) / size}));
+            const glm::dvec3 p = ray.origin + ray.direction * tiltedWallHit(ray).value();
+            const double depth = glm::dot(p - camera.eye(), camera.forward());
+            depths[static_cast<std::size_t>(y) * size + x] = static_cast<float>(depth);
+        }
+    return DepthImage(camera, std::move(map), size, size, std::move(depths), false);
+}
+// Rays from inside sphereCamera's view toward the wall where the image shows it within half a
+// texel of a side (or a corner).
+inline std::vector<Ray> raysIntoTheWallsSideStrips(int size, unsigned seed, int count) {
+    const double strip = 0.5 / size;
+    const Camera camera = sphereCamera();
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> inStrip(0.05 * strip, 0.95 * strip), along(0.05, 0.95);
+    std::uniform_real_distribution<double> jitter(-0.1, 0.1);
+    std::vector<Ray> rays;
+    while (static_cast<int>(rays.size()) < count)
+        for (const glm::dvec2 uv : sideStripPoints(inStrip(rng), along(rng))) {
+            const Ray sight = camera.ray(uv);
+            const glm::dvec3 target = sight.origin + sight.direction * tiltedWallHit(sight).value();
+            rays.push_back(rayThrough({0.3 + jitter(rng), 0.2 + jitter(rng), -3.5}, target));
+        }
     return rays;
 }
 

@@ -87,6 +87,26 @@ TEST(Intersect, TiltedPlaneReachesTheImagesSides) {
     }
 }
 
+// The same in perspective, in a scene's image: 1/depth carried on to the side, where a plane's is
+// affine, so a wall is met where it is (linear depth would fall short by its curvature; the edge
+// texel's depth by half a texel's step).
+TEST(Intersect, TiltedWallReachesAPerspectiveImagesSides) {
+    constexpr int kSize = 64;
+    IntersectOptions options;
+    options.refinements = 24;  // the hit to a hair of the surface: the depths here are about 8
+    for (const bool conus : {false, true}) {
+        const DepthImage image = test::tiltedWallImage(conus ? focusMap(0.3, 0.6, 0.15, 3.0) : identityMap(), kSize);
+        for (const Ray& ray : test::raysIntoTheWallsSideStrips(kSize, 6, 400)) {
+            const auto hit = intersect(image, ray, options);
+            ASSERT_TRUE(hit) << (conus ? "CoNUS" : "identity");
+            const double tolerance = conus ? 5e-3 : 2e-4;  // CoNUS: larger texels at the sides
+            EXPECT_NEAR(hit->t, test::tiltedWallHit(ray).value(), tolerance) << (conus ? "CoNUS" : "identity");
+            EXPECT_FALSE(hit->hidden);
+            expectConsistent(image, ray, *hit);
+        }
+    }
+}
+
 // A sphere in front of a wall, seen by a perspective camera; rays from elsewhere (as reflected
 // rays would come) must find the sphere where it truly is.
 TEST(Intersect, PerspectiveSphereFromAnotherViewpoint) {

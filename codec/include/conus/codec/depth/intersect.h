@@ -99,9 +99,10 @@ public:
     const std::vector<float>& depths() const { return m_depths; }
     float depthAt(int x, int y) const { return m_depths[static_cast<std::size_t>(y) * m_width + x]; }
     // The surface's depth at distorted position pd: bilinear in the CoNUS image (pixel centres at
-    // (i + 0.5) / width; between the last centres and the image's side, the last cell's step
-    // carried on, so a surface reaches the side at its own slope), split in flagged cells (file
-    // comment): what the linear search compares the ray with.
+    // (i + 0.5) / width; between the last centres and the image's side, an unflagged cell's
+    // surface carried on, in 1/depth for a perspective camera, where a plane's is affine, within
+    // its near and far planes), split in flagged cells (file comment): what the linear search
+    // compares the ray with.
     double sampleDepth(glm::dvec2 pd) const;
     // The four texels around pd and their weights in sampleDepth (zero for the far side of a
     // flagged cell; at the side, the edge texels' without extrapolation); the colour a hit takes
