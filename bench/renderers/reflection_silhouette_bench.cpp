@@ -157,9 +157,11 @@ void BM_ReflectionSilhouetteVariants(benchmark::State& state) {
                                 {{3, -1, 3.9f}, 128},
                                 {{3, -1, 4.1f}, 128},
                                 {{3.1f, -1.03f, 4.1f}, 128}};
-    // [mirror][0 ROI, 1 rest]
-    double sum[2][2] = {}, lowest[2][2] = {{1e9, 1e9}, {1e9, 1e9}};
-    for (auto _ : state)
+    // [mirror][0 ROI, 1 rest], of the last iteration
+    double sum[2][2] = {}, lowest[2][2] = {};
+    for (auto _ : state) {
+        for (auto& m : sum) m[0] = m[1] = 0.0;
+        for (auto& m : lowest) m[0] = m[1] = 1e9;
         for (const Variant& v : variants) {
             const Scene s(v.room, v.size);
             for (int mirror = 0; mirror < 2; ++mirror) {
@@ -172,6 +174,7 @@ void BM_ReflectionSilhouetteVariants(benchmark::State& state) {
                 }
             }
         }
+    }
     const char* names[2] = {"sphere", "plane"};
     const char* regions[2] = {"roi", "rest"};
     for (int mirror = 0; mirror < 2; ++mirror)

@@ -229,10 +229,10 @@ TEST(Reflection, FocusedFaceSpendsTheSkysTexelsOnItsOutline) {
     // The +x and -x faces see the wall's ends against the sky but not the box: they keep the identity.
     for (int f : {0, 1}) {
         const Image& image = faces[f].image;
-        float seen = 0, sky = 1;
+        float most = 0, least = 1;  // coverage
         for (std::size_t i = kMeshChannelA; i < image.pixels.size(); i += image.channels.size())
-            seen = std::max(seen, image.pixels[i]), sky = std::min(sky, image.pixels[i]);
-        EXPECT_EQ(seen - sky, 1.0f);
+            most = std::max(most, image.pixels[i]), least = std::min(least, image.pixels[i]);
+        EXPECT_EQ(most - least, 1.0f);
         EXPECT_EQ(faces[f].depth.map().columns(), 2);
     }
 }
