@@ -42,9 +42,9 @@ vec4 splitWeights(vec4 d, vec4 w, vec2 f) {
     return w * vec4(equal(lessThanEqual(d, vec4(middle)), bvec4(nearest <= middle)));
 }
 
-// depth_surface.cpp's cellAt: the cell of four texels around pd (pixel centres at (i + 0.5) / size; corners
-// i0 and i1) and pd's place in it, past [0, 1] within half a texel of the image's side (the last
-// cell's step carried on to the side).
+// depth_surface.cpp's cellAt: the cell of four texels around pd (pixel centres at (i + 0.5) /
+// size; corners i0 and i1) and pd's place in it, past [0, 1] within half a texel of the image's
+// side (the last cell's step carried on to the side).
 vec2 cellAt(ivec2 size, vec2 pd, out ivec2 i0, out ivec2 i1) {
     const vec2 g = pd * vec2(size) - 0.5;
     i0 = clamp(ivec2(floor(g)), ivec2(0), max(size - 2, ivec2(0)));
@@ -52,12 +52,17 @@ vec2 cellAt(ivec2 size, vec2 pd, out ivec2 i0, out ivec2 i1) {
     return mix(vec2(0.0), clamp(g - vec2(i0), -0.5, 1.5), greaterThan(i1, i0));
 }
 
+// The bilinear weights of a cell's texels (x, y, z, w as splitWeights) at f in [0, 1]^2.
+vec4 bilinearWeights(vec2 f) {
+    return vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+}
+
 // DepthImage::surfaceWeights: the four texels around pd and their weights (x, y, z, w as
 // splitWeights), which do not extrapolate.
 vec4 surfaceWeights(sampler2D depths, vec2 pd, out ivec2 i0, out ivec2 i1) {
     const vec2 f = clamp(cellAt(textureSize(depths, 0), pd, i0, i1), 0.0, 1.0);
     const float a = texelFetch(depths, i0, 0).r;
-    const vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    const vec4 w = bilinearWeights(f);
     if (!flagBit(a)) return w;
     const vec4 d = vec4(a, texelFetch(depths, ivec2(i1.x, i0.y), 0).r, texelFetch(depths, ivec2(i0.x, i1.y), 0).r,
                         texelFetch(depths, i1, 0).r);
@@ -81,8 +86,7 @@ float sampleDepth(sampler2D depths, DepthView view, vec2 pd, out bool flagged) {
     }
     const vec2 fc = clamp(f, 0.0, 1.0);
     const vec4 d = vec4(a, b, c, e);
-    const vec4 bilinear = vec4((1.0 - fc.x) * (1.0 - fc.y), fc.x * (1.0 - fc.y), (1.0 - fc.x) * fc.y, fc.x * fc.y);
-    const vec4 w = splitWeights(d, bilinear, fc);
+    const vec4 w = splitWeights(d, bilinearWeights(fc), fc);
     return dot(w, d) / (w.x + w.y + w.z + w.w);
 }
 
