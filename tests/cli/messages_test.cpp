@@ -189,3 +189,41 @@ TEST_F(Cli, StandardInputIsAnInput) {
     ASSERT_EQ(run("info " + path("s.exr")).exitCode, 0);
     EXPECT_NE(run("info " + path("s.exr")).out.find("source        64 x 48"), std::string::npos);
 }
+
+// A name too long for the folder: it passes every check made before the work (the folder is
+// there) and fails only when the file is created, after the command's other outputs were written.
+std::string unwritableName(const std::string& extension) { return std::string(250, 'n') + extension; }
+
+TEST_F(Cli, ACommandThatFailsLeavesNoneOfItsOutputs) {
+    // A preview into a folder that is not there: refused before the work.
+    Result r = run("map foci --focus 0.5,0.5,0.1,4 -o " + path("m.exr") + " --preview " + path("nodir/p.png"));
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_EQ(countLines(r.err, ""), 1) << r.err;
+    EXPECT_NE(r.err.find("nodir"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("m.exr")));
+    // A preview that fails once the map is written: the map goes too.
+    r = run("map foci --focus 0.5,0.5,0.1,4 -o " + path("m.exr") + " --preview " + path(unwritableName(".png")) + " -q");
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_EQ(countLines(r.err, ""), 1) << r.err;
+    EXPECT_FALSE(fs::exists(path("m.exr")));
+    EXPECT_EQ(r.out.find("wrote"), std::string::npos) << "nothing said written: " << r.out;
+    // A volume's picture, likewise.
+    r = run("volume render procedural:shepp-logan:16 -o " + path("v.exr") + " --size 16x16 --uniform --picture " +
+            path(unwritableName(".png")));
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_FALSE(fs::exists(path("v.exr")));
+    // The demo: one of its pictures cannot be written (a folder has its name); none of them is
+    // left, and the folder the demo made is gone.
+    const std::string in = makePicture(64, 48);
+    fs::create_directories(m_dir / "demo" / "view-frame.png");
+    r = run("demo --input " + in + " --focus 0.5,0.5,0.1,2 --out " + path("demo") + " -q");
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_NE(r.err.find("view-frame.png is a directory"), std::string::npos) << r.err;
+    EXPECT_EQ(fs::directory_iterator(m_dir / "demo")->path().filename(), "view-frame.png");
+    EXPECT_EQ(std::distance(fs::directory_iterator(m_dir / "demo"), fs::directory_iterator()), 1) << "only what was there";
+    fs::remove(m_dir / "demo" / "view-frame.png");
+    r = run("demo --input " + path("missing.png") + " --out " + path("demo/new"));
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_FALSE(fs::exists(path("demo/new")));
+    EXPECT_TRUE(leftovers().empty());
+}
