@@ -174,7 +174,7 @@ CLI::App* declareDecode(CLI::App& root, DecodeCommandOptions& options) {
     addBatchOptions(*command, options.batch, "CoNUS file (.exr)", "output image (.png, .jpg, .tif, .exr, .bmp, ...)", "{stem}.png");
     command->add_option("--view", options.viewText,
                         "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image; "
-                        "outside [0,1] shows the background)");
+                        "a part outside [0,1] shows the background)");
     command->add_option("--size", options.sizeText,
                         "output size WxH; W, Wx or xH keep the view's aspect (default: the view at the source's "
                         "resolution)");

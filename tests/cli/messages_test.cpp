@@ -227,3 +227,15 @@ TEST_F(Cli, ACommandThatFailsLeavesNoneOfItsOutputs) {
     EXPECT_FALSE(fs::exists(path("demo/new")));
     EXPECT_TRUE(leftovers().empty());
 }
+
+TEST_F(Cli, AViewWhollyOutsideThePictureIsRefusedBeforeAnyWork) {
+    ASSERT_NO_FATAL_FAILURE(makeUniformFile());
+    for (const char* view : {"1.2,0,1.5,0.5", "-0.5,0.2,0,0.4", "0.2,1,0.4,1.5"}) {
+        const Result r = run("decode " + path("u.exr") + " -o " + path("x.png") + " --view " + view);
+        EXPECT_EQ(r.exitCode, 2) << view << ": " << r.err;
+        EXPECT_EQ(countLines(r.err, ""), 1) << r.err;
+        EXPECT_NE(r.err.find("lies wholly outside the image"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("done"), std::string::npos) << "nothing read first: " << r.err;
+        EXPECT_FALSE(fs::exists(path("x.png")));
+    }
+}

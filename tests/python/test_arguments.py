@@ -115,6 +115,9 @@ def test_python_refuses_what_the_cli_refuses(tmp_path, asymmetric, conus_bin):
     cli = subprocess.run([conus_bin, "decode", str(tmp_path / "f.exr"), "-o", str(tmp_path / "v.png"), "--view",
                           "0.7,0.5,0.3,0.1"], capture_output=True, text=True)
     assert cli.returncode == 2 and "is empty or inverted: it needs u0 < u1" in cli.stderr
+    # A view wholly outside the picture: refused by both.
+    with pytest.raises(conus.Error, match=r"view \(1.2, 0, 1.5, 0.5\) lies wholly outside the image"):
+        conus.decode(f, view=(1.2, 0, 1.5, 0.5))
     # fit is a count, as --fit-iterations.
     assert "not True" in one_line_type_error(lambda: conus.encode(pixels, fit=True))
     with pytest.raises(conus.Error, match="fit must be 0 .none. or 1 to 100 iterations"):
