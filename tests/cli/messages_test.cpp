@@ -239,3 +239,27 @@ TEST_F(Cli, AViewWhollyOutsideThePictureIsRefusedBeforeAnyWork) {
         EXPECT_FALSE(fs::exists(path("x.png")));
     }
 }
+
+TEST_F(Cli, AMissingFileIsOnePlainLineNamingItOnce) {
+    const std::string missing = path("missing.exr");
+    for (const std::string& args : {"decode " + missing + " -o " + path("x.png"), "info " + missing,
+                                    "map compose " + missing + " -o " + path("m.exr"), "validate " + missing}) {
+        const Result r = run(args);
+        EXPECT_EQ(r.exitCode, 1) << args << ": " << r.err;
+        EXPECT_EQ(countLines(r.err, ""), 1) << args << ": " << r.err;
+        EXPECT_EQ(countLines(r.err, "missing.exr"), 1) << args << ": " << r.err;
+        EXPECT_NE(r.err.find("no such file"), std::string::npos) << args << ": " << r.err;
+        EXPECT_EQ(r.err.find("missing.exr: missing.exr"), std::string::npos) << args << ": " << r.err;
+        EXPECT_EQ(r.err.find("V1"), std::string::npos) << "no rule number for a file that is not there: " << r.err;
+    }
+    // The viewer says it before any window opens (no display needed), once.
+    for (const std::string& args : {missing, missing + " --screenshot " + path("s.png"), "--edit " + path("missing.png")}) {
+        const std::string command = std::string(CONUS_BIN_DIR) + "/conus-view " + args + " 2>" + path("view.txt") + " </dev/null";
+        const int status = std::system(command.c_str());
+        const std::string err = slurp(path("view.txt"));
+        EXPECT_EQ(WEXITSTATUS(status), 1) << args << ": " << err;
+        EXPECT_EQ(countLines(err, ""), 1) << args << ": " << err;
+        EXPECT_EQ(err.find(".exr: " + missing), std::string::npos) << err;
+        EXPECT_NE(err.find("no such file"), std::string::npos) << args << ": " << err;
+    }
+}
