@@ -160,7 +160,12 @@ int runDecode(const DecodeCommandOptions& o) {
     if (!o.viewText.empty()) parseView(o.viewText);
     if (const std::string& t = o.sizeText; !t.empty()) {
         const std::size_t x = t.find('x');
-        parseSize(x == 0 ? t.substr(1) + "x1" : x == std::string::npos || x + 1 == t.size() ? t.substr(0, x) + "x1" : t);
+        try {
+            parseSize(x == 0 ? t.substr(1) + "x1" : x == std::string::npos || x + 1 == t.size() ? t.substr(0, x) + "x1" : t);
+        } catch (const Error&) {  // said in the words the user wrote
+            throw Error(ErrorCode::InvalidArgument, "--size '" + t + "' is not WxH, or W, Wx or xH (the view's aspect kept), " +
+                                                        "each side a whole number in [1, " + std::to_string(kMaxImageSide) + "]");
+        }
     }
     return runConversions(o.batch, [&o](const Job& job) { return decodeOne(o, job.input, job.output); });
 }

@@ -17,7 +17,8 @@
 namespace conus::cli {
 
 void addStorageOptions(CLI::App& command, StorageOptions& options) {
-    command.add_option("--size", options.sizeText, "CoNUS image size WxH (default: a quarter of each source side)");
+    command.add_option("--size", options.sizeText, "CoNUS image size WxH (default: a quarter of each source side)")
+        ->check(sizeCheck());
     auto* half = command.add_flag("--half", options.half,
                                   "store colour channels as 16-bit half (default for 8-bit sources: exact for them)");
     command.add_flag("--float", options.full,

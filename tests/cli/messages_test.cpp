@@ -263,3 +263,14 @@ TEST_F(Cli, AMissingFileIsOnePlainLineNamingItOnce) {
         EXPECT_NE(err.find("no such file"), std::string::npos) << args << ": " << err;
     }
 }
+
+TEST_F(Cli, ASizeIsCheckedBeforeThePictureIsRead) {
+    const std::string in = makePicture(64, 48);
+    for (const std::string& command : {"uniform", "encode"}) {
+        const Result r = run(command + " " + in + " -o " + path("u.exr") + " --size 0x0");
+        EXPECT_EQ(r.exitCode, 2) << command << ": " << r.err;
+        EXPECT_EQ(countLines(r.err, ""), 1) << command << ": " << r.err;
+        EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("read "), std::string::npos) << "nothing read first: " << r.err;
+    }
+}
