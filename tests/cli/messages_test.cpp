@@ -274,3 +274,22 @@ TEST_F(Cli, ASizeIsCheckedBeforeThePictureIsRead) {
         EXPECT_EQ(r.err.find("read "), std::string::npos) << "nothing read first: " << r.err;
     }
 }
+
+TEST_F(Cli, AMisspeltOptionIsNamedWithTheOneMeant) {
+    const std::string in = makePicture(64, 48);
+    Result r = run("encode " + in + " -o " + path("x.exr") + " --foccus 0.5,0.5,0.1,4");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(countLines(r.err, ""), 1) << r.err;
+    EXPECT_NE(r.err.find("conus encode: unknown option --foccus; did you mean --focus?"), std::string::npos) << r.err;
+    r = run("decode " + path("x.exr") + " -o " + path("x.png") + " --veiw=0,0,1,1");
+    EXPECT_NE(r.err.find("unknown option --veiw; did you mean --view?"), std::string::npos) << r.err;
+    r = run("map foci --focus 0.5,0.5,0.1,4 -o " + path("m.exr") + " --prevew " + path("m.png"));
+    EXPECT_NE(r.err.find("unknown option --prevew; did you mean --preview?"), std::string::npos) << r.err;
+    r = run("info " + path("x.exr") + " --nothing-like-it");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("unknown option --nothing-like-it (see --help)"), std::string::npos) << r.err;
+    const std::string command = std::string(CONUS_BIN_DIR) + "/conus-view x.exr --screenshoot s.png 2>" + path("view.txt");
+    EXPECT_EQ(WEXITSTATUS(std::system(command.c_str())), 2);
+    EXPECT_NE(slurp(path("view.txt")).find("did you mean --screenshot?"), std::string::npos) << slurp(path("view.txt"));
+    EXPECT_FALSE(fs::exists(path("x.exr")) || fs::exists(path("m.exr")));
+}
