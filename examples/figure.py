@@ -5,7 +5,10 @@ A built-in test picture (fine stripes, text-like bars, a radial target) is encod
 its centre at 1/16 of the pixels, then shown three ways, zoomed on the focus: the source, the
 CoNUS image decoded, and the uniform image of the same pixel count resized. PSNR in each title.
 
-    PYTHONPATH=build/python python3 examples/figure.py -o figure.png [--input photo.jpg --focus u,v,r,k]
+    python3 figure.py -o figure.png [--input photo.jpg --focus u,v,r,k]
+
+Installed with the package in PREFIX/share/doc/conus/examples/; `import conus` needs the package on
+PYTHONPATH (PREFIX/lib/python3/dist-packages, or build/python in a build tree).
 """
 import argparse
 
