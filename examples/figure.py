@@ -49,7 +49,7 @@ def main():
     x1, y1 = int(round(view[2] * w)), int(round(view[3] * h))
     truth = pixels[y0:y1, x0:x1]
     ours = conus.decode(f, view=view, size=(x1 - x0, y1 - y0))
-    uniform = conus.resize(conus.uniform(pixels, size), (w, h))[y0:y1, x0:x1]
+    uniform = conus.decode(conus.uniform(pixels, size), view=view, size=(x1 - x0, y1 - y0))
     panels = [("source", truth, None), ("CoNUS", ours, conus.psnr(ours, truth)), ("uniform", uniform, conus.psnr(uniform, truth))]
     fig, axes = plt.subplots(1, 3, figsize=(12, 4.4))
     for ax, (title, img, db) in zip(axes, panels):

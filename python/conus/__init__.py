@@ -9,6 +9,7 @@
     m = conus.Map.foci([(0.5, 0.5, 0.1, 4)]); m.undistort(m.distort(points))
     m = conus.Map.auto(conus.importance(pixels, "faces", channels=channels))  # as --importance faces
     f = conus.encode(pixels)   # as `conus encode` with no focus: the samples follow the picture's detail
+    u = conus.uniform(pixels)  # as `conus uniform`: the uniform image of the same pixel count, a File
 
 Float pixels are linear light (read_image linearizes sRGB pictures); uint8 and uint16 arrays are
 display-encoded codes, converted as an 8- or 16-bit PNG is (colorspace= overrides). To save a

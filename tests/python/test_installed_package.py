@@ -1,0 +1,34 @@
+"""The installed package as a user's own script meets it, run from an empty folder in the
+environment docs/README.md gives: conus.uniform a conus.File like the one `conus uniform` writes."""
+import subprocess
+import textwrap
+
+import numpy as np
+
+import conus
+
+
+def run_script(installed, folder, text):
+    (folder / "user.py").write_text(textwrap.dedent(text).lstrip())
+    return subprocess.run(["python3", "-W", "always", "user.py"], cwd=folder, env=installed, capture_output=True, text=True,
+                          timeout=300)
+
+
+def test_uniform_is_a_file_like_the_one_conus_uniform_writes(tmp_path, installed, asymmetric):
+    conus.write_image(str(tmp_path / "p.png"), asymmetric[..., :3])
+    done = run_script(installed, tmp_path, """
+        import conus
+        pixels, channels = conus.read_image("p.png")
+        u = conus.uniform(pixels, channels=channels)
+        conus.write("u-py.exr", u)
+        print(u, conus.decode(u).shape)
+    """)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("<conus.File 60x40 CoNUS image of a 240x160 source, 2x2 map> (160, 240, 3)"), done.stdout
+    cli = subprocess.run(["conus", "uniform", "p.png", "-o", "u-cli.exr", "--backend", "cpu", "-q"], cwd=tmp_path,
+                         env=installed, capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    ours, theirs = conus.read(str(tmp_path / "u-py.exr")), conus.read(str(tmp_path / "u-cli.exr"))
+    assert ours.channels == theirs.channels == ["R", "G", "B"]
+    np.testing.assert_allclose(ours.pixels, theirs.pixels, atol=1e-3)  # both stored as half
+    np.testing.assert_array_equal(ours.map.nodes, theirs.map.nodes)
