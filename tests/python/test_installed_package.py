@@ -1,5 +1,6 @@
 """The installed package as a user's own script meets it, run from an empty folder in the
-environment docs/README.md gives: conus.uniform a conus.File like the one `conus uniform` writes."""
+environment docs/README.md gives: arrays it cannot mean refused in the caller's words, and
+conus.uniform a conus.File like the one `conus uniform` writes."""
 import subprocess
 import textwrap
 
@@ -12,6 +13,29 @@ def run_script(installed, folder, text):
     (folder / "user.py").write_text(textwrap.dedent(text).lstrip())
     return subprocess.run(["python3", "-W", "always", "user.py"], cwd=folder, env=installed, capture_output=True, text=True,
                           timeout=300)
+
+
+def test_arrays_it_cannot_mean_are_refused_in_the_callers_words(tmp_path, installed):
+    done = run_script(installed, tmp_path, """
+        import numpy as np
+        import conus
+        for shape in [(3, 40, 60), (40, 60, 0), (0, 60, 3)]:
+            try:
+                conus.encode(np.zeros(shape, np.float32))
+                print("accepted", shape)
+            except conus.Error as e:
+                print(e.code, "|", e)
+        # Channel names that say so: three rows of 60 channels.
+        print(conus.uniform(np.zeros((3, 40, 60), np.float32), size=(20, 1), channels=[f"C{i}" for i in range(60)]))
+    """)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[0] == ("invalid-argument | pixels of shape (3, 40, 60) look channel-first (channels, height, width); "
+                        "CoNUS takes (height, width, channels): pass numpy.moveaxis(pixels, 0, -1)"), lines[0]
+    assert lines[1].startswith("invalid-argument | pixels of shape (40, 60, 0) have no channels"), lines[1]
+    assert lines[2] == "invalid-argument | pixels of shape (0, 60, 3) hold no pixels", lines[2]
+    assert lines[3].startswith("<conus.File 20x1 CoNUS image of a 40x3 source"), lines[3]
+    assert "makeImage" not in done.stdout + done.stderr
 
 
 def test_uniform_is_a_file_like_the_one_conus_uniform_writes(tmp_path, installed, asymmetric):
