@@ -150,7 +150,8 @@ Image pixelsFrom(py::handle pixels, const std::optional<std::vector<std::string>
     if (const std::int64_t bad = imageio::countNonFinite(image); bad > 0) {
         const std::string count = std::to_string(bad) + (bad == 1 ? " NaN or infinite value" : " NaN or infinite values");
         if (repair == imageio::NonFiniteRepair::Keep) {
-            warn(std::string(what) + " hold " + count + "; filtering spreads them to their neighbours (repair with fix_nonfinite=" +
+            warn(std::string(what) + ", " + describe(pixels) + ", hold " + count +
+                 "; filtering spreads them to their neighbours (repair with fix_nonfinite=" +
                  quotedChoices(enumNames({imageio::NonFiniteRepair::Box3, imageio::NonFiniteRepair::Black})) + ")");
         } else {
             imageio::repairNonFinite(image, repair);
@@ -260,8 +261,6 @@ py::array toArray(Image image) {
                               {py::ssize_t(held->width) * c * 4, c * 4, py::ssize_t(4)}, held->pixels.data(), owner);
 }
 
-void warn(const std::string& text) {
-    if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) < 0) throw py::error_already_set();
-}
+void warn(const std::string& text) { py::module_::import("conus").attr("_warn")(text); }
 
 }  // namespace conus::python

@@ -128,7 +128,8 @@ def test_nonfinite_pixels_warn_or_are_repaired_as_fix_nonfinite(tmp_path, asymme
     pixels = np.ascontiguousarray(asymmetric[..., :3]).copy()
     pixels[50, 60] = np.nan
     pixels[51, 60, 1] = np.inf
-    with pytest.warns(UserWarning, match="pixels hold 4 NaN or infinite values; .*fix_nonfinite='box3' or 'black'"):
+    with pytest.warns(UserWarning, match=r"conus.uniform: pixels, an array of shape \(160, 240, 3\) and dtype float32, hold 4 NaN "
+                                         r"or infinite values; .*fix_nonfinite='box3' or 'black'"):
         kept = conus.uniform(pixels, size=(240, 160)).pixels
     assert np.isnan(kept).any()
     with warnings.catch_warnings():

@@ -1,5 +1,6 @@
 """The installed package as a user's own script meets it, run from an empty folder in the
-environment docs/README.md gives: arrays it cannot mean refused in the caller's words, and
+environment docs/README.md gives: arrays it cannot mean refused in the caller's words, warnings at
+the caller's line naming the call and the input (conus.dask's naming the inputs), and
 conus.uniform a conus.File like the one `conus uniform` writes."""
 import subprocess
 import textwrap
@@ -36,6 +37,31 @@ def test_arrays_it_cannot_mean_are_refused_in_the_callers_words(tmp_path, instal
     assert lines[2] == "invalid-argument | pixels of shape (0, 60, 3) hold no pixels", lines[2]
     assert lines[3].startswith("<conus.File 20x1 CoNUS image of a 40x3 source"), lines[3]
     assert "makeImage" not in done.stdout + done.stderr
+
+
+def test_warnings_point_at_the_callers_line_and_name_the_input(tmp_path, installed):
+    done = run_script(installed, tmp_path, """
+        import numpy as np
+        import conus, conus.dask
+        pixels = np.full((40, 60, 3), 0.5, np.float32)
+        pixels[5, 5] = np.nan
+        conus.encode(pixels, map=conus.Map.foci([(0.5, 0.5, 0.1, 2)]), size=(30, 20), fit=0)
+        conus.write_image("nan.exr", pixels)
+        conus.write_image("fine.png", np.full((40, 60, 3), 0.5, np.float32))
+        rows = conus.dask.encode_files(["nan.exr", "fine.png"], "exr", scheduler="sync", size=(30, 20), fit=0)
+        print(rows.count("converted"), [r["warnings"] for r in rows])
+    """)
+    assert done.returncode == 0, done.stderr
+    err = done.stderr
+    nan = "pixels, an array of shape (40, 60, 3) and dtype float32, hold 3 NaN or infinite values;"
+    assert f"user.py:5: UserWarning: conus.encode: {nan}" in err, err
+    assert "user.py:5: UserWarning: conus.encode: the map was made for pictures of aspect 1" in err, err
+    assert f"user.py:6: UserWarning: conus.write_image: {nan}" in err, err
+    # A batch says each warning once, at the line that started it, with the inputs it held for.
+    assert "user.py:8: UserWarning: conus.dask.encode_files: nan.exr: pixels, an array of shape (40, 60, 3)" in err, err
+    assert "user.py:8: UserWarning: conus.dask.encode_files: 2 of 2 inputs (fine.png, nan.exr): conus.encode: no foci or map" in err, err
+    assert "__init__.py" not in err and "dask.py" not in err, err
+    assert done.stdout.startswith("2 [["), done.stdout
 
 
 def test_uniform_is_a_file_like_the_one_conus_uniform_writes(tmp_path, installed, asymmetric):
