@@ -172,7 +172,7 @@ def load(path):
     pixels = np.ascontiguousarray(pixels[..., :3], np.float32)
     h, w = pixels.shape[:2]
     if w > MAX_WIDTH:
-        pixels = conus.uniform(pixels, size=(MAX_WIDTH, round(h * MAX_WIDTH / w)))
+        pixels = conus.uniform(pixels, size=(MAX_WIDTH, round(h * MAX_WIDTH / w))).pixels
     return np.ascontiguousarray(pixels, np.float32)
 
 
@@ -192,7 +192,7 @@ def encode_with(src, size, regions, k=K, map=None, fit=0, falloff=None):
 
 def uniform_view(src, size, fit=0):
     h, w = src.shape[:2]
-    return np.asarray(conus.resize(conus.uniform(src, size=size, fit=fit), size=(w, h)))[..., :3]
+    return np.asarray(conus.resize(conus.uniform(src, size=size, fit=fit).pixels, size=(w, h)))[..., :3]
 
 
 def measure(name, src, regions, out, quick):
@@ -228,7 +228,7 @@ def measure(name, src, regions, out, quick):
             pick = np.nonzero(level == lv)[0]
             scale = np.exp(lv * step)
             dsize = (min(w, max(1, round(size[0] * scale))), min(h, max(1, round(size[1] * scale))))
-            view = np.asarray(conus.resize(conus.uniform(src, size=dsize), size=(w, h)))[..., :3]
+            view = np.asarray(conus.resize(conus.uniform(src, size=dsize).pixels, size=(w, h)))[..., :3]
             dview[pick] = view[where[0][pick], where[1][pick]]
             dmajor, dminor, ddirection, _ = footprint_sigmas(identity, dsize, src.shape, ring)
             fp_d[pick] = lowpassed_footprint(src, dmajor[pick], dminor[pick], ddirection[pick], (where[0][pick], where[1][pick]))
@@ -278,7 +278,7 @@ def zones(src, regions, cfile, cview, uview, size):
         sv = np.linalg.svd(jac, compute_uv=False)
         density = float(np.mean(np.asarray(cfile.map.density(points[mask]))))
         scaled = (max(1, round(size[0] * np.sqrt(min(density, 1e6)))), max(1, round(size[1] * np.sqrt(min(density, 1e6)))))
-        ideal = np.asarray(conus.resize(conus.uniform(src, size=(min(scaled[0], w), min(scaled[1], h))), size=(w, h)))[..., :3]
+        ideal = np.asarray(conus.resize(conus.uniform(src, size=(min(scaled[0], w), min(scaled[1], h))).pixels, size=(w, h)))[..., :3]
         err = lambda view: ((view - src) ** 2)[mask].mean()
         out.append(dict(zone=f"{lo}r..{hi}r" if hi else f"beyond {lo}r", share=float(mask.mean()), density=density,
                         anisotropy=float(np.median(sv[:, 0] / sv[:, 1])),
@@ -371,7 +371,7 @@ def equal_bytes(name, src, regions, quick):
     cfile = encode_with(src, size, regions)
     pixels = np.asarray(cfile.pixels)
     original = pixels.copy()
-    small = np.asarray(conus.uniform(src, size=size))[..., :3]
+    small = np.asarray(conus.uniform(src, size=size).pixels)[..., :3]
     curves = {}
     with tempfile.TemporaryDirectory() as tmp:
         work = pathlib.Path(tmp)

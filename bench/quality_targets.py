@@ -156,7 +156,7 @@ def measure_photo(conus, binary, name, path, regions, out, extra_args=(), detail
     pixels = np.ascontiguousarray(pixels[..., :3], np.float32)
     h, w = pixels.shape[:2]
     if w > MAX_WIDTH:
-        pixels = conus.uniform(pixels, size=(MAX_WIDTH, round(h * MAX_WIDTH / w)))
+        pixels = conus.uniform(pixels, size=(MAX_WIDTH, round(h * MAX_WIDTH / w))).pixels
     source8 = srgb8(np.asarray(pixels))
     h, w = source8.shape[:2]
     rows = {}

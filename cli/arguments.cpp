@@ -41,6 +41,19 @@ Size parseSize(const std::string& text) {
     return {static_cast<int>(values[0]), static_cast<int>(values[1])};
 }
 
+CLI::Validator sizeCheck() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            try {
+                parseSize(text);
+                return {};
+            } catch (const Error& e) {
+                return e.what();
+            }
+        },
+        "WxH");
+}
+
 codec::View parseView(const std::string& text) {
     const auto values = parseNumbers(text, ',');
     if (values.size() != 4) invalid("view '" + text + "' is not of the form u0,v0,u1,v1");

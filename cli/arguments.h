@@ -20,6 +20,7 @@ struct Size {
 };
 
 Size parseSize(const std::string& text);        // "1024x768"; each side in [1, 65536]
+CLI::Validator sizeCheck();                      // parseSize as a CLI11 check: a usage error before any work
 codec::View parseView(const std::string& text);  // "u0,v0,u1,v1" with u0 < u1, v0 < v1, all finite
 
 // "x,y,z,lx,ly,lz,fovDeg": eye, look-at point, vertical field of view in degrees (what

@@ -181,6 +181,7 @@ std::vector<Job> planJobs(const BatchOptions& o) {
 
 int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const std::function<std::string(const Job&)>& convert) {
     std::error_code ec;
+    const bool made = !fs::exists(options.outDir, ec);  // removed again when the batch writes nothing into it
     fs::create_directories(options.outDir, ec);
     if (ec) throw Error(ErrorCode::Io, "cannot make the folder " + options.outDir + ": " + ec.message());
     removeStaleTemporaries(options.outDir);  // even when --skip-existing writes nothing
@@ -238,7 +239,8 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
                 // Most messages name the file already.
                 const std::string reason = error.rfind(job.input, 0) == 0 ? error : job.input + ": " + error;
                 reasons.push_back(reason);
-                report("[" + std::to_string(finished) + "/" + std::to_string(jobs.size()) + "] failed: " + reason);
+                if (!userQuiet)  // -q: the summary alone lists it
+                    report("[" + std::to_string(finished) + "/" + std::to_string(jobs.size()) + "] failed: " + reason);
                 if (options.failFast) stop = true;
             } else {
                 ++converted;
@@ -270,6 +272,7 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
     if (!userQuiet && ::isatty(STDERR_FILENO)) std::fprintf(stderr, "\r\033[K");
     if (!userQuiet || failed > 0) std::printf("%s\n", summary.c_str());  // -q: silent on success
     for (const std::string& reason : reasons) std::printf("  failed: %s\n", reason.c_str());
+    if (made && converted == 0) fs::remove(options.outDir, ec);  // only when empty
     return failed > 0 ? 1 : 0;
 }
 

@@ -49,7 +49,8 @@ std::vector<Job> planJobs(const BatchOptions& options);
 
 // Runs `convert` on every job, options.jobs at a time (each returns the line that says what it
 // wrote; it runs quiet: the batch reports). Prints the batch's progress on stderr, each failure as
-// it happens, and the summary on stdout; returns the exit code.
+// it happens (not with -q, where the summary alone lists them), and the summary on stdout; returns
+// the exit code.
 int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const std::function<std::string(const Job&)>& convert);
 
 // What `encode` and `decode` run: the jobs the options plan, as a batch (runBatch) or, for a

@@ -160,7 +160,12 @@ int runDecode(const DecodeCommandOptions& o) {
     if (!o.viewText.empty()) parseView(o.viewText);
     if (const std::string& t = o.sizeText; !t.empty()) {
         const std::size_t x = t.find('x');
-        parseSize(x == 0 ? t.substr(1) + "x1" : x == std::string::npos || x + 1 == t.size() ? t.substr(0, x) + "x1" : t);
+        try {
+            parseSize(x == 0 ? t.substr(1) + "x1" : x == std::string::npos || x + 1 == t.size() ? t.substr(0, x) + "x1" : t);
+        } catch (const Error&) {  // said in the words the user wrote
+            throw Error(ErrorCode::InvalidArgument, "--size '" + t + "' is not WxH, or W, Wx or xH (the view's aspect kept), " +
+                                                        "each side a whole number in [1, " + std::to_string(kMaxImageSide) + "]");
+        }
     }
     return runConversions(o.batch, [&o](const Job& job) { return decodeOne(o, job.input, job.output); });
 }
@@ -174,7 +179,7 @@ CLI::App* declareDecode(CLI::App& root, DecodeCommandOptions& options) {
     addBatchOptions(*command, options.batch, "CoNUS file (.exr)", "output image (.png, .jpg, .tif, .exr, .bmp, ...)", "{stem}.png");
     command->add_option("--view", options.viewText,
                         "rectangle u0,v0,u1,v1 of the undistorted image plane (default 0,0,1,1: the whole image; "
-                        "outside [0,1] shows the background)");
+                        "a part outside [0,1] shows the background)");
     command->add_option("--size", options.sizeText,
                         "output size WxH; W, Wx or xH keep the view's aspect (default: the view at the source's "
                         "resolution)");

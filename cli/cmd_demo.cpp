@@ -19,6 +19,7 @@
 #include "conus/codec/build/foci_budget.h"
 #include "conus/codec/build/frame_budget.h"
 #include "conus/codec/image/metrics.h"
+#include "conus/core/atomic_file.h"
 #include "conus/renderers/gpu_image.h"
 #include "demo_picture.h"
 #include "encoding.h"
@@ -154,9 +155,23 @@ std::vector<ViewCase> demoViews(const DemoOptions& o, const std::vector<codec::F
     return views;
 }
 
+// What one view gave: the PSNR of each file's decode against the source, and the picture of the
+// three side by side.
+struct ViewResult {
+    double conus = 0, uniform = 0;
+    Image strip;  // source | CoNUS | uniform
+};
+
+void writeConusStage(const std::string& path, const format::ConusFile& file) {
+    Progress writing("write " + path);
+    format::writeConusFile(path, file);
+    writing.done();
+}
+
 int runDemo(const DemoOptions& o) {
     namespace fs = std::filesystem;
-    fs::create_directories(o.out);
+    AtomicOutputs outputs;  // everything the demo writes, or nothing
+    outputs.makeFolder(o.out);
     const fs::path out(o.out);
     DemoSource source = demoSource(o);
     const int w = source.image.width, h = source.image.height;
@@ -166,10 +181,12 @@ int runDemo(const DemoOptions& o) {
 
     const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::Faster, "the demo");
     const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
-    const format::ConusFile conus = encodeToConus(device, source.image, source.encoding, map, size, built.analytic);
-    const format::ConusFile uniform = encodeToConus(device, source.image, source.encoding, identity, size, std::nullopt);
-    format::writeConusFile((out / "conus.exr").string(), conus);
-    format::writeConusFile((out / "uniform.exr").string(), uniform);
+    const format::ConusFile conus =
+        encodeToConus(device, source.image, source.encoding, map, size, built.analytic, {}, nullptr, "the CoNUS image");
+    const format::ConusFile uniform = encodeToConus(device, source.image, source.encoding, identity, size, std::nullopt, {},
+                                                    nullptr, "the uniform image (the identity map)");
+    writeConusStage((out / "conus.exr").string(), conus);
+    writeConusStage((out / "uniform.exr").string(), uniform);
     imageio::WriteOptions picture;
     picture.source = &source.encoding;
     if (o.input.empty()) writePicture((out / "source.png").string(), source.image, picture);  // to try the other commands on
@@ -180,13 +197,8 @@ int runDemo(const DemoOptions& o) {
     writeDrawing((out / "density.png").string(), densityPicture(map, pw, ph, 32, built.analytic ? &*built.analytic : nullptr));
 
     const std::vector<ViewCase> views = demoViews(o, source.foci, w, h, shrink);
-    std::printf("\nCoNUS demo: %dx%d %s -> %dx%d (1/16 of the pixels), ", w, h,
-                o.input.empty() ? "built-in picture" : o.input.c_str(), size.width, size.height);
-    if (!o.importance.empty()) std::printf("map from '%s' importance", o.importance.c_str());
-    else std::printf("%s", plural(source.foci.size(), "focus", "foci").c_str());
-    for (const auto& f : source.foci) std::printf(" (%g,%g,r=%g,k=%g)", f.u, f.v, f.r, f.k);
-    std::printf("\nrenderer: %s\n", device.describe().c_str());
-    std::printf("%-22s %12s %14s %8s\n", "view", "CoNUS PSNR", "uniform PSNR", "gain");
+    std::vector<ViewResult> results;
+    Progress comparing("decode " + plural(views.size(), "view", "views") + " from both files, PSNR against the source");
     for (const auto& v : views) {
         codec::DecodeOptions decode;
         decode.view = {double(v.x0) / w, double(v.y0) / h, double(v.x0 + v.width) / w, double(v.y0 + v.height) / h};
@@ -195,13 +207,28 @@ int runDemo(const DemoOptions& o) {
         const Image reference = codec::crop(source.image, v.x0, v.y0, v.width, v.height);
         const Image fromConus = renderers::decodeImage(device, conus.image, map, decode);
         const Image fromUniform = renderers::decodeImage(device, uniform.image, identity, decode);
-        const double a = codec::psnr(reference, fromConus), b = codec::psnr(reference, fromUniform);
-        std::printf("%-22s %9.2f dB %11.2f dB %+7.2f\n", v.label.c_str(), a, b, a - b);
         std::vector<Image> strip{reference, fromConus, fromUniform};
         if (v.outWidth != v.width)
             for (auto& image : strip) image = codec::areaDownsample(image, v.outWidth, v.outHeight);
-        writePicture((out / ("view-" + v.name + ".png")).string(), sideBySide(strip), picture);
+        results.push_back({codec::psnr(reference, fromConus), codec::psnr(reference, fromUniform), sideBySide(strip)});
     }
+    comparing.done();
+    for (std::size_t i = 0; i < views.size(); ++i)
+        writePicture((out / ("view-" + views[i].name + ".png")).string(), results[i].strip, picture);
+    outputs.commit();
+
+    std::printf("\nCoNUS demo: %dx%d %s -> %dx%d (1/16 of the pixels), ", w, h,
+                o.input.empty() ? "built-in picture" : o.input.c_str(), size.width, size.height);
+    if (!o.importance.empty()) std::printf("map from '%s' importance", o.importance.c_str());
+    else std::printf("%s", plural(source.foci.size(), "focus", "foci").c_str());
+    for (const auto& f : source.foci) std::printf(" (%g,%g,r=%g,k=%g)", f.u, f.v, f.r, f.k);
+    std::printf("\nuniform: the same %dx%d pixels spread evenly (the identity map, as `conus uniform` makes it)\n"
+                "renderer: %s\n",
+                size.width, size.height, device.describe().c_str());
+    std::printf("%-22s %12s %14s %8s\n", "view", "CoNUS PSNR", "uniform PSNR", "gain");
+    for (std::size_t i = 0; i < views.size(); ++i)
+        std::printf("%-22s %9.2f dB %11.2f dB %+7.2f\n", views[i].label.c_str(), results[i].conus, results[i].uniform,
+                    results[i].conus - results[i].uniform);
     std::string written;
     for (const auto& v : views) written += ", view-" + v.name + ".png";
     std::printf("\nwrote %s/: %sconus.exr, uniform.exr, conus.png, uniform.png, density.png%s\n"

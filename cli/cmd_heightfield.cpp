@@ -19,7 +19,9 @@
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 #include "conus/renderers/terrain.h"
+#include "conus/core/atomic_file.h"
 #include "conus/imageio/image_file.h"
+#include "encoding.h"
 #include "image_files.h"
 #include "map_options.h"
 #include "pictures.h"
@@ -157,6 +159,7 @@ codec::GroundParams groundFor(const EncodeOptions& o, const sceneio::Dem& dem) {
 }
 
 int runEncode(const EncodeOptions& o) {
+    checkConusOutput(o.output, o.dem);
     Progress loading("read " + o.dem);
     const sceneio::Dem dem = demFrom(o.dem, o.heightScale);
     loading.done();
@@ -240,6 +243,8 @@ void writeComparison(renderers::Context& context, const RenderOptions& o, const 
 }
 
 int runRender(const RenderOptions& o) {
+    checkPictureOutput(o.frame, {}, {o.input});
+    if (!o.compare.empty() && o.compare.rfind("procedural", 0) != 0) checkInputPath(o.compare);  // before the render
     const format::ConusFile file = format::readConusFile(o.input);
     const Size size = parseSize(o.frameSize);
     const renderers::Device device = deviceFor(o.backend, renderers::CpuPath::None, "terrain rendering");

@@ -268,6 +268,7 @@ int runInfo(const InfoOptions& o) {
     if (o.backends) return printBackends(o.json);
     if (o.limits) return printLimits(o.json);
     if (o.input.empty()) throw Error(ErrorCode::InvalidArgument, "give a CoNUS file (or --backends, --limits)");
+    if (!o.densityPng.empty()) checkPictureOutput(o.densityPng, {}, {o.input});  // before the file is read
     if (o.verbose) explainIfInvalid(o.input);
     if (format::isReflectionAsset(o.input)) return printReflectionAsset(o);
     const FileFacts facts = readFacts(o.input);

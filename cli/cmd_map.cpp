@@ -61,22 +61,29 @@ std::pair<double, double> parsePair(const std::string& text, const char* what) {
     return {a, b};
 }
 
-// Writes the map file (codec/conus_file.h), reports it, and draws its preview. `aspect` (width /
-// height of the pictures it is meant for) makes the anisotropy one of pixels.
+// Checks before the work that the map file and its preview can be written (usage errors).
+void checkOutputs(const OutputOptions& out) {
+    checkConusOutput(out.output, "");
+    if (!out.preview.empty()) checkPictureOutput(out.preview, {}, {out.output});
+}
+
+// Writes the map file (codec/conus_file.h) and its preview, both or neither, then reports them.
+// `aspect` (width / height of the pictures it is meant for) makes the anisotropy one of pixels.
 void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticMap> analytic, const OutputOptions& out,
                   double aspect = 1.0) {
     const format::ConusFile file = codec::makeMapFile(map, std::move(analytic));
+    AtomicOutputs outputs;
     format::writeConusFile(out.output, file);
-    const DensityStats stats = densityStats(map);
-    const codec::MapMeasures measures = codec::measureMap(map, aspect);
-    if (!quiet())  // -q: silent on success
-        std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
-                map.rows(), stats.min, stats.max, measures.maxAnisotropy);
-    if (!out.preview.empty()) {
+    if (!out.preview.empty())
         writeDrawing(out.preview,
                      densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr, aspect));
-        if (!quiet()) std::printf("wrote %s\n", out.preview.c_str());
-    }
+    outputs.commit();
+    const DensityStats stats = densityStats(map);
+    const codec::MapMeasures measures = codec::measureMap(map, aspect);
+    if (quiet()) return;  // -q: silent on success
+    std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
+                map.rows(), stats.min, stats.max, measures.maxAnisotropy);
+    if (!out.preview.empty()) std::printf("wrote %s\n", out.preview.c_str());
 }
 
 // The strokes as given: inline JSON (it starts with '[' or '{'), or the path of a JSON file.
@@ -112,6 +119,7 @@ void addSpringsOptions(CLI::App& command, SpringsOptions& o) {
 }
 
 void runSprings(const SpringsOptions& o) {
+    checkOutputs(o.out);
     const std::vector<codec::Stroke> strokes = codec::parseStrokes(strokesText(o.strokes));
     codec::SpringSystem system(o.particles, o.particles);
     for (const codec::Stroke& s : strokes) system.addStroke(s);
@@ -182,6 +190,7 @@ codec::SamplingMap composeInput(const ComposeOptions& o, std::size_t k, codec::S
 }
 
 void runCompose(const ComposeOptions& o) {
+    checkOutputs(o.out);
     if (o.translate.size() > o.inputs.size() || o.scale.size() > o.inputs.size() || o.weights.size() > o.inputs.size()) {
         throw Error(ErrorCode::InvalidArgument, "more --translate, --scale or --weight values than inputs");
     }
@@ -228,6 +237,7 @@ void addGroundOptions(CLI::App& command, GroundOptions& o) {
 }
 
 void runGround(const GroundOptions& o) {
+    checkOutputs(o.out);
     const codec::SamplingMap map = codec::buildGroundMap(o.ground, o.grid, o.grid);
     writeMapFile(map, codec::toAnalytic(o.ground), o.out);
 }
@@ -255,6 +265,7 @@ void addFociOptions(CLI::App& command, FociOptions& o) {
 }
 
 void runFoci(const FociOptions& o) {
+    checkOutputs(o.out);
     const std::vector<codec::Focus> list = parseFoci(o.foci);
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
@@ -298,6 +309,7 @@ void addAutoOptions(CLI::App& command, AutoOptions& o) {
 }
 
 void runAuto(const AutoOptions& o) {
+    checkOutputs(o.out);
     const Image picture = o.image.empty() ? Image{} : imageio::readImageFile(o.image).image;
     const Image importance = importanceFrom(o.importance, picture);
     const codec::AutoMapOptions options = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);

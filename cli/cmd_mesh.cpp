@@ -319,10 +319,10 @@ int runAnimate(const AnimateOptions& a) {
     const CameraChoice cameraChoice = parseCameraOptions(o);
     const double aspect = double(size.width) / size.height;
     const std::filesystem::path dir(a.outDir);
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec || !std::filesystem::is_directory(dir))
-        throw Error(ErrorCode::Io, "cannot create the output folder " + a.outDir + (ec ? ": " + ec.message() : ""));
+    // The frames and the contact sheet, all or none; the video (optional, ffmpeg reads the frames
+    // from the folder) follows once they are in place.
+    AtomicOutputs outputs;
+    outputs.makeFolder(a.outDir);
     const codec::CityScene city;
     const Camera camera =
         cameraChoice.given ? meshCamera(cameraChoice, boundsOf(city.meshAt(o.time)), aspect) : cityCamera(city, aspect);
@@ -361,6 +361,7 @@ int runAnimate(const AnimateOptions& a) {
     rendering.done();
     const std::string sheet = (dir / "contact_sheet.png").string();
     writePicture(sheet, contactSheet(tiles, columns));
+    outputs.commit();
     std::printf("wrote %d frames to %s (frame_0000.exr/.png ...), contact sheet %s; largest per-frame move of a map "
                 "node %.4f (normalized)\n",
                 a.frames, a.outDir.c_str(), sheet.c_str(), largestStep);

@@ -22,6 +22,7 @@
 #include "conus/codec/volume/raycast.h"
 #include "conus/codec/volume/transfer_function.h"
 #include "conus/core/camera.h"
+#include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
 #include "conus/renderers/mesh_sequence.h"
@@ -132,6 +133,7 @@ Scene loadScene(const VolumeOptions& o, double aspect) {
 
 int runRender(const VolumeOptions& o) {
     checkConusOutput(o.output, o.volume);
+    if (!o.picture.empty()) checkPictureOutput(o.picture, {}, {o.volume, o.output});
     checkCameraOptions(o);
     const Size size = parseSize(o.sizeText);
     checkGridForImage(o.grid, size.width, size.height);
@@ -155,8 +157,10 @@ int runRender(const VolumeOptions& o) {
     const Image image = renderers::renderVolume(device, volume, tf, fpc, size.width, size.height, options);
     rendering.done();
     Progress writing("write " + o.output);
+    AtomicOutputs outputs;  // the file and its picture, both or neither
     format::writeConusFile(o.output, codec::makeDepthImageFile(image, map, camera, o.units, chosen.analytic));
     if (!o.picture.empty()) writePicture(o.picture, toRgb(image));
+    outputs.commit();
     writing.done();
     const glm::dvec3 eye = camera.eye(), look = eye + camera.forward();
     std::printf("camera %.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g (near %.4g, far %.4g)\n", eye.x, eye.y, eye.z, look.x, look.y,
@@ -193,11 +197,9 @@ int runAnimate(const AnimateOptions& a) {
     const Size size = parseSize(o.sizeText);
     checkGridForImage(o.grid, size.width, size.height);
     const double aspect = double(size.width) / size.height;
-    std::error_code ec;
-    std::filesystem::create_directories(a.outDir, ec);
-    if (ec || !std::filesystem::is_directory(a.outDir))
-        throw Error(ErrorCode::Io, "--out-dir '" + a.outDir + "' cannot be made (" + ec.message() + ")");
     codec::VolumeRenderOptions options = renderOptions(o);
+    AtomicOutputs outputs;  // every frame or none
+    outputs.makeFolder(a.outDir);
     const Scene scene = loadScene(o, aspect);
     const Volume& volume = scene.volume;
     const Camera& camera = scene.camera;
@@ -230,6 +232,7 @@ int runAnimate(const AnimateOptions& a) {
         if (const ProgressFn report = rendering.callback()) report(double(f + 1) / a.frames);
     }
     rendering.done();
+    outputs.commit();
     std::printf("wrote %d frames to %s; largest node step between frames %.4g (normalized units)\n", a.frames,
                 a.outDir.c_str(), largest);
     return 0;

@@ -17,7 +17,8 @@
 namespace conus::cli {
 
 void addStorageOptions(CLI::App& command, StorageOptions& options) {
-    command.add_option("--size", options.sizeText, "CoNUS image size WxH (default: a quarter of each source side)");
+    command.add_option("--size", options.sizeText, "CoNUS image size WxH (default: a quarter of each source side)")
+        ->check(sizeCheck());
     auto* half = command.add_flag("--half", options.half,
                                   "store colour channels as 16-bit half (default for 8-bit sources: exact for them)");
     command.add_flag("--float", options.full,
@@ -78,9 +79,9 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault) {
 
 format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
-                                const FitSetting& fit, std::string* fitNote) {
+                                const FitSetting& fit, std::string* fitNote, const std::string& what) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
-                      std::to_string(size.width) + "x" + std::to_string(size.height));
+                      std::to_string(size.width) + "x" + std::to_string(size.height) + (what.empty() ? "" : ": " + what));
     Image image = renderers::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
     progress.done();
     if (fit.count() > 0) {

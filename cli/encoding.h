@@ -51,9 +51,10 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault = false);
 // Encodes `source` through `map` at `size` (with progress) into a file model ready to write,
 // remembering the source's encoding. fit.iterations > 0 then fits the image to the decoder with that many
 // iterations (codec/image/fit.h) and, when `fitNote` is given, says what the fit achieved there.
+// `what`, when given, says in the stage's line which image this is (a command that encodes two).
 format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
-                                const FitSetting& fit = {}, std::string* fitNote = nullptr);
+                                const FitSetting& fit = {}, std::string* fitNote = nullptr, const std::string& what = {});
 
 // Applies the storage options to a file model. Without --half or --float, colour is stored as
 // float when the source had more precision than half keeps (16-bit integers, float), else half.

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "option_checks.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
@@ -50,7 +51,11 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         for (CLI::App* sub : app.get_subcommands()) name = sub->get_name();
-        std::fprintf(stderr, "conus%s%s: %s (see --help)\n", name.empty() ? "" : " ", name.c_str(), conus::oneLine(e.what()).c_str());
+        CLI::App* deepest = &app;  // the (sub)command whose options were being read
+        while (!deepest->get_subcommands().empty()) deepest = deepest->get_subcommands().front();
+        std::string reason = dynamic_cast<const CLI::ExtrasError*>(&e) ? conus::cli::unknownOptionLine(deepest, argc, argv) : "";
+        if (reason.empty()) reason = conus::oneLine(e.what());
+        std::fprintf(stderr, "conus%s%s: %s (see --help)\n", name.empty() ? "" : " ", name.c_str(), reason.c_str());
         return 2;
     }
 

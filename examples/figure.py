@@ -5,7 +5,10 @@ A built-in test picture (fine stripes, text-like bars, a radial target) is encod
 its centre at 1/16 of the pixels, then shown three ways, zoomed on the focus: the source, the
 CoNUS image decoded, and the uniform image of the same pixel count resized. PSNR in each title.
 
-    PYTHONPATH=build/python python3 examples/figure.py -o figure.png [--input photo.jpg --focus u,v,r,k]
+    python3 figure.py -o figure.png [--input photo.jpg --focus u,v,r,k]
+
+Installed with the package in PREFIX/share/doc/conus/examples/; `import conus` needs the package on
+PYTHONPATH (PREFIX/lib/python3/dist-packages, or build/python in a build tree).
 """
 import argparse
 
@@ -46,7 +49,7 @@ def main():
     x1, y1 = int(round(view[2] * w)), int(round(view[3] * h))
     truth = pixels[y0:y1, x0:x1]
     ours = conus.decode(f, view=view, size=(x1 - x0, y1 - y0))
-    uniform = conus.resize(conus.uniform(pixels, size), (w, h))[y0:y1, x0:x1]
+    uniform = conus.decode(conus.uniform(pixels, size), view=view, size=(x1 - x0, y1 - y0))
     panels = [("source", truth, None), ("CoNUS", ours, conus.psnr(ours, truth)), ("uniform", uniform, conus.psnr(uniform, truth))]
     fig, axes = plt.subplots(1, 3, figsize=(12, 4.4))
     for ax, (title, img, db) in zip(axes, panels):

@@ -34,7 +34,7 @@ bool Controller::load() {
             imageio::ImageFile source = imageio::readImageFile(m_options.edit);
             m_editor.emplace(std::move(source.image), source.info.encoding);
         } catch (const std::exception& e) {
-            std::fprintf(stderr, "conus-view: %s: %s\n", m_options.edit.c_str(), e.what());
+            std::fprintf(stderr, "conus-view: %s\n", aboutFile(m_options.edit, e.what()).c_str());
             return false;
         }
         // The source, shown raw (it is undistorted), with the live map's grid over it.
@@ -49,7 +49,7 @@ bool Controller::load() {
     for (const std::string& path : m_options.files) {
         m_docs.push_back(loadDocument(path));
         if (!m_docs.back().ok()) {
-            std::fprintf(stderr, "conus-view: %s: %s\n", path.c_str(), m_docs.back().error.c_str());
+            std::fprintf(stderr, "conus-view: %s\n", m_docs.back().error.c_str());
             m_exitCode = 1;
         }
     }
@@ -265,7 +265,7 @@ void Controller::saveFromEditor(bool mapOnly) {
         std::printf("wrote %s\n", path.c_str());
     } catch (const std::exception& e) {
         m_editorMessage = std::string("ERROR: ") + e.what();
-        std::fprintf(stderr, "conus-view: %s: %s\n", path.c_str(), e.what());
+        std::fprintf(stderr, "conus-view: %s\n", aboutFile(path, e.what()).c_str());
     }
     std::fflush(stdout);
 }

@@ -27,10 +27,13 @@ Document loadDocument(const std::string& path) {
         // Anything from the reader (OpenEXR's own exceptions are translated there) or the map.
         doc.file.reset();
         doc.map.reset();
-        doc.error = e.what();
-        if (doc.error.empty()) doc.error = "unknown error";
+        doc.error = aboutFile(path, *e.what() ? e.what() : "unknown error");
     }
     return doc;
+}
+
+std::string aboutFile(const std::string& path, const std::string& message) {
+    return message.find(path) != std::string::npos ? message : path + ": " + message;
 }
 
 Image uniformBaseline(const std::string& path) {

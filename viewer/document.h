@@ -16,7 +16,7 @@ struct Document {
     std::string path;
     std::optional<format::ConusFile> file;
     std::optional<codec::SamplingMap> map;
-    std::string error;  // empty when loaded
+    std::string error;  // empty when loaded; names the file (aboutFile)
     bool ok() const { return file.has_value() && map.has_value(); }
     // Source size (the conventional frame), falling back to the CoNUS image's.
     int sourceWidth() const;
@@ -24,6 +24,10 @@ struct Document {
 };
 
 Document loadDocument(const std::string& path);
+
+// `message` about the file at `path`, naming it once: as it is when it names the file already
+// (the readers' messages do), else after "path: ".
+std::string aboutFile(const std::string& path, const std::string& message);
 
 // The uniform baseline in the CoNUS file at `path` (what `conus uniform` wrote: an identity map, so
 // its image is the area-downsampled source), reconstructed through its map at its own size, for

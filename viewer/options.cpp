@@ -162,7 +162,9 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
             *exitCode = app.exit(e);
             return std::nullopt;
         }
-        std::fprintf(stderr, "conus-view: %s (see --help)\n", oneLine(e.what()).c_str());  // as conus says a usage error
+        std::string reason = dynamic_cast<const CLI::ExtrasError*>(&e) ? cli::unknownOptionLine(&app, argc, argv) : "";
+        if (reason.empty()) reason = oneLine(e.what());
+        std::fprintf(stderr, "conus-view: %s (see --help)\n", reason.c_str());  // as conus says a usage error
         *exitCode = 2;
         return std::nullopt;
     } catch (const Error& e) {

@@ -57,7 +57,7 @@ int runScreenshot(const Options& options) {
     if (options.sceneKind != SceneKind::None) return sceneScreenshot(options);
     const Document doc = loadDocument(options.files.front());
     if (!doc.ok()) {
-        std::fprintf(stderr, "conus-view: %s: %s\n", doc.path.c_str(), doc.error.c_str());
+        std::fprintf(stderr, "conus-view: %s\n", doc.error.c_str());
         return 1;
     }
     try {

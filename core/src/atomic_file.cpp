@@ -62,6 +62,9 @@ extern "C" void removeTemporariesAndDie(int signal) {
 
 std::atomic<unsigned> g_counter{0};
 
+// The set of outputs this thread's commits wait in, if any (AtomicOutputs).
+thread_local AtomicOutputs* t_outputs = nullptr;
+
 std::string errnoText(int error) { return std::strerror(error); }
 
 // The file a write to `destination` replaces: a symbolic link's target, else the path itself.
@@ -239,6 +242,11 @@ void AtomicFile::commit() {
     const int fd = m_fd;
     m_fd = -1;
     if (::close(fd) != 0) fail("cannot close it", errno);
+    if (t_outputs) {  // finished; renamed with the rest of the command's outputs
+        t_outputs->m_waiting.push_back({m_destination, m_target, m_temporary, m_slot});
+        m_committed = true;
+        return;
+    }
     // Refused again at the last moment: something may have appeared at the destination meanwhile.
     checkReplaceable(m_destination, m_target, ErrorCode::Io);
     if (::rename(m_temporary.c_str(), m_target.c_str()) != 0) fail("cannot move the finished file into place", errno);
@@ -294,6 +302,65 @@ void removeTemporariesOnSignals() {
     action.sa_flags = SA_RESETHAND;
     for (int signal : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(signal, &action, nullptr);
     std::signal(SIGXFSZ, SIG_IGN);
+}
+
+// ---- AtomicOutputs -----------------------------------------------------------------------------
+
+AtomicOutputs::AtomicOutputs() : m_outer(t_outputs) { t_outputs = this; }
+
+AtomicOutputs::~AtomicOutputs() {
+    if (t_outputs == this) t_outputs = m_outer;
+    if (m_committed) return;
+    for (const Waiting& w : m_waiting) {
+        ::unlink(w.temporary.c_str());
+        unregisterTemporary(w.slot);
+    }
+    std::error_code ec;
+    for (auto folder = m_madeFolders.rbegin(); folder != m_madeFolders.rend(); ++folder)
+        if (fs::is_empty(*folder, ec)) fs::remove(*folder, ec);
+}
+
+void AtomicOutputs::makeFolder(const std::string& folder) {
+    std::vector<fs::path> missing;
+    std::error_code ec;
+    fs::path deepest = fs::path(folder).lexically_normal();
+    if (deepest.filename().empty()) deepest = deepest.parent_path();  // "out/"
+    for (fs::path p = deepest; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+        missing.push_back(p);
+        if (p == p.parent_path()) break;
+    }
+    fs::create_directories(folder, ec);
+    if (ec || !fs::is_directory(folder, ec))
+        throw Error(ErrorCode::Io, "cannot make the folder " + folder + (ec ? ": " + ec.message() : ": a file has that name"));
+    for (auto p = missing.rbegin(); p != missing.rend(); ++p) m_madeFolders.push_back(p->string());
+}
+
+void AtomicOutputs::commit() {
+    if (m_committed) return;
+    if (t_outputs == this) t_outputs = m_outer;  // what is written from now on is not this set's
+    if (m_outer) {
+        m_outer->m_waiting.insert(m_outer->m_waiting.end(), m_waiting.begin(), m_waiting.end());
+        m_outer->m_madeFolders.insert(m_outer->m_madeFolders.end(), m_madeFolders.begin(), m_madeFolders.end());
+        m_committed = true;
+        return;
+    }
+    for (std::size_t renamed = 0; renamed < m_waiting.size(); ++renamed) {
+        const Waiting& w = m_waiting[renamed];
+        try {
+            checkReplaceable(w.destination, w.target, ErrorCode::Io);
+            if (::rename(w.temporary.c_str(), w.target.c_str()) != 0) {
+                const int error = errno;
+                throw Error(ErrorCode::Io, "cannot write " + w.destination + ": cannot move the finished file into place: " +
+                                               errnoText(error));
+            }
+        } catch (const Error&) {
+            m_waiting.erase(m_waiting.begin(), m_waiting.begin() + std::ptrdiff_t(renamed));  // in place already
+            throw;
+        }
+        unregisterTemporary(w.slot);
+    }
+    m_waiting.clear();
+    m_committed = true;
 }
 
 }  // namespace conus

@@ -81,17 +81,24 @@ void checkConusFileName(const std::string& path) {
 
 namespace {
 
+// A file that cannot be opened (missing, a directory, unreadable) breaks no rule a reader would
+// look up: its message alone, which names the file ("cannot open x.exr: no such file"); a file
+// that opens but breaks rules names them (`validate` lists every one).
+void throwIfRefused(const detail::LoadResult& result, const std::string& path) {
+    if (result.report.ok()) return;
+    if (result.code == ErrorCode::Io) throw Error(result.code, result.report.issues.front().message);
+    throw Error(result.code, path + ": " + result.report.summary(), result.report.ruleNumbers());
+}
+
 ConusFile load(const std::string& path, const Limits& limits, bool readPixels) {
     ConusFile file;
-    const detail::LoadResult result = detail::loadConusFile(path, limits, readPixels, file);
-    if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.summary(), result.report.ruleNumbers());
+    throwIfRefused(detail::loadConusFile(path, limits, readPixels, file), path);
     return file;
 }
 
 ReflectionAssetFile loadAsset(const std::string& path, const Limits& limits, bool readPixels) {
     ReflectionAssetFile asset;
-    const detail::LoadResult result = detail::loadReflectionAsset(path, limits, readPixels, asset);
-    if (!result.report.ok()) throw Error(result.code, path + ": " + result.report.summary(), result.report.ruleNumbers());
+    throwIfRefused(detail::loadReflectionAsset(path, limits, readPixels, asset), path);
     return asset;
 }
 

@@ -42,8 +42,9 @@ LoadResult refusal(const Problem& problem) {
 Problem screen(const std::string& path, const Limits& limits, std::uintmax_t& size, std::unique_ptr<CoreFile>& core) {
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);
-    if (ec || !std::filesystem::exists(status))
-        return {Rule::V1, ErrorCode::Io, "cannot open " + path + ": " + (ec ? ec.message() : std::string("no such file"))};
+    if (status.type() == std::filesystem::file_type::not_found)
+        return {Rule::V1, ErrorCode::Io, "cannot open " + path + ": no such file"};
+    if (ec || !std::filesystem::exists(status)) return {Rule::V1, ErrorCode::Io, "cannot open " + path + ": " + ec.message()};
     if (!std::filesystem::is_regular_file(status)) return {Rule::V1, ErrorCode::Io, "cannot read " + path + ": not a regular file"};
     size = std::filesystem::file_size(path, ec);
     if (ec || !std::ifstream(path, std::ios::binary))

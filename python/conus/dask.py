@@ -11,18 +11,20 @@ s3fs is installed; memory://, file://). Each picture is one task: read it, encod
 OUT_DIR/<name> (local folders through a temporary file and a rename; object stores in one put),
 so a task that is retried, or a batch that is run again, rewrites or (skip_existing, the default)
 leaves the same output: retries are idempotent. Failures never stop the batch; they come back as
-rows of the summary with their reason. The compiled calls release the GIL, so threads use every
-core.
+rows of the summary with their reason. A warning is kept in its input's row ("warnings") and said
+once by encode_files, naming the inputs it held for. The compiled calls release the GIL, so
+threads use every core.
 """
 import os
 import tempfile
 import time
+import warnings
 
 import dask.bag
 import fsspec
 from fsspec.implementations.local import LocalFileSystem
 
-from . import _conus
+from . import _conus, _keeping_warnings
 
 
 def _outputs(out_dir, name, path, index):
@@ -33,7 +35,7 @@ def _outputs(out_dir, name, path, index):
 def _convert(item, out_dir, name, skip_existing, options):
     index, path = item
     output = _outputs(out_dir, name, path, index)
-    row = {"input": path, "output": output, "status": "converted", "seconds": 0.0, "error": ""}
+    row = {"input": path, "output": output, "status": "converted", "seconds": 0.0, "error": "", "warnings": []}
     start = time.perf_counter()
     try:
         out_fs, out_path = fsspec.core.url_to_fs(output)
@@ -45,8 +47,9 @@ def _convert(item, out_dir, name, skip_existing, options):
             local_in = in_path if isinstance(in_fs, LocalFileSystem) else os.path.join(work, os.path.basename(in_path))
             if local_in != in_path:
                 in_fs.get(in_path, local_in)
-            pixels, channels = _conus.read_image(local_in)
-            encoded = _conus.encode(pixels, channels=channels, **options)
+            with _keeping_warnings(row["warnings"]):
+                pixels, channels = _conus.read_image(local_in)
+                encoded = _conus.encode(pixels, channels=channels, **options)
             if isinstance(out_fs, LocalFileSystem):
                 out_fs.makedirs(os.path.dirname(out_path) or ".", exist_ok=True)
                 _conus.write(out_path, encoded)  # a temporary file and a rename: atomic
@@ -82,7 +85,7 @@ def encode_bag(inputs, out_dir, name="{stem}.exr", skip_existing=True, partition
 
 
 class Summary(list):
-    """The rows of a batch (dicts: input, output, status, seconds, error) with their counts."""
+    """The rows of a batch (dicts: input, output, status, seconds, error, warnings) with their counts."""
 
     def count(self, status):
         return sum(1 for row in self if row["status"] == status)
@@ -100,4 +103,14 @@ def encode_files(inputs, out_dir, name="{stem}.exr", skip_existing=True, schedul
     """Encodes every input on the active Dask scheduler (a distributed Client if one is set up,
     else `scheduler`, else local threads) and returns the Summary."""
     rows = encode_bag(inputs, out_dir, name=name, skip_existing=skip_existing, **options).compute(scheduler=scheduler)
-    return Summary(sorted(rows, key=lambda r: r["input"]))
+    summary = Summary(sorted(rows, key=lambda r: r["input"]))
+    # Each warning once, at the caller's line, with the inputs it held for (as `conus encode`'s batch).
+    held = {}
+    for row in summary:
+        for text in row.get("warnings", ()):
+            held.setdefault(text, []).append(row["input"])
+    for text, paths in held.items():
+        shown = ", ".join(paths[:3]) + (f" and {len(paths) - 3} more" if len(paths) > 3 else "")
+        where = paths[0] if len(paths) == 1 else f"{len(paths)} of {len(summary)} inputs ({shown})"
+        warnings.warn(f"conus.dask.encode_files: {where}: {text}", UserWarning, stacklevel=2)
+    return summary

@@ -69,6 +69,14 @@ Image toImage(const py::array& array, std::optional<std::vector<std::string>> ch
     if (array.ndim() != 2 && array.ndim() != 3)
         invalid(std::string(what) + " must have shape (height, width) or (height, width, channels), not " + shape(array));
     const py::ssize_t h = array.shape(0), w = array.shape(1), c = array.ndim() == 3 ? array.shape(2) : 1;
+    if (h == 0 || w == 0) invalid(std::string(what) + " of shape " + shape(array) + " hold no pixels");
+    if (c == 0)
+        invalid(std::string(what) + " of shape " + shape(array) + " have no channels: give (height, width) or (height, width, channels)");
+    // (3, H, W), as torch and some readers hold a picture, would be 3 rows of W channels: refused
+    // unless the channel names say that many channels are meant.
+    if (array.ndim() == 3 && h <= 4 && c > 4 && !(channels && py::ssize_t(channels->size()) == c))
+        invalid(std::string(what) + " of shape " + shape(array) + " look channel-first (channels, height, width); CoNUS takes " +
+                "(height, width, channels): pass numpy.moveaxis(" + what + ", 0, -1)");
     std::vector<std::string> names = channels ? *channels : defaultChannelNames(int(c));
     if (py::ssize_t(names.size()) != c)
         invalid(std::string(what) + " has " + std::to_string(c) + " channels but " + std::to_string(names.size()) +
@@ -142,7 +150,8 @@ Image pixelsFrom(py::handle pixels, const std::optional<std::vector<std::string>
     if (const std::int64_t bad = imageio::countNonFinite(image); bad > 0) {
         const std::string count = std::to_string(bad) + (bad == 1 ? " NaN or infinite value" : " NaN or infinite values");
         if (repair == imageio::NonFiniteRepair::Keep) {
-            warn(std::string(what) + " hold " + count + "; filtering spreads them to their neighbours (repair with fix_nonfinite=" +
+            warn(std::string(what) + ", " + describe(pixels) + ", hold " + count +
+                 "; filtering spreads them to their neighbours (repair with fix_nonfinite=" +
                  quotedChoices(enumNames({imageio::NonFiniteRepair::Box3, imageio::NonFiniteRepair::Black})) + ")");
         } else {
             imageio::repairNonFinite(image, repair);
@@ -252,8 +261,6 @@ py::array toArray(Image image) {
                               {py::ssize_t(held->width) * c * 4, c * 4, py::ssize_t(4)}, held->pixels.data(), owner);
 }
 
-void warn(const std::string& text) {
-    if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) < 0) throw py::error_already_set();
-}
+void warn(const std::string& text) { py::module_::import("conus").attr("_warn")(text); }
 
 }  // namespace conus::python

@@ -72,7 +72,8 @@ void requireReal(const py::array& input, const std::string& what);
 // The image as an array that owns it: no copy of the pixels (a capsule holds the C++ image).
 py::array toArray(Image image);
 
-// Warns (Python's warnings, a UserWarning) with `text`; raises if warnings are errors.
+// Warns (a UserWarning) with `text` through conus._warn (python/conus/__init__.py): at the caller's
+// line, naming the call; raises if warnings are errors.
 void warn(const std::string& text);
 
 }  // namespace conus::python

@@ -11,6 +11,7 @@
 
 #include "conus/codec/build/foci_budget.h"
 #include "conus/core/error.h"
+#include "arguments.h"
 
 namespace conus::python {
 
@@ -50,7 +51,7 @@ inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, i
                   numberText(std::round(b.predicted.tileLoss * 10) / 10) + " dB (the budget: " + numberText(frameLoss) + " and " +
                   numberText(codec::kDefaultTileLoss) + " dB)";
     if (b.gridLimited) warning += (warning.empty() ? "conus.encode: " : "; ") + std::string("the grid holds the foci only to k ") + list(given);
-    if (!warning.empty()) pybind11::module_::import("warnings").attr("warn")(warning, pybind11::module_::import("builtins").attr("UserWarning"), 2);
+    if (!warning.empty()) warn(warning);
     return d;
 }
 

@@ -371,21 +371,31 @@ PYBIND11_MODULE(_conus, m) {
     m.def(
         "uniform",
         [](py::object pixels, py::object sizeArgument, py::object fitArgument, const std::string& colorspace,
-           const std::string& fixNonFinite) {
+           const std::string& fixNonFinite, py::object channels) {
             const auto size = sizeFrom(sizeArgument);
             const int fit = iterationsFrom(fitArgument);
-            Image source = pixelsFrom(pixels, std::nullopt, "pixels", rulesOf(colorspace, fixNonFinite));
+            Image source = pixelsFrom(pixels, channelsFrom(channels), "pixels", rulesOf(colorspace, fixNonFinite));
             const auto [w, h] = sizeOr(size, source.width, source.height);
-            py::gil_scoped_release release;
-            Image small = codec::areaDownsample(source, w, h);
-            fitTo(source, codec::SamplingMap::identity(2, 2), small, fit);
-            py::gil_scoped_acquire acquire;
-            return toArray(std::move(small));
+            codec::checkEncodeMemory(source, w, h);
+            auto file = std::make_shared<File>();
+            {
+                // As `conus uniform`: the encode through the identity map, fitted as --fit says.
+                py::gil_scoped_release release;
+                const codec::SamplingMap identity = codec::SamplingMap::identity(2, 2);
+                codec::EncodeOptions options;
+                options.width = w;
+                options.height = h;
+                Image small = codec::encodeImage(source, identity, options);
+                fitTo(source, identity, small, fit);
+                file->file = codec::makeImageFile(std::move(small), identity, source.width, source.height, SourceEncoding{}, std::nullopt);
+            }
+            return file;
         },
         py::arg("pixels"), py::arg("size") = py::none(), py::arg("fit") = 0, py::arg("colorspace") = kAutoColorspace,
-        py::arg("fix_nonfinite") = enumName(imageio::NonFiniteRepair::Keep),
-        "The uniform baseline (pixels as for encode): an area downsample to the same pixel count; fit = N > 0 fits it to its bilinear\n"
-        "resize to the source's size (`conus uniform --fit --fit-iterations N`)");
+        py::arg("fix_nonfinite") = enumName(imageio::NonFiniteRepair::Keep), py::arg("channels") = py::none(),
+        "The uniform baseline as `conus uniform` makes it: a conus.File of the same pixel count through the identity map\n"
+        "(pixels as for encode; size (w, h) defaults to a quarter of each side), to write or decode like any other;\n"
+        "fit = N > 0 fits it to its decoder (`conus uniform --fit --fit-iterations N`)");
     m.def(
         "resize",
         [](py::object pixels, py::object sizeArgument) {

@@ -79,5 +79,22 @@ TEST_F(Batch, MistakesAreUsageErrors) {
     EXPECT_FALSE(fs::exists(path("o")));
 }
 
+TEST_F(Batch, QuietSaysEachFailureOnceAndABatchThatWroteNothingLeavesNoFolder) {
+    std::ofstream(path("bad.png")) << "broken";
+    const std::string good = makePicture(48, 32, "good.png");
+    Result r = run("encode " + path("bad.png") + " " + good + " --out-dir " + path("out") + " -q");
+    EXPECT_EQ(r.exitCode, 1);
+    const std::string both = r.out + r.err;
+    std::size_t said = 0;
+    for (std::size_t at = both.find("bad.png:"); at != std::string::npos; at = both.find("bad.png:", at + 1)) ++said;
+    EXPECT_EQ(said, 1u) << "once, in the summary:\n" << r.out << "---\n" << r.err;
+    EXPECT_TRUE(contains(r.out, "1 converted, 0 skipped (output exists), 1 failed")) << r.out;
+    EXPECT_TRUE(fs::exists(path("out/good.exr")));
+    // Every input failed: the folder the batch made is gone again.
+    r = run("encode " + path("bad.png") + " " + path("missing.png") + " --out-dir " + path("none") + " -q");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_FALSE(fs::exists(path("none")));
+}
+
 }  // namespace
 }  // namespace conus::test

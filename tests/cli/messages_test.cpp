@@ -189,3 +189,107 @@ TEST_F(Cli, StandardInputIsAnInput) {
     ASSERT_EQ(run("info " + path("s.exr")).exitCode, 0);
     EXPECT_NE(run("info " + path("s.exr")).out.find("source        64 x 48"), std::string::npos);
 }
+
+// A name too long for the folder: it passes every check made before the work (the folder is
+// there) and fails only when the file is created, after the command's other outputs were written.
+std::string unwritableName(const std::string& extension) { return std::string(250, 'n') + extension; }
+
+TEST_F(Cli, ACommandThatFailsLeavesNoneOfItsOutputs) {
+    // A preview into a folder that is not there: refused before the work.
+    Result r = run("map foci --focus 0.5,0.5,0.1,4 -o " + path("m.exr") + " --preview " + path("nodir/p.png"));
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_EQ(countLines(r.err, ""), 1) << r.err;
+    EXPECT_NE(r.err.find("nodir"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("m.exr")));
+    // A preview that fails once the map is written: the map goes too.
+    r = run("map foci --focus 0.5,0.5,0.1,4 -o " + path("m.exr") + " --preview " + path(unwritableName(".png")) + " -q");
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_EQ(countLines(r.err, ""), 1) << r.err;
+    EXPECT_FALSE(fs::exists(path("m.exr")));
+    EXPECT_EQ(r.out.find("wrote"), std::string::npos) << "nothing said written: " << r.out;
+    // A volume's picture, likewise.
+    r = run("volume render procedural:shepp-logan:16 -o " + path("v.exr") + " --size 16x16 --uniform --picture " +
+            path(unwritableName(".png")));
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_FALSE(fs::exists(path("v.exr")));
+    // The demo: one of its pictures cannot be written (a folder has its name); none of them is
+    // left, and the folder the demo made is gone.
+    const std::string in = makePicture(64, 48);
+    fs::create_directories(m_dir / "demo" / "view-frame.png");
+    r = run("demo --input " + in + " --focus 0.5,0.5,0.1,2 --out " + path("demo") + " -q");
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_NE(r.err.find("view-frame.png is a directory"), std::string::npos) << r.err;
+    EXPECT_EQ(fs::directory_iterator(m_dir / "demo")->path().filename(), "view-frame.png");
+    EXPECT_EQ(std::distance(fs::directory_iterator(m_dir / "demo"), fs::directory_iterator()), 1) << "only what was there";
+    fs::remove(m_dir / "demo" / "view-frame.png");
+    r = run("demo --input " + path("missing.png") + " --out " + path("demo/new"));
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_FALSE(fs::exists(path("demo/new")));
+    EXPECT_TRUE(leftovers().empty());
+}
+
+TEST_F(Cli, AViewWhollyOutsideThePictureIsRefusedBeforeAnyWork) {
+    ASSERT_NO_FATAL_FAILURE(makeUniformFile());
+    for (const char* view : {"1.2,0,1.5,0.5", "-0.5,0.2,0,0.4", "0.2,1,0.4,1.5"}) {
+        const Result r = run("decode " + path("u.exr") + " -o " + path("x.png") + " --view " + view);
+        EXPECT_EQ(r.exitCode, 2) << view << ": " << r.err;
+        EXPECT_EQ(countLines(r.err, ""), 1) << r.err;
+        EXPECT_NE(r.err.find("lies wholly outside the image"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("done"), std::string::npos) << "nothing read first: " << r.err;
+        EXPECT_FALSE(fs::exists(path("x.png")));
+    }
+}
+
+TEST_F(Cli, AMissingFileIsOnePlainLineNamingItOnce) {
+    const std::string missing = path("missing.exr");
+    for (const std::string& args : {"decode " + missing + " -o " + path("x.png"), "info " + missing,
+                                    "map compose " + missing + " -o " + path("m.exr"), "validate " + missing}) {
+        const Result r = run(args);
+        EXPECT_EQ(r.exitCode, 1) << args << ": " << r.err;
+        EXPECT_EQ(countLines(r.err, ""), 1) << args << ": " << r.err;
+        EXPECT_EQ(countLines(r.err, "missing.exr"), 1) << args << ": " << r.err;
+        EXPECT_NE(r.err.find("no such file"), std::string::npos) << args << ": " << r.err;
+        EXPECT_EQ(r.err.find("missing.exr: missing.exr"), std::string::npos) << args << ": " << r.err;
+        EXPECT_EQ(r.err.find("V1"), std::string::npos) << "no rule number for a file that is not there: " << r.err;
+    }
+    // The viewer says it before any window opens (no display needed), once.
+    for (const std::string& args : {missing, missing + " --screenshot " + path("s.png"), "--edit " + path("missing.png")}) {
+        const std::string command = std::string(CONUS_BIN_DIR) + "/conus-view " + args + " 2>" + path("view.txt") + " </dev/null";
+        const int status = std::system(command.c_str());
+        const std::string err = slurp(path("view.txt"));
+        EXPECT_EQ(WEXITSTATUS(status), 1) << args << ": " << err;
+        EXPECT_EQ(countLines(err, ""), 1) << args << ": " << err;
+        EXPECT_EQ(err.find(".exr: " + missing), std::string::npos) << err;
+        EXPECT_NE(err.find("no such file"), std::string::npos) << args << ": " << err;
+    }
+}
+
+TEST_F(Cli, ASizeIsCheckedBeforeThePictureIsRead) {
+    const std::string in = makePicture(64, 48);
+    for (const std::string& command : {"uniform", "encode"}) {
+        const Result r = run(command + " " + in + " -o " + path("u.exr") + " --size 0x0");
+        EXPECT_EQ(r.exitCode, 2) << command << ": " << r.err;
+        EXPECT_EQ(countLines(r.err, ""), 1) << command << ": " << r.err;
+        EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("read "), std::string::npos) << "nothing read first: " << r.err;
+    }
+}
+
+TEST_F(Cli, AMisspeltOptionIsNamedWithTheOneMeant) {
+    const std::string in = makePicture(64, 48);
+    Result r = run("encode " + in + " -o " + path("x.exr") + " --foccus 0.5,0.5,0.1,4");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(countLines(r.err, ""), 1) << r.err;
+    EXPECT_NE(r.err.find("conus encode: unknown option --foccus; did you mean --focus?"), std::string::npos) << r.err;
+    r = run("decode " + path("x.exr") + " -o " + path("x.png") + " --veiw=0,0,1,1");
+    EXPECT_NE(r.err.find("unknown option --veiw; did you mean --view?"), std::string::npos) << r.err;
+    r = run("map foci --focus 0.5,0.5,0.1,4 -o " + path("m.exr") + " --prevew " + path("m.png"));
+    EXPECT_NE(r.err.find("unknown option --prevew; did you mean --preview?"), std::string::npos) << r.err;
+    r = run("info " + path("x.exr") + " --nothing-like-it");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("unknown option --nothing-like-it (see --help)"), std::string::npos) << r.err;
+    const std::string command = std::string(CONUS_BIN_DIR) + "/conus-view x.exr --screenshoot s.png 2>" + path("view.txt");
+    EXPECT_EQ(WEXITSTATUS(std::system(command.c_str())), 2);
+    EXPECT_NE(slurp(path("view.txt")).find("did you mean --screenshot?"), std::string::npos) << slurp(path("view.txt"));
+    EXPECT_FALSE(fs::exists(path("x.exr")) || fs::exists(path("m.exr")));
+}

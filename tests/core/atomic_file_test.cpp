@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -172,4 +173,61 @@ TEST_F(AtomicFileTest, SigtermRemovesTheTemporaryFile) {
     ASSERT_EQ(::waitpid(child, &status, 0), child);
     EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << "ends as SIGTERM would";
     EXPECT_TRUE(entries().empty()) << "the temporary was removed";
+}
+
+TEST_F(AtomicFileTest, AFailedSetOfOutputsLeavesNoneOfThemNorTheFoldersItMade) {
+    conus::writeFileAtomically(path("kept.bin"), std::vector<unsigned char>{'o', 'l', 'd'});
+    {
+        conus::AtomicOutputs outputs;
+        outputs.makeFolder(path("made/deeper"));
+        conus::writeFileAtomically(path("made/deeper/a.bin"), std::vector<unsigned char>{'a'});
+        conus::writeFileAtomically(path("kept.bin"), std::vector<unsigned char>{'n', 'e', 'w'});
+        EXPECT_FALSE(fs::exists(path("made/deeper/a.bin"))) << "nothing in place before the set commits";
+        EXPECT_EQ(slurp(path("kept.bin")), "old");
+        // The command fails here: the set is destroyed without commit().
+    }
+    EXPECT_EQ(entries(), std::vector<std::string>{"kept.bin"}) << "no temporary, no folder the set made";
+    EXPECT_EQ(slurp(path("kept.bin")), "old");
+}
+
+TEST_F(AtomicFileTest, ACommittedSetRenamesEveryOutputAndNestedSetsJoinTheOuterOne) {
+    conus::AtomicOutputs outputs;
+    outputs.makeFolder(path("out"));
+    conus::writeFileAtomically(path("out/a.bin"), std::vector<unsigned char>{'a'});
+    {
+        conus::AtomicOutputs inner;
+        conus::writeFileAtomically(path("b.bin"), std::vector<unsigned char>{'b'});
+        inner.commit();
+    }
+    EXPECT_FALSE(fs::exists(path("b.bin"))) << "the inner set's file waits for the outer set";
+    outputs.commit();
+    EXPECT_EQ(slurp(path("out/a.bin")), "a");
+    EXPECT_EQ(slurp(path("b.bin")), "b");
+    std::vector<std::string> names = entries();
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"b.bin", "out"}));
+    // Once the set is committed, a commit renames at once again.
+    conus::writeFileAtomically(path("c.bin"), std::vector<unsigned char>{'c'});
+    EXPECT_TRUE(fs::exists(path("c.bin")));
+}
+
+TEST_F(AtomicFileTest, SigtermRemovesTheOutputsWaitingInASet) {
+    int ready[2];
+    ASSERT_EQ(::pipe(ready), 0);
+    const pid_t child = ::fork();
+    if (child == 0) {
+        conus::removeTemporariesOnSignals();
+        conus::AtomicOutputs outputs;
+        conus::writeFileAtomically(path("first.bin"), std::vector<unsigned char>{'1'});
+        (void)!::write(ready[1], "r", 1);
+        ::pause();  // killed while the command's second output is being made
+        std::_Exit(0);
+    }
+    char c;
+    ASSERT_EQ(::read(ready[0], &c, 1), 1);
+    EXPECT_EQ(entries().size(), 1u) << "the finished first output waits as a temporary";
+    ::kill(child, SIGTERM);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    EXPECT_TRUE(entries().empty()) << "the signal removed it";
 }

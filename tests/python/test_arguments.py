@@ -24,7 +24,7 @@ def test_uint8_arrays_are_display_codes_like_an_8_bit_png(tmp_path, asymmetric, 
     read, channels = conus.read_image(png)
     assert np.abs(codes_of(read).astype(int) - codes).max() <= 1  # not a near-white picture
     # The array and the file read back are the same light, within 8-bit rounding ...
-    np.testing.assert_allclose(np.asarray(conus.uniform(codes, size=(120, 80))), np.asarray(conus.uniform(read, size=(120, 80))), atol=1e-4)
+    np.testing.assert_allclose(conus.uniform(codes, size=(120, 80)).pixels, conus.uniform(read, size=(120, 80)).pixels, atol=1e-4)
     # ... and encode to the same CoNUS image through the same map. (The budget's choices, made on
     # trial encodes, may differ for two pictures that differ by rounding: the map is given here.)
     from_array = conus.encode(codes, foci=[FOCUS], size=(120, 80))
@@ -50,13 +50,13 @@ def test_uint8_arrays_are_display_codes_like_an_8_bit_png(tmp_path, asymmetric, 
 def test_uint16_codes_and_the_colorspace_override(asymmetric):
     rgb = np.ascontiguousarray(asymmetric[..., :3])
     codes16 = np.round(conus.linear_to_srgb(rgb) * 65535).astype(np.uint16)
-    a = conus.uniform(codes16, size=(60, 40))
-    b = conus.uniform(rgb, size=(60, 40))
+    a = conus.uniform(codes16, size=(60, 40)).pixels
+    b = conus.uniform(rgb, size=(60, 40)).pixels
     np.testing.assert_allclose(a, b, atol=1e-3)
     # colorspace="linear": codes scaled to [0, 1] and taken as light; "srgb" on floats linearizes them.
-    lin = conus.uniform(codes16, size=(60, 40), colorspace="linear")
-    np.testing.assert_allclose(lin, conus.uniform(codes16.astype(np.float32) / 65535, size=(60, 40)), atol=1e-5)
-    srgb_floats = conus.uniform(conus.linear_to_srgb(rgb), size=(60, 40), colorspace="srgb")
+    lin = conus.uniform(codes16, size=(60, 40), colorspace="linear").pixels
+    np.testing.assert_allclose(lin, conus.uniform(codes16.astype(np.float32) / 65535, size=(60, 40)).pixels, atol=1e-5)
+    srgb_floats = conus.uniform(conus.linear_to_srgb(rgb), size=(60, 40), colorspace="srgb").pixels
     np.testing.assert_allclose(srgb_floats, b, atol=2e-3)
     with pytest.raises(conus.Error, match="colorspace must be 'auto', 'srgb' or 'linear'"):
         conus.uniform(rgb, colorspace="rec709")
@@ -115,6 +115,9 @@ def test_python_refuses_what_the_cli_refuses(tmp_path, asymmetric, conus_bin):
     cli = subprocess.run([conus_bin, "decode", str(tmp_path / "f.exr"), "-o", str(tmp_path / "v.png"), "--view",
                           "0.7,0.5,0.3,0.1"], capture_output=True, text=True)
     assert cli.returncode == 2 and "is empty or inverted: it needs u0 < u1" in cli.stderr
+    # A view wholly outside the picture: refused by both.
+    with pytest.raises(conus.Error, match=r"view \(1.2, 0, 1.5, 0.5\) lies wholly outside the image"):
+        conus.decode(f, view=(1.2, 0, 1.5, 0.5))
     # fit is a count, as --fit-iterations.
     assert "not True" in one_line_type_error(lambda: conus.encode(pixels, fit=True))
     with pytest.raises(conus.Error, match="fit must be 0 .none. or 1 to 100 iterations"):
@@ -125,13 +128,14 @@ def test_nonfinite_pixels_warn_or_are_repaired_as_fix_nonfinite(tmp_path, asymme
     pixels = np.ascontiguousarray(asymmetric[..., :3]).copy()
     pixels[50, 60] = np.nan
     pixels[51, 60, 1] = np.inf
-    with pytest.warns(UserWarning, match="pixels hold 4 NaN or infinite values; .*fix_nonfinite='box3' or 'black'"):
-        kept = conus.uniform(pixels, size=(240, 160))
+    with pytest.warns(UserWarning, match=r"conus.uniform: pixels, an array of shape \(160, 240, 3\) and dtype float32, hold 4 NaN "
+                                         r"or infinite values; .*fix_nonfinite='box3' or 'black'"):
+        kept = conus.uniform(pixels, size=(240, 160)).pixels
     assert np.isnan(kept).any()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        black = conus.uniform(pixels, size=(240, 160), fix_nonfinite="black")
-        box3 = conus.uniform(pixels, size=(240, 160), fix_nonfinite="box3")
+        black = conus.uniform(pixels, size=(240, 160), fix_nonfinite="black").pixels
+        box3 = conus.uniform(pixels, size=(240, 160), fix_nonfinite="box3").pixels
     assert np.isfinite(black).all() and np.isfinite(box3).all()
     assert black[50, 60].tolist() == [0, 0, 0]
     # box3: the mean of the finite neighbours, close to the smooth picture around it.

@@ -1,23 +1,21 @@
 """Every `sh` and `python` block of docs/*.md runs, in order, page by page, as a user would paste
-it: each `python` block saved as a script and run with `python3 block.py`, each `sh` block in a
-fresh shell, in a scratch folder that sees the repository's build/, tests/ and examples/, with the
-built tools on PATH (then the interpreter running the tests, as `python3`), the package on
-PYTHONPATH and HOME in the scratch folder (cpp.md installs there). Then what the page says is
-checked against what its blocks made: the view it names as the focus holds the demo's fine print and
-decodes sharper than the same view of the uniform image, a size it says keeps the aspect does."""
-import os
-import pathlib
+it from an empty folder with only the installed package: the build installed (`cmake --install`)
+to a fresh $HOME/conus, the environment docs/README.md's `export` line gives (its PATH and
+PYTHONPATH, nothing of the build tree or the sources), each page in an empty folder of its own;
+each `python` block saved as a script and run with `python3 block.py` (the interpreter running
+the tests), each `sh` block in a fresh shell. Then what the page says is checked against what its
+blocks made: the view it names as the focus holds the demo's fine print and decodes sharper than
+the same view of the uniform image, a size it says keeps the aspect does; and whatever the page
+wrote is ignored by git when it is run from the repository root (.gitignore)."""
 import re
 import subprocess
-import sys
 
 import numpy as np
 import pytest
 
-from conftest import BIN_DIR, SOURCE_DIR
+from conftest import BLOCK, SOURCE_DIR
 
 DOCS = sorted((SOURCE_DIR / "docs").glob("*.md"))
-BLOCK = re.compile(r"^```(\w+)\n(.*?)^```", re.S | re.M)
 
 
 def blocks(page):
@@ -133,21 +131,37 @@ CHECKS = {"convert-photos.md": check_convert_photos, "view-and-zoom.md": check_v
           "cluster.md": check_cluster}
 
 
+def not_ignored(names):
+    """Those of `names` (entries at the repository root) that git does not ignore; none when the
+    sources are not a git work tree."""
+    git = subprocess.run(["git", "-C", str(SOURCE_DIR), "rev-parse", "--is-inside-work-tree"], capture_output=True, text=True)
+    if git.returncode != 0:
+        return []
+    # A folder's own files are what git would list: ask about one inside it.
+    paths = [f"{name}/file" if is_dir else name for name, is_dir in names]
+    done = subprocess.run(["git", "-C", str(SOURCE_DIR), "check-ignore", "--no-index", "--stdin"], input="\n".join(paths),
+                          capture_output=True, text=True)
+    ignored = set(done.stdout.split())
+    return [p for p in paths if p not in ignored]
+
+
 @pytest.mark.parametrize("page", [p for p in DOCS if p.name != "README.md"], ids=lambda p: p.name)
-def test_page_runs(page, tmp_path):
-    build = BIN_DIR.parent
-    for name, target in (("build", build), ("tests", SOURCE_DIR / "tests"), ("examples", SOURCE_DIR / "examples")):
-        (tmp_path / name).symlink_to(target)
-    env = dict(os.environ, HOME=str(tmp_path), PATH=f"{BIN_DIR}:{pathlib.Path(sys.executable).parent}:{os.environ['PATH']}", MPLBACKEND="Agg",
-               PYTHONPATH=str(build / "python"))
+def test_page_runs_from_an_empty_folder_with_the_installed_package(page, tmp_path, installed):
+    work = tmp_path / "work"
+    work.mkdir()
+    scripts = set()
     for i, (lang, code) in enumerate(blocks(page)):
         if lang == "sh":
             command = ["bash", "-euo", "pipefail", "-c", code]
         else:
-            script = tmp_path / f"{page.stem}_block{i + 1}.py"
+            script = work / f"{page.stem}_block{i + 1}.py"
             script.write_text(code)
+            scripts.add(script.name)
             command = ["python3", script.name]
-        done = subprocess.run(command, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+        done = subprocess.run(command, cwd=work, env=installed, capture_output=True, text=True, timeout=600)
         assert done.returncode == 0, f"{page.name} block {i + 1} ({lang}) failed:\n{code}\n--- stdout\n{done.stdout}\n--- stderr\n{done.stderr}"
     if page.name in CHECKS:
-        CHECKS[page.name](page.read_text(), tmp_path)
+        CHECKS[page.name](page.read_text(), work)
+    written = [(p.name, p.is_dir()) for p in work.iterdir() if p.name not in scripts]
+    assert written, f"{page.name} wrote nothing"
+    assert not not_ignored(written), f"run from the repository root, {page.name} leaves these for git to see: {not_ignored(written)}"

@@ -44,7 +44,8 @@ public:
     // Reads back what was written (writers that patch a header read it first); returns the bytes read.
     std::size_t readAt(std::uint64_t offset, void* data, std::size_t size);
 
-    // Flushes, syncs and closes the temporary file, then renames it over the destination.
+    // Flushes, syncs and closes the temporary file, then renames it over the destination (inside
+    // an AtomicOutputs, when the set is committed).
     void commit();
 
 private:
@@ -82,5 +83,39 @@ void removeStaleTemporaries(const std::string& folder);
 // then end the process as the signal would have. Also ignores SIGXFSZ, so that a write past a
 // file-size limit fails with an error instead of killing the process mid-file.
 void removeTemporariesOnSignals();
+
+// The outputs of one command, all or none. While an AtomicOutputs lives, each AtomicFile its
+// thread commits is finished (written, synced, closed, checked) but stays a temporary; commit()
+// then renames them all into place, in the order they were finished. One destroyed without
+// commit() (the command failed) removes those temporaries and the folders its makeFolder made
+// (when they are empty), so a command that fails leaves none of its outputs. Signals remove the
+// waiting temporaries as they remove open ones. A file written inside the set cannot be read back
+// under its own name before commit(). Sets nest: an inner set's commit() hands its files to the
+// outer one.
+class AtomicOutputs {
+public:
+    AtomicOutputs();
+    ~AtomicOutputs();
+    AtomicOutputs(const AtomicOutputs&) = delete;
+    AtomicOutputs& operator=(const AtomicOutputs&) = delete;
+
+    // Makes `folder` and its missing parents; throws conus::Error(Io) naming it when it cannot.
+    void makeFolder(const std::string& folder);
+    // Renames every waiting file into place; files committed afterwards are renamed at once (or
+    // wait in the outer set). A rename that fails throws conus::Error(Io) naming its destination;
+    // the files renamed before it stay, the rest are removed.
+    void commit();
+
+private:
+    friend class AtomicFile;
+    struct Waiting {
+        std::string destination, target, temporary;
+        int slot = -1;
+    };
+    std::vector<Waiting> m_waiting;
+    std::vector<std::string> m_madeFolders;  // deepest last
+    AtomicOutputs* m_outer = nullptr;
+    bool m_committed = false;
+};
 
 }  // namespace conus

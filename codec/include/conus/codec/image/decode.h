@@ -29,7 +29,8 @@ struct View {
 };
 
 // Refuses (InvalidArgument) a view that is empty or inverted (it needs u0 < u1 and v0 < v1), not
-// finite, or absurdly far from the image; `shown` is the view as the caller wrote it.
+// finite, absurdly far from the image, or wholly outside it (a view partly outside shows the
+// background there); `shown` is the view as the caller wrote it.
 void checkView(const View& view, const std::string& shown);
 
 // Whether some output pixel of `view` decoded at width x height has a footprint in `conus` longer
