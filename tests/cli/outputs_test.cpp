@@ -94,6 +94,7 @@ TEST_F(Cli, AnOutputThatIsAnInputIsRefusedByAnyPathAndTheInputIsUnchanged) {
     fs::create_hard_link(path("a.exr"), path("hard.exr"));
     fs::create_directories(m_dir / "in");
     fs::copy_file(path("a.exr"), path("in/b.exr"));
+    fs::copy_file(picture, path("in/conus.png"));
     fs::create_directories(m_dir / "sub");
     fs::create_symlink("../a.exr", path("sub/up.exr"));  // a relative link
     const std::string a = path("a.exr");
@@ -117,6 +118,8 @@ TEST_F(Cli, AnOutputThatIsAnInputIsRefusedByAnyPathAndTheInputIsUnchanged) {
         // A batch whose --out-dir is the inputs' own folder.
         "encode " + path("in/b.exr") + " " + picture + " --out-dir " + path("in") + " --name {name} --size 16x12",
         "decode " + path("in/b.exr") + " --out-dir " + path("in") + " --name {name}",
+        // A folder of outputs with fixed names, one of which is the input.
+        "demo --input " + path("in/conus.png") + " --out " + path("in"),
     };
     const auto before = snapshot(m_dir);
     for (const std::string& command : commands) {
@@ -131,6 +134,21 @@ TEST_F(Cli, AnOutputThatIsAnInputIsRefusedByAnyPathAndTheInputIsUnchanged) {
         EXPECT_EQ(after, expected) << command << ": every file as it was, nothing new";
     }
     EXPECT_TRUE(fs::is_symlink(path("soft.exr")));
+}
+
+TEST_F(Cli, TheViewersScreenshotNeverReplacesAFileItShows) {
+    ASSERT_NO_FATAL_FAILURE(makeUniformFile());
+    fs::create_symlink(path("u.exr"), path("alias.exr"));
+    const std::string before = slurp(path("u.exr"));
+    for (const std::string& shown : {path("u.exr"), path("alias.exr")}) {
+        const std::string command = std::string(CONUS_BIN_DIR) + "/conus-view " + shown + " --screenshot " + path("u.exr") +
+                                    " 2>" + path("err.txt");
+        const int status = std::system(command.c_str());
+        EXPECT_EQ(WEXITSTATUS(status), 2) << shown;
+        EXPECT_NE(slurp(path("err.txt")).find("refusing to write " + path("u.exr") + ": it is the input"), std::string::npos)
+            << slurp(path("err.txt"));
+        EXPECT_EQ(slurp(path("u.exr")), before);
+    }
 }
 
 TEST_F(Cli, TwoOutputsOfOneCommandThatAreOneFileAreRefused) {
