@@ -45,7 +45,8 @@ constexpr const char* kDefaultText = "CoNUS|FLEXIBLE PINHOLE|CAMERA";
 
 // --tablet-size: below 8 pixels a side not one letter of the inscription (4 pixels at the least)
 // shows, and 4096x4096 keeps the bake's working images (height, colour, ink and their
-// filtered copies, 4 bytes a sample) near 0.7 GB (measured: 8.9 s, 663 MB peak for a 256x256 bake).
+// filtered copies, 4 bytes a sample) under 0.8 GB (measured on a loaded 2-core machine: 752 MB
+// peak, 13 s, for the default 1024x1024 bake of a 4096x4096 tablet).
 constexpr int kTabletMinSide = 8;
 constexpr int kTabletMaxSide = 8192;
 constexpr std::int64_t kTabletMaxPixels = std::int64_t{4096} * 4096;
