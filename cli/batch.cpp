@@ -21,6 +21,7 @@
 
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
+#include "output_files.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -130,7 +131,7 @@ void addBatchOptions(CLI::App& command, BatchOptions& options, const std::string
                      const std::string& defaultName) {
     options.name = defaultName;
     command.add_option("inputs", options.inputs, inputHelp + " (several make a batch; see --out-dir)");
-    command.add_option("-o,--output", options.output, outputHelp + " (one input)");
+    writesFile(command.add_option("-o,--output", options.output, outputHelp + " (one input)"));
     command.add_option("--out-dir", options.outDir, "batch: write each input's output into this folder (made if missing)");
     command.add_option("--name", options.name, "batch: output file name, from {stem}, {name}, {ext}, {index} (default " +
                                                    defaultName + ")");
@@ -176,6 +177,9 @@ std::vector<Job> planJobs(const BatchOptions& o) {
                                                         "; use {name} or {index} in --name");
         jobs.push_back(std::move(job));
     }
+    // Before any work: no output replaces an input (its own or another's; a --list's too).
+    for (const std::string& input : inputs) protectInput(input);
+    for (const Job& job : jobs) checkNotAnInput(job.output, inputs);
     return jobs;
 }
 
@@ -184,7 +188,6 @@ int runBatch(const std::vector<Job>& jobs, const BatchOptions& options, const st
     const bool made = !fs::exists(options.outDir, ec);  // removed again when the batch writes nothing into it
     fs::create_directories(options.outDir, ec);
     if (ec) throw Error(ErrorCode::Io, "cannot make the folder " + options.outDir + ": " + ec.message());
-    removeStaleTemporaries(options.outDir);  // even when --skip-existing writes nothing
 
     const bool userQuiet = quiet();  // -q; the items below run quiet whatever it says
     const auto start = std::chrono::steady_clock::now();

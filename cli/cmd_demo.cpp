@@ -170,9 +170,12 @@ void writeConusStage(const std::string& path, const format::ConusFile& file) {
 
 int runDemo(const DemoOptions& o) {
     namespace fs = std::filesystem;
+    const fs::path out(o.out);
+    // Before any work: none of the files it always writes replaces the --input picture.
+    for (const char* name : {"conus.exr", "uniform.exr", "source.png", "conus.png", "uniform.png", "density.png"})
+        checkNotAnInput((out / name).string());
     AtomicOutputs outputs;  // everything the demo writes, or nothing
     outputs.makeFolder(o.out);
-    const fs::path out(o.out);
     DemoSource source = demoSource(o);
     const int w = source.image.width, h = source.image.height;
     const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels

@@ -24,6 +24,7 @@
 #include "encoding.h"
 #include "image_files.h"
 #include "map_options.h"
+#include "output_files.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -103,7 +104,7 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
                       "DEM: 16-bit PNG/TIFF (read as [0,1]: give --height-scale), float EXR, .npy, .npz "
                       "(e.g. matplotlib's jacksboro_fault_dem.npz) or procedural[:SIZE[:SEED]]")
         ->required();
-    encode.add_option("-o,--output", o.output, "CoNUS file (.exr)")->required();
+    writesFile(encode.add_option("-o,--output", o.output, "CoNUS file (.exr)"))->required();
     encode.add_option("--size", o.sizeText, "CoNUS image size WxH")->capture_default_str();
     // The ground map's own ranges (ground_map.h), checked here so a bad value is a usage error.
     encode.add_option("--eye-height", o.eyeHeight, "viewer's eye above the base plane, metres")
@@ -200,7 +201,7 @@ struct RenderOptions {
 CLI::App* addRender(CLI::App& command, RenderOptions& o) {
     CLI::App& render = *command.add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
     render.add_option("input", o.input, "CoNUS height field (.exr)")->required();
-    render.add_option("-o,--output", o.frame, "frame (.png, .exr, ...)")->required();
+    writesFile(render.add_option("-o,--output", o.frame, "frame (.png, .exr, ...)"))->required();
     render.add_option("--camera", o.cameraText,
                       "x,y,z,lx,ly,lz,fovDeg: eye, look-at point (world metres: x right, y up, z toward the "
                       "viewer) and vertical fov (default: the ground map's viewer)");

@@ -15,6 +15,7 @@
 #include "conus/core/limits.h"
 #include "conus/renderers/context.h"
 #include "image_files.h"
+#include "output_files.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -305,8 +306,8 @@ Command addInfoCommand(CLI::App& root) {
                        "conus info photo.exr --json --density density.png",
                        "conus info asset.exr                # a reflection asset: the cube's frame and its six faces",
                        "conus info --backends"});
-    command->add_option("--density", options->densityPng,
-                        "write the sampling density as a heat map with the sampling pattern over it (.png)");
+    writesFile(command->add_option("--density", options->densityPng,
+                                   "write the sampling density as a heat map with the sampling pattern over it (.png)"));
     addQuietOption(*command);  // progress only: the description is what info is for
     return {command, [options] { return runInfo(*options); }};
 }

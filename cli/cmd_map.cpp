@@ -29,6 +29,7 @@
 #include "image_files.h"
 #include "encoding.h"
 #include "map_options.h"
+#include "output_files.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -45,9 +46,9 @@ struct OutputOptions {
 
 void addOutputOptions(CLI::App& command, OutputOptions& options) {
     addQuietOption(command);
-    command.add_option("-o,--output", options.output, "output map file (.exr, a CoNUS file)")->required();
-    command.add_option("--preview", options.preview,
-                       "also write a picture of the map (PNG, ...): density heat map with the distorted grid");
+    writesFile(command.add_option("-o,--output", options.output, "output map file (.exr, a CoNUS file)"))->required();
+    writesFile(command.add_option("--preview", options.preview,
+                                  "also write a picture of the map (PNG, ...): density heat map with the distorted grid"));
 }
 
 // "a,b" -> two finite numbers.

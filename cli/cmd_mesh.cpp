@@ -37,6 +37,7 @@
 #include "encoding.h"
 #include "image_files.h"
 #include "map_options.h"
+#include "output_files.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -389,7 +390,7 @@ CLI::App* addRender(CLI::App& command, RenderOptions& r) {
          "conus mesh render model.obj -o model.exr --size 1024x1024 --camera 0,1,3,0,0,0,40 --max-bend 0.1",
          "conus mesh render city -o city.exr --track 0,2 --time 3.5 --reference"});
     render->add_option("model", r.mesh.model, "mesh file (anything Assimp reads) or `city` (the procedural city)")->required();
-    render->add_option("-o,--output", r.output, "CoNUS file (.exr): R, G, B, A (coverage), Z (camera depth)")->required();
+    writesFile(render->add_option("-o,--output", r.output, "CoNUS file (.exr): R, G, B, A (coverage), Z (camera depth)"))->required();
     render->add_option("--focus", r.foci, "focus u,v,r,k (repeatable): centre, radius (fraction of the width), magnification");
     render->add_option("--map", r.mapFile, "take the sampling map from this CoNUS file")->excludes("--focus");
     render->add_option("--track", r.mesh.track, "city: foci on these cars' projected centres (e.g. 0,2)")

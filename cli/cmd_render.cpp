@@ -19,6 +19,7 @@
 #include "conus/renderers/relief.h"
 #include "conus/sceneio/mesh_file.h"
 #include "image_files.h"
+#include "output_files.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -132,7 +133,7 @@ CLI::App* addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
     reflection->add_option("asset", o.asset, "reflection asset (.exr, from `conus bake reflection`)")->required();
     reflection->add_option("--scene", o.scene, "the mesh file the asset was baked from (drawn behind)")->required();
     addAllowDirOption(*reflection, o.allowDirs);
-    reflection->add_option("-o,--output", o.output, "frame (.png, .exr, ...)")->required();
+    writesFile(reflection->add_option("-o,--output", o.output, "frame (.png, .exr, ...)"))->required();
     reflection->add_option("--camera", o.cameraText, "x,y,z,lx,ly,lz,fovDeg")->required();
     reflection->add_option("--size", o.sizeText, "frame size WxH")->capture_default_str();
     reflection->add_option("--reflector", o.reflector, "the mirror's shape")
@@ -156,7 +157,7 @@ CLI::App* addRenderRelief(CLI::App& command, RenderOptions& o) {
                                       "conus render relief tablet.exr -o frame.png --shadows --size 1280x960",
                                       "conus render relief tablet.exr -o frame.png --camera 0.5,0.6,1.2,0.5,0,0.375,35"});
     relief->add_option("input", o.input, "relief asset (.exr, from `conus bake relief`)")->required();
-    relief->add_option("-o,--output", o.output, "frame (.png, .exr, ...)")->required();
+    writesFile(relief->add_option("-o,--output", o.output, "frame (.png, .exr, ...)"))->required();
     relief->add_option("--camera", o.cameraText,
                        "x,y,z,lx,ly,lz,fovDeg: eye, look-at point (world: x right, y up, z toward the front "
                        "edge) and vertical fov (default: from the front, above)");

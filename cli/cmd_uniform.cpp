@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "encoding.h"
 #include "image_files.h"
+#include "output_files.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -45,7 +46,7 @@ CLI::App* declareUniform(CLI::App& root, UniformOptions& options) {
          "conus uniform photo.png -o same.exr --size 4000x3000   # at source size: an exact round trip",
          "conus uniform photo.jpg -o uniform.exr --fit           # fitted to its bilinear decode, like encode --fit"});
     command->add_option("input", options.input, "source image ('-' reads standard input)")->required();
-    command->add_option("-o,--output", options.output, "output CoNUS file (.exr)")->required();
+    writesFile(command->add_option("-o,--output", options.output, "output CoNUS file (.exr)"))->required();
     addSourceOptions(*command, options.source);
     addStorageOptions(*command, options.storage);
     addFitOption(*command, options.fit);

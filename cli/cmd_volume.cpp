@@ -31,6 +31,7 @@
 #include "encoding.h"
 #include "image_files.h"
 #include "map_options.h"
+#include "output_files.h"
 #include "pictures.h"
 #include "progress.h"
 
@@ -254,8 +255,8 @@ Command addVolumeCommand(CLI::App& root) {
                        "file.vdb | file.nrrd | file.nhdr | file.den | " + sceneio::rawVolumeForm() +
                            " | procedural:marschner-lobb[:n] | procedural:shepp-logan[:n]")
         ->required();
-    render->add_option("-o,--output", o->output, "the CoNUS file to write (.exr)")->required();
-    render->add_option("--picture", o->picture, "also write the CoNUS image's colour as a picture (PNG)");
+    writesFile(render->add_option("-o,--output", o->output, "the CoNUS file to write (.exr)"))->required();
+    writesFile(render->add_option("--picture", o->picture, "also write the CoNUS image's colour as a picture (PNG)"));
     render->add_option("--size", o->sizeText, "CoNUS image size WxH")->capture_default_str();
     render->add_option("--camera", o->cameraText,
                        "ex,ey,ez,lx,ly,lz,fovDeg: eye, look-at point and vertical field of view, in the volume's world "

@@ -11,6 +11,7 @@
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
+#include "output_files.h"
 #include "progress.h"
 
 
@@ -64,6 +65,7 @@ int main(int argc, char** argv) {
         name = command.app->get_name();
         conus::cli::beginCommand(name);
         try {
+            conus::cli::checkOutputsOfCommand(*command.app);
             const int code = command.run();
             if (code == 0) conus::cli::printTotal();
             return code;

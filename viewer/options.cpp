@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "../cli/option_checks.h"
+#include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 
 namespace conus::viewer {
@@ -157,6 +158,12 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
             throw Error(ErrorCode::InvalidArgument, "--screenshot needs a CoNUS file or a 3-D mode");
         if (!o.uniform.empty() && o.files.empty() && o.sceneKind == SceneKind::None) throw Error(ErrorCode::InvalidArgument, "--uniform goes with a CoNUS file");
         if (o.benchmarkFrames < 0) throw Error(ErrorCode::InvalidArgument, "--benchmark-frames must be >= 0");
+        // What the viewer reads is never replaced by what it writes (a screenshot, the editor's
+        // saves): every file named on the command line but the outputs is protected.
+        for (const CLI::Option* option : app.get_options())
+            if (option->get_name() != "--screenshot" && option->get_name() != "--output")
+                for (const std::string& value : option->results()) protectInput(value);
+        if (!o.screenshot.empty()) checkNotAnInput(o.screenshot);
     } catch (const CLI::ParseError& e) {
         if (e.get_exit_code() == 0) {  // --help
             *exitCode = app.exit(e);

@@ -3,6 +3,8 @@
 #include "conus/core/atomic_file.h"
 
 #include <fcntl.h>
+#include <pthread.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -13,11 +15,10 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <mutex>
-#include <regex>
-#include <set>
-#include <sstream>
+#include <optional>
+#include <utility>
+#include <vector>
 #include <system_error>
 
 #include "conus/core/error.h"
@@ -31,18 +32,24 @@ namespace {
 constexpr int kSlots = 256;
 constexpr std::size_t kPathBytes = 4096;
 enum SlotState : int { kFree = 0, kFilling = 1, kActive = 2 };
+// A temporary is known by its name and by the file it was created as (device and inode): what
+// is removed is only ever that file, never whatever has been put under its name since.
 struct Slot {
     std::atomic<int> state{kFree};
     char path[kPathBytes];
+    dev_t device;
+    ino_t inode;
 };
 Slot g_slots[kSlots];
 
-int registerTemporary(const std::string& path) {
+int registerTemporary(const std::string& path, dev_t device, ino_t inode) {
     if (path.size() + 1 > kPathBytes) return -1;
     for (int i = 0; i < kSlots; ++i) {
         int expected = kFree;
         if (!g_slots[i].state.compare_exchange_strong(expected, kFilling)) continue;
         std::memcpy(g_slots[i].path, path.c_str(), path.size() + 1);
+        g_slots[i].device = device;
+        g_slots[i].inode = inode;
         g_slots[i].state.store(kActive);
         return i;
     }
@@ -53,14 +60,23 @@ void unregisterTemporary(int slot) {
     if (slot >= 0) g_slots[slot].state.store(kFree);
 }
 
+// Whether `path` is still the file this process created there (async-signal-safe).
+bool isOwnTemporary(const char* path, dev_t device, ino_t inode) {
+    struct stat st {};
+    return ::lstat(path, &st) == 0 && S_ISREG(st.st_mode) && st.st_dev == device && st.st_ino == inode;
+}
+
+// Removes `path` when it is still that file: never anything else put under its name.
+void removeOwnTemporary(const char* path, dev_t device, ino_t inode) {
+    if (isOwnTemporary(path, device, inode)) ::unlink(path);
+}
+
 extern "C" void removeTemporariesAndDie(int signal) {
     for (Slot& slot : g_slots)
-        if (slot.state.load() == kActive) ::unlink(slot.path);
+        if (slot.state.load() == kActive) removeOwnTemporary(slot.path, slot.device, slot.inode);
     std::signal(signal, SIG_DFL);
     std::raise(signal);
 }
-
-std::atomic<unsigned> g_counter{0};
 
 // The set of outputs this thread's commits wait in, if any (AtomicOutputs).
 thread_local AtomicOutputs* t_outputs = nullptr;
@@ -87,60 +103,67 @@ void checkReplaceable(const std::string& destination, const std::string& target,
                               " is not a regular file (a device, FIFO or socket); CoNUS writes regular files only");
 }
 
-// ---- stale temporaries -------------------------------------------------------------------------
+// ---- temporary names --------------------------------------------------------------------------
 
-// ".<stem>.tmp-<pid>-<n><ext>": what the constructor below names a temporary.
+// ".<stem>.tmp-<12 random letters and digits><ext>": unpredictable, so that nobody can plant a
+// link or a file under the name before it is created (and creation is exclusive besides).
 std::string temporaryName(const fs::path& target) {
-    return "." + target.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-           std::to_string(g_counter.fetch_add(1)) + target.extension().string();
+    static constexpr char kAlphabet[] = "abcdefghijklmnopqrstuvwxyz0123456789";
+    unsigned char random[12];
+    std::size_t got = 0;
+    while (got < sizeof random) {
+        const ssize_t n = ::getrandom(random + got, sizeof random - got, 0);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) throw Error(ErrorCode::Io, "cannot name a temporary file: no random numbers (" + errnoText(errno) + ")");
+        got += static_cast<std::size_t>(n);
+    }
+    std::string name = ".";
+    name += target.stem().string();
+    name += ".tmp-";
+    for (unsigned char r : random) name += kAlphabet[r % (sizeof kAlphabet - 1)];
+    name += target.extension().string();
+    return name;
 }
 
-// When process `pid` started, in seconds since the epoch; -1 when no such process runs.
-double processStart(long pid) {
-    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-    std::string text;
-    if (!std::getline(stat, text)) return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM ? 0.0 : -1.0;
-    // Field 22 (starttime, clock ticks after boot) follows the command name in parentheses.
-    const std::size_t close = text.rfind(')');
-    if (close == std::string::npos) return 0.0;
-    std::istringstream fields(text.substr(close + 2));
-    std::string field;
-    for (int i = 3; i < 22 && fields >> field;) ++i;
-    double ticks = 0;
-    if (!(fields >> ticks)) return 0.0;
-    std::ifstream boot("/proc/stat");
-    double bootTime = 0;
-    for (std::string line; std::getline(boot, line);)
-        if (line.rfind("btime ", 0) == 0) bootTime = std::stod(line.substr(6));
-    return bootTime + ticks / double(::sysconf(_SC_CLK_TCK));
+// ---- inputs that no output may replace ---------------------------------------------------------
+
+std::mutex g_inputsMutex;
+std::vector<std::pair<std::string, std::pair<dev_t, ino_t>>> g_inputs;  // as named, and the file
+
+// The input that `path` (followed through links) is, if any.
+std::optional<std::string> protectedInputAt(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return std::nullopt;
+    std::lock_guard lock(g_inputsMutex);
+    for (const auto& [name, file] : g_inputs)
+        if (file.first == st.st_dev && file.second == st.st_ino) return name;
+    return std::nullopt;
+}
+
+[[noreturn]] void refuseInput(const std::string& output, const std::string& input) {
+    throw Error(ErrorCode::InvalidArgument,
+                "refusing to write " + output + ": it is the input " +
+                    (input == output ? std::string("file") : input + " (the same file)") + "; name another output");
 }
 
 }  // namespace
 
-void removeStaleTemporaries(const std::string& folder) {
-    static std::mutex mutex;
-    static std::set<std::string> done;
-    std::error_code ec;
-    const std::string key = fs::weakly_canonical(folder.empty() ? "." : folder, ec).string();
-    {
-        std::lock_guard lock(mutex);
-        if (!done.insert(key).second) return;
-    }
-    static const std::regex kName(R"(\..*\.tmp-([0-9]{1,9})-[0-9]{1,10}(\.[^.]*)?)");
-    fs::directory_iterator entries(folder.empty() ? "." : folder, ec);
-    if (ec) return;
-    for (; entries != fs::directory_iterator(); entries.increment(ec)) {
-        if (ec) return;
-        const std::string name = entries->path().filename().string();
-        std::smatch m;
-        if (name.empty() || name[0] != '.' || !std::regex_match(name, m, kName)) continue;
-        const long pid = std::stol(m[1].str());
-        if (pid == ::getpid()) continue;
-        struct stat st {};
-        if (::lstat(entries->path().c_str(), &st) != 0 || !(S_ISREG(st.st_mode) || S_ISDIR(st.st_mode))) continue;
-        const double started = processStart(pid);
-        if (started >= 0 && started <= double(st.st_mtime) + 1) continue;  // its process still runs
-        fs::remove_all(entries->path(), ec);
+void protectInput(const std::string& path) {
+    if (path.empty() || path == "-") return;
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
+    std::lock_guard lock(g_inputsMutex);
+    g_inputs.push_back({path, {st.st_dev, st.st_ino}});
+}
+
+void checkNotAnInput(const std::string& output, std::span<const std::string> inputs) {
+    if (const auto input = protectedInputAt(output)) refuseInput(output, *input);
+    struct stat out {};
+    if (::stat(output.c_str(), &out) != 0) return;  // absent (or unreachable): replaces nothing
+    for (const std::string& input : inputs) {
+        struct stat in {};
+        if (input.empty() || input == "-" || ::stat(input.c_str(), &in) != 0) continue;
+        if (in.st_dev == out.st_dev && in.st_ino == out.st_ino) refuseInput(output, input);
     }
 }
 
@@ -149,18 +172,41 @@ void removeStaleTemporaries(const std::string& folder) {
 AtomicFile::AtomicFile(const std::string& destination) : m_destination(destination), m_target(targetOf(destination)) {
     if (destination.empty()) throw Error(ErrorCode::InvalidArgument, "no output file name given");
     checkReplaceable(m_destination, m_target, ErrorCode::Io);
+    if (const auto input = protectedInputAt(m_target)) refuseInput(m_destination, *input);
     const fs::path target(m_target);
     const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-    removeStaleTemporaries(folder.string());
-    m_temporary = (folder / temporaryName(target)).string();
-    // Registered before it exists, so a signal between open and registration leaves nothing.
-    m_slot = registerTemporary(m_temporary);
-    m_fd = ::open(m_temporary.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (m_fd < 0) {
-        const int error = errno;
-        unregisterTemporary(m_slot);
-        throw Error(ErrorCode::Io, "cannot write " + m_destination + ": " + errnoText(error));
+    // Signals wait until the new file is registered, so that one arriving in between leaves nothing.
+    sigset_t blocked, previous;
+    sigemptyset(&blocked);
+    for (int signal : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&blocked, signal);
+    ::pthread_sigmask(SIG_BLOCK, &blocked, &previous);
+    int error = 0;
+    for (int attempt = 0; attempt < 100 && m_fd < 0; ++attempt) {
+        m_temporary = (folder / temporaryName(target)).string();
+        // Exclusive and not through a link: a name someone else made (a file, a link) is never
+        // opened, and the next random name is tried.
+        m_fd = ::open(m_temporary.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        error = errno;
+        if (m_fd < 0 && error != EEXIST) break;
     }
+    struct stat made {};
+    if (m_fd >= 0 && ::fstat(m_fd, &made) == 0) {
+        m_device = made.st_dev;
+        m_inode = made.st_ino;
+        m_slot = registerTemporary(m_temporary, m_device, m_inode);
+    } else if (m_fd >= 0) {
+        error = errno;
+        ::close(m_fd);
+        m_fd = -1;  // never stat'ed: not known to be ours, so left where it is
+    }
+    ::pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+    if (m_fd < 0) throw Error(ErrorCode::Io, "cannot write " + m_destination + ": " + errnoText(error));
+    // Libraries that open by name reopen this very file through /proc, whatever is put under the
+    // temporary's name meanwhile.
+    m_openPath = "/proc/" + std::to_string(::getpid()) + "/fd/" + std::to_string(m_fd);
+    struct stat viaProc {};
+    if (::stat(m_openPath.c_str(), &viaProc) != 0 || viaProc.st_dev != m_device || viaProc.st_ino != m_inode)
+        m_openPath = m_temporary;  // no /proc: the exclusively created name
     // A replaced file keeps its permissions.
     struct stat st {};
     if (::stat(m_target.c_str(), &st) == 0) ::fchmod(m_fd, st.st_mode & 07777);
@@ -170,7 +216,7 @@ AtomicFile::AtomicFile(const std::string& destination) : m_destination(destinati
 AtomicFile::~AtomicFile() {
     if (m_committed) return;
     if (m_fd >= 0) ::close(m_fd);
-    ::unlink(m_temporary.c_str());
+    removeOwnTemporary(m_temporary.c_str(), m_device, m_inode);
     unregisterTemporary(m_slot);
 }
 
@@ -243,12 +289,14 @@ void AtomicFile::commit() {
     m_fd = -1;
     if (::close(fd) != 0) fail("cannot close it", errno);
     if (t_outputs) {  // finished; renamed with the rest of the command's outputs
-        t_outputs->m_waiting.push_back({m_destination, m_target, m_temporary, m_slot});
+        t_outputs->m_waiting.push_back({m_destination, m_target, m_temporary, m_device, m_inode, m_slot});
         m_committed = true;
         return;
     }
-    // Refused again at the last moment: something may have appeared at the destination meanwhile.
+    // Refused again at the last moment: something may have appeared at the destination meanwhile,
+    // or something else under the temporary's name.
     checkReplaceable(m_destination, m_target, ErrorCode::Io);
+    if (!isOwnTemporary(m_temporary.c_str(), m_device, m_inode)) fail("the temporary file was replaced", 0);
     if (::rename(m_temporary.c_str(), m_target.c_str()) != 0) fail("cannot move the finished file into place", errno);
     m_committed = true;
     unregisterTemporary(m_slot);
@@ -270,12 +318,7 @@ void checkOutputPath(const std::string& output, std::span<const std::string> inp
     std::error_code ec;
     if (!folder.empty() && !fs::is_directory(folder, ec))
         throw Error(ErrorCode::InvalidArgument, output + ": the folder " + folder.string() + " does not exist");
-    for (const std::string& input : inputs) {
-        if (input.empty() || input == "-") continue;
-        if (fs::equivalent(input, output, ec))
-            throw Error(ErrorCode::InvalidArgument, "the output " + output + " is the input file " + input +
-                                                        "; writing it would destroy the input");
-    }
+    checkNotAnInput(output, inputs);
 }
 
 void checkInputPath(const std::string& input, bool allowStdin) {
@@ -312,7 +355,7 @@ AtomicOutputs::~AtomicOutputs() {
     if (t_outputs == this) t_outputs = m_outer;
     if (m_committed) return;
     for (const Waiting& w : m_waiting) {
-        ::unlink(w.temporary.c_str());
+        removeOwnTemporary(w.temporary.c_str(), w.device, w.inode);
         unregisterTemporary(w.slot);
     }
     std::error_code ec;
@@ -348,6 +391,8 @@ void AtomicOutputs::commit() {
         const Waiting& w = m_waiting[renamed];
         try {
             checkReplaceable(w.destination, w.target, ErrorCode::Io);
+            if (!isOwnTemporary(w.temporary.c_str(), w.device, w.inode))
+                throw Error(ErrorCode::Io, "cannot write " + w.destination + ": the temporary file was replaced");
             if (::rename(w.temporary.c_str(), w.target.c_str()) != 0) {
                 const int error = errno;
                 throw Error(ErrorCode::Io, "cannot write " + w.destination + ": cannot move the finished file into place: " +

@@ -2,7 +2,10 @@
 // OpenEXR screen, the part, the limits before memory, integer samples through tables, colour to
 // linear light with associated alpha, metadata, the EXIF orientation. OpenImageIO's failures
 // become conus::Error right where it is called, naming the user's path.
+#include <sys/mman.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <algorithm>
 #include <array>
@@ -110,26 +113,32 @@ bool isOpenExr(const unsigned char* bytes, std::size_t size) {
 // OpenEXR files are screened before OpenImageIO opens them (format/exr_check.h): it reads them with
 // OpenEXR's C++ library, which allocates what a header declares (a 1.9 GB attribute in a 4 KB file
 // cost 8 s and 2 GB; a 32768x32768 window in 5 KB, 73 s and 12.7 GB). Standard input is screened
-// from a temporary copy, since the screen reads a file. Returns the file's size in bytes.
+// from an anonymous copy (memfd_create: no name in any folder, so nothing to plant a link at and
+// nothing left behind), read through /proc/self/fd, since the screen reads a file. Returns the
+// file's size in bytes.
 std::uintmax_t screenInput(const std::string& path, const StdinImage& stdinImage, const Limits& limits) {
     if (path == "-") {
         const std::vector<unsigned char>& bytes = stdinImage.bytes;
         if (isOpenExr(bytes.data(), bytes.size())) {
-            const std::filesystem::path copy =
-                std::filesystem::temp_directory_path() / ("conus-stdin-" + std::to_string(::getpid()) + ".exr");
-            struct Remove {
-                const std::filesystem::path& path;
-                ~Remove() { std::error_code ec; std::filesystem::remove(path, ec); }
-            } remove{copy};
-            std::FILE* f = std::fopen(copy.c_str(), "wb");
-            const bool written = f && std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-            if (f && std::fclose(f) != 0) throw Error(ErrorCode::Io, "cannot copy standard input to " + copy.string());
-            if (!written) throw Error(ErrorCode::Io, "cannot copy standard input to " + copy.string());
+            const int fd = ::memfd_create("conus-stdin", MFD_CLOEXEC);
+            if (fd < 0) throw Error(ErrorCode::Io, "cannot screen standard input: " + std::string(std::strerror(errno)) + "; give a file instead");
+            struct Close {
+                int fd;
+                ~Close() { ::close(fd); }
+            } closer{fd};
+            std::size_t done = 0;
+            while (done < bytes.size()) {
+                const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+                if (n < 0 && errno == EINTR) continue;
+                if (n <= 0) throw Error(ErrorCode::Io, "cannot screen standard input: " + std::string(std::strerror(n < 0 ? errno : ENOSPC)));
+                done += static_cast<std::size_t>(n);
+            }
+            const std::string copy = "/proc/self/fd/" + std::to_string(fd);
             try {
-                format::checkExrFile(copy.string(), limits);
+                format::checkExrFile(copy, limits);
             } catch (const Error& e) {
                 const std::string what = e.what();
-                throw Error(e.code(), "standard input" + what.substr(std::min(what.size(), copy.string().size())));
+                throw Error(e.code(), "standard input" + what.substr(what.rfind(copy, 0) == 0 ? copy.size() : 0));
             }
         }
         return bytes.size();

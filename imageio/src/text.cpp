@@ -16,6 +16,10 @@ namespace conus::imageio::oiio {
 constexpr const char* kFont = "DejaVuSans";
 
 void drawText(Image& image, int x, int y, int size, const std::string& text, const float color[3]) {
+    // Text wholly outside the image is not drawn: OpenImageIO 2.4's render_text fails an assertion
+    // (ends the process) on text entirely above or below the image.
+    if (const OIIO::ROI box = OIIO::ImageBufAlgo::text_size(text, size, kFont); box.defined())
+        if (y + box.yend <= 0 || y + box.ybegin >= image.height || x + box.xend <= 0 || x + box.xbegin >= image.width) return;
     OIIO::ImageSpec spec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT);
     OIIO::ImageBuf buffer(spec, image.pixels.data());  // wraps our pixels: drawn in place
     const float rgba[4] = {color[0], color[1], color[2], 1.0f};

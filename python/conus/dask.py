@@ -43,6 +43,11 @@ def _convert(item, out_dir, name, skip_existing, options):
             row["status"] = "skipped"
             return row
         in_fs, in_path = fsspec.core.url_to_fs(path)
+        if (isinstance(in_fs, LocalFileSystem) and isinstance(out_fs, LocalFileSystem) and os.path.exists(out_path)
+                and os.path.samefile(in_path, out_path)):
+            row["status"] = "failed"
+            row["error"] = f"refusing to write {output}: it is the input {path} (the same file); name another output"
+            return row
         with tempfile.TemporaryDirectory(prefix="conus-dask-") as work:
             local_in = in_path if isinstance(in_fs, LocalFileSystem) else os.path.join(work, os.path.basename(in_path))
             if local_in != in_path:

@@ -12,6 +12,7 @@
 #include <string>
 #include <system_error>
 
+#include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "conus/core/parallel.h"
 #include "conus/sceneio/volume_file.h"
@@ -22,11 +23,6 @@ namespace {
 void initializeOnce() {
     static std::once_flag flag;
     std::call_once(flag, [] { openvdb::initialize(); });
-}
-
-std::error_code& ec_ignore() {
-    thread_local std::error_code ignored;
-    return ignored;
 }
 
 }  // namespace
@@ -104,23 +100,17 @@ void writeVdbVolume(const std::string& path, const Volume& volume, float backgro
                 const float v = volume.at(x, y, z);
                 if (v != background) accessor.setValue(openvdb::Coord(x, y, z), v);
             }
-    // OpenVDB writes to a path of its own: a temporary beside the destination, renamed over it
-    // once complete, so a reader never sees half a file.
-    const std::string temporary = path + ".tmp-conus";
+    // OpenVDB writes by name: into the AtomicFile's temporary (reopened through /proc, never a
+    // name someone could plant), renamed over the destination once complete.
+    AtomicFile out(path);
     try {
-        openvdb::io::File file(temporary);
+        openvdb::io::File file(out.temporaryPath());
         file.write({grid});
         file.close();
     } catch (const openvdb::Exception& e) {
-        std::filesystem::remove(temporary, ec_ignore());
         throw Error(ErrorCode::Io, "vdb volume '" + path + "': " + e.what());
     }
-    std::error_code ec;
-    std::filesystem::rename(temporary, path, ec);
-    if (ec) {
-        std::filesystem::remove(temporary, ec_ignore());
-        throw Error(ErrorCode::Io, "vdb volume '" + path + "': " + ec.message());
-    }
+    out.commit();
 }
 
 }  // namespace conus::sceneio

@@ -313,22 +313,6 @@ TEST_F(SceneHostile, SmallerItemsHaveTheirExitCodes) {
     EXPECT_EQ(errorLines(r.err).size(), 1u) << r.err;
 }
 
-// What SIGKILL leaves (a temporary of a process that is gone) is removed by the next write into
-// the folder; the temporary of a process that still runs stays.
-TEST_F(SceneHostile, StaleTemporariesAreRemovedByTheNextRun) {
-    const pid_t child = ::fork();
-    if (child == 0) ::_exit(0);
-    ::waitpid(child, nullptr, 0);  // its id now names no process
-    const std::string stale = ".u.tmp-" + std::to_string(child) + "-0.exr";
-    const std::string live = ".u.tmp-" + std::to_string(::getpid()) + "-0.exr";
-    write(stale, "half a file");
-    write(live, "being written");
-    write("a.pgm", "P2\n2 2\n255\n0 1 2 3\n");
-    ASSERT_EQ(run({"uniform", path("a.pgm"), "-o", path("u.exr"), "--size", "2x2"}).exitCode, 0);
-    EXPECT_FALSE(fs::exists(m_dir / stale));
-    EXPECT_TRUE(fs::exists(m_dir / live));
-}
-
 // A reflection asset is one file written as a whole: a new bake replaces the earlier asset, a
 // failed one leaves it as it was, and neither leaves a temporary file.
 TEST_F(SceneHostile, AReflectionAssetIsWrittenAsAWhole) {

@@ -8,8 +8,12 @@
 
 #include <algorithm>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -42,7 +46,8 @@ std::string slurp(const std::string& path) {
 TEST_F(AtomicFileTest, WritesAppendsAndPatchesThenRenames) {
     conus::AtomicFile file(path("out.bin"));
     EXPECT_FALSE(fs::exists(path("out.bin"))) << "nothing at the destination before commit";
-    EXPECT_NE(file.temporaryPath().find(".out.tmp-"), std::string::npos);
+    ASSERT_EQ(entries().size(), 1u);
+    EXPECT_EQ(entries()[0].rfind(".out.tmp-", 0), 0u) << entries()[0];
     std::string big(3 << 20, 'x');  // past the buffer: written straight through
     file.write("head", 4);
     file.write(big.data(), big.size());
@@ -230,4 +235,105 @@ TEST_F(AtomicFileTest, SigtermRemovesTheOutputsWaitingInASet) {
     int status = 0;
     ASSERT_EQ(::waitpid(child, &status, 0), child);
     EXPECT_TRUE(entries().empty()) << "the signal removed it";
+}
+
+// The one temporary entry in the test folder besides `except`.
+static std::string onlyTemporary(const std::vector<std::string>& names) {
+    std::string found;
+    for (const std::string& n : names)
+        if (n.find(".tmp-") != std::string::npos) {
+            EXPECT_TRUE(found.empty()) << "two temporaries: " << found << ", " << n;
+            found = n;
+        }
+    return found;
+}
+
+TEST_F(AtomicFileTest, TemporaryNamesAreUnpredictableAndCarryNoProcessId) {
+    std::vector<std::unique_ptr<conus::AtomicFile>> files;
+    std::set<std::string> names;
+    for (int i = 0; i < 20; ++i) {
+        files.push_back(std::make_unique<conus::AtomicFile>(path("same.exr")));
+        for (const std::string& n : entries()) names.insert(n);
+    }
+    EXPECT_EQ(names.size(), 20u) << "twenty writers of one destination, twenty names";
+    const std::string pid = std::to_string(::getpid());
+    for (const std::string& n : names) {
+        EXPECT_EQ(n.rfind(".same.tmp-", 0), 0u) << n;
+        EXPECT_EQ(n.size(), std::string(".same.tmp-").size() + 12 + 4) << n;
+        EXPECT_EQ(n.find(pid), std::string::npos) << n;
+        EXPECT_EQ(n.substr(n.size() - 4), ".exr") << "the destination's extension, for libraries that look at it";
+    }
+    files.clear();
+    EXPECT_TRUE(entries().empty()) << "each removed its own";
+}
+
+TEST_F(AtomicFileTest, ALinkPutUnderTheTemporarysNameIsNeitherWrittenNorRenamedNorRemoved) {
+    { std::ofstream(path("victim.txt")) << "precious"; }
+    conus::AtomicFile file(path("out.tif"));
+    const std::string temporary = onlyTemporary(entries());
+    ASSERT_FALSE(temporary.empty());
+    // Someone with write access to the folder swaps the temporary for a link to another file.
+    ASSERT_EQ(::unlink(path(temporary).c_str()), 0);
+    fs::create_symlink(path("victim.txt"), path(temporary));
+    // A library that writes by name (as OpenImageIO's TIFF writer and ffmpeg do) writes the file
+    // the AtomicFile created, not the link.
+    EXPECT_EQ(file.temporaryPath().find(temporary), std::string::npos) << file.temporaryPath();
+    { std::ofstream(file.temporaryPath(), std::ios::binary | std::ios::trunc) << "library bytes"; }
+    EXPECT_EQ(slurp(path("victim.txt")), "precious");
+    EXPECT_THROW(file.commit(), conus::Error) << "what is under the name now is not the file written";
+    EXPECT_FALSE(fs::exists(path("out.tif")));
+    EXPECT_TRUE(fs::is_symlink(path(temporary))) << "the stranger's link is left alone";
+    EXPECT_EQ(slurp(path("victim.txt")), "precious");
+}
+
+TEST_F(AtomicFileTest, AFailedWriterRemovesOnlyTheFileItMade) {
+    auto file = std::make_unique<conus::AtomicFile>(path("out.exr"));
+    const std::string temporary = onlyTemporary(entries());
+    ASSERT_FALSE(temporary.empty());
+    ASSERT_EQ(::unlink(path(temporary).c_str()), 0);
+    { std::ofstream(path(temporary)) << "someone else's"; }
+    file.reset();  // destroyed without commit
+    EXPECT_EQ(slurp(path(temporary)), "someone else's") << "a file this process did not make is never removed";
+}
+
+TEST_F(AtomicFileTest, LookAlikeTemporariesOfOtherProcessesAreNeverRemoved) {
+    // Names of the old "<pid>-<counter>" kind, of processes that are not running, a folder among them.
+    fs::create_directory(path(".photos.tmp-999999-1"));
+    { std::ofstream(path(".photos.tmp-999999-1/keep.txt")) << "keep"; }
+    { std::ofstream(path(".notes.tmp-424242-7.txt")) << "notes"; }
+    { std::ofstream(path(".out.tmp-999998-0.exr")) << "mine"; }
+    conus::writeFileAtomically(path("out.exr"), std::vector<unsigned char>{'x'});
+    EXPECT_EQ(slurp(path(".photos.tmp-999999-1/keep.txt")), "keep");
+    EXPECT_EQ(slurp(path(".notes.tmp-424242-7.txt")), "notes");
+    EXPECT_EQ(slurp(path(".out.tmp-999998-0.exr")), "mine");
+}
+
+TEST_F(AtomicFileTest, AProtectedInputIsNeverReplacedByAnyPath) {
+    { std::ofstream(path("input.exr")) << "input"; }
+    fs::create_symlink(path("input.exr"), path("soft.exr"));
+    fs::create_hard_link(path("input.exr"), path("hard.exr"));
+    // In a child: the protection lasts as long as the process (and inodes are reused later).
+    const auto child = [&] {
+        conus::protectInput(path("input.exr"));
+        int wrong = 0;
+        for (const char* name : {"input.exr", "soft.exr", "hard.exr", "./input.exr"}) {
+            try {
+                conus::AtomicFile file(path(name));
+                std::fprintf(stderr, "%s was opened for writing\n", name), ++wrong;
+            } catch (const conus::Error& e) {
+                if (std::string(e.what()).rfind("refusing to write " + path(name) + ": it is the input", 0) != 0)
+                    std::fprintf(stderr, "%s\n", e.what()), ++wrong;
+            }
+            try {
+                conus::checkNotAnInput(path(name));
+                std::fprintf(stderr, "%s passed checkNotAnInput\n", name), ++wrong;
+            } catch (const conus::Error&) {
+            }
+        }
+        conus::writeFileAtomically(path("other.exr"), std::vector<unsigned char>{'o'});
+        std::exit(wrong);
+    };
+    EXPECT_EXIT(child(), ::testing::ExitedWithCode(0), "");
+    EXPECT_EQ(slurp(path("input.exr")), "input");
+    EXPECT_EQ(slurp(path("other.exr")), "o") << "other files are written as ever";
 }

@@ -46,6 +46,21 @@ def test_a_local_cluster_of_two_workers_converts_a_directory(tmp_path, pictures)
     assert (again.count("skipped"), again.count("failed")) == (4, 1)
 
 
+def test_an_output_that_is_its_input_is_refused_and_the_input_kept(pictures, asymmetric):
+    source = pictures / "e.exr"  # a picture the encoder would replace by its CoNUS file
+    conus.write_image(str(source), asymmetric[..., :3])
+    before = source.read_bytes()
+    for path in (source, pictures / "link.exr"):
+        if path != source:
+            path.symlink_to(source)
+        summary = conus.dask.encode_files([str(path)], str(pictures), name="{name}", skip_existing=False, scheduler="sync")
+        row = list(summary)[0]
+        assert row["status"] == "failed", row
+        assert row["error"].startswith(f"refusing to write {pictures}/{path.name}: it is the input"), row["error"]
+        assert source.read_bytes() == before
+    assert sorted(os.listdir(pictures)) == ["broken.png", "e.exr", "link.exr", "p0.png", "p1.png", "p2.png", "p3.png"]
+
+
 def test_an_object_store_prefix_in_and_out(pictures):
     store = fsspec.filesystem("memory")
     for name in ("p0.png", "p1.png"):

@@ -226,7 +226,7 @@ TEST(VdbVolume, SparseRoundTripOverTheActiveBox) {
     ASSERT_EQ(back.depth, 4);
     EXPECT_NEAR(back.spacing.x, 0.25, 1e-12);
     EXPECT_EQ(back.values, v.values);
-    EXPECT_FALSE(std::filesystem::exists(dir.file("v.vdb.tmp-conus")));
+    EXPECT_EQ(dir.entries(), std::vector<std::string>{"v.vdb"}) << "no temporary left";
 }
 
 TEST(VdbVolume, HostileFiles) {
