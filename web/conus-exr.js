@@ -213,12 +213,15 @@ const ConusExr = (() => {
   // OpenEXR's zip and rle filters: the byte-wise difference predictor, then the two halves
   // (even bytes, odd bytes) interleaved back.
   function unpredict(t) {
-    for (let i = 1; i < t.length; ++i) t[i] = (t[i - 1] + t[i] - 128) & 0xff;
-    const out = new Uint8Array(t.length), half = (t.length + 1) >> 1;
-    for (let i = 0, j = 0; j < t.length; ++i) {
-      out[j++] = t[i];
-      if (j < t.length) out[j++] = t[half + i];
+    const n = t.length;
+    let previous = t[0];
+    for (let i = 1; i < n; ++i) previous = t[i] = previous + t[i] - 128;  // the Uint8Array wraps mod 256
+    const out = new Uint8Array(n), half = (n + 1) >> 1, pairs = n >> 1;
+    for (let i = 0; i < pairs; ++i) {
+      out[2 * i] = t[i];
+      out[2 * i + 1] = t[half + i];
     }
+    if (n & 1) out[n - 1] = t[half - 1];
     return out;
   }
 
@@ -285,18 +288,27 @@ const ConusExr = (() => {
       if (size < 0 || at + size > bytes.length) throw new Error("damaged file: a chunk runs past the end of the file");
       if (size > expected * 2048 + 1024) throw new Error("damaged file: a chunk larger than its lines could compress to");
       const raw = await unpack(part, bytes.subarray(at, at + size), expected);
+      // Samples through typed views where aligned (every browser is little-endian, as EXR is), else a DataView.
       const rv = new DataView(raw.buffer, raw.byteOffset, raw.byteLength);
       let p = 0;
       for (let y = 0; y < h; ++y) {
         const row = (y0 + y) * width + x0;
-        channels.forEach((c, ci) => {
-          const plane = planes[ci];
-          if (c.pixelType === 1) {
-            for (let x = 0; x < w; ++x, p += 2) plane[row + x] = kHalfToFloat[rv.getUint16(p, true)];
+        for (let ci = 0; ci < channels.length; ++ci) {
+          const plane = planes[ci], at = raw.byteOffset + p;
+          if (channels[ci].pixelType === 1) {
+            if (at % 2 === 0) {
+              const line = new Uint16Array(raw.buffer, at, w);
+              for (let x = 0; x < w; ++x) plane[row + x] = kHalfToFloat[line[x]];
+            } else {
+              for (let x = 0; x < w; ++x) plane[row + x] = kHalfToFloat[rv.getUint16(p + 2 * x, true)];
+            }
+            p += 2 * w;
           } else {
-            for (let x = 0; x < w; ++x, p += 4) plane[row + x] = rv.getFloat32(p, true);
+            if (at % 4 === 0) plane.set(new Float32Array(raw.buffer, at, w), row);
+            else for (let x = 0; x < w; ++x) plane[row + x] = rv.getFloat32(p + 4 * x, true);
+            p += 4 * w;
           }
-        });
+        }
       }
     });
     await Promise.all(jobs);

@@ -85,6 +85,16 @@ void main() {
   }
   function halve(level) {
     const w = Math.max(1, level.width >> 1), h = Math.max(1, level.height >> 1);
+    if (level.width === 2 * w && level.height === 2 * h) {  // even sides: each texel the mean of four
+      const out = new Float32Array(w * h * 4), src = level.data, stride = level.width * 4;
+      for (let y = 0; y < h; ++y)
+        for (let x = 0; x < w; ++x) {
+          const s = 2 * y * stride + 8 * x, d = (y * w + x) * 4;
+          for (let c = 0; c < 4; ++c)
+            out[d + c] = 0.25 * ((src[s + c] + src[s + 4 + c]) + (src[s + stride + c] + src[s + stride + 4 + c]));
+        }
+      return { width: w, height: h, data: out };
+    }
     const wx = areaWeights(level.width, w), wy = areaWeights(level.height, h);
     const rows = new Float32Array(w * level.height * 4), out = new Float32Array(w * h * 4);
     for (let y = 0; y < level.height; ++y)
@@ -198,6 +208,16 @@ void main() {
     return [0, 0.5 - 0.5 / aspect, 1, 0.5 + 0.5 / aspect];
   }
 
+  // `v` widened about its centre to the canvas's aspect (source pixels square): a view given
+  // without a size, and the view after the window resizes.
+  function fitAspect(v) {
+    const [sw, sh] = frame.sourceSize, want = canvas.width / canvas.height;
+    const w = (v[2] - v[0]) * sw, h = (v[3] - v[1]) * sh, cu = (v[0] + v[2]) / 2, cv = (v[1] + v[3]) / 2;
+    if (w / h < want) { const hu = (h * want / sw) / 2; return [cu - hu, v[1], cu + hu, v[3]]; }
+    const hv = (w / want / sh) / 2;
+    return [v[0], cv - hv, v[2], cv + hv];
+  }
+
   let pending = false;
   function requestDraw() {
     if (pending) return;
@@ -237,6 +257,9 @@ void main() {
     window.conusFrames = frames;
   }
 
+  // For tests: the view drawn now, and how many frames the page has asked `conus serve` for.
+  window.conusView = () => view && view.slice();
+
   // For bench/web_bench.py: `count` frames of a pan and zoom about the current view, each drawn
   // and waited for (a one-pixel read), in frames a second; the view is put back.
   window.conusPanZoomRate = (count) => {
@@ -256,11 +279,13 @@ void main() {
   };
 
   function finishFirstFrame() {
+    const t0 = performance.now();
     draw();
     const pixel = new Uint8Array(4);
     gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);  // waits for the frame
     const error = gl.getError();
     if (error !== gl.NO_ERROR) throw new Error("WebGL error " + error);
+    window.conusTimings.firstDraw = performance.now() - t0;
     if (window.conusReadyAt === undefined) window.conusReadyAt = performance.now();  // ms after navigation began
     document.title = "ready";
     status.textContent = statusText();
@@ -303,7 +328,7 @@ void main() {
   }
 
   let drag = null;
-  canvas.addEventListener("pointerdown", (e) => { if (e.pointerType === "mouse") { drag = [e.clientX, e.clientY]; canvas.setPointerCapture(e.pointerId); } });
+  canvas.addEventListener("pointerdown", (e) => { if (e.pointerType !== "touch") { drag = [e.clientX, e.clientY]; canvas.setPointerCapture(e.pointerId); } });
   canvas.addEventListener("pointermove", (e) => {
     if (!drag || !view) return;
     panBy(e.clientX - drag[0], e.clientY - drag[1]);
@@ -347,7 +372,12 @@ void main() {
     else return;
     changed();
   });
-  window.addEventListener("resize", () => { if (!fixedSize && view) requestDraw(); });
+  window.addEventListener("resize", () => {
+    if (fixedSize || !view) return;
+    resize();
+    view = fitAspect(view);
+    changed();
+  });
 
   // ---- loading -------------------------------------------------------------------------------
   // Bytes of a file beside the page: fetched over HTTP; opened from disk (file://, where fetch
@@ -371,12 +401,20 @@ void main() {
     return bytes;
   }
 
+  // Where the first frame's time went (ms), for bench/web_bench.py.
+  window.conusTimings = {};
   async function show(bytes, label) {
+    const t0 = performance.now();
     const file = await ConusExr.readConus(bytes);
+    const t1 = performance.now();
     upload(file);
+    Object.assign(window.conusTimings, { parse: t1 - t0, upload: performance.now() - t1 });
     statusBase = `${label}: ${file.image.width}x${file.image.height} CoNUS image of a ${file.sourceSize[0]}x${file.sourceSize[1]} frame`;
-    if (!view) view = params.has("view") ? parseNumbers(params.get("view"), 4, "view") : wholeView();
-    if (view[0] === view[2] || view[1] === view[3]) throw new Error("view: empty");
+    if (!view) {
+      view = params.has("view") ? parseNumbers(params.get("view"), 4, "view") : wholeView();
+      if (view[0] === view[2] || view[1] === view[3]) throw new Error("view: empty");
+      if (!fixedSize) view = fitAspect(view);  // with a size the view is drawn as given, as conus decode does
+    }
     finishFirstFrame();
   }
 
@@ -431,7 +469,10 @@ void main() {
     }
     const name = params.get("file") || document.body.dataset.file;
     if (!name) throw new Error("no file: open the page with ?file=NAME.exr");
-    await show(await fileBytes(name), name);
+    const t0 = performance.now();
+    const bytes = await fileBytes(name);
+    window.conusTimings.fetch = performance.now() - t0;
+    await show(bytes, name);
   }
   start().catch(fail);
 })();

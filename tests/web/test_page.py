@@ -6,6 +6,7 @@ zoomed out. Broken and non-CoNUS files show one line of error."""
 import subprocess
 
 import pytest
+from selenium.webdriver.support.ui import WebDriverWait
 
 from conftest import CONUS, canvas_rgb, png_rgb, psnr8, wait_title
 
@@ -93,3 +94,25 @@ def test_conus_web_refuses_what_is_not_conus(served, tmp_path):
         assert done.returncode != 0
         assert len(done.stderr.strip().splitlines()) == 1, done.stderr
         assert not (tmp_path / name).exists()
+
+
+def test_drag_wheel_and_double_click_move_the_view(browser, server):
+    """Mouse drag pans by the pixels dragged, the wheel zooms about the pointer, double-click zooms in 2x there."""
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
+    assert open_page(browser, server, "file=foci.exr") == "ready"
+    canvas = browser.find_element("id", "view")
+    width = browser.execute_script("return document.getElementById('view').getBoundingClientRect().width")
+    before = browser.execute_script("return window.conusView()")
+    ActionChains(browser).move_to_element(canvas).click_and_hold().move_by_offset(100, 0).release().perform()
+    after = browser.execute_script("return window.conusView()")
+    shift = 100 / width * (before[2] - before[0])
+    assert abs((before[0] - after[0]) - shift) < 1e-3 and abs(after[1] - before[1]) < 1e-9, (before, after)
+    ActionChains(browser).scroll_from_origin(ScrollOrigin.from_element(canvas), 0, 200).perform()
+    WebDriverWait(browser, 10).until(lambda d: d.execute_script("return window.conusView()")[2] - d.execute_script("return window.conusView()")[0] > (after[2] - after[0]) * 1.01)
+    out = browser.execute_script("return window.conusView()")
+    # Zoomed about the pointer (the canvas's centre): the centre stays where it was.
+    assert abs((out[0] + out[2]) / 2 - (after[0] + after[2]) / 2) < 1e-3, (after, out)
+    ActionChains(browser).double_click(canvas).perform()
+    WebDriverWait(browser, 10).until(lambda d: abs((d.execute_script("return window.conusView()")[2] - d.execute_script("return window.conusView()")[0]) * 2 - (out[2] - out[0])) < 1e-6)
+    assert browser.title == "ready"

@@ -126,3 +126,21 @@ def test_hundred_concurrent_bad_requests(server, link_out, served):
     status, body = get(server, "/")
     assert status == 200 and b"conus-view.js" in body
     assert get(server, "/foci.exr") == (200, (served / "foci.exr").read_bytes())
+
+
+def test_double_click_asks_for_a_frame_there(browser, server):
+    """?picture: a double-click asks /frame for a focus at the clicked point; the last frame stays until it arrives."""
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.support.ui import WebDriverWait
+    browser.get(server["url"] + "?picture=photo.png&size=300x200&frame=192x128")
+    assert wait_title(browser) == "ready", browser.title
+    frames = "return performance.getEntriesByType('resource').map(e => e.name).filter(n => n.includes('/frame?'))"
+    assert len(browser.execute_script(frames)) == 1
+    canvas = browser.find_element("id", "view")
+    # 60 px right of and 40 px above the centre of a 300x200 canvas showing the whole frame.
+    ActionChains(browser).move_to_element_with_offset(canvas, 60, -40).double_click().perform()
+    WebDriverWait(browser, 60).until(lambda d: len(d.execute_script(frames)) == 2)
+    focus = urllib.parse.parse_qs(urllib.parse.urlsplit(browser.execute_script(frames)[1]).query)["focus"][0].split(",")
+    assert abs(float(focus[0]) - 0.7) < 0.01 and abs(float(focus[1]) - 0.3) < 0.01, focus
+    WebDriverWait(browser, 60).until(lambda d: "focus 0.7" in d.execute_script("return document.getElementById('status').textContent"))
+    assert browser.title == "ready"
