@@ -55,6 +55,10 @@ std::vector<unsigned char> pageBytes(const std::string& input, const format::Con
 int runWeb(const WebOptions& o) {
     checkInputPath(o.input);
     const std::string name = std::filesystem::path(o.input).filename().string();
+    const std::filesystem::path copy = std::filesystem::path(o.output) / name;
+    std::error_code same;
+    if (std::filesystem::equivalent(copy, o.input, same))
+        throw Error(ErrorCode::InvalidArgument, o.input + " is in " + o.output + " already; give another folder for the page");
     Progress reading("read " + o.input);
     const format::ConusFile file = format::readConusFile(o.input);  // a file the page would refuse is refused here
     reading.done();
@@ -64,10 +68,7 @@ int runWeb(const WebOptions& o) {
     outputs.makeFolder(o.output);
     const std::filesystem::path folder(o.output);
     const auto write = [&](const std::string& fileName, std::span<const unsigned char> data) {
-        const std::string path = (folder / fileName).string();
-        if (std::filesystem::exists(path) && std::filesystem::equivalent(path, o.input))
-            throw Error(ErrorCode::InvalidArgument, path + " is the input; give another folder");
-        writeFileAtomically(path, data);
+        writeFileAtomically((folder / fileName).string(), data);
     };
     const auto asBytes = [](const std::string& text) {
         return std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(text.data()), text.size());

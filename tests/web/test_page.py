@@ -116,3 +116,14 @@ def test_drag_wheel_and_double_click_move_the_view(browser, server):
     ActionChains(browser).double_click(canvas).perform()
     WebDriverWait(browser, 10).until(lambda d: abs((d.execute_script("return window.conusView()")[2] - d.execute_script("return window.conusView()")[0]) * 2 - (out[2] - out[0])) < 1e-6)
     assert browser.title == "ready"
+
+
+def test_conus_web_keeps_the_input(served, tmp_path):
+    """A folder that holds the input already is refused in one line, the input untouched."""
+    site = tmp_path / "here"
+    site.mkdir()
+    (site / "piz.exr").write_bytes((served / "piz.exr").read_bytes())
+    before = (site / "piz.exr").read_bytes()
+    done = subprocess.run([CONUS, "web", site / "piz.exr", "-o", site], capture_output=True, text=True)
+    assert done.returncode != 0 and len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert sorted(p.name for p in site.iterdir()) == ["piz.exr"] and (site / "piz.exr").read_bytes() == before
