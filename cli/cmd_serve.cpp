@@ -1,11 +1,10 @@
-// conus serve: the browser viewer over HTTP (cpp-httplib), bound to localhost unless told
+// conus serve: the browser viewer over HTTP (http_server.h), bound to localhost unless told
 // otherwise. It answers the page and its scripts, the files of one folder, and
 // GET /frame?file=NAME&focus=u,v,r,k&size=WxH: a CoNUS file of the picture NAME encoded on request
 // around that focus (the filtered encode, not fitted: encode --fast), kept for the next identical
 // request. Names stay inside the folder (their canonical path is checked); a bad parameter is a
 // 400 with one line, a name that is not there a 404.
 #include <CLI/CLI.hpp>
-#include <httplib.h>
 
 #include <chrono>
 #include <cmath>
@@ -29,6 +28,7 @@
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
 #include "encoding.h"
+#include "http_server.h"
 #include "image_files.h"
 #include "web_page.h"
 
@@ -85,13 +85,6 @@ std::vector<double> numbers(const std::string& text, std::size_t count, const st
     return values;
 }
 
-std::vector<unsigned char> fileBytes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (!in.eof() && in.fail()) throw Error(ErrorCode::Io, path.string() + ": cannot be read");
-    return bytes;
-}
-
 class FrameServer {
 public:
     explicit FrameServer(const ServeOptions& o) : m_options(o), m_root(fs::canonical(o.folder)) {}
@@ -99,10 +92,11 @@ public:
     const fs::path& root() const { return m_root; }
 
     // GET /frame: the CoNUS file's bytes, encoded now or kept from an identical request.
-    std::vector<unsigned char> frame(const httplib::Request& request) {
+    std::vector<unsigned char> frame(const HttpRequest& request) {
         const auto param = [&](const char* name) {
-            if (!request.has_param(name)) throw Refusal{400, std::string(name) + ": missing (frame?file=NAME&focus=u,v,r,k&size=WxH)"};
-            return request.get_param_value(name);
+            const auto found = request.params.find(name);
+            if (found == request.params.end()) throw Refusal{400, std::string(name) + ": missing (frame?file=NAME&focus=u,v,r,k&size=WxH)"};
+            return found->second;
         };
         const fs::path picture = confined(m_root, param("file"));
         const std::vector<double> f = numbers(param("focus"), 4, "focus");
@@ -139,7 +133,7 @@ public:
         applyStorage(StorageOptions{}, file);
         const fs::path temporary = fs::temp_directory_path() / ("conus-serve-" + std::to_string(::getpid()) + ".exr");
         format::writeConusFile(temporary.string(), file);
-        std::vector<unsigned char> bytes = fileBytes(temporary);
+        std::vector<unsigned char> bytes = fileBytes(temporary.string());
         fs::remove(temporary);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!quiet())
@@ -209,64 +203,31 @@ std::string contentTypeOf(const fs::path& path) {
 int runServe(const ServeOptions& o) {
     if (!fs::is_directory(o.folder)) throw Error(ErrorCode::InvalidArgument, o.folder + ": not a folder");
     FrameServer frames(o);
-    httplib::Server server;
-    server.set_payload_max_length(1 << 16);  // requests are GETs
-    server.set_read_timeout(5, 0);
-    server.set_write_timeout(30, 0);
-    // Browsers hold a few idle keep-alive connections, each a worker until it times out: more
-    // workers than the library's default (8 here), and a short keep-alive, keep bad or slow
-    // clients from starving the rest. Encodes still run one at a time (FrameServer).
-    server.new_task_queue = [] { return new httplib::ThreadPool(32); };
-    server.set_keep_alive_max_count(20);
-    server.set_keep_alive_timeout(2);
-
-    const auto refuse = [](httplib::Response& response, const Refusal& r) {
-        response.status = r.status;
-        response.set_content(r.line + "\n", "text/plain; charset=utf-8");
-    };
     const std::vector<WebFile> page = viewerFiles("");
-    for (const WebFile& f : page) {
-        const auto serveFile = [&f](const httplib::Request&, httplib::Response& response) {
-            response.set_content(f.text, f.contentType);
-            response.set_header("Cache-Control", "no-cache");
-        };
-        server.Get("/" + f.name, serveFile);
-        if (f.name == "index.html") server.Get("/", serveFile);
-    }
-    server.Get("/frame", [&](const httplib::Request& request, httplib::Response& response) {
+    const auto text = [](int status, const std::string& line) { return HttpReply{status, "text/plain; charset=utf-8", line + "\n"}; };
+    const HttpHandler handler = [&](const HttpRequest& request) -> HttpReply {
         try {
-            const std::vector<unsigned char> bytes = frames.frame(request);
-            response.set_content(reinterpret_cast<const char*>(bytes.data()), bytes.size(), "image/x-exr");
+            const std::string name = request.path == "/" ? "index.html" : request.path.substr(1);
+            for (const WebFile& f : page)
+                if (f.name == name) return {200, f.contentType, f.text};
+            if (name == "frame") {
+                const std::vector<unsigned char> bytes = frames.frame(request);
+                return {200, "image/x-exr", std::string(bytes.begin(), bytes.end())};
+            }
+            // Any other name: a file of the folder.
+            const fs::path path = confined(frames.root(), name);
+            const std::vector<unsigned char> bytes = fileBytes(path.string());
+            return {200, contentTypeOf(path), std::string(bytes.begin(), bytes.end())};
         } catch (const Refusal& r) {
-            refuse(response, r);
+            return text(r.status, r.line);
         } catch (const std::exception& e) {
-            refuse(response, {500, std::string("frame: ") + e.what()});
+            return text(500, e.what());
         }
+    };
+    serveHttp(o.host, o.port, handler, [&](int port) {
+        std::printf("serving %s at http://%s:%d/ (Ctrl-C stops)\n", frames.root().c_str(), o.host.c_str(), port);
+        std::fflush(stdout);
     });
-    // Any other name: a file of the folder.
-    server.Get(R"(/(.+))", [&](const httplib::Request& request, httplib::Response& response) {
-        try {
-            const fs::path path = confined(frames.root(), request.matches[1].str());
-            const std::vector<unsigned char> bytes = fileBytes(path);
-            response.set_content(reinterpret_cast<const char*>(bytes.data()), bytes.size(), contentTypeOf(path));
-        } catch (const Refusal& r) {
-            refuse(response, r);
-        } catch (const std::exception& e) {
-            refuse(response, {500, e.what()});
-        }
-    });
-    server.set_error_handler([&](const httplib::Request&, httplib::Response& response) {
-        if (response.body.empty()) response.set_content(std::to_string(response.status) + "\n", "text/plain; charset=utf-8");
-    });
-
-    int port = o.port;
-    if (port == 0) port = server.bind_to_any_port(o.host);
-    else if (!server.bind_to_port(o.host, port)) port = -1;
-    if (port <= 0)
-        throw Error(ErrorCode::Io, "cannot listen on " + o.host + ":" + std::to_string(o.port) + " (in use, or not an address here)");
-    std::printf("serving %s at http://%s:%d/ (Ctrl-C stops)\n", frames.root().c_str(), o.host.c_str(), port);
-    std::fflush(stdout);
-    if (!server.listen_after_bind()) throw Error(ErrorCode::Io, "the server stopped listening");
     return 0;
 }
 

@@ -25,13 +25,6 @@ struct WebOptions {
     std::string input, output;
 };
 
-std::vector<unsigned char> fileBytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (!in.eof() && in.fail()) throw Error(ErrorCode::Io, path + ": cannot be read");
-    return bytes;
-}
-
 // The file's bytes as the page reads them: as they are when stored uncompressed or with zip (the
 // compressions the page decodes), else the same file written again with zip.
 std::vector<unsigned char> pageBytes(const std::string& input, const format::ConusFile& file) {

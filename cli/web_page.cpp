@@ -1,7 +1,11 @@
 #include "web_page.h"
 
+#include <fstream>
+#include <iterator>
+
 #include <nlohmann/json.hpp>
 
+#include "conus/core/error.h"
 #include "conus/renderers/web_shader.h"
 #include "web_files.h"
 
@@ -59,6 +63,13 @@ std::vector<WebFile> viewerFiles(const std::string& defaultFile) {
 
 std::string embeddedFileScript(const std::string& name, std::span<const unsigned char> bytes) {
     return "(window.CONUS_FILES = window.CONUS_FILES || {})[" + nlohmann::json(name).dump() + "] = \"" + base64(bytes) + "\";\n";
+}
+
+std::vector<unsigned char> fileBytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.eof() && in.fail()) throw Error(ErrorCode::Io, path + ": cannot be read");
+    return bytes;
 }
 
 }  // namespace conus::cli

@@ -22,4 +22,8 @@ std::vector<WebFile> viewerFiles(const std::string& defaultFile);
 // disk (file://, where it cannot fetch) reads the CoNUS file beside it.
 std::string embeddedFileScript(const std::string& name, std::span<const unsigned char> bytes);
 
+// A file's bytes, as `conus web` copies them and `conus serve` sends them; conus::Error(Io) when
+// it cannot be read.
+std::vector<unsigned char> fileBytes(const std::string& path);
+
 }  // namespace conus::cli
