@@ -41,7 +41,8 @@ const ConusExr = (() => {
         ++this.at;
       }
       if (this.at >= this.bytes.length) throw new Error("damaged file: a header runs past the end of the file");
-      const text = new TextDecoder().decode(this.bytes.subarray(start, this.at));
+      // Control characters as "?": a name goes into one line of error.
+      const text = new TextDecoder().decode(this.bytes.subarray(start, this.at)).replace(/[\u0000-\u001f\u007f]/g, "?");
       ++this.at;
       return text;
     }
@@ -317,23 +318,26 @@ const ConusExr = (() => {
 
   // The grid rules the page relies on: V8..V11 of spec/conus-format.md.
   function checkGrid(nodes, n, m) {
-    const at = (i, j) => [nodes[2 * (j * n + i)], nodes[2 * (j * n + i) + 1]];
     for (let k = 0; k < n * m * 2; ++k) {
       if (!Number.isFinite(nodes[k])) throw new Error("not a valid CoNUS file: a sampling-map node is not finite (V8)");
       if (nodes[k] < 0 || nodes[k] > 1) throw new Error("not a valid CoNUS file: a sampling-map node lies outside [0,1] (V9)");
     }
+    const u = (i, j) => nodes[2 * (j * n + i)], v = (i, j) => nodes[2 * (j * n + i) + 1];
     for (let j = 0; j < m; ++j)
-      for (let i = 0; i < n; ++i) {
-        const [u, v] = at(i, j);
-        if ((i === 0 && u !== 0) || (i === n - 1 && u !== 1) || (j === 0 && v !== 0) || (j === m - 1 && v !== 1))
-          throw new Error(`not a valid CoNUS file: boundary node (${i}, ${j}) is off its edge (V10)`);
-      }
+      if (u(0, j) !== 0 || u(n - 1, j) !== 1) throw new Error(`not a valid CoNUS file: a boundary node of row ${j} is off its edge (V10)`);
+    for (let i = 0; i < n; ++i)
+      if (v(i, 0) !== 0 || v(i, m - 1) !== 1) throw new Error(`not a valid CoNUS file: a boundary node of column ${i} is off its edge (V10)`);
+    // V11: at each corner of each cell, taken in the order (i,j), (i+1,j), (i+1,j+1), (i,j+1), the
+    // cross product of the incident edges is positive (v down, as the identity's).
+    const cu = new Float64Array(4), cv = new Float64Array(4);
     for (let j = 0; j + 1 < m; ++j)
       for (let i = 0; i + 1 < n; ++i) {
-        const q = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+        const a = 2 * (j * n + i), b = a + 2 * n;
+        cu[0] = nodes[a]; cv[0] = nodes[a + 1]; cu[1] = nodes[a + 2]; cv[1] = nodes[a + 3];
+        cu[2] = nodes[b + 2]; cv[2] = nodes[b + 3]; cu[3] = nodes[b]; cv[3] = nodes[b + 1];
         for (let c = 0; c < 4; ++c) {
-          const a = q[(c + 3) % 4], b = q[c], d = q[(c + 1) % 4];
-          const cross = (b[0] - a[0]) * (d[1] - b[1]) - (b[1] - a[1]) * (d[0] - b[0]);
+          const p = (c + 3) & 3, q = (c + 1) & 3;
+          const cross = (cu[c] - cu[p]) * (cv[q] - cv[c]) - (cv[c] - cv[p]) * (cu[q] - cu[c]);
           if (!(cross > 1e-12)) throw new Error(`not a valid CoNUS file: map cell (${i}, ${j}) is folded or degenerate (V11)`);
         }
       }
@@ -341,7 +345,8 @@ const ConusExr = (() => {
 
   // A CoNUS file from its bytes: {image: {width, height, channels, planes, half}, map: {columns, rows,
   // nodes (Float32Array u,v per node)}, sourceSize: [w, h], foci: [[u,v,r,k]...], mapKind}.
-  async function readConus(bytes) {
+  async function readConus(bytes, limits = {}) {
+    const maxSide = limits.maxSide || 16384, maxValues = limits.maxValues || 2 ** 27;
     const parts = readParts(bytes);
     const conusIndex = parts.findIndex((p) => p.name === "conus");
     if (conusIndex < 0) {
@@ -368,6 +373,11 @@ const ConusExr = (() => {
     if (mapChannels.length !== 2 || mapChannels[0].name !== "ud" || mapChannels[1].name !== "vd" ||
         mapChannels.some((c) => c.pixelType !== 2))
       throw new Error("not a valid CoNUS file: part samplingmap does not hold exactly the FLOAT channels ud and vd (V7)");
+    // Before any pixel memory: what a browser tab can hold and a texture can show.
+    const channelCount = (value(h, "channels", "chlist") || []).length;
+    if (conus.width > maxSide || conus.height > maxSide || conus.width * conus.height * channelCount > maxValues)
+      throw new Error(`the CoNUS image is ${conus.width}x${conus.height} of ${channelCount} channels, more than this page ` +
+        `shows (${maxSide} a side, ${maxValues} values)`);
     const [image, grid] = await Promise.all([readPixels(bytes, conus, conusIndex), readPixels(bytes, mp, mapIndex)]);
     const nodes = new Float32Array(2 * n * m);
     for (let k = 0; k < n * m; ++k) {

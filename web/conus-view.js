@@ -405,7 +405,7 @@ void main() {
   window.conusTimings = {};
   async function show(bytes, label) {
     const t0 = performance.now();
-    const file = await ConusExr.readConus(bytes);
+    const file = await ConusExr.readConus(bytes, { maxSide: gl.getParameter(gl.MAX_TEXTURE_SIZE) });
     const t1 = performance.now();
     upload(file);
     Object.assign(window.conusTimings, { parse: t1 - t0, upload: performance.now() - t1 });

@@ -3,6 +3,7 @@ size (?file=NAME&view=...&size=WxH) in headless Chromium (WebGL2 on SwiftShader)
 back, is the same view decoded by `conus decode --view ... --size ...` within 40 dB PSNR (8-bit),
 for foci, importance (float, uncompressed) and analytic ground-map files, zoomed in, whole and
 zoomed out. Broken and non-CoNUS files show one line of error."""
+import pathlib
 import subprocess
 
 import pytest
@@ -127,3 +128,21 @@ def test_conus_web_keeps_the_input(served, tmp_path):
     done = subprocess.run([CONUS, "web", site / "piz.exr", "-o", site], capture_output=True, text=True)
     assert done.returncode != 0 and len(done.stderr.strip().splitlines()) == 1, done.stderr
     assert sorted(p.name for p in site.iterdir()) == ["piz.exr"] and (site / "piz.exr").read_bytes() == before
+
+
+SHARED = pathlib.Path(__file__).resolve().parents[3] / "shared" / "data"
+HOSTILE = ["hostile/dw_32768x32768_rgb_dwab.exr", "hostile/tiled_65536x16384_tile_4096_64ch.exr",
+           "exr/damaged/clusterfuzz-testcase-minimized-openexr_exrcheck_fuzzer-4675763792117760",
+           "exr/damaged/NULL_pointer", "exr/Beachball_multipart.0001.exr"]
+
+
+def test_hostile_files_say_one_line_at_once(browser, server, served):
+    """Files made to break readers (sizes that would take gigabytes, names with control bytes, damaged
+    chunks, a multipart EXR that is not CoNUS) end in one line of error, before any pixel memory."""
+    if not SHARED.is_dir():
+        pytest.skip(f"{SHARED} is absent: the hostile files were not tried")
+    for name in HOSTILE:
+        target = served / ("hostile-" + pathlib.Path(name).name)
+        target.write_bytes((SHARED / name).read_bytes())
+        title = open_page(browser, server, f"file={target.name}&size=64x64")
+        assert title.startswith("error: ") and "\n" not in title, (name, title)
