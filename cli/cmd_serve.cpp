@@ -126,19 +126,25 @@ public:
         codec::FociOptions fo;
         fo.aspect = double(source.image.width) / source.image.height;
         const std::vector<codec::Focus> foci{focus};
+        const auto seconds = [](auto from) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - from).count(); };
+        const double read = seconds(start);
+        const auto mapStart = std::chrono::steady_clock::now();
         const codec::SamplingMap map = codec::buildFociMap(foci, fo);
+        const double mapTime = seconds(mapStart);
+        const auto encodeStart = std::chrono::steady_clock::now();
         const renderers::Device device = deviceFor(m_options.backend, renderers::CpuPath::Faster, "encoding");
         format::ConusFile file = encodeToConus(device, source.image, source.info.encoding, map, size,
                                                codec::toAnalytic(foci, fo.composition, fo.falloff));
+        const double encodeTime = seconds(encodeStart);
         applyStorage(StorageOptions{}, file);
         const fs::path temporary = fs::temp_directory_path() / ("conus-serve-" + std::to_string(::getpid()) + ".exr");
         format::writeConusFile(temporary.string(), file);
         std::vector<unsigned char> bytes = fileBytes(temporary.string());
         fs::remove(temporary);
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!quiet())
-            std::fprintf(stderr, "frame %s focus %s size %dx%d: %zu bytes in %.2f s\n", picture.filename().c_str(),
-                         param("focus").c_str(), size.width, size.height, bytes.size(), seconds);
+            std::fprintf(stderr, "frame %s focus %s size %dx%d: %zu bytes in %.2f s (picture %.2f, map %.2f, encode %.2f)\n",
+                         picture.filename().c_str(), param("focus").c_str(), size.width, size.height, bytes.size(),
+                         seconds(start), read, mapTime, encodeTime);
         keep(key, bytes);
         return bytes;
     }
