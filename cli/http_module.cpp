@@ -18,6 +18,12 @@ int serve(const std::string& host, int port, const conus::cli::HttpHandler& hand
     server.set_write_timeout(30, 0);
     server.set_keep_alive_max_count(20);
     server.set_keep_alive_timeout(2);
+    // SO_REUSEADDR (a restart binds while old connections linger) but not the library's default
+    // SO_REUSEPORT, which lets a second server, or anyone's, bind the same port and take half the requests.
+    server.set_socket_options([](socket_t sock) {
+        int yes = 1;
+        setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
     server.Get(R"(/.*)", [&handler](const httplib::Request& request, httplib::Response& response) {
         conus::cli::HttpRequest r;
         r.path = request.path;

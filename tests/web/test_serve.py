@@ -144,3 +144,11 @@ def test_double_click_asks_for_a_frame_there(browser, server):
     assert abs(float(focus[0]) - 0.7) < 0.01 and abs(float(focus[1]) - 0.3) < 0.01, focus
     WebDriverWait(browser, 60).until(lambda d: "focus 0.7" in d.execute_script("return document.getElementById('status').textContent"))
     assert browser.title == "ready"
+
+
+def test_a_second_server_on_the_same_port_is_refused(server, served):
+    """No port sharing (SO_REUSEPORT): a second `conus serve` on the port in use says so in one line."""
+    port = urllib.parse.urlsplit(server["url"]).port
+    done = subprocess.run([CONUS, "serve", served, "--port", str(port)], capture_output=True, text=True, timeout=30)
+    assert done.returncode != 0 and "cannot listen" in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert get(server, "/")[0] == 200
