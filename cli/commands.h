@@ -56,7 +56,7 @@ Command addCommandGroup(CLI::App& parent, const std::string& name, const std::st
 // The subcommands, in the order `conus --help` lists them: the one list, which declares each
 // cmd_<name>.cpp's `Command add<Name>Command(CLI::App& root)` here and registers them in main.cpp.
 #define CONUS_CLI_COMMANDS(X) \
-    X(Encode) X(Uniform) X(Decode) X(Info) X(Validate) X(Demo) X(Map) X(HeightField) X(Mesh) X(Volume) X(Bake) X(Render)
+    X(Encode) X(Uniform) X(Decode) X(Info) X(Validate) X(Demo) X(Map) X(HeightField) X(Mesh) X(Volume) X(Bake) X(Render) X(Web) X(Serve)
 #define CONUS_CLI_DECLARE_COMMAND(Name) Command add##Name##Command(CLI::App& root);
 CONUS_CLI_COMMANDS(CONUS_CLI_DECLARE_COMMAND)
 #undef CONUS_CLI_DECLARE_COMMAND

@@ -31,7 +31,7 @@ set(libdir ${prefix}/${LIBDIR})
 foreach(path bin/conus ${LIBDIR}/cmake/conus/conusConfig.cmake ${LIBDIR}/cmake/conus/conusConfigVersion.cmake
         ${LIBDIR}/pkgconfig/conus.pc include/conus/codec/image/encode.h share/doc/conus/spec/conus-format.md
         share/man/man1/conus.1 ${LIBDIR}/python3/dist-packages/conus/__init__.py
-        ${LIBDIR}/libconus_imageio_oiio.so ${LIBDIR}/conus/libconus_faces.so)
+        ${LIBDIR}/libconus_imageio_oiio.so ${LIBDIR}/conus/libconus_faces.so ${LIBDIR}/conus/libconus_http.so)
   if(NOT EXISTS ${prefix}/${path})
     message(FATAL_ERROR "consumer_test: ${path} is not installed")
   endif()

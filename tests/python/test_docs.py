@@ -127,7 +127,17 @@ def check_cluster(text, folder):
         assert conus.read(str(folder / "exr" / f"{name}.exr")).source_size[0] > 0
 
 
-CHECKS = {"convert-photos.md": check_convert_photos, "view-and-zoom.md": check_view_and_zoom, "python.md": check_python,
+def check_web(text, folder):
+    """The page's folder holds the viewer and the file; the served frame is a CoNUS file around the focus asked."""
+    import conus
+    assert (folder / "site" / "index.html").is_file() and (folder / "site" / "conus.exr").is_file()
+    asked = numbers(re.search(r"focus=([0-9.,]+)&", text).group(1))
+    frame = conus.read(str(folder / "frame.exr"))
+    (u, v, r, _), = frame.attributes["analytic"]["foci"]
+    assert abs(u - asked[0]) < 1e-6 and abs(v - asked[1]) < 1e-6 and abs(r - asked[2]) < 1e-6, (u, v, r, asked)
+
+
+CHECKS = {"convert-photos.md": check_convert_photos, "web.md": check_web, "view-and-zoom.md": check_view_and_zoom, "python.md": check_python,
           "cluster.md": check_cluster}
 
 
