@@ -15,6 +15,7 @@
 #include "conus/core/error.h"
 #include "conus/format/container.h"
 #include "conus/format/names.h"
+#include "output_files.h"
 #include "progress.h"
 #include "web_page.h"
 
@@ -83,7 +84,7 @@ CLI::App* declareWeb(CLI::App& root, WebOptions& options) {
         {"conus web photo.exr -o photo-web          # open photo-web/index.html: drag to pan, wheel to zoom",
          "conus web photo.exr -o site && conus serve site --port 8080   # the same page over HTTP"});
     command->add_option("input", options.input, "CoNUS file (.exr)")->required();
-    command->add_option("-o,--output", options.output, "folder to write (made if missing): index.html, its scripts, a copy of the file")
+    writesFile(command->add_option("-o,--output", options.output, "folder to write (made if missing): index.html, its scripts, a copy of the file"))
         ->required();
     return command;
 }
