@@ -55,21 +55,43 @@ inline std::vector<float> flaggedDepths(const codec::DepthImage& image) {
     return out;
 }
 
-// The depth image's textures: depths on texture unit `unit`, map nodes on unit + 1.
+// Images of one size side by side in one (layer k's texel (x, y) at (x + k * width, y)), as
+// intersect.inc.glsl reads a layered depth image; `channels` floats a texel.
+inline std::vector<float> sideBySide(const std::vector<std::vector<float>>& layers, int width, int height, int channels) {
+    const std::size_t row = std::size_t(width) * channels, count = layers.size();
+    std::vector<float> out(row * count * height);
+    for (std::size_t k = 0; k < count; ++k)
+        for (int y = 0; y < height; ++y)
+            std::memcpy(&out[(std::size_t(y) * count + k) * row], &layers[k][std::size_t(y) * row], row * sizeof(float));
+    return out;
+}
+
+// The depth image's textures: depths on texture unit `unit`, map nodes on unit + 1. A layered
+// image's layers (one camera, one map, one size) lie side by side in the depth texture.
 struct DepthTextures {
     GlHandle depths, map;
     int unit = 0;
 
     DepthTextures(Context& context, const GladGLContext& gl, const codec::DepthImage& image, const char* what,
                   int firstUnit = 0)
+        : DepthTextures(context, gl, std::vector<const codec::DepthImage*>{&image}, what, firstUnit) {}
+
+    DepthTextures(Context& context, const GladGLContext& gl, const std::vector<const codec::DepthImage*>& layers,
+                  const char* what, int firstUnit = 0)
         : unit(firstUnit) {
-        if (image.width() > context.maxTextureSize() || image.height() > context.maxTextureSize())
+        const codec::DepthImage& image = *layers.front();
+        const long long wide = static_cast<long long>(image.width()) * static_cast<long long>(layers.size());
+        if (wide > context.maxTextureSize() || image.height() > context.maxTextureSize())
             throw Error(ErrorCode::LimitExceeded, std::string(what) + ": depth image " + std::to_string(image.width()) +
                                                       "x" + std::to_string(image.height()) +
+                                                      (layers.size() > 1 ? " of " + std::to_string(layers.size()) + " layers side by side" : "") +
                                                       " exceeds GL_MAX_TEXTURE_SIZE " +
                                                       std::to_string(context.maxTextureSize()));
-        depths = floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(unit), image.width(), image.height(), 1,
-                              flaggedDepths(image).data());
+        std::vector<std::vector<float>> flagged;
+        for (const codec::DepthImage* layer : layers) flagged.push_back(flaggedDepths(*layer));
+        depths = floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(unit), static_cast<int>(wide), image.height(), 1,
+                              layers.size() == 1 ? flagged.front().data()
+                                                 : sideBySide(flagged, image.width(), image.height(), 1).data());
         const codec::SamplingMap& sampling = image.map();
         map = uploadMapTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(unit + 1), sampling.columns(), sampling.rows(),
                                glm::value_ptr(sampling.nodes().front()));

@@ -75,12 +75,20 @@ TEST_F(ReliefCli, BakeValidatesAndRenders) {
         OIIO::ImageBufAlgo::sub(OIIO::ImageBuf(lowLight), OIIO::ImageBuf(shadowed)));
     EXPECT_GT(*std::max_element(darkening.max.begin(), darkening.max.end()), 0.1f);
     EXPECT_GE(*std::min_element(darkening.min.begin(), darkening.min.end()), -0.01f);
-    // A camera given: from straight above the centre, the field fills the frame.
-    ASSERT_EQ(run("render relief " + conus + " -o " + path("above.png") +
-                  " --size 64x48 --camera 0.5,3,0.376,0.5,0,0.375,12")
-                  .exitCode,
-              0);
+    // A camera given: from straight above the centre, the field fills the frame; the line echoes
+    // that camera as given.
+    r = run("render relief " + conus + " -o " + path("above.png") + " --size 64x48 --camera 0.5,3,0.376,0.5,0,0.375,12");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("camera 0.5,3,0.376,0.5,0,0.375,12\n"), std::string::npos) << r.out;
     EXPECT_GT(meanAndSpread(path("above.png")).first, 0.25);
+    // The default view's echo, given back, draws the same frame.
+    r = run("render relief " + conus + " -o " + path("default.png") + " --size 64x48");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::size_t echoed = r.out.find("camera ");
+    ASSERT_NE(echoed, std::string::npos) << r.out;
+    const std::string camera = r.out.substr(echoed + 7, r.out.find('\n', echoed) - echoed - 7);
+    ASSERT_EQ(run("render relief " + conus + " -o " + path("again.png") + " --size 64x48 --camera " + camera).exitCode, 0);
+    EXPECT_LT(meanDifference(path("default.png"), path("again.png")), 2e-3) << camera;
     EXPECT_TRUE(leftovers().empty());
 }
 
