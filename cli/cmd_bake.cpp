@@ -251,7 +251,7 @@ CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
         command, "relief", "A height field plus colour -> an orthographic CoNUS depth image (relief asset)",
         {"conus bake relief tablet -o tablet.exr --size 256x192",
          "conus bake relief tablet --text 'HELLO|WORLD' --uniform -o tablet-uniform.exr --size 256x192",
-         "conus bake relief dem.tif --height-scale 0.1 --colour ortho.png -o relief.exr --focus 0.5,0.5,0.1,4"});
+         "conus bake relief dem.tif --width 1 --height-scale 0.1 --colour ortho.png -o relief.exr --focus 0.5,0.5,0.1,4"});
     relief->add_option("source", o.source,
                        "'tablet' (the engraved tablet made in code) or a height field: 16-bit PNG/TIFF, float EXR, "
                        ".npy, .npz or procedural[:SIZE[:SEED]]")
@@ -281,7 +281,9 @@ CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
     relief->add_option("--width", o.width, "the field's width in world units (its depth follows the aspect)")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9));
-    relief->add_option("--height-scale", o.heightScale, "multiplies a height file's values")
+    relief->add_option("--height-scale", o.heightScale,
+                       "the heights in world units (those of --width): a float file's values times this; an 8- or "
+                       "16-bit image's codes span 0..1 first (its largest code, 255 or 65535, becomes this)")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9));
     relief->add_option("--colour,--color", o.colour, "colour image (default: a ramp by height and slope)");

@@ -92,6 +92,33 @@ TEST_F(ReliefCli, BakeValidatesAndRenders) {
     EXPECT_TRUE(leftovers().empty());
 }
 
+// --height-scale gives heights in world units: a float file's values times the scale, a 16-bit
+// image's codes over 0..65535 first (code 65535 stands the scale high); the baked asset's heights
+// (its Z channel, read back) say so, and the help says it in those words.
+TEST_F(ReliefCli, HeightScaleIsWorldUnitsForFloatAndSixteenBitFiles) {
+    const std::string png = path("dem.png"), exr = path("dem.exr");
+    // Constant fields, so that resampling to the asset's texels changes nothing.
+    OIIO::ImageBuf codes(OIIO::ImageSpec(24, 16, 1, OIIO::TypeDesc::UINT16));
+    const float fraction = 40000.0f / 65535.0f;
+    OIIO::ImageBufAlgo::fill(codes, {fraction});
+    ASSERT_TRUE(codes.write(png));
+    OIIO::ImageBuf metres(OIIO::ImageSpec(24, 16, 1, OIIO::TypeDesc::FLOAT));
+    OIIO::ImageBufAlgo::fill(metres, {3.5f});
+    ASSERT_TRUE(metres.write(exr));
+    for (const auto& [source, expected] : {std::pair{png, 0.2 * 40000.0 / 65535.0}, std::pair{exr, 0.2 * 3.5}}) {
+        const std::string out = source + "-relief.exr";
+        const Result r = run("bake relief " + source + " --width 1 --height-scale 0.2 --uniform --size 12x8 -o " + out);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        const format::ConusFile file = format::readConusFile(out);
+        const int z = file.image.channelIndex("Z");
+        ASSERT_GE(z, 0);
+        for (int y = 0; y < file.image.height; ++y)
+            for (int x = 0; x < file.image.width; ++x) ASSERT_NEAR(file.image.at(x, y, z), expected, 1e-4) << source;
+    }
+    const Result help = run("bake relief --help");
+    EXPECT_NE(help.out.find("world units"), std::string::npos) << help.out;
+}
+
 // PSNR (dB) of picture a against the reference r, over the pixels whose (u, v) `in` accepts.
 template <class Mask>
 double psnrWhere(const std::string& a, const std::string& r, Mask in) {

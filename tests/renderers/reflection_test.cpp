@@ -25,11 +25,10 @@ const codec::MeshScene& scene() {
     return s;
 }
 
-std::vector<codec::ReflectionFace> faces(bool uniform, int layers = 1) {
+std::vector<codec::ReflectionFace> faces(bool uniform) {
     codec::ReflectionBakeOptions bake;
     bake.size = 40;
     bake.uniform = uniform;
-    bake.layers = layers;
     bake.roi = codec::AxisBox{glm::dvec3(kBoxLo), glm::dvec3(kBoxHi)};
     return codec::bakeReflection(scene(), bake);
 }
@@ -73,10 +72,9 @@ Agreement compare(const Image& gpu, const Image& cpu) {
 // one such flip of error 0.5 among the ~2000 reflecting pixels alone is 39 dB, so 35 dB allows a
 // few on another driver while a wrong colour filter, face, map or step shows at once (the CPU's
 // own CoNUS and conventional frames are about 20 dB apart here).
-// `cpuFrame`, when given, gets the CPU frame.
 void expectAgreement(Context& context, const Camera& camera, const codec::ReflectionFrameOptions& options,
-                     bool uniform, int layers = 1, Image* cpuFrame = nullptr) {
-    const auto set = faces(uniform, layers);
+                     bool uniform) {
+    const auto set = faces(uniform);
     const Image cpu = codec::renderReflectionFrame(scene(), &set, glm::dvec3(0.0), camera, kFrame, kFrame, options);
     ReflectionRenderer renderer(context, scene().mesh(), set, options);
     const Image gpu = renderer.render(camera, kFrame, kFrame);
@@ -94,30 +92,40 @@ void expectAgreement(Context& context, const Camera& camera, const codec::Reflec
     const Image viaDevice = renderReflection(Device::on(std::shared_ptr<Context>(&context, [](Context*) {})), scene(),
                                              set, camera, kFrame, kFrame, options);
     EXPECT_EQ(viaDevice.pixels, gpu.pixels);
-    if (cpuFrame) *cpuFrame = cpu;
 }
 
-// A large plane mirror seen at an angle: its edges see the floor behind the box and the box's
-// sides that face away from the centre, which only deeper layers hold. GLSL walks the layers as
-// the CPU does, and the layers bring the frame nearer the traced one than one layer does.
+// A plane mirror of radius 1.2 between an occluding box and the camera, a wall behind both (the
+// camera between box and wall): the mirror's edges see parts of the wall and of the box's sides
+// that the centre cannot, which only deeper layers hold. GLSL walks the layers as the CPU does, and
+// the layers bring the frame nearer the traced one than one layer does (measured: squared error
+// 34.6 against 47.2 on the CPU).
 TEST_P(ReflectionGl, LayeredFacesMatchCpuAndSeeBehindTheBox) {
+    static const codec::MeshScene wallScene(codec::test::boxBeforeWall());
     codec::ReflectionFrameOptions options;
     options.reflector.kind = codec::Reflector::Kind::Plane;
-    options.reflector.radius = 1.6;
-    options.reflector.normal = glm::normalize(glm::dvec3(0.25, 0.1, 1.0));
-    const Camera camera = Camera::perspective({-1.6, 0.7, 3.6}, {0.3, -0.2, 0.0}, {0, 1, 0}, 50.0, 1.0, 1e-3, 1e3);
-    Image layered, single;
-    expectAgreement(context(), camera, options, true, 3, &layered);
-    expectAgreement(context(), camera, options, true, 1, &single);
-    ASSERT_EQ(layered.pixels.size(), single.pixels.size());
-    const Image truth = codec::renderReflectionFrame(scene(), nullptr, glm::dvec3(0.0), camera, kFrame, kFrame, options);
-    double layeredError = 0, singleError = 0;
-    for (std::size_t i = 0; i < truth.pixels.size(); ++i) {
-        if (i % 4 == 3) continue;
-        layeredError += std::pow(layered.pixels[i] - truth.pixels[i], 2.0);
-        singleError += std::pow(single.pixels[i] - truth.pixels[i], 2.0);
+    options.reflector.radius = 1.2;
+    options.reflector.normal = glm::normalize(glm::dvec3(0.1, 0.05, 1.0));
+    const Camera camera = Camera::perspective({-1.2, 0.9, 2.8}, {0.0, 0.0, 0.0}, {0, 1, 0}, 55.0, 1.0, 1e-3, 1e3);
+    const Image truth = codec::renderReflectionFrame(wallScene, nullptr, glm::dvec3(0.0), camera, kFrame, kFrame, options);
+    double error[2] = {0, 0};
+    for (const int layers : {1, 3}) {
+        codec::ReflectionBakeOptions bake;
+        bake.size = 40;
+        bake.uniform = true;
+        bake.layers = layers;
+        const auto set = codec::bakeReflection(wallScene, bake);
+        ASSERT_EQ(set.front().layers(), layers);
+        const Image cpu = codec::renderReflectionFrame(wallScene, &set, glm::dvec3(0.0), camera, kFrame, kFrame, options);
+        ReflectionRenderer renderer(context(), wallScene.mesh(), set, options);
+        const Agreement a = compare(renderer.render(camera, kFrame, kFrame), cpu);
+        EXPECT_GT(a.reflecting, 2000);
+        EXPECT_LE(a.maskMismatches, kFrame * kFrame / 500) << layers << " layers";
+        EXPECT_GT(a.reflectorPsnr, 35.0) << layers << " layers, " << a.maskMismatches << " mask mismatches";
+        EXPECT_LE(a.differing, kFrame * kFrame / 500) << layers << " layers";
+        for (std::size_t i = 0; i < truth.pixels.size(); ++i)
+            if (i % 4 != 3) error[layers == 3] += std::pow(cpu.pixels[i] - truth.pixels[i], 2.0);
     }
-    EXPECT_LT(layeredError, 0.7 * singleError);
+    EXPECT_LT(error[1], 0.85 * error[0]) << "layered " << error[1] << ", single " << error[0];
 }
 
 TEST_P(ReflectionGl, SphereMirrorMatchesCpuCoNUSAndConventional) {

@@ -394,22 +394,16 @@ TEST(Reflection, FloorAcrossAFaceSeamIsHitNotMissed) {
     }
 }
 
-// Layered faces: an occluding box in front of a wall (a slab), both off the axes, seen from the
-// centre at the origin along +z; rays from points beside the centre (where a mirror of radius 1
-// reflects from) that pass behind the box's front surface.
-const glm::dvec3 kOccluderLo(-0.35, -0.25, 1.6), kOccluderHi(0.25, 0.3, 2.0);
-const glm::dvec3 kWallLo(-3.0, -2.5, 3.0), kWallHi(3.2, 2.8, 3.3);
+// Layered faces: an occluding box before a wall (test::boxBeforeWall), seen from the centre at
+// the origin along +z; rays from points beside the centre (where a mirror of radius 1 reflects
+// from) that pass behind the box's front surface.
+using test::kOccluderHi;
+using test::kOccluderLo;
+using test::kWallHi;
+using test::kWallLo;
 
 const MeshScene& occluderAndWall() {
-    static const MeshScene scene = [] {
-        Mesh m = flatBox(glm::vec3(kOccluderLo), glm::vec3(kOccluderHi));
-        const Mesh wall = flatBox(glm::vec3(kWallLo), glm::vec3(kWallHi));
-        const auto base = static_cast<std::uint32_t>(m.positions.size());
-        m.positions.insert(m.positions.end(), wall.positions.begin(), wall.positions.end());
-        m.normals.insert(m.normals.end(), wall.normals.begin(), wall.normals.end());
-        for (std::uint32_t i : wall.indices) m.indices.push_back(base + i);
-        return MeshScene(std::move(m));
-    }();
+    static const MeshScene scene(test::boxBeforeWall());
     return scene;
 }
 
