@@ -42,7 +42,7 @@ struct DepthHit {
     ivec2 texel;
     int steps;
     bool hidden;  // the background carried on behind an occluder
-    bool wentHidden;  // the walk went behind the surface on the way (deeper layers may hold the hit)
+    float firstHidden;  // where the walk first went behind the surface (t; 1e38: never): deeper layers from there
     int face;  // the face of the clipped volume the ray entered through when steps == 0 (0..5), else -1
 };
 
@@ -260,7 +260,7 @@ DepthHit noDepthHit() {
     result.steps = 0;
     result.face = -1;
     result.hidden = false;
-    result.wentHidden = false;
+    result.firstHidden = 1e38;
     return result;
 }
 
@@ -285,7 +285,8 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     const bool across = behind && acrossSide(view, g, entry);
     if (behind && !view.solid && !across) {
         if (g.end <= 0.0) return result;  // entered beyond the data's depth range
-        hidden = result.wentHidden = true;
+        hidden = true;
+        result.firstHidden = mix(g.tw0, g.tw1, 0.0) / mix(g.iw0, g.iw1, 0.0);
         hiddenDepth = segmentDepth(g, 0.0);
         hiddenFrom = m;
     }
@@ -352,7 +353,8 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
                 m = evalMap(map, g.p0 + g.along * s);
                 break;
             }
-            hidden = result.wentHidden = true;  // a wall: the ray passes behind an occluder's silhouette
+            hidden = true;  // a wall: the ray passes behind an occluder's silhouette
+            result.firstHidden = min(result.firstHidden, mix(g.tw0, g.tw1, a) / mix(g.iw0, g.iw1, a));
             hiddenDepth = segmentDepth(g, b);
             hiddenFrom = qa;
         }

@@ -117,16 +117,20 @@ void main() {
             mineT = h.t;
             mineColour = reflectionColour(uDepths[f], uColours[f], h.distorted, h.texel);
         }
-        if (h.wentHidden)
+        // From where the ray first went behind layer 0 (codec::traceReflection).
+        if (h.firstHidden < best && uLayers > 1) {
+            const vec3 behind = at + reflected * h.firstHidden;
             for (int k = 1; k < uLayers; ++k) {
+                if (!(mineT - h.firstHidden > 0.0)) break;
                 gDepthLayer = k;
-                const DepthHit d = intersectBehindLayer(uDepths[f], uMaps[f], uViews[f], at, reflected, uStepTexels,
-                                                        uRefinements, uMaxSteps, mineT);
+                const DepthHit d = intersectBehindLayer(uDepths[f], uMaps[f], uViews[f], behind, reflected, uStepTexels,
+                                                        uRefinements, uMaxSteps, mineT - h.firstHidden);
                 if (!d.hit || onSky(f, d)) continue;
                 mine = true;
-                mineT = d.t;
+                mineT = d.t + h.firstHidden;
                 mineColour = reflectionColour(uDepths[f], uColours[f], d.distorted, d.texel);
             }
+        }
         if (mine) {
             found = true;
             best = mineT;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "conus/core/error.h"
@@ -183,12 +184,13 @@ struct Walk {
 }  // namespace
 
 std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options) {
-    bool wentHidden = false;
-    return intersect(image, ray, options, wentHidden);
+    double firstHidden = 0;
+    return intersect(image, ray, options, firstHidden);
 }
 
-std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options, bool& wentHidden) {
-    wentHidden = false;
+std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options,
+                                  double& firstHidden) {
+    firstHidden = std::numeric_limits<double>::infinity();
     const std::optional<Segment> clipped = clipRay(image, ray, options.tMax);
     if (!clipped) return std::nullopt;
     const Segment& segment = *clipped;
@@ -204,7 +206,8 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
     if (const double entry = walk.surface(0.0, pd); entry - segment.depth(0.0) <= 0.0) {
         if (image.solid() || walk.acrossSide(entry)) return walk.hitAt(0.0, pd, 0, false);
         if (segment.end <= 0.0) return std::nullopt;  // entered beyond the data's depth range
-        hidden = wentHidden = true;
+        hidden = true;
+        firstHidden = segment.t(0.0);
         hiddenDepth = segment.depth(0.0);
         hiddenFrom = pd;
     }
@@ -248,7 +251,8 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
             return walk.hitAt(mid, pd, steps, false);
         }
         // A wall: the ray passes behind an occluder's silhouette.
-        hidden = wentHidden = true;
+        hidden = true;
+        firstHidden = std::min(firstHidden, segment.t(a));
         hiddenDepth = segment.depth(b);
         hiddenFrom = pa;
     }

@@ -248,22 +248,28 @@ std::optional<ReflectionHit> traceReflection(const std::vector<ReflectionFace>& 
         const ReflectionFace& face = faces[f];
         IntersectOptions o = options;
         if (best) o.tMax = best->hit.t;
-        bool wentHidden = false;
-        const auto hit = intersect(face.depth, ray, o, wentHidden);
+        double firstHidden = 0;
+        const auto hit = intersect(face.depth, ray, o, firstHidden);
         std::optional<ReflectionHit> mine;
         // A hidden hit is a guess (the background carried on behind an occluder); a layered face
         // holds what lies behind its occluders, so that a ray that meets none of its layers there
         // meets nothing in this face: the guess is the single-layer face's alone.
         if (hit && !onSky(*hit, face, 0) && !(best && hit->t >= best->hit.t) && !(hit->hidden && face.layers() > 1))
             mine = ReflectionHit{*hit, static_cast<int>(f), 0, reflectionColour(face, 0, *hit)};
-        // The deeper layers (intersect.h): only behind a silhouette, short of a layer-0 hit.
-        if (wentHidden)
+        // The deeper layers (intersect.h): only behind a silhouette, from where the ray first went
+        // behind it, short of a layer-0 hit.
+        if (firstHidden < o.tMax && face.layers() > 1) {
+            const Ray behind{ray.origin + ray.direction * firstHidden, ray.direction};
             for (int k = 1; k < face.layers(); ++k) {
-                if (mine) o.tMax = mine->hit.t;
-                const auto deeper = intersectBehind(face.layerDepth(k), ray, o);
+                IntersectOptions d = o;
+                d.tMax = (mine ? mine->hit.t : o.tMax) - firstHidden;
+                if (!(d.tMax > 0.0)) break;
+                auto deeper = intersectBehind(face.layerDepth(k), behind, d);
                 if (!deeper || onSky(*deeper, face, k)) continue;
+                deeper->t += firstHidden;
                 mine = ReflectionHit{*deeper, static_cast<int>(f), k, reflectionColour(face, k, *deeper)};
             }
+        }
         if (mine) best = mine;
     }
     return best;

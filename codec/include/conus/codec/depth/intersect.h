@@ -173,11 +173,12 @@ struct DepthHit {
 
 // The first hit along `ray` (direction unit), or nothing. Never throws for a finite ray.
 std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options = {});
-// The same, saying whether the walk went behind a scene's surface on the way (a wall crossed, or
-// the ray entered hidden): only then can a deeper layer of a layered image hold what it meets
-// first (below).
+// The same, saying where the walk first went behind a scene's surface (a wall crossed: the last
+// sample in front of it; or where the ray entered hidden), as a distance along the ray; infinity
+// when it never did: only beyond it can a deeper layer of a layered image hold what the ray meets
+// (below).
 std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options,
-                                  bool& wentHidden);
+                                  double& firstHidden);
 
 // Layered depth images (depth peeling: layer k holds the k-th surface along each texel's ray, the
 // camera's far plane where there is none) keep what a single layer loses behind a silhouette.
@@ -189,8 +190,9 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
 //
 // The nearest hit among the layers is the ray's. A ray that never goes behind layer 0 before its
 // layer-0 hit (or its exit) stays in front of every deeper layer too (each lies behind layer 0
-// along the camera's rays), so the deeper layers are walked only when intersect() reports
-// wentHidden; then a deeper hit short of the layer-0 hit wins. A hidden (carried-on, guessed)
+// along the camera's rays), so the deeper layers are walked only when intersect() reports that it
+// went hidden, and only from there on (the ray's origin moved to firstHidden); then a deeper hit
+// short of the layer-0 hit wins. A hidden (carried-on, guessed)
 // layer-0 hit is no hit in a layered image: its layers hold what lies behind the occluders, and a
 // ray that meets none of them there meets nothing. A one-layer image is intersected exactly as
 // before.
