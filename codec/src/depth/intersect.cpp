@@ -126,11 +126,18 @@ namespace {
 struct Walk {
     const DepthImage& image;
     const Ray& ray;
-    const Segment& segment;
+    const Segment segment;
     glm::dvec2 size, along;
 
     Walk(const DepthImage& i, const Ray& r, const Segment& s)
         : image(i), ray(r), segment(s), size(i.width(), i.height()), along(s.p1 - s.p0) {}
+
+    // The walk of `ray` clipped to the image's volume, or nothing when it misses.
+    static std::optional<Walk> start(const DepthImage& image, const Ray& ray, double tMax) {
+        const std::optional<Segment> clipped = clipRay(image, ray, tMax);
+        if (!clipped) return std::nullopt;
+        return Walk(image, ray, *clipped);
+    }
 
     // The stored surface's depth at s (and where s lies in the CoNUS image).
     double surface(double s, glm::dvec2& pd) const {
@@ -191,10 +198,10 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
 std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options,
                                   double& firstHidden) {
     firstHidden = std::numeric_limits<double>::infinity();
-    const std::optional<Segment> clipped = clipRay(image, ray, options.tMax);
-    if (!clipped) return std::nullopt;
-    const Segment& segment = *clipped;
-    const Walk walk(image, ray, segment);
+    const std::optional<Walk> started = Walk::start(image, ray, options.tMax);
+    if (!started) return std::nullopt;
+    const Walk& walk = *started;
+    const Segment& segment = walk.segment;
 
     glm::dvec2 pd;
     double before = 0.0, s = 0.0;
@@ -259,10 +266,10 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
 }
 
 std::optional<DepthHit> intersectBehind(const DepthImage& layer, const Ray& ray, const IntersectOptions& options) {
-    const std::optional<Segment> clipped = clipRay(layer, ray, options.tMax);
-    if (!clipped) return std::nullopt;
-    const Segment& segment = *clipped;
-    const Walk walk(layer, ray, segment);
+    const std::optional<Walk> started = Walk::start(layer, ray, options.tMax);
+    if (!started) return std::nullopt;
+    const Walk& walk = *started;
+    const Segment& segment = walk.segment;
 
     glm::dvec2 pd;
     double before = 0.0, s = 0.0;
