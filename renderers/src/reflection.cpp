@@ -62,7 +62,7 @@ struct ReflectionScene : DepthFrameRenderer::Scene {
             depths.emplace_back(c, gl, layers, kWhat, k * kUnitsPerFace);
             colours[static_cast<std::size_t>(k)] =
                 floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(k * kUnitsPerFace + 2), face.image.width * face.layers(),
-                             face.image.height, 4, sideBySide(rgba, face.image.width, face.image.height, 4).data());
+                             face.image.height, 4, codec::sideBySide(rgba, face.image.width, face.image.height, 4).data());
         }
         layers = f.front().layers();
     }
