@@ -16,7 +16,6 @@
 #include <cfloat>
 #include <cstdio>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -37,19 +36,26 @@ std::vector<double> numbers(const std::string& text) {
     return out;
 }
 
-// An installed shader with its #include lines replaced by the files they name (same folder) and
-// codec's constants after #version.
-std::string shaderSource(const std::string& name) {
+std::string installedFile(const std::string& name) {
     std::ifstream in(std::string(CONUS_GLSL_DIR) + "/" + name);
     if (!in) throw std::runtime_error("cannot read " + std::string(CONUS_GLSL_DIR) + "/" + name);
     std::stringstream text;
     text << in.rdbuf();
-    std::string source = text.str();
-    static const std::regex include("#include \"([^\"]+)\"");
-    for (std::smatch m; std::regex_search(source, m, include);)
-        source.replace(m.position(0), m.length(0), shaderSource(m[1].str()));
-    const std::size_t eol = source.find('\n');
-    if (source.rfind("#version", 0) == 0) source.insert(eol + 1, conus::codec::glslConstants());
+    return text.str();
+}
+
+// An installed shader with each line `#include "x"` replaced by the installed file x (GLSL has no
+// include of its own) and codec's constants after its #version line.
+std::string shaderSource(const std::string& name) {
+    std::stringstream in(installedFile(name));
+    std::string source;
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind("#include \"", 0) == 0)
+            source += installedFile(line.substr(10, line.rfind('"') - 10));
+        else
+            source += line + "\n";
+        if (line.rfind("#version", 0) == 0) source += conus::codec::glslConstants();
+    }
     return source;
 }
 
@@ -157,7 +163,8 @@ void run(int argc, char** argv) {
         glUniform1f(at("uFar" + i), d.far);
     }
     // Nothing drawn behind the mirror here: the pass's scene texture says "nothing" everywhere.
-    const std::vector<float> nothing(std::size_t(width) * height * 4, FLT_MAX);
+    std::vector<float> nothing(std::size_t(width) * height * 4, 0.0f);  // black, at no depth
+    for (std::size_t p = 3; p < nothing.size(); p += 4) nothing[p] = FLT_MAX;
     texture(18, width, height, 4, nothing.data());
     glUniform1i(at("uBehind"), 18);
     glUniform1i(at("uLayers"), layers);
