@@ -14,6 +14,8 @@
 //     rows, row 0 first), read with texelFetch;
 //   - a `DepthView` uniform (intersect.inc.glsl) holding depthViewValues();
 //   - the constants glslConstants() declares, placed after the shader's #version line.
+// The inverse of Equation 1 has no GLSL twin: where a shader needs the undistorted point of each
+// CoNUS pixel it reads undistortedTable() (exact, SamplingMap::undistort), as the volume renderer does.
 // Everything here is header-only and uses codec's own values, so the GPU and the CPU reference
 // cannot drift apart.
 #pragma once
@@ -28,6 +30,8 @@
 
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/image/decode.h"
+#include "conus/core/fpc.h"
+#include "conus/core/parallel.h"
 
 namespace conus::codec {
 
@@ -77,6 +81,23 @@ inline std::vector<float> sideBySide(const std::vector<std::vector<float>>& laye
         for (int y = 0; y < height; ++y)
             std::memcpy(&out[(std::size_t(y) * count + k) * row], &layers[k][std::size_t(y) * row], row * sizeof(float));
     return out;
+}
+
+// The undistorted point (u, v) of each pixel centre of a width x height CoNUS image, interleaved,
+// top row first: the exact inverse of Equation 1 (Distortion::undistort) as an RG32F texture's
+// data, computed on `threads` cores (0: all).
+inline std::vector<float> undistortedTable(const Distortion& distortion, int width, int height, int threads = 0) {
+    std::vector<float> table(static_cast<std::size_t>(width) * height * 2);
+    parallelRows(height, threads, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < width; ++x) {
+                const glm::dvec2 p = distortion.undistort({(x + 0.5) / width, (y + 0.5) / height});
+                float* out = &table[(static_cast<std::size_t>(y) * width + x) * 2];
+                out[0] = float(p.x);
+                out[1] = float(p.y);
+            }
+    });
+    return table;
 }
 
 // The fields of intersect.inc.glsl's `DepthView` uniform for `image`, in its order (matrices
