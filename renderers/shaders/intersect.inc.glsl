@@ -1,10 +1,12 @@
 // Ray / depth-image intersection in GLSL: the twin of codec/src/depth/intersect.cpp and
 // depth_surface.cpp, function for function (clip in homogeneous coordinates, project, walk the
 // projected segment distorting each point with Equation 1, bisect; walls and hidden rays as
-// codec/depth/intersect.h says). Include equation1.inc.glsl first. kIntersectDepthMargin and
-// kSilhouetteStep are injected from C++. The depth texture is R32F; each depth's lowest mantissa
-// bit is its cell's discontinuity flag (DepthImage::cellFlags, computed once on the CPU;
-// renderers/src/depth_pvt.h).
+// codec/depth/intersect.h says). Include equation1.inc.glsl first. kIntersectDepthMargin,
+// kSilhouetteStep and kSideRuleFarMargin are declared before it from C++ (codec::glslConstants).
+// The depth texture is R32F; each depth's lowest mantissa bit is its cell's discontinuity flag
+// (DepthImage::cellFlags, computed once on the CPU: codec::flaggedDepths); a DepthView holds
+// codec::depthViewValues. Installed (<datadir>/conus/glsl) for renderers of one's own:
+// conus/codec/depth/glsl_interface.h, docs/reflections-in-your-renderer.md.
 //
 // A layered depth image (codec/depth/intersect.h) lies in one texture, its layers side by side
 // (layer k's texel (x, y) at (x + k * width, y)); gDepthLayers says how many, gDepthLayer which one

@@ -8,6 +8,7 @@
 // their layers side by side in their depth and colour textures (intersect.inc.glsl), the deeper
 // ones walked as codec::traceReflection walks them. Out: R, G, B and the mask M
 // (0 the scene or nothing, 1 the reflector showing the sky, 2 the reflector showing the scene).
+// Installed (<datadir>/conus/glsl); examples/reflection_gl sets its uniforms outside CoNUS.
 #include "equation1.inc.glsl"
 #include "intersect.inc.glsl"
 
