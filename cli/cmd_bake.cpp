@@ -189,7 +189,18 @@ struct ReflectionBakeText {
     int size = 128;
     double magnification = codec::ReflectionBakeOptions{}.magnification;
     bool uniform = false;
+    std::string layers = "auto";
+    double mirrorRadius = 0.5;
 };
+
+// --layers: 1..kMaxReflectionLayers, or `auto` (0: as many as the scene needs).
+int parseLayers(const std::string& text) {
+    if (text == "auto") return 0;
+    for (int k = 1; k <= codec::kMaxReflectionLayers; ++k)
+        if (text == std::to_string(k)) return k;
+    throw Error(ErrorCode::InvalidArgument, "--layers " + text + ": want 1 to " + std::to_string(codec::kMaxReflectionLayers) +
+                                                " or auto");
+}
 
 int runBakeReflection(const ReflectionBakeText& o) {
     try {
@@ -204,6 +215,7 @@ int runBakeReflection(const ReflectionBakeText& o) {
     options.size = o.size;
     options.uniform = o.uniform;
     options.magnification = o.magnification;
+    options.layers = parseLayers(o.layers);
     if (o.roiMin.empty() != o.roiMax.empty())
         throw Error(ErrorCode::InvalidArgument, "--roi-min and --roi-max go together");
     if (!o.roiMin.empty()) {
@@ -225,9 +237,14 @@ int runBakeReflection(const ReflectionBakeText& o) {
     Progress writing("write " + o.output);
     format::writeReflectionAsset(o.output, codec::reflectionAssetFile(faces));
     writing.done();
-    std::printf("wrote %s: reflection asset of six %dx%d CoNUS colour + depth faces from %g,%g,%g (%s)\n", o.output.c_str(),
-                o.size, o.size, options.centre.x, options.centre.y, options.centre.z,
-                o.uniform ? "uniform, the baseline" : "foci on the region of interest");
+    const int layers = faces.front().layers();
+    std::printf("wrote %s: reflection asset of six %dx%d CoNUS colour + depth faces, %d layer%s, from %g,%g,%g (%s)\n",
+                o.output.c_str(), o.size, o.size, layers, layers == 1 ? "" : "s", options.centre.x, options.centre.y,
+                options.centre.z, o.uniform ? "uniform, the baseline" : "foci on the region of interest");
+    const double one = codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, 1);
+    const double all = codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, layers);
+    std::printf("mirror rays (radius %g) that land in a disocclusion: %.2f%% with 1 layer, %.2f%% with %d\n", o.mirrorRadius,
+                100.0 * one, 100.0 * all, layers);
     return 0;
 }
 
@@ -247,6 +264,13 @@ CLI::App* addBakeReflection(CLI::App& command, ReflectionBakeText& o) {
     reflection->add_option("--roi-min", o.roiMin, "region of interest, lowest corner x,y,z (default: the whole scene)");
     reflection->add_option("--roi-max", o.roiMax, "region of interest, highest corner x,y,z");
     reflection->add_flag("--uniform", o.uniform, "identity maps: the conventional asset of the same texel count");
+    reflection->add_option("--layers", o.layers,
+                           "surfaces kept along each texel's ray, 1 to 4, or auto: until the next covers under 1% of the texels")
+        ->capture_default_str();
+    reflection->add_option("--mirror-radius", o.mirrorRadius,
+                           "the reflector's radius, for the report of mirror rays that land in a disocclusion")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e6));
     addAllowDirOption(*reflection, o.allowDirs);
     return reflection;
 }
@@ -256,7 +280,7 @@ CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
         command, "relief", "A height field plus colour -> an orthographic CoNUS depth image (relief asset)",
         {"conus bake relief tablet -o tablet.exr --size 256x192",
          "conus bake relief tablet --text 'HELLO|WORLD' --uniform -o tablet-uniform.exr --size 256x192",
-         "conus bake relief dem.tif --height-scale 0.1 --colour ortho.png -o relief.exr --focus 0.5,0.5,0.1,4"});
+         "conus bake relief dem.tif --width 1 --height-scale 0.1 --colour ortho.png -o relief.exr --focus 0.5,0.5,0.1,4"});
     relief->add_option("source", o.source,
                        "'tablet' (the engraved tablet made in code) or a height field: 16-bit PNG/TIFF, float EXR, "
                        ".npy, .npz or procedural[:SIZE[:SEED]]")
@@ -290,7 +314,9 @@ CLI::App* addBakeRelief(CLI::App& command, BakeOptions& o) {
     relief->add_option("--width", o.width, "the field's width in world units (its depth follows the aspect)")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9));
-    relief->add_option("--height-scale", o.heightScale, "multiplies a height file's values")
+    relief->add_option("--height-scale", o.heightScale,
+                       "the heights in world units (those of --width): a float file's values times this; an 8- or "
+                       "16-bit image's codes span 0..1 first (its largest code, 255 or 65535, becomes this)")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9));
     relief->add_option("--colour,--color", o.colour, "colour image (default: a ramp by height and slope)");

@@ -2,7 +2,10 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 
@@ -11,9 +14,11 @@
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/format/reflection_asset.h"
+#include "conus/core/bounds.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
 #include "conus/renderers/context.h"
+#include "conus/sceneio/mesh_file.h"
 #include "image_files.h"
 #include "output_files.h"
 #include "pictures.h"
@@ -221,6 +226,13 @@ void writeDensityPicture(const std::string& path, const FileFacts& f) {
                                       double(file.sourceWidth) / file.sourceHeight));
 }
 
+// The layers a reflection asset's face keeps (spec "Layers": layer k >= 1 in `layer<k>.*`).
+int faceLayers(const format::ConusFile& face) {
+    int layers = 1;
+    while (face.image.channelIndex("layer" + std::to_string(layers) + ".Z") >= 0) ++layers;
+    return layers;
+}
+
 // A reflection asset: its frame, then each face in a line (JSON: each face as a file's facts).
 int printReflectionAsset(const InfoOptions& o) {
     if (!o.densityPng.empty())
@@ -235,6 +247,7 @@ int printReflectionAsset(const InfoOptions& o) {
         j["file"] = o.input;
         j["formatVersion"] = format::kFormatVersion;
         j["kind"] = "reflectionAsset";
+        j["layers"] = faceLayers(asset.faces.front());
         j["cubeFrame"] = {{"centre", c}, {"axes", {{a[0], a[1], a[2]}, {a[3], a[4], a[5]}, {a[6], a[7], a[8]}}}};
         for (std::size_t f = 0; f < faces.size(); ++f) {
             nlohmann::ordered_json face{{"name", format::kCubeFaceNames[f]}};
@@ -247,9 +260,10 @@ int printReflectionAsset(const InfoOptions& o) {
     const format::ConusFile& first = faces.front().file;
     std::string channelList;
     for (const auto& name : faces.front().channels) channelList += (channelList.empty() ? "" : ",") + name;
-    std::printf("%s: CoNUS reflection asset, format version %d: six %d x %d faces, channels %s, %s, %s compression\n",
-                o.input.c_str(), format::kFormatVersion, first.image.width, first.image.height, channelList.c_str(),
-                enumName(first.pixelType), enumName(first.compression));
+    const int layers = faceLayers(asset.faces.front());
+    std::printf("%s: CoNUS reflection asset, format version %d: six %d x %d faces of %d layer%s, channels %s, %s, %s compression\n",
+                o.input.c_str(), format::kFormatVersion, first.image.width, first.image.height, layers, layers == 1 ? "" : "s",
+                channelList.c_str(), enumName(first.pixelType), enumName(first.compression));
     std::printf("  cube frame    centre (%g, %g, %g); axes +x (%g, %g, %g), +y (%g, %g, %g), +z (%g, %g, %g)\n", c[0], c[1], c[2],
                 a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], a[8]);
     for (std::size_t f = 0; f < faces.size(); ++f) {
@@ -265,6 +279,42 @@ int printReflectionAsset(const InfoOptions& o) {
     return 0;
 }
 
+// Whether the file begins with OpenEXR's magic number (every CoNUS file and asset does).
+bool isExr(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::array<unsigned char, 4> magic{};
+    in.read(reinterpret_cast<char*>(magic.data()), magic.size());
+    return in && magic == std::array<unsigned char, 4>{0x76, 0x2f, 0x31, 0x01};
+}
+
+// A mesh file (what `bake reflection`, `mesh render` take): its size and bounds, so that --center
+// and --roi-min/--roi-max can be chosen without another tool.
+int printMesh(const InfoOptions& o, const Mesh& mesh) {
+    const AxisBox box = boundsOf(mesh);
+    const glm::dvec3 size = box.hi - box.lo, centre = 0.5 * (box.lo + box.hi) + 0.0;  // + 0.0: no -0
+    const std::size_t triangles = mesh.indices.size() / 3, vertices = mesh.positions.size();
+    if (o.json) {
+        nlohmann::ordered_json j;
+        j["file"] = o.input;
+        j["kind"] = "mesh";
+        j["triangles"] = triangles;
+        j["vertices"] = vertices;
+        j["bounds"] = {{"min", {box.lo.x, box.lo.y, box.lo.z}}, {"max", {box.hi.x, box.hi.y, box.hi.z}},
+                       {"centre", {centre.x, centre.y, centre.z}}, {"size", {size.x, size.y, size.z}}};
+        j["colours"] = !mesh.colours.empty();
+        if (mesh.texture) j["texture"] = {{"width", mesh.texture->width}, {"height", mesh.texture->height}};
+        std::printf("%s\n", j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
+        return 0;
+    }
+    std::printf("%s: mesh, %zu triangles, %zu vertices%s", o.input.c_str(), triangles, vertices,
+                mesh.colours.empty() ? "" : ", vertex colours");
+    if (mesh.texture) std::printf(", a %d x %d texture", mesh.texture->width, mesh.texture->height);
+    std::printf("\n");
+    std::printf("  bounds        min %g,%g,%g  max %g,%g,%g\n", box.lo.x, box.lo.y, box.lo.z, box.hi.x, box.hi.y, box.hi.z);
+    std::printf("  centre        %g,%g,%g  size %g x %g x %g\n", centre.x, centre.y, centre.z, size.x, size.y, size.z);
+    return 0;
+}
+
 int runInfo(const InfoOptions& o) {
     if (o.backends) return printBackends(o.json);
     if (o.limits) return printLimits(o.json);
@@ -272,6 +322,18 @@ int runInfo(const InfoOptions& o) {
     if (!o.densityPng.empty()) checkPictureOutput(o.densityPng, {}, {o.input});  // before the file is read
     if (o.verbose) explainIfInvalid(o.input);
     if (format::isReflectionAsset(o.input)) return printReflectionAsset(o);
+    // Not OpenEXR: a mesh file when Assimp reads it; otherwise the CoNUS reader says what is wrong.
+    if (std::filesystem::is_regular_file(o.input) && !isExr(o.input)) {
+        std::optional<Mesh> mesh;
+        try {
+            mesh = sceneio::readMesh(o.input);
+        } catch (const Error&) {
+        }
+        if (mesh) {
+            if (!o.densityPng.empty()) throw Error(ErrorCode::InvalidArgument, "--density draws a CoNUS file's map; " + o.input + " is a mesh");
+            return printMesh(o, *mesh);
+        }
+    }
     const FileFacts facts = readFacts(o.input);
     nlohmann::ordered_json j = toJson(o.input, facts);
     if (!o.densityPng.empty()) {
@@ -292,8 +354,8 @@ int runInfo(const InfoOptions& o) {
 
 Command addInfoCommand(CLI::App& root) {
     auto options = std::make_shared<InfoOptions>();
-    CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth (a reflection asset: its frame and six faces)");
-    command->add_option("input", options->input, "CoNUS file or reflection asset (.exr)");
+    CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth (a reflection asset: its frame and six faces; a mesh: its bounds)");
+    command->add_option("input", options->input, "CoNUS file or reflection asset (.exr), or a mesh file (its bounds and size)");
     command->add_flag("--backends", options->backends,
                       "list the rendering backends (EGL, OSMesa, CPU): whether each works, its GL_RENDERER, why not");
     command->add_flag("--limits", options->limits,
@@ -305,6 +367,7 @@ Command addInfoCommand(CLI::App& root) {
     setExamples(*command, {"conus info photo.exr",
                        "conus info photo.exr --json --density density.png",
                        "conus info asset.exr                # a reflection asset: the cube's frame and its six faces",
+                       "conus info teapot.obj               # a mesh: triangles, vertices, bounds (for --center, --roi-min/--roi-max)",
                        "conus info --backends"});
     writesFile(command->add_option("--density", options->densityPng,
                                    "write the sampling density as a heat map with the sampling pattern over it (.png)"));

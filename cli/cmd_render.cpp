@@ -65,10 +65,13 @@ int runRenderRelief(const RenderOptions& o) {
     const Image frame = renderer.render(camera, size.width, size.height);
     progress.done();
     writePicture(o.output, frame, write);
-    const glm::dvec3 eye = camera.eye(), at = eye + camera.forward();
-    std::printf("wrote %s: %dx%d frame of a %dx%d relief asset (%s); camera %.3g,%.3g,%.3g,%.3g,%.3g,%.3g,%.3g\n",
+    // The camera as --camera takes it: the one given, as given; else the default view's eye and a
+    // point one unit along its view (the same camera when given back).
+    const glm::dvec3 eye = given ? given->eye : camera.eye(), at = given ? given->target : eye + camera.forward();
+    std::printf("wrote %s: %dx%d frame of a %dx%d relief asset (%s); camera %g,%g,%g,%g,%g,%g,%g\n",
                 o.output.c_str(), size.width, size.height, file.image.width, file.image.height,
-                device.context().renderer().c_str(), eye.x, eye.y, eye.z, at.x, at.y, at.z, camera.verticalFovDegrees());
+                device.context().renderer().c_str(), eye.x, eye.y, eye.z, at.x, at.y, at.z,
+                given ? given->fovYDegrees : camera.verticalFovDegrees());
     return 0;
 }
 

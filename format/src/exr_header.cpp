@@ -249,7 +249,7 @@ void fillMetadata(const HeaderModel& m, const Imf::Header& h, ConusFile& out) {
     const PartModel& part = m.part(PartKind::Conus);
     out.pixelType = PixelType::Half;
     for (const ChannelModel& c : part.channels) {
-        if (c.name != "Z" && c.type == ChannelType::Float) out.pixelType = PixelType::Float;
+        if (!isDepthChannel(c.name) && c.type == ChannelType::Float) out.pixelType = PixelType::Float;
     }
     out.compression = part.compression;
     out.sourceWidth = m.sourceSize.value[0];

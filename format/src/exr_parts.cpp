@@ -70,7 +70,7 @@ void writeImagePart(Imf::MultiPartOutputFile& exr, int index, const Image& im, P
     std::vector<std::vector<Imath::half>> halves;
     Imf::FrameBuffer fb;
     for (std::size_t c = 0; c < nc; ++c) {
-        if (im.channels[c] != "Z" && pixelType == PixelType::Half) {
+        if (!isDepthChannel(im.channels[c]) && pixelType == PixelType::Half) {
             std::vector<Imath::half>& h = halves.emplace_back(count);
             for (std::size_t i = 0; i < count; ++i) h[i] = Imath::half(im.pixels[i * nc + c]);
             fb.insert(im.channels[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(h.data()), sizeof(Imath::half),

@@ -28,7 +28,7 @@ HeaderModel modelOf(const ConusFile& file, const std::string& suffix) {
     conus.type = "scanlineimage";
     conus.compression = file.compression;
     for (const std::string& name : im.channels) {
-        conus.channels.push_back({name, name == "Z" || file.pixelType == PixelType::Float ? ChannelType::Float : ChannelType::Half, 1, 1});
+        conus.channels.push_back({name, isDepthChannel(name) || file.pixelType == PixelType::Float ? ChannelType::Float : ChannelType::Half, 1, 1});
     }
     // OpenEXR stores channels sorted by name; so does the model, so checks read the same.
     std::sort(conus.channels.begin(), conus.channels.end(), [](const auto& a, const auto& b) { return a.name < b.name; });

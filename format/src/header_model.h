@@ -144,6 +144,12 @@ struct AttributeSpec {
 };
 
 // Attribute names (spec/conus-format.md, "Attributes").
+// A channel that holds depth, always FLOAT (V3, V18): `Z`, and a reflection asset's deeper layers'
+// `layer<k>.Z` (spec "Layers").
+inline bool isDepthChannel(const std::string& name) {
+    return name == "Z" || (name.rfind("layer", 0) == 0 && name.size() > 2 && name.compare(name.size() - 2, 2, ".Z") == 0);
+}
+
 inline constexpr const char* kAttrVersion = "conus:version";
 inline constexpr const char* kAttrSourceSize = "conus:sourceSize";
 inline constexpr const char* kAttrDataKind = "conus:dataKind";

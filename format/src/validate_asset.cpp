@@ -25,8 +25,42 @@ std::string vectorText(glm::dvec3 v) {
     return "(" + numberText(v.x, 6) + ", " + numberText(v.y, 6) + ", " + numberText(v.z, 6) + ")";
 }
 
+// V18's layers: the deeper layers' channels (`layer<k>.R` .. `.Z`, k = 1..L-1) in one face; L, or
+// 0 after saying what is wrong.
+int faceLayers(const PartModel& part, const std::string& face, ValidationReport& r) {
+    int layers = 1;
+    bool ok = true;
+    for (const ChannelModel& c : part.channels) {
+        if (c.name.rfind("layer", 0) != 0) continue;
+        const std::size_t dot = c.name.find('.');
+        const std::string number = c.name.substr(5, dot == std::string::npos ? std::string::npos : dot - 5);
+        if (dot == std::string::npos || number.empty() || number.size() > 2 || number[0] == '0' ||
+            !std::all_of(number.begin(), number.end(), [](char d) { return d >= '0' && d <= '9'; })) {
+            r.add(Rule::V18, "face " + face + " has channel " + c.name + ", not a layer's (layer<k>.R, .G, .B, .A, .Z)");
+            ok = false;
+            continue;
+        }
+        layers = std::max(layers, std::stoi(number) + 1);
+        if (c.name.substr(dot) == ".Z" && c.type != ChannelType::Float) {
+            r.add(Rule::V18, "face " + face + " channel " + c.name + " is not FLOAT");
+            ok = false;
+        }
+    }
+    for (int k = 1; k < layers; ++k)
+        for (const char* channel : {".A", ".B", ".G", ".R", ".Z"}) {
+            const std::string name = "layer" + std::to_string(k) + channel;
+            if (std::none_of(part.channels.begin(), part.channels.end(), [&](const ChannelModel& c) { return c.name == name; })) {
+                r.add(Rule::V18, "face " + face + " has no channel " + name + " (a layer holds R, G, B, A and Z; layers 1.." +
+                                     std::to_string(layers - 1) + " all)");
+                ok = false;
+            }
+        }
+    return ok ? layers : 0;
+}
+
 // V18: what each face holds; the faces square and of one size.
 void checkFaces(const AssetModel& faces, ValidationReport& r) {
+    int layers = -1;
     const PartModel& first = faces[0].part(PartKind::Conus);
     for (int f = 0; f < kCubeFaceCount; ++f) {
         const HeaderModel& m = faces[static_cast<std::size_t>(f)];
@@ -38,6 +72,12 @@ void checkFaces(const AssetModel& faces, ValidationReport& r) {
             if (std::none_of(part.channels.begin(), part.channels.end(), [&](const ChannelModel& c) { return c.name == channel; }))
                 missing += std::string(missing.empty() ? "" : ", ") + channel;
         if (!missing.empty()) r.add(Rule::V18, "face " + faceName(f) + " has no channel " + missing + " (a face holds R, G, B, A and Z)");
+        if (const int l = faceLayers(part, faceName(f), r); l > 0) {
+            if (layers > 0 && l != layers)
+                r.add(Rule::V18, "face " + faceName(f) + " has " + std::to_string(l) + " layers, face " + faceName(0) + " " +
+                                     std::to_string(layers) + "; every face has one count of layers");
+            if (layers < 0) layers = l;
+        }
         const std::int64_t w = part.dataWindow.width(), h = part.dataWindow.height();
         if (w != h) r.add(Rule::V18, "face " + faceName(f) + " is " + std::to_string(w) + "x" + std::to_string(h) + ", not square");
         else if (f > 0 && !(part.dataWindow == first.dataWindow))

@@ -4,7 +4,9 @@
 // first and then u as codec's row stepping does, with its partial derivatives. Outside [0,1] the
 // point is clamped to the edge, as SamplingMap::distort does. And the decoder's footprint filter:
 // bilinear taps over a pixel's footprint, as many as codec::decodeImage takes; or, with a mipmapped
-// texture, one trilinear tap at the level codec's pyramid decode chooses.
+// texture, one trilinear tap at the level codec's pyramid decode chooses. The constants it reads
+// (kDecodeMultiTap, kDecodeMaxTaps, kDecodePyramidBias) are declared before it from C++
+// (codec::glslConstants). Installed with intersect.inc.glsl (<datadir>/conus/glsl).
 struct MapPoint {
     vec2 pd;  // distorted position
     vec2 du;  // d pd / du

@@ -1,10 +1,27 @@
 // Ray / depth-image intersection in GLSL: the twin of codec/src/depth/intersect.cpp and
 // depth_surface.cpp, function for function (clip in homogeneous coordinates, project, walk the
 // projected segment distorting each point with Equation 1, bisect; walls and hidden rays as
-// codec/depth/intersect.h says). Include equation1.inc.glsl first. kIntersectDepthMargin and
-// kSilhouetteStep are injected from C++. The depth texture is R32F; each depth's lowest mantissa
-// bit is its cell's discontinuity flag (DepthImage::cellFlags, computed once on the CPU;
-// renderers/src/depth_pvt.h).
+// codec/depth/intersect.h says). Include equation1.inc.glsl first. kIntersectDepthMargin,
+// kSilhouetteStep and kSideRuleFarMargin are declared before it from C++ (codec::glslConstants).
+// The depth texture is R32F; each depth's lowest mantissa bit is its cell's discontinuity flag
+// (DepthImage::cellFlags, computed once on the CPU: codec::flaggedDepths); a DepthView holds
+// codec::depthViewValues. Installed (<datadir>/conus/glsl) for renderers of one's own:
+// conus/codec/depth/glsl_interface.h, docs/reflections-in-your-renderer.md.
+//
+// A layered depth image (codec/depth/intersect.h) lies in one texture, its layers side by side
+// (layer k's texel (x, y) at (x + k * width, y)); gDepthLayers says how many, gDepthLayer which one
+// the functions below read. A single-layer image needs neither set.
+int gDepthLayers = 1;
+int gDepthLayer = 0;
+
+// One layer's size, and texel i of the layer being read.
+ivec2 depthSize(sampler2D depths) {
+    const ivec2 all = textureSize(depths, 0);
+    return ivec2(all.x / gDepthLayers, all.y);
+}
+ivec2 layerTexel(sampler2D depths, ivec2 i) { return ivec2(i.x + gDepthLayer * depthSize(depths).x, i.y); }
+float depthAt(sampler2D depths, ivec2 i) { return texelFetch(depths, layerTexel(depths, i), 0).r; }
+
 struct DepthView {
     mat4 worldToNdc;  // the camera's worldToNdcMatrix (u, v = xy / w)
     mat4 ndcToWorld;  // its inverse, for unprojectDepth
@@ -27,6 +44,7 @@ struct DepthHit {
     ivec2 texel;
     int steps;
     bool hidden;  // the background carried on behind an occluder
+    float firstHidden;  // where the walk first went behind the surface (t; 1e38: never): deeper layers from there
     int face;  // the face of the clipped volume the ray entered through when steps == 0 (0..5), else -1
 };
 
@@ -60,12 +78,12 @@ vec4 bilinearWeights(vec2 f) {
 // DepthImage::surfaceWeights: the four texels around pd and their weights (x, y, z, w as
 // splitWeights), which do not extrapolate.
 vec4 surfaceWeights(sampler2D depths, vec2 pd, out ivec2 i0, out ivec2 i1) {
-    const vec2 f = clamp(cellAt(textureSize(depths, 0), pd, i0, i1), 0.0, 1.0);
-    const float a = texelFetch(depths, i0, 0).r;
+    const vec2 f = clamp(cellAt(depthSize(depths), pd, i0, i1), 0.0, 1.0);
+    const float a = depthAt(depths, i0);
     const vec4 w = bilinearWeights(f);
     if (!flagBit(a)) return w;
-    const vec4 d = vec4(a, texelFetch(depths, ivec2(i1.x, i0.y), 0).r, texelFetch(depths, ivec2(i0.x, i1.y), 0).r,
-                        texelFetch(depths, i1, 0).r);
+    const vec4 d = vec4(a, depthAt(depths, ivec2(i1.x, i0.y)), depthAt(depths, ivec2(i0.x, i1.y)),
+                        depthAt(depths, i1));
     return splitWeights(d, w, f);
 }
 
@@ -74,10 +92,10 @@ vec4 surfaceWeights(sampler2D depths, vec2 pd, out ivec2 i0, out ivec2 i1) {
 // image); `flagged` says which.
 float sampleDepth(sampler2D depths, DepthView view, vec2 pd, out bool flagged) {
     ivec2 i0, i1;
-    const vec2 f = cellAt(textureSize(depths, 0), pd, i0, i1);
-    const float a = texelFetch(depths, i0, 0).r;
-    const float b = texelFetch(depths, ivec2(i1.x, i0.y), 0).r, c = texelFetch(depths, ivec2(i0.x, i1.y), 0).r;
-    const float e = texelFetch(depths, i1, 0).r;
+    const vec2 f = cellAt(depthSize(depths), pd, i0, i1);
+    const float a = depthAt(depths, i0);
+    const float b = depthAt(depths, ivec2(i1.x, i0.y)), c = depthAt(depths, ivec2(i0.x, i1.y));
+    const float e = depthAt(depths, i1);
     flagged = flagBit(a);
     if (!flagged) {
         if (f == clamp(f, 0.0, 1.0) || !view.perspective) return mix(mix(a, b, f.x), mix(c, e, f.x), f.y);
@@ -130,17 +148,23 @@ float surfaceAlong(sampler2D depths, DepthView view, sampler2D map, vec2 p0, vec
     return surfaceAlong(depths, view, map, p0, along, s, m, flagged);
 }
 
-// The ray's camera depth at s (perspective-correct).
-float rayDepth(float dw0, float dw1, float iw0, float iw1, float s) { return mix(dw0, dw1, s) / mix(iw0, iw1, s); }
+// The ray clipped to the image's volume (Segment in intersect.cpp): the projected segment from p0
+// along `along`, 1/w, depth/w and t/w at its ends (linear along it), where the walk ends and
+// whether that is the data's farthest depth, and the face entered through (-1: none).
+struct DepthSegment {
+    vec2 p0, along;
+    float iw0, iw1, dw0, dw1, tw0, tw1;
+    float end;
+    bool endsAtRange;
+    int entered;
+};
 
-DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, vec3 origin, vec3 direction,
-                             float stepTexels, int refinements, int maxSteps, float tMax) {
-    DepthHit result;
-    result.hit = false;
-    result.steps = 0;
-    result.face = -1;
-    result.hidden = false;
-    // 1. Clip: u, v in [0,1] and depth in [lo, hi], each a + b t >= 0.
+// The ray's camera depth at s (perspective-correct).
+float segmentDepth(DepthSegment g, float s) { return mix(g.dw0, g.dw1, s) / mix(g.iw0, g.iw1, s); }
+
+// 1. Clip: u, v in [0,1] and depth in [lo, hi], each a + b t >= 0; 2. project the ends. False when
+// the ray misses the volume.
+bool clipDepthRay(DepthView view, vec3 origin, vec3 direction, float tMax, out DepthSegment g) {
     const vec4 c0 = view.worldToNdc * vec4(origin, 1.0), cd = view.worldToNdc * vec4(direction, 0.0);
     const float z0 = dot(origin - view.eye, view.forward), zd = dot(direction, view.forward);
     const float margin = kIntersectDepthMargin * (1.0 + max(abs(view.minDepth), abs(view.maxDepth)));
@@ -156,7 +180,7 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     for (int k = 0; k < 6; ++k) {
         const float a = planes[2 * k], b = planes[2 * k + 1];
         if (b == 0.0) {
-            if (a < 0.0) return result;
+            if (a < 0.0) return false;
             continue;
         }
         const float t = -a / b;
@@ -170,23 +194,84 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
             exited = k;
         }
     }
-    if (!(tEnter <= tExit)) return result;
+    if (!(tEnter <= tExit)) return false;
 
-    // 2. Project the ends; 1/w, depth/w and t/w are linear along the projected segment.
+    // 1/w, depth/w and t/w are linear along the projected segment.
     const vec4 ca = c0 + cd * tEnter, cb = c0 + cd * tExit;
-    const float iw0 = 1.0 / ca.w, iw1 = 1.0 / cb.w;
-    const vec2 p0 = clamp(ca.xy * iw0, 0.0, 1.0), p1 = clamp(cb.xy * iw1, 0.0, 1.0);
-    const float dw0 = (z0 + zd * tEnter) * iw0, dw1 = (z0 + zd * tExit) * iw1;
-    const float tw0 = tEnter * iw0, tw1 = tExit * iw1;
-    const vec2 along = p1 - p0;
-    const vec2 size = vec2(textureSize(depths, 0));
-    float end = 1.0;  // where the walk ends (Segment::end)
-    bool endsAtRange = exited == 5;
-    if (hi > range && rayDepth(dw0, dw1, iw0, iw1, 1.0) > range) {
-        const float den = (dw1 - dw0) - range * (iw1 - iw0);
-        end = den != 0.0 ? clamp((range * iw0 - dw0) / den, 0.0, 1.0) : 1.0;
-        endsAtRange = true;
+    g.iw0 = 1.0 / ca.w;
+    g.iw1 = 1.0 / cb.w;
+    g.p0 = clamp(ca.xy * g.iw0, 0.0, 1.0);
+    g.along = clamp(cb.xy * g.iw1, 0.0, 1.0) - g.p0;
+    g.dw0 = (z0 + zd * tEnter) * g.iw0;
+    g.dw1 = (z0 + zd * tExit) * g.iw1;
+    g.tw0 = tEnter * g.iw0;
+    g.tw1 = tExit * g.iw1;
+    g.entered = entered;
+    g.end = 1.0;  // where the walk ends (Segment::end)
+    g.endsAtRange = exited == 5;
+    if (hi > range && segmentDepth(g, 1.0) > range) {
+        const float den = (g.dw1 - g.dw0) - range * (g.iw1 - g.iw0);
+        g.end = den != 0.0 ? clamp((range * g.iw0 - g.dw0) / den, 0.0, 1.0) : 1.0;
+        g.endsAtRange = true;
     }
+    return true;
+}
+
+// Through a side, behind a scene's surface `entry` by less than a jump, short of the far plane
+// (where a scene saw nothing): met where it enters.
+bool acrossSide(DepthView view, DepthSegment g, float entry) {
+    return !view.solid && g.entered >= 0 && g.entered < 4 && entry < view.far * (1.0 - kSideRuleFarMargin) &&
+           segmentDepth(g, 0.0) - entry <= view.jumpRelative * entry + view.jumpAbsolute;
+}
+
+// One step of the linear search (Walk::step in intersect.cpp): stepTexels CoNUS pixels along the
+// distorted curve from s, kSilhouetteStep as long from or into a flagged cell. Updates before, s,
+// m and flagged; returns the stored depth at the new s.
+float stepAlong(sampler2D depths, sampler2D map, DepthView view, DepthSegment g, float stepTexels, vec2 size,
+                inout float before, inout float s, inout MapPoint m, inout bool flagged) {
+    const float speed = length((m.du * g.along.x + m.dv * g.along.y) * size);
+    const bool fine = flagged;
+    before = s;
+    s = min(g.end, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
+    float stored = surfaceAlong(depths, view, map, g.p0, g.along, s, m, flagged);
+    if (!fine && flagged) {  // a full step into a flagged cell: taken again, finely
+        s = min(g.end, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
+        stored = surfaceAlong(depths, view, map, g.p0, g.along, s, m, flagged);
+    }
+    return stored;
+}
+
+// The hit at s (where the CoNUS image holds pd).
+void finishHit(inout DepthHit result, DepthSegment g, vec3 origin, vec3 direction, float s, vec2 pd, vec2 size,
+               int steps) {
+    const float iw = mix(g.iw0, g.iw1, s);
+    result.hit = true;
+    result.t = mix(g.tw0, g.tw1, s) / iw;
+    result.position = origin + direction * result.t;
+    result.depth = mix(g.dw0, g.dw1, s) / iw;
+    result.point = g.p0 + g.along * s;
+    result.distorted = pd;
+    result.texel = clamp(ivec2(floor(pd * size)), ivec2(0), ivec2(size) - 1);
+    result.steps = steps;
+    result.face = steps == 0 ? g.entered : -1;
+}
+
+DepthHit noDepthHit() {
+    DepthHit result;
+    result.hit = false;
+    result.steps = 0;
+    result.face = -1;
+    result.hidden = false;
+    result.firstHidden = 1e38;
+    return result;
+}
+
+DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, vec3 origin, vec3 direction,
+                             float stepTexels, int refinements, int maxSteps, float tMax) {
+    DepthHit result = noDepthHit();
+    DepthSegment g;
+    if (!clipDepthRay(view, origin, direction, tMax, g)) return result;
+    const vec2 size = vec2(depthSize(depths));
 
     // 3. Walk near to far, each step stepTexels CoNUS pixels along the distorted curve. The walk
     // stops at an event; the bisections run after it, so that rays bisect together.
@@ -197,35 +282,24 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     MapPoint m, hiddenFrom;  // hiddenFrom: the last point in front of the surface
     MapPoint q;
     bool flagged;  // whether the sample at s lies in a flagged cell (never in a solid image)
-    const float entry = surfaceAlong(depths, view, map, p0, along, 0.0, m, flagged);
-    const bool behind = entry - rayDepth(dw0, dw1, iw0, iw1, 0.0) <= 0.0;
-    // Through a side, behind a scene's surface by less than a jump, short of the far plane (where a
-    // scene saw nothing): met where it enters.
-    const bool acrossSide = behind && !view.solid && entered >= 0 && entered < 4 &&
-                            entry < view.far * (1.0 - kSideRuleFarMargin) &&
-                            rayDepth(dw0, dw1, iw0, iw1, 0.0) - entry <= view.jumpRelative * entry + view.jumpAbsolute;
-    if (behind && !view.solid && !acrossSide) {
-        if (end <= 0.0) return result;  // entered beyond the data's depth range
+    const float entry = surfaceAlong(depths, view, map, g.p0, g.along, 0.0, m, flagged);
+    const bool behind = entry - segmentDepth(g, 0.0) <= 0.0;
+    const bool across = behind && acrossSide(view, g, entry);
+    if (behind && !view.solid && !across) {
+        if (g.end <= 0.0) return result;  // entered beyond the data's depth range
         hidden = true;
-        hiddenDepth = rayDepth(dw0, dw1, iw0, iw1, 0.0);
+        result.firstHidden = mix(g.tw0, g.tw1, 0.0) / mix(g.iw0, g.iw1, 0.0);
+        hiddenDepth = segmentDepth(g, 0.0);
         hiddenFrom = m;
     }
-    if (!(behind && (view.solid || acrossSide))) {  // else hit where entered: a solid image, or a surface across the side
+    if (!(behind && (view.solid || across))) {  // else hit where entered: a solid image, or a surface across the side
         for (;;) {
             // The event: 1 a crossing, 2 behind the background while hidden, 0 the end.
             int event = 0;
-            while (!(s >= end || steps >= maxSteps)) {
-                const float speed = length((m.du * along.x + m.dv * along.y) * size);
-                const bool fine = flagged;
-                before = s;
-                s = min(end, before + (speed > 0.0 ? stepTexels * (fine ? kSilhouetteStep : 1.0) / speed : 1.0));
+            while (!(s >= g.end || steps >= maxSteps)) {
+                const float stored = stepAlong(depths, map, view, g, stepTexels, size, before, s, m, flagged);
                 ++steps;
-                float stored = surfaceAlong(depths, view, map, p0, along, s, m, flagged);
-                if (!fine && flagged) {  // a full step into a flagged cell: taken again, finely
-                    s = min(end, before + (speed > 0.0 ? stepTexels * kSilhouetteStep / speed : 1.0));
-                    stored = surfaceAlong(depths, view, map, p0, along, s, m, flagged);
-                }
-                const float gap = stored - rayDepth(dw0, dw1, iw0, iw1, s);
+                const float gap = stored - segmentDepth(g, s);
                 if (hidden) {
                     if (gap > 0.0) {
                         hidden = false;  // in front of the surface again
@@ -240,10 +314,10 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
             }
             if (event == 0) {
                 // Hidden up to the farthest stored depth: the background where the ray went hidden.
-                if (!(hidden && s >= end && endsAtRange)) return result;
+                if (!(hidden && s >= g.end && g.endsAtRange)) return result;
                 m = hiddenFrom;
                 result.hidden = true;
-                s = end;
+                s = g.end;
                 break;
             }
             float a = before, b = s;
@@ -251,50 +325,86 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
                 // Behind the background: where the stored surface first reaches hiddenDepth.
                 for (int k = 0; k < refinements; ++k) {
                     const float mid = 0.5 * (a + b);
-                    if (surfaceAlong(depths, view, map, p0, along, mid, q) >= hiddenDepth)
+                    if (surfaceAlong(depths, view, map, g.p0, g.along, mid, q) >= hiddenDepth)
                         b = mid;
                     else
                         a = mid;
                 }
                 s = b;
-                m = evalMap(map, p0 + along * s);
+                m = evalMap(map, g.p0 + g.along * s);
                 result.hidden = true;
                 break;
             }
             // 4. Bisect between the last sample in front and the first behind.
             for (int k = 0; k < refinements; ++k) {
                 const float mid = 0.5 * (a + b);
-                if (surfaceAlong(depths, view, map, p0, along, mid, q) - rayDepth(dw0, dw1, iw0, iw1, mid) > 0.0)
+                if (surfaceAlong(depths, view, map, g.p0, g.along, mid, q) - segmentDepth(g, mid) > 0.0)
                     a = mid;
                 else
                     b = mid;
             }
             if (view.solid) {
                 s = 0.5 * (a + b);
-                m = evalMap(map, p0 + along * s);
+                m = evalMap(map, g.p0 + g.along * s);
                 break;
             }
-            const float sb = surfaceAlong(depths, view, map, p0, along, b, q);
+            const float sb = surfaceAlong(depths, view, map, g.p0, g.along, b, q);
             MapPoint qa;
-            if (surfaceAlong(depths, view, map, p0, along, a, qa) - sb <= 0.5 * (view.jumpRelative * sb + view.jumpAbsolute)) {
+            if (surfaceAlong(depths, view, map, g.p0, g.along, a, qa) - sb <= 0.5 * (view.jumpRelative * sb + view.jumpAbsolute)) {
                 s = 0.5 * (a + b);
-                m = evalMap(map, p0 + along * s);
+                m = evalMap(map, g.p0 + g.along * s);
                 break;
             }
             hidden = true;  // a wall: the ray passes behind an occluder's silhouette
-            hiddenDepth = rayDepth(dw0, dw1, iw0, iw1, b);
+            result.firstHidden = min(result.firstHidden, mix(g.tw0, g.tw1, a) / mix(g.iw0, g.iw1, a));
+            hiddenDepth = segmentDepth(g, b);
             hiddenFrom = qa;
         }
     }
-    const float iw = mix(iw0, iw1, s);
-    result.hit = true;
-    result.t = mix(tw0, tw1, s) / iw;
-    result.position = origin + direction * result.t;
-    result.depth = mix(dw0, dw1, s) / iw;
-    result.point = p0 + along * s;
-    result.distorted = m.pd;
-    result.texel = clamp(ivec2(floor(m.pd * size)), ivec2(0), ivec2(size) - 1);
-    result.steps = steps;
-    result.face = steps == 0 ? entered : -1;
+    finishHit(result, g, origin, direction, s, m.pd, size, steps);
+    return result;
+}
+
+// A deeper layer of a layered image (codec::intersectBehind): a continuous crossing of the stored
+// surface either way is a hit, a wall none, nothing carried on behind an occluder.
+DepthHit intersectBehindLayer(sampler2D depths, sampler2D map, DepthView view, vec3 origin, vec3 direction,
+                              float stepTexels, int refinements, int maxSteps, float tMax) {
+    DepthHit result = noDepthHit();
+    DepthSegment g;
+    if (!clipDepthRay(view, origin, direction, tMax, g)) return result;
+    const vec2 size = vec2(depthSize(depths));
+    MapPoint m, q;
+    bool flagged;
+    float before = 0.0, s = 0.0;
+    int steps = 0;
+    const float entry = surfaceAlong(depths, view, map, g.p0, g.along, 0.0, m, flagged);
+    if (entry - segmentDepth(g, 0.0) <= 0.0 && acrossSide(view, g, entry)) {
+        finishHit(result, g, origin, direction, 0.0, m.pd, size, 0);
+        return result;
+    }
+    bool front = entry - segmentDepth(g, 0.0) > 0.0;
+    while (s < g.end && steps < maxSteps) {
+        const float stored = stepAlong(depths, map, view, g, stepTexels, size, before, s, m, flagged);
+        ++steps;
+        if ((stored - segmentDepth(g, s) > 0.0) == front) continue;
+        float a = before, b = s;
+        for (int k = 0; k < refinements; ++k) {
+            const float mid = 0.5 * (a + b);
+            if ((surfaceAlong(depths, view, map, g.p0, g.along, mid, q) - segmentDepth(g, mid) > 0.0) == front)
+                a = mid;
+            else
+                b = mid;
+        }
+        MapPoint qa, qb;
+        const float sa = surfaceAlong(depths, view, map, g.p0, g.along, a, qa);
+        const float sb = surfaceAlong(depths, view, map, g.p0, g.along, b, qb);
+        if ((front ? sa - sb : sb - sa) <= 0.5 * (view.jumpRelative * min(sa, sb) + view.jumpAbsolute)) {
+            const float mid = 0.5 * (a + b);
+            m = evalMap(map, g.p0 + g.along * mid);
+            finishHit(result, g, origin, direction, mid, m.pd, size, steps);
+            return result;
+        }
+        front = !front;  // a wall: the ray is now on the other side, with nothing met
+    }
     return result;
 }

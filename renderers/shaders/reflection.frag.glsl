@@ -4,8 +4,11 @@
 // where the reflector lies in front of the scene behind (a mesh frame of the same camera), the
 // reflected ray is intersected with the six cube faces of the asset (intersect.inc.glsl, the one
 // algorithm), the nearest hit that is not the far plane wins and takes the face's colour there
-// (codec::reflectionColour); a ray that meets nothing shows the sky. Out: R, G, B and the mask M
+// (codec::reflectionColour); a ray that meets nothing shows the sky. A layered asset's faces hold
+// their layers side by side in their depth and colour textures (intersect.inc.glsl), the deeper
+// ones walked as codec::traceReflection walks them. Out: R, G, B and the mask M
 // (0 the scene or nothing, 1 the reflector showing the sky, 2 the reflector showing the scene).
+// Installed (<datadir>/conus/glsl); examples/reflection_gl sets its uniforms outside CoNUS.
 #include "equation1.inc.glsl"
 #include "intersect.inc.glsl"
 
@@ -14,6 +17,7 @@ const int kFaces = 6;
 uniform sampler2D uDepths[kFaces];
 uniform sampler2D uMaps[kFaces];
 uniform sampler2D uColours[kFaces];  // R, G, B, coverage per CoNUS pixel
+uniform int uLayers;                 // each face's layers (side by side in its textures)
 uniform DepthView uViews[kFaces];
 uniform float uFar[kFaces];          // each face's far clip (where nothing was seen)
 uniform sampler2D uBehind;           // the scene: R, G, B and camera depth (huge where nothing)
@@ -65,12 +69,20 @@ float hitReflector(vec3 origin, vec3 d, out vec3 normal) {
 vec3 reflectionColour(sampler2D depths, sampler2D colours, vec2 pd, ivec2 texel) {
     ivec2 i0, i1;
     const vec4 w = surfaceWeights(depths, pd, i0, i1);
-    const vec4 c00 = texelFetch(colours, i0, 0), c10 = texelFetch(colours, ivec2(i1.x, i0.y), 0);
-    const vec4 c01 = texelFetch(colours, ivec2(i0.x, i1.y), 0), c11 = texelFetch(colours, i1, 0);
+    const vec4 c00 = texelFetch(colours, layerTexel(depths, i0), 0);
+    const vec4 c10 = texelFetch(colours, layerTexel(depths, ivec2(i1.x, i0.y)), 0);
+    const vec4 c01 = texelFetch(colours, layerTexel(depths, ivec2(i0.x, i1.y)), 0);
+    const vec4 c11 = texelFetch(colours, layerTexel(depths, i1), 0);
     const vec4 wc = w * vec4(c00.a, c10.a, c01.a, c11.a);
     const float total = wc.x + wc.y + wc.z + wc.w;
-    if (!(total > 0.0)) return texelFetch(colours, texel, 0).rgb;
+    if (!(total > 0.0)) return texelFetch(colours, layerTexel(depths, texel), 0).rgb;
     return (c00.rgb * wc.x + c10.rgb * wc.y + c01.rgb * wc.z + c11.rgb * wc.w) / total;
+}
+
+// codec's onSky: the hit lies where face f (the layer gDepthLayer) saw nothing.
+bool onSky(int f, DepthHit h) {
+    return texelFetch(uColours[f], layerTexel(uDepths[f], h.texel), 0).a < 0.5 ||
+           (!h.hidden && h.depth >= uFar[f] * (1.0 - 1e-4));
 }
 
 void main() {
@@ -87,18 +99,44 @@ void main() {
     if (!(dot(at - uFrameEye, uFrameForward) < behind.a)) return;
     const vec3 reflected = normalize(direction - 2.0 * dot(direction, normal) * normal);
 
-    // codec::traceReflection: the nearest hit among the faces that is not the far plane.
+    // codec::traceReflection: the nearest hit among the faces that is not the far plane; a face's
+    // deeper layers only where its first went hidden, short of a real first-layer hit.
     bool found = false;
     float best = uTMax;
     vec3 colour = uSky;
+    gDepthLayers = uLayers;
     for (int f = 0; f < kFaces; ++f) {
+        gDepthLayer = 0;
         const DepthHit h = intersectDepthImage(uDepths[f], uMaps[f], uViews[f], at, reflected, uStepTexels,
                                                uRefinements, uMaxSteps, best);
-        if (!h.hit || (found && h.t >= best)) continue;
-        if (texelFetch(uColours[f], h.texel, 0).a < 0.5 || (!h.hidden && h.depth >= uFar[f] * (1.0 - 1e-4))) continue;
-        found = true;
-        best = h.t;
-        colour = reflectionColour(uDepths[f], uColours[f], h.distorted, h.texel);
+        bool mine = false;
+        float mineT = best;
+        vec3 mineColour;
+        // A hidden hit (a guess) is the single-layer face's alone: layers hold what lies behind.
+        if (h.hit && !(found && h.t >= best) && !onSky(f, h) && !(h.hidden && uLayers > 1)) {
+            mine = true;
+            mineT = h.t;
+            mineColour = reflectionColour(uDepths[f], uColours[f], h.distorted, h.texel);
+        }
+        // From where the ray first went behind layer 0 (codec::traceReflection).
+        if (h.firstHidden < best && uLayers > 1) {
+            const vec3 behind = at + reflected * h.firstHidden;
+            for (int k = 1; k < uLayers; ++k) {
+                if (!(mineT - h.firstHidden > 0.0)) break;
+                gDepthLayer = k;
+                const DepthHit d = intersectBehindLayer(uDepths[f], uMaps[f], uViews[f], behind, reflected, uStepTexels,
+                                                        uRefinements, uMaxSteps, mineT - h.firstHidden);
+                if (!d.hit || onSky(f, d)) continue;
+                mine = true;
+                mineT = d.t + h.firstHidden;
+                mineColour = reflectionColour(uDepths[f], uColours[f], d.distorted, d.texel);
+            }
+        }
+        if (mine) {
+            found = true;
+            best = mineT;
+            colour = mineColour;
+        }
     }
     outColour = vec4(colour, found ? 2.0 : 1.0);
 }

@@ -5,15 +5,13 @@
 // scene a DepthFrameRenderer keeps (depth_frames.h).
 #pragma once
 
-#include <cstdint>
-#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "conus/codec/depth/intersect.h"
+#include "conus/codec/depth/glsl_interface.h"
 #include "conus/renderers/depth_frames.h"
 #include "context_pvt.h"
 #include "gl_objects.h"
@@ -40,36 +38,32 @@ inline GlHandle floatTexture(const GladGLContext& gl, GLenum unit, int width, in
     return texture;
 }
 
-// The depths as the GPU reads them: each with its cell's flag (DepthImage::cellFlags; never set in
-// a solid image) in the lowest mantissa bit, a change of at most one unit in the last place. One
-// R32F fetch then gives both: a second channel (RG32F) made every walk about 1.6x slower on
-// llvmpipe, solid images' too.
-inline std::vector<float> flaggedDepths(const codec::DepthImage& image) {
-    std::vector<float> out = image.depths();
-    for (std::size_t i = 0; i < out.size(); ++i) {
-        std::uint32_t bits;
-        std::memcpy(&bits, &out[i], sizeof bits);
-        bits = (bits & ~std::uint32_t{1}) | std::uint32_t{image.cellFlags()[i]};
-        std::memcpy(&out[i], &bits, sizeof bits);
-    }
-    return out;
-}
-
-// The depth image's textures: depths on texture unit `unit`, map nodes on unit + 1.
+// The depth image's textures: depths on texture unit `unit`, map nodes on unit + 1. A layered
+// image's layers (one camera, one map, one size) lie side by side in the depth texture.
 struct DepthTextures {
     GlHandle depths, map;
     int unit = 0;
 
     DepthTextures(Context& context, const GladGLContext& gl, const codec::DepthImage& image, const char* what,
                   int firstUnit = 0)
+        : DepthTextures(context, gl, std::vector<const codec::DepthImage*>{&image}, what, firstUnit) {}
+
+    DepthTextures(Context& context, const GladGLContext& gl, const std::vector<const codec::DepthImage*>& layers,
+                  const char* what, int firstUnit = 0)
         : unit(firstUnit) {
-        if (image.width() > context.maxTextureSize() || image.height() > context.maxTextureSize())
+        const codec::DepthImage& image = *layers.front();
+        const long long wide = static_cast<long long>(image.width()) * static_cast<long long>(layers.size());
+        if (wide > context.maxTextureSize() || image.height() > context.maxTextureSize())
             throw Error(ErrorCode::LimitExceeded, std::string(what) + ": depth image " + std::to_string(image.width()) +
                                                       "x" + std::to_string(image.height()) +
+                                                      (layers.size() > 1 ? " of " + std::to_string(layers.size()) + " layers side by side" : "") +
                                                       " exceeds GL_MAX_TEXTURE_SIZE " +
                                                       std::to_string(context.maxTextureSize()));
-        depths = floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(unit), image.width(), image.height(), 1,
-                              flaggedDepths(image).data());
+        std::vector<std::vector<float>> flagged;
+        for (const codec::DepthImage* layer : layers) flagged.push_back(flaggedDepths(*layer));
+        depths = floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(unit), static_cast<int>(wide), image.height(), 1,
+                              layers.size() == 1 ? flagged.front().data()
+                                                 : codec::sideBySide(flagged, image.width(), image.height(), 1).data());
         const codec::SamplingMap& sampling = image.map();
         map = uploadMapTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(unit + 1), sampling.columns(), sampling.rows(),
                                glm::value_ptr(sampling.nodes().front()));
@@ -88,23 +82,20 @@ struct DepthTextures {
 inline void setDepthView(const GladGLContext& gl, GLuint program, const codec::DepthImage& image,
                          const DepthTextures& textures, const std::string& view = "uView",
                          const std::string& depths = "uDepths", const std::string& map = "uMap") {
-    const Camera& camera = image.camera();
-    const glm::dmat4 toNdc = camera.worldToNdcMatrix();
-    const glm::mat4 worldToNdc(toNdc), ndcToWorld(glm::inverse(toNdc));
-    const glm::vec3 eye(camera.eye()), forward(camera.forward());
+    const codec::DepthViewValues v = codec::depthViewValues(image);
     const auto at = [&](const char* field) { return gl.GetUniformLocation(program, (view + field).c_str()); };
-    gl.UniformMatrix4fv(at(".worldToNdc"), 1, GL_FALSE, glm::value_ptr(worldToNdc));
-    gl.UniformMatrix4fv(at(".ndcToWorld"), 1, GL_FALSE, glm::value_ptr(ndcToWorld));
-    gl.Uniform3f(at(".eye"), eye.x, eye.y, eye.z);
-    gl.Uniform3f(at(".forward"), forward.x, forward.y, forward.z);
-    gl.Uniform1f(at(".near"), static_cast<float>(camera.near()));
-    gl.Uniform1f(at(".far"), static_cast<float>(camera.far()));
-    gl.Uniform1i(at(".perspective"), camera.projection() == Projection::Perspective ? 1 : 0);
-    gl.Uniform1f(at(".minDepth"), static_cast<float>(image.minDepth()));
-    gl.Uniform1f(at(".maxDepth"), static_cast<float>(image.maxDepth()));
-    gl.Uniform1i(at(".solid"), image.solid() ? 1 : 0);
-    gl.Uniform1f(at(".jumpRelative"), static_cast<float>(image.jumpRelative()));
-    gl.Uniform1f(at(".jumpAbsolute"), static_cast<float>(image.jumpAbsolute()));
+    gl.UniformMatrix4fv(at(".worldToNdc"), 1, GL_FALSE, glm::value_ptr(v.worldToNdc));
+    gl.UniformMatrix4fv(at(".ndcToWorld"), 1, GL_FALSE, glm::value_ptr(v.ndcToWorld));
+    gl.Uniform3f(at(".eye"), v.eye.x, v.eye.y, v.eye.z);
+    gl.Uniform3f(at(".forward"), v.forward.x, v.forward.y, v.forward.z);
+    gl.Uniform1f(at(".near"), v.near);
+    gl.Uniform1f(at(".far"), v.far);
+    gl.Uniform1i(at(".perspective"), v.perspective ? 1 : 0);
+    gl.Uniform1f(at(".minDepth"), v.minDepth);
+    gl.Uniform1f(at(".maxDepth"), v.maxDepth);
+    gl.Uniform1i(at(".solid"), v.solid ? 1 : 0);
+    gl.Uniform1f(at(".jumpRelative"), v.jumpRelative);
+    gl.Uniform1f(at(".jumpAbsolute"), v.jumpAbsolute);
     gl.Uniform1i(gl.GetUniformLocation(program, depths.c_str()), textures.unit);
     gl.Uniform1i(gl.GetUniformLocation(program, map.c_str()), textures.unit + 1);
 }

@@ -42,6 +42,7 @@ struct ReflectionScene : DepthFrameRenderer::Scene {
     std::vector<DepthTextures> depths;
     std::array<GlHandle, codec::kCubeFaces> colours;
     std::vector<codec::DepthImage> images;  // their cameras and depth ranges, for the uniforms
+    int layers = 1;                         // each face's
     GlHandle behind;
 
     ReflectionScene(Context& c, const GladGLContext& gl, const Mesh& mesh, const std::vector<codec::ReflectionFace>& f,
@@ -51,12 +52,19 @@ struct ReflectionScene : DepthFrameRenderer::Scene {
         for (int k = 0; k < codec::kCubeFaces; ++k) {
             const codec::ReflectionFace& face = f[static_cast<std::size_t>(k)];
             images.push_back(face.depth);
-            depths.emplace_back(c, gl, face.depth, kWhat, k * kUnitsPerFace);
-            const std::vector<float> rgba = colourAndCoverage(face.image);
+            // The layers side by side (intersect.inc.glsl), in the depths and in the colours.
+            std::vector<const codec::DepthImage*> layers;
+            std::vector<std::vector<float>> rgba;
+            for (int l = 0; l < face.layers(); ++l) {
+                layers.push_back(&face.layerDepth(l));
+                rgba.push_back(colourAndCoverage(face.layerImage(l)));
+            }
+            depths.emplace_back(c, gl, layers, kWhat, k * kUnitsPerFace);
             colours[static_cast<std::size_t>(k)] =
-                floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(k * kUnitsPerFace + 2), face.image.width,
-                             face.image.height, 4, rgba.data());
+                floatTexture(gl, GL_TEXTURE0 + static_cast<GLenum>(k * kUnitsPerFace + 2), face.image.width * face.layers(),
+                             face.image.height, 4, codec::sideBySide(rgba, face.image.width, face.image.height, 4).data());
         }
+        layers = f.front().layers();
     }
 
     void drawFrame(const Camera& camera, int w, int h) override {
@@ -94,6 +102,7 @@ struct ReflectionScene : DepthFrameRenderer::Scene {
         gl.ActiveTexture(GL_TEXTURE0 + kBehindUnit);
         gl.BindTexture(GL_TEXTURE_2D, behind.id());
         gl.Uniform1i(at("uBehind"), kBehindUnit);
+        gl.Uniform1i(at("uLayers"), layers);
         setIntersectOptions(gl, program, options.intersect);
         gl.Uniform1f(at("uTMax"), static_cast<float>(std::min(options.intersect.tMax, 1e30)));
         // Camera::ray as affine functions of uv (reflection.frag.glsl).
@@ -132,11 +141,18 @@ std::unique_ptr<DepthFrameRenderer::Scene> reflectionScene(Context& context, con
         throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": " + std::to_string(faces.size()) +
                                                     " faces; the GPU renderer draws a cube of " +
                                                     std::to_string(codec::kCubeFaces));
-    for (const codec::ReflectionFace& face : faces)
-        if (face.image.width != face.depth.width() || face.image.height != face.depth.height() ||
-            face.image.channels.size() < 4)
-            throw Error(ErrorCode::InvalidArgument,
-                        std::string(kWhat) + ": a face's colour is not R, G, B, A of its depth image's size");
+    for (const codec::ReflectionFace& face : faces) {
+        if (face.layers() != faces.front().layers())
+            throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": every face has one count of layers");
+        for (int l = 0; l < face.layers(); ++l) {
+            const Image& image = face.layerImage(l);
+            const codec::DepthImage& depth = face.layerDepth(l);
+            if (image.width != face.depth.width() || image.height != face.depth.height() || depth.width() != image.width ||
+                depth.height() != image.height || image.channels.size() < 4)
+                throw Error(ErrorCode::InvalidArgument,
+                            std::string(kWhat) + ": a face's colour is not R, G, B, A of its depth image's size");
+        }
+    }
     const codec::Reflector& r = options.reflector;
     if (!(r.radius > 0.0) || !(glm::length(r.normal) > 0.0))
         throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": the reflector needs a radius > 0 and a normal");

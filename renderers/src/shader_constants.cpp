@@ -1,8 +1,6 @@
 #include "shader_constants.h"
 
-#include <cstdio>
-
-#include "conus/codec/depth/intersect.h"
+#include "conus/codec/depth/glsl_interface.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/mesh/shading.h"
@@ -12,20 +10,11 @@
 namespace conus::renderers {
 namespace {
 
-// Exact decimal text of a float (9 significant digits round-trip it).
-std::string glslFloat(double value) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.9g", value);
-    std::string text = buffer;
-    if (text.find_first_of(".e") == std::string::npos) text += ".0";
-    return text;
-}
+using codec::glslFloat;
 
 std::string constantsBlock() {
     std::string s = "// shared with C++ (renderers/src/shader_constants.h)\n";
-    s += "const float kDecodeMultiTap = " + glslFloat(codec::kDecodeMultiTap) + ";\n";
-    s += "const int kDecodeMaxTaps = " + std::to_string(codec::kDecodeMaxTaps) + ";\n";
-    s += "const float kDecodePyramidBias = " + glslFloat(codec::kDecodePyramidBias) + ";\n";
+    s += codec::glslConstants();  // equation1.inc.glsl and intersect.inc.glsl's
     s += "const int kEncodeMaxTaps = " + std::to_string(codec::kEncodeMaxTaps) + ";\n";
     s += "const float kEncodeTapTolerance = " + glslFloat(codec::kEncodeTapTolerance) + ";\n";
     s += "const int kEncodeMaxAxisTaps = " + std::to_string(codec::kEncodeMaxAxisTaps) + ";\n";
@@ -43,9 +32,6 @@ std::string constantsBlock() {
     s += ");\n";
     s += "const float kMeshAmbient = " + glslFloat(codec::kAmbient) + ";\n";
     s += "const float kMeshGrey = " + glslFloat(codec::kDefaultAlbedo) + ";\n";
-    s += "const float kIntersectDepthMargin = " + glslFloat(codec::kIntersectDepthMargin) + ";\n";
-    s += "const float kSilhouetteStep = " + glslFloat(codec::kSilhouetteStep) + ";\n";
-    s += "const float kSideRuleFarMargin = " + glslFloat(codec::kSideRuleFarMargin) + ";\n";
     s += "const float kMeshMaxTessLevel = " + glslFloat(kMeshMaxTessLevel) + ";\n";
     return s;
 }

@@ -10,7 +10,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "conus/core/parallel.h"
+#include "conus/codec/depth/glsl_interface.h"
 #include "context_pvt.h"
 #include "embedded_shaders.h"
 #include "gl_objects.h"
@@ -96,16 +96,7 @@ Image VolumeRendererGpu::render(const Fpc& fpc, int width, int height, const cod
     GlHandle undistorted;
     const Distortion* distortion = fpc.distortion();
     if (distortion) {
-        std::vector<float> table(static_cast<std::size_t>(width) * height * 2);
-        parallelRows(height, options.threads, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y)
-                for (int x = 0; x < width; ++x) {
-                    const glm::dvec2 p = distortion->undistort({(x + 0.5) / width, (y + 0.5) / height});
-                    float* out = &table[(static_cast<std::size_t>(y) * width + x) * 2];
-                    out[0] = float(p.x);
-                    out[1] = float(p.y);
-                }
-        });
+        const std::vector<float> table = codec::undistortedTable(*distortion, width, height, options.threads);
         undistorted = makeTexture(gl);
         gl.ActiveTexture(GL_TEXTURE2);
         gl.BindTexture(GL_TEXTURE_2D, undistorted.id());

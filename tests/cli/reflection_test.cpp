@@ -107,6 +107,81 @@ TEST_F(ReflectionCli, OneFileBakesValidatesDescribesAndRenders) {
     EXPECT_GT(psnr(path("gl.png"), path("conus.png")), conusPsnr + 10.0);
 }
 
+// `conus info` on a mesh file: its counts and bounds, what --center and --roi-min/--roi-max need
+// (the scene: a box over a floor, 12 vertices, 14 triangles, x and z -4..4, y -1..0.5). A file
+// that is neither a mesh nor OpenEXR is still refused in one line.
+TEST_F(ReflectionCli, InfoDescribesAMeshFile) {
+    const std::string scene = path("scene.obj");
+    writeScene(scene);
+    Result r = run("info " + scene);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("mesh, 14 triangles, 12 vertices"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("min -4,-1,-4  max 4,0.5,4"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("centre        0,-0.25,0  size 8 x 1.5 x 8"), std::string::npos) << r.out;
+    r = run("info --json " + scene);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["kind"], "mesh");
+    EXPECT_EQ(j["triangles"], 14);
+    EXPECT_EQ(j["vertices"], 12);
+    EXPECT_EQ(j["bounds"]["max"][1], 0.5);
+    EXPECT_EQ(j["bounds"]["min"][0], -4.0);
+    std::ofstream(path("notes.txt")) << "not a mesh\n";
+    r = run("info " + path("notes.txt"));
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+}
+
+// A layered asset: the bake reports the mirror rays that land in a disocclusion with one layer and
+// with the layers kept; the faces' extra layers are ordinary EXR channels (`layer1.R` ..), which
+// OpenImageIO and exrheader read, and validate and info accept and describe.
+TEST_F(ReflectionCli, LayeredAssetsReportDisocclusionsAndStayOrdinaryExr) {
+    const std::string scene = path("scene.obj"), asset = path("layered.exr");
+    writeScene(scene);
+    Result r = run("bake reflection " + scene + " --center 0,0,0 --size 32 --layers 3 --mirror-radius 1 -o " + asset);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("3 layers"), std::string::npos) << r.out;
+    double one = -1, three = -1;
+    const std::size_t at = r.out.find("land in a disocclusion: ");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    ASSERT_EQ(std::sscanf(r.out.c_str() + at, "land in a disocclusion: %lf%% with 1 layer, %lf%% with 3", &one, &three), 2) << r.out;
+    EXPECT_GT(one, 0.0);
+    EXPECT_LT(three, one);
+    r = run("validate " + asset);
+    EXPECT_EQ(r.exitCode, 0) << r.out << r.err;
+    r = run("info " + asset);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("faces of 3 layers"), std::string::npos) << r.out;
+    EXPECT_EQ(nlohmann::json::parse(run("info --json " + asset).out)["layers"], 3);
+
+    auto in = OIIO::ImageInput::open(asset);
+    ASSERT_TRUE(in);
+    ASSERT_TRUE(in->seek_subimage(8, 0));  // conus.pz
+    EXPECT_EQ(in->spec().get_string_attribute("oiio:subimagename"), "conus.pz");
+    const std::vector<std::string> channels = in->spec().channelnames;
+    for (const char* name : {"R", "Z", "layer1.R", "layer1.A", "layer1.Z", "layer2.G", "layer2.Z"})
+        EXPECT_NE(std::find(channels.begin(), channels.end(), name), channels.end()) << name;
+    EXPECT_EQ(channels.size(), 15u);
+    // Layer 1's depths where it saw a surface (the box's back) lie behind layer 0's, as OpenImageIO
+    // reads them.
+    OIIO::ImageBuf face(asset, 8, 0);
+    ASSERT_TRUE(face.read(8, 0));
+    const int z0 = face.spec().channelindex("Z"), z1 = face.spec().channelindex("layer1.Z"),
+              a1 = face.spec().channelindex("layer1.A");
+    int seen = 0;
+    for (OIIO::ImageBuf::ConstIterator<float> p(face); !p.done(); ++p)
+        if (p[a1] > 0.5f) {
+            ++seen;
+            EXPECT_GT(p[z1], p[z0]);
+        }
+    EXPECT_GT(seen, 10);
+    const std::string header = path("header.txt");
+    ASSERT_EQ(std::system(("exrheader " + asset + " >" + header).c_str()), 0);
+    const std::string text = slurp(header);
+    EXPECT_NE(text.find("layer2.Z, 32-bit floating-point"), std::string::npos) << text;
+    EXPECT_NE(text.find("name (type string): \"conus.nz\""), std::string::npos) << text;
+}
+
 // A damaged asset: validate lists the broken rule and exits 1; render says it in one line and
 // exits 1, writing nothing.
 TEST_F(ReflectionCli, ADamagedAssetIsRefusedInOneLine) {

@@ -75,13 +75,48 @@ TEST_F(ReliefCli, BakeValidatesAndRenders) {
         OIIO::ImageBufAlgo::sub(OIIO::ImageBuf(lowLight), OIIO::ImageBuf(shadowed)));
     EXPECT_GT(*std::max_element(darkening.max.begin(), darkening.max.end()), 0.1f);
     EXPECT_GE(*std::min_element(darkening.min.begin(), darkening.min.end()), -0.01f);
-    // A camera given: from straight above the centre, the field fills the frame.
-    ASSERT_EQ(run("render relief " + conus + " -o " + path("above.png") +
-                  " --size 64x48 --camera 0.5,3,0.376,0.5,0,0.375,12")
-                  .exitCode,
-              0);
+    // A camera given: from straight above the centre, the field fills the frame; the line echoes
+    // that camera as given.
+    r = run("render relief " + conus + " -o " + path("above.png") + " --size 64x48 --camera 0.5,3,0.376,0.5,0,0.375,12");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("camera 0.5,3,0.376,0.5,0,0.375,12\n"), std::string::npos) << r.out;
     EXPECT_GT(meanAndSpread(path("above.png")).first, 0.25);
+    // The default view's echo, given back, draws the same frame.
+    r = run("render relief " + conus + " -o " + path("default.png") + " --size 64x48");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::size_t echoed = r.out.find("camera ");
+    ASSERT_NE(echoed, std::string::npos) << r.out;
+    const std::string camera = r.out.substr(echoed + 7, r.out.find('\n', echoed) - echoed - 7);
+    ASSERT_EQ(run("render relief " + conus + " -o " + path("again.png") + " --size 64x48 --camera " + camera).exitCode, 0);
+    EXPECT_LT(meanDifference(path("default.png"), path("again.png")), 2e-3) << camera;
     EXPECT_TRUE(leftovers().empty());
+}
+
+// --height-scale gives heights in world units: a float file's values times the scale, a 16-bit
+// image's codes over 0..65535 first (code 65535 stands the scale high); the baked asset's heights
+// (its Z channel, read back) say so, and the help says it in those words.
+TEST_F(ReliefCli, HeightScaleIsWorldUnitsForFloatAndSixteenBitFiles) {
+    const std::string png = path("dem.png"), exr = path("dem.exr");
+    // Constant fields, so that resampling to the asset's texels changes nothing.
+    OIIO::ImageBuf codes(OIIO::ImageSpec(24, 16, 1, OIIO::TypeDesc::UINT16));
+    const float fraction = 40000.0f / 65535.0f;
+    OIIO::ImageBufAlgo::fill(codes, {fraction});
+    ASSERT_TRUE(codes.write(png));
+    OIIO::ImageBuf metres(OIIO::ImageSpec(24, 16, 1, OIIO::TypeDesc::FLOAT));
+    OIIO::ImageBufAlgo::fill(metres, {3.5f});
+    ASSERT_TRUE(metres.write(exr));
+    for (const auto& [source, expected] : {std::pair{png, 0.2 * 40000.0 / 65535.0}, std::pair{exr, 0.2 * 3.5}}) {
+        const std::string out = source + "-relief.exr";
+        const Result r = run("bake relief " + source + " --width 1 --height-scale 0.2 --uniform --size 12x8 -o " + out);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        const format::ConusFile file = format::readConusFile(out);
+        const int z = file.image.channelIndex("Z");
+        ASSERT_GE(z, 0);
+        for (int y = 0; y < file.image.height; ++y)
+            for (int x = 0; x < file.image.width; ++x) ASSERT_NEAR(file.image.at(x, y, z), expected, 1e-4) << source;
+    }
+    const Result help = run("bake relief --help");
+    EXPECT_NE(help.out.find("world units"), std::string::npos) << help.out;
 }
 
 // PSNR (dB) of picture a against the reference r, over the pixels whose (u, v) `in` accepts.

@@ -158,6 +158,48 @@ TEST_F(ReflectionAsset, ABadFrameOrFaceIsRefusedInMemoryAndNothingIsWritten) {
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(m_dir.path()), std::filesystem::directory_iterator()), 0);
 }
 
+// Layers (spec "Layers"): `layer<k>.R..Z` for k = 1..L-1 in every face, the same L; a face
+// with a deeper layer round-trips, a gap, a missing channel, a name that is no layer's or a face
+// with fewer layers is V18.
+TEST_F(ReflectionAsset, LayersAreFiveChannelsEachInEveryFace) {
+    const auto layered = [](int layers, int face = -1, const std::vector<std::string>& channels = {}) {
+        ReflectionAssetFile a = validAsset();
+        for (int f = 0; f < kCubeFaceCount; ++f) {
+            std::vector<std::string> names = {"A", "B", "G", "R", "Z"};
+            for (int k = 1; k < layers; ++k)
+                for (const char* c : {"A", "B", "G", "R", "Z"}) names.push_back("layer" + std::to_string(k) + "." + c);
+            if (f == face) names = channels;
+            Image image = makeImage(kSize, kSize, names);
+            for (int y = 0; y < kSize; ++y)
+                for (int x = 0; x < kSize; ++x)
+                    for (std::size_t c = 0; c < names.size(); ++c)
+                        image.at(x, y, int(c)) = c < 5 ? a.faces[std::size_t(f)].image.at(x, y, int(c)) : 2.0f + 0.25f * float(c);
+            a.faces[std::size_t(f)].image = std::move(image);
+        }
+        return a;
+    };
+    const ReflectionAssetFile three = layered(3);
+    EXPECT_TRUE(validateReflectionAsset(three).ok()) << validateReflectionAsset(three).str();
+    writeReflectionAsset(m_dir.file("layered.exr"), three);
+    EXPECT_TRUE(validateConusFile(m_dir.file("layered.exr")).ok());
+    const ReflectionAssetFile read = readReflectionAsset(m_dir.file("layered.exr"));
+    EXPECT_EQ(read.faces[4].image.channels.size(), 15u);
+    const int z2 = read.faces[4].image.channelIndex("layer2.Z");
+    ASSERT_GE(z2, 0);
+    EXPECT_EQ(read.faces[4].image.at(3, 5, z2), three.faces[4].image.at(3, 5, three.faces[4].image.channelIndex("layer2.Z")));
+
+    const std::vector<std::string> gap = {"A", "B", "G", "R", "Z", "layer2.A", "layer2.B", "layer2.G", "layer2.R", "layer2.Z"};
+    const ValidationReport gapped = validateReflectionAsset(layered(1, 2, gap));
+    EXPECT_TRUE(only(gapped, {Rule::V18})) << gapped.str();
+    EXPECT_NE(gapped.str().find("face py has no channel layer1.A"), std::string::npos) << gapped.str();
+    const ValidationReport partial = validateReflectionAsset(layered(1, 0, {"A", "B", "G", "R", "Z", "layer1.Z"}));
+    EXPECT_TRUE(only(partial, {Rule::V18})) << partial.str();
+    EXPECT_TRUE(only(validateReflectionAsset(layered(1, 5, {"A", "B", "G", "R", "Z", "layerX.Z"})), {Rule::V18}));
+    const ValidationReport fewer = validateReflectionAsset(layered(2, 3, {"A", "B", "G", "R", "Z"}));
+    EXPECT_TRUE(only(fewer, {Rule::V18})) << fewer.str();
+    EXPECT_NE(fewer.str().find("every face has one count of layers"), std::string::npos) << fewer.str();
+}
+
 TEST_F(ReflectionAsset, AMissingFaceIsV18) {
     const std::string path = damaged([](int p, Imf::Header&) { return p != 10 && p != 11; });  // no nz
     const ValidationReport r = validateConusFile(path);

@@ -3,7 +3,8 @@
 # 1. the shared libraries carry a SONAME and the programs, the headers and the spec are in place;
 # 2. no installed header includes OpenEXR, Imath, OpenImageIO, OpenGL, Assimp or Embree, and the exported targets
 #    name none of them;
-# 3. the consumer project (consumer/) builds with find_package(conus) and runs;
+# 3. the consumer project (consumer/) builds with find_package(conus) and runs; so does the installed
+#    GL example (examples/reflection_gl) with the installed GLSL;
 # 4. the same program builds with pkg-config's flags alone and runs.
 # 5. with PYTHON, the installed Python package imports and works.
 # Usage: cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -DLIBDIR=lib [-DPYTHON=python3] -P consumer_test.cmake
@@ -31,7 +32,9 @@ set(libdir ${prefix}/${LIBDIR})
 foreach(path bin/conus ${LIBDIR}/cmake/conus/conusConfig.cmake ${LIBDIR}/cmake/conus/conusConfigVersion.cmake
         ${LIBDIR}/pkgconfig/conus.pc include/conus/codec/image/encode.h share/doc/conus/spec/conus-format.md
         share/man/man1/conus.1 ${LIBDIR}/python3/dist-packages/conus/__init__.py
-        ${LIBDIR}/libconus_imageio_oiio.so ${LIBDIR}/conus/libconus_faces.so ${LIBDIR}/conus/libconus_http.so)
+        ${LIBDIR}/libconus_imageio_oiio.so ${LIBDIR}/conus/libconus_faces.so ${LIBDIR}/conus/libconus_http.so
+        include/conus/codec/depth/glsl_interface.h share/conus/glsl/equation1.inc.glsl share/conus/glsl/intersect.inc.glsl
+        share/conus/glsl/reflection.frag.glsl share/doc/conus/examples/reflection_gl/main.cpp)
   if(NOT EXISTS ${prefix}/${path})
     message(FATAL_ERROR "consumer_test: ${path} is not installed")
   endif()
@@ -88,6 +91,20 @@ run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/install/consumer -B ${build} -DCMAKE
 run(${CMAKE_COMMAND} --build ${build})
 run(${build}/consumer ${WORK_DIR}/cmake.exr)
 message(STATUS "find_package consumer:\n${run_output}")
+
+# 3b. The GL example of docs/reflections-in-your-renderer.md, as installed, built against the
+# package (conus_GLSL_DIR, the installed GLSL) and run on an asset the installed conus bakes.
+set(gl_build ${WORK_DIR}/reflection-gl-build)
+run(${CMAKE_COMMAND} -S ${prefix}/share/doc/conus/examples/reflection_gl -B ${gl_build} -DCMAKE_PREFIX_PATH=${prefix}
+    -DCMAKE_BUILD_TYPE=Release)
+run(${CMAKE_COMMAND} --build ${gl_build})
+file(WRITE ${WORK_DIR}/room.obj "v -3 -1 -3\nv 3 -1 -3\nv 3 -1 3\nv -3 -1 3\nv 0.4 -1 1.5\nv 1 -1 1.5\nv 1 0.5 1.5\nv 0.4 0.5 1.5\nf 1 4 3 2\nf 5 6 7 8\n")
+run(${prefix}/bin/conus bake reflection ${WORK_DIR}/room.obj --center 0,0,0 --size 32 -o ${WORK_DIR}/asset.exr -q)
+run(${gl_build}/reflection_gl ${WORK_DIR}/asset.exr -0.8,0.5,3,0,0,0,30 64x48 sphere 0.5 0,0,1 ${WORK_DIR}/mirror.exr)
+if(NOT EXISTS ${WORK_DIR}/mirror.exr)
+  message(FATAL_ERROR "consumer_test: the reflection example wrote no frame: ${run_output}")
+endif()
+message(STATUS "reflection example:\n${run_output}")
 
 # 4. pkg-config.
 set(ENV{PKG_CONFIG_PATH} ${libdir}/pkgconfig)

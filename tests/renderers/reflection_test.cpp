@@ -94,6 +94,40 @@ void expectAgreement(Context& context, const Camera& camera, const codec::Reflec
     EXPECT_EQ(viaDevice.pixels, gpu.pixels);
 }
 
+// A plane mirror of radius 1.2 between an occluding box and the camera, a wall behind both (the
+// camera between box and wall): the mirror's edges see parts of the wall and of the box's sides
+// that the centre cannot, which only deeper layers hold. GLSL walks the layers as the CPU does, and
+// the layers bring the frame nearer the traced one than one layer does (measured: squared error
+// 34.6 against 47.2 on the CPU).
+TEST_P(ReflectionGl, LayeredFacesMatchCpuAndSeeBehindTheBox) {
+    static const codec::MeshScene wallScene(codec::test::boxBeforeWall());
+    codec::ReflectionFrameOptions options;
+    options.reflector.kind = codec::Reflector::Kind::Plane;
+    options.reflector.radius = 1.2;
+    options.reflector.normal = glm::normalize(glm::dvec3(0.1, 0.05, 1.0));
+    const Camera camera = Camera::perspective({-1.2, 0.9, 2.8}, {0.0, 0.0, 0.0}, {0, 1, 0}, 55.0, 1.0, 1e-3, 1e3);
+    const Image truth = codec::renderReflectionFrame(wallScene, nullptr, glm::dvec3(0.0), camera, kFrame, kFrame, options);
+    double error[2] = {0, 0};
+    for (const int layers : {1, 3}) {
+        codec::ReflectionBakeOptions bake;
+        bake.size = 40;
+        bake.uniform = true;
+        bake.layers = layers;
+        const auto set = codec::bakeReflection(wallScene, bake);
+        ASSERT_EQ(set.front().layers(), layers);
+        const Image cpu = codec::renderReflectionFrame(wallScene, &set, glm::dvec3(0.0), camera, kFrame, kFrame, options);
+        ReflectionRenderer renderer(context(), wallScene.mesh(), set, options);
+        const Agreement a = compare(renderer.render(camera, kFrame, kFrame), cpu);
+        EXPECT_GT(a.reflecting, 2000);
+        EXPECT_LE(a.maskMismatches, kFrame * kFrame / 500) << layers << " layers";
+        EXPECT_GT(a.reflectorPsnr, 35.0) << layers << " layers, " << a.maskMismatches << " mask mismatches";
+        EXPECT_LE(a.differing, kFrame * kFrame / 500) << layers << " layers";
+        for (std::size_t i = 0; i < truth.pixels.size(); ++i)
+            if (i % 4 != 3) error[layers == 3] += std::pow(cpu.pixels[i] - truth.pixels[i], 2.0);
+    }
+    EXPECT_LT(error[1], 0.85 * error[0]) << "layered " << error[1] << ", single " << error[0];
+}
+
 TEST_P(ReflectionGl, SphereMirrorMatchesCpuCoNUSAndConventional) {
     codec::ReflectionFrameOptions options;
     options.reflector.radius = 0.5;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "conus/core/error.h"
@@ -118,23 +119,54 @@ void checkRay(const Ray& ray) {
                                                     std::to_string(length) + ")");
 }
 
-std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options) {
-    const std::optional<Segment> clipped = clipRay(image, ray, options.tMax);
-    if (!clipped) return std::nullopt;
-    const Segment& segment = *clipped;
-    const SamplingMap& map = image.map();
-    const glm::dvec2 size(image.width(), image.height());
-    const glm::dvec2 along = segment.p1 - segment.p0;
+namespace {
+
+// What both walks (the first surface's and a deeper layer's) share: the clipped segment, the
+// stored surface along it, the step and the hit record.
+struct Walk {
+    const DepthImage& image;
+    const Ray& ray;
+    const Segment segment;
+    glm::dvec2 size, along;
+
+    Walk(const DepthImage& i, const Ray& r, const Segment& s)
+        : image(i), ray(r), segment(s), size(i.width(), i.height()), along(s.p1 - s.p0) {}
+
+    // The walk of `ray` clipped to the image's volume, or nothing when it misses.
+    static std::optional<Walk> start(const DepthImage& image, const Ray& ray, double tMax) {
+        const std::optional<Segment> clipped = clipRay(image, ray, tMax);
+        if (!clipped) return std::nullopt;
+        return Walk(image, ray, *clipped);
+    }
+
     // The stored surface's depth at s (and where s lies in the CoNUS image).
-    const auto surface = [&](double s, glm::dvec2& pd) {
-        pd = map.distort(segment.point(s));
+    double surface(double s, glm::dvec2& pd) const {
+        pd = image.map().distort(segment.point(s));
         return image.sampleDepth(pd);
-    };
+    }
     // Whether pd lies in a flagged cell: steps from or into one are kSilhouetteStep as long, so that
     // a near surface a texel wide is not stepped over (a wall, unlike a skin, can be).
-    const bool solid = image.solid();  // no cell of a solid image is flagged
-    const auto flagged = [&](glm::dvec2 p) { return !solid && image.cellFlags()[image.cellIndex(p)] != 0; };
-    const auto hitAt = [&](double s, glm::dvec2 pd, int steps, bool hidden) {
+    bool flagged(glm::dvec2 p) const { return !image.solid() && image.cellFlags()[image.cellIndex(p)] != 0; }
+    // The smallest jump that is a discontinuity at depth d.
+    double jump(double d) const { return image.jumpRelative() * d + image.jumpAbsolute(); }
+    // One step of the linear search from s (updated, with before and pd): stepTexels CoNUS pixels
+    // along the curve, as measured by the map's Jacobian where the step starts, kSilhouetteStep
+    // as long from or into a flagged cell. Returns the stored depth at the new s.
+    double step(double& before, double& s, glm::dvec2& pd, double stepTexels) const {
+        // CoNUS pixels the curve covers per unit s here: |J (p1 - p0)| in pixels.
+        const double speed = glm::length(image.map().jacobian(segment.point(s)) * along * size);
+        const auto advance = [&](double texels) { return std::min(segment.end, before + (speed > 0.0 ? texels / speed : 1.0)); };
+        const bool fine = flagged(pd);
+        before = s;
+        s = advance(stepTexels * (fine ? kSilhouetteStep : 1.0));
+        double stored = surface(s, pd);
+        if (!fine && flagged(pd)) {  // a full step into a flagged cell: taken again, finely
+            s = advance(stepTexels * kSilhouetteStep);
+            stored = surface(s, pd);
+        }
+        return stored;
+    }
+    DepthHit hitAt(double s, glm::dvec2 pd, int steps, bool hidden) const {
         DepthHit hit;
         hit.t = segment.t(s);
         hit.position = ray.origin + ray.direction * hit.t;
@@ -146,7 +178,30 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
         hit.hidden = hidden;
         hit.face = steps == 0 ? segment.face : -1;
         return hit;
-    };
+    }
+    // Through a side, behind a scene's surface `entry` by less than a jump (continuous with it by
+    // the image's own measure), short of the camera's far plane (where a scene's image saw
+    // nothing): the surface goes on across the edge, and the ray met it there.
+    bool acrossSide(double entry) const {
+        return segment.face >= 0 && segment.face < 4 && entry < image.camera().far() * (1.0 - kSideRuleFarMargin) &&
+               segment.depth(0.0) - entry <= jump(entry);
+    }
+};
+
+}  // namespace
+
+std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options) {
+    double firstHidden = 0;
+    return intersect(image, ray, options, firstHidden);
+}
+
+std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options,
+                                  double& firstHidden) {
+    firstHidden = std::numeric_limits<double>::infinity();
+    const std::optional<Walk> started = Walk::start(image, ray, options.tMax);
+    if (!started) return std::nullopt;
+    const Walk& walk = *started;
+    const Segment& segment = walk.segment;
 
     glm::dvec2 pd;
     double before = 0.0, s = 0.0;
@@ -155,16 +210,11 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
     bool hidden = false;
     double hiddenDepth = 0.0;
     glm::dvec2 hiddenFrom(0.0);  // the last point in front of the surface: the background's side
-    if (const double entry = surface(0.0, pd); entry - segment.depth(0.0) <= 0.0) {
-        if (image.solid()) return hitAt(0.0, pd, 0, false);
-        // Through a side, behind a scene's surface by less than a jump (continuous with it by the
-        // image's own measure): the surface goes on across the edge, and the ray met it there. Not
-        // at the camera's far plane, which is where a scene's image saw nothing.
-        if (segment.face >= 0 && segment.face < 4 && entry < image.camera().far() * (1.0 - kSideRuleFarMargin) &&
-            segment.depth(0.0) - entry <= image.jumpRelative() * entry + image.jumpAbsolute())
-            return hitAt(0.0, pd, 0, false);
+    if (const double entry = walk.surface(0.0, pd); entry - segment.depth(0.0) <= 0.0) {
+        if (image.solid() || walk.acrossSide(entry)) return walk.hitAt(0.0, pd, 0, false);
         if (segment.end <= 0.0) return std::nullopt;  // entered beyond the data's depth range
         hidden = true;
+        firstHidden = segment.t(0.0);
         hiddenDepth = segment.depth(0.0);
         hiddenFrom = pd;
     }
@@ -172,21 +222,11 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
         if (s >= segment.end || steps >= options.maxSteps) {
             // Hidden up to the farthest stored depth: behind the background, which takes the
             // colour of where the ray went hidden.
-            if (hidden && s >= segment.end && segment.endsAtRange) return hitAt(segment.end, hiddenFrom, steps, true);
+            if (hidden && s >= segment.end && segment.endsAtRange) return walk.hitAt(segment.end, hiddenFrom, steps, true);
             return std::nullopt;
         }
-        // CoNUS pixels the curve covers per unit s here: |J (p1 - p0)| in pixels.
-        const double speed = glm::length(map.jacobian(segment.point(s)) * along * size);
-        const auto advance = [&](double texels) { return std::min(segment.end, before + (speed > 0.0 ? texels / speed : 1.0)); };
-        const bool fine = flagged(pd);
-        before = s;
-        s = advance(options.stepTexels * (fine ? kSilhouetteStep : 1.0));
+        const double stored = walk.step(before, s, pd, options.stepTexels);
         ++steps;
-        double stored = surface(s, pd);
-        if (!fine && flagged(pd)) {  // a full step into a flagged cell: taken again, finely
-            s = advance(options.stepTexels * kSilhouetteStep);
-            stored = surface(s, pd);
-        }
         const double gap = stored - segment.depth(s);
         if (hidden) {
             if (gap > 0.0) {
@@ -196,10 +236,10 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
                 double a = before, b = s;
                 for (int k = 0; k < options.refinements; ++k) {
                     const double m = 0.5 * (a + b);
-                    (surface(m, pd) >= hiddenDepth ? b : a) = m;
+                    (walk.surface(m, pd) >= hiddenDepth ? b : a) = m;
                 }
-                surface(b, pd);
-                return hitAt(b, pd, steps, true);
+                walk.surface(b, pd);
+                return walk.hitAt(b, pd, steps, true);
             }
             continue;
         }
@@ -208,20 +248,57 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
         double a = before, b = s;
         for (int k = 0; k < options.refinements; ++k) {
             const double m = 0.5 * (a + b);
-            (surface(m, pd) - segment.depth(m) > 0.0 ? a : b) = m;
+            (walk.surface(m, pd) - segment.depth(m) > 0.0 ? a : b) = m;
         }
         glm::dvec2 pa, pb;
-        const double jump = surface(a, pa) - surface(b, pb);
-        if (image.solid() || jump <= 0.5 * (image.jumpRelative() * surface(b, pb) + image.jumpAbsolute())) {
+        const double jump = walk.surface(a, pa) - walk.surface(b, pb);
+        if (image.solid() || jump <= 0.5 * walk.jump(walk.surface(b, pb))) {
             const double mid = 0.5 * (a + b);
-            surface(mid, pd);
-            return hitAt(mid, pd, steps, false);
+            walk.surface(mid, pd);
+            return walk.hitAt(mid, pd, steps, false);
         }
         // A wall: the ray passes behind an occluder's silhouette.
         hidden = true;
+        firstHidden = std::min(firstHidden, segment.t(a));
         hiddenDepth = segment.depth(b);
         hiddenFrom = pa;
     }
+}
+
+std::optional<DepthHit> intersectBehind(const DepthImage& layer, const Ray& ray, const IntersectOptions& options) {
+    const std::optional<Walk> started = Walk::start(layer, ray, options.tMax);
+    if (!started) return std::nullopt;
+    const Walk& walk = *started;
+    const Segment& segment = walk.segment;
+
+    glm::dvec2 pd;
+    double before = 0.0, s = 0.0;
+    int steps = 0;
+    const double entry = walk.surface(0.0, pd);
+    if (entry - segment.depth(0.0) <= 0.0 && walk.acrossSide(entry)) return walk.hitAt(0.0, pd, 0, false);
+    // Which side of the stored surface the ray is on; a crossing either way is a hit where the
+    // surface is continuous (the mirror meets a surface that faces the centre from its front, one
+    // that faces away from its back), a wall where it is not.
+    bool front = entry - segment.depth(0.0) > 0.0;
+    while (s < segment.end && steps < options.maxSteps) {
+        const double stored = walk.step(before, s, pd, options.stepTexels);
+        ++steps;
+        if ((stored - segment.depth(s) > 0.0) == front) continue;
+        double a = before, b = s;
+        for (int k = 0; k < options.refinements; ++k) {
+            const double m = 0.5 * (a + b);
+            ((walk.surface(m, pd) - segment.depth(m) > 0.0) == front ? a : b) = m;
+        }
+        glm::dvec2 pa, pb;
+        const double sa = walk.surface(a, pa), sb = walk.surface(b, pb);
+        if ((front ? sa - sb : sb - sa) <= 0.5 * walk.jump(std::min(sa, sb))) {
+            const double mid = 0.5 * (a + b);
+            walk.surface(mid, pd);
+            return walk.hitAt(mid, pd, steps, false);
+        }
+        front = !front;  // a wall: the ray is now on the other side, with nothing met
+    }
+    return std::nullopt;
 }
 
 }  // namespace conus::codec

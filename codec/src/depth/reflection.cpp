@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <random>
 #include <string>
 
 #include "conus/codec/conus_file.h"
@@ -23,9 +24,28 @@ bool finite(glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && s
 // A face's far plane lies where nothing was seen (coverage 0): a hit there, or one the bisection
 // leaves just short of it, is the sky, not a surface. A hidden hit (intersect.h) lies on the
 // background carried on behind an occluder, wherever the ray ends: its texel alone says.
-bool onSky(const DepthHit& hit, const ReflectionFace& face) {
-    return face.image.at(hit.texel.x, hit.texel.y, kMeshChannelA) < 0.5f ||
+bool onSky(const DepthHit& hit, const ReflectionFace& face, int layer) {
+    return face.layerImage(layer).at(hit.texel.x, hit.texel.y, kMeshChannelA) < 0.5f ||
            (!hit.hidden && hit.depth >= face.depth.camera().far() * (1.0 - 1e-4));
+}
+
+// The Z channel of a mesh render.
+std::vector<float> depthsOf(const Image& rgbaz) {
+    std::vector<float> depths(static_cast<std::size_t>(rgbaz.width) * rgbaz.height);
+    for (std::size_t i = 0; i < depths.size(); ++i) depths[i] = rgbaz.pixels[i * rgbaz.channels.size() + kMeshChannelZ];
+    return depths;
+}
+
+// The fraction of the faces' texels that layer k covers.
+double layerCoverage(const std::vector<ReflectionFace>& faces, int k) {
+    double covered = 0, texels = 0;
+    for (const ReflectionFace& face : faces) {
+        const Image& image = face.layerImage(k);
+        for (int y = 0; y < image.height; ++y)
+            for (int x = 0; x < image.width; ++x) covered += image.at(x, y, kMeshChannelA) > 0.0f ? 1.0 : 0.0;
+        texels += double(image.width) * image.height;
+    }
+    return texels > 0 ? covered / texels : 0.0;
 }
 
 // The context a face's focus multiplies, from a uniform render of the face: a reflected ray meets
@@ -117,6 +137,10 @@ std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const Reflect
     if (!(o.magnification >= 1.0 && o.magnification <= 16.0))
         throw Error(ErrorCode::InvalidArgument, "reflection magnification must lie in [1, 16]");
     if (!finite(o.centre)) throw Error(ErrorCode::InvalidArgument, "the reflector's centre is not finite");
+    if (o.layers < 0 || o.layers > kMaxReflectionLayers)
+        throw Error(ErrorCode::InvalidArgument, "reflection layers must be 1 to " + std::to_string(kMaxReflectionLayers) +
+                                                    " (0: as many as the scene needs), not " + std::to_string(o.layers));
+    const int peel = o.layers == 0 ? kMaxReflectionLayers : o.layers;
     const AxisBox bounds = boundsOf(scene.mesh());
     // Far: beyond every point of the scene from the centre (the farthest box corner), with room.
     const glm::dvec3 reach = glm::max(glm::abs(bounds.lo - o.centre), glm::abs(bounds.hi - o.centre));
@@ -144,10 +168,21 @@ std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const Reflect
             foci.context = context ? &*context : nullptr;
             map = std::make_shared<SamplingMap>(buildFociMap(std::span<const Focus>(&*focus, 1), foci));
         }
-        const Image rgbaz = renderMeshReference(scene, Fpc(camera, map), o.size, o.size);
-        std::vector<float> depths(static_cast<std::size_t>(o.size) * o.size);
-        for (std::size_t i = 0; i < depths.size(); ++i) depths[i] = rgbaz.pixels[i * rgbaz.channels.size() + kMeshChannelZ];
-        faces.push_back({DepthImage(camera, map, o.size, o.size, std::move(depths), false), rgbaz});
+        if (peel == 1) {
+            Image rgbaz = renderMeshReference(scene, Fpc(camera, map), o.size, o.size);
+            faces.push_back({DepthImage(camera, map, o.size, o.size, depthsOf(rgbaz), false), std::move(rgbaz), {}});
+            continue;
+        }
+        std::vector<Image> layers = renderMeshLayers(scene, Fpc(camera, map), o.size, o.size, peel);
+        ReflectionFace face{DepthImage(camera, map, o.size, o.size, depthsOf(layers[0]), false), std::move(layers[0]), {}};
+        for (std::size_t k = 1; k < layers.size(); ++k)
+            face.behind.push_back({DepthImage(camera, map, o.size, o.size, depthsOf(layers[k]), false), std::move(layers[k])});
+        faces.push_back(std::move(face));
+    }
+    if (o.layers == 0) {  // as many as the scene needs: up to the first layer that covers too little
+        int keep = 1;
+        while (keep < peel && layerCoverage(faces, keep) >= kLayerMinCoverage) ++keep;
+        for (ReflectionFace& face : faces) face.behind.erase(face.behind.begin() + (keep - 1), face.behind.end());
     }
     return faces;
 }
@@ -184,14 +219,16 @@ std::optional<ReflectorHit> hitReflector(const Reflector& r, const Ray& ray) {
     return out;
 }
 
-glm::vec3 reflectionColour(const ReflectionFace& face, const DepthHit& hit) {
-    const Image& c = face.image;
+glm::vec3 reflectionColour(const ReflectionFace& face, const DepthHit& hit) { return reflectionColour(face, 0, hit); }
+
+glm::vec3 reflectionColour(const ReflectionFace& face, int layer, const DepthHit& hit) {
+    const Image& c = face.layerImage(layer);
     const auto texel = [&](glm::ivec2 t) {
         return glm::vec4(c.at(t.x, t.y, kMeshChannelR), c.at(t.x, t.y, kMeshChannelR + 1),
                          c.at(t.x, t.y, kMeshChannelR + 2), c.at(t.x, t.y, kMeshChannelA));
     };
     // The surface's own weights (a silhouette's far side weighs nothing), times coverage.
-    const DepthImage::Weights weights = face.depth.surfaceWeights(hit.distorted);
+    const DepthImage::Weights weights = face.layerDepth(layer).surfaceWeights(hit.distorted);
     glm::vec3 sum(0.0f);
     float w = 0.0f;
     for (int k = 0; k < 4; ++k) {
@@ -208,29 +245,83 @@ std::optional<ReflectionHit> traceReflection(const std::vector<ReflectionFace>& 
                                              const IntersectOptions& options) {
     std::optional<ReflectionHit> best;
     for (std::size_t f = 0; f < faces.size(); ++f) {
+        const ReflectionFace& face = faces[f];
         IntersectOptions o = options;
         if (best) o.tMax = best->hit.t;
-        const auto hit = intersect(faces[f].depth, ray, o);
-        if (!hit || onSky(*hit, faces[f]) || (best && hit->t >= best->hit.t)) continue;
-        best = ReflectionHit{*hit, static_cast<int>(f), reflectionColour(faces[f], *hit)};
+        double firstHidden = 0;
+        const auto hit = intersect(face.depth, ray, o, firstHidden);
+        std::optional<ReflectionHit> mine;
+        // A hidden hit is a guess (the background carried on behind an occluder); a layered face
+        // holds what lies behind its occluders, so that a ray that meets none of its layers there
+        // meets nothing in this face: the guess is the single-layer face's alone.
+        if (hit && !onSky(*hit, face, 0) && !(best && hit->t >= best->hit.t) && !(hit->hidden && face.layers() > 1))
+            mine = ReflectionHit{*hit, static_cast<int>(f), 0, reflectionColour(face, 0, *hit)};
+        // The deeper layers (intersect.h): only behind a silhouette, from where the ray first went
+        // behind it, short of a layer-0 hit.
+        if (firstHidden < o.tMax && face.layers() > 1) {
+            const Ray behind{ray.origin + ray.direction * firstHidden, ray.direction};
+            for (int k = 1; k < face.layers(); ++k) {
+                IntersectOptions d = o;
+                d.tMax = (mine ? mine->hit.t : o.tMax) - firstHidden;
+                if (!(d.tMax > 0.0)) break;
+                auto deeper = intersectBehind(face.layerDepth(k), behind, d);
+                if (!deeper || onSky(*deeper, face, k)) continue;
+                deeper->t += firstHidden;
+                mine = ReflectionHit{*deeper, static_cast<int>(f), k, reflectionColour(face, k, *deeper)};
+            }
+        }
+        if (mine) best = mine;
     }
     return best;
 }
 
 namespace {
 
-ReflectionFace faceFromFile(const format::ConusFile& file) {
+// The channel a face's layer k stores `name` in (spec "Reflection assets": layer 0 the plain
+// names, layer k >= 1 `layer<k>.<name>`).
+std::string layerChannel(int k, const std::string& name) { return k == 0 ? name : "layer" + std::to_string(k) + "." + name; }
+
+// Layer k's channels of a face file as a mesh render (R, G, B, A, Z in that order).
+Image layerFromFile(const format::ConusFile& file, int k) {
     const std::vector<std::string> names = meshChannelNames();
-    DepthImage depth = DepthImage::fromFile(file);
     // The file keeps channels in its own (EXR: alphabetical) order; faces hold the mesh render's.
-    Image image{file.image.width, file.image.height, names, std::vector<float>(file.image.pixels.size() / file.image.channels.size() * names.size())};
+    Image image{file.image.width, file.image.height, names, std::vector<float>(std::size_t(file.image.width) * file.image.height * names.size())};
     for (std::size_t c = 0; c < names.size(); ++c) {
-        const int from = file.image.channelIndex(names[c]);
+        const int from = file.image.channelIndex(layerChannel(k, names[c]));
         for (int y = 0; y < image.height; ++y)
             for (int x = 0; x < image.width; ++x)
                 image.at(x, y, static_cast<int>(c)) = from < 0 ? 1.0f : file.image.at(x, y, from);
     }
-    return {std::move(depth), std::move(image)};
+    return image;
+}
+
+ReflectionFace faceFromFile(const format::ConusFile& file) {
+    DepthImage depth = DepthImage::fromFile(file);
+    ReflectionFace face{depth, layerFromFile(file, 0), {}};
+    for (int k = 1; file.image.channelIndex(layerChannel(k, "Z")) >= 0; ++k) {
+        Image image = layerFromFile(file, k);
+        face.behind.push_back({DepthImage(depth.camera(), depth.sharedMap(), image.width, image.height, depthsOf(image), false),
+                               std::move(image)});
+    }
+    return face;
+}
+
+// A face's layers as one image: layer 0's channels, then each deeper layer's under its names.
+Image layeredImage(const ReflectionFace& face) {
+    if (face.behind.empty()) return face.image;
+    const std::vector<std::string> names = meshChannelNames();
+    Image out{face.image.width, face.image.height, {}, {}};
+    for (int k = 0; k < face.layers(); ++k)
+        for (const std::string& name : names) out.channels.push_back(layerChannel(k, name));
+    out.pixels.resize(std::size_t(out.width) * out.height * out.channels.size());
+    for (int k = 0; k < face.layers(); ++k) {
+        const Image& layer = face.layerImage(k);
+        for (int y = 0; y < out.height; ++y)
+            for (int x = 0; x < out.width; ++x)
+                for (std::size_t c = 0; c < names.size(); ++c)
+                    out.at(x, y, static_cast<int>(k * names.size() + c)) = layer.at(x, y, static_cast<int>(c));
+    }
+    return out;
 }
 
 }  // namespace
@@ -242,8 +333,11 @@ format::ReflectionAssetFile reflectionAssetFile(const std::vector<ReflectionFace
     const glm::dvec3 centre = faces.front().depth.camera().eye();
     // + 0 turns the -0 an inverted matrix gives into 0 (the file and `conus info` show it).
     asset.frame.centre = {static_cast<float>(centre.x) + 0.0f, static_cast<float>(centre.y) + 0.0f, static_cast<float>(centre.z) + 0.0f};
-    for (std::size_t f = 0; f < faces.size(); ++f)
-        asset.faces[f] = makeDepthImageFile(faces[f].image, faces[f].depth.map(), faces[f].depth.camera(), "world");
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+        if (faces[f].layers() != faces.front().layers())
+            throw Error(ErrorCode::InvalidArgument, "every face of a reflection asset has one count of layers");
+        asset.faces[f] = makeDepthImageFile(layeredImage(faces[f]), faces[f].depth.map(), faces[f].depth.camera(), "world");
+    }
     return asset;
 }
 
@@ -269,6 +363,43 @@ std::optional<glm::vec3> traceReflectionReference(const MeshScene& scene, const 
     const double length = glm::length(toCentre);
     const glm::vec3 l = length > 0 ? glm::vec3(toCentre / length) : hit->normal;
     return shadeHeadlight(albedo, hit->normal, l);
+}
+
+double disocclusionFraction(const MeshScene& scene, glm::dvec3 centre, double radius, int layers, int rays, unsigned seed) {
+    if (!(radius >= 0) || !std::isfinite(radius) || layers < 1 || rays < 1)
+        throw Error(ErrorCode::InvalidArgument, "disocclusion: needs a radius >= 0, at least one layer and one ray");
+    std::mt19937 random(seed);
+    std::normal_distribution<double> gauss;
+    const auto unit = [&] {
+        for (;;) {
+            const glm::dvec3 v(gauss(random), gauss(random), gauss(random));
+            if (const double l = glm::length(v); l > 1e-9) return v / l;
+        }
+    };
+    int met = 0, unseen = 0;
+    for (int i = 0; i < rays; ++i) {
+        const glm::dvec3 n = unit();
+        glm::dvec3 d = unit();
+        if (glm::dot(d, n) < 0) d = -d;
+        const auto hit = scene.intersect(Ray{centre + n * radius, d}, 1e-6);
+        if (!hit) continue;
+        ++met;
+        const glm::dvec3 toHit = hit->position - centre;
+        const double distance = glm::length(toHit);
+        if (!(distance > 0)) continue;
+        // Peel from the centre toward the hit, as the bake does, until the hit's own surface.
+        const Ray fromCentre{centre, toHit / distance};
+        double from = 1e-6;
+        bool stored = false;
+        for (int k = 0; k < layers && !stored; ++k) {
+            const auto on = scene.intersect(fromCentre, from);
+            if (!on) break;
+            stored = on->distance >= distance * (1.0 - kPeelGap);
+            from = on->distance * (1.0 + kPeelGap);
+        }
+        unseen += stored ? 0 : 1;
+    }
+    return met > 0 ? double(unseen) / met : 0.0;
 }
 
 Image renderReflectionFrame(const MeshScene& scene, const std::vector<ReflectionFace>* faces, glm::dvec3 centre,

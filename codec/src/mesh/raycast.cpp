@@ -6,6 +6,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -136,18 +137,44 @@ std::optional<MeshScene::Hit> MeshScene::intersect(const Ray& ray, double tNear,
     return hit;
 }
 
+namespace {
+
+// The shaded R, G, B, A, Z of the first surface along `ray` at distance in [from, to] (the far
+// plane with A = 0 when none), and the distance it lies at (`at`, untouched on a miss).
+std::array<float, 5> shadeFirst(const MeshScene& scene, const Camera& camera, const Ray& ray, double from, double to,
+                                double& at) {
+    const auto hit = scene.intersect(ray, from, to);
+    if (!hit) return {0, 0, 0, 0, float(camera.far())};
+    const glm::vec3 albedo = meshAlbedo(scene.mesh(), hit->triangle, hit->b1, hit->b2);
+    const glm::vec3 colour = shadeHeadlight(albedo, hit->normal, glm::vec3(directionToEye(camera, hit->position)));
+    at = hit->distance;
+    return {colour.r, colour.g, colour.b, 1.0f, float(camera.project(hit->position).z)};
+}
+
+}  // namespace
+
 std::array<float, 5> shadeRay(const MeshScene& scene, const Camera& camera, glm::dvec2 uv) {
     const Ray ray = camera.ray(uv);
     // A point at distance t has depth t * dot(direction, forward) (+ the origin's depth, which is
     // 0 for both projections): the near..far depth range as a range of t.
     const double cosine = glm::dot(ray.direction, camera.forward());
-    std::array<float, 5> out{0, 0, 0, 0, float(camera.far())};
+    if (!(cosine > 0)) return {0, 0, 0, 0, float(camera.far())};
+    double at = 0;
+    return shadeFirst(scene, camera, ray, camera.near() / cosine, camera.far() / cosine, at);
+}
+
+std::vector<std::array<float, 5>> shadeRayLayers(const MeshScene& scene, const Camera& camera, glm::dvec2 uv, int layers) {
+    const Ray ray = camera.ray(uv);
+    const double cosine = glm::dot(ray.direction, camera.forward());
+    std::vector<std::array<float, 5>> out(static_cast<std::size_t>(std::max(layers, 0)),
+                                          std::array<float, 5>{0, 0, 0, 0, float(camera.far())});
     if (!(cosine > 0)) return out;
-    const auto hit = scene.intersect(ray, camera.near() / cosine, camera.far() / cosine);
-    if (!hit) return out;
-    const glm::vec3 albedo = meshAlbedo(scene.mesh(), hit->triangle, hit->b1, hit->b2);
-    const glm::vec3 colour = shadeHeadlight(albedo, hit->normal, glm::vec3(directionToEye(camera, hit->position)));
-    out = {colour.r, colour.g, colour.b, 1.0f, float(camera.project(hit->position).z)};
+    double from = camera.near() / cosine, at = -1;
+    for (auto& layer : out) {
+        layer = shadeFirst(scene, camera, ray, from, camera.far() / cosine, at);
+        if (layer[kMeshChannelA] <= 0) break;
+        from = at * (1.0 + kPeelGap);
+    }
     return out;
 }
 
@@ -187,6 +214,22 @@ Image renderMeshReference(const MeshScene& scene, const Fpc& fpc, int width, int
             }
         }
         progress.add(y1 - y0);
+    });
+    return out;
+}
+
+std::vector<Image> renderMeshLayers(const MeshScene& scene, const Fpc& fpc, int width, int height, int layers, int threads) {
+    if (layers < 1) throw Error(ErrorCode::InvalidArgument, "mesh layers: at least one layer, got " + std::to_string(layers));
+    std::vector<Image> out(static_cast<std::size_t>(layers), makeImage(width, height, meshChannelNames()));
+    const Distortion* distortion = fpc.distortion();
+    parallelRows(height, threads, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < width; ++x) {
+                const glm::dvec2 pd((x + 0.5) / width, (y + 0.5) / height);
+                const auto surfaces = shadeRayLayers(scene, fpc.camera(), distortion ? distortion->undistort(pd) : pd, layers);
+                for (std::size_t k = 0; k < surfaces.size(); ++k)
+                    std::copy(surfaces[k].begin(), surfaces[k].end(), &out[k].at(x, y, 0));
+            }
     });
     return out;
 }

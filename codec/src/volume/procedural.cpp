@@ -78,17 +78,42 @@ Volume sheppLogan3d(int n) {
         const glm::dmat3 rz2(std::cos(s), std::sin(s), 0, -std::sin(s), std::cos(s), 0, 0, 0, 1);
         placed.push_back({&e, glm::transpose(rz2 * rx * rz1)});
     }
+    // Each voxel holds the phantom's mean over the voxel's cube (what a scanner measures: partial
+    // volume), not its value at the centre: point samples leave the ellipsoids' surfaces as
+    // voxel-sized terraces, which a ray caster draws as rings. A voxel no surface crosses keeps its
+    // centre's value; one that a surface may cross (normalized radius s with |s - 1| times the
+    // smallest semi-axis, a lower bound on the distance to the surface, under half the cube's
+    // diagonal) takes the mean of kSub^3 points.
+    constexpr int kSub = 4;
+    const double h = v.spacing.x, halfDiagonal = 0.5 * std::sqrt(3.0) * h;
+    const auto valueAt = [&](glm::dvec3 p, bool& nearSurface) {
+        double value = 0;
+        for (const Placed& e : placed) {
+            const glm::dvec3 q = e.rotation * (p - glm::dvec3(e.e->x, e.e->y, e.e->z));
+            const glm::dvec3 r = q / glm::dvec3(e.e->a, e.e->b, e.e->c);
+            const double s2 = glm::dot(r, r);
+            if (s2 <= 1.0) value += e.e->value;
+            nearSurface = nearSurface || std::abs(std::sqrt(s2) - 1.0) * std::min({e.e->a, e.e->b, e.e->c}) < halfDiagonal;
+        }
+        return std::clamp(value, 0.0, 1.0);
+    };
     for (int z = 0; z < n; ++z)
         for (int y = 0; y < n; ++y)
             for (int x = 0; x < n; ++x) {
                 const glm::dvec3 p(coordinate(x, n), coordinate(y, n), coordinate(z, n));
-                double value = 0;
-                for (const Placed& e : placed) {
-                    const glm::dvec3 q = e.rotation * (p - glm::dvec3(e.e->x, e.e->y, e.e->z));
-                    const glm::dvec3 r = q / glm::dvec3(e.e->a, e.e->b, e.e->c);
-                    if (glm::dot(r, r) <= 1.0) value += e.e->value;
+                bool nearSurface = false;
+                double value = valueAt(p, nearSurface);
+                if (nearSurface) {
+                    double sum = 0;
+                    bool ignored = false;
+                    for (int k = 0; k < kSub * kSub * kSub; ++k) {
+                        const glm::dvec3 o((k % kSub + 0.5) / kSub - 0.5, (k / kSub % kSub + 0.5) / kSub - 0.5,
+                                           (k / (kSub * kSub) + 0.5) / kSub - 0.5);
+                        sum += valueAt(p + o * h, ignored);
+                    }
+                    value = sum / (kSub * kSub * kSub);
                 }
-                v.values[v.index(x, y, z)] = static_cast<float>(std::clamp(value, 0.0, 1.0));
+                v.values[v.index(x, y, z)] = static_cast<float>(value);
             }
     return v;
 }

@@ -394,5 +394,176 @@ TEST(Reflection, FloorAcrossAFaceSeamIsHitNotMissed) {
     }
 }
 
+// Layered faces: an occluding box before a wall (test::boxBeforeWall), seen from the centre at
+// the origin along +z; rays from points beside the centre (where a mirror of radius 1 reflects
+// from) that pass behind the box's front surface.
+using test::kOccluderHi;
+using test::kOccluderLo;
+using test::kWallHi;
+using test::kWallLo;
+
+const MeshScene& occluderAndWall() {
+    static const MeshScene scene(test::boxBeforeWall());
+    return scene;
+}
+
+std::vector<ReflectionFace> bakeLayers(int layers) {
+    ReflectionBakeOptions o;
+    o.size = 96;
+    o.layers = layers;
+    o.roi = AxisBox{kOccluderLo, kOccluderHi};
+    return bakeReflection(occluderAndWall(), o);
+}
+
+struct LayerScore {
+    int rays = 0, right = 0, hidden = 0;
+};
+
+// Rays from `from` to `targets` (each expected to meet the surface there first: `expected` gives
+// the analytic t or nothing to skip the target); right: the traced hit within `tolerance` of it.
+template <class Expected>
+LayerScore score(const std::vector<ReflectionFace>& faces, glm::dvec3 from, const std::vector<glm::dvec3>& targets,
+                 Expected expected, double tolerance) {
+    LayerScore s;
+    for (const glm::dvec3& target : targets) {
+        const Ray ray{from, glm::normalize(target - from)};
+        const std::optional<double> t = expected(ray);
+        if (!t) continue;
+        ++s.rays;
+        const auto hit = traceReflection(faces, ray);
+        if (!hit) continue;
+        s.hidden += hit->hit.hidden;
+        s.right += glm::distance(hit->hit.position, ray.origin + ray.direction * *t) < tolerance;
+    }
+    return s;
+}
+
+TEST(ReflectionLayers, ARayBehindTheOccluderMeetsTheWallBehindIt) {
+    // Targets on the wall's front (z = 3) in the occluder's shadow from the centre, so a single
+    // layer stores the box there, and the wall only in deeper layers (the box's back face is the
+    // second surface, the wall the third).
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> inset(0.1, 0.9);
+    std::vector<glm::dvec3> targets;
+    for (int i = 0; i < 300; ++i) {
+        const glm::dvec3 onFront(kOccluderLo.x + inset(random) * (kOccluderHi.x - kOccluderLo.x),
+                                 kOccluderLo.y + inset(random) * (kOccluderHi.y - kOccluderLo.y), kOccluderLo.z);
+        targets.push_back(onFront * (kWallLo.z / kOccluderLo.z));
+    }
+    for (const glm::dvec3 from : {glm::dvec3(0.9, 0.2, 0.3), glm::dvec3(-0.6, -0.7, 0.1)}) {
+        const auto expected = [&](const Ray& ray) -> std::optional<double> {
+            if (test::hitBox(ray, kOccluderLo, kOccluderHi)) return std::nullopt;  // the box still in the way
+            const auto wall = test::hitBox(ray, kWallLo, kWallHi);
+            if (!wall || wall->axis != 2) return std::nullopt;
+            return wall->t;
+        };
+        const LayerScore one = score(bakeLayers(1), from, targets, expected, 0.03);
+        const LayerScore three = score(bakeLayers(3), from, targets, expected, 0.03);
+        ASSERT_GT(one.rays, 60) << "from " << from.x;
+        // One layer knows nothing behind the box: its hits are guesses (hidden) or elsewhere.
+        EXPECT_LT(one.right, one.rays / 4) << "from " << from.x;
+        EXPECT_GT(one.hidden, one.rays / 2) << "from " << from.x;
+        // Three meet the wall where the ray does.
+        EXPECT_GE(three.right, three.rays - three.rays / 50) << "from " << from.x;
+        EXPECT_EQ(three.hidden, 0) << "from " << from.x;
+    }
+}
+
+TEST(ReflectionLayers, ARayMeetsTheOccludersSideThatFacesAwayFromTheCentre) {
+    // The box's side x = hi.x faces away from the centre (its normal +x, the centre at x = 0 <
+    // hi.x): the centre sees it only through the box, as the second surface along its rays; a
+    // point to the right of the centre sees it from outside.
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> inset(0.1, 0.9);
+    std::vector<glm::dvec3> targets;
+    for (int i = 0; i < 300; ++i)
+        targets.push_back({kOccluderHi.x, kOccluderLo.y + inset(random) * (kOccluderHi.y - kOccluderLo.y),
+                           kOccluderLo.z + inset(random) * (kOccluderHi.z - kOccluderLo.z)});
+    const glm::dvec3 from(1.0, -0.15, 0.2);
+    const auto expected = [&](const Ray& ray) -> std::optional<double> {
+        const auto box = test::hitBox(ray, kOccluderLo, kOccluderHi);
+        if (!box || box->axis != 0) return std::nullopt;
+        return box->t;
+    };
+    const LayerScore one = score(bakeLayers(1), from, targets, expected, 0.03);
+    const LayerScore two = score(bakeLayers(2), from, targets, expected, 0.03);
+    ASSERT_GT(one.rays, 200);
+    EXPECT_LT(one.right, one.rays / 4);
+    // The side is seen edge-on from the centre (about 2 degrees across, 8 texels of the focused
+    // face): a few rays near its edges land more than 0.03 off (measured: 278 of 294 within).
+    EXPECT_GE(two.right, two.rays * 9 / 10);
+}
+
+TEST(ReflectionLayers, OneLayerIsTheSingleLayerAssetAndLayersRoundTrip) {
+    const std::vector<ReflectionFace> one = bakeLayers(1), three = bakeLayers(3);
+    ASSERT_EQ(one.front().layers(), 1);
+    ASSERT_EQ(three.front().layers(), 3);
+    // Layer 0 of a layered bake is the single-layer bake, texel for texel.
+    for (std::size_t f = 0; f < one.size(); ++f) {
+        EXPECT_EQ(one[f].image.pixels, three[f].image.pixels);
+        EXPECT_EQ(one[f].depth.depths(), three[f].depth.depths());
+    }
+    // Deeper layers lie behind: where layer k saw a surface, its depth exceeds layer k-1's.
+    int behind = 0;
+    for (const ReflectionFace& face : three)
+        for (int k = 1; k < face.layers(); ++k)
+            for (int y = 0; y < face.image.height; ++y)
+                for (int x = 0; x < face.image.width; ++x)
+                    if (face.layerImage(k).at(x, y, kMeshChannelA) > 0) {
+                        ++behind;
+                        EXPECT_GT(face.layerDepth(k).depthAt(x, y), face.layerDepth(k - 1).depthAt(x, y));
+                    }
+    EXPECT_GT(behind, 1000);
+    // Through the file and back: the same layers, and a single-layer file stays single.
+    const conus::test::TestDir dir("reflection-layers");
+    const std::string path = dir.file("layered.exr");
+    format::writeReflectionAsset(path, reflectionAssetFile(three));
+    EXPECT_TRUE(format::validateConusFile(path).ok());
+    const std::vector<ReflectionFace> read = readReflectionFaces(path);
+    ASSERT_EQ(read.front().layers(), 3);
+    for (std::size_t f = 0; f < read.size(); ++f)
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_EQ(read[f].layerDepth(k).depths(), three[f].layerDepth(k).depths());
+            EXPECT_EQ(read[f].layerImage(k).pixels, three[f].layerImage(k).pixels);
+        }
+    format::writeReflectionAsset(path, reflectionAssetFile(one));
+    EXPECT_EQ(readReflectionFaces(path).front().layers(), 1);
+    EXPECT_TRUE(format::validateConusFile(path).ok());
+}
+
+TEST(ReflectionLayers, TheBakeCountsDisocclusionsAndAutoStopsWhenLayersCoverLittle) {
+    const MeshScene& scene = occluderAndWall();
+    // The wall seen past the box, and the box's sides, need deeper layers; beyond the third
+    // (the wall) nothing is left that a mirror of radius 1 sees.
+    const double one = disocclusionFraction(scene, {0, 0, 0}, 1.0, 1), three = disocclusionFraction(scene, {0, 0, 0}, 1.0, 3);
+    EXPECT_GT(one, 0.0);
+    EXPECT_LT(three, one / 5);
+    EXPECT_EQ(disocclusionFraction(scene, {0, 0, 0}, 0.0, 1), 0.0);  // the centre sees all it meets
+    // Auto keeps the layers up to the first that covers under 1% of the faces' texels, counted
+    // here on the bake of every layer.
+    ReflectionBakeOptions o;
+    o.size = 32;
+    o.layers = kMaxReflectionLayers;
+    const auto all = bakeReflection(scene, o);
+    int expected = 1;
+    for (int k = 1; k < kMaxReflectionLayers; ++k) {
+        double covered = 0, texels = 0;
+        for (const ReflectionFace& face : all)
+            for (std::size_t i = 0; i < face.layerDepth(k).depths().size(); ++i) {
+                covered += face.layerImage(k).pixels[i * 5 + kMeshChannelA] > 0;
+                texels += 1;
+            }
+        if (covered / texels < kLayerMinCoverage) break;
+        expected = k + 1;
+    }
+    o.layers = 0;
+    const auto faces = bakeReflection(scene, o);
+    EXPECT_EQ(faces.front().layers(), expected);
+    EXPECT_GE(expected, 2);  // the box's back and the wall's cover more than 1%
+    EXPECT_LT(expected, kMaxReflectionLayers);
+    o.layers = kMaxReflectionLayers + 1;
+    EXPECT_THROW(bakeReflection(scene, o), Error);
+}
+
 }  // namespace
 }  // namespace conus::codec

@@ -73,6 +73,25 @@ inline Mesh rampedBoxAndFloor(glm::vec3 lo, glm::vec3 hi) {
     return scene;
 }
 
+// The layered reflection tests' scene: an occluding box before a wall (a slab), both off the
+// axes, seen from the origin along +z; a colour ramp across both (the box bluish, the wall
+// yellowish) so that a hit on the wrong one shows.
+inline const glm::dvec3 kOccluderLo(-0.35, -0.25, 1.6), kOccluderHi(0.25, 0.3, 2.0);
+inline const glm::dvec3 kWallLo(-3.0, -2.5, 3.0), kWallHi(3.2, 2.8, 3.3);
+inline Mesh boxBeforeWall() {
+    Mesh m = flatBox(glm::vec3(kOccluderLo), glm::vec3(kOccluderHi));
+    const Mesh wall = flatBox(glm::vec3(kWallLo), glm::vec3(kWallHi));
+    const auto base = static_cast<std::uint32_t>(m.positions.size());
+    m.positions.insert(m.positions.end(), wall.positions.begin(), wall.positions.end());
+    m.normals.insert(m.normals.end(), wall.normals.begin(), wall.normals.end());
+    for (std::uint32_t i : wall.indices) m.indices.push_back(base + i);
+    for (std::size_t i = 0; i < m.positions.size(); ++i) {
+        const glm::vec3 p = m.positions[i];
+        m.colours.emplace_back(0.5f + 0.15f * p.x, 0.5f + 0.15f * p.y, i < base ? 0.8f : 0.2f);
+    }
+    return m;
+}
+
 // Ray-sphere: the nearest t >= 0 along a unit-direction ray, if it meets the sphere.
 inline std::optional<double> hitSphere(const Ray& ray, glm::dvec3 centre, double radius) {
     const glm::dvec3 oc = ray.origin - centre;

@@ -70,10 +70,15 @@ TEST(Procedural, SheppLoganHasSkullBrainAndVentricles) {
         return v.at(int(std::lround((x + 1) * 32)), int(std::lround((y + 1) * 32)), int(std::lround((z + 1) * 32)));
     };
     EXPECT_FLOAT_EQ(at(0, 0, 0), 0.2f);      // brain: 1 - 0.8
-    EXPECT_FLOAT_EQ(at(0, 0.9, 0), 1.0f);    // skull
+    EXPECT_FLOAT_EQ(at(0, 0.875, 0), 1.0f);  // skull (the voxel wholly inside it)
     EXPECT_FLOAT_EQ(at(0.22, 0, 0), 0.0f);   // right ventricle: 0.2 - 0.2
     EXPECT_FLOAT_EQ(at(0.95, 0.95, 0.95), 0.0f);  // air
     EXPECT_FLOAT_EQ(at(0, 0.35, -0.15), 0.3f);     // the large inner ellipsoid
+    // A voxel the skull's outer surface crosses (x = 0.69 at y = z = 0) holds the part of its cube
+    // inside, not its centre's value: x 0.672..0.703 (index 54, centre 0.6875, inside the skull),
+    // of which 0.58 lies inside (4 sub-samples a side: 2 of 4 along x).
+    EXPECT_GT(at(0.69, 0, 0), 0.3f);
+    EXPECT_LT(at(0.69, 0, 0), 0.8f);
     EXPECT_EQ(codeOf([] { proceduralVolume("procedural:torus"); }), ErrorCode::InvalidArgument);
     EXPECT_EQ(proceduralVolume("procedural:shepp-logan:17").width, 17);
 }

@@ -94,6 +94,7 @@ public:
 
     const Camera& camera() const { return m_camera; }
     const SamplingMap& map() const { return *m_map; }
+    const std::shared_ptr<const SamplingMap>& sharedMap() const { return m_map; }
     int width() const { return m_width; }
     int height() const { return m_height; }
     const std::vector<float>& depths() const { return m_depths; }
@@ -172,6 +173,30 @@ struct DepthHit {
 
 // The first hit along `ray` (direction unit), or nothing. Never throws for a finite ray.
 std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options = {});
+// The same, saying where the walk first went behind a scene's surface (a wall crossed: the last
+// sample in front of it; or where the ray entered hidden), as a distance along the ray; infinity
+// when it never did: only beyond it can a deeper layer of a layered image hold what the ray meets
+// (below).
+std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const IntersectOptions& options,
+                                  double& firstHidden);
+
+// Layered depth images (depth peeling: layer k holds the k-th surface along each texel's ray, the
+// camera's far plane where there is none) keep what a single layer loses behind a silhouette.
+// Layer 0 is an ordinary scene image and is walked by intersect() above. A deeper layer is walked
+// by intersectBehind: the same clip, steps, flags and bisection, but a crossing of the stored
+// surface counts either way (a ray from beside the camera meets surfaces that face away from it
+// from their back: a teapot's far side), is no hit where the surface jumps (the discontinuity
+// rule, per layer), and nothing is carried on behind an occluder (the next layer holds it).
+//
+// The nearest hit among the layers is the ray's. A ray that never goes behind layer 0 before its
+// layer-0 hit (or its exit) stays in front of every deeper layer too (each lies behind layer 0
+// along the camera's rays), so the deeper layers are walked only when intersect() reports that it
+// went hidden, and only from there on (the ray's origin moved to firstHidden); then a deeper hit
+// short of the layer-0 hit wins. A hidden (carried-on, guessed)
+// layer-0 hit is no hit in a layered image: its layers hold what lies behind the occluders, and a
+// ray that meets none of them there meets nothing. A one-layer image is intersected exactly as
+// before.
+std::optional<DepthHit> intersectBehind(const DepthImage& layer, const Ray& ray, const IntersectOptions& options = {});
 
 // The options' and rays' checks shared with the GL twin: conus::Error(InvalidArgument) for a
 // step outside (0, 64], refinements outside [0, 64], maxSteps outside [1, 1<<20], a non-positive

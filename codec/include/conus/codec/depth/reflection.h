@@ -41,12 +41,31 @@ using format::kCubeFaceNames;
 // conus::Error(InvalidArgument) for a face outside 0..5 or bad clips.
 Camera cubeFaceCamera(glm::dvec3 centre, int face, double near, double far);
 
-// One face: its depth image (what rays intersect) and the mesh render it came from (R, G, B, A, Z
-// per CoNUS pixel, codec/mesh/shading.h's channels; the colour a hit takes).
-struct ReflectionFace {
+// One surface layer of a face: its depth image (what rays intersect) and the mesh render it came
+// from (R, G, B, A, Z per CoNUS pixel, codec/mesh/shading.h's channels; the colour a hit takes).
+struct ReflectionLayer {
     DepthImage depth;
     Image image;
 };
+
+// One face: its first surface (`depth`, `image`: the single-layer asset) and the surfaces behind
+// it along the face's rays, layer 1 on (depth peeling, intersect.h's layered images), each with
+// the face's camera and map; none in a single-layer asset.
+struct ReflectionFace {
+    DepthImage depth;
+    Image image;
+    std::vector<ReflectionLayer> behind;
+
+    int layers() const { return 1 + static_cast<int>(behind.size()); }
+    const DepthImage& layerDepth(int k) const { return k == 0 ? depth : behind[static_cast<std::size_t>(k - 1)].depth; }
+    const Image& layerImage(int k) const { return k == 0 ? image : behind[static_cast<std::size_t>(k - 1)].image; }
+};
+
+// The most layers a face keeps, and the coverage below which the bake adds no further layer when
+// asked for as many as the scene needs: a layer found in under this fraction of the faces' texels
+// buys less than it costs (every layer stores all its texels).
+inline constexpr int kMaxReflectionLayers = 4;
+inline constexpr double kLayerMinCoverage = 0.01;
 
 // The six faces as one asset file's contents (each face codec/conus_file.h's makeDepthImageFile,
 // units "world"; the frame the first face's eye and the world's axes), and back. Throws
@@ -66,6 +85,9 @@ struct ReflectionBakeOptions {
     double magnification = 4.0;  // linear magnification of the focus on the region of interest
     std::optional<AxisBox> roi;  // the region of interest; none: the scene's bounding box
     double near = 0.01;          // the faces' near clip (far: beyond the scene's bounding box)
+    // Surfaces kept along each texel's ray: 1 (the first only) .. kMaxReflectionLayers, or 0: as
+    // many as the scene needs (layers added while the next covers kLayerMinCoverage of the texels).
+    int layers = 1;
 };
 
 // The focus a face puts on the region of interest: the disc inscribed in the bounding square of
@@ -76,8 +98,10 @@ std::optional<Focus> reflectionFocus(const Camera& face, const AxisBox& roi, dou
 // The six faces of `scene` from options.centre, each rendered by the Embree reference (one exact
 // ray per CoNUS pixel: depths of one surface, never a mean across a silhouette); a face with a
 // focus is rendered uniform first, for its context. Throws
-// conus::Error(InvalidArgument) for a size outside [8, 4096], a magnification outside [1, 16], a
-// non-finite centre, or a centre inside no free space (a near clip at or beyond the far one).
+// conus::Error(InvalidArgument) for a size outside [8, 4096], a magnification outside [1, 16],
+// layers outside [0, kMaxReflectionLayers], a non-finite centre, or a centre inside no free space
+// (a near clip at or beyond the far one). Deeper layers are rendered the same way
+// (shadeRayLayers: the k-th surface along each CoNUS pixel's ray), through the layer-0 maps.
 std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const ReflectionBakeOptions& options);
 
 // A specular reflector: a sphere (centre, radius) or a square plane mirror (centre, unit normal,
@@ -103,14 +127,18 @@ std::optional<ReflectorHit> hitReflector(const Reflector& reflector, const Ray& 
 // weighing nothing) times coverage (the far plane's texels carry no colour); the hit's own texel
 // where none of the four weighs anything.
 glm::vec3 reflectionColour(const ReflectionFace& face, const DepthHit& hit);
+// The same on layer `layer` of the face.
+glm::vec3 reflectionColour(const ReflectionFace& face, int layer, const DepthHit& hit);
 
 struct ReflectionHit {
     DepthHit hit;
     int face = 0;
+    int layer = 0;           // the face's layer it lies on
     glm::vec3 colour{0.0f};  // reflectionColour
 };
 
-// The nearest hit of `ray` among the faces (each face intersected by intersect.h; the nearest t
+// The nearest hit of `ray` among the faces (each face intersected by intersect.h, its deeper
+// layers as a layered image's: intersectBehind when layer 0's walk went hidden; the nearest t
 // wins), or nothing when it meets only the far planes.
 std::optional<ReflectionHit> traceReflection(const std::vector<ReflectionFace>& faces, const Ray& ray,
                                              const IntersectOptions& options = {});
@@ -118,6 +146,14 @@ std::optional<ReflectionHit> traceReflection(const std::vector<ReflectionFace>& 
 // The ground truth of a reflected ray: the mesh itself traced (Embree), the hit shaded as the
 // faces are (the headlight from `centre`, the faces' eye), so that only where the ray lands differs.
 std::optional<glm::vec3> traceReflectionReference(const MeshScene& scene, const Ray& ray, glm::dvec3 centre);
+
+// Mirror rays that land in a disocclusion: of `rays` rays leaving a sphere of `radius` about the
+// centre (origins uniform on it, directions uniform over the outward hemisphere: what a sphere
+// mirror of that radius reflects, a plane mirror's among them) that meet the scene, the fraction
+// whose first surface (traced against the mesh) is not among the first `layers` surfaces along the
+// centre's ray to it (shadeRayLayers' peeling rule): what no asset of that many layers stores.
+double disocclusionFraction(const MeshScene& scene, glm::dvec3 centre, double radius, int layers, int rays = 20000,
+                            unsigned seed = 1);
 
 // What the reflector shows where a reflected ray meets nothing: a constant sky.
 inline constexpr float kReflectionSky[3] = {0.55f, 0.65f, 0.8f};

@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -71,5 +72,17 @@ Image renderMeshReference(const MeshScene& scene, const Fpc& fpc, int width, int
 // The shaded R, G, B, A, Z of one ray of `camera`'s through undistorted image position uv (what
 // one sample of renderMeshReference computes).
 std::array<float, 5> shadeRay(const MeshScene& scene, const Camera& camera, glm::dvec2 uv);
+
+// The first `layers` surfaces along that ray (depth peeling by ray casting): entry k is shadeRay's
+// R, G, B, A, Z of the first surface more than kPeelGap * its depth behind surface k - 1 (front or
+// back side alike: the mirror sees either); the far plane with A = 0 where there is none.
+inline constexpr double kPeelGap = 1e-3;
+std::vector<std::array<float, 5>> shadeRayLayers(const MeshScene& scene, const Camera& camera, glm::dvec2 uv, int layers);
+
+// `layers` width x height CoNUS renders of `scene` through `fpc`, one ray per pixel, image k the
+// k-th surface (shadeRayLayers); image 0 is renderMeshReference's at one sample. Throws
+// conus::Error(InvalidArgument) for layers < 1.
+std::vector<Image> renderMeshLayers(const MeshScene& scene, const Fpc& fpc, int width, int height, int layers,
+                                    int threads = 0);
 
 }  // namespace conus::codec
