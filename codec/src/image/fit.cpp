@@ -289,6 +289,82 @@ std::vector<float> lowPassShare(const SamplingMap& map, int sourceWidth, int sou
     return share;
 }
 
+// Per CoNUS pixel, how much of the Local fit's correction it takes: 1 / (1 + damping + hold *
+// low-pass share), times min(1, short axis in source pixels)^2 (fit.h).
+std::vector<float> localWeights(const SamplingMap& map, int sourceWidth, int sourceHeight, int width, int height,
+                                const FitOptions& options) {
+    std::vector<float> weight(static_cast<std::size_t>(width) * height);
+    const FootprintField field(map);
+    const double uniform = uniformSpacing(sourceWidth, sourceHeight, width, height);
+    const glm::dvec2 scale(sourceWidth, sourceHeight);
+    parallelRows(height, options.threads, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < width; ++x) {
+                const glm::dmat2 inverse = field.inverseJacobian(map.undistort({(x + 0.5) / width, (y + 0.5) / height}));
+                const glm::dvec2 a = inverse[0] / double(width) * scale, b = inverse[1] / double(height) * scale;
+                const FootprintPlan plan = planFootprint(a, b, uniform);
+                const double share = std::clamp(std::max(plan.extent.x, plan.extent.y) - 1.0, 0.0, 1.0);
+                // The short axis: |det| / long axis, from the singular values of [a b].
+                const double p = glm::dot(a, a), q = glm::dot(a, b), r = glm::dot(b, b);
+                const double mean = 0.5 * (p + r), half = std::sqrt(0.25 * (p - r) * (p - r) + q * q);
+                const double minor = std::sqrt(std::max(0.0, mean - half));
+                const double fade = std::min(1.0, minor * minor);
+                weight[static_cast<std::size_t>(y) * width + x] =
+                    static_cast<float>(fade / (1.0 + options.damping + options.holdLowPass * share));
+            }
+    });
+    return weight;
+}
+
+// The Local fit's inverse kernel along one axis: K = [q, 1 - 2q, q] has the inverse
+// h[n] = p^|n| / sqrt(1 - 4 q^2) with p = (sqrt(1 - 4q^2) - (1 - 2q)) / (2q); cut where |h| < 1e-3.
+std::vector<float> localInverse(double q) {
+    const double root = std::sqrt(1.0 - 4.0 * q * q);
+    const double pole = (root - (1.0 - 2.0 * q)) / (2.0 * q);
+    std::vector<float> h;
+    for (double v = 1.0 / root; std::abs(v) >= 1e-3 && h.size() < 16; v *= pole) h.push_back(static_cast<float>(v));
+    return h;
+}
+
+// x (width x height, `channels` values a pixel) convolved with the symmetric kernel h along rows
+// (step = channels) or columns (step = a row), clamped at the edges, into out.
+void convolveAxis(const float* x, float* out, int width, int height, int channels, const std::vector<float>& h,
+                  bool alongRows, int threads) {
+    const int radius = static_cast<int>(h.size()) - 1;
+    parallelRows(height, threads, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int xi = 0; xi < width; ++xi) {
+                float* o = out + (static_cast<std::size_t>(y) * width + xi) * channels;
+                const auto at = [&](int dx, int dy) {
+                    const int cx = std::clamp(xi + dx, 0, width - 1), cy = std::clamp(y + dy, 0, height - 1);
+                    return x + (static_cast<std::size_t>(cy) * width + cx) * channels;
+                };
+                for (int c = 0; c < channels; ++c) o[c] = h[0] * at(0, 0)[c];
+                for (int n = 1; n <= radius; ++n) {
+                    const float* lo = alongRows ? at(-n, 0) : at(0, -n);
+                    const float* hi = alongRows ? at(n, 0) : at(0, n);
+                    for (int c = 0; c < channels; ++c) o[c] += h[n] * (lo[c] + hi[c]);
+                }
+            }
+    });
+}
+
+// The Local fit (fit.h) on the packed fitted channels x of a width x height CoNUS image.
+void localFit(std::vector<float>& x, int width, int height, int channels, const std::vector<float>& weight,
+              double side, int threads) {
+    const std::vector<float> h = localInverse(side);
+    std::vector<float> across(x.size()), both(x.size());
+    convolveAxis(x.data(), across.data(), width, height, channels, h, true, threads);
+    convolveAxis(across.data(), both.data(), width, height, channels, h, false, threads);
+    parallelRows(height, threads, [&](int y0, int y1) {
+        for (std::size_t i = std::size_t(y0) * width; i < std::size_t(y1) * width; ++i)
+            for (int c = 0; c < channels; ++c) {
+                const std::size_t k = i * channels + c;
+                x[k] += weight[i] * (both[k] - x[k]);
+            }
+    });
+}
+
 }  // namespace
 
 Image fitForward(const Image& conus, const SamplingMap& map, int width, int height, int threads) {
@@ -328,6 +404,9 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         if (!(d >= 0.0) || !std::isfinite(d))
             throw Error(ErrorCode::InvalidArgument, "fitToDecoder: damping " + std::to_string(d) +
                                                         " must be finite and at least 0");
+    if (!(options.localSide > 0.0 && options.localSide < 0.25))
+        throw Error(ErrorCode::InvalidArgument,
+                    "fitToDecoder: the local fit's side weight " + std::to_string(options.localSide) + " must be in (0, 0.25)");
 
     std::vector<int> fitted;
     for (int c = 0; c < conus.channelCount(); ++c)
@@ -338,6 +417,30 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
     const bool all = channels == conus.channelCount();
     // Work on packed copies of the fitted channels unless they are all of them.
     std::vector<float> x = all ? conus.pixels : detail::pack(conus, fitted);
+    const auto finish = [&] {
+        result.minimum = x.empty() ? 0.0f : x[0];
+        result.maximum = result.minimum;
+        for (float v : x) {
+            result.negatives += v < 0.0f;
+            result.minimum = std::min(result.minimum, v);
+            result.maximum = std::max(result.maximum, v);
+        }
+        if (all) {
+            conus.pixels = std::move(x);
+        } else {
+            const std::size_t c = conus.channels.size();
+            for (std::size_t px = 0; px < std::size_t(conus.width) * conus.height; ++px)
+                for (int k = 0; k < channels; ++k) conus.pixels[px * c + fitted[k]] = x[px * channels + k];
+        }
+        if (options.progress) options.progress(1.0);
+        return result;
+    };
+    if (options.method == FitMethod::Local) {
+        const std::vector<float> weight =
+            detail::localWeights(map, source.width, source.height, conus.width, conus.height, options);
+        detail::localFit(x, conus.width, conus.height, channels, weight, options.localSide, options.threads);
+        return finish();
+    }
     std::vector<float> packedSource;
     if (!all) packedSource = detail::pack(source, fitted);
     const float* s = all ? source.pixels.data() : packedSource.data();
@@ -418,22 +521,7 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         gamma = next;
     }
 
-    result.minimum = x.empty() ? 0.0f : x[0];
-    result.maximum = result.minimum;
-    for (float v : x) {
-        result.negatives += v < 0.0f;
-        result.minimum = std::min(result.minimum, v);
-        result.maximum = std::max(result.maximum, v);
-    }
-    if (all) {
-        conus.pixels = std::move(x);
-    } else {
-        const std::size_t c = conus.channels.size();
-        for (std::size_t px = 0; px < pixels; ++px)
-            for (int k = 0; k < channels; ++k) conus.pixels[px * c + fitted[k]] = x[px * channels + k];
-    }
-    if (options.progress) options.progress(1.0);
-    return result;
+    return finish();
 }
 
 }  // namespace conus::codec
