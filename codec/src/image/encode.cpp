@@ -1,10 +1,13 @@
 // CPU reference encoder (paper section 3.2) and the area-downsample baseline.
 //
-// Each CoNUS pixel filters the source over its footprint (encode.h states the rule): a grid of
-// bilinear taps in the pixel's own units (s,t), carried into the source through the local inverse
-// Jacobian (FootprintField), weighted by the unit box convolved with a Gaussian along the
-// footprint's major axis. A square footprint has no Gaussian: with the identity map and an integer
-// ratio the taps land exactly on source pixel centres, so the result is the exact area average.
+// Each CoNUS pixel filters the source over its footprint (encode.h states the rule), by one of two
+// kernels (EncodeFilter). The EWA filter: a grid of bilinear taps in the pixel's own units (s,t),
+// carried into the source through the local inverse Jacobian (FootprintField), weighted by the unit
+// box convolved with a Gaussian along the footprint's major axis; a square footprint has no
+// Gaussian, and with the identity map and an integer ratio the taps land exactly on source pixel
+// centres, so the result is the exact area average. The anisotropic kernel: the same footprint's
+// principal axes, the minor one filtered by the pyramid level it picks, a row of taps along the
+// major one; exact at power-of-two ratios.
 #include <array>
 #include <cmath>
 #include <cstring>

@@ -317,12 +317,18 @@ std::vector<float> localWeights(const SamplingMap& map, int sourceWidth, int sou
 }
 
 // The Local fit's inverse kernel along one axis: K = [q, 1 - 2q, q] has the inverse
-// h[n] = p^|n| / sqrt(1 - 4 q^2) with p = (sqrt(1 - 4q^2) - (1 - 2q)) / (2q); cut where |h| < 1e-3.
+// h[n] = p^|n| / sqrt(1 - 4q) with p = (sqrt(1 - 4q) - (1 - 2q)) / (2q), the root of
+// q z^2 + (1 - 2q) z + q inside the unit circle; cut where |h| < 1e-3 and scaled to sum to 1.
 std::vector<float> localInverse(double q) {
-    const double root = std::sqrt(1.0 - 4.0 * q * q);
+    const double root = std::sqrt(1.0 - 4.0 * q);
     const double pole = (root - (1.0 - 2.0 * q)) / (2.0 * q);
     std::vector<float> h;
-    for (double v = 1.0 / root; std::abs(v) >= 1e-3 && h.size() < 16; v *= pole) h.push_back(static_cast<float>(v));
+    std::vector<double> taps;
+    for (double v = 1.0 / root; std::abs(v) >= 1e-3 && taps.size() < 16; v *= pole) taps.push_back(v);
+    // The cut series, scaled so that a constant stays that constant.
+    double sum = taps[0];
+    for (std::size_t n = 1; n < taps.size(); ++n) sum += 2.0 * taps[n];
+    for (const double v : taps) h.push_back(static_cast<float>(v / sum));
     return h;
 }
 

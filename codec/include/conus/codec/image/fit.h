@@ -64,8 +64,11 @@ constexpr auto enumNameTable(FitMethod) {
 // q of the Local fit: the side weight of the encode-then-decode kernel along each axis. 1/8 is the
 // exact box's; the anisotropic encoder's pyramid levels blur a little more.
 inline constexpr double kFitLocalSide = 0.125;
-// What `encode` (and conus.encode) fits with by default.
-inline constexpr FitMethod kDefaultEncodeFitMethod = FitMethod::Local;
+// What `encode` fits with by default: the least squares. The local fit keeps most of the fit's gain
+// inside the foci (0.2-0.6 dB below it on astronaut and the dogs) but a fifth of it over the whole
+// frame, where the context holds detail above its sampling rate and only the least squares (the
+// orthogonal projection) uses it (bench/notes/2026-12-06-encode-speed.md); it stays an option.
+inline constexpr FitMethod kDefaultEncodeFitMethod = FitMethod::LeastSquares;
 
 struct FitOptions {
     int iterations = kFitIterations;  // 0 measures only
