@@ -105,7 +105,8 @@ stages() {
             printf "\n%s: stage, median wall s, vs oiiotool resize wall, vs the encode kernel\n", name
             for (s = 1; s <= stages; ++s) {
                 k = order[s]
-                printf "| %-10s | %7.3f | %6.2fx | %s |\n", k, med[k], med[k] / resize, kernel > 0 ? sprintf("%6.2fx", med[k] / kernel) : "-"
+                vs = kernel > 0 ? sprintf("%6.2fx", med[k] / kernel) : "-"
+                printf "| %-10s | %7.3f | %6.2fx | %s |\n", k, med[k], med[k] / resize, vs
             }
         }'
 }

@@ -544,6 +544,18 @@ void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& 
                 for (int x = tx; x < std::min(W, tx + kTileColumns); ++x) pixel(x, y);
 }
 
+// Whether every node of the map sits where the identity puts it (to float rounding).
+bool isUniform(const SamplingMap& map) {
+    for (int j = 0; j < map.rows(); ++j)
+        for (int i = 0; i < map.columns(); ++i) {
+            const glm::vec2 n = map.node(i, j);
+            if (std::abs(n.x - float(i) / float(map.columns() - 1)) > 1e-6f ||
+                std::abs(n.y - float(j) / float(map.rows() - 1)) > 1e-6f)
+                return false;
+        }
+    return true;
+}
+
 }  // namespace
 
 FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b, double uniform) {
@@ -600,7 +612,7 @@ Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptio
     Image out = detail::makeOutput(source, options.width, options.height);
     Pyramid pyramid(source);
     const FootprintField field(map);
-    const bool anisotropic = options.filter == EncodeFilter::Anisotropic;
+    const bool anisotropic = options.filter == EncodeFilter::Anisotropic && !isUniform(map);  // encode.h says why
     detail::RowProgress progress(options.progress, out.height);
     parallelRows(out.height, options.threads, [&](int y0, int y1) {
         detail::dispatchChannels(source.channelCount(), [&]<int kC>() {

@@ -85,6 +85,9 @@ private:
 //  - Ewa: the tap grid over the footprint's parallelogram in (s,t) described above, with the exact
 //    weight of each tap; the GL encoder's twin, and the reference the anisotropic kernel is tested
 //    against.
+// Under a uniform map (every node where the identity puts it) the encoder takes the EWA filter
+// whatever is asked: there it is the exact area average at integer ratios, and the uniform image
+// (`conus uniform`, the baseline every gain is measured against) stays that average.
 enum class EncodeFilter { Anisotropic, Ewa };
 constexpr auto enumNameTable(EncodeFilter) {
     return makeEnumNameTable<EncodeFilter>("encode filter",
