@@ -5,7 +5,8 @@
 // its taps reach (found once, up front), and the buffers are summed row by row afterwards: no
 // locks, no per-source-pixel storage, and the same sums whatever the thread count. The residual
 // s - D x is recomputed from x in every pass instead of being stored (a 4096^2 source would need
-// 192 MiB per vector), which also keeps it from drifting.
+// 192 MiB per vector), which also keeps it from drifting; after the last step only its norm is
+// wanted (the PSNR reported), and that follows from the step's own sums without a pass.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -482,22 +483,31 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
     const std::vector<float> x0 = damped ? x : std::vector<float>{};
     std::vector<float> z(values), p(values);
     // r = s - D x with sum |r|^2, and z = D^T r - lambda diag (x - x0) when asked; returns the objective.
-    const auto residual = [&](bool adjoint) {
-        if (adjoint) op.clearBuffers(channels);
-        detail::dispatchChannels(channels, [&]<int kC>() { detail::residualPass<kC>(op, x.data(), s, channels, adjoint); });
-        const double data = op.bandSum();
-        double penalty = 0;
-        if (adjoint) op.sumBuffers(z.data(), channels);
-        if (damped)
-            for (std::size_t i = 0; i < values; ++i) {
-                const float d = x[i] - x0[i], w = hold[i / channels] * diag[i / channels];
-                penalty += double(w) * d * d;
-                if (adjoint) z[i] -= w * d;
-            }
+    double lastData = 0;  // |s - D x|^2 for the x of the last step recorded
+    const auto record = [&](double data, double penalty) {
+        lastData = data;
         const double mse = data / samples;
         const int iteration = static_cast<int>(result.steps.size());
         result.steps.push_back({iteration, std::sqrt(mse), 10 * std::log10(1.0 / std::max(mse, 1e-30)), data + penalty});
         passDone();
+    };
+    const auto penaltyOf = [&] {
+        double penalty = 0;
+        if (damped)
+            for (std::size_t i = 0; i < values; ++i) {
+                const float d = x[i] - x0[i], w = hold[i / channels] * diag[i / channels];
+                penalty += double(w) * d * d;
+            }
+        return penalty;
+    };
+    const auto residual = [&](bool adjoint) {
+        if (adjoint) op.clearBuffers(channels);
+        detail::dispatchChannels(channels, [&]<int kC>() { detail::residualPass<kC>(op, x.data(), s, channels, adjoint); });
+        const double data = op.bandSum();
+        if (adjoint) op.sumBuffers(z.data(), channels);
+        if (damped && adjoint)
+            for (std::size_t i = 0; i < values; ++i) z[i] -= hold[i / channels] * diag[i / channels] * (x[i] - x0[i]);
+        record(data, penaltyOf());
     };
     const auto applyPreconditioner = [&](std::vector<float>& out) {
         for (std::size_t i = 0; i < values; ++i) out[i] = precondition[i / channels] * z[i];
@@ -509,17 +519,28 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
     std::vector<float> zp(values);
     for (int it = 1; it <= options.iterations && gamma > 0; ++it) {
         detail::dispatchChannels(channels, [&]<int kC>() { detail::normPass<kC>(op, p.data(), channels); });
-        double delta = op.bandSum();
+        const double dataDelta = op.bandSum();  // |D p|^2
+        double delta = dataDelta;
         if (damped)
             for (std::size_t i = 0; i < values; ++i)
                 delta += double(hold[i / channels]) * diag[i / channels] * p[i] * p[i];
         passDone();
         if (!(delta > 0)) break;
         const float alpha = static_cast<float>(gamma / delta);
-        for (std::size_t i = 0; i < values; ++i) x[i] += alpha * p[i];
         const bool last = it == options.iterations;
-        residual(!last);
-        if (last) break;
+        // After the last step no adjoint is needed, only |s - D x|^2 to report: along the step it
+        // is |r|^2 - 2 alpha <D p, r> + alpha^2 |D p|^2, with <D p, r> = <p, D^T r> and
+        // D^T r = z + lambda diag (x - x0), all on the CoNUS image: no pass over the source.
+        double pDtr = 0;
+        if (last)
+            for (std::size_t i = 0; i < values; ++i)
+                pDtr += double(p[i]) * (z[i] + (damped ? hold[i / channels] * diag[i / channels] * (x[i] - x0[i]) : 0.0f));
+        for (std::size_t i = 0; i < values; ++i) x[i] += alpha * p[i];
+        if (last) {
+            record(std::max(0.0, lastData - 2.0 * alpha * pDtr + double(alpha) * alpha * dataDelta), penaltyOf());
+            break;
+        }
+        residual(true);
         applyPreconditioner(zp);
         const double next = detail::dot(z, zp);
         const float beta = static_cast<float>(next / gamma);
