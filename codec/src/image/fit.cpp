@@ -35,6 +35,7 @@ struct Band {
     int y0 = 0, y1 = 0;   // output rows [y0, y1)
     int lo = 0, hi = -1;  // CoNUS rows its taps reach
     std::vector<float> buffer;
+    std::vector<float> squares;  // the taps' squared corner weights (diag(D^T D)), one value a CoNUS pixel
     double sum = 0;       // the pass's sum over the band (sums of squares)
 };
 
@@ -60,15 +61,15 @@ public:
             1);
     }
 
-    // Zeroes every band's buffer for a splat of `channels` values per pixel.
-    void clearBuffers(int channels) {
+    // Zeroes every band's buffer (`which` of them) for a splat of `channels` values per pixel.
+    void clearBuffers(int channels, std::vector<float> Band::*which = &Band::buffer) {
         forEachBand([&](Band& band, DecoderTaps::Scratch&) {
-            band.buffer.assign(static_cast<std::size_t>(band.hi - band.lo + 1) * m_taps.conusWidth() * channels, 0.0f);
+            (band.*which).assign(static_cast<std::size_t>(band.hi - band.lo + 1) * m_taps.conusWidth() * channels, 0.0f);
         });
     }
 
-    // out (CoNUS size, `channels` values a pixel) = the sum of the bands' buffers.
-    void sumBuffers(float* out, int channels) {
+    // out (CoNUS size, `channels` values a pixel) = the sum of the bands' buffers (`which` of them).
+    void sumBuffers(float* out, int channels, std::vector<float> Band::*which = &Band::buffer) {
         const int wc = m_taps.conusWidth();
         const std::size_t rowValues = static_cast<std::size_t>(wc) * channels;
         parallelRows(m_taps.conusHeight(), m_threads, [&](int r0, int r1) {
@@ -76,7 +77,7 @@ public:
             for (const Band& band : m_bands) {
                 const int a = std::max(r0, band.lo), b = std::min(r1 - 1, band.hi);
                 for (int r = a; r <= b; ++r) {
-                    const float* from = band.buffer.data() + (r - band.lo) * rowValues;
+                    const float* from = (band.*which).data() + (r - band.lo) * rowValues;
                     float* to = out + r * rowValues;
                     for (std::size_t k = 0; k < rowValues; ++k) to[k] += from[k];
                 }
@@ -168,6 +169,19 @@ inline void splat(float* buffer, int lo, int width, int height, int c, const Dec
     }
 }
 
+// Adds the taps' squared corner weights into a band's `squares` (rows from `lo`): diag(D^T D)
+// approximated per CoNUS pixel (exact where no two taps of one output pixel share a CoNUS pixel,
+// i.e. wherever the view magnifies).
+inline void splatSquares(float* squares, int lo, int width, int height, const DecoderTap* taps, int count) {
+    for (int k = 0; k < count; ++k) {
+        const TapCorners q = tapCorners(taps[k], width, height);
+        squares[(q.y0 - lo) * width + q.x0] += q.w00 * q.w00;
+        squares[(q.y0 - lo) * width + q.x1] += q.w01 * q.w01;
+        squares[(q.y1 - lo) * width + q.x0] += q.w10 * q.w10;
+        squares[(q.y1 - lo) * width + q.x1] += q.w11 * q.w11;
+    }
+}
+
 // view = D image (view: width x height, the operator's channels).
 template <int kC>
 void forwardPass(DecoderOperator& op, const float* image, int c, float* view) {
@@ -201,9 +215,11 @@ void normPass(DecoderOperator& op, const float* image, int c) {
 }
 
 // r = source - D image per pixel; each band's sum of |r|^2, and (when `adjoint`) r splatted into
-// the band buffers (D^T r once summed). With a null image, r = source.
+// the band buffers (D^T r once summed), and (when `diagonal`) the squared weights into `squares`
+// (diag(D^T D) once summed): the same walk of the taps. With a null image, r = source.
 template <int kC>
-void residualPass(DecoderOperator& op, const float* image, const float* source, int c, bool adjoint) {
+void residualPass(DecoderOperator& op, const float* image, const float* source, int c, bool adjoint,
+                  bool diagonal = false) {
     const DecoderTaps& taps = op.taps();
     const int channels = kC > 0 ? kC : c;
     op.forEachBand([&](Band& band, DecoderTaps::Scratch& scratch) {
@@ -221,32 +237,11 @@ void residualPass(DecoderOperator& op, const float* image, const float* source, 
                 if (adjoint)
                     splat<kC>(band.buffer.data(), band.lo, taps.conusWidth(), taps.conusHeight(), channels, t, count,
                               value.data());
+                if (diagonal) splatSquares(band.squares.data(), band.lo, taps.conusWidth(), taps.conusHeight(), t, count);
             });
         }
         band.sum = sum;
     });
-}
-
-// diag(D^T D) approximated per CoNUS pixel by the sum of its squared corner weights (exact where
-// no two taps of one output pixel share a CoNUS pixel, i.e. wherever the view magnifies).
-void diagonalPass(DecoderOperator& op, float* diag) {
-    const DecoderTaps& taps = op.taps();
-    op.clearBuffers(1);
-    op.forEachBand([&](Band& band, DecoderTaps::Scratch& scratch) {
-        const int wc = taps.conusWidth();
-        for (int y = band.y0; y < band.y1; ++y)
-            taps.row(y, scratch, [&](int, const DecoderTap* t, int count) {
-                for (int k = 0; k < count; ++k) {
-                    const TapCorners q = tapCorners(t[k], wc, taps.conusHeight());
-                    float* b = band.buffer.data();
-                    b[(q.y0 - band.lo) * wc + q.x0] += q.w00 * q.w00;
-                    b[(q.y0 - band.lo) * wc + q.x1] += q.w01 * q.w01;
-                    b[(q.y1 - band.lo) * wc + q.x0] += q.w10 * q.w10;
-                    b[(q.y1 - band.lo) * wc + q.x1] += q.w11 * q.w11;
-                }
-            });
-    });
-    op.sumBuffers(diag, 1);
 }
 
 double dot(const std::vector<float>& a, const std::vector<float>& b) {
@@ -464,21 +459,22 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         for (std::size_t i = 0; i < pixels; ++i) hold[i] += static_cast<float>(options.holdLowPass) * share[i];
     }
     const bool damped = std::any_of(hold.begin(), hold.end(), [](float h) { return h > 0; });
-    const int passes = 2 + 2 * options.iterations;
+    const int passes = 1 + 2 * options.iterations;  // a residual (with the diagonal), per iteration a norm and a residual
     int passesDone = 0;
     const auto passDone = [&] {
         if (options.progress) options.progress(double(++passesDone) / passes);
     };
 
     // Jacobi preconditioner: 1 / diag(D^T D) (with the damping, (1 + lambda) diag); 0 where no tap
-    // reaches, so those pixels never move.
+    // reaches, so those pixels never move. diag comes with the first residual's pass.
     std::vector<float> diag(pixels), precondition(pixels);
-    detail::diagonalPass(op, diag.data());
-    float largest = 0;
-    for (float d : diag) largest = std::max(largest, d);
-    for (std::size_t i = 0; i < pixels; ++i)
-        precondition[i] = diag[i] > 1e-6f * largest ? 1.0f / ((1.0f + hold[i]) * diag[i]) : 0.0f;
-    passDone();
+    const auto findPreconditioner = [&] {
+        op.sumBuffers(diag.data(), 1, &detail::Band::squares);
+        float largest = 0;
+        for (float d : diag) largest = std::max(largest, d);
+        for (std::size_t i = 0; i < pixels; ++i)
+            precondition[i] = diag[i] > 1e-6f * largest ? 1.0f / ((1.0f + hold[i]) * diag[i]) : 0.0f;
+    };
 
     const std::vector<float> x0 = damped ? x : std::vector<float>{};
     std::vector<float> z(values), p(values);
@@ -500,10 +496,14 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
             }
         return penalty;
     };
-    const auto residual = [&](bool adjoint) {
+    const auto residual = [&](bool adjoint, bool diagonal) {
         if (adjoint) op.clearBuffers(channels);
-        detail::dispatchChannels(channels, [&]<int kC>() { detail::residualPass<kC>(op, x.data(), s, channels, adjoint); });
+        if (diagonal) op.clearBuffers(1, &detail::Band::squares);
+        detail::dispatchChannels(channels, [&]<int kC>() {
+            detail::residualPass<kC>(op, x.data(), s, channels, adjoint, diagonal);
+        });
         const double data = op.bandSum();
+        if (diagonal) findPreconditioner();
         if (adjoint) op.sumBuffers(z.data(), channels);
         if (damped && adjoint)
             for (std::size_t i = 0; i < values; ++i) z[i] -= hold[i / channels] * diag[i / channels] * (x[i] - x0[i]);
@@ -513,7 +513,7 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         for (std::size_t i = 0; i < values; ++i) out[i] = precondition[i / channels] * z[i];
     };
 
-    residual(options.iterations > 0);
+    residual(options.iterations > 0, options.iterations > 0);
     applyPreconditioner(p);
     double gamma = detail::dot(z, p);
     std::vector<float> zp(values);
@@ -540,7 +540,7 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
             record(std::max(0.0, lastData - 2.0 * alpha * pDtr + double(alpha) * alpha * dataDelta), penaltyOf());
             break;
         }
-        residual(true);
+        residual(true, false);
         applyPreconditioner(zp);
         const double next = detail::dot(z, zp);
         const float beta = static_cast<float>(next / gamma);
