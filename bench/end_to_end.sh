@@ -81,3 +81,34 @@ awk '
         printf "\nthreads, end to end (wall, 1 core / 2 cores): conus encode %.2fx, oiiotool resize %.2fx\n",
                wall["conus-encode-1core"] / wall["conus-encode"], wall["oiiotool-resize-1core"] / wall["oiiotool-resize"]
     }' "$results"
+
+# The encode's stages (its own stage lines, "conus encode: <stage> done (0.21 s)"), each the median
+# over $runs runs, against the oiiotool resize's wall time measured above and against the encode
+# kernel's ("encode ..." stage): where the time goes, as ratios read off one run.
+stages() {
+    local name=$1
+    shift
+    local i
+    for ((i = 0; i < runs; ++i)); do
+        "$conus" encode "$big" -o "$work/staged.exr" --size 1024x1024 --focus 0.5,0.4,0.1,3 "$@" 2>&1 >/dev/null |
+            tr '\r' '\n' | sed -n 's/^conus encode: \(.*\) done (\([0-9.]*\) s).*/\1\t\2/p' |
+            awk -F'\t' -v run="$i" '{ split($1, w, " "); printf "%s\t%s\t%s\n", run, w[1] (w[2] == "to" ? " to" : ""), $2 }'
+    done | awk -F'\t' -v name="$name" -v resize="$(awk '$1 == "oiiotool-resize" { print $2 }' "$results")" '
+        { key = $2; if (!(key in n)) order[++stages] = key; v[key, ++n[key]] = $3 }
+        function median(k, m,   i, j, t, a) {
+            for (i = 1; i <= m; ++i) a[i] = v[k, i]
+            for (i = 1; i <= m; ++i) for (j = i + 1; j <= m; ++j) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
+            return m % 2 ? a[(m + 1) / 2] : (a[m / 2] + a[m / 2 + 1]) / 2
+        }
+        END {
+            for (s = 1; s <= stages; ++s) { k = order[s]; med[k] = median(k, n[k]); if (k == "encode") kernel = med[k] }
+            printf "\n%s: stage, median wall s, vs oiiotool resize wall, vs the encode kernel\n", name
+            for (s = 1; s <= stages; ++s) {
+                k = order[s]
+                vs = kernel > 0 ? sprintf("%6.2fx", med[k] / kernel) : "-"
+                printf "| %-10s | %7.3f | %6.2fx | %s |\n", k, med[k], med[k] / resize, vs
+            }
+        }'
+}
+stages "conus encode (defaults)"
+stages "conus encode --fast" --fast

@@ -226,6 +226,7 @@ Command addEncodeCommand(CLI::App& root) {
     command->add_flag("--fast", options->fast, "the filtered encode alone, not fitted to the decoder: faster, softer")
         ->excludes("--fit")
         ->excludes("--fit-iterations")
+        ->excludes("--fit-method")
         ->excludes("--fit-hold");
     addSourceOptions(*command, options->source);
     addStorageOptions(*command, options->storage);

@@ -52,14 +52,28 @@ void checkConusOutput(const std::string& output, const std::string& input) {
 }
 
 void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault) {
+    command.add_option("--filter", fit.filter,
+                       "how each CoNUS pixel is filtered from the source: anisotropic (a few taps along the footprint's "
+                       "long axis on the pyramid level of its short one, as GPUs do: the fast default) or ewa (every tap "
+                       "over the footprint, as the GL encoder does)")
+        ->check(CLI::IsMember(enumNames<codec::EncodeFilter>(), CLI::ignore_case))
+        ->capture_default_str();
     CLI::Option* enabled = command.add_flag(
         "--fit", fit.enabled,
         std::string(byDefault ? "(the default) " : "") +
-            "fit the CoNUS image to the decoder: least squares (CGLS) from the filtered encode, so that the decoded "
-            "view at the source's size comes closest to the source (the decoder's bilinear and multi-tap paths; "
+            "fit the CoNUS image to the decoder (--fit-method), from the filtered encode, so that the decoded "
+            "view at the source's size comes closer to the source (the decoder's bilinear and multi-tap paths; "
             "zoomed-out views through the pyramid and the viewer reconstruct a little differently; colour and alpha "
             "are fitted, unclamped)");
     const std::string with = byDefault ? "" : "with --fit: ";
+    CLI::Option* method =
+        command
+            .add_option("--fit-method", fit.method,
+                        with + "local (one pass over the CoNUS image: the encode-then-decode kernel inverted, "
+                               "held where the encoder low-passed) or least-squares (CGLS through the decoder at the "
+                               "source's size, --fit-iterations passes)")
+            ->check(CLI::IsMember(enumNames<codec::FitMethod>(), CLI::ignore_case))
+            ->capture_default_str();
     CLI::Option* iterations = command.add_option("--fit-iterations", fit.iterations, with + "how many least-squares iterations")
                                   ->capture_default_str()
                                   ->type_name("N")
@@ -72,6 +86,7 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault) {
                                "with more aliasing (default " + std::to_string(codec::kFitHoldLowPass).substr(0, 3) + ")")
             ->check(finiteRange(0.0, 1000.0, true, true));
     if (!byDefault) {
+        method->needs(enabled);
         iterations->needs(enabled);
         hold->needs(enabled);
     }
@@ -82,11 +97,16 @@ format::ConusFile encodeToConus(const renderers::Device& device, const Image& so
                                 const FitSetting& fit, std::string* fitNote, const std::string& what) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                       std::to_string(size.width) + "x" + std::to_string(size.height) + (what.empty() ? "" : ": " + what));
-    Image image = renderers::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback()});
+    Image image =
+        renderers::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback(),
+                                                   parseEnum<codec::EncodeFilter>(fit.filter)});
     progress.done();
     if (fit.count() > 0) {
-        Progress fitting("fit to the decoder (" + std::to_string(fit.count()) + " iterations)");
         codec::FitOptions options;
+        options.method = parseEnum<codec::FitMethod>(fit.method);
+        const bool local = options.method == codec::FitMethod::Local;
+        Progress fitting(local ? std::string("fit to the decoder (local)")
+                               : "fit to the decoder (" + std::to_string(fit.count()) + " iterations)");
         options.iterations = fit.count();
         options.holdLowPass = fit.hold;
         options.progress = fitting.callback();

@@ -7,6 +7,7 @@
 
 #include "arguments.h"
 #include "backend.h"
+#include "conus/codec/image/encode.h"
 #include "conus/codec/image/fit.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
@@ -29,11 +30,13 @@ void addStorageOptions(CLI::App& command, StorageOptions& options);
 // Resolves the CoNUS image size (checking it against the source) and the storage settings.
 Size conusSize(const StorageOptions& options, const Image& source);
 
-// Adds --fit, --fit-iterations N and --fit-hold H (encode and uniform alike, so that comparisons
+// Adds --filter, --fit, --fit-iterations N and --fit-hold H (encode and uniform alike, so that comparisons
 // can be like for like). --fit is a plain flag (an optional count after it would take the input's name when
 // written first); --fit-iterations and --fit-hold need it.
 struct FitSetting {
+    std::string filter = enumName(codec::EncodeFilter::Anisotropic);  // --filter: the encode before any fit
     bool enabled = false;
+    std::string method = enumName(codec::FitMethod::LeastSquares);  // --fit-method
     int iterations = codec::kFitIterations;
     double hold = codec::kFitHoldLowPass;
     int count() const { return enabled ? iterations : 0; }  // iterations to run; 0: the filtered encode alone
@@ -43,6 +46,7 @@ struct FitSetting {
 inline FitSetting defaultFit() {
     FitSetting fit;
     fit.enabled = true;
+    fit.method = enumName(codec::kDefaultEncodeFitMethod);
     fit.iterations = codec::kDefaultEncodeFitIterations;
     return fit;
 }

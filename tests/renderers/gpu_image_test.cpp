@@ -27,10 +27,12 @@ using test::contextFor;
 constexpr double kEncodePsnr = 45.0;
 constexpr double kDecodePsnr = 50.0;
 
+// The GL encoder is the EWA filter's twin: the CPU reference it is compared with is that filter.
 codec::EncodeOptions encodeSize(int w, int h) {
     codec::EncodeOptions o;
     o.width = w;
     o.height = h;
+    o.filter = codec::EncodeFilter::Ewa;
     return o;
 }
 

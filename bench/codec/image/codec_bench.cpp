@@ -1,5 +1,8 @@
 // CPU encode and decode against their uniform baselines, read off one run:
-//   BM_EncodeConus / BM_EncodeBaselineAreaDownsample: 4096^2 RGB -> 1024^2 (2-focus map vs plain area average)
+//   BM_EncodeConus / BM_EncodeBaselineAreaDownsample: 4096^2 RGB -> 1024^2 (2-focus map vs plain area average);
+//   BM_EncodeConusEwa: the same encode through the EWA filter (EncodeFilter::Ewa), the GL encoder's twin;
+//   BM_FitLocal / BM_FitLeastSquares: the fit to the decoder of that encode (fit.h's two methods,
+//   the least squares with the encode's default iterations), each on a copy of the encoded image.
 //   BM_DecodeConusView / BM_DecodeBaselineBilinear: a 1920x1080 view of a 2048^2 image (CoNUS
 //   through the map vs a uniform image), for the whole frame and for a zoom on the first focus.
 //   BM_DecodeConusPyramid: the same views through the CoNUS image's mip chain (one trilinear tap
@@ -10,6 +13,7 @@
 
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
+#include "conus/codec/image/fit.h"
 #include "decode_views.h"
 
 namespace {
@@ -32,6 +36,37 @@ void BM_EncodeConus(benchmark::State& state) {
     }
     state.SetItemsProcessed(state.iterations() * 1024 * 1024);
 }
+
+void BM_EncodeConusEwa(benchmark::State& state) {
+    const Image& src = source4096();
+    const SamplingMap& map = fociMap();
+    EncodeOptions options{1024, 1024, 0, {}};
+    options.filter = EncodeFilter::Ewa;
+    for (auto _ : state) {
+        Image out = encodeImage(src, map, options);
+        benchmark::DoNotOptimize(out.pixels.data());
+    }
+    state.SetItemsProcessed(state.iterations() * 1024 * 1024);
+}
+
+void fitEncoded(benchmark::State& state, FitMethod method) {
+    const Image& src = source4096();
+    const SamplingMap& map = fociMap();
+    static const Image encoded = encodeImage(src, map, {1024, 1024, 0, {}});
+    FitOptions options;
+    options.method = method;
+    options.iterations = kDefaultEncodeFitIterations;
+    for (auto _ : state) {
+        state.PauseTiming();
+        Image image = encoded;
+        state.ResumeTiming();
+        fitToDecoder(src, map, image, options);
+        benchmark::DoNotOptimize(image.pixels.data());
+    }
+}
+
+void BM_FitLocal(benchmark::State& state) { fitEncoded(state, FitMethod::Local); }
+void BM_FitLeastSquares(benchmark::State& state) { fitEncoded(state, FitMethod::LeastSquares); }
 
 void BM_EncodeBaselineAreaDownsample(benchmark::State& state) {
     const Image& src = source4096();
@@ -78,7 +113,10 @@ void BM_BuildPyramid(benchmark::State& state) {
 }
 
 BENCHMARK(BM_EncodeConus)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodeConusEwa)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EncodeBaselineAreaDownsample)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FitLocal)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FitLeastSquares)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeConusView)->ArgName("zoom")->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeBaselineBilinear)->ArgName("zoom")->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeConusPyramid)->ArgName("zoom")->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);

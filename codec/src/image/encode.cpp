@@ -1,10 +1,13 @@
 // CPU reference encoder (paper section 3.2) and the area-downsample baseline.
 //
-// Each CoNUS pixel filters the source over its footprint (encode.h states the rule): a grid of
-// bilinear taps in the pixel's own units (s,t), carried into the source through the local inverse
-// Jacobian (FootprintField), weighted by the unit box convolved with a Gaussian along the
-// footprint's major axis. A square footprint has no Gaussian: with the identity map and an integer
-// ratio the taps land exactly on source pixel centres, so the result is the exact area average.
+// Each CoNUS pixel filters the source over its footprint (encode.h states the rule), by one of two
+// kernels (EncodeFilter). The EWA filter: a grid of bilinear taps in the pixel's own units (s,t),
+// carried into the source through the local inverse Jacobian (FootprintField), weighted by the unit
+// box convolved with a Gaussian along the footprint's major axis; a square footprint has no
+// Gaussian, and with the identity map and an integer ratio the taps land exactly on source pixel
+// centres, so the result is the exact area average. The anisotropic kernel: the same footprint's
+// principal axes, the minor one filtered by the pyramid level it picks, a row of taps along the
+// major one; exact at power-of-two ratios.
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -399,10 +402,104 @@ void filterOnLevel(Pyramid& pyramid, int level, int threads, int channels, const
     for (int c = 0; c < channels; ++c) out[c] *= norm;
 }
 
+// The anisotropic kernel's footprint (encode.h, EncodeFilter::Anisotropic): one CoNUS pixel along
+// the major and the minor singular directions, carried into level-0 source pixels.
+struct PrincipalAxes {
+    glm::dvec2 major{0.0}, minor{0.0};
+};
+
+PrincipalAxes principalAxes(glm::dvec2 a, glm::dvec2 b, const FootprintFilter& filter) {
+    const glm::dvec2 v1 = filter.major, v2(-filter.major.y, filter.major.x);
+    return {a * v1.x + b * v1.y, a * v2.x + b * v2.y};
+}
+
+// The continuous level of the anisotropic kernel: where the minor axis is
+// kEncodeAnisotropicMinorTexels texels, or coarser where the major axis's extent would need more
+// than kEncodeAnisotropicMaxTaps taps; 0 at least.
+double anisotropicLevel(const PrincipalAxes& axes, const FootprintFilter& filter) {
+    const double tol = kTapTolerance;
+    const double extent = 1.0 + 2.0 * filter.reach;
+    const double coarsest = std::max({glm::length(axes.minor) / (kEncodeAnisotropicMinorTexels + tol),
+                                      glm::length(axes.major) * extent / (kEncodeAnisotropicMaxTaps + tol), 1.0});
+    return std::log2(coarsest);
+}
+
+// The anisotropic kernel on one level, normalized, written to out: nw rows of taps across the
+// minor axis (slice centres of the unit box), each of nu taps along the major axis (slice centres
+// of the box widened by the Gaussian's reach), taps at most a texel apart. A tap's weight is the
+// truncated Gaussian's mass over the offsets that keep it in the unit box, as in the EWA filter.
+template <int kC>
+void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, const Image& src, glm::dvec2 p,
+                        const PrincipalAxes& axes, const FootprintFilter& filter, float* out) {
+    const Plane img = pyramid.level(level, threads);
+    const glm::dvec2 scale(double(img.width) / src.width, double(img.height) / src.height);
+    const glm::dvec2 major = axes.major * scale, minor = axes.minor * scale;
+    const double extent = 1.0 + 2.0 * filter.reach;
+    const int nu = std::clamp(static_cast<int>(std::ceil(glm::length(major) * extent - kTapTolerance)), 1, RowTaps::kMax);
+    const int nw = std::clamp(static_cast<int>(std::ceil(glm::length(minor) - kTapTolerance)), 1, RowTaps::kMax);
+    const double du = extent / nu, dw = 1.0 / nw;
+    const double u0 = 0.5 * du - 0.5 * extent, w0 = 0.5 * dw - 0.5;
+    constexpr double kMinSigma = 1e-4;  // below it the filter is the plain box (encode.h)
+    double weight[RowTaps::kMax];
+    if (filter.sigma < kMinSigma) {
+        for (int i = 0; i < nu; ++i) weight[i] = 1.0;
+    } else {
+        const double k = 1.0 / (std::sqrt(2.0) * filter.sigma), reach = filter.reach;
+        for (int i = 0; i < nu; ++i) {
+            const double u = u0 + i * du;
+            const double lo = u - 0.5 > -reach ? u - 0.5 : -reach, hi = u + 0.5 < reach ? u + 0.5 : reach;
+            weight[i] = hi > lo ? detail::erfOnReach(hi * k) - detail::erfOnReach(lo * k) : 0.0;
+        }
+    }
+    const double cx = p.x * img.width - 0.5, cy = p.y * img.height - 0.5;
+    // Away from the borders no tap needs clamping: decide once for the whole footprint.
+    const double ex = 0.5 * (std::abs(major.x) * extent + std::abs(minor.x));
+    const double ey = 0.5 * (std::abs(major.y) * extent + std::abs(minor.y));
+    const bool inner = cx - ex >= 0 && cx + ex < img.width - 1 && cy - ey >= 0 && cy + ey < img.height - 1;
+    const std::size_t stride = static_cast<std::size_t>(img.width) * channels;
+    RowTaps r;
+    double total = 0;
+    const auto row = [&](int j) {
+        const double w = w0 + j * dw;
+        const double rx = cx + minor.x * w + major.x * u0, ry = cy + minor.y * w + major.y * u0;
+        r.count = nu;
+        for (int i = 0; i < nu; ++i) {
+            r.x[i] = rx + major.x * (i * du);
+            r.y[i] = ry + major.y * (i * du);
+            r.weight[i] = weight[i];
+        }
+    };
+    if constexpr (kC > 0 && kC <= 4) {
+        // (The four-float reads of accumulateRow: see filterOnLevel.)
+        if (inner && cy + ey < img.height - 2 && (kC >= 2 || img.width >= 3)) {
+            Float4 acc{0.0f, 0.0f, 0.0f, 0.0f};
+            for (int j = 0; j < nw; ++j) {
+                row(j);
+                accumulateRow<kC>(img.data, stride, r, acc, total);
+            }
+            const float norm = total > 0 ? static_cast<float>(1.0 / total) : 0.0f;
+            for (int c = 0; c < kC; ++c) out[c] = acc[c] * norm;
+            return;
+        }
+    }
+    for (int c = 0; c < channels; ++c) out[c] = 0.0f;
+    for (int j = 0; j < nw; ++j) {
+        row(j);
+        for (int n = 0; n < r.count; ++n) {
+            if (r.weight[n] <= 0) continue;
+            const float w = static_cast<float>(r.weight[n]);
+            total += r.weight[n];
+            if (inner) detail::addBilinearInterior<kC>(img.data, stride, channels, r.x[n], r.y[n], w, out);
+            else detail::addBilinear<kC>(img.data, img.width, img.height, channels, r.x[n], r.y[n], w, out);
+        }
+    }
+    const float norm = total > 0 ? static_cast<float>(1.0 / total) : 0.0f;
+    for (int c = 0; c < channels; ++c) out[c] *= norm;
+}
+
 template <int kC>
 void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& field, Pyramid& pyramid, Image& dst,
-                int threads,
-                int y0, int y1) {
+                int threads, bool anisotropic, int y0, int y1) {
     const int channels = kC > 0 ? kC : src.channelCount();
     const int W = dst.width, H = dst.height;
     const double uniform = uniformSpacing(src.width, src.height, W, H);
@@ -419,15 +516,20 @@ void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& 
         double minor = 0;
         const FootprintFilter filter = footprintFilter(a, b, uniform, minor);
         const glm::dvec2 extent = filterExtent(filter);
-        const double lambda = footprintLevel(a, b, minor, extent);
+        const PrincipalAxes axes = principalAxes(a, b, filter);
+        const double lambda = anisotropic ? anisotropicLevel(axes, filter) : footprintLevel(a, b, minor, extent);
         const int top = pyramid.levels() - 1;
         const int level = std::min(static_cast<int>(lambda), top);
         const double blend = level < top ? lambda - level : 0.0;
-        filterOnLevel<kC>(pyramid, level, threads, channels, src, p, a, b, filter, extent, out);
+        const auto onLevel = [&](int l, float* to) {
+            if (anisotropic) anisotropicOnLevel<kC>(pyramid, l, threads, channels, src, p, axes, filter, to);
+            else filterOnLevel<kC>(pyramid, l, threads, channels, src, p, a, b, filter, extent, to);
+        };
+        onLevel(level, out);
         if (blend > 0) {
             float fixedUpper[kC > 0 ? kC : 1];
             float* upper = kC > 0 ? fixedUpper : dynamicUpper.data();
-            filterOnLevel<kC>(pyramid, level + 1, threads, channels, src, p, a, b, filter, extent, upper);
+            onLevel(level + 1, upper);
             const float f = static_cast<float>(blend);
             for (int c = 0; c < channels; ++c) out[c] += f * (upper[c] - out[c]);
         }
@@ -440,6 +542,18 @@ void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& 
         for (int tx = 0; tx < W; tx += kTileColumns)
             for (int y = ty; y < std::min(y1, ty + kTileRows); ++y)
                 for (int x = tx; x < std::min(W, tx + kTileColumns); ++x) pixel(x, y);
+}
+
+// Whether every node of the map sits where the identity puts it (to float rounding).
+bool isUniform(const SamplingMap& map) {
+    for (int j = 0; j < map.rows(); ++j)
+        for (int i = 0; i < map.columns(); ++i) {
+            const glm::vec2 n = map.node(i, j);
+            if (std::abs(n.x - float(i) / float(map.columns() - 1)) > 1e-6f ||
+                std::abs(n.y - float(j) / float(map.rows() - 1)) > 1e-6f)
+                return false;
+        }
+    return true;
 }
 
 }  // namespace
@@ -498,10 +612,11 @@ Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptio
     Image out = detail::makeOutput(source, options.width, options.height);
     Pyramid pyramid(source);
     const FootprintField field(map);
+    const bool anisotropic = options.filter == EncodeFilter::Anisotropic && !isUniform(map);  // encode.h says why
     detail::RowProgress progress(options.progress, out.height);
     parallelRows(out.height, options.threads, [&](int y0, int y1) {
         detail::dispatchChannels(source.channelCount(), [&]<int kC>() {
-            encodeRows<kC>(source, map, field, pyramid, out, options.threads, y0, y1);
+            encodeRows<kC>(source, map, field, pyramid, out, options.threads, anisotropic, y0, y1);
         });
         progress.add(y1 - y0);
     });

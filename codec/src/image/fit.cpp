@@ -5,7 +5,8 @@
 // its taps reach (found once, up front), and the buffers are summed row by row afterwards: no
 // locks, no per-source-pixel storage, and the same sums whatever the thread count. The residual
 // s - D x is recomputed from x in every pass instead of being stored (a 4096^2 source would need
-// 192 MiB per vector), which also keeps it from drifting.
+// 192 MiB per vector), which also keeps it from drifting; after the last step only its norm is
+// wanted (the PSNR reported), and that follows from the step's own sums without a pass.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -34,6 +35,7 @@ struct Band {
     int y0 = 0, y1 = 0;   // output rows [y0, y1)
     int lo = 0, hi = -1;  // CoNUS rows its taps reach
     std::vector<float> buffer;
+    std::vector<float> squares;  // the taps' squared corner weights (diag(D^T D)), one value a CoNUS pixel
     double sum = 0;       // the pass's sum over the band (sums of squares)
 };
 
@@ -59,15 +61,15 @@ public:
             1);
     }
 
-    // Zeroes every band's buffer for a splat of `channels` values per pixel.
-    void clearBuffers(int channels) {
+    // Zeroes every band's buffer (`which` of them) for a splat of `channels` values per pixel.
+    void clearBuffers(int channels, std::vector<float> Band::*which = &Band::buffer) {
         forEachBand([&](Band& band, DecoderTaps::Scratch&) {
-            band.buffer.assign(static_cast<std::size_t>(band.hi - band.lo + 1) * m_taps.conusWidth() * channels, 0.0f);
+            (band.*which).assign(static_cast<std::size_t>(band.hi - band.lo + 1) * m_taps.conusWidth() * channels, 0.0f);
         });
     }
 
-    // out (CoNUS size, `channels` values a pixel) = the sum of the bands' buffers.
-    void sumBuffers(float* out, int channels) {
+    // out (CoNUS size, `channels` values a pixel) = the sum of the bands' buffers (`which` of them).
+    void sumBuffers(float* out, int channels, std::vector<float> Band::*which = &Band::buffer) {
         const int wc = m_taps.conusWidth();
         const std::size_t rowValues = static_cast<std::size_t>(wc) * channels;
         parallelRows(m_taps.conusHeight(), m_threads, [&](int r0, int r1) {
@@ -75,7 +77,7 @@ public:
             for (const Band& band : m_bands) {
                 const int a = std::max(r0, band.lo), b = std::min(r1 - 1, band.hi);
                 for (int r = a; r <= b; ++r) {
-                    const float* from = band.buffer.data() + (r - band.lo) * rowValues;
+                    const float* from = (band.*which).data() + (r - band.lo) * rowValues;
                     float* to = out + r * rowValues;
                     for (std::size_t k = 0; k < rowValues; ++k) to[k] += from[k];
                 }
@@ -167,6 +169,19 @@ inline void splat(float* buffer, int lo, int width, int height, int c, const Dec
     }
 }
 
+// Adds the taps' squared corner weights into a band's `squares` (rows from `lo`): diag(D^T D)
+// approximated per CoNUS pixel (exact where no two taps of one output pixel share a CoNUS pixel,
+// i.e. wherever the view magnifies).
+inline void splatSquares(float* squares, int lo, int width, int height, const DecoderTap* taps, int count) {
+    for (int k = 0; k < count; ++k) {
+        const TapCorners q = tapCorners(taps[k], width, height);
+        squares[(q.y0 - lo) * width + q.x0] += q.w00 * q.w00;
+        squares[(q.y0 - lo) * width + q.x1] += q.w01 * q.w01;
+        squares[(q.y1 - lo) * width + q.x0] += q.w10 * q.w10;
+        squares[(q.y1 - lo) * width + q.x1] += q.w11 * q.w11;
+    }
+}
+
 // view = D image (view: width x height, the operator's channels).
 template <int kC>
 void forwardPass(DecoderOperator& op, const float* image, int c, float* view) {
@@ -200,9 +215,11 @@ void normPass(DecoderOperator& op, const float* image, int c) {
 }
 
 // r = source - D image per pixel; each band's sum of |r|^2, and (when `adjoint`) r splatted into
-// the band buffers (D^T r once summed). With a null image, r = source.
+// the band buffers (D^T r once summed), and (when `diagonal`) the squared weights into `squares`
+// (diag(D^T D) once summed): the same walk of the taps. With a null image, r = source.
 template <int kC>
-void residualPass(DecoderOperator& op, const float* image, const float* source, int c, bool adjoint) {
+void residualPass(DecoderOperator& op, const float* image, const float* source, int c, bool adjoint,
+                  bool diagonal = false) {
     const DecoderTaps& taps = op.taps();
     const int channels = kC > 0 ? kC : c;
     op.forEachBand([&](Band& band, DecoderTaps::Scratch& scratch) {
@@ -220,32 +237,11 @@ void residualPass(DecoderOperator& op, const float* image, const float* source, 
                 if (adjoint)
                     splat<kC>(band.buffer.data(), band.lo, taps.conusWidth(), taps.conusHeight(), channels, t, count,
                               value.data());
+                if (diagonal) splatSquares(band.squares.data(), band.lo, taps.conusWidth(), taps.conusHeight(), t, count);
             });
         }
         band.sum = sum;
     });
-}
-
-// diag(D^T D) approximated per CoNUS pixel by the sum of its squared corner weights (exact where
-// no two taps of one output pixel share a CoNUS pixel, i.e. wherever the view magnifies).
-void diagonalPass(DecoderOperator& op, float* diag) {
-    const DecoderTaps& taps = op.taps();
-    op.clearBuffers(1);
-    op.forEachBand([&](Band& band, DecoderTaps::Scratch& scratch) {
-        const int wc = taps.conusWidth();
-        for (int y = band.y0; y < band.y1; ++y)
-            taps.row(y, scratch, [&](int, const DecoderTap* t, int count) {
-                for (int k = 0; k < count; ++k) {
-                    const TapCorners q = tapCorners(t[k], wc, taps.conusHeight());
-                    float* b = band.buffer.data();
-                    b[(q.y0 - band.lo) * wc + q.x0] += q.w00 * q.w00;
-                    b[(q.y0 - band.lo) * wc + q.x1] += q.w01 * q.w01;
-                    b[(q.y1 - band.lo) * wc + q.x0] += q.w10 * q.w10;
-                    b[(q.y1 - band.lo) * wc + q.x1] += q.w11 * q.w11;
-                }
-            });
-    });
-    op.sumBuffers(diag, 1);
 }
 
 double dot(const std::vector<float>& a, const std::vector<float>& b) {
@@ -289,6 +285,88 @@ std::vector<float> lowPassShare(const SamplingMap& map, int sourceWidth, int sou
     return share;
 }
 
+// Per CoNUS pixel, how much of the Local fit's correction it takes: 1 / (1 + damping + hold *
+// low-pass share), times min(1, short axis in source pixels)^2 (fit.h).
+std::vector<float> localWeights(const SamplingMap& map, int sourceWidth, int sourceHeight, int width, int height,
+                                const FitOptions& options) {
+    std::vector<float> weight(static_cast<std::size_t>(width) * height);
+    const FootprintField field(map);
+    const double uniform = uniformSpacing(sourceWidth, sourceHeight, width, height);
+    const glm::dvec2 scale(sourceWidth, sourceHeight);
+    parallelRows(height, options.threads, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < width; ++x) {
+                const glm::dmat2 inverse = field.inverseJacobian(map.undistort({(x + 0.5) / width, (y + 0.5) / height}));
+                const glm::dvec2 a = inverse[0] / double(width) * scale, b = inverse[1] / double(height) * scale;
+                const FootprintPlan plan = planFootprint(a, b, uniform);
+                const double share = std::clamp(std::max(plan.extent.x, plan.extent.y) - 1.0, 0.0, 1.0);
+                // The short axis: |det| / long axis, from the singular values of [a b].
+                const double p = glm::dot(a, a), q = glm::dot(a, b), r = glm::dot(b, b);
+                const double mean = 0.5 * (p + r), half = std::sqrt(0.25 * (p - r) * (p - r) + q * q);
+                const double minor = std::sqrt(std::max(0.0, mean - half));
+                const double fade = std::min(1.0, minor * minor);
+                weight[static_cast<std::size_t>(y) * width + x] =
+                    static_cast<float>(fade / (1.0 + options.damping + options.holdLowPass * share));
+            }
+    });
+    return weight;
+}
+
+// The Local fit's inverse kernel along one axis: K = [q, 1 - 2q, q] has the inverse
+// h[n] = p^|n| / sqrt(1 - 4q) with p = (sqrt(1 - 4q) - (1 - 2q)) / (2q), the root of
+// q z^2 + (1 - 2q) z + q inside the unit circle; cut where |h| < 1e-3 and scaled to sum to 1.
+std::vector<float> localInverse(double q) {
+    const double root = std::sqrt(1.0 - 4.0 * q);
+    const double pole = (root - (1.0 - 2.0 * q)) / (2.0 * q);
+    std::vector<float> h;
+    std::vector<double> taps;
+    for (double v = 1.0 / root; std::abs(v) >= 1e-3 && taps.size() < 16; v *= pole) taps.push_back(v);
+    // The cut series, scaled so that a constant stays that constant.
+    double sum = taps[0];
+    for (std::size_t n = 1; n < taps.size(); ++n) sum += 2.0 * taps[n];
+    for (const double v : taps) h.push_back(static_cast<float>(v / sum));
+    return h;
+}
+
+// x (width x height, `channels` values a pixel) convolved with the symmetric kernel h along rows
+// (step = channels) or columns (step = a row), clamped at the edges, into out.
+void convolveAxis(const float* x, float* out, int width, int height, int channels, const std::vector<float>& h,
+                  bool alongRows, int threads) {
+    const int radius = static_cast<int>(h.size()) - 1;
+    parallelRows(height, threads, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int xi = 0; xi < width; ++xi) {
+                float* o = out + (static_cast<std::size_t>(y) * width + xi) * channels;
+                const auto at = [&](int dx, int dy) {
+                    const int cx = std::clamp(xi + dx, 0, width - 1), cy = std::clamp(y + dy, 0, height - 1);
+                    return x + (static_cast<std::size_t>(cy) * width + cx) * channels;
+                };
+                for (int c = 0; c < channels; ++c) o[c] = h[0] * at(0, 0)[c];
+                for (int n = 1; n <= radius; ++n) {
+                    const float* lo = alongRows ? at(-n, 0) : at(0, -n);
+                    const float* hi = alongRows ? at(n, 0) : at(0, n);
+                    for (int c = 0; c < channels; ++c) o[c] += h[n] * (lo[c] + hi[c]);
+                }
+            }
+    });
+}
+
+// The Local fit (fit.h) on the packed fitted channels x of a width x height CoNUS image.
+void localFit(std::vector<float>& x, int width, int height, int channels, const std::vector<float>& weight,
+              double side, int threads) {
+    const std::vector<float> h = localInverse(side);
+    std::vector<float> across(x.size()), both(x.size());
+    convolveAxis(x.data(), across.data(), width, height, channels, h, true, threads);
+    convolveAxis(across.data(), both.data(), width, height, channels, h, false, threads);
+    parallelRows(height, threads, [&](int y0, int y1) {
+        for (std::size_t i = std::size_t(y0) * width; i < std::size_t(y1) * width; ++i)
+            for (int c = 0; c < channels; ++c) {
+                const std::size_t k = i * channels + c;
+                x[k] += weight[i] * (both[k] - x[k]);
+            }
+    });
+}
+
 }  // namespace
 
 Image fitForward(const Image& conus, const SamplingMap& map, int width, int height, int threads) {
@@ -328,6 +406,9 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         if (!(d >= 0.0) || !std::isfinite(d))
             throw Error(ErrorCode::InvalidArgument, "fitToDecoder: damping " + std::to_string(d) +
                                                         " must be finite and at least 0");
+    if (!(options.localSide > 0.0 && options.localSide < 0.25))
+        throw Error(ErrorCode::InvalidArgument,
+                    "fitToDecoder: the local fit's side weight " + std::to_string(options.localSide) + " must be in (0, 0.25)");
 
     std::vector<int> fitted;
     for (int c = 0; c < conus.channelCount(); ++c)
@@ -338,6 +419,30 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
     const bool all = channels == conus.channelCount();
     // Work on packed copies of the fitted channels unless they are all of them.
     std::vector<float> x = all ? conus.pixels : detail::pack(conus, fitted);
+    const auto finish = [&] {
+        result.minimum = x.empty() ? 0.0f : x[0];
+        result.maximum = result.minimum;
+        for (float v : x) {
+            result.negatives += v < 0.0f;
+            result.minimum = std::min(result.minimum, v);
+            result.maximum = std::max(result.maximum, v);
+        }
+        if (all) {
+            conus.pixels = std::move(x);
+        } else {
+            const std::size_t c = conus.channels.size();
+            for (std::size_t px = 0; px < std::size_t(conus.width) * conus.height; ++px)
+                for (int k = 0; k < channels; ++k) conus.pixels[px * c + fitted[k]] = x[px * channels + k];
+        }
+        if (options.progress) options.progress(1.0);
+        return result;
+    };
+    if (options.method == FitMethod::Local) {
+        const std::vector<float> weight =
+            detail::localWeights(map, source.width, source.height, conus.width, conus.height, options);
+        detail::localFit(x, conus.width, conus.height, channels, weight, options.localSide, options.threads);
+        return finish();
+    }
     std::vector<float> packedSource;
     if (!all) packedSource = detail::pack(source, fitted);
     const float* s = all ? source.pixels.data() : packedSource.data();
@@ -354,63 +459,88 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         for (std::size_t i = 0; i < pixels; ++i) hold[i] += static_cast<float>(options.holdLowPass) * share[i];
     }
     const bool damped = std::any_of(hold.begin(), hold.end(), [](float h) { return h > 0; });
-    const int passes = 2 + 2 * options.iterations;
+    const int passes = 1 + 2 * options.iterations;  // a residual (with the diagonal), per iteration a norm and a residual
     int passesDone = 0;
     const auto passDone = [&] {
         if (options.progress) options.progress(double(++passesDone) / passes);
     };
 
     // Jacobi preconditioner: 1 / diag(D^T D) (with the damping, (1 + lambda) diag); 0 where no tap
-    // reaches, so those pixels never move.
+    // reaches, so those pixels never move. diag comes with the first residual's pass.
     std::vector<float> diag(pixels), precondition(pixels);
-    detail::diagonalPass(op, diag.data());
-    float largest = 0;
-    for (float d : diag) largest = std::max(largest, d);
-    for (std::size_t i = 0; i < pixels; ++i)
-        precondition[i] = diag[i] > 1e-6f * largest ? 1.0f / ((1.0f + hold[i]) * diag[i]) : 0.0f;
-    passDone();
+    const auto findPreconditioner = [&] {
+        op.sumBuffers(diag.data(), 1, &detail::Band::squares);
+        float largest = 0;
+        for (float d : diag) largest = std::max(largest, d);
+        for (std::size_t i = 0; i < pixels; ++i)
+            precondition[i] = diag[i] > 1e-6f * largest ? 1.0f / ((1.0f + hold[i]) * diag[i]) : 0.0f;
+    };
 
     const std::vector<float> x0 = damped ? x : std::vector<float>{};
     std::vector<float> z(values), p(values);
     // r = s - D x with sum |r|^2, and z = D^T r - lambda diag (x - x0) when asked; returns the objective.
-    const auto residual = [&](bool adjoint) {
-        if (adjoint) op.clearBuffers(channels);
-        detail::dispatchChannels(channels, [&]<int kC>() { detail::residualPass<kC>(op, x.data(), s, channels, adjoint); });
-        const double data = op.bandSum();
-        double penalty = 0;
-        if (adjoint) op.sumBuffers(z.data(), channels);
-        if (damped)
-            for (std::size_t i = 0; i < values; ++i) {
-                const float d = x[i] - x0[i], w = hold[i / channels] * diag[i / channels];
-                penalty += double(w) * d * d;
-                if (adjoint) z[i] -= w * d;
-            }
+    double lastData = 0;  // |s - D x|^2 for the x of the last step recorded
+    const auto record = [&](double data, double penalty) {
+        lastData = data;
         const double mse = data / samples;
         const int iteration = static_cast<int>(result.steps.size());
         result.steps.push_back({iteration, std::sqrt(mse), 10 * std::log10(1.0 / std::max(mse, 1e-30)), data + penalty});
         passDone();
     };
+    const auto penaltyOf = [&] {
+        double penalty = 0;
+        if (damped)
+            for (std::size_t i = 0; i < values; ++i) {
+                const float d = x[i] - x0[i], w = hold[i / channels] * diag[i / channels];
+                penalty += double(w) * d * d;
+            }
+        return penalty;
+    };
+    const auto residual = [&](bool adjoint, bool diagonal) {
+        if (adjoint) op.clearBuffers(channels);
+        if (diagonal) op.clearBuffers(1, &detail::Band::squares);
+        detail::dispatchChannels(channels, [&]<int kC>() {
+            detail::residualPass<kC>(op, x.data(), s, channels, adjoint, diagonal);
+        });
+        const double data = op.bandSum();
+        if (diagonal) findPreconditioner();
+        if (adjoint) op.sumBuffers(z.data(), channels);
+        if (damped && adjoint)
+            for (std::size_t i = 0; i < values; ++i) z[i] -= hold[i / channels] * diag[i / channels] * (x[i] - x0[i]);
+        record(data, penaltyOf());
+    };
     const auto applyPreconditioner = [&](std::vector<float>& out) {
         for (std::size_t i = 0; i < values; ++i) out[i] = precondition[i / channels] * z[i];
     };
 
-    residual(options.iterations > 0);
+    residual(options.iterations > 0, options.iterations > 0);
     applyPreconditioner(p);
     double gamma = detail::dot(z, p);
     std::vector<float> zp(values);
     for (int it = 1; it <= options.iterations && gamma > 0; ++it) {
         detail::dispatchChannels(channels, [&]<int kC>() { detail::normPass<kC>(op, p.data(), channels); });
-        double delta = op.bandSum();
+        const double dataDelta = op.bandSum();  // |D p|^2
+        double delta = dataDelta;
         if (damped)
             for (std::size_t i = 0; i < values; ++i)
                 delta += double(hold[i / channels]) * diag[i / channels] * p[i] * p[i];
         passDone();
         if (!(delta > 0)) break;
         const float alpha = static_cast<float>(gamma / delta);
-        for (std::size_t i = 0; i < values; ++i) x[i] += alpha * p[i];
         const bool last = it == options.iterations;
-        residual(!last);
-        if (last) break;
+        // After the last step no adjoint is needed, only |s - D x|^2 to report: along the step it
+        // is |r|^2 - 2 alpha <D p, r> + alpha^2 |D p|^2, with <D p, r> = <p, D^T r> and
+        // D^T r = z + lambda diag (x - x0), all on the CoNUS image: no pass over the source.
+        double pDtr = 0;
+        if (last)
+            for (std::size_t i = 0; i < values; ++i)
+                pDtr += double(p[i]) * (z[i] + (damped ? hold[i / channels] * diag[i / channels] * (x[i] - x0[i]) : 0.0f));
+        for (std::size_t i = 0; i < values; ++i) x[i] += alpha * p[i];
+        if (last) {
+            record(std::max(0.0, lastData - 2.0 * alpha * pDtr + double(alpha) * alpha * dataDelta), penaltyOf());
+            break;
+        }
+        residual(true, false);
         applyPreconditioner(zp);
         const double next = detail::dot(z, zp);
         const float beta = static_cast<float>(next / gamma);
@@ -418,22 +548,7 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         gamma = next;
     }
 
-    result.minimum = x.empty() ? 0.0f : x[0];
-    result.maximum = result.minimum;
-    for (float v : x) {
-        result.negatives += v < 0.0f;
-        result.minimum = std::min(result.minimum, v);
-        result.maximum = std::max(result.maximum, v);
-    }
-    if (all) {
-        conus.pixels = std::move(x);
-    } else {
-        const std::size_t c = conus.channels.size();
-        for (std::size_t px = 0; px < pixels; ++px)
-            for (int k = 0; k < channels; ++k) conus.pixels[px * c + fitted[k]] = x[px * channels + k];
-    }
-    if (options.progress) options.progress(1.0);
-    return result;
+    return finish();
 }
 
 }  // namespace conus::codec

@@ -12,6 +12,7 @@
 #include <glm/glm.hpp>
 
 #include "conus/codec/map/sampling_map.h"
+#include "conus/core/enum_names.h"
 #include "conus/core/error.h"
 #include "conus/core/image.h"
 #include "conus/core/limits.h"
@@ -73,10 +74,33 @@ private:
     std::vector<glm::dmat2> m_nodes;
 };
 
+// How each CoNUS pixel is filtered from the source; both follow the footprint rule above (the
+// unit box in CoNUS pixels, the Gaussian along a long major axis).
+//  - Anisotropic (the default): as GPUs' anisotropic filtering does. The footprint's principal axes
+//    (the singular vectors of [a b]) set the pyramid level, where the minor axis is
+//    kEncodeAnisotropicMinorTexels texels, and a row of taps along the major axis (at most a texel
+//    apart, at most kEncodeAnisotropicMaxTaps: a longer one moves up a level) weighted by the box
+//    convolved with the Gaussian. The pyramid's box levels do the minor axis's filtering. The box's
+//    projection on the major axis is taken as a unit box (the same variance for every direction).
+//  - Ewa: the tap grid over the footprint's parallelogram in (s,t) described above, with the exact
+//    weight of each tap; the GL encoder's twin, and the reference the anisotropic kernel is tested
+//    against.
+// Under a uniform map (every node where the identity puts it) the encoder takes the EWA filter
+// whatever is asked: there it is the exact area average at integer ratios, and the uniform image
+// (`conus uniform`, the baseline every gain is measured against) stays that average.
+enum class EncodeFilter { Anisotropic, Ewa };
+constexpr auto enumNameTable(EncodeFilter) {
+    return makeEnumNameTable<EncodeFilter>("encode filter",
+                                           {{EncodeFilter::Anisotropic, "anisotropic"}, {EncodeFilter::Ewa, "ewa"}}, true);
+}
+inline constexpr double kEncodeAnisotropicMinorTexels = 2.0;
+inline constexpr int kEncodeAnisotropicMaxTaps = 32;
+
 struct EncodeOptions {
     int width = 0, height = 0;  // CoNUS image size
     int threads = 0;
     ProgressFn progress;
+    EncodeFilter filter = EncodeFilter::Anisotropic;
 };
 
 // Throws conus::Error(LimitExceeded) when encoding `source` (its size and channels) to a width x

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "conus/codec/map/sampling_map.h"
+#include "conus/core/enum_names.h"
 #include "conus/core/error.h"
 #include "conus/core/image.h"
 
@@ -43,12 +44,40 @@ inline constexpr int kDefaultEncodeFitIterations = 2;
 inline constexpr double kFitDamping = 0.0;
 inline constexpr double kFitHoldLowPass = 3.0;
 
+// How the fit is found.
+//  - LeastSquares: CGLS through the decoder's taps at the source's size, as above: each iteration
+//    walks every source pixel twice.
+//  - Local: one pass over the CoNUS image. Where the decoder magnifies (a CoNUS pixel covers a
+//    source pixel or more), re-encoding the decoded view is a fixed convolution in CoNUS pixel units,
+//    whatever the map: the encoder's unit box over the decoder's bilinear tent, [q, 1 - 2q, q] along
+//    each axis (q = 1/8 for the exact box). The fit inverts it, c = K^-1 c0 (a separable filter,
+//    q's geometric series cut where it falls below 1e-3): the CoNUS image whose decoded view
+//    re-encodes to c0, the "consistent" reconstruction of sampling theory. The correction c - c0 is
+//    scaled by 1 / (1 + hold) like the least squares' damping (holdLowPass times the low-pass share)
+//    and fades where a CoNUS pixel's short axis covers less than a source pixel (there the decoder
+//    minifies the CoNUS image and K no longer holds). No decoded view is made: FitResult::steps is empty.
+enum class FitMethod { LeastSquares, Local };
+constexpr auto enumNameTable(FitMethod) {
+    return makeEnumNameTable<FitMethod>("fit method", {{FitMethod::LeastSquares, "least-squares"}, {FitMethod::Local, "local"}},
+                                        true);
+}
+// q of the Local fit: the side weight of the encode-then-decode kernel along each axis. 1/8 is the
+// exact box's; the anisotropic encoder's pyramid levels blur a little more.
+inline constexpr double kFitLocalSide = 0.125;
+// What `encode` fits with by default: the least squares. The local fit keeps most of the fit's gain
+// inside the foci (0.2-0.6 dB below it on astronaut and the dogs) but a fifth of it over the whole
+// frame, where the context holds detail above its sampling rate and only the least squares (the
+// orthogonal projection) uses it (bench/notes/2026-12-06-encode-speed.md); it stays an option.
+inline constexpr FitMethod kDefaultEncodeFitMethod = FitMethod::LeastSquares;
+
 struct FitOptions {
     int iterations = kFitIterations;  // 0 measures only
     double damping = kFitDamping;     // >= 0, relative to each CoNUS pixel's own weight diag_j
     double holdLowPass = kFitHoldLowPass;  // >= 0, added where the encoder low-passed a long axis
     int threads = 0;
     ProgressFn progress;
+    FitMethod method = FitMethod::LeastSquares;
+    double localSide = kFitLocalSide;  // Local: q, in (0, 0.25)
 };
 
 // The decoded view's error against the source over the fitted channels after `iteration`
