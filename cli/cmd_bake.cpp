@@ -119,7 +119,7 @@ int runBakeRelief(const BakeOptions& o) {
                 o.exactK, o.grid);
             if (!quiet()) std::printf("%s\n", said.c_str());
             map = std::move(budget.map);
-            analytic = codec::toAnalytic(budget.given, fo.composition, fo.falloff);
+            analytic = codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff));
             how = plural(foci.size(), "focus", "foci") + " map (k " + fociKText(budget.given) + ")";
         } else {
             codec::AutoMapOptions ao;

@@ -15,8 +15,12 @@ namespace {
 constexpr int kShareSide = 512;
 constexpr double kShareSamplesPerRadius = 8.0;
 constexpr int kMaxShareSide = 2048;
-// Halvings of the exponent t of k^t: t to within 1/64 (k = 4: to within 2%).
-constexpr int kBisectionSteps = 6;
+// Halvings of the exponent t of k^t without a picture: t to within 1/1024 (k = 4: to 0.14%).
+constexpr int kBisectionSteps = 10;
+// With a picture: the search for t stops within kTolerance of t, or within kToleranceDb under the
+// budget, or after kSearchSteps maps built.
+constexpr double kTolerance = 1.0 / 1024, kToleranceDb = 0.01;
+constexpr int kSearchSteps = 12;
 
 bool inDisc(const Focus& f, double aspect, double u, double v) {
     const double dx = u - f.u, dy = (v - f.v) / aspect;
@@ -101,53 +105,74 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         throw Error(ErrorCode::InvalidArgument, "the frame-loss budget " + std::to_string(frameLossDb) + " dB must be finite and >= 0");
     if (!(tileLossDb >= 0))  // NaN fails; infinity: no tile budget
         throw Error(ErrorCode::InvalidArgument, "the tile-loss budget " + std::to_string(tileLossDb) + " dB must be >= 0");
-    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false, {}};
-    // A lower k leaves the context more samples: the loss falls with t. Each try builds the map and
-    // predicts what it loses (its target alone predicts too little: stretched footprints lose along
-    // their long axis).
-    double bestT = -1;
-    const auto holds = [&](double t) {
-        std::vector<Focus> tried = powered(foci, t);
+    struct Try {
+        double t;
+        std::vector<Focus> given;
+        SamplingMap map;
         FociReport report;
-        SamplingMap map = buildFociMap(tried, options, &report);
-        const FramePrediction p = model.predict(map);
-        const bool ok = p.frameLoss <= frameLossDb && p.tileLoss <= tileLossDb && p.restLoss <= restLossDb;
-        if (ok && t > bestT) {
-            bestT = t;
-            out.given = std::move(tried);
-            out.map = std::move(map);
-            out.builderNotes = std::move(report.notes);
-            out.predicted = p;
-        }
-        return ok;
+        FramePrediction predicted;
     };
-    if (exactK) {
-        out.given = out.asked;
-        FociReport report;
-        out.map = buildFociMap(out.given, options, &report);
-        out.builderNotes = std::move(report.notes);
-        out.predicted = model.predict(out.map);
-    } else {
-        const double t = largestHolding(holds);
-        if (options.context) {
-            // A context that follows the picture usually lets the foci keep more k; where it does
-            // not (a focus on a softer part of the picture than the rest, or a context that alone
-            // loses the budget), or where it crowds a few tiles (small features on a flat ground),
-            // the foci on a uniform context are kept (keepsContext).
-            FociOptions uniform = options;
-            uniform.context = nullptr;
-            FociBudget plain = fociForFrameLoss(foci, uniform, model, frameLossDb, exactK, tileLossDb, restLossDb);
-            if (bestT < 0 || !keepsContext(out.predicted, plain.predicted)) return plain;
+    const auto attempt = [&](double t, const FociOptions& o) {
+        Try x{t, powered(foci, t), SamplingMap::identity(2, 2), {}, {}};
+        x.map = buildFociMap(x.given, o, &x.report);
+        x.predicted = model.predict(x.map);
+        return x;
+    };
+    // How far a try is over the budget (dB, <= 0: within): continuous in t, as the model is.
+    const auto over = [&](const Try& x) {
+        const FramePrediction& p = x.predicted;
+        return std::max({p.frameLoss - frameLossDb, p.tileLoss - tileLossDb, std::isfinite(restLossDb) ? p.restLoss - restLossDb : -1e9});
+    };
+    // A lower k leaves the context more samples: the loss falls with t. The largest t within the
+    // budget: regula falsi (Illinois) on over(t) between t = 0 (k = 1) and 1, to kTolerance in t,
+    // each step a map built and predicted; the t chosen is a continuous function of the picture.
+    const auto search = [&](const FociOptions& o, Try* asked) {
+        Try hi = attempt(1.0, o);
+        *asked = hi;
+        if (exactK || over(hi) <= 0) return hi;
+        Try lo = attempt(0.0, o);
+        if (over(lo) > 0) return lo;  // even k = 1 loses more: the closest to the budget there is
+        double flo = over(lo), fhi = over(hi);
+        int side = 0;
+        for (int i = 0; i < kSearchSteps && hi.t - lo.t > kTolerance; ++i) {
+            double t = (lo.t * fhi - hi.t * flo) / (fhi - flo);
+            t = std::clamp(t, lo.t + 0.01 * (hi.t - lo.t), hi.t - 0.01 * (hi.t - lo.t));
+            Try mid = attempt(t, o);
+            const double f = over(mid);
+            if (std::abs(f) < kToleranceDb && f <= 0) return mid;
+            if (f <= 0) {
+                lo = std::move(mid);
+                flo = f;
+                if (side == -1) fhi *= 0.5;
+                side = -1;
+            } else {
+                hi = std::move(mid);
+                fhi = f;
+                if (side == 1) flo *= 0.5;
+                side = 1;
+            }
         }
-        if (bestT < 0) {  // even the lowest t tried loses more: the identity (k = 1) holds any budget
-            out.given = powered(foci, t);
-            FociReport report;
-            out.map = buildFociMap(out.given, options, &report);
-            out.builderNotes = std::move(report.notes);
-            out.predicted = model.predict(out.map);
-        }
-        out.lowered = t < 1.0;
+        return lo;
+    };
+    Try asked{1.0, {}, SamplingMap::identity(2, 2), {}, {}};
+    Try chosen = search(options, &asked);
+    if (!exactK && options.context) {
+        // A context that follows the picture usually lets the foci keep more k; where it does not (a
+        // focus on a softer part of the picture than the rest, or a context that alone loses the
+        // budget), or where it crowds a few tiles (small features on a flat ground), the foci on a
+        // uniform context are kept (keepsContext).
+        FociOptions uniform = options;
+        uniform.context = nullptr;
+        Try plainAsked{1.0, {}, SamplingMap::identity(2, 2), {}, {}};
+        Try plain = search(uniform, &plainAsked);
+        if ((over(chosen) > 0 && over(plain) <= 0) || !keepsContext(chosen.predicted, plain.predicted)) chosen = std::move(plain);
     }
+    FociBudget out{.asked = std::vector<Focus>(foci.begin(), foci.end()), .given = std::move(chosen.given), .map = std::move(chosen.map),
+                   .builderNotes = std::move(chosen.report.notes)};
+    out.predicted = chosen.predicted;
+    out.askedPredicted = asked.predicted;
+    out.transition = chosen.report.transition;
+    out.lowered = chosen.t < 1.0;
     out.gridLimited = recordReached(out.map, out.given);
     out.share = fociShare(out.given, options.aspect, options.falloff);
     out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;
@@ -155,7 +180,7 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
 }
 
 FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options, double floor, bool exactK) {
-    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false, {}};
+    FociBudget out{.asked = std::vector<Focus>(foci.begin(), foci.end()), .map = SamplingMap::identity(2, 2)};
     const double t = exactK ? 1.0 : largestHolding([&](double t) {
         return fociShare(powered(foci, t), options.aspect, options.falloff).contextDensity >= floor;
     });
@@ -164,6 +189,7 @@ FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& o
     FociReport report;
     out.map = buildFociMap(out.given, options, &report);
     out.builderNotes = std::move(report.notes);
+    out.transition = report.transition;
     out.gridLimited = recordReached(out.map, out.given);
     out.share = fociShare(out.given, options.aspect, options.falloff);
     out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;

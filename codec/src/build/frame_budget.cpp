@@ -1,25 +1,31 @@
-// The whole-frame loss, tile loss and ROI gain of a map, measured on a trial encode, and the context floor a loss budget allows.
+// The whole-frame loss, tile loss and ROI gain of a map, predicted by the band model, and the context floor a loss budget allows.
 #include "conus/codec/build/frame_budget.h"
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <string>
 
-#include "conus/codec/image/decode.h"
-#include "conus/codec/image/encode.h"
-#include "conus/codec/image/fit.h"
 #include "conus/core/display.h"
 #include "conus/core/error.h"
 
 namespace conus::codec {
 namespace {
 
-// The picture trial encodes run on: the source, reduced to at most this many pixels a side (the
-// CoNUS size with it, so that the rates relative to the picture are the encode's). 1024: the
-// pictures people compare by eye are about that size, and a trial there costs about 60 ms.
-constexpr int kTrialSide = 1024;
-// Tiles of the tile loss: max(W, H) / kTilesPerSide of the frame a side (bench/quality.py's tiles),
+// The band model's constants (frame_budget.h: S(sigma) = a * sum_j E_j * R(log2 sigma - j - b),
+// R a smoothstep from 0 at t = -c to 1 at t = c). Fitted by `bench/budget_check.py --fit` on the six photographs of
+// bench/quality_targets.PHOTOS (reduced to 1280 px wide, 8-bit sRGB, foci of k 1.5..6 with --exact-k,
+// tile by tile against real encodes and `conus uniform`), by least squares on log(e + f) per tile;
+// the fit and the held-out table: bench/notes/2026-12-06-budget-model.md.
+struct BandFit {
+    double scale;  // a
+    double shift;  // b
+};
+constexpr double kHalfWidth = 1.0;                 // c
+constexpr BandFit kUniformFit{1.0, 0.0};           // area downsample, bilinear resize
+constexpr BandFit kConusFitted{1.0, 0.0};          // encode, fit to the decoder, decode
+constexpr BandFit kConusFiltered{1.0, 0.0};        // encode alone (`--fast`), decode
+
+// Tiles of the tile loss: max(W, H) / kTilesPerSide source pixels a side (bench/quality.py's tiles),
 // and the floor added to both errors of a tile and of the frame: on a flat picture a tiny error
 // twice as large is no loss. Displayed: bench/quality.py's (2/255)^2 of 8-bit sRGB; linear: about
 // that near mid-grey.
@@ -28,14 +34,54 @@ constexpr double kDisplayFloor = (2.0 / 255.0) * (2.0 / 255.0);
 constexpr double kLinearFloor = (1.5 / 255.0) * (1.5 / 255.0);
 constexpr double kTilePercentile = 0.95;
 constexpr double kWorstTilesPercentile = 0.99;
+// Bands of the pyramid: detail up to 2^kMaxLevels source pixels (a 1/256 downscale).
+constexpr int kMaxLevels = 9;
+// Points a side of each tile where the map's Jacobian is taken, and where the importance is read.
+constexpr int kJacobianPoints = 3;
+constexpr int kRegionPoints = 16;
+// D through a table, linear between its entries (continuous, and some 20x faster than pow).
+constexpr int kDisplayTableSteps = 4096;
 constexpr double kLowestFloor = 0.02, kHighestFloor = 0.99;
-// Halvings of log floor: the floor to within a factor of (0.99 / 0.02)^(1/256), 1.5%.
-constexpr int kBisectionSteps = 8;
+// The budget's search for the floor stops within kFloorTolerance of log floor, or within
+// kToleranceDb under the budget, or after kSearchSteps maps built (each a map build and
+// microseconds of prediction).
+constexpr double kFloorTolerance = 0.002, kToleranceDb = 0.01;
+constexpr int kSearchSteps = 12;
+// The own-detail map's floor: searched in [kBestLowest, kBestHighest] (half the uniform rate to
+// nearly uniform) by kGoldenSteps golden sections (the interval shrunk to 0.618^8 = 2% of its log).
+constexpr double kBestLowest = 0.25, kBestHighest = 0.85;
+constexpr int kGoldenSteps = 8;
+constexpr double kTilePenalty = 4.0;  // dB of frame loss per dB of tile loss over its budget
 
 [[noreturn]] void invalid(const std::string& what) { throw Error(ErrorCode::InvalidArgument, what); }
 
 // The channels a display shows through its transfer curve: colour and grey, not alpha or data.
 bool isColourChannel(const std::string& name) { return name == "R" || name == "G" || name == "B" || name == "Y"; }
+
+const std::vector<float>& displayTable() {
+    static const std::vector<float> table = [] {
+        std::vector<float> t(kDisplayTableSteps + 2);
+        for (int i = 0; i <= kDisplayTableSteps; ++i) t[i] = linearToSrgbDisplay(float(i) / kDisplayTableSteps);
+        t[kDisplayTableSteps + 1] = t[kDisplayTableSteps];
+        return t;
+    }();
+    return table;
+}
+
+float shown(float v, bool display, const std::vector<float>& table) {
+    if (!display) return v;
+    const float x = std::clamp(v, 0.0f, 1.0f) * kDisplayTableSteps;
+    const int i = static_cast<int>(x);
+    const float f = x - float(i);
+    return table[i] + f * (table[i + 1] - table[i]);
+}
+
+// Singular values of a 2x2 matrix (largest first).
+std::pair<double, double> singularValues(double a, double b, double c, double d) {
+    const double s1 = a * a + b * b + c * c + d * d, det = std::abs(a * d - b * c);
+    const double root = std::sqrt(std::max(0.0, s1 * s1 - 4 * det * det));
+    return {std::sqrt(0.5 * (s1 + root)), std::sqrt(std::max(0.0, 0.5 * (s1 - root)))};
+}
 
 }  // namespace
 
@@ -45,21 +91,74 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
     if (width < 1 || height < 1 || width > source.width || height > source.height)
         invalid("the frame-loss model: CoNUS size " + std::to_string(width) + "x" + std::to_string(height) +
                 " is outside 1x1 .. the source's " + std::to_string(source.width) + "x" + std::to_string(source.height));
-    const double shrink = std::min(1.0, double(kTrialSide) / std::max(source.width, source.height));
-    const int gw = std::max(1, static_cast<int>(std::lround(source.width * shrink)));
-    const int gh = std::max(1, static_cast<int>(std::lround(source.height * shrink)));
-    m_picture = shrink < 1 ? areaDownsample(source, gw, gh) : source;
-    m_conusWidth = std::clamp(static_cast<int>(std::lround(width * shrink)), 1, gw);
-    m_conusHeight = std::clamp(static_cast<int>(std::lround(height * shrink)), 1, gh);
+    const int sw = source.width, sh = source.height;
+    m_sourceWidth = sw;
+    m_sourceHeight = sh;
+    m_conusWidth = width;
+    m_conusHeight = height;
     m_floor = options.space == ErrorSpace::Display ? kDisplayFloor : kLinearFloor;
-    const std::size_t pixels = std::size_t(gw) * gh, channels = m_picture.channels.size();
-    m_shown.assign(channels, false);
-    if (options.space == ErrorSpace::Display)
-        for (std::size_t c = 0; c < channels; ++c) m_shown[c] = isColourChannel(m_picture.channels[c]);
-    m_reference = shownValues(m_picture);
+    m_tile = std::max(1, std::max(sw, sh) / kTilesPerSide);
+    m_columns = (sw + m_tile - 1) / m_tile;
+    m_rows = (sh + m_tile - 1) / m_tile;
+    const std::size_t tiles = std::size_t(m_columns) * m_rows, channels = source.channels.size();
+    m_pixels.assign(tiles, 0.0);
+    for (int ty = 0; ty < m_rows; ++ty)
+        for (int tx = 0; tx < m_columns; ++tx)
+            m_pixels[std::size_t(ty) * m_columns + tx] =
+                double(std::min(sw, (tx + 1) * m_tile) - tx * m_tile) * double(std::min(sh, (ty + 1) * m_tile) - ty * m_tile);
 
-    // The region: the picture's pixels where the importance reaches half its peak (all of them without one).
-    m_roi.assign(pixels, 1);
+    // The pyramid: each level's 2x2 cells, their energy about their mean (the channels' mean) spread
+    // over the tiles their source pixels cover, their mean the next level.
+    m_levels = 0;
+    for (int w = sw, h = sh; w >= 2 && h >= 2 && m_levels < kMaxLevels; w /= 2, h /= 2) ++m_levels;
+    m_bands.assign(tiles * std::max(1, m_levels), 0.0);
+    std::vector<bool> display(channels, false);
+    if (options.space == ErrorSpace::Display)
+        for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
+    const std::vector<float>& table = displayTable();
+    std::vector<float> level, next;
+    int w = sw, h = sh;
+    const auto at = [&](int j, int x, int y, std::size_t c) {
+        return j == 0 ? shown(source.pixels[(std::size_t(y) * sw + x) * channels + c], display[c], table)
+                      : level[(std::size_t(y) * w + x) * channels + c];
+    };
+    for (int j = 0; j < m_levels; ++j) {
+        const int nw = w / 2, nh = h / 2, cell = 1 << (j + 1);
+        next.assign(std::size_t(nw) * nh * channels, 0.0f);
+        for (int y = 0; y < nh; ++y) {
+            const int y0 = y * cell, y1 = std::min(sh, y0 + cell);
+            for (int x = 0; x < nw; ++x) {
+                double energy = 0;
+                for (std::size_t c = 0; c < channels; ++c) {
+                    const double v00 = at(j, 2 * x, 2 * y, c), v10 = at(j, 2 * x + 1, 2 * y, c);
+                    const double v01 = at(j, 2 * x, 2 * y + 1, c), v11 = at(j, 2 * x + 1, 2 * y + 1, c);
+                    const double mean = 0.25 * (v00 + v10 + v01 + v11);
+                    energy += 0.25 * ((v00 - mean) * (v00 - mean) + (v10 - mean) * (v10 - mean) + (v01 - mean) * (v01 - mean) +
+                                      (v11 - mean) * (v11 - mean));
+                    next[(std::size_t(y) * nw + x) * channels + c] = static_cast<float>(mean);
+                }
+                energy /= double(channels);
+                const int x0 = x * cell, x1 = std::min(sw, x0 + cell);
+                for (int ty = y0 / m_tile; ty <= (y1 - 1) / m_tile; ++ty) {
+                    const int oy = std::min(y1, (ty + 1) * m_tile) - std::max(y0, ty * m_tile);
+                    for (int tx = x0 / m_tile; tx <= (x1 - 1) / m_tile; ++tx) {
+                        const int ox = std::min(x1, (tx + 1) * m_tile) - std::max(x0, tx * m_tile);
+                        m_bands[(std::size_t(ty) * m_columns + tx) * m_levels + j] += energy * double(ox) * double(oy);
+                    }
+                }
+            }
+        }
+        level.swap(next);
+        w = nw;
+        h = nh;
+    }
+    for (std::size_t t = 0; t < tiles; ++t)
+        for (int j = 0; j < m_levels; ++j) m_bands[t * m_levels + j] /= m_pixels[t];
+
+    // The region: where the importance reaches half its peak (nowhere without one: R empty, the
+    // whole frame's tiles counted), read at kRegionPoints^2 points of each tile.
+    m_roi.assign(tiles, 0.0);
+    m_touches.assign(tiles, 0);
     if (!importance.empty()) {
         const std::size_t ic = importance.channels.size();
         const auto meanAt = [&](std::size_t i) {
@@ -69,94 +168,90 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
         };
         float peak = 0;
         for (std::size_t i = 0; i < std::size_t(importance.width) * importance.height; ++i) peak = std::max(peak, meanAt(i));
-        if (peak > 0) {
-            for (int y = 0; y < gh; ++y)
-                for (int x = 0; x < gw; ++x) {
-                    const int ix = std::min(importance.width - 1, static_cast<int>((x + 0.5) / gw * importance.width));
-                    const int iy = std::min(importance.height - 1, static_cast<int>((y + 0.5) / gh * importance.height));
-                    m_roi[std::size_t(y) * gw + x] = meanAt(std::size_t(iy) * importance.width + ix) >= 0.5f * peak ? 1 : 0;
+        if (peak > 0)
+            for (int ty = 0; ty < m_rows; ++ty)
+                for (int tx = 0; tx < m_columns; ++tx) {
+                    const double x0 = tx * m_tile, y0 = ty * m_tile;
+                    const double tw = std::min<double>(sw, x0 + m_tile) - x0, th = std::min<double>(sh, y0 + m_tile) - y0;
+                    int in = 0;
+                    for (int j = 0; j < kRegionPoints; ++j)
+                        for (int i = 0; i < kRegionPoints; ++i) {
+                            const double u = (x0 + (i + 0.5) / kRegionPoints * tw) / sw, v = (y0 + (j + 0.5) / kRegionPoints * th) / sh;
+                            const int ix = std::min(importance.width - 1, static_cast<int>(u * importance.width));
+                            const int iy = std::min(importance.height - 1, static_cast<int>(v * importance.height));
+                            in += meanAt(std::size_t(iy) * importance.width + ix) >= 0.5f * peak ? 1 : 0;
+                        }
+                    const std::size_t t = std::size_t(ty) * m_columns + tx;
+                    m_roi[t] = double(in) / (kRegionPoints * kRegionPoints);
+                    m_touches[t] = in > 0;
                 }
-        }
     }
-    // The baseline: the uniform image of the same pixel count, shown by a bilinear resize.
-    m_uniformError = errors(resizeBilinear(areaDownsample(m_picture, m_conusWidth, m_conusHeight), {}, gw, gh));
+    if (importance.empty()) {  // R: the whole frame (every tile touches it)
+        std::fill(m_roi.begin(), m_roi.end(), 1.0);
+        std::fill(m_touches.begin(), m_touches.end(), 1);
+    }
+    // The baseline: the uniform image of the same pixel count, every footprint the same.
+    m_uniformError.resize(tiles);
+    const double su = double(sw) / width, sv = double(sh) / height;
+    for (std::size_t t = 0; t < tiles; ++t)
+        m_uniformError[t] = tileError(t, std::max(su, sv), std::min(su, sv), kUniformFit.scale, kUniformFit.shift);
 }
 
-std::vector<float> FrameErrorModel::shownValues(const Image& image) const {
-    const std::size_t channels = m_shown.size();
-    std::vector<float> out(image.pixels.size());
-    for (std::size_t i = 0; i < out.size(); ++i) {
-        const float v = image.pixels[i];
-        out[i] = m_shown[i % channels] ? linearToSrgbDisplay(v) : v;
-    }
+double FrameErrorModel::tileError(std::size_t tile, double sigma1, double sigma2, double scale, double shift) const {
+    const double* e = &m_bands[tile * m_levels];
+    const double l1 = std::log2(std::max(sigma1, 1e-6)) - shift, l2 = std::log2(std::max(sigma2, 1e-6)) - shift;
+    const auto ramp = [](double t) {
+        const double x = std::clamp((t + kHalfWidth) / (2 * kHalfWidth), 0.0, 1.0);
+        return x * x * (3 - 2 * x);
+    };
+    double sum = 0;
+    for (int j = 0; j < m_levels; ++j) sum += e[j] * 0.5 * (ramp(l1 - j) + ramp(l2 - j));
+    return scale * sum;
+}
+
+std::vector<double> FrameErrorModel::tileErrors(const SamplingMap& map) const {
+    const BandFit fit = m_options.fitIterations > 0 ? kConusFitted : kConusFiltered;
+    std::vector<double> out(m_uniformError.size());
+    // J is d(CoNUS normalized)/d(source normalized); in pixels, CoNUS pixels per source pixel.
+    const double W = m_conusWidth, H = m_conusHeight, sw = m_sourceWidth, sh = m_sourceHeight;
+    for (int ty = 0; ty < m_rows; ++ty)
+        for (int tx = 0; tx < m_columns; ++tx) {
+            const double x0 = tx * m_tile, y0 = ty * m_tile;
+            const double tw = std::min<double>(m_sourceWidth, x0 + m_tile) - x0, th = std::min<double>(m_sourceHeight, y0 + m_tile) - y0;
+            const std::size_t t = std::size_t(ty) * m_columns + tx;
+            double sum = 0;
+            for (int j = 0; j < kJacobianPoints; ++j)
+                for (int i = 0; i < kJacobianPoints; ++i) {
+                    const glm::dvec2 p((x0 + (i + 0.5) / kJacobianPoints * tw) / m_sourceWidth,
+                                       (y0 + (j + 0.5) / kJacobianPoints * th) / m_sourceHeight);
+                    const glm::dmat2 J = map.jacobian(p);
+                    const auto [l1, l2] = singularValues(W * J[0][0] / sw, W * J[1][0] / sh, H * J[0][1] / sw, H * J[1][1] / sh);
+                    sum += tileError(t, 1.0 / std::max(l2, 1e-9), 1.0 / std::max(l1, 1e-9), fit.scale, fit.shift);
+                }
+            out[t] = sum / (kJacobianPoints * kJacobianPoints);
+        }
     return out;
 }
 
-std::vector<float> FrameErrorModel::errors(const Image& view) const {
-    const std::vector<float> shown = shownValues(view);
-    const std::size_t channels = m_shown.size(), pixels = shown.size() / channels;
-    std::vector<float> out(pixels);
-    for (std::size_t p = 0; p < pixels; ++p) {
-        double sum = 0;
-        for (std::size_t c = 0; c < channels; ++c) {
-            const double d = double(shown[p * channels + c]) - m_reference[p * channels + c];
-            sum += d * d;
-        }
-        out[p] = static_cast<float>(sum / double(channels));
-    }
-    return out;
-}
+FramePrediction FrameErrorModel::predict(const SamplingMap& map) const { return measure(tileErrors(map)); }
 
-FramePrediction FrameErrorModel::predict(const SamplingMap& map) const {
-    EncodeOptions encode;
-    encode.width = m_conusWidth;
-    encode.height = m_conusHeight;
-    Image conus = encodeImage(m_picture, map, encode);
-    if (m_options.fitIterations > 0) {
-        FitOptions fit;
-        fit.iterations = m_options.fitIterations;
-        fit.holdLowPass = m_options.fitHold;
-        fitToDecoder(m_picture, map, conus, fit);
-    }
-    DecodeOptions decode;
-    decode.width = m_picture.width;
-    decode.height = m_picture.height;
-    return measure(errors(decodeImage(conus, map, decode)));
-}
-
-FramePrediction FrameErrorModel::measure(const std::vector<float>& mapped) const {
-    const int w = m_picture.width, h = m_picture.height;
+FramePrediction FrameErrorModel::measure(const std::vector<double>& mapped) const {
     const auto db = [](double a, double b) { return 10.0 * std::log10(std::max(a, 1e-30) / std::max(b, 1e-30)); };
-    double frameUniform = 0, frameMapped = 0, roiUniform = 0, roiMapped = 0, roiCount = 0;
-    for (std::size_t p = 0; p < mapped.size(); ++p) {
-        frameUniform += m_uniformError[p];
-        frameMapped += mapped[p];
-        if (m_roi[p]) {
-            roiUniform += m_uniformError[p];
-            roiMapped += mapped[p];
-            roiCount += 1;
-        }
+    double frameUniform = 0, frameMapped = 0, roiUniform = 0, roiMapped = 0, roiCount = 0, n = 0;
+    std::vector<double> losses;
+    for (std::size_t t = 0; t < mapped.size(); ++t) {
+        const double p = m_pixels[t], r = p * m_roi[t];
+        frameUniform += p * m_uniformError[t];
+        frameMapped += p * mapped[t];
+        roiUniform += r * m_uniformError[t];
+        roiMapped += r * mapped[t];
+        roiCount += r;
+        n += p;
+        if (!m_touches[t]) losses.push_back(db(mapped[t] + m_floor, m_uniformError[t] + m_floor));
     }
-    const double n = double(mapped.size()), rest = std::max(1.0, n - roiCount);
+    const double rest = std::max(1.0, n - roiCount);
     FramePrediction out{db(frameMapped / n + m_floor, frameUniform / n + m_floor), db(roiUniform, roiMapped), 0.0,
                         db((frameMapped - roiMapped) / rest + m_floor, (frameUniform - roiUniform) / rest + m_floor)};
-    // Tiles of max(W, H) / 32 touching no region: the loss at the 95th percentile.
-    const int tile = std::max(1, std::max(w, h) / kTilesPerSide);
-    std::vector<double> losses;
-    for (int ty = 0; ty < h; ty += tile)
-        for (int tx = 0; tx < w; tx += tile) {
-            double u = 0, m = 0, count = 0;
-            bool touches = false;
-            for (int y = ty; y < std::min(h, ty + tile); ++y)
-                for (int x = tx; x < std::min(w, tx + tile); ++x) {
-                    const std::size_t p = std::size_t(y) * w + x;
-                    touches |= m_roi[p] != 0;
-                    u += m_uniformError[p];
-                    m += mapped[p];
-                    count += 1;
-                }
-            if (!touches) losses.push_back(db(m / count + m_floor, u / count + m_floor));
-        }
     if (!losses.empty()) {
         const std::size_t at = std::min(losses.size() - 1, static_cast<std::size_t>(kTilePercentile * double(losses.size())));
         std::nth_element(losses.begin(), losses.begin() + static_cast<std::ptrdiff_t>(at), losses.end());
@@ -172,10 +267,9 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
                                       AutoMapOptions options, double tileLossDb) {
     if (!(frameLossDb >= 0) || !std::isfinite(frameLossDb))
         invalid("the frame-loss budget " + std::to_string(frameLossDb) + " dB must be finite and >= 0");
-    // A higher floor leaves the context more samples: the loss falls as the floor rises. Bisect in
-    // log floor, on what each built map is predicted to lose (its target alone predicts too little:
-    // the grid cannot follow a steep rise, and stretched footprints lose along their long axis),
-    // for the lowest floor within the budget.
+    // A higher floor leaves the context more samples: the loss falls as the floor rises. The lowest
+    // floor within the budget, by regula falsi (Illinois) in log floor on how far each built map is
+    // predicted to be over it: a continuous function of the picture.
     options.refuseBounds = false;
     const auto build = [&](double floor) {
         options.minDensity = floor;
@@ -183,18 +277,35 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         r.predicted = model.predict(r.map);
         return r;
     };
-    const auto within = [&](const BudgetResult& r) { return r.predicted.frameLoss <= frameLossDb && r.predicted.tileLoss <= tileLossDb; };
+    const auto over = [&](const BudgetResult& r) { return std::max(r.predicted.frameLoss - frameLossDb, r.predicted.tileLoss - tileLossDb); };
     const auto search = [&]() {
         BudgetResult low = build(kLowestFloor);
-        if (within(low)) {
+        if (over(low) <= 0) {
             low.budgetBinds = false;
             return low;
         }
         BudgetResult high = build(kHighestFloor);
-        if (!within(high)) return high;  // the closest to the budget there is
-        for (int i = 0; i < kBisectionSteps; ++i) {
-            BudgetResult mid = build(std::sqrt(low.minDensity * high.minDensity));
-            (within(mid) ? high : low) = std::move(mid);
+        double fl = over(low), fh = over(high);
+        if (fh > 0) return high;  // the closest to the budget there is
+        int side = 0;
+        for (int i = 0; i < kSearchSteps && std::log(high.minDensity / low.minDensity) > kFloorTolerance; ++i) {
+            const double ll = std::log(low.minDensity), lh = std::log(high.minDensity);
+            double l = (ll * fh - lh * fl) / (fh - fl);
+            l = std::clamp(l, ll + 0.01 * (lh - ll), lh - 0.01 * (lh - ll));
+            BudgetResult mid = build(std::exp(l));
+            const double f = over(mid);
+            if (f <= 0 && f > -kToleranceDb) return mid;
+            if (f <= 0) {
+                high = std::move(mid);
+                fh = f;
+                if (side == 1) fl *= 0.5;
+                side = 1;
+            } else {
+                low = std::move(mid);
+                fl = f;
+                if (side == -1) fh *= 0.5;
+                side = -1;
+            }
         }
         return high;
     };
@@ -205,7 +316,7 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         // alone loses the budget) or crowds a few tiles (keepsContext), the uniform context's map is kept.
         options.context = nullptr;
         BudgetResult plain = search();
-        if ((within(plain) && !within(chosen)) || (within(plain) == within(chosen) && !keepsContext(chosen.predicted, plain.predicted)))
+        if ((over(plain) <= 0 && over(chosen) > 0) || ((over(plain) <= 0) == (over(chosen) <= 0) && !keepsContext(chosen.predicted, plain.predicted)))
             return plain;
     }
     return chosen;
@@ -213,23 +324,42 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
 
 BudgetResult buildAutoMapForBestFrame(const Image& importance, const FrameErrorModel& model, double tileLossDb,
                                       AutoMapOptions options) {
-    // Floors a quarter octave of density apart, from half the uniform rate to nearly uniform: the
-    // whole-frame loss is not monotone in the floor (too low starves the flat parts, too high leaves
-    // the detail nothing), so each is built and predicted.
-    constexpr double kFloors[] = {0.25, 0.35, 0.5, 0.6, 0.7, 0.85};
+    // The whole-frame loss is not monotone in the floor (too low starves the flat parts, too high
+    // leaves the detail nothing): golden-section search in log floor over [kBestLowest, kBestHighest]
+    // for the least of the frame's loss plus kTilePenalty per dB the tiles lose over their budget
+    // (a continuous objective: a tiny change of the picture moves the floor a little).
     options.refuseBounds = false;
-    std::optional<BudgetResult> best;
-    for (double floor : kFloors) {
+    const auto build = [&](double floor) {
         options.minDensity = floor;
         BudgetResult r{buildAutoMap(importance, options), floor, {}, true};
         r.predicted = model.predict(r.map);
-        const bool fits = r.predicted.tileLoss <= tileLossDb, bestFits = best && best->predicted.tileLoss <= tileLossDb;
-        if (!best || (fits && !bestFits) || (fits == bestFits && (fits ? r.predicted.frameLoss < best->predicted.frameLoss
-                                                                        : r.predicted.tileLoss < best->predicted.tileLoss)))
-            best = std::move(r);
+        return r;
+    };
+    const auto cost = [&](const BudgetResult& r) {
+        return r.predicted.frameLoss + kTilePenalty * std::max(0.0, r.predicted.tileLoss - tileLossDb);
+    };
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double a = std::log(kBestLowest), b = std::log(kBestHighest);
+    double c = b - g * (b - a), d = a + g * (b - a);
+    BudgetResult rc = build(std::exp(c)), rd = build(std::exp(d));
+    for (int i = 0; i < kGoldenSteps; ++i) {
+        if (cost(rc) <= cost(rd)) {
+            b = d;
+            d = c;
+            rd = std::move(rc);
+            c = b - g * (b - a);
+            rc = build(std::exp(c));
+        } else {
+            a = c;
+            c = d;
+            rc = std::move(rd);
+            d = a + g * (b - a);
+            rd = build(std::exp(d));
+        }
     }
-    best->budgetBinds = best->predicted.tileLoss <= tileLossDb;
-    return std::move(*best);
+    BudgetResult best = cost(rc) <= cost(rd) ? std::move(rc) : std::move(rd);
+    best.budgetBinds = best.predicted.tileLoss <= tileLossDb;
+    return best;
 }
 
 BudgetResult buildOwnDetailMap(const Image& source, const Image& detail, int width, int height, const AutoMapOptions& options,
