@@ -19,6 +19,7 @@ constants a, b (per image kind) and c (shared) minimizing the squared error of l
 """
 import argparse
 import json
+import pickle
 import pathlib
 import re
 import sys
@@ -227,14 +228,14 @@ def collect(photos):
             cw, ch = uf.pixels.shape[1], uf.pixels.shape[0]
             su = np.full(bands.shape[:2] + (9, 2), 0.0)
             su[..., 0], su[..., 1] = max(w / cw, h / ch), min(w / cw, h / ch)
-            data.append(dict(kind="uniform", bands=bands, sigma=su, mse=tile_mse(u8, s8)))
+            data.append(dict(kind="uniform", name=name, k=0, bands=bands, sigma=su, mse=tile_mse(u8, s8)))
             for fast in (False, True):
                 for k in FIT_K:
                     foci = [a for u, v, r in regions for a in ("--focus", f"{u},{v},{r},{k}")]
                     run(BINARY, ["encode", src, "-o", work / "c.exr", "--exact-k", "-q"] + foci + (["--fast"] if fast else []))
                     c8, f = decoded8(work / "c.exr", w, h)
-                    data.append(dict(kind="fast" if fast else "fitted", bands=bands, sigma=footprints(f, cw, ch, w, h),
-                                     mse=tile_mse(c8, s8)))
+                    data.append(dict(kind="fast" if fast else "fitted", name=name, k=k, bands=bands,
+                                     sigma=footprints(f, cw, ch, w, h), mse=tile_mse(c8, s8)))
             print(f"collected {name}", flush=True)
     return data
 
@@ -271,13 +272,20 @@ def main():
     ap.add_argument("--out", default=str(ROOT / "build" / "budget"))
     ap.add_argument("--fit", action="store_true", help="fit the model's constants on the fitting photographs")
     ap.add_argument("--photos", help="only these (names, comma-separated)")
+    ap.add_argument("--reuse", action="store_true", help="with --fit: fit again on the data of the last --fit run")
     args = ap.parse_args()
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     chosen = set(args.photos.split(",")) if args.photos else None
     if args.fit:
         photos = [p for p in PHOTOS if not chosen or p[0] in chosen]
-        (out / "fit.json").write_text(json.dumps(fit(collect(photos)), indent=1))
+        cache = out / "fit-data.pickle"
+        if args.reuse and cache.exists():
+            data = pickle.loads(cache.read_bytes())
+        else:
+            data = collect(photos)
+            cache.write_bytes(pickle.dumps(data))
+        (out / "fit.json").write_text(json.dumps(fit(data), indent=1))
         return
     photos = ([("fitted", *p) for p in PHOTOS] + [("unseen", *p) for p in UNSEEN] + [("held-out", *p) for p in HELD_OUT])
     check([p for p in photos if not chosen or p[1] in chosen], out)

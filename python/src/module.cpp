@@ -270,9 +270,10 @@ PYBIND11_MODULE(_conus, m) {
             const auto [w, h] = sizeOr(size, source.width, source.height);
             codec::checkEncodeMemory(source, w, h);  // before a map is built for it
             std::optional<codec::FociBudget> budget;
-            // The budgets' model takes this encode's errors: on what a display shows (data as stored), fitted or not.
+            // The budgets' model takes this encode's errors: on what a display shows (data as stored),
+            // fitted or not; one real encode confirms it, but unfitted (fit=0, as `--fast`).
             const codec::FrameModelOptions trials{colorspace == enumName(Transfer::Raw) ? codec::ErrorSpace::Linear : codec::ErrorSpace::Display,
-                                                  fit, fitHold};
+                                                  fit, fitHold, fit > 0};
             if (!map) {
                 if (!foci.empty()) {
                     const std::vector<codec::Focus>& f = foci;

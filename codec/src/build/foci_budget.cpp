@@ -156,6 +156,7 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
     };
     Try asked{1.0, {}, SamplingMap::identity(2, 2), {}, {}};
     Try chosen = search(options, &asked);
+    bool context = options.context != nullptr;
     if (!exactK && options.context) {
         // A context that follows the picture usually lets the foci keep more k; where it does not (a
         // focus on a softer part of the picture than the rest, or a context that alone loses the
@@ -165,13 +166,21 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         uniform.context = nullptr;
         Try plainAsked{1.0, {}, SamplingMap::identity(2, 2), {}, {}};
         Try plain = search(uniform, &plainAsked);
-        if ((over(chosen) > 0 && over(plain) <= 0) || !keepsContext(chosen.predicted, plain.predicted)) chosen = std::move(plain);
+        if ((over(chosen) > 0 && over(plain) <= 0) || !keepsContext(chosen.predicted, plain.predicted)) {
+            chosen = std::move(plain);
+            asked = std::move(plainAsked);
+            context = false;
+        }
     }
-    FociBudget out{.asked = std::vector<Focus>(foci.begin(), foci.end()), .given = std::move(chosen.given), .map = std::move(chosen.map),
-                   .builderNotes = std::move(chosen.report.notes)};
-    out.predicted = chosen.predicted;
-    out.askedPredicted = asked.predicted;
-    out.transition = chosen.report.transition;
+    if (model.options().confirm && !model.isConfirmed()) {
+        // One real encode of the map chosen, and the choice made again on the model it confirms
+        // (the context kept as chosen): what the block prints is then that encode's measure near it.
+        FociOptions kept = options;
+        if (!context) kept.context = nullptr;
+        return fociForFrameLoss(foci, kept, model.confirmed(chosen.map), frameLossDb, exactK, tileLossDb, restLossDb);
+    }
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), std::move(chosen.given), std::move(chosen.map), {}, {},
+                   chosen.predicted, asked.predicted, chosen.report.transition, false, false, std::move(chosen.report.notes)};
     out.lowered = chosen.t < 1.0;
     out.gridLimited = recordReached(out.map, out.given);
     out.share = fociShare(out.given, options.aspect, options.falloff);
@@ -180,7 +189,7 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
 }
 
 FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options, double floor, bool exactK) {
-    FociBudget out{.asked = std::vector<Focus>(foci.begin(), foci.end()), .map = SamplingMap::identity(2, 2)};
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, {}, {}, {}, false, false, {}};
     const double t = exactK ? 1.0 : largestHolding([&](double t) {
         return fociShare(powered(foci, t), options.aspect, options.falloff).contextDensity >= floor;
     });

@@ -5,6 +5,9 @@
 #include <cmath>
 #include <string>
 
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/image/fit.h"
 #include "conus/core/display.h"
 #include "conus/core/error.h"
 
@@ -12,18 +15,30 @@ namespace conus::codec {
 namespace {
 
 // The band model's constants (frame_budget.h: S(sigma) = a * sum_j E_j * R(log2 sigma - j - b),
-// R a smoothstep from 0 at t = -c to 1 at t = c). Fitted by `bench/budget_check.py --fit` on the six photographs of
-// bench/quality_targets.PHOTOS (reduced to 1280 px wide, 8-bit sRGB, foci of k 1.5..6 with --exact-k,
-// tile by tile against real encodes and `conus uniform`), by least squares on log(e + f) per tile;
-// the fit and the held-out table: bench/notes/2026-12-06-budget-model.md.
-struct BandFit {
-    double scale;  // a
-    double shift;  // b
+// R a smoothstep from 0 at t = -c to 1 at t = c; a footprint of axes sigma1 >= sigma2 taken as
+// one of sigma1^w sigma2^(1-w)). Fitted by `bench/budget_check.py --fit` on the six photographs of
+// bench/quality_targets.PHOTOS (at most 1280 px wide, 8-bit sRGB, one focus per region at k 1.5,
+// 2.5, 4 and 6 with --exact-k, fitted and --fast), tile by tile against real encodes and `conus
+// uniform`, by least squares on log(e + f), then for the whole-frame and p95 tile losses: the
+// uniform image's error is the bands finer than its spacing (b = c = 0.5: at a 1/4 downscale,
+// bands 0 and 1, as the box pyramid's arithmetic says); the CoNUS image loses more along a
+// stretched footprint than its long axis alone says (w > 1). Per tile the model is within about
+// 1.6 dB (uniform) and 3.5 dB (CoNUS, rms); whence the confirming encode (FrameErrorModel::confirmed).
+// bench/notes/2026-12-06-budget-model.md.
+}  // namespace
+
+struct FrameErrorModel::BandFit {
+    double scale;    // a
+    double shift;    // b
+    double stretch;  // w
 };
-constexpr double kHalfWidth = 1.0;                 // c
-constexpr BandFit kUniformFit{1.0, 0.0};           // area downsample, bilinear resize
-constexpr BandFit kConusFitted{1.0, 0.0};          // encode, fit to the decoder, decode
-constexpr BandFit kConusFiltered{1.0, 0.0};        // encode alone (`--fast`), decode
+
+namespace {
+using BandFit = FrameErrorModel::BandFit;
+constexpr double kHalfWidth = 0.5;                    // c
+constexpr BandFit kUniformFit{0.832, 0.5, 0.5};       // area downsample, bilinear resize (isotropic: w moot)
+constexpr BandFit kConusFitted{1.0, 1.5, 1.2};        // encode, fit to the decoder, decode
+constexpr BandFit kConusFiltered{0.832, 1.5, 1.6};    // encode alone (`--fast`), decode
 
 // Tiles of the tile loss: max(W, H) / kTilesPerSide source pixels a side (bench/quality.py's tiles),
 // and the floor added to both errors of a tile and of the frame: on a flat picture a tiny error
@@ -92,6 +107,7 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
         invalid("the frame-loss model: CoNUS size " + std::to_string(width) + "x" + std::to_string(height) +
                 " is outside 1x1 .. the source's " + std::to_string(source.width) + "x" + std::to_string(source.height));
     const int sw = source.width, sh = source.height;
+    m_source = &source;
     m_sourceWidth = sw;
     m_sourceHeight = sh;
     m_conusWidth = width;
@@ -194,19 +210,20 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
     m_uniformError.resize(tiles);
     const double su = double(sw) / width, sv = double(sh) / height;
     for (std::size_t t = 0; t < tiles; ++t)
-        m_uniformError[t] = tileError(t, std::max(su, sv), std::min(su, sv), kUniformFit.scale, kUniformFit.shift);
+        m_uniformError[t] = tileError(t, std::max(su, sv), std::min(su, sv), kUniformFit);
+    m_correction.assign(tiles, 1.0);
 }
 
-double FrameErrorModel::tileError(std::size_t tile, double sigma1, double sigma2, double scale, double shift) const {
+double FrameErrorModel::tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const {
     const double* e = &m_bands[tile * m_levels];
-    const double l1 = std::log2(std::max(sigma1, 1e-6)) - shift, l2 = std::log2(std::max(sigma2, 1e-6)) - shift;
+    const double l = fit.stretch * std::log2(std::max(sigma1, 1e-6)) + (1 - fit.stretch) * std::log2(std::max(sigma2, 1e-6)) - fit.shift;
     const auto ramp = [](double t) {
         const double x = std::clamp((t + kHalfWidth) / (2 * kHalfWidth), 0.0, 1.0);
         return x * x * (3 - 2 * x);
     };
     double sum = 0;
-    for (int j = 0; j < m_levels; ++j) sum += e[j] * 0.5 * (ramp(l1 - j) + ramp(l2 - j));
-    return scale * sum;
+    for (int j = 0; j < m_levels; ++j) sum += e[j] * ramp(l - j);
+    return fit.scale * sum;
 }
 
 std::vector<double> FrameErrorModel::tileErrors(const SamplingMap& map) const {
@@ -226,14 +243,65 @@ std::vector<double> FrameErrorModel::tileErrors(const SamplingMap& map) const {
                                        (y0 + (j + 0.5) / kJacobianPoints * th) / m_sourceHeight);
                     const glm::dmat2 J = map.jacobian(p);
                     const auto [l1, l2] = singularValues(W * J[0][0] / sw, W * J[1][0] / sh, H * J[0][1] / sw, H * J[1][1] / sh);
-                    sum += tileError(t, 1.0 / std::max(l2, 1e-9), 1.0 / std::max(l1, 1e-9), fit.scale, fit.shift);
+                    sum += tileError(t, 1.0 / std::max(l2, 1e-9), 1.0 / std::max(l1, 1e-9), fit);
                 }
-            out[t] = sum / (kJacobianPoints * kJacobianPoints);
+            out[t] = std::max(0.0, (sum / (kJacobianPoints * kJacobianPoints) + m_floor) * m_correction[t] - m_floor);
         }
     return out;
 }
 
 FramePrediction FrameErrorModel::predict(const SamplingMap& map) const { return measure(tileErrors(map)); }
+
+FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
+    const Image& source = *m_source;
+    // The real encode (fitted as the encode will be) and decode at the source's size, and the
+    // uniform image's, each tile's mean squared error on the values shown; the model then keeps
+    // each tile's ratio of measured to predicted (e + f over e + f: a flat tile's tiny errors are
+    // not magnified), so that it predicts what this map loses exactly and maps near it by the
+    // model's differences.
+    FrameErrorModel out = *this;
+    std::fill(out.m_correction.begin(), out.m_correction.end(), 1.0);
+    const std::vector<double> predicted = out.tileErrors(map);
+    EncodeOptions encode;
+    encode.width = m_conusWidth;
+    encode.height = m_conusHeight;
+    Image conus = encodeImage(source, map, encode);
+    if (m_options.fitIterations > 0) {
+        FitOptions fit;
+        fit.iterations = m_options.fitIterations;
+        fit.holdLowPass = m_options.fitHold;
+        fitToDecoder(source, map, conus, fit);
+    }
+    DecodeOptions decode;
+    decode.width = source.width;
+    decode.height = source.height;
+    const std::vector<double> measured = shownTileErrors(source, decodeImage(conus, map, decode));
+    out.m_uniformError = shownTileErrors(source, resizeBilinear(areaDownsample(source, m_conusWidth, m_conusHeight), {}, source.width, source.height));
+    for (std::size_t t = 0; t < measured.size(); ++t) out.m_correction[t] = (measured[t] + m_floor) / (predicted[t] + m_floor);
+    out.m_confirmed = true;
+    return out;
+}
+
+std::vector<double> FrameErrorModel::shownTileErrors(const Image& source, const Image& view) const {
+    const std::size_t channels = source.channels.size();
+    std::vector<bool> display(channels, false);
+    if (m_options.space == ErrorSpace::Display)
+        for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
+    const std::vector<float>& table = displayTable();
+    std::vector<double> out(m_pixels.size(), 0.0);
+    for (int y = 0; y < source.height; ++y)
+        for (int x = 0; x < source.width; ++x) {
+            double e = 0;
+            for (std::size_t c = 0; c < channels; ++c) {
+                const std::size_t i = (std::size_t(y) * source.width + x) * channels + c;
+                const double d = double(shown(view.pixels[i], display[c], table)) - shown(source.pixels[i], display[c], table);
+                e += d * d;
+            }
+            out[std::size_t(y / m_tile) * m_columns + x / m_tile] += e / double(channels);
+        }
+    for (std::size_t t = 0; t < out.size(); ++t) out[t] /= m_pixels[t];
+    return out;
+}
 
 FramePrediction FrameErrorModel::measure(const std::vector<double>& mapped) const {
     const auto db = [](double a, double b) { return 10.0 * std::log10(std::max(a, 1e-30) / std::max(b, 1e-30)); };
@@ -310,14 +378,22 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         return high;
     };
     BudgetResult chosen = search();
-    if (options.context) {
+    if (const DensityField* context = options.context) {
         // As for foci (foci_budget.cpp): where the context that follows the picture gives the region
         // less (a region softer than the rest, whose factor the max density caps; a context that
         // alone loses the budget) or crowds a few tiles (keepsContext), the uniform context's map is kept.
         options.context = nullptr;
         BudgetResult plain = search();
         if ((over(plain) <= 0 && over(chosen) > 0) || ((over(plain) <= 0) == (over(chosen) <= 0) && !keepsContext(chosen.predicted, plain.predicted)))
-            return plain;
+            chosen = std::move(plain);
+        else
+            options.context = context;
+    }
+    if (model.options().confirm && !model.isConfirmed()) {
+        // One real encode of the map chosen, and the choice made again on the model it confirms
+        // (the context kept as chosen).
+        const FrameErrorModel confirmed = model.confirmed(chosen.map);
+        return buildAutoMapForFrameLoss(importance, confirmed, frameLossDb, options, tileLossDb);
     }
     return chosen;
 }

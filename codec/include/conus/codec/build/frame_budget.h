@@ -52,8 +52,11 @@ enum class ErrorSpace { Display, Linear };
 
 struct FrameModelOptions {
     ErrorSpace space = ErrorSpace::Display;
-    int fitIterations = kDefaultEncodeFitIterations;  // the encode's fit (0: the filtered encode alone, `--fast`): its constants
-    double fitHold = kFitHoldLowPass;                 // (not used by the model: the fit's constants are the default hold's)
+    int fitIterations = kDefaultEncodeFitIterations;  // the encode's fit (0: the filtered encode alone, `--fast`)
+    double fitHold = kFitHoldLowPass;
+    // Whether the budgets confirm their choice by one real encode (FrameErrorModel::confirmed) and
+    // choose again on the confirmed model; `--fast` does not.
+    bool confirm = true;
 };
 
 class FrameErrorModel {
@@ -65,6 +68,13 @@ public:
 
     // The losses and gain of encoding through `map`, predicted by the model (microseconds).
     FramePrediction predict(const SamplingMap& map) const;
+    // The model confirmed by one real encode of the picture it was built from (which must outlive it) through
+    // `map`, fitted as options say, decoded at the source's size, and the uniform image's: each
+    // tile's error then scaled (on e + f) so that `map` predicts what it measured, and the uniform
+    // image's errors measured. A map near `map` is then predicted by the model's differences.
+    FrameErrorModel confirmed(const SamplingMap& map) const;
+    bool isConfirmed() const { return m_confirmed; }
+    const FrameModelOptions& options() const { return m_options; }
     // The same from each tile's predicted mean squared error of the CoNUS image (tiles row by row,
     // tileColumns() x tileRows()), as predict computes them: what bench and tests compare.
     FramePrediction measure(const std::vector<double>& conusError) const;
@@ -74,11 +84,15 @@ public:
     int tileRows() const { return m_rows; }
     int tileSide() const { return m_tile; }
 
+    struct BandFit;
+
 private:
-    // a * mean over the two axes of S(sigma): the tile's error at footprint axes sigma1, sigma2.
-    double tileError(std::size_t tile, double sigma1, double sigma2, double scale, double shift) const;
+    // S of the footprint of axes sigma1 >= sigma2 (source pixels) on `tile`, with `fit`'s constants.
+    double tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const;
+    std::vector<double> shownTileErrors(const Image& source, const Image& view) const;  // measured, per tile
 
     FrameModelOptions m_options;
+    const Image* m_source = nullptr;    // for confirmed()
     int m_sourceWidth = 1, m_sourceHeight = 1, m_conusWidth = 1, m_conusHeight = 1;
     int m_tile = 1, m_columns = 1, m_rows = 1, m_levels = 0;
     double m_floor = 0;                 // f, of the space the errors are taken in
@@ -87,6 +101,8 @@ private:
     std::vector<double> m_uniformError; // per tile: e_u
     std::vector<double> m_roi;          // per tile: the share of its pixels in R
     std::vector<unsigned char> m_touches;  // per tile: touches R
+    std::vector<double> m_correction;   // per tile: what confirmed() measured over the model (on e + f)
+    bool m_confirmed = false;
 };
 
 struct BudgetResult {
