@@ -54,6 +54,8 @@ constexpr int kMaxLevels = 9;
 // Points a side of each tile where the map's Jacobian is taken, and where the importance is read.
 constexpr int kJacobianPoints = 3;
 constexpr int kRegionPoints = 16;
+// The most a confirming encode moves a tile's footprints (octaves either way).
+constexpr double kMostShift = 3.0;
 // D through a table, linear between its entries (continuous, and some 20x faster than pow).
 constexpr int kDisplayTableSteps = 4096;
 constexpr double kLowestFloor = 0.02, kHighestFloor = 0.99;
@@ -211,7 +213,7 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
     const double su = double(sw) / width, sv = double(sh) / height;
     for (std::size_t t = 0; t < tiles; ++t)
         m_uniformError[t] = tileError(t, std::max(su, sv), std::min(su, sv), kUniformFit);
-    m_correction.assign(tiles, 1.0);
+    m_shift.assign(tiles, 0.0);
 }
 
 double FrameErrorModel::tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const {
@@ -226,27 +228,39 @@ double FrameErrorModel::tileError(std::size_t tile, double sigma1, double sigma2
     return fit.scale * sum;
 }
 
-std::vector<double> FrameErrorModel::tileErrors(const SamplingMap& map) const {
-    const BandFit fit = m_options.fitIterations > 0 ? kConusFitted : kConusFiltered;
-    std::vector<double> out(m_uniformError.size());
-    // J is d(CoNUS normalized)/d(source normalized); in pixels, CoNUS pixels per source pixel.
+std::vector<std::pair<double, double>> FrameErrorModel::footprints(const SamplingMap& map) const {
+    // J is d(CoNUS normalized)/d(source normalized); in pixels, CoNUS pixels per source pixel; its
+    // inverse singular values are the footprint's axes in source pixels.
+    std::vector<std::pair<double, double>> out;
+    out.reserve(m_pixels.size() * kJacobianPoints * kJacobianPoints);
     const double W = m_conusWidth, H = m_conusHeight, sw = m_sourceWidth, sh = m_sourceHeight;
     for (int ty = 0; ty < m_rows; ++ty)
         for (int tx = 0; tx < m_columns; ++tx) {
             const double x0 = tx * m_tile, y0 = ty * m_tile;
-            const double tw = std::min<double>(m_sourceWidth, x0 + m_tile) - x0, th = std::min<double>(m_sourceHeight, y0 + m_tile) - y0;
-            const std::size_t t = std::size_t(ty) * m_columns + tx;
-            double sum = 0;
+            const double tw = std::min(sw, x0 + m_tile) - x0, th = std::min(sh, y0 + m_tile) - y0;
             for (int j = 0; j < kJacobianPoints; ++j)
                 for (int i = 0; i < kJacobianPoints; ++i) {
-                    const glm::dvec2 p((x0 + (i + 0.5) / kJacobianPoints * tw) / m_sourceWidth,
-                                       (y0 + (j + 0.5) / kJacobianPoints * th) / m_sourceHeight);
+                    const glm::dvec2 p((x0 + (i + 0.5) / kJacobianPoints * tw) / sw, (y0 + (j + 0.5) / kJacobianPoints * th) / sh);
                     const glm::dmat2 J = map.jacobian(p);
                     const auto [l1, l2] = singularValues(W * J[0][0] / sw, W * J[1][0] / sh, H * J[0][1] / sw, H * J[1][1] / sh);
-                    sum += tileError(t, 1.0 / std::max(l2, 1e-9), 1.0 / std::max(l1, 1e-9), fit);
+                    out.emplace_back(1.0 / std::max(l2, 1e-9), 1.0 / std::max(l1, 1e-9));
                 }
-            out[t] = std::max(0.0, (sum / (kJacobianPoints * kJacobianPoints) + m_floor) * m_correction[t] - m_floor);
         }
+    return out;
+}
+
+double FrameErrorModel::footprintError(std::size_t tile, const std::pair<double, double>* axes, double shift) const {
+    const BandFit& fit = m_options.fitIterations > 0 ? kConusFitted : kConusFiltered;
+    const double scale = std::exp2(shift);
+    double sum = 0;
+    for (int p = 0; p < kJacobianPoints * kJacobianPoints; ++p) sum += tileError(tile, axes[p].first * scale, axes[p].second * scale, fit);
+    return sum / (kJacobianPoints * kJacobianPoints);
+}
+
+std::vector<double> FrameErrorModel::tileErrors(const SamplingMap& map) const {
+    const std::vector<std::pair<double, double>> axes = footprints(map);
+    std::vector<double> out(m_pixels.size());
+    for (std::size_t t = 0; t < out.size(); ++t) out[t] = footprintError(t, &axes[t * kJacobianPoints * kJacobianPoints], m_shift[t]);
     return out;
 }
 
@@ -260,8 +274,6 @@ FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
     // not magnified), so that it predicts what this map loses exactly and maps near it by the
     // model's differences.
     FrameErrorModel out = *this;
-    std::fill(out.m_correction.begin(), out.m_correction.end(), 1.0);
-    const std::vector<double> predicted = out.tileErrors(map);
     EncodeOptions encode;
     encode.width = m_conusWidth;
     encode.height = m_conusHeight;
@@ -277,7 +289,19 @@ FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
     decode.height = source.height;
     const std::vector<double> measured = shownTileErrors(source, decodeImage(conus, map, decode));
     out.m_uniformError = shownTileErrors(source, resizeBilinear(areaDownsample(source, m_conusWidth, m_conusHeight), {}, source.width, source.height));
-    for (std::size_t t = 0; t < measured.size(); ++t) out.m_correction[t] = (measured[t] + m_floor) / (predicted[t] + m_floor);
+    // Each tile's footprints scaled by 2^shift so that the model gives what was measured: the
+    // error grows with the footprint, so the shift is found by bisection (to 1e-4 octaves, within
+    // +-kMostShift: a tile with no detail to lose keeps what it can).
+    const std::vector<std::pair<double, double>> axes = footprints(map);
+    for (std::size_t t = 0; t < measured.size(); ++t) {
+        const std::pair<double, double>* a = &axes[t * kJacobianPoints * kJacobianPoints];
+        double lo = -kMostShift, hi = kMostShift;
+        while (hi - lo > 1e-4) {
+            const double mid = 0.5 * (lo + hi);
+            (footprintError(t, a, mid) < measured[t] ? lo : hi) = mid;
+        }
+        out.m_shift[t] = 0.5 * (lo + hi);
+    }
     out.m_confirmed = true;
     return out;
 }

@@ -23,6 +23,7 @@
 #pragma once
 
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "conus/codec/build/auto_map.h"
@@ -70,8 +71,9 @@ public:
     FramePrediction predict(const SamplingMap& map) const;
     // The model confirmed by one real encode of the picture it was built from (which must outlive it) through
     // `map`, fitted as options say, decoded at the source's size, and the uniform image's: each
-    // tile's error then scaled (on e + f) so that `map` predicts what it measured, and the uniform
-    // image's errors measured. A map near `map` is then predicted by the model's differences.
+    // tile's footprints then scaled so that `map` predicts what it measured (the tile's effective
+    // footprint), and the uniform image's errors measured. Other maps are predicted through the
+    // footprints so scaled.
     FrameErrorModel confirmed(const SamplingMap& map) const;
     bool isConfirmed() const { return m_confirmed; }
     const FrameModelOptions& options() const { return m_options; }
@@ -90,6 +92,10 @@ private:
     // S of the footprint of axes sigma1 >= sigma2 (source pixels) on `tile`, with `fit`'s constants.
     double tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const;
     std::vector<double> shownTileErrors(const Image& source, const Image& view) const;  // measured, per tile
+    // The footprint's axes (source pixels, largest first) at a few points of each tile, tile by tile.
+    std::vector<std::pair<double, double>> footprints(const SamplingMap& map) const;
+    // A tile's error from its points' axes, each scaled by 2^shift.
+    double footprintError(std::size_t tile, const std::pair<double, double>* axes, double shift) const;
 
     FrameModelOptions m_options;
     const Image* m_source = nullptr;    // for confirmed()
@@ -101,7 +107,7 @@ private:
     std::vector<double> m_uniformError; // per tile: e_u
     std::vector<double> m_roi;          // per tile: the share of its pixels in R
     std::vector<unsigned char> m_touches;  // per tile: touches R
-    std::vector<double> m_correction;   // per tile: what confirmed() measured over the model (on e + f)
+    std::vector<double> m_shift;        // per tile: octaves confirmed() scales the footprints by
     bool m_confirmed = false;
 };
 
