@@ -11,6 +11,8 @@ the frame and 1 dB for the p95 tile; measured frame loss within the budget and p
 <= 4 dB. The photographs: bench/quality_targets.PHOTOS (the model's constants were fitted on
 these), its UNSEEN ones and HELD_OUT below, on which nothing was fitted.
 
+`--fast`: the same with `encode --fast`, whose budget is the model alone (no confirming encode).
+
 `--fit`: the data the constants of codec/src/build/frame_budget.cpp were fitted on and the fit
 itself: on the fitting photographs, encodes with `--exact-k` at several k (and with `--fast`), each
 tile's measured mean squared error of the CoNUS and the uniform image beside the model's terms (the
@@ -85,7 +87,7 @@ def predicted(text):
             value(r"tiles outside the foci (lose|gain) ([-0-9.]+) dB"))
 
 
-def check(photos, out):
+def check(photos, out, extra=()):
     rows = []
     for group, name, path, regions in photos:
         s8 = source8(name, path)
@@ -96,7 +98,7 @@ def check(photos, out):
             write_png(src, s8)
             u8 = uniform8(work, src, w, h)
             foci = [a for u, v, r in regions for a in ("--focus", f"{u},{v},{r},4")]
-            text, wall = run(BINARY, ["encode", src, "-o", work / "c.exr"] + foci)
+            text, wall = run(BINARY, ["encode", src, "-o", work / "c.exr"] + foci + list(extra))
             c8, _ = decoded8(work / "c.exr", w, h)
             m = scores(c8, u8, s8, regions)
             pf, pt = predicted(text)
@@ -272,6 +274,7 @@ def main():
     ap.add_argument("--out", default=str(ROOT / "build" / "budget"))
     ap.add_argument("--fit", action="store_true", help="fit the model's constants on the fitting photographs")
     ap.add_argument("--photos", help="only these (names, comma-separated)")
+    ap.add_argument("--fast", action="store_true", help="encode with --fast (the model alone: no confirming encode)")
     ap.add_argument("--reuse", action="store_true", help="with --fit: fit again on the data of the last --fit run")
     args = ap.parse_args()
     out = pathlib.Path(args.out)
@@ -288,7 +291,7 @@ def main():
         (out / "fit.json").write_text(json.dumps(fit(data), indent=1))
         return
     photos = ([("fitted", *p) for p in PHOTOS] + [("unseen", *p) for p in UNSEEN] + [("held-out", *p) for p in HELD_OUT])
-    check([p for p in photos if not chosen or p[1] in chosen], out)
+    check([p for p in photos if not chosen or p[1] in chosen], out, ["--fast"] if args.fast else [])
 
 
 if __name__ == "__main__":

@@ -102,8 +102,8 @@ std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, 
     std::snprintf(floor, sizeof floor, "%.3g", r.minDensity);
     return "budget: the whole frame within " + numberText(frameLoss) + " dB and tiles outside the region within " +
            numberText(codec::kDefaultTileLoss) + " dB (95th percentile), predicted against `conus uniform` of the same pixel count "
-           "(--frame-loss sets it)\n  " + what + ": context floor " + floor +
-           (r.budgetBinds ? "" : " (the lowest there is: the budget does not bind; raise --max-density for more)") +
+           "(--frame-loss sets it)\n  " + what + ": context floor " + floor + ", density cap " + numberText(std::round(r.maxDensity * 10) / 10) +
+           (r.budgetBinds ? "" : " (the budget does not bind: the lowest floor and the highest cap hold it)") +
            "\n  predicted: the whole frame " + lossText(r.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the region " +
            lossText(r.predicted.tileLoss, "lose", "gain", 1) + " at the 95th percentile, the region gains " +
            numberText(std::round(r.predicted.roiGain * 10) / 10) + " dB";

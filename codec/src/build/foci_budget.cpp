@@ -7,6 +7,7 @@
 #include <string>
 
 #include "conus/core/error.h"
+#include "budget_search.h"
 
 namespace conus::codec {
 namespace {
@@ -132,27 +133,8 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         if (exactK || over(hi) <= 0) return hi;
         Try lo = attempt(0.0, o);
         if (over(lo) > 0) return lo;  // even k = 1 loses more: the closest to the budget there is
-        double flo = over(lo), fhi = over(hi);
-        int side = 0;
-        for (int i = 0; i < kSearchSteps && hi.t - lo.t > kTolerance; ++i) {
-            double t = (lo.t * fhi - hi.t * flo) / (fhi - flo);
-            t = std::clamp(t, lo.t + 0.01 * (hi.t - lo.t), hi.t - 0.01 * (hi.t - lo.t));
-            Try mid = attempt(t, o);
-            const double f = over(mid);
-            if (std::abs(f) < kToleranceDb && f <= 0) return mid;
-            if (f <= 0) {
-                lo = std::move(mid);
-                flo = f;
-                if (side == -1) fhi *= 0.5;
-                side = -1;
-            } else {
-                hi = std::move(mid);
-                fhi = f;
-                if (side == 1) flo *= 0.5;
-                side = 1;
-            }
-        }
-        return lo;
+        return detail::searchWithin(std::move(lo), 0.0, std::move(hi), 1.0, [&](double t) { return attempt(t, o); }, over,
+                                    kSearchSteps, kTolerance, kToleranceDb);
     };
     Try asked{1.0, {}, SamplingMap::identity(2, 2), {}, {}};
     Try chosen = search(options, &asked);

@@ -10,6 +10,7 @@
 #include "conus/codec/image/fit.h"
 #include "conus/core/display.h"
 #include "conus/core/error.h"
+#include "budget_search.h"
 
 namespace conus::codec {
 namespace {
@@ -67,6 +68,9 @@ constexpr int kSearchSteps = 12;
 // The own-detail map's floor: searched in [kBestLowest, kBestHighest] (half the uniform rate to
 // nearly uniform) by kGoldenSteps golden sections (the interval shrunk to 0.618^8 = 2% of its log).
 constexpr double kBestLowest = 0.25, kBestHighest = 0.85;
+// The highest density cap a frame-loss budget raises an importance map's to, once its floor is at
+// the lowest (16x the uniform density: 4x the linear rate, as the default cap; this, 16x it).
+constexpr double kHighestCap = 256.0;
 constexpr int kGoldenSteps = 8;
 constexpr double kTilePenalty = 4.0;  // dB of frame loss per dB of tile loss over its budget
 
@@ -365,41 +369,39 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
     options.refuseBounds = false;
     const auto build = [&](double floor) {
         options.minDensity = floor;
-        BudgetResult r{buildAutoMap(importance, options), floor, {}, true};
+        BudgetResult r{buildAutoMap(importance, options), floor, {}, true, options.maxDensity};
         r.predicted = model.predict(r.map);
         return r;
     };
     const auto over = [&](const BudgetResult& r) { return std::max(r.predicted.frameLoss - frameLossDb, r.predicted.tileLoss - tileLossDb); };
+    const double cap = options.maxDensity;
     const auto search = [&]() {
         BudgetResult low = build(kLowestFloor);
         if (over(low) <= 0) {
-            low.budgetBinds = false;
-            return low;
+            // The lowest floor holds the budget (a map that follows the picture's detail often gains
+            // over the whole frame): the rest is spent by raising the density cap, in log cap by
+            // regula falsi between the cap given and kHighestCap, as continuous as the floor's.
+            options.maxDensity = kHighestCap;
+            BudgetResult top = build(kLowestFloor);
+            options.maxDensity = cap;
+            if (over(top) <= 0 || cap >= kHighestCap) {
+                (over(top) <= 0 ? top : low).budgetBinds = false;
+                return over(top) <= 0 ? top : low;
+            }
+            const auto withCap = [&](double logCap) {
+                options.maxDensity = std::exp(logCap);
+                BudgetResult r = build(kLowestFloor);
+                options.maxDensity = cap;
+                return r;
+            };
+            return detail::searchWithin(std::move(low), std::log(cap), std::move(top), std::log(kHighestCap), withCap, over, kSearchSteps,
+                                        kFloorTolerance, kToleranceDb);
         }
         BudgetResult high = build(kHighestFloor);
-        double fl = over(low), fh = over(high);
-        if (fh > 0) return high;  // the closest to the budget there is
-        int side = 0;
-        for (int i = 0; i < kSearchSteps && std::log(high.minDensity / low.minDensity) > kFloorTolerance; ++i) {
-            const double ll = std::log(low.minDensity), lh = std::log(high.minDensity);
-            double l = (ll * fh - lh * fl) / (fh - fl);
-            l = std::clamp(l, ll + 0.01 * (lh - ll), lh - 0.01 * (lh - ll));
-            BudgetResult mid = build(std::exp(l));
-            const double f = over(mid);
-            if (f <= 0 && f > -kToleranceDb) return mid;
-            if (f <= 0) {
-                high = std::move(mid);
-                fh = f;
-                if (side == 1) fl *= 0.5;
-                side = 1;
-            } else {
-                low = std::move(mid);
-                fl = f;
-                if (side == -1) fh *= 0.5;
-                side = -1;
-            }
-        }
-        return high;
+        if (over(high) > 0) return high;  // the closest to the budget there is
+        return detail::searchWithin(std::move(high), std::log(kHighestFloor), std::move(low), std::log(kLowestFloor),
+                                    [&](double logFloor) { return build(std::exp(logFloor)); }, over, kSearchSteps, kFloorTolerance,
+                                    kToleranceDb);
     };
     BudgetResult chosen = search();
     if (const DensityField* context = options.context) {
@@ -431,7 +433,7 @@ BudgetResult buildAutoMapForBestFrame(const Image& importance, const FrameErrorM
     options.refuseBounds = false;
     const auto build = [&](double floor) {
         options.minDensity = floor;
-        BudgetResult r{buildAutoMap(importance, options), floor, {}, true};
+        BudgetResult r{buildAutoMap(importance, options), floor, {}, true, options.maxDensity};
         r.predicted = model.predict(r.map);
         return r;
     };

@@ -115,13 +115,15 @@ struct BudgetResult {
     SamplingMap map;
     double minDensity = 0;          // the context floor chosen
     FramePrediction predicted;      // of `map` itself
-    bool budgetBinds = true;        // false: even the lowest floor stays under the budget
+    bool budgetBinds = true;        // false: even the lowest floor and the highest cap stay under the budget
+    double maxDensity = 0;          // the density cap the map was built with (raised by a budget the lowest floor holds)
 };
 
 // The automatic map (buildAutoMap with `options`, its minDensity replaced) with the lowest context
 // floor in [0.02, 0.99] (to 0.2%, by regula falsi, a map built for each try) whose own predicted
 // whole-frame loss stays within `frameLossDb` and tile loss within `tileLossDb` (infinity: no tile
-// budget): the most ROI gain the budget allows. The map is built without refusing
+// budget): the most ROI gain the budget allows; where even the lowest floor holds the budget, the
+// density cap is raised (up to 256, regula falsi in log cap) until it binds. The map is built without refusing
 // density bounds (the budget, not the floor, is the promise). Throws conus::Error(InvalidArgument) for a budget that is not finite
 // and >= 0.
 BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorModel& model, double frameLossDb,
