@@ -33,9 +33,11 @@
 namespace conus::cli {
 namespace {
 
-// The loss (dB) a relief asset's focus may cost the field outside it, against the uniform asset, on
-// the budget's trial (which encodes the colour as `encode` does): the baked tablet then loses 0.75 dB
-// outside its focus, within the 1 dB a relief read all over can spare (bench/notes/2026-11-27-narrow-transitions.md).
+// The loss (dB) a relief asset's focus may cost the field outside it, against the uniform asset, as
+// the budget predicts it on the colour (encoded as `encode` does, confirmed by one encode); chosen
+// when the budget ran trial encodes, for a baked tablet that lost 0.75 dB outside its focus
+// (bench/notes/2026-11-27-narrow-transitions.md); with the band model the rendered tablet of
+// tests/cli/relief_test.cpp loses 1.05-1.09 dB there whatever this is set to (0.2 to 0.6 tried).
 constexpr double kReliefRestLoss = 0.6;
 
 constexpr const char* kTabletSource = "tablet";
