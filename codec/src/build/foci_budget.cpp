@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "conus/core/error.h"
@@ -113,10 +114,10 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         FociReport report;
         FramePrediction predicted;
     };
-    const auto attempt = [&](double t, const FociOptions& o) {
+    const auto attempt = [&](const FrameErrorModel& m, double t, const FociOptions& o) {
         Try x{t, powered(foci, t), SamplingMap::identity(2, 2), {}, {}};
         x.map = buildFociMap(x.given, o, &x.report);
-        x.predicted = model.predict(x.map);
+        x.predicted = m.predict(x.map);
         return x;
     };
     // How far a try is over the budget (dB, <= 0: within): continuous in t, as the model is.
@@ -127,43 +128,44 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
     // A lower k leaves the context more samples: the loss falls with t. The largest t within the
     // budget: regula falsi (Illinois) on over(t) between t = 0 (k = 1) and 1, to kTolerance in t,
     // each step a map built and predicted; the t chosen is a continuous function of the picture.
-    const auto search = [&](const FociOptions& o, Try* asked) {
-        Try hi = attempt(1.0, o);
-        *asked = hi;
-        if (exactK || over(hi) <= 0) return hi;
-        Try lo = attempt(0.0, o);
-        if (over(lo) > 0) return lo;  // even k = 1 loses more: the closest to the budget there is
-        return detail::searchWithin(std::move(lo), 0.0, std::move(hi), 1.0, [&](double t) { return attempt(t, o); }, over,
-                                    kSearchSteps, kTolerance, kToleranceDb);
+    struct Search {
+        Try chosen, asked;
     };
-    Try asked{1.0, {}, SamplingMap::identity(2, 2), {}, {}};
-    Try chosen = search(options, &asked);
-    bool context = options.context != nullptr;
-    if (!exactK && options.context) {
-        // A context that follows the picture usually lets the foci keep more k; where it does not (a
-        // focus on a softer part of the picture than the rest, or a context that alone loses the
-        // budget), or where it crowds a few tiles (small features on a flat ground), the foci on a
-        // uniform context are kept (keepsContext).
-        FociOptions uniform = options;
-        uniform.context = nullptr;
-        Try plainAsked{1.0, {}, SamplingMap::identity(2, 2), {}, {}};
-        Try plain = search(uniform, &plainAsked);
-        if ((over(chosen) > 0 && over(plain) <= 0) || !keepsContext(chosen.predicted, plain.predicted)) {
-            chosen = std::move(plain);
-            asked = std::move(plainAsked);
-            context = false;
-        }
-    }
+    const auto search = [&](const FrameErrorModel& m, const FociOptions& o) {
+        Try hi = attempt(m, 1.0, o);
+        if (exactK || over(hi) <= 0) return Search{hi, hi};
+        Try lo = attempt(m, 0.0, o);
+        if (over(lo) > 0) return Search{std::move(lo), std::move(hi)};  // even k = 1 loses more: the closest to the budget there is
+        Try within = detail::searchWithin(std::move(lo), 0.0, hi, 1.0, [&](double t) { return attempt(m, t, o); }, over, kSearchSteps,
+                                          kTolerance, kToleranceDb);
+        return Search{std::move(within), std::move(hi)};
+    };
+    // A context that follows the picture usually lets the foci keep more k; where it does not (a
+    // focus on a softer part of the picture than the rest, or a context that alone loses the
+    // budget), or where it crowds a few tiles (small features on a flat ground), the foci on a
+    // uniform context are kept (keepsContext). Both candidates are searched on the model.
+    const bool compare = !exactK && options.context != nullptr;
+    FociOptions uniform = options;
+    uniform.context = nullptr;
+    Search chosen = search(model, options);
+    std::optional<Search> plain;
+    if (compare) plain = search(model, uniform);
     if (model.options().confirm && !model.isConfirmed()) {
-        // One real encode of the map chosen, and the choice made again on the model it confirms
-        // (the context kept as chosen): what the block prints is then that encode's measure near it.
-        FociOptions kept = options;
-        if (!context) kept.context = nullptr;
-        return fociForFrameLoss(foci, kept, model.confirmed(chosen.map), frameLossDb, exactK, tileLossDb, restLossDb);
+        // One real encode of each candidate's map, and each searched again on the model its encode
+        // confirms: the model alone can be off by dB in either direction, and differently on the two
+        // contexts' maps (their footprints differ where the context does), so the two are compared
+        // on what their encodes measured, not on the model alone. What the block prints is then the
+        // chosen map's encode's measure near it.
+        chosen = search(model.confirmed(chosen.chosen.map), options);
+        if (plain) plain = search(model.confirmed(plain->chosen.map), uniform);
     }
-    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), std::move(chosen.given), std::move(chosen.map), {}, {},
-                   chosen.predicted, asked.predicted, chosen.report.transition, false, false, std::move(chosen.report.notes)};
-    out.lowered = chosen.t < 1.0;
+    if (plain && ((over(chosen.chosen) > 0 && over(plain->chosen) <= 0) || !keepsContext(chosen.chosen.predicted, plain->chosen.predicted)))
+        chosen = std::move(*plain);
+    const Try& asked = chosen.asked;
+    Try& given = chosen.chosen;
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), std::move(given.given), std::move(given.map), {}, {},
+                   given.predicted, asked.predicted, given.report.transition, false, false, std::move(given.report.notes)};
+    out.lowered = given.t < 1.0;
     out.gridLimited = recordReached(out.map, out.given);
     out.share = fociShare(out.given, options.aspect, options.falloff);
     out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;
