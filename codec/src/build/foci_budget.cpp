@@ -23,6 +23,8 @@ constexpr int kBisectionSteps = 10;
 // budget, or after kSearchSteps maps built.
 constexpr double kTolerance = 1.0 / 1024, kToleranceDb = 0.01;
 constexpr int kSearchSteps = 12;
+// The rounds of confirming encodes (FrameModelOptions::confirmRounds) stop within this of the budget.
+constexpr double kMeasuredToleranceDb = 0.05;
 
 bool inDisc(const Focus& f, double aspect, double u, double v) {
     const double dx = u - f.u, dy = (v - f.v) / aspect;
@@ -156,8 +158,45 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         // contexts' maps (their footprints differ where the context does), so the two are compared
         // on what their encodes measured, not on the model alone. What the block prints is then the
         // chosen map's encode's measure near it.
-        chosen = search(model.confirmed(chosen.chosen.map), options);
-        if (plain) plain = search(model.confirmed(plain->chosen.map), uniform);
+        const auto confirm = [&](Search s, const FociOptions& o) {
+            // The map encoded and its losses as that encode measured them.
+            Try encoded = s.chosen;
+            const FrameErrorModel confirmed = model.confirmed(encoded.map);
+            encoded.predicted = confirmed.predict(encoded.map);
+            s = search(confirmed, o);
+            const int rounds = model.options().confirmRounds - 1;
+            if (rounds <= 0 || exactK || std::abs(s.chosen.t - encoded.t) <= kConfirmedT) return s;
+            // Further rounds: the same regula falsi on t, each try's losses measured by its own
+            // encode, between the map first encoded and the one its confirmed model chose (k = 1
+            // where both hold or both miss the budget): the map kept holds the budget as measured.
+            const auto measured = [&](double t) {
+                Try x = attempt(model, t, o);
+                x.predicted = model.confirmed(x.map).predict(x.map);
+                return x;
+            };
+            Try next = measured(s.chosen.t);
+            const bool nextHolds = over(next) <= 0, encodedHolds = over(encoded) <= 0;
+            if (nextHolds && encodedHolds) {  // both hold: the larger k
+                s.chosen = std::move(next.t >= encoded.t ? next : encoded);
+                return s;
+            }
+            if (nextHolds != encodedHolds && (nextHolds ? next.t > encoded.t : encoded.t > next.t)) {
+                s.chosen = std::move(nextHolds ? next : encoded);  // a larger k holds where a smaller one missed: kept
+                return s;
+            }
+            // A try that misses the budget and, at a smaller t, one that holds it (k = 1 where both miss).
+            Try beyond = std::move(!nextHolds && (encodedHolds || next.t < encoded.t) ? next : encoded);
+            Try within = nextHolds ? std::move(next) : encodedHolds ? std::move(encoded) : measured(0.0);
+            if (over(within) > 0) {  // even k = 1 misses: the closest there is
+                s.chosen = std::move(within);
+                return s;
+            }
+            const double a = within.t, b = beyond.t;
+            s.chosen = detail::searchWithin(std::move(within), a, std::move(beyond), b, measured, over, std::max(0, rounds - 1), kConfirmedT, kMeasuredToleranceDb);
+            return s;
+        };
+        chosen = confirm(std::move(chosen), options);
+        if (plain) plain = confirm(std::move(*plain), uniform);
     }
     if (plain && ((over(chosen.chosen) > 0 && over(plain->chosen) <= 0) || !keepsContext(chosen.chosen.predicted, plain->chosen.predicted)))
         chosen = std::move(*plain);

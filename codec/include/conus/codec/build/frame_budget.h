@@ -58,7 +58,20 @@ struct FrameModelOptions {
     // Whether the budgets confirm their choice by one real encode (FrameErrorModel::confirmed) and
     // choose again on the confirmed model; `--fast` does not.
     bool confirm = true;
+    // The foci's budget (fociForFrameLoss): how many confirming encodes each candidate may take.
+    // One: the map chosen on the model alone is encoded and the choice made again on the model that
+    // encode confirms. More: where that choice moved (its exponent of k by more than kConfirmedT),
+    // the search goes on on measured losses alone, each try encoded (regula falsi between the maps
+    // encoded, up to this many encodes in all), and keeps a map whose own encode holds the budget:
+    // a correction measured on one map carries to maps near it only roughly (on the relief tablet's
+    // colour, a map a quarter of an octave of k away lost 0.3 dB more outside its focus than the
+    // corrected model said), so a budget that must hold to the tenth of a dB confirms more than once.
+    int confirmRounds = 1;
 };
+
+// How near (in the exponent t of k^t) the map chosen on a confirmed model must be to the map that
+// model's encode measured for no further confirming encode to be taken.
+inline constexpr double kConfirmedT = 0.02;
 
 class FrameErrorModel {
 public:
