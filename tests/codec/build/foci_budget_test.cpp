@@ -295,6 +295,33 @@ TEST(FociBudget, AContextFollowingTheDetailGivesTheFocusMore) {
     EXPECT_LE(detailed.tileLoss, kDefaultTileLoss + 1.0);
 }
 
+// More than one confirming encode (FrameModelOptions::confirmRounds, what `bake relief` uses): the map
+// kept is one whose own encode holds the budget, and what the budget says of it is that encode's
+// measure; a real encode and decode of it, read as 8-bit sRGB, agrees.
+TEST(FociBudget, ConfirmingRoundsKeepAMapItsOwnEncodeHolds) {
+    const Image source = picture();
+    const double aspect = double(kWidth) / kHeight;
+    const std::vector<Focus> foci{{0.62, 0.4, 0.13, 4.0}};
+    const Image importance = fociImportance(foci, aspect, 96, 64);
+    constexpr double kBudget = 0.5;
+    for (int rounds : {1, 6}) {
+        SCOPED_TRACE(rounds);
+        const FrameErrorModel model(source, kWidth / 4, kHeight / 4, importance, {ErrorSpace::Display, 0, kFitHoldLowPass, true, rounds});
+        const FociBudget b = fociForFrameLoss(foci, optionsFor(aspect), model, kBudget);
+        const FramePrediction own = model.confirmed(b.map).predict(b.map);
+        const Shown shown = measureShown(source, b.map, importance);
+        std::printf("%d confirming rounds: k %.3f, predicted frame loss %.3f dB, its own encode %.3f dB, 8-bit sRGB %.3f dB\n", rounds,
+                    b.given[0].k, b.predicted.frameLoss, own.frameLoss, shown.frameLoss);
+        EXPECT_TRUE(b.lowered);
+        if (rounds > 1) {
+            EXPECT_NEAR(b.predicted.frameLoss, own.frameLoss, 1e-9);
+            EXPECT_LE(own.frameLoss, kBudget);
+            EXPECT_GT(own.frameLoss, kBudget - 0.2);  // not lowered further than the rounds need
+            EXPECT_NEAR(shown.frameLoss, own.frameLoss, 0.1);
+        }
+    }
+}
+
 // Where the context gives the focus less (fine noise everywhere but a smooth focus, which the
 // context starves), the uniform context's map is kept: the context never costs the regions more
 // than the margin that keeps the choice stable.
