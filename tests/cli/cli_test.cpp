@@ -503,9 +503,11 @@ TEST_F(Cli, FocusViewOfARealPhotoBeatsTheUniformImage) {
     if (!fs::exists(photo)) GTEST_SKIP() << "python3-skimage's photographs not installed (" << photo << ")";
     const Result r = run("demo --input " + photo + " --focus 0.44,0.23,0.08,4 --out " + path("q"));
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    // "focus 1   31.30 dB   24.31 dB   +6.99"
-    const auto line = r.out.find("focus 1");
+    // The table's row "focus 1   31.30 dB   24.31 dB   +6.99" (the budget's block above it says
+    // "  focus 1 at (u, v), r ...: k ...", indented).
+    auto line = r.out.find("\nfocus 1 ");
     ASSERT_NE(line, std::string::npos) << r.out;
+    ++line;
     double conusDb = 0, uniformDb = 0;
     ASSERT_EQ(std::sscanf(r.out.c_str() + line, "focus 1 %lf dB %lf dB", &conusDb, &uniformDb), 2) << r.out;
     EXPECT_GT(conusDb, uniformDb + 3.0) << r.out;
