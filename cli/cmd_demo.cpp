@@ -125,7 +125,7 @@ DemoMap demoMap(const DemoOptions& o, DemoSource& source, const Size& size) {
         said = describeFociBudget(budget, BudgetFrame{size.width, size.height, w, h}, false, fociOptions.columns);
         source.foci = budget.given;
         m.map = std::move(budget.map);
-        m.analytic = codec::toAnalytic(source.foci, fociOptions.composition, fociOptions.falloff);
+        m.analytic = codec::toAnalytic(source.foci, fociOptions.composition, codec::recordedFalloff(budget, fociOptions.falloff));
     }
     building.done();
     if (!said.empty() && !quiet()) std::printf("%s\n", said.c_str());

@@ -68,12 +68,12 @@ BuiltMap mapFromFile(const std::string& path, const Image& source) {
 // context foci and importance maps sit on.
 codec::AutoMapOptions ownDetailOptions(const EncodeOptions& o) { return autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method); }
 
-// The density the picture's own detail asks for (codec::ownDetailContext), this encode's trials choosing its floor.
-codec::DensityField ownDetailContext(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials) {
-    return codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), trials);
+// The density the picture's own detail asks for (codec::ownDetailContext), the budget's model choosing its floor.
+codec::DensityField ownDetailContext(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
+    return codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), modelOptions);
 }
 
-BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials) {
+BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
     Progress progress("build sampling map from " + o.importance + " importance");
     codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
     const Image importance = importanceFrom(o.importance, source);
@@ -86,22 +86,20 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     // samples follow the picture's own detail, as with no importance at all (`detail` is that already).
     codec::DensityField context;
     if (o.importance != "detail") {
-        context = ownDetailContext(o, source, size, trials);
+        context = ownDetailContext(o, source, size, modelOptions);
         autoOptions.context = &context;
     }
-    const codec::FrameErrorModel model(source, size.width, size.height, importance, trials);
+    const codec::FrameErrorModel model(source, size.width, size.height, importance, modelOptions);
     codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions, codec::kDefaultTileLoss);
     progress.done();
     if (!quiet())
-        std::printf("frame-loss budget %.2f dB (tiles %.2g dB): context floor %.3g; predicted whole-frame loss %.2f dB (tiles %.1f dB), ROI gain %+.2f dB%s\n",
-                    o.frameLoss, codec::kDefaultTileLoss, r.minDensity, r.predicted.frameLoss, r.predicted.tileLoss, r.predicted.roiGain,
-                    r.budgetBinds ? "" : " (the lowest floor stays within the budget: raise --max-density for more)");
+        std::printf("%s\n", describeFloorBudget(r, o.frameLoss, o.importance + " importance").c_str());
     return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt};
 }
 
 // The foci's map under the frame-loss budget (foci_budget.h): says, before the work, what the foci
 // take and the k each got; `given` receives that k for the line that says what was written.
-BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials, std::string* given) {
+BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
     const std::vector<codec::Focus> foci = parseFoci(o.foci);
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
@@ -111,11 +109,11 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
     // Away from the foci the samples follow the picture's own detail, as with no focus at all.
-    const codec::DensityField context = ownDetailContext(o, source, size, trials);
+    const codec::DensityField context = ownDetailContext(o, source, size, modelOptions);
     fo.context = &context;
     const int side = 256;
     const codec::FrameErrorModel model(source, size.width, size.height,
-                                       codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))), trials);
+                                       codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))), modelOptions);
     codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, o.frameLoss, o.exactK);
     progress.done();
     const std::string said =
@@ -123,23 +121,26 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
                            o.maxAnisotropy);
     if (!quiet()) std::printf("%s\n", said.c_str());
     *given = "k " + fociKText(budget.given);
-    return {std::make_unique<codec::SamplingMap>(std::move(budget.map)), codec::toAnalytic(budget.given, fo.composition, fo.falloff)};
+    // The file records the falloff the map holds (a transition widened for the anisotropy bound).
+    return {std::make_unique<codec::SamplingMap>(std::move(budget.map)),
+            codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff))};
 }
 
 // No focus, map or importance: the samples follow the picture's own detail, with the context floor
 // the model predicts gains most over the whole frame (frame_budget.h), said once per batch.
-BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& trials, std::string* given) {
+BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
     Progress progress("build sampling map from the picture's detail");
     codec::BudgetResult r =
-        codec::buildOwnDetailMap(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), trials);
+        codec::buildOwnDetailMap(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), modelOptions);
     progress.done();
     static std::once_flag once;  // once per batch, not per file
     std::call_once(once, [] {
         warn("no --focus, --map or --importance: the samples follow the picture's own detail (--importance detail, "
              "the context floor chosen for the whole frame); `conus uniform` writes the uniform image");
     });
-    char text[120];
-    std::snprintf(text, sizeof text, "detail, context floor %.2g, predicted whole-frame gain %+.1f dB", r.minDensity, -r.predicted.frameLoss);
+    char text[160];
+    std::snprintf(text, sizeof text, "detail, context floor %.2g, predicted: the whole frame %s", r.minDensity,
+                  lossText(r.predicted.frameLoss, "loses", "gains", 1).c_str());
     *given = text;
     return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt};
 }
@@ -153,14 +154,15 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     if (!o.importance.empty() || !o.foci.empty()) checkGridForImage(o.grid, size.width, size.height);
     BuiltMap built;
     std::string given;
-    // The budgets' trial encodes are this encode's, measured on what a user sees: colour through the
-    // display's curve, raw data as stored.
-    const codec::FrameModelOptions trials{
-        source.info.encoding.transfer == Transfer::Raw ? codec::ErrorSpace::Linear : codec::ErrorSpace::Display, o.fit.count(), o.fit.hold};
+    // The budgets' model predicts this encode (fitted or `--fast`) on what a user sees: colour
+    // through the display's curve, raw data as stored; one real encode confirms it, but under `--fast`.
+    const codec::FrameModelOptions modelOptions{
+        source.info.encoding.transfer == Transfer::Raw ? codec::ErrorSpace::Linear : codec::ErrorSpace::Display, o.fit.count(), o.fit.hold,
+        !o.fast};
     if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image);
-    else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, trials);
-    else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, trials, &given);
-    else built = mapFromOwnDetail(o, source.image, size, trials, &given);
+    else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, modelOptions);
+    else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, modelOptions, &given);
+    else built = mapFromOwnDetail(o, source.image, size, modelOptions, &given);
     const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Faster, "encoding");
     std::string fitNote;
     format::ConusFile file =

@@ -280,7 +280,7 @@ void runFoci(const FociOptions& o) {
     progress.done();
     const std::string said = describeFociBudget(budget, std::nullopt, o.exactK, o.grid, o.maxAnisotropy);
     if (!quiet()) std::printf("%s\n", said.c_str());
-    std::optional<format::AnalyticMap> analytic = codec::toAnalytic(budget.given, fo.composition, fo.falloff);
+    std::optional<format::AnalyticMap> analytic = codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff));
     analytic->scalars["aspect"] = o.aspect;  // so an encode of a picture of another aspect can warn
     writeMapFile(budget.map, std::move(analytic), o.out, o.aspect);
 }

@@ -65,8 +65,8 @@ FrameMap chooseFrameMap(bool uniform, const std::string& mapFile, const FociSour
 CLI::Option* addFrameLossOption(CLI::App& command, double& frameLoss, const std::string& what) {
     return command
         .add_option("--frame-loss", frameLoss,
-                    "whole-frame loss budget in dB against the uniform image of the same pixel count, measured "
-                    "before the work by trial encodes of the picture at 1024 px: " + what + " (default " +
+                    "whole-frame loss budget in dB against the uniform image of the same pixel count, predicted "
+                    "before the work from the picture's detail at every scale and the map's density: " + what + " (default " +
                     numberText(codec::kDefaultFrameLoss) + ")")
         ->check(finiteRange(0.0, 60.0, true, true));
 }
@@ -91,34 +91,62 @@ std::string oneIn(double downscale) { return "1/" + numberText(std::round(downsc
 
 }  // namespace
 
+std::string lossText(double db, const char* lose, const char* gain, int decimals) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%s %.*f dB", db < 0 ? gain : lose, decimals, std::abs(db));
+    return text;
+}
+
+std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what) {
+    char floor[32];
+    std::snprintf(floor, sizeof floor, "%.3g", r.minDensity);
+    return "budget: the whole frame within " + numberText(frameLoss) + " dB and tiles outside the region within " +
+           numberText(codec::kDefaultTileLoss) + " dB (95th percentile), predicted against `conus uniform` of the same pixel count "
+           "(--frame-loss sets it)\n  " + what + ": context floor " + floor + ", density cap " + numberText(std::round(r.maxDensity * 10) / 10) +
+           (r.budgetBinds ? "" : " (the budget does not bind: the lowest floor and the highest cap hold it)") +
+           "\n  predicted: the whole frame " + lossText(r.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the region " +
+           lossText(r.predicted.tileLoss, "lose", "gain", 1) + " at the 95th percentile, the region gains " +
+           numberText(std::round(r.predicted.roiGain * 10) / 10) + " dB";
+}
+
 std::string describeFociBudget(const codec::FociBudget& b, const std::optional<BudgetFrame>& frame, bool exactK, int grid,
                                double maxAnisotropy) {
     std::string text;
-    if (b.askedShare.ask > 1.0)
-        text = "the foci ask " + numberText(std::round(b.askedShare.ask * 10) / 10) + "x the pixels there are at k " + fociKText(b.asked) + "; ";
-    if (b.lowered)
-        text += (frame ? "the loss budget (whole frame " + numberText(frame->frameLoss) + " dB, tiles " + numberText(codec::kDefaultTileLoss) + " dB" +
-                             (std::isfinite(frame->restLoss) ? ", outside the foci " + numberText(frame->restLoss) + " dB" : "") + ")"
-                       : "the context floor (density " + numberText(codec::kDefaultContextFloor) + ")") +
-                " lowered k from " + fociKText(b.asked) + " to " + fociKText(b.given) + " (--exact-k keeps k); ";
-    const std::string pixels = frame ? std::to_string(frame->width) + "x" + std::to_string(frame->height) + " pixels" : "map's samples";
-    text += "foci take " + percent(b.share.share) + " of the " + pixels + (b.lowered ? "" : " at k " + fociKText(b.given));
+    const auto kOf = [](double k) { return numberText(std::round(k * 100) / 100); };
     if (frame) {
+        // One short block: the budget, the k each focus got, what the frame holds, how to get the k asked.
+        text = "budget: the whole frame within " + numberText(frame->frameLoss) + " dB and tiles outside the foci within " +
+               numberText(codec::kDefaultTileLoss) + " dB (95th percentile)" +
+               (std::isfinite(frame->restLoss) ? ", outside the foci " + numberText(frame->restLoss) + " dB" : "") +
+               ", predicted against `conus uniform` of the same pixel count (--frame-loss sets it)";
+        for (std::size_t i = 0; i < b.given.size(); ++i) {
+            char line[160];
+            std::snprintf(line, sizeof line, "\n  focus %zu at (%.3g, %.3g), r %.3g: k %s (asked %s)", i + 1, b.given[i].u, b.given[i].v,
+                          b.given[i].r, kOf(b.given[i].k).c_str(), kOf(b.asked[i].k).c_str());
+            text += line;
+        }
+        text += "\n  predicted: the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the foci " +
+                lossText(b.predicted.tileLoss, "lose", "gain", 1) + " at the 95th percentile, the foci gain " +
+                numberText(std::round(b.predicted.roiGain * 10) / 10) + " dB";
+        if (b.lowered)
+            text += "\n  k as asked: --exact-k (predicted: the whole frame " + lossText(b.askedPredicted.frameLoss, "loses", "gains", 2) +
+                    ", the tiles " + lossText(b.askedPredicted.tileLoss, "lose", "gain", 1) + ")";
         const double uniform = codec::contextDownscale({0, 1, 0}, frame->width, frame->height, frame->sourceWidth, frame->sourceHeight);
-        text += "; the context is sampled like a " + oneIn(codec::contextDownscale(b.share, frame->width, frame->height, frame->sourceWidth, frame->sourceHeight)) +
+        text += "\n  the foci take " + percent(b.share.share) + " of the " + std::to_string(frame->width) + "x" +
+                std::to_string(frame->height) + " pixels; the context is sampled like a " +
+                oneIn(codec::contextDownscale(b.share, frame->width, frame->height, frame->sourceWidth, frame->sourceHeight)) +
                 " downscale (the uniform image: " + oneIn(uniform) + ")";
-        char predicted[200];
-        std::snprintf(predicted, sizeof predicted, "; predicted whole-frame loss %.2f dB (tiles outside the foci: %.1f dB at the 95th percentile), ROI gain %+.1f dB",
-                      b.predicted.frameLoss, b.predicted.tileLoss, b.predicted.roiGain);
-        text += predicted;
         if (exactK && (b.predicted.frameLoss > frame->frameLoss || b.predicted.tileLoss > codec::kDefaultTileLoss))
-            warn("--exact-k: the foci leave the context sampled like a " +
-                 oneIn(codec::contextDownscale(b.share, frame->width, frame->height, frame->sourceWidth, frame->sourceHeight)) +
-                 " downscale; predicted against the uniform image: the whole frame loses " +
-                 numberText(std::round(b.predicted.frameLoss * 10) / 10) + " dB, the tiles outside the foci " +
-                 numberText(std::round(b.predicted.tileLoss * 10) / 10) + " dB (the budget: " + numberText(frame->frameLoss) +
-                 " and " + numberText(codec::kDefaultTileLoss) + " dB)");
+            warn("--exact-k: predicted against the uniform image, the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 1) +
+                 ", the tiles outside the foci " + lossText(b.predicted.tileLoss, "lose", "gain", 1) + " (the budget: " +
+                 numberText(frame->frameLoss) + " and " + numberText(codec::kDefaultTileLoss) + " dB)");
     } else {
+        if (b.askedShare.ask > 1.0)
+            text = "the foci ask " + numberText(std::round(b.askedShare.ask * 10) / 10) + "x the pixels there are at k " + fociKText(b.asked) + "; ";
+        if (b.lowered)
+            text += "the context floor (density " + numberText(codec::kDefaultContextFloor) + ") lowered k from " + fociKText(b.asked) +
+                    " to " + fociKText(b.given) + " (--exact-k keeps k); ";
+        text += "foci take " + percent(b.share.share) + " of the map's samples" + (b.lowered ? "" : " at k " + fociKText(b.given));
         text += "; the context keeps density " + numberText(std::round(b.share.contextDensity * 1000) / 1000) + " (" +
                 numberText(std::round(std::sqrt(b.share.contextDensity) * 100) / 100) + "x the uniform image's linear rate)";
         if (exactK && b.share.contextDensity < codec::kDefaultContextFloor)
@@ -130,7 +158,7 @@ std::string describeFociBudget(const codec::FociBudget& b, const std::optional<B
              std::to_string(grid) + "x" + std::to_string(grid) + " grid" +
              (maxAnisotropy > 0 ? " under --max-anisotropy " + numberText(maxAnisotropy) : std::string()) +
              ": recorded so (a finer --grid or a wider focus holds more)");
-    for (const std::string& note : b.builderNotes) text += "\n" + note;  // what the anisotropy bound cost
+    for (const std::string& note : b.builderNotes) text += "\n" + std::string(frame ? "  " : "") + note;  // what the anisotropy bound cost
     return text;
 }
 

@@ -31,6 +31,10 @@ inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, i
     d["predicted_frame_loss"] = b.predicted.frameLoss;
     d["predicted_roi_gain"] = b.predicted.roiGain;
     d["predicted_tile_loss"] = b.predicted.tileLoss;
+    // What k as asked would hold (exact_k=True), predicted the same way.
+    d["predicted_frame_loss_exact_k"] = b.askedPredicted.frameLoss;
+    d["predicted_tile_loss_exact_k"] = b.askedPredicted.tileLoss;
+    d["tile_loss"] = codec::kDefaultTileLoss;
     d["foci_share"] = b.share.share;
     d["ask"] = b.askedShare.ask;
     d["context_downscale"] = codec::contextDownscale(b.share, w, h, sourceW, sourceH);
@@ -44,7 +48,9 @@ inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, i
     if (b.lowered)
         warning = "conus.encode: the loss budget (whole frame " + numberText(frameLoss) + " dB, tiles " + numberText(codec::kDefaultTileLoss) +
                   " dB) lowered k from " + list(asked) + " to " +
-                  list(given) + " (exact_k=True keeps k)";
+                  list(given) + " (exact_k=True keeps k: predicted, the whole frame then loses " +
+                  numberText(std::round(b.askedPredicted.frameLoss * 100) / 100) + " dB, the tiles " +
+                  numberText(std::round(b.askedPredicted.tileLoss * 10) / 10) + " dB)";
     else if (exactK && (b.predicted.frameLoss > frameLoss || b.predicted.tileLoss > codec::kDefaultTileLoss))
         warning = "conus.encode: exact_k: predicted against the uniform image, the whole frame loses " +
                   numberText(std::round(b.predicted.frameLoss * 10) / 10) + " dB, the tiles outside the foci " +

@@ -220,7 +220,9 @@ PYBIND11_MODULE(_conus, m) {
         .def_property_readonly(
             "budget", [](const File& self) -> py::object { return self.budget ? py::object(*self.budget) : py::none(); },
             "What encode(foci=...)'s budget did, or None: k_asked, k_given (each focus's), lowered, frame_loss (the\n"
-            "budget), predicted_frame_loss, predicted_roi_gain (dB), foci_share (of the CoNUS pixels),\n"
+            "budget), tile_loss (its tiles' budget), predicted_frame_loss, predicted_tile_loss, predicted_roi_gain (dB;\n"
+            "a negative loss is a gain), predicted_frame_loss_exact_k and predicted_tile_loss_exact_k (what the k\n"
+            "asked would hold: the price of exact_k=True), foci_share (of the CoNUS pixels),\n"
             "context_downscale and uniform_downscale (the linear downscale the context and the uniform image are\n"
             "sampled like), ask (the discs' pixels at k over all the pixels), grid_limited")
         .def("__repr__", [](const File& self) {
@@ -268,9 +270,10 @@ PYBIND11_MODULE(_conus, m) {
             const auto [w, h] = sizeOr(size, source.width, source.height);
             codec::checkEncodeMemory(source, w, h);  // before a map is built for it
             std::optional<codec::FociBudget> budget;
-            // The budgets' trial encodes are this encode's, on what a display shows (data as stored).
+            // The budgets' model takes this encode's errors: on what a display shows (data as stored),
+            // fitted or not; one real encode confirms it, but unfitted (fit=0, as `--fast`).
             const codec::FrameModelOptions trials{colorspace == enumName(Transfer::Raw) ? codec::ErrorSpace::Linear : codec::ErrorSpace::Display,
-                                                  fit, fitHold};
+                                                  fit, fitHold, fit > 0};
             if (!map) {
                 if (!foci.empty()) {
                     const std::vector<codec::Focus>& f = foci;
@@ -289,7 +292,8 @@ PYBIND11_MODULE(_conus, m) {
                         budget = codec::fociForFrameLoss(f, options, model, frameLoss, exactK);
                         options.context = nullptr;  // the field ends with this block
                     }
-                    map = std::make_shared<Map>(Map{budget->map, codec::toAnalytic(budget->given, options.composition), aspect});
+                    map = std::make_shared<Map>(
+                        Map{budget->map, codec::toAnalytic(budget->given, options.composition, codec::recordedFalloff(*budget, options.falloff)), aspect});
                 } else {
                     // As `conus encode` with no focus, map or importance: the picture's own detail.
                     warn("conus.encode: no foci or map: the samples follow the picture's own detail (conus.importance(pixels, "

@@ -2,7 +2,9 @@
 // through the real binary: the line before the work, the k the file records, --exact-k, and the
 // documented option combinations that once refused a grid as too coarse.
 #include <algorithm>
+#include <cmath>
 #include <regex>
+#include <utility>
 
 #include "cli/cli_fixture.h"
 #include "conus/codec/map/sampling_map.h"
@@ -38,56 +40,115 @@ std::vector<double> numbersAfter(const std::string& text, const std::string& pre
     return out;
 }
 
+// The k each focus got and the k asked, from the block `encode` prints ("focus 1 at (...): k 2.6 (asked 4)").
+std::vector<std::pair<double, double>> printedK(const std::string& text) {
+    const std::regex line(R"(focus [0-9]+ at \([^)]*\), r [0-9.e-]+: k ([0-9.]+) \(asked ([0-9.]+)\))");
+    std::vector<std::pair<double, double>> out;
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), line); it != std::sregex_iterator(); ++it)
+        out.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]));
+    return out;
+}
+
+// A printed loss: "loses 1.50 dB" as 1.5, "gains 0.44 dB" as -0.44, after `subject` ("the whole frame").
+double printedLoss(const std::string& text, const std::string& subject) {
+    const std::regex loss(subject + R"( (loses|gains|lose|gain) ([0-9.]+) dB)");
+    std::smatch m;
+    if (!std::regex_search(text, m, loss)) return std::nan("");
+    return (m[1].str().rfind("gain", 0) == 0 ? -1.0 : 1.0) * std::stod(m[2]);
+}
+
 TEST_F(BudgetCli, TwoLargeFociAreLoweredAndSaySo) {
     const std::string picture = makePicture(360, 240);
     const std::string foci = " --focus 0.3,0.4,0.16,4 --focus 0.7,0.55,0.15,4 --size 90x60";
     const Result r = run("encode " + picture + foci + " -o " + path("held.exr"));
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    // Before the work: what they ask, that the budget lowered k, what they take, the context's rate.
-    EXPECT_NE(r.out.find("the foci ask "), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("x the pixels there are at k 4, 4"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("the loss budget (whole frame 1.5 dB, tiles 4 dB) lowered k from 4, 4 to "), std::string::npos) << r.out;
+    // Before the work, on stdout: the budget, the k each focus got and was asked, what the frame
+    // holds, how to get the k asked and what it costs, what the foci take.
+    EXPECT_NE(r.out.find("budget: the whole frame within 1.5 dB and tiles outside the foci within 4 dB"), std::string::npos) << r.out;
+    const std::vector<std::pair<double, double>> k = printedK(r.out);
+    ASSERT_EQ(k.size(), 2u) << r.out;
+    EXPECT_EQ(k[0].second, 4.0);
+    EXPECT_GT(k[0].first, 1.0);
+    EXPECT_LT(k[0].first, 4.0);
+    EXPECT_NEAR(std::log(k[0].first), std::log(k[1].first), 0.02);  // every k lowered alike
+    const double frame = printedLoss(r.out, "predicted: the whole frame");
+    EXPECT_LE(frame, 1.5 + 0.005) << r.out;
+    EXPECT_LE(printedLoss(r.out, "tiles outside the foci"), 4.0 + 0.05) << r.out;
+    EXPECT_NE(r.out.find("k as asked: --exact-k (predicted: the whole frame "), std::string::npos) << r.out;
+    const double asked = printedLoss(r.out.substr(r.out.find("k as asked")), "the whole frame");
+    EXPECT_GT(asked, frame) << r.out;
     EXPECT_NE(r.out.find("of the 90x60 pixels"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("the context is sampled like a 1/"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("(the uniform image: 1/4)"), std::string::npos) << r.out;
-    const std::vector<double> said = numbersAfter(r.out, "lowered k from 4, 4 to ");
-    ASSERT_EQ(said.size(), 2u) << r.out;
-    EXPECT_GT(said[0], 1.0);
-    EXPECT_LT(said[0], 4.0);
-    // The file records the k given, which the 'wrote' line repeats.
-    const std::vector<double> k = recordedK(path("held.exr"));
-    ASSERT_EQ(k.size(), 2u);
-    EXPECT_NEAR(k[0], said[0], 0.01);
-    EXPECT_NEAR(k[1], said[1], 0.01);
+    // The file records the k printed, which the 'wrote' line repeats.
+    const std::vector<double> recorded = recordedK(path("held.exr"));
+    ASSERT_EQ(recorded.size(), 2u);
+    EXPECT_NEAR(recorded[0], k[0].first, 0.006);
+    EXPECT_NEAR(recorded[1], k[1].first, 0.006);
     EXPECT_NE(r.out.find("sampling map (k "), std::string::npos) << r.out;
 
-    // --exact-k keeps k as asked and warns what the frame pays for it.
+    // --exact-k keeps k as asked and warns what the frame pays for it, as the block said it would.
     const Result exact = run("encode " + picture + foci + " --exact-k -o " + path("exact.exr"));
     ASSERT_EQ(exact.exitCode, 0) << exact.err;
     EXPECT_EQ(recordedK(path("exact.exr")), (std::vector<double>{4.0, 4.0}));
-    EXPECT_EQ(exact.out.find("lowered"), std::string::npos) << exact.out;
-    EXPECT_NE(exact.err.find("warning: --exact-k: the foci leave the context sampled like a 1/"), std::string::npos) << exact.err;
+    EXPECT_EQ(exact.out.find("k as asked"), std::string::npos) << exact.out;
+    // (Each run confirms its model by an encode of the map it chose: the --exact-k run on this very map.)
+    EXPECT_NEAR(printedLoss(exact.out, "predicted: the whole frame"), asked, 0.3) << exact.out;
+    EXPECT_NE(exact.err.find("warning: --exact-k: predicted against the uniform image, the whole frame "), std::string::npos) << exact.err;
 
-    // A tighter whole-frame budget gives less: the k falls with it. (Without the fit, whose gain
-    // keeps this picture's whole frame within any budget at the k the tiles allow.)
+    // A tighter whole-frame budget holds, as predicted, by lowering k.
     ASSERT_EQ(run("encode " + picture + foci + " --fast -o " + path("fast.exr")).exitCode, 0);
     const Result tight = run("encode " + picture + foci + " --fast --frame-loss 0.1 -o " + path("tight.exr"));
     ASSERT_EQ(tight.exitCode, 0) << tight.err;
-    EXPECT_NE(tight.out.find("the loss budget (whole frame 0.1 dB, tiles 4 dB) lowered k"), std::string::npos) << tight.out;
-    EXPECT_LT(recordedK(path("tight.exr"))[0], recordedK(path("fast.exr"))[0] - 0.05);
+    EXPECT_NE(tight.out.find("budget: the whole frame within 0.1 dB"), std::string::npos) << tight.out;
+    EXPECT_LE(printedLoss(tight.out, "predicted: the whole frame"), 0.1 + 0.005) << tight.out;
+    EXPECT_LT(recordedK(path("tight.exr"))[0], 4.0 - 0.05);
 }
 
 TEST_F(BudgetCli, ASmallFocusKeepsItsK) {
     const std::string picture = makePicture(320, 240);
     const Result r = run("encode " + picture + " --focus 0.62,0.35,0.05,3 --size 80x60 --frame-loss 6 -o " + path("a.exr"));
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_EQ(r.out.find("lowered"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("foci take "), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("of the 80x60 pixels at k 3;"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("k as asked"), std::string::npos) << r.out;
+    EXPECT_EQ(printedK(r.out), (std::vector<std::pair<double, double>>{{3.0, 3.0}})) << r.out;
+    EXPECT_NE(r.out.find("the foci take "), std::string::npos) << r.out;
     EXPECT_EQ(recordedK(path("a.exr")), std::vector<double>{3.0});
     // --exact-k is about foci only.
     EXPECT_EQ(run("encode " + picture + " --exact-k -o " + path("b.exr")).exitCode, 2);
     EXPECT_FALSE(fs::exists(path("b.exr")));
+}
+
+// --frame-loss is the budget of the detail map too: a looser one spends more on the detail (a lower
+// context floor, or where the lowest floor holds the budget, a higher density cap), the prediction
+// printed follows it, and the files differ.
+TEST_F(BudgetCli, FrameLossSetsTheDetailMap) {
+    const std::string picture = makePicture(320, 240);
+    const Result tight = run("encode " + picture + " --importance detail --size 80x60 --frame-loss 0.2 -o " + path("t.exr"));
+    const Result loose = run("encode " + picture + " --importance detail --size 80x60 --frame-loss 3 -o " + path("l.exr"));
+    ASSERT_EQ(tight.exitCode, 0) << tight.err;
+    ASSERT_EQ(loose.exitCode, 0) << loose.err;
+    const auto floorAndCap = [](const std::string& text) {
+        const std::vector<double> floor = numbersAfter(text, "context floor "), cap = numbersAfter(text, "density cap ");
+        return std::make_pair(floor.empty() ? std::nan("") : floor[0], cap.empty() ? std::nan("") : cap[0]);
+    };
+    const auto [floorTight, capTight] = floorAndCap(tight.out);
+    const auto [floorLoose, capLoose] = floorAndCap(loose.out);
+    ASSERT_TRUE(std::isfinite(floorTight) && std::isfinite(capTight)) << tight.out;
+    ASSERT_TRUE(std::isfinite(floorLoose) && std::isfinite(capLoose)) << loose.out;
+    const double tightLoss = printedLoss(tight.out, "predicted: the whole frame"), looseLoss = printedLoss(loose.out, "predicted: the whole frame");
+    EXPECT_LE(tightLoss, 0.2 + 0.005) << tight.out;
+    EXPECT_LE(looseLoss, 3 + 0.005) << loose.out;
+    // Where the budget binds, the looser one spends more on the detail; where even the lowest floor
+    // and the highest cap hold it (a detail map that gains over the whole frame), the block says so.
+    const bool binds = tight.out.find("does not bind") == std::string::npos;
+    if (binds) {
+        EXPECT_TRUE(floorLoose < floorTight - 0.01 || capLoose > capTight * 1.05) << tight.out << loose.out;
+        EXPECT_GT(looseLoss, tightLoss + 0.3) << loose.out;
+        EXPECT_NE(format::readConusFile(path("t.exr")).map.xy, format::readConusFile(path("l.exr")).map.xy);
+    } else {
+        EXPECT_NE(loose.out.find("does not bind"), std::string::npos) << loose.out;
+        EXPECT_EQ(capTight, 256.0) << tight.out;
+    }
 }
 
 TEST_F(BudgetCli, MapFociKeepsTheContextFloor) {
@@ -110,6 +171,15 @@ TEST_F(BudgetCli, MapFociKeepsTheContextFloor) {
     EXPECT_NE(exact.err.find("under the default floor 0.25"), std::string::npos) << exact.err;
     // What the anisotropy bound cost the k = 5 focus is said, with numbers.
     EXPECT_NE(exact.out.find("focus 0.25,0.3,0.2,5: transition widened from 1.25 to "), std::string::npos) << exact.out;
+    // And the file records the transition the map holds (the widest said), not the one asked.
+    double widest = 0;
+    for (std::size_t at = exact.out.find("transition widened from 1.25 to "); at != std::string::npos;
+         at = exact.out.find("transition widened from 1.25 to ", at + 1))
+        widest = std::max(widest, numbersAfter(exact.out.substr(at), "transition widened from 1.25 to ").at(0));
+    const format::ConusFile e = format::readConusFile(path("e.exr"));
+    ASSERT_TRUE(e.analytic);
+    ASSERT_TRUE(e.analytic->scalars.count("falloffWidth")) << exact.out;
+    EXPECT_NEAR(e.analytic->scalars.at("falloffWidth"), widest, 0.01) << exact.out;
 }
 
 TEST_F(BudgetCli, DocumentedCombinationsAreNotRefused) {

@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "conus/core/error.h"
+#include "budget_search.h"
 
 namespace conus::codec {
 namespace {
@@ -15,8 +17,14 @@ namespace {
 constexpr int kShareSide = 512;
 constexpr double kShareSamplesPerRadius = 8.0;
 constexpr int kMaxShareSide = 2048;
-// Halvings of the exponent t of k^t: t to within 1/64 (k = 4: to within 2%).
-constexpr int kBisectionSteps = 6;
+// Halvings of the exponent t of k^t without a picture: t to within 1/1024 (k = 4: to 0.14%).
+constexpr int kBisectionSteps = 10;
+// With a picture: the search for t stops within kTolerance of t, or within kToleranceDb under the
+// budget, or after kSearchSteps maps built.
+constexpr double kTolerance = 1.0 / 1024, kToleranceDb = 0.01;
+constexpr int kSearchSteps = 12;
+// The rounds of confirming encodes (FrameModelOptions::confirmRounds) stop within this of the budget.
+constexpr double kMeasuredToleranceDb = 0.05;
 
 bool inDisc(const Focus& f, double aspect, double u, double v) {
     const double dx = u - f.u, dy = (v - f.v) / aspect;
@@ -101,53 +109,102 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         throw Error(ErrorCode::InvalidArgument, "the frame-loss budget " + std::to_string(frameLossDb) + " dB must be finite and >= 0");
     if (!(tileLossDb >= 0))  // NaN fails; infinity: no tile budget
         throw Error(ErrorCode::InvalidArgument, "the tile-loss budget " + std::to_string(tileLossDb) + " dB must be >= 0");
-    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false, {}};
-    // A lower k leaves the context more samples: the loss falls with t. Each try builds the map and
-    // predicts what it loses (its target alone predicts too little: stretched footprints lose along
-    // their long axis).
-    double bestT = -1;
-    const auto holds = [&](double t) {
-        std::vector<Focus> tried = powered(foci, t);
+    struct Try {
+        double t;
+        std::vector<Focus> given;
+        SamplingMap map;
         FociReport report;
-        SamplingMap map = buildFociMap(tried, options, &report);
-        const FramePrediction p = model.predict(map);
-        const bool ok = p.frameLoss <= frameLossDb && p.tileLoss <= tileLossDb && p.restLoss <= restLossDb;
-        if (ok && t > bestT) {
-            bestT = t;
-            out.given = std::move(tried);
-            out.map = std::move(map);
-            out.builderNotes = std::move(report.notes);
-            out.predicted = p;
-        }
-        return ok;
+        FramePrediction predicted;
     };
-    if (exactK) {
-        out.given = out.asked;
-        FociReport report;
-        out.map = buildFociMap(out.given, options, &report);
-        out.builderNotes = std::move(report.notes);
-        out.predicted = model.predict(out.map);
-    } else {
-        const double t = largestHolding(holds);
-        if (options.context) {
-            // A context that follows the picture usually lets the foci keep more k; where it does
-            // not (a focus on a softer part of the picture than the rest, or a context that alone
-            // loses the budget), or where it crowds a few tiles (small features on a flat ground),
-            // the foci on a uniform context are kept (keepsContext).
-            FociOptions uniform = options;
-            uniform.context = nullptr;
-            FociBudget plain = fociForFrameLoss(foci, uniform, model, frameLossDb, exactK, tileLossDb, restLossDb);
-            if (bestT < 0 || !keepsContext(out.predicted, plain.predicted)) return plain;
-        }
-        if (bestT < 0) {  // even the lowest t tried loses more: the identity (k = 1) holds any budget
-            out.given = powered(foci, t);
-            FociReport report;
-            out.map = buildFociMap(out.given, options, &report);
-            out.builderNotes = std::move(report.notes);
-            out.predicted = model.predict(out.map);
-        }
-        out.lowered = t < 1.0;
+    const auto attempt = [&](const FrameErrorModel& m, double t, const FociOptions& o) {
+        Try x{t, powered(foci, t), SamplingMap::identity(2, 2), {}, {}};
+        x.map = buildFociMap(x.given, o, &x.report);
+        x.predicted = m.predict(x.map);
+        return x;
+    };
+    // How far a try is over the budget (dB, <= 0: within): continuous in t, as the model is.
+    const auto over = [&](const Try& x) {
+        const FramePrediction& p = x.predicted;
+        return std::max({p.frameLoss - frameLossDb, p.tileLoss - tileLossDb, std::isfinite(restLossDb) ? p.restLoss - restLossDb : -1e9});
+    };
+    // A lower k leaves the context more samples: the loss falls with t. The largest t within the
+    // budget: regula falsi (Illinois) on over(t) between t = 0 (k = 1) and 1, to kTolerance in t,
+    // each step a map built and predicted; the t chosen is a continuous function of the picture.
+    struct Search {
+        Try chosen, asked;
+    };
+    const auto search = [&](const FrameErrorModel& m, const FociOptions& o) {
+        Try hi = attempt(m, 1.0, o);
+        if (exactK || over(hi) <= 0) return Search{hi, hi};
+        Try lo = attempt(m, 0.0, o);
+        if (over(lo) > 0) return Search{std::move(lo), std::move(hi)};  // even k = 1 loses more: the closest to the budget there is
+        Try within = detail::searchWithin(std::move(lo), 0.0, hi, 1.0, [&](double t) { return attempt(m, t, o); }, over, kSearchSteps,
+                                          kTolerance, kToleranceDb);
+        return Search{std::move(within), std::move(hi)};
+    };
+    // A context that follows the picture usually lets the foci keep more k; where it does not (a
+    // focus on a softer part of the picture than the rest, or a context that alone loses the
+    // budget), or where it crowds a few tiles (small features on a flat ground), the foci on a
+    // uniform context are kept (keepsContext). Both candidates are searched on the model.
+    const bool compare = !exactK && options.context != nullptr;
+    FociOptions uniform = options;
+    uniform.context = nullptr;
+    Search chosen = search(model, options);
+    std::optional<Search> plain;
+    if (compare) plain = search(model, uniform);
+    if (model.options().confirm && !model.isConfirmed()) {
+        // One real encode of each candidate's map, and each searched again on the model its encode
+        // confirms: the model alone can be off by dB in either direction, and differently on the two
+        // contexts' maps (their footprints differ where the context does), so the two are compared
+        // on what their encodes measured, not on the model alone. What the block prints is then the
+        // chosen map's encode's measure near it.
+        const auto confirm = [&](Search s, const FociOptions& o) {
+            // The map encoded and its losses as that encode measured them.
+            Try encoded = s.chosen;
+            const FrameErrorModel confirmed = model.confirmed(encoded.map);
+            encoded.predicted = confirmed.predict(encoded.map);
+            s = search(confirmed, o);
+            const int rounds = model.options().confirmRounds - 1;
+            if (rounds <= 0 || exactK || std::abs(s.chosen.t - encoded.t) <= kConfirmedT) return s;
+            // Further rounds: the same regula falsi on t, each try's losses measured by its own
+            // encode, between the map first encoded and the one its confirmed model chose (k = 1
+            // where both hold or both miss the budget): the map kept holds the budget as measured.
+            const auto measured = [&](double t) {
+                Try x = attempt(model, t, o);
+                x.predicted = model.confirmed(x.map).predict(x.map);
+                return x;
+            };
+            Try next = measured(s.chosen.t);
+            const bool nextHolds = over(next) <= 0, encodedHolds = over(encoded) <= 0;
+            if (nextHolds && encodedHolds) {  // both hold: the larger k
+                s.chosen = std::move(next.t >= encoded.t ? next : encoded);
+                return s;
+            }
+            if (nextHolds != encodedHolds && (nextHolds ? next.t > encoded.t : encoded.t > next.t)) {
+                s.chosen = std::move(nextHolds ? next : encoded);  // a larger k holds where a smaller one missed: kept
+                return s;
+            }
+            // A try that misses the budget and, at a smaller t, one that holds it (k = 1 where both miss).
+            Try beyond = std::move(!nextHolds && (encodedHolds || next.t < encoded.t) ? next : encoded);
+            Try within = nextHolds ? std::move(next) : encodedHolds ? std::move(encoded) : measured(0.0);
+            if (over(within) > 0) {  // even k = 1 misses: the closest there is
+                s.chosen = std::move(within);
+                return s;
+            }
+            const double a = within.t, b = beyond.t;
+            s.chosen = detail::searchWithin(std::move(within), a, std::move(beyond), b, measured, over, std::max(0, rounds - 1), kConfirmedT, kMeasuredToleranceDb);
+            return s;
+        };
+        chosen = confirm(std::move(chosen), options);
+        if (plain) plain = confirm(std::move(*plain), uniform);
     }
+    if (plain && ((over(chosen.chosen) > 0 && over(plain->chosen) <= 0) || !keepsContext(chosen.chosen.predicted, plain->chosen.predicted)))
+        chosen = std::move(*plain);
+    const Try& asked = chosen.asked;
+    Try& given = chosen.chosen;
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), std::move(given.given), std::move(given.map), {}, {},
+                   given.predicted, asked.predicted, given.report.transition, false, false, std::move(given.report.notes)};
+    out.lowered = given.t < 1.0;
     out.gridLimited = recordReached(out.map, out.given);
     out.share = fociShare(out.given, options.aspect, options.falloff);
     out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;
@@ -155,7 +212,7 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
 }
 
 FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options, double floor, bool exactK) {
-    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, false, false, {}};
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, {}, {}, {}, false, false, {}};
     const double t = exactK ? 1.0 : largestHolding([&](double t) {
         return fociShare(powered(foci, t), options.aspect, options.falloff).contextDensity >= floor;
     });
@@ -164,6 +221,7 @@ FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& o
     FociReport report;
     out.map = buildFociMap(out.given, options, &report);
     out.builderNotes = std::move(report.notes);
+    out.transition = report.transition;
     out.gridLimited = recordReached(out.map, out.given);
     out.share = fociShare(out.given, options.aspect, options.falloff);
     out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -13,6 +15,7 @@
 #include "conus/codec/build/importance.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
+#include "conus/core/display.h"
 #include "conus/core/error.h"
 #include "../../test_images.h"
 
@@ -211,6 +214,57 @@ Budgets budgetsFor(const Image& source, const std::vector<Focus>& foci, DensityF
     return b;
 }
 
+// What a map's real encode (unfitted, as budgetsFor's model) and decode lose and gain against the
+// uniform image of the same pixel count, on 8-bit sRGB as bench/quality.py measures: the ROI gain
+// (where `importance` reaches half), the whole-frame loss and the 95th percentile of the tiles'
+// (max(W, H) / 32 pixels a side) touching no region, both with the floor (2/255)^2.
+struct Shown {
+    double roiGain, frameLoss, tileLoss;
+};
+
+std::vector<double> srgb8(const Image& im) {
+    std::vector<double> out(im.pixels.size());
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = std::round(255.0 * linearToSrgbDisplay(im.pixels[i]));
+    return out;
+}
+
+Shown measureShown(const Image& source, const SamplingMap& map, const Image& importance) {
+    const int w = source.width / 4, h = source.height / 4;
+    EncodeOptions e;
+    e.width = w;
+    e.height = h;
+    DecodeOptions d;
+    d.width = source.width;
+    d.height = source.height;
+    const std::vector<double> s = srgb8(source), c = srgb8(decodeImage(encodeImage(source, map, e), map, d)),
+                              u = srgb8(resizeBilinear(areaDownsample(source, w, h), {}, source.width, source.height));
+    const int tile = std::max(source.width, source.height) / 32, columns = (source.width + tile - 1) / tile,
+              rows = (source.height + tile - 1) / tile;
+    std::vector<double> tileC(std::size_t(columns) * rows), tileU(tileC.size()), tileN(tileC.size());
+    std::vector<char> touches(tileC.size(), 0);
+    double roiC = 0, roiU = 0, frameC = 0, frameU = 0;
+    const std::size_t channels = source.channels.size();
+    for (int y = 0; y < source.height; ++y)
+        for (int x = 0; x < source.width; ++x) {
+            const bool roi = importance.at(x * importance.width / source.width, y * importance.height / source.height) >= 0.5f;
+            const std::size_t t = std::size_t(y / tile) * columns + x / tile;
+            touches[t] |= roi;
+            for (std::size_t ch = 0; ch < channels; ++ch) {
+                const std::size_t i = (std::size_t(y) * source.width + x) * channels + ch;
+                const double ec = (c[i] - s[i]) * (c[i] - s[i]), eu = (u[i] - s[i]) * (u[i] - s[i]);
+                frameC += ec, frameU += eu, tileC[t] += ec, tileU[t] += eu, tileN[t] += 1;
+                if (roi) roiC += ec, roiU += eu;
+            }
+        }
+    const double floor = 4.0, n = double(s.size());  // (2/255)^2 in 8-bit codes
+    std::vector<double> losses;
+    for (std::size_t t = 0; t < tileC.size(); ++t)
+        if (!touches[t] && tileN[t] > 0) losses.push_back(10 * std::log10((tileC[t] / tileN[t] + floor) / (tileU[t] / tileN[t] + floor)));
+    std::sort(losses.begin(), losses.end());
+    return {10 * std::log10(roiU / roiC), 10 * std::log10((frameC / n + floor) / (frameU / n + floor)),
+            losses[std::min(losses.size() - 1, std::size_t(0.95 * double(losses.size())))]};
+}
+
 // The foci multiply the context: the textured part away from the focus gets more samples than the
 // flat rest, and the budget, spent where the picture shows it, gives the focus (on the texture) more
 // in its region than the uniform context can; its k, relative to the denser context there, is lower.
@@ -220,13 +274,52 @@ TEST(FociBudget, AContextFollowingTheDetailGivesTheFocusMore) {
     context.width = 8;
     context.height = 1;
     context.values = {2, 2, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
-    const Budgets b = budgetsFor(halfTextured(), {{0.12, 0.5, 0.08, 6.0}}, context, true);
+    const Image source = halfTextured();
+    const std::vector<Focus> foci{{0.12, 0.5, 0.08, 6.0}};
+    const Budgets b = budgetsFor(source, foci, context, true);
     EXPECT_LT(b.plain.given[0].k, 6.0);  // the uniform context's budget binds
     EXPECT_LE(b.detailed.predicted.tileLoss, kDefaultTileLoss);
     EXPECT_LE(b.detailed.predicted.frameLoss, kDefaultFrameLoss);
     EXPECT_GT(b.detailed.predicted.roiGain, b.plain.predicted.roiGain + 1.0);
     EXPECT_GT(b.detailed.map.density({0.2, 0.15}), 2.0 * b.detailed.map.density({0.95, 0.08}));
     EXPECT_NEAR(b.plain.map.density({0.2, 0.15}) / b.plain.map.density({0.95, 0.08}), 1.0, 0.2);
+    // Measured, not only predicted: the context's map, at the k its budget gives, shows the focus
+    // more than the uniform context's at its own, and holds the budgets as measured (within the
+    // model's tolerance: 0.5 dB on the frame, 1 dB on the tiles).
+    const Image importance = fociImportance(foci, double(kWidth) / kHeight, 96, 64);
+    const Shown plain = measureShown(source, b.plain.map, importance), detailed = measureShown(source, b.detailed.map, importance);
+    std::printf("measured: uniform context ROI gain %+.2f dB, frame loss %.2f dB, tile loss %.2f dB; detail context %+.2f, %.2f, %.2f dB\n",
+                plain.roiGain, plain.frameLoss, plain.tileLoss, detailed.roiGain, detailed.frameLoss, detailed.tileLoss);
+    EXPECT_GT(detailed.roiGain, plain.roiGain + 1.0);
+    EXPECT_LE(detailed.frameLoss, kDefaultFrameLoss + 0.5);
+    EXPECT_LE(detailed.tileLoss, kDefaultTileLoss + 1.0);
+}
+
+// More than one confirming encode (FrameModelOptions::confirmRounds, what `bake relief` uses): the map
+// kept is one whose own encode holds the budget, and what the budget says of it is that encode's
+// measure; a real encode and decode of it, read as 8-bit sRGB, agrees.
+TEST(FociBudget, ConfirmingRoundsKeepAMapItsOwnEncodeHolds) {
+    const Image source = picture();
+    const double aspect = double(kWidth) / kHeight;
+    const std::vector<Focus> foci{{0.62, 0.4, 0.13, 4.0}};
+    const Image importance = fociImportance(foci, aspect, 96, 64);
+    constexpr double kBudget = 0.5;
+    for (int rounds : {1, 6}) {
+        SCOPED_TRACE(rounds);
+        const FrameErrorModel model(source, kWidth / 4, kHeight / 4, importance, {ErrorSpace::Display, 0, kFitHoldLowPass, true, rounds});
+        const FociBudget b = fociForFrameLoss(foci, optionsFor(aspect), model, kBudget);
+        const FramePrediction own = model.confirmed(b.map).predict(b.map);
+        const Shown shown = measureShown(source, b.map, importance);
+        std::printf("%d confirming rounds: k %.3f, predicted frame loss %.3f dB, its own encode %.3f dB, 8-bit sRGB %.3f dB\n", rounds,
+                    b.given[0].k, b.predicted.frameLoss, own.frameLoss, shown.frameLoss);
+        EXPECT_TRUE(b.lowered);
+        if (rounds > 1) {
+            EXPECT_NEAR(b.predicted.frameLoss, own.frameLoss, 1e-9);
+            EXPECT_LE(own.frameLoss, kBudget);
+            EXPECT_GT(own.frameLoss, kBudget - 0.2);  // not lowered further than the rounds need
+            EXPECT_NEAR(shown.frameLoss, own.frameLoss, 0.1);
+        }
+    }
 }
 
 // Where the context gives the focus less (fine noise everywhere but a smooth focus, which the

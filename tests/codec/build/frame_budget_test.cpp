@@ -1,14 +1,22 @@
-// The frame-loss budget: its trial encodes against what an encode and decode measure, and a tighter
-// budget giving a smaller measured loss.
+// The frame-loss budget: its model against what real encodes and decodes lose on pictures it was
+// not fitted on, the choice continuous in the picture, and a tighter budget giving less.
 #include "conus/codec/build/frame_budget.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <initializer_list>
+#include <utility>
 #include <vector>
 
+#include "conus/codec/build/foci.h"
+#include "conus/codec/build/foci_budget.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
+#include "conus/codec/image/fit.h"
+#include "conus/core/display.h"
 #include "conus/core/error.h"
 #include "../../test_images.h"
 
@@ -85,68 +93,209 @@ Measured measure(const Image& source, const SamplingMap& map, const Image& impor
             10 * std::log10(mse(uniform, source, importance, true) / mse(view, source, importance, true))};
 }
 
-// The trial of the identity map is the uniform image but for the encoder's filter: about no loss
-// and no gain; fitted to the decoder (as `encode` does by default) it gains over the whole frame.
-TEST(FrameBudget, IdentityPredictsAboutNoLossAndTheFitGains) {
+// The model alone predicts roughly (bench/notes/2026-12-06-budget-model.md); confirmed by a real
+// encode of a map, it predicts that map's losses as measured: the identity map, unfitted and
+// fitted, against the real encodes (the fit gains over the whole frame).
+TEST(FrameBudget, ConfirmedModelPredictsTheMapItMeasured) {
     const Image source = picture();
-    const FrameErrorModel plain(source, kWidth / 4, kHeight / 4, boxes(), {ErrorSpace::Display, 0});
-    const FramePrediction p = plain.predict(SamplingMap::identity(9, 9));
-    EXPECT_NEAR(p.frameLoss, 0.0, 0.5);
-    EXPECT_NEAR(p.roiGain, 0.0, 0.5);
-    EXPECT_NEAR(p.tileLoss, 0.0, 1.0);
-    const FrameErrorModel fitted(source, kWidth / 4, kHeight / 4, boxes());
-    const FramePrediction f = fitted.predict(SamplingMap::identity(9, 9));
-    EXPECT_LT(f.frameLoss, p.frameLoss - 0.5);
-    EXPECT_GT(f.roiGain, p.roiGain + 0.5);
+    const SamplingMap identity = SamplingMap::identity(9, 9);
+    std::vector<double> frame;
+    for (int fit : {0, 2}) {
+        SCOPED_TRACE(fit);
+        const FrameErrorModel model(source, kWidth / 4, kHeight / 4, boxes(), {ErrorSpace::Display, fit});
+        const FramePrediction p = model.confirmed(identity).predict(identity);
+        EncodeOptions e;
+        e.width = kWidth / 4;
+        e.height = kHeight / 4;
+        Image conus = encodeImage(source, identity, e);
+        if (fit > 0) {
+            FitOptions f;
+            f.iterations = fit;
+            fitToDecoder(source, identity, conus, f);
+        }
+        DecodeOptions d;
+        d.width = kWidth;
+        d.height = kHeight;
+        const Image view = decodeImage(conus, identity, d);
+        const Image uniform = resizeBilinear(areaDownsample(source, e.width, e.height), {}, kWidth, kHeight);
+        const auto displayMse = [&](const Image& im) {
+            double sum = 0;
+            for (std::size_t i = 0; i < im.pixels.size(); ++i) {
+                const double dv = double(linearToSrgbDisplay(im.pixels[i])) - linearToSrgbDisplay(source.pixels[i]);
+                sum += dv * dv;
+            }
+            return sum / double(im.pixels.size());
+        };
+        const double f2 = (2.0 / 255) * (2.0 / 255);
+        const double measured = 10 * std::log10((displayMse(view) + f2) / (displayMse(uniform) + f2));
+        EXPECT_NEAR(p.frameLoss, measured, 0.05);
+        frame.push_back(p.frameLoss);
+    }
+    EXPECT_LT(frame[1], frame[0] - 0.3);  // the fit gains
 }
 
-// A map that magnifies the boxes: the trial's figures are those of the real encode and decode at
-// the source's size (the picture is under the trial's 1024 px, so nothing is reduced), in linear
-// light without the fit, as measure() takes them.
-TEST(FrameBudget, TrialIsTheEncodeAndDecode) {
+// The 8-bit sRGB error of each tile of max(W, H) / 32 (the model's tiles), as bench/quality.py takes it.
+std::vector<double> displayTileErrors(const Image& view, const Image& source, int tile) {
+    const int cols = (source.width + tile - 1) / tile, rows = (source.height + tile - 1) / tile;
+    std::vector<double> sum(std::size_t(cols) * rows, 0.0), count(sum.size(), 0.0);
+    const auto code = [](float v) { return std::round(255.0 * linearToSrgbDisplay(v)) / 255.0; };
+    for (int y = 0; y < source.height; ++y)
+        for (int x = 0; x < source.width; ++x) {
+            double e = 0;
+            for (int c = 0; c < 3; ++c) {
+                const double d = code(view.at(x, y, c)) - code(source.at(x, y, c));
+                e += d * d / 3;
+            }
+            const std::size_t t = std::size_t(y / tile) * cols + x / tile;
+            sum[t] += e;
+            count[t] += 1;
+        }
+    for (std::size_t t = 0; t < sum.size(); ++t) sum[t] /= count[t];
+    return sum;
+}
+
+struct Losses {
+    double frame, tile95;
+};
+
+Losses losses(const std::vector<double>& conus, const std::vector<double>& uniform, const std::vector<double>& pixels) {
+    const double f = (2.0 / 255) * (2.0 / 255);
+    double c = 0, u = 0, n = 0;
+    std::vector<double> tiles;
+    for (std::size_t t = 0; t < conus.size(); ++t) {
+        c += pixels[t] * conus[t];
+        u += pixels[t] * uniform[t];
+        n += pixels[t];
+        tiles.push_back(10 * std::log10((conus[t] + f) / (uniform[t] + f)));
+    }
+    std::sort(tiles.begin(), tiles.end());
+    return {10 * std::log10((c / n + f) / (u / n + f)), tiles[std::min(tiles.size() - 1, std::size_t(0.95 * double(tiles.size())))]};
+}
+
+// IEC 61966-2-1's decoding: display-encoded [0,1] to linear light.
+float srgbToLinear(float s) { return s <= 0.04045f ? s / 12.92f : std::pow((s + 0.055f) / 1.055f, 2.4f); }
+
+// Pictures the model was not fitted on (it was fitted on photographs): detail of different
+// scales in different places, asymmetric, 8-bit codes as a PNG gives them.
+Image varied(int which) {
+    const int w = 512, h = 384;
+    const Image n = test::noise(w, h, {"R", "G", "B"}, 20 + which);
+    Image im = makeImage(w, h, {"R", "G", "B"});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                double v;
+                if (which == 0)  // fine noise on the left third, slow waves elsewhere
+                    v = x < w / 3 ? 0.2 + 0.6 * n.at(x, y, c) : 0.5 + 0.3 * std::sin(0.05 * x + 0.03 * y + c);
+                else if (which == 1)  // a ring of waves of rising frequency about an off-centre point, flat outside
+                    v = std::hypot(x - 0.65 * w, y - 0.4 * h) < 0.3 * w ? 0.5 + 0.35 * std::sin(0.002 * (x * x + y * y) / 4 + c) : 0.3 + 0.1 * c;
+                else  // blurred noise whose blur shrinks from top to bottom
+                    v = 0.5 + 0.4 * (n.at(x, y, c) - 0.5) * (0.3 + 0.7 * y / h) + 0.2 * std::sin(0.3 * x) * (y > h / 2);
+                im.at(x, y, c) = static_cast<float>(std::clamp(v, 0.0, 1.0));
+            }
+    // As 8-bit sRGB codes, read back to linear light.
+    for (float& v : im.pixels) v = srgbToLinear(std::round(255.0f * v) / 255.0f);
+    return im;
+}
+
+// The model confirmed on one map predicts a map near it (the foci's k lowered by a third, an
+// automatic map's floor raised), against real encodes (fitted to the decoder, as the default) and
+// the uniform image, decoded to the source's size, on 8-bit sRGB: whole frame within 0.75 dB, p95
+// tile within 1 dB, on pictures the model was not fitted on (synthetic, harsher than the photographs
+// bench/budget_check.py holds to 0.5 dB).
+TEST(FrameBudget, ConfirmedModelPredictsMapsNearIt) {
+    for (int which = 0; which < 3; ++which) {
+        SCOPED_TRACE(which);
+        const Image source = varied(which);
+        const int w = source.width / 4, h = source.height / 4;
+        FociOptions fo;
+        fo.aspect = double(source.width) / source.height;
+        const std::vector<Focus> asked{{0.7, 0.35, 0.1, 4.0}, {0.2, 0.7, 0.07, 3.0}};
+        std::vector<Focus> lower = asked;
+        for (Focus& f : lower) f.k = std::pow(f.k, 0.67);
+        const Image importance = fociImportance(asked, fo.aspect, 128, 96);
+        AutoMapOptions tight, loose;
+        tight.minDensity = 0.3;
+        loose.minDensity = 0.45;
+        const std::vector<std::pair<SamplingMap, SamplingMap>> pairs{{buildFociMap(asked, fo), buildFociMap(lower, fo)},
+                                                                     {buildAutoMap(importance, tight), buildAutoMap(importance, loose)}};
+        const FrameErrorModel model(source, w, h, Image{});
+        for (const auto& [measuredMap, nearMap] : pairs) {
+            const FrameErrorModel confirmed = model.confirmed(measuredMap);
+            EncodeOptions e;
+            e.width = w;
+            e.height = h;
+            Image conus = encodeImage(source, nearMap, e);
+            fitToDecoder(source, nearMap, conus, FitOptions{});
+            DecodeOptions d;
+            d.width = source.width;
+            d.height = source.height;
+            const Image view = decodeImage(conus, nearMap, d);
+            const Image uniform = resizeBilinear(areaDownsample(source, w, h), {}, source.width, source.height);
+            const int tile = model.tileSide();
+            std::vector<double> pixels;
+            for (int ty = 0; ty < model.tileRows(); ++ty)
+                for (int tx = 0; tx < model.tileColumns(); ++tx)
+                    pixels.push_back(double(std::min(source.width, (tx + 1) * tile) - tx * tile) *
+                                     double(std::min(source.height, (ty + 1) * tile) - ty * tile));
+            const Losses measured = losses(displayTileErrors(view, source, tile), displayTileErrors(uniform, source, tile), pixels);
+            const Losses alone = losses(model.tileErrors(nearMap), model.uniformErrors(), pixels);
+            const Losses predicted = losses(confirmed.tileErrors(nearMap), confirmed.uniformErrors(), pixels);
+            std::printf("picture %d: frame alone %.2f confirmed %.2f measured %.2f dB; tile p95 alone %.2f confirmed %.2f measured %.2f dB\n",
+                        which, alone.frame, predicted.frame, measured.frame, alone.tile95, predicted.tile95, measured.tile95);
+            EXPECT_GT(measured.tile95, 0.5);  // the map does cost the context something
+            EXPECT_NEAR(predicted.frame, measured.frame, 0.75);
+            EXPECT_NEAR(predicted.tile95, measured.tile95, 1.0);
+        }
+    }
+}
+
+// The choice is continuous in the picture: the same 8-bit picture decoded to linear light by two
+// routes (values within a few 1e-7) and nudged by 1e-4 gives k within 1%.
+TEST(FrameBudget, KIsContinuousInThePicture) {
+    const Image a = varied(0);
+    Image b = a, c = a;
+    for (float& v : b.pixels) v = srgbToLinear(linearToSrgbDisplay(v));  // the codes' round trip
+    for (std::size_t i = 0; i < c.pixels.size(); ++i) c.pixels[i] = std::clamp(c.pixels[i] + (i % 7 == 0 ? 1e-4f : -1e-4f), 0.0f, 1.0f);
+    const std::vector<Focus> foci{{0.6, 0.4, 0.18, 5.0}};
+    FociOptions fo;
+    fo.aspect = double(a.width) / a.height;
+    std::vector<double> k;
+    for (const Image* im : std::initializer_list<const Image*>{&a, &b, &c}) {
+        const FrameErrorModel model(*im, im->width / 4, im->height / 4, fociImportance(foci, fo.aspect, 128, 96));
+        const FociBudget budget = fociForFrameLoss(foci, fo, model, 1.0);
+        EXPECT_TRUE(budget.lowered);
+        k.push_back(budget.given[0].k);
+    }
+    std::printf("k %.4f, round trip %.4f, nudged %.4f\n", k[0], k[1], k[2]);
+    EXPECT_NEAR(k[1], k[0], 0.01 * k[0]);
+    EXPECT_NEAR(k[2], k[0], 0.01 * k[0]);
+}
+
+TEST(FrameBudget, TighterBudgetGivesSmallerLoss) {
     const Image source = picture(), importance = boxes();
-    AutoMapOptions options;
-    options.maxDensity = 16;
-    options.minDensity = 0.4;
-    const SamplingMap map = buildAutoMap(importance, options);
     const FrameErrorModel model(source, kWidth / 4, kHeight / 4, importance, {ErrorSpace::Linear, 0});
-    const FramePrediction p = model.predict(map);
-    const Measured m = measure(source, map, importance);
-    EXPECT_GT(m.roiGain, 1.0);  // the map does magnify them
-    EXPECT_GT(m.frameLoss, 0.5);  // and the frame pays
-    EXPECT_NEAR(p.frameLoss, m.frameLoss, 0.1);  // only the floor f differs
-    EXPECT_NEAR(p.roiGain, m.roiGain, 1e-3);
-}
-
-TEST(FrameBudget, TighterBudgetGivesSmallerMeasuredLoss) {
-    const Image source = picture(), importance = boxes();
-    const FrameErrorModel model(source, kWidth / 4, kHeight / 4, importance, {ErrorSpace::Linear, 0});  // as measure() takes them
     AutoMapOptions options;
     options.maxDensity = 36;
-    std::vector<Measured> measured;
     std::vector<double> floors;
+    std::vector<Measured> measured;
     for (double budget : {0.5, 1.5, 3.0}) {
         SCOPED_TRACE(budget);
         const BudgetResult r = buildAutoMapForFrameLoss(importance, model, budget, options);
-        // The floor is chosen on the target density; the built map predicts near the budget.
         EXPECT_TRUE(r.budgetBinds);
-        EXPECT_LE(r.predicted.frameLoss, budget + 0.5);
-        EXPECT_GT(r.predicted.roiGain, 0.0);
-        measured.push_back(measure(source, r.map, importance));
+        // The search stops within 0.01 dB under the budget or at the floor's tolerance.
+        EXPECT_LE(r.predicted.frameLoss, budget + 1e-9);
+        EXPECT_GT(r.predicted.frameLoss, budget - 0.1);
         floors.push_back(r.minDensity);
-        // The prediction is the real encode and decode (a trial of it): only the floor f differs.
-        EXPECT_NEAR(measured.back().frameLoss, r.predicted.frameLoss, 0.1);
-        EXPECT_NEAR(measured.back().roiGain, r.predicted.roiGain, 1e-3);
-        std::printf("budget %.1f dB: floor %.3f, predicted loss %.2f gain %+.2f, measured loss %.2f gain %+.2f\n", budget,
-                    r.minDensity, r.predicted.frameLoss, r.predicted.roiGain, measured.back().frameLoss,
-                    measured.back().roiGain);
+        measured.push_back(measure(source, r.map, importance));
+        std::printf("budget %.1f dB: floor %.3f, predicted loss %.2f, measured loss %.2f gain %+.2f\n", budget, r.minDensity,
+                    r.predicted.frameLoss, measured.back().frameLoss, measured.back().roiGain);
     }
-    for (std::size_t i = 1; i < measured.size(); ++i) {
-        EXPECT_LT(floors[i], floors[i - 1]);
-        EXPECT_LT(measured[i - 1].frameLoss, measured[i].frameLoss);  // tighter: smaller loss
-        EXPECT_LT(measured[i - 1].roiGain, measured[i].roiGain);      // and less gain
+    for (std::size_t i = 1; i < floors.size(); ++i) {
+        EXPECT_LT(floors[i], floors[i - 1]);                          // looser: a lower floor
+        EXPECT_LT(measured[i - 1].frameLoss, measured[i].frameLoss);  // measured: more loss
+        EXPECT_LT(measured[i - 1].roiGain, measured[i].roiGain);      // and more gain
     }
-    EXPECT_GT(measured.front().roiGain, 0.0);
 }
 
 TEST(FrameBudget, RejectsBadInput) {

@@ -9,11 +9,13 @@
 // - with the picture: the whole-frame loss that FrameErrorModel predicts for the built map
 //   (frame_budget.h; kDefaultFrameLoss dB against the uniform image of the same pixel count), and
 //   its loss in the tiles outside the foci (kDefaultTileLoss dB at the 95th percentile): a frame
-//   can hold its mean while the context beside a focus is crushed;
+//   can hold its mean while the context beside a focus is crushed; k is searched continuously (a
+//   tiny change of the picture changes k a little), each try a map built and predicted;
 // - without one (`map foci`): the context's density, at least kDefaultContextFloor.
 // The foci then record the k they were given. An explicit choice (`--exact-k`) keeps k as asked.
 #pragma once
 
+#include <algorithm>
 #include <limits>
 #include <span>
 #include <string>
@@ -49,12 +51,23 @@ struct FociBudget {
     SamplingMap map;
     FociShare share, askedShare;      // of the foci given, and of those asked
     FramePrediction predicted;        // with a picture; zeros without
+    FramePrediction askedPredicted;   // the same for the map of k as asked (what --exact-k would hold)
+    std::vector<double> transition;   // per focus: where its transition ends, in radii (widened or as asked)
     bool lowered = false;             // the budget lowered k
     bool gridLimited = false;         // the grid held less than half a focus's extra magnification
     // What the builder gave way on to keep the anisotropy bound (FociReport::notes: a transition
     // widened, a grid refined, a k not reached), one line each with numbers.
     std::vector<std::string> builderNotes{};
 };
+
+// The falloff the file records for a budget's map: `asked`, its width the widest transition the
+// builder gave a focus (FociReport::transition: widened to keep an anisotropy bound), so that the
+// file says what the map holds.
+inline FociFalloff recordedFalloff(const FociBudget& budget, const FociFalloff& asked) {
+    FociFalloff out = asked;
+    for (double w : budget.transition) out.width = std::clamp(w, out.width, std::max(out.width, 8.0));  // the format's (1, 8]
+    return out;
+}
 
 // An importance image that is 1 on the foci's discs and 0 elsewhere (w x h), the region a
 // FrameErrorModel of foci measures the gain on.
