@@ -107,18 +107,20 @@ TEST_F(Hostile, MapsFinerThanTheirImageAreRefusedFromTheHeaders) {
         Outcome r = run({"decode", c.file, "-o", path("view.png"), "--size", "64x64"});
         expectRefused(r, "decode", c.size);
         EXPECT_TRUE(contains(r.err, "readers take at most 129 nodes a side")) << r.err;
-        expectMemory(r, 100);
+        expectMemory(r, 200);  // what loading OpenImageIO and GL costs any command: ~145 MB
         EXPECT_FALSE(fs::exists(path("view.png")));
         r = run({"info", c.file});
         expectRefused(r, "info", c.size);
-        expectMemory(r, 100);
+        expectMemory(r, 200);
         r = run({"validate", c.file});
         expectRefused(r, "validate", "not a valid CoNUS file");
         EXPECT_TRUE(contains(r.out, c.size)) << r.out;
+        // The file as a picture (its image part, with a warning naming the part) through a map of its own.
         r = run({"encode", c.file, "--map", c.file, "-o", path("again.exr"), "--size", "24x16", "--backend", "cpu"});
         EXPECT_EQ(r.exitCode, 1) << r.err;
-        EXPECT_EQ(errorLines(r.err).size(), 1u) << r.err;
-        expectMemory(r, 100);
+        ASSERT_FALSE(errorLines(r.err).empty());
+        EXPECT_TRUE(contains(errorLines(r.err).back(), c.size)) << r.err;
+        expectMemory(r, 200);
         r = runTool("conus-view", {c.file, "--screenshot", path("s.png"), "--size", "32x32"});
         EXPECT_EQ(r.exitCode, 1) << r.err;
         EXPECT_TRUE(contains(r.err, c.size)) << r.err;

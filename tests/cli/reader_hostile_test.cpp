@@ -113,7 +113,7 @@ TEST_F(ReaderHostile, VolumeAndCubeTexturesAreRefusedAsPictures) {
     write("flat.dds", dds(8, 4, 1, false));
     const Outcome r = run({"uniform", path("flat.dds"), "-o", path("flat.exr")});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_TRUE(contains(run({"info", path("flat.exr")}).out, "8 x 4")) << run({"info", path("flat.exr")}).out;
+    EXPECT_TRUE(contains(r.out, "of a 8x4 source")) << r.out;
 }
 
 // A model whose material names the volume texture: the mesh read refuses it, through render,
@@ -235,7 +235,7 @@ TEST_F(ReaderHostile, DeepAndInstancedGltfNodeTreesAreRefusedBeforeAssimp) {
         {"chain_past.gltf", "its node tree is more than " + std::to_string(conus::kMaxSceneDepth) + " nodes deep"},
         {"chain_20000.gltf", "its node tree is more than"},
         {"dag_22.gltf", "its node tree expands to more than " + std::to_string(conus::kMaxSceneNodes) + " nodes"},
-        {"cycle.gltf", "node 1 is its own ancestor"},
+        {"cycle.gltf", "node 0 is its own ancestor"},
         {"json_deep.gltf", "its JSON nests more than " + std::to_string(conus::kMaxMarkupDepth) + " levels deep"},
     };
     for (const auto& c : cases) {
