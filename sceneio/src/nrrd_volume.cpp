@@ -90,17 +90,17 @@ HeaderText headerText(const std::string& path, const std::string& what) {
 // Whether a header line is the "data file" field the way teem finds fields: the text before the
 // line's first ": " names the field, in any case, with or without its space ("datafile"); a
 // line holding ":=" is a key/value pair, a line starting with '#' a comment. Spaces, tabs and
-// underscores are ignored here, so that every spelling teem might take is checked (one it does
-// not take is only checked in vain).
+// underscores are ignored here, and any ':' ends the name, so that every spelling teem might
+// take is checked (one it does not take is only checked in vain).
 bool isDataFileField(const std::string& line, std::string& value) {
     if (line.empty() || line[0] == '#' || line.find(":=") != std::string::npos) return false;
-    const std::size_t colon = line.find(": ");
+    const std::size_t colon = line.find(':');
     if (colon == std::string::npos) return false;
     std::string field;
     for (char c : line.substr(0, colon))
         if (c != ' ' && c != '\t' && c != '_') field += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (field != "datafile") return false;
-    value = line.substr(colon + 2);
+    value = line.substr(colon + 1);
     const auto first = value.find_first_not_of(" \t");  // teem skips the separators after ": "
     value = first == std::string::npos ? std::string() : value.substr(first);
     return true;
