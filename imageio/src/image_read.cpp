@@ -153,6 +153,28 @@ void checkJpegScans(const std::string& path, const std::string& shown) {
         shown);
 }
 
+// A DDS header (the 4-byte magic, 124 bytes of header, and DX10's 20 more) is read before
+// OpenImageIO opens the file: a volume, a cube map or an array is refused from what the header
+// declares, whatever OpenImageIO would make of it (a header with a depth but no volume flag had its
+// reader loop on slices its one-slice image does not have).
+void checkDdsHeader(const unsigned char* bytes, std::size_t size, const std::string& shown) {
+    if (size < 128 || std::memcmp(bytes, "DDS ", 4) != 0) return;  // OpenImageIO refuses what is short
+    const auto u32 = [&](std::size_t at) {
+        return std::uint32_t(bytes[at]) | std::uint32_t(bytes[at + 1]) << 8 | std::uint32_t(bytes[at + 2]) << 16 |
+               std::uint32_t(bytes[at + 3]) << 24;
+    };
+    const std::uint32_t flags = u32(8), height = u32(12), width = u32(16), depth = u32(24), caps2 = u32(112);
+    const bool dx10 = std::memcmp(bytes + 84, "DX10", 4) == 0 && size >= 148;
+    const std::uint32_t dimension = dx10 ? u32(132) : 0, misc = dx10 ? u32(136) : 0, layers = dx10 ? u32(140) : 1;
+    constexpr std::uint32_t kDepthFlag = 0x800000, kVolume = 0x200000, kCube = 0x200, kTexture3d = 4, kCubeMisc = 4;
+    if ((flags & kDepthFlag) || depth > 1 || (caps2 & kVolume) || dimension == kTexture3d)
+        throw Error(ErrorCode::Unsupported, shown + ": a volume texture of " + std::to_string(width) + "x" + std::to_string(height) +
+                                                "x" + std::to_string(depth) + " samples, not a picture");
+    if ((caps2 & kCube) || (misc & kCubeMisc)) throw Error(ErrorCode::Unsupported, shown + ": a cube map, not a picture");
+    if (layers > 1)
+        throw Error(ErrorCode::Unsupported, shown + ": an array of " + std::to_string(layers) + " textures, not a picture");
+}
+
 bool isJpeg(const unsigned char* bytes, std::size_t size) {
     return size >= 3 && std::memcmp(bytes, "\xFF\xD8\xFF", 3) == 0;
 }
@@ -182,17 +204,19 @@ std::uintmax_t screenInput(const std::string& path, const StdinImage& stdinImage
                 throw Error(e.code(), "standard input" + what.substr(std::min(what.size(), copy.string().size())));
             }
         }
+        checkDdsHeader(bytes.data(), bytes.size(), "standard input");
         if (isJpeg(bytes.data(), bytes.size())) {
             std::size_t at = 0;
             checkJpegScans([&] { return at < bytes.size() ? int(bytes[at++]) : -1; }, "standard input");
         }
         return bytes.size();
     }
-    unsigned char magic[4] = {};
+    unsigned char magic[148] = {};  // a DDS header's length
     std::FILE* f = std::fopen(path.c_str(), "rb");
     const std::size_t n = f ? std::fread(magic, 1, sizeof magic, f) : 0;
     if (f) std::fclose(f);
     if (isOpenExr(magic, n)) format::checkExrFile(path, limits);
+    checkDdsHeader(magic, n, path);
     if (isJpeg(magic, n)) checkJpegScans(path, path);
     std::error_code ec;
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
