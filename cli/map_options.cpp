@@ -194,7 +194,7 @@ void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDe
 }
 
 void checkGridForImage(int grid, int width, int height, int defaultGrid) {
-    const int most = std::max(defaultGrid, 4 * std::max(width, height) + 1);
+    const int most = std::max(defaultGrid, static_cast<int>(map_rules::maxSideForImage(width, height)));
     if (grid > most)
         throw Error(ErrorCode::InvalidArgument, "--grid " + std::to_string(grid) + " is finer than a " + std::to_string(width) +
                                                     "x" + std::to_string(height) + " image can show; at most " +

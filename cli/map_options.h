@@ -67,7 +67,8 @@ std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, 
 
 // A map much finer than the image it shapes adds nothing the image can show and costs a build in
 // proportion to its nodes (a minute at 4097 a side): --grid is refused (InvalidArgument) past
-// the larger of the command's default and 4 nodes a pixel along the image's longer side.
+// the larger of the command's default and map_rules::maxSideForImage (4 nodes a pixel along the
+// image's longer side plus one, 129 always), the bound readers hold files to.
 void checkGridForImage(int grid, int width, int height, int defaultGrid = map_rules::kDefaultSide);
 
 // The foci of repeated --focus u,v,r,k options, in order.

@@ -152,6 +152,14 @@ void checkMapPart(const HeaderModel& m, const Limits& limits, ValidationReport& 
         r.add(Rule::V7, "sampling map of " + std::to_string(n) + "x" + std::to_string(rows) + " nodes exceeds the reader's limit of " +
                      std::to_string(limits.maxMapSide) + " a side");
         hc.limitExceeded = true;
+    } else if (const Box& image = m.part(PartKind::Conus).dataWindow;
+               image.width() >= 1 && image.height() >= 1 &&
+               std::max(n, rows) > map_rules::maxSideForImage(image.width(), image.height())) {
+        // Checked before the map's pixels are read: a 16x16 image may not make a reader hold 4097^2 nodes.
+        r.add(Rule::V7, "sampling map of " + std::to_string(n) + "x" + std::to_string(rows) + " nodes is finer than its " +
+                     std::to_string(image.width()) + "x" + std::to_string(image.height()) + " image can show; readers take at most " +
+                     std::to_string(map_rules::maxSideForImage(image.width(), image.height())) + " nodes a side (limit mapNodesPerPixel)");
+        hc.limitExceeded = true;
     }
 }
 

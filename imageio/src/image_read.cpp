@@ -110,6 +110,78 @@ bool isOpenExr(const unsigned char* bytes, std::size_t size) {
     return size >= 4 && std::memcmp(bytes, "\x76\x2f\x31\x01", 4) == 0;
 }
 
+// A progressive JPEG's decoder passes over every block of the image once per scan, and a scan
+// may code nothing but an end-of-band run: 2,000 such scans in 592 KB cost libjpeg over a minute
+// at 8192x8192. OpenImageIO sets no scan limit, so the scans are counted here, walking the
+// markers (each segment's length, the entropy-coded data to its next marker), before it opens
+// the file. `next` gives the file's bytes in order, -1 at the end.
+template <class Next>
+void checkJpegScans(Next next, const std::string& shown) {
+    int scans = 0;
+    int c = next();
+    while (c >= 0) {
+        if (c != 0xFF) {  // entropy-coded data (or garbage between segments): on to the next marker
+            c = next();
+            continue;
+        }
+        do c = next();
+        while (c == 0xFF);  // fill bytes
+        if (c < 0 || c == 0xD9) return;  // the end, or EOI
+        if (c == 0x00 || (c >= 0xD0 && c <= 0xD8) || c == 0x01) {  // stuffed zero, RSTn, SOI, TEM: no length
+            c = next();
+            continue;
+        }
+        if (c == 0xDA && ++scans > kMaxJpegScans)
+            throw Error(ErrorCode::LimitExceeded, shown + ": a JPEG of more than " + std::to_string(kMaxJpegScans) +
+                                                      " scans, the limit (each scan is a pass over the whole image)");
+        const int high = next(), low = next();
+        if (high < 0 || low < 0) return;
+        for (int left = (high << 8 | low) - 2; left > 0 && c >= 0; --left) c = next();  // the segment
+        c = next();
+    }
+}
+
+void checkJpegScans(const std::string& path, const std::string& shown) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return;  // OpenImageIO says why it cannot open it
+    struct Close {
+        std::FILE* f;
+        ~Close() { std::fclose(f); }
+    } close{f};
+    checkJpegScans(
+        [f] {
+            const int c = getc_unlocked(f);
+            return c == EOF ? -1 : c;
+        },
+        shown);
+}
+
+// A DDS header (the 4-byte magic, 124 bytes of header, and DX10's 20 more) is read before
+// OpenImageIO opens the file: a volume, a cube map or an array is refused from what the header
+// declares, whatever OpenImageIO would make of it (a header with a depth but no volume flag had its
+// reader loop on slices its one-slice image does not have).
+void checkDdsHeader(const unsigned char* bytes, std::size_t size, const std::string& shown) {
+    if (size < 128 || std::memcmp(bytes, "DDS ", 4) != 0) return;  // OpenImageIO refuses what is short
+    const auto u32 = [&](std::size_t at) {
+        return std::uint32_t(bytes[at]) | std::uint32_t(bytes[at + 1]) << 8 | std::uint32_t(bytes[at + 2]) << 16 |
+               std::uint32_t(bytes[at + 3]) << 24;
+    };
+    const std::uint32_t flags = u32(8), height = u32(12), width = u32(16), depth = u32(24), caps2 = u32(112);
+    const bool dx10 = std::memcmp(bytes + 84, "DX10", 4) == 0 && size >= 148;
+    const std::uint32_t dimension = dx10 ? u32(132) : 0, misc = dx10 ? u32(136) : 0, layers = dx10 ? u32(140) : 1;
+    constexpr std::uint32_t kDepthFlag = 0x800000, kVolume = 0x200000, kCube = 0x200, kTexture3d = 4, kCubeMisc = 4;
+    if ((flags & kDepthFlag) || depth > 1 || (caps2 & kVolume) || dimension == kTexture3d)
+        throw Error(ErrorCode::Unsupported, shown + ": a volume texture of " + std::to_string(width) + "x" + std::to_string(height) +
+                                                "x" + std::to_string(depth) + " samples, not a picture");
+    if ((caps2 & kCube) || (misc & kCubeMisc)) throw Error(ErrorCode::Unsupported, shown + ": a cube map, not a picture");
+    if (layers > 1)
+        throw Error(ErrorCode::Unsupported, shown + ": an array of " + std::to_string(layers) + " textures, not a picture");
+}
+
+bool isJpeg(const unsigned char* bytes, std::size_t size) {
+    return size >= 3 && std::memcmp(bytes, "\xFF\xD8\xFF", 3) == 0;
+}
+
 // OpenEXR files are screened before OpenImageIO opens them (format/exr_check.h): it reads them with
 // OpenEXR's C++ library, which allocates what a header declares (a 1.9 GB attribute in a 4 KB file
 // cost 8 s and 2 GB; a 32768x32768 window in 5 KB, 73 s and 12.7 GB). Standard input is screened
@@ -141,13 +213,20 @@ std::uintmax_t screenInput(const std::string& path, const StdinImage& stdinImage
                 throw Error(e.code(), "standard input" + what.substr(what.rfind(copy, 0) == 0 ? copy.size() : 0));
             }
         }
+        checkDdsHeader(bytes.data(), bytes.size(), "standard input");
+        if (isJpeg(bytes.data(), bytes.size())) {
+            std::size_t at = 0;
+            checkJpegScans([&] { return at < bytes.size() ? int(bytes[at++]) : -1; }, "standard input");
+        }
         return bytes.size();
     }
-    unsigned char magic[4] = {};
+    unsigned char magic[148] = {};  // a DDS header's length
     std::FILE* f = std::fopen(path.c_str(), "rb");
     const std::size_t n = f ? std::fread(magic, 1, sizeof magic, f) : 0;
     if (f) std::fclose(f);
     if (isOpenExr(magic, n)) format::checkExrFile(path, limits);
+    checkDdsHeader(magic, n, path);
+    if (isJpeg(magic, n)) checkJpegScans(path, path);
     std::error_code ec;
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
     return ec ? 0 : size;
@@ -270,6 +349,24 @@ bool readThroughTables(OIIO::ImageInput& in, int part, const OIIO::ImageSpec& sp
     return true;
 }
 
+// Only a flat picture is read: one slice of one image, in scanlines or flat tiles. A volume
+// texture (a DDS with depth, a 3-D TIFF), a cube map or a deep image is refused: OpenImageIO
+// writes every slice (or face) of it into the buffer it is given, and the buffer holds one.
+void checkPlainPicture(const OIIO::ImageSpec& spec, const std::string& shown) {
+    const std::string layout = spec.get_string_attribute("textureformat");
+    const auto has = [&](const char* word) { return layout.find(word) != std::string::npos; };
+    if (spec.depth != 1 || spec.full_depth > 1 || spec.tile_depth > 1 || spec.z != 0 || has("Volume"))
+        throw Error(ErrorCode::Unsupported, shown + ": a volume texture of " + std::to_string(spec.width) + "x" +
+                                                std::to_string(spec.height) + "x" + std::to_string(spec.depth) +
+                                                " samples, not a picture");
+    if (has("CubeFace"))
+        throw Error(ErrorCode::Unsupported, shown + ": a cube map (" + layout + "), not a picture");
+    if (spec.deep) throw Error(ErrorCode::Unsupported, shown + ": a deep image (several samples a pixel), not a picture");
+    if (spec.tile_width < 0 || spec.tile_height < 0)
+        throw Error(ErrorCode::Corrupt, shown + ": declares tiles of " + std::to_string(spec.tile_width) + "x" +
+                                            std::to_string(spec.tile_height) + " pixels");
+}
+
 Transfer detectTransfer(const OIIO::ImageSpec& spec) {
     const OIIO::TypeDesc::BASETYPE base = static_cast<OIIO::TypeDesc::BASETYPE>(spec.format.basetype);
     if (base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::DOUBLE)
@@ -316,6 +413,7 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
     if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
         throw Error(ErrorCode::Io, shown + ": the image is empty (" + std::to_string(spec.width) + "x" +
                                        std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) + " channels)");
+    checkPlainPicture(spec, shown);
     const Limits& limits = options.limits;
     if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || pixels > limits.maxPixels ||
         spec.nchannels > limits.maxChannels)
@@ -357,6 +455,12 @@ ImageFile readImageFile(const std::string& path, const ReadOptions& options) {
     // Integer samples without alpha: straight to linear float through tables (same values).
     const bool tabled = readsThroughTables(spec, rolesOf(image), encoding.transfer) &&
                         readThroughTables(*in, info.part, spec, rolesOf(image), encoding.transfer, image, shown);
+    // What OpenImageIO writes (every pixel of every slice, all channels, as float) is exactly
+    // what was allocated: checked once more against the buffer itself before it writes.
+    if (std::uint64_t(spec.image_pixels()) * std::uint64_t(spec.nchannels) != image.pixels.size() ||
+        image.pixels.size() != std::uint64_t(pixels) * std::uint64_t(spec.nchannels))
+        throw Error(ErrorCode::Corrupt, shown + ": OpenImageIO's description of the image does not match its " +
+                                            std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels");
     if (!tabled && !in->read_image(info.part, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
         std::string reason = in->geterror();
         if (reason.empty()) reason = "the file ends early or is damaged";

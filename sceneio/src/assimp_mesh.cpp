@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <iterator>
 #include <set>
 #include <stdexcept>
@@ -34,6 +35,7 @@
 #include "conus/imageio/image_file.h"
 #include "conus/sceneio/named_files.h"
 #include "extension_pvt.h"
+#include "scene_screen.h"
 
 // Debian's Assimp keeps its internal assertions, which abort the process (a hostile PLY reaches
 // one in the triangulation step). This definition takes the place of Assimp's own (the library
@@ -184,30 +186,36 @@ std::string trimmed(std::string text) {
 }
 
 // Assimp's MTL reader dereferences the material being defined, and dies (SIGSEGV) on a statement
-// before a library's first `newmtl`. The first such statement's keyword in `library`, or "".
-std::string statementBeforeNewmtl(const fs::path& library) {
+// before a library's first `newmtl`. The first such statement's number among the non-empty lines
+// of `library` (a file the policy already allowed), or 0. The statement itself is never quoted: a message shows no
+// file's content.
+int statementBeforeNewmtl(const fs::path& library) {
     std::error_code ec;
-    if (!fs::is_regular_file(library, ec)) return {};
+    if (!fs::is_regular_file(library, ec)) return 0;
     AssimpLines mtl(library.string(), std::min<std::uintmax_t>(fs::file_size(library, ec), kMaxNamedFileBytes));
+    int number = 0;
     for (std::string statement; mtl.next(statement);) {
+        ++number;
         statement = trimmed(statement);
         if (statement.empty() || statement[0] == '#') continue;
-        if (statement.rfind("newmtl", 0) == 0) return {};
-        return statement.substr(0, std::min<std::size_t>(statement.find(' '), 24));
+        if (statement.rfind("newmtl", 0) == 0) return 0;
+        return number;
     }
-    return {};
+    return 0;
 }
 
-std::string materialRefusal(const std::string& path, const std::string& named, const std::string& statement) {
-    return "mesh '" + path + "': its material library '" + named + "' has '" + statement + "' before its first newmtl";
+std::string materialRefusal(const std::string& path, const std::string& named, int line) {
+    return "mesh '" + path + "': its material library '" + named + "' has a statement before its first newmtl (non-empty line " +
+           std::to_string(line) + ")";
 }
 
 // An OBJ's material libraries (its `mtllib` lines), as Assimp joins them to the scene's folder
-// ("./" for none) as strings ("/m.mtl" is inside the folder): a library with a statement before
-// its first newmtl is refused before Assimp reads the OBJ (an OBJ naming itself included). Every
-// other file Assimp opens while such an OBJ is read is checked the same way (PolicyIoSystem).
-// Returns whether the scene names material libraries at all.
-bool checkMaterialLibraries(const std::string& path, std::uintmax_t bytes) {
+// ("./" for none) as strings ("/m.mtl" is inside the folder): each that exists is checked by the
+// policy (named_files.h) before a byte of it is read, then a library with a statement before its
+// first newmtl is refused before Assimp reads the OBJ (an OBJ naming itself included). Every other
+// file Assimp opens while such an OBJ is read is checked the same way (PolicyIoSystem). Returns
+// whether the scene names material libraries at all.
+bool checkMaterialLibraries(const std::string& path, std::uintmax_t bytes, const NamedFiles& policy) {
     const std::string folder = path.substr(0, path.find_last_of("\\/") + 1);
     AssimpLines obj(path, bytes);
     bool names = false;
@@ -216,8 +224,11 @@ bool checkMaterialLibraries(const std::string& path, std::uintmax_t bytes) {
         if (line.rfind("mtllib", 0) != 0 || line.size() < 7 || !std::isspace(static_cast<unsigned char>(line[6]))) continue;
         names = true;
         const std::string named = trimmed(line.substr(7));
-        const std::string statement = statementBeforeNewmtl((folder.empty() ? std::string("./") : folder) + named);
-        if (!statement.empty()) throw Error(ErrorCode::Corrupt, materialRefusal(path, named, statement));
+        const std::string joined = (folder.empty() ? std::string("./") : folder) + named;
+        std::error_code ec;
+        if (!fs::exists(joined, ec)) continue;  // missing: Assimp goes on without it
+        const int statement = statementBeforeNewmtl(policy.check(joined));
+        if (statement > 0) throw Error(ErrorCode::Corrupt, materialRefusal(path, named, statement));
     }
     return names;
 }
@@ -337,8 +348,8 @@ private:
                                                           std::to_string(kMaxNamedFileBytes) + " bytes");
             // A scene that names material libraries is read as an OBJ: what Assimp opens for it
             // (a library, or its fallback) is a library to Assimp's MTL reader.
-            const std::string statement = m_materialLibraries ? statementBeforeNewmtl(resolved) : std::string();
-            if (!statement.empty()) throw Error(ErrorCode::Corrupt, materialRefusal(m_scene, file, statement));
+            const int statement = m_materialLibraries ? statementBeforeNewmtl(resolved) : 0;
+            if (statement > 0) throw Error(ErrorCode::Corrupt, materialRefusal(m_scene, file, statement));
             return resolved;
         } catch (const Error& e) {
             if (m_refusal.empty()) {
@@ -357,8 +368,8 @@ private:
     std::set<TrackedStream*> m_open;
 };
 
-// Returns whether the scene names material libraries (checkMaterialLibraries).
-bool checkFile(const std::string& path, const MeshReadOptions& options) {
+// The file's own checks, before anything it names is looked at. Returns its size in bytes.
+std::uintmax_t checkFile(const std::string& path, const MeshReadOptions& options) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);
     if (ec || !fs::exists(status)) fail(ErrorCode::Io, path, "no such file");
@@ -372,7 +383,34 @@ bool checkFile(const std::string& path, const MeshReadOptions& options) {
     checkPlyCounts(path, bytes, options);
     checkOffCounts(path, bytes, options);
     checkGlbLengths(path, bytes);
-    return checkMaterialLibraries(path, bytes);
+    screenSceneText(path, bytes, {options.maxTriangles, kMaxSceneNodes, kMaxSceneDepth, kMaxMarkupDepth}, "mesh '" + path + "'");
+    return bytes;
+}
+
+// The imported node tree, before PreTransformVertices copies each mesh once per node that names
+// it: its depth, its nodes and the faces it instances, within the caps (walked without recursion).
+void checkNodeTree(const aiScene& scene, const MeshReadOptions& options, const std::string& path) {
+    if (!scene.mRootNode) return;
+    std::vector<std::pair<const aiNode*, int>> stack{{scene.mRootNode, 1}};
+    std::int64_t nodes = 0, faces = 0;
+    while (!stack.empty()) {
+        const auto [node, depth] = stack.back();
+        stack.pop_back();
+        if (depth > kMaxSceneDepth)
+            fail(ErrorCode::LimitExceeded, path, "its node tree is more than " + std::to_string(kMaxSceneDepth) +
+                                                     " nodes deep, the limit");
+        if (++nodes > kMaxSceneNodes)
+            fail(ErrorCode::LimitExceeded, path, "its node tree holds more than " + std::to_string(kMaxSceneNodes) +
+                                                     " nodes, the limit");
+        for (unsigned m = 0; m < node->mNumMeshes; ++m)
+            if (node->mMeshes[m] < scene.mNumMeshes && scene.mMeshes[node->mMeshes[m]])
+                faces += scene.mMeshes[node->mMeshes[m]]->mNumFaces;
+        if (faces > options.maxTriangles)
+            fail(ErrorCode::LimitExceeded, path, "its nodes instance more than " + std::to_string(options.maxTriangles) +
+                                                     " faces, the limit (counted before any instance is expanded)");
+        for (unsigned c = 0; c < node->mNumChildren; ++c)
+            if (node->mChildren[c]) stack.emplace_back(node->mChildren[c], depth + 1);
+    }
 }
 
 // glTF states its vertex colours in linear light; the older formats (PLY, OBJ extensions, OFF)
@@ -453,9 +491,9 @@ std::int64_t dropDuplicateTriangles(Mesh& mesh) {
 
 Mesh readMesh(const std::string& path, const MeshReadOptions& options, MeshReadReport* report) {
     MeshReadReport counts;
-    const bool materialLibraries = checkFile(path, options);
-
+    const std::uintmax_t bytes = checkFile(path, options);
     const NamedFiles named(path, options.allowedDirs, "mesh '" + path + "'");
+    const bool materialLibraries = checkMaterialLibraries(path, bytes, named);
     checkGltfUris(path, named);
     Assimp::Importer importer;
     auto* io = new PolicyIoSystem(path, named, materialLibraries);
@@ -467,19 +505,30 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options, MeshReadR
     const aiScene* scene = nullptr;
     AssimpLog log;
     std::string thrown;  // Assimp's own exceptions (its asserts among them), said after the logger is detached
+    std::optional<Error> refused;  // ours
     {
         const std::lock_guard<std::mutex> lock(assimpLogMutex);
         const bool created = Assimp::DefaultLogger::isNullLogger();
         if (created) Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
         Assimp::DefaultLogger::get()->attachStream(&log, Assimp::Logger::Warn | Assimp::Logger::Err);
         try {
-            scene = importer.ReadFile(path, flags);
+            // Imported as it is, its node tree checked, then post-processed: the same steps in the
+            // same order as ReadFile(path, flags), but PreTransformVertices (which copies a mesh
+            // once per node that uses it) only runs on a tree within the caps.
+            scene = importer.ReadFile(path, 0);
+            if (scene) {
+                checkNodeTree(*scene, options, path);
+                scene = importer.ApplyPostProcessing(flags);
+            }
+        } catch (const Error& e) {
+            refused = e;
         } catch (const std::exception& e) {
             thrown = e.what();
         }
         Assimp::DefaultLogger::get()->detachStream(&log, Assimp::Logger::Warn | Assimp::Logger::Err);
         if (created) Assimp::DefaultLogger::kill();
     }
+    if (refused) throw *refused;
     if (!thrown.empty()) fail(ErrorCode::Corrupt, path, thrown);
     if (!io->refusal().empty()) throw Error(io->refusalCode(), io->refusal());
     if (scene && log.text.find("out-of-range indices") != std::string::npos)

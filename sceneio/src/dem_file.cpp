@@ -4,6 +4,7 @@
 
 #include <zip.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -11,8 +12,9 @@
 #include <fstream>
 #include <map>
 #include <memory>
-#include <regex>
+#include <optional>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 #include "conus/core/error.h"
@@ -66,6 +68,71 @@ std::int64_t dimension(std::string item, const std::string& shape, const std::st
     return n;
 }
 
+// The header's dict literal, {'descr': '<f8', 'fortran_order': False, 'shape': (344, 403), },
+// read by hand in one pass: keys and string values in single or double quotes, a tuple of
+// numbers, or a word (True, False). Each value has a length limit far beyond what NumPy writes,
+// so that neither the scan nor a message grows with a hostile header; keys NumPy does not write
+// are passed over.
+struct NpyDict {
+    std::optional<std::string> descr, shape;  // the shape without its parentheses
+    std::string fortranOrder;
+};
+
+NpyDict parseNpyDict(std::string_view text, const std::string& what) {
+    constexpr std::size_t kMaxKey = 32, kMaxString = 32, kMaxShape = 256, kMaxWord = 8;
+    std::size_t at = 0;
+    const auto skipSpace = [&] {
+        while (at < text.size() && (text[at] == ' ' || text[at] == '\t' || text[at] == '\n' || text[at] == '\r')) ++at;
+    };
+    const auto broken = [&](const std::string& why) { fail(what, "the header is not a NumPy dict: " + why); };
+    // Characters up to `end` (exclusive), at most `limit` of them; `at` ends past `end`.
+    const auto until = [&](char end, std::size_t limit, const char* field) {
+        const std::size_t from = at;
+        while (at < text.size() && text[at] != end) {
+            if (at - from >= limit)
+                fail(what, std::string("the header's ") + field + " is longer than " + std::to_string(limit) + " characters");
+            ++at;
+        }
+        if (at >= text.size()) broken(std::string("its ") + field + " does not end");
+        return std::string(text.substr(from, at++ - from));
+    };
+    NpyDict dict;
+    skipSpace();
+    if (at >= text.size() || text[at++] != '{') broken("it does not start with '{'");
+    for (;;) {
+        skipSpace();
+        if (at < text.size() && text[at] == '}') break;
+        if (at >= text.size() || (text[at] != '\'' && text[at] != '"')) broken("a key is not a quoted string");
+        const std::string key = until(text[at++], kMaxKey, "key");
+        skipSpace();
+        if (at >= text.size() || text[at++] != ':') broken("no ':' after a key");
+        skipSpace();
+        if (at >= text.size()) broken("a value is missing");
+        if (text[at] == '\'' || text[at] == '"') {
+            std::string value = until(text[at++], kMaxString, "dtype");
+            if (key == "descr") dict.descr = std::move(value);
+        } else if (text[at] == '(') {
+            ++at;
+            std::string value = until(')', kMaxShape, "shape");
+            if (key == "shape") dict.shape = std::move(value);
+        } else {
+            const std::size_t from = at;
+            while (at < text.size() && std::isalpha(static_cast<unsigned char>(text[at])))
+                if (++at - from > kMaxWord) broken("a word value is too long");
+            if (at == from) broken("a value is neither a string, a tuple nor a word");
+            if (key == "fortran_order") dict.fortranOrder = std::string(text.substr(from, at - from));
+        }
+        skipSpace();
+        if (at < text.size() && text[at] == ',') {
+            ++at;
+            continue;
+        }
+        if (at < text.size() && text[at] == '}') break;
+        broken("no ',' or '}' after a value");
+    }
+    return dict;
+}
+
 // Format: magic "\x93NUMPY", major, minor, header length (2 bytes in v1, 4 in v2/3), then a Python
 // dict literal {'descr': '<f8', 'fortran_order': False, 'shape': (344, 403), }, then C-order data.
 // `available` bytes of the file are at `data`; the header must lie within them.
@@ -86,15 +153,13 @@ NpyHeader parseNpyHeader(const unsigned char* data, std::size_t available, const
     if (headerLength > kMaxNpyHeaderBytes)
         fail(what, "header of " + std::to_string(headerLength) + " bytes, more than " + std::to_string(kMaxNpyHeaderBytes));
     if (offset + headerLength > available) fail(what, "header runs past the end of the data");
-    const std::string header(reinterpret_cast<const char*>(data + offset), headerLength);
-    std::smatch m;
+    const NpyDict dict = parseNpyDict(std::string_view(reinterpret_cast<const char*>(data + offset), headerLength), what);
     NpyHeader h;
-    if (!std::regex_search(header, m, std::regex("'descr'\\s*:\\s*'([^']*)'"))) fail(what, "no dtype in the header");
-    h.dtype = m[1];
-    if (std::regex_search(header, m, std::regex("'fortran_order'\\s*:\\s*True")))
-        fail(what, "Fortran-ordered arrays are not supported");
-    if (!std::regex_search(header, m, std::regex("'shape'\\s*:\\s*\\(([^)]*)\\)"))) fail(what, "no shape in the header");
-    const std::string shape = m[1];
+    if (!dict.descr) fail(what, "no dtype in the header");
+    h.dtype = *dict.descr;
+    if (dict.fortranOrder == "True") fail(what, "Fortran-ordered arrays are not supported");
+    if (!dict.shape) fail(what, "no shape in the header");
+    const std::string shape = *dict.shape;
     std::stringstream items(shape);
     for (std::string item; std::getline(items, item, ',');) {
         if (item.find_first_not_of(" \t") == std::string::npos && items.eof()) break;  // "(5,)": the trailing comma
@@ -180,56 +245,89 @@ void requireRegularFile(const std::string& path) {
     if (!std::filesystem::is_regular_file(status)) throw Error(ErrorCode::Io, path + ": not a regular file");
 }
 
-// Every .npy member of a .npz archive, by name without ".npy". Each member's claimed size is
-// checked against its compressed size, its own header and the limits before memory is committed.
-std::map<std::string, NpyArray> readNpz(const std::string& path) {
-    const std::uintmax_t archiveSize = std::filesystem::file_size(path);
-    int error = 0;
-    std::unique_ptr<zip_t, decltype(&zip_close)> archive(zip_open(path.c_str(), ZIP_RDONLY, &error), &zip_close);
-    if (!archive) throw Error(ErrorCode::Io, path + ": cannot open as a .npz (zip) archive (libzip error " +
-                                                 std::to_string(error) + ")");
-    std::map<std::string, NpyArray> arrays;
-    // What all members may inflate to: the largest elevation model as int64 or float64, and headers.
-    constexpr std::uint64_t kMaxInflatedBytes = std::uint64_t(kMaxDemSamples) * 8 + 16 * (kMaxNpyHeaderBytes + 12);
-    std::uint64_t inflated = 0;
-    const zip_int64_t entries = zip_get_num_entries(archive.get(), 0);
-    for (zip_int64_t i = 0; i < entries; ++i) {
-        zip_stat_t stat;
-        zip_stat_init(&stat);
-        constexpr zip_uint64_t kNeeded = ZIP_STAT_NAME | ZIP_STAT_SIZE | ZIP_STAT_COMP_SIZE | ZIP_STAT_COMP_METHOD;
-        if (zip_stat_index(archive.get(), i, 0, &stat) != 0 || (stat.valid & kNeeded) != kNeeded) continue;
-        std::string name = stat.name;
-        if (name.size() < 4 || name.substr(name.size() - 4) != ".npy") continue;
-        const std::string what = path + ":" + name;
+// A .npz archive's .npy members, read one at a time and only when asked: the elevation model and
+// a few scalars are all a DEM needs, so a large member nobody uses is never inflated. Each
+// member's claimed size is checked against its compressed size before any of it is read, and a
+// member is inflated whole only once its own header (the first bytes, inflated alone) has passed
+// the limits.
+class Npz {
+public:
+    explicit Npz(const std::string& path) : m_path(path), m_archive(nullptr, &zip_close) {
+        m_archiveSize = std::filesystem::file_size(path);
+        int error = 0;
+        m_archive.reset(zip_open(path.c_str(), ZIP_RDONLY, &error));
+        if (!m_archive) throw Error(ErrorCode::Io, path + ": cannot open as a .npz (zip) archive (libzip error " +
+                                                       std::to_string(error) + ")");
+        const zip_int64_t entries = zip_get_num_entries(m_archive.get(), 0);
+        for (zip_int64_t i = 0; i < entries; ++i) {
+            zip_stat_t stat;
+            zip_stat_init(&stat);
+            constexpr zip_uint64_t kNeeded = ZIP_STAT_NAME | ZIP_STAT_SIZE | ZIP_STAT_COMP_SIZE | ZIP_STAT_COMP_METHOD;
+            if (zip_stat_index(m_archive.get(), i, 0, &stat) != 0 || (stat.valid & kNeeded) != kNeeded) continue;
+            std::string name = stat.name;
+            if (name.size() < 4 || name.substr(name.size() - 4) != ".npy") continue;
+            name.resize(name.size() - 4);
+            m_members.emplace(name, stat);  // the first of a repeated name, as before
+        }
+    }
+
+    // Member names without ".npy", in name order.
+    std::vector<std::string> names() const {
+        std::vector<std::string> out;
+        for (const auto& [name, stat] : m_members) out.push_back(name);
+        return out;
+    }
+    bool has(const std::string& name) const { return m_members.count(name) > 0; }
+
+    // The member's header alone (its bytes hold the header only).
+    NpyArray header(const std::string& name) { return read(name, true); }
+    // The whole member.
+    NpyArray array(const std::string& name) { return read(name, false); }
+
+private:
+    NpyArray read(const std::string& name, bool headerOnly) {
+        const zip_stat_t& stat = m_members.at(name);
+        const std::string what = m_path + ":" + name + ".npy";
         if (stat.comp_method != ZIP_CM_STORE && stat.comp_method != ZIP_CM_DEFLATE)
             throw Error(ErrorCode::Unsupported, what + ": compression method " + std::to_string(stat.comp_method) +
                                                     " is not supported (stored or deflate, as NumPy writes)");
         const std::uint64_t ratio = stat.comp_method == ZIP_CM_STORE ? 1 : kMaxDeflateRatio;
-        if (stat.comp_size > archiveSize || stat.size > stat.comp_size * ratio + 64)
+        if (stat.comp_size > m_archiveSize || stat.size > stat.comp_size * ratio + 64)
             throw Error(ErrorCode::Corrupt, what + ": claims " + std::to_string(stat.size) + " bytes from " +
                                                 std::to_string(stat.comp_size) + " compressed bytes in a " +
-                                                std::to_string(archiveSize) + "-byte archive; " +
+                                                std::to_string(m_archiveSize) + "-byte archive; " +
                                                 (ratio == 1 ? std::string("stored data cannot expand")
                                                             : "deflate expands at most " + std::to_string(ratio) + " times"));
-        inflated += stat.size;
-        if (inflated > kMaxInflatedBytes)
-            throw Error(ErrorCode::LimitExceeded, what + ": the archive's arrays inflate to more than " +
-                                                      std::to_string(kMaxInflatedBytes) + " bytes, the limit for " +
-                                                      std::to_string(kMaxDemSamples) + " height samples");
-        std::unique_ptr<zip_file_t, decltype(&zip_fclose)> file(zip_fopen_index(archive.get(), i, 0), &zip_fclose);
+        std::unique_ptr<zip_file_t, decltype(&zip_fclose)> file(zip_fopen_index(m_archive.get(), stat.index, 0), &zip_fclose);
         if (!file) throw Error(ErrorCode::Io, what + ": cannot read the member");
-        NpyArray array = readNpy(
-            stat.size,
-            [&](unsigned char* buffer, std::size_t n) {
-                if (zip_fread(file.get(), buffer, n) != static_cast<zip_int64_t>(n))
-                    throw Error(ErrorCode::Io, what + ": the member is truncated or damaged");
-            },
-            what);
-        name.resize(name.size() - 4);
-        arrays.emplace(name, std::move(array));
+        const auto readBytes = [&](unsigned char* buffer, std::size_t n) {
+            if (zip_fread(file.get(), buffer, n) != static_cast<zip_int64_t>(n))
+                throw Error(ErrorCode::Io, what + ": the member is truncated or damaged");
+        };
+        if (!headerOnly) {
+            // What the members read may inflate to in all: the largest elevation model as int64
+            // or float64, and headers.
+            constexpr std::uint64_t kMaxInflatedBytes = std::uint64_t(kMaxDemSamples) * 8 + 16 * (kMaxNpyHeaderBytes + 12);
+            m_inflated += stat.size;
+            if (m_inflated > kMaxInflatedBytes)
+                throw Error(ErrorCode::LimitExceeded, what + ": the arrays read inflate to more than " +
+                                                          std::to_string(kMaxInflatedBytes) + " bytes, the limit for " +
+                                                          std::to_string(kMaxDemSamples) + " height samples");
+            return readNpy(stat.size, readBytes, what);
+        }
+        NpyArray a;
+        a.bytes.resize(std::min<std::uint64_t>(stat.size, kMaxNpyHeaderBytes + 12));
+        readBytes(a.bytes.data(), a.bytes.size());
+        a.header = parseNpyHeader(a.bytes.data(), a.bytes.size(), what);
+        return a;
     }
-    return arrays;
-}
+
+    std::string m_path;
+    std::uintmax_t m_archiveSize = 0;
+    std::unique_ptr<zip_t, decltype(&zip_close)> m_archive;
+    std::map<std::string, zip_stat_t> m_members;
+    std::uint64_t m_inflated = 0;
+};
 
 // Every height a file gives is a finite number (NaN or an overflow past float is bad data).
 void checkHeights(const Image& heights, const std::string& what) {
@@ -278,16 +376,20 @@ Dem readDem(const std::string& source, double heightScale) {
     Dem dem;
     requireRegularFile(source);
     if (endsWith(source, ".npz")) {
-        const auto arrays = readNpz(source);
-        auto it = arrays.find("elevation");
-        if (it == arrays.end())
-            it = std::find_if(arrays.begin(), arrays.end(), [](const auto& a) { return a.second.header.shape.size() == 2; });
-        if (it == arrays.end()) throw Error(ErrorCode::Corrupt, source + ": holds no 2-D array");
-        dem.heights = toHeights(it->second, heightScale, source + ":" + it->first);
+        Npz npz(source);
+        // The elevation model: the member named so, else the first 2-D one (by its header alone).
+        std::string chosen = npz.has("elevation") ? std::string("elevation") : std::string();
+        for (const std::string& name : npz.names())
+            if (chosen.empty() && npz.header(name).header.shape.size() == 2) chosen = name;
+        if (chosen.empty()) throw Error(ErrorCode::Corrupt, source + ": holds no 2-D array");
+        const NpyArray elevation = npz.array(chosen);
+        dem.heights = toHeights(elevation, heightScale, source + ":" + chosen);
+        const std::string dtype = elevation.header.dtype;
         // matplotlib's sample stores its spacing in degrees of longitude / latitude.
+        // A scalar member is read whole only when its header says it holds one value.
         const auto scalarOf = [&](const char* name) {
-            const auto s = arrays.find(name);
-            return s != arrays.end() ? scalar(s->second) : std::nan("");
+            if (!npz.has(name) || npz.header(name).header.count != 1) return std::nan("");
+            return scalar(npz.array(name));
         };
         const double dx = scalarOf("dx"), dy = scalarOf("dy"), y0 = scalarOf("ymin"), y1 = scalarOf("ymax");
         if (std::isfinite(dx) && std::isfinite(dy) && dx > 0 && dy > 0) {
@@ -304,8 +406,8 @@ Dem readDem(const std::string& source, double heightScale) {
                                                     " gives cells of " + numberText(dem.cellMetres.x) + " x " +
                                                     numberText(dem.cellMetres.y) + " m, outside [1e-6, 1e6] m");
         }
-        dem.description = source + " " + it->first + " " + std::to_string(dem.heights.width) + "x" +
-                          std::to_string(dem.heights.height) + " " + it->second.header.dtype;
+        dem.description = source + " " + chosen + " " + std::to_string(dem.heights.width) + "x" +
+                          std::to_string(dem.heights.height) + " " + dtype;
         return dem;
     }
     if (endsWith(source, ".npy")) {

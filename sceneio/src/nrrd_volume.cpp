@@ -6,6 +6,8 @@
 // for the samples; teem then reads and decodes the payload (raw, ascii, gzip, ...).
 #include <teem/nrrd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -50,52 +52,81 @@ double axisSpacing(const Nrrd* nrrd, unsigned axis) {
     return 1.0;
 }
 
-// The header's text: the lines up to the first blank one (attached data follows it) or the end.
+// The header's text as teem reads it: a line ends at LF, CR or CR LF (teem's airOneLine), and the
+// lines run up to the first empty one (attached data follows it) or the end.
 struct HeaderText {
     std::vector<std::string> lines;
-    std::uint64_t bytes = 0;  // through the blank line: where attached data starts
+    std::uint64_t bytes = 0;  // through the empty line: where attached data starts
 };
 
 HeaderText headerText(const std::string& path, const std::string& what) {
     constexpr std::uint64_t kMaxHeaderBytes = 1 << 20;
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(ErrorCode::Io, what + ": cannot open it");
+    std::streambuf& bytes = *in.rdbuf();
     HeaderText header;
-    for (std::string line; std::getline(in, line);) {
-        header.bytes += line.size() + 1;
-        if (header.bytes > kMaxHeaderBytes)
+    std::string line;
+    for (int c; (c = bytes.sbumpc()) != std::char_traits<char>::eof();) {
+        if (++header.bytes > kMaxHeaderBytes)
             throw Error(ErrorCode::Corrupt, what + ": no end of the header in its first " + std::to_string(kMaxHeaderBytes) + " bytes");
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (line.empty()) break;
-        header.lines.push_back(line);
+        if (c != '\n' && c != '\r') {
+            line += static_cast<char>(c);
+            continue;
+        }
+        if (c == '\r' && bytes.sgetc() == '\n') {
+            bytes.sbumpc();
+            ++header.bytes;
+        }
+        if (line.empty()) return header;
+        line.resize(std::min(line.size(), line.find('\0')));  // teem's line is a C string
+        header.lines.push_back(std::move(line));
+        line.clear();
     }
+    line.resize(std::min(line.size(), line.find('\0')));
+    if (!line.empty()) header.lines.push_back(std::move(line));
     return header;
 }
 
+// Whether a header line is the "data file" field the way teem finds fields: the text before the
+// line's first ": " names the field, in any case, with or without its space ("datafile"); a
+// line holding ":=" is a key/value pair, a line starting with '#' a comment. Spaces, tabs and
+// underscores are ignored here, and any ':' ends the name, so that every spelling teem might
+// take is checked (one it does not take is only checked in vain).
+bool isDataFileField(const std::string& line, std::string& value) {
+    if (line.empty() || line[0] == '#' || line.find(":=") != std::string::npos) return false;
+    const std::size_t colon = line.find(':');
+    if (colon == std::string::npos) return false;
+    std::string field;
+    for (char c : line.substr(0, colon))
+        if (c != ' ' && c != '\t' && c != '_') field += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (field != "datafile") return false;
+    value = line.substr(colon + 1);
+    const auto first = value.find_first_not_of(" \t");  // teem skips the separators after ": "
+    value = first == std::string::npos ? std::string() : value.substr(first);
+    return true;
+}
+
 // The data files the header names ("data file: NAME", "data file: LIST" followed by one name a
-// line), each resolved and checked by `named`; none for attached data. The numbered form
-// ("data file: FORMAT MIN MAX STEP") is refused: its names are not listed to check.
+// line), each resolved and checked by `named`; none for attached data. A numbered pattern
+// ("data file: FORMAT MIN MAX STEP", any '%') is refused: its names are not listed to check;
+// so is "-", teem's standard input.
 std::vector<std::string> dataFiles(const HeaderText& header, const NamedFiles& named, const std::string& what) {
     std::vector<std::string> files;
+    const auto resolve = [&](const std::string& name) {
+        if (name == "-") throw Error(ErrorCode::Unsupported, what + ": names standard input ('-') as its data file");
+        files.push_back(named.resolve(name));
+    };
     for (std::size_t i = 1; i < header.lines.size(); ++i) {
-        const std::string& line = header.lines[i];
         std::string value;
-        if (line.rfind("data file:", 0) == 0) value = line.substr(10);
-        else if (line.rfind("datafile:", 0) == 0) value = line.substr(9);
-        else continue;
-        const auto first = value.find_first_not_of(" \t");
-        value = first == std::string::npos ? std::string() : value.substr(first);
-        std::istringstream words(value);
-        std::vector<std::string> tokens;
-        for (std::string w; words >> w;) tokens.push_back(w);
-        if (!tokens.empty() && tokens[0] == "LIST") {
-            for (std::size_t k = i + 1; k < header.lines.size(); ++k) files.push_back(named.resolve(header.lines[k]));
+        if (!isDataFileField(header.lines[i], value)) continue;
+        if (value.rfind("LIST", 0) == 0) {  // teem takes any value starting so as a list
+            for (std::size_t k = i + 1; k < header.lines.size(); ++k) resolve(header.lines[k]);
             break;
         }
-        if (tokens.size() >= 4 && tokens[0].find('%') != std::string::npos)
-            throw Error(ErrorCode::Unsupported, what + ": a numbered data file pattern ('" + value +
-                                                    "') is not read; name the files with 'data file: LIST'");
-        files.push_back(named.resolve(value));
+        if (value.find('%') != std::string::npos)
+            throw Error(ErrorCode::Unsupported, what + ": a numbered data file pattern is not read; name the files "
+                                                       "with 'data file: LIST'");
+        resolve(value);
     }
     return files;
 }

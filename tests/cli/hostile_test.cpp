@@ -90,24 +90,59 @@ TEST_F(Hostile, SourceSizedDecodeBeyondTheMemoryLimitIsRefused) {
     EXPECT_EQ(r.exitCode, 0) << r.err;
 }
 
-TEST_F(Hostile, LargeMapsDecodeWithBoundedMemory) {
-    // 900x900 nodes: SIGSEGV in the inverse's index; 257x257: 575 MB for a 300x200 view.
-    for (const char* name : {"samplingmap-index-uint32-overflow-n900.exr", "samplingmap-index-blowup-n257-575MB.exr"}) {
-        const std::string file = (fs::path(CONUS_SHARED_DATA) / "hostile" / name).string();
-        CONUS_REQUIRE(file);
-        Outcome r = run({"decode", file, "-o", path("view.png")});
-        EXPECT_EQ(r.exitCode, 0) << name << ": " << r.err;
-        EXPECT_TRUE(contains(r.out, "300x200")) << r.out;
-        expectBounded(r, 450);
-        r = run({"info", file});
-        EXPECT_EQ(r.exitCode, 0) << name << ": " << r.err;
-        expectBounded(r, 450);
-        // Encoding through the map undistorts: the index is built, within its budget. (The file's
-        // own image, 24x16, is the source.)
-        r = run({"encode", file, "--map", file, "-o", path("again.exr"), "--size", "24x16", "--backend", "cpu"});
-        EXPECT_EQ(r.exitCode, 0) << name << ": " << r.err;
-        expectBounded(r, 450);
+// Maps far finer than their image: 900x900 nodes (SIGSEGV in the inverse's index once) and
+// 257x257 (575 MB for a 300x200 view once) over a 24x16 image, and 4097x4097 over a 16x16 one
+// (info 572 MB, decode 664 MB once). Readers take at most 4 nodes a pixel of the longer side (and
+// 129 always): each is refused from its headers, before the map's pixels are read.
+TEST_F(Hostile, MapsFinerThanTheirImageAreRefusedFromTheHeaders) {
+    const struct {
+        std::string file;
+        const char* size;
+    } cases[] = {{(fs::path(CONUS_SHARED_DATA) / "hostile" / "samplingmap-index-uint32-overflow-n900.exr").string(), "900x900 nodes is finer than its 24x16 image"},
+                 {(fs::path(CONUS_SHARED_DATA) / "hostile" / "samplingmap-index-blowup-n257-575MB.exr").string(), "257x257 nodes is finer than its 24x16 image"},
+                 {(fs::path(CONUS_SHARED_DATA) / "hostile" / "round4" / "conus" / "map4097_img16.exr").string(), "4097x4097 nodes is finer than its 16x16 image"}};
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.file);
+        CONUS_REQUIRE(c.file);
+        Outcome r = run({"decode", c.file, "-o", path("view.png"), "--size", "64x64"});
+        expectRefused(r, "decode", c.size);
+        EXPECT_TRUE(contains(r.err, "readers take at most 129 nodes a side")) << r.err;
+        expectMemory(r, 200);  // what loading OpenImageIO and GL costs any command: ~145 MB
+        EXPECT_FALSE(fs::exists(path("view.png")));
+        r = run({"info", c.file});
+        expectRefused(r, "info", c.size);
+        expectMemory(r, 200);
+        r = run({"validate", c.file});
+        expectRefused(r, "validate", "not a valid CoNUS file");
+        EXPECT_TRUE(contains(r.out, c.size)) << r.out;
+        // The file as a picture (its image part, with a warning naming the part) through a map of its own.
+        r = run({"encode", c.file, "--map", c.file, "-o", path("again.exr"), "--size", "24x16", "--backend", "cpu"});
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        ASSERT_FALSE(errorLines(r.err).empty());
+        EXPECT_TRUE(contains(errorLines(r.err).back(), c.size)) << r.err;
+        expectMemory(r, 200);
+        r = runTool("conus-view", {c.file, "--screenshot", path("s.png"), "--size", "32x32"});
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_TRUE(contains(r.err, c.size)) << r.err;
+        expectMemory(r, 200);
     }
+}
+
+// The same limit for files the tools make: a map of 257 nodes a side is fine for a 64x64 image
+// and refused, at the write, for a 16x16 one.
+TEST_F(Hostile, AMapIsNeverWrittenFinerThanItsImage) {
+    std::string pgm = "P2\n16 16\n255\n";
+    for (int i = 0; i < 256; ++i) pgm += std::to_string((i * 7) % 256) + " ";
+    std::ofstream(path("p.pgm")) << pgm;
+    Outcome r = run({"map", "foci", "--focus", "0.5,0.5,0.1,4", "--grid", "257", "-o", path("m.exr")});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    r = run({"encode", path("p.pgm"), "--map", path("m.exr"), "-o", path("big.exr"), "--size", "64x64"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(run({"info", path("big.exr")}).exitCode, 0);
+    r = run({"encode", path("p.pgm"), "--map", path("m.exr"), "-o", path("small.exr"), "--size", "16x16"});
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_TRUE(contains(r.err, "257x257 nodes is finer than its 16x16 image")) << r.err;
+    EXPECT_FALSE(fs::exists(path("small.exr")));
 }
 
 TEST_F(Hostile, LyingNpzIsRefusedBeforeAllocating) {

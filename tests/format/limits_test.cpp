@@ -283,12 +283,29 @@ TEST(Hostile, LargeMapsAreReadWithinBounds) {
     CONUS_REQUIRE_SHARED_DATA();
     const auto folder = testing::sharedData() / "hostile";
     if (!std::filesystem::is_directory(folder)) GTEST_SKIP() << "shared data not found at " << folder;
+    // Valid maps far finer than their 24x16 images: refused from the headers (mapNodesPerPixel),
+    // before the map's pixels are read.
     for (const char* name : {"samplingmap-index-uint32-overflow-n900.exr", "samplingmap-index-blowup-n257-575MB.exr"}) {
-        const auto start = std::chrono::steady_clock::now();
-        const ConusFile f = readConusFile((folder / name).string());
-        EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), kSecond) << name;
-        EXPECT_TRUE(validateGrid(f.map).ok()) << name;  // valid maps: the inverse's index is codec's test
+        for (const bool header : {false, true}) {
+            const Refusal r = refusal([&] { header ? readConusHeader((folder / name).string()) : readConusFile((folder / name).string()); });
+            EXPECT_EQ(r.code, ErrorCode::LimitExceeded) << name << ": " << r.message;
+            EXPECT_NE(r.message.find("nodes is finer than its 24x16 image can show; readers take at most 129 nodes a side"),
+                      std::string::npos)
+                << r.message;
+            EXPECT_LT(r.seconds, kSecond) << name;
+        }
     }
+    // At the limit a map reads and is written: 4 nodes a pixel of the longer side, plus one.
+    const testing::TempDir dir;
+    ConusFile fine = testing::validFile();
+    fine.image = makeImage(40, 10, fine.image.channels);
+    fine.map = testing::identityGrid(161, 9);
+    writeConusFile(dir.file("fine.exr"), fine);
+    EXPECT_EQ(readConusFile(dir.file("fine.exr")).map.columns, 161);
+    fine.map = testing::identityGrid(162, 9);
+    const Refusal past = refusal([&] { writeConusFile(dir.file("past.exr"), fine); });
+    EXPECT_NE(past.message.find("162x9 nodes is finer than its 40x10 image can show; readers take at most 161"), std::string::npos)
+        << past.message;
 }
 
 TEST(Hostile, EveryReproducerIsHandledWithinASecond) {

@@ -1,5 +1,7 @@
 // Fuzz harness: ordinary image files through conus::imageio (the one reader of PNG, JPEG, TIFF,
-// EXR, BMP, HDR, PPM, TGA): its size checks, channel placement, colour conversion, orientation and
+// EXR, BMP, HDR, PPM, TGA, DDS, PSD; OpenImageIO also goes by content, so TIFF pages, DDS volumes
+// and cube maps reach it under any name): its JPEG scan count, its refusal of what is not one flat
+// picture, its size checks, channel placement, colour conversion, orientation and
 // metadata on top of OpenImageIO. The first byte picks the format (the reader goes by the name's
 // extension), the rest is the file, written to /dev/shm (memory). A file that reads must keep the
 // reader's promises: within the limits, one line per error, values placed by name.
@@ -14,7 +16,7 @@
 #include "fuzz.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    static const char* kExtensions[] = {"png", "jpg", "tif", "exr", "bmp", "hdr", "ppm", "tga"};
+    static const char* kExtensions[] = {"png", "jpg", "tif", "exr", "bmp", "hdr", "ppm", "tga", "dds", "psd"};
     if (size < 1) return 0;
     const std::string path = "/dev/shm/conus-fuzz-image-" + std::to_string(::getpid()) + "." +
                              kExtensions[data[0] % (sizeof kExtensions / sizeof *kExtensions)];

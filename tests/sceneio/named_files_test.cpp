@@ -193,14 +193,15 @@ TEST_F(NamedFilesTest, APlyHeaderBehindLineEndsIsCheckedWhateverTheName) {
 
 // Assimp's MTL reader died (SIGSEGV) on a statement before a library's first newmtl, whether the
 // library was a .mtl or the OBJ itself (the mesh harness found the second on a GPU machine's cores).
+// The refusal names the line, never the statement: a message shows no file's content.
 TEST_F(NamedFilesTest, AMaterialLibraryWithAStatementBeforeNewmtlIsRefused) {
     const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     scene("early.mtl", "# made by hand\n\nmap_d x.png\nnewmtl red\n");
     Refusal r = refusal([&] { readMesh(scene("early.obj", "mtllib early.mtl\n" + triangle)); });
     EXPECT_EQ(r.code, ErrorCode::Corrupt) << r.message;
-    EXPECT_TRUE(contains(r.message, "material library 'early.mtl' has 'map_d' before its first newmtl")) << r.message;
+    EXPECT_TRUE(contains(r.message, "material library 'early.mtl' has a statement before its first newmtl (non-empty line 2)")) << r.message;
     r = refusal([&] { readMesh(scene("self.obj", std::string("mtllib self.obj") + '\0' + "map_d\n" + triangle)); });
-    EXPECT_TRUE(contains(r.message, "material library 'self.obj' has 'mtllib' before its first newmtl")) << r.message;
+    EXPECT_TRUE(contains(r.message, "material library 'self.obj' has a statement before its first newmtl (non-empty line 1)")) << r.message;
     // Comments and blank lines may come first; a missing library is Assimp's to go on without.
     scene("good.mtl", "# made by hand\r\n\r\nnewmtl red\nKd 1 0 0\nmap_d x.png\n");
     EXPECT_EQ(readMesh(scene("good.obj", "mtllib good.mtl\n" + triangle)).indices.size(), 3u);

@@ -20,6 +20,11 @@ inline constexpr std::int64_t kMaxTilePixels = std::int64_t{1} << 24;   // pixel
 inline constexpr int kMinMapSide = 2;
 inline constexpr int kMaxMapSide = 4097;
 inline constexpr std::int64_t kMaxMapNodes = std::int64_t{kMaxMapSide} * kMaxMapSide;
+// Nodes per side a map may have for its image: kMapNodesPerPixel a pixel along the image's longer
+// side, plus one, and kMapSideAlways whatever the image (the largest grid a builder makes by
+// default); map_rules.h's maxSideForImage.
+inline constexpr int kMapNodesPerPixel = 4;
+inline constexpr int kMapSideAlways = 129;
 
 // File headers: bytes of one attribute's value, and of all attribute values of one part.
 inline constexpr std::int64_t kMaxAttributeBytes = std::int64_t{1} << 20;
@@ -50,6 +55,17 @@ inline constexpr std::int64_t kMaxVolumeReadBytes = std::int64_t{2} << 30;
 inline constexpr std::int64_t kMaxRayStepsPerSample = 16;
 // Height samples of one elevation model (.npy, .npz, image, procedural).
 inline constexpr std::int64_t kMaxDemSamples = std::int64_t{1} << 26;
+// A scene's node tree: nodes along one path from a root, and nodes once every instance is
+// expanded (a node shared by several parents counts once per path to it). Assimp recurses along
+// the tree and copies each shared node once per parent.
+inline constexpr int kMaxSceneDepth = 256;
+inline constexpr std::int64_t kMaxSceneNodes = std::int64_t{1} << 20;
+// Nesting of a text scene file's structure (glTF's JSON arrays and objects, COLLADA's and X3D's
+// XML elements): the parsers Assimp uses recurse once per level.
+inline constexpr int kMaxMarkupDepth = 512;
+// Scans of a progressive JPEG: each is a pass over the whole image (libjpeg's progressive
+// pictures have 10 or fewer).
+inline constexpr int kMaxJpegScans = 100;
 
 // The caps a reader applies; a caller may lower any of them (never raise them past the constants:
 // the constants are also what the format's own rules allow).
@@ -70,7 +86,7 @@ struct LimitEntry {
     const char* meaning;  // one line
 };
 
-inline constexpr std::array<LimitEntry, 23> limitTable() {
+inline constexpr std::array<LimitEntry, 29> limitTable() {
     return {{
         {"imageSide", kMaxImageSide, "pixels", "width or height of any image (CoNUS image, source, decoded frame)"},
         {"imagePixels", kMaxImagePixels, "pixels", "width x height of any image"},
@@ -79,6 +95,8 @@ inline constexpr std::array<LimitEntry, 23> limitTable() {
         {"mapSideMin", kMinMapSide, "nodes", "sampling-map nodes per side, at least"},
         {"mapSide", kMaxMapSide, "nodes", "sampling-map nodes per side, at most"},
         {"mapNodes", kMaxMapNodes, "nodes", "sampling-map nodes in all"},
+        {"mapNodesPerPixel", kMapNodesPerPixel, "nodes", "sampling-map nodes per side per pixel of the image's longer side, plus one"},
+        {"mapSideAlways", kMapSideAlways, "nodes", "sampling-map nodes per side allowed whatever the image's size"},
         {"attributeBytes", kMaxAttributeBytes, "bytes", "value of one header attribute"},
         {"headerBytes", kMaxHeaderBytes, "bytes", "attribute values of one part's header"},
         {"indexBytesPerCell", kIndexBytesPerCell, "bytes", "inverse-map index per map cell (plus indexBytesBase)"},
@@ -95,6 +113,10 @@ inline constexpr std::array<LimitEntry, 23> limitTable() {
         {"rayStepsPerSample", kMaxRayStepsPerSample, "steps", "steps of one volume ray per sample of width + height + depth"},
         {"demSamples", kMaxDemSamples, "samples", "height samples of one elevation model"},
         {"namedFileBytes", kMaxNamedFileBytes, "bytes", "one file a scene file names (glTF buffer, material library, NRRD data file)"},
+        {"sceneDepth", kMaxSceneDepth, "nodes", "nodes along one path of a scene's node tree"},
+        {"sceneNodes", kMaxSceneNodes, "nodes", "nodes of a scene once shared nodes are expanded (instancing)"},
+        {"markupDepth", kMaxMarkupDepth, "levels", "nesting of a glTF's JSON or a COLLADA or X3D file's XML"},
+        {"jpegScans", kMaxJpegScans, "scans", "scans of a progressive JPEG (each a pass over the image)"},
     }};
 }
 

@@ -28,6 +28,14 @@ inline constexpr double kMaxFalloffWidth = 8.0;
 inline constexpr int kFalloffShapes = 3;
 // The grid the builders make when a user does not say (nodes per side).
 inline constexpr int kDefaultSide = 65;
+// A map finer than its image adds nothing the image can show and costs memory and work in
+// proportion to its nodes (a 16x16 image with a 4097^2 map: 570 MB to describe): builders and
+// readers take at most kMapNodesPerPixel (limits.h) nodes a pixel along the image's longer side,
+// plus one, and always kMapSideAlways.
+inline constexpr std::int64_t maxSideForImage(std::int64_t width, std::int64_t height) {
+    const std::int64_t side = kMapNodesPerPixel * (width > height ? width : height) + 1;
+    return side < kMapSideAlways ? kMapSideAlways : side;
+}
 // The builders' default bound on anisotropy: the ratio of a cell's Jacobian singular values in
 // pixels (codec's map_measures.h). A CoNUS pixel's footprint is at most this elongated, so the
 // encode's filter and the decode's stretch stay local; foci reach their k by widening their
