@@ -137,10 +137,7 @@ public:
                                                codec::toAnalytic(foci, fo.composition, fo.falloff));
         const double encodeTime = seconds(encodeStart);
         applyStorage(StorageOptions{}, file);
-        const fs::path temporary = fs::temp_directory_path() / ("conus-serve-" + std::to_string(::getpid()) + ".exr");
-        format::writeConusFile(temporary.string(), file);
-        std::vector<unsigned char> bytes = fileBytes(temporary.string());
-        fs::remove(temporary);
+        std::vector<unsigned char> bytes = conusFileBytes(file);
         if (!quiet())
             std::fprintf(stderr, "frame %s focus %s size %dx%d: %zu bytes in %.2f s (picture %.2f, map %.2f, encode %.2f)\n",
                          picture.filename().c_str(), param("focus").c_str(), size.width, size.height, bytes.size(),

@@ -32,18 +32,7 @@ std::vector<unsigned char> pageBytes(const std::string& input, const format::Con
     if (file.compression == format::Compression::None || file.compression == format::Compression::Zip) return fileBytes(input);
     format::ConusFile zipped = file;
     zipped.compression = format::Compression::Zip;
-    const std::string temporary =
-        (std::filesystem::temp_directory_path() / ("conus-web-" + std::to_string(::getpid()) + ".exr")).string();
-    format::writeConusFile(temporary, zipped);
-    std::vector<unsigned char> bytes;
-    try {
-        bytes = fileBytes(temporary);
-    } catch (...) {
-        std::filesystem::remove(temporary);
-        throw;
-    }
-    std::filesystem::remove(temporary);
-    return bytes;
+    return conusFileBytes(zipped);
 }
 
 int runWeb(const WebOptions& o) {

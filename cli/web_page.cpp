@@ -1,11 +1,16 @@
 #include "web_page.h"
 
+#include <cstdlib>
+#include <cstring>
+#include <cerrno>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
 #include <nlohmann/json.hpp>
 
 #include "conus/core/error.h"
+#include "conus/format/container.h"
 #include "conus/renderers/web_shader.h"
 #include "web_files.h"
 
@@ -70,6 +75,22 @@ std::vector<unsigned char> fileBytes(const std::string& path) {
     std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (!in.eof() && in.fail()) throw Error(ErrorCode::Io, path + ": cannot be read");
     return bytes;
+}
+
+std::vector<unsigned char> conusFileBytes(const format::ConusFile& file) {
+    std::string folder = (std::filesystem::temp_directory_path() / "conus-XXXXXX").string();
+    if (::mkdtemp(folder.data()) == nullptr) throw Error(ErrorCode::Io, "cannot make a private temporary folder: " + std::string(std::strerror(errno)));
+    const std::string path = folder + "/frame.exr";
+    struct Remove {
+        std::string path, folder;
+        ~Remove() {  // the file and the folder this call made; a folder left non-empty stays
+            std::error_code ignored;
+            std::filesystem::remove(path, ignored);
+            std::filesystem::remove(folder, ignored);
+        }
+    } remover{path, folder};
+    format::writeConusFile(path, file);
+    return fileBytes(path);
 }
 
 }  // namespace conus::cli

@@ -6,6 +6,10 @@
 #include <string>
 #include <vector>
 
+namespace conus::format {
+struct ConusFile;
+}
+
 namespace conus::cli {
 
 struct WebFile {
@@ -25,5 +29,9 @@ std::string embeddedFileScript(const std::string& name, std::span<const unsigned
 // A file's bytes, as `conus web` copies them and `conus serve` sends them; conus::Error(Io) when
 // it cannot be read.
 std::vector<unsigned char> fileBytes(const std::string& path);
+
+// `file` as the bytes of a CoNUS file, written through a private folder that only this process can
+// enter (mkdtemp, 0700: no name another user can predict or plant a link at) and removed at once.
+std::vector<unsigned char> conusFileBytes(const format::ConusFile& file);
 
 }  // namespace conus::cli

@@ -27,6 +27,8 @@ std::string vectorText(glm::dvec3 v) {
 
 // V18's layers: the deeper layers' channels (`layer<k>.R` .. `.Z`, k = 1..L-1) in one face; L, or
 // 0 after saying what is wrong.
+constexpr int kMaxLayers = 4;  // the spec's bound (Layers), which the writer and the GL renderer's side-by-side textures keep
+
 int faceLayers(const PartModel& part, const std::string& face, ValidationReport& r) {
     int layers = 1;
     bool ok = true;
@@ -37,6 +39,17 @@ int faceLayers(const PartModel& part, const std::string& face, ValidationReport&
         if (dot == std::string::npos || number.empty() || number.size() > 2 || number[0] == '0' ||
             !std::all_of(number.begin(), number.end(), [](char d) { return d >= '0' && d <= '9'; })) {
             r.add(Rule::V18, "face " + face + " has channel " + c.name + ", not a layer's (layer<k>.R, .G, .B, .A, .Z)");
+            ok = false;
+            continue;
+        }
+        const std::string suffix = c.name.substr(dot);
+        if (suffix != ".R" && suffix != ".G" && suffix != ".B" && suffix != ".A" && suffix != ".Z") {
+            r.add(Rule::V18, "face " + face + " has channel " + c.name + ", not a layer's (layer<k>.R, .G, .B, .A, .Z)");
+            ok = false;
+            continue;
+        }
+        if (std::stoi(number) >= kMaxLayers) {
+            r.add(Rule::V18, "face " + face + " has channel " + c.name + ": an asset holds at most " + std::to_string(kMaxLayers) + " layers");
             ok = false;
             continue;
         }

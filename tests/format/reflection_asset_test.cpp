@@ -159,8 +159,8 @@ TEST_F(ReflectionAsset, ABadFrameOrFaceIsRefusedInMemoryAndNothingIsWritten) {
 }
 
 // Layers (spec "Layers"): `layer<k>.R..Z` for k = 1..L-1 in every face, the same L; a face
-// with a deeper layer round-trips, a gap, a missing channel, a name that is no layer's or a face
-// with fewer layers is V18.
+// with a deeper layer round-trips, a gap, a missing channel, a name that is no layer's, a fifth
+// layer or a face with fewer layers is V18.
 TEST_F(ReflectionAsset, LayersAreFiveChannelsEachInEveryFace) {
     const auto layered = [](int layers, int face = -1, const std::vector<std::string>& channels = {}) {
         ReflectionAssetFile a = validAsset();
@@ -195,6 +195,13 @@ TEST_F(ReflectionAsset, LayersAreFiveChannelsEachInEveryFace) {
     const ValidationReport partial = validateReflectionAsset(layered(1, 0, {"A", "B", "G", "R", "Z", "layer1.Z"}));
     EXPECT_TRUE(only(partial, {Rule::V18})) << partial.str();
     EXPECT_TRUE(only(validateReflectionAsset(layered(1, 5, {"A", "B", "G", "R", "Z", "layerX.Z"})), {Rule::V18}));
+    const ValidationReport odd = validateReflectionAsset(layered(2, 1, {"A", "B", "G", "R", "Z", "layer1.A", "layer1.B", "layer1.G",
+                                                                        "layer1.R", "layer1.Z", "layer1.N"}));
+    EXPECT_TRUE(only(odd, {Rule::V18})) << odd.str();
+    EXPECT_NE(odd.str().find("layer1.N, not a layer's"), std::string::npos) << odd.str();
+    const ValidationReport five = validateReflectionAsset(layered(5));
+    EXPECT_TRUE(only(five, {Rule::V18})) << five.str();
+    EXPECT_NE(five.str().find("at most 4 layers"), std::string::npos) << five.str();
     const ValidationReport fewer = validateReflectionAsset(layered(2, 3, {"A", "B", "G", "R", "Z"}));
     EXPECT_TRUE(only(fewer, {Rule::V18})) << fewer.str();
     EXPECT_NE(fewer.str().find("every face has one count of layers"), std::string::npos) << fewer.str();

@@ -26,7 +26,7 @@ def test_uint8_arrays_are_display_codes_like_an_8_bit_png(tmp_path, asymmetric, 
     # The array and the file read back are the same light, within 8-bit rounding ...
     np.testing.assert_allclose(conus.uniform(codes, size=(120, 80)).pixels, conus.uniform(read, size=(120, 80)).pixels, atol=1e-4)
     # ... and encode to the same CoNUS image through the same map. (The budget's choices, made on
-    # trial encodes, may differ for two pictures that differ by rounding: the map is given here.)
+    # its model and confirming encodes, may differ for two pictures that differ by rounding: the map is given here.)
     from_array = conus.encode(codes, foci=[FOCUS], size=(120, 80))
     from_file = conus.encode(read, map=from_array.map, size=(120, 80), channels=channels)
     np.testing.assert_allclose(from_array.pixels, from_file.pixels, atol=2e-3)

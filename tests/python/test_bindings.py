@@ -272,7 +272,7 @@ def test_fit_brings_the_decoded_frame_closer_for_conus_and_uniform(tmp_path, asy
     with pytest.raises(conus.Error):
         conus.encode(asymmetric, foci=[FOCUS], size=(60, 40), fit=-1)
     # fit_hold=0: the plain least squares, no damping toward the filtered encode: closer still
-    # (through the same map: the budget's trial encodes are fitted with the hold given).
+    # (through the same map: the budget's confirming encodes are fitted with the hold given).
     unheld = conus.encode(asymmetric, map=fitted.map, size=(60, 40), fit=3, fit_hold=0.0)
     assert mse(conus.decode(unheld), asymmetric) <= mse(conus.decode(fitted), asymmetric)
     with pytest.raises(conus.Error):
