@@ -89,7 +89,10 @@ const std::vector<float>& displayTable() {
     return table;
 }
 
+// A value as the model weighs it; a NaN or infinite one (a picture kept as read, which filtering
+// spreads) as 0, so that it neither indexes the table nor turns a tile's error into NaN.
 float shown(float v, bool display, const std::vector<float>& table) {
+    if (!std::isfinite(v)) return 0.0f;
     if (!display) return v;
     const float x = std::clamp(v, 0.0f, 1.0f) * kDisplayTableSteps;
     const int i = static_cast<int>(x);

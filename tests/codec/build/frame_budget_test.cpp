@@ -272,6 +272,27 @@ TEST(FrameBudget, KIsContinuousInThePicture) {
     EXPECT_NEAR(k[2], k[0], 0.01 * k[0]);
 }
 
+// A picture kept with NaN and infinite values (encode warns and goes on) gives a model whose
+// predictions are numbers, confirmed by an encode or not, in display and linear terms alike.
+TEST(FrameBudget, NonFiniteValuesGiveFinitePredictions) {
+    Image source = varied(0);
+    source.pixels[(std::size_t(10) * source.width + 10) * source.channels.size()] = std::nanf("");
+    source.pixels[(std::size_t(20) * source.width + 50) * source.channels.size() + 1] = INFINITY;
+    source.pixels[(std::size_t(30) * source.width + 5) * source.channels.size() + 2] = -INFINITY;
+    const std::vector<Focus> foci{{0.5, 0.5, 0.2, 2.0}};
+    FociOptions fo;
+    fo.aspect = double(source.width) / source.height;
+    for (ErrorSpace space : {ErrorSpace::Display, ErrorSpace::Linear}) {
+        const FrameErrorModel model(source, source.width / 4, source.height / 4, fociImportance(foci, fo.aspect, 128, 96), {space, 0});
+        const SamplingMap map = buildFociMap(foci, fo);
+        const FramePrediction p = model.predict(map);
+        EXPECT_TRUE(std::isfinite(p.frameLoss) && std::isfinite(p.tileLoss) && std::isfinite(p.roiGain));
+        const FramePrediction confirmed = model.confirmed(map).predict(map);
+        EXPECT_TRUE(std::isfinite(confirmed.frameLoss) && std::isfinite(confirmed.tileLoss) && std::isfinite(confirmed.roiGain));
+        EXPECT_TRUE(std::isfinite(fociForFrameLoss(foci, fo, model, 1.5).given[0].k));
+    }
+}
+
 TEST(FrameBudget, TighterBudgetGivesSmallerLoss) {
     const Image source = picture(), importance = boxes();
     const FrameErrorModel model(source, kWidth / 4, kHeight / 4, importance, {ErrorSpace::Linear, 0});
