@@ -35,6 +35,7 @@
 #include "conus/imageio/image_file.h"
 #include "conus/sceneio/named_files.h"
 #include "extension_pvt.h"
+#include "mesh_headers_pvt.h"
 #include "scene_screen.h"
 
 // Debian's Assimp keeps its internal assertions, which abort the process (a hostile PLY reaches
@@ -52,9 +53,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void fail(ErrorCode code, const std::string& path, const std::string& why) {
-    throw Error(code, "mesh '" + path + "': " + why);
-}
 
 // Assimp says some things only in its log: that it dropped faces whose indices point past their
 // mesh's vertices (glTF's importer does). While a file is read, its warnings and errors are kept
@@ -64,118 +62,6 @@ struct AssimpLog : Assimp::LogStream {
     void write(const char* message) override { text += message; }
 };
 std::mutex assimpLogMutex;
-
-// Assimp's text importers (PLY headers, OBJ, MTL) end a line at any of \n \r \0 \f and skip empty
-// lines; the checks below read files the same way: the first `limit` bytes of `path`, a line at a
-// time, streamed (a check that stops at its first statement reads no further).
-class AssimpLines {
-public:
-    AssimpLines(const std::string& path, std::uintmax_t limit) : m_in(path, std::ios::binary), m_left(limit) {}
-    bool next(std::string& line) {
-        const auto end = [](int c) { return c == '\n' || c == '\r' || c == '\0' || c == '\f'; };
-        line.clear();
-        for (int c; m_left > 0 && (c = m_in.rdbuf()->sbumpc()) != std::ifstream::traits_type::eof(); --m_left) {
-            if (!end(c)) {
-                line += static_cast<char>(c);
-            } else if (!line.empty()) {
-                --m_left;
-                return true;
-            }
-        }
-        return !line.empty();
-    }
-
-private:
-    std::ifstream m_in;
-    std::uintmax_t m_left;
-};
-
-// A PLY header's format and property lines as the spec has them: Assimp's reader loops on a list
-// whose type it does not know, and on a format it does not know.
-void checkPlyLine(const std::string& path, const std::string& keyword, std::istringstream& words) {
-    static const std::set<std::string> kTypes = {"char",  "uchar",  "short", "ushort", "int",    "uint",
-                                                 "float", "double", "int8",  "uint8",  "int16",  "uint16",
-                                                 "int32", "uint32", "float32", "float64"};
-    std::string a, b, c, d;
-    words >> a >> b >> c >> d;
-    const bool ok = keyword == "format"
-                        ? (a == "ascii" || a == "binary_little_endian" || a == "binary_big_endian") && b == "1.0" && c.empty()
-                        : a == "list" ? kTypes.count(b) && kTypes.count(c) && !d.empty() : kTypes.count(a) && !b.empty() && c.empty();
-    if (!ok) fail(ErrorCode::Corrupt, path, "its PLY header has a " + keyword + " line the format does not define");
-}
-
-// PLY headers declare their element counts up front and Assimp reserves memory for them before
-// reading a single vertex; a count no file of this size can hold (every element takes at least a
-// byte) or one past the caps is refused here, before Assimp sees the file.
-void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
-    // Assimp takes a file whose first line starts with the three letters ("ply@" included) as a
-    // PLY whatever its name: a .glb or .gltf its own importer refuses is tried as one.
-    AssimpLines lines(path, std::min<std::uintmax_t>(bytes, 1 << 20));
-    std::string line;
-    if (!lines.next(line) || line.size() < 3) return;
-    std::string magic = line.substr(0, 3);
-    for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (magic != "ply") return;
-    for (int n = 0; n < 10000 && lines.next(line); ++n) {
-        while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
-        if (line == "end_header") return;
-        std::istringstream words(line);
-        std::string keyword, element;
-        long double count = 0;
-        // Assimp's ASCII reader loops forever on some malformed headers: only the spec's lines pass.
-        words >> keyword;
-        if (keyword != "format" && keyword != "element" && keyword != "property" && keyword != "comment" &&
-            keyword != "obj_info")
-            fail(ErrorCode::Corrupt, path, "its PLY header has a line that is not format, element, property, comment "
-                                           "or end_header");
-        if (keyword == "format" || keyword == "property") checkPlyLine(path, keyword, words);
-        if (!(words >> element >> count) || keyword != "element") continue;
-        const std::int64_t cap = element == "vertex" ? options.maxVertices : element == "face" ? options.maxTriangles : -1;
-        if (count > static_cast<long double>(bytes))
-            fail(ErrorCode::Corrupt, path, "its header declares " + numberText(double(count)) + " " + element +
-                                               " elements in a file of " + std::to_string(bytes) + " bytes");
-        if (cap >= 0 && count > static_cast<long double>(cap))
-            fail(ErrorCode::LimitExceeded, path, "its header declares " + numberText(double(count)) + " " + element +
-                                                     " elements, more than the limit of " + std::to_string(cap));
-    }
-    // Assimp's ASCII PLY reader loops forever on a header that never ends.
-    fail(ErrorCode::Corrupt, path, "its PLY header has no end_header line");
-}
-
-// OFF files declare their vertex and face counts in the first line after the keyword, and Assimp
-// allocates the faces by the count before reading one (a 139-byte file asked for 61 GB): a count no
-// file of this size can hold (a vertex takes at least 6 bytes, a face 8) or one past the caps is
-// refused here.
-void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
-    std::ifstream in(path, std::ios::binary);
-    std::string token;
-    std::vector<std::string> tokens;
-    for (std::string line; tokens.size() < 4 && std::getline(in, line) && in.tellg() < 65536;) {
-        std::istringstream words(line.substr(0, line.find('#')));
-        while (tokens.size() < 4 && words >> token) tokens.push_back(token);
-    }
-    const std::string ext = lowerExtension(path);
-    const bool keyword = !tokens.empty() && tokens[0].size() >= 3 && tokens[0].compare(tokens[0].size() - 3, 3, "OFF") == 0;
-    if (!keyword && ext != ".off") return;
-    const std::size_t first = keyword ? 1 : 0;
-    if (tokens.size() < first + 2) return;  // Assimp refuses what has no counts
-    long double counts[2] = {0, 0};
-    for (int i = 0; i < 2; ++i) {
-        std::istringstream number(tokens[first + std::size_t(i)]);
-        if (!(number >> counts[i])) return;  // not a count: Assimp refuses it itself
-    }
-    const char* names[2] = {"vertices", "faces"};
-    const long double leastBytes[2] = {6, 8};
-    const std::int64_t caps[2] = {options.maxVertices, options.maxTriangles};
-    for (int i = 0; i < 2; ++i) {
-        if (counts[i] * leastBytes[i] > static_cast<long double>(bytes))
-            fail(ErrorCode::Corrupt, path, "its OFF header declares " + numberText(double(counts[i])) + " " + names[i] +
-                                               " in a file of " + std::to_string(bytes) + " bytes");
-        if (counts[i] > static_cast<long double>(caps[i]))
-            fail(ErrorCode::LimitExceeded, path, "its OFF header declares " + numberText(double(counts[i])) + " " +
-                                                     names[i] + ", more than the limit of " + std::to_string(caps[i]));
-    }
-}
 
 std::string trimmed(std::string text) {
     const auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };

@@ -1,4 +1,4 @@
-// CPU reference encoder (paper section 3.2) and the area-downsample baseline.
+// CPU reference encoder (paper section 3.2); the area-downsample baseline is area_downsample.cpp.
 //
 // Each CoNUS pixel filters the source over its footprint (encode.h states the rule), by one of two
 // kernels (EncodeFilter). The EWA filter: a grid of bilinear taps in the pixel's own units (s,t),
@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "conus/codec/image/encode.h"
+#include "area_downsample_pvt.h"
 #include "conus/core/parallel.h"
 #include "encode_pvt.h"
 #include "resample_pvt.h"
@@ -25,77 +26,8 @@ namespace {
 constexpr int kMaxTapsPerAxis = kEncodeMaxTaps;  // encode.h says why (the minor axis's bound)
 constexpr double kTapTolerance = kEncodeTapTolerance;
 
-// Source-pixel intervals covered by each output pixel along one axis, with exact overlap weights.
-struct AxisWeights {
-    std::vector<int> first, count, offset;
-    std::vector<float> weight;
-};
-
-AxisWeights areaWeights(int source, int target) {
-    AxisWeights w;
-    w.first.resize(target);
-    w.count.resize(target);
-    w.offset.resize(target);
-    const double scale = static_cast<double>(source) / target;
-    for (int i = 0; i < target; ++i) {
-        const double lo = i * scale, hi = (i + 1) * scale;
-        const int k0 = std::min(source - 1, static_cast<int>(std::floor(lo)));
-        const int k1 = std::min(source, static_cast<int>(std::ceil(hi)));
-        w.first[i] = k0;
-        w.offset[i] = static_cast<int>(w.weight.size());
-        for (int k = k0; k < k1; ++k) {
-            const double overlap = std::min(hi, k + 1.0) - std::max(lo, static_cast<double>(k));
-            if (overlap > 0) w.weight.push_back(static_cast<float>(overlap / scale));
-            else if (k == k0) ++w.first[i];  // a zero-width sliver at the start: skip it
-        }
-        w.count[i] = static_cast<int>(w.weight.size()) - w.offset[i];
-    }
-    return w;
-}
-
-// Vertical pass into a row of source width, then the horizontal pass: each source value is read
-// once per output row it touches and the row buffer stays in cache.
-// A pixel array without its channel names.
-struct Plane {
-    const float* data = nullptr;
-    int width = 0, height = 0;
-};
-
-template <int kC>
-void areaRows(Plane src, float* dst, int dstWidth, int c, const AxisWeights& wx, const AxisWeights& wy, int y0,
-              int y1) {
-    const int channels = kC > 0 ? kC : c;
-    const std::size_t rowValues = static_cast<std::size_t>(src.width) * channels;
-    std::vector<float> row(rowValues);
-    std::vector<float> dynamicAcc(kC > 0 ? 0 : channels);
-    for (int y = y0; y < y1; ++y) {
-        std::fill(row.begin(), row.end(), 0.0f);
-        for (int k = 0; k < wy.count[y]; ++k) {
-            const float w = wy.weight[wy.offset[y] + k];
-            const float* s = src.data + (wy.first[y] + k) * rowValues;
-            for (std::size_t i = 0; i < rowValues; ++i) row[i] += w * s[i];
-        }
-        float* out = dst + static_cast<std::size_t>(y) * dstWidth * channels;
-        for (int x = 0; x < dstWidth; ++x, out += channels) {
-            float fixedAcc[kC > 0 ? kC : 1];
-            float* a = kC > 0 ? fixedAcc : dynamicAcc.data();
-            for (int c = 0; c < channels; ++c) a[c] = 0.0f;
-            const float* s = row.data() + static_cast<std::size_t>(wx.first[x]) * channels;
-            const float* w = wx.weight.data() + wx.offset[x];
-            for (int k = 0; k < wx.count[x]; ++k, s += channels)
-                for (int c = 0; c < channels; ++c) a[c] += w[k] * s[c];
-            for (int c = 0; c < channels; ++c) out[c] = a[c];
-        }
-    }
-}
-
-void areaDownsamplePlane(Plane src, float* dst, int width, int height, int channels, int threads) {
-    const AxisWeights wx = areaWeights(src.width, width);
-    const AxisWeights wy = areaWeights(src.height, height);
-    parallelRows(height, threads, [&](int y0, int y1) {
-        detail::dispatchChannels(channels, [&]<int kC>() { areaRows<kC>(src, dst, width, channels, wx, wy, y0, y1); });
-    });
-}
+using detail::areaDownsamplePlane;
+using detail::Plane;
 
 // Box-filtered mip levels of the source, each built the first time a footprint needs it.
 class Pyramid {
@@ -620,22 +552,6 @@ Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptio
         });
         progress.add(y1 - y0);
     });
-    return out;
-}
-
-// Downsample only: growing an axis has no area to average over, and the decoder's bilinear
-// baseline (resizeBilinear) is the tool for that.
-Image areaDownsample(const Image& source, int width, int height, int threads) {
-    checkImage(source, "areaDownsample");
-    detail::checkOutputSize(width, height, "areaDownsample");
-    if (width > source.width || height > source.height)
-        throw Error(ErrorCode::InvalidArgument,
-                    "areaDownsample: " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
-                        std::to_string(width) + "x" + std::to_string(height) +
-                        " grows the image; it only shrinks (use resizeBilinear)");
-    Image out = detail::makeOutput(source, width, height);
-    areaDownsamplePlane({source.pixels.data(), source.width, source.height}, out.pixels.data(), width, height,
-                        source.channelCount(), threads);
     return out;
 }
 
