@@ -239,16 +239,17 @@ int runBakeReflection(const ReflectionBakeText& o) {
     Progress baking("bake six " + std::to_string(o.size) + "x" + std::to_string(o.size) + " faces (Embree)");
     const auto faces = codec::bakeReflection(scene, options);
     baking.done();
+    // The report's rays are traced before the write, so that nothing fails after the asset is there.
+    const int layers = faces.front().layers();
+    const double one = codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, 1);
+    const double all = codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, layers);
     // One file, written through a temporary and renamed: a failed bake leaves the earlier asset whole.
     Progress writing("write " + o.output);
     format::writeReflectionAsset(o.output, codec::reflectionAssetFile(faces));
     writing.done();
-    const int layers = faces.front().layers();
     std::printf("wrote %s: reflection asset of six %dx%d CoNUS colour + depth faces, %d layer%s, from %g,%g,%g (%s)\n",
                 o.output.c_str(), o.size, o.size, layers, layers == 1 ? "" : "s", options.centre.x, options.centre.y,
                 options.centre.z, o.uniform ? "uniform, the baseline" : "foci on the region of interest");
-    const double one = codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, 1);
-    const double all = codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, layers);
     std::printf("mirror rays (radius %g) that land in a disocclusion: %.2f%% with 1 layer, %.2f%% with %d\n", o.mirrorRadius,
                 100.0 * one, 100.0 * all, layers);
     return 0;

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -47,6 +48,9 @@ struct ServeOptions {
 };
 
 // A request the server refuses: its status and one line.
+// The largest file of the folder sent as it is (each is read whole into memory to be sent).
+constexpr std::uintmax_t kMaxServedBytes = std::uintmax_t(1) << 30;
+
 struct Refusal {
     int status;
     std::string line;
@@ -219,6 +223,9 @@ int runServe(const ServeOptions& o) {
             }
             // Any other name: a file of the folder.
             const fs::path path = confined(frames.root(), name);
+            std::error_code ec;
+            if (fs::file_size(path, ec) > kMaxServedBytes && !ec)
+                throw Refusal{413, name + ": larger than " + std::to_string(kMaxServedBytes >> 20) + " MiB, which conus serve does not send"};
             const std::vector<unsigned char> bytes = fileBytes(path.string());
             return {200, contentTypeOf(path), std::string(bytes.begin(), bytes.end())};
         } catch (const Refusal& r) {

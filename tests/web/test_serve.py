@@ -82,14 +82,18 @@ BAD = [
     ("/%2e%2e/%2e%2e/%2e%2e/etc/passwd", 400),
     ("/link-out.png", 400),
     ("/nothing-here.exr", 404),
+    ("/huge.exr", 413),  # past the 1 GiB that serve sends (a sparse file)
 ]
 
 
 @pytest.fixture(scope="module")
 def link_out(served):
+    """A link out of the folder, and a file too large to send (sparse: it takes no disk)."""
     link = served / "link-out.png"
     if not link.exists():
         os.symlink("/etc/passwd", link)
+    with open(served / "huge.exr", "wb") as f:
+        f.truncate((1 << 30) + 1)
     return link
 
 
