@@ -156,9 +156,11 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     std::string given;
     // The budgets' model predicts this encode (fitted or `--fast`) on what a user sees: colour
     // through the display's curve, raw data as stored; one real encode confirms it, but under `--fast`.
-    const codec::FrameModelOptions modelOptions{
+    codec::FrameModelOptions modelOptions{
         source.info.encoding.transfer == Transfer::Raw ? codec::ErrorSpace::Linear : codec::ErrorSpace::Display, o.fit.count(), o.fit.hold,
         !o.fast};
+    modelOptions.filter = parseEnum<codec::EncodeFilter>(o.fit.filter);
+    modelOptions.fitMethod = parseEnum<codec::FitMethod>(o.fit.method);
     if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image);
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, modelOptions);
     else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, modelOptions, &given);

@@ -284,11 +284,13 @@ FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
     EncodeOptions encode;
     encode.width = m_conusWidth;
     encode.height = m_conusHeight;
+    encode.filter = m_options.filter;
     Image conus = encodeImage(source, map, encode);
     if (m_options.fitIterations > 0) {
         FitOptions fit;
         fit.iterations = m_options.fitIterations;
         fit.holdLowPass = m_options.fitHold;
+        fit.method = m_options.fitMethod;
         fitToDecoder(source, map, conus, fit);
     }
     DecodeOptions decode;

@@ -67,6 +67,9 @@ struct FrameModelOptions {
     // colour, a map a quarter of an octave of k away lost 0.3 dB more outside its focus than the
     // corrected model said), so a budget that must hold to the tenth of a dB confirms more than once.
     int confirmRounds = 1;
+    // The encode's kernel and fit method, which the confirming encodes use as the encode will.
+    EncodeFilter filter = EncodeFilter::Anisotropic;
+    FitMethod fitMethod = FitMethod::LeastSquares;
 };
 
 // How near (in the exponent t of k^t) the map chosen on a confirmed model must be to the map that
