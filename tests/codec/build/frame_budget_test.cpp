@@ -93,6 +93,39 @@ Measured measure(const Image& source, const SamplingMap& map, const Image& impor
             10 * std::log10(mse(uniform, source, importance, true) / mse(view, source, importance, true))};
 }
 
+// The whole-frame loss (dB, display values, floor (2/255)^2) of a real encode through `map` with
+// `filter`, fitted by `fitIterations` of `method` (0: none), against the uniform image of kWidth/4 x
+// kHeight/4: what a confirmed model must predict.
+double measuredFrameLoss(const Image& source, const SamplingMap& map, int fitIterations, EncodeFilter filter = EncodeFilter::Anisotropic,
+                         FitMethod method = FitMethod::LeastSquares) {
+    EncodeOptions e;
+    e.width = kWidth / 4;
+    e.height = kHeight / 4;
+    e.filter = filter;
+    Image conus = encodeImage(source, map, e);
+    if (fitIterations > 0) {
+        FitOptions f;
+        f.iterations = fitIterations;
+        f.method = method;
+        fitToDecoder(source, map, conus, f);
+    }
+    DecodeOptions d;
+    d.width = kWidth;
+    d.height = kHeight;
+    const Image view = decodeImage(conus, map, d);
+    const Image uniform = resizeBilinear(areaDownsample(source, e.width, e.height), {}, kWidth, kHeight);
+    const auto displayMse = [&](const Image& im) {
+        double sum = 0;
+        for (std::size_t i = 0; i < im.pixels.size(); ++i) {
+            const double dv = double(linearToSrgbDisplay(im.pixels[i])) - linearToSrgbDisplay(source.pixels[i]);
+            sum += dv * dv;
+        }
+        return sum / double(im.pixels.size());
+    };
+    const double f2 = (2.0 / 255) * (2.0 / 255);
+    return 10 * std::log10((displayMse(view) + f2) / (displayMse(uniform) + f2));
+}
+
 // The model alone predicts roughly (bench/notes/2026-12-06-budget-model.md); confirmed by a real
 // encode of a map, it predicts that map's losses as measured: the identity map, unfitted and
 // fitted, against the real encodes (the fit gains over the whole frame).
@@ -104,30 +137,7 @@ TEST(FrameBudget, ConfirmedModelPredictsTheMapItMeasured) {
         SCOPED_TRACE(fit);
         const FrameErrorModel model(source, kWidth / 4, kHeight / 4, boxes(), {ErrorSpace::Display, fit});
         const FramePrediction p = model.confirmed(identity).predict(identity);
-        EncodeOptions e;
-        e.width = kWidth / 4;
-        e.height = kHeight / 4;
-        Image conus = encodeImage(source, identity, e);
-        if (fit > 0) {
-            FitOptions f;
-            f.iterations = fit;
-            fitToDecoder(source, identity, conus, f);
-        }
-        DecodeOptions d;
-        d.width = kWidth;
-        d.height = kHeight;
-        const Image view = decodeImage(conus, identity, d);
-        const Image uniform = resizeBilinear(areaDownsample(source, e.width, e.height), {}, kWidth, kHeight);
-        const auto displayMse = [&](const Image& im) {
-            double sum = 0;
-            for (std::size_t i = 0; i < im.pixels.size(); ++i) {
-                const double dv = double(linearToSrgbDisplay(im.pixels[i])) - linearToSrgbDisplay(source.pixels[i]);
-                sum += dv * dv;
-            }
-            return sum / double(im.pixels.size());
-        };
-        const double f2 = (2.0 / 255) * (2.0 / 255);
-        const double measured = 10 * std::log10((displayMse(view) + f2) / (displayMse(uniform) + f2));
+        const double measured = measuredFrameLoss(source, identity, fit);
         EXPECT_NEAR(p.frameLoss, measured, 0.05);
         frame.push_back(p.frameLoss);
     }
@@ -157,32 +167,7 @@ TEST(FrameBudget, ConfirmingEncodeTakesTheEncodesKernelAndFit) {
         options.fitMethod = c.method;
         const FrameErrorModel model(source, kWidth / 4, kHeight / 4, boxes(), options);
         const FramePrediction p = model.confirmed(map).predict(map);
-        EncodeOptions e;
-        e.width = kWidth / 4;
-        e.height = kHeight / 4;
-        e.filter = c.filter;
-        Image conus = encodeImage(source, map, e);
-        if (c.fit > 0) {
-            FitOptions f;
-            f.iterations = c.fit;
-            f.method = c.method;
-            fitToDecoder(source, map, conus, f);
-        }
-        DecodeOptions d;
-        d.width = kWidth;
-        d.height = kHeight;
-        const Image view = decodeImage(conus, map, d);
-        const Image uniform = resizeBilinear(areaDownsample(source, e.width, e.height), {}, kWidth, kHeight);
-        const auto displayMse = [&](const Image& im) {
-            double sum = 0;
-            for (std::size_t i = 0; i < im.pixels.size(); ++i) {
-                const double dv = double(linearToSrgbDisplay(im.pixels[i])) - linearToSrgbDisplay(source.pixels[i]);
-                sum += dv * dv;
-            }
-            return sum / double(im.pixels.size());
-        };
-        const double f2 = (2.0 / 255) * (2.0 / 255);
-        EXPECT_NEAR(p.frameLoss, 10 * std::log10((displayMse(view) + f2) / (displayMse(uniform) + f2)), 0.25);
+        EXPECT_NEAR(p.frameLoss, measuredFrameLoss(source, map, c.fit, c.filter, c.method), 0.25);
         predicted.push_back(p.frameLoss);
     }
     std::printf("confirmed frame loss: EWA %.3f, anisotropic %.3f, anisotropic + local fit %.3f dB\n", predicted[0], predicted[1],
