@@ -10,7 +10,7 @@
 #include <optional>
 
 #include "commands.h"
-#include "conus/codec/build/map_measures.h"
+#include "conus/codec/builders/map_measures.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/format/reflection_asset.h"

@@ -21,7 +21,7 @@
 #include "arguments.h"
 #include "backend.h"
 #include "commands.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/mesh/city.h"

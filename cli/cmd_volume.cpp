@@ -16,7 +16,7 @@
 #include "arguments.h"
 #include "backend.h"
 #include "commands.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/codec/volume/raycast.h"

@@ -3,7 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "arguments.h"
-#include "conus/codec/build/importance.h"
+#include "conus/codec/builders/importance.h"
 #include "conus/core/atomic_file.h"
 #include "progress.h"
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/foci_budget.h"
+#include "conus/codec/builders/auto_map.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/foci_budget.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"

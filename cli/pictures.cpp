@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "conus/codec/build/map_measures.h"
+#include "conus/codec/builders/map_measures.h"
 #include "conus/core/display.h"
 
 namespace conus::cli {

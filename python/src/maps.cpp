@@ -10,11 +10,11 @@
 #include <tuple>
 #include <vector>
 
-#include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/frame_budget.h"
-#include "conus/codec/build/map_measures.h"
-#include "conus/codec/build/springs.h"
+#include "conus/codec/builders/auto_map.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/frame_budget.h"
+#include "conus/codec/builders/map_measures.h"
+#include "conus/codec/builders/springs.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
 #include "conus/imageio/image_file.h"

@@ -26,10 +26,10 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/foci_budget.h"
-#include "conus/codec/build/frame_budget.h"
-#include "conus/codec/build/importance.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/foci_budget.h"
+#include "conus/codec/builders/frame_budget.h"
+#include "conus/codec/builders/importance.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "conus/codec/build/frame_foci.h"
+#include "conus/codec/builders/frame_foci.h"
 #include "conus/core/error.h"
 
 namespace conus::renderers {

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/conus_file.h"
 
 using namespace conus;

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/ground_map.h"
+#include "conus/codec/builders/ground_map.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 

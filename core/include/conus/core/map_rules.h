@@ -39,7 +39,7 @@ inline constexpr std::int64_t maxSideForImage(std::int64_t width, std::int64_t h
 // The builders' default bound on anisotropy: the ratio of a cell's Jacobian singular values in
 // pixels (codec's map_measures.h). A CoNUS pixel's footprint is at most this elongated, so the
 // encode's filter and the decode's stretch stay local; foci reach their k by widening their
-// transition instead (codec/build/density_map.h, foci.h).
+// transition instead (codec/builders/density_map.h, foci.h).
 inline constexpr double kMaxAnisotropy = 7.0;
 
 // The corners of cell (i,j) in its cyclic order: (i,j), (i+1,j), (i+1,j+1), (i,j+1).

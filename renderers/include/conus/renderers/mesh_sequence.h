@@ -7,7 +7,7 @@
 // linearly to 1 as the projected centre goes from the border to one radius beyond it; a radius is
 // measured in widths, as Focus::r), and an object at or behind the camera's near plane has no focus.
 // Two foci that pass each other merge and separate smoothly because the map of a set of foci is a
-// continuous function of their parameters (codec/build/frame_foci.h).
+// continuous function of their parameters (codec/builders/frame_foci.h).
 #pragma once
 
 #include <span>
@@ -15,7 +15,7 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/camera.h"
 

@@ -16,7 +16,7 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/build/ground_map.h"
+#include "conus/codec/builders/ground_map.h"
 #include "conus/core/camera.h"
 #include "conus/codec/depth/heightfield.h"
 #include "conus/core/image.h"

@@ -23,7 +23,7 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/build/ground_map.h"
+#include "conus/codec/builders/ground_map.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
