@@ -22,6 +22,7 @@
 #include "backend.h"
 #include "commands.h"
 #include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/mesh_sequence.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/mesh/city.h"
@@ -32,7 +33,6 @@
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/renderers/mesh_render.h"
-#include "conus/renderers/mesh_sequence.h"
 #include "conus/sceneio/mesh_file.h"
 #include "encoding.h"
 #include "image_files.h"
@@ -54,7 +54,7 @@ struct MeshOptions {
     std::vector<int> track;
     std::vector<std::string> allowDirs;
     double trackRadius = 0.05, trackK = 3;  // a car is small: a small, moderate focus keeps the context
-    // animate: add, smooth from frame to frame (tests/renderers/mesh_sequence_test.cpp); render sets
+    // animate: add, smooth from frame to frame (tests/codec/builders/mesh_sequence_test.cpp); render sets
     // density, as encode, volume and map compose foci.
     std::string compose = enumName(format::FociComposition::Add);
 };
@@ -221,7 +221,7 @@ int runRender(const RenderOptions& r) {
         std::vector<codec::Focus> given = parseFoci(r.foci);
         if (city) {
             const auto centres = carCentres(*city, o.track, o.time);
-            const auto tracked = renderers::trackedFoci(camera, centres, aspect, {o.trackRadius, o.trackK});
+            const auto tracked = codec::trackedFoci(camera, centres, aspect, {o.trackRadius, o.trackK});
             given.insert(given.end(), tracked.begin(), tracked.end());
         }
         return given;
@@ -340,9 +340,9 @@ int runAnimate(const AnimateOptions& a) {
     Progress rendering("render " + std::to_string(a.frames) + " frames at " + o.sizeText + " (" + device.describe() + ")");
     for (int i = 0; i < a.frames; ++i) {
         const double t = o.time + i / a.fps;
-        const auto foci = renderers::trackedFoci(camera, carCentres(city, o.track, t), aspect, {o.trackRadius, o.trackK});
-        codec::SamplingMap map = renderers::frameMap(foci, fo);
-        if (previous) largestStep = std::max(largestStep, renderers::largestNodeStep(*previous, map));
+        const auto foci = codec::trackedFoci(camera, carCentres(city, o.track, t), aspect, {o.trackRadius, o.trackK});
+        codec::SamplingMap map = codec::frameMap(foci, fo);
+        if (previous) largestStep = std::max(largestStep, codec::largestNodeStep(*previous, map));
         const Image image = renderFrame(device, city.meshAt(t), camera, map, size, o, false);
         char name[32];
         std::snprintf(name, sizeof name, "frame_%04d", i);

@@ -17,15 +17,15 @@
 #include "backend.h"
 #include "commands.h"
 #include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/mesh_sequence.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/codec/volume/raycast.h"
 #include "conus/codec/volume/transfer_function.h"
-#include "conus/core/camera.h"
 #include "conus/core/atomic_file.h"
+#include "conus/core/camera.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
-#include "conus/renderers/mesh_sequence.h"
 #include "conus/renderers/volume_renderer.h"
 #include "conus/sceneio/volume_file.h"
 #include "encoding.h"
@@ -218,8 +218,8 @@ int runAnimate(const AnimateOptions& a) {
         const double t = a.frames > 1 ? double(f) / (a.frames - 1) : 0.0;
         const glm::dvec2 centre = glm::mix(from, to, t);
         const std::vector<codec::Focus> foci{{centre.x, centre.y, a.radius, a.k}};
-        codec::SamplingMap map = renderers::frameMap(foci, fo);
-        if (previous) largest = std::max(largest, renderers::largestNodeStep(*previous, map));
+        codec::SamplingMap map = codec::frameMap(foci, fo);
+        if (previous) largest = std::max(largest, codec::largestNodeStep(*previous, map));
         const Fpc fpc(camera, std::make_shared<codec::SamplingMap>(map));
         const Image image = gpu ? gpu->render(fpc, size.width, size.height, options)
                                 : codec::renderVolumeReference(volume, tf, fpc, size.width, size.height, options);

@@ -8,10 +8,9 @@
 #include <cstdio>
 #include <string>
 
+#include "conus/codec/builders/mesh_sequence.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
-
-#include "conus/renderers/mesh_sequence.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -53,7 +52,7 @@ FrameMap chooseFrameMap(bool uniform, const std::string& mapFile, const FociSour
     if (fociSource) {
         const std::vector<codec::Focus> foci = fociSource();
         Progress building("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
-        FrameMap chosen{renderers::frameMap(foci, options), std::nullopt, false};
+        FrameMap chosen{codec::frameMap(foci, options), std::nullopt, false};
         if (!foci.empty()) chosen.analytic = codec::toAnalytic(foci, options.composition);
         building.done();
         return chosen;

@@ -1,4 +1,4 @@
-#include "conus/renderers/mesh_sequence.h"
+#include "conus/codec/builders/mesh_sequence.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 
 #include "conus/core/error.h"
 
-namespace conus::renderers {
+namespace conus::codec {
 namespace {
 
 Camera camera(double aspect) {
@@ -54,17 +54,17 @@ TEST(TrackedFoci, FadeOutBeyondTheBorderAndVanishBehindTheEye) {
 
 // The per-frame largest node move while two foci (k = 4) pass each other in 40 steps of 1% of the
 // width each, with the maps built by `build`.
-using MapBuilder = codec::SamplingMap (*)(std::span<const codec::Focus>, const codec::FociOptions&);
-std::vector<double> passingMoves(MapBuilder build, codec::FociComposition composition, double step) {
-    codec::FociOptions options;
+using MapBuilder = SamplingMap (*)(std::span<const Focus>, const FociOptions&);
+std::vector<double> passingMoves(MapBuilder build, FociComposition composition, double step) {
+    FociOptions options;
     options.aspect = 16.0 / 9.0;
     options.composition = composition;
     std::vector<double> moves;
-    std::optional<codec::SamplingMap> previous;
+    std::optional<SamplingMap> previous;
     for (int frame = 0; frame <= 40; ++frame) {
         const double s = frame * step;
-        const codec::Focus foci[] = {{0.3 + s, 0.45, 0.08, 4.0}, {0.7 - s, 0.55, 0.08, 4.0}};
-        codec::SamplingMap map = build(std::span<const codec::Focus>(foci), options);
+        const Focus foci[] = {{0.3 + s, 0.45, 0.08, 4.0}, {0.7 - s, 0.55, 0.08, 4.0}};
+        SamplingMap map = build(std::span<const Focus>(foci), options);
         if (previous) moves.push_back(largestNodeStep(*previous, map));
         previous = std::move(map);
     }
@@ -86,9 +86,9 @@ double largestRatio(const std::vector<double>& moves) {
 // rebuilds the map globally from a sampled density and jitters.
 TEST(FrameMaps, FociMergeAndSeparateWithoutJumps) {
     const double step = 0.01, k = 4.0;
-    const std::vector<double> add = passingMoves(frameMap, codec::FociComposition::Add, step);
-    const std::vector<double> gridAdd = passingMoves(codec::buildFociMap, codec::FociComposition::Add, step);
-    const std::vector<double> density = passingMoves(frameMap, codec::FociComposition::Density, step);
+    const std::vector<double> add = passingMoves(frameMap, FociComposition::Add, step);
+    const std::vector<double> gridAdd = passingMoves(buildFociMap, FociComposition::Add, step);
+    const std::vector<double> density = passingMoves(frameMap, FociComposition::Density, step);
     const double largest = *std::max_element(add.begin(), add.end());
     std::printf("largest per-frame node move for a 0.01 focus step: closed-form add %.4f (frame-to-frame ratio up "
                 "to %.2f), density-grid add %.4f (%.2f), density %.4f (%.2f)\n",
@@ -100,12 +100,12 @@ TEST(FrameMaps, FociMergeAndSeparateWithoutJumps) {
 }
 
 TEST(FrameMaps, NoFociIsTheIdentityOfTheGrid) {
-    codec::FociOptions options;
+    FociOptions options;
     const auto map = frameMap({}, options);
     EXPECT_EQ(map.columns(), options.columns);
-    EXPECT_EQ(largestNodeStep(map, codec::SamplingMap::identity(options.columns, options.rows)), 0.0);
-    EXPECT_THROW(largestNodeStep(map, codec::SamplingMap::identity(2, 2)), Error);
+    EXPECT_EQ(largestNodeStep(map, SamplingMap::identity(options.columns, options.rows)), 0.0);
+    EXPECT_THROW(largestNodeStep(map, SamplingMap::identity(2, 2)), Error);
 }
 
 }  // namespace
-}  // namespace conus::renderers
+}  // namespace conus::codec

@@ -19,7 +19,7 @@
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/camera.h"
 
-namespace conus::renderers {
+namespace conus::codec {
 
 struct TrackOptions {
     double radius = 0.08;  // each focus's radius, a fraction of the image width
@@ -28,15 +28,15 @@ struct TrackOptions {
 
 // The foci of `points` (world) seen by `camera` in an image of `aspect` = width / height, by the
 // rule above; those that faded out entirely are left out.
-std::vector<codec::Focus> trackedFoci(const Camera& camera, std::span<const glm::dvec3> points, double aspect,
+std::vector<Focus> trackedFoci(const Camera& camera, std::span<const glm::dvec3> points, double aspect,
                                       const TrackOptions& options = {});
 
 // One frame's map. The add composition (the animation's, the paper's) is built in closed form by
-// codec::buildFrameFociMap, microseconds a frame; the density composition by codec::buildFociMap.
+// buildFrameFociMap, microseconds a frame; the density composition by buildFociMap.
 // The identity of the same grid when there are no foci.
-codec::SamplingMap frameMap(std::span<const codec::Focus> foci, const codec::FociOptions& options);
+SamplingMap frameMap(std::span<const Focus> foci, const FociOptions& options);
 
 // The largest distance any node moved between two maps of the same grid (normalized units).
-double largestNodeStep(const codec::SamplingMap& from, const codec::SamplingMap& to);
+double largestNodeStep(const SamplingMap& from, const SamplingMap& to);
 
-}  // namespace conus::renderers
+}  // namespace conus::codec

@@ -1,4 +1,4 @@
-#include "conus/renderers/mesh_sequence.h"
+#include "conus/codec/builders/mesh_sequence.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,14 +7,14 @@
 #include "conus/codec/builders/frame_foci.h"
 #include "conus/core/error.h"
 
-namespace conus::renderers {
+namespace conus::codec {
 
-std::vector<codec::Focus> trackedFoci(const Camera& camera, std::span<const glm::dvec3> points, double aspect,
+std::vector<Focus> trackedFoci(const Camera& camera, std::span<const glm::dvec3> points, double aspect,
                                       const TrackOptions& options) {
     if (!(options.radius > 0) || !(options.k >= 1) || !(aspect > 0) || !std::isfinite(aspect))
         throw Error(ErrorCode::InvalidArgument, "trackedFoci: radius " + std::to_string(options.radius) + ", k " +
                                                     std::to_string(options.k) + ", aspect " + std::to_string(aspect));
-    std::vector<codec::Focus> foci;
+    std::vector<Focus> foci;
     for (const glm::dvec3& point : points) {
         const glm::dvec3 p = camera.project(point);
         if (!(p.z > camera.near()) || !std::isfinite(p.x) || !std::isfinite(p.y)) continue;
@@ -31,13 +31,13 @@ std::vector<codec::Focus> trackedFoci(const Camera& camera, std::span<const glm:
     return foci;
 }
 
-codec::SamplingMap frameMap(std::span<const codec::Focus> foci, const codec::FociOptions& options) {
-    if (options.composition == codec::FociComposition::Add) return codec::buildFrameFociMap(foci, options);
-    if (foci.empty()) return codec::SamplingMap::identity(options.columns, options.rows);
-    return codec::buildFociMap(foci, options);
+SamplingMap frameMap(std::span<const Focus> foci, const FociOptions& options) {
+    if (options.composition == FociComposition::Add) return buildFrameFociMap(foci, options);
+    if (foci.empty()) return SamplingMap::identity(options.columns, options.rows);
+    return buildFociMap(foci, options);
 }
 
-double largestNodeStep(const codec::SamplingMap& from, const codec::SamplingMap& to) {
+double largestNodeStep(const SamplingMap& from, const SamplingMap& to) {
     if (from.columns() != to.columns() || from.rows() != to.rows())
         throw Error(ErrorCode::InvalidArgument, "largestNodeStep: maps of " + std::to_string(from.columns()) + "x" +
                                                     std::to_string(from.rows()) + " and " + std::to_string(to.columns()) +
@@ -48,4 +48,4 @@ double largestNodeStep(const codec::SamplingMap& from, const codec::SamplingMap&
     return largest;
 }
 
-}  // namespace conus::renderers
+}  // namespace conus::codec
