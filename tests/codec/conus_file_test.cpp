@@ -1,7 +1,12 @@
+#include <cmath>
+#include <limits>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "conus/codec/builders/foci.h"
 #include "conus/codec/conus_file.h"
+#include "conus/core/error.h"
 
 using namespace conus;
 
@@ -21,6 +26,33 @@ TEST(MapFile, HoldsTheMapAndItsDensityAndIsValid) {
     EXPECT_LT(file.image.at(map.columns() - 1, map.rows() - 1), 1.0f);
     ASSERT_TRUE(file.analytic.has_value());
     EXPECT_EQ(file.analytic->foci.size(), 1u);
+}
+
+// V12 is one rule (map_rules::isValidFocus): the builders refuse exactly the foci that the file
+// validator refuses, at and past each end of every range.
+TEST(MapFile, BuildersAndValidatorAgreeOnWhichFociAreValid) {
+    const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
+    const std::vector<codec::Focus> cases{
+        {0.3, 0.4, 0.1, 3},   {0.0, 1.0, 1.0, 1.0},  {1.0, 0.0, 0.001, 64}, {0.5, 0.5, 1.5, 2},  {0.5, 0.5, 1.0001, 2},
+        {0.5, 0.5, 0.0, 2},   {0.5, 0.5, -0.1, 2},   {0.5, 0.5, inf, 2},    {0.5, 0.5, nan, 2},  {1.01, 0.5, 0.1, 2},
+        {0.5, -0.01, 0.1, 2}, {nan, 0.5, 0.1, 2},    {0.5, 0.5, 0.1, 0.99}, {0.5, 0.5, 0.1, 65}, {0.5, 0.5, 0.1, nan}};
+    int accepted = 0;
+    for (const codec::Focus& f : cases) {
+        bool builds = true;
+        try {
+            codec::checkFocus(f);
+        } catch (const Error&) {
+            builds = false;
+        }
+        const format::AnalyticMap analytic{"foci", {{f.u, f.v, f.r, f.k}}, "density", {}};
+        const format::ValidationReport report = format::validateConusFile(codec::makeMapFile(codec::SamplingMap::identity(5, 5), analytic));
+        EXPECT_EQ(builds, report.ok()) << f.u << "," << f.v << "," << f.r << "," << f.k << ": " << report.str();
+        if (!report.ok()) {
+            EXPECT_TRUE(report.violates(format::Rule::V12)) << report.str();
+        }
+        accepted += builds;
+    }
+    EXPECT_EQ(accepted, 3);
 }
 
 TEST(ConusFile, ImageFilesWithDepthAreValidDepthImages) {

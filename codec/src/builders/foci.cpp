@@ -254,12 +254,13 @@ std::string falloffText(const FociFalloff& falloff) {
 }
 
 void checkFocus(const Focus& f) {
-    // Written as negations so that NaN fails every check.
-    if (!(f.u >= 0.0 && f.u <= 1.0 && f.v >= 0.0 && f.v <= 1.0)) {
+    if (!map_rules::focusCentreValid(f.u, f.v)) {
         throw Error(ErrorCode::InvalidArgument, "focus centre (" + numberText(f.u) + ", " + numberText(f.v) + ") is outside [0,1]^2");
     }
-    if (!(f.r > 0.0 && f.r <= 1.0)) throw Error(ErrorCode::InvalidArgument, "focus radius " + numberText(f.r) + " is not in (0, 1]");
-    if (!(f.k >= 1.0 && f.k <= map_rules::kMaxMagnification)) {
+    if (!map_rules::focusRadiusValid(f.r)) {
+        throw Error(ErrorCode::InvalidArgument, "focus radius " + numberText(f.r) + " is not in (0, " + numberText(map_rules::kMaxFocusRadius) + "]");
+    }
+    if (!map_rules::focusMagnificationValid(f.k)) {
         throw Error(ErrorCode::InvalidArgument, "focus magnification " + numberText(f.k) + " is not in [1, " + numberText(map_rules::kMaxMagnification) + "]");
     }
 }

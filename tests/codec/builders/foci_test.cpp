@@ -258,6 +258,8 @@ TEST(Foci, RejectsBadFoci) {
     EXPECT_EQ(code({1.2, 0.5, 0.1, 2}), ErrorCode::InvalidArgument);
     EXPECT_EQ(code({0.5, -0.1, 0.1, 2}), ErrorCode::InvalidArgument);
     EXPECT_EQ(code({0.5, 0.5, 0.0, 2}), ErrorCode::InvalidArgument);
+    EXPECT_EQ(code({0.5, 0.5, 1.5, 2}), ErrorCode::InvalidArgument);
+    EXPECT_EQ(code({0.5, 0.5, 1.0, 2}), ErrorCode::Unsupported);  // the widest focus: the image's width
     EXPECT_EQ(code({0.5, 0.5, 0.1, 0.5}), ErrorCode::InvalidArgument);
     EXPECT_EQ(code({0.5, 0.5, 0.1, map_rules::kMaxMagnification + 1}), ErrorCode::InvalidArgument);
     EXPECT_EQ(code({0.5, std::nan(""), 0.1, 2}), ErrorCode::InvalidArgument);
