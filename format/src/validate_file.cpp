@@ -9,7 +9,7 @@
 #include "conus/core/camera.h"
 #include "conus/core/color.h"
 #include "conus/core/map_rules.h"
-#include "header_model.h"
+#include "header_model_pvt.h"
 
 namespace conus::format {
 namespace detail {

@@ -30,7 +30,7 @@
 #include "conus/codec/builders/map_measures.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
-#include "density_cells.h"
+#include "density_cells_pvt.h"
 
 namespace conus::codec {
 namespace {

@@ -20,7 +20,7 @@
 #include "conus/codec/builders/density_map.h"
 
 #include "conus/codec/builders/map_measures.h"
-#include "density_cells.h"
+#include "density_cells_pvt.h"
 
 #include <fftw3.h>
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "conus/core/error.h"
-#include "budget_search.h"
+#include "budget_search_pvt.h"
 
 namespace conus::codec {
 namespace {

@@ -10,7 +10,7 @@
 #include "conus/codec/image/fit.h"
 #include "conus/core/display.h"
 #include "conus/core/error.h"
-#include "budget_search.h"
+#include "budget_search_pvt.h"
 
 namespace conus::codec {
 namespace {

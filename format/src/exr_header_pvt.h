@@ -6,7 +6,7 @@
 #include <ImfMultiPartInputFile.h>
 
 #include "conus/format/container.h"
-#include "header_model.h"
+#include "header_model_pvt.h"
 
 namespace conus::format::detail {
 

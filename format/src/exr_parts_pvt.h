@@ -13,7 +13,7 @@
 #include "conus/core/atomic_file.h"
 #include "conus/core/image.h"
 #include "conus/format/container.h"
-#include "header_model.h"
+#include "header_model_pvt.h"
 
 namespace conus::format::detail {
 
