@@ -8,10 +8,10 @@
 #include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
 
+#include "conus/cli/option_checks.h"
 #include "conus/codec/image/decode.h"
 #include "conus/format/container.h"
 #include "conus/sceneio/dem_file.h"
-#include "option_checks.h"
 
 namespace conus::cli {
 

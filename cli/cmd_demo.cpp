@@ -26,7 +26,7 @@
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
 #include "map_options.h"
-#include "option_checks.h"
+#include "conus/cli/option_checks.h"
 #include "pictures.h"
 #include "progress.h"
 

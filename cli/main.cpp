@@ -7,7 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
-#include "option_checks.h"
+#include "conus/cli/option_checks.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"

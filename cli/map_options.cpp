@@ -1,5 +1,4 @@
 #include "map_options.h"
-#include "option_checks.h"
 
 #include <CLI/CLI.hpp>
 
@@ -8,6 +7,7 @@
 #include <cstdio>
 #include <string>
 
+#include "conus/cli/option_checks.h"
 #include "conus/codec/builders/mesh_sequence.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
