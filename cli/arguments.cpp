@@ -69,6 +69,14 @@ CameraText parseCamera(const std::string& text) {
     return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6]};
 }
 
+Camera givenCamera(const CameraText& given, glm::dvec3 up, const AxisBox& box, double aspect, const std::string& what) {
+    try {
+        return lookingAtBox(box, given.eye, given.target, up, given.fovYDegrees, aspect, what);
+    } catch (const Error& e) {
+        throw Error(e.code(), std::string("--camera: ") + e.what());
+    }
+}
+
 glm::dvec3 parseVector3(const std::string& text, const std::string& what) {
     const auto v = parseNumbers(text, ',');
     if (v.size() != 3 || text.back() == ',') invalid(what + " '" + text + "' needs 3 values x,y,z");

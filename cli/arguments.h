@@ -10,6 +10,7 @@
 
 #include "conus/cli/option_checks.h"
 #include "conus/codec/image/decode.h"
+#include "conus/core/camera.h"
 #include "conus/format/container.h"
 #include "conus/sceneio/dem_file.h"
 
@@ -30,6 +31,9 @@ struct CameraText {
     double fovYDegrees = 50;
 };
 CameraText parseCamera(const std::string& text);
+// That camera with `up`, clipped to `box` (core's lookingAtBox; `what` names the box); its errors
+// name --camera.
+Camera givenCamera(const CameraText& given, glm::dvec3 up, const AxisBox& box, double aspect, const std::string& what);
 glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "x,y,z", all finite
 
 // The elevation model a DEM argument names: procedural[:SIZE[:SEED]] (codec's terrain, SIZE x SIZE

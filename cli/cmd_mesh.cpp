@@ -76,17 +76,8 @@ CameraChoice parseCameraOptions(const MeshOptions& o) {
 // --camera (with --up), or one that frames the model's bounding box from the front right and
 // above (+x, +y, +z).
 Camera meshCamera(const CameraChoice& choice, const AxisBox& b, double aspect) {
-    const glm::dvec3 up = choice.up;
-    if (!choice.given) return framingCamera(b, {0.55, 0.45, 1.0}, up, aspect);
-    const CameraText& given = *choice.given;
-    const glm::dvec3 forward = given.target - given.eye;
-    if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
-        throw Error(ErrorCode::InvalidArgument,
-                    "--camera: the eye must differ from the look-at point and not look along --up");
-    const std::optional<ClipRange> clip = clipRangeFor(b, given.eye, glm::normalize(forward));
-    if (!clip)
-        throw Error(ErrorCode::InvalidArgument, "the model lies entirely behind the camera (look toward it with --camera)");
-    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, clip->near, clip->far);
+    if (!choice.given) return framingCamera(b, {0.55, 0.45, 1.0}, choice.up, aspect);
+    return givenCamera(*choice.given, choice.up, b, aspect, "the model");
 }
 
 // The whole city from high above its front edge, steep enough that buildings hide few streets.

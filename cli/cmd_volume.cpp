@@ -69,17 +69,9 @@ codec::VolumeRenderOptions renderOptions(const VolumeOptions& o);
 Camera volumeCamera(const VolumeOptions& o, const Volume& volume, const codec::TransferFunction& tf, double aspect) {
     // What the transfer function shows fills the frame (a head, not the box around it).
     if (o.cameraText.empty()) return codec::defaultVolumeCamera(volume, tf, codec::renderRange(volume, renderOptions(o)), aspect);
-    const CameraText given = parseCamera(o.cameraText);
-    const glm::dvec3 up = parseVector3(o.upText, "--up");
-    const glm::dvec3 forward = given.target - given.eye;
-    if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
-        throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText +
-                                                    "': the eye must differ from the look-at point and not look along --up");
     // Near and far bracket the volume's box along the view axis.
-    const std::optional<ClipRange> clip = clipRangeFor(AxisBox{glm::dvec3(0.0), volume.extent()}, given.eye, glm::normalize(forward));
-    if (!clip)
-        throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText + "': the volume lies entirely behind the camera");
-    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, clip->near, clip->far);
+    return givenCamera(parseCamera(o.cameraText), parseVector3(o.upText, "--up"), AxisBox{glm::dvec3(0.0), volume.extent()}, aspect,
+                       "the volume");
 }
 
 // "a,b": two finite numbers.
