@@ -8,8 +8,11 @@
 #include <vector>
 
 #include "conus/codec/depth/heightfield.h"
+#include "conus/codec/image/encode.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
+#include "conus/imageio/image_file.h"
+#include "image_files.h"
 
 namespace conus::cli {
 namespace {
@@ -103,6 +106,25 @@ sceneio::Dem demFrom(const std::string& source, double heightScale) {
     return sceneio::demFromHeights(codec::generateTerrain(options), heightScale,
                                    "procedural terrain " + std::to_string(options.width) + "x" +
                                        std::to_string(options.height) + " seed " + std::to_string(options.seed));
+}
+
+Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding) {
+    if (texture.empty()) {
+        Image ramp = codec::terrainColours(dem.heights, extent);
+        imageio::linearize(ramp);
+        if (encoding) *encoding = {Transfer::Srgb, SampleType::Uint8, kRec709Chromaticities, {}, {}};
+        return ramp;
+    }
+    imageio::ImageFile file = readSource(texture, {});
+    if (encoding) *encoding = file.info.encoding;
+    Image image = std::move(file.image);
+    if (image.width == dem.heights.width && image.height == dem.heights.height) return image;
+    if (image.width < dem.heights.width || image.height < dem.heights.height)
+        throw Error(ErrorCode::InvalidArgument, "colour texture " + texture + " (" + std::to_string(image.width) + "x" +
+                                                    std::to_string(image.height) + ") is smaller than the DEM (" +
+                                                    std::to_string(dem.heights.width) + "x" +
+                                                    std::to_string(dem.heights.height) + ")");
+    return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
 }
 
 }  // namespace conus::cli

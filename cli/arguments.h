@@ -39,6 +39,10 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "
 // The elevation model a DEM argument names: procedural[:SIZE[:SEED]] (codec's terrain, SIZE x SIZE
 // samples) or a file (sceneio::readDem), its heights times `heightScale`.
 sceneio::Dem demFrom(const std::string& source, double heightScale);
+// The DEM's colour in linear light: `texture` (an image file, resized down to the DEM when larger;
+// smaller is refused), else codec's height/slope ramp (drawn as display colours). `encoding`
+// receives what the colour came from.
+Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding = nullptr);
 
 // --compression (format::Compression's names; default zip) for the commands that write a CoNUS file.
 CLI::Option* addCompressionOption(CLI::App& command, std::string& compression);

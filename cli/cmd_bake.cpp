@@ -102,15 +102,7 @@ Source readReliefSource(const BakeOptions& o) {
     }
     sceneio::Dem dem = demFrom(o.source, o.heightScale);
     const glm::dvec2 extent(o.width, o.width * dem.heights.height / dem.heights.width);
-    Image colour;
-    if (o.colour.empty()) {
-        colour = codec::terrainColours(dem.heights, extent);
-        imageio::linearize(colour);
-    } else {
-        colour = readSource(o.colour, {}).image;
-        if (colour.width != dem.heights.width || colour.height != dem.heights.height)
-            colour = codec::areaDownsample(colour, dem.heights.width, dem.heights.height);
-    }
+    Image colour = demColour(dem, o.colour, extent);
     return {std::move(dem.heights), std::move(colour), extent, dem.description};
 }
 

@@ -31,28 +31,6 @@
 namespace conus::cli {
 namespace {
 
-// The DEM's colour in linear light: a texture (resized down to the DEM when larger), else the
-// height/slope ramp (drawn as display colours). `encoding` receives what the colour came from.
-Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent,
-                SourceEncoding* encoding = nullptr) {
-    if (texture.empty()) {
-        Image ramp = codec::terrainColours(dem.heights, extent);
-        imageio::linearize(ramp);
-        if (encoding) *encoding = {Transfer::Srgb, SampleType::Uint8, kRec709Chromaticities, {}, {}};
-        return ramp;
-    }
-    imageio::ImageFile file = readSource(texture, {});
-    if (encoding) *encoding = file.info.encoding;
-    Image image = std::move(file.image);
-    if (image.width == dem.heights.width && image.height == dem.heights.height) return image;
-    if (image.width < dem.heights.width || image.height < dem.heights.height)
-        throw Error(ErrorCode::InvalidArgument, "colour texture " + texture + " (" + std::to_string(image.width) + "x" +
-                                                    std::to_string(image.height) + ") is smaller than the DEM (" +
-                                                    std::to_string(dem.heights.width) + "x" +
-                                                    std::to_string(dem.heights.height) + ")");
-    return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
-}
-
 // The camera as given, or the ground map's own viewer as a --camera value to start from.
 void printCamera(const Camera& c, const std::string& given) {
     if (quiet()) return;
