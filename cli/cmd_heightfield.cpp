@@ -72,7 +72,8 @@ Frame renderFrame(renderers::Context& context, const format::ConusFile& file, co
 
 struct EncodeOptions {
     std::string dem, output, sizeText = "512x512", colour, compression = enumName(format::Compression::Zip), rows = "terrain";
-    double eyeHeight = 150, near = 200, far = 0, fov = 0, heightScale = 1;  // far, fov: 0 until given
+    codec::TerrainViewer viewer;  // --eye-height, --near, --far, --fov
+    double heightScale = 1;
     int grid = 129;
 };
 
@@ -85,24 +86,24 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
     writesFile(encode.add_option("-o,--output", o.output, "CoNUS file (.exr)"))->required();
     encode.add_option("--size", o.sizeText, "CoNUS image size WxH")->capture_default_str();
     // The ground map's own ranges (ground_map.h), checked here so a bad value is a usage error.
-    encode.add_option("--eye-height", o.eyeHeight, "viewer's eye above the base plane, metres")
+    encode.add_option("--eye-height", o.viewer.eyeHeight, "viewer's eye above the base plane, metres")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9));
-    encode.add_option("--near", o.near, "distance from the viewer to the field's near edge, metres")
+    encode.add_option("--near", o.viewer.near, "distance from the viewer to the field's near edge, metres")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9, true));
-    CLI::Option* far = encode.add_option("--far", o.far,
+    CLI::Option* far = encode.add_option("--far", o.viewer.far,
                                          "distance to the far edge, metres, beyond --near (default: near + the DEM's "
                                          "depth when the file gives its spacing, else 6000)")
                            ->check(finiteRange(0, 1e9));
-    encode.add_option("--fov", o.fov,
+    encode.add_option("--fov", o.viewer.fovDegrees,
                       "horizontal field of view at the far edge, degrees; sets the field's width (default: the "
                       "DEM's own width when known, else 60)")
         ->check(finiteRange(0, 170));
     encode.callback([&o, far] {
-        if (far->count() > 0 && !(o.far > o.near)) {
+        if (far->count() > 0 && !(o.viewer.far > o.viewer.near)) {
             std::ostringstream why;
-            why << o.far << " is not beyond --near " << o.near;
+            why << o.viewer.far << " is not beyond --near " << o.viewer.near;
             throw CLI::ValidationError("--far", why.str());
         }
     });
@@ -123,27 +124,14 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
     return &encode;
 }
 
-// The ground map: the options as given, the DEM's own size in metres where the user left
-// --far or --fov out and the file knows its spacing, else the defaults.
-codec::GroundParams groundFor(const EncodeOptions& o, const sceneio::Dem& dem) {
-    const glm::dvec2 demMetres(dem.cellMetres.x * dem.heights.width, dem.cellMetres.y * dem.heights.height);
-    codec::GroundParams ground;
-    ground.eyeHeight = o.eyeHeight;
-    ground.near = o.near;
-    ground.far = o.far > 0 ? o.far : demMetres.y > 0 ? o.near + demMetres.y : 6000.0;
-    ground.fovDegrees = o.fov > 0           ? o.fov
-                        : demMetres.x > 0 ? codec::fovForFieldWidth(o.eyeHeight, o.near, ground.far, demMetres.x)
-                                          : 60.0;
-    return ground;
-}
-
 int runEncode(const EncodeOptions& o) {
     checkConusOutput(o.output, o.dem);
     Progress loading("read " + o.dem);
     const sceneio::Dem dem = demFrom(o.dem, o.heightScale);
     loading.done();
     codec::HeightFieldOptions options;
-    options.ground = groundFor(o, dem);
+    options.ground = codec::groundForField(
+        o.viewer, glm::dvec2(dem.cellMetres.x * dem.heights.width, dem.cellMetres.y * dem.heights.height));
     const Size size = parseSize(o.sizeText);
     checkGridForImage(o.grid, size.width, size.height, EncodeOptions{}.grid);
     options.width = size.width;

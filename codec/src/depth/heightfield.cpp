@@ -242,6 +242,18 @@ double fovForFieldWidth(double eyeHeight, double near, double far, double width)
     return fov;
 }
 
+GroundParams groundForField(const TerrainViewer& viewer, glm::dvec2 fieldMetres) {
+    constexpr double kDefaultFar = 6000.0, kDefaultFov = 60.0;
+    GroundParams ground;
+    ground.eyeHeight = viewer.eyeHeight;
+    ground.near = viewer.near;
+    ground.far = viewer.far > 0 ? viewer.far : fieldMetres.y > 0 ? viewer.near + fieldMetres.y : kDefaultFar;
+    ground.fovDegrees = viewer.fovDegrees > 0 ? viewer.fovDegrees
+                        : fieldMetres.x > 0   ? fovForFieldWidth(viewer.eyeHeight, viewer.near, ground.far, fieldMetres.x)
+                                              : kDefaultFov;
+    return ground;
+}
+
 format::ConusFile encodeHeightField(const Image& heights, const Image& colour,
                                     const HeightFieldOptions& options) {
     constexpr const char* kWhat = "encodeHeightField";

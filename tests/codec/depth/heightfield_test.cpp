@@ -67,6 +67,24 @@ TEST(HeightFieldTerrain, ColoursInRange) {
     }
 }
 
+// The viewer a user gives, completed from the field's size in metres: far to its far edge, the
+// field of view to its width there; the defaults where the size is unknown; what was given kept.
+TEST(HeightFieldGround, TheViewerIsCompletedFromTheFieldsSize) {
+    const TerrainViewer viewer{120.0, 300.0, 0.0, 0.0};
+    const GroundParams fitted = groundForField(viewer, {5000.0, 3500.0});
+    EXPECT_EQ(fitted.eyeHeight, 120.0);
+    EXPECT_EQ(fitted.near, 300.0);
+    EXPECT_DOUBLE_EQ(fitted.far, 3800.0);
+    EXPECT_NEAR(fieldExtent(fitted).x, 5000.0, 1e-6);
+    const GroundParams unknown = groundForField(viewer, {0.0, 0.0});
+    EXPECT_EQ(unknown.far, 6000.0);
+    EXPECT_EQ(unknown.fovDegrees, 60.0);
+    const GroundParams given = groundForField({120.0, 300.0, 900.0, 45.0}, {5000.0, 3500.0});
+    EXPECT_EQ(given.far, 900.0);
+    EXPECT_EQ(given.fovDegrees, 45.0);
+    EXPECT_THROW(groundForField(viewer, {1e9, 100.0}), Error);  // no field of view spans it
+}
+
 TEST(HeightFieldEncode, ValidFileWithHeightAndGroundParams) {
     const format::ConusFile file = encodeSmall(256, 64);
     const format::ValidationReport report = format::validateConusFile(file);

@@ -61,6 +61,16 @@ glm::dvec2 fieldExtent(const GroundParams& params);
 // throws conus::Error(InvalidArgument) when no fov in (0, 170) does.
 double fovForFieldWidth(double eyeHeight, double near, double far, double width);
 
+// A terrain's viewer in metres as a user gives it (`conus heightfield encode`): far and the field of
+// view 0 until given.
+struct TerrainViewer {
+    double eyeHeight = 150, near = 200, far = 0, fovDegrees = 0;
+};
+// The ground map a terrain of `fieldMetres` (width, depth; 0 where its cell spacing is unknown) is
+// seen through: far, where not given, near + the field's depth, else 6000; the field of view, where
+// not given, the one that spans the field's width at far (fovForFieldWidth), else 60 degrees.
+GroundParams groundForField(const TerrainViewer& viewer, glm::dvec2 fieldMetres);
+
 // The ground map's rows for a terrain (GroundParams::rows): each band of depth gets rows in
 // proportion to the screen rows it covers for the ground map's viewer (eyeHeight above the DEM at
 // the middle of the near edge), its hidden parts left out (a horizon sweep along 128 rays), at most
