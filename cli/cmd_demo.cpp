@@ -33,26 +33,6 @@
 namespace conus::cli {
 namespace {
 
-// The view around the most important region: the bounding square of the importance above half its
-// peak, as a focus-shaped rectangle (centre, half side as a fraction of the width).
-codec::Focus hottestRegion(const Image& importance, int width, int height) {
-    float peak = 0;
-    for (int y = 0; y < importance.height; ++y)
-        for (int x = 0; x < importance.width; ++x) peak = std::max(peak, importance.at(x, y));
-    double u0 = 1, v0 = 1, u1 = 0, v1 = 0;
-    for (int y = 0; y < importance.height; ++y)
-        for (int x = 0; x < importance.width; ++x)
-            if (peak > 0 && importance.at(x, y) >= 0.5f * peak) {
-                u0 = std::min(u0, double(x) / importance.width);
-                u1 = std::max(u1, double(x + 1) / importance.width);
-                v0 = std::min(v0, double(y) / importance.height);
-                v1 = std::max(v1, double(y + 1) / importance.height);
-            }
-    if (u1 <= u0) return {0.5, 0.5, 0.1, 1};
-    const double half = 0.5 * std::max((u1 - u0) * width, (v1 - v0) * height) / width;
-    return {0.5 * (u0 + u1), 0.5 * (v0 + v1), std::max(half, 8.0 / width), 1};
-}
-
 struct DemoOptions {
     std::string out = "demo-out", input, importance, backend = enumName(renderers::Backend::Auto);
     std::vector<std::string> foci;
@@ -108,7 +88,7 @@ DemoMap demoMap(const DemoOptions& o, DemoSource& source, const Size& size) {
         const Image importance = importanceFrom(o.importance, source.image);
         const codec::FrameErrorModel model(source.image, size.width, size.height, importance, kDemoTrials);
         m.map = codec::buildAutoMapForFrameLoss(importance, model, codec::kDefaultFrameLoss, {}, codec::kDefaultTileLoss).map;
-        if (o.foci.empty()) source.foci = {hottestRegion(importance, w, h)};
+        if (o.foci.empty()) source.foci = {codec::hottestRegion(importance, w, h)};
     } else {
         codec::FociOptions fociOptions;
         fociOptions.aspect = double(w) / h;

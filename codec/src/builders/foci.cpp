@@ -265,6 +265,24 @@ void checkFocus(const Focus& f) {
     }
 }
 
+Focus hottestRegion(const Image& importance, int width, int height) {
+    float peak = 0;
+    for (int y = 0; y < importance.height; ++y)
+        for (int x = 0; x < importance.width; ++x) peak = std::max(peak, importance.at(x, y));
+    double u0 = 1, v0 = 1, u1 = 0, v1 = 0;
+    for (int y = 0; y < importance.height; ++y)
+        for (int x = 0; x < importance.width; ++x)
+            if (peak > 0 && importance.at(x, y) >= 0.5f * peak) {
+                u0 = std::min(u0, double(x) / importance.width);
+                u1 = std::max(u1, double(x + 1) / importance.width);
+                v0 = std::min(v0, double(y) / importance.height);
+                v1 = std::max(v1, double(y + 1) / importance.height);
+            }
+    if (u1 <= u0) return {0.5, 0.5, 0.1, 1};
+    const double half = 0.5 * std::max((u1 - u0) * width, (v1 - v0) * height) / width;
+    return {0.5 * (u0 + u1), 0.5 * (v0 + v1), std::max(half, 8.0 / width), 1};
+}
+
 namespace {
 // The larger of the falloff's density and the bound's, joined smoothly (a p-norm of their excess
 // over the context's 1): never below either, and without the kink of a plain max, whose sudden

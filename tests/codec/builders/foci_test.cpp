@@ -361,3 +361,32 @@ TEST(Foci, ParseFocus) {
 
 }  // namespace
 }  // namespace conus::codec
+
+namespace conus::codec {
+namespace {
+
+// The most important region: the square around what is at or above half the peak, measured in the
+// pixels of the image it is for (here 2:1, the importance map 40x10), centred on that region.
+TEST(Foci, TheHottestRegionIsTheSquareAroundHalfThePeak) {
+    Image importance = makeImage(40, 10, {"Y"});
+    for (int y = 0; y < 10; ++y)
+        for (int x = 0; x < 40; ++x) importance.at(x, y) = 0.1f;
+    for (int y = 2; y < 6; ++y)
+        for (int x = 24; x < 32; ++x) importance.at(x, y) = (x == 30 && y == 3) ? 2.0f : 1.2f;
+    const Focus hot = hottestRegion(importance, 800, 400);
+    EXPECT_DOUBLE_EQ(hot.u, 28.0 / 40);
+    EXPECT_DOUBLE_EQ(hot.v, 4.0 / 10);
+    // 8 of 40 columns of 800 px = 160 px wide, 4 of 10 rows of 400 px = 160 px tall: half 80 px.
+    EXPECT_DOUBLE_EQ(hot.r, 80.0 / 800);
+    EXPECT_EQ(hot.k, 1.0);
+    // Nothing important: the centre; a single hot pixel: at least 8 pixels.
+    const Focus none = hottestRegion(makeImage(4, 4, {"Y"}), 100, 100);
+    EXPECT_EQ(none.u, 0.5);
+    EXPECT_EQ(none.r, 0.1);
+    Image dot = makeImage(100, 100, {"Y"});
+    dot.at(10, 90) = 1.0f;
+    EXPECT_DOUBLE_EQ(hottestRegion(dot, 100, 100).r, 8.0 / 100);
+}
+
+}  // namespace
+}  // namespace conus::codec

@@ -93,8 +93,14 @@ struct FociReport {
 };
 
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r outside (0, 1] or k outside
-// [1, 64] (NaN fails): what every builder of foci asks of a focus.
+// [1, 64] (NaN fails): what every builder of foci asks of a focus (map_rules::isValidFocus, V12).
 void checkFocus(const Focus& focus);
+
+// The region an importance map (any size) finds most important: the bounding square, in the pixels
+// of a width x height image, of the importance at or above half its peak, as a focus (centre; r
+// the half side as a fraction of the width, at least 8 pixels; k 1). A map with no positive value
+// gives the centre (r 0.1). What `conus demo` shows magnified.
+Focus hottestRegion(const Image& importance, int width, int height);
 
 // Throws conus::Error(InvalidArgument) for a focus outside [0,1]^2, r <= 0 or k < 1 or k > 64.
 // Never for a grid too coarse: the bounded builder refines it (FociOptions::columns).
