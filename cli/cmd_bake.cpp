@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "arguments.h"
@@ -17,6 +18,7 @@
 #include "conus/codec/builders/foci.h"
 #include "conus/codec/builders/foci_budget.h"
 #include "conus/codec/builders/frame_budget.h"
+#include "conus/codec/conus_file.h"
 #include "conus/codec/depth/heightfield.h"
 #include "conus/codec/depth/reflection.h"
 #include "conus/codec/depth/relief.h"
@@ -113,7 +115,7 @@ int runBakeRelief(const BakeOptions& o) {
     reading.done();
     Size size;
     if (o.sizeText.empty())
-        size = {std::max(1, source.heights.width / 4), std::max(1, source.heights.height / 4)};
+        std::tie(size.width, size.height) = codec::defaultConusSize(source.heights.width, source.heights.height);
     else
         size = parseSize(o.sizeText);
     checkGridForImage(o.grid, size.width, size.height);

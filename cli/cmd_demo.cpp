@@ -18,6 +18,7 @@
 #include "conus/codec/builders/foci.h"
 #include "conus/codec/builders/foci_budget.h"
 #include "conus/codec/builders/frame_budget.h"
+#include "conus/codec/conus_file.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/core/atomic_file.h"
 #include "conus/renderers/gpu_image.h"
@@ -158,7 +159,8 @@ int runDemo(const DemoOptions& o) {
     outputs.makeFolder(o.out);
     DemoSource source = demoSource(o);
     const int w = source.image.width, h = source.image.height;
-    const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
+    const auto [conusWidth, conusHeight] = codec::defaultConusSize(w, h);  // 1/16 of the pixels
+    const Size size{conusWidth, conusHeight};
     const DemoMap built = demoMap(o, source, size);
     const codec::SamplingMap& map = *built.map;
 

@@ -52,7 +52,7 @@ BuiltMap mapFromFile(const std::string& path, const Image& source) {
     // Foci built for another aspect are ellipses on this picture.
     if (const std::optional<double> aspect = codec::madeForAspect(mapSource)) {
         const double here = double(source.width) / source.height;
-        if (std::abs(std::log(*aspect / here)) > 0.01) {
+        if (codec::aspectsDiffer(*aspect, here)) {
             char text[320];
             std::snprintf(text, sizeof text,
                           "the map %s was made for pictures of aspect %.3g (width / height) and this one's is %.3g: its "

@@ -30,7 +30,8 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
 
 Size conusSize(const StorageOptions& options, const Image& source) {
     if (!options.sizeText.empty()) return parseSize(options.sizeText);
-    return {std::max(1, (source.width + 2) / 4), std::max(1, (source.height + 2) / 4)};
+    const auto [width, height] = codec::defaultConusSize(source.width, source.height);
+    return {width, height};
 }
 
 void applyStorage(const StorageOptions& options, format::ConusFile& file) {

@@ -9,6 +9,7 @@
 
 #include "conus/cli/option_checks.h"
 #include "conus/codec/builders/mesh_sequence.h"
+#include "conus/codec/conus_file.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
 #include "progress.h"
@@ -192,12 +193,6 @@ void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDe
         ->check(finiteRange(1.001, 4096.0, true, true));
 }
 
-void checkGridForImage(int grid, int width, int height, int defaultGrid) {
-    const int most = std::max(defaultGrid, static_cast<int>(map_rules::maxSideForImage(width, height)));
-    if (grid > most)
-        throw Error(ErrorCode::InvalidArgument, "--grid " + std::to_string(grid) + " is finer than a " + std::to_string(width) +
-                                                    "x" + std::to_string(height) + " image can show; at most " +
-                                                    std::to_string(most) + " nodes a side");
-}
+void checkGridForImage(int grid, int width, int height, int defaultGrid) { codec::checkGridForImage(grid, width, height, "--grid", defaultGrid); }
 
 }  // namespace conus::cli

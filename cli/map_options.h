@@ -65,10 +65,7 @@ std::string lossText(double db, const char* lose, const char* gain, int decimals
 // chose, the predicted losses and the region's gain (`what`: the importance's name).
 std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what);
 
-// A map much finer than the image it shapes adds nothing the image can show and costs a build in
-// proportion to its nodes (a minute at 4097 a side): --grid is refused (InvalidArgument) past
-// the larger of the command's default and map_rules::maxSideForImage (4 nodes a pixel along the
-// image's longer side plus one, 129 always), the bound readers hold files to.
+// --grid against the image it shapes (codec::checkGridForImage).
 void checkGridForImage(int grid, int width, int height, int defaultGrid = map_rules::kDefaultSide);
 
 // The foci of repeated --focus u,v,r,k options, in order.

@@ -68,3 +68,25 @@ TEST(ConusFile, ImageFilesWithDepthAreValidDepthImages) {
     EXPECT_EQ(file.sourceEncoding.transfer, conus::Transfer::Srgb);
     EXPECT_EQ(file.sourceWidth, 16);
 }
+
+// The encode's defaults and checks that every caller (the CLI's encode, bake and demo, Python)
+// shares: a quarter of each side to the nearest pixel, aspects 1% apart, the grid an image can show.
+TEST(ConusFile, DefaultSizeAspectAndGridRules) {
+    EXPECT_EQ(codec::defaultConusSize(4096, 3072), std::make_pair(1024, 768));
+    EXPECT_EQ(codec::defaultConusSize(1001, 999), std::make_pair(250, 250));
+    EXPECT_EQ(codec::defaultConusSize(1002, 3), std::make_pair(251, 1));
+    EXPECT_EQ(codec::defaultConusSize(1, 1), std::make_pair(1, 1));
+    EXPECT_FALSE(codec::aspectsDiffer(1.5, 1.505));
+    EXPECT_TRUE(codec::aspectsDiffer(1.5, 1.52));
+    EXPECT_TRUE(codec::aspectsDiffer(1.0, 1.5));
+    EXPECT_NO_THROW(codec::checkGridForImage(129, 16, 11, "--grid"));  // 129 always
+    EXPECT_NO_THROW(codec::checkGridForImage(257, 64, 43, "--grid"));  // 4 a pixel of 64, plus one
+    try {
+        codec::checkGridForImage(258, 64, 43, "--grid");
+        ADD_FAILURE() << "accepted";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+        EXPECT_STREQ(e.what(), "--grid 258 is finer than a 64x43 image can show; at most 257 nodes a side");
+    }
+    EXPECT_NO_THROW(codec::checkGridForImage(513, 16, 11, "--grid", 513));  // the command's own default
+}
