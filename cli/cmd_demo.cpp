@@ -20,6 +20,7 @@
 #include "conus/codec/builders/frame_budget.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/metrics.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/core/atomic_file.h"
 #include "conus/renderers/gpu_image.h"
 #include "demo_picture.h"
@@ -28,7 +29,6 @@
 #include "image_files.h"
 #include "map_options.h"
 #include "conus/cli/option_checks.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -179,7 +179,7 @@ int runDemo(const DemoOptions& o) {
     writePicture((out / "uniform.png").string(), uniform.image, picture);
     const double shrink = std::min(1.0, 1024.0 / std::max(w, h));
     const int pw = std::max(16, int(w * shrink)), ph = std::max(16, int(h * shrink));
-    writeDrawing((out / "density.png").string(), densityPicture(map, pw, ph, 32, built.analytic ? &*built.analytic : nullptr));
+    writeDrawing((out / "density.png").string(), codec::densityPicture(map, pw, ph, 32, built.analytic ? &*built.analytic : nullptr));
 
     const std::vector<ViewCase> views = demoViews(o, source.foci, w, h, shrink);
     std::vector<ViewResult> results;
@@ -195,7 +195,7 @@ int runDemo(const DemoOptions& o) {
         std::vector<Image> strip{reference, fromConus, fromUniform};
         if (v.outWidth != v.width)
             for (auto& image : strip) image = codec::areaDownsample(image, v.outWidth, v.outHeight);
-        results.push_back({codec::psnr(reference, fromConus), codec::psnr(reference, fromUniform), sideBySide(strip)});
+        results.push_back({codec::psnr(reference, fromConus), codec::psnr(reference, fromUniform), codec::sideBySide(strip)});
     }
     comparing.done();
     for (std::size_t i = 0; i < views.size(); ++i)

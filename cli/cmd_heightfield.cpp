@@ -16,6 +16,7 @@
 #include "conus/codec/image/encode.h"
 #include "conus/codec/depth/heightfield.h"
 #include "conus/codec/image/metrics.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 #include "conus/renderers/terrain.h"
@@ -25,7 +26,6 @@
 #include "image_files.h"
 #include "map_options.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -201,7 +201,7 @@ void writeComparison(renderers::Context& context, const RenderOptions& o, const 
     const Image uniform = renderUniform(context, dem, colour, file.image.width, file.image.height, frame);
     comparing.done();
     const Image panels[] = {full, frame.image, uniform};
-    writePicture(o.frame, sideBySide(panels));
+    writePicture(o.frame, codec::sideBySide(panels));
     std::printf("wrote %s: full resolution %dx%d | CoNUS %dx%d | uniform %dx%d (%s)\n", o.frame.c_str(), dem.heights.width,
                 dem.heights.height, file.image.width, file.image.height, file.image.width, file.image.height,
                 context.renderer().c_str());

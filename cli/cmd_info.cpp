@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "conus/codec/builders/map_measures.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/format/reflection_asset.h"
@@ -21,7 +22,6 @@
 #include "conus/sceneio/mesh_file.h"
 #include "image_files.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -82,7 +82,7 @@ struct FileFacts {
     format::ConusFile file;  // everything but the image's pixels, which nothing here needs
     std::vector<std::string> channels;  // display order
     codec::SamplingMap map;
-    DensityStats stats;
+    codec::DensityStats stats;
     codec::MapMeasures measures;  // anisotropy in the source's pixels
     std::optional<Camera> camera;
     double pixelRatio = 0;  // CoNUS pixels over source pixels
@@ -90,7 +90,7 @@ struct FileFacts {
 
 FileFacts factsOf(format::ConusFile file) {
     codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
-    const DensityStats stats = densityStats(map);
+    const codec::DensityStats stats = codec::densityStats(map);
     const codec::MapMeasures measures = codec::measureMap(map, double(file.sourceWidth) / file.sourceHeight);
     std::optional<Camera> camera = file.camera ? std::optional<Camera>(format::toCamera(*file.camera)) : std::nullopt;
     const double ratio = double(file.image.width) * file.image.height / (double(file.sourceWidth) * file.sourceHeight);
@@ -222,7 +222,7 @@ void writeDensityPicture(const std::string& path, const FileFacts& f) {
     const int w = std::max(16, static_cast<int>(file.sourceWidth * std::min(1.0, scale)));
     const int h = std::max(16, static_cast<int>(file.sourceHeight * std::min(1.0, scale)));
     const int lines = std::max(8, std::min(64, file.image.width / 8));
-    writeDrawing(path, densityPicture(f.map, w, h, lines, file.analytic ? &*file.analytic : nullptr,
+    writeDrawing(path, codec::densityPicture(f.map, w, h, lines, file.analytic ? &*file.analytic : nullptr,
                                       double(file.sourceWidth) / file.sourceHeight));
 }
 

@@ -20,6 +20,7 @@
 #include "conus/codec/builders/map_measures.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/builders/springs.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/format/container.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
@@ -30,7 +31,6 @@
 #include "encoding.h"
 #include "map_options.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -77,9 +77,9 @@ void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticM
     format::writeConusFile(out.output, file);
     if (!out.preview.empty())
         writeDrawing(out.preview,
-                     densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr, aspect));
+                     codec::densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr, aspect));
     outputs.commit();
-    const DensityStats stats = densityStats(map);
+    const codec::DensityStats stats = codec::densityStats(map);
     const codec::MapMeasures measures = codec::measureMap(map, aspect);
     if (quiet()) return;  // -q: silent on success
     std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),

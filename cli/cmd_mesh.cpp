@@ -25,6 +25,7 @@
 #include "conus/codec/builders/mesh_sequence.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/codec/mesh/city.h"
 #include "conus/codec/mesh/subdivide.h"
 #include "conus/core/atomic_file.h"
@@ -38,7 +39,6 @@
 #include "image_files.h"
 #include "map_options.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -246,20 +246,6 @@ struct AnimateOptions {
     bool video = true;
 };
 
-// Frames side by side in rows of `columns`, each scaled to `tileWidth`, on black.
-Image contactSheet(const std::vector<Image>& tiles, int columns) {
-    const int tw = tiles.front().width, th = tiles.front().height, gap = 4;
-    const int rows = (static_cast<int>(tiles.size()) + columns - 1) / columns;
-    Image sheet = makeImage(columns * tw + (columns + 1) * gap, rows * th + (rows + 1) * gap, {"R", "G", "B"});
-    for (std::size_t k = 0; k < tiles.size(); ++k) {
-        const int x0 = gap + static_cast<int>(k % columns) * (tw + gap), y0 = gap + static_cast<int>(k / columns) * (th + gap);
-        for (int y = 0; y < th; ++y)
-            for (int x = 0; x < tw; ++x)
-                for (int c = 0; c < 3; ++c) sheet.at(x0 + x, y0 + y, c) = tiles[k].at(x, y, c);
-    }
-    return sheet;
-}
-
 std::optional<std::string> findOnPath(const std::string& program) {
     const char* path = std::getenv("PATH");
     if (!path) return std::nullopt;
@@ -341,7 +327,7 @@ int runAnimate(const AnimateOptions& a) {
                                codec::makeDepthImageFile(image, map, camera, o.units,
                                                          foci.empty() ? std::nullopt
                                                                       : std::optional(codec::toAnalytic(foci, fo.composition))));
-        const Image rgb = toRgb(image);
+        const Image rgb = codec::toRgb(image);
         setQuiet(true);
         writePicture((dir / (std::string(name) + ".png")).string(), rgb);
         setQuiet(false);
@@ -352,7 +338,7 @@ int runAnimate(const AnimateOptions& a) {
     }
     rendering.done();
     const std::string sheet = (dir / "contact_sheet.png").string();
-    writePicture(sheet, contactSheet(tiles, columns));
+    writePicture(sheet, codec::contactSheet(tiles, columns));
     outputs.commit();
     std::printf("wrote %d frames to %s (frame_0000.exr/.png ...), contact sheet %s; largest per-frame move of a map "
                 "node %.4f (normalized)\n",

@@ -19,6 +19,7 @@
 #include "conus/codec/builders/foci.h"
 #include "conus/codec/builders/mesh_sequence.h"
 #include "conus/codec/conus_file.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/codec/volume/raycast.h"
 #include "conus/codec/volume/transfer_function.h"
@@ -32,7 +33,6 @@
 #include "image_files.h"
 #include "map_options.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -152,7 +152,7 @@ int runRender(const VolumeOptions& o) {
     Progress writing("write " + o.output);
     AtomicOutputs outputs;  // the file and its picture, both or neither
     format::writeConusFile(o.output, codec::makeDepthImageFile(image, map, camera, o.units, chosen.analytic));
-    if (!o.picture.empty()) writePicture(o.picture, toRgb(image));
+    if (!o.picture.empty()) writePicture(o.picture, codec::toRgb(image));
     outputs.commit();
     writing.done();
     const glm::dvec3 eye = camera.eye(), look = eye + camera.forward();
@@ -220,7 +220,7 @@ int runAnimate(const AnimateOptions& a) {
         const std::filesystem::path base = std::filesystem::path(a.outDir) / name;
         format::writeConusFile(base.string() + ".exr",
                                codec::makeDepthImageFile(image, map, camera, o.units, codec::toAnalytic(foci, fo.composition)));
-        writePicture(base.string() + ".png", toRgb(image));
+        writePicture(base.string() + ".png", codec::toRgb(image));
         previous = std::move(map);
         if (const ProgressFn report = rendering.callback()) report(double(f + 1) / a.frames);
     }

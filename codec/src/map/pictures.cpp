@@ -1,4 +1,4 @@
-#include "pictures.h"
+#include "conus/codec/map/pictures.h"
 
 #include <algorithm>
 #include <array>
@@ -7,8 +7,9 @@
 
 #include "conus/codec/builders/map_measures.h"
 #include "conus/core/display.h"
+#include "conus/core/error.h"
 
-namespace conus::cli {
+namespace conus::codec {
 namespace {
 
 // The density ramp (core/display.h), interpolated.
@@ -29,7 +30,7 @@ void blend(Image& image, int x, int y, glm::vec3 color, float alpha) {
 
 }  // namespace
 
-DensityStats densityStats(const codec::SamplingMap& map, int samples) {
+DensityStats densityStats(const SamplingMap& map, int samples) {
     DensityStats stats{1e300, 0, 0};
     for (int j = 0; j < samples; ++j)
         for (int i = 0; i < samples; ++i) {
@@ -42,8 +43,7 @@ DensityStats densityStats(const codec::SamplingMap& map, int samples) {
     return stats;
 }
 
-Image densityPicture(const codec::SamplingMap& map, int width, int height, int lines,
-                             const format::AnalyticMap* analytic, double aspect) {
+Image densityPicture(const SamplingMap& map, int width, int height, int lines, const format::AnalyticMap* analytic, double aspect) {
     Image picture = makeImage(width, height, {"R", "G", "B"});
     std::vector<glm::dvec2> distorted(static_cast<std::size_t>(width) * height);
     std::vector<double> logDensity(distorted.size());
@@ -81,7 +81,7 @@ Image densityPicture(const codec::SamplingMap& map, int width, int height, int l
     std::vector<double> ratio(distorted.size());
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
-            ratio[static_cast<std::size_t>(y) * width + x] = codec::anisotropy(codec::cellJacobianAt(map, {(x + 0.5) / width, (y + 0.5) / height}), aspect);
+            ratio[static_cast<std::size_t>(y) * width + x] = anisotropy(cellJacobianAt(map, {(x + 0.5) / width, (y + 0.5) / height}), aspect);
     const glm::vec3 cyan(0.2f, 0.9f, 1.0f);
     for (int y = 0; y + 1 < height; ++y)
         for (int x = 0; x + 1 < width; ++x) {
@@ -90,7 +90,7 @@ Image densityPicture(const codec::SamplingMap& map, int width, int height, int l
                 if ((ratio[k] >= level) != (ratio[k + 1] >= level) || (ratio[k] >= level) != (ratio[k + width] >= level))
                     blend(picture, x, y, cyan, 0.9f);
         }
-    const codec::MapMeasures measures = codec::measureMap(map, aspect);
+    const MapMeasures measures = measureMap(map, aspect);
     const int cx = static_cast<int>(measures.mostAnisotropic.x * width), cy = static_cast<int>(measures.mostAnisotropic.y * height);
     for (int d = -6; d <= 6; ++d) {
         blend(picture, cx + d, cy + d, cyan, 1.0f);
@@ -144,4 +144,18 @@ Image sideBySide(std::span<const Image> images, int gap) {
     return strip;
 }
 
-}  // namespace conus::cli
+Image contactSheet(std::span<const Image> tiles, int columns) {
+    if (tiles.empty() || columns < 1) throw Error(ErrorCode::InvalidArgument, "contactSheet: no tiles or no columns");
+    const int tw = tiles.front().width, th = tiles.front().height, gap = 4;
+    const int rows = (static_cast<int>(tiles.size()) + columns - 1) / columns;
+    Image sheet = makeImage(columns * tw + (columns + 1) * gap, rows * th + (rows + 1) * gap, {"R", "G", "B"});
+    for (std::size_t k = 0; k < tiles.size(); ++k) {
+        const int x0 = gap + static_cast<int>(k % columns) * (tw + gap), y0 = gap + static_cast<int>(k / columns) * (th + gap);
+        for (int y = 0; y < th; ++y)
+            for (int x = 0; x < tw; ++x)
+                for (int c = 0; c < 3; ++c) sheet.at(x0 + x, y0 + y, c) = tiles[k].at(x, y, c);
+    }
+    return sheet;
+}
+
+}  // namespace conus::codec
