@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <regex>
 #include <sstream>
 #include <vector>
 
@@ -93,19 +92,11 @@ CLI::Option* addCompressionOption(CLI::App& command, std::string& compression) {
 }
 
 sceneio::Dem demFrom(const std::string& source, double heightScale) {
-    std::smatch m;
-    if (!std::regex_match(source, m, std::regex("procedural(?::(\\d+))?(?::(\\d+))?")))
-        return sceneio::readDem(source, heightScale);
-    codec::TerrainOptions options;
-    if (m[1].matched) options.width = options.height = std::stoi(m[1].str().substr(0, 6));
-    if (std::int64_t{options.width} * options.height > kMaxDemSamples)
-        throw Error(ErrorCode::InvalidArgument, "procedural terrain " + std::to_string(options.width) + "x" +
-                                                    std::to_string(options.height) + " holds more than the limit of " +
-                                                    std::to_string(kMaxDemSamples) + " height samples");
-    if (m[2].matched) options.seed = static_cast<std::uint32_t>(std::stoul(m[2].str().substr(0, 9)));
-    return sceneio::demFromHeights(codec::generateTerrain(options), heightScale,
-                                   "procedural terrain " + std::to_string(options.width) + "x" +
-                                       std::to_string(options.height) + " seed " + std::to_string(options.seed));
+    const std::optional<codec::TerrainOptions> terrain = codec::proceduralTerrain(source);
+    if (!terrain) return sceneio::readDem(source, heightScale);
+    return sceneio::demFromHeights(codec::generateTerrain(*terrain), heightScale,
+                                   "procedural terrain " + std::to_string(terrain->width) + "x" +
+                                       std::to_string(terrain->height) + " seed " + std::to_string(terrain->seed));
 }
 
 Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding) {

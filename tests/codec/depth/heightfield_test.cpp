@@ -281,3 +281,29 @@ TEST(HeightFieldEncode, RejectsBadInput) {
 
 }  // namespace
 }  // namespace conus::codec
+
+namespace conus::codec {
+namespace {
+
+// A DEM argument that names the procedural terrain: its size and seed, the defaults where left out;
+// anything else is a file's name; past the sample limit refused.
+TEST(HeightFieldTerrain, ProceduralArgumentsNameTheTerrain) {
+    const TerrainOptions defaults;
+    const auto plain = proceduralTerrain("procedural");
+    ASSERT_TRUE(plain);
+    EXPECT_EQ(plain->width, defaults.width);
+    EXPECT_EQ(plain->seed, defaults.seed);
+    const auto sized = proceduralTerrain("procedural:300:7");
+    ASSERT_TRUE(sized);
+    EXPECT_EQ(sized->width, 300);
+    EXPECT_EQ(sized->height, 300);
+    EXPECT_EQ(sized->seed, 7u);
+    EXPECT_EQ(proceduralTerrain("procedural:64")->seed, defaults.seed);
+    EXPECT_FALSE(proceduralTerrain("dem.tif"));
+    EXPECT_FALSE(proceduralTerrain("procedural.tif"));
+    EXPECT_FALSE(proceduralTerrain("procedural:x"));
+    EXPECT_THROW(proceduralTerrain("procedural:999999"), Error);
+}
+
+}  // namespace
+}  // namespace conus::codec

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,10 @@ struct TerrainOptions {
 // fBm of gradient noise blended with ridged noise, one channel "Z" in metres (>= 0). The terrain is
 // a function of (u, v) in [0,1]^2, so two sizes of the same seed sample the same landscape.
 Image generateTerrain(const TerrainOptions& options);
+// The terrain a DEM argument "procedural[:SIZE[:SEED]]" names (SIZE x SIZE samples, SEED as
+// TerrainOptions::seed; the defaults where left out), or none for any other text (a file's name).
+// Throws InvalidArgument past kMaxDemSamples samples.
+std::optional<TerrainOptions> proceduralTerrain(const std::string& source);
 
 // Colour ramp by height (water-green lowlands, brown slopes, grey rock, snow on the highest) and
 // slope (steep faces turn to rock), RGB in [0,1]. `extent` is the field's size in metres (width,
