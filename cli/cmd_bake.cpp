@@ -155,7 +155,7 @@ int runBakeRelief(const BakeOptions& o) {
             ao.columns = ao.rows = o.grid;
             ao.minDensity = o.minDensity;
             ao.maxDensity = o.maxDensity;
-            const std::string importance = o.importance.empty() ? "detail" : o.importance;
+            const std::string importance = o.importance.empty() ? enumName(codec::ImportanceRule::Detail) : o.importance;
             map = codec::buildAutoMap(importanceFrom(importance, source.colour), ao);
             how = importance + " importance map";
         }

@@ -95,7 +95,7 @@ DemoMap demoMap(const DemoOptions& o, DemoSource& source, const Size& size) {
         fociOptions.aspect = double(w) / h;
         // As `encode`: away from the foci the samples follow the picture's own detail.
         const codec::DensityField context =
-            codec::ownDetailContext(source.image, importanceFrom("detail", source.image), size.width, size.height, {}, kDemoTrials);
+            codec::ownDetailContext(source.image, importanceFrom(enumName(codec::ImportanceRule::Detail), source.image), size.width, size.height, {}, kDemoTrials);
         fociOptions.context = &context;
         const int side = 256;
         const codec::FrameErrorModel model(

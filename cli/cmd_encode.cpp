@@ -70,7 +70,7 @@ codec::AutoMapOptions ownDetailOptions(const EncodeOptions& o) { return autoMapO
 
 // The density the picture's own detail asks for (codec::ownDetailContext), the budget's model choosing its floor.
 codec::DensityField ownDetailContext(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
-    return codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), modelOptions);
+    return codec::ownDetailContext(source, importanceFrom(enumName(codec::ImportanceRule::Detail), source), size.width, size.height, ownDetailOptions(o), modelOptions);
 }
 
 BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
@@ -85,7 +85,7 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     // The budget chooses the context floor; say what it achieved. Apart from the importance the
     // samples follow the picture's own detail, as with no importance at all (`detail` is that already).
     codec::DensityField context;
-    if (o.importance != "detail") {
+    if (o.importance != enumName(codec::ImportanceRule::Detail)) {
         context = ownDetailContext(o, source, size, modelOptions);
         autoOptions.context = &context;
     }
@@ -131,7 +131,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
 BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
     Progress progress("build sampling map from the picture's detail");
     codec::BudgetResult r =
-        codec::buildOwnDetailMap(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), modelOptions);
+        codec::buildOwnDetailMap(source, importanceFrom(enumName(codec::ImportanceRule::Detail), source), size.width, size.height, ownDetailOptions(o), modelOptions);
     progress.done();
     static std::once_flag once;  // once per batch, not per file
     std::call_once(once, [] {

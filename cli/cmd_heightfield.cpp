@@ -71,7 +71,8 @@ Frame renderFrame(renderers::Context& context, const format::ConusFile& file, co
 // ---- encode ----
 
 struct EncodeOptions {
-    std::string dem, output, sizeText = "512x512", colour, compression = enumName(format::Compression::Zip), rows = "terrain";
+    std::string dem, output, sizeText = "512x512", colour, compression = enumName(format::Compression::Zip),
+                rows = enumName(codec::GroundRows::Terrain);
     codec::TerrainViewer viewer;  // --eye-height, --near, --far, --fov
     double heightScale = 1;
     int grid = 129;
@@ -113,7 +114,7 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
                       "terrain covers for the map's viewer, within the DEM's resolution) or planar (the paper's "
                       "perspective ground plane, which starves far mountains)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"terrain", "planar"}));
+        ->check(CLI::IsMember(enumNames<codec::GroundRows>()));
     encode.add_option("--height-scale", o.heightScale, "multiplies the DEM's values (to metres)")
         ->capture_default_str();
     encode.add_option("--colour,--color", o.colour, "colour texture (default: a ramp by height and slope)");
@@ -137,7 +138,7 @@ int runEncode(const EncodeOptions& o) {
     options.width = size.width;
     options.height = size.height;
     options.mapGrid = o.grid;
-    options.fitRows = o.rows == "terrain";
+    options.fitRows = parseEnum<codec::GroundRows>(o.rows) == codec::GroundRows::Terrain;
     const glm::dvec2 extent = codec::fieldExtent(options.ground);
     SourceEncoding encoding;
     const Image colour = demColour(dem, o.colour, extent, &encoding);
@@ -153,7 +154,7 @@ int runEncode(const EncodeOptions& o) {
                 "far %g m, fov %.2f deg; %s rows); heights %.1f..%.1f m\n",
                 o.output.c_str(), file.image.width, file.image.height, dem.description.c_str(), extent.x, extent.y,
                 options.ground.eyeHeight, options.ground.near, options.ground.far, options.ground.fovDegrees,
-                fitted ? "terrain" : "planar", file.depth.near, file.depth.far);
+                enumName(fitted ? codec::GroundRows::Terrain : codec::GroundRows::Planar), file.depth.near, file.depth.far);
     return 0;
 }
 

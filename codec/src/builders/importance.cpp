@@ -4,14 +4,6 @@
 
 namespace conus::codec {
 
-const char* toString(ImportanceRule rule) { return kImportanceRuleNames[static_cast<std::size_t>(rule)]; }
-
-std::optional<ImportanceRule> parseImportanceRule(std::string_view text) {
-    for (std::size_t i = 0; i < kImportanceRuleNames.size(); ++i)
-        if (text == kImportanceRuleNames[i]) return static_cast<ImportanceRule>(i);
-    return std::nullopt;
-}
-
 Image ruleImportance(ImportanceRule rule, const Image& shown) {
     return rule == ImportanceRule::Faces ? faceImportance(shown) : detailImportance(shown);
 }

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "conus/codec/builders/importance.h"
 #include "conus/core/error.h"
@@ -11,13 +13,14 @@ namespace conus::codec {
 namespace {
 
 TEST(Importance, RulesGoByTheirNames) {
-    EXPECT_EQ(kImportanceRuleNames.size(), 2u);
+    EXPECT_EQ(enumNames<ImportanceRule>(), (std::vector<std::string>{"detail", "faces"}));
     for (ImportanceRule rule : {ImportanceRule::Detail, ImportanceRule::Faces})
-        EXPECT_EQ(parseImportanceRule(toString(rule)), rule);
-    EXPECT_STREQ(toString(ImportanceRule::Faces), "faces");
-    EXPECT_FALSE(parseImportanceRule("Detail"));  // names are exact, as the CLI's choices
-    EXPECT_FALSE(parseImportanceRule("saliency"));
-    EXPECT_FALSE(parseImportanceRule(""));
+        EXPECT_EQ(tryParseEnum<ImportanceRule>(enumName(rule)), rule);
+    EXPECT_STREQ(enumName(ImportanceRule::Faces), "faces");
+    EXPECT_FALSE(tryParseEnum<ImportanceRule>("Detail"));  // names are exact, as the CLI's choices
+    EXPECT_FALSE(tryParseEnum<ImportanceRule>("saliency"));
+    EXPECT_FALSE(tryParseEnum<ImportanceRule>(""));
+    EXPECT_EQ(enumChoices<ImportanceRule>(), "detail, faces");
 }
 
 // A display-encoded grey picture, 0.3, with a white square on the right half's top.

@@ -6,20 +6,16 @@
 // detail people see, and the face detector was trained on ordinary 8-bit photographs.
 #pragma once
 
-#include <array>
-#include <optional>
-#include <string_view>
-
+#include "conus/core/enum_names.h"
 #include "conus/core/image.h"
 
 namespace conus::codec {
 
 enum class ImportanceRule { Detail, Faces };
-
-// The rules' names, in the enumeration's order.
-inline constexpr std::array<const char*, 2> kImportanceRuleNames{"detail", "faces"};
-const char* toString(ImportanceRule rule);
-std::optional<ImportanceRule> parseImportanceRule(std::string_view text);
+// Their names (core/enum_names.h: enumName, tryParseEnum, enumChoices), exact as the CLI's choices.
+constexpr auto enumNameTable(ImportanceRule) {
+    return makeEnumNameTable<ImportanceRule>("importance rule", {{ImportanceRule::Detail, "detail"}, {ImportanceRule::Faces, "faces"}});
+}
 
 // The importance `rule` gives the display-encoded picture `shown`: detailImportance or
 // faceImportance.

@@ -27,6 +27,7 @@
 #include "conus/codec/builders/ground_map.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
+#include "conus/core/enum_names.h"
 #include "conus/core/error.h"
 #include "conus/core/mesh.h"
 #include "conus/core/image.h"
@@ -83,6 +84,13 @@ GroundParams groundForField(const TerrainViewer& viewer, glm::dvec2 fieldMetres)
 // of mountains far away the few rows that flat ground would cover there. Empty when the DEM has
 // nothing to see (the planar rows then stay).
 std::vector<double> groundRowsForTerrain(const Image& heights, const GroundParams& ground, int imageRows);
+
+// How a height field's map spends its rows on depth: fitted to the terrain (groundRowsForTerrain)
+// or the planar pinhole rows (the paper's perspective ground plane).
+enum class GroundRows { Terrain, Planar };
+constexpr auto enumNameTable(GroundRows) {
+    return makeEnumNameTable<GroundRows>("rows", {{GroundRows::Terrain, "terrain"}, {GroundRows::Planar, "planar"}});
+}
 
 struct HeightFieldOptions {
     GroundParams ground;         // with no row profile: fitted to the terrain when fitRows
