@@ -179,7 +179,8 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
            (given.empty() ? "" : " (" + given + ")") + (fitNote.empty() ? "" : "; " + fitNote);
 }
 
-int runEncode(EncodeOptions o) {
+int runEncode(const EncodeOptions& given) {
+    EncodeOptions o = given;  // --fast turns the fit off below
     // Usage first, before any input is read.
     if (o.frameLossGiven && o.foci.empty() && o.importance.empty())
         throw Error(ErrorCode::InvalidArgument, "--frame-loss is the budget of --focus and --importance: give one of them");
@@ -189,10 +190,9 @@ int runEncode(EncodeOptions o) {
     return runConversions(o.batch, [&o](const Job& job) { return encodeOne(o, job.input, job.output); });
 }
 
-}  // namespace
 
-Command addEncodeCommand(CLI::App& root) {
-    auto options = std::make_shared<EncodeOptions>();
+CLI::App* declareEncode(CLI::App& root, EncodeOptions& o) {
+    EncodeOptions* options = &o;  // lives as long as the command (defineCommand)
     CLI::App* command = addSubcommand(root, "encode", "Encode an image (PNG, JPEG, TIFF, EXR, ...) into a CoNUS file through a sampling map",
         {"conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4",
          "conus encode photo.jpg -o photo.exr --size 1024x768 --importance faces",
@@ -234,8 +234,11 @@ Command addEncodeCommand(CLI::App& root) {
         ->excludes("--fit-hold");
     addSourceOptions(*command, options->source);
     addStorageOptions(*command, options->storage);
-    addQuietOption(*command);
-    return {command, [options] { return runEncode(*options); }};
+    return command;
 }
+
+}  // namespace
+
+Command addEncodeCommand(CLI::App& root) { return defineCommand(root, declareEncode, runEncode); }
 
 }  // namespace conus::cli

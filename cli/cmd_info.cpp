@@ -352,27 +352,27 @@ int runInfo(const InfoOptions& o) {
 
 }  // namespace
 
-Command addInfoCommand(CLI::App& root) {
-    auto options = std::make_shared<InfoOptions>();
+CLI::App* declareInfo(CLI::App& root, InfoOptions& options) {
     CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth (a reflection asset: its frame and six faces; a mesh: its bounds)");
-    command->add_option("input", options->input, "CoNUS file or reflection asset (.exr), or a mesh file (its bounds and size)");
-    command->add_flag("--backends", options->backends,
+    command->add_option("input", options.input, "CoNUS file or reflection asset (.exr), or a mesh file (its bounds and size)");
+    command->add_flag("--backends", options.backends,
                       "list the rendering backends (EGL, OSMesa, CPU): whether each works, its GL_RENDERER, why not");
-    command->add_flag("--limits", options->limits,
+    command->add_flag("--limits", options.limits,
                       "print the resource limits every reader checks before allocating (image, map, header, "
                       "index, decode memory)");
-    command->add_flag("--json", options->json, "print JSON instead of text");
-    command->add_flag("-v,--verbose", options->verbose,
+    command->add_flag("--json", options.json, "print JSON instead of text");
+    command->add_flag("-v,--verbose", options.verbose,
                       "also list the source's metadata; for an invalid file, every broken rule (as `conus validate`)");
     setExamples(*command, {"conus info photo.exr",
                        "conus info photo.exr --json --density density.png",
                        "conus info asset.exr                # a reflection asset: the cube's frame and its six faces",
                        "conus info teapot.obj               # a mesh: triangles, vertices, bounds (for --center, --roi-min/--roi-max)",
                        "conus info --backends"});
-    writesFile(command->add_option("--density", options->densityPng,
+    writesFile(command->add_option("--density", options.densityPng,
                                    "write the sampling density as a heat map with the sampling pattern over it (.png)"));
-    addQuietOption(*command);  // progress only: the description is what info is for
-    return {command, [options] { return runInfo(*options); }};
+    return command;  // --quiet: progress only, the description is what info is for
 }
+
+Command addInfoCommand(CLI::App& root) { return defineCommand(root, declareInfo, runInfo); }
 
 }  // namespace conus::cli

@@ -231,15 +231,11 @@ int runAnimate(const AnimateOptions& a) {
     return 0;
 }
 
-}  // namespace
 
-Command addVolumeCommand(CLI::App& root) {
-    CLI::App* volume = root.add_subcommand(
-        "volume", "Scalar volumes through the flexible pinhole camera: CoNUS ray casting into colour + depth images");
-    volume->require_subcommand(1);
-    auto o = std::make_shared<VolumeOptions>();
+CLI::App* addRender(CLI::App& volume, VolumeOptions& options) {
+    VolumeOptions* o = &options;
     CLI::App* render = addSubcommand(
-        *volume, "render", "Render a volume as a CoNUS colour + depth image (R, G, B, A, Z and its camera)",
+        volume, "render", "Render a volume as a CoNUS colour + depth image (R, G, B, A, Z and its camera)",
         {"conus volume render procedural:shepp-logan -o head.exr --focus 0.5,0.45,0.12,3 --picture head.png  # a phantom, a focus",
          "conus volume render brain.den -o brain.exr --tf bone --size 640x480 --uniform  # the uniform baseline",
          "conus volume render raw:256x256x128:uint16:0.8:ct.raw -o ct.exr --tf grey --range 0,4095  # a raw brick"});
@@ -277,11 +273,13 @@ Command addVolumeCommand(CLI::App& root) {
     render->add_option("--units", o->units, "the volume's length unit, recorded as the depth's units")->capture_default_str();
     addBackendOption(*render, o->backend, renderers::CpuPath::Available);
     addAllowDirOption(*render, o->allowDirs);
-    addQuietOption(*render);
+    return render;
+}
 
-    auto a = std::make_shared<AnimateOptions>();
+CLI::App* addAnimate(CLI::App& volume, AnimateOptions& animation) {
+    AnimateOptions* a = &animation;
     CLI::App* animate = addSubcommand(
-        *volume, "animate", "Render a focus sliding across a volume: numbered CoNUS frames and pictures",
+        volume, "animate", "Render a focus sliding across a volume: numbered CoNUS frames and pictures",
         {"conus volume animate procedural:shepp-logan --out-dir frames --from 0.3,0.45 --to 0.7,0.45 --frames 24"});
     animate->add_option("volume", a->volume.volume, "the volume, as for render")->required();
     animate->add_option("--out-dir", a->outDir, "folder for frame_NNNN.exr and frame_NNNN.png")->required();
@@ -300,8 +298,14 @@ Command addVolumeCommand(CLI::App& root) {
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addBackendOption(*animate, a->volume.backend, renderers::CpuPath::Available);
     addAllowDirOption(*animate, a->volume.allowDirs);
-    addQuietOption(*animate);
-    return {volume, [o, a, render] { return render->parsed() ? runRender(*o) : runAnimate(*a); }};
+    return animate;
+}
+
+}  // namespace
+
+Command addVolumeCommand(CLI::App& root) {
+    return addCommandGroup(root, "volume", "Scalar volumes through the flexible pinhole camera: CoNUS ray casting into colour + depth images",
+                           {commandPart(addRender, runRender), commandPart(addAnimate, runAnimate)});
 }
 
 }  // namespace conus::cli
