@@ -25,7 +25,7 @@ CLI::Validator sizeCheck();                      // parseSize as a CLI11 check: 
 codec::View parseView(const std::string& text);  // "u0,v0,u1,v1" with u0 < u1, v0 < v1, all finite
 
 // "x,y,z,lx,ly,lz,fovDeg": eye, look-at point, vertical field of view in degrees (what
-// `heightfield render` and `mesh render` take as --camera).
+// `render heightfield` and `render mesh` take as --camera).
 struct CameraText {
     glm::dvec3 eye{0.0}, target{0.0};
     double fovYDegrees = 50;

@@ -166,7 +166,7 @@ struct RenderOptions {
 };
 
 CLI::App* addRender(CLI::App& command, RenderOptions& o) {
-    CLI::App& render = *command.add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
+    CLI::App& render = *command.add_subcommand("heightfield", "Undistort a CoNUS height field to a mesh and render a frame");
     render.add_option("input", o.input, "CoNUS height field (.exr)")->required();
     writesFile(render.add_option("-o,--output", o.frame, "frame (.png, .exr, ...)"))->required();
     render.add_option("--camera", o.cameraText,
@@ -179,9 +179,9 @@ CLI::App* addRender(CLI::App& command, RenderOptions& o) {
     render.add_option("--height-scale", o.heightScale, "as given to encode (for --compare)")->capture_default_str();
     render.add_option("--colour,--color", o.colour, "as given to encode (for --compare)");
     addBackendOption(render, o.backend, renderers::CpuPath::None);
-    setExamples(render, {"conus heightfield render terrain.exr -o frame.png",
-                       "conus heightfield render terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720",
-                       "conus heightfield render terrain.exr -o compare.png --compare procedural"});
+    setExamples(render, {"conus render heightfield terrain.exr -o frame.png",
+                       "conus render heightfield terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720",
+                       "conus render heightfield terrain.exr -o compare.png --compare procedural"});
     return &render;
 }
 
@@ -240,8 +240,10 @@ Image heightFieldFrame(const format::ConusFile& file, const std::string& cameraT
 
 Command addHeightFieldCommand(CLI::App& root) {
     return addCommandGroup(root, "heightfield",
-                           "CoNUS height fields: sample a DEM densely near a viewer (encode), render it (render)",
-                           {commandPart(addEncode, runEncode), commandPart(addRender, runRender)});
+                           "CoNUS height fields: sample a DEM densely near a viewer (encode; a frame of it: `conus render heightfield`)",
+                           {commandPart(addEncode, runEncode)});
 }
+
+CommandPart heightFieldRenderPart() { return commandPart(addRender, runRender); }
 
 }  // namespace conus::cli

@@ -287,7 +287,7 @@ bool isExr(const std::string& path) {
     return in && magic == std::array<unsigned char, 4>{0x76, 0x2f, 0x31, 0x01};
 }
 
-// A mesh file (what `bake reflection`, `mesh render` take): its size and bounds, so that --center
+// A mesh file (what `bake reflection`, `render mesh` take): its size and bounds, so that --center
 // and --roi-min/--roi-max can be chosen without another tool.
 int printMesh(const InfoOptions& o, const Mesh& mesh) {
     const AxisBox box = boundsOf(mesh);

@@ -1,4 +1,4 @@
-// conus mesh render|animate: triangle meshes through the flexible pinhole camera (paper sections
+// conus render mesh, conus mesh animate: triangle meshes through the flexible pinhole camera (paper sections
 // 3.2 and 6). render writes one CoNUS colour + depth image (a `depthimage` file with its camera);
 // animate renders the procedural city's focus-plus-context sequence, each frame's foci following
 // chosen cars, as numbered CoNUS files and pictures, a contact sheet and (with ffmpeg) an MP4.
@@ -362,10 +362,10 @@ int runAnimate(const AnimateOptions& a) {
 
 CLI::App* addRender(CLI::App& command, RenderOptions& r) {
     CLI::App* render = addSubcommand(
-        command, "render", "Render a mesh (OBJ, PLY, STL, glTF, ... or `city`) as a CoNUS colour + depth image",
-        {"conus mesh render bunny.ply -o bunny.exr --focus 0.45,0.4,0.1,4",
-         "conus mesh render model.obj -o model.exr --size 1024x1024 --camera 0,1,3,0,0,0,40 --max-bend 0.1",
-         "conus mesh render city -o city.exr --track 0,2 --time 3.5 --reference"});
+        command, "mesh", "Render a mesh (OBJ, PLY, STL, glTF, ... or `city`) as a CoNUS colour + depth image",
+        {"conus render mesh bunny.ply -o bunny.exr --focus 0.45,0.4,0.1,4",
+         "conus render mesh model.obj -o model.exr --size 1024x1024 --camera 0,1,3,0,0,0,40 --max-bend 0.1",
+         "conus render mesh city -o city.exr --track 0,2 --time 3.5 --reference"});
     render->add_option("model", r.mesh.model, "mesh file (anything Assimp reads) or `city` (the procedural city)")->required();
     writesFile(render->add_option("-o,--output", r.output, "CoNUS file (.exr): R, G, B, A (coverage), Z (camera depth)"))->required();
     render->add_option("--focus", r.foci, "focus u,v,r,k (repeatable): centre, radius (fraction of the width), magnification");
@@ -406,8 +406,10 @@ CLI::App* addAnimate(CLI::App& command, AnimateOptions& a) {
 Command addMeshCommand(CLI::App& root) {
     return addCommandGroup(
         root, "mesh",
-        "Triangle meshes through the flexible pinhole camera: CoNUS colour + depth images, focus-plus-context sequences",
-        {commandPart(addRender, runRender), commandPart(addAnimate, runAnimate)});
+        "Triangle meshes through the flexible pinhole camera: focus-plus-context sequences (a frame: `conus render mesh`)",
+        {commandPart(addAnimate, runAnimate)});
 }
+
+CommandPart meshRenderPart() { return commandPart(addRender, runRender); }
 
 }  // namespace conus::cli

@@ -177,8 +177,11 @@ CLI::App* addRenderRelief(CLI::App& command, RenderOptions& o) {
 }  // namespace
 
 Command addRenderCommand(CLI::App& root) {
-    return addCommandGroup(root, "render", "Render frames of baked assets (relief, reflection)",
-                           {commandPart(addRenderRelief, runRenderRelief), commandPart(addRenderReflection, runRenderReflection)});
+    return addCommandGroup(root, "render",
+                           "Render frames: of baked assets (relief, reflection), of meshes and volumes as CoNUS colour + depth "
+                           "images (mesh, volume), of a CoNUS height field (heightfield)",
+                           {commandPart(addRenderRelief, runRenderRelief), commandPart(addRenderReflection, runRenderReflection),
+                            meshRenderPart(), volumeRenderPart(), heightFieldRenderPart()});
 }
 
 }  // namespace conus::cli

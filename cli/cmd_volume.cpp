@@ -1,4 +1,4 @@
-// conus volume render|animate: scalar volumes through the flexible pinhole camera (paper section 3.2,
+// conus render volume, conus volume animate: scalar volumes through the flexible pinhole camera (paper section 3.2,
 // "Volume data"): one CoNUS ray per pixel through the undistorted image-plane point, composited
 // front to back through a transfer function; written as a CoNUS depth image (R, G, B, A and the
 // camera depth Z of the first sample past the opacity threshold, with its camera). animate slides
@@ -235,10 +235,10 @@ int runAnimate(const AnimateOptions& a) {
 CLI::App* addRender(CLI::App& volume, VolumeOptions& options) {
     VolumeOptions* o = &options;
     CLI::App* render = addSubcommand(
-        volume, "render", "Render a volume as a CoNUS colour + depth image (R, G, B, A, Z and its camera)",
-        {"conus volume render procedural:shepp-logan -o head.exr --focus 0.5,0.45,0.12,3 --picture head.png  # a phantom, a focus",
-         "conus volume render brain.den -o brain.exr --tf bone --size 640x480 --uniform  # the uniform baseline",
-         "conus volume render raw:256x256x128:uint16:0.8:ct.raw -o ct.exr --tf grey --range 0,4095  # a raw brick"});
+        volume, "volume", "Render a volume as a CoNUS colour + depth image (R, G, B, A, Z and its camera)",
+        {"conus render volume procedural:shepp-logan -o head.exr --focus 0.5,0.45,0.12,3 --picture head.png  # a phantom, a focus",
+         "conus render volume brain.den -o brain.exr --tf bone --size 640x480 --uniform  # the uniform baseline",
+         "conus render volume raw:256x256x128:uint16:0.8:ct.raw -o ct.exr --tf grey --range 0,4095  # a raw brick"});
     render->add_option("volume", o->volume,
                        "file.vdb | file.nrrd | file.nhdr | file.den | " + sceneio::rawVolumeForm() +
                            " | procedural:marschner-lobb[:n] | procedural:shepp-logan[:n]")
@@ -304,8 +304,12 @@ CLI::App* addAnimate(CLI::App& volume, AnimateOptions& animation) {
 }  // namespace
 
 Command addVolumeCommand(CLI::App& root) {
-    return addCommandGroup(root, "volume", "Scalar volumes through the flexible pinhole camera: CoNUS ray casting into colour + depth images",
-                           {commandPart(addRender, runRender), commandPart(addAnimate, runAnimate)});
+    return addCommandGroup(root, "volume",
+                           "Scalar volumes through the flexible pinhole camera: a focus sliding across a volume (a frame: "
+                           "`conus render volume`)",
+                           {commandPart(addAnimate, runAnimate)});
 }
+
+CommandPart volumeRenderPart() { return commandPart(addRender, runRender); }
 
 }  // namespace conus::cli

@@ -1,5 +1,5 @@
 // The options that shape a built map, shared by `map foci`, `map auto` and `encode`, and the map a
-// rendered frame (`mesh render`, `volume render`) is taken through.
+// rendered frame (`render mesh`, `render volume`) is taken through.
 #pragma once
 
 #include <functional>
@@ -31,7 +31,7 @@ std::string defaultFalloffText();
 // --falloff WIDTH[,SHAPE] for `map foci`, `encode --focus` and `bake relief --focus`.
 CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff);
 // --compose: how several foci combine (format::FociComposition's names), for `map foci`, `encode`,
-// `mesh` and `volume render`.
+// `mesh` and `render volume`.
 CLI::Option* addComposeOption(CLI::App& command, std::string& compose);
 // "4, 3.1": the foci's k, as the budget lines say them.
 std::string fociKText(const std::vector<codec::Focus>& foci);
