@@ -12,6 +12,7 @@
 #include "conus/core/limits.h"
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
+#include "progress.h"
 
 namespace conus::cli {
 namespace {
@@ -116,6 +117,16 @@ Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 
                                                     std::to_string(dem.heights.width) + "x" +
                                                     std::to_string(dem.heights.height) + ")");
     return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
+}
+
+Mesh readSceneMesh(const std::string& path, const std::vector<std::string>& allowDirs) {
+    Progress loading("read " + path);
+    sceneio::MeshReadOptions read;
+    read.allowedDirs = allowDirs;
+    read.warn = warn;
+    Mesh mesh = sceneio::readMesh(path, read);
+    loading.done();
+    return mesh;
 }
 
 }  // namespace conus::cli

@@ -13,6 +13,7 @@
 #include "conus/core/camera.h"
 #include "conus/format/container.h"
 #include "conus/sceneio/dem_file.h"
+#include "conus/sceneio/mesh_file.h"
 
 namespace conus::cli {
 
@@ -43,6 +44,10 @@ sceneio::Dem demFrom(const std::string& source, double heightScale);
 // smaller is refused), else codec's height/slope ramp (drawn as display colours). `encoding`
 // receives what the colour came from.
 Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding = nullptr);
+
+// The mesh a scene argument names (sceneio::readMesh: files it names may also lie in `allowDirs`;
+// its warnings said), read as a progress stage.
+Mesh readSceneMesh(const std::string& path, const std::vector<std::string>& allowDirs);
 
 // --compression (format::Compression's names; default zip) for the commands that write a CoNUS file.
 CLI::Option* addCompressionOption(CLI::App& command, std::string& compression);

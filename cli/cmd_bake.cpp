@@ -224,12 +224,7 @@ int runBakeReflection(const ReflectionBakeText& o) {
             throw Error(ErrorCode::InvalidArgument, "--roi-min must lie below --roi-max on every axis");
         options.roi = codec::AxisBox{lo, hi};
     }
-    Progress loading("read " + o.scene);
-    sceneio::MeshReadOptions read;
-    read.allowedDirs = o.allowDirs;
-    read.warn = warn;
-    const codec::MeshScene scene(sceneio::readMesh(o.scene, read));
-    loading.done();
+    const codec::MeshScene scene(readSceneMesh(o.scene, o.allowDirs));
     Progress baking("bake six " + std::to_string(o.size) + "x" + std::to_string(o.size) + " faces (Embree)");
     const auto faces = codec::bakeReflection(scene, options);
     baking.done();

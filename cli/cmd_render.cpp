@@ -101,12 +101,7 @@ int runRenderReflection(const ReflectionRenderText& o) {
     const std::vector<codec::ReflectionFace> faces = codec::readReflectionFaces(o.asset);
     const glm::dvec3 centre = faces.front().depth.camera().eye();
     options.reflector.centre = o.at.empty() ? centre : parseVector3(o.at, "--at");
-    Progress loading("read " + o.scene);
-    sceneio::MeshReadOptions read;
-    read.allowedDirs = o.allowDirs;
-    read.warn = warn;
-    const codec::MeshScene scene(sceneio::readMesh(o.scene, read));
-    loading.done();
+    const codec::MeshScene scene(readSceneMesh(o.scene, o.allowDirs));
     const double aspect = double(size.width) / size.height;
     const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);
     // The ground truth traces the mesh itself: the CPU only.
