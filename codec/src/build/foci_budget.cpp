@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -25,6 +26,11 @@ constexpr double kTolerance = 1.0 / 1024, kToleranceDb = 0.01;
 constexpr int kSearchSteps = 12;
 // The rounds of confirming encodes (FrameModelOptions::confirmRounds) stop within this of the budget.
 constexpr double kMeasuredToleranceDb = 0.05;
+// How far (dB, on keepsContext's margins) the two contexts' candidates, compared on a model
+// confirmed by one of them, must be from turning the choice for the other to go without its own
+// confirming encode: on a picture half textured, half flat, the model confirmed by the uniform
+// context's map still predicted the detail context's ROI gain 2 dB under its encode's.
+constexpr double kUndecidedDb = 2.5;
 
 bool inDisc(const Focus& f, double aspect, double u, double v) {
     const double dx = u - f.u, dy = (v - f.v) / aspect;
@@ -115,9 +121,10 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         SamplingMap map;
         FociReport report;
         FramePrediction predicted;
+        std::shared_ptr<const ModelEncode> encode{};  // this map's own encode, where one was made
     };
     const auto attempt = [&](const FrameErrorModel& m, double t, const FociOptions& o) {
-        Try x{t, powered(foci, t), SamplingMap::identity(2, 2), {}, {}};
+        Try x{t, powered(foci, t), SamplingMap::identity(2, 2), {}, {}, {}};
         x.map = buildFociMap(x.given, o, &x.report);
         x.predicted = m.predict(x.map);
         return x;
@@ -152,58 +159,86 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
     Search chosen = search(model, options);
     std::optional<Search> plain;
     if (compare) plain = search(model, uniform);
+    // Whether the candidate on the uniform context is kept over the one on the picture's own detail;
+    // with `bias` (dB) given to the context's side of every margin (its budget, ROI gain and worst tiles).
+    const auto takesPlain = [&](const Search& own, const Search& other, double bias = 0.0) {
+        const double ownOver = over(own.chosen) - bias, otherOver = over(other.chosen) + bias;
+        if ((ownOver > 0) != (otherOver > 0)) return ownOver > 0;
+        FramePrediction context = own.chosen.predicted;
+        context.roiGain += bias;
+        context.tileLoss99 -= bias;
+        return !keepsContext(context, other.chosen.predicted);
+    };
     if (model.options().confirm && !model.isConfirmed()) {
-        // One real encode of each candidate's map, and each searched again on the model its encode
-        // confirms: the model alone can be off by dB in either direction, and differently on the two
-        // contexts' maps (their footprints differ where the context does), so the two are compared
-        // on what their encodes measured, not on the model alone. What the block prints is then the
-        // chosen map's encode's measure near it.
+        // A real encode of the candidate the model chooses, and that candidate searched again on the
+        // model its encode confirms (the model alone can be off by dB in either direction). Where the
+        // model's choice between the two contexts' candidates would turn within kUndecidedDb of its
+        // margins, each candidate gets its own confirming encode and the two are compared on what
+        // their encodes measured (a model confirmed by one context's map does not carry to the
+        // other's: their footprints differ where the contexts do). Where the choice stays next to
+        // the map encoded (kConfirmedT in t) and that map holds the budget as measured, it is kept
+        // with its encode, which the caller then need not make again; what the block prints is then
+        // what that encode measured.
+        const bool plainFirst = plain && takesPlain(chosen, *plain);
         const auto confirm = [&](Search s, const FociOptions& o) {
-            // The map encoded and its losses as that encode measured them.
             Try encoded = s.chosen;
             const FrameErrorModel confirmed = model.confirmed(encoded.map);
             encoded.predicted = confirmed.predict(encoded.map);
+            encoded.encode = confirmed.encode();
             s = search(confirmed, o);
             const int rounds = model.options().confirmRounds - 1;
-            if (rounds <= 0 || exactK || std::abs(s.chosen.t - encoded.t) <= kConfirmedT) return s;
+            if (std::abs(s.chosen.t - encoded.t) <= kConfirmedT) {
+                if (over(encoded) <= 0 || over(s.chosen) > 0) s.chosen = std::move(encoded);
+                return s;
+            }
+            if (rounds <= 0 || exactK) return s;
             // Further rounds: the same regula falsi on t, each try's losses measured by its own
             // encode, between the map first encoded and the one its confirmed model chose (k = 1
             // where both hold or both miss the budget): the map kept holds the budget as measured.
             const auto measured = [&](double t) {
                 Try x = attempt(model, t, o);
-                x.predicted = model.confirmed(x.map).predict(x.map);
+                const FrameErrorModel c = model.confirmed(x.map);
+                x.predicted = c.predict(x.map);
+                x.encode = c.encode();
                 return x;
             };
             Try next = measured(s.chosen.t);
             const bool nextHolds = over(next) <= 0, encodedHolds = over(encoded) <= 0;
             if (nextHolds && encodedHolds) {  // both hold: the larger k
                 s.chosen = std::move(next.t >= encoded.t ? next : encoded);
-                return s;
-            }
-            if (nextHolds != encodedHolds && (nextHolds ? next.t > encoded.t : encoded.t > next.t)) {
+            } else if (nextHolds != encodedHolds && (nextHolds ? next.t > encoded.t : encoded.t > next.t)) {
                 s.chosen = std::move(nextHolds ? next : encoded);  // a larger k holds where a smaller one missed: kept
-                return s;
+            } else {
+                // A try that misses the budget and, at a smaller t, one that holds it (k = 1 where both miss).
+                Try beyond = std::move(!nextHolds && (encodedHolds || next.t < encoded.t) ? next : encoded);
+                Try within = nextHolds ? std::move(next) : encodedHolds ? std::move(encoded) : measured(0.0);
+                if (over(within) > 0) {  // even k = 1 misses: the closest there is
+                    s.chosen = std::move(within);
+                } else {
+                    const double a = within.t, b = beyond.t;
+                    s.chosen = detail::searchWithin(std::move(within), a, std::move(beyond), b, measured, over,
+                                                    std::max(0, rounds - 1), kConfirmedT, kMeasuredToleranceDb);
+                }
             }
-            // A try that misses the budget and, at a smaller t, one that holds it (k = 1 where both miss).
-            Try beyond = std::move(!nextHolds && (encodedHolds || next.t < encoded.t) ? next : encoded);
-            Try within = nextHolds ? std::move(next) : encodedHolds ? std::move(encoded) : measured(0.0);
-            if (over(within) > 0) {  // even k = 1 misses: the closest there is
-                s.chosen = std::move(within);
-                return s;
-            }
-            const double a = within.t, b = beyond.t;
-            s.chosen = detail::searchWithin(std::move(within), a, std::move(beyond), b, measured, over, std::max(0, rounds - 1), kConfirmedT, kMeasuredToleranceDb);
             return s;
         };
-        chosen = confirm(std::move(chosen), options);
-        if (plain) plain = confirm(std::move(*plain), uniform);
+        // Both candidates confirmed where the model's choice between them would turn within
+        // kUndecidedDb; otherwise only the one it chooses, the other left out of the comparison.
+        const bool both = plain && takesPlain(chosen, *plain, kUndecidedDb) != takesPlain(chosen, *plain, -kUndecidedDb);
+        if (plainFirst || both) plain = confirm(std::move(*plain), uniform);
+        if (!plainFirst || both) chosen = confirm(std::move(chosen), options);
+        if (plain && !both) {
+            if (plainFirst) chosen = std::move(*plain);
+            plain.reset();
+        }
     }
-    if (plain && ((over(chosen.chosen) > 0 && over(plain->chosen) <= 0) || !keepsContext(chosen.chosen.predicted, plain->chosen.predicted)))
-        chosen = std::move(*plain);
+    if (plain && takesPlain(chosen, *plain)) chosen = std::move(*plain);
+    std::shared_ptr<const ModelEncode> encode = chosen.chosen.encode;
     const Try& asked = chosen.asked;
     Try& given = chosen.chosen;
     FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), std::move(given.given), std::move(given.map), {}, {},
                    given.predicted, asked.predicted, given.report.transition, false, false, std::move(given.report.notes)};
+    out.encode = std::move(encode);
     out.lowered = given.t < 1.0;
     out.gridLimited = recordReached(out.map, out.given);
     out.share = fociShare(out.given, options.aspect, options.falloff);
