@@ -157,22 +157,32 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
         return j == 0 ? shown(source.pixels[(std::size_t(y) * sw + x) * channels + c], display[c], table)
                       : level[(std::size_t(y) * w + x) * channels + c];
     };
+    std::vector<double> energies;
     for (int j = 0; j < m_levels; ++j) {
         const int nw = w / 2, nh = h / 2, cell = 1 << (j + 1);
         next.assign(std::size_t(nw) * nh * channels, 0.0f);
+        // Each cell's energy and mean, rows of cells spread over the threads; then the energies
+        // spread over the tiles in the same order whatever the thread count.
+        energies.assign(std::size_t(nw) * nh, 0.0);
+        parallelRows(nh, 0, [&](int r0, int r1) {
+            for (int y = r0; y < r1; ++y)
+                for (int x = 0; x < nw; ++x) {
+                    double energy = 0;
+                    for (std::size_t c = 0; c < channels; ++c) {
+                        const double v00 = at(j, 2 * x, 2 * y, c), v10 = at(j, 2 * x + 1, 2 * y, c);
+                        const double v01 = at(j, 2 * x, 2 * y + 1, c), v11 = at(j, 2 * x + 1, 2 * y + 1, c);
+                        const double mean = 0.25 * (v00 + v10 + v01 + v11);
+                        energy += 0.25 * ((v00 - mean) * (v00 - mean) + (v10 - mean) * (v10 - mean) + (v01 - mean) * (v01 - mean) +
+                                          (v11 - mean) * (v11 - mean));
+                        next[(std::size_t(y) * nw + x) * channels + c] = static_cast<float>(mean);
+                    }
+                    energies[std::size_t(y) * nw + x] = energy / double(channels);
+                }
+        });
         for (int y = 0; y < nh; ++y) {
             const int y0 = y * cell, y1 = std::min(sh, y0 + cell);
             for (int x = 0; x < nw; ++x) {
-                double energy = 0;
-                for (std::size_t c = 0; c < channels; ++c) {
-                    const double v00 = at(j, 2 * x, 2 * y, c), v10 = at(j, 2 * x + 1, 2 * y, c);
-                    const double v01 = at(j, 2 * x, 2 * y + 1, c), v11 = at(j, 2 * x + 1, 2 * y + 1, c);
-                    const double mean = 0.25 * (v00 + v10 + v01 + v11);
-                    energy += 0.25 * ((v00 - mean) * (v00 - mean) + (v10 - mean) * (v10 - mean) + (v01 - mean) * (v01 - mean) +
-                                      (v11 - mean) * (v11 - mean));
-                    next[(std::size_t(y) * nw + x) * channels + c] = static_cast<float>(mean);
-                }
-                energy /= double(channels);
+                const double energy = energies[std::size_t(y) * nw + x];
                 const int x0 = x * cell, x1 = std::min(sw, x0 + cell);
                 for (int ty = y0 / m_tile; ty <= (y1 - 1) / m_tile; ++ty) {
                     const int oy = std::min(y1, (ty + 1) * m_tile) - std::max(y0, ty * m_tile);
