@@ -45,6 +45,7 @@ struct EncodeOptions {
 struct BuiltMap {
     std::unique_ptr<codec::SamplingMap> map;
     std::optional<format::AnalyticMap> analytic;
+    std::shared_ptr<const codec::ModelEncode> encoded{};  // the budget's confirming encode of `map`, kept
 };
 
 BuiltMap mapFromFile(const std::string& path, const Image& source) {
@@ -68,11 +69,6 @@ BuiltMap mapFromFile(const std::string& path, const Image& source) {
 // context foci and importance maps sit on.
 codec::AutoMapOptions ownDetailOptions(const EncodeOptions& o) { return autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method); }
 
-// The density the picture's own detail asks for (codec::ownDetailContext), the budget's model choosing its floor.
-codec::DensityField ownDetailContext(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
-    return codec::ownDetailContext(source, importanceFrom(enumName(codec::ImportanceRule::Detail), source), size.width, size.height, ownDetailOptions(o), modelOptions);
-}
-
 BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
     Progress progress("build sampling map from " + o.importance + " importance");
     codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
@@ -85,16 +81,20 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     // The budget chooses the context floor; say what it achieved. Apart from the importance the
     // samples follow the picture's own detail, as with no importance at all (`detail` is that already).
     codec::DensityField context;
-    if (o.importance != enumName(codec::ImportanceRule::Detail)) {
-        context = ownDetailContext(o, source, size, modelOptions);
+    const bool notDetail = o.importance != enumName(codec::ImportanceRule::Detail);
+    const Image detail = notDetail ? importanceFrom(enumName(codec::ImportanceRule::Detail), source) : Image{};
+    // One model of the picture (its pyramid taken once), its region the detail's for the context.
+    const codec::FrameErrorModel picture(source, size.width, size.height, notDetail ? detail : importance, modelOptions);
+    if (notDetail) {
+        context = codec::ownDetailContext(picture, detail, ownDetailOptions(o));
         autoOptions.context = &context;
     }
-    const codec::FrameErrorModel model(source, size.width, size.height, importance, modelOptions);
+    const codec::FrameErrorModel model = notDetail ? picture.withRegion(importance) : picture;
     codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions, codec::kDefaultTileLoss);
     progress.done();
     if (!quiet())
         std::printf("%s\n", describeFloorBudget(r, o.frameLoss, o.importance + " importance").c_str());
-    return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt};
+    return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt, std::move(r.encode)};
 }
 
 // The foci's map under the frame-loss budget (foci_budget.h): says, before the work, what the foci
@@ -109,11 +109,14 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
     // Away from the foci the samples follow the picture's own detail, as with no focus at all.
-    const codec::DensityField context = ownDetailContext(o, source, size, modelOptions);
+    // One model of the picture (its pyramid taken once), its region the detail's for the context.
+    const Image detail = importanceFrom(enumName(codec::ImportanceRule::Detail), source);
+    const codec::FrameErrorModel picture(source, size.width, size.height, detail, modelOptions);
+    const codec::DensityField context = codec::ownDetailContext(picture, detail, ownDetailOptions(o));
     fo.context = &context;
     const int side = 256;
-    const codec::FrameErrorModel model(source, size.width, size.height,
-                                       codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))), modelOptions);
+    const codec::FrameErrorModel model =
+        picture.withRegion(codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))));
     codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, o.frameLoss, o.exactK);
     progress.done();
     const std::string said =
@@ -123,7 +126,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     *given = "k " + fociKText(budget.given);
     // The file records the falloff the map holds (a transition widened for the anisotropy bound).
     return {std::make_unique<codec::SamplingMap>(std::move(budget.map)),
-            codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff))};
+            codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff)), std::move(budget.encode)};
 }
 
 // No focus, map or importance: the samples follow the picture's own detail, with the context floor
@@ -167,8 +170,12 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     else built = mapFromOwnDetail(o, source.image, size, modelOptions, &given);
     const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Faster, "encoding");
     std::string fitNote;
+    // The budget's confirming encode is this encode on the CPU (same kernel, same fit): kept.
     format::ConusFile file =
-        encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
+        built.encoded && !device.onGpu()
+            ? keptEncodeToConus(*built.encoded, source.info.encoding, *built.map, source.image.width, source.image.height,
+                                built.analytic, &fitNote)
+            : encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
     applyStorage(o.storage, file);
     Progress writing("write " + output);
     format::writeConusFile(output, file);

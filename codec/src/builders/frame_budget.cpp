@@ -10,6 +10,7 @@
 #include "conus/codec/image/fit.h"
 #include "conus/core/display.h"
 #include "conus/core/error.h"
+#include "conus/core/parallel.h"
 #include "budget_search_pvt.h"
 
 namespace conus::codec {
@@ -27,6 +28,11 @@ namespace {
 // 1.6 dB (uniform) and 3.5 dB (CoNUS, rms); whence the confirming encode (FrameErrorModel::confirmed).
 // bench/notes/2026-12-06-budget-model.md.
 }  // namespace
+
+struct FrameErrorModel::MeasuredUniform {
+    std::once_flag once;
+    std::vector<double> errors;
+};
 
 struct FrameErrorModel::BandFit {
     double scale;    // a
@@ -72,6 +78,9 @@ constexpr double kBestLowest = 0.25, kBestHighest = 0.85;
 // the lowest (16x the uniform density: 4x the linear rate, as the default cap; this, 16x it).
 constexpr double kHighestCap = 256.0;
 constexpr int kGoldenSteps = 8;
+// How near (in log floor and log cap) the map chosen on a confirmed model must be to the map whose
+// encode confirmed it for that map and its encode to be kept instead of a second encode.
+constexpr double kNearEncoded = 0.02;
 constexpr double kTilePenalty = 4.0;  // dB of frame loss per dB of tile loss over its budget
 
 [[noreturn]] void invalid(const std::string& what) { throw Error(ErrorCode::InvalidArgument, what); }
@@ -117,6 +126,7 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
                 " is outside 1x1 .. the source's " + std::to_string(source.width) + "x" + std::to_string(source.height));
     const int sw = source.width, sh = source.height;
     m_source = &source;
+    m_measuredUniform = std::make_shared<MeasuredUniform>();
     m_sourceWidth = sw;
     m_sourceHeight = sh;
     m_conusWidth = width;
@@ -147,22 +157,32 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
         return j == 0 ? shown(source.pixels[(std::size_t(y) * sw + x) * channels + c], display[c], table)
                       : level[(std::size_t(y) * w + x) * channels + c];
     };
+    std::vector<double> energies;
     for (int j = 0; j < m_levels; ++j) {
         const int nw = w / 2, nh = h / 2, cell = 1 << (j + 1);
         next.assign(std::size_t(nw) * nh * channels, 0.0f);
+        // Each cell's energy and mean, rows of cells spread over the threads; then the energies
+        // spread over the tiles in the same order whatever the thread count.
+        energies.assign(std::size_t(nw) * nh, 0.0);
+        parallelRows(nh, 0, [&](int r0, int r1) {
+            for (int y = r0; y < r1; ++y)
+                for (int x = 0; x < nw; ++x) {
+                    double energy = 0;
+                    for (std::size_t c = 0; c < channels; ++c) {
+                        const double v00 = at(j, 2 * x, 2 * y, c), v10 = at(j, 2 * x + 1, 2 * y, c);
+                        const double v01 = at(j, 2 * x, 2 * y + 1, c), v11 = at(j, 2 * x + 1, 2 * y + 1, c);
+                        const double mean = 0.25 * (v00 + v10 + v01 + v11);
+                        energy += 0.25 * ((v00 - mean) * (v00 - mean) + (v10 - mean) * (v10 - mean) + (v01 - mean) * (v01 - mean) +
+                                          (v11 - mean) * (v11 - mean));
+                        next[(std::size_t(y) * nw + x) * channels + c] = static_cast<float>(mean);
+                    }
+                    energies[std::size_t(y) * nw + x] = energy / double(channels);
+                }
+        });
         for (int y = 0; y < nh; ++y) {
             const int y0 = y * cell, y1 = std::min(sh, y0 + cell);
             for (int x = 0; x < nw; ++x) {
-                double energy = 0;
-                for (std::size_t c = 0; c < channels; ++c) {
-                    const double v00 = at(j, 2 * x, 2 * y, c), v10 = at(j, 2 * x + 1, 2 * y, c);
-                    const double v01 = at(j, 2 * x, 2 * y + 1, c), v11 = at(j, 2 * x + 1, 2 * y + 1, c);
-                    const double mean = 0.25 * (v00 + v10 + v01 + v11);
-                    energy += 0.25 * ((v00 - mean) * (v00 - mean) + (v10 - mean) * (v10 - mean) + (v01 - mean) * (v01 - mean) +
-                                      (v11 - mean) * (v11 - mean));
-                    next[(std::size_t(y) * nw + x) * channels + c] = static_cast<float>(mean);
-                }
-                energy /= double(channels);
+                const double energy = energies[std::size_t(y) * nw + x];
                 const int x0 = x * cell, x1 = std::min(sw, x0 + cell);
                 for (int ty = y0 / m_tile; ty <= (y1 - 1) / m_tile; ++ty) {
                     const int oy = std::min(y1, (ty + 1) * m_tile) - std::max(y0, ty * m_tile);
@@ -180,8 +200,20 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
     for (std::size_t t = 0; t < tiles; ++t)
         for (int j = 0; j < m_levels; ++j) m_bands[t * m_levels + j] /= m_pixels[t];
 
+    setRegion(importance);
+    // The baseline: the uniform image of the same pixel count, every footprint the same.
+    m_uniformError.resize(tiles);
+    const double su = double(sw) / width, sv = double(sh) / height;
+    for (std::size_t t = 0; t < tiles; ++t)
+        m_uniformError[t] = tileError(t, std::max(su, sv), std::min(su, sv), kUniformFit);
+    m_shift.assign(tiles, 0.0);
+}
+
+void FrameErrorModel::setRegion(const Image& importance) {
     // The region: where the importance reaches half its peak (nowhere without one: R empty, the
     // whole frame's tiles counted), read at kRegionPoints^2 points of each tile.
+    const std::size_t tiles = m_pixels.size();
+    const int sw = m_sourceWidth, sh = m_sourceHeight;
     m_roi.assign(tiles, 0.0);
     m_touches.assign(tiles, 0);
     if (!importance.empty()) {
@@ -215,12 +247,12 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
         std::fill(m_roi.begin(), m_roi.end(), 1.0);
         std::fill(m_touches.begin(), m_touches.end(), 1);
     }
-    // The baseline: the uniform image of the same pixel count, every footprint the same.
-    m_uniformError.resize(tiles);
-    const double su = double(sw) / width, sv = double(sh) / height;
-    for (std::size_t t = 0; t < tiles; ++t)
-        m_uniformError[t] = tileError(t, std::max(su, sv), std::min(su, sv), kUniformFit);
-    m_shift.assign(tiles, 0.0);
+}
+
+FrameErrorModel FrameErrorModel::withRegion(const Image& importance) const {
+    FrameErrorModel out = *this;
+    out.setRegion(importance);
+    return out;
 }
 
 double FrameErrorModel::tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const {
@@ -285,19 +317,24 @@ FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
     encode.width = m_conusWidth;
     encode.height = m_conusHeight;
     encode.filter = m_options.filter;
-    Image conus = encodeImage(source, map, encode);
+    auto kept = std::make_shared<ModelEncode>();
+    kept->image = encodeImage(source, map, encode);
     if (m_options.fitIterations > 0) {
         FitOptions fit;
         fit.iterations = m_options.fitIterations;
         fit.holdLowPass = m_options.fitHold;
         fit.method = m_options.fitMethod;
-        fitToDecoder(source, map, conus, fit);
+        kept->fit = fitToDecoder(source, map, kept->image, fit);
     }
     DecodeOptions decode;
     decode.width = source.width;
     decode.height = source.height;
-    const std::vector<double> measured = shownTileErrors(source, decodeImage(conus, map, decode));
-    out.m_uniformError = shownTileErrors(source, resizeBilinear(areaDownsample(source, m_conusWidth, m_conusHeight), {}, source.width, source.height));
+    const std::vector<double> measured = shownTileErrors(source, decodeImage(kept->image, map, decode));
+    std::call_once(m_measuredUniform->once, [&] {
+        m_measuredUniform->errors =
+            shownTileErrors(source, resizeBilinear(areaDownsample(source, m_conusWidth, m_conusHeight), {}, source.width, source.height));
+    });
+    out.m_uniformError = m_measuredUniform->errors;
     // Each tile's footprints scaled by 2^shift so that the model gives what was measured: the
     // error grows with the footprint, so the shift is found by bisection (to 1e-4 octaves, within
     // +-kMostShift: a tile with no detail to lose keeps what it can).
@@ -312,6 +349,7 @@ FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
         out.m_shift[t] = 0.5 * (lo + hi);
     }
     out.m_confirmed = true;
+    out.m_encode = std::move(kept);
     return out;
 }
 
@@ -321,17 +359,26 @@ std::vector<double> FrameErrorModel::shownTileErrors(const Image& source, const 
     if (m_options.space == ErrorSpace::Display)
         for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
     const std::vector<float>& table = displayTable();
+    // A row of tiles at a time, the rows of tiles spread over the threads (each tile's sum is
+    // taken in the same order whatever the thread count).
     std::vector<double> out(m_pixels.size(), 0.0);
-    for (int y = 0; y < source.height; ++y)
-        for (int x = 0; x < source.width; ++x) {
-            double e = 0;
-            for (std::size_t c = 0; c < channels; ++c) {
-                const std::size_t i = (std::size_t(y) * source.width + x) * channels + c;
-                const double d = double(shown(view.pixels[i], display[c], table)) - shown(source.pixels[i], display[c], table);
-                e += d * d;
+    parallelRows(
+        m_rows, 0,
+        [&](int r0, int r1) {
+            for (int y = r0 * m_tile; y < std::min(source.height, r1 * m_tile); ++y) {
+                double* row = &out[std::size_t(y / m_tile) * m_columns];
+                for (int x = 0; x < source.width; ++x) {
+                    double e = 0;
+                    for (std::size_t c = 0; c < channels; ++c) {
+                        const std::size_t i = (std::size_t(y) * source.width + x) * channels + c;
+                        const double d = double(shown(view.pixels[i], display[c], table)) - shown(source.pixels[i], display[c], table);
+                        e += d * d;
+                    }
+                    row[x / m_tile] += e / double(channels);
+                }
             }
-            out[std::size_t(y / m_tile) * m_columns + x / m_tile] += e / double(channels);
-        }
+        },
+        1);
     for (std::size_t t = 0; t < out.size(); ++t) out[t] /= m_pixels[t];
     return out;
 }
@@ -424,7 +471,18 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         // One real encode of the map chosen, and the choice made again on the model it confirms
         // (the context kept as chosen).
         const FrameErrorModel confirmed = model.confirmed(chosen.map);
-        return buildAutoMapForFrameLoss(importance, confirmed, frameLossDb, options, tileLossDb);
+        BudgetResult again = buildAutoMapForFrameLoss(importance, confirmed, frameLossDb, options, tileLossDb);
+        // Where that choice is next to the map encoded (kNearEncoded in log floor and log cap) and
+        // the encoded map holds the budget as measured (or neither does), the map encoded is kept,
+        // with its encode and what it measured: the encode is then not made again.
+        chosen.predicted = confirmed.predict(chosen.map);
+        const bool near = std::abs(std::log(again.minDensity / chosen.minDensity)) <= kNearEncoded &&
+                          std::abs(std::log(again.maxDensity / chosen.maxDensity)) <= kNearEncoded;
+        if (near && (over(chosen) <= 0 || over(again) > 0)) {
+            chosen.encode = confirmed.encode();
+            return chosen;
+        }
+        return again;
     }
     return chosen;
 }
@@ -477,8 +535,12 @@ BudgetResult buildOwnDetailMap(const Image& source, const Image& detail, int wid
 
 DensityField ownDetailContext(const Image& source, const Image& detail, int width, int height, const AutoMapOptions& options,
                               const FrameModelOptions& model) {
+    return ownDetailContext(FrameErrorModel(source, width, height, detail, model), detail, options);
+}
+
+DensityField ownDetailContext(const FrameErrorModel& model, const Image& detail, const AutoMapOptions& options) {
     AutoMapOptions at = options;
-    at.minDensity = buildOwnDetailMap(source, detail, width, height, options, model).minDensity;
+    at.minDensity = buildAutoMapForBestFrame(detail, model, kOwnDetailTileLoss, options).minDensity;
     return importanceToDensity(detail, at);
 }
 

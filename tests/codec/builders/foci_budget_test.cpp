@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "conus/codec/builders/auto_map.h"
@@ -322,6 +323,34 @@ TEST(FociBudget, ConfirmingRoundsKeepAMapItsOwnEncodeHolds) {
             EXPECT_NEAR(shown.frameLoss, own.frameLoss, 0.1);
         }
     }
+}
+
+// The budget confirms with one real encode and, where it keeps the map that encode was of, hands
+// the encode on with what it measured: the image is that map's own encode (so the caller's file is
+// the map's encode), and the losses said are that encode's measure. With k as asked the map encoded
+// is always the one kept.
+TEST(FociBudget, AKeptConfirmingEncodeIsTheMapsOwn) {
+    const Image source = picture();
+    const double aspect = double(kWidth) / kHeight;
+    const std::vector<Focus> foci{{0.62, 0.4, 0.13, 4.0}};
+    const Image importance = fociImportance(foci, aspect, 96, 64);
+    const FrameErrorModel model(source, kWidth / 4, kHeight / 4, importance, {ErrorSpace::Display, 2});
+    int kept = 0;
+    for (const bool exactK : {true, false})
+        for (const double budget : {0.5, 1.5}) {
+            SCOPED_TRACE(std::to_string(exactK) + " " + std::to_string(budget));
+            const FociBudget b = fociForFrameLoss(foci, optionsFor(aspect), model, budget, exactK);
+            if (exactK) ASSERT_NE(b.encode, nullptr);
+            if (!b.encode) continue;
+            ++kept;
+            const FrameErrorModel own = model.confirmed(b.map);
+            EXPECT_EQ(b.encode->image.pixels, own.encode()->image.pixels);
+            EXPECT_NEAR(b.predicted.frameLoss, own.predict(b.map).frameLoss, 1e-9);
+            EXPECT_NEAR(b.predicted.tileLoss, own.predict(b.map).tileLoss, 1e-9);
+            if (!exactK) EXPECT_LE(b.predicted.frameLoss, budget + 0.01);
+        }
+    std::printf("budget's confirming encode kept in %d of 4 cases\n", kept);
+    EXPECT_GE(kept, 3);
 }
 
 // Where the context gives the focus less (fine noise everywhere but a smooth focus, which the

@@ -174,6 +174,63 @@ TEST(FrameBudget, ConfirmingEncodeTakesTheEncodesKernelAndFit) {
                 predicted[2]);
 }
 
+// A model given another region (withRegion) is the model built afresh with it: the same picture's
+// bands, the other region's gain and tile losses, unconfirmed and confirmed alike.
+TEST(FrameBudget, AnotherRegionOnTheSamePyramidIsAFreshModel) {
+    const Image source = picture();
+    FociOptions fo;
+    fo.aspect = double(kWidth) / kHeight;
+    const SamplingMap map = buildFociMap(std::vector<Focus>{{0.3, 0.6, 0.12, 3.0}}, fo);
+    Image other = makeImage(48, 32, {"Y"});
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 48; ++x) other.at(x, y) = x > 30 && y < 12 ? 1.0f : 0.0f;
+    const FrameErrorModel first(source, kWidth / 4, kHeight / 4, boxes()), fresh(source, kWidth / 4, kHeight / 4, other);
+    const FramePrediction a = first.withRegion(other).predict(map), b = fresh.predict(map), c = first.predict(map);
+    EXPECT_EQ(a.frameLoss, b.frameLoss);
+    EXPECT_EQ(a.roiGain, b.roiGain);
+    EXPECT_EQ(a.tileLoss, b.tileLoss);
+    EXPECT_GT(std::abs(a.roiGain - c.roiGain), 0.1);  // the region did change what is predicted
+}
+
+// The confirming encode is kept for the caller: exactly the CoNUS image (and fit report) that
+// encodeImage and fitToDecoder make of the map with the model's options, fitted and not.
+TEST(FrameBudget, ConfirmedModelKeepsItsEncode) {
+    const Image source = picture();
+    FociOptions fo;
+    fo.aspect = double(kWidth) / kHeight;
+    const SamplingMap map = buildFociMap(std::vector<Focus>{{0.62, 0.4, 0.13, 3.0}}, fo);
+    for (int fit : {0, 2}) {
+        SCOPED_TRACE(fit);
+        FrameModelOptions options{ErrorSpace::Display, fit};
+        const FrameErrorModel model(source, kWidth / 4, kHeight / 4, boxes(), options);
+        EXPECT_EQ(model.encode(), nullptr);
+        const FrameErrorModel confirmed = model.confirmed(map);
+        ASSERT_NE(confirmed.encode(), nullptr);
+        EncodeOptions e;
+        e.width = kWidth / 4;
+        e.height = kHeight / 4;
+        e.filter = options.filter;
+        Image expected = encodeImage(source, map, e);
+        FitResult report;
+        if (fit > 0) {
+            FitOptions f;
+            f.iterations = fit;
+            f.holdLowPass = options.fitHold;
+            f.method = options.fitMethod;
+            report = fitToDecoder(source, map, expected, f);
+        }
+        const ModelEncode& kept = *confirmed.encode();
+        EXPECT_EQ(kept.image.width, expected.width);
+        EXPECT_EQ(kept.image.channels, expected.channels);
+        EXPECT_EQ(kept.image.pixels, expected.pixels);  // bit for bit: the caller writes it as the encode
+        ASSERT_EQ(kept.fit.steps.size(), report.steps.size());
+        if (fit > 0) {
+            EXPECT_EQ(kept.fit.steps.back().psnr, report.steps.back().psnr);
+            EXPECT_GT(kept.fit.steps.back().psnr, kept.fit.steps.front().psnr);  // a fit that did something
+        }
+    }
+}
+
 // The 8-bit sRGB error of each tile of max(W, H) / 32 (the model's tiles), as bench/quality.py takes it.
 std::vector<double> displayTileErrors(const Image& view, const Image& source, int tile) {
     const int cols = (source.width + tile - 1) / tile, rows = (source.height + tile - 1) / tile;

@@ -58,6 +58,9 @@ struct FociBudget {
     // What the builder gave way on to keep the anisotropy bound (FociReport::notes: a transition
     // widened, a grid refined, a k not reached), one line each with numbers.
     std::vector<std::string> builderNotes{};
+    // The encode of `map` where the budget's confirming encode was of the map kept (FrameErrorModel::
+    // confirmed; `predicted` is then what it measured); null otherwise.
+    std::shared_ptr<const ModelEncode> encode{};
 };
 
 // The falloff the file records for a budget's map: `asked`, its width the widest transition the

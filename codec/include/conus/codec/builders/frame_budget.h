@@ -23,6 +23,8 @@
 #pragma once
 
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -76,12 +78,25 @@ struct FrameModelOptions {
 // model's encode measured for no further confirming encode to be taken.
 inline constexpr double kConfirmedT = 0.02;
 
+// A confirming encode (FrameErrorModel::confirmed): the CoNUS image of the model's picture through
+// the map it confirmed, encoded with the model's kernel and fitted as its options say, exactly what
+// `encodeImage` then `fitToDecoder` with those options make of that map; a budget that keeps this
+// map hands it on so that the encode is not made twice.
+struct ModelEncode {
+    Image image;     // the CoNUS image, fitted (or filtered alone when the model's fitIterations is 0)
+    FitResult fit;   // the fit's report (empty steps when not fitted)
+};
+
 class FrameErrorModel {
 public:
     // `source` the picture, (width, height) the CoNUS image size (at most the source's), `importance`
     // any size (its region R is where it reaches half its peak; empty: R is the whole frame). Throws
     // conus::Error(InvalidArgument) on an empty source or a size outside 1..source size.
     FrameErrorModel(const Image& source, int width, int height, const Image& importance, const FrameModelOptions& options = {});
+
+    // The same model (the same picture's bands, unconfirmed or confirmed alike) with the region of
+    // `importance` instead: the picture's pyramid is not taken again.
+    FrameErrorModel withRegion(const Image& importance) const;
 
     // The losses and gain of encoding through `map`, predicted by the model (microseconds).
     FramePrediction predict(const SamplingMap& map) const;
@@ -92,6 +107,8 @@ public:
     // footprints so scaled.
     FrameErrorModel confirmed(const SamplingMap& map) const;
     bool isConfirmed() const { return m_confirmed; }
+    // The encode a confirmed model measured (null before confirmed()).
+    const std::shared_ptr<const ModelEncode>& encode() const { return m_encode; }
     const FrameModelOptions& options() const { return m_options; }
     // The same from each tile's predicted mean squared error of the CoNUS image (tiles row by row,
     // tileColumns() x tileRows()), as predict computes them: what bench and tests compare.
@@ -112,6 +129,7 @@ private:
     std::vector<std::pair<double, double>> footprints(const SamplingMap& map) const;
     // A tile's error from its points' axes, each scaled by 2^shift.
     double footprintError(std::size_t tile, const std::pair<double, double>* axes, double shift) const;
+    void setRegion(const Image& importance);  // m_roi and m_touches
 
     FrameModelOptions m_options;
     const Image* m_source = nullptr;    // for confirmed()
@@ -125,6 +143,11 @@ private:
     std::vector<unsigned char> m_touches;  // per tile: touches R
     std::vector<double> m_shift;        // per tile: octaves confirmed() scales the footprints by
     bool m_confirmed = false;
+    std::shared_ptr<const ModelEncode> m_encode;  // confirmed(): the encode measured
+    // The uniform image's errors as measured, taken by the first confirmed() of this model or of
+    // any copy (the same picture and size): shared, measured once.
+    struct MeasuredUniform;
+    std::shared_ptr<MeasuredUniform> m_measuredUniform;
 };
 
 struct BudgetResult {
@@ -133,6 +156,9 @@ struct BudgetResult {
     FramePrediction predicted;      // of `map` itself
     bool budgetBinds = true;        // false: even the lowest floor and the highest cap stay under the budget
     double maxDensity = 0;          // the density cap the map was built with (raised by a budget the lowest floor holds)
+    // The encode of `map` itself where the budget's confirming encode was of the map kept (its
+    // `predicted` then what that encode measured); null otherwise.
+    std::shared_ptr<const ModelEncode> encode{};
 };
 
 // The automatic map (buildAutoMap with `options`, its minDensity replaced) with the lowest context
@@ -182,5 +208,8 @@ BudgetResult buildOwnDetailMap(const Image& source, const Image& detail, int wid
 // so that the frame outside them is sampled as the no-focus default would sample it.
 DensityField ownDetailContext(const Image& source, const Image& detail, int width, int height,
                               const AutoMapOptions& options = {}, const FrameModelOptions& model = {});
+// The same on a model of the picture already built with `detail` as its region (a model whose
+// pyramid the caller then reuses through withRegion).
+DensityField ownDetailContext(const FrameErrorModel& model, const Image& detail, const AutoMapOptions& options = {});
 
 }  // namespace conus::codec
