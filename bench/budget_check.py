@@ -13,7 +13,7 @@ these), its UNSEEN ones and HELD_OUT below, on which nothing was fitted.
 
 `--fast`: the same with `encode --fast`, whose budget is the model alone (no confirming encode).
 
-`--fit`: the data the constants of codec/src/build/frame_budget.cpp were fitted on and the fit
+`--fit`: the data the constants of codec/src/builders/frame_budget.cpp were fitted on and the fit
 itself: on the fitting photographs, encodes with `--exact-k` at several k (and with `--fast`), each
 tile's measured mean squared error of the CoNUS and the uniform image beside the model's terms (the
 picture's box-pyramid band energies, the map's Jacobian at 3x3 points of the tile), and the

@@ -3,7 +3,7 @@
 gain falls as the camera leaves the ground map's viewer.
 
 For each procedural seed, `conus heightfield encode` (the default terrain-fitted rows, and
-`--rows planar` for the paper's flat ground plane), then `conus heightfield render --compare` from
+`--rows planar` for the paper's flat ground plane), then `conus render heightfield --compare` from
 the map's own viewer and from cameras moved back along the viewing direction, up, and sideways.
 Wall clock does not matter here; each row is a PSNR difference (CoNUS - uniform, dB, the frame
 against the full-resolution DEM's) measured in the same run. Writes build/bench-results/terrain.json
@@ -69,7 +69,7 @@ def main():
             for name, back, up, sideways in POSES:
                 pose = "viewer" if name == "viewer" else "moved"
                 picture = os.path.join(args.out, f"terrain-{seed}-{kind}-{pose}.png")
-                command = [args.conus, "heightfield", "render", exr, "--compare", dem, "--size", args.frame, "-o", picture]
+                command = [args.conus, "render", "heightfield", exr, "--compare", dem, "--size", args.frame, "-o", picture]
                 if viewer is not None:
                     command += ["--camera", ",".join(f"{x:.2f}" for x in moved(viewer, back, up, sideways))]
                 out = run(command)

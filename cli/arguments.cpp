@@ -3,13 +3,16 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <regex>
 #include <sstream>
 #include <vector>
 
 #include "conus/codec/depth/heightfield.h"
+#include "conus/codec/image/encode.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
+#include "conus/imageio/image_file.h"
+#include "image_files.h"
+#include "progress.h"
 
 namespace conus::cli {
 namespace {
@@ -69,6 +72,14 @@ CameraText parseCamera(const std::string& text) {
     return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6]};
 }
 
+Camera givenCamera(const CameraText& given, glm::dvec3 up, const AxisBox& box, double aspect, const std::string& what) {
+    try {
+        return lookingAtBox(box, given.eye, given.target, up, given.fovYDegrees, aspect, what);
+    } catch (const Error& e) {
+        throw Error(e.code(), std::string("--camera: ") + e.what());
+    }
+}
+
 glm::dvec3 parseVector3(const std::string& text, const std::string& what) {
     const auto v = parseNumbers(text, ',');
     if (v.size() != 3 || text.back() == ',') invalid(what + " '" + text + "' needs 3 values x,y,z");
@@ -82,19 +93,40 @@ CLI::Option* addCompressionOption(CLI::App& command, std::string& compression) {
 }
 
 sceneio::Dem demFrom(const std::string& source, double heightScale) {
-    std::smatch m;
-    if (!std::regex_match(source, m, std::regex("procedural(?::(\\d+))?(?::(\\d+))?")))
-        return sceneio::readDem(source, heightScale);
-    codec::TerrainOptions options;
-    if (m[1].matched) options.width = options.height = std::stoi(m[1].str().substr(0, 6));
-    if (std::int64_t{options.width} * options.height > kMaxDemSamples)
-        throw Error(ErrorCode::InvalidArgument, "procedural terrain " + std::to_string(options.width) + "x" +
-                                                    std::to_string(options.height) + " holds more than the limit of " +
-                                                    std::to_string(kMaxDemSamples) + " height samples");
-    if (m[2].matched) options.seed = static_cast<std::uint32_t>(std::stoul(m[2].str().substr(0, 9)));
-    return sceneio::demFromHeights(codec::generateTerrain(options), heightScale,
-                                   "procedural terrain " + std::to_string(options.width) + "x" +
-                                       std::to_string(options.height) + " seed " + std::to_string(options.seed));
+    const std::optional<codec::TerrainOptions> terrain = codec::proceduralTerrain(source);
+    if (!terrain) return sceneio::readDem(source, heightScale);
+    return sceneio::demFromHeights(codec::generateTerrain(*terrain), heightScale,
+                                   "procedural terrain " + std::to_string(terrain->width) + "x" +
+                                       std::to_string(terrain->height) + " seed " + std::to_string(terrain->seed));
+}
+
+Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding) {
+    if (texture.empty()) {
+        Image ramp = codec::terrainColours(dem.heights, extent);
+        imageio::linearize(ramp);
+        if (encoding) *encoding = {Transfer::Srgb, SampleType::Uint8, kRec709Chromaticities, {}, {}};
+        return ramp;
+    }
+    imageio::ImageFile file = readSource(texture, {});
+    if (encoding) *encoding = file.info.encoding;
+    Image image = std::move(file.image);
+    if (image.width == dem.heights.width && image.height == dem.heights.height) return image;
+    if (image.width < dem.heights.width || image.height < dem.heights.height)
+        throw Error(ErrorCode::InvalidArgument, "colour texture " + texture + " (" + std::to_string(image.width) + "x" +
+                                                    std::to_string(image.height) + ") is smaller than the DEM (" +
+                                                    std::to_string(dem.heights.width) + "x" +
+                                                    std::to_string(dem.heights.height) + ")");
+    return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
+}
+
+Mesh readSceneMesh(const std::string& path, const std::vector<std::string>& allowDirs) {
+    Progress loading("read " + path);
+    sceneio::MeshReadOptions read;
+    read.allowedDirs = allowDirs;
+    read.warn = warn;
+    Mesh mesh = sceneio::readMesh(path, read);
+    loading.done();
+    return mesh;
 }
 
 }  // namespace conus::cli

@@ -9,14 +9,16 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "arguments.h"
 #include "commands.h"
-#include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/foci_budget.h"
-#include "conus/codec/build/frame_budget.h"
+#include "conus/codec/builders/auto_map.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/foci_budget.h"
+#include "conus/codec/builders/frame_budget.h"
+#include "conus/codec/conus_file.h"
 #include "conus/codec/depth/heightfield.h"
 #include "conus/codec/depth/reflection.h"
 #include "conus/codec/depth/relief.h"
@@ -102,15 +104,7 @@ Source readReliefSource(const BakeOptions& o) {
     }
     sceneio::Dem dem = demFrom(o.source, o.heightScale);
     const glm::dvec2 extent(o.width, o.width * dem.heights.height / dem.heights.width);
-    Image colour;
-    if (o.colour.empty()) {
-        colour = codec::terrainColours(dem.heights, extent);
-        imageio::linearize(colour);
-    } else {
-        colour = readSource(o.colour, {}).image;
-        if (colour.width != dem.heights.width || colour.height != dem.heights.height)
-            colour = codec::areaDownsample(colour, dem.heights.width, dem.heights.height);
-    }
+    Image colour = demColour(dem, o.colour, extent);
     return {std::move(dem.heights), std::move(colour), extent, dem.description};
 }
 
@@ -121,7 +115,7 @@ int runBakeRelief(const BakeOptions& o) {
     reading.done();
     Size size;
     if (o.sizeText.empty())
-        size = {std::max(1, source.heights.width / 4), std::max(1, source.heights.height / 4)};
+        std::tie(size.width, size.height) = codec::defaultConusSize(source.heights.width, source.heights.height);
     else
         size = parseSize(o.sizeText);
     checkGridForImage(o.grid, size.width, size.height);
@@ -161,7 +155,7 @@ int runBakeRelief(const BakeOptions& o) {
             ao.columns = ao.rows = o.grid;
             ao.minDensity = o.minDensity;
             ao.maxDensity = o.maxDensity;
-            const std::string importance = o.importance.empty() ? "detail" : o.importance;
+            const std::string importance = o.importance.empty() ? enumName(codec::ImportanceRule::Detail) : o.importance;
             map = codec::buildAutoMap(importanceFrom(importance, source.colour), ao);
             how = importance + " importance map";
         }
@@ -230,12 +224,7 @@ int runBakeReflection(const ReflectionBakeText& o) {
             throw Error(ErrorCode::InvalidArgument, "--roi-min must lie below --roi-max on every axis");
         options.roi = codec::AxisBox{lo, hi};
     }
-    Progress loading("read " + o.scene);
-    sceneio::MeshReadOptions read;
-    read.allowedDirs = o.allowDirs;
-    read.warn = warn;
-    const codec::MeshScene scene(sceneio::readMesh(o.scene, read));
-    loading.done();
+    const codec::MeshScene scene(readSceneMesh(o.scene, o.allowDirs));
     Progress baking("bake six " + std::to_string(o.size) + "x" + std::to_string(o.size) + " faces (Embree)");
     const auto faces = codec::bakeReflection(scene, options);
     baking.done();

@@ -14,11 +14,13 @@
 #include "commands.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
-#include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/foci_budget.h"
-#include "conus/codec/build/frame_budget.h"
+#include "conus/codec/builders/auto_map.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/foci_budget.h"
+#include "conus/codec/builders/frame_budget.h"
+#include "conus/codec/conus_file.h"
 #include "conus/codec/image/metrics.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/core/atomic_file.h"
 #include "conus/renderers/gpu_image.h"
 #include "demo_picture.h"
@@ -26,32 +28,11 @@
 #include "conus/imageio/image_file.h"
 #include "image_files.h"
 #include "map_options.h"
-#include "option_checks.h"
-#include "pictures.h"
+#include "conus/cli/option_checks.h"
 #include "progress.h"
 
 namespace conus::cli {
 namespace {
-
-// The view around the most important region: the bounding square of the importance above half its
-// peak, as a focus-shaped rectangle (centre, half side as a fraction of the width).
-codec::Focus hottestRegion(const Image& importance, int width, int height) {
-    float peak = 0;
-    for (int y = 0; y < importance.height; ++y)
-        for (int x = 0; x < importance.width; ++x) peak = std::max(peak, importance.at(x, y));
-    double u0 = 1, v0 = 1, u1 = 0, v1 = 0;
-    for (int y = 0; y < importance.height; ++y)
-        for (int x = 0; x < importance.width; ++x)
-            if (peak > 0 && importance.at(x, y) >= 0.5f * peak) {
-                u0 = std::min(u0, double(x) / importance.width);
-                u1 = std::max(u1, double(x + 1) / importance.width);
-                v0 = std::min(v0, double(y) / importance.height);
-                v1 = std::max(v1, double(y + 1) / importance.height);
-            }
-    if (u1 <= u0) return {0.5, 0.5, 0.1, 1};
-    const double half = 0.5 * std::max((u1 - u0) * width, (v1 - v0) * height) / width;
-    return {0.5 * (u0 + u1), 0.5 * (v0 + v1), std::max(half, 8.0 / width), 1};
-}
 
 struct DemoOptions {
     std::string out = "demo-out", input, importance, backend = enumName(renderers::Backend::Auto);
@@ -108,13 +89,13 @@ DemoMap demoMap(const DemoOptions& o, DemoSource& source, const Size& size) {
         const Image importance = importanceFrom(o.importance, source.image);
         const codec::FrameErrorModel model(source.image, size.width, size.height, importance, kDemoTrials);
         m.map = codec::buildAutoMapForFrameLoss(importance, model, codec::kDefaultFrameLoss, {}, codec::kDefaultTileLoss).map;
-        if (o.foci.empty()) source.foci = {hottestRegion(importance, w, h)};
+        if (o.foci.empty()) source.foci = {codec::hottestRegion(importance, w, h)};
     } else {
         codec::FociOptions fociOptions;
         fociOptions.aspect = double(w) / h;
         // As `encode`: away from the foci the samples follow the picture's own detail.
         const codec::DensityField context =
-            codec::ownDetailContext(source.image, importanceFrom("detail", source.image), size.width, size.height, {}, kDemoTrials);
+            codec::ownDetailContext(source.image, importanceFrom(enumName(codec::ImportanceRule::Detail), source.image), size.width, size.height, {}, kDemoTrials);
         fociOptions.context = &context;
         const int side = 256;
         const codec::FrameErrorModel model(
@@ -178,7 +159,8 @@ int runDemo(const DemoOptions& o) {
     outputs.makeFolder(o.out);
     DemoSource source = demoSource(o);
     const int w = source.image.width, h = source.image.height;
-    const Size size{std::max(1, w / 4), std::max(1, h / 4)};  // 1/16 of the pixels
+    const auto [conusWidth, conusHeight] = codec::defaultConusSize(w, h);  // 1/16 of the pixels
+    const Size size{conusWidth, conusHeight};
     const DemoMap built = demoMap(o, source, size);
     const codec::SamplingMap& map = *built.map;
 
@@ -197,7 +179,7 @@ int runDemo(const DemoOptions& o) {
     writePicture((out / "uniform.png").string(), uniform.image, picture);
     const double shrink = std::min(1.0, 1024.0 / std::max(w, h));
     const int pw = std::max(16, int(w * shrink)), ph = std::max(16, int(h * shrink));
-    writeDrawing((out / "density.png").string(), densityPicture(map, pw, ph, 32, built.analytic ? &*built.analytic : nullptr));
+    writeDrawing((out / "density.png").string(), codec::densityPicture(map, pw, ph, 32, built.analytic ? &*built.analytic : nullptr));
 
     const std::vector<ViewCase> views = demoViews(o, source.foci, w, h, shrink);
     std::vector<ViewResult> results;
@@ -213,7 +195,7 @@ int runDemo(const DemoOptions& o) {
         std::vector<Image> strip{reference, fromConus, fromUniform};
         if (v.outWidth != v.width)
             for (auto& image : strip) image = codec::areaDownsample(image, v.outWidth, v.outHeight);
-        results.push_back({codec::psnr(reference, fromConus), codec::psnr(reference, fromUniform), sideBySide(strip)});
+        results.push_back({codec::psnr(reference, fromConus), codec::psnr(reference, fromUniform), codec::sideBySide(strip)});
     }
     comparing.done();
     for (std::size_t i = 0; i < views.size(); ++i)

@@ -9,10 +9,10 @@
 #include "arguments.h"
 #include "batch.h"
 #include "commands.h"
-#include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/foci_budget.h"
-#include "conus/codec/build/frame_budget.h"
+#include "conus/codec/builders/auto_map.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/foci_budget.h"
+#include "conus/codec/builders/frame_budget.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
 #include "conus/core/limits.h"
@@ -45,6 +45,7 @@ struct EncodeOptions {
 struct BuiltMap {
     std::unique_ptr<codec::SamplingMap> map;
     std::optional<format::AnalyticMap> analytic;
+    std::shared_ptr<const codec::ModelEncode> encoded{};  // the budget's confirming encode of `map`, kept
 };
 
 BuiltMap mapFromFile(const std::string& path, const Image& source) {
@@ -52,7 +53,7 @@ BuiltMap mapFromFile(const std::string& path, const Image& source) {
     // Foci built for another aspect are ellipses on this picture.
     if (const std::optional<double> aspect = codec::madeForAspect(mapSource)) {
         const double here = double(source.width) / source.height;
-        if (std::abs(std::log(*aspect / here)) > 0.01) {
+        if (codec::aspectsDiffer(*aspect, here)) {
             char text[320];
             std::snprintf(text, sizeof text,
                           "the map %s was made for pictures of aspect %.3g (width / height) and this one's is %.3g: its "
@@ -68,11 +69,6 @@ BuiltMap mapFromFile(const std::string& path, const Image& source) {
 // context foci and importance maps sit on.
 codec::AutoMapOptions ownDetailOptions(const EncodeOptions& o) { return autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method); }
 
-// The density the picture's own detail asks for (codec::ownDetailContext), the budget's model choosing its floor.
-codec::DensityField ownDetailContext(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
-    return codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), modelOptions);
-}
-
 BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
     Progress progress("build sampling map from " + o.importance + " importance");
     codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
@@ -85,16 +81,20 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     // The budget chooses the context floor; say what it achieved. Apart from the importance the
     // samples follow the picture's own detail, as with no importance at all (`detail` is that already).
     codec::DensityField context;
-    if (o.importance != "detail") {
-        context = ownDetailContext(o, source, size, modelOptions);
+    const bool notDetail = o.importance != enumName(codec::ImportanceRule::Detail);
+    const Image detail = notDetail ? importanceFrom(enumName(codec::ImportanceRule::Detail), source) : Image{};
+    // One model of the picture (its pyramid taken once), its region the detail's for the context.
+    const codec::FrameErrorModel picture(source, size.width, size.height, notDetail ? detail : importance, modelOptions);
+    if (notDetail) {
+        context = codec::ownDetailContext(picture, detail, ownDetailOptions(o));
         autoOptions.context = &context;
     }
-    const codec::FrameErrorModel model(source, size.width, size.height, importance, modelOptions);
+    const codec::FrameErrorModel model = notDetail ? picture.withRegion(importance) : picture;
     codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions, codec::kDefaultTileLoss);
     progress.done();
     if (!quiet())
         std::printf("%s\n", describeFloorBudget(r, o.frameLoss, o.importance + " importance").c_str());
-    return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt};
+    return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt, std::move(r.encode)};
 }
 
 // The foci's map under the frame-loss budget (foci_budget.h): says, before the work, what the foci
@@ -109,11 +109,14 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
     // Away from the foci the samples follow the picture's own detail, as with no focus at all.
-    const codec::DensityField context = ownDetailContext(o, source, size, modelOptions);
+    // One model of the picture (its pyramid taken once), its region the detail's for the context.
+    const Image detail = importanceFrom(enumName(codec::ImportanceRule::Detail), source);
+    const codec::FrameErrorModel picture(source, size.width, size.height, detail, modelOptions);
+    const codec::DensityField context = codec::ownDetailContext(picture, detail, ownDetailOptions(o));
     fo.context = &context;
     const int side = 256;
-    const codec::FrameErrorModel model(source, size.width, size.height,
-                                       codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))), modelOptions);
+    const codec::FrameErrorModel model =
+        picture.withRegion(codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))));
     codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, o.frameLoss, o.exactK);
     progress.done();
     const std::string said =
@@ -123,7 +126,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     *given = "k " + fociKText(budget.given);
     // The file records the falloff the map holds (a transition widened for the anisotropy bound).
     return {std::make_unique<codec::SamplingMap>(std::move(budget.map)),
-            codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff))};
+            codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff)), std::move(budget.encode)};
 }
 
 // No focus, map or importance: the samples follow the picture's own detail, with the context floor
@@ -131,7 +134,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
 BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
     Progress progress("build sampling map from the picture's detail");
     codec::BudgetResult r =
-        codec::buildOwnDetailMap(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), modelOptions);
+        codec::buildOwnDetailMap(source, importanceFrom(enumName(codec::ImportanceRule::Detail), source), size.width, size.height, ownDetailOptions(o), modelOptions);
     progress.done();
     static std::once_flag once;  // once per batch, not per file
     std::call_once(once, [] {
@@ -167,8 +170,12 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     else built = mapFromOwnDetail(o, source.image, size, modelOptions, &given);
     const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Faster, "encoding");
     std::string fitNote;
+    // The budget's confirming encode is this encode on the CPU (same kernel, same fit): kept.
     format::ConusFile file =
-        encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
+        built.encoded && !device.onGpu()
+            ? keptEncodeToConus(*built.encoded, source.info.encoding, *built.map, source.image.width, source.image.height,
+                                built.analytic, &fitNote)
+            : encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
     applyStorage(o.storage, file);
     Progress writing("write " + output);
     format::writeConusFile(output, file);
@@ -179,7 +186,8 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
            (given.empty() ? "" : " (" + given + ")") + (fitNote.empty() ? "" : "; " + fitNote);
 }
 
-int runEncode(EncodeOptions o) {
+int runEncode(const EncodeOptions& given) {
+    EncodeOptions o = given;  // --fast turns the fit off below
     // Usage first, before any input is read.
     if (o.frameLossGiven && o.foci.empty() && o.importance.empty())
         throw Error(ErrorCode::InvalidArgument, "--frame-loss is the budget of --focus and --importance: give one of them");
@@ -189,10 +197,9 @@ int runEncode(EncodeOptions o) {
     return runConversions(o.batch, [&o](const Job& job) { return encodeOne(o, job.input, job.output); });
 }
 
-}  // namespace
 
-Command addEncodeCommand(CLI::App& root) {
-    auto options = std::make_shared<EncodeOptions>();
+CLI::App* declareEncode(CLI::App& root, EncodeOptions& o) {
+    EncodeOptions* options = &o;  // lives as long as the command (defineCommand)
     CLI::App* command = addSubcommand(root, "encode", "Encode an image (PNG, JPEG, TIFF, EXR, ...) into a CoNUS file through a sampling map",
         {"conus encode photo.jpg -o photo.exr --focus 0.42,0.31,0.08,4",
          "conus encode photo.jpg -o photo.exr --size 1024x768 --importance faces",
@@ -234,8 +241,11 @@ Command addEncodeCommand(CLI::App& root) {
         ->excludes("--fit-hold");
     addSourceOptions(*command, options->source);
     addStorageOptions(*command, options->storage);
-    addQuietOption(*command);
-    return {command, [options] { return runEncode(*options); }};
+    return command;
 }
+
+}  // namespace
+
+Command addEncodeCommand(CLI::App& root) { return defineCommand(root, declareEncode, runEncode); }
 
 }  // namespace conus::cli

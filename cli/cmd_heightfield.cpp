@@ -16,6 +16,7 @@
 #include "conus/codec/image/encode.h"
 #include "conus/codec/depth/heightfield.h"
 #include "conus/codec/image/metrics.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 #include "conus/renderers/terrain.h"
@@ -25,33 +26,10 @@
 #include "image_files.h"
 #include "map_options.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
 namespace {
-
-// The DEM's colour in linear light: a texture (resized down to the DEM when larger), else the
-// height/slope ramp (drawn as display colours). `encoding` receives what the colour came from.
-Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent,
-                SourceEncoding* encoding = nullptr) {
-    if (texture.empty()) {
-        Image ramp = codec::terrainColours(dem.heights, extent);
-        imageio::linearize(ramp);
-        if (encoding) *encoding = {Transfer::Srgb, SampleType::Uint8, kRec709Chromaticities, {}, {}};
-        return ramp;
-    }
-    imageio::ImageFile file = readSource(texture, {});
-    if (encoding) *encoding = file.info.encoding;
-    Image image = std::move(file.image);
-    if (image.width == dem.heights.width && image.height == dem.heights.height) return image;
-    if (image.width < dem.heights.width || image.height < dem.heights.height)
-        throw Error(ErrorCode::InvalidArgument, "colour texture " + texture + " (" + std::to_string(image.width) + "x" +
-                                                    std::to_string(image.height) + ") is smaller than the DEM (" +
-                                                    std::to_string(dem.heights.width) + "x" +
-                                                    std::to_string(dem.heights.height) + ")");
-    return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
-}
 
 // The camera as given, or the ground map's own viewer as a --camera value to start from.
 void printCamera(const Camera& c, const std::string& given) {
@@ -93,8 +71,10 @@ Frame renderFrame(renderers::Context& context, const format::ConusFile& file, co
 // ---- encode ----
 
 struct EncodeOptions {
-    std::string dem, output, sizeText = "512x512", colour, compression = enumName(format::Compression::Zip), rows = "terrain";
-    double eyeHeight = 150, near = 200, far = 0, fov = 0, heightScale = 1;  // far, fov: 0 until given
+    std::string dem, output, sizeText = "512x512", colour, compression = enumName(format::Compression::Zip),
+                rows = enumName(codec::GroundRows::Terrain);
+    codec::TerrainViewer viewer;  // --eye-height, --near, --far, --fov
+    double heightScale = 1;
     int grid = 129;
 };
 
@@ -107,24 +87,24 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
     writesFile(encode.add_option("-o,--output", o.output, "CoNUS file (.exr)"))->required();
     encode.add_option("--size", o.sizeText, "CoNUS image size WxH")->capture_default_str();
     // The ground map's own ranges (ground_map.h), checked here so a bad value is a usage error.
-    encode.add_option("--eye-height", o.eyeHeight, "viewer's eye above the base plane, metres")
+    encode.add_option("--eye-height", o.viewer.eyeHeight, "viewer's eye above the base plane, metres")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9));
-    encode.add_option("--near", o.near, "distance from the viewer to the field's near edge, metres")
+    encode.add_option("--near", o.viewer.near, "distance from the viewer to the field's near edge, metres")
         ->capture_default_str()
         ->check(finiteRange(0, 1e9, true));
-    CLI::Option* far = encode.add_option("--far", o.far,
+    CLI::Option* far = encode.add_option("--far", o.viewer.far,
                                          "distance to the far edge, metres, beyond --near (default: near + the DEM's "
                                          "depth when the file gives its spacing, else 6000)")
                            ->check(finiteRange(0, 1e9));
-    encode.add_option("--fov", o.fov,
+    encode.add_option("--fov", o.viewer.fovDegrees,
                       "horizontal field of view at the far edge, degrees; sets the field's width (default: the "
                       "DEM's own width when known, else 60)")
         ->check(finiteRange(0, 170));
     encode.callback([&o, far] {
-        if (far->count() > 0 && !(o.far > o.near)) {
+        if (far->count() > 0 && !(o.viewer.far > o.viewer.near)) {
             std::ostringstream why;
-            why << o.far << " is not beyond --near " << o.near;
+            why << o.viewer.far << " is not beyond --near " << o.viewer.near;
             throw CLI::ValidationError("--far", why.str());
         }
     });
@@ -134,7 +114,7 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
                       "terrain covers for the map's viewer, within the DEM's resolution) or planar (the paper's "
                       "perspective ground plane, which starves far mountains)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"terrain", "planar"}));
+        ->check(CLI::IsMember(enumNames<codec::GroundRows>()));
     encode.add_option("--height-scale", o.heightScale, "multiplies the DEM's values (to metres)")
         ->capture_default_str();
     encode.add_option("--colour,--color", o.colour, "colour texture (default: a ramp by height and slope)");
@@ -145,33 +125,20 @@ CLI::App* addEncode(CLI::App& command, EncodeOptions& o) {
     return &encode;
 }
 
-// The ground map: the options as given, the DEM's own size in metres where the user left
-// --far or --fov out and the file knows its spacing, else the defaults.
-codec::GroundParams groundFor(const EncodeOptions& o, const sceneio::Dem& dem) {
-    const glm::dvec2 demMetres(dem.cellMetres.x * dem.heights.width, dem.cellMetres.y * dem.heights.height);
-    codec::GroundParams ground;
-    ground.eyeHeight = o.eyeHeight;
-    ground.near = o.near;
-    ground.far = o.far > 0 ? o.far : demMetres.y > 0 ? o.near + demMetres.y : 6000.0;
-    ground.fovDegrees = o.fov > 0           ? o.fov
-                        : demMetres.x > 0 ? codec::fovForFieldWidth(o.eyeHeight, o.near, ground.far, demMetres.x)
-                                          : 60.0;
-    return ground;
-}
-
 int runEncode(const EncodeOptions& o) {
     checkConusOutput(o.output, o.dem);
     Progress loading("read " + o.dem);
     const sceneio::Dem dem = demFrom(o.dem, o.heightScale);
     loading.done();
     codec::HeightFieldOptions options;
-    options.ground = groundFor(o, dem);
+    options.ground = codec::groundForField(
+        o.viewer, glm::dvec2(dem.cellMetres.x * dem.heights.width, dem.cellMetres.y * dem.heights.height));
     const Size size = parseSize(o.sizeText);
     checkGridForImage(o.grid, size.width, size.height, EncodeOptions{}.grid);
     options.width = size.width;
     options.height = size.height;
     options.mapGrid = o.grid;
-    options.fitRows = o.rows == "terrain";
+    options.fitRows = parseEnum<codec::GroundRows>(o.rows) == codec::GroundRows::Terrain;
     const glm::dvec2 extent = codec::fieldExtent(options.ground);
     SourceEncoding encoding;
     const Image colour = demColour(dem, o.colour, extent, &encoding);
@@ -187,7 +154,7 @@ int runEncode(const EncodeOptions& o) {
                 "far %g m, fov %.2f deg; %s rows); heights %.1f..%.1f m\n",
                 o.output.c_str(), file.image.width, file.image.height, dem.description.c_str(), extent.x, extent.y,
                 options.ground.eyeHeight, options.ground.near, options.ground.far, options.ground.fovDegrees,
-                fitted ? "terrain" : "planar", file.depth.near, file.depth.far);
+                enumName(fitted ? codec::GroundRows::Terrain : codec::GroundRows::Planar), file.depth.near, file.depth.far);
     return 0;
 }
 
@@ -199,7 +166,7 @@ struct RenderOptions {
 };
 
 CLI::App* addRender(CLI::App& command, RenderOptions& o) {
-    CLI::App& render = *command.add_subcommand("render", "Undistort a CoNUS height field to a mesh and render a frame");
+    CLI::App& render = *command.add_subcommand("heightfield", "Undistort a CoNUS height field to a mesh and render a frame");
     render.add_option("input", o.input, "CoNUS height field (.exr)")->required();
     writesFile(render.add_option("-o,--output", o.frame, "frame (.png, .exr, ...)"))->required();
     render.add_option("--camera", o.cameraText,
@@ -212,9 +179,9 @@ CLI::App* addRender(CLI::App& command, RenderOptions& o) {
     render.add_option("--height-scale", o.heightScale, "as given to encode (for --compare)")->capture_default_str();
     render.add_option("--colour,--color", o.colour, "as given to encode (for --compare)");
     addBackendOption(render, o.backend, renderers::CpuPath::None);
-    setExamples(render, {"conus heightfield render terrain.exr -o frame.png",
-                       "conus heightfield render terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720",
-                       "conus heightfield render terrain.exr -o compare.png --compare procedural"});
+    setExamples(render, {"conus render heightfield terrain.exr -o frame.png",
+                       "conus render heightfield terrain.exr -o frame.png --camera 0,150,0,0,0,-2000,50 --size 1280x720",
+                       "conus render heightfield terrain.exr -o compare.png --compare procedural"});
     return &render;
 }
 
@@ -235,7 +202,7 @@ void writeComparison(renderers::Context& context, const RenderOptions& o, const 
     const Image uniform = renderUniform(context, dem, colour, file.image.width, file.image.height, frame);
     comparing.done();
     const Image panels[] = {full, frame.image, uniform};
-    writePicture(o.frame, sideBySide(panels));
+    writePicture(o.frame, codec::sideBySide(panels));
     std::printf("wrote %s: full resolution %dx%d | CoNUS %dx%d | uniform %dx%d (%s)\n", o.frame.c_str(), dem.heights.width,
                 dem.heights.height, file.image.width, file.image.height, file.image.width, file.image.height,
                 context.renderer().c_str());
@@ -273,8 +240,10 @@ Image heightFieldFrame(const format::ConusFile& file, const std::string& cameraT
 
 Command addHeightFieldCommand(CLI::App& root) {
     return addCommandGroup(root, "heightfield",
-                           "CoNUS height fields: sample a DEM densely near a viewer (encode), render it (render)",
-                           {commandPart(addEncode, runEncode), commandPart(addRender, runRender)});
+                           "CoNUS height fields: sample a DEM densely near a viewer (encode; a frame of it: `conus render heightfield`)",
+                           {commandPart(addEncode, runEncode)});
 }
+
+CommandPart heightFieldRenderPart() { return commandPart(addRender, runRender); }
 
 }  // namespace conus::cli

@@ -10,7 +10,8 @@
 #include <optional>
 
 #include "commands.h"
-#include "conus/codec/build/map_measures.h"
+#include "conus/codec/builders/map_measures.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "conus/format/reflection_asset.h"
@@ -21,7 +22,6 @@
 #include "conus/sceneio/mesh_file.h"
 #include "image_files.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -82,7 +82,7 @@ struct FileFacts {
     format::ConusFile file;  // everything but the image's pixels, which nothing here needs
     std::vector<std::string> channels;  // display order
     codec::SamplingMap map;
-    DensityStats stats;
+    codec::DensityStats stats;
     codec::MapMeasures measures;  // anisotropy in the source's pixels
     std::optional<Camera> camera;
     double pixelRatio = 0;  // CoNUS pixels over source pixels
@@ -90,7 +90,7 @@ struct FileFacts {
 
 FileFacts factsOf(format::ConusFile file) {
     codec::SamplingMap map = codec::SamplingMap::fromGrid(file.map);
-    const DensityStats stats = densityStats(map);
+    const codec::DensityStats stats = codec::densityStats(map);
     const codec::MapMeasures measures = codec::measureMap(map, double(file.sourceWidth) / file.sourceHeight);
     std::optional<Camera> camera = file.camera ? std::optional<Camera>(format::toCamera(*file.camera)) : std::nullopt;
     const double ratio = double(file.image.width) * file.image.height / (double(file.sourceWidth) * file.sourceHeight);
@@ -222,7 +222,7 @@ void writeDensityPicture(const std::string& path, const FileFacts& f) {
     const int w = std::max(16, static_cast<int>(file.sourceWidth * std::min(1.0, scale)));
     const int h = std::max(16, static_cast<int>(file.sourceHeight * std::min(1.0, scale)));
     const int lines = std::max(8, std::min(64, file.image.width / 8));
-    writeDrawing(path, densityPicture(f.map, w, h, lines, file.analytic ? &*file.analytic : nullptr,
+    writeDrawing(path, codec::densityPicture(f.map, w, h, lines, file.analytic ? &*file.analytic : nullptr,
                                       double(file.sourceWidth) / file.sourceHeight));
 }
 
@@ -287,7 +287,7 @@ bool isExr(const std::string& path) {
     return in && magic == std::array<unsigned char, 4>{0x76, 0x2f, 0x31, 0x01};
 }
 
-// A mesh file (what `bake reflection`, `mesh render` take): its size and bounds, so that --center
+// A mesh file (what `bake reflection`, `render mesh` take): its size and bounds, so that --center
 // and --roi-min/--roi-max can be chosen without another tool.
 int printMesh(const InfoOptions& o, const Mesh& mesh) {
     const AxisBox box = boundsOf(mesh);
@@ -352,27 +352,27 @@ int runInfo(const InfoOptions& o) {
 
 }  // namespace
 
-Command addInfoCommand(CLI::App& root) {
-    auto options = std::make_shared<InfoOptions>();
+CLI::App* declareInfo(CLI::App& root, InfoOptions& options) {
     CLI::App* command = root.add_subcommand("info", "Describe a CoNUS file: image, sampling map, camera, depth (a reflection asset: its frame and six faces; a mesh: its bounds)");
-    command->add_option("input", options->input, "CoNUS file or reflection asset (.exr), or a mesh file (its bounds and size)");
-    command->add_flag("--backends", options->backends,
+    command->add_option("input", options.input, "CoNUS file or reflection asset (.exr), or a mesh file (its bounds and size)");
+    command->add_flag("--backends", options.backends,
                       "list the rendering backends (EGL, OSMesa, CPU): whether each works, its GL_RENDERER, why not");
-    command->add_flag("--limits", options->limits,
+    command->add_flag("--limits", options.limits,
                       "print the resource limits every reader checks before allocating (image, map, header, "
                       "index, decode memory)");
-    command->add_flag("--json", options->json, "print JSON instead of text");
-    command->add_flag("-v,--verbose", options->verbose,
+    command->add_flag("--json", options.json, "print JSON instead of text");
+    command->add_flag("-v,--verbose", options.verbose,
                       "also list the source's metadata; for an invalid file, every broken rule (as `conus validate`)");
     setExamples(*command, {"conus info photo.exr",
                        "conus info photo.exr --json --density density.png",
                        "conus info asset.exr                # a reflection asset: the cube's frame and its six faces",
                        "conus info teapot.obj               # a mesh: triangles, vertices, bounds (for --center, --roi-min/--roi-max)",
                        "conus info --backends"});
-    writesFile(command->add_option("--density", options->densityPng,
+    writesFile(command->add_option("--density", options.densityPng,
                                    "write the sampling density as a heat map with the sampling pattern over it (.png)"));
-    addQuietOption(*command);  // progress only: the description is what info is for
-    return {command, [options] { return runInfo(*options); }};
+    return command;  // --quiet: progress only, the description is what info is for
 }
+
+Command addInfoCommand(CLI::App& root) { return defineCommand(root, declareInfo, runInfo); }
 
 }  // namespace conus::cli

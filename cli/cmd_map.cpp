@@ -13,13 +13,14 @@
 #include <vector>
 
 #include "commands.h"
-#include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/compose.h"
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/ground_map.h"
-#include "conus/codec/build/map_measures.h"
+#include "conus/codec/builders/auto_map.h"
+#include "conus/codec/builders/compose.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/ground_map.h"
+#include "conus/codec/builders/map_measures.h"
 #include "conus/codec/conus_file.h"
-#include "conus/codec/build/springs.h"
+#include "conus/codec/builders/springs.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/format/container.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
@@ -30,7 +31,6 @@
 #include "encoding.h"
 #include "map_options.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -45,7 +45,6 @@ struct OutputOptions {
 };
 
 void addOutputOptions(CLI::App& command, OutputOptions& options) {
-    addQuietOption(command);
     writesFile(command.add_option("-o,--output", options.output, "output map file (.exr, a CoNUS file)"))->required();
     writesFile(command.add_option("--preview", options.preview,
                                   "also write a picture of the map (PNG, ...): density heat map with the distorted grid"));
@@ -77,9 +76,9 @@ void writeMapFile(const codec::SamplingMap& map, std::optional<format::AnalyticM
     format::writeConusFile(out.output, file);
     if (!out.preview.empty())
         writeDrawing(out.preview,
-                     densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr, aspect));
+                     codec::densityPicture(map, kPreviewSide, kPreviewSide, 32, file.analytic ? &*file.analytic : nullptr, aspect));
     outputs.commit();
-    const DensityStats stats = densityStats(map);
+    const codec::DensityStats stats = codec::densityStats(map);
     const codec::MapMeasures measures = codec::measureMap(map, aspect);
     if (quiet()) return;  // -q: silent on success
     std::printf("wrote %s: %dx%d sampling map, density %.3g .. %.3g, anisotropy up to %.3g\n", out.output.c_str(), map.columns(),
@@ -108,7 +107,10 @@ struct SpringsOptions {
     OutputOptions out;
 };
 
-void addSpringsOptions(CLI::App& command, SpringsOptions& o) {
+CLI::App* addSprings(CLI::App& map, SpringsOptions& o) {
+    CLI::App& command = *addSubcommand(map, "springs", "Mass-spring brush system (paper 3.1): paint strokes from a JSON list, solve until stable",
+        {"conus map springs --strokes '[{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1,\"duration\":0.5}]' -o m.exr",
+         "conus map springs --strokes strokes.json -o m.exr --preview m.png"});
     command.add_option("--strokes", o.strokes,
                        "strokes as JSON, inline or a file: [{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1.0,\"duration\":0.5}, ...]")
         ->required();
@@ -117,9 +119,10 @@ void addSpringsOptions(CLI::App& command, SpringsOptions& o) {
     command.add_option("--max-steps", o.maxSteps, "give up waiting for the stable state after this many steps (default 20000)")
         ->check(CLI::Range(1, 10000000));
     addOutputOptions(command, o.out);
+    return &command;
 }
 
-void runSprings(const SpringsOptions& o) {
+int runSprings(const SpringsOptions& o) {
     checkOutputs(o.out);
     const std::vector<codec::Stroke> strokes = codec::parseStrokes(strokesText(o.strokes));
     codec::SpringSystem system(o.particles, o.particles);
@@ -137,6 +140,7 @@ void runSprings(const SpringsOptions& o) {
     const codec::SamplingMap map = system.toMap(o.grid, o.grid, &scale);
     if (scale < 1.0) std::printf("the %d-node grid folded; displacements scaled by %.4f\n", o.grid, scale);
     writeMapFile(map, std::nullopt, o.out);
+    return 0;
 }
 
 // ---- compose ----
@@ -148,7 +152,9 @@ struct ComposeOptions {
     OutputOptions out;
 };
 
-void addComposeOptions(CLI::App& command, ComposeOptions& o) {
+CLI::App* addCompose(CLI::App& map, ComposeOptions& o) {
+    CLI::App& command = *map.add_subcommand(
+        "compose", "Add the displacement fields of map files (paper Fig. 9), each optionally translated and scaled");
     command.add_option("inputs", o.inputs, "map files (any CoNUS file)")->required()->expected(1, -1);
     command.add_option("--translate", o.translate, "dx,dy: move the k-th input's pattern (k-th use, k-th input)");
     command.add_option("--scale", o.scale, "s or s,cu,cv: scale the k-th input's pattern by s about (cu,cv), default centre 0.5,0.5");
@@ -156,6 +162,7 @@ void addComposeOptions(CLI::App& command, ComposeOptions& o) {
     command.add_option("--grid", o.grid, "nodes per side of the result (default: the largest input's)")
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addOutputOptions(command, o.out);
+    return &command;
 }
 
 // "s" or "s,cu,cv": a scale factor and its centre (default the middle).
@@ -190,7 +197,7 @@ codec::SamplingMap composeInput(const ComposeOptions& o, std::size_t k, codec::S
     return map;
 }
 
-void runCompose(const ComposeOptions& o) {
+int runCompose(const ComposeOptions& o) {
     checkOutputs(o.out);
     if (o.translate.size() > o.inputs.size() || o.scale.size() > o.inputs.size() || o.weights.size() > o.inputs.size()) {
         throw Error(ErrorCode::InvalidArgument, "more --translate, --scale or --weight values than inputs");
@@ -218,6 +225,7 @@ void runCompose(const ComposeOptions& o) {
         std::printf("added %zu maps\n", maps.size());
     }
     writeMapFile(sum.map, std::nullopt, o.out, aspect);
+    return 0;
 }
 
 // ---- ground ----
@@ -228,19 +236,23 @@ struct GroundOptions {
     OutputOptions out;
 };
 
-void addGroundOptions(CLI::App& command, GroundOptions& o) {
+CLI::App* addGround(CLI::App& map, GroundOptions& o) {
+    CLI::App& command = *map.add_subcommand(
+        "ground", "Perspective ground-plane map of a height field (paper section 4), viewer at the bottom edge's middle");
     command.add_option("--eye-height", o.ground.eyeHeight, "eye height above the ground (ground units)")->required();
     command.add_option("--near", o.ground.near, "ground distance of the bottom edge (v = 1)")->required();
     command.add_option("--far", o.ground.far, "ground distance of the top edge (v = 0)")->required();
     command.add_option("--fov", o.ground.fovDegrees, "horizontal field of view in degrees at the far edge (default 60)");
     command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addOutputOptions(command, o.out);
+    return &command;
 }
 
-void runGround(const GroundOptions& o) {
+int runGround(const GroundOptions& o) {
     checkOutputs(o.out);
     const codec::SamplingMap map = codec::buildGroundMap(o.ground, o.grid, o.grid);
     writeMapFile(map, codec::toAnalytic(o.ground), o.out);
+    return 0;
 }
 
 // ---- foci ----
@@ -254,7 +266,8 @@ struct FociOptions {
     OutputOptions out;
 };
 
-void addFociOptions(CLI::App& command, FociOptions& o) {
+CLI::App* addFoci(CLI::App& map, FociOptions& o) {
+    CLI::App& command = *map.add_subcommand("foci", "Circular foci u,v,r,k");
     addMaxAnisotropyOption(command, o.maxAnisotropy);
     command.add_option("--focus", o.foci, "focus u,v,r,k (repeat for several)")->required();
     addComposeOption(command, o.composition);
@@ -263,9 +276,10 @@ void addFociOptions(CLI::App& command, FociOptions& o) {
     command.add_option("--aspect", o.aspect, "image width / height, so foci are circular in pixels (default 1)");
     addExactKOption(command, o.exactK);
     addOutputOptions(command, o.out);
+    return &command;
 }
 
-void runFoci(const FociOptions& o) {
+int runFoci(const FociOptions& o) {
     checkOutputs(o.out);
     const std::vector<codec::Focus> list = parseFoci(o.foci);
     codec::FociOptions fo;
@@ -283,6 +297,7 @@ void runFoci(const FociOptions& o) {
     std::optional<format::AnalyticMap> analytic = codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff));
     analytic->scalars["aspect"] = o.aspect;  // so an encode of a picture of another aspect can warn
     writeMapFile(budget.map, std::move(analytic), o.out, o.aspect);
+    return 0;
 }
 
 // ---- auto ----
@@ -294,7 +309,9 @@ struct AutoOptions {
     OutputOptions out;
 };
 
-void addAutoOptions(CLI::App& command, AutoOptions& o) {
+CLI::App* addAuto(CLI::App& map, AutoOptions& o) {
+    CLI::App& command = *map.add_subcommand(
+        "auto", "Automatic map from importance: density follows the importance, with a floor for context");
     addMaxAnisotropyOption(command, o.maxAnisotropy);
     command.add_option("--importance", o.importance,
                        "importance image (one channel or RGB; higher = more samples), or 'detail' / 'faces' "
@@ -307,9 +324,10 @@ void addAutoOptions(CLI::App& command, AutoOptions& o) {
         ->check(CLI::IsMember(enumNames<codec::AutoMethod>()));
     command.add_option("--grid", o.grid, kGridHelp)->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addOutputOptions(command, o.out);
+    return &command;
 }
 
-void runAuto(const AutoOptions& o) {
+int runAuto(const AutoOptions& o) {
     checkOutputs(o.out);
     const Image picture = o.image.empty() ? Image{} : imageio::readImageFile(o.image).image;
     const Image importance = importanceFrom(o.importance, picture);
@@ -322,6 +340,7 @@ void runAuto(const AutoOptions& o) {
                 codec::densityCorrelation(map, codec::importanceToDensity(importance, options)), measures.minCellDensity,
                 measures.maxCellDensity, o.minDensity, o.maxDensity);
     writeMapFile(map, std::nullopt, o.out, double(importance.width) / importance.height);
+    return 0;
 }
 
 struct MapOptions {
@@ -335,37 +354,13 @@ struct MapOptions {
 }  // namespace
 
 Command addMapCommand(CLI::App& root) {
-    auto o = std::make_shared<MapOptions>();
-    CLI::App* command = root.add_subcommand("map", "Build a sampling map and write it as a map file for `conus encode --map`");
-    command->require_subcommand(1);
-    setExamples(*command, {"conus map foci --focus 0.3,0.4,0.08,4 --focus 0.7,0.6,0.05,3 --aspect 1.5 -o m.exr --preview m.png",
-                       "conus map springs --strokes '[{\"u\":0.5,\"v\":0.4,\"radius\":0.1}]' -o m.exr",
-                       "conus map auto --importance faces --image portrait.jpg -o m.exr"});
-
-    CLI::App* springs = addSubcommand(*command, "springs", "Mass-spring brush system (paper 3.1): paint strokes from a JSON list, solve until stable",
-        {"conus map springs --strokes '[{\"u\":0.3,\"v\":0.4,\"radius\":0.1,\"strength\":1,\"duration\":0.5}]' -o m.exr",
-         "conus map springs --strokes strokes.json -o m.exr --preview m.png"});
-    addSpringsOptions(*springs, o->springs);
-    CLI::App* compose = command->add_subcommand(
-        "compose", "Add the displacement fields of map files (paper Fig. 9), each optionally translated and scaled");
-    addComposeOptions(*compose, o->compose);
-    CLI::App* ground = command->add_subcommand(
-        "ground", "Perspective ground-plane map of a height field (paper section 4), viewer at the bottom edge's middle");
-    addGroundOptions(*ground, o->ground);
-    CLI::App* foci = command->add_subcommand("foci", "Circular foci u,v,r,k");
-    addFociOptions(*foci, o->foci);
-    CLI::App* automatic = command->add_subcommand(
-        "auto", "Automatic map from importance: density follows the importance, with a floor for context");
-    addAutoOptions(*automatic, o->automatic);
-
-    return {command, [o, springs, compose, ground, foci, automatic] {
-                if (springs->parsed()) runSprings(o->springs);
-                else if (compose->parsed()) runCompose(o->compose);
-                else if (ground->parsed()) runGround(o->ground);
-                else if (automatic->parsed()) runAuto(o->automatic);
-                else if (foci->parsed()) runFoci(o->foci);
-                return 0;
-            }};
+    Command map = addCommandGroup(root, "map", "Build a sampling map and write it as a map file for `conus encode --map`",
+                                  {commandPart(addSprings, runSprings), commandPart(addCompose, runCompose),
+                                   commandPart(addGround, runGround), commandPart(addFoci, runFoci), commandPart(addAuto, runAuto)});
+    setExamples(*map.app, {"conus map foci --focus 0.3,0.4,0.08,4 --focus 0.7,0.6,0.05,3 --aspect 1.5 -o m.exr --preview m.png",
+                           "conus map springs --strokes '[{\"u\":0.5,\"v\":0.4,\"radius\":0.1}]' -o m.exr",
+                           "conus map auto --importance faces --image portrait.jpg -o m.exr"});
+    return map;
 }
 
 }  // namespace conus::cli

@@ -1,4 +1,4 @@
-// conus mesh render|animate: triangle meshes through the flexible pinhole camera (paper sections
+// conus render mesh, conus mesh animate: triangle meshes through the flexible pinhole camera (paper sections
 // 3.2 and 6). render writes one CoNUS colour + depth image (a `depthimage` file with its camera);
 // animate renders the procedural city's focus-plus-context sequence, each frame's foci following
 // chosen cars, as numbered CoNUS files and pictures, a contact sheet and (with ffmpeg) an MP4.
@@ -21,9 +21,11 @@
 #include "arguments.h"
 #include "backend.h"
 #include "commands.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/mesh_sequence.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/codec/mesh/city.h"
 #include "conus/codec/mesh/subdivide.h"
 #include "conus/core/atomic_file.h"
@@ -32,13 +34,11 @@
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/renderers/mesh_render.h"
-#include "conus/renderers/mesh_sequence.h"
 #include "conus/sceneio/mesh_file.h"
 #include "encoding.h"
 #include "image_files.h"
 #include "map_options.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -54,7 +54,7 @@ struct MeshOptions {
     std::vector<int> track;
     std::vector<std::string> allowDirs;
     double trackRadius = 0.05, trackK = 3;  // a car is small: a small, moderate focus keeps the context
-    // animate: add, smooth from frame to frame (tests/renderers/mesh_sequence_test.cpp); render sets
+    // animate: add, smooth from frame to frame (tests/codec/builders/mesh_sequence_test.cpp); render sets
     // density, as encode, volume and map compose foci.
     std::string compose = enumName(format::FociComposition::Add);
 };
@@ -76,17 +76,8 @@ CameraChoice parseCameraOptions(const MeshOptions& o) {
 // --camera (with --up), or one that frames the model's bounding box from the front right and
 // above (+x, +y, +z).
 Camera meshCamera(const CameraChoice& choice, const AxisBox& b, double aspect) {
-    const glm::dvec3 up = choice.up;
-    if (!choice.given) return framingCamera(b, {0.55, 0.45, 1.0}, up, aspect);
-    const CameraText& given = *choice.given;
-    const glm::dvec3 forward = given.target - given.eye;
-    if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
-        throw Error(ErrorCode::InvalidArgument,
-                    "--camera: the eye must differ from the look-at point and not look along --up");
-    const std::optional<ClipRange> clip = clipRangeFor(b, given.eye, glm::normalize(forward));
-    if (!clip)
-        throw Error(ErrorCode::InvalidArgument, "the model lies entirely behind the camera (look toward it with --camera)");
-    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, clip->near, clip->far);
+    if (!choice.given) return framingCamera(b, {0.55, 0.45, 1.0}, choice.up, aspect);
+    return givenCamera(*choice.given, choice.up, b, aspect, "the model");
 }
 
 // The whole city from high above its front edge, steep enough that buildings hide few streets.
@@ -221,7 +212,7 @@ int runRender(const RenderOptions& r) {
         std::vector<codec::Focus> given = parseFoci(r.foci);
         if (city) {
             const auto centres = carCentres(*city, o.track, o.time);
-            const auto tracked = renderers::trackedFoci(camera, centres, aspect, {o.trackRadius, o.trackK});
+            const auto tracked = codec::trackedFoci(camera, centres, aspect, {o.trackRadius, o.trackK});
             given.insert(given.end(), tracked.begin(), tracked.end());
         }
         return given;
@@ -254,20 +245,6 @@ struct AnimateOptions {
     double fps = 12;
     bool video = true;
 };
-
-// Frames side by side in rows of `columns`, each scaled to `tileWidth`, on black.
-Image contactSheet(const std::vector<Image>& tiles, int columns) {
-    const int tw = tiles.front().width, th = tiles.front().height, gap = 4;
-    const int rows = (static_cast<int>(tiles.size()) + columns - 1) / columns;
-    Image sheet = makeImage(columns * tw + (columns + 1) * gap, rows * th + (rows + 1) * gap, {"R", "G", "B"});
-    for (std::size_t k = 0; k < tiles.size(); ++k) {
-        const int x0 = gap + static_cast<int>(k % columns) * (tw + gap), y0 = gap + static_cast<int>(k / columns) * (th + gap);
-        for (int y = 0; y < th; ++y)
-            for (int x = 0; x < tw; ++x)
-                for (int c = 0; c < 3; ++c) sheet.at(x0 + x, y0 + y, c) = tiles[k].at(x, y, c);
-    }
-    return sheet;
-}
 
 std::optional<std::string> findOnPath(const std::string& program) {
     const char* path = std::getenv("PATH");
@@ -340,9 +317,9 @@ int runAnimate(const AnimateOptions& a) {
     Progress rendering("render " + std::to_string(a.frames) + " frames at " + o.sizeText + " (" + device.describe() + ")");
     for (int i = 0; i < a.frames; ++i) {
         const double t = o.time + i / a.fps;
-        const auto foci = renderers::trackedFoci(camera, carCentres(city, o.track, t), aspect, {o.trackRadius, o.trackK});
-        codec::SamplingMap map = renderers::frameMap(foci, fo);
-        if (previous) largestStep = std::max(largestStep, renderers::largestNodeStep(*previous, map));
+        const auto foci = codec::trackedFoci(camera, carCentres(city, o.track, t), aspect, {o.trackRadius, o.trackK});
+        codec::SamplingMap map = codec::frameMap(foci, fo);
+        if (previous) largestStep = std::max(largestStep, codec::largestNodeStep(*previous, map));
         const Image image = renderFrame(device, city.meshAt(t), camera, map, size, o, false);
         char name[32];
         std::snprintf(name, sizeof name, "frame_%04d", i);
@@ -350,7 +327,7 @@ int runAnimate(const AnimateOptions& a) {
                                codec::makeDepthImageFile(image, map, camera, o.units,
                                                          foci.empty() ? std::nullopt
                                                                       : std::optional(codec::toAnalytic(foci, fo.composition))));
-        const Image rgb = toRgb(image);
+        const Image rgb = codec::toRgb(image);
         setQuiet(true);
         writePicture((dir / (std::string(name) + ".png")).string(), rgb);
         setQuiet(false);
@@ -361,7 +338,7 @@ int runAnimate(const AnimateOptions& a) {
     }
     rendering.done();
     const std::string sheet = (dir / "contact_sheet.png").string();
-    writePicture(sheet, contactSheet(tiles, columns));
+    writePicture(sheet, codec::contactSheet(tiles, columns));
     outputs.commit();
     std::printf("wrote %d frames to %s (frame_0000.exr/.png ...), contact sheet %s; largest per-frame move of a map "
                 "node %.4f (normalized)\n",
@@ -385,10 +362,10 @@ int runAnimate(const AnimateOptions& a) {
 
 CLI::App* addRender(CLI::App& command, RenderOptions& r) {
     CLI::App* render = addSubcommand(
-        command, "render", "Render a mesh (OBJ, PLY, STL, glTF, ... or `city`) as a CoNUS colour + depth image",
-        {"conus mesh render bunny.ply -o bunny.exr --focus 0.45,0.4,0.1,4",
-         "conus mesh render model.obj -o model.exr --size 1024x1024 --camera 0,1,3,0,0,0,40 --max-bend 0.1",
-         "conus mesh render city -o city.exr --track 0,2 --time 3.5 --reference"});
+        command, "mesh", "Render a mesh (OBJ, PLY, STL, glTF, ... or `city`) as a CoNUS colour + depth image",
+        {"conus render mesh bunny.ply -o bunny.exr --focus 0.45,0.4,0.1,4",
+         "conus render mesh model.obj -o model.exr --size 1024x1024 --camera 0,1,3,0,0,0,40 --max-bend 0.1",
+         "conus render mesh city -o city.exr --track 0,2 --time 3.5 --reference"});
     render->add_option("model", r.mesh.model, "mesh file (anything Assimp reads) or `city` (the procedural city)")->required();
     writesFile(render->add_option("-o,--output", r.output, "CoNUS file (.exr): R, G, B, A (coverage), Z (camera depth)"))->required();
     render->add_option("--focus", r.foci, "focus u,v,r,k (repeatable): centre, radius (fraction of the width), magnification");
@@ -429,8 +406,10 @@ CLI::App* addAnimate(CLI::App& command, AnimateOptions& a) {
 Command addMeshCommand(CLI::App& root) {
     return addCommandGroup(
         root, "mesh",
-        "Triangle meshes through the flexible pinhole camera: CoNUS colour + depth images, focus-plus-context sequences",
-        {commandPart(addRender, runRender), commandPart(addAnimate, runAnimate)});
+        "Triangle meshes through the flexible pinhole camera: focus-plus-context sequences (a frame: `conus render mesh`)",
+        {commandPart(addAnimate, runAnimate)});
 }
+
+CommandPart meshRenderPart() { return commandPart(addRender, runRender); }
 
 }  // namespace conus::cli

@@ -101,12 +101,7 @@ int runRenderReflection(const ReflectionRenderText& o) {
     const std::vector<codec::ReflectionFace> faces = codec::readReflectionFaces(o.asset);
     const glm::dvec3 centre = faces.front().depth.camera().eye();
     options.reflector.centre = o.at.empty() ? centre : parseVector3(o.at, "--at");
-    Progress loading("read " + o.scene);
-    sceneio::MeshReadOptions read;
-    read.allowedDirs = o.allowDirs;
-    read.warn = warn;
-    const codec::MeshScene scene(sceneio::readMesh(o.scene, read));
-    loading.done();
+    const codec::MeshScene scene(readSceneMesh(o.scene, o.allowDirs));
     const double aspect = double(size.width) / size.height;
     const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);
     // The ground truth traces the mesh itself: the CPU only.
@@ -177,8 +172,11 @@ CLI::App* addRenderRelief(CLI::App& command, RenderOptions& o) {
 }  // namespace
 
 Command addRenderCommand(CLI::App& root) {
-    return addCommandGroup(root, "render", "Render frames of baked assets (relief, reflection)",
-                           {commandPart(addRenderRelief, runRenderRelief), commandPart(addRenderReflection, runRenderReflection)});
+    return addCommandGroup(root, "render",
+                           "Render frames: of baked assets (relief, reflection), of meshes and volumes as CoNUS colour + depth "
+                           "images (mesh, volume), of a CoNUS height field (heightfield)",
+                           {commandPart(addRenderRelief, runRenderRelief), commandPart(addRenderReflection, runRenderReflection),
+                            meshRenderPart(), volumeRenderPart(), heightFieldRenderPart()});
 }
 
 }  // namespace conus::cli

@@ -25,7 +25,7 @@
 #include "arguments.h"
 #include "backend.h"
 #include "commands.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
 #include "encoding.h"

@@ -1,4 +1,4 @@
-// conus volume render|animate: scalar volumes through the flexible pinhole camera (paper section 3.2,
+// conus render volume, conus volume animate: scalar volumes through the flexible pinhole camera (paper section 3.2,
 // "Volume data"): one CoNUS ray per pixel through the undistorted image-plane point, composited
 // front to back through a transfer function; written as a CoNUS depth image (R, G, B, A and the
 // camera depth Z of the first sample past the opacity threshold, with its camera). animate slides
@@ -16,23 +16,23 @@
 #include "arguments.h"
 #include "backend.h"
 #include "commands.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/mesh_sequence.h"
 #include "conus/codec/conus_file.h"
+#include "conus/codec/map/pictures.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/codec/volume/raycast.h"
 #include "conus/codec/volume/transfer_function.h"
-#include "conus/core/camera.h"
 #include "conus/core/atomic_file.h"
+#include "conus/core/camera.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
-#include "conus/renderers/mesh_sequence.h"
 #include "conus/renderers/volume_renderer.h"
 #include "conus/sceneio/volume_file.h"
 #include "encoding.h"
 #include "image_files.h"
 #include "map_options.h"
 #include "output_files.h"
-#include "pictures.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -69,17 +69,9 @@ codec::VolumeRenderOptions renderOptions(const VolumeOptions& o);
 Camera volumeCamera(const VolumeOptions& o, const Volume& volume, const codec::TransferFunction& tf, double aspect) {
     // What the transfer function shows fills the frame (a head, not the box around it).
     if (o.cameraText.empty()) return codec::defaultVolumeCamera(volume, tf, codec::renderRange(volume, renderOptions(o)), aspect);
-    const CameraText given = parseCamera(o.cameraText);
-    const glm::dvec3 up = parseVector3(o.upText, "--up");
-    const glm::dvec3 forward = given.target - given.eye;
-    if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
-        throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText +
-                                                    "': the eye must differ from the look-at point and not look along --up");
     // Near and far bracket the volume's box along the view axis.
-    const std::optional<ClipRange> clip = clipRangeFor(AxisBox{glm::dvec3(0.0), volume.extent()}, given.eye, glm::normalize(forward));
-    if (!clip)
-        throw Error(ErrorCode::InvalidArgument, "--camera '" + o.cameraText + "': the volume lies entirely behind the camera");
-    return Camera::perspective(given.eye, given.target, up, given.fovYDegrees, aspect, clip->near, clip->far);
+    return givenCamera(parseCamera(o.cameraText), parseVector3(o.upText, "--up"), AxisBox{glm::dvec3(0.0), volume.extent()}, aspect,
+                       "the volume");
 }
 
 // "a,b": two finite numbers.
@@ -160,7 +152,7 @@ int runRender(const VolumeOptions& o) {
     Progress writing("write " + o.output);
     AtomicOutputs outputs;  // the file and its picture, both or neither
     format::writeConusFile(o.output, codec::makeDepthImageFile(image, map, camera, o.units, chosen.analytic));
-    if (!o.picture.empty()) writePicture(o.picture, toRgb(image));
+    if (!o.picture.empty()) writePicture(o.picture, codec::toRgb(image));
     outputs.commit();
     writing.done();
     const glm::dvec3 eye = camera.eye(), look = eye + camera.forward();
@@ -218,8 +210,8 @@ int runAnimate(const AnimateOptions& a) {
         const double t = a.frames > 1 ? double(f) / (a.frames - 1) : 0.0;
         const glm::dvec2 centre = glm::mix(from, to, t);
         const std::vector<codec::Focus> foci{{centre.x, centre.y, a.radius, a.k}};
-        codec::SamplingMap map = renderers::frameMap(foci, fo);
-        if (previous) largest = std::max(largest, renderers::largestNodeStep(*previous, map));
+        codec::SamplingMap map = codec::frameMap(foci, fo);
+        if (previous) largest = std::max(largest, codec::largestNodeStep(*previous, map));
         const Fpc fpc(camera, std::make_shared<codec::SamplingMap>(map));
         const Image image = gpu ? gpu->render(fpc, size.width, size.height, options)
                                 : codec::renderVolumeReference(volume, tf, fpc, size.width, size.height, options);
@@ -228,7 +220,7 @@ int runAnimate(const AnimateOptions& a) {
         const std::filesystem::path base = std::filesystem::path(a.outDir) / name;
         format::writeConusFile(base.string() + ".exr",
                                codec::makeDepthImageFile(image, map, camera, o.units, codec::toAnalytic(foci, fo.composition)));
-        writePicture(base.string() + ".png", toRgb(image));
+        writePicture(base.string() + ".png", codec::toRgb(image));
         previous = std::move(map);
         if (const ProgressFn report = rendering.callback()) report(double(f + 1) / a.frames);
     }
@@ -239,18 +231,14 @@ int runAnimate(const AnimateOptions& a) {
     return 0;
 }
 
-}  // namespace
 
-Command addVolumeCommand(CLI::App& root) {
-    CLI::App* volume = root.add_subcommand(
-        "volume", "Scalar volumes through the flexible pinhole camera: CoNUS ray casting into colour + depth images");
-    volume->require_subcommand(1);
-    auto o = std::make_shared<VolumeOptions>();
+CLI::App* addRender(CLI::App& volume, VolumeOptions& options) {
+    VolumeOptions* o = &options;
     CLI::App* render = addSubcommand(
-        *volume, "render", "Render a volume as a CoNUS colour + depth image (R, G, B, A, Z and its camera)",
-        {"conus volume render procedural:shepp-logan -o head.exr --focus 0.5,0.45,0.12,3 --picture head.png  # a phantom, a focus",
-         "conus volume render brain.den -o brain.exr --tf bone --size 640x480 --uniform  # the uniform baseline",
-         "conus volume render raw:256x256x128:uint16:0.8:ct.raw -o ct.exr --tf grey --range 0,4095  # a raw brick"});
+        volume, "volume", "Render a volume as a CoNUS colour + depth image (R, G, B, A, Z and its camera)",
+        {"conus render volume procedural:shepp-logan -o head.exr --focus 0.5,0.45,0.12,3 --picture head.png  # a phantom, a focus",
+         "conus render volume brain.den -o brain.exr --tf bone --size 640x480 --uniform  # the uniform baseline",
+         "conus render volume raw:256x256x128:uint16:0.8:ct.raw -o ct.exr --tf grey --range 0,4095  # a raw brick"});
     render->add_option("volume", o->volume,
                        "file.vdb | file.nrrd | file.nhdr | file.den | " + sceneio::rawVolumeForm() +
                            " | procedural:marschner-lobb[:n] | procedural:shepp-logan[:n]")
@@ -285,11 +273,13 @@ Command addVolumeCommand(CLI::App& root) {
     render->add_option("--units", o->units, "the volume's length unit, recorded as the depth's units")->capture_default_str();
     addBackendOption(*render, o->backend, renderers::CpuPath::Available);
     addAllowDirOption(*render, o->allowDirs);
-    addQuietOption(*render);
+    return render;
+}
 
-    auto a = std::make_shared<AnimateOptions>();
+CLI::App* addAnimate(CLI::App& volume, AnimateOptions& animation) {
+    AnimateOptions* a = &animation;
     CLI::App* animate = addSubcommand(
-        *volume, "animate", "Render a focus sliding across a volume: numbered CoNUS frames and pictures",
+        volume, "animate", "Render a focus sliding across a volume: numbered CoNUS frames and pictures",
         {"conus volume animate procedural:shepp-logan --out-dir frames --from 0.3,0.45 --to 0.7,0.45 --frames 24"});
     animate->add_option("volume", a->volume.volume, "the volume, as for render")->required();
     animate->add_option("--out-dir", a->outDir, "folder for frame_NNNN.exr and frame_NNNN.png")->required();
@@ -308,8 +298,18 @@ Command addVolumeCommand(CLI::App& root) {
         ->check(CLI::Range(kMinMapSide, kMaxMapSide));
     addBackendOption(*animate, a->volume.backend, renderers::CpuPath::Available);
     addAllowDirOption(*animate, a->volume.allowDirs);
-    addQuietOption(*animate);
-    return {volume, [o, a, render] { return render->parsed() ? runRender(*o) : runAnimate(*a); }};
+    return animate;
 }
+
+}  // namespace
+
+Command addVolumeCommand(CLI::App& root) {
+    return addCommandGroup(root, "volume",
+                           "Scalar volumes through the flexible pinhole camera: a focus sliding across a volume (a frame: "
+                           "`conus render volume`)",
+                           {commandPart(addAnimate, runAnimate)});
+}
+
+CommandPart volumeRenderPart() { return commandPart(addRender, runRender); }
 
 }  // namespace conus::cli

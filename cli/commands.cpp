@@ -1,5 +1,8 @@
 #include "commands.h"
 
+#include <cstdio>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -32,6 +35,14 @@ Command addCommandGroup(CLI::App& parent, const std::string& name, const std::st
                     if (part.app->parsed()) return part.run();
                 throw Error(ErrorCode::InvalidArgument, name + ": no subcommand given");
             }};
+}
+
+void acceptOldRenderOrder(int argc, char** argv) {
+    if (argc < 3 || std::string(argv[2]) != "render") return;
+    const std::string what = argv[1];
+    if (what != "mesh" && what != "volume" && what != "heightfield") return;
+    std::fprintf(stderr, "conus: `conus %s render` is spelled `conus render %s` now\n", what.c_str(), what.c_str());
+    std::swap(argv[1], argv[2]);
 }
 
 }  // namespace conus::cli

@@ -48,10 +48,20 @@ CommandPart commandPart(CLI::App* (*declare)(CLI::App& parent, Options& options)
     return [declare, run](CLI::App& group) { return defineCommand(group, declare, run); };
 }
 
-// A command whose work is done by exactly one of its subcommands (`conus mesh render | animate`):
+// A command whose work is done by exactly one of its subcommands (`conus mesh animate`, `conus render mesh | volume | ...`):
 // the parts are defined under it, and running it runs the part the command line named.
 Command addCommandGroup(CLI::App& parent, const std::string& name, const std::string& description,
                         std::initializer_list<CommandPart> parts);
+
+// `conus render <what>`'s parts that live with their scene's other commands (cmd_mesh.cpp,
+// cmd_volume.cpp, cmd_heightfield.cpp); cmd_render.cpp gathers them.
+CommandPart meshRenderPart();
+CommandPart volumeRenderPart();
+CommandPart heightFieldRenderPart();
+
+// The old word order `conus mesh|volume|heightfield render`, still taken: when argv spells it, it is
+// turned into `conus render mesh|volume|heightfield` in place and the new spelling said on stderr.
+void acceptOldRenderOrder(int argc, char** argv);
 
 // The subcommands, in the order `conus --help` lists them: the one list, which declares each
 // cmd_<name>.cpp's `Command add<Name>Command(CLI::App& root)` here and registers them in main.cpp.

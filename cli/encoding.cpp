@@ -8,6 +8,7 @@
 
 #include "conus/core/atomic_file.h"
 
+#include "conus/codec/builders/frame_budget.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/image/fit.h"
@@ -30,7 +31,8 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
 
 Size conusSize(const StorageOptions& options, const Image& source) {
     if (!options.sizeText.empty()) return parseSize(options.sizeText);
-    return {std::max(1, (source.width + 2) / 4), std::max(1, (source.height + 2) / 4)};
+    const auto [width, height] = codec::defaultConusSize(source.width, source.height);
+    return {width, height};
 }
 
 void applyStorage(const StorageOptions& options, format::ConusFile& file) {
@@ -92,6 +94,23 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault) {
     }
 }
 
+namespace {
+
+// What a fit achieved, for the line that says what was written (empty when nothing was fitted).
+std::string fitText(const codec::FitResult& r) {
+    if (r.steps.empty()) return {};
+    // Overshoot at hard edges is kept, not clamped (the decoder interpolates it away): say how much.
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "fitted to the decoder: decoded PSNR %.2f -> %.2f dB in %d iterations; %lld values below 0 "
+                  "(lowest %.3g), kept",
+                  r.steps.front().psnr, r.steps.back().psnr, r.steps.back().iteration, static_cast<long long>(r.negatives),
+                  r.minimum);
+    return text;
+}
+
+}  // namespace
+
 format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
                                 const FitSetting& fit, std::string* fitNote, const std::string& what) {
@@ -112,18 +131,16 @@ format::ConusFile encodeToConus(const renderers::Device& device, const Image& so
         options.progress = fitting.callback();
         const codec::FitResult r = codec::fitToDecoder(source, map, image, options);
         fitting.done();
-        if (fitNote && !r.steps.empty()) {
-            // Overshoot at hard edges is kept, not clamped (the decoder interpolates it away): say how much.
-            char text[200];
-            std::snprintf(text, sizeof text,
-                          "fitted to the decoder: decoded PSNR %.2f -> %.2f dB in %d iterations; %lld values below 0 "
-                          "(lowest %.3g), kept",
-                          r.steps.front().psnr, r.steps.back().psnr, r.steps.back().iteration,
-                          static_cast<long long>(r.negatives), r.minimum);
-            *fitNote = text;
-        }
+        if (fitNote) *fitNote = fitText(r);
     }
     return codec::makeImageFile(std::move(image), map, source.width, source.height, encoding, std::move(analytic));
+}
+
+format::ConusFile keptEncodeToConus(const codec::ModelEncode& kept, const SourceEncoding& encoding, const codec::SamplingMap& map,
+                                    int sourceWidth, int sourceHeight, std::optional<format::AnalyticMap> analytic,
+                                    std::string* fitNote) {
+    if (fitNote) *fitNote = fitText(kept.fit);
+    return codec::makeImageFile(kept.image, map, sourceWidth, sourceHeight, encoding, std::move(analytic));
 }
 
 }  // namespace conus::cli

@@ -12,6 +12,10 @@
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 
+namespace conus::codec {
+struct ModelEncode;
+}
+
 namespace CLI {
 class App;
 }
@@ -59,6 +63,12 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault = false);
 format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
                                 const FitSetting& fit = {}, std::string* fitNote = nullptr, const std::string& what = {});
+
+// The same file from an encode already made of `map` (a budget's confirming encode, kept:
+// codec::ModelEncode, encoded and fitted as `encode` asks), with the same note on its fit.
+format::ConusFile keptEncodeToConus(const codec::ModelEncode& kept, const SourceEncoding& encoding, const codec::SamplingMap& map,
+                                    int sourceWidth, int sourceHeight, std::optional<format::AnalyticMap> analytic,
+                                    std::string* fitNote = nullptr);
 
 // Applies the storage options to a file model. Without --half or --float, colour is stored as
 // float when the source had more precision than half keeps (16-bit integers, float), else half.

@@ -3,7 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "arguments.h"
-#include "conus/codec/build/importance.h"
+#include "conus/codec/builders/importance.h"
 #include "conus/core/atomic_file.h"
 #include "progress.h"
 
@@ -56,16 +56,18 @@ Image readData(const std::string& path) {
 }
 
 Image importanceFrom(const std::string& source, const Image& picture) {
-    const std::optional<codec::ImportanceRule> rule = codec::parseImportanceRule(source);
+    const std::optional<codec::ImportanceRule> rule = tryParseEnum<codec::ImportanceRule>(source);
     if (!rule) return readData(source);
     if (picture.empty()) throw Error(ErrorCode::InvalidArgument, "'" + source + "' importance needs an input image");
     return codec::ruleImportance(*rule, imageio::displayEncoded(picture));
 }
 
 void addPictureOptions(CLI::App& command, PictureOptions& options) {
+    std::string bits;
+    for (const std::string& name : pictureBitsNames()) bits += (bits.empty() ? "" : ", ") + name;
     command.add_option("--bits", options.bits,
-                       "sample type of the picture: 8, 16, half or float (default: the source's where the format holds it)")
-        ->check(CLI::IsMember({"8", "16", "half", "float"}));
+                       "sample type of the picture: one of " + bits + " (default: the source's where the format holds it)")
+        ->check(CLI::IsMember(pictureBitsNames()));
     command.add_option("--exposure", options.exposure, "exposure in stops (multiplies colour by 2^EV)")
         ->check(finiteRange(-64.0, 64.0, true));
     command.add_option("--tonemap", options.toneMap,
@@ -79,10 +81,7 @@ imageio::WriteOptions writeOptionsOf(const PictureOptions& options, const Source
     write.source = source;
     write.display.exposure = options.exposure;
     write.display.toneMap = parseEnum<ToneMap>(options.toneMap);
-    if (options.bits == "8") write.sampleType = SampleType::Uint8;
-    else if (options.bits == "16") write.sampleType = SampleType::Uint16;
-    else if (options.bits == "half") write.sampleType = SampleType::Half;
-    else if (options.bits == "float") write.sampleType = SampleType::Float;
+    if (!options.bits.empty()) write.sampleType = parsePictureBits(options.bits);
     return write;
 }
 

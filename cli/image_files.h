@@ -34,7 +34,7 @@ imageio::ImageFile readSource(const std::string& path, const SourceOptions& opti
 // Reads a data image (importance map, DEM): raw values, never converted, upright.
 Image readData(const std::string& path);
 
-// An --importance argument: a rule's name ("detail", "faces": codec/build/importance.h) applied to
+// An --importance argument: a rule's name ("detail", "faces": codec/builders/importance.h) applied to
 // `picture` as a display shows it, or the path of an importance image (readData). `picture` may be
 // empty for a path.
 Image importanceFrom(const std::string& source, const Image& picture);

@@ -7,7 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
-#include "option_checks.h"
+#include "conus/cli/option_checks.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "conus/format/container.h"
@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
     std::vector<conus::cli::Command> commands{CONUS_CLI_COMMANDS(CONUS_CLI_ADD_COMMAND)};
 #undef CONUS_CLI_ADD_COMMAND
 
+    conus::cli::acceptOldRenderOrder(argc, argv);
     std::string name;
     // CLI11 would only say "a subcommand is required"; name the word it did not know instead.
     std::string known;

@@ -1,5 +1,4 @@
 #include "map_options.h"
-#include "option_checks.h"
 
 #include <CLI/CLI.hpp>
 
@@ -8,10 +7,11 @@
 #include <cstdio>
 #include <string>
 
+#include "conus/cli/option_checks.h"
+#include "conus/codec/builders/mesh_sequence.h"
+#include "conus/codec/conus_file.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
-
-#include "conus/renderers/mesh_sequence.h"
 #include "progress.h"
 
 namespace conus::cli {
@@ -53,7 +53,7 @@ FrameMap chooseFrameMap(bool uniform, const std::string& mapFile, const FociSour
     if (fociSource) {
         const std::vector<codec::Focus> foci = fociSource();
         Progress building("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
-        FrameMap chosen{renderers::frameMap(foci, options), std::nullopt, false};
+        FrameMap chosen{codec::frameMap(foci, options), std::nullopt, false};
         if (!foci.empty()) chosen.analytic = codec::toAnalytic(foci, options.composition);
         building.done();
         return chosen;
@@ -193,12 +193,6 @@ void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDe
         ->check(finiteRange(1.001, 4096.0, true, true));
 }
 
-void checkGridForImage(int grid, int width, int height, int defaultGrid) {
-    const int most = std::max(defaultGrid, static_cast<int>(map_rules::maxSideForImage(width, height)));
-    if (grid > most)
-        throw Error(ErrorCode::InvalidArgument, "--grid " + std::to_string(grid) + " is finer than a " + std::to_string(width) +
-                                                    "x" + std::to_string(height) + " image can show; at most " +
-                                                    std::to_string(most) + " nodes a side");
-}
+void checkGridForImage(int grid, int width, int height, int defaultGrid) { codec::checkGridForImage(grid, width, height, "--grid", defaultGrid); }
 
 }  // namespace conus::cli

@@ -1,5 +1,5 @@
 // The options that shape a built map, shared by `map foci`, `map auto` and `encode`, and the map a
-// rendered frame (`mesh render`, `volume render`) is taken through.
+// rendered frame (`render mesh`, `render volume`) is taken through.
 #pragma once
 
 #include <functional>
@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/foci_budget.h"
+#include "conus/codec/builders/auto_map.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/foci_budget.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
@@ -31,7 +31,7 @@ std::string defaultFalloffText();
 // --falloff WIDTH[,SHAPE] for `map foci`, `encode --focus` and `bake relief --focus`.
 CLI::Option* addFalloffOption(CLI::App& command, std::string& falloff);
 // --compose: how several foci combine (format::FociComposition's names), for `map foci`, `encode`,
-// `mesh` and `volume render`.
+// `mesh` and `render volume`.
 CLI::Option* addComposeOption(CLI::App& command, std::string& compose);
 // "4, 3.1": the foci's k, as the budget lines say them.
 std::string fociKText(const std::vector<codec::Focus>& foci);
@@ -65,10 +65,7 @@ std::string lossText(double db, const char* lose, const char* gain, int decimals
 // chose, the predicted losses and the region's gain (`what`: the importance's name).
 std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what);
 
-// A map much finer than the image it shapes adds nothing the image can show and costs a build in
-// proportion to its nodes (a minute at 4097 a side): --grid is refused (InvalidArgument) past
-// the larger of the command's default and map_rules::maxSideForImage (4 nodes a pixel along the
-// image's longer side plus one, 129 always), the bound readers hold files to.
+// --grid against the image it shapes (codec::checkGridForImage).
 void checkGridForImage(int grid, int width, int height, int defaultGrid = map_rules::kDefaultSide);
 
 // The foci of repeated --focus u,v,r,k options, in order.

@@ -8,7 +8,7 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/build/springs.h"
+#include "conus/codec/builders/springs.h"
 #include "conus/format/container.h"
 #include "conus/core/image.h"
 #include "conus/core/map_rules.h"

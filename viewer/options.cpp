@@ -7,7 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "../cli/option_checks.h"
+#include "conus/cli/option_checks.h"
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 

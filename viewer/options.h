@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/decode.h"
 #include "actions.h"
 #include "conus/renderers/mesh_render.h"

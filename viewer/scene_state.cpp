@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "conus/codec/build/frame_foci.h"
+#include "conus/codec/builders/frame_foci.h"
 #include "conus/codec/conus_file.h"
 #include "conus/core/bounds.h"
 

@@ -3,7 +3,7 @@
 // sections 3.1 and 6), and whether the frame is CoNUS or conventional. Each frame the window renders
 // the scene through camera() and map() (scene.h) and shows the CoNUS image itself: the paper's
 // focus-plus-context display. The map is rebuilt from the foci in closed form
-// (codec/build/frame_foci.h) whenever they move, so dragging a focus is live.
+// (codec/builders/frame_foci.h) whenever they move, so dragging a focus is live.
 //
 // Image coordinates are the displayed CoNUS image's normalized (u_d, v_d), v down.
 #pragma once
@@ -13,7 +13,7 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/camera.h"
 #include "conus/core/image.h"

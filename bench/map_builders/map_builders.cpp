@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/map_measures.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/map_measures.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"

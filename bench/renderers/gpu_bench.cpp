@@ -14,7 +14,7 @@
 
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "bench_context.h"
 #include "conus/renderers/context.h"
 #include "conus/renderers/gpu_image.h"

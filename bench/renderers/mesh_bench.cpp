@@ -17,12 +17,12 @@
 #include <vector>
 
 #include "bench_context.h"
+#include "conus/codec/builders/mesh_sequence.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/codec/mesh/city.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/codec/mesh/subdivide.h"
 #include "conus/renderers/mesh_render.h"
-#include "conus/renderers/mesh_sequence.h"
 #include "paired.h"
 
 namespace {
@@ -56,7 +56,7 @@ Data& data() {
         const std::vector<glm::dvec3> cars{d->city.carCentre(0, 0.0), d->city.carCentre(2, 0.0)};
         codec::FociOptions fo;
         fo.aspect = kAspect;
-        d->map = std::make_unique<codec::SamplingMap>(renderers::frameMap(renderers::trackedFoci(d->camera, cars, kAspect), fo));
+        d->map = std::make_unique<codec::SamplingMap>(codec::frameMap(codec::trackedFoci(d->camera, cars, kAspect), fo));
         d->identity = std::make_unique<codec::SamplingMap>(codec::SamplingMap::identity(2, 2));
         d->fine = codec::subdivideForMap(d->mesh, d->camera, *d->map, 0.5);
         d->context = bench::createBenchContext();
@@ -182,7 +182,7 @@ void fociFrame(benchmark::State& state, codec::FociComposition composition) {
     codec::FociOptions options;
     options.aspect = kAspect;
     options.composition = composition;
-    for (auto _ : state) benchmark::DoNotOptimize(renderers::frameMap(foci, options));
+    for (auto _ : state) benchmark::DoNotOptimize(codec::frameMap(foci, options));
 }
 void BM_FociFrameDensity(benchmark::State& state) { fociFrame(state, codec::FociComposition::Density); }
 void BM_FociFrameAdd(benchmark::State& state) { fociFrame(state, codec::FociComposition::Add); }

@@ -13,7 +13,7 @@
 
 #include "bench_context.h"
 #include "paired.h"
-#include "conus/codec/build/auto_map.h"
+#include "conus/codec/builders/auto_map.h"
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/depth/relief.h"
 #include "conus/imageio/text.h"

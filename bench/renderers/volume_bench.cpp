@@ -22,7 +22,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/codec/volume/raycast.h"
 #include "bench_context.h"

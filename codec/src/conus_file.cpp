@@ -1,5 +1,11 @@
 #include "conus/codec/conus_file.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "conus/core/error.h"
+
 namespace conus::codec {
 
 format::ConusFile makeImageFile(Image image, const SamplingMap& map, int sourceWidth, int sourceHeight,
@@ -42,6 +48,20 @@ std::optional<double> madeForAspect(const format::ConusFile& file) {
     if (file.sourceWidth == file.map.columns && file.sourceHeight == file.map.rows && file.image.width == file.map.columns)
         return std::nullopt;
     return double(file.sourceWidth) / file.sourceHeight;
+}
+
+bool aspectsDiffer(double madeFor, double aspect) { return std::abs(std::log(madeFor / aspect)) > 0.01; }
+
+std::pair<int, int> defaultConusSize(int sourceWidth, int sourceHeight) {
+    return {std::max(1, (sourceWidth + 2) / 4), std::max(1, (sourceHeight + 2) / 4)};
+}
+
+void checkGridForImage(int side, int width, int height, const std::string& what, int defaultSide) {
+    const std::int64_t most = std::max<std::int64_t>(defaultSide, map_rules::maxSideForImage(width, height));
+    if (side > most)
+        throw Error(ErrorCode::InvalidArgument, what + " " + std::to_string(side) + " is finer than a " + std::to_string(width) + "x" +
+                                                    std::to_string(height) + " image can show; at most " + std::to_string(most) +
+                                                    " nodes a side");
 }
 
 format::ConusFile makeMapFile(const SamplingMap& map, std::optional<format::AnalyticMap> analytic) {

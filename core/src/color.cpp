@@ -28,6 +28,22 @@ int bitsOf(SampleType t) {
     return 32;
 }
 
+std::string pictureBitsName(SampleType t) {
+    return t == SampleType::Half || t == SampleType::Float ? enumName(t) : std::to_string(bitsOf(t));
+}
+
+std::optional<SampleType> parsePictureBits(std::string_view text) {
+    for (SampleType t : kPictureSampleTypes)
+        if (text == pictureBitsName(t)) return t;
+    return std::nullopt;
+}
+
+std::vector<std::string> pictureBitsNames() {
+    std::vector<std::string> names;
+    for (SampleType t : kPictureSampleTypes) names.push_back(pictureBitsName(t));
+    return names;
+}
+
 std::string iccProfileProblem(const std::string& bytes) {
     if (bytes.size() < 132) return std::to_string(bytes.size()) + " bytes, shorter than an ICC header and tag count";
     const auto byte = [&](std::size_t i) { return std::uint32_t(static_cast<unsigned char>(bytes[i])); };

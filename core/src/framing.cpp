@@ -1,8 +1,9 @@
-// Framing a scene's box with a camera (camera.h): the clip range that holds it, and the default
-// view the mesh commands start from.
+// Framing a scene's box with a camera (camera.h): the clip range that holds it, the default view
+// the mesh commands start from, and a user's eye and look-at point clipped to the box.
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "conus/core/camera.h"
 #include "conus/core/error.h"
@@ -49,6 +50,16 @@ Camera framingCamera(const AxisBox& box, glm::dvec3 direction, glm::dvec3 up, do
         distance = std::max(distance * scale, radius * 1.05);  // never inside the bounding sphere
     }
     return at(distance);
+}
+
+Camera lookingAtBox(const AxisBox& box, glm::dvec3 eye, glm::dvec3 target, glm::dvec3 up, double fovYDegrees, double aspect,
+                    const std::string& what) {
+    const glm::dvec3 forward = target - eye;
+    if (!(glm::length(forward) > 0) || !(glm::length(glm::cross(forward, up)) > 1e-9 * glm::length(forward)))
+        throw Error(ErrorCode::InvalidArgument, "the eye must differ from the look-at point and not look along the up vector");
+    const std::optional<ClipRange> clip = clipRangeFor(box, eye, glm::normalize(forward));
+    if (!clip) throw Error(ErrorCode::InvalidArgument, what + " lies entirely behind the camera");
+    return Camera::perspective(eye, target, up, fovYDegrees, aspect, clip->near, clip->far);
 }
 
 }  // namespace conus

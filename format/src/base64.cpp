@@ -1,5 +1,5 @@
 // Base64 (RFC 4648, with padding) for byte strings stored in string attributes.
-#include "header_model.h"
+#include "header_model_pvt.h"
 
 namespace conus::format::detail {
 namespace {

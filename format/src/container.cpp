@@ -8,8 +8,8 @@
 #include "conus/core/atomic_file.h"
 #include "conus/format/exr_check.h"
 #include "conus/format/reflection_asset.h"
-#include "exr_io.h"
-#include "header_model.h"
+#include "exr_io_pvt.h"
+#include "header_model_pvt.h"
 
 namespace conus::format {
 

@@ -1,6 +1,6 @@
-// OpenEXR headers <-> HeaderModel (exr_header.h): each value type of kAttributes with its OpenEXR
+// OpenEXR headers <-> HeaderModel (exr_header_pvt.h): each value type of kAttributes with its OpenEXR
 // attribute class, a part's header both ways, and the model's fields as a ConusFile's.
-#include "exr_header.h"
+#include "exr_header_pvt.h"
 
 #include <ImfChannelList.h>
 #include <ImfChromaticitiesAttribute.h>

@@ -1,9 +1,9 @@
 // Reading and writing a CoNUS file (one image, or a reflection asset's six) through OpenEXR: the
-// screen before OpenEXR's C++ library reads (exr_screen.h), the header rules on the model of the
-// headers (exr_header.h), then the parts' pixels (exr_parts.h). OpenEXR's exceptions (Iex::BaseExc
+// screen before OpenEXR's C++ library reads (exr_screen_pvt.h), the header rules on the model of the
+// headers (exr_header_pvt.h), then the parts' pixels (exr_parts_pvt.h). OpenEXR's exceptions (Iex::BaseExc
 // derives from std::exception) are caught here and turned into report issues or conus::Error, so
 // nothing from OpenEXR escapes format/.
-#include "exr_io.h"
+#include "exr_io_pvt.h"
 
 #include <ImfHeader.h>
 #include <ImfDoubleAttribute.h>
@@ -20,10 +20,10 @@
 #include <system_error>
 #include <variant>
 
-#include "exr_header.h"
-#include "exr_parts.h"
-#include "exr_screen.h"
-#include "header_model.h"
+#include "exr_header_pvt.h"
+#include "exr_parts_pvt.h"
+#include "exr_screen_pvt.h"
+#include "header_model_pvt.h"
 
 namespace conus::format::detail {
 namespace {
@@ -38,7 +38,7 @@ LoadResult refusal(const Problem& problem) {
 }
 
 // A regular file (a FIFO never ends and a device may not either) that passes the screen
-// (exr_screen.h); its size and the C core's context for the chunk checks.
+// (exr_screen_pvt.h); its size and the C core's context for the chunk checks.
 Problem screen(const std::string& path, const Limits& limits, std::uintmax_t& size, std::unique_ptr<CoreFile>& core) {
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);

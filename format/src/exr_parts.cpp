@@ -1,5 +1,5 @@
-// The pixels of one part of a multipart EXR, read and written by its index (exr_parts.h).
-#include "exr_parts.h"
+// The pixels of one part of a multipart EXR, read and written by its index (exr_parts_pvt.h).
+#include "exr_parts_pvt.h"
 
 #include <ImfFrameBuffer.h>
 #include <ImfInputPart.h>

@@ -1,13 +1,13 @@
-// The checks before OpenEXR's C++ library reads a file (exr_screen.h): they refuse, with the rule
+// The checks before OpenEXR's C++ library reads a file (exr_screen_pvt.h): they refuse, with the rule
 // broken, what would make that library allocate or read past what the file holds.
-#include "exr_screen.h"
+#include "exr_screen_pvt.h"
 
 #include <cstring>
 #include <filesystem>
 #include <system_error>
 
-#include "exr_io.h"
-#include "header_scan.h"
+#include "exr_io_pvt.h"
+#include "header_scan_pvt.h"
 
 namespace conus::format::detail {
 

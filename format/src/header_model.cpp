@@ -2,7 +2,7 @@
 // validated as (validate_file.cpp), built in this one place.
 #include <algorithm>
 
-#include "header_model.h"
+#include "header_model_pvt.h"
 
 namespace conus::format::detail {
 namespace {

@@ -1,7 +1,7 @@
-// The raw header walk of header_scan.h. OpenEXR's layout ("OpenEXR File Layout"): magic, version
+// The raw header walk of header_scan_pvt.h. OpenEXR's layout ("OpenEXR File Layout"): magic, version
 // and flags, then one header (single part) or headers each ended by a null byte and the list ended
 // by an empty header (multipart); an attribute is name\0 type\0 int32 size, then size bytes.
-#include "header_scan.h"
+#include "header_scan_pvt.h"
 
 #include <cstring>
 #include <fstream>

@@ -8,7 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "conus/core/camera.h"
-#include "header_model.h"
+#include "header_model_pvt.h"
 
 namespace conus::format {
 namespace detail {

@@ -9,7 +9,7 @@
 #include "conus/core/camera.h"
 #include "conus/core/color.h"
 #include "conus/core/map_rules.h"
-#include "header_model.h"
+#include "header_model_pvt.h"
 
 namespace conus::format {
 namespace detail {
@@ -232,10 +232,10 @@ void checkAnalytic(const HeaderModel& m, ValidationReport& r) {
             } else {
                 for (std::size_t i = 0; i < f.size() / 4; ++i) {
                     const float u = f[4 * i], v = f[4 * i + 1], rad = f[4 * i + 2], k = f[4 * i + 3];
-                    // Written as negations so NaN fails every test.
-                    if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1 && rad > 0 && std::isfinite(rad) && k >= 1 && k <= map_rules::kMaxMagnification)) {
+                    if (!map_rules::isValidFocus(u, v, rad, k)) {
                         r.add(Rule::V12, "focus " + std::to_string(i) + " (u,v,r,k) = (" + numberText(u, 9) + ", " + numberText(v, 9) + ", " + numberText(rad, 9) + ", " +
-                                      numberText(k, 9) + "): need u,v in [0,1], r > 0 finite, k in [1," + numberText(map_rules::kMaxMagnification, 9) + "]");
+                                      numberText(k, 9) + "): need u,v in [0,1], r in (0," + numberText(map_rules::kMaxFocusRadius, 9) + "], k in [1," +
+                                      numberText(map_rules::kMaxMagnification, 9) + "]");
                     }
                 }
             }

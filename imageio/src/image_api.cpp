@@ -1,13 +1,13 @@
 // The public functions of image_file.h and text.h. Those that need OpenImageIO forward to its
-// module (oiio_module.h), so a process that never touches an image file never loads it.
+// module (oiio_module_pvt.h), so a process that never touches an image file never loads it.
 #include <algorithm>
 #include <sstream>
 
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
 #include "conus/imageio/text.h"
-#include "oiio_module.h"
-#include "png_direct.h"
+#include "oiio_module_pvt.h"
+#include "png_direct_pvt.h"
 
 namespace conus::imageio {
 

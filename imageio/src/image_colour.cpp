@@ -1,6 +1,6 @@
-// Colour by channel role through OpenImageIO (image_colour.h), and the module's linearize and
+// Colour by channel role through OpenImageIO (image_colour_pvt.h), and the module's linearize and
 // displayEncoded built from it.
-#include "image_colour.h"
+#include "image_colour_pvt.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <OpenImageIO/imagebufalgo.h>
 
 #include "conus/core/error.h"
-#include "oiio_module.h"
+#include "oiio_module_pvt.h"
 
 namespace conus::imageio::oiio {
 

@@ -1,4 +1,4 @@
-// Reading image files through OpenImageIO (oiio_module.h's readImageFile): standard input, the
+// Reading image files through OpenImageIO (oiio_module_pvt.h's readImageFile): standard input, the
 // OpenEXR screen, the part, the limits before memory, integer samples through tables, colour to
 // linear light with associated alpha, metadata, the EXIF orientation. OpenImageIO's failures
 // become conus::Error right where it is called, naming the user's path.
@@ -24,8 +24,8 @@
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "conus/format/exr_check.h"
-#include "image_colour.h"
-#include "oiio_module.h"
+#include "image_colour_pvt.h"
+#include "oiio_module_pvt.h"
 
 namespace conus::imageio::oiio {
 namespace {

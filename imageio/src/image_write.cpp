@@ -1,4 +1,4 @@
-// Writing image files through OpenImageIO (oiio_module.h's writeImageFile): what each format
+// Writing image files through OpenImageIO (oiio_module_pvt.h's writeImageFile): what each format
 // holds, channels by name, colour from linear light to what the format stores, metadata, and the
 // atomic write through an IOProxy. Failures become conus::Error naming the user's path.
 #include <algorithm>
@@ -12,8 +12,8 @@
 
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
-#include "image_colour.h"
-#include "oiio_module.h"
+#include "image_colour_pvt.h"
+#include "oiio_module_pvt.h"
 
 namespace conus::imageio::oiio {
 namespace {

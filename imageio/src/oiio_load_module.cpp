@@ -1,7 +1,7 @@
 // Shared builds: OpenImageIO (and the ~260 libraries it links: OpenCV, GDAL, FFmpeg, ...) is
 // loaded with its module the first time an image file is read or written, not at start-up.
 #include "conus/core/plugin.h"
-#include "oiio_module.h"
+#include "oiio_module_pvt.h"
 
 namespace conus::imageio {
 

@@ -1,5 +1,5 @@
 // Static builds (the fuzz harnesses): the OpenImageIO half is linked in, nothing to load.
-#include "oiio_module.h"
+#include "oiio_module_pvt.h"
 
 namespace conus::imageio {
 

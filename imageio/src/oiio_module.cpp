@@ -1,5 +1,5 @@
 // The table of the OpenImageIO module: its only exported symbol.
-#include "oiio_module.h"
+#include "oiio_module_pvt.h"
 
 extern "C" __attribute__((visibility("default"))) const conus::imageio::OiioFunctions* conusImageioOiio() {
     using namespace conus::imageio;

@@ -1,7 +1,7 @@
-// Plain PNG files through libpng, without OpenImageIO (png_direct.h says which files and why).
+// Plain PNG files through libpng, without OpenImageIO (png_direct_pvt.h says which files and why).
 // What the file's chunks become follows OpenImageIO 2.4's PNG reader, as image_read.cpp then
 // keeps it (tests/imageio/png_direct_test.cpp compares the two paths on the same files).
-#include "png_direct.h"
+#include "png_direct_pvt.h"
 
 #include <png.h>
 

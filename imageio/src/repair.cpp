@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "conus/core/error.h"
-#include "oiio_module.h"
+#include "oiio_module_pvt.h"
 
 namespace conus::imageio::oiio {
 

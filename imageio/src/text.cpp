@@ -1,4 +1,4 @@
-// Text through OpenImageIO's render_text (in the module libconus_imageio_oiio, oiio_module.h).
+// Text through OpenImageIO's render_text (in the module libconus_imageio_oiio, oiio_module_pvt.h).
 #include "conus/imageio/text.h"
 
 #include <algorithm>
@@ -9,7 +9,7 @@
 #include <OpenImageIO/imagebufalgo.h>
 
 #include "conus/core/error.h"
-#include "oiio_module.h"
+#include "oiio_module_pvt.h"
 
 namespace conus::imageio::oiio {
 

@@ -16,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/decode.h"
 #include "conus/core/enum_names.h"
 #include "conus/core/error.h"

@@ -1,4 +1,4 @@
-// What encode(foci=...)'s budget did (codec/build/foci_budget.h), as File.budget shows it, and the
+// What encode(foci=...)'s budget did (codec/builders/foci_budget.h), as File.budget shows it, and the
 // warning it gives. Included by module.cpp only.
 #pragma once
 
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/build/foci_budget.h"
+#include "conus/codec/builders/foci_budget.h"
 #include "conus/core/error.h"
 #include "arguments.h"
 

@@ -10,11 +10,11 @@
 #include <tuple>
 #include <vector>
 
-#include "conus/codec/build/auto_map.h"
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/frame_budget.h"
-#include "conus/codec/build/map_measures.h"
-#include "conus/codec/build/springs.h"
+#include "conus/codec/builders/auto_map.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/frame_budget.h"
+#include "conus/codec/builders/map_measures.h"
+#include "conus/codec/builders/springs.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
 #include "conus/imageio/image_file.h"
@@ -56,14 +56,6 @@ py::array mapPoints(const py::array& input, F&& f) {
     return out;
 }
 
-// "'detail' or 'faces'": the rules' names, for messages.
-std::string ruleNames() {
-    std::string text;
-    for (std::size_t i = 0; i < codec::kImportanceRuleNames.size(); ++i)
-        text += std::string(i == 0 ? "'" : i + 1 == codec::kImportanceRuleNames.size() ? " or '" : ", '") +
-                codec::kImportanceRuleNames[i] + "'";
-    return text;
-}
 
 }  // namespace
 
@@ -203,14 +195,14 @@ void addMaps(py::module_& m) {
         "importance",
         [](py::object pixels, const std::string& kind, py::object channels) {
             const Image image = pixelsFrom(pixels, channelsFrom(channels), "pixels");
-            const std::optional<codec::ImportanceRule> rule = codec::parseImportanceRule(kind);
-            if (!rule) throw Error(ErrorCode::InvalidArgument, "importance: kind '" + kind + "' is not " + ruleNames());
+            const std::optional<codec::ImportanceRule> rule = tryParseEnum<codec::ImportanceRule>(kind);
+            if (!rule) throw Error(ErrorCode::InvalidArgument, "importance: kind '" + kind + "' is not one of " + enumChoices<codec::ImportanceRule>());
             py::gil_scoped_release release;
             Image out = pictureImportance(*rule, image);
             py::gil_scoped_acquire acquire;
             return toArray(std::move(out));
         },
-        py::arg("pixels"), py::arg("kind") = "detail", py::arg("channels") = py::none(),
+        py::arg("pixels"), py::arg("kind") = enumName(codec::ImportanceRule::Detail), py::arg("channels") = py::none(),
         "The picture's own importance for Map.auto, as `--importance KIND`: \"detail\", the gradient magnitude of\n"
         "its display-encoded luminance, or \"faces\", a soft disc over each face found in it (conus.Error when\n"
         "none is); (H', W', 1) at most 1024 px a side");

@@ -7,7 +7,7 @@
 
 #include <optional>
 
-#include "conus/codec/build/importance.h"
+#include "conus/codec/builders/importance.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/image.h"
 #include "conus/format/container.h"

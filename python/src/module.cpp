@@ -26,10 +26,10 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/foci_budget.h"
-#include "conus/codec/build/frame_budget.h"
-#include "conus/codec/build/importance.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/foci_budget.h"
+#include "conus/codec/builders/frame_budget.h"
+#include "conus/codec/builders/importance.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
@@ -157,13 +157,13 @@ void fitTo(const Image& source, const codec::SamplingMap& map, Image& encoded, i
 }
 
 std::pair<int, int> sizeOr(const std::optional<std::pair<int, int>>& size, int w, int h) {
-    return size ? *size : std::pair<int, int>{std::max(1, (w + 2) / 4), std::max(1, (h + 2) / 4)};
+    return size ? *size : codec::defaultConusSize(w, h);
 }
 
 // A map made for pictures of another aspect stretches its foci into ellipses: say so.
 void checkAspect(const Map& map, const Image& picture) {
     const double aspect = double(picture.width) / picture.height;
-    if (!map.aspect || std::abs(std::log(*map.aspect / aspect)) < 0.01) return;
+    if (!map.aspect || !codec::aspectsDiffer(*map.aspect, aspect)) return;
     char text[256];
     std::snprintf(text, sizeof text,
                   "the map was made for pictures of aspect %.3g (width / height) and this one's is %.3g: its foci become "
@@ -268,6 +268,7 @@ PYBIND11_MODULE(_conus, m) {
             if (map) checkAspect(*map, source);
             const double aspect = double(source.width) / source.height;
             const auto [w, h] = sizeOr(size, source.width, source.height);
+            if (map) codec::checkGridForImage(std::max(map->map.columns(), map->map.rows()), w, h, "the map's grid of");
             codec::checkEncodeMemory(source, w, h);  // before a map is built for it
             std::optional<codec::FociBudget> budget;
             // The budgets' model takes this encode's errors: on what a display shows (data as stored),

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "context_pvt.h"
-#include "shader_constants.h"
+#include "shader_constants_pvt.h"
 #include "conus/core/error.h"
 
 namespace conus::renderers {

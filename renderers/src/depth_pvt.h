@@ -14,7 +14,7 @@
 #include "conus/codec/depth/glsl_interface.h"
 #include "conus/renderers/depth_frames.h"
 #include "context_pvt.h"
-#include "gl_objects.h"
+#include "gl_objects_pvt.h"
 
 namespace conus::renderers {
 

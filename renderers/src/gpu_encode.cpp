@@ -11,9 +11,9 @@
 #include "context_pvt.h"
 #include "conus/renderers/gpu_image.h"
 #include "embedded_shaders.h"
-#include "gl_objects.h"
-#include "gpu_encode_plan.h"
-#include "gpu_pass.h"
+#include "gl_objects_pvt.h"
+#include "gpu_encode_plan_pvt.h"
+#include "gpu_pass_pvt.h"
 
 namespace conus::renderers {
 namespace {

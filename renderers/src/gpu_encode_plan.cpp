@@ -1,5 +1,5 @@
-// The GPU encoder's plan on the CPU (gpu_encode_plan.h): the mesh, the pyramid's layout, the tiles.
-#include "gpu_encode_plan.h"
+// The GPU encoder's plan on the CPU (gpu_encode_plan_pvt.h): the mesh, the pyramid's layout, the tiles.
+#include "gpu_encode_plan_pvt.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
-// What the GPU image encoder and decoder share (gpu_pass.h).
-#include "gpu_pass.h"
+// What the GPU image encoder and decoder share (gpu_pass_pvt.h).
+#include "gpu_pass_pvt.h"
 
 #include "context_pvt.h"
 #include "conus/core/error.h"

@@ -19,8 +19,8 @@
 #include "context_pvt.h"
 #include "embedded_shaders.h"
 #include "frame_pvt.h"
-#include "gl_objects.h"
-#include "shader_constants.h"
+#include "gl_objects_pvt.h"
+#include "shader_constants_pvt.h"
 
 namespace conus::renderers {
 namespace {

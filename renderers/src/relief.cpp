@@ -15,7 +15,7 @@
 #include "depth_pvt.h"
 #include "embedded_shaders.h"
 #include "frame_pvt.h"
-#include "gl_objects.h"
+#include "gl_objects_pvt.h"
 
 namespace conus::renderers {
 namespace {

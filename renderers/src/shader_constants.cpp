@@ -1,4 +1,4 @@
-#include "shader_constants.h"
+#include "shader_constants_pvt.h"
 
 #include "conus/codec/depth/glsl_interface.h"
 #include "conus/codec/image/decode.h"
@@ -13,7 +13,7 @@ namespace {
 using codec::glslFloat;
 
 std::string constantsBlock() {
-    std::string s = "// shared with C++ (renderers/src/shader_constants.h)\n";
+    std::string s = "// shared with C++ (renderers/src/shader_constants_pvt.h)\n";
     s += codec::glslConstants();  // equation1.inc.glsl and intersect.inc.glsl's
     s += "const int kEncodeMaxTaps = " + std::to_string(codec::kEncodeMaxTaps) + ";\n";
     s += "const float kEncodeTapTolerance = " + glslFloat(codec::kEncodeTapTolerance) + ";\n";

@@ -9,7 +9,7 @@
 #include "conus/core/display.h"
 #include "conus/core/parallel.h"
 #include "conus/renderers/backend.h"
-#include "shader_constants.h"
+#include "shader_constants_pvt.h"
 #include "view_renderer_pvt.h"
 
 namespace conus::renderers {

@@ -21,8 +21,8 @@
 #include "conus/renderers/gpu_image.h"
 #include "conus/renderers/view_renderer.h"
 #include "embedded_shaders.h"
-#include "gl_objects.h"
-#include "shader_constants.h"
+#include "gl_objects_pvt.h"
+#include "shader_constants_pvt.h"
 #include "view_renderer_pvt.h"
 
 namespace conus::renderers {

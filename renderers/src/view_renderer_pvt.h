@@ -10,7 +10,7 @@
 
 #include "context_pvt.h"
 #include "conus/renderers/view_renderer.h"
-#include "gl_objects.h"
+#include "gl_objects_pvt.h"
 
 namespace conus::renderers {
 

@@ -13,7 +13,7 @@
 #include "conus/codec/depth/glsl_interface.h"
 #include "context_pvt.h"
 #include "embedded_shaders.h"
-#include "gl_objects.h"
+#include "gl_objects_pvt.h"
 
 namespace conus::renderers {
 namespace {

@@ -3,7 +3,7 @@
 #include <regex>
 
 #include "embedded_shaders.h"
-#include "shader_constants.h"
+#include "shader_constants_pvt.h"
 
 namespace conus::renderers {
 

@@ -36,7 +36,7 @@
 #include "conus/sceneio/named_files.h"
 #include "extension_pvt.h"
 #include "mesh_headers_pvt.h"
-#include "scene_screen.h"
+#include "scene_screen_pvt.h"
 
 // Debian's Assimp keeps its internal assertions, which abort the process (a hostile PLY reaches
 // one in the triangulation step). This definition takes the place of Assimp's own (the library

@@ -1,6 +1,6 @@
-// The text screen of scene files (scene_screen.h): nesting depth by a streaming scan of the bytes,
+// The text screen of scene files (scene_screen_pvt.h): nesting depth by a streaming scan of the bytes,
 // then glTF's node tree from its JSON, parsed only once the nesting is known to be shallow.
-#include "scene_screen.h"
+#include "scene_screen_pvt.h"
 
 #include <algorithm>
 #include <cctype>

@@ -262,5 +262,32 @@ TEST_F(BudgetCli, NoFocusFollowsTheDetailAndBeatsUniform) {
     EXPECT_GT(map.density({0.75, 0.3}), 1.2 * map.density({0.25, 0.9}));
 }
 
+// The budget's confirming encode of the map it keeps is the file's encode (not made a second time):
+// the file `encode --focus` writes holds the same pixels, read back by OIIO, as an encode through
+// that file's own map (`--map`, no budget: a fresh encode and fit), and both say the same fit.
+TEST_F(BudgetCli, TheConfirmingEncodeIsTheFilesEncode) {
+    const std::string picture = texturedPicture(path("t.png"), 320, 240);
+    for (const std::string k : {"", " --exact-k"}) {
+        SCOPED_TRACE(k);
+        const Result held = run("encode " + picture + " --focus 0.62,0.4,0.13,3" + k + " --size 80x60 --float -o " + path("held.exr"));
+        ASSERT_EQ(held.exitCode, 0) << held.err;
+        const Result again = run("encode " + picture + " --map " + path("held.exr") + " --size 80x60 --float -o " + path("again.exr"));
+        ASSERT_EQ(again.exitCode, 0) << again.err;
+        const ExrRead a = readExr(path("held.exr")), b = readExr(path("again.exr"));
+        ASSERT_EQ(a.width, 80);
+        ASSERT_EQ(b.width, 80);
+        double worst = 0;
+        for (const char* c : {"R", "G", "B"})
+            for (std::size_t p = 0; p < a.channels.at(c).size(); ++p)
+                worst = std::max(worst, double(std::abs(a.channels.at(c)[p] - b.channels.at(c)[p])));
+        EXPECT_LT(worst, 1e-4);  // the map read back from the file is the map kept, to float precision
+        const auto fitted = [](const std::string& text) { return numbersAfter(text, "decoded PSNR"); };
+        ASSERT_FALSE(fitted(held.out + held.err).empty()) << held.out << held.err;
+        ASSERT_FALSE(fitted(again.out + again.err).empty()) << again.out << again.err;
+        EXPECT_NEAR(fitted(held.out + held.err)[0], fitted(again.out + again.err)[0], 0.01);
+        EXPECT_NEAR(fitted(held.out + held.err).back(), fitted(again.out + again.err).back(), 0.01);
+    }
+}
+
 }  // namespace
 }  // namespace conus::test

@@ -59,7 +59,7 @@ inline ExrRead readExr(const std::string& path) {
     return r;
 }
 
-// A camera-depth image as `conus mesh render` and `conus volume render` write it: width x height,
+// A camera-depth image as `conus render mesh` and `conus render volume` write it: width x height,
 // the channels R, G, B, A (coverage) and Z, the data kind and depth kind. Wrap the call in
 // ASSERT_NO_FATAL_FAILURE: a wrong size or a missing channel stops the test.
 inline void expectCameraDepthImage(const ExrRead& exr, int width, int height) {

@@ -15,8 +15,8 @@
 
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/metrics.h"
-#include "conus/codec/build/foci.h"
-#include "conus/codec/build/map_measures.h"
+#include "conus/codec/builders/foci.h"
+#include "conus/codec/builders/map_measures.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
 #include "cli_fixture.h"

@@ -28,7 +28,7 @@ TEST_F(Cli, HeightFieldEncodeDecodeAndCompare) {
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.err.find("needs GL"), std::string::npos) << r.err;
 
-    r = run("heightfield render " + path("t.exr") + " -o " + path("cmp.png") + " --size 160x90 --compare procedural:256:7");
+    r = run("render heightfield " + path("t.exr") + " -o " + path("cmp.png") + " --size 160x90 --compare procedural:256:7");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("PSNR vs full resolution: CoNUS"), std::string::npos) << r.out;
 
@@ -51,7 +51,7 @@ TEST_F(Cli, TheDefaultHeightFieldBeatsUniformFromItsViewer) {
         Result r = run("heightfield encode " + dem + " -o " + path("t.exr") + " --size " + size);
         ASSERT_EQ(r.exitCode, 0) << r.err;
         EXPECT_NE(r.out.find("terrain rows"), std::string::npos) << r.out;
-        r = run("heightfield render " + path("t.exr") + " -o " + path("cmp.png") + " --size 320x180 --compare " + dem);
+        r = run("render heightfield " + path("t.exr") + " -o " + path("cmp.png") + " --size 320x180 --compare " + dem);
         ASSERT_EQ(r.exitCode, 0) << r.err;
         const std::size_t line = r.out.find("PSNR vs full resolution:");
         ASSERT_NE(line, std::string::npos) << r.out;

@@ -4,7 +4,7 @@
 // bounded memory. The small reproducers are committed as fuzz seeds, so most cases never skip.
 #include "hostile_fixture.h"
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/map/sampling_map.h"
 
 namespace {

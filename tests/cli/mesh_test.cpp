@@ -1,4 +1,4 @@
-// `conus mesh render|animate` through the real binary; outputs read back with OpenImageIO.
+// `conus render mesh|animate` through the real binary; outputs read back with OpenImageIO.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -39,7 +39,7 @@ using Mesh = Cli;
 
 TEST_F(Mesh, RenderWritesACameraDepthImageThatOpenImageIoReads) {
     const std::string obj = writeObj(m_dir / "cube.obj");
-    const Result r = run("mesh render " + obj + " -o " + path("cube.exr") +
+    const Result r = run("render mesh " + obj + " -o " + path("cube.exr") +
                          " --size 96x64 --focus 0.35,0.4,0.12,3 --backend egl --camera 0.4,0.6,3,0.1,0,0,40");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("wrote"), std::string::npos);
@@ -88,7 +88,7 @@ TEST_F(Mesh, RenderWritesACameraDepthImageThatOpenImageIoReads) {
 
 TEST_F(Mesh, DecodeGivesColourAndNearestDepth) {
     const std::string obj = writeObj(m_dir / "cube.obj");
-    ASSERT_EQ(run("mesh render " + obj + " -o " + path("cube.exr") +
+    ASSERT_EQ(run("render mesh " + obj + " -o " + path("cube.exr") +
                   " --size 96x64 --focus 0.35,0.4,0.12,3 --backend egl --camera 0.4,0.6,3,0.1,0,0,40").exitCode, 0);
     const Result r = run("decode " + path("cube.exr") + " -o " + path("view.exr") + " --size 192x128");
     ASSERT_EQ(r.exitCode, 0) << r.err;
@@ -113,8 +113,8 @@ TEST_F(Mesh, DecodeGivesColourAndNearestDepth) {
 TEST_F(Mesh, GpuAgreesWithTheEmbreeReference) {
     const std::string obj = writeObj(m_dir / "cube.obj");
     const std::string common = " --size 96x64 --focus 0.35,0.4,0.12,3 --camera 0.4,0.6,3,0.1,0,0,40 --samples 4";
-    ASSERT_EQ(run("mesh render " + obj + " -o " + path("gpu.exr") + common + " --backend osmesa --max-edge 0.25").exitCode, 0);
-    const Result ref = run("mesh render " + obj + " -o " + path("ref.exr") + common + " --reference");
+    ASSERT_EQ(run("render mesh " + obj + " -o " + path("gpu.exr") + common + " --backend osmesa --max-edge 0.25").exitCode, 0);
+    const Result ref = run("render mesh " + obj + " -o " + path("ref.exr") + common + " --reference");
     ASSERT_EQ(ref.exitCode, 0) << ref.err;
     EXPECT_NE(ref.out.find("cpu"), std::string::npos);
     EXPECT_GE(psnrRgb(readExr(path("gpu.exr")), readExr(path("ref.exr"))), 30.0);
@@ -123,11 +123,11 @@ TEST_F(Mesh, GpuAgreesWithTheEmbreeReference) {
 TEST_F(Mesh, AFocusEnlargesTheModelAndUniformIsTheBaseline) {
     const std::string obj = writeObj(m_dir / "cube.obj");
     const std::string common = " --size 96x64 --camera 0.4,0.6,6,0.1,0,0,30 --backend egl";
-    ASSERT_EQ(run("mesh render " + obj + " -o " + path("u.exr") + common + " --uniform").exitCode, 0);
-    ASSERT_EQ(run("mesh render " + obj + " -o " + path("f.exr") + common + " --focus 0.5,0.5,0.15,4").exitCode, 0);
+    ASSERT_EQ(run("render mesh " + obj + " -o " + path("u.exr") + common + " --uniform").exitCode, 0);
+    ASSERT_EQ(run("render mesh " + obj + " -o " + path("f.exr") + common + " --focus 0.5,0.5,0.15,4").exitCode, 0);
     EXPECT_GT(covered(readExr(path("f.exr"))), 2.0 * covered(readExr(path("u.exr"))));
     // Foci compose by density, as encode, volume and map compose them.
-    ASSERT_EQ(run("mesh render " + obj + " -o " + path("two.exr") + common + " --focus 0.3,0.5,0.1,3 --focus 0.7,0.5,0.1,3")
+    ASSERT_EQ(run("render mesh " + obj + " -o " + path("two.exr") + common + " --focus 0.3,0.5,0.1,3 --focus 0.7,0.5,0.1,3")
                   .exitCode,
               0);
     const format::ConusFile two = format::readConusFile(path("two.exr"));
@@ -137,7 +137,7 @@ TEST_F(Mesh, AFocusEnlargesTheModelAndUniformIsTheBaseline) {
 
 TEST_F(Mesh, DefaultCameraFramesTheModel) {
     const std::string obj = writeObj(m_dir / "cube.obj");
-    const Result r = run("mesh render " + obj + " -o " + path("d.exr") + " --size 64x64 --uniform -q");
+    const Result r = run("render mesh " + obj + " -o " + path("d.exr") + " --size 64x64 --uniform -q");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_TRUE(r.err.empty()) << r.err;  // -q: no progress
     const ExrRead exr = readExr(path("d.exr"));
@@ -153,7 +153,7 @@ TEST_F(Mesh, DefaultCameraFramesTheModel) {
 }
 
 TEST_F(Mesh, CityWithTrackedCars) {
-    const Result r = run("mesh render city -o " + path("c.exr") + " --size 128x72 --track 0,2 --time 2 --backend egl");
+    const Result r = run("render mesh city -o " + path("c.exr") + " --size 128x72 --track 0,2 --time 2 --backend egl");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const ExrRead exr = readExr(path("c.exr"));
     EXPECT_EQ(exr.width, 128);
@@ -170,11 +170,11 @@ std::pair<long, long> triangleCounts(const std::string& out, const char* format)
     return {before, after};
 }
 
-// The city through two tracked cars at the default size, as `conus mesh render` draws it by default
+// The city through two tracked cars at the default size, as `conus render mesh` draws it by default
 // (split on the GPU where the map bends), against the Embree reference, beside no split and the
 // uniform CPU split to half a map cell (--max-edge 0.5).
 TEST_F(Mesh, TheCityFollowsTheMapWhereItBends) {
-    const std::string city = "mesh render city --track 0,2 --time 1 -o ";
+    const std::string city = "render mesh city --track 0,2 --time 1 -o ";
     const Result bend = run(city + path("bend.exr") + " --backend egl");
     ASSERT_EQ(bend.exitCode, 0) << bend.err;
     EXPECT_NE(bend.out.find("where the map bends"), std::string::npos) << bend.out;
@@ -209,14 +209,14 @@ TEST_F(Mesh, BadInputIsOneLineAndNonZero) {
     const struct {
         std::string args, says;
     } cases[] = {
-        {"mesh render " + path("missing.obj") + " -o " + path("x.exr"), "missing.obj"},
-        {"mesh render " + obj + " -o " + path("x.png"), ".exr"},
-        {"mesh render " + obj + " -o " + path("x.exr") + " --track 0", "city"},
-        {"mesh render " + obj + " -o " + path("x.exr") + " --camera 1,2,3", "7 values"},
-        {"mesh render " + obj + " -o " + path("x.exr") + " --camera 0,0,-5,0,0,-10,40", "behind"},
-        {"mesh render city -o " + path("x.exr") + " --track 99", "cars"},
+        {"render mesh " + path("missing.obj") + " -o " + path("x.exr"), "missing.obj"},
+        {"render mesh " + obj + " -o " + path("x.png"), ".exr"},
+        {"render mesh " + obj + " -o " + path("x.exr") + " --track 0", "city"},
+        {"render mesh " + obj + " -o " + path("x.exr") + " --camera 1,2,3", "7 values"},
+        {"render mesh " + obj + " -o " + path("x.exr") + " --camera 0,0,-5,0,0,-10,40", "behind"},
+        {"render mesh city -o " + path("x.exr") + " --track 99", "cars"},
         {"mesh animate " + obj + " --out-dir " + path("d") + " --frames 2", "city"},
-        {"mesh render " + path("past.gltf") + " -o " + path("x.exr"), "indexes past"},
+        {"render mesh " + path("past.gltf") + " -o " + path("x.exr"), "indexes past"},
     };
     test::writeGltfCube(path("past.gltf"), 9);
     for (const auto& c : cases) {
@@ -229,7 +229,7 @@ TEST_F(Mesh, BadInputIsOneLineAndNonZero) {
     EXPECT_TRUE(leftovers().empty());
     // A degenerate triangle is dropped, and the warning says so even with -q.
     writeText(path("flat.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n");
-    const Result r = run("mesh render " + path("flat.obj") + " -o " + path("flat.exr") + " --uniform --size 32x32 -q");
+    const Result r = run("render mesh " + path("flat.obj") + " -o " + path("flat.exr") + " --uniform --size 32x32 -q");
     EXPECT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("dropped 1 of 2 triangles, degenerate"), std::string::npos) << r.err;
 }

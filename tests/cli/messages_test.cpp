@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <OpenImageIO/imageio.h>
 
@@ -107,7 +109,7 @@ TEST_F(Cli, SpringStrokesInlineOrFromAFile) {
 TEST_F(Cli, UsageErrorsExitWithTwoBeforeAnyWork) {
     const std::string cases[] = {
         "heightfield encode procedural:64 -o " + path("t.exr") + " --compression foo",
-        "heightfield render " + path("t.exr") + " -o " + path("f.png") + " --backend cpu",
+        "render heightfield " + path("t.exr") + " -o " + path("f.png") + " --backend cpu",
         "decode " + path("t.exr") + " -o " + path("f.png") + " --tonemap sideways",
         "encode " + path("t.png") + " -o " + path("t.exr") + " --input-colorspace cmyk",
     };
@@ -117,13 +119,13 @@ TEST_F(Cli, UsageErrorsExitWithTwoBeforeAnyWork) {
         EXPECT_EQ(countLines(r.err, ""), 1) << args << "\n" << r.err;
     }
     // cpu is not offered where there is no CPU path.
-    const Result help = run("heightfield render --help");
+    const Result help = run("render heightfield --help");
     EXPECT_EQ(help.out.find("cpu"), std::string::npos) << help.out;
 }
 
 TEST_F(Cli, EveryCommandsHelpHasExamplesAndTheExitCodesAreDocumented) {
     for (const char* command : {"encode", "uniform", "decode", "info", "validate", "demo", "map", "map springs",
-                                "heightfield encode", "heightfield render"}) {
+                                "heightfield encode", "render heightfield"}) {
         const Result r = run(std::string(command) + " --help");
         EXPECT_EQ(r.exitCode, 0) << command;
         EXPECT_NE(r.out.find("Examples:"), std::string::npos) << command << "\n" << r.out;
@@ -208,7 +210,7 @@ TEST_F(Cli, ACommandThatFailsLeavesNoneOfItsOutputs) {
     EXPECT_FALSE(fs::exists(path("m.exr")));
     EXPECT_EQ(r.out.find("wrote"), std::string::npos) << "nothing said written: " << r.out;
     // A volume's picture, likewise.
-    r = run("volume render procedural:shepp-logan:16 -o " + path("v.exr") + " --size 16x16 --uniform --picture " +
+    r = run("render volume procedural:shepp-logan:16 -o " + path("v.exr") + " --size 16x16 --uniform --picture " +
             path(unwritableName(".png")));
     EXPECT_EQ(r.exitCode, 1) << r.err;
     EXPECT_FALSE(fs::exists(path("v.exr")));
@@ -292,4 +294,36 @@ TEST_F(Cli, AMisspeltOptionIsNamedWithTheOneMeant) {
     EXPECT_EQ(WEXITSTATUS(std::system(command.c_str())), 2);
     EXPECT_NE(slurp(path("view.txt")).find("did you mean --screenshot?"), std::string::npos) << slurp(path("view.txt"));
     EXPECT_FALSE(fs::exists(path("x.exr")) || fs::exists(path("m.exr")));
+}
+
+// One word order for render: `conus render mesh|volume|heightfield`. The old order still runs the
+// same command and says the new spelling on stderr; the new order says nothing of it.
+TEST_F(Cli, TheOldRenderWordOrderIsAnAliasThatSaysTheNewOne) {
+    const std::string common = " --size 24x16 --uniform --backend cpu -q";
+    const Result old = run("volume render procedural:shepp-logan:16 -o " + path("old.exr") + common);
+    ASSERT_EQ(old.exitCode, 0) << old.err;
+    EXPECT_EQ(old.err, "conus: `conus volume render` is spelled `conus render volume` now\n");
+    const Result now = run("render volume procedural:shepp-logan:16 -o " + path("new.exr") + common);
+    ASSERT_EQ(now.exitCode, 0) << now.err;
+    EXPECT_EQ(now.err, "");
+    // The same command: the same pixels, read back with OpenImageIO.
+    std::vector<float> a, b;
+    for (const auto& [file, pixels] : {std::pair{path("old.exr"), &a}, std::pair{path("new.exr"), &b}}) {
+        auto in = OIIO::ImageInput::open(file);
+        ASSERT_TRUE(in) << file;
+        const OIIO::ImageSpec& spec = in->spec();
+        EXPECT_EQ(spec.width, 24);
+        pixels->resize(std::size_t(spec.width) * spec.height * spec.nchannels);
+        ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels->data()));
+    }
+    EXPECT_EQ(a, b);
+    // Errors and help under the old order are the new command's; the groups' help names the new order.
+    const Result bad = run("mesh render " + path("missing.obj") + " -o " + path("x.exr"));
+    EXPECT_NE(bad.exitCode, 0);
+    EXPECT_NE(bad.err.find("spelled `conus render mesh` now\nconus render: "), std::string::npos) << bad.err;
+    const Result help = run("heightfield render --help");
+    EXPECT_EQ(help.exitCode, 0) << help.err;
+    EXPECT_NE(help.out.find("render heightfield"), std::string::npos) << help.out;
+    EXPECT_NE(run("mesh --help").out.find("`conus render mesh`"), std::string::npos);
+    EXPECT_NE(run("render --help").out.find("heightfield"), std::string::npos);
 }

@@ -114,7 +114,7 @@ TEST_F(Cli, AnOutputThatIsAnInputIsRefusedByAnyPathAndTheInputIsUnchanged) {
         "decode " + a + " -o " + path("sub/up.exr"),
         "render relief " + path("t.exr") + " -o " + path("t.exr"),
         "bake relief " + picture + " -o " + picture,
-        "volume render procedural:shepp-logan:16 -o " + a + " --map " + a + " --size 16x16",
+        "render volume procedural:shepp-logan:16 -o " + a + " --map " + a + " --size 16x16",
         // A batch whose --out-dir is the inputs' own folder.
         "encode " + path("in/b.exr") + " " + picture + " --out-dir " + path("in") + " --name {name} --size 16x12",
         "decode " + path("in/b.exr") + " --out-dir " + path("in") + " --name {name}",
@@ -158,7 +158,7 @@ TEST_F(Cli, TwoOutputsOfOneCommandThatAreOneFileAreRefused) {
         "map foci --focus 0.5,0.5,0.1,3 -o " + path("m.exr") + " --preview " + path("m.exr"),
         "map foci --focus 0.5,0.5,0.1,3 -o " + path("new.exr") + " --preview " + path("./new.exr"),
         "map foci --focus 0.5,0.5,0.1,3 -o " + path("m.exr") + " --preview " + path("alias.exr"),
-        "volume render procedural:shepp-logan:16 -o " + path("v.exr") + " --picture " + path("v.exr") + " --size 16x16",
+        "render volume procedural:shepp-logan:16 -o " + path("v.exr") + " --picture " + path("v.exr") + " --size 16x16",
     };
     for (const std::string& command : commands) {
         const Result r = run(command);

@@ -128,8 +128,8 @@ TEST_F(ReaderHostile, AVolumeTextureNamedByAMeshIsRefused) {
     write("m/vol.dds", dds(4, 4, 4, false));
     write("m/tex.mtl", "newmtl t\nKd 1 1 1\nmap_Kd vol.dds\n");
     write("m/tri.obj", "mtllib tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3\n");
-    Outcome r = run({"mesh", "render", path("m/tri.obj"), "-o", path("x.exr"), "--size", "32x32"});
-    expectRefused(r, "mesh", "a volume texture of 4x4x4 samples");
+    Outcome r = run({"render", "mesh", path("m/tri.obj"), "-o", path("x.exr"), "--size", "32x32"});
+    expectRefused(r, "render", "a volume texture of 4x4x4 samples");
     expectMemory(r, 400);
     r = run({"bake", "reflection", path("m/tri.obj"), "--size", "8", "-o", path("a.exr")});
     expectRefused(r, "bake", "a volume texture");
@@ -230,9 +230,9 @@ TEST_F(ReaderHostile, DeepAndInstancedGltfNodeTreesAreRefusedBeforeAssimp) {
         g.insert(g.size() - 1, ", \"extras\": " + std::string(300000, '[') + std::string(300000, ']'));
         return g;
     }());
-    Outcome r = run({"mesh", "render", path("chain_at_limit.gltf"), "-o", path("ok.exr"), "--size", "32x32"});
+    Outcome r = run({"render", "mesh", path("chain_at_limit.gltf"), "-o", path("ok.exr"), "--size", "32x32"});
     EXPECT_EQ(r.exitCode, 0) << r.err;  // at the limit: Assimp's recursion is fine
-    r = run({"mesh", "render", path("dag_12.gltf"), "-o", path("dag.exr"), "--size", "32x32"});
+    r = run({"render", "mesh", path("dag_12.gltf"), "-o", path("dag.exr"), "--size", "32x32"});
     EXPECT_EQ(r.exitCode, 0) << r.err;  // 4096 instances: within every cap
     const struct {
         const char* file;
@@ -246,8 +246,8 @@ TEST_F(ReaderHostile, DeepAndInstancedGltfNodeTreesAreRefusedBeforeAssimp) {
     };
     for (const auto& c : cases) {
         SCOPED_TRACE(c.file);
-        r = run({"mesh", "render", path(c.file), "-o", path("x.exr"), "--size", "32x32"});
-        expectRefused(r, "mesh", c.reason);
+        r = run({"render", "mesh", path(c.file), "-o", path("x.exr"), "--size", "32x32"});
+        expectRefused(r, "render", c.reason);
         expectMemory(r, 300);
         r = run({"bake", "reflection", path(c.file), "--size", "8", "-o", path("a.exr")});
         expectRefused(r, "bake", c.reason);
@@ -259,8 +259,8 @@ TEST_F(ReaderHostile, DeepAndInstancedGltfNodeTreesAreRefusedBeforeAssimp) {
     for (const char* name : {"mesh/deep_nodes_20000.gltf", "mesh/instance_dag_4M.gltf"}) {
         const std::string file = round4(name);
         CONUS_REQUIRE(file);
-        r = run({"mesh", "render", file, "-o", path("x.exr"), "--size", "32x32"});
-        expectRefused(r, "mesh", "its node tree");
+        r = run({"render", "mesh", file, "-o", path("x.exr"), "--size", "32x32"});
+        expectRefused(r, "render", "its node tree");
         expectMemory(r, 300);
     }
 }
@@ -271,8 +271,8 @@ TEST_F(ReaderHostile, TrianglesAfterInstancingCountAgainstTheCap) {
     std::string g = dagGltf(10);  // 1024 instances of an accessor that claims 2^15 corners...
     g.replace(g.find("\"count\": 3"), 10, "\"count\": 98304");
     write("many.gltf", g);
-    const Outcome r = run({"mesh", "render", path("many.gltf"), "-o", path("x.exr"), "--size", "32x32"});
-    expectRefused(r, "mesh", "its nodes instance more than " + std::to_string(conus::kMaxMeshTriangles) + " triangles");
+    const Outcome r = run({"render", "mesh", path("many.gltf"), "-o", path("x.exr"), "--size", "32x32"});
+    expectRefused(r, "render", "its nodes instance more than " + std::to_string(conus::kMaxMeshTriangles) + " triangles");
     expectMemory(r, 300);
 }
 
@@ -328,7 +328,7 @@ TEST_F(ReaderHostile, DeepColladaAndX3dAreRefused) {
     write("xml_20000.dae", collada(20000));
     write("deep.x3d", x3d(20000));
     write("deep_comments.x3d", "<!-- <a><b><c> -->" + x3d(20000));
-    Outcome r = run({"mesh", "render", path("shallow.dae"), "-o", path("ok.exr"), "--size", "32x32"});
+    Outcome r = run({"render", "mesh", path("shallow.dae"), "-o", path("ok.exr"), "--size", "32x32"});
     EXPECT_EQ(r.exitCode, 0) << r.err;
     const struct {
         const char* file;
@@ -342,8 +342,8 @@ TEST_F(ReaderHostile, DeepColladaAndX3dAreRefused) {
     };
     for (const auto& c : cases) {
         SCOPED_TRACE(c.file);
-        r = run({"mesh", "render", path(c.file), "-o", path("x.exr"), "--size", "32x32"});
-        expectRefused(r, "mesh", c.reason);
+        r = run({"render", "mesh", path(c.file), "-o", path("x.exr"), "--size", "32x32"});
+        expectRefused(r, "render", c.reason);
         expectMemory(r, 300);
         r = run({"bake", "reflection", path(c.file), "--size", "8", "-o", path("a.exr")});
         expectRefused(r, "bake", c.reason);
@@ -371,7 +371,7 @@ TEST_F(ReaderHostile, AMaterialLibraryIsCheckedBeforeItIsOpened) {
                  {"model/fifo.obj", "not a regular file", ""}};
     for (const auto& c : cases) {
         SCOPED_TRACE(c.file);
-        Outcome r = run({"mesh", "render", path(c.file), "-o", path("x.exr"), "--size", "32x32"});
+        Outcome r = run({"render", "mesh", path(c.file), "-o", path("x.exr"), "--size", "32x32"});
         expectRefusedQuietly(r, "mesh", c.reason, c.secret);
         expectMemory(r, 300);
         r = run({"bake", "reflection", path(c.file), "--size", "8", "-o", path("a.exr")});
@@ -383,7 +383,7 @@ TEST_F(ReaderHostile, AMaterialLibraryIsCheckedBeforeItIsOpened) {
     }
     const std::string shared = round4("mesh/model/mtllib_passwd.obj");
     CONUS_REQUIRE(shared);
-    const Outcome r = run({"mesh", "render", shared, "-o", path("x.exr")});
+    const Outcome r = run({"render", "mesh", shared, "-o", path("x.exr")});
     expectRefusedQuietly(r, "mesh", "outside its folder", "root:");
 }
 
@@ -417,7 +417,7 @@ TEST_F(ReaderHostile, NrrdDataFilesAreVettedInAnyCaseAndLineEnding) {
         SCOPED_TRACE(c.text);
         const std::string name = "data/h" + std::to_string(n++) + ".nhdr";
         write(name, c.text);
-        const Outcome r = run({"volume", "render", path(name), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+        const Outcome r = run({"render", "volume", path(name), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
         expectRefusedQuietly(r, "volume", c.reason, "root:");
         expectMemory(r, 300);
         EXPECT_FALSE(fs::exists(path("v.exr")));
@@ -429,12 +429,12 @@ TEST_F(ReaderHostile, NrrdDataFilesAreVettedInAnyCaseAndLineEnding) {
     // A data file beside the header reads whatever the line ends and the field's case.
     for (const std::string eol : {"\n", "\r\n", "\r"}) {
         write("data/ok.nhdr", header("DATA FILE", "cube.raw", eol));
-        const Outcome r = run({"volume", "render", path("data/ok.nhdr"), "-o", path("ok.exr"), "--size", "16x16", "--backend", "cpu"});
+        const Outcome r = run({"render", "volume", path("data/ok.nhdr"), "-o", path("ok.exr"), "--size", "16x16", "--backend", "cpu"});
         EXPECT_EQ(r.exitCode, 0) << r.err;
     }
     const std::string shared = round4("volume/model/nhdr_upper_passwd.nhdr");
     CONUS_REQUIRE(shared);
-    const Outcome r = run({"volume", "render", shared, "-o", path("v.exr"), "--size", "32x32"});
+    const Outcome r = run({"render", "volume", shared, "-o", path("v.exr"), "--size", "32x32"});
     expectRefusedQuietly(r, "volume", "an absolute path", "root:");
 }
 

@@ -42,8 +42,8 @@ TEST_F(SceneHostile, AGltfNamingAFileOutsideItsFolderIsRefused) {
         SCOPED_TRACE(c.file);
         const std::string file = scene(c.file);
         CONUS_REQUIRE(file);
-        Outcome r = run({"mesh", "render", file, "-o", path("x.exr"), "--size", "32x32"});
-        expectRefused(r, "mesh", c.reason);
+        Outcome r = run({"render", "mesh", file, "-o", path("x.exr"), "--size", "32x32"});
+        expectRefused(r, "render", c.reason);
         EXPECT_TRUE(contains(r.err, "/etc/passwd")) << r.err;
         expectBounded(r, 400);
         r = run({"bake", "reflection", file, "--size", "8", "-o", path("asset.exr")});
@@ -64,21 +64,21 @@ TEST_F(SceneHostile, LinksFifosAndDevicesBehindAGltfNameAreRefused) {
     for (const auto& c : cases) {
         SCOPED_TRACE(c.uri);
         writeGltf("m.gltf", c.uri);
-        const Outcome r = run({"mesh", "render", path("m.gltf"), "-o", path("x.exr"), "--size", "32x32"});
-        expectRefused(r, "mesh", c.reason);
+        const Outcome r = run({"render", "mesh", path("m.gltf"), "-o", path("x.exr"), "--size", "32x32"});
+        expectRefused(r, "render", c.reason);
         expectBounded(r, 400);
     }
     // --allow-dir lets the same buffer read from the folder it names.
     writeGltf("far.gltf", "elsewhere/tri.bin");
-    EXPECT_EQ(run({"mesh", "render", path("far.gltf"), "-o", path("x.exr"), "--size", "32x32"}).exitCode, 0);
+    EXPECT_EQ(run({"render", "mesh", path("far.gltf"), "-o", path("x.exr"), "--size", "32x32"}).exitCode, 0);
     // A link out of the model's folder into another one the user allows.
     writeGltf("link.gltf", "link.bin");
     fs::create_directories(m_dir / "model");
     fs::rename(m_dir / "link.gltf", m_dir / "model" / "link.gltf");
     fs::create_symlink(m_dir / "elsewhere" / "tri.bin", m_dir / "model" / "link.bin");
-    Outcome r = run({"mesh", "render", path("model/link.gltf"), "-o", path("y.exr"), "--size", "32x32"});
-    expectRefused(r, "mesh", "outside its folder");
-    r = run({"mesh", "render", path("model/link.gltf"), "-o", path("y.exr"), "--size", "32x32", "--allow-dir",
+    Outcome r = run({"render", "mesh", path("model/link.gltf"), "-o", path("y.exr"), "--size", "32x32"});
+    expectRefused(r, "render", "outside its folder");
+    r = run({"render", "mesh", path("model/link.gltf"), "-o", path("y.exr"), "--size", "32x32", "--allow-dir",
              path("elsewhere")});
     EXPECT_EQ(r.exitCode, 0) << r.err;
 }
@@ -110,7 +110,7 @@ TEST_F(SceneHostile, NotANumberIsAUsageErrorInEveryNumberOption) {
         {"encode", path("a.pgm"), "-o", path("a.exr"), "--frame-loss", "nan"},
         {"encode", path("a.pgm"), "-o", path("a.exr"), "--focus", "0.5,0.5,0.1,4", "--max-anisotropy", "nan"},
         {"encode", path("a.pgm"), "-o", path("a.exr"), "--fit-hold", "inf"},
-        {"mesh", "render", "city", "-o", path("c.exr"), "--max-bend", "nan"},
+        {"render", "mesh", "city", "-o", path("c.exr"), "--max-bend", "nan"},
         {"demo", "--out", path("demo"), "--k", "nan"}};
     for (const auto& args : conusRuns) {
         SCOPED_TRACE(args[0] + " " + args[args.size() - 2]);
@@ -134,14 +134,14 @@ TEST_F(SceneHostile, AnNrrdDataFileOutsideItsFolderOrADeviceOrFifoIsRefused) {
         SCOPED_TRACE(name);
         const std::string file = scene(name);
         CONUS_REQUIRE(file);
-        const Outcome r = run({"volume", "render", file, "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
-        expectRefused(r, "volume", "an absolute path");
+        const Outcome r = run({"render", "volume", file, "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+        expectRefused(r, "render", "an absolute path");
         expectBounded(r, 400);
     }
     ASSERT_EQ(::mkfifo(path("fifo.raw").c_str(), 0600), 0);
     write("fifo.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\ndata file: fifo.raw\n");
-    Outcome r = run({"volume", "render", path("fifo.nhdr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
-    expectRefused(r, "volume", "not a regular file");  // teem would block on it forever
+    Outcome r = run({"render", "volume", path("fifo.nhdr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+    expectRefused(r, "render", "not a regular file");  // teem would block on it forever
     expectBounded(r, 400);
     // A data file in another folder reads once that folder is allowed.
     fs::create_directories(m_dir / "data");
@@ -150,9 +150,9 @@ TEST_F(SceneHostile, AnNrrdDataFileOutsideItsFolderOrADeviceOrFifoIsRefused) {
     std::ofstream(m_dir / "data" / "cube.raw", std::ios::binary) << samples;
     fs::create_directories(m_dir / "headers");
     write("headers/cube.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\ndata file: ../data/cube.raw\n");
-    r = run({"volume", "render", path("headers/cube.nhdr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
-    expectRefused(r, "volume", "outside its folder");
-    r = run({"volume", "render", path("headers/cube.nhdr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu",
+    r = run({"render", "volume", path("headers/cube.nhdr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+    expectRefused(r, "render", "outside its folder");
+    r = run({"render", "volume", path("headers/cube.nhdr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu",
              "--allow-dir", path("data")});
     EXPECT_EQ(r.exitCode, 0) << r.err;
 }
@@ -161,7 +161,7 @@ TEST_F(SceneHostile, AGlbChunkLengthPastTheFileIsRefusedAtOnce) {
     const std::string file = scene("glb_jsonlen.glb");
     CONUS_REQUIRE(file);
     for (const std::vector<std::string>& args :
-         {std::vector<std::string>{"mesh", "render", file, "-o", path("x.exr"), "--size", "32x32"},
+         {std::vector<std::string>{"render", "mesh", file, "-o", path("x.exr"), "--size", "32x32"},
           std::vector<std::string>{"bake", "reflection", file, "--size", "8", "-o", path("asset.exr")}}) {
         const Outcome r = run(args);
         expectRefused(r, args[0], "its GLB header declares 4294967295 bytes in a file of 400");
@@ -173,12 +173,12 @@ TEST_F(SceneHostile, AGlbChunkLengthPastTheFileIsRefusedAtOnce) {
 // file asked for 61 GB), is checked against the file's size and the caps first.
 TEST_F(SceneHostile, AnOffFaceCountPastTheFileIsRefusedAtOnce) {
     const std::string file = (fs::path(CONUS_FUZZ_CORPUS) / "mesh" / "found-off-face-count.off").string();
-    Outcome r = run({"mesh", "render", file, "-o", path("x.exr"), "--size", "32x32"});
-    expectRefused(r, "mesh", "its OFF header declares");
+    Outcome r = run({"render", "mesh", file, "-o", path("x.exr"), "--size", "32x32"});
+    expectRefused(r, "render", "its OFF header declares");
     expectBounded(r, 400);
     write("big.off", "OFF\n3 2000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-    r = run({"mesh", "render", path("big.off"), "-o", path("x.exr"), "--size", "32x32"});
-    expectRefused(r, "mesh", "faces in a file of");
+    r = run({"render", "mesh", path("big.off"), "-o", path("x.exr"), "--size", "32x32"});
+    expectRefused(r, "render", "faces in a file of");
 }
 
 TEST_F(SceneHostile, AnNpzBombIsRefusedBeforeInflating) {
@@ -196,19 +196,19 @@ TEST_F(SceneHostile, AnNpzBombIsRefusedBeforeInflating) {
 TEST_F(SceneHostile, CoincidentTrianglesAreMergedSoARenderStaysFast) {
     const std::string file = scene("coincident_20k.obj");
     CONUS_REQUIRE(file);
-    const Outcome r = run({"mesh", "render", file, "-o", path("x.exr"), "--size", "128x128"});
+    const Outcome r = run({"render", "mesh", file, "-o", path("x.exr"), "--size", "128x128"});
     EXPECT_EQ(r.exitCode, 0) << r.err;
     EXPECT_TRUE(contains(r.err, "dropped 19999 exact duplicate triangles")) << r.err;
     expectBounded(r, 700);
 }
 
 TEST_F(SceneHostile, AVolumeRayTakesStepsBoundedByTheVolume) {
-    Outcome r = run({"volume", "render", "procedural:shepp-logan:32", "-o", path("v.exr"), "--size", "16x16", "--backend",
+    Outcome r = run({"render", "volume", "procedural:shepp-logan:32", "-o", path("v.exr"), "--size", "16x16", "--backend",
                      "cpu", "--step", "1e-6", "--uniform"});
-    expectRefused(r, "volume", "give a larger step", 2);
+    expectRefused(r, "render", "give a larger step", 2);
     expectBounded(r, 400);
-    r = run({"volume", "render", "procedural:shepp-logan:700", "-o", path("v.exr"), "--size", "16x16"});
-    expectRefused(r, "volume", "pass the limit of " + std::to_string(conus::kMaxVolumeVoxels), 2);
+    r = run({"render", "volume", "procedural:shepp-logan:700", "-o", path("v.exr"), "--size", "16x16"});
+    expectRefused(r, "render", "pass the limit of " + std::to_string(conus::kMaxVolumeVoxels), 2);
     expectBounded(r, 400);
 }
 
@@ -308,7 +308,7 @@ TEST_F(SceneHostile, SmallerItemsHaveTheirExitCodes) {
     expectRefused(r, "heightfield", "every height must be finite");
     write("zero.nrrd", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\nspace dimension: 3\n"
                        "space directions: (0,0,0) (0,1,0) (0,0,1)\n\n" + std::string(64, '\1'));
-    r = run({"volume", "render", path("zero.nrrd"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+    r = run({"render", "volume", path("zero.nrrd"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
     EXPECT_EQ(r.exitCode, 1) << r.err;
     EXPECT_EQ(errorLines(r.err).size(), 1u) << r.err;
 }

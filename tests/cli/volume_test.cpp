@@ -1,4 +1,4 @@
-// `conus volume render` through the real binary; outputs read back with OpenImageIO and the
+// `conus render volume` through the real binary; outputs read back with OpenImageIO and the
 // project's reader.
 #include <algorithm>
 #include <cmath>
@@ -20,7 +20,7 @@ namespace {
 using Volume = Cli;
 
 TEST_F(Volume, RenderWritesACameraDepthImage) {
-    const Result r = run("volume render procedural:shepp-logan:48 -o " + path("head.exr") +
+    const Result r = run("render volume procedural:shepp-logan:48 -o " + path("head.exr") +
                          " --size 80x60 --focus 0.5,0.45,0.12,3 --backend cpu --picture " + path("head.png"));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("wrote"), std::string::npos);
@@ -53,7 +53,7 @@ TEST_F(Volume, RenderWritesACameraDepthImage) {
 // frame's height, uncut (it sits in a larger box, which framed whole left it half the height and
 // 40% of the width).
 TEST_F(Volume, DefaultCameraFillsTheFrameWithTheHead) {
-    ASSERT_EQ(run("volume render procedural:shepp-logan:48 -o " + path("u.exr") + " --size 80x80 --uniform --backend cpu")
+    ASSERT_EQ(run("render volume procedural:shepp-logan:48 -o " + path("u.exr") + " --size 80x80 --uniform --backend cpu")
                   .exitCode,
               0);
     const ExrRead exr = readExr(path("u.exr"));
@@ -93,7 +93,7 @@ TEST_F(Volume, GpuAndCpuBackendsAgreeOnARawBrick) {
     }
     const std::string spec = "raw:24x18x20:uint16:1,1,1.5:" + path("brick.raw");
     for (const char* backend : {"cpu", "egl"}) {
-        const Result r = run("volume render " + spec + " -o " + path(std::string(backend) + ".exr") +
+        const Result r = run("render volume " + spec + " -o " + path(std::string(backend) + ".exr") +
                              " --size 64x48 --tf " + path("tf.txt") + " --focus 0.6,0.4,0.15,4 --backend " + backend);
         ASSERT_EQ(r.exitCode, 0) << r.err;
     }
@@ -111,12 +111,12 @@ TEST_F(Volume, BadInputGetsOneLineAndANonZeroExit) {
         out << "0123456789";
     }
     const std::vector<std::pair<std::string, std::string>> cases = {
-        {"volume render raw:10x10x10:uint8:" + path("short.raw") + " -o " + path("a.exr"), "bytes"},
-        {"volume render procedural:klein-bottle -o " + path("a.exr"), "procedural"},
-        {"volume render procedural:shepp-logan:16 -o " + path("a.exr") + " --tf nosuchpreset", "preset"},
-        {"volume render " + path("missing.nrrd") + " -o " + path("a.exr"), "no such file"},
-        {"volume render procedural:shepp-logan:16 -o " + path("a.exr") + " --range 5,1", "--range"},
-        {"volume render procedural:shepp-logan:16 -o " + path("a.exr") + " --camera 1,2,3", "camera"},
+        {"render volume raw:10x10x10:uint8:" + path("short.raw") + " -o " + path("a.exr"), "bytes"},
+        {"render volume procedural:klein-bottle -o " + path("a.exr"), "procedural"},
+        {"render volume procedural:shepp-logan:16 -o " + path("a.exr") + " --tf nosuchpreset", "preset"},
+        {"render volume " + path("missing.nrrd") + " -o " + path("a.exr"), "no such file"},
+        {"render volume procedural:shepp-logan:16 -o " + path("a.exr") + " --range 5,1", "--range"},
+        {"render volume procedural:shepp-logan:16 -o " + path("a.exr") + " --camera 1,2,3", "camera"},
     };
     for (const auto& [args, words] : cases) {
         const Result r = run(args);

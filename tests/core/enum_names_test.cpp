@@ -4,6 +4,7 @@
 
 #include <set>
 #include <string>
+#include <vector>
 
 #include "conus/core/camera.h"
 #include "conus/core/color.h"
@@ -75,6 +76,17 @@ TEST(EnumNames, AnyCaseOnlyWhereTheTableSaysSo) {
     EXPECT_FALSE(tryParseEnum<Shout>("loud!"));
     EXPECT_FALSE(tryParseEnum<Fruit>("APPLE"));
     EXPECT_FALSE(tryParseEnum<ToneMap>("Reinhard"));
+}
+
+// --bits names a picture's sample type from SampleType's own table: integers by their bits, floats
+// by their names; uint32 (no picture format writes it) and SampleType's integer names are not --bits.
+TEST(EnumNames, PictureBitsComeFromTheSampleTypes) {
+    EXPECT_EQ(pictureBitsNames(), (std::vector<std::string>{"8", "16", "half", "float"}));
+    for (SampleType t : kPictureSampleTypes) EXPECT_EQ(parsePictureBits(pictureBitsName(t)), t);
+    EXPECT_EQ(pictureBitsName(SampleType::Half), std::string(enumName(SampleType::Half)));
+    EXPECT_FALSE(parsePictureBits("32"));
+    EXPECT_FALSE(parsePictureBits("uint8"));
+    EXPECT_FALSE(parsePictureBits(""));
 }
 
 }  // namespace

@@ -2,10 +2,12 @@
 // commands, the reflection bake and the viewer frame a scene with.
 #include <gtest/gtest.h>
 
+#include <string>
 #include <vector>
 
 #include "conus/core/bounds.h"
 #include "conus/core/camera.h"
+#include "conus/core/error.h"
 #include "conus/core/mesh.h"
 
 namespace conus {
@@ -70,6 +72,37 @@ TEST(Framing, TheDefaultViewLooksAtTheCentreAndFillsTheFrame) {
         EXPECT_GT(camera.eye().x, box.centre().x);
         EXPECT_GT(camera.eye().z, box.hi.z);
     }
+}
+
+// A user's eye and look-at point: the camera looks where asked, its clip range holds the box, and
+// the eye on the target, a view along up and a box behind the eye are refused with one line each.
+TEST(Framing, AGivenViewIsClippedToTheBoxOrRefused) {
+    const AxisBox box{{1.0, -1.0, 2.0}, {3.0, 0.5, 6.0}};
+    const Camera camera = lookingAtBox(box, {0.5, 0.2, -1.0}, {2.0, -0.25, 4.0}, {0, 1, 0}, 35.0, 1.5, "the model");
+    const std::optional<ClipRange> clip = clipRangeFor(box, {0.5, 0.2, -1.0}, glm::normalize(glm::dvec3(1.5, -0.45, 5.0)));
+    ASSERT_TRUE(clip);
+    EXPECT_DOUBLE_EQ(camera.near(), clip->near);
+    EXPECT_DOUBLE_EQ(camera.far(), clip->far);
+    const glm::dvec3 target = camera.project({2.0, -0.25, 4.0});
+    EXPECT_NEAR(target.x, 0.5, 1e-9);
+    EXPECT_NEAR(target.y, 0.5, 1e-9);
+    for (int corner = 0; corner < 8; ++corner) {
+        const double depth = camera.project(box.corner(corner)).z;
+        EXPECT_GE(depth, camera.near());
+        EXPECT_LE(depth, camera.far());
+    }
+    const auto message = [&](glm::dvec3 eye, glm::dvec3 at, glm::dvec3 up) -> std::string {
+        try {
+            lookingAtBox(box, eye, at, up, 35.0, 1.5, "the volume");
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+            return e.what();
+        }
+        return "accepted";
+    };
+    EXPECT_NE(message({1, 1, 1}, {1, 1, 1}, {0, 1, 0}).find("must differ"), std::string::npos);
+    EXPECT_NE(message({1, -3, 4}, {1, 3, 4}, {0, 1, 0}).find("along the up vector"), std::string::npos);
+    EXPECT_EQ(message({0, 0, 10}, {0, 0, 20}, {0, 1, 0}), "the volume lies entirely behind the camera");
 }
 
 }  // namespace

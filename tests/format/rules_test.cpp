@@ -182,6 +182,13 @@ TEST_F(RuleTest, V12AnalyticMap) {
     ConusFile f = validFile();
     f.analytic = AnalyticMap{"foci", {{0.5, 0.5, 0.1, 100}}, "density", {}};
     EXPECT_TRUE(onlyRule(validateConusFile(f), 12));
+    // A focus's radius is in (0, 1]: no wider than the image (codec's builders refuse the same).
+    for (const double radius : {1.5, 1.0001, 0.0, -0.1, std::numeric_limits<double>::infinity(), std::nan("")}) {
+        f.analytic = AnalyticMap{"foci", {{0.5, 0.5, radius, 2}}, "density", {}};
+        EXPECT_TRUE(onlyRule(validateConusFile(f), 12)) << radius;
+    }
+    f.analytic = AnalyticMap{"foci", {{0.5, 0.5, 1.0, 2}}, "density", {}};
+    EXPECT_TRUE(validateConusFile(f).ok()) << validateConusFile(f).str();
     f.analytic = AnalyticMap{"foci", {{0.5, 0.5, 0.1, 2}}, "multiply", {}};
     EXPECT_TRUE(onlyRule(validateConusFile(f), 12));
     f.analytic = AnalyticMap{"foci", {}, "add", {}};

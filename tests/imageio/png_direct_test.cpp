@@ -1,4 +1,4 @@
-// The libpng reader (imageio/src/png_direct.h) against the OpenImageIO path it stands in for: the
+// The libpng reader (imageio/src/png_direct_pvt.h) against the OpenImageIO path it stands in for: the
 // same pixels, channel names and encoding on the PNGs it takes, and the OpenImageIO path (same
 // result as before) for every PNG it must not take.
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 
 #include <OpenImageIO/imageio.h>
 
-#include "../../imageio/src/oiio_module.h"
-#include "../../imageio/src/png_direct.h"
+#include "../../imageio/src/oiio_module_pvt.h"
+#include "../../imageio/src/png_direct_pvt.h"
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
 #include "test_dir.h"

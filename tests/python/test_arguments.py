@@ -168,6 +168,22 @@ def test_a_map_made_for_another_aspect_warns(tmp_path, asymmetric, conus_bin):
         assert ("foci become ellipses" in done.stderr) == warned, done.stderr
 
 
+def test_a_map_finer_than_the_image_can_show_is_refused_as_the_cli_refuses_grid(tmp_path, asymmetric, conus_bin):
+    pixels = np.ascontiguousarray(asymmetric[..., :3])  # 240x160
+    fine = conus.Map.foci([FOCUS], aspect=1.5, grid=257)
+    # 16x11 pixels hold at most 129 nodes a side (4 a pixel along the longer side plus one, 129 always).
+    with pytest.raises(conus.Error, match=r"grid of 257 is finer than a 16x11 image can show; at most 129 nodes a side"):
+        conus.encode(pixels, map=fine, size=(16, 11))
+    assert conus.encode(pixels, map=fine, size=(64, 43)).map.columns == 257  # 4 nodes a pixel of 64, plus one
+    # The CLI words the same rule for its --grid.
+    png = str(tmp_path / "p.png")
+    conus.write_image(png, pixels)
+    done = subprocess.run([conus_bin, "encode", png, "-o", str(tmp_path / "e.exr"), "--focus", "0.3,0.4,0.1,3",
+                           "--grid", "257", "--size", "16x11"], capture_output=True, text=True)
+    assert done.returncode != 0
+    assert "--grid 257 is finer than a 16x11 image can show; at most 129 nodes a side" in done.stderr, done.stderr
+
+
 def test_linear_to_srgb_is_documented():
     from conftest import SOURCE_DIR
     assert "conus.linear_to_srgb" in (SOURCE_DIR / "docs" / "python.md").read_text()

@@ -158,7 +158,7 @@ def test_faces_importance_is_the_clis(tmp_path, conus_bin):
     with pytest.raises(conus.Error, match="no face found") as e:
         conus.importance(flat, "faces")
     assert e.value.code == "unsupported"
-    with pytest.raises(conus.Error, match="'detail' or 'faces'"):
+    with pytest.raises(conus.Error, match="is not one of detail, faces"):
         conus.importance(flat, "saliency")
 
 

@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/image.h"
 #include "conus/renderers/context.h"

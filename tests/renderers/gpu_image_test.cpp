@@ -14,7 +14,7 @@
 
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/core/error.h"
 #include "gl_test_util.h"

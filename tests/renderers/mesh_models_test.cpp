@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/codec/mesh/subdivide.h"
 #include "conus/renderers/mesh_render.h"

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/core/error.h"
 #include "gl_test_util.h"
 #include "mesh_test_util.h"

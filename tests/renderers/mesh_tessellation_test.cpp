@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/core/error.h"
@@ -50,7 +50,7 @@ Camera floorCamera() {
     return Camera::perspective({1.0, 5.0, 6.0}, {-0.5, 0.0, -1.0}, {0, 1, 0}, 50.0, double(kWidth) / kHeight, 0.5, 100.0);
 }
 
-// Two strong foci, composed by density as `mesh render --track` does: the whole frame bends.
+// Two strong foci, composed by density as `render mesh --track` does: the whole frame bends.
 codec::SamplingMap bentMap() {
     const codec::Focus foci[] = {{0.3, 0.4, 0.1, 4.0}, {0.72, 0.62, 0.08, 3.0}};
     codec::FociOptions options;

@@ -140,7 +140,7 @@ TEST(TerrainRealDem, JacksboroThroughTheCli) {
     const std::string encode = conus + " heightfield encode " + dem + " -o " + exr +
                                " --size 128x128 --eye-height 1500 --near 500 --far 30000 > " + log + " 2>&1";
     ASSERT_EQ(std::system(encode.c_str()), 0) << encode;
-    const std::string render = conus + " heightfield render " + exr + " -o " + png + " --size 256x192 --compare " +
+    const std::string render = conus + " render heightfield " + exr + " -o " + png + " --size 256x192 --compare " +
                                dem + " > " + log + " 2>&1";
     ASSERT_EQ(std::system(render.c_str()), 0) << render;
     std::ifstream in(log);

@@ -13,7 +13,7 @@
 #include <random>
 #include <string>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/sceneio/volume_file.h"

@@ -1,4 +1,4 @@
-// Depth images in the viewer, on a real file: `conus mesh render` of a square floor (the plane
+// Depth images in the viewer, on a real file: `conus render mesh` of a square floor (the plane
 // y = 0) seen from above and in front through a focus. The inspector's 3-D point must lie on the
 // plane where the camera's exact ray meets it, the Z picture must be bright near and dark far with
 // the background marked, and the window (under Xvfb) must show and inspect the same.
@@ -50,13 +50,13 @@ std::string floorObj() {
 std::string conusBinary() { return std::string(CONUS_BIN_DIR) + "/conus"; }
 
 // Rendered once per process by the real command, with the `add` composition the probe's
-// tolerances below were set for (density, mesh render's default, compresses this context more:
+// tolerances below were set for (density, `render mesh`'s default, compresses this context more:
 // 2.4e-3 of the distance at the worst probe).
 const std::string& floorDepthImage() {
     static const std::string path = [] {
         const std::string out = (test::tempDir() / "floor.exr").string();
         std::string log;
-        const int status = test::run(conusBinary() + " mesh render " + floorObj() + " -o " + out + " --size " +
+        const int status = test::run(conusBinary() + " render mesh " + floorObj() + " -o " + out + " --size " +
                                          std::to_string(kWidth) + "x" + std::to_string(kHeight) + " --camera " + kCamera +
                                          " --focus " + kFocus + " --max-edge 0.5 --compose add --quiet",
                                      &log);

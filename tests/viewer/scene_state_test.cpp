@@ -2,7 +2,7 @@
 // map and camera a frame is rendered with.
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/frame_foci.h"
+#include "conus/codec/builders/frame_foci.h"
 #include "controller.h"
 #include "scene_state.h"
 #include "viewer_test_util.h"

@@ -206,7 +206,7 @@ TEST(SceneWindow, VolumeFramesAreTheRayCastersAndTCyclesTheLook) {
     const Volume volume = codec::proceduralVolume(spec);
     SceneState state(0.5 * volume.extent(), 0.5 * glm::length(volume.extent()), {focus});
     const double aspect = double(kW) / kH;
-    // The first frame has the command line's default preset (`volume render`'s too), T the next.
+    // The first frame has the command line's default preset (`render volume`'s too), T the next.
     const std::vector<std::string> presets = codec::TransferFunction::presetNames();
     ASSERT_GE(presets.size(), 2u);
     const auto at = std::find(presets.begin(), presets.end(), codec::TransferFunction::kDefaultPreset);

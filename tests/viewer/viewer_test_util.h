@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "conus/codec/image/encode.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/format/container.h"
 #include "conus/renderers/context.h"
 

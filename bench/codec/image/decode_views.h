@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/decode.h"
 
 namespace conus::bench {

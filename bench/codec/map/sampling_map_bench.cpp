@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "conus/codec/build/density_map.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/density_map.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/map_rules.h"
 

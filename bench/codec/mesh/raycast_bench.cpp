@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/mesh/city.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/codec/mesh/subdivide.h"

@@ -3,11 +3,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
+#include <regex>
 #include <string>
 
 #include "conus/codec/image/encode.h"
+#include "conus/core/error.h"
+#include "conus/core/limits.h"
 #include "conus/core/parallel.h"
 
 namespace conus::codec {
@@ -156,6 +160,19 @@ void addNormals(Mesh& mesh) {
 
 }  // namespace
 
+std::optional<TerrainOptions> proceduralTerrain(const std::string& source) {
+    std::smatch m;
+    if (!std::regex_match(source, m, std::regex("procedural(?::(\\d+))?(?::(\\d+))?"))) return std::nullopt;
+    TerrainOptions options;
+    if (m[1].matched) options.width = options.height = std::stoi(m[1].str().substr(0, 6));
+    if (std::int64_t{options.width} * options.height > kMaxDemSamples)
+        throw Error(ErrorCode::InvalidArgument, "procedural terrain " + std::to_string(options.width) + "x" +
+                                                    std::to_string(options.height) + " holds more than the limit of " +
+                                                    std::to_string(kMaxDemSamples) + " height samples");
+    if (m[2].matched) options.seed = static_cast<std::uint32_t>(std::stoul(m[2].str().substr(0, 9)));
+    return options;
+}
+
 Image generateTerrain(const TerrainOptions& o) {
     checkSize(o.width, o.height, "generateTerrain");
     if (!(o.reliefMetres >= 0.0 && o.reliefMetres < 1e6) || !(o.features > 0.0 && o.features < 1e4) ||
@@ -240,6 +257,18 @@ double fovForFieldWidth(double eyeHeight, double near, double far, double width)
                                                     " wide needs a field of view of " + std::to_string(fov) +
                                                     " degrees, outside (0, 170)");
     return fov;
+}
+
+GroundParams groundForField(const TerrainViewer& viewer, glm::dvec2 fieldMetres) {
+    constexpr double kDefaultFar = 6000.0, kDefaultFov = 60.0;
+    GroundParams ground;
+    ground.eyeHeight = viewer.eyeHeight;
+    ground.near = viewer.near;
+    ground.far = viewer.far > 0 ? viewer.far : fieldMetres.y > 0 ? viewer.near + fieldMetres.y : kDefaultFar;
+    ground.fovDegrees = viewer.fovDegrees > 0 ? viewer.fovDegrees
+                        : fieldMetres.x > 0   ? fovForFieldWidth(viewer.eyeHeight, viewer.near, ground.far, fieldMetres.x)
+                                              : kDefaultFov;
+    return ground;
 }
 
 format::ConusFile encodeHeightField(const Image& heights, const Image& colour,

@@ -59,16 +59,16 @@ float pixelJitter(int x, int y) {
 
 void checkVolumeRenderOptions(int width, int height, const VolumeRenderOptions& options) {
     if (width < 1 || height < 1 || width > kMaxRenderSide || height > kMaxRenderSide)
-        throw Error(ErrorCode::InvalidArgument, "volume render: size " + std::to_string(width) + "x" +
+        throw Error(ErrorCode::InvalidArgument, "render volume: size " + std::to_string(width) + "x" +
                                                     std::to_string(height) + " is outside [1, 16384] per side");
     if (!(options.stepVoxels > 0.0 && options.stepVoxels <= 16.0))
-        throw Error(ErrorCode::InvalidArgument, "volume render: step " + numberText(options.stepVoxels) +
+        throw Error(ErrorCode::InvalidArgument, "render volume: step " + numberText(options.stepVoxels) +
                                                     " voxels is outside (0, 16]");
     if (!(options.depthOpacity > 0.0f && options.depthOpacity < 1.0f))
-        throw Error(ErrorCode::InvalidArgument, "volume render: depth opacity " + numberText(options.depthOpacity) +
+        throw Error(ErrorCode::InvalidArgument, "render volume: depth opacity " + numberText(options.depthOpacity) +
                                                     " is outside (0, 1)");
     if (!std::isfinite(options.rangeLo) || !std::isfinite(options.rangeHi) || options.rangeLo > options.rangeHi)
-        throw Error(ErrorCode::InvalidArgument, "volume render: value range " + numberText(options.rangeLo) + ".." +
+        throw Error(ErrorCode::InvalidArgument, "render volume: value range " + numberText(options.rangeLo) + ".." +
                                                     numberText(options.rangeHi) + " is not lo <= hi");
 }
 
@@ -81,7 +81,7 @@ void checkRaySteps(const Volume& volume, double stepVoxels) {
     // With an even spacing a step of at least 1/kMaxRayStepsPerSample always fits.
     const bool stepTooSmall = stepVoxels < 1.0 / double(kMaxRayStepsPerSample);
     throw Error(stepTooSmall ? ErrorCode::InvalidArgument : ErrorCode::LimitExceeded,
-                "volume render: a step of " + numberText(stepVoxels) + " voxels takes up to " + numberText(steps) +
+                "render volume: a step of " + numberText(stepVoxels) + " voxels takes up to " + numberText(steps) +
                     " steps per ray through a " + std::to_string(volume.width) + "x" + std::to_string(volume.height) +
                     "x" + std::to_string(volume.depth) + " volume of spacing " + numberText(volume.spacing.x) + "," +
                     numberText(volume.spacing.y) + "," + numberText(volume.spacing.z) + ", more than the limit of " +
@@ -145,7 +145,7 @@ std::array<float, 5> castVolumeRay(const Volume& volume, const TransferFunction&
 
 Image renderVolumeReference(const Volume& volume, const TransferFunction& tf, const Fpc& fpc, int width, int height,
                             const VolumeRenderOptions& options) {
-    checkVolume(volume, "volume render");
+    checkVolume(volume, "render volume");
     checkVolumeRenderOptions(width, height, options);
     checkRaySteps(volume, options.stepVoxels);
     Image out = makeImage(width, height, {kVolumeChannels.begin(), kVolumeChannels.end()});

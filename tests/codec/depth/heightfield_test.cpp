@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/ground_map.h"
+#include "conus/codec/builders/ground_map.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
 
@@ -65,6 +65,24 @@ TEST(HeightFieldTerrain, ColoursInRange) {
         EXPECT_GE(c, 0.0f);
         EXPECT_LE(c, 1.0f);
     }
+}
+
+// The viewer a user gives, completed from the field's size in metres: far to its far edge, the
+// field of view to its width there; the defaults where the size is unknown; what was given kept.
+TEST(HeightFieldGround, TheViewerIsCompletedFromTheFieldsSize) {
+    const TerrainViewer viewer{120.0, 300.0, 0.0, 0.0};
+    const GroundParams fitted = groundForField(viewer, {5000.0, 3500.0});
+    EXPECT_EQ(fitted.eyeHeight, 120.0);
+    EXPECT_EQ(fitted.near, 300.0);
+    EXPECT_DOUBLE_EQ(fitted.far, 3800.0);
+    EXPECT_NEAR(fieldExtent(fitted).x, 5000.0, 1e-6);
+    const GroundParams unknown = groundForField(viewer, {0.0, 0.0});
+    EXPECT_EQ(unknown.far, 6000.0);
+    EXPECT_EQ(unknown.fovDegrees, 60.0);
+    const GroundParams given = groundForField({120.0, 300.0, 900.0, 45.0}, {5000.0, 3500.0});
+    EXPECT_EQ(given.far, 900.0);
+    EXPECT_EQ(given.fovDegrees, 45.0);
+    EXPECT_THROW(groundForField(viewer, {1e9, 100.0}), Error);  // no field of view spans it
 }
 
 TEST(HeightFieldEncode, ValidFileWithHeightAndGroundParams) {
@@ -259,6 +277,32 @@ TEST(HeightFieldEncode, RejectsBadInput) {
     EXPECT_THROW(encodeHeightField(dem, makeImage(16, 16, {"R", "G", "B"}), options), Error);
     options.width = 0;
     EXPECT_THROW(encodeHeightField(dem, makeImage(16, 16, {"R", "G", "B"}), options), Error);
+}
+
+}  // namespace
+}  // namespace conus::codec
+
+namespace conus::codec {
+namespace {
+
+// A DEM argument that names the procedural terrain: its size and seed, the defaults where left out;
+// anything else is a file's name; past the sample limit refused.
+TEST(HeightFieldTerrain, ProceduralArgumentsNameTheTerrain) {
+    const TerrainOptions defaults;
+    const auto plain = proceduralTerrain("procedural");
+    ASSERT_TRUE(plain);
+    EXPECT_EQ(plain->width, defaults.width);
+    EXPECT_EQ(plain->seed, defaults.seed);
+    const auto sized = proceduralTerrain("procedural:300:7");
+    ASSERT_TRUE(sized);
+    EXPECT_EQ(sized->width, 300);
+    EXPECT_EQ(sized->height, 300);
+    EXPECT_EQ(sized->seed, 7u);
+    EXPECT_EQ(proceduralTerrain("procedural:64")->seed, defaults.seed);
+    EXPECT_FALSE(proceduralTerrain("dem.tif"));
+    EXPECT_FALSE(proceduralTerrain("procedural.tif"));
+    EXPECT_FALSE(proceduralTerrain("procedural:x"));
+    EXPECT_THROW(proceduralTerrain("procedural:999999"), Error);
 }
 
 }  // namespace

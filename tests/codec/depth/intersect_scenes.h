@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/depth/relief.h"
 #include "conus/core/map_rules.h"

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/depth/intersect.h"
 #include "conus/core/error.h"
 #include "test_dir.h"

@@ -9,7 +9,7 @@
 
 #include "../../../codec/src/image/decode_pvt.h"
 #include "conus/codec/image/encode.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/core/error.h"
 #include "codec/image/decode_views.h"

@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "../../../codec/src/image/fit_pvt.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/image/fit.h"

@@ -11,7 +11,7 @@
 
 #include "../../../codec/src/image/decode_simd_pvt.h"
 #include "codec/image/decode_views.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/image/metrics.h"

@@ -11,8 +11,8 @@
 #include <string>
 #include <thread>
 
-#include "conus/codec/build/density_map.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/density_map.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"

@@ -6,7 +6,7 @@
 #include <memory>
 #include <optional>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/core/fpc.h"
 #include "conus/core/mesh.h"
 #include "sceneio/test_meshes.h"

@@ -10,7 +10,7 @@
 #include <set>
 #include <string>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/volume/procedural.h"
 #include "conus/codec/volume/raycast.h"

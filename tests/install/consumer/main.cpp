@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/depth/glsl_interface.h"
 #include "conus/codec/image/decode.h"

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <utility>
 
@@ -95,5 +96,12 @@ std::optional<ClipRange> clipRangeFor(const AxisBox& box, glm::dvec3 eye, glm::d
 // `up` is replaced by (1, 0, 0.2)), as close as keeps the box's corners within 90% of the frame
 // and never inside its bounding sphere, clipped by clipRangeFor: a default view of a scene.
 Camera framingCamera(const AxisBox& box, glm::dvec3 direction, glm::dvec3 up, double aspect, double fovYDegrees = 40.0);
+
+// A perspective camera at `eye` looking at `target` (vertical field of view in degrees), its clip
+// range the one that holds `box` (clipRangeFor): a user's view of a scene. Throws
+// InvalidArgument when the eye is the target or looks along `up`, and when the box lies entirely
+// behind the eye (`what` names the box in that message: "the model", "the volume").
+Camera lookingAtBox(const AxisBox& box, glm::dvec3 eye, glm::dvec3 target, glm::dvec3 up, double fovYDegrees, double aspect,
+                    const std::string& what);
 
 }  // namespace conus

@@ -63,6 +63,14 @@ inline constexpr std::array<float, 8> kRec709Chromaticities{0.64f, 0.33f, 0.30f,
 // Bits per sample of a type: 8, 16, 32, 16, 32.
 int bitsOf(SampleType sampleType);
 
+// A picture's sample type as `--bits` names it: an integer type by its bits ("8", "16"), a floating
+// type by its name in SampleType's table ("half", "float"); the types a picture file is written
+// in, in that order (pictureBitsNames: "8, 16, half, float" for CLI11's IsMember and help).
+inline constexpr SampleType kPictureSampleTypes[] = {SampleType::Uint8, SampleType::Uint16, SampleType::Half, SampleType::Float};
+std::string pictureBitsName(SampleType sampleType);
+std::optional<SampleType> parsePictureBits(std::string_view text);
+std::vector<std::string> pictureBitsNames();
+
 // Whether a metadata item of this name travels from a source file into a CoNUS file and back out:
 // the EXIF, GPS and IPTC blocks (names "Exif:...", "GPS:...", "IPTC:...") and Make, Model,
 // DateTime, Artist, Copyright, ImageDescription and Orientation.

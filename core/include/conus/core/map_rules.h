@@ -1,8 +1,9 @@
 // The sampling-map rules of spec/conus-format.md, written once: the grid's node count (V7), finite
 // nodes (V8) inside [0,1]^2 (V9), boundary nodes exactly on their edge (V10) and strictly convex
 // cells with the identity's orientation (V11); the focus parameters (V12). isValidGrid is the one
-// question "is this grid a valid map?": codec's builders and SamplingMap ask it, and format's
-// validator asks it too before it words each broken rule, so what one accepts the other accepts.
+// question "is this grid a valid map?" and isValidFocus "is this a valid focus?": codec's builders
+// and SamplingMap ask them, and format's validator asks them too before it words each broken rule,
+// so what one accepts the other accepts.
 #pragma once
 
 #include <cmath>
@@ -20,6 +21,9 @@ namespace conus::map_rules {
 inline constexpr double kMinCornerCross = 1e-12;
 // V12: a focus magnifies by k in [1, kMaxMagnification].
 inline constexpr double kMaxMagnification = 64.0;
+// V12: a focus's radius r (a fraction of the image width) is in (0, kMaxFocusRadius]: no wider than
+// the picture, which is what every builder makes and every writer has written.
+inline constexpr double kMaxFocusRadius = 1.0;
 // V12: a ground map's row profile (conus:groundRows) holds 2 to kMaxGroundRows values.
 inline constexpr int kMaxGroundRows = 4097;
 // V12: a focus's transition (conus:param:falloffWidth) ends at w radii, w in (1, kMaxFalloffWidth];
@@ -39,7 +43,7 @@ inline constexpr std::int64_t maxSideForImage(std::int64_t width, std::int64_t h
 // The builders' default bound on anisotropy: the ratio of a cell's Jacobian singular values in
 // pixels (codec's map_measures.h). A CoNUS pixel's footprint is at most this elongated, so the
 // encode's filter and the decode's stretch stay local; foci reach their k by widening their
-// transition instead (codec/build/density_map.h, foci.h).
+// transition instead (codec/builders/density_map.h, foci.h).
 inline constexpr double kMaxAnisotropy = 7.0;
 
 // The corners of cell (i,j) in its cyclic order: (i,j), (i+1,j), (i+1,j+1), (i,j+1).
@@ -89,6 +93,17 @@ inline bool nodeOnItsEdge(const GridView& g, int i, int j) {
     const double u = g.u(i, j), v = g.v(i, j);
     return !((i == 0 && u != 0.0) || (i == g.columns - 1 && u != 1.0) || (j == 0 && v != 0.0) ||
              (j == g.rows - 1 && v != 1.0));
+}
+
+// V12, one focus (u, v, r, k), each part asked on its own so that callers can say which failed; all
+// written as negations of the accepting test, so that NaN fails every one.
+inline bool focusCentreValid(double u, double v) { return u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0; }
+inline bool focusRadiusValid(double r) { return r > 0.0 && r <= kMaxFocusRadius; }
+inline bool focusMagnificationValid(double k) { return k >= 1.0 && k <= kMaxMagnification; }
+// V12 for one focus: what codec's builders accept (codec::checkFocus) and what format's validator
+// accepts in conus:foci.
+inline bool isValidFocus(double u, double v, double r, double k) {
+    return focusCentreValid(u, v) && focusRadiusValid(r) && focusMagnificationValid(k);
 }
 
 // V7's size and V8..V11 together, without messages (format::validateGrid says what is wrong).

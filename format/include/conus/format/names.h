@@ -17,7 +17,7 @@ enum class DepthKind { None, CameraDepth, Height };  // what a `Z` channel holds
 // How a map was built (conus:mapKind): foci, or the perspective ground plane.
 enum class MapKind { Foci, Ground };
 // How a foci map's foci combine (conus:composition) and the shape of a focus's transition
-// (conus:param:falloffShape, stored as the value's number); codec/build/foci.h builds each.
+// (conus:param:falloffShape, stored as the value's number); codec/builders/foci.h builds each.
 enum class FociComposition { Density, Add };
 enum class FociFalloffShape { Density, LogDensity, LogRadius };
 

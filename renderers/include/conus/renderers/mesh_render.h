@@ -36,7 +36,7 @@
 
 namespace conus::renderers {
 
-inline constexpr double kDefaultMaxBend = 0.5;   // CoNUS pixels: `conus mesh render`'s --max-bend
+inline constexpr double kDefaultMaxBend = 0.5;   // CoNUS pixels: `conus render mesh`'s --max-bend
 
 struct MeshRenderOptions {
     int samples = 4;  // multisampling per pixel (1: one sample at the centre); the driver's maximum caps it

@@ -16,7 +16,7 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/build/ground_map.h"
+#include "conus/codec/builders/ground_map.h"
 #include "conus/core/camera.h"
 #include "conus/codec/depth/heightfield.h"
 #include "conus/core/image.h"
@@ -61,7 +61,7 @@ private:
 Image renderTerrain(Context& context, const Mesh& mesh, const Camera& camera, int width,
                             int height, const TerrainLook& look = {});
 
-// ---- Frames of a CoNUS height field (`conus heightfield render`, `conus decode --camera`) ----
+// ---- Frames of a CoNUS height field (`conus render heightfield`, `conus decode --camera`) ----
 
 // The ground map of a CoNUS height field, from its analytic parameters; throws
 // conus::Error(InvalidArgument), naming the file as `name`, unless `file` is a height field with them.

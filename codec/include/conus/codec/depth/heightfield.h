@@ -18,14 +18,16 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/build/ground_map.h"
+#include "conus/codec/builders/ground_map.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
+#include "conus/core/enum_names.h"
 #include "conus/core/error.h"
 #include "conus/core/mesh.h"
 #include "conus/core/image.h"
@@ -46,6 +48,10 @@ struct TerrainOptions {
 // fBm of gradient noise blended with ridged noise, one channel "Z" in metres (>= 0). The terrain is
 // a function of (u, v) in [0,1]^2, so two sizes of the same seed sample the same landscape.
 Image generateTerrain(const TerrainOptions& options);
+// The terrain a DEM argument "procedural[:SIZE[:SEED]]" names (SIZE x SIZE samples, SEED as
+// TerrainOptions::seed; the defaults where left out), or none for any other text (a file's name).
+// Throws InvalidArgument past kMaxDemSamples samples.
+std::optional<TerrainOptions> proceduralTerrain(const std::string& source);
 
 // Colour ramp by height (water-green lowlands, brown slopes, grey rock, snow on the highest) and
 // slope (steep faces turn to rock), RGB in [0,1]. `extent` is the field's size in metres (width,
@@ -61,6 +67,16 @@ glm::dvec2 fieldExtent(const GroundParams& params);
 // throws conus::Error(InvalidArgument) when no fov in (0, 170) does.
 double fovForFieldWidth(double eyeHeight, double near, double far, double width);
 
+// A terrain's viewer in metres as a user gives it (`conus heightfield encode`): far and the field of
+// view 0 until given.
+struct TerrainViewer {
+    double eyeHeight = 150, near = 200, far = 0, fovDegrees = 0;
+};
+// The ground map a terrain of `fieldMetres` (width, depth; 0 where its cell spacing is unknown) is
+// seen through: far, where not given, near + the field's depth, else 6000; the field of view, where
+// not given, the one that spans the field's width at far (fovForFieldWidth), else 60 degrees.
+GroundParams groundForField(const TerrainViewer& viewer, glm::dvec2 fieldMetres);
+
 // The ground map's rows for a terrain (GroundParams::rows): each band of depth gets rows in
 // proportion to the screen rows it covers for the ground map's viewer (eyeHeight above the DEM at
 // the middle of the near edge), its hidden parts left out (a horizon sweep along 128 rays), at most
@@ -68,6 +84,13 @@ double fovForFieldWidth(double eyeHeight, double near, double far, double width)
 // of mountains far away the few rows that flat ground would cover there. Empty when the DEM has
 // nothing to see (the planar rows then stay).
 std::vector<double> groundRowsForTerrain(const Image& heights, const GroundParams& ground, int imageRows);
+
+// How a height field's map spends its rows on depth: fitted to the terrain (groundRowsForTerrain)
+// or the planar pinhole rows (the paper's perspective ground plane).
+enum class GroundRows { Terrain, Planar };
+constexpr auto enumNameTable(GroundRows) {
+    return makeEnumNameTable<GroundRows>("rows", {{GroundRows::Terrain, "terrain"}, {GroundRows::Planar, "planar"}});
+}
 
 struct HeightFieldOptions {
     GroundParams ground;         // with no row profile: fitted to the terrain when fitRows

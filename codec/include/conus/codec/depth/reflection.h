@@ -22,7 +22,7 @@
 
 #include <glm/glm.hpp>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/depth/intersect.h"
 #include "conus/codec/mesh/raycast.h"
 #include "conus/core/bounds.h"

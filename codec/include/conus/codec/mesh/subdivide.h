@@ -1,7 +1,7 @@
 // Uniform edge subdivision for the GPU mesh encoder (paper, section 3.2): Equation 1 is bilinear
 // in each map cell, so a straight edge becomes a curve while the rasterizer draws the chord
 // between its distorted ends. The renderer's default follows the bend on the GPU (the tessellation
-// stages, renderers/mesh_render.h); this is the CPU alternative, `conus mesh render --max-edge`:
+// stages, renderers/mesh_render.h); this is the CPU alternative, `conus render mesh --max-edge`:
 // every edge longer than a bound in undistorted map cells is split, where an edge from image
 // position a to b (the camera's projection, before Eq. 1) spans |((b-a).u * (columns-1),
 // (b-a).v * (rows-1))| cells. Edges with an end at or behind the near plane of a perspective

@@ -77,7 +77,7 @@ std::array<float, 5> castVolumeRay(const Volume& volume, const TransferFunction&
 // box's bounding sphere fills the vertical field of view; near and far bracket the sphere.
 Camera defaultVolumeCamera(const Volume& volume, double aspect, double fovYDegrees = 30.0);
 
-// The same view of what the transfer function shows (`volume render`'s default): the box of the
+// The same view of what the transfer function shows (`render volume`'s default): the box of the
 // samples whose opacity under `tf` (over `range`, renderRange's) is above 1/255 is looked at from
 // where every such sample just fits the frame, so a head in a larger box fills it; the whole
 // volume as above when no sample shows.

@@ -31,7 +31,7 @@ public:
     // not finite, or values not strictly increasing.
     explicit TransferFunction(std::vector<TransferPoint> points);
 
-    // The preset a volume gets when none is named (`volume render` and the viewer alike).
+    // The preset a volume gets when none is named (`render volume` and the viewer alike).
     static constexpr const char* kDefaultPreset = "bone";
     // The presets by name (presetNames()); an unknown name throws InvalidArgument listing them.
     static TransferFunction preset(const std::string& name);

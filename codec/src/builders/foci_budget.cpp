@@ -1,0 +1,255 @@
+// The pixel budget of foci: their share of the samples, and the k a budget allows (foci_budget.h).
+#include "conus/codec/builders/foci_budget.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "conus/core/error.h"
+#include "budget_search_pvt.h"
+
+namespace conus::codec {
+namespace {
+
+// Samples along the share grid's longer side, and at least this many across the smallest radius.
+constexpr int kShareSide = 512;
+constexpr double kShareSamplesPerRadius = 8.0;
+constexpr int kMaxShareSide = 2048;
+// Halvings of the exponent t of k^t without a picture: t to within 1/1024 (k = 4: to 0.14%).
+constexpr int kBisectionSteps = 10;
+// With a picture: the search for t stops within kTolerance of t, or within kToleranceDb under the
+// budget, or after kSearchSteps maps built.
+constexpr double kTolerance = 1.0 / 1024, kToleranceDb = 0.01;
+constexpr int kSearchSteps = 12;
+// The rounds of confirming encodes (FrameModelOptions::confirmRounds) stop within this of the budget.
+constexpr double kMeasuredToleranceDb = 0.05;
+
+bool inDisc(const Focus& f, double aspect, double u, double v) {
+    const double dx = u - f.u, dy = (v - f.v) / aspect;
+    return dx * dx + dy * dy <= f.r * f.r;
+}
+
+std::vector<Focus> powered(std::span<const Focus> foci, double t) {
+    std::vector<Focus> out(foci.begin(), foci.end());
+    for (Focus& f : out) f.k = std::pow(f.k, t);
+    return out;
+}
+
+// Each focus records what `map` reaches where that is below half its extra magnification (a grid
+// too coarse for it): the file must not record a magnification its map does not have.
+bool recordReached(const SamplingMap& map, std::vector<Focus>& foci) {
+    const std::vector<double> reached = reachedMagnification(map, foci);
+    bool limited = false;
+    for (std::size_t i = 0; i < foci.size(); ++i)
+        if (reached[i] < 1.0 + 0.5 * (foci[i].k - 1.0)) {
+            foci[i].k = std::clamp(reached[i], 1.0, foci[i].k);
+            limited = true;
+        }
+    return limited;
+}
+
+// The largest t in [0, 1] (to 1/64) for which holds(t); holds(0) is taken as true.
+double largestHolding(const std::function<bool(double)>& holds) {
+    if (holds(1.0)) return 1.0;
+    double lo = 0.0, hi = 1.0;
+    for (int i = 0; i < kBisectionSteps; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (holds(mid) ? lo : hi) = mid;
+    }
+    return lo;
+}
+
+}  // namespace
+
+FociShare fociShare(std::span<const Focus> foci, double aspect, const FociFalloff& falloff) {
+    FociShare out;
+    if (foci.empty()) return out;
+    double rMin = 1.0;
+    for (const Focus& f : foci) rMin = std::min(rMin, f.r);
+    // Pixel-isotropic samples (the width is `aspect` times the height), fine enough for every disc.
+    const int longSide = std::clamp(static_cast<int>(std::ceil(kShareSamplesPerRadius / rMin * std::max(1.0, 1.0 / aspect))),
+                                    kShareSide, kMaxShareSide);
+    const int w = aspect >= 1 ? longSide : std::max(8, static_cast<int>(std::lround(longSide * aspect)));
+    const int h = aspect >= 1 ? std::max(8, static_cast<int>(std::lround(longSide / aspect))) : longSide;
+    double total = 0, discs = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const double u = (x + 0.5) / w, v = (y + 0.5) / h;
+            const double d = fociDensity(foci, aspect, u, v, falloff);
+            total += d;
+            if (std::any_of(foci.begin(), foci.end(), [&](const Focus& f) { return inDisc(f, aspect, u, v); })) discs += d;
+        }
+    const double samples = double(w) * h;
+    out.contextDensity = samples / total;
+    out.share = discs / total;
+    out.ask = discs / samples;
+    return out;
+}
+
+double contextDownscale(const FociShare& share, int width, int height, int sourceWidth, int sourceHeight) {
+    const double rate = std::sqrt(double(width) * height / (double(sourceWidth) * sourceHeight) * share.contextDensity);
+    return 1.0 / std::max(rate, 1e-12);
+}
+
+Image fociImportance(std::span<const Focus> foci, double aspect, int width, int height) {
+    Image image = makeImage(width, height, {"Y"});
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const double u = (x + 0.5) / width, v = (y + 0.5) / height;
+            image.at(x, y) = std::any_of(foci.begin(), foci.end(), [&](const Focus& f) { return inDisc(f, aspect, u, v); }) ? 1.0f : 0.0f;
+        }
+    return image;
+}
+
+FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& options, const FrameErrorModel& model,
+                            double frameLossDb, bool exactK, double tileLossDb, double restLossDb) {
+    if (!(frameLossDb >= 0) || !std::isfinite(frameLossDb))
+        throw Error(ErrorCode::InvalidArgument, "the frame-loss budget " + std::to_string(frameLossDb) + " dB must be finite and >= 0");
+    if (!(tileLossDb >= 0))  // NaN fails; infinity: no tile budget
+        throw Error(ErrorCode::InvalidArgument, "the tile-loss budget " + std::to_string(tileLossDb) + " dB must be >= 0");
+    struct Try {
+        double t;
+        std::vector<Focus> given;
+        SamplingMap map;
+        FociReport report;
+        FramePrediction predicted;
+        std::shared_ptr<const ModelEncode> encode{};  // this map's own encode, where one was made
+    };
+    const auto attempt = [&](const FrameErrorModel& m, double t, const FociOptions& o) {
+        Try x{t, powered(foci, t), SamplingMap::identity(2, 2), {}, {}, {}};
+        x.map = buildFociMap(x.given, o, &x.report);
+        x.predicted = m.predict(x.map);
+        return x;
+    };
+    // How far a try is over the budget (dB, <= 0: within): continuous in t, as the model is.
+    const auto over = [&](const Try& x) {
+        const FramePrediction& p = x.predicted;
+        return std::max({p.frameLoss - frameLossDb, p.tileLoss - tileLossDb, std::isfinite(restLossDb) ? p.restLoss - restLossDb : -1e9});
+    };
+    // A lower k leaves the context more samples: the loss falls with t. The largest t within the
+    // budget: regula falsi (Illinois) on over(t) between t = 0 (k = 1) and 1, to kTolerance in t,
+    // each step a map built and predicted; the t chosen is a continuous function of the picture.
+    struct Search {
+        Try chosen, asked;
+    };
+    const auto search = [&](const FrameErrorModel& m, const FociOptions& o) {
+        Try hi = attempt(m, 1.0, o);
+        if (exactK || over(hi) <= 0) return Search{hi, hi};
+        Try lo = attempt(m, 0.0, o);
+        if (over(lo) > 0) return Search{std::move(lo), std::move(hi)};  // even k = 1 loses more: the closest to the budget there is
+        Try within = detail::searchWithin(std::move(lo), 0.0, hi, 1.0, [&](double t) { return attempt(m, t, o); }, over, kSearchSteps,
+                                          kTolerance, kToleranceDb);
+        return Search{std::move(within), std::move(hi)};
+    };
+    // A context that follows the picture usually lets the foci keep more k; where it does not (a
+    // focus on a softer part of the picture than the rest, or a context that alone loses the
+    // budget), or where it crowds a few tiles (small features on a flat ground), the foci on a
+    // uniform context are kept (keepsContext).
+    const bool compare = !exactK && options.context != nullptr;
+    FociOptions uniform = options;
+    uniform.context = nullptr;
+    const auto takesPlain = [&](const Search& own, const Search& other) {
+        return (over(own.chosen) > 0 && over(other.chosen) <= 0) || !keepsContext(own.chosen.predicted, other.chosen.predicted);
+    };
+    Search chosen = search(model, options);
+    std::optional<Search> plain;
+    if (model.options().confirm && !model.isConfirmed()) {
+        // A real encode of the candidate's map, and the candidate searched again on the model that
+        // encode confirms (the model alone can be off by dB in either direction). Where the choice
+        // stays next to the map encoded (kConfirmedT in t) and that map holds the budget as
+        // measured, it is kept with its encode, which the caller then need not make again; what the
+        // block prints is then what that encode measured.
+        const auto confirm = [&](Search s, const FociOptions& o) {
+            Try encoded = s.chosen;
+            FrameErrorModel confirmed = model.confirmed(encoded.map);
+            encoded.predicted = confirmed.predict(encoded.map);
+            encoded.encode = confirmed.encode();
+            s = search(confirmed, o);
+            const int rounds = model.options().confirmRounds - 1;
+            if (std::abs(s.chosen.t - encoded.t) <= kConfirmedT) {
+                if (over(encoded) <= 0 || over(s.chosen) > 0) s.chosen = std::move(encoded);
+                return std::pair{std::move(s), std::move(confirmed)};
+            }
+            if (rounds <= 0 || exactK) return std::pair{std::move(s), std::move(confirmed)};
+            // Further rounds: the same regula falsi on t, each try's losses measured by its own
+            // encode, between the map first encoded and the one its confirmed model chose (k = 1
+            // where both hold or both miss the budget): the map kept holds the budget as measured.
+            const auto measured = [&](double t) {
+                Try x = attempt(model, t, o);
+                const FrameErrorModel c = model.confirmed(x.map);
+                x.predicted = c.predict(x.map);
+                x.encode = c.encode();
+                return x;
+            };
+            Try next = measured(s.chosen.t);
+            const bool nextHolds = over(next) <= 0, encodedHolds = over(encoded) <= 0;
+            if (nextHolds && encodedHolds) {  // both hold: the larger k
+                s.chosen = std::move(next.t >= encoded.t ? next : encoded);
+            } else if (nextHolds != encodedHolds && (nextHolds ? next.t > encoded.t : encoded.t > next.t)) {
+                s.chosen = std::move(nextHolds ? next : encoded);  // a larger k holds where a smaller one missed: kept
+            } else {
+                // A try that misses the budget and, at a smaller t, one that holds it (k = 1 where both miss).
+                Try beyond = std::move(!nextHolds && (encodedHolds || next.t < encoded.t) ? next : encoded);
+                Try within = nextHolds ? std::move(next) : encodedHolds ? std::move(encoded) : measured(0.0);
+                if (over(within) > 0) {  // even k = 1 misses: the closest there is
+                    s.chosen = std::move(within);
+                } else {
+                    const double a = within.t, b = beyond.t;
+                    s.chosen = detail::searchWithin(std::move(within), a, std::move(beyond), b, measured, over,
+                                                    std::max(0, rounds - 1), kConfirmedT, kMeasuredToleranceDb);
+                }
+            }
+            return std::pair{std::move(s), std::move(confirmed)};
+        };
+        // The candidate on the picture's own detail is encoded first; the uniform context's is
+        // searched on the model that encode confirms, and gets its own confirming encode (and the
+        // two are compared on what their encodes measured) only where that model says it may be
+        // kept. On photographs that model gives the uniform context's map more ROI gain than its
+        // own encode measures (0.1 to 1.8 dB more on five unseen photographs,
+        // bench/notes/2026-12-07-default-encode.md), so where it still keeps the own-detail map, a
+        // second encode would keep it too. The model alone, unconfirmed, is no judge between the
+        // two: it chose the uniform context on four of those five, their encodes the own detail's.
+        auto [own, ownModel] = confirm(std::move(chosen), options);
+        chosen = std::move(own);
+        if (compare) {
+            Search cross = search(ownModel, uniform);
+            if (takesPlain(chosen, cross)) plain = confirm(std::move(cross), uniform).first;
+        }
+    } else if (compare) {
+        plain = search(model, uniform);
+    }
+    if (plain && takesPlain(chosen, *plain)) chosen = std::move(*plain);
+    std::shared_ptr<const ModelEncode> encode = chosen.chosen.encode;
+    const Try& asked = chosen.asked;
+    Try& given = chosen.chosen;
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), std::move(given.given), std::move(given.map), {}, {},
+                   given.predicted, asked.predicted, given.report.transition, false, false, std::move(given.report.notes)};
+    out.encode = std::move(encode);
+    out.lowered = given.t < 1.0;
+    out.gridLimited = recordReached(out.map, out.given);
+    out.share = fociShare(out.given, options.aspect, options.falloff);
+    out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;
+    return out;
+}
+
+FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options, double floor, bool exactK) {
+    FociBudget out{std::vector<Focus>(foci.begin(), foci.end()), {}, SamplingMap::identity(2, 2), {}, {}, {}, {}, {}, false, false, {}};
+    const double t = exactK ? 1.0 : largestHolding([&](double t) {
+        return fociShare(powered(foci, t), options.aspect, options.falloff).contextDensity >= floor;
+    });
+    out.given = powered(foci, t);
+    out.lowered = t < 1.0;
+    FociReport report;
+    out.map = buildFociMap(out.given, options, &report);
+    out.builderNotes = std::move(report.notes);
+    out.transition = report.transition;
+    out.gridLimited = recordReached(out.map, out.given);
+    out.share = fociShare(out.given, options.aspect, options.falloff);
+    out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;
+    return out;
+}
+
+}  // namespace conus::codec

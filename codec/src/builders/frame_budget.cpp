@@ -1,0 +1,547 @@
+// The whole-frame loss, tile loss and ROI gain of a map, predicted by the band model, and the context floor a loss budget allows.
+#include "conus/codec/builders/frame_budget.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "conus/codec/image/decode.h"
+#include "conus/codec/image/encode.h"
+#include "conus/codec/image/fit.h"
+#include "conus/core/display.h"
+#include "conus/core/error.h"
+#include "conus/core/parallel.h"
+#include "budget_search_pvt.h"
+
+namespace conus::codec {
+namespace {
+
+// The band model's constants (frame_budget.h: S(sigma) = a * sum_j E_j * R(log2 sigma - j - b),
+// R a smoothstep from 0 at t = -c to 1 at t = c; a footprint of axes sigma1 >= sigma2 taken as
+// one of sigma1^w sigma2^(1-w)). Fitted by `bench/budget_check.py --fit` on the six photographs of
+// bench/quality_targets.PHOTOS (at most 1280 px wide, 8-bit sRGB, one focus per region at k 1.5,
+// 2.5, 4 and 6 with --exact-k, fitted and --fast), tile by tile against real encodes and `conus
+// uniform`, by least squares on log(e + f), then for the whole-frame and p95 tile losses: the
+// uniform image's error is the bands finer than its spacing (b = c = 0.5: at a 1/4 downscale,
+// bands 0 and 1, as the box pyramid's arithmetic says); the CoNUS image loses more along a
+// stretched footprint than its long axis alone says (w > 1). Per tile the model is within about
+// 1.6 dB (uniform) and 3.5 dB (CoNUS, rms); whence the confirming encode (FrameErrorModel::confirmed).
+// bench/notes/2026-12-06-budget-model.md.
+}  // namespace
+
+struct FrameErrorModel::MeasuredUniform {
+    std::once_flag once;
+    std::vector<double> errors;
+};
+
+struct FrameErrorModel::BandFit {
+    double scale;    // a
+    double shift;    // b
+    double stretch;  // w
+};
+
+namespace {
+using BandFit = FrameErrorModel::BandFit;
+constexpr double kHalfWidth = 0.5;                    // c
+constexpr BandFit kUniformFit{0.832, 0.5, 0.5};       // area downsample, bilinear resize (isotropic: w moot)
+constexpr BandFit kConusFitted{1.0, 1.5, 1.2};        // encode, fit to the decoder, decode
+constexpr BandFit kConusFiltered{0.832, 1.5, 1.6};    // encode alone (`--fast`), decode
+
+// Tiles of the tile loss: max(W, H) / kTilesPerSide source pixels a side (bench/quality.py's tiles),
+// and the floor added to both errors of a tile and of the frame: on a flat picture a tiny error
+// twice as large is no loss. Displayed: bench/quality.py's (2/255)^2 of 8-bit sRGB; linear: about
+// that near mid-grey.
+constexpr int kTilesPerSide = 32;
+constexpr double kDisplayFloor = (2.0 / 255.0) * (2.0 / 255.0);
+constexpr double kLinearFloor = (1.5 / 255.0) * (1.5 / 255.0);
+constexpr double kTilePercentile = 0.95;
+constexpr double kWorstTilesPercentile = 0.99;
+// Bands of the pyramid: detail up to 2^kMaxLevels source pixels (a 1/256 downscale).
+constexpr int kMaxLevels = 9;
+// Points a side of each tile where the map's Jacobian is taken, and where the importance is read.
+constexpr int kJacobianPoints = 3;
+constexpr int kRegionPoints = 16;
+// The most a confirming encode moves a tile's footprints (octaves either way).
+constexpr double kMostShift = 3.0;
+// D through a table, linear between its entries (continuous, and some 20x faster than pow).
+constexpr int kDisplayTableSteps = 4096;
+constexpr double kLowestFloor = 0.02, kHighestFloor = 0.99;
+// The budget's search for the floor stops within kFloorTolerance of log floor, or within
+// kToleranceDb under the budget, or after kSearchSteps maps built (each a map build and
+// microseconds of prediction).
+constexpr double kFloorTolerance = 0.002, kToleranceDb = 0.01;
+constexpr int kSearchSteps = 12;
+// The own-detail map's floor: searched in [kBestLowest, kBestHighest] (half the uniform rate to
+// nearly uniform) by kGoldenSteps golden sections (the interval shrunk to 0.618^8 = 2% of its log).
+constexpr double kBestLowest = 0.25, kBestHighest = 0.85;
+// The highest density cap a frame-loss budget raises an importance map's to, once its floor is at
+// the lowest (16x the uniform density: 4x the linear rate, as the default cap; this, 16x it).
+constexpr double kHighestCap = 256.0;
+constexpr int kGoldenSteps = 8;
+// How near (in log floor and log cap) the map chosen on a confirmed model must be to the map whose
+// encode confirmed it for that map and its encode to be kept instead of a second encode.
+constexpr double kNearEncoded = 0.02;
+constexpr double kTilePenalty = 4.0;  // dB of frame loss per dB of tile loss over its budget
+
+[[noreturn]] void invalid(const std::string& what) { throw Error(ErrorCode::InvalidArgument, what); }
+
+// The channels a display shows through its transfer curve: colour and grey, not alpha or data.
+bool isColourChannel(const std::string& name) { return name == "R" || name == "G" || name == "B" || name == "Y"; }
+
+const std::vector<float>& displayTable() {
+    static const std::vector<float> table = [] {
+        std::vector<float> t(kDisplayTableSteps + 2);
+        for (int i = 0; i <= kDisplayTableSteps; ++i) t[i] = linearToSrgbDisplay(float(i) / kDisplayTableSteps);
+        t[kDisplayTableSteps + 1] = t[kDisplayTableSteps];
+        return t;
+    }();
+    return table;
+}
+
+// A value as the model weighs it; a NaN or infinite one (a picture kept as read, which filtering
+// spreads) as 0, so that it neither indexes the table nor turns a tile's error into NaN.
+float shown(float v, bool display, const std::vector<float>& table) {
+    if (!std::isfinite(v)) return 0.0f;
+    if (!display) return v;
+    const float x = std::clamp(v, 0.0f, 1.0f) * kDisplayTableSteps;
+    const int i = static_cast<int>(x);
+    const float f = x - float(i);
+    return table[i] + f * (table[i + 1] - table[i]);
+}
+
+// Singular values of a 2x2 matrix (largest first).
+std::pair<double, double> singularValues(double a, double b, double c, double d) {
+    const double s1 = a * a + b * b + c * c + d * d, det = std::abs(a * d - b * c);
+    const double root = std::sqrt(std::max(0.0, s1 * s1 - 4 * det * det));
+    return {std::sqrt(0.5 * (s1 + root)), std::sqrt(std::max(0.0, 0.5 * (s1 - root)))};
+}
+
+}  // namespace
+
+FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, const Image& importance, const FrameModelOptions& options)
+    : m_options(options) {
+    if (source.empty()) invalid("the frame-loss model needs the source picture");
+    if (width < 1 || height < 1 || width > source.width || height > source.height)
+        invalid("the frame-loss model: CoNUS size " + std::to_string(width) + "x" + std::to_string(height) +
+                " is outside 1x1 .. the source's " + std::to_string(source.width) + "x" + std::to_string(source.height));
+    const int sw = source.width, sh = source.height;
+    m_source = &source;
+    m_measuredUniform = std::make_shared<MeasuredUniform>();
+    m_sourceWidth = sw;
+    m_sourceHeight = sh;
+    m_conusWidth = width;
+    m_conusHeight = height;
+    m_floor = options.space == ErrorSpace::Display ? kDisplayFloor : kLinearFloor;
+    m_tile = std::max(1, std::max(sw, sh) / kTilesPerSide);
+    m_columns = (sw + m_tile - 1) / m_tile;
+    m_rows = (sh + m_tile - 1) / m_tile;
+    const std::size_t tiles = std::size_t(m_columns) * m_rows, channels = source.channels.size();
+    m_pixels.assign(tiles, 0.0);
+    for (int ty = 0; ty < m_rows; ++ty)
+        for (int tx = 0; tx < m_columns; ++tx)
+            m_pixels[std::size_t(ty) * m_columns + tx] =
+                double(std::min(sw, (tx + 1) * m_tile) - tx * m_tile) * double(std::min(sh, (ty + 1) * m_tile) - ty * m_tile);
+
+    // The pyramid: each level's 2x2 cells, their energy about their mean (the channels' mean) spread
+    // over the tiles their source pixels cover, their mean the next level.
+    m_levels = 0;
+    for (int w = sw, h = sh; w >= 2 && h >= 2 && m_levels < kMaxLevels; w /= 2, h /= 2) ++m_levels;
+    m_bands.assign(tiles * std::max(1, m_levels), 0.0);
+    std::vector<bool> display(channels, false);
+    if (options.space == ErrorSpace::Display)
+        for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
+    const std::vector<float>& table = displayTable();
+    std::vector<float> level, next;
+    int w = sw, h = sh;
+    const auto at = [&](int j, int x, int y, std::size_t c) {
+        return j == 0 ? shown(source.pixels[(std::size_t(y) * sw + x) * channels + c], display[c], table)
+                      : level[(std::size_t(y) * w + x) * channels + c];
+    };
+    std::vector<double> energies;
+    for (int j = 0; j < m_levels; ++j) {
+        const int nw = w / 2, nh = h / 2, cell = 1 << (j + 1);
+        next.assign(std::size_t(nw) * nh * channels, 0.0f);
+        // Each cell's energy and mean, rows of cells spread over the threads; then the energies
+        // spread over the tiles in the same order whatever the thread count.
+        energies.assign(std::size_t(nw) * nh, 0.0);
+        parallelRows(nh, 0, [&](int r0, int r1) {
+            for (int y = r0; y < r1; ++y)
+                for (int x = 0; x < nw; ++x) {
+                    double energy = 0;
+                    for (std::size_t c = 0; c < channels; ++c) {
+                        const double v00 = at(j, 2 * x, 2 * y, c), v10 = at(j, 2 * x + 1, 2 * y, c);
+                        const double v01 = at(j, 2 * x, 2 * y + 1, c), v11 = at(j, 2 * x + 1, 2 * y + 1, c);
+                        const double mean = 0.25 * (v00 + v10 + v01 + v11);
+                        energy += 0.25 * ((v00 - mean) * (v00 - mean) + (v10 - mean) * (v10 - mean) + (v01 - mean) * (v01 - mean) +
+                                          (v11 - mean) * (v11 - mean));
+                        next[(std::size_t(y) * nw + x) * channels + c] = static_cast<float>(mean);
+                    }
+                    energies[std::size_t(y) * nw + x] = energy / double(channels);
+                }
+        });
+        for (int y = 0; y < nh; ++y) {
+            const int y0 = y * cell, y1 = std::min(sh, y0 + cell);
+            for (int x = 0; x < nw; ++x) {
+                const double energy = energies[std::size_t(y) * nw + x];
+                const int x0 = x * cell, x1 = std::min(sw, x0 + cell);
+                for (int ty = y0 / m_tile; ty <= (y1 - 1) / m_tile; ++ty) {
+                    const int oy = std::min(y1, (ty + 1) * m_tile) - std::max(y0, ty * m_tile);
+                    for (int tx = x0 / m_tile; tx <= (x1 - 1) / m_tile; ++tx) {
+                        const int ox = std::min(x1, (tx + 1) * m_tile) - std::max(x0, tx * m_tile);
+                        m_bands[(std::size_t(ty) * m_columns + tx) * m_levels + j] += energy * double(ox) * double(oy);
+                    }
+                }
+            }
+        }
+        level.swap(next);
+        w = nw;
+        h = nh;
+    }
+    for (std::size_t t = 0; t < tiles; ++t)
+        for (int j = 0; j < m_levels; ++j) m_bands[t * m_levels + j] /= m_pixels[t];
+
+    setRegion(importance);
+    // The baseline: the uniform image of the same pixel count, every footprint the same.
+    m_uniformError.resize(tiles);
+    const double su = double(sw) / width, sv = double(sh) / height;
+    for (std::size_t t = 0; t < tiles; ++t)
+        m_uniformError[t] = tileError(t, std::max(su, sv), std::min(su, sv), kUniformFit);
+    m_shift.assign(tiles, 0.0);
+}
+
+void FrameErrorModel::setRegion(const Image& importance) {
+    // The region: where the importance reaches half its peak (nowhere without one: R empty, the
+    // whole frame's tiles counted), read at kRegionPoints^2 points of each tile.
+    const std::size_t tiles = m_pixels.size();
+    const int sw = m_sourceWidth, sh = m_sourceHeight;
+    m_roi.assign(tiles, 0.0);
+    m_touches.assign(tiles, 0);
+    if (!importance.empty()) {
+        const std::size_t ic = importance.channels.size();
+        const auto meanAt = [&](std::size_t i) {
+            float v = 0;
+            for (std::size_t c = 0; c < ic; ++c) v += importance.pixels[i * ic + c];
+            return v / float(ic);
+        };
+        float peak = 0;
+        for (std::size_t i = 0; i < std::size_t(importance.width) * importance.height; ++i) peak = std::max(peak, meanAt(i));
+        if (peak > 0)
+            for (int ty = 0; ty < m_rows; ++ty)
+                for (int tx = 0; tx < m_columns; ++tx) {
+                    const double x0 = tx * m_tile, y0 = ty * m_tile;
+                    const double tw = std::min<double>(sw, x0 + m_tile) - x0, th = std::min<double>(sh, y0 + m_tile) - y0;
+                    int in = 0;
+                    for (int j = 0; j < kRegionPoints; ++j)
+                        for (int i = 0; i < kRegionPoints; ++i) {
+                            const double u = (x0 + (i + 0.5) / kRegionPoints * tw) / sw, v = (y0 + (j + 0.5) / kRegionPoints * th) / sh;
+                            const int ix = std::min(importance.width - 1, static_cast<int>(u * importance.width));
+                            const int iy = std::min(importance.height - 1, static_cast<int>(v * importance.height));
+                            in += meanAt(std::size_t(iy) * importance.width + ix) >= 0.5f * peak ? 1 : 0;
+                        }
+                    const std::size_t t = std::size_t(ty) * m_columns + tx;
+                    m_roi[t] = double(in) / (kRegionPoints * kRegionPoints);
+                    m_touches[t] = in > 0;
+                }
+    }
+    if (importance.empty()) {  // R: the whole frame (every tile touches it)
+        std::fill(m_roi.begin(), m_roi.end(), 1.0);
+        std::fill(m_touches.begin(), m_touches.end(), 1);
+    }
+}
+
+FrameErrorModel FrameErrorModel::withRegion(const Image& importance) const {
+    FrameErrorModel out = *this;
+    out.setRegion(importance);
+    return out;
+}
+
+double FrameErrorModel::tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const {
+    const double* e = &m_bands[tile * m_levels];
+    const double l = fit.stretch * std::log2(std::max(sigma1, 1e-6)) + (1 - fit.stretch) * std::log2(std::max(sigma2, 1e-6)) - fit.shift;
+    const auto ramp = [](double t) {
+        const double x = std::clamp((t + kHalfWidth) / (2 * kHalfWidth), 0.0, 1.0);
+        return x * x * (3 - 2 * x);
+    };
+    double sum = 0;
+    for (int j = 0; j < m_levels; ++j) sum += e[j] * ramp(l - j);
+    return fit.scale * sum;
+}
+
+std::vector<std::pair<double, double>> FrameErrorModel::footprints(const SamplingMap& map) const {
+    // J is d(CoNUS normalized)/d(source normalized); in pixels, CoNUS pixels per source pixel; its
+    // inverse singular values are the footprint's axes in source pixels.
+    std::vector<std::pair<double, double>> out;
+    out.reserve(m_pixels.size() * kJacobianPoints * kJacobianPoints);
+    const double W = m_conusWidth, H = m_conusHeight, sw = m_sourceWidth, sh = m_sourceHeight;
+    for (int ty = 0; ty < m_rows; ++ty)
+        for (int tx = 0; tx < m_columns; ++tx) {
+            const double x0 = tx * m_tile, y0 = ty * m_tile;
+            const double tw = std::min(sw, x0 + m_tile) - x0, th = std::min(sh, y0 + m_tile) - y0;
+            for (int j = 0; j < kJacobianPoints; ++j)
+                for (int i = 0; i < kJacobianPoints; ++i) {
+                    const glm::dvec2 p((x0 + (i + 0.5) / kJacobianPoints * tw) / sw, (y0 + (j + 0.5) / kJacobianPoints * th) / sh);
+                    const glm::dmat2 J = map.jacobian(p);
+                    const auto [l1, l2] = singularValues(W * J[0][0] / sw, W * J[1][0] / sh, H * J[0][1] / sw, H * J[1][1] / sh);
+                    out.emplace_back(1.0 / std::max(l2, 1e-9), 1.0 / std::max(l1, 1e-9));
+                }
+        }
+    return out;
+}
+
+double FrameErrorModel::footprintError(std::size_t tile, const std::pair<double, double>* axes, double shift) const {
+    const BandFit& fit = m_options.fitIterations > 0 ? kConusFitted : kConusFiltered;
+    const double scale = std::exp2(shift);
+    double sum = 0;
+    for (int p = 0; p < kJacobianPoints * kJacobianPoints; ++p) sum += tileError(tile, axes[p].first * scale, axes[p].second * scale, fit);
+    return sum / (kJacobianPoints * kJacobianPoints);
+}
+
+std::vector<double> FrameErrorModel::tileErrors(const SamplingMap& map) const {
+    const std::vector<std::pair<double, double>> axes = footprints(map);
+    std::vector<double> out(m_pixels.size());
+    for (std::size_t t = 0; t < out.size(); ++t) out[t] = footprintError(t, &axes[t * kJacobianPoints * kJacobianPoints], m_shift[t]);
+    return out;
+}
+
+FramePrediction FrameErrorModel::predict(const SamplingMap& map) const { return measure(tileErrors(map)); }
+
+FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
+    const Image& source = *m_source;
+    // The real encode (fitted as the encode will be) and decode at the source's size, and the
+    // uniform image's, each tile's mean squared error on the values shown; the model then keeps
+    // each tile's ratio of measured to predicted (e + f over e + f: a flat tile's tiny errors are
+    // not magnified), so that it predicts what this map loses exactly and maps near it by the
+    // model's differences.
+    FrameErrorModel out = *this;
+    EncodeOptions encode;
+    encode.width = m_conusWidth;
+    encode.height = m_conusHeight;
+    encode.filter = m_options.filter;
+    auto kept = std::make_shared<ModelEncode>();
+    kept->image = encodeImage(source, map, encode);
+    if (m_options.fitIterations > 0) {
+        FitOptions fit;
+        fit.iterations = m_options.fitIterations;
+        fit.holdLowPass = m_options.fitHold;
+        fit.method = m_options.fitMethod;
+        kept->fit = fitToDecoder(source, map, kept->image, fit);
+    }
+    DecodeOptions decode;
+    decode.width = source.width;
+    decode.height = source.height;
+    const std::vector<double> measured = shownTileErrors(source, decodeImage(kept->image, map, decode));
+    std::call_once(m_measuredUniform->once, [&] {
+        m_measuredUniform->errors =
+            shownTileErrors(source, resizeBilinear(areaDownsample(source, m_conusWidth, m_conusHeight), {}, source.width, source.height));
+    });
+    out.m_uniformError = m_measuredUniform->errors;
+    // Each tile's footprints scaled by 2^shift so that the model gives what was measured: the
+    // error grows with the footprint, so the shift is found by bisection (to 1e-4 octaves, within
+    // +-kMostShift: a tile with no detail to lose keeps what it can).
+    const std::vector<std::pair<double, double>> axes = footprints(map);
+    for (std::size_t t = 0; t < measured.size(); ++t) {
+        const std::pair<double, double>* a = &axes[t * kJacobianPoints * kJacobianPoints];
+        double lo = -kMostShift, hi = kMostShift;
+        while (hi - lo > 1e-4) {
+            const double mid = 0.5 * (lo + hi);
+            (footprintError(t, a, mid) < measured[t] ? lo : hi) = mid;
+        }
+        out.m_shift[t] = 0.5 * (lo + hi);
+    }
+    out.m_confirmed = true;
+    out.m_encode = std::move(kept);
+    return out;
+}
+
+std::vector<double> FrameErrorModel::shownTileErrors(const Image& source, const Image& view) const {
+    const std::size_t channels = source.channels.size();
+    std::vector<bool> display(channels, false);
+    if (m_options.space == ErrorSpace::Display)
+        for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
+    const std::vector<float>& table = displayTable();
+    // A row of tiles at a time, the rows of tiles spread over the threads (each tile's sum is
+    // taken in the same order whatever the thread count).
+    std::vector<double> out(m_pixels.size(), 0.0);
+    parallelRows(
+        m_rows, 0,
+        [&](int r0, int r1) {
+            for (int y = r0 * m_tile; y < std::min(source.height, r1 * m_tile); ++y) {
+                double* row = &out[std::size_t(y / m_tile) * m_columns];
+                for (int x = 0; x < source.width; ++x) {
+                    double e = 0;
+                    for (std::size_t c = 0; c < channels; ++c) {
+                        const std::size_t i = (std::size_t(y) * source.width + x) * channels + c;
+                        const double d = double(shown(view.pixels[i], display[c], table)) - shown(source.pixels[i], display[c], table);
+                        e += d * d;
+                    }
+                    row[x / m_tile] += e / double(channels);
+                }
+            }
+        },
+        1);
+    for (std::size_t t = 0; t < out.size(); ++t) out[t] /= m_pixels[t];
+    return out;
+}
+
+FramePrediction FrameErrorModel::measure(const std::vector<double>& mapped) const {
+    const auto db = [](double a, double b) { return 10.0 * std::log10(std::max(a, 1e-30) / std::max(b, 1e-30)); };
+    double frameUniform = 0, frameMapped = 0, roiUniform = 0, roiMapped = 0, roiCount = 0, n = 0;
+    std::vector<double> losses;
+    for (std::size_t t = 0; t < mapped.size(); ++t) {
+        const double p = m_pixels[t], r = p * m_roi[t];
+        frameUniform += p * m_uniformError[t];
+        frameMapped += p * mapped[t];
+        roiUniform += r * m_uniformError[t];
+        roiMapped += r * mapped[t];
+        roiCount += r;
+        n += p;
+        if (!m_touches[t]) losses.push_back(db(mapped[t] + m_floor, m_uniformError[t] + m_floor));
+    }
+    const double rest = std::max(1.0, n - roiCount);
+    FramePrediction out{db(frameMapped / n + m_floor, frameUniform / n + m_floor), db(roiUniform, roiMapped), 0.0,
+                        db((frameMapped - roiMapped) / rest + m_floor, (frameUniform - roiUniform) / rest + m_floor)};
+    if (!losses.empty()) {
+        const std::size_t at = std::min(losses.size() - 1, static_cast<std::size_t>(kTilePercentile * double(losses.size())));
+        std::nth_element(losses.begin(), losses.begin() + static_cast<std::ptrdiff_t>(at), losses.end());
+        out.tileLoss = losses[at];
+        const std::size_t at99 = std::min(losses.size() - 1, static_cast<std::size_t>(kWorstTilesPercentile * double(losses.size())));
+        std::nth_element(losses.begin(), losses.begin() + static_cast<std::ptrdiff_t>(at99), losses.end());
+        out.tileLoss99 = losses[at99];
+    }
+    return out;
+}
+
+BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorModel& model, double frameLossDb,
+                                      AutoMapOptions options, double tileLossDb) {
+    if (!(frameLossDb >= 0) || !std::isfinite(frameLossDb))
+        invalid("the frame-loss budget " + std::to_string(frameLossDb) + " dB must be finite and >= 0");
+    // A higher floor leaves the context more samples: the loss falls as the floor rises. The lowest
+    // floor within the budget, by regula falsi (Illinois) in log floor on how far each built map is
+    // predicted to be over it: a continuous function of the picture.
+    options.refuseBounds = false;
+    const auto build = [&](double floor) {
+        options.minDensity = floor;
+        BudgetResult r{buildAutoMap(importance, options), floor, {}, true, options.maxDensity};
+        r.predicted = model.predict(r.map);
+        return r;
+    };
+    const auto over = [&](const BudgetResult& r) { return std::max(r.predicted.frameLoss - frameLossDb, r.predicted.tileLoss - tileLossDb); };
+    const double cap = options.maxDensity;
+    const auto search = [&]() {
+        BudgetResult low = build(kLowestFloor);
+        if (over(low) <= 0) {
+            // The lowest floor holds the budget (a map that follows the picture's detail often gains
+            // over the whole frame): the rest is spent by raising the density cap, in log cap by
+            // regula falsi between the cap given and kHighestCap, as continuous as the floor's.
+            options.maxDensity = kHighestCap;
+            BudgetResult top = build(kLowestFloor);
+            options.maxDensity = cap;
+            if (over(top) <= 0 || cap >= kHighestCap) {
+                (over(top) <= 0 ? top : low).budgetBinds = false;
+                return over(top) <= 0 ? top : low;
+            }
+            const auto withCap = [&](double logCap) {
+                options.maxDensity = std::exp(logCap);
+                BudgetResult r = build(kLowestFloor);
+                options.maxDensity = cap;
+                return r;
+            };
+            return detail::searchWithin(std::move(low), std::log(cap), std::move(top), std::log(kHighestCap), withCap, over, kSearchSteps,
+                                        kFloorTolerance, kToleranceDb);
+        }
+        BudgetResult high = build(kHighestFloor);
+        if (over(high) > 0) return high;  // the closest to the budget there is
+        return detail::searchWithin(std::move(high), std::log(kHighestFloor), std::move(low), std::log(kLowestFloor),
+                                    [&](double logFloor) { return build(std::exp(logFloor)); }, over, kSearchSteps, kFloorTolerance,
+                                    kToleranceDb);
+    };
+    BudgetResult chosen = search();
+    if (const DensityField* context = options.context) {
+        // As for foci (foci_budget.cpp): where the context that follows the picture gives the region
+        // less (a region softer than the rest, whose factor the max density caps; a context that
+        // alone loses the budget) or crowds a few tiles (keepsContext), the uniform context's map is kept.
+        options.context = nullptr;
+        BudgetResult plain = search();
+        if ((over(plain) <= 0 && over(chosen) > 0) || ((over(plain) <= 0) == (over(chosen) <= 0) && !keepsContext(chosen.predicted, plain.predicted)))
+            chosen = std::move(plain);
+        else
+            options.context = context;
+    }
+    if (model.options().confirm && !model.isConfirmed()) {
+        // One real encode of the map chosen, and the choice made again on the model it confirms
+        // (the context kept as chosen).
+        const FrameErrorModel confirmed = model.confirmed(chosen.map);
+        BudgetResult again = buildAutoMapForFrameLoss(importance, confirmed, frameLossDb, options, tileLossDb);
+        // Where that choice is next to the map encoded (kNearEncoded in log floor and log cap) and
+        // the encoded map holds the budget as measured (or neither does), the map encoded is kept,
+        // with its encode and what it measured: the encode is then not made again.
+        chosen.predicted = confirmed.predict(chosen.map);
+        const bool near = std::abs(std::log(again.minDensity / chosen.minDensity)) <= kNearEncoded &&
+                          std::abs(std::log(again.maxDensity / chosen.maxDensity)) <= kNearEncoded;
+        if (near && (over(chosen) <= 0 || over(again) > 0)) {
+            chosen.encode = confirmed.encode();
+            return chosen;
+        }
+        return again;
+    }
+    return chosen;
+}
+
+BudgetResult buildAutoMapForBestFrame(const Image& importance, const FrameErrorModel& model, double tileLossDb,
+                                      AutoMapOptions options) {
+    // The whole-frame loss is not monotone in the floor (too low starves the flat parts, too high
+    // leaves the detail nothing): golden-section search in log floor over [kBestLowest, kBestHighest]
+    // for the least of the frame's loss plus kTilePenalty per dB the tiles lose over their budget
+    // (a continuous objective: a tiny change of the picture moves the floor a little).
+    options.refuseBounds = false;
+    const auto build = [&](double floor) {
+        options.minDensity = floor;
+        BudgetResult r{buildAutoMap(importance, options), floor, {}, true, options.maxDensity};
+        r.predicted = model.predict(r.map);
+        return r;
+    };
+    const auto cost = [&](const BudgetResult& r) {
+        return r.predicted.frameLoss + kTilePenalty * std::max(0.0, r.predicted.tileLoss - tileLossDb);
+    };
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double a = std::log(kBestLowest), b = std::log(kBestHighest);
+    double c = b - g * (b - a), d = a + g * (b - a);
+    BudgetResult rc = build(std::exp(c)), rd = build(std::exp(d));
+    for (int i = 0; i < kGoldenSteps; ++i) {
+        if (cost(rc) <= cost(rd)) {
+            b = d;
+            d = c;
+            rd = std::move(rc);
+            c = b - g * (b - a);
+            rc = build(std::exp(c));
+        } else {
+            a = c;
+            c = d;
+            rc = std::move(rd);
+            d = a + g * (b - a);
+            rd = build(std::exp(d));
+        }
+    }
+    BudgetResult best = cost(rc) <= cost(rd) ? std::move(rc) : std::move(rd);
+    best.budgetBinds = best.predicted.tileLoss <= tileLossDb;
+    return best;
+}
+
+BudgetResult buildOwnDetailMap(const Image& source, const Image& detail, int width, int height, const AutoMapOptions& options,
+                               const FrameModelOptions& model) {
+    const FrameErrorModel trials(source, width, height, detail, model);
+    return buildAutoMapForBestFrame(detail, trials, kOwnDetailTileLoss, options);
+}
+
+DensityField ownDetailContext(const Image& source, const Image& detail, int width, int height, const AutoMapOptions& options,
+                              const FrameModelOptions& model) {
+    return ownDetailContext(FrameErrorModel(source, width, height, detail, model), detail, options);
+}
+
+DensityField ownDetailContext(const FrameErrorModel& model, const Image& detail, const AutoMapOptions& options) {
+    AutoMapOptions at = options;
+    at.minDensity = buildAutoMapForBestFrame(detail, model, kOwnDetailTileLoss, options).minDensity;
+    return importanceToDensity(detail, at);
+}
+
+}  // namespace conus::codec
