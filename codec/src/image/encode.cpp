@@ -9,13 +9,19 @@
 // principal axes, the minor one filtered by the pyramid level it picks, a row of taps along the
 // major one; exact at power-of-two ratios.
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <mutex>
 #include <vector>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include "conus/codec/image/encode.h"
 #include "area_downsample_pvt.h"
+#include "cpu_features_pvt.h"
 #include "conus/core/parallel.h"
 #include "encode_pvt.h"
 #include "resample_pvt.h"
@@ -264,6 +270,95 @@ void accumulateRow(const float* pixels, std::size_t stride, const RowTaps& r, Fl
     }
 }
 
+// One row of the anisotropic kernel's taps, all inside the level a row clear of its last: tap i
+// at texel coordinates (x + i sx, y + i sy), weight weight[i] (every one > 0), bilinear on all
+// channels at once, added to acc. The taps' texel offsets and fractions are worked out first,
+// without a branch, so that loop vectorizes.
+struct TapRow {
+    double x = 0, y = 0, sx = 0, sy = 0;
+    int count = 0;
+    const float* weight = nullptr;
+};
+
+template <int kC>
+inline void tapRowBaseline(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
+    std::size_t offset[RowTaps::kMax];
+    float fx[RowTaps::kMax], fy[RowTaps::kMax];
+    for (int n = 0; n < row.count; ++n) {
+        const double x = row.x + n * row.sx, y = row.y + n * row.sy;
+        const int xi = static_cast<int>(x), yi = static_cast<int>(y);
+        fx[n] = static_cast<float>(x - xi);
+        fy[n] = static_cast<float>(y - yi);
+        offset[n] = yi * stride + static_cast<std::size_t>(xi) * kC;
+    }
+    for (int n = 0; n < row.count; ++n) {
+        const float* p0 = pixels + offset[n];
+        const float* p1 = p0 + stride;
+        const Float4 a = load4(p0), b = load4(p1);
+        const Float4 top = a + fx[n] * (load4(p0 + kC) - a);
+        const Float4 bottom = b + fx[n] * (load4(p1 + kC) - b);
+        acc += row.weight[n] * (top + fy[n] * (bottom - top));
+    }
+}
+
+std::atomic<bool> g_forceBaselineEncode{false};
+
+#if CONUS_HAVE_AVX2_COPY
+// tapRowBaseline on a processor with AVX2: the offsets four taps at a time, then two taps a step,
+// one in each 128-bit half of a register, each lerp a fused multiply-add (so the sums differ from
+// the baseline's in their last bits); the same four-float texel reads.
+template <int kC>
+CONUS_TARGET_AVX2 void tapRowAvx2(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
+    std::size_t offset[RowTaps::kMax];
+    float fx[RowTaps::kMax], fy[RowTaps::kMax];
+    for (int n = 0; n < row.count; ++n) {
+        const double x = row.x + n * row.sx, y = row.y + n * row.sy;
+        const int xi = static_cast<int>(x), yi = static_cast<int>(y);
+        fx[n] = static_cast<float>(x - xi);
+        fy[n] = static_cast<float>(y - yi);
+        offset[n] = yi * stride + static_cast<std::size_t>(xi) * kC;
+    }
+    __m256 sum = _mm256_setzero_ps();
+    int n = 0;
+    for (; n + 1 < row.count; n += 2) {
+        const float* p = pixels + offset[n];
+        const float* q = pixels + offset[n + 1];
+        const __m256 a = _mm256_set_m128(_mm_loadu_ps(q), _mm_loadu_ps(p));
+        const __m256 a1 = _mm256_set_m128(_mm_loadu_ps(q + kC), _mm_loadu_ps(p + kC));
+        const __m256 b = _mm256_set_m128(_mm_loadu_ps(q + stride), _mm_loadu_ps(p + stride));
+        const __m256 b1 = _mm256_set_m128(_mm_loadu_ps(q + stride + kC), _mm_loadu_ps(p + stride + kC));
+        const __m256 fxv = _mm256_set_m128(_mm_set1_ps(fx[n + 1]), _mm_set1_ps(fx[n]));
+        const __m256 fyv = _mm256_set_m128(_mm_set1_ps(fy[n + 1]), _mm_set1_ps(fy[n]));
+        const __m256 wv = _mm256_set_m128(_mm_set1_ps(row.weight[n + 1]), _mm_set1_ps(row.weight[n]));
+        const __m256 top = _mm256_fmadd_ps(fxv, _mm256_sub_ps(a1, a), a);
+        const __m256 bottom = _mm256_fmadd_ps(fxv, _mm256_sub_ps(b1, b), b);
+        sum = _mm256_fmadd_ps(wv, _mm256_fmadd_ps(fyv, _mm256_sub_ps(bottom, top), top), sum);
+    }
+    __m128 s = _mm_add_ps(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1));
+    if (n < row.count) {
+        const float* p = pixels + offset[n];
+        const __m128 a = _mm_loadu_ps(p), a1 = _mm_loadu_ps(p + kC);
+        const __m128 b = _mm_loadu_ps(p + stride), b1 = _mm_loadu_ps(p + stride + kC);
+        const __m128 fxv = _mm_set1_ps(fx[n]);
+        const __m128 top = _mm_fmadd_ps(fxv, _mm_sub_ps(a1, a), a);
+        const __m128 bottom = _mm_fmadd_ps(fxv, _mm_sub_ps(b1, b), b);
+        s = _mm_fmadd_ps(_mm_set1_ps(row.weight[n]), _mm_fmadd_ps(_mm_set1_ps(fy[n]), _mm_sub_ps(bottom, top), top), s);
+    }
+    Float4 v;
+    std::memcpy(&v, &s, sizeof v);
+    acc += v;
+}
+#endif
+
+template <int kC>
+void tapRow(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
+#if CONUS_HAVE_AVX2_COPY
+    static const bool avx2 = detail::cpuHasAvx2();
+    if (avx2 && !g_forceBaselineEncode.load(std::memory_order_relaxed)) return tapRowAvx2<kC>(pixels, stride, row, acc);
+#endif
+    tapRowBaseline<kC>(pixels, stride, row, acc);
+}
+
 // The filtered value on one level, normalized, written to out. The taps are encode.h's grid
 // (ns x nt, at slice centres over the filter's extent), a row at a time.
 template <int kC>
@@ -356,6 +451,20 @@ double anisotropicLevel(const PrincipalAxes& axes, const FootprintFilter& filter
     return std::log2(coarsest);
 }
 
+// The weights of nu taps at u0 + i du along the major axis (u0 = -(nu - 1) du / 2: symmetric about
+// the centre): the Gaussian's mass (erf at k times the offset) over the offsets within the reach
+// that keep a tap in the unit box. Symmetric, so half of them are computed and mirrored; the
+// polynomial erf is most of a footprint's arithmetic, and an AVX2 copy takes four taps at a time.
+CONUS_VECTOR_CLONES void majorWeights(double u0, double du, int nu, double reach, double k, double* weight) {
+    const int half = (nu + 1) / 2;
+    for (int i = 0; i < half; ++i) {
+        const double u = u0 + i * du;
+        const double lo = u - 0.5 > -reach ? u - 0.5 : -reach, hi = u + 0.5 < reach ? u + 0.5 : reach;
+        weight[i] = hi > lo ? detail::erfOnReach(hi * k) - detail::erfOnReach(lo * k) : 0.0;
+    }
+    for (int i = half; i < nu; ++i) weight[i] = weight[nu - 1 - i];
+}
+
 // The anisotropic kernel on one level, normalized, written to out: nw rows of taps across the
 // minor axis (slice centres of the unit box), each of nu taps along the major axis (slice centres
 // of the box widened by the Gaussian's reach), taps at most a texel apart. A tap's weight is the
@@ -376,12 +485,7 @@ void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, 
     if (filter.sigma < kMinSigma) {
         for (int i = 0; i < nu; ++i) weight[i] = 1.0;
     } else {
-        const double k = 1.0 / (std::sqrt(2.0) * filter.sigma), reach = filter.reach;
-        for (int i = 0; i < nu; ++i) {
-            const double u = u0 + i * du;
-            const double lo = u - 0.5 > -reach ? u - 0.5 : -reach, hi = u + 0.5 < reach ? u + 0.5 : reach;
-            weight[i] = hi > lo ? detail::erfOnReach(hi * k) - detail::erfOnReach(lo * k) : 0.0;
-        }
+        majorWeights(u0, du, nu, filter.reach, 1.0 / (std::sqrt(2.0) * filter.sigma), weight);
     }
     const double cx = p.x * img.width - 0.5, cy = p.y * img.height - 0.5;
     // Away from the borders no tap needs clamping: decide once for the whole footprint.
@@ -402,13 +506,31 @@ void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, 
         }
     };
     if constexpr (kC > 0 && kC <= 4) {
-        // (The four-float reads of accumulateRow: see filterOnLevel.)
+        // (The four-float reads of the taps: see filterOnLevel.) Every row has the same weights:
+        // the taps that weigh anything (a run about the centre) and their sum are found once.
         if (inner && cy + ey < img.height - 2 && (kC >= 2 || img.width >= 3)) {
-            Float4 acc{0.0f, 0.0f, 0.0f, 0.0f};
-            for (int j = 0; j < nw; ++j) {
-                row(j);
-                accumulateRow<kC>(img.data, stride, r, acc, total);
+            int i0 = 0, i1 = nu;
+            while (i0 < i1 && weight[i0] <= 0) ++i0;
+            while (i1 > i0 && weight[i1 - 1] <= 0) --i1;
+            float taken[RowTaps::kMax];
+            double sum = 0;
+            for (int i = i0; i < i1; ++i) {
+                taken[i - i0] = static_cast<float>(weight[i]);
+                sum += weight[i];
             }
+            TapRow tr;
+            tr.sx = major.x * du;
+            tr.sy = major.y * du;
+            tr.count = i1 - i0;
+            tr.weight = taken;
+            Float4 acc{0.0f, 0.0f, 0.0f, 0.0f};
+            for (int j = 0; j < nw && tr.count > 0; ++j) {
+                const double w = w0 + j * dw, u = u0 + i0 * du;
+                tr.x = cx + minor.x * w + major.x * u;
+                tr.y = cy + minor.y * w + major.y * u;
+                tapRow<kC>(img.data, stride, tr, acc);
+            }
+            total = sum * nw;
             const float norm = total > 0 ? static_cast<float>(1.0 / total) : 0.0f;
             for (int c = 0; c < kC; ++c) out[c] = acc[c] * norm;
             return;
@@ -489,6 +611,11 @@ bool isUniform(const SamplingMap& map) {
 }
 
 }  // namespace
+
+namespace detail {
+bool encodeAvx2Available() { return cpuHasAvx2(); }
+void forceBaselineEncode(bool baseline) { g_forceBaselineEncode.store(baseline, std::memory_order_relaxed); }
+}  // namespace detail
 
 FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b, double uniform) {
     double minor = 0;

@@ -1,4 +1,5 @@
-// Private: the CPU encoder's erf, shared with its test (tests/codec/image/encode_test.cpp).
+// Private: the CPU encoder's erf and its choice of tap loop, shared with its test
+// (tests/codec/image/encode_test.cpp).
 #pragma once
 
 #include "conus/codec/image/encode.h"
@@ -27,5 +28,10 @@ inline double erfOnReach(double x) {
     p = p * t + 1.1283791620114259;
     return x * p;
 }
+
+// Whether this processor runs the encoder's AVX2 tap loop (false where the build has none), and a
+// switch to the baseline loop for every encode after it (tests compare the two).
+bool encodeAvx2Available();
+void forceBaselineEncode(bool baseline);
 
 }  // namespace conus::codec::detail
