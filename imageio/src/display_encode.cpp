@@ -60,11 +60,8 @@ Image displayEncodedOpaque(const Image& image) {
     std::vector<char> isColour(channels, 0);
     for (int c : colour) isColour[c] = 1;
     const SrgbTable& table = srgbTable();
-    Image out;
-    out.width = image.width;
-    out.height = image.height;
-    out.channels = image.channels;
-    out.pixels.resize(image.pixels.size());
+    // Through makeImage: a large array is faulted in huge pages, on every core (core/image.h).
+    Image out = makeImage(image.width, image.height, image.channels);
     const std::size_t row = static_cast<std::size_t>(image.width) * channels;
     parallelRows(image.height, 0, [&](int y0, int y1) {
         for (std::size_t i = y0 * row, end = y1 * row; i < end; i += channels)
