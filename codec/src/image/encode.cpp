@@ -455,12 +455,15 @@ double anisotropicLevel(const PrincipalAxes& axes, const FootprintFilter& filter
 // the centre): the Gaussian's mass (erf at k times the offset) over the offsets within the reach
 // that keep a tap in the unit box. Symmetric, so half of them are computed and mirrored; the
 // polynomial erf is most of a footprint's arithmetic, and an AVX2 copy takes four taps at a time.
-CONUS_VECTOR_CLONES void majorWeights(double u0, double du, int nu, double reach, double k, double* weight) {
+CONUS_VECTOR_CLONES void majorWeights(double u0, double du, int nu, double reach, double k, float* weight) {
     const int half = (nu + 1) / 2;
+    const float u0f = static_cast<float>(u0), duf = static_cast<float>(du);
+    const float reachf = static_cast<float>(reach), kf = static_cast<float>(k);
     for (int i = 0; i < half; ++i) {
-        const double u = u0 + i * du;
-        const double lo = u - 0.5 > -reach ? u - 0.5 : -reach, hi = u + 0.5 < reach ? u + 0.5 : reach;
-        weight[i] = hi > lo ? detail::erfOnReach(hi * k) - detail::erfOnReach(lo * k) : 0.0;
+        const float u = u0f + static_cast<float>(i) * duf;
+        const float lo = u - 0.5f > -reachf ? u - 0.5f : -reachf, hi = u + 0.5f < reachf ? u + 0.5f : reachf;
+        const float w = detail::erfOnReachFloat(hi * kf) - detail::erfOnReachFloat(lo * kf);
+        weight[i] = hi > lo ? w : 0.0f;
     }
     for (int i = half; i < nu; ++i) weight[i] = weight[nu - 1 - i];
 }
@@ -481,9 +484,9 @@ void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, 
     const double du = extent / nu, dw = 1.0 / nw;
     const double u0 = 0.5 * du - 0.5 * extent, w0 = 0.5 * dw - 0.5;
     constexpr double kMinSigma = 1e-4;  // below it the filter is the plain box (encode.h)
-    double weight[RowTaps::kMax];
+    float weight[RowTaps::kMax];
     if (filter.sigma < kMinSigma) {
-        for (int i = 0; i < nu; ++i) weight[i] = 1.0;
+        for (int i = 0; i < nu; ++i) weight[i] = 1.0f;
     } else {
         majorWeights(u0, du, nu, filter.reach, 1.0 / (std::sqrt(2.0) * filter.sigma), weight);
     }
@@ -512,17 +515,13 @@ void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, 
             int i0 = 0, i1 = nu;
             while (i0 < i1 && weight[i0] <= 0) ++i0;
             while (i1 > i0 && weight[i1 - 1] <= 0) --i1;
-            float taken[RowTaps::kMax];
             double sum = 0;
-            for (int i = i0; i < i1; ++i) {
-                taken[i - i0] = static_cast<float>(weight[i]);
-                sum += weight[i];
-            }
+            for (int i = i0; i < i1; ++i) sum += weight[i];
             TapRow tr;
             tr.sx = major.x * du;
             tr.sy = major.y * du;
             tr.count = i1 - i0;
-            tr.weight = taken;
+            tr.weight = weight + i0;
             Float4 acc{0.0f, 0.0f, 0.0f, 0.0f};
             for (int j = 0; j < nw && tr.count > 0; ++j) {
                 const double w = w0 + j * dw, u = u0 + i0 * du;

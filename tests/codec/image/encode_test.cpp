@@ -292,6 +292,15 @@ TEST(EncodeErf, MatchesTheLibraryOverTheReachAndNeverDecreases) {
         previous = e;
     }
     EXPECT_LT(worst, 2e-9);
+    // The float twin (the anisotropic kernel's weights): within float rounding of erf.
+    double worstFloat = 0;
+    for (int i = -200000; i <= 200000; ++i) {
+        const double x = reach * i / 200000.0;
+        worstFloat = std::max(worstFloat, std::abs(detail::erfOnReachFloat(static_cast<float>(x)) -
+                                                   std::erf(double(static_cast<float>(x)))));
+    }
+    EXPECT_LT(worstFloat, 4e-7);
+    EXPECT_FLOAT_EQ(detail::erfOnReachFloat(-3.0f), -detail::erfOnReachFloat(float(reach)));
     EXPECT_DOUBLE_EQ(detail::erfOnReach(3.0), detail::erfOnReach(reach));
     EXPECT_DOUBLE_EQ(detail::erfOnReach(-1e300), -detail::erfOnReach(reach));
 }
