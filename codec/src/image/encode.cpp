@@ -515,8 +515,13 @@ void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, 
             int i0 = 0, i1 = nu;
             while (i0 < i1 && weight[i0] <= 0) ++i0;
             while (i1 > i0 && weight[i1 - 1] <= 0) --i1;
-            double sum = 0;
-            for (int i = i0; i < i1; ++i) sum += weight[i];
+            // (Four partial sums: one running total waited on each add.)
+            float part[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+            int i = i0;
+            for (; i + 4 <= i1; i += 4)
+                for (int q = 0; q < 4; ++q) part[q] += weight[i + q];
+            for (; i < i1; ++i) part[0] += weight[i];
+            const double sum = double(part[0]) + part[1] + part[2] + part[3];
             TapRow tr;
             tr.sx = major.x * du;
             tr.sy = major.y * du;
