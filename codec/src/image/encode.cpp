@@ -12,7 +12,9 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #if defined(__x86_64__)
@@ -35,6 +37,56 @@ constexpr double kTapTolerance = kEncodeTapTolerance;
 using detail::areaDownsamplePlane;
 using detail::Plane;
 
+// The memory of the last encodes' pyramid levels, kept for the next encode of a source of the
+// same size (the budget's confirming encodes and the final one, a batch of photos from one
+// camera): a fresh 50 MB level is first touched page by page, and the kernel's clearing of those
+// pages cost more than building the level (perf: clear_page ~20 % of a repeated 4096^2 encode).
+// Every value of a level is written when it is built, so a kept array is handed out as it is.
+// At most kMaxKeptBytes are kept; the oldest arrays go first.
+class LevelMemory {
+public:
+    static constexpr std::size_t kMaxKeptBytes = std::size_t{160} << 20;
+
+    // An array of exactly `values` floats: a kept one if there is one, else a new one (makeImage:
+    // huge pages, faulted in on every core).
+    static std::vector<float> take(std::size_t values, int width, int height, const std::vector<std::string>& channels) {
+        {
+            std::lock_guard lock(mutex());
+            std::vector<std::vector<float>>& kept = store();
+            for (auto it = kept.rbegin(); it != kept.rend(); ++it)
+                if (it->size() == values) {
+                    std::vector<float> found = std::move(*it);
+                    kept.erase(std::next(it).base());
+                    return found;
+                }
+        }
+        return std::move(makeImage(width, height, channels).pixels);
+    }
+    static void give(std::vector<float>&& array) {
+        const std::size_t bytes = array.size() * sizeof(float);
+        if (bytes == 0 || bytes > kMaxKeptBytes) return;
+        std::lock_guard lock(mutex());
+        std::vector<std::vector<float>>& kept = store();
+        kept.push_back(std::move(array));
+        std::size_t total = 0;
+        for (const auto& a : kept) total += a.size() * sizeof(float);
+        while (total > kMaxKeptBytes) {
+            total -= kept.front().size() * sizeof(float);
+            kept.erase(kept.begin());
+        }
+    }
+
+private:
+    static std::mutex& mutex() {
+        static std::mutex m;
+        return m;
+    }
+    static std::vector<std::vector<float>>& store() {
+        static std::vector<std::vector<float>> s;
+        return s;
+    }
+};
+
 // Box-filtered mip levels of the source, each built the first time a footprint needs it.
 class Pyramid {
 public:
@@ -49,6 +101,11 @@ public:
             m_sizes.push_back({w, h});
         }
     }
+    ~Pyramid() {
+        for (std::vector<float>& level : m_levels) LevelMemory::give(std::move(level));
+    }
+    Pyramid(const Pyramid&) = delete;
+    Pyramid& operator=(const Pyramid&) = delete;
     int levels() const { return static_cast<int>(m_sizes.size()); }
     int width(int level) const { return m_sizes[level][0]; }
     int height(int level) const { return m_sizes[level][1]; }
@@ -57,19 +114,18 @@ public:
         if (level == 0) return {m_source.pixels.data(), m_source.width, m_source.height};
         std::call_once(m_once[level], [&] {
             const Plane below = this->level(level - 1, threads);
-            // A checked Image: zero-filled first, but in huge pages where large (core/image.cpp),
-            // which costs less than a 4 KiB page fault every 1024 floats of a new level.
-            m_levels[level] = makeImage(width(level), height(level), m_source.channels);
-            areaDownsamplePlane(below, m_levels[level].pixels.data(), width(level), height(level), m_channels, threads);
+            const std::size_t values = static_cast<std::size_t>(width(level)) * height(level) * m_channels;
+            m_levels[level] = LevelMemory::take(values, width(level), height(level), m_source.channels);
+            areaDownsamplePlane(below, m_levels[level].data(), width(level), height(level), m_channels, threads);
         });
-        return {m_levels[level].pixels.data(), width(level), height(level)};
+        return {m_levels[level].data(), width(level), height(level)};
     }
 
 private:
     const Image& m_source;
     int m_channels;
     std::vector<std::array<int, 2>> m_sizes;
-    std::array<Image, kMaxLevels> m_levels;
+    std::array<std::vector<float>, kMaxLevels> m_levels;
     std::array<std::once_flag, kMaxLevels> m_once;
 };
 
