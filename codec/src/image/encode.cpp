@@ -336,10 +336,10 @@ struct TapRow {
     const float* weight = nullptr;
 };
 
+// The row's taps' first texels (offsets in floats) and their fractions, without a branch so the
+// loop vectorizes (inlined into each copy of the tap loop, with that copy's instructions).
 template <int kC>
-inline void tapRowBaseline(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
-    std::size_t offset[RowTaps::kMax];
-    float fx[RowTaps::kMax], fy[RowTaps::kMax];
+inline void tapPlaces(std::size_t stride, const TapRow& row, std::size_t* offset, float* fx, float* fy) {
     for (int n = 0; n < row.count; ++n) {
         const double x = row.x + n * row.sx, y = row.y + n * row.sy;
         const int xi = static_cast<int>(x), yi = static_cast<int>(y);
@@ -347,6 +347,13 @@ inline void tapRowBaseline(const float* pixels, std::size_t stride, const TapRow
         fy[n] = static_cast<float>(y - yi);
         offset[n] = yi * stride + static_cast<std::size_t>(xi) * kC;
     }
+}
+
+template <int kC>
+inline void tapRowBaseline(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
+    std::size_t offset[RowTaps::kMax];
+    float fx[RowTaps::kMax], fy[RowTaps::kMax];
+    tapPlaces<kC>(stride, row, offset, fx, fy);
     for (int n = 0; n < row.count; ++n) {
         const float* p0 = pixels + offset[n];
         const float* p1 = p0 + stride;
@@ -367,13 +374,7 @@ template <int kC>
 CONUS_TARGET_AVX2 void tapRowAvx2(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
     std::size_t offset[RowTaps::kMax];
     float fx[RowTaps::kMax], fy[RowTaps::kMax];
-    for (int n = 0; n < row.count; ++n) {
-        const double x = row.x + n * row.sx, y = row.y + n * row.sy;
-        const int xi = static_cast<int>(x), yi = static_cast<int>(y);
-        fx[n] = static_cast<float>(x - xi);
-        fy[n] = static_cast<float>(y - yi);
-        offset[n] = yi * stride + static_cast<std::size_t>(xi) * kC;
-    }
+    tapPlaces<kC>(stride, row, offset, fx, fy);
     __m256 sum = _mm256_setzero_ps();
     int n = 0;
     for (; n + 1 < row.count; n += 2) {
