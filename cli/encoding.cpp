@@ -57,7 +57,8 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault) {
     command.add_option("--filter", fit.filter,
                        "how each CoNUS pixel is filtered from the source: anisotropic (a few taps along the footprint's "
                        "long axis on the pyramid level of its short one, as GPUs do: the fast default) or ewa (every tap "
-                       "over the footprint, as the GL encoder does)")
+                       "over the footprint). Acts on the CPU encoder under a non-uniform map only: the GL encoder "
+                       "always filters as ewa, and a uniform map (conus uniform) always takes the exact area average")
         ->check(CLI::IsMember(enumNames<codec::EncodeFilter>(), CLI::ignore_case))
         ->capture_default_str();
     CLI::Option* enabled = command.add_flag(

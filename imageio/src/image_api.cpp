@@ -6,6 +6,7 @@
 #include "conus/core/error.h"
 #include "conus/imageio/image_file.h"
 #include "conus/imageio/text.h"
+#include "display_encode_pvt.h"
 #include "oiio_module_pvt.h"
 #include "png_direct_pvt.h"
 
@@ -27,7 +28,12 @@ std::string sampleTypesOf(const std::string& path) { return oiioFunctions().samp
 
 void linearize(Image& image) { oiioFunctions().linearize(image); }
 
-Image displayEncoded(const Image& image) { return oiioFunctions().displayEncoded(image); }
+// Without alpha (a photograph) there is nothing to divide out and the sRGB curve needs no
+// OpenImageIO (display_encode_pvt.h): a `conus encode` of a PNG then never loads it.
+Image displayEncoded(const Image& image) {
+    if (image.channelIndex("A") < 0) return displayEncodedOpaque(image);
+    return oiioFunctions().displayEncoded(image);
+}
 
 void repairNonFinite(Image& image, NonFiniteRepair repair) { oiioFunctions().repairNonFinite(image, repair, "an image"); }
 

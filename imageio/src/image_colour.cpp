@@ -13,16 +13,6 @@
 
 namespace conus::imageio::oiio {
 
-ChannelRoles rolesOf(const Image& image) {
-    ChannelRoles roles;
-    const int r = image.channelIndex("R"), g = image.channelIndex("G"), b = image.channelIndex("B");
-    const int y = image.channelIndex("Y");
-    if (r >= 0 && g >= 0 && b >= 0) roles.colour = {r, g, b};
-    else if (y >= 0) roles.colour = {y};
-    roles.alpha = image.channelIndex("A");
-    return roles;
-}
-
 void convertColour(float* pixels, int width, int height, int channels, const std::vector<int>& colour,
                    const char* from, const char* to, const std::string& path) {
     if (colour.empty()) return;

@@ -16,8 +16,17 @@ struct ChannelRoles {
     int alpha = -1;
 };
 
-// The roles of `image`'s channels.
-ChannelRoles rolesOf(const Image& image);
+// The roles of `image`'s channels (inline: the display encode without OpenImageIO,
+// display_encode.cpp, outside the module, takes them too).
+inline ChannelRoles rolesOf(const Image& image) {
+    ChannelRoles roles;
+    const int r = image.channelIndex("R"), g = image.channelIndex("G"), b = image.channelIndex("B");
+    const int y = image.channelIndex("Y");
+    if (r >= 0 && g >= 0 && b >= 0) roles.colour = {r, g, b};
+    else if (y >= 0) roles.colour = {y};
+    roles.alpha = image.channelIndex("A");
+    return roles;
+}
 
 // Converts the channels `colour` of an interleaved float buffer between OpenImageIO colour spaces
 // ("sRGB", "linear"). OpenImageIO converts the first channels of a buffer (its colorconvert does

@@ -4,7 +4,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -223,4 +225,64 @@ TEST_F(ImageFileTest, UnreadableFilesSayWhy) {
         EXPECT_GT(what.size(), what.find("cannot read pixels: ") + 20) << what;
     }
     EXPECT_THROW(conus::imageio::readImageFile("/dev/zero"), conus::Error);
+}
+
+namespace {
+
+// A 3-channel picture of varied linear values: every octave from 1e-6 to 1 (dense near the sRGB
+// curve's linear end), negatives, values past 1 and non-finite ones, each channel different.
+Image variedLinear() {
+    Image im;
+    im.width = 997;
+    im.height = 13;
+    im.channels = {"G", "B", "R", "Z"};  // colour not leading, and one data channel
+    im.pixels.resize(static_cast<std::size_t>(im.width) * im.height * 4);
+    for (std::size_t i = 0; i < im.pixels.size(); ++i) {
+        const double t = static_cast<double>((i * 7919) % 100003) / 100003.0;
+        im.pixels[i] = static_cast<float>(std::pow(10.0, -6.0 + 6.2 * t));
+    }
+    const float odd[] = {-0.25f, 0.0f, 0.0031308f, 0.00313f, 1.0f, 1.5f, NAN, INFINITY, -INFINITY};
+    for (std::size_t k = 0; k < std::size(odd); ++k)
+        for (int c = 0; c < 4; ++c) im.pixels[(k * 5 + c) * 4 + c] = odd[k];
+    return im;
+}
+
+}  // namespace
+
+// Without alpha, displayEncoded takes the sRGB curve from its own table (no OpenImageIO): the
+// same values, within 1e-6, as the exact curve in double and (within OpenImageIO's own
+// approximation) as OpenImageIO's colorconvert; data channels are kept, non-finite values 0.
+TEST(DisplayEncoded, OpaquePictureMatchesTheSrgbCurveAndOpenImageIO) {
+    const Image linear = variedLinear();
+    const Image shown = conus::imageio::displayEncoded(linear);
+    ASSERT_EQ(shown.channels, linear.channels);
+    ASSERT_EQ(shown.pixels.size(), linear.pixels.size());
+    // OpenImageIO's conversion of the colour channels, gathered to lead the buffer (R, G, B).
+    const std::size_t count = static_cast<std::size_t>(linear.width) * linear.height;
+    std::vector<float> rgb(count * 3);
+    const int order[3] = {2, 0, 1};
+    for (std::size_t p = 0; p < count; ++p)
+        for (int k = 0; k < 3; ++k) {
+            const float v = linear.pixels[p * 4 + order[k]];
+            rgb[p * 3 + k] = std::isfinite(v) ? v : 0.0f;
+        }
+    OIIO::ImageBuf buffer(OIIO::ImageSpec(linear.width, linear.height, 3, OIIO::TypeDesc::FLOAT), rgb.data());
+    ASSERT_TRUE(OIIO::ImageBufAlgo::colorconvert(buffer, buffer, "linear", "sRGB"));
+    double worstExact = 0, worstOiio = 0;
+    for (std::size_t p = 0; p < count; ++p) {
+        for (int k = 0; k < 3; ++k) {
+            const float v = linear.pixels[p * 4 + order[k]];
+            const double x = std::isfinite(v) ? v : 0.0;
+            const double exact = std::clamp(x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1 / 2.4) - 0.055, 0.0, 1.0);
+            const float got = shown.pixels[p * 4 + order[k]];
+            worstExact = std::max(worstExact, std::abs(got - exact));
+            worstOiio = std::max(worstOiio, std::abs(double(got) - std::clamp(rgb[p * 3 + k], 0.0f, 1.0f)));
+        }
+        const float z = linear.pixels[p * 4 + 3];
+        EXPECT_EQ(shown.pixels[p * 4 + 3], std::isfinite(z) ? z : 0.0f) << p;
+    }
+    std::printf("[ info ] display encode against the exact sRGB curve: %.2g, against OpenImageIO: %.2g\n", worstExact,
+                worstOiio);
+    EXPECT_LT(worstExact, 1e-6);
+    EXPECT_LT(worstOiio, 2e-5);
 }

@@ -9,13 +9,21 @@
 // principal axes, the minor one filtered by the pyramid level it picks, a row of taps along the
 // major one; exact at power-of-two ratios.
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <mutex>
+#include <string>
 #include <vector>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #include "conus/codec/image/encode.h"
 #include "area_downsample_pvt.h"
+#include "cpu_features_pvt.h"
 #include "conus/core/parallel.h"
 #include "encode_pvt.h"
 #include "resample_pvt.h"
@@ -28,6 +36,56 @@ constexpr double kTapTolerance = kEncodeTapTolerance;
 
 using detail::areaDownsamplePlane;
 using detail::Plane;
+
+// The memory of the last encodes' pyramid levels, kept for the next encode of a source of the
+// same size (the budget's confirming encodes and the final one, a batch of photos from one
+// camera): a fresh 50 MB level is first touched page by page, and the kernel's clearing of those
+// pages cost more than building the level (perf: clear_page ~20 % of a repeated 4096^2 encode).
+// Every value of a level is written when it is built, so a kept array is handed out as it is.
+// At most kMaxKeptBytes are kept; the oldest arrays go first.
+class LevelMemory {
+public:
+    static constexpr std::size_t kMaxKeptBytes = std::size_t{160} << 20;
+
+    // An array of exactly `values` floats: a kept one if there is one, else a new one (makeImage:
+    // huge pages, faulted in on every core).
+    static std::vector<float> take(std::size_t values, int width, int height, const std::vector<std::string>& channels) {
+        {
+            std::lock_guard lock(mutex());
+            std::vector<std::vector<float>>& kept = store();
+            for (auto it = kept.rbegin(); it != kept.rend(); ++it)
+                if (it->size() == values) {
+                    std::vector<float> found = std::move(*it);
+                    kept.erase(std::next(it).base());
+                    return found;
+                }
+        }
+        return std::move(makeImage(width, height, channels).pixels);
+    }
+    static void give(std::vector<float>&& array) {
+        const std::size_t bytes = array.size() * sizeof(float);
+        if (bytes == 0 || bytes > kMaxKeptBytes) return;
+        std::lock_guard lock(mutex());
+        std::vector<std::vector<float>>& kept = store();
+        kept.push_back(std::move(array));
+        std::size_t total = 0;
+        for (const auto& a : kept) total += a.size() * sizeof(float);
+        while (total > kMaxKeptBytes) {
+            total -= kept.front().size() * sizeof(float);
+            kept.erase(kept.begin());
+        }
+    }
+
+private:
+    static std::mutex& mutex() {
+        static std::mutex m;
+        return m;
+    }
+    static std::vector<std::vector<float>>& store() {
+        static std::vector<std::vector<float>> s;
+        return s;
+    }
+};
 
 // Box-filtered mip levels of the source, each built the first time a footprint needs it.
 class Pyramid {
@@ -43,6 +101,11 @@ public:
             m_sizes.push_back({w, h});
         }
     }
+    ~Pyramid() {
+        for (std::vector<float>& level : m_levels) LevelMemory::give(std::move(level));
+    }
+    Pyramid(const Pyramid&) = delete;
+    Pyramid& operator=(const Pyramid&) = delete;
     int levels() const { return static_cast<int>(m_sizes.size()); }
     int width(int level) const { return m_sizes[level][0]; }
     int height(int level) const { return m_sizes[level][1]; }
@@ -51,19 +114,18 @@ public:
         if (level == 0) return {m_source.pixels.data(), m_source.width, m_source.height};
         std::call_once(m_once[level], [&] {
             const Plane below = this->level(level - 1, threads);
-            // A checked Image: zero-filled first, but in huge pages where large (core/image.cpp),
-            // which costs less than a 4 KiB page fault every 1024 floats of a new level.
-            m_levels[level] = makeImage(width(level), height(level), m_source.channels);
-            areaDownsamplePlane(below, m_levels[level].pixels.data(), width(level), height(level), m_channels, threads);
+            const std::size_t values = static_cast<std::size_t>(width(level)) * height(level) * m_channels;
+            m_levels[level] = LevelMemory::take(values, width(level), height(level), m_source.channels);
+            areaDownsamplePlane(below, m_levels[level].data(), width(level), height(level), m_channels, threads);
         });
-        return {m_levels[level].pixels.data(), width(level), height(level)};
+        return {m_levels[level].data(), width(level), height(level)};
     }
 
 private:
     const Image& m_source;
     int m_channels;
     std::vector<std::array<int, 2>> m_sizes;
-    std::array<Image, kMaxLevels> m_levels;
+    std::array<std::vector<float>, kMaxLevels> m_levels;
     std::array<std::once_flag, kMaxLevels> m_once;
 };
 
@@ -264,6 +326,96 @@ void accumulateRow(const float* pixels, std::size_t stride, const RowTaps& r, Fl
     }
 }
 
+// One row of the anisotropic kernel's taps, all inside the level a row clear of its last: tap i
+// at texel coordinates (x + i sx, y + i sy), weight weight[i] (every one > 0), bilinear on all
+// channels at once, added to acc. The taps' texel offsets and fractions are worked out first,
+// without a branch, so that loop vectorizes.
+struct TapRow {
+    double x = 0, y = 0, sx = 0, sy = 0;
+    int count = 0;
+    const float* weight = nullptr;
+};
+
+// The row's taps' first texels (offsets in floats) and their fractions, without a branch so the
+// loop vectorizes (inlined into each copy of the tap loop, with that copy's instructions).
+template <int kC>
+inline void tapPlaces(std::size_t stride, const TapRow& row, std::size_t* offset, float* fx, float* fy) {
+    for (int n = 0; n < row.count; ++n) {
+        const double x = row.x + n * row.sx, y = row.y + n * row.sy;
+        const int xi = static_cast<int>(x), yi = static_cast<int>(y);
+        fx[n] = static_cast<float>(x - xi);
+        fy[n] = static_cast<float>(y - yi);
+        offset[n] = yi * stride + static_cast<std::size_t>(xi) * kC;
+    }
+}
+
+template <int kC>
+inline void tapRowBaseline(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
+    std::size_t offset[RowTaps::kMax];
+    float fx[RowTaps::kMax], fy[RowTaps::kMax];
+    tapPlaces<kC>(stride, row, offset, fx, fy);
+    for (int n = 0; n < row.count; ++n) {
+        const float* p0 = pixels + offset[n];
+        const float* p1 = p0 + stride;
+        const Float4 a = load4(p0), b = load4(p1);
+        const Float4 top = a + fx[n] * (load4(p0 + kC) - a);
+        const Float4 bottom = b + fx[n] * (load4(p1 + kC) - b);
+        acc += row.weight[n] * (top + fy[n] * (bottom - top));
+    }
+}
+
+std::atomic<bool> g_forceBaselineEncode{false};
+
+#if CONUS_HAVE_AVX2_COPY
+// tapRowBaseline on a processor with AVX2: the offsets four taps at a time, then two taps a step,
+// one in each 128-bit half of a register, each lerp a fused multiply-add (so the sums differ from
+// the baseline's in their last bits); the same four-float texel reads.
+template <int kC>
+CONUS_TARGET_AVX2 void tapRowAvx2(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
+    std::size_t offset[RowTaps::kMax];
+    float fx[RowTaps::kMax], fy[RowTaps::kMax];
+    tapPlaces<kC>(stride, row, offset, fx, fy);
+    __m256 sum = _mm256_setzero_ps();
+    int n = 0;
+    for (; n + 1 < row.count; n += 2) {
+        const float* p = pixels + offset[n];
+        const float* q = pixels + offset[n + 1];
+        const __m256 a = _mm256_set_m128(_mm_loadu_ps(q), _mm_loadu_ps(p));
+        const __m256 a1 = _mm256_set_m128(_mm_loadu_ps(q + kC), _mm_loadu_ps(p + kC));
+        const __m256 b = _mm256_set_m128(_mm_loadu_ps(q + stride), _mm_loadu_ps(p + stride));
+        const __m256 b1 = _mm256_set_m128(_mm_loadu_ps(q + stride + kC), _mm_loadu_ps(p + stride + kC));
+        const __m256 fxv = _mm256_set_m128(_mm_set1_ps(fx[n + 1]), _mm_set1_ps(fx[n]));
+        const __m256 fyv = _mm256_set_m128(_mm_set1_ps(fy[n + 1]), _mm_set1_ps(fy[n]));
+        const __m256 wv = _mm256_set_m128(_mm_set1_ps(row.weight[n + 1]), _mm_set1_ps(row.weight[n]));
+        const __m256 top = _mm256_fmadd_ps(fxv, _mm256_sub_ps(a1, a), a);
+        const __m256 bottom = _mm256_fmadd_ps(fxv, _mm256_sub_ps(b1, b), b);
+        sum = _mm256_fmadd_ps(wv, _mm256_fmadd_ps(fyv, _mm256_sub_ps(bottom, top), top), sum);
+    }
+    __m128 s = _mm_add_ps(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1));
+    if (n < row.count) {
+        const float* p = pixels + offset[n];
+        const __m128 a = _mm_loadu_ps(p), a1 = _mm_loadu_ps(p + kC);
+        const __m128 b = _mm_loadu_ps(p + stride), b1 = _mm_loadu_ps(p + stride + kC);
+        const __m128 fxv = _mm_set1_ps(fx[n]);
+        const __m128 top = _mm_fmadd_ps(fxv, _mm_sub_ps(a1, a), a);
+        const __m128 bottom = _mm_fmadd_ps(fxv, _mm_sub_ps(b1, b), b);
+        s = _mm_fmadd_ps(_mm_set1_ps(row.weight[n]), _mm_fmadd_ps(_mm_set1_ps(fy[n]), _mm_sub_ps(bottom, top), top), s);
+    }
+    Float4 v;
+    std::memcpy(&v, &s, sizeof v);
+    acc += v;
+}
+#endif
+
+template <int kC>
+void tapRow(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
+#if CONUS_HAVE_AVX2_COPY
+    static const bool avx2 = detail::cpuHasAvx2();
+    if (avx2 && !g_forceBaselineEncode.load(std::memory_order_relaxed)) return tapRowAvx2<kC>(pixels, stride, row, acc);
+#endif
+    tapRowBaseline<kC>(pixels, stride, row, acc);
+}
+
 // The filtered value on one level, normalized, written to out. The taps are encode.h's grid
 // (ns x nt, at slice centres over the filter's extent), a row at a time.
 template <int kC>
@@ -356,6 +508,23 @@ double anisotropicLevel(const PrincipalAxes& axes, const FootprintFilter& filter
     return std::log2(coarsest);
 }
 
+// The weights of nu taps at u0 + i du along the major axis (u0 = -(nu - 1) du / 2: symmetric about
+// the centre): the Gaussian's mass (erf at k times the offset) over the offsets within the reach
+// that keep a tap in the unit box. Symmetric, so half of them are computed and mirrored; the
+// polynomial erf is most of a footprint's arithmetic, and an AVX2 copy takes four taps at a time.
+CONUS_VECTOR_CLONES void majorWeights(double u0, double du, int nu, double reach, double k, float* weight) {
+    const int half = (nu + 1) / 2;
+    const float u0f = static_cast<float>(u0), duf = static_cast<float>(du);
+    const float reachf = static_cast<float>(reach), kf = static_cast<float>(k);
+    for (int i = 0; i < half; ++i) {
+        const float u = u0f + static_cast<float>(i) * duf;
+        const float lo = u - 0.5f > -reachf ? u - 0.5f : -reachf, hi = u + 0.5f < reachf ? u + 0.5f : reachf;
+        const float w = detail::erfOnReachFloat(hi * kf) - detail::erfOnReachFloat(lo * kf);
+        weight[i] = hi > lo ? w : 0.0f;
+    }
+    for (int i = half; i < nu; ++i) weight[i] = weight[nu - 1 - i];
+}
+
 // The anisotropic kernel on one level, normalized, written to out: nw rows of taps across the
 // minor axis (slice centres of the unit box), each of nu taps along the major axis (slice centres
 // of the box widened by the Gaussian's reach), taps at most a texel apart. A tap's weight is the
@@ -372,16 +541,11 @@ void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, 
     const double du = extent / nu, dw = 1.0 / nw;
     const double u0 = 0.5 * du - 0.5 * extent, w0 = 0.5 * dw - 0.5;
     constexpr double kMinSigma = 1e-4;  // below it the filter is the plain box (encode.h)
-    double weight[RowTaps::kMax];
+    float weight[RowTaps::kMax];
     if (filter.sigma < kMinSigma) {
-        for (int i = 0; i < nu; ++i) weight[i] = 1.0;
+        for (int i = 0; i < nu; ++i) weight[i] = 1.0f;
     } else {
-        const double k = 1.0 / (std::sqrt(2.0) * filter.sigma), reach = filter.reach;
-        for (int i = 0; i < nu; ++i) {
-            const double u = u0 + i * du;
-            const double lo = u - 0.5 > -reach ? u - 0.5 : -reach, hi = u + 0.5 < reach ? u + 0.5 : reach;
-            weight[i] = hi > lo ? detail::erfOnReach(hi * k) - detail::erfOnReach(lo * k) : 0.0;
-        }
+        majorWeights(u0, du, nu, filter.reach, 1.0 / (std::sqrt(2.0) * filter.sigma), weight);
     }
     const double cx = p.x * img.width - 0.5, cy = p.y * img.height - 0.5;
     // Away from the borders no tap needs clamping: decide once for the whole footprint.
@@ -402,13 +566,32 @@ void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, 
         }
     };
     if constexpr (kC > 0 && kC <= 4) {
-        // (The four-float reads of accumulateRow: see filterOnLevel.)
+        // (The four-float reads of the taps: see filterOnLevel.) Every row has the same weights:
+        // the taps that weigh anything (a run about the centre) and their sum are found once.
         if (inner && cy + ey < img.height - 2 && (kC >= 2 || img.width >= 3)) {
+            int i0 = 0, i1 = nu;
+            while (i0 < i1 && weight[i0] <= 0) ++i0;
+            while (i1 > i0 && weight[i1 - 1] <= 0) --i1;
+            // (Four partial sums: one running total waited on each add.)
+            float part[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+            int i = i0;
+            for (; i + 4 <= i1; i += 4)
+                for (int q = 0; q < 4; ++q) part[q] += weight[i + q];
+            for (; i < i1; ++i) part[0] += weight[i];
+            const double sum = double(part[0]) + part[1] + part[2] + part[3];
+            TapRow tr;
+            tr.sx = major.x * du;
+            tr.sy = major.y * du;
+            tr.count = i1 - i0;
+            tr.weight = weight + i0;
             Float4 acc{0.0f, 0.0f, 0.0f, 0.0f};
-            for (int j = 0; j < nw; ++j) {
-                row(j);
-                accumulateRow<kC>(img.data, stride, r, acc, total);
+            for (int j = 0; j < nw && tr.count > 0; ++j) {
+                const double w = w0 + j * dw, u = u0 + i0 * du;
+                tr.x = cx + minor.x * w + major.x * u;
+                tr.y = cy + minor.y * w + major.y * u;
+                tapRow<kC>(img.data, stride, tr, acc);
             }
+            total = sum * nw;
             const float norm = total > 0 ? static_cast<float>(1.0 / total) : 0.0f;
             for (int c = 0; c < kC; ++c) out[c] = acc[c] * norm;
             return;
@@ -489,6 +672,11 @@ bool isUniform(const SamplingMap& map) {
 }
 
 }  // namespace
+
+namespace detail {
+bool encodeAvx2Available() { return cpuHasAvx2(); }
+void forceBaselineEncode(bool baseline) { g_forceBaselineEncode.store(baseline, std::memory_order_relaxed); }
+}  // namespace detail
 
 FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b, double uniform) {
     double minor = 0;
