@@ -6,7 +6,11 @@
 // against the traced reference (the reflected rays traced against the mesh, Embree) over the mirror
 // and the teapot's reflection, reports the asset bytes and the bake's disocclusion fractions, and
 // writes CONUS_BENCH_PICTURES-<mirror>.png (CoNUS 1 layer | CoNUS layered | reference; below, 3x)
-// when that variable names a path prefix. BM_LayeredReflectionPaired times single-layer and
+// when that variable names a path prefix. The "placed_" figures are the layered asset baked from
+// the eye placeReflectionEye picks for the camera (CONUS_BENCH_PICTURES-placed-<mirror>.png: CoNUS
+// layered from the centre | from the placed eye | reference; each asset scored against the
+// reference shaded from its own eye); "moved_" the layered CoNUS assets seen from kMovedEye, a
+// viewpoint the eye was not placed for. BM_LayeredReflectionPaired times single-layer and
 // layered CoNUS frames in interleaved pairs, on the CPU (/0) and through GLSL (/1, the context
 // CONUS_BACKEND names, default auto).
 #include <benchmark/benchmark.h>
@@ -34,11 +38,17 @@ struct Setup {
     codec::MeshScene scene;
     codec::ReflectionFrameOptions options;
     Camera camera;
-    // [uniform 0 / CoNUS 1][single 0 / layered 1]
-    std::vector<codec::ReflectionFace> faces[2][2];
-    double bytes[2][2] = {};
+    double fov = 40;
+    // [uniform 0 / CoNUS 1][single 0 / layered 1 / layered from the placed eye 2]
+    std::vector<codec::ReflectionFace> faces[2][3];
+    double bytes[2][3] = {};
     double disoccluded[2] = {};  // single, layered
+    codec::EyePlacement placed{};  // the faces' eye placed for the camera (placeReflectionEye)
 };
+
+// The camera moved away from the one the eye was placed for: what the placed asset shows a viewer
+// elsewhere.
+const glm::dvec3 kMovedEye(2.5, 2.0, 6.5);
 
 // The models: the Utah teapot, and Cesium's milk truck (a textured glTF from Debian's
 // assimp-testmodels, a model the project was not tuned on).
@@ -54,18 +64,21 @@ Setup* setup(int index) {
     if (s) return s.get();
     if (!std::filesystem::exists(kModels[index / 2])) return nullptr;
     s = std::make_unique<Setup>(Setup{codec::MeshScene(sceneio::readMesh(kModels[index / 2])), {},
-                                      Camera::perspective({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 40, 1, 0.1, 10), {}});
+                                      Camera::perspective({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 40, 1, 0.1, 10), 40.0, {}});
     codec::Reflector& r = s->options.reflector;
     r.kind = mirror == 0 ? codec::Reflector::Kind::Plane : codec::Reflector::Kind::Sphere;
     r.centre = mirror == 0 ? glm::dvec3(0.0, 1.5, -6.0) : glm::dvec3(0.0, 1.5, -7.0);
     r.radius = 4.0;
     r.normal = glm::normalize(glm::dvec3(0.15, 0.0, 1.0));
-    s->camera = Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, mirror == 0 ? 38.0 : 45.0, 1.0, 1e-3, 1e3);
+    s->fov = mirror == 0 ? 38.0 : 45.0;
+    s->camera = Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, s->fov, 1.0, 1e-3, 1e3);
     const AxisBox bounds = boundsOf(s->scene.mesh());
     for (int uniform = 0; uniform < 2; ++uniform)
-        for (int layered = 0; layered < 2; ++layered) {
+        for (int layered = 0; layered < 3; ++layered) {
+            if (layered == 2 && uniform == 0)  // placed once, for the layers the centred asset needs
+                s->placed = codec::placeReflectionEye(s->scene, r, s->camera.eye(), s->faces[1][1].front().layers());
             codec::ReflectionBakeOptions bake;
-            bake.centre = r.centre;
+            bake.centre = layered == 2 ? s->placed.eye : r.centre;
             bake.size = kFace;
             bake.uniform = uniform == 0;
             bake.roi = bounds;
@@ -90,19 +103,31 @@ void BM_LayeredReflectionQuality(benchmark::State& state) {
         return;
     }
     Setup& s = *found;
-    Image truth, frames[2][2];
+    // The reference shades with the headlight at the faces' eye, as the asset does: the placed
+    // asset has its own (traced rays land on the same surfaces; only the shading moves).
+    Image truth[2], frames[2][3];
+    const Camera moved = Camera::perspective(kMovedEye, s.options.reflector.centre, {0, 1, 0}, s.fov, 1.0, 1e-3, 1e3);
+    Image movedTruth[2], movedFrames[2];
     for (auto _ : state) {
-        truth = codec::renderReflectionFrame(s.scene, nullptr, s.options.reflector.centre, s.camera, kFrame, kFrame, s.options);
-        for (int u = 0; u < 2; ++u)
-            for (int l = 0; l < 2; ++l)
-                frames[u][l] = codec::renderReflectionFrame(s.scene, &s.faces[u][l], s.options.reflector.centre, s.camera,
-                                                            kFrame, kFrame, s.options);
+        for (int l = 0; l < 3; ++l) {
+            const glm::dvec3 eye = s.faces[1][l].front().depth.camera().eye();
+            if (l < 2) truth[l] = codec::renderReflectionFrame(s.scene, nullptr, eye, s.camera, kFrame, kFrame, s.options);
+            for (int u = 0; u < 2; ++u)
+                frames[u][l] = codec::renderReflectionFrame(s.scene, &s.faces[u][l], eye, s.camera, kFrame, kFrame, s.options);
+        }
+        for (int p = 0; p < 2; ++p) {  // the layered asset from the centre, from the placed eye
+            const glm::dvec3 eye = s.faces[1][p + 1].front().depth.camera().eye();
+            movedTruth[p] = codec::renderReflectionFrame(s.scene, nullptr, eye, moved, kFrame, kFrame, s.options);
+            movedFrames[p] = codec::renderReflectionFrame(s.scene, &s.faces[1][p + 1], eye, moved, kFrame, kFrame, s.options);
+        }
     }
     const auto triangles = static_cast<std::uint32_t>(s.scene.mesh().indices.size() / 3);
-    for (int l = 0; l < 2; ++l) {
+    for (int l = 0; l < 3; ++l) {
         const Image pair[2] = {frames[0][l], frames[1][l]};
-        const bench::MirrorScore score = bench::scoreMirror(pair, truth, s.scene, s.options.reflector, s.camera, kFrame, triangles);
-        const std::string tag = l ? "layered_" : "single_";
+        const bench::MirrorScore score =
+            bench::scoreMirror(pair, truth[l == 2 ? 1 : 0], s.scene, s.options.reflector, s.camera, kFrame, triangles);
+        const char* tags[3] = {"single_", "layered_", "placed_"};
+        const std::string tag = tags[l];
         state.counters[tag + "mirror_conus_dB"] = score.psnr(1, {0, 1});
         state.counters[tag + "mirror_uniform_dB"] = score.psnr(0, {0, 1});
         state.counters[tag + "teapot_conus_dB"] = score.psnr(1, {0});
@@ -110,17 +135,33 @@ void BM_LayeredReflectionQuality(benchmark::State& state) {
         state.counters[tag + "wrong_conus"] = score.wrong[1][0] + score.wrong[1][1];
     }
     state.counters["layers"] = s.faces[1][1].front().layers();
+    for (int p = 0; p < 2; ++p) {
+        const Image pair[2] = {movedFrames[p], movedFrames[p]};
+        const bench::MirrorScore score = bench::scoreMirror(pair, movedTruth[p], s.scene, s.options.reflector, moved, kFrame, triangles);
+        state.counters[std::string(p ? "moved_placed" : "moved_layered") + "_mirror_conus_dB"] = score.psnr(1, {0, 1});
+    }
+    state.counters["placed_layers"] = s.faces[1][2].front().layers();
+    state.counters["placed_disoccluded_pct"] = 100.0 * s.placed.disoccluded;
+    state.counters["centre_disoccluded_pct"] = 100.0 * s.placed.centreDisoccluded;
+    state.counters["placed_eye_x"] = s.placed.eye.x;
+    state.counters["placed_eye_z"] = s.placed.eye.z;
     state.counters["bytes_ratio_conus"] = s.bytes[1][1] / s.bytes[1][0];
     state.counters["bytes_ratio_uniform"] = s.bytes[0][1] / s.bytes[0][0];
+    state.counters["bytes_ratio_placed"] = s.bytes[1][2] / s.bytes[1][0];
     state.counters["bytes_single_conus"] = s.bytes[1][0];
     state.counters["disoccluded_single_pct"] = 100.0 * s.disoccluded[0];
     state.counters["disoccluded_layered_pct"] = 100.0 * s.disoccluded[1];
     if (const char* prefix = std::getenv("CONUS_BENCH_PICTURES")) {
         // CoNUS single | CoNUS layered | reference (writeMirrorStrip's order: frames[1], frames[0], truth).
         const Image pair[2] = {frames[1][1], frames[1][0]};
-        const bench::MirrorScore score = bench::scoreMirror(pair, truth, s.scene, s.options.reflector, s.camera, kFrame, triangles);
+        const bench::MirrorScore score = bench::scoreMirror(pair, truth[0], s.scene, s.options.reflector, s.camera, kFrame, triangles);
         const char* names[4] = {"-plane.png", "-sphere.png", "-truck-plane.png", "-truck-sphere.png"};
-        bench::writeMirrorStrip(std::string(prefix) + names[state.range(0)], pair, truth, score, kFrame, 3);
+        bench::writeMirrorStrip(std::string(prefix) + names[state.range(0)], pair, truth[0], score, kFrame, 3);
+        // CoNUS layered from the centre | from the placed eye | the reference shaded from the placed eye.
+        const Image placed[2] = {frames[1][2], frames[1][1]};
+        const bench::MirrorScore placedScore =
+            bench::scoreMirror(placed, truth[1], s.scene, s.options.reflector, s.camera, kFrame, triangles);
+        bench::writeMirrorStrip(std::string(prefix) + "-placed" + names[state.range(0)], placed, truth[1], placedScore, kFrame, 3);
     }
 }
 
