@@ -252,10 +252,11 @@ int runBakeReflection(const ReflectionBakeText& o) {
         if (!(o.mirrorRadius > 0)) throw Error(ErrorCode::InvalidArgument, "--view needs a mirror of --mirror-radius > 0");
         const glm::dvec3 viewpoint = parseVector3(o.view, "--view");
         Progress placing("place the eye for the view");
-        placed = codec::placeReflectionEye(scene, reflector, viewpoint, std::max(options.layers, 1));
+        placed = codec::placeReflectionEye(scene, reflector, viewpoint, options.layers);
         viewRays = codec::reflectedRays(reflector, viewpoint, 4000);
         placing.done();
         options.centre = placed->eye;
+        options.layers = placed->layers;  // auto: the layers the view needs there
     }
     Progress baking("bake six " + std::to_string(o.size) + "x" + std::to_string(o.size) + " faces (Embree)");
     const auto faces = codec::bakeReflection(scene, options);
@@ -279,7 +280,7 @@ int runBakeReflection(const ReflectionBakeText& o) {
         std::printf("rays the %s mirror reflects toward the view that land in a disocclusion: %.2f%% with 1 layer, %.2f%% with "
                     "%d (%.2f%% from the centre with %d)\n",
                     o.reflector.c_str(), 100.0 * one, 100.0 * all, layers, 100.0 * placed->centreDisoccluded,
-                    std::max(options.layers, 1));
+                    parseLayers(o.layers) == 0 ? 1 : layers);
     } else {
         std::printf("mirror rays (radius %g) that land in a disocclusion: %.2f%% with 1 layer, %.2f%% with %d\n", o.mirrorRadius,
                     100.0 * one, 100.0 * all, layers);
@@ -304,7 +305,8 @@ CLI::App* addBakeReflection(CLI::App& command, ReflectionBakeText& o) {
     reflection->add_option("--roi-max", o.roiMax, "region of interest, highest corner x,y,z");
     reflection->add_flag("--uniform", o.uniform, "identity maps: the conventional asset of the same texel count");
     reflection->add_option("--layers", o.layers,
-                           "surfaces kept along each texel's ray, 1 to 4, or auto: until the next covers under 1% of the texels")
+                           "surfaces kept along each texel's ray, 1 to 4, or auto: until the next covers under 1% of the texels "
+                           "(with --view: until under 1% of the rays toward the view land in a disocclusion)")
         ->capture_default_str();
     reflection->add_option("--mirror-radius", o.mirrorRadius,
                            "the reflector's radius, for the report of mirror rays that land in a disocclusion")

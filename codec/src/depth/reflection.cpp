@@ -472,18 +472,24 @@ glm::dvec3 reflectedViewpoint(const Reflector& r, glm::dvec3 viewpoint) {
 }
 
 EyePlacement placeReflectionEye(const MeshScene& scene, const Reflector& reflector, glm::dvec3 viewpoint, int layers, int rays) {
+    if (layers < 0 || layers > kMaxReflectionLayers)
+        throw Error(ErrorCode::InvalidArgument, "eye placement: layers must be 0 to " + std::to_string(kMaxReflectionLayers));
     const std::vector<Ray> sample = reflectedRays(reflector, viewpoint, rays);
     const glm::dvec3 image = reflectedViewpoint(reflector, viewpoint);
     glm::dvec3 eyes[kEyeCandidates];
     double fractions[kEyeCandidates];
     for (int k = 0; k < kEyeCandidates; ++k) {
         eyes[k] = reflector.centre + (image - reflector.centre) * (double(k) / (kEyeCandidates - 1));
-        fractions[k] = disocclusionFraction(scene, eyes[k], sample, layers);
+        fractions[k] = disocclusionFraction(scene, eyes[k], sample, std::max(layers, 1));
     }
     const double fewest = *std::min_element(fractions, fractions + kEyeCandidates);
     int k = 0;
     while (fractions[k] > fewest + kEyeTie) ++k;
-    return {eyes[k], fractions[k], fractions[0]};
+    EyePlacement placed{eyes[k], fractions[k], fractions[0], std::max(layers, 1)};
+    if (layers == 0)
+        for (double f = fractions[k]; f >= kLayerMinCoverage && placed.layers < kMaxReflectionLayers;)
+            f = disocclusionFraction(scene, placed.eye, sample, ++placed.layers);
+    return placed;
 }
 
 Image renderReflectionFrame(const MeshScene& scene, const std::vector<ReflectionFace>* faces, glm::dvec3 centre,

@@ -647,6 +647,11 @@ TEST(ReflectionEye, ThePlacedEyeSeesWhatTheMirrorShowsAndItsFrameBeatsTheCentres
     const glm::dvec3 image = reflectedViewpoint(mirror, kViewpoint);
     EXPECT_LT(glm::length(glm::cross(placed.eye - mirror.centre, image - mirror.centre)), 1e-9);
     EXPECT_GT(glm::length(placed.eye - mirror.centre), 0.0);
+    // As many layers as the view needs: one there; a bad count is refused.
+    EXPECT_EQ(placed.layers, 1);
+    EXPECT_EQ(placeReflectionEye(scene, mirror, kViewpoint, 0).layers, 1);
+    EXPECT_EQ(placeReflectionEye(scene, mirror, kViewpoint, 3).layers, 3);
+    EXPECT_THROW(placeReflectionEye(scene, mirror, kViewpoint, kMaxReflectionLayers + 1), Error);
 
     const Camera camera = Camera::perspective(kViewpoint, mirror.centre, {0, 1, 0}, 60.0, 1.0, 1e-3, 100.0);
     ReflectionFrameOptions o;

@@ -173,14 +173,18 @@ glm::dvec3 reflectedViewpoint(const Reflector& reflector, glm::dvec3 viewpoint);
 // The faces' eye placed for a reflector seen from about `viewpoint`: of the candidates on the
 // segment from the reflector's centre to the reflected viewpoint (kEyeCandidates, evenly spaced,
 // both ends included), the one where the fewest of reflectedRays land in a disocclusion of a
-// `layers`-layer asset; within kEyeTie of the fewest, the one nearest the centre (nearer the
-// scene: more texels on it).
+// `layers`-layer asset (0: as many as the view needs, placed for one); within kEyeTie of the
+// fewest, the one nearest the centre (nearer the scene: more texels on it). Throws as reflectedRays.
 inline constexpr int kEyeCandidates = 5;
 inline constexpr double kEyeTie = 0.002;
 struct EyePlacement {
     glm::dvec3 eye{0.0};
-    double disoccluded = 0;        // at the eye
+    double disoccluded = 0;        // at the eye, with the layers placed for
     double centreDisoccluded = 0;  // at the reflector's centre, for comparison
+    // The layers the view needs at the eye: `layers` when given; for 0, the fewest (1 to
+    // kMaxReflectionLayers) that leave under kLayerMinCoverage of the view's rays in a
+    // disocclusion (what the view needs, where the bake's auto counts the faces' texels).
+    int layers = 1;
 };
 EyePlacement placeReflectionEye(const MeshScene& scene, const Reflector& reflector, glm::dvec3 viewpoint, int layers,
                                 int rays = 4000);
