@@ -217,7 +217,16 @@ TEST_F(ReflectionCli, AViewPlacesTheEyeAndItsFrameBeatsTheCentredAsset) {
     // On the segment from the centre to the viewpoint's mirror image (0.6, 0.35, 1.1 mirrored in z = 0).
     EXPECT_LT(glm::length(glm::cross(eye, glm::dvec3(0.6, 0.35, -1.1))), 1e-4) << r.out;
     EXPECT_LT(eye.z, 0.0) << r.out;
-    const auto centre = nlohmann::json::parse(run("info --json " + placed).out)["cubeFrame"]["centre"];
+    const auto info = nlohmann::json::parse(run("info --json " + placed).out);
+    const auto centre = info["cubeFrame"]["centre"];
+    // info says where the texels went: the +z face (the box's) magnifies a part of itself that
+    // holds more of its texels than of its area, about where the box projects; the faces that see
+    // no box keep the identity (nothing magnified).
+    const auto magnified = info["faces"][4]["magnified"];
+    EXPECT_GT(magnified["areaShare"].get<double>(), 0.01);
+    EXPECT_GT(magnified["texelShare"].get<double>(), 1.5 * magnified["areaShare"].get<double>());  // measured 0.79 on 0.41
+    EXPECT_EQ(info["faces"][5]["magnified"]["texelShare"].get<double>(), 0.0);
+    EXPECT_NE(run("info " + placed).out.find("of its texels"), std::string::npos);
     EXPECT_NEAR(centre[0].get<double>(), eye.x, 1e-4);
     EXPECT_NEAR(centre[2].get<double>(), eye.z, 1e-4);
     double one = -1, before = -1;
