@@ -132,6 +132,8 @@ void BM_LayeredReflectionQuality(benchmark::State& state) {
         state.counters[tag + "mirror_uniform_dB"] = score.psnr(0, {0, 1});
         state.counters[tag + "teapot_conus_dB"] = score.psnr(1, {0});
         state.counters[tag + "teapot_uniform_dB"] = score.psnr(0, {0});
+        state.counters[tag + "rest_conus_dB"] = score.psnr(1, {1});
+        state.counters[tag + "rest_uniform_dB"] = score.psnr(0, {1});
         state.counters[tag + "wrong_conus"] = score.wrong[1][0] + score.wrong[1][1];
     }
     state.counters["layers"] = s.faces[1][1].front().layers();
@@ -163,6 +165,48 @@ void BM_LayeredReflectionQuality(benchmark::State& state) {
             bench::scoreMirror(placed, truth[1], s.scene, s.options.reflector, s.camera, kFrame, triangles);
         bench::writeMirrorStrip(std::string(prefix) + "-placed" + names[state.range(0)], placed, truth[1], placedScore, kFrame, 3);
     }
+}
+
+// The eye at candidate k of placeReflectionEye's (k/4 of the way from the mirror's centre to the
+// reflected viewpoint; range(1)), one layer, faces of range(2) texels: the rays toward the camera that land in a
+// disocclusion there and the mirror's dB against the reference shaded from that eye.
+void BM_LayeredReflectionEyeSweep(benchmark::State& state) {
+    Setup* found = setup(static_cast<int>(state.range(0)));
+    if (!found) {
+        state.SkipWithError("the model is not installed (assimp-testmodels)");
+        return;
+    }
+    Setup& s = *found;
+    const codec::Reflector& r = s.options.reflector;
+    const glm::dvec3 image = codec::reflectedViewpoint(r, s.camera.eye());
+    const glm::dvec3 eye = r.centre + (image - r.centre) * (double(state.range(1)) / (codec::kEyeCandidates - 1));
+    codec::ReflectionBakeOptions bake;
+    bake.centre = eye;
+    bake.size = static_cast<int>(state.range(2));
+    bake.roi = boundsOf(s.scene.mesh());
+    Image frames[2], truth;
+    double bytes = 0;
+    for (auto _ : state) {
+        for (int u = 0; u < 2; ++u) {
+            bake.uniform = u == 0;
+            const auto faces = codec::bakeReflection(s.scene, bake);
+            frames[u] = codec::renderReflectionFrame(s.scene, &faces, eye, s.camera, kFrame, kFrame, s.options);
+            if (u == 1) {
+                const std::string path = (std::filesystem::temp_directory_path() / "conus-eye-sweep.exr").string();
+                format::writeReflectionAsset(path, codec::reflectionAssetFile(faces));
+                bytes = static_cast<double>(std::filesystem::file_size(path));
+                std::filesystem::remove(path);
+            }
+        }
+        truth = codec::renderReflectionFrame(s.scene, nullptr, eye, s.camera, kFrame, kFrame, s.options);
+    }
+    const auto triangles = static_cast<std::uint32_t>(s.scene.mesh().indices.size() / 3);
+    const bench::MirrorScore score = bench::scoreMirror(frames, truth, s.scene, r, s.camera, kFrame, triangles);
+    state.counters["mirror_conus_dB"] = score.psnr(1, {0, 1});
+    state.counters["mirror_uniform_dB"] = score.psnr(0, {0, 1});
+    state.counters["model_conus_dB"] = score.psnr(1, {0});
+    state.counters["bytes_ratio"] = bytes / s.bytes[1][0];
+    state.counters["disoccluded_pct"] = 100.0 * codec::disocclusionFraction(s.scene, eye, codec::reflectedRays(r, s.camera.eye(), 4000), 1);
 }
 
 // Single-layer (A) against layered (B) CoNUS frames: /x/0 the CPU reference, /x/1 GLSL; /x/x/1 the
@@ -204,6 +248,8 @@ void BM_LayeredReflectionPaired(benchmark::State& state) {
 }
 
 BENCHMARK(BM_LayeredReflectionQuality)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LayeredReflectionEyeSweep)->ArgsProduct({{0, 2}, {0, 1, 2, 3, 4}, {kFace}})->Args({0, 4, 160})->Args({2, 4, 160})
+    ->Args({0, 4, 192})->Args({2, 4, 192})->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LayeredReflectionPaired)->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})->Iterations(21)
     ->Unit(benchmark::kMillisecond);
 
