@@ -253,7 +253,7 @@ int runBakeReflection(const ReflectionBakeText& o) {
         const glm::dvec3 viewpoint = parseVector3(o.view, "--view");
         Progress placing("place the eye for the view");
         placed = codec::placeReflectionEye(scene, reflector, viewpoint, options.layers);
-        viewRays = codec::reflectedRays(reflector, viewpoint, 4000);
+        viewRays = codec::reflectedRays(reflector, viewpoint, codec::kViewRays);
         placing.done();
         options.centre = placed->eye;
         options.layers = placed->layers;  // auto: the layers the view needs there

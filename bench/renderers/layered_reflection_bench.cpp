@@ -206,7 +206,7 @@ void BM_LayeredReflectionEyeSweep(benchmark::State& state) {
     state.counters["mirror_uniform_dB"] = score.psnr(0, {0, 1});
     state.counters["model_conus_dB"] = score.psnr(1, {0});
     state.counters["bytes_ratio"] = bytes / s.bytes[1][0];
-    state.counters["disoccluded_pct"] = 100.0 * codec::disocclusionFraction(s.scene, eye, codec::reflectedRays(r, s.camera.eye(), 4000), 1);
+    state.counters["disoccluded_pct"] = 100.0 * codec::disocclusionFraction(s.scene, eye, codec::reflectedRays(r, s.camera.eye(), codec::kViewRays), 1);
 }
 
 // Single-layer (A) against layered (B) CoNUS frames: /x/0 the CPU reference, /x/1 GLSL; /x/x/1 the

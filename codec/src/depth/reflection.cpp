@@ -375,8 +375,7 @@ std::optional<glm::vec3> traceReflectionReference(const MeshScene& scene, const 
 
 namespace {
 
-glm::dvec3 unitVector(std::mt19937& random) {
-    std::normal_distribution<double> gauss;
+glm::dvec3 unitVector(std::mt19937& random, std::normal_distribution<double>& gauss) {
     for (;;) {
         const glm::dvec3 v(gauss(random), gauss(random), gauss(random));
         if (const double l = glm::length(v); l > 1e-9) return v / l;
@@ -406,11 +405,12 @@ double disocclusionFraction(const MeshScene& scene, glm::dvec3 centre, double ra
     if (!(radius >= 0) || !std::isfinite(radius) || layers < 1 || rays < 1)
         throw Error(ErrorCode::InvalidArgument, "disocclusion: needs a radius >= 0, at least one layer and one ray");
     std::mt19937 random(seed);
+    std::normal_distribution<double> gauss;
     std::vector<Ray> sample;
     sample.reserve(static_cast<std::size_t>(rays));
     for (int i = 0; i < rays; ++i) {
-        const glm::dvec3 n = unitVector(random);
-        glm::dvec3 d = unitVector(random);
+        const glm::dvec3 n = unitVector(random, gauss);
+        glm::dvec3 d = unitVector(random, gauss);
         if (glm::dot(d, n) < 0) d = -d;
         sample.push_back(Ray{centre + n * radius, d});
     }
@@ -440,6 +440,7 @@ std::vector<Ray> reflectedRays(const Reflector& r, glm::dvec3 viewpoint, int cou
         throw Error(ErrorCode::InvalidArgument, std::string("the viewpoint sees no mirror side: it is ") +
                                                     (plane ? "behind the plane mirror" : "inside the sphere"));
     std::mt19937 random(seed);
+    std::normal_distribution<double> gauss;
     std::uniform_real_distribution<double> across(-1.0, 1.0);
     glm::dvec3 s, u;
     planeAxes(n, s, u);
@@ -451,7 +452,7 @@ std::vector<Ray> reflectedRays(const Reflector& r, glm::dvec3 viewpoint, int cou
         if (plane) {
             p = r.centre + r.radius * (across(random) * s + across(random) * u);
         } else {
-            p = r.centre + r.radius * unitVector(random);
+            p = r.centre + r.radius * unitVector(random, gauss);
             if (!(glm::dot(p - r.centre, viewpoint - p) > 0)) continue;  // the far side of the sphere
         }
         const Ray eye{viewpoint, glm::normalize(p - viewpoint)};

@@ -177,6 +177,10 @@ glm::dvec3 reflectedViewpoint(const Reflector& reflector, glm::dvec3 viewpoint);
 // fewest, the one nearest the centre (nearer the scene: more texels on it). Throws as reflectedRays.
 inline constexpr int kEyeCandidates = 5;
 inline constexpr double kEyeTie = 0.002;
+// The rays a placement traces: a sphere's cap sends most of them past a small model, so the
+// fraction of those that meet it rests on a few hundred at 4000 (the truck's sphere: the eye
+// chosen moved between two samples).
+inline constexpr int kViewRays = 16000;
 struct EyePlacement {
     glm::dvec3 eye{0.0};
     double disoccluded = 0;        // at the eye, with the layers placed for
@@ -187,7 +191,7 @@ struct EyePlacement {
     int layers = 1;
 };
 EyePlacement placeReflectionEye(const MeshScene& scene, const Reflector& reflector, glm::dvec3 viewpoint, int layers,
-                                int rays = 4000);
+                                int rays = kViewRays);
 
 // What the reflector shows where a reflected ray meets nothing: a constant sky.
 inline constexpr float kReflectionSky[3] = {0.55f, 0.65f, 0.8f};
