@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -191,6 +192,7 @@ struct ReflectionBakeText {
     bool uniform = false;
     std::string layers = "auto";
     double mirrorRadius = 0.5;
+    std::string view, reflector = "sphere", normal = "0,0,1";
 };
 
 // --layers: 1..kMaxReflectionLayers, or `auto` (0: as many as the scene needs).
@@ -225,13 +227,35 @@ int runBakeReflection(const ReflectionBakeText& o) {
         options.roi = codec::AxisBox{lo, hi};
     }
     const codec::MeshScene scene(readSceneMesh(o.scene, o.allowDirs));
+    // --view: the faces' eye placed where the reflector's rays toward the viewpoint are best seen.
+    std::optional<codec::EyePlacement> placed;
+    codec::Reflector reflector;
+    std::vector<Ray> viewRays;
+    if (!o.view.empty()) {
+        reflector.kind = parseEnum<codec::Reflector::Kind>(o.reflector);
+        reflector.centre = options.centre;
+        reflector.radius = o.mirrorRadius;
+        reflector.normal = parseVector3(o.normal, "--normal");
+        if (!(glm::length(reflector.normal) > 0)) throw Error(ErrorCode::InvalidArgument, "--normal is the zero vector");
+        reflector.normal = glm::normalize(reflector.normal);
+        if (!(o.mirrorRadius > 0)) throw Error(ErrorCode::InvalidArgument, "--view needs a mirror of --mirror-radius > 0");
+        const glm::dvec3 viewpoint = parseVector3(o.view, "--view");
+        Progress placing("place the eye for the view");
+        placed = codec::placeReflectionEye(scene, reflector, viewpoint, options.layers);
+        viewRays = codec::reflectedRays(reflector, viewpoint, codec::kViewRays);
+        placing.done();
+        options.centre = placed->eye;
+        options.layers = placed->layers;  // auto: the layers the view needs there
+    }
     Progress baking("bake six " + std::to_string(o.size) + "x" + std::to_string(o.size) + " faces (Embree)");
     const auto faces = codec::bakeReflection(scene, options);
     baking.done();
     // The report's rays are traced before the write, so that nothing fails after the asset is there.
     const int layers = faces.front().layers();
-    const double one = codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, 1);
-    const double all = codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, layers);
+    const double one = placed ? codec::disocclusionFraction(scene, options.centre, viewRays, 1)
+                              : codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, 1);
+    const double all = placed ? codec::disocclusionFraction(scene, options.centre, viewRays, layers)
+                              : codec::disocclusionFraction(scene, options.centre, o.mirrorRadius, layers);
     // One file, written through a temporary and renamed: a failed bake leaves the earlier asset whole.
     Progress writing("write " + o.output);
     format::writeReflectionAsset(o.output, codec::reflectionAssetFile(faces));
@@ -239,8 +263,17 @@ int runBakeReflection(const ReflectionBakeText& o) {
     std::printf("wrote %s: reflection asset of six %dx%d CoNUS colour + depth faces, %d layer%s, from %g,%g,%g (%s)\n",
                 o.output.c_str(), o.size, o.size, layers, layers == 1 ? "" : "s", options.centre.x, options.centre.y,
                 options.centre.z, o.uniform ? "uniform, the baseline" : "foci on the region of interest");
-    std::printf("mirror rays (radius %g) that land in a disocclusion: %.2f%% with 1 layer, %.2f%% with %d\n", o.mirrorRadius,
-                100.0 * one, 100.0 * all, layers);
+    if (placed) {
+        std::printf("eye placed for the view: %g,%g,%g (render with --at %g,%g,%g, the reflector's centre)\n", options.centre.x,
+                    options.centre.y, options.centre.z, reflector.centre.x, reflector.centre.y, reflector.centre.z);
+        std::printf("rays the %s mirror reflects toward the view that land in a disocclusion: %.2f%% with 1 layer, %.2f%% with "
+                    "%d (%.2f%% from the centre with %d)\n",
+                    o.reflector.c_str(), 100.0 * one, 100.0 * all, layers, 100.0 * placed->centreDisoccluded,
+                    parseLayers(o.layers) == 0 ? 1 : layers);
+    } else {
+        std::printf("mirror rays (radius %g) that land in a disocclusion: %.2f%% with 1 layer, %.2f%% with %d\n", o.mirrorRadius,
+                    100.0 * one, 100.0 * all, layers);
+    }
     return 0;
 }
 
@@ -261,12 +294,21 @@ CLI::App* addBakeReflection(CLI::App& command, ReflectionBakeText& o) {
     reflection->add_option("--roi-max", o.roiMax, "region of interest, highest corner x,y,z");
     reflection->add_flag("--uniform", o.uniform, "identity maps: the conventional asset of the same texel count");
     reflection->add_option("--layers", o.layers,
-                           "surfaces kept along each texel's ray, 1 to 4, or auto: until the next covers under 1% of the texels")
+                           "surfaces kept along each texel's ray, 1 to 4, or auto: until the next covers under 1% of the texels "
+                           "(with --view: until under 1% of the rays toward the view land in a disocclusion)")
         ->capture_default_str();
     reflection->add_option("--mirror-radius", o.mirrorRadius,
                            "the reflector's radius, for the report of mirror rays that land in a disocclusion")
         ->capture_default_str()
         ->check(finiteRange(0, 1e6));
+    reflection->add_option("--view", o.view,
+                           "x,y,z the reflector is seen from: the faces' eye moves from --center toward the reflected "
+                           "viewpoint, where the fewest reflected rays land in a disocclusion (--reflector, --normal, "
+                           "--mirror-radius give the mirror)");
+    reflection->add_option("--reflector", o.reflector, "with --view: the mirror's shape")
+        ->capture_default_str()
+        ->check(CLI::IsMember(enumNames<codec::Reflector::Kind>()));
+    reflection->add_option("--normal", o.normal, "with --view, plane: the mirror's facing direction x,y,z")->capture_default_str();
     addAllowDirOption(*reflection, o.allowDirs);
     return reflection;
 }

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -233,6 +234,32 @@ int faceLayers(const format::ConusFile& face) {
     return layers;
 }
 
+// Where a face's texels went: the part of the face its map magnifies (density above 1), as a
+// share of the face's area and of its texels (CoNUS pixels whose undistorted centre lies there),
+// and that part's centre (u, v); a uniform face spends the area's share on it.
+struct MagnifiedShare {
+    double area = 0, texels = 0;
+    glm::dvec2 centre{0.5};
+};
+MagnifiedShare magnifiedShare(const FileFacts& face) {
+    const int w = face.file.image.width, h = face.file.image.height;
+    MagnifiedShare share;
+    glm::dvec2 sum(0.0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const glm::dvec2 p((x + 0.5) / w, (y + 0.5) / h);
+            if (face.map.density(p) > 1.0) {
+                share.area += 1;
+                sum += p;
+            }
+            share.texels += face.map.density(face.map.undistort(p)) > 1.0;
+        }
+    if (share.area > 0) share.centre = sum / share.area;
+    share.area /= double(w) * h;
+    share.texels /= double(w) * h;
+    return share;
+}
+
 // A reflection asset: its frame, then each face in a line (JSON: each face as a file's facts).
 int printReflectionAsset(const InfoOptions& o) {
     if (!o.densityPng.empty())
@@ -252,6 +279,8 @@ int printReflectionAsset(const InfoOptions& o) {
         for (std::size_t f = 0; f < faces.size(); ++f) {
             nlohmann::ordered_json face{{"name", format::kCubeFaceNames[f]}};
             face.update(toJson("", faces[f]));
+            const MagnifiedShare share = magnifiedShare(faces[f]);
+            face["magnified"] = {{"areaShare", share.area}, {"texelShare", share.texels}, {"centre", {share.centre.x, share.centre.y}}};
             j["faces"].push_back(face);
         }
         std::printf("%s\n", j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
@@ -274,6 +303,9 @@ int printReflectionAsset(const InfoOptions& o) {
         if (face.file.analytic && face.file.analytic->is(format::MapKind::Foci))
             for (const auto& focus : face.file.analytic->foci)
                 std::printf("; focus u=%.3g v=%.3g r=%.3g k=%.3g", focus.u, focus.v, focus.r, focus.k);
+        if (const MagnifiedShare share = magnifiedShare(face); share.area > 0)
+            std::printf("; magnified about u=%.2f v=%.2f: %.1f%% of the face, %.1f%% of its texels", share.centre.x, share.centre.y,
+                        100.0 * share.area, 100.0 * share.texels);
         std::printf("; depth [%g, %g] %s\n", face.file.depth.near, face.file.depth.far, face.file.depth.units.c_str());
     }
     return 0;

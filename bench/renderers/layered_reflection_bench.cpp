@@ -6,7 +6,11 @@
 // against the traced reference (the reflected rays traced against the mesh, Embree) over the mirror
 // and the teapot's reflection, reports the asset bytes and the bake's disocclusion fractions, and
 // writes CONUS_BENCH_PICTURES-<mirror>.png (CoNUS 1 layer | CoNUS layered | reference; below, 3x)
-// when that variable names a path prefix. BM_LayeredReflectionPaired times single-layer and
+// when that variable names a path prefix. The "placed_" figures are the layered asset baked from
+// the eye placeReflectionEye picks for the camera (CONUS_BENCH_PICTURES-placed-<mirror>.png: CoNUS
+// layered from the centre | from the placed eye | reference; each asset scored against the
+// reference shaded from its own eye); "moved_" the layered CoNUS assets seen from kMovedEye, a
+// viewpoint the eye was not placed for. BM_LayeredReflectionPaired times single-layer and
 // layered CoNUS frames in interleaved pairs, on the CPU (/0) and through GLSL (/1, the context
 // CONUS_BACKEND names, default auto).
 #include <benchmark/benchmark.h>
@@ -34,11 +38,17 @@ struct Setup {
     codec::MeshScene scene;
     codec::ReflectionFrameOptions options;
     Camera camera;
-    // [uniform 0 / CoNUS 1][single 0 / layered 1]
-    std::vector<codec::ReflectionFace> faces[2][2];
-    double bytes[2][2] = {};
+    double fov = 40;
+    // [uniform 0 / CoNUS 1][single 0 / layered 1 / layered from the placed eye 2]
+    std::vector<codec::ReflectionFace> faces[2][3];
+    double bytes[2][3] = {};
     double disoccluded[2] = {};  // single, layered
+    codec::EyePlacement placed{};  // the faces' eye placed for the camera (placeReflectionEye)
 };
+
+// The camera moved away from the one the eye was placed for: what the placed asset shows a viewer
+// elsewhere.
+const glm::dvec3 kMovedEye(2.5, 2.0, 6.5);
 
 // The models: the Utah teapot, and Cesium's milk truck (a textured glTF from Debian's
 // assimp-testmodels, a model the project was not tuned on).
@@ -54,22 +64,25 @@ Setup* setup(int index) {
     if (s) return s.get();
     if (!std::filesystem::exists(kModels[index / 2])) return nullptr;
     s = std::make_unique<Setup>(Setup{codec::MeshScene(sceneio::readMesh(kModels[index / 2])), {},
-                                      Camera::perspective({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 40, 1, 0.1, 10), {}});
+                                      Camera::perspective({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 40, 1, 0.1, 10), 40.0, {}});
     codec::Reflector& r = s->options.reflector;
     r.kind = mirror == 0 ? codec::Reflector::Kind::Plane : codec::Reflector::Kind::Sphere;
     r.centre = mirror == 0 ? glm::dvec3(0.0, 1.5, -6.0) : glm::dvec3(0.0, 1.5, -7.0);
     r.radius = 4.0;
     r.normal = glm::normalize(glm::dvec3(0.15, 0.0, 1.0));
-    s->camera = Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, mirror == 0 ? 38.0 : 45.0, 1.0, 1e-3, 1e3);
+    s->fov = mirror == 0 ? 38.0 : 45.0;
+    s->camera = Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, s->fov, 1.0, 1e-3, 1e3);
     const AxisBox bounds = boundsOf(s->scene.mesh());
     for (int uniform = 0; uniform < 2; ++uniform)
-        for (int layered = 0; layered < 2; ++layered) {
+        for (int layered = 0; layered < 3; ++layered) {
+            if (layered == 2 && uniform == 0)  // placed once, as `bake reflection --view` places it for --layers auto
+                s->placed = codec::placeReflectionEye(s->scene, r, s->camera.eye(), 0);
             codec::ReflectionBakeOptions bake;
-            bake.centre = r.centre;
+            bake.centre = layered == 2 ? s->placed.eye : r.centre;
             bake.size = kFace;
             bake.uniform = uniform == 0;
             bake.roi = bounds;
-            bake.layers = layered ? 0 : 1;
+            bake.layers = layered == 2 ? s->placed.layers : layered ? 0 : 1;
             auto& faces = s->faces[uniform][layered];
             faces = codec::bakeReflection(s->scene, bake);
             const std::string path = (std::filesystem::temp_directory_path() / "conus-layered-bench.exr").string();
@@ -90,41 +103,114 @@ void BM_LayeredReflectionQuality(benchmark::State& state) {
         return;
     }
     Setup& s = *found;
-    Image truth, frames[2][2];
+    // The reference shades with the headlight at the faces' eye, as the asset does: the placed
+    // asset has its own (traced rays land on the same surfaces; only the shading moves).
+    Image truth[2], frames[2][3];
+    const Camera moved = Camera::perspective(kMovedEye, s.options.reflector.centre, {0, 1, 0}, s.fov, 1.0, 1e-3, 1e3);
+    Image movedTruth[2], movedFrames[2];
     for (auto _ : state) {
-        truth = codec::renderReflectionFrame(s.scene, nullptr, s.options.reflector.centre, s.camera, kFrame, kFrame, s.options);
-        for (int u = 0; u < 2; ++u)
-            for (int l = 0; l < 2; ++l)
-                frames[u][l] = codec::renderReflectionFrame(s.scene, &s.faces[u][l], s.options.reflector.centre, s.camera,
-                                                            kFrame, kFrame, s.options);
+        for (int l = 0; l < 3; ++l) {
+            const glm::dvec3 eye = s.faces[1][l].front().depth.camera().eye();
+            if (l != 1) truth[l / 2] = codec::renderReflectionFrame(s.scene, nullptr, eye, s.camera, kFrame, kFrame, s.options);
+            for (int u = 0; u < 2; ++u)
+                frames[u][l] = codec::renderReflectionFrame(s.scene, &s.faces[u][l], eye, s.camera, kFrame, kFrame, s.options);
+        }
+        for (int p = 0; p < 2; ++p) {  // the layered asset from the centre, from the placed eye
+            const glm::dvec3 eye = s.faces[1][p + 1].front().depth.camera().eye();
+            movedTruth[p] = codec::renderReflectionFrame(s.scene, nullptr, eye, moved, kFrame, kFrame, s.options);
+            movedFrames[p] = codec::renderReflectionFrame(s.scene, &s.faces[1][p + 1], eye, moved, kFrame, kFrame, s.options);
+        }
     }
     const auto triangles = static_cast<std::uint32_t>(s.scene.mesh().indices.size() / 3);
-    for (int l = 0; l < 2; ++l) {
+    for (int l = 0; l < 3; ++l) {
         const Image pair[2] = {frames[0][l], frames[1][l]};
-        const bench::MirrorScore score = bench::scoreMirror(pair, truth, s.scene, s.options.reflector, s.camera, kFrame, triangles);
-        const std::string tag = l ? "layered_" : "single_";
+        const bench::MirrorScore score =
+            bench::scoreMirror(pair, truth[l == 2 ? 1 : 0], s.scene, s.options.reflector, s.camera, kFrame, triangles);
+        const char* tags[3] = {"single_", "layered_", "placed_"};
+        const std::string tag = tags[l];
         state.counters[tag + "mirror_conus_dB"] = score.psnr(1, {0, 1});
         state.counters[tag + "mirror_uniform_dB"] = score.psnr(0, {0, 1});
         state.counters[tag + "teapot_conus_dB"] = score.psnr(1, {0});
         state.counters[tag + "teapot_uniform_dB"] = score.psnr(0, {0});
+        state.counters[tag + "rest_conus_dB"] = score.psnr(1, {1});
+        state.counters[tag + "rest_uniform_dB"] = score.psnr(0, {1});
         state.counters[tag + "wrong_conus"] = score.wrong[1][0] + score.wrong[1][1];
     }
     state.counters["layers"] = s.faces[1][1].front().layers();
+    for (int p = 0; p < 2; ++p) {
+        const Image pair[2] = {movedFrames[p], movedFrames[p]};
+        const bench::MirrorScore score = bench::scoreMirror(pair, movedTruth[p], s.scene, s.options.reflector, moved, kFrame, triangles);
+        state.counters[std::string(p ? "moved_placed" : "moved_layered") + "_mirror_conus_dB"] = score.psnr(1, {0, 1});
+    }
+    state.counters["placed_layers"] = s.faces[1][2].front().layers();
+    state.counters["placed_disoccluded_pct"] = 100.0 * s.placed.disoccluded;
+    state.counters["centre_disoccluded_pct"] = 100.0 * s.placed.centreDisoccluded;
+    state.counters["placed_eye_x"] = s.placed.eye.x;
+    state.counters["placed_eye_z"] = s.placed.eye.z;
     state.counters["bytes_ratio_conus"] = s.bytes[1][1] / s.bytes[1][0];
     state.counters["bytes_ratio_uniform"] = s.bytes[0][1] / s.bytes[0][0];
+    state.counters["bytes_ratio_placed"] = s.bytes[1][2] / s.bytes[1][0];
     state.counters["bytes_single_conus"] = s.bytes[1][0];
     state.counters["disoccluded_single_pct"] = 100.0 * s.disoccluded[0];
     state.counters["disoccluded_layered_pct"] = 100.0 * s.disoccluded[1];
     if (const char* prefix = std::getenv("CONUS_BENCH_PICTURES")) {
         // CoNUS single | CoNUS layered | reference (writeMirrorStrip's order: frames[1], frames[0], truth).
         const Image pair[2] = {frames[1][1], frames[1][0]};
-        const bench::MirrorScore score = bench::scoreMirror(pair, truth, s.scene, s.options.reflector, s.camera, kFrame, triangles);
+        const bench::MirrorScore score = bench::scoreMirror(pair, truth[0], s.scene, s.options.reflector, s.camera, kFrame, triangles);
         const char* names[4] = {"-plane.png", "-sphere.png", "-truck-plane.png", "-truck-sphere.png"};
-        bench::writeMirrorStrip(std::string(prefix) + names[state.range(0)], pair, truth, score, kFrame, 3);
+        bench::writeMirrorStrip(std::string(prefix) + names[state.range(0)], pair, truth[0], score, kFrame, 3);
+        // CoNUS layered from the centre | from the placed eye | the reference shaded from the placed eye.
+        const Image placed[2] = {frames[1][2], frames[1][1]};
+        const bench::MirrorScore placedScore =
+            bench::scoreMirror(placed, truth[1], s.scene, s.options.reflector, s.camera, kFrame, triangles);
+        bench::writeMirrorStrip(std::string(prefix) + "-placed" + names[state.range(0)], placed, truth[1], placedScore, kFrame, 3);
     }
 }
 
-// Single-layer (A) against layered (B) CoNUS frames: /0 the CPU reference, /1 GLSL.
+// The eye at candidate k of placeReflectionEye's (k/4 of the way from the mirror's centre to the
+// reflected viewpoint; range(1)), one layer, faces of range(2) texels: the rays toward the camera that land in a
+// disocclusion there and the mirror's dB against the reference shaded from that eye.
+void BM_LayeredReflectionEyeSweep(benchmark::State& state) {
+    Setup* found = setup(static_cast<int>(state.range(0)));
+    if (!found) {
+        state.SkipWithError("the model is not installed (assimp-testmodels)");
+        return;
+    }
+    Setup& s = *found;
+    const codec::Reflector& r = s.options.reflector;
+    const glm::dvec3 image = codec::reflectedViewpoint(r, s.camera.eye());
+    const glm::dvec3 eye = r.centre + (image - r.centre) * (double(state.range(1)) / (codec::kEyeCandidates - 1));
+    codec::ReflectionBakeOptions bake;
+    bake.centre = eye;
+    bake.size = static_cast<int>(state.range(2));
+    bake.roi = boundsOf(s.scene.mesh());
+    Image frames[2], truth;
+    double bytes = 0;
+    for (auto _ : state) {
+        for (int u = 0; u < 2; ++u) {
+            bake.uniform = u == 0;
+            const auto faces = codec::bakeReflection(s.scene, bake);
+            frames[u] = codec::renderReflectionFrame(s.scene, &faces, eye, s.camera, kFrame, kFrame, s.options);
+            if (u == 1) {
+                const std::string path = (std::filesystem::temp_directory_path() / "conus-eye-sweep.exr").string();
+                format::writeReflectionAsset(path, codec::reflectionAssetFile(faces));
+                bytes = static_cast<double>(std::filesystem::file_size(path));
+                std::filesystem::remove(path);
+            }
+        }
+        truth = codec::renderReflectionFrame(s.scene, nullptr, eye, s.camera, kFrame, kFrame, s.options);
+    }
+    const auto triangles = static_cast<std::uint32_t>(s.scene.mesh().indices.size() / 3);
+    const bench::MirrorScore score = bench::scoreMirror(frames, truth, s.scene, r, s.camera, kFrame, triangles);
+    state.counters["mirror_conus_dB"] = score.psnr(1, {0, 1});
+    state.counters["mirror_uniform_dB"] = score.psnr(0, {0, 1});
+    state.counters["model_conus_dB"] = score.psnr(1, {0});
+    state.counters["bytes_ratio"] = bytes / s.bytes[1][0];
+    state.counters["disoccluded_pct"] = 100.0 * codec::disocclusionFraction(s.scene, eye, codec::reflectedRays(r, s.camera.eye(), codec::kViewRays), 1);
+}
+
+// Single-layer (A) against layered (B) CoNUS frames: /x/0 the CPU reference, /x/1 GLSL; /x/x/1 the
+// layered asset from the placed eye as B.
 void BM_LayeredReflectionPaired(benchmark::State& state) {
     Setup* found = setup(static_cast<int>(state.range(0)));
     if (!found) {
@@ -132,6 +218,7 @@ void BM_LayeredReflectionPaired(benchmark::State& state) {
         return;
     }
     Setup& s = *found;
+    const int b = state.range(2) ? 2 : 1;
     const auto ms = [](auto&& render) {
         const auto start = std::chrono::steady_clock::now();
         render();
@@ -144,7 +231,7 @@ void BM_LayeredReflectionPaired(benchmark::State& state) {
                                                                       s.camera, kFrame, kFrame, s.options));
             });
         };
-        bench::pairedRatio(state, [&] { return frame(0); }, [&] { return frame(1); });
+        bench::pairedRatio(state, [&] { return frame(0); }, [&] { return frame(b); });
         return;
     }
     static std::unique_ptr<renderers::Context> context = [] {
@@ -152,7 +239,7 @@ void BM_LayeredReflectionPaired(benchmark::State& state) {
         return renderers::Context::create(backend ? parseEnum<renderers::Backend>(backend) : renderers::Backend::Auto);
     }();
     renderers::ReflectionRenderer single(*context, s.scene.mesh(), s.faces[1][0], s.options);
-    renderers::ReflectionRenderer layered(*context, s.scene.mesh(), s.faces[1][1], s.options);
+    renderers::ReflectionRenderer layered(*context, s.scene.mesh(), s.faces[1][b], s.options);
     single.draw(s.camera, kFrame, kFrame);  // compiles the program
     layered.draw(s.camera, kFrame, kFrame);
     bench::pairedRatio(state, [&] { return ms([&] { single.draw(s.camera, kFrame, kFrame); }); },
@@ -161,7 +248,9 @@ void BM_LayeredReflectionPaired(benchmark::State& state) {
 }
 
 BENCHMARK(BM_LayeredReflectionQuality)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Iterations(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_LayeredReflectionPaired)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})->Iterations(21)
+BENCHMARK(BM_LayeredReflectionEyeSweep)->ArgsProduct({{0, 2}, {0, 1, 2, 3, 4}, {kFace}})->Args({0, 4, 160})->Args({2, 4, 160})
+    ->Args({0, 4, 192})->Args({2, 4, 192})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LayeredReflectionPaired)->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})->Iterations(21)
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <numeric>
 #include <random>
 #include <string>
 
@@ -93,6 +94,15 @@ std::optional<DensityField> outlineContext(const Image& uniform) {
     }
     if (!outline) return std::nullopt;
     return field;
+}
+
+// A plane mirror's in-plane axes for unit normal n: any orthonormal pair; the mirror is square
+// about its centre, so a disc test would not do, but the pair's choice only turns the square in
+// its plane.
+void planeAxes(glm::dvec3 n, glm::dvec3& s, glm::dvec3& u) {
+    const glm::dvec3 helper = std::abs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+    s = glm::normalize(glm::cross(helper, n));
+    u = glm::cross(n, s);
 }
 
 }  // namespace
@@ -206,10 +216,8 @@ std::optional<ReflectorHit> hitReflector(const Reflector& r, const Ray& ray) {
         const double t = glm::dot(r.centre - ray.origin, n) / facing;
         if (!(t > 0)) return std::nullopt;
         const glm::dvec3 p = ray.origin + d * t - r.centre;
-        // The square's in-plane axes: any orthonormal pair; the mirror is square about its centre,
-        // so a disc test would not do, but the pair's choice only turns the square in its plane.
-        const glm::dvec3 helper = std::abs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
-        const glm::dvec3 s = glm::normalize(glm::cross(helper, n)), u = glm::cross(n, s);
+        glm::dvec3 s, u;
+        planeAxes(n, s, u);
         if (std::abs(glm::dot(p, s)) > r.radius || std::abs(glm::dot(p, u)) > r.radius) return std::nullopt;
         out.t = t;
         out.normal = n;
@@ -365,41 +373,124 @@ std::optional<glm::vec3> traceReflectionReference(const MeshScene& scene, const 
     return shadeHeadlight(albedo, hit->normal, l);
 }
 
+namespace {
+
+glm::dvec3 unitVector(std::mt19937& random, std::normal_distribution<double>& gauss) {
+    for (;;) {
+        const glm::dvec3 v(gauss(random), gauss(random), gauss(random));
+        if (const double l = glm::length(v); l > 1e-9) return v / l;
+    }
+}
+
+// Whether the surface at `position` is among the first `layers` along the eye's ray to it: peeled
+// from the eye toward it as the bake peels (shadeRayLayers' rule), until its own surface.
+bool storedFrom(const MeshScene& scene, glm::dvec3 eye, glm::dvec3 position, int layers) {
+    const glm::dvec3 toHit = position - eye;
+    const double distance = glm::length(toHit);
+    if (!(distance > 0)) return true;
+    const Ray fromEye{eye, toHit / distance};
+    double from = 1e-6;
+    for (int k = 0; k < layers; ++k) {
+        const auto on = scene.intersect(fromEye, from);
+        if (!on) return false;
+        if (on->distance >= distance * (1.0 - kPeelGap)) return true;
+        from = on->distance * (1.0 + kPeelGap);
+    }
+    return false;
+}
+
+}  // namespace
+
 double disocclusionFraction(const MeshScene& scene, glm::dvec3 centre, double radius, int layers, int rays, unsigned seed) {
     if (!(radius >= 0) || !std::isfinite(radius) || layers < 1 || rays < 1)
         throw Error(ErrorCode::InvalidArgument, "disocclusion: needs a radius >= 0, at least one layer and one ray");
     std::mt19937 random(seed);
     std::normal_distribution<double> gauss;
-    const auto unit = [&] {
-        for (;;) {
-            const glm::dvec3 v(gauss(random), gauss(random), gauss(random));
-            if (const double l = glm::length(v); l > 1e-9) return v / l;
-        }
-    };
-    int met = 0, unseen = 0;
+    std::vector<Ray> sample;
+    sample.reserve(static_cast<std::size_t>(rays));
     for (int i = 0; i < rays; ++i) {
-        const glm::dvec3 n = unit();
-        glm::dvec3 d = unit();
+        const glm::dvec3 n = unitVector(random, gauss);
+        glm::dvec3 d = unitVector(random, gauss);
         if (glm::dot(d, n) < 0) d = -d;
-        const auto hit = scene.intersect(Ray{centre + n * radius, d}, 1e-6);
-        if (!hit) continue;
-        ++met;
-        const glm::dvec3 toHit = hit->position - centre;
-        const double distance = glm::length(toHit);
-        if (!(distance > 0)) continue;
-        // Peel from the centre toward the hit, as the bake does, until the hit's own surface.
-        const Ray fromCentre{centre, toHit / distance};
-        double from = 1e-6;
-        bool stored = false;
-        for (int k = 0; k < layers && !stored; ++k) {
-            const auto on = scene.intersect(fromCentre, from);
-            if (!on) break;
-            stored = on->distance >= distance * (1.0 - kPeelGap);
-            from = on->distance * (1.0 + kPeelGap);
-        }
-        unseen += stored ? 0 : 1;
+        sample.push_back(Ray{centre + n * radius, d});
     }
-    return met > 0 ? double(unseen) / met : 0.0;
+    return disocclusionFraction(scene, centre, sample, layers);
+}
+
+double disocclusionFraction(const MeshScene& scene, glm::dvec3 eye, const std::vector<Ray>& rays, int layers) {
+    if (layers < 1 || !finite(eye)) throw Error(ErrorCode::InvalidArgument, "disocclusion: needs a finite eye and at least one layer");
+    std::vector<int> met(rays.size()), unseen(rays.size());
+    parallelRows(static_cast<int>(rays.size()), 0, [&](int i0, int i1) {
+        for (int i = i0; i < i1; ++i) {
+            const auto hit = scene.intersect(rays[static_cast<std::size_t>(i)], 1e-6);
+            if (!hit) continue;
+            met[static_cast<std::size_t>(i)] = 1;
+            unseen[static_cast<std::size_t>(i)] = storedFrom(scene, eye, hit->position, layers) ? 0 : 1;
+        }
+    });
+    const double hits = std::accumulate(met.begin(), met.end(), 0.0);
+    return hits > 0 ? std::accumulate(unseen.begin(), unseen.end(), 0.0) / hits : 0.0;
+}
+
+std::vector<Ray> reflectedRays(const Reflector& r, glm::dvec3 viewpoint, int count, unsigned seed) {
+    if (count < 1 || !finite(viewpoint)) throw Error(ErrorCode::InvalidArgument, "reflected rays: needs a finite viewpoint and a count >= 1");
+    const bool plane = r.kind == Reflector::Kind::Plane;
+    const glm::dvec3 n = glm::normalize(r.normal);
+    if (plane ? !(glm::dot(viewpoint - r.centre, n) > 0) : !(glm::distance(viewpoint, r.centre) > r.radius))
+        throw Error(ErrorCode::InvalidArgument, std::string("the viewpoint sees no mirror side: it is ") +
+                                                    (plane ? "behind the plane mirror" : "inside the sphere"));
+    std::mt19937 random(seed);
+    std::normal_distribution<double> gauss;
+    std::uniform_real_distribution<double> across(-1.0, 1.0);
+    glm::dvec3 s, u;
+    planeAxes(n, s, u);
+    std::vector<Ray> rays;
+    rays.reserve(static_cast<std::size_t>(count));
+    while (static_cast<int>(rays.size()) < count) {
+        // A point of the mirror side that faces the viewpoint, uniform over its area.
+        glm::dvec3 p;
+        if (plane) {
+            p = r.centre + r.radius * (across(random) * s + across(random) * u);
+        } else {
+            p = r.centre + r.radius * unitVector(random, gauss);
+            if (!(glm::dot(p - r.centre, viewpoint - p) > 0)) continue;  // the far side of the sphere
+        }
+        const Ray eye{viewpoint, glm::normalize(p - viewpoint)};
+        if (const auto hit = hitReflector(r, eye)) rays.push_back(hit->reflected);
+    }
+    return rays;
+}
+
+glm::dvec3 reflectedViewpoint(const Reflector& r, glm::dvec3 viewpoint) {
+    const glm::dvec3 n = glm::normalize(r.normal);
+    if (r.kind == Reflector::Kind::Plane) return viewpoint - 2.0 * glm::dot(viewpoint - r.centre, n) * n;
+    // A convex mirror of focal length r/2: an object d - r before its surface has its virtual
+    // image 1 / (2/r + 1/(d - r)) behind it.
+    const glm::dvec3 toView = viewpoint - r.centre;
+    const double d = glm::length(toView);
+    if (!(d > r.radius)) return r.centre;
+    return r.centre + toView / d * (r.radius - 1.0 / (2.0 / r.radius + 1.0 / (d - r.radius)));
+}
+
+EyePlacement placeReflectionEye(const MeshScene& scene, const Reflector& reflector, glm::dvec3 viewpoint, int layers, int rays) {
+    if (layers < 0 || layers > kMaxReflectionLayers)
+        throw Error(ErrorCode::InvalidArgument, "eye placement: layers must be 0 to " + std::to_string(kMaxReflectionLayers));
+    const std::vector<Ray> sample = reflectedRays(reflector, viewpoint, rays);
+    const glm::dvec3 image = reflectedViewpoint(reflector, viewpoint);
+    glm::dvec3 eyes[kEyeCandidates];
+    double fractions[kEyeCandidates];
+    for (int k = 0; k < kEyeCandidates; ++k) {
+        eyes[k] = reflector.centre + (image - reflector.centre) * (double(k) / (kEyeCandidates - 1));
+        fractions[k] = disocclusionFraction(scene, eyes[k], sample, std::max(layers, 1));
+    }
+    const double fewest = *std::min_element(fractions, fractions + kEyeCandidates);
+    int k = 0;
+    while (fractions[k] > fewest + kEyeTie) ++k;
+    EyePlacement placed{eyes[k], fractions[k], fractions[0], std::max(layers, 1)};
+    if (layers == 0)
+        for (double f = fractions[k]; f >= kLayerMinCoverage && placed.layers < kMaxReflectionLayers;)
+            f = disocclusionFraction(scene, placed.eye, sample, ++placed.layers);
+    return placed;
 }
 
 Image renderReflectionFrame(const MeshScene& scene, const std::vector<ReflectionFace>* faces, glm::dvec3 centre,

@@ -155,6 +155,44 @@ std::optional<glm::vec3> traceReflectionReference(const MeshScene& scene, const 
 double disocclusionFraction(const MeshScene& scene, glm::dvec3 centre, double radius, int layers, int rays = 20000,
                             unsigned seed = 1);
 
+// The same for the rays of `rays` (unit directions) from an asset whose faces' eye is `eye`.
+double disocclusionFraction(const MeshScene& scene, glm::dvec3 eye, const std::vector<Ray>& rays, int layers);
+
+// What the reflector sends back toward `viewpoint`: `count` eye rays from the viewpoint to points
+// uniform on the reflector's side that faces it (a plane mirror's square, a sphere's visible cap),
+// each reflected there (hitReflector's ray). Throws conus::Error(InvalidArgument) for a count
+// under 1, a non-finite viewpoint, or one that sees no mirror side (behind a plane, inside a sphere).
+std::vector<Ray> reflectedRays(const Reflector& reflector, glm::dvec3 viewpoint, int count, unsigned seed = 1);
+
+// Where the reflected viewpoint lies: a plane's mirror image of the viewpoint (every ray the
+// mirror reflects toward the viewpoint passes through it, so an eye there stores the first surface
+// along each of them); a sphere's paraxial virtual image of it, between the centre and the surface
+// (its rays pass near it, no longer through one point).
+glm::dvec3 reflectedViewpoint(const Reflector& reflector, glm::dvec3 viewpoint);
+
+// The faces' eye placed for a reflector seen from about `viewpoint`: of the candidates on the
+// segment from the reflector's centre to the reflected viewpoint (kEyeCandidates, evenly spaced,
+// both ends included), the one where the fewest of reflectedRays land in a disocclusion of a
+// `layers`-layer asset (0: as many as the view needs, placed for one); within kEyeTie of the
+// fewest, the one nearest the centre (nearer the scene: more texels on it). Throws as reflectedRays.
+inline constexpr int kEyeCandidates = 5;
+inline constexpr double kEyeTie = 0.002;
+// The rays a placement traces: a sphere's cap sends most of them past a small model, so the
+// fraction of those that meet it rests on a few hundred at 4000 (the truck's sphere: the eye
+// chosen moved between two samples).
+inline constexpr int kViewRays = 16000;
+struct EyePlacement {
+    glm::dvec3 eye{0.0};
+    double disoccluded = 0;        // at the eye, with the layers placed for
+    double centreDisoccluded = 0;  // at the reflector's centre, for comparison
+    // The layers the view needs at the eye: `layers` when given; for 0, the fewest (1 to
+    // kMaxReflectionLayers) that leave under kLayerMinCoverage of the view's rays in a
+    // disocclusion (what the view needs, where the bake's auto counts the faces' texels).
+    int layers = 1;
+};
+EyePlacement placeReflectionEye(const MeshScene& scene, const Reflector& reflector, glm::dvec3 viewpoint, int layers,
+                                int rays = kViewRays);
+
 // What the reflector shows where a reflected ray meets nothing: a constant sky.
 inline constexpr float kReflectionSky[3] = {0.55f, 0.65f, 0.8f};
 
