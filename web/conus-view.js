@@ -47,12 +47,8 @@ void main() {
     gl_Position = vec4(p, 0.0, 1.0);
 }`;
   const programs = new Map();
-  function program(mode, outlines) {
-    const key = mode + "/" + outlines;
-    if (programs.has(key)) return programs.get(key);
-    const body = window.CONUS_VIEW_SHADER;
-    if (!body) throw new Error("conus-shaders.js did not load");
-    const source = `#version 300 es\n#define VIEW_MODE ${mode}\n#define VIEW_GRID 0\n#define VIEW_OUTLINES ${outlines ? 1 : 0}\n` + body;
+  // A program of the full-screen triangle and `fragment`; a compile or link error is one line.
+  function linkProgram(fragment) {
     const compile = (type, text) => {
       const s = gl.createShader(type);
       gl.shaderSource(s, text);
@@ -62,9 +58,17 @@ void main() {
     };
     const p = gl.createProgram();
     gl.attachShader(p, compile(gl.VERTEX_SHADER, kVertex));
-    gl.attachShader(p, compile(gl.FRAGMENT_SHADER, source));
+    gl.attachShader(p, compile(gl.FRAGMENT_SHADER, fragment));
     gl.linkProgram(p);
     if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error("shader link: " + gl.getProgramInfoLog(p).split("\n")[0]);
+    return p;
+  }
+  function program(mode, outlines) {
+    const key = mode + "/" + outlines;
+    if (programs.has(key)) return programs.get(key);
+    const body = window.CONUS_VIEW_SHADER;
+    if (!body) throw new Error("conus-shaders.js did not load");
+    const p = linkProgram(`#version 300 es\n#define VIEW_MODE ${mode}\n#define VIEW_GRID 0\n#define VIEW_OUTLINES ${outlines ? 1 : 0}\n` + body);
     const locations = new Map();
     const u = (name) => {
       if (!locations.has(name)) locations.set(name, gl.getUniformLocation(p, name));
@@ -196,18 +200,7 @@ void main() {
   function drawPyramid(texture, width, height, levels) {
     const pyramidProgram = (even) => {
       if (pyramidPrograms[even]) return pyramidPrograms[even];
-      const compile = (type, text) => {
-        const sh = gl.createShader(type);
-        gl.shaderSource(sh, text);
-        gl.compileShader(sh);
-        if (!gl.getShaderParameter(sh, gl.COMPILE_STATUS)) throw new Error("shader: " + gl.getShaderInfoLog(sh).split("\n")[0]);
-        return sh;
-      };
-      const p = gl.createProgram();
-      gl.attachShader(p, compile(gl.VERTEX_SHADER, kVertex));
-      gl.attachShader(p, compile(gl.FRAGMENT_SHADER, kPyramidFragment.replace("\n", `\n#define EVEN ${even}\n`)));
-      gl.linkProgram(p);
-      if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error("shader link: " + gl.getProgramInfoLog(p).split("\n")[0]);
+      const p = linkProgram(kPyramidFragment.replace("\n", `\n#define EVEN ${even}\n`));
       gl.useProgram(p);
       gl.uniform1i(gl.getUniformLocation(p, "uBelow"), 0);
       return (pyramidPrograms[even] = p);
