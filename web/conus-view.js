@@ -68,7 +68,7 @@ void main() {
     if (programs.has(key)) return programs.get(key);
     const body = window.CONUS_VIEW_SHADER;
     if (!body) throw new Error("conus-shaders.js did not load");
-    const p = linkProgram(`#version 300 es\n#define VIEW_MODE ${mode}\n#define VIEW_GRID 0\n#define VIEW_OUTLINES ${outlines ? 1 : 0}\n` + body);
+    const p = linkProgram(`#version 300 es\n#define VIEW_MODE ${mode}\n#define VIEW_GRID 0\n#define VIEW_OUTLINES ${outlines ? 1 : 0}\n#define VIEW_PLAIN_DISPLAY 1\n` + body);
     const locations = new Map();
     const u = (name) => {
       if (!locations.has(name)) locations.set(name, gl.getUniformLocation(p, name));
@@ -345,9 +345,6 @@ void main() {
     const foci = frame.foci.slice(0, 16);
     gl.uniform1i(u("uFocusCount"), foci.length);
     if (foci.length) gl.uniform3fv(u("uFoci"), new Float32Array(foci.flatMap((f) => [f[0], f[1], f[2]])));
-    gl.uniform1f(u("uExposure"), 1);
-    gl.uniform1f(u("uInvGamma"), 0);
-    gl.uniform1i(u("uToneMap"), 0);
     gl.uniform1f(u("uWipeX"), 0);
     gl.uniform2f(u("uLogDensity"), frame.logDensity[0], frame.logDensity[1]);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
