@@ -20,6 +20,7 @@ import argparse
 import json
 import os
 import pathlib
+import shutil
 import statistics
 import subprocess
 import sys
@@ -74,21 +75,12 @@ def dzi_views(folder, size, whole_level, roi_box, tile=254, overlap=1):
     return whole, roi, a + b + [folder / "photo.dzi"]
 
 
-GL = {"swiftshader": [], "llvmpipe": ["--use-gl=angle", "--use-angle=gl-egl", "--ignore-gpu-blocklist"]}
+from web_page_speed import GL, browser  # noqa: E402 (beside this file)
 
 
 def browser_figures(conus, folder, file_name, picture, gl):
     from conftest import wait_title
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-    from conftest import CHROMIUM_ARGS
-    options = webdriver.ChromeOptions()
-    profile = tempfile.mkdtemp(prefix="conus-bench-chromium-")
-    for a in CHROMIUM_ARGS + ["--user-data-dir=" + profile, "--window-size=1400,900"] + GL[gl]:
-        options.add_argument(a)
-    options.binary_location = "/usr/bin/chromium"
-    driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
-    driver.set_script_timeout(600)
+    driver, profile = browser(gl)
     server = subprocess.Popen([conus, "serve", folder, "--port", "0", "-q", "--max-side", "2048"], stdout=subprocess.PIPE, text=True)
     url = server.stdout.readline().split(" at ")[1].split(" ")[0]
     try:
@@ -119,6 +111,7 @@ def browser_figures(conus, folder, file_name, picture, gl):
                 "serve_frame_s": statistics.median(serve_times), "serve_frame_s_all": serve_times}
     finally:
         driver.quit()
+        shutil.rmtree(profile, ignore_errors=True)
         server.terminate()
         server.wait(10)
 

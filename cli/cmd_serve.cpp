@@ -2,7 +2,8 @@
 // otherwise. It answers the page and its scripts, the files of one folder, and
 // GET /frame?file=NAME&focus=u,v,r,k&size=WxH: a CoNUS file of the picture NAME encoded on request
 // around that focus (the filtered encode, not fitted: encode --fast), kept for the next identical
-// request. Names stay inside the folder (their canonical path is checked); a bad parameter is a
+// request. The pictures themselves are kept decoded, with the box-filtered levels the encoder
+// builds from them, within --memory: a new focus on a picture already asked for is an encode only. Names stay inside the folder (their canonical path is checked); a bad parameter is a
 // 400 with one line, a name that is not there a 404.
 #include <CLI/CLI.hpp>
 
@@ -44,6 +45,7 @@ struct ServeOptions {
     int port = 8080;
     int maxSide = 2048;     // the largest frame side /frame encodes
     int cacheFrames = 64;   // frames kept for repeated requests
+    int memoryMiB = 4096;   // pictures kept decoded (and their encoder levels), at most this many MiB
     std::string backend = enumName(renderers::Backend::Auto);
 };
 
@@ -123,7 +125,8 @@ public:
         std::lock_guard encoding(m_encodeMutex);  // one encode at a time: it uses every core
         if (auto kept = cached(key)) return *kept;
         const auto start = std::chrono::steady_clock::now();
-        const imageio::ImageFile& source = sourcePicture(picture);
+        Picture& kept = sourcePicture(picture);
+        const imageio::ImageFile& source = kept.file;
         if (size.width > source.image.width || size.height > source.image.height)
             throw Refusal{400, "size: " + std::to_string(size.width) + "x" + std::to_string(size.height) + " is larger than the picture (" +
                                    std::to_string(source.image.width) + "x" + std::to_string(source.image.height) + ")"};
@@ -138,14 +141,17 @@ public:
         const auto encodeStart = std::chrono::steady_clock::now();
         const renderers::Device device = deviceFor(m_options.backend, renderers::CpuPath::Faster, "encoding");
         format::ConusFile file = encodeToConus(device, source.image, source.info.encoding, map, size,
-                                               codec::toAnalytic(foci, fo.composition, fo.falloff));
+                                               codec::toAnalytic(foci, fo.composition, fo.falloff), {}, nullptr, "",
+                                               &kept.levels);
         const double encodeTime = seconds(encodeStart);
+        keepWithinMemory();
+        const auto writeStart = std::chrono::steady_clock::now();
         applyStorage(StorageOptions{}, file);
         std::vector<unsigned char> bytes = conusFileBytes(file);
         if (!quiet())
-            std::fprintf(stderr, "frame %s focus %s size %dx%d: %zu bytes in %.2f s (picture %.2f, map %.2f, encode %.2f)\n",
+            std::fprintf(stderr, "frame %s focus %s size %dx%d: %zu bytes in %.2f s (picture %.2f, map %.2f, encode %.2f, write %.2f)\n",
                          picture.filename().c_str(), param("focus").c_str(), size.width, size.height, bytes.size(),
-                         seconds(start), read, mapTime, encodeTime);
+                         seconds(start), read, mapTime, encodeTime, seconds(writeStart));
         keep(key, bytes);
         return bytes;
     }
@@ -173,29 +179,60 @@ private:
         while (static_cast<int>(m_frames.size()) > m_options.cacheFrames) m_frames.pop_back();
     }
 
-    // The picture, read once while it is unchanged (a 4096^2 photo takes longer to read than to encode).
-    const imageio::ImageFile& sourcePicture(const fs::path& path) {
+    // A picture kept decoded, with the levels the encoder built from it.
+    struct Picture {
+        fs::path path;
+        fs::file_time_type written;
+        imageio::ImageFile file;
+        codec::EncodeLevels levels;
+        std::int64_t bytes() const {
+            return static_cast<std::int64_t>(file.image.pixels.size()) * std::int64_t(sizeof(float)) + levels.bytes();
+        }
+    };
+
+    // The picture, read once while it is unchanged (a 4096^2 photo takes longer to read than to
+    // encode), the most recently asked for first. Called under m_encodeMutex.
+    Picture& sourcePicture(const fs::path& path) {
         std::error_code error;
         const auto written = fs::last_write_time(path, error);
-        if (m_picturePath != path || m_pictureTime != written) {
-            try {
-                m_picture = readSource(path.string(), SourceOptions{});
-            } catch (const Error& e) {
-                throw Refusal{400, "file: " + std::string(e.what())};
+        for (auto it = m_pictures.begin(); it != m_pictures.end(); ++it)
+            if (it->path == path) {
+                if (it->written == written) {
+                    m_pictures.splice(m_pictures.begin(), m_pictures, it);
+                    return m_pictures.front();
+                }
+                m_pictures.erase(it);  // changed on disk: read again
+                break;
             }
-            m_picturePath = path;
-            m_pictureTime = written;
+        Picture picture{path, written, {}, {}};
+        try {
+            picture.file = readSource(path.string(), SourceOptions{});
+        } catch (const Error& e) {
+            throw Refusal{400, "file: " + std::string(e.what())};
         }
-        return m_picture;
+        m_pictures.push_front(std::move(picture));
+        return m_pictures.front();
+    }
+
+    // The least recently asked for pictures let go until the rest fit in --memory; one that does
+    // not fit alone first lets go of its levels, then is not kept either.
+    void keepWithinMemory() {
+        const std::int64_t cap = std::int64_t(m_options.memoryMiB) << 20;
+        const auto total = [&] {
+            std::int64_t sum = 0;
+            for (const Picture& p : m_pictures) sum += p.bytes();
+            return sum;
+        };
+        while (m_pictures.size() > 1 && total() > cap) m_pictures.pop_back();
+        if (!m_pictures.empty() && total() > cap) m_pictures.front().levels.clear();
+        if (!m_pictures.empty() && total() > cap) m_pictures.clear();
     }
 
     ServeOptions m_options;
     fs::path m_root;
     std::mutex m_encodeMutex, m_cacheMutex;
     std::list<std::pair<std::string, std::vector<unsigned char>>> m_frames;
-    fs::path m_picturePath;
-    fs::file_time_type m_pictureTime;
-    imageio::ImageFile m_picture;
+    std::list<Picture> m_pictures;
 };
 
 std::string contentTypeOf(const fs::path& path) {
@@ -251,6 +288,11 @@ CLI::App* declareServe(CLI::App& root, ServeOptions& options) {
     command->add_option("--host", options.host, "address to listen on (default 127.0.0.1: this machine only)");
     command->add_option("--max-side", options.maxSide, "the largest side of a frame /frame encodes")->check(CLI::Range(16, 8192));
     command->add_option("--cache", options.cacheFrames, "frames kept for repeated requests")->check(CLI::Range(0, 4096));
+    command->add_option("--memory", options.memoryMiB,
+                        "MiB of pictures kept decoded between requests, with the levels the encoder builds from them "
+                        "(a new focus on a kept picture is an encode only)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 20));
     addBackendOption(*command, options.backend);
     return command;
 }

@@ -114,12 +114,13 @@ std::string fitText(const codec::FitResult& r) {
 
 format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
-                                const FitSetting& fit, std::string* fitNote, const std::string& what) {
+                                const FitSetting& fit, std::string* fitNote, const std::string& what,
+                                codec::EncodeLevels* keptLevels) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
                       std::to_string(size.width) + "x" + std::to_string(size.height) + (what.empty() ? "" : ": " + what));
     Image image =
         renderers::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback(),
-                                                   parseEnum<codec::EncodeFilter>(fit.filter)});
+                                                   parseEnum<codec::EncodeFilter>(fit.filter), keptLevels});
     progress.done();
     if (fit.count() > 0) {
         codec::FitOptions options;

@@ -60,9 +60,11 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault = false);
 // remembering the source's encoding. fit.iterations > 0 then fits the image to the decoder with that many
 // iterations (codec/image/fit.h) and, when `fitNote` is given, says what the fit achieved there.
 // `what`, when given, says in the stage's line which image this is (a command that encodes two).
+// `keptLevels`: the CPU encoder's levels of this source kept between calls (codec::EncodeLevels).
 format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
-                                const FitSetting& fit = {}, std::string* fitNote = nullptr, const std::string& what = {});
+                                const FitSetting& fit = {}, std::string* fitNote = nullptr, const std::string& what = {},
+                                codec::EncodeLevels* keptLevels = nullptr);
 
 // The same file from an encode already made of `map` (a budget's confirming encode, kept:
 // codec::ModelEncode, encoded and fitted as `encode` asks), with the same note on its fit.

@@ -5,7 +5,6 @@
 #include <cerrno>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 
 #include <nlohmann/json.hpp>
 
@@ -71,9 +70,14 @@ std::string embeddedFileScript(const std::string& name, std::span<const unsigned
 }
 
 std::vector<unsigned char> fileBytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (!in.eof() && in.fail()) throw Error(ErrorCode::Io, path + ": cannot be read");
+    // One read of the file's size, not a byte at a time: `conus serve` reads every file it sends.
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    if (!in) throw Error(ErrorCode::Io, path + ": cannot be read");
+    const std::streamoff size = in.tellg();
+    if (size < 0) throw Error(ErrorCode::Io, path + ": cannot be read");
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+    in.seekg(0);
+    if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) throw Error(ErrorCode::Io, path + ": cannot be read");
     return bytes;
 }
 

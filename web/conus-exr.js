@@ -11,6 +11,10 @@ const ConusExr = (() => {
   const kLinesPerChunk = { 0: 1, 1: 1, 2: 1, 3: 16 };
   const kMaxSide = 65536;
   const kMaxMapSide = 4097;
+  // A map no finer than 4 nodes a pixel of the image's longer side, plus one, and 129 nodes a side
+  // whatever the image (core/map_rules.h's maxSideForImage; limits mapNodesPerPixel, mapSideAlways).
+  const kMapNodesPerPixel = 4, kMapSideAlways = 129;
+  const maxMapSideForImage = (width, height) => Math.max(kMapSideAlways, kMapNodesPerPixel * Math.max(width, height) + 1);
   const kMaxAttributeBytes = 1 << 20;
 
   class Reader {
@@ -211,34 +215,38 @@ const ConusExr = (() => {
     return out;
   }
 
-  // OpenEXR's zip and rle filters: the byte-wise difference predictor, then the two halves
-  // (even bytes, odd bytes) interleaved back.
-  function unpredict(t) {
+  // OpenEXR's zip and rle filters: the byte-wise difference predictor over the whole chunk (undone
+  // here in place), and the chunk's bytes split in two, its even bytes first ((n+1)/2 of them), then
+  // its odd ones (split: true). A chunk of HALF samples is read from the split bytes as they are
+  // (sample k: byte k low, byte (n+1)/2 + k high); interleave() puts them back in order for FLOAT.
+  function undoPredictor(t) {
     const n = t.length;
-    let previous = t[0];
-    for (let i = 1; i < n; ++i) previous = t[i] = previous + t[i] - 128;  // the Uint8Array wraps mod 256
-    const out = new Uint8Array(n), half = (n + 1) >> 1, pairs = n >> 1;
-    for (let i = 0; i < pairs; ++i) {
-      out[2 * i] = t[i];
-      out[2 * i + 1] = t[half + i];
-    }
-    if (n & 1) out[n - 1] = t[half - 1];
+    for (let i = 1, previous = t[0]; i < n; ++i) t[i] = previous = (previous + t[i] - 128) & 255;
+    return { bytes: t, split: true };
+  }
+  function interleave(t) {
+    const n = t.length, out = new Uint8Array(n), half = (n + 1) >> 1;
+    for (let i = 0; i < half; ++i) out[2 * i] = t[i];
+    for (let i = half, o = 1; i < n; ++i, o += 2) out[o] = t[i];
     return out;
   }
 
+  // A chunk's bytes, unpacked: {bytes, split} (see undoPredictor).
   async function unpack(part, packed, expected) {
-    if (packed.length === expected) return packed;  // stored raw where compression would not shrink it
+    if (packed.length === expected) return { bytes: packed, split: false };  // stored raw where compression would not shrink it
     switch (part.compression) {
       case 0: throw new Error(`damaged file: an uncompressed chunk of ${packed.length} bytes for ${expected}`);
-      case 1: return unpredict(unRle(packed, expected));
-      case 2: case 3: return unpredict(await inflate(packed, expected));
+      case 1: return undoPredictor(unRle(packed, expected));
+      case 2: case 3: return undoPredictor(await inflate(packed, expected));
       default:
         throw new Error(`compression ${kCompressionNames[part.compression] || part.compression} is not read by this page ` +
           "(conus web and conus serve write zip)");
     }
   }
 
-  // The part's pixels as float planes, one per channel (in the part's channel order).
+  // The part's pixels as planes, one per channel (in the part's channel order): a HALF channel's as
+  // its 16-bit values (Uint16Array: what a half-float texture takes as it is), a FLOAT one's as a
+  // Float32Array; halfToFloat() converts.
   async function readPixels(bytes, part, partIndex) {
     const channels = value(part.header, "channels", "chlist");
     if (!channels || !channels.length) throw new Error(`damaged file: part ${part.name} has no channels`);
@@ -248,14 +256,15 @@ const ConusExr = (() => {
     }
     if (!(part.compression in kLinesPerChunk)) await unpack(part, new Uint8Array(0), 1);  // names the compression
     const { width, height, window } = part;
-    const planes = channels.map(() => new Float32Array(width * height));
+    const planes = channels.map((c) => (c.pixelType === 1 ? new Uint16Array(width * height) : new Float32Array(width * height)));
     const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
     const tiled = part.type === "tiledimage";
     if (tiled && (!part.tiles || (part.tiles.mode & 0xf) !== 0 || part.tiles.xSize < 1 || part.tiles.ySize < 1 ||
                   part.tiles.xSize * part.tiles.ySize > (1 << 24)))
       throw new Error("not read by this page: a tiled part that is not one level of tiles of at most 2^24 pixels");
     const seen = new Uint8Array(part.chunks);
-    const jobs = part.offsets.map(async (offset, index) => {
+    const allHalf = channels.every((c) => c.pixelType === 1);
+    const chunk = async (offset, index) => {
       if (offset === 0) throw new Error(`damaged file: chunk ${index} of part ${part.name} is missing`);
       let at = offset;
       const int = () => {
@@ -288,7 +297,20 @@ const ConusExr = (() => {
       const expected = h * channels.reduce((sum, c) => sum + w * (c.pixelType === 1 ? 2 : 4), 0);
       if (size < 0 || at + size > bytes.length) throw new Error("damaged file: a chunk runs past the end of the file");
       if (size > expected * 2048 + 1024) throw new Error("damaged file: a chunk larger than its lines could compress to");
-      const raw = await unpack(part, bytes.subarray(at, at + size), expected);
+      const unpacked = await unpack(part, bytes.subarray(at, at + size), expected);
+      if (unpacked.split && allHalf) {
+        const t = unpacked.bytes, high = (t.length + 1) >> 1;
+        let k = 0;
+        for (let y = 0; y < h; ++y) {
+          const row = (y0 + y) * width + x0;
+          for (let ci = 0; ci < channels.length; ++ci) {
+            const plane = planes[ci];
+            for (let x = 0; x < w; ++x, ++k) plane[row + x] = t[k] | (t[high + k] << 8);
+          }
+        }
+        return;
+      }
+      const raw = unpacked.split ? interleave(unpacked.bytes) : unpacked.bytes;
       // Samples through typed views where aligned (every browser is little-endian, as EXR is), else a DataView.
       const rv = new DataView(raw.buffer, raw.byteOffset, raw.byteLength);
       let p = 0;
@@ -297,12 +319,8 @@ const ConusExr = (() => {
         for (let ci = 0; ci < channels.length; ++ci) {
           const plane = planes[ci], at = raw.byteOffset + p;
           if (channels[ci].pixelType === 1) {
-            if (at % 2 === 0) {
-              const line = new Uint16Array(raw.buffer, at, w);
-              for (let x = 0; x < w; ++x) plane[row + x] = kHalfToFloat[line[x]];
-            } else {
-              for (let x = 0; x < w; ++x) plane[row + x] = kHalfToFloat[rv.getUint16(p + 2 * x, true)];
-            }
+            if (at % 2 === 0) plane.set(new Uint16Array(raw.buffer, at, w), row);
+            else for (let x = 0; x < w; ++x) plane[row + x] = rv.getUint16(p + 2 * x, true);
             p += 2 * w;
           } else {
             if (at % 4 === 0) plane.set(new Float32Array(raw.buffer, at, w), row);
@@ -311,8 +329,17 @@ const ConusExr = (() => {
           }
         }
       }
-    });
-    await Promise.all(jobs);
+    };
+    // Two chunks in flight: the inflate of one while the other is placed (more, on a busy core,
+    // only queue up; measured in bench/notes/2026-12-07-web-speed.md).
+    let next = 0;
+    const worker = async () => {
+      while (next < part.chunks) {
+        const index = next++;
+        await chunk(part.offsets[index], index);
+      }
+    };
+    await Promise.all([worker(), worker()]);
     return { channels: channels.map((c) => c.name), pixelTypes: channels.map((c) => c.pixelType), planes, width, height };
   }
 
@@ -369,6 +396,10 @@ const ConusExr = (() => {
     const n = mp.width, m = mp.height;
     if (mp.type !== "scanlineimage" || mp.window.xMin !== 0 || mp.window.yMin !== 0 || n < 2 || m < 2 || n > kMaxMapSide || m > kMaxMapSide)
       throw new Error(`not a valid CoNUS file: part samplingmap is not a scanline grid of 2..4097 nodes a side (V7)`);
+    const mapBound = maxMapSideForImage(conus.width, conus.height);
+    if (Math.max(n, m) > mapBound)
+      throw new Error(`not a valid CoNUS file: a sampling map of ${n}x${m} nodes is finer than its ${conus.width}x${conus.height} ` +
+        `image can show (at most ${mapBound} nodes a side, V7)`);
     const mapChannels = value(mp.header, "channels", "chlist") || [];
     if (mapChannels.length !== 2 || mapChannels[0].name !== "ud" || mapChannels[1].name !== "vd" ||
         mapChannels.some((c) => c.pixelType !== 2))
@@ -398,5 +429,12 @@ const ConusExr = (() => {
     };
   }
 
-  return { readConus, readParts };
+  // A HALF plane's values as floats.
+  function halfToFloat(plane) {
+    const out = new Float32Array(plane.length);
+    for (let i = 0; i < plane.length; ++i) out[i] = kHalfToFloat[plane[i]];
+    return out;
+  }
+
+  return { readConus, readParts, halfToFloat, maxMapSideForImage };
 })();

@@ -39,6 +39,7 @@
   // ---- GL ----------------------------------------------------------------------------------
   const gl = canvas.getContext("webgl2", { preserveDrawingBuffer: true, antialias: false, alpha: false, premultipliedAlpha: false });
   const floatLinear = gl && gl.getExtension("OES_texture_float_linear");
+  const colorBufferFloat = gl && gl.getExtension("EXT_color_buffer_float");
 
   const kVertex = `#version 300 es
 void main() {
@@ -46,12 +47,8 @@ void main() {
     gl_Position = vec4(p, 0.0, 1.0);
 }`;
   const programs = new Map();
-  function program(mode, outlines) {
-    const key = mode + "/" + outlines;
-    if (programs.has(key)) return programs.get(key);
-    const body = window.CONUS_VIEW_SHADER;
-    if (!body) throw new Error("conus-shaders.js did not load");
-    const source = `#version 300 es\n#define VIEW_MODE ${mode}\n#define VIEW_GRID 0\n#define VIEW_OUTLINES ${outlines ? 1 : 0}\n` + body;
+  // A program of the full-screen triangle and `fragment`; a compile or link error is one line.
+  function linkProgram(fragment) {
     const compile = (type, text) => {
       const s = gl.createShader(type);
       gl.shaderSource(s, text);
@@ -61,10 +58,22 @@ void main() {
     };
     const p = gl.createProgram();
     gl.attachShader(p, compile(gl.VERTEX_SHADER, kVertex));
-    gl.attachShader(p, compile(gl.FRAGMENT_SHADER, source));
+    gl.attachShader(p, compile(gl.FRAGMENT_SHADER, fragment));
     gl.linkProgram(p);
     if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error("shader link: " + gl.getProgramInfoLog(p).split("\n")[0]);
-    const u = (name) => gl.getUniformLocation(p, name);
+    return p;
+  }
+  function program(mode, outlines) {
+    const key = mode + "/" + outlines;
+    if (programs.has(key)) return programs.get(key);
+    const body = window.CONUS_VIEW_SHADER;
+    if (!body) throw new Error("conus-shaders.js did not load");
+    const p = linkProgram(`#version 300 es\n#define VIEW_MODE ${mode}\n#define VIEW_GRID 0\n#define VIEW_OUTLINES ${outlines ? 1 : 0}\n#define VIEW_PLAIN_DISPLAY 1\n` + body);
+    const locations = new Map();
+    const u = (name) => {
+      if (!locations.has(name)) locations.set(name, gl.getUniformLocation(p, name));
+      return locations.get(name);
+    };
     const entry = { p, u };
     programs.set(key, entry);
     return entry;
@@ -120,7 +129,9 @@ void main() {
     return { width: w, height: h, data: out };
   }
 
-  // The display channels as RGBA, as the desktop viewer takes them: R,G,B(,A), else Y (or the first channel) as grey.
+  // The display channels as RGBA, as the desktop viewer takes them: R,G,B(,A), else Y (or the first
+  // channel) as grey. HALF channels stay 16-bit (Uint16Array, uploaded as they are) when all four
+  // are; otherwise floats.
   function displayRgba(image) {
     const index = (name) => image.channels.indexOf(name);
     let src = [index("R"), index("G"), index("B")];
@@ -129,13 +140,96 @@ void main() {
       src = [grey, grey, grey];
     }
     const alpha = index("A");
-    const n = image.width * image.height, data = new Float32Array(n * 4);
-    const [pr, pg, pb] = src.map((i) => image.planes[i]);
-    const pa = alpha >= 0 ? image.planes[alpha] : null;
-    for (let k = 0; k < n; ++k) {
-      data[4 * k] = pr[k]; data[4 * k + 1] = pg[k]; data[4 * k + 2] = pb[k]; data[4 * k + 3] = pa ? pa[k] : 1;
+    const used = alpha >= 0 ? [...src, alpha] : src;
+    const half = used.every((i) => image.pixelTypes[i] === 1);
+    const plane = (i) => (half || image.pixelTypes[i] !== 1 ? image.planes[i] : ConusExr.halfToFloat(image.planes[i]));
+    const n = image.width * image.height, data = half ? new Uint16Array(n * 4) : new Float32Array(n * 4);
+    const [pr, pg, pb] = src.map(plane);
+    const pa = alpha >= 0 ? plane(alpha) : null;
+    const one = half ? 0x3c00 : 1;
+    for (let k = 0, d = 0; k < n; ++k, d += 4) {
+      data[d] = pr[k]; data[d + 1] = pg[k]; data[d + 2] = pb[k]; data[d + 3] = pa ? pa[k] : one;
     }
-    return { width: image.width, height: image.height, data };
+    return { width: image.width, height: image.height, data, half };
+  }
+
+  // The pyramid's levels 1.. drawn by the GPU, each from the one below: codec::buildPyramid's exact
+  // area average onto max(1, w/2) x max(1, h/2), its weights in integers (a texel's overlap with
+  // the one below, at most 3 a side where a side is odd). Needs a float colour target
+  // (EXT_color_buffer_float); without one, halve() in JavaScript.
+  const kPyramidFragment = `#version 300 es
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+uniform sampler2D uBelow;  // its base level is the level below
+out vec4 fragColor;
+// Texels of the level below (from texels) under texel x of this level (to texels) and their weights.
+void taps(int x, int from, int to, out ivec3 i, out vec3 w) {
+    const int a = x * from, b = (x + 1) * from;
+    const int first = a / to;
+    for (int k = 0; k < 3; ++k) {
+        const int j = first + k;
+        i[k] = min(j, from - 1);
+        w[k] = j < from ? float(max(0, min(b, (j + 1) * to) - max(a, j * to))) / float(from) : 0.0;
+    }
+}
+void main() {
+    const ivec2 from = textureSize(uBelow, 0);
+    const ivec2 p = ivec2(gl_FragCoord.xy);
+#if EVEN
+    // Both sides even: the mean of four texels is one bilinear tap at their shared corner.
+    fragColor = textureLod(uBelow, vec2(2 * p + 1) / vec2(from), 0.0);
+    return;
+#endif
+    const ivec2 to = max(from / 2, ivec2(1));
+    ivec3 ix, iy;
+    vec3 wx, wy;
+    taps(p.x, from.x, to.x, ix, wx);
+    taps(p.y, from.y, to.y, iy, wy);
+    vec4 sum = vec4(0.0);
+    for (int j = 0; j < 3; ++j) {
+        if (wy[j] == 0.0) continue;
+        vec4 row = vec4(0.0);
+        for (int i = 0; i < 3; ++i)
+            if (wx[i] != 0.0) row += wx[i] * texelFetch(uBelow, ivec2(ix[i], iy[j]), 0);
+        sum += wy[j] * row;
+    }
+    fragColor = sum;
+}`.replace(/\n( +)const /g, "\n$1");
+  const pyramidPrograms = [];
+  function drawPyramid(texture, width, height, levels) {
+    const pyramidProgram = (even) => {
+      if (pyramidPrograms[even]) return pyramidPrograms[even];
+      const p = linkProgram(kPyramidFragment.replace("\n", `\n#define EVEN ${even}\n`));
+      gl.useProgram(p);
+      gl.uniform1i(gl.getUniformLocation(p, "uBelow"), 0);
+      return (pyramidPrograms[even] = p);
+    };
+    const fb = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D, texture);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
+    for (let k = 1; k < levels; ++k) {
+      const w = Math.max(1, width >> (k - 1)), h = Math.max(1, height >> (k - 1));
+      gl.useProgram(pyramidProgram(w % 2 === 0 && h % 2 === 0 ? 1 : 0));
+      // Sampling only level k-1 while level k is the target: no feedback loop.
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_BASE_LEVEL, k - 1);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAX_LEVEL, k - 1);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, texture, k);
+      if (k === 1 && gl.checkFramebufferStatus(gl.FRAMEBUFFER) !== gl.FRAMEBUFFER_COMPLETE) {
+        gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+        gl.deleteFramebuffer(fb);
+        return false;
+      }
+      gl.viewport(0, 0, Math.max(1, width >> k), Math.max(1, height >> k));
+      gl.drawArrays(gl.TRIANGLES, 0, 3);
+    }
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_BASE_LEVEL, 0);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAX_LEVEL, levels - 1);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.deleteFramebuffer(fb);
+    return true;
   }
 
   function densityRange(map) {
@@ -162,17 +256,21 @@ void main() {
       throw new Error(`the CoNUS image is ${file.image.width}x${file.image.height}, larger than this browser's largest texture (${max})`);
     // RGBA32F where it filters (a float file's values as they are), else RGBA16F: half's step is a
     // tenth of 8-bit sRGB's finest.
-    const internal = floatLinear && !file.image.half ? gl.RGBA32F : gl.RGBA16F;
+    let level = displayRgba(file.image);
+    const internal = floatLinear && !level.half ? gl.RGBA32F : gl.RGBA16F;
     const conus = gl.createTexture();
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D, conus);
-    let level = displayRgba(file.image);
     const levels = Math.floor(Math.log2(Math.max(level.width, level.height))) + 1;
     gl.texStorage2D(gl.TEXTURE_2D, levels, internal, level.width, level.height);
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 4);
-    for (let k = 0; k < levels; ++k) {
-      if (k) level = halve(level);
-      gl.texSubImage2D(gl.TEXTURE_2D, k, 0, 0, level.width, level.height, gl.RGBA, gl.FLOAT, level.data);
+    gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, level.width, level.height, gl.RGBA, level.half ? gl.HALF_FLOAT : gl.FLOAT, level.data);
+    if (levels > 1 && !(colorBufferFloat && drawPyramid(conus, level.width, level.height, levels))) {
+      if (level.half) level = { ...level, data: ConusExr.halfToFloat(level.data) };
+      for (let k = 1; k < levels; ++k) {
+        level = halve(level);
+        gl.texSubImage2D(gl.TEXTURE_2D, k, 0, 0, level.width, level.height, gl.RGBA, gl.FLOAT, level.data);
+      }
     }
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR_MIPMAP_LINEAR);
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
@@ -247,9 +345,6 @@ void main() {
     const foci = frame.foci.slice(0, 16);
     gl.uniform1i(u("uFocusCount"), foci.length);
     if (foci.length) gl.uniform3fv(u("uFoci"), new Float32Array(foci.flatMap((f) => [f[0], f[1], f[2]])));
-    gl.uniform1f(u("uExposure"), 1);
-    gl.uniform1f(u("uInvGamma"), 0);
-    gl.uniform1i(u("uToneMap"), 0);
     gl.uniform1f(u("uWipeX"), 0);
     gl.uniform2f(u("uLogDensity"), frame.logDensity[0], frame.logDensity[1]);
     gl.drawArrays(gl.TRIANGLES, 0, 3);

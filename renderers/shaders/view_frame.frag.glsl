@@ -37,9 +37,18 @@ uniform vec2 uGridLines;     // CoNUS pixels (or every n-th) across u and v; 0: 
 uniform vec2 uSourceSize;    // conventional frame in pixels (focus radii are fractions of its width)
 uniform int uFocusCount;
 uniform vec3 uFoci[kMaxFoci];  // u, v, r
+#ifdef VIEW_PLAIN_DISPLAY
+// The browser page's display: exposure 1, no tone map, the sRGB curve, as constants. As uniforms,
+// llvmpipe and SwiftShader evaluate every branch of display() under a mask, the plain gamma's pow
+// included (the page's pan/zoom on llvmpipe: 1.35x the frames a second as constants).
+const float uExposure = 1.0;
+const float uInvGamma = 0.0;
+const int uToneMap = 0;
+#else
 uniform float uExposure;     // 2^ev, applied before gamma
 uniform float uInvGamma;     // 0: the sRGB curve
 uniform int uToneMap;        // conus::ToneMap: 0 none, 1 reinhard, 2 aces
+#endif
 uniform float uWipeX;        // pixels
 uniform vec2 uLogDensity;    // log density range for the heat map
 

@@ -146,3 +146,44 @@ def test_hostile_files_say_one_line_at_once(browser, server, served):
         target.write_bytes((SHARED / name).read_bytes())
         title = open_page(browser, server, f"file={target.name}&size=64x64")
         assert title.startswith("error: ") and "\n" not in title, (name, title)
+
+
+def exr_part_attribute(data, part_name, attribute):
+    """Where the value of `attribute` of the part named `part_name` lies in a multipart EXR's headers: (offset, size)."""
+    at = 8
+    while data[at] != 0:
+        found, name = None, None
+        while data[at] != 0:
+            end = data.index(b"\0", at)
+            key = data[at:end].decode()
+            type_end = data.index(b"\0", end + 1)
+            size = int.from_bytes(data[type_end + 1:type_end + 5], "little")
+            value = type_end + 5
+            if key == "name":
+                name = data[value:value + size].decode()
+            if key == attribute:
+                found = (value, size)
+            at = value + size
+        at += 1
+        if name == part_name:
+            return found
+    raise KeyError(part_name)
+
+
+def test_a_map_finer_than_its_image_is_refused(browser, server, served):
+    """V7: a map no finer than 4 nodes a pixel of the image's longer side (plus one), 129 always. The
+    192x128 image of foci.exr may have a map of 769 nodes a side; its map's grid declared 800x140 is
+    refused before any pixel is read, and 769x140 is not refused for that reason."""
+    good = bytearray((served / "foci.exr").read_bytes())
+    at, size = exr_part_attribute(good, "samplingmap", "dataWindow")
+    assert size == 16
+    for columns, finer in [(800, True), (769, False)]:
+        patched = bytearray(good)
+        patched[at + 8:at + 12] = (columns - 1).to_bytes(4, "little", signed=True)
+        patched[at + 12:at + 16] = (139).to_bytes(4, "little", signed=True)
+        name = f"finer-map-{columns}.exr"
+        (served / name).write_bytes(bytes(patched))
+        title = open_page(browser, server, f"file={name}&size=64x64")
+        assert title.startswith("error: "), title
+        refused = "finer than its 192x128 image can show (at most 769 nodes a side, V7)" in title
+        assert refused == finer, title

@@ -156,3 +156,22 @@ def test_a_second_server_on_the_same_port_is_refused(server, served):
     done = subprocess.run([CONUS, "serve", served, "--port", str(port)], capture_output=True, text=True, timeout=30)
     assert done.returncode != 0 and "cannot listen" in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
     assert get(server, "/")[0] == 200
+
+
+def test_kept_pictures_give_the_frames_of_fresh_ones(server, served, tmp_path):
+    """Pictures kept decoded with the encoder's levels (the default --memory) answer a new focus
+    with the bytes a server that keeps nothing (--memory 0: each frame read and built afresh) sends."""
+    process = subprocess.Popen([CONUS, "serve", str(served), "--port", "0", "-q", "--memory", "0"], stdout=subprocess.PIPE, text=True)
+    try:
+        line = process.stdout.readline()
+        assert line.startswith("serving "), line
+        fresh = {"url": line.split(" at ")[1].split(" ")[0]}
+        for focus in ["0.35,0.45,0.06,5", "0.8,0.7,0.05,3", "0.5,0.5,0.2,2"]:
+            path = f"/frame?file=photo.png&focus={focus}&size=200x150"
+            kept_status, kept = get(server, path)
+            fresh_status, made = get(fresh, path)
+            assert kept_status == fresh_status == 200
+            assert kept == made, focus
+    finally:
+        process.terminate()
+        process.wait(timeout=10)

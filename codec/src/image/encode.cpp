@@ -87,12 +87,28 @@ private:
     }
 };
 
-// Box-filtered mip levels of the source, each built the first time a footprint needs it.
+}  // namespace
+
+// EncodeLevels's fields, for the Pyramid below.
+class EncodeLevelsAccess {
+public:
+    static const float*& source(EncodeLevels& k) { return k.m_source; }
+    static int& width(EncodeLevels& k) { return k.m_width; }
+    static int& height(EncodeLevels& k) { return k.m_height; }
+    static int& channels(EncodeLevels& k) { return k.m_channels; }
+    static std::vector<Image>& levels(EncodeLevels& k) { return k.m_levels; }
+};
+
+namespace {
+
+// Box-filtered mip levels of the source, each built the first time a footprint needs it (or taken
+// from `kept`, where the same source's levels were left by an earlier encode).
 class Pyramid {
 public:
     static constexpr int kMaxLevels = 40;
+    using Access = EncodeLevelsAccess;
 
-    explicit Pyramid(const Image& source) : m_source(source), m_channels(source.channelCount()) {
+    Pyramid(const Image& source, EncodeLevels* kept) : m_source(source), m_channels(source.channelCount()), m_kept(kept) {
         int w = source.width, h = source.height;
         m_sizes.push_back({w, h});
         while ((w > 1 || h > 1) && static_cast<int>(m_sizes.size()) < kMaxLevels) {
@@ -100,9 +116,34 @@ public:
             h = std::max(1, (h + 1) / 2);
             m_sizes.push_back({w, h});
         }
+        if (!m_kept) return;
+        if (Access::source(*m_kept) != source.pixels.data() || Access::width(*m_kept) != source.width ||
+            Access::height(*m_kept) != source.height || Access::channels(*m_kept) != m_channels) {
+            m_kept->clear();
+            Access::source(*m_kept) = source.pixels.data();
+            Access::width(*m_kept) = source.width;
+            Access::height(*m_kept) = source.height;
+            Access::channels(*m_kept) = m_channels;
+        }
+        std::vector<Image>& held = Access::levels(*m_kept);
+        for (int l = 1; l < std::min<int>(levels(), static_cast<int>(held.size())); ++l)
+            if (!held[l].pixels.empty()) {
+                m_levels[l] = std::move(held[l].pixels);
+                std::call_once(m_once[l], [] {});
+            }
     }
+    // The levels built or taken go back to `kept` when there is one, else their memory to
+    // LevelMemory for the next encode.
     ~Pyramid() {
-        for (std::vector<float>& level : m_levels) LevelMemory::give(std::move(level));
+        if (!m_kept) {
+            for (std::vector<float>& level : m_levels) LevelMemory::give(std::move(level));
+            return;
+        }
+        std::vector<Image>& held = Access::levels(*m_kept);
+        held.resize(levels());
+        for (int l = 1; l < levels(); ++l)
+            if (!m_levels[l].empty())
+                held[l] = Image{width(l), height(l), m_source.channels, std::move(m_levels[l])};
     }
     Pyramid(const Pyramid&) = delete;
     Pyramid& operator=(const Pyramid&) = delete;
@@ -115,8 +156,9 @@ public:
         std::call_once(m_once[level], [&] {
             const Plane below = this->level(level - 1, threads);
             const std::size_t values = static_cast<std::size_t>(width(level)) * height(level) * m_channels;
-            m_levels[level] = LevelMemory::take(values, width(level), height(level), m_source.channels);
-            areaDownsamplePlane(below, m_levels[level].data(), width(level), height(level), m_channels, threads);
+            std::vector<float> built = LevelMemory::take(values, width(level), height(level), m_source.channels);
+            areaDownsamplePlane(below, built.data(), width(level), height(level), m_channels, threads);
+            m_levels[level] = std::move(built);  // only a whole level is ever kept
         });
         return {m_levels[level].data(), width(level), height(level)};
     }
@@ -124,6 +166,7 @@ public:
 private:
     const Image& m_source;
     int m_channels;
+    EncodeLevels* m_kept;
     std::vector<std::array<int, 2>> m_sizes;
     std::array<std::vector<float>, kMaxLevels> m_levels;
     std::array<std::once_flag, kMaxLevels> m_once;
@@ -713,6 +756,18 @@ glm::dmat2 FootprintField::inverseJacobian(glm::dvec2 p) const {
     return (at(0, 0) * (1 - s) + at(1, 0) * s) * (1 - t) + (at(0, 1) * (1 - s) + at(1, 1) * s) * t;
 }
 
+std::int64_t EncodeLevels::bytes() const {
+    std::int64_t total = 0;
+    for (const Image& level : m_levels) total += static_cast<std::int64_t>(level.pixels.size()) * std::int64_t(sizeof(float));
+    return total;
+}
+
+void EncodeLevels::clear() {
+    m_levels.clear();
+    m_source = nullptr;
+    m_width = m_height = m_channels = 0;
+}
+
 void checkEncodeMemory(const Image& source, int width, int height, std::int64_t maxBytes) {
     const std::int64_t channels = source.channelCount();
     const std::int64_t bytes =
@@ -730,7 +785,7 @@ Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptio
     detail::checkOutputSize(options.width, options.height, "encodeImage");
     checkEncodeMemory(source, options.width, options.height);
     Image out = detail::makeOutput(source, options.width, options.height);
-    Pyramid pyramid(source);
+    Pyramid pyramid(source, options.keptLevels);
     const FootprintField field(map);
     const bool anisotropic = options.filter == EncodeFilter::Anisotropic && !isUniform(map);  // encode.h says why
     detail::RowProgress progress(options.progress, out.height);

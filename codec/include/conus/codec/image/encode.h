@@ -7,6 +7,7 @@
 // threads = 0 uses every core; sizes are checked (conus::Error InvalidArgument / LimitExceeded).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -96,11 +97,31 @@ constexpr auto enumNameTable(EncodeFilter) {
 inline constexpr double kEncodeAnisotropicMinorTexels = 2.0;
 inline constexpr int kEncodeAnisotropicMaxTaps = 32;
 
+// The box-filtered levels of one source that the CPU encoder builds as footprints need them (level
+// k the exact area halving of level k-1, down to 1x1), kept between encodes: an encode given one in
+// EncodeOptions::keptLevels takes the levels it holds and leaves there those it built, so encodes
+// of one picture after another (a server answering frames of it) build each level once. It belongs
+// to one source: an encode of another (pixels elsewhere, another size or channels) empties it
+// first; a caller that changes a source's pixels in place clears it. One encode at a time may use it.
+class EncodeLevels {
+public:
+    // Bytes of pixels held.
+    std::int64_t bytes() const;
+    void clear();
+
+private:
+    friend class EncodeLevelsAccess;
+    const float* m_source = nullptr;
+    int m_width = 0, m_height = 0, m_channels = 0;
+    std::vector<Image> m_levels;  // [k] is level k (level 0, the source, is never held); empty where not built
+};
+
 struct EncodeOptions {
     int width = 0, height = 0;  // CoNUS image size
     int threads = 0;
     ProgressFn progress;
     EncodeFilter filter = EncodeFilter::Anisotropic;
+    EncodeLevels* keptLevels = nullptr;  // the CPU encoder's; GPU encoders build their own
 };
 
 // Throws conus::Error(LimitExceeded) when encoding `source` (its size and channels) to a width x
