@@ -17,6 +17,7 @@
 #include "conus/codec/image/encode.h"
 #include "conus/core/limits.h"
 #include "conus/core/map_rules.h"
+#include "conus/renderers/gpu_image.h"
 #include "encoding.h"
 #include "image_files.h"
 #include "map_options.h"
@@ -165,7 +166,7 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, modelOptions);
     else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, modelOptions, &given);
     else built = mapFromOwnDetail(o, source.image, size, modelOptions, &given);
-    const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Faster, "encoding");
+    const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Measured, "encoding", renderers::encodeSpeedProbe());
     std::string fitNote;
     format::ConusFile file =
         encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
@@ -233,7 +234,7 @@ Command addEncodeCommand(CLI::App& root) {
         ->excludes("--fit-method")
         ->excludes("--fit-hold");
     addSourceOptions(*command, options->source);
-    addStorageOptions(*command, options->storage);
+    addStorageOptions(*command, options->storage, renderers::CpuPath::Measured);
     addQuietOption(*command);
     return {command, [options] { return runEncode(*options); }};
 }

@@ -16,7 +16,7 @@
 
 namespace conus::cli {
 
-void addStorageOptions(CLI::App& command, StorageOptions& options) {
+void addStorageOptions(CLI::App& command, StorageOptions& options, renderers::CpuPath cpuPath) {
     command.add_option("--size", options.sizeText, "CoNUS image size WxH (default: a quarter of each source side)")
         ->check(sizeCheck());
     auto* half = command.add_flag("--half", options.half,
@@ -25,7 +25,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
                      "store colour channels as 32-bit float (default for 16-bit and float sources)")
         ->excludes(half);
     addCompressionOption(command, options.compression);
-    addBackendOption(command, options.backend, renderers::CpuPath::Faster);
+    addBackendOption(command, options.backend, cpuPath);
 }
 
 Size conusSize(const StorageOptions& options, const Image& source) {

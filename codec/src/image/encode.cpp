@@ -490,6 +490,8 @@ bool isUniform(const SamplingMap& map) {
 
 }  // namespace
 
+bool isUniformMap(const SamplingMap& map) { return isUniform(map); }
+
 FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b, double uniform) {
     double minor = 0;
     const glm::dvec2 extent = filterExtent(footprintFilter(a, b, uniform, minor));

@@ -31,6 +31,8 @@
 // encoder's output, and the decoder's CoNUS image and output.
 #pragma once
 
+#include <string>
+
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/map/sampling_map.h"
@@ -42,16 +44,62 @@ namespace conus::renderers {
 
 // Where the time of one call went, in milliseconds; each phase ends with glFinish, so the phases
 // add up to the call (minus CPU-side argument checks). Upload includes building the source pyramid
-// and the mesh or map upload; readback includes the copy into the returned image.
+// and the mesh or map upload; readback includes the copy into the returned image. `path` says how
+// an encode ran: "mipmapped (srgb8, anisotropy 4)", "ewa", "ewa, tiled".
 struct GpuTimings {
     double uploadMs = 0, drawMs = 0, readbackMs = 0;
+    std::string path;
 };
 
+// The GL encoders.
+//  - Mipmapped: the twin of the CPU's anisotropic kernel (codec::EncodeFilter::Anisotropic) on GL's
+//    own mipmaps (glGenerateMipmap): each pass of up to four channels is converted by threads into
+//    a pixel buffer object as 8-bit sRGB (GL_SRGB8_ALPHA8, which the sampler linearises) or half
+//    floats (GL_RGBA16F), uploaded, mipmapped on the GPU, filtered in one draw (trilinear taps along
+//    the footprint's major axis on the level its minor axis picks, or the sampler's anisotropic
+//    filter for a few taps at once) and read back through a pixel buffer object. GL's mip levels
+//    halve with rounding down where the CPU's round up: odd sizes differ slightly (within the
+//    tests' 8-bit sRGB bound). Sources over the texture limit take the EWA encoder (tiled).
+//  - Ewa: the EWA filter's twin (codec::EncodeFilter::Ewa) on a pyramid built on the GPU at the
+//    CPU's level sizes, from float textures; tiled past the texture limit (above).
+// Auto takes the kernel the CPU takes for the same options: Mipmapped for the anisotropic filter,
+// Ewa for the EWA filter and under a uniform map (encode.h says why).
+enum class GpuEncodeKernel { Auto, Mipmapped, Ewa };
+// How the mipmapped encoder uploads a pass: Auto as 8-bit sRGB where the pass is R, G, B (and A)
+// and every value is exactly an 8-bit code's (an opaque 8-bit picture, read as linear light), else
+// half floats; Srgb8 always 8-bit sRGB (other values rounded to the nearest code, clamped to [0, 1]);
+// Half always half floats (finite values above 65504 become infinite).
+enum class GpuUpload { Auto, Srgb8, Half };
+struct GpuEncodeOptions {
+    GpuEncodeKernel kernel = GpuEncodeKernel::Auto;
+    GpuUpload upload = GpuUpload::Auto;
+    // Taps along the major axis that one anisotropic sample of the sampler stands for (GL 4.6's or
+    // EXT_texture_filter_anisotropic's GL_TEXTURE_MAX_ANISOTROPY), at most the driver's limit: 0
+    // takes kDefaultGpuAnisotropy where the driver has it, 1 (or no such filter) a trilinear
+    // sample per tap.
+    int anisotropy = 0;
+};
+inline constexpr int kDefaultGpuAnisotropy = 4;
+
 Image encodeImageGpu(Context& context, const Image& source, const codec::SamplingMap& map,
-                             const codec::EncodeOptions& options, GpuTimings* timings = nullptr);
+                     const codec::EncodeOptions& options, GpuTimings* timings = nullptr,
+                     const GpuEncodeOptions& gpu = {});
 
 Image decodeImageGpu(Context& context, const Image& conus, const codec::SamplingMap& map,
                              const codec::DecodeOptions& options, GpuTimings* timings = nullptr);
+
+// Whether GL encodes faster than the CPU here, measured once per process (later calls return the
+// first answer, whatever the context): a 1024x1024 RGB picture encoded to 256x256 through a focus
+// map with the default options, on the context (the mipmapped kernel, after a first call that
+// compiles its shader) and on the CPU (every core), the better of two runs each. Tens of
+// milliseconds on a GPU, a few hundred on llvmpipe.
+struct EncodeSpeed {
+    double glMs = 0, cpuMs = 0;
+    bool glFaster() const { return glMs < cpuMs; }
+};
+EncodeSpeed measureEncodeSpeed(Context& context);
+// The probe Device::choose takes for CpuPath::Measured encodes: measureEncodeSpeed's answer.
+SpeedProbe encodeSpeedProbe();
 
 // Encode and decode on a device: the GPU paths above, or codec's CPU reference.
 Image encodeImage(const Device& device, const Image& source, const codec::SamplingMap& map,
