@@ -96,7 +96,8 @@ format::ConusFile encodeToConus(const renderers::Device& device, const Image& so
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
                                 const FitSetting& fit, std::string* fitNote, const std::string& what) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
-                      std::to_string(size.width) + "x" + std::to_string(size.height) + (what.empty() ? "" : ": " + what));
+                      std::to_string(size.width) + "x" + std::to_string(size.height) + (what.empty() ? "" : ": " + what) +
+                      (device.onGpu() ? " (" + device.describe() + ")" : ""));
     Image image =
         renderers::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback(),
                                                    parseEnum<codec::EncodeFilter>(fit.filter)});

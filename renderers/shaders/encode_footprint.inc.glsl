@@ -16,8 +16,8 @@ struct FootprintFilter {
 };
 
 // The footprint's major and minor lengths and the major direction in (s,t) are the singular
-// values and right singular vector of [a b]; uniform is the uniform image's pixel in texels.
-FootprintFilter footprintFilter(vec2 a, vec2 b, float uniform) {
+// values and right singular vector of [a b]; uniformPixel is the uniform image's pixel in texels.
+FootprintFilter footprintFilter(vec2 a, vec2 b, float uniformPixel) {
     const float P = dot(a, a), Q = dot(a, b), R = dot(b, b);
     const float mean = 0.5 * (P + R), spread = sqrt(0.25 * (P - R) * (P - R) + Q * Q);
     const float l1 = mean + spread, l2 = max(0.0, mean - spread);
@@ -26,7 +26,7 @@ FootprintFilter footprintFilter(vec2 a, vec2 b, float uniform) {
     f.sigma = 0.0;
     f.major = vec2(1.0, 0.0);
     if (l1 > 0.0) {
-        f.sigma = kEncodeAnisotropicSigma * max(0.0, min(1.0 - kEncodeBoxAnisotropy * sqrt(l2 / l1), 1.0 - uniform / sqrt(l1)));
+        f.sigma = kEncodeAnisotropicSigma * max(0.0, min(1.0 - kEncodeBoxAnisotropy * sqrt(l2 / l1), 1.0 - uniformPixel / sqrt(l1)));
         const vec2 e1 = vec2(Q, l1 - P), e2 = vec2(l1 - R, Q);
         const vec2 e = dot(e1, e1) >= dot(e2, e2) ? e1 : e2;
         if (length(e) > 0.0) f.major = normalize(e);

@@ -22,7 +22,9 @@ namespace {
 using test::contextFor;
 
 // The bound on what a viewer sees: GL against the CPU, both rounded to 8-bit sRGB codes.
-constexpr double kSrgb8Psnr = 42.0;
+constexpr double kSrgb8Psnr = 45.0;
+// Where the driver's own anisotropic filter takes part.
+constexpr double kNearPsnr = 30.0;
 
 double toSrgb(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055; }
 double toLinear(double s) { return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4); }
@@ -85,9 +87,10 @@ protected:
         const Image gl = encodeImageGpu(context(), source, map, sized(w, h), &t, gpu);
         EXPECT_NE(t.path.find(expectPath), std::string::npos) << t.path;
         const double psnr = psnrSrgb8(cpu, gl);
-        std::printf("    %dx%d %s -> %dx%d, map %dx%d, %s, %s: %.2f dB (8-bit sRGB) against the CPU\n", source.width,
-                    source.height, source.channelCount() == 4 ? "RGBA" : "RGB", w, h, map.columns(), map.rows(),
-                    enumName(GetParam()), t.path.c_str(), psnr);
+        std::printf("    %dx%d %s -> %dx%d, map %dx%d, %s, %s: %.2f dB (8-bit sRGB) against the CPU; upload %.0f, draw "
+                    "%.0f, readback %.0f ms\n",
+                    source.width, source.height, source.channelCount() == 4 ? "RGBA" : "RGB", w, h, map.columns(),
+                    map.rows(), enumName(GetParam()), t.path.c_str(), psnr, t.uploadMs, t.drawMs, t.readbackMs);
         return psnr;
     }
 };
@@ -100,14 +103,20 @@ TEST_P(GpuEncodeMip, MatchesTheCpuAnisotropicKernel) {
     const std::vector<codec::SamplingMap> maps = {
         codec::buildFociMap(std::vector<codec::Focus>{{0.3, 0.35, 0.08, 4}, {0.7, 0.6, 0.06, 3}}), test::randomFociMap(2),
         test::jitteredMap(7, 5, 0.3, 4)};
-    for (const int anisotropy : {1, 4}) {
-        GpuEncodeOptions gpu;
-        gpu.anisotropy = anisotropy;
-        for (const codec::SamplingMap& map : maps) {
-            EXPECT_GE(psnrAgainstCpu(opaque, map, 181, 127, gpu, "srgb8"), kSrgb8Psnr);
-            EXPECT_GE(psnrAgainstCpu(alpha, map, 133, 170, gpu, "half"), kSrgb8Psnr);
-        }
+    for (const codec::SamplingMap& map : maps) {
+        EXPECT_GE(psnrAgainstCpu(opaque, map, 181, 127, {}, "srgb8, anisotropy 1"), kSrgb8Psnr);
+        EXPECT_GE(psnrAgainstCpu(alpha, map, 133, 170, {}, "half, anisotropy 1"), kSrgb8Psnr);
     }
+}
+
+// The sampler's anisotropic filter for up to four taps at once: the driver's own filter within each
+// sample (llvmpipe's is an elliptical Gaussian, wider than the box), so only near the CPU kernel.
+TEST_P(GpuEncodeMip, TheSamplersAnisotropicFilterStaysNearTheCpuKernel) {
+    const Image opaque = rounded8Bit(test::photoLike(533, 389, {"R", "G", "B"}, 3));
+    GpuEncodeOptions gpu;
+    gpu.anisotropy = 4;
+    EXPECT_GE(psnrAgainstCpu(opaque, test::jitteredMap(7, 5, 0.3, 4), 181, 127, gpu, "srgb8, anisotropy 4"), kNearPsnr);
+    EXPECT_GE(psnrAgainstCpu(opaque, test::randomFociMap(2), 181, 127, gpu, "srgb8, anisotropy 4"), kNearPsnr);
 }
 
 // An 8-bit picture goes up as 8-bit sRGB, exactly: the half-float upload of the same picture
@@ -126,7 +135,8 @@ TEST_P(GpuEncodeMip, EightBitPicturesUploadAsSrgb8Exactly) {
     std::printf("    srgb8 against half upload: %.2f dB (8-bit sRGB)\n", psnr);
     EXPECT_GE(psnr, 48.0);
     // Not 8-bit values: half floats, unless 8-bit is forced (then it is rounded, and stays close).
-    const Image smooth = test::photoLike(300, 200, {"R", "G", "B"}, 11);
+    Image smooth = test::photoLike(300, 200, {"R", "G", "B"}, 11);
+    for (float& v : smooth.pixels) v = std::clamp(v, 0.0f, 1.0f);  // what 8-bit can hold
     GpuTimings t;
     encodeImageGpu(context(), smooth, map, sized(120, 90), &t);
     EXPECT_NE(t.path.find("half"), std::string::npos) << t.path;
@@ -143,16 +153,13 @@ TEST_P(GpuEncodeMip, EightBitPicturesUploadAsSrgb8Exactly) {
 TEST_P(GpuEncodeMip, IdentityMapGivesTheAreaAverage) {
     GpuEncodeOptions gpu;
     gpu.kernel = GpuEncodeKernel::Mipmapped;
-    for (const int anisotropy : {1, 4}) {
-        gpu.anisotropy = anisotropy;
-        for (const int ratio : {2, 4}) {
-            const Image source = withPartialAlpha(64 * ratio, 48 * ratio, 9);
-            const Image gl = encodeImageGpu(context(), source, codec::SamplingMap::identity(9, 9), sized(64, 48), nullptr, gpu);
-            const Image average = codec::areaDownsample(source, 64, 48);
-            const double psnr = codec::psnr(gl, average);
-            std::printf("    identity map, %d:1, anisotropy %d: %.2f dB (linear) against the area average\n", ratio, anisotropy, psnr);
-            EXPECT_GE(psnr, 60.0);
-        }
+    for (const int ratio : {2, 4, 8}) {
+        const Image source = withPartialAlpha(64 * ratio, 48 * ratio, 9);
+        const Image gl = encodeImageGpu(context(), source, codec::SamplingMap::identity(9, 9), sized(64, 48), nullptr, gpu);
+        const Image average = codec::areaDownsample(source, 64, 48);
+        const double psnr = codec::psnr(gl, average);
+        std::printf("    identity map, %d:1: %.2f dB (linear) against the area average\n", ratio, psnr);
+        EXPECT_GE(psnr, 70.0);
     }
     Image flat = makeImage(300, 170, {"R", "G", "B", "A"});
     const float value[4] = {0.25f, 0.5f, 0.125f, 0.75f};  // exact in half floats
@@ -227,7 +234,8 @@ TEST(EncodeDevice, TheProbeMeasuresOnce) {
     const EncodeSpeed again = measureEncodeSpeed(context);
     EXPECT_EQ(again.glMs, first.glMs);
     EXPECT_EQ(again.cpuMs, first.cpuMs);
-    EXPECT_EQ(encodeSpeedProbe().glFaster(context), first.glFaster());
+    // The probe itself leaves a software rasterizer unmeasured: the CPU.
+    EXPECT_EQ(encodeSpeedProbe().glFaster(context), first.glFaster() && !prefersCpu(context));
     std::printf("    probe on %s: GL %.1f ms, CPU %.1f ms: auto takes %s\n", context.renderer().c_str(), first.glMs,
                 first.cpuMs, first.glFaster() ? "GL" : "the CPU");
 }

@@ -73,13 +73,15 @@ enum class GpuUpload { Auto, Srgb8, Half };
 struct GpuEncodeOptions {
     GpuEncodeKernel kernel = GpuEncodeKernel::Auto;
     GpuUpload upload = GpuUpload::Auto;
-    // Taps along the major axis that one anisotropic sample of the sampler stands for (GL 4.6's or
-    // EXT_texture_filter_anisotropic's GL_TEXTURE_MAX_ANISOTROPY), at most the driver's limit: 0
-    // takes kDefaultGpuAnisotropy where the driver has it, 1 (or no such filter) a trilinear
-    // sample per tap.
-    int anisotropy = 0;
+    // Taps along the major axis that one sample of the sampler's anisotropic filter stands for
+    // (GL 4.6's or EXT_texture_filter_anisotropic's GL_TEXTURE_MAX_ANISOTROPY; at most the driver's
+    // limit; 1 where it has none). 1 (the default): a bilinear sample per tap, the CPU kernel's own
+    // taps. Within the footprint of one sample the driver filters as it likes: llvmpipe's
+    // elliptical Gaussian lands 31-35 dB (8-bit sRGB) from the CPU kernel and costs it more, not less
+    // (bench/notes/2026-12-07-gl-encode.md), so it is asked for by name until hardware shows it
+    // closer and faster.
+    int anisotropy = 1;
 };
-inline constexpr int kDefaultGpuAnisotropy = 4;
 
 Image encodeImageGpu(Context& context, const Image& source, const codec::SamplingMap& map,
                      const codec::EncodeOptions& options, GpuTimings* timings = nullptr,
@@ -91,14 +93,15 @@ Image decodeImageGpu(Context& context, const Image& conus, const codec::Sampling
 // Whether GL encodes faster than the CPU here, measured once per process (later calls return the
 // first answer, whatever the context): a 1024x1024 RGB picture encoded to 256x256 through a focus
 // map with the default options, on the context (the mipmapped kernel, after a first call that
-// compiles its shader) and on the CPU (every core), the better of two runs each. Tens of
-// milliseconds on a GPU, a few hundred on llvmpipe.
+// compiles its shader) and on the CPU (every core), the better of two runs each: about 10 s on
+// llvmpipe (2 loaded cores), where GL took 2.6 s an encode against the CPU's 0.16 s.
 struct EncodeSpeed {
     double glMs = 0, cpuMs = 0;
     bool glFaster() const { return glMs < cpuMs; }
 };
 EncodeSpeed measureEncodeSpeed(Context& context);
-// The probe Device::choose takes for CpuPath::Measured encodes: measureEncodeSpeed's answer.
+// The probe Device::choose takes for CpuPath::Measured encodes: measureEncodeSpeed's answer on a
+// hardware GPU; the CPU, unmeasured, on a software rasterizer (prefersCpu).
 SpeedProbe encodeSpeedProbe();
 
 // Encode and decode on a device: the GPU paths above, or codec's CPU reference.
