@@ -1,19 +1,20 @@
 // GPU image encode and decode (paper section 3.2 and section 4), the GL counterparts of
 // codec::encodeImage and codec::decodeImage, and meant to agree with them (the tests hold them to
-// PSNR >= 45 dB for encode and >= 50 dB for decode).
+// PSNR >= 45 dB for encode, linear or as 8-bit sRGB codes, and >= 50 dB for decode).
 //
-// Encode rasterizes the mesh of distorted map nodes carrying undistorted texture coordinates, each
-// map cell subdivided so the piecewise-linear mesh follows the bilinear cells to a small fraction
-// of a pixel; the fragment shader averages bilinear taps over the pixel's footprint in the source
-// (from the screen-space derivatives of the texture coordinates) on a pyramid level chosen like
-// the CPU reference's, in a pyramid built on the GPU at the CPU's level sizes with exact area
-// weights (GL's own mipmaps differ for odd sizes). Decode is one full-screen pass that evaluates
+// Encode rasterizes the mesh of distorted map nodes carrying undistorted texture coordinates and
+// each vertex's footprint, each map cell subdivided so the piecewise-linear mesh follows the
+// bilinear cells to a small fraction of a pixel; the fragment shader filters the source over the
+// pixel's footprint by the CPU kernel's rule (GpuEncodeKernel below: the anisotropic kernel on GL's
+// mipmaps, or the EWA filter on a pyramid built on the GPU at the CPU's level sizes with exact area
+// weights). Decode is one full-screen pass that evaluates
 // Equation 1 per pixel from the map's nodes and samples the CoNUS image bilinearly (several taps
 // where zoomed out).
 //
-// Shared rules: images are float with any number of channels, processed four per pass (32-bit
-// float textures, an RGBA32F target); the options' threads and progress are ignored (the GPU runs
-// the whole image at once); sizes are checked like the CPU paths (conus::Error InvalidArgument /
+// Shared rules: images are float with any number of channels, processed four per pass (float
+// textures, or the mipmapped encoder's 8-bit sRGB or half ones; an RGBA32F target); progress is
+// ignored (the GPU runs the whole image at once), threads convert the mipmapped encoder's uploads
+// and read-backs; sizes are checked like the CPU paths (conus::Error InvalidArgument /
 // LimitExceeded). The context is made current on the calling thread; a GL failure throws
 // conus::Error(Unsupported), a GL out-of-memory LimitExceeded.
 //
