@@ -45,7 +45,7 @@ encode_check() {
       >>"$out/cli_encode.txt" 2>&1 || status=1
     echo "time conus encode --backend $backend: $((($(date +%s%N) - start) / 1000000)) ms" | tee -a "$out/cli_encode.txt"
   done
-  grep -E "^encode .*->" "$out/cli_encode.txt" | sort | uniq -c  # which device each took
+  grep -oE "encode [0-9]+x[0-9]+ -> [0-9]+x[0-9]+( \([^)]*\))?" "$out/cli_encode.txt" | sort | uniq -c  # which device each took
   rm -rf "$demo"
   echo "== renderers_bench, encode rows ($repetitions repetitions)"
   timeout "$limit" "$bin/renderers_bench" --benchmark_filter='^BM_Encode(Cpu|Gpu|Cpu8Bit|Gpu8Bit/[14]|GpuEwa)/real_time$' \

@@ -183,6 +183,14 @@ TEST_P(GpuEncodeMip, HandlesAnyChannelCount) {
         ASSERT_EQ(gl.channels, channels);
         EXPECT_GE(codec::psnr(cpu, gl), 40.0) << channels.size() << " channels";
     }
+    // 8-bit forced: the R, G, B, A pass only; Z stays half.
+    Image source = test::photoLike(250, 190, {"R", "G", "B", "A", "Z"}, 13);
+    for (float& v : source.pixels) v = std::clamp(v, 0.0f, 1.0f);
+    gpu.upload = GpuUpload::Srgb8;
+    GpuTimings t;
+    const Image gl = encodeImageGpu(context(), source, map, sized(100, 80), &t, gpu);
+    EXPECT_NE(t.path.find("srgb8+half"), std::string::npos) << t.path;
+    EXPECT_GE(psnrSrgb8(codec::encodeImage(source, map, sized(100, 80)), gl), kSrgb8Psnr);
 }
 
 // Auto takes the kernel the CPU takes: mipmapped for the anisotropic filter under a map that is

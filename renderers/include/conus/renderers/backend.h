@@ -6,9 +6,9 @@
 // instead, since the CPU reference measured several times faster (bench/README.md); and work whose
 // CPU path measured faster than a hardware GPU too (image encode and decode: the upload of a
 // host-resident image costs more than the CPU's whole pass, bench/notes/2026-11-27-gpu-h200.md)
-// runs on the CPU unless GL is asked for by name; work whose speed differs by machine (image encode)
-// runs where a one-time measurement on the machine's GL says it is faster. Work without a CPU path (terrain rendering)
-// needs GL on any rasterizer, and asking for the CPU is refused.
+// runs on the CPU unless GL is asked for by name; work whose speed differs by machine (image
+// encode) runs where a one-time measurement on the machine's GL says it is faster. Work without a
+// CPU path (terrain rendering) needs GL on any rasterizer, and asking for the CPU is refused.
 //
 // A GPU path and its CPU reference are registered once, where the work is declared, through
 // Device::run (gpu_image.h's encodeImage / decodeImage are the pattern to follow).

@@ -68,8 +68,9 @@ struct GpuTimings {
 enum class GpuEncodeKernel { Auto, Mipmapped, Ewa };
 // How the mipmapped encoder uploads a pass: Auto as 8-bit sRGB where the pass is R, G, B (and A)
 // and every value is exactly an 8-bit code's (an opaque 8-bit picture, read as linear light), else
-// half floats; Srgb8 always 8-bit sRGB (other values rounded to the nearest code, clamped to [0, 1]);
-// Half always half floats (finite values above 65504 become infinite).
+// half floats; Srgb8 8-bit sRGB for every R, G, B (, A) pass (other values rounded to the nearest
+// code, clamped to [0, 1]; other passes half floats); Half always half floats (finite values above
+// 65504 become infinite).
 enum class GpuUpload { Auto, Srgb8, Half };
 struct GpuEncodeOptions {
     GpuEncodeKernel kernel = GpuEncodeKernel::Auto;
