@@ -5,6 +5,10 @@
 # timed on each backend, and renderers_bench's GPU / CPU pairs as JSON (medians of interleaved
 # repetitions of at least a second each, so that the GPU's clocks have risen and every ratio is read
 # off one run on one machine).
+# CONUS_GPU_CHECK_ONLY=encode runs only the image encode's checks (a few minutes): the mipmapped GL
+# encoder's tests, `conus encode --backend auto|egl|cpu` of the demo's 4096x4096 picture, and the
+# 4096^2 -> 1024^2 encode rows from memory, GL beside CPU, with the issue's targets read off them
+# (>= 200 encodes a second and >= 5x the CPU) in encode_summary.txt.
 # Usage: bench/gpu_check.sh BIN_DIR OUT_DIR [REPETITIONS]
 #   BIN_DIR holds renderers_tests, renderers_bench and conus (build/bin); OUT_DIR receives
 #   machine.txt, renderers_tests.txt, cli.txt, demo-egl.png, renderers_bench.json (+ .err) and
@@ -26,6 +30,45 @@ status=0
   echo "cores: $(nproc)"
 } >"$out/machine.txt"
 cat "$out/machine.txt"
+
+encode_check() {
+  echo "== renderers_tests, the encoders"
+  timeout "$limit" "$bin/renderers_tests" --gtest_brief=1 --gtest_filter='GpuEncodeMip*:EncodeDevice*:Backends/GpuImage.Encode*' \
+    >"$out/renderers_tests_encode.txt" 2>&1 || status=1
+  grep -E "dB|probe on|PASSED|FAILED" "$out/renderers_tests_encode.txt" | tail -40
+  local demo
+  demo=$(mktemp -d)
+  timeout "$limit" "$bin/conus" demo --backend cpu --out "$demo/d" >/dev/null 2>&1 || status=1
+  for backend in auto egl cpu auto egl cpu; do
+    start=$(date +%s%N)
+    timeout "$limit" "$bin/conus" encode "$demo/d/source.png" --focus 0.3,0.3,0.1,4 -o "$demo/t-$backend.exr" --backend "$backend" \
+      >>"$out/cli_encode.txt" 2>&1 || status=1
+    echo "time conus encode --backend $backend: $((($(date +%s%N) - start) / 1000000)) ms" | tee -a "$out/cli_encode.txt"
+  done
+  grep -oE "encode [0-9]+x[0-9]+ -> [0-9]+x[0-9]+( \([^)]*\))?" "$out/cli_encode.txt" | sort | uniq -c  # which device each took
+  rm -rf "$demo"
+  echo "== renderers_bench, encode rows ($repetitions repetitions)"
+  timeout "$limit" "$bin/renderers_bench" --benchmark_filter='^BM_Encode(Cpu|Gpu|Cpu8Bit|Gpu8Bit/[14]|GpuEwa)/real_time$' \
+    --benchmark_repetitions="$repetitions" --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
+    --benchmark_min_time="${CONUS_GPU_CHECK_MIN_TIME:-1}" --benchmark_format=json >"$out/encode_bench.json" 2>"$out/encode_bench.err" || status=1
+  python3 - "$out/encode_bench.json" <<'PY' | tee "$out/encode_summary.txt"
+import json, sys
+rows = {b["run_name"]: b for b in json.load(open(sys.argv[1]))["benchmarks"] if b.get("aggregate_name") == "median"}
+ms = {name.replace("/real_time", ""): b["real_time"] for name, b in rows.items()}
+for name, b in rows.items():
+    print(f"{name}: {b['real_time']:.1f} ms  {b.get('label', '')}")
+for gpu, cpu in (("BM_EncodeGpu8Bit/4", "BM_EncodeCpu8Bit"), ("BM_EncodeGpu8Bit/1", "BM_EncodeCpu8Bit"), ("BM_EncodeGpu", "BM_EncodeCpu")):
+    if gpu in ms and cpu in ms:
+        rate, speedup = 1000.0 / ms[gpu], ms[cpu] / ms[gpu]
+        print(f"{gpu}: {rate:.1f} encodes/s (target >= 200), {speedup:.2f}x {cpu} (target >= 5x):",
+              "met" if rate >= 200 and speedup >= 5 else "not met")
+PY
+}
+
+if [ "${CONUS_GPU_CHECK_ONLY:-}" = encode ]; then
+  encode_check
+  exit $status
+fi
 
 echo "== renderers_tests"
 timeout "$limit" "$bin/renderers_tests" --gtest_brief=1 --gtest_filter="${CONUS_GPU_CHECK_TESTS:-*}" >"$out/renderers_tests.txt" 2>&1 || status=1
@@ -51,7 +94,7 @@ done
 rm -rf "$demo"
 
 # Each GPU figure beside its baseline: conventional beside CoNUS, CPU beside GL.
-pairs='BM_(Encode|Decode)(Gpu|Cpu)|BM_Gpu(Conventional|Conus|ConusSubdivided)|BM_GpuConusOverConventionalPaired/.*'
+pairs='BM_(Encode|Decode)(Gpu|Cpu)|BM_Encode(Cpu8Bit|Gpu8Bit/[14]|GpuEwa)|BM_Gpu(Conventional|Conus|ConusSubdivided)|BM_GpuConusOverConventionalPaired/.*'
 pairs+='|BM_Volume(Gpu|Cpu)(Conventional|Conus)(Filled)?|BM_VolumeGpuConusOverConventionalPaired/.*'
 pairs+='|BM_Intersect(Cpu|Glsl)/[01]|BM_ReflectionFrame(Gl)?/[01]|BM_ReliefFrame/[01]|BM_Render(Conus|Uniform)'
 pairs+='|BM_GpuConusBend|BM_ReliefPaired/.*|BM_GpuBendOverAsBuiltPaired.*|BM_SubdivisionQuality.*'

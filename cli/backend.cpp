@@ -12,16 +12,18 @@ void addBackendOption(CLI::App& command, std::string& backend, renderers::CpuPat
             ->check(CLI::IsMember(enumNames({renderers::Backend::Auto, renderers::Backend::Egl, renderers::Backend::OsMesa}), CLI::ignore_case));
         return;
     }
-    const std::string rule = cpuPath == renderers::CpuPath::Faster
-                                 ? ": the CPU (measured faster than a GPU at this work; egl and osmesa ask for GL)"
-                                 : ": a GPU when there is one, else the CPU";
+    const std::string rule =
+        cpuPath == renderers::CpuPath::Faster     ? ": the CPU (measured faster than a GPU at this work; egl and osmesa ask for GL)"
+        : cpuPath == renderers::CpuPath::Measured ? ": GL where a first encode on this machine's GPU measures faster than the CPU, else the CPU"
+                                                  : ": a GPU when there is one, else the CPU";
     command.add_option("--backend", backend, "what runs the work; " + automatic + rule)
         ->default_val(automatic)
         ->check(CLI::IsMember(enumNames<renderers::Backend>(), CLI::ignore_case));
 }
 
-renderers::Device deviceFor(const std::string& backend, renderers::CpuPath cpuPath, const std::string& work) {
-    return renderers::Device::choose(parseEnum<renderers::Backend>(backend), cpuPath, work);
+renderers::Device deviceFor(const std::string& backend, renderers::CpuPath cpuPath, const std::string& work,
+                            const renderers::SpeedProbe& probe) {
+    return renderers::Device::choose(parseEnum<renderers::Backend>(backend), cpuPath, work, probe);
 }
 
 }  // namespace conus::cli

@@ -15,7 +15,8 @@ namespace conus::cli {
 // Work without a CPU path offers auto, egl and osmesa only.
 void addBackendOption(CLI::App& command, std::string& backend, renderers::CpuPath cpuPath = renderers::CpuPath::Available);
 
-// The device for `work` from the option's value.
-renderers::Device deviceFor(const std::string& backend, renderers::CpuPath cpuPath, const std::string& work);
+// The device for `work` from the option's value (`probe`: CpuPath::Measured's, renderers/backend.h).
+renderers::Device deviceFor(const std::string& backend, renderers::CpuPath cpuPath, const std::string& work,
+                            const renderers::SpeedProbe& probe = {});
 
 }  // namespace conus::cli

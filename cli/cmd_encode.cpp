@@ -17,6 +17,7 @@
 #include "conus/codec/image/encode.h"
 #include "conus/core/limits.h"
 #include "conus/core/map_rules.h"
+#include "conus/renderers/gpu_image.h"
 #include "encoding.h"
 #include "image_files.h"
 #include "map_options.h"
@@ -168,7 +169,7 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, modelOptions);
     else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, modelOptions, &given);
     else built = mapFromOwnDetail(o, source.image, size, modelOptions, &given);
-    const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Faster, "encoding");
+    const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Measured, "encoding", renderers::encodeSpeedProbe());
     std::string fitNote;
     // The budget's confirming encode is this encode on the CPU (same kernel, same fit): kept.
     format::ConusFile file =
@@ -240,7 +241,7 @@ CLI::App* declareEncode(CLI::App& root, EncodeOptions& o) {
         ->excludes("--fit-method")
         ->excludes("--fit-hold");
     addSourceOptions(*command, options->source);
-    addStorageOptions(*command, options->storage);
+    addStorageOptions(*command, options->storage, renderers::CpuPath::Measured);
     return command;
 }
 

@@ -29,6 +29,7 @@
 #include "conus/codec/builders/foci.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
+#include "conus/renderers/gpu_image.h"
 #include "encoding.h"
 #include "http_server.h"
 #include "image_files.h"
@@ -139,7 +140,7 @@ public:
         const codec::SamplingMap map = codec::buildFociMap(foci, fo);
         const double mapTime = seconds(mapStart);
         const auto encodeStart = std::chrono::steady_clock::now();
-        const renderers::Device device = deviceFor(m_options.backend, renderers::CpuPath::Faster, "encoding");
+        const renderers::Device device = deviceFor(m_options.backend, renderers::CpuPath::Measured, "encoding", renderers::encodeSpeedProbe());
         format::ConusFile file = encodeToConus(device, source.image, source.info.encoding, map, size,
                                                codec::toAnalytic(foci, fo.composition, fo.falloff), {}, nullptr, "",
                                                &kept.levels);

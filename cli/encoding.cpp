@@ -17,7 +17,7 @@
 
 namespace conus::cli {
 
-void addStorageOptions(CLI::App& command, StorageOptions& options) {
+void addStorageOptions(CLI::App& command, StorageOptions& options, renderers::CpuPath cpuPath) {
     command.add_option("--size", options.sizeText, "CoNUS image size WxH (default: a quarter of each source side)")
         ->check(sizeCheck());
     auto* half = command.add_flag("--half", options.half,
@@ -26,7 +26,7 @@ void addStorageOptions(CLI::App& command, StorageOptions& options) {
                      "store colour channels as 32-bit float (default for 16-bit and float sources)")
         ->excludes(half);
     addCompressionOption(command, options.compression);
-    addBackendOption(command, options.backend, renderers::CpuPath::Faster);
+    addBackendOption(command, options.backend, cpuPath);
 }
 
 Size conusSize(const StorageOptions& options, const Image& source) {
@@ -117,7 +117,8 @@ format::ConusFile encodeToConus(const renderers::Device& device, const Image& so
                                 const FitSetting& fit, std::string* fitNote, const std::string& what,
                                 codec::EncodeLevels* keptLevels) {
     Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
-                      std::to_string(size.width) + "x" + std::to_string(size.height) + (what.empty() ? "" : ": " + what));
+                      std::to_string(size.width) + "x" + std::to_string(size.height) + (what.empty() ? "" : ": " + what) +
+                      (device.onGpu() ? " (" + device.describe() + ")" : ""));
     Image image =
         renderers::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback(),
                                                    parseEnum<codec::EncodeFilter>(fit.filter), keptLevels});

@@ -29,7 +29,8 @@ struct StorageOptions {
     std::string backend = enumName(renderers::Backend::Auto);
 };
 
-void addStorageOptions(CLI::App& command, StorageOptions& options);
+void addStorageOptions(CLI::App& command, StorageOptions& options,
+                       renderers::CpuPath cpuPath = renderers::CpuPath::Faster);
 
 // Resolves the CoNUS image size (checking it against the source) and the storage settings.
 Size conusSize(const StorageOptions& options, const Image& source);

@@ -2,8 +2,14 @@
 // CONUS_BACKEND picks the GL backend (auto, egl, osmesa; default auto: the EGL hardware device on a
 // GPU machine, llvmpipe elsewhere). GPU rows report upload, draw and readback per call.
 //
-//   encode: a 4096^2 RGB source -> 1024^2 CoNUS image through a two-focus map
+//   encode: a 4096^2 RGB source -> 1024^2 CoNUS image through a two-focus map, from memory, with
+//           the default (anisotropic) filter: a float source (BM_EncodeCpu, BM_EncodeGpu: the
+//           mipmapped GL encoder uploads half floats) and the same picture rounded to 8-bit sRGB
+//           codes, as a PNG or JPEG reads (BM_EncodeCpu8Bit, BM_EncodeGpu8Bit/<anisotropy>: 8-bit
+//           sRGB textures; /1 a trilinear sample per tap, /4 the sampler's anisotropic filter for
+//           up to 4 taps); BM_EncodeGpuEwa is the EWA GL encoder on the float source
 //   decode: a 1920x1080 view of a 2048^2 RGB CoNUS image
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <memory>
@@ -46,6 +52,21 @@ const Image& encodeSource() {
     return image;
 }
 
+// The source rounded to 8-bit sRGB codes and linearised again, as reading an 8-bit file gives.
+Image rounded8Bit(Image image) {
+    for (float& v : image.pixels) {
+        const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(std::max(0.0f, v), 1 / 2.4) - 0.055;
+        const double code = std::round(std::clamp(s, 0.0, 1.0) * 255.0) / 255.0;
+        v = static_cast<float>(code <= 0.04045 ? code / 12.92 : std::pow((code + 0.055) / 1.055, 2.4));
+    }
+    return image;
+}
+
+const Image& encodeSource8Bit() {
+    static const Image image = rounded8Bit(encodeSource());
+    return image;
+}
+
 const Image& decodeSource() {
     static const Image image = smoothSource(2048);
     return image;
@@ -59,7 +80,7 @@ void reportTimings(benchmark::State& state, const renderers::GpuTimings& sum) {
     state.counters["upload_ms"] = benchmark::Counter(sum.uploadMs, avg);
     state.counters["draw_ms"] = benchmark::Counter(sum.drawMs, avg);
     state.counters["readback_ms"] = benchmark::Counter(sum.readbackMs, avg);
-    state.SetLabel(context()->renderer());
+    state.SetLabel(context()->renderer() + ": " + sum.path);
 }
 
 codec::EncodeOptions encodeOptions() {
@@ -94,6 +115,7 @@ void timeGpu(benchmark::State& state, Run run) {
         sum.uploadMs += t.uploadMs;
         sum.drawMs += t.drawMs;
         sum.readbackMs += t.readbackMs;
+        sum.path = t.path;
     }
     reportTimings(state, sum);
 }
@@ -101,6 +123,29 @@ void timeGpu(benchmark::State& state, Run run) {
 void BM_EncodeGpu(benchmark::State& state) {
     const Image& source = encodeSource();
     timeGpu(state, [&](renderers::GpuTimings* t) { return renderers::encodeImageGpu(*context(), source, focusMap(), encodeOptions(), t); });
+}
+
+void BM_EncodeCpu8Bit(benchmark::State& state) {
+    const Image& source = encodeSource8Bit();
+    for (auto _ : state) benchmark::DoNotOptimize(codec::encodeImage(source, focusMap(), encodeOptions()));
+}
+
+void BM_EncodeGpu8Bit(benchmark::State& state) {
+    const Image& source = encodeSource8Bit();
+    renderers::GpuEncodeOptions gpu;
+    gpu.anisotropy = static_cast<int>(state.range(0));
+    timeGpu(state, [&](renderers::GpuTimings* t) {
+        return renderers::encodeImageGpu(*context(), source, focusMap(), encodeOptions(), t, gpu);
+    });
+}
+
+void BM_EncodeGpuEwa(benchmark::State& state) {
+    const Image& source = encodeSource();
+    renderers::GpuEncodeOptions gpu;
+    gpu.kernel = renderers::GpuEncodeKernel::Ewa;
+    timeGpu(state, [&](renderers::GpuTimings* t) {
+        return renderers::encodeImageGpu(*context(), source, focusMap(), encodeOptions(), t, gpu);
+    });
 }
 
 Image decodeInput() {
@@ -127,6 +172,9 @@ void BM_DecodeGpu(benchmark::State& state) {
 
 BENCHMARK(BM_EncodeCpu)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EncodeGpu)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodeCpu8Bit)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodeGpu8Bit)->Arg(1)->Arg(4)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodeGpuEwa)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeCpu)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeGpu)->UseRealTime()->Unit(benchmark::kMillisecond);
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "conus/core/parallel.h"
-#include "image_colour.h"
+#include "image_colour_pvt.h"
 
 namespace conus::imageio {
 namespace {

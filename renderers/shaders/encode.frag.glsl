@@ -34,12 +34,7 @@ vec4 tap(vec2 q, int level) {
     return textureLod(uPyramid, at / vec2(textureSize(uPyramid, 0)), 0.0);
 }
 
-// erf, Abramowitz and Stegun 7.1.26 (absolute error below 1.5e-7; GLSL has none built in).
-float erfApprox(float x) {
-    const float t = 1.0 / (1.0 + 0.3275911 * abs(x));
-    const float poly = t * (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
-    return sign(x) * (1.0 - poly * exp(-x * x));
-}
+#include "encode_footprint.inc.glsl"
 
 // Narrows [lo, hi] to the offsets o for which |x - o * d| <= 0.5; false when none is left.
 bool slab(float x, float d, inout float lo, inout float hi) {
@@ -88,21 +83,9 @@ void main() {
     if (any(lessThan(p, uCore.xy)) || any(greaterThanEqual(p, uCore.zw))) discard;
     const vec2 size0 = vec2(uLevelRect[0].zw);
     const vec2 a = vFootprint.xy * size0, b = vFootprint.zw * size0;  // in level-0 texels
-    // The footprint's major and minor lengths and the major direction in (s,t): the singular
-    // values and right singular vector of [a b].
-    const float P = dot(a, a), Q = dot(a, b), R = dot(b, b);
-    const float mean = 0.5 * (P + R), spread = sqrt(0.25 * (P - R) * (P - R) + Q * Q);
-    const float l1 = mean + spread, l2 = max(0.0, mean - spread);
-    const float minor = sqrt(l2);
-    float sigma = 0.0;
-    vec2 major = vec2(1.0, 0.0);
-    if (l1 > 0.0) {
-        sigma = kEncodeAnisotropicSigma * max(0.0, min(1.0 - kEncodeBoxAnisotropy * sqrt(l2 / l1), 1.0 - uUniform / sqrt(l1)));
-        const vec2 e1 = vec2(Q, l1 - P), e2 = vec2(l1 - R, Q);
-        const vec2 e = dot(e1, e1) >= dot(e2, e2) ? e1 : e2;
-        if (length(e) > 0.0) major = normalize(e);
-    }
-    const float reach = kEncodeGaussianReach * sigma;
+    const FootprintFilter f = footprintFilter(a, b, uUniform);
+    const float minor = f.minor, sigma = f.sigma, reach = f.reach;
+    const vec2 major = f.major;
     const vec2 extent = vec2(1.0) + 2.0 * reach * abs(major);
     const float tol = kEncodeTapTolerance;
     const float coarsest = max(max(minor / (float(kEncodeMaxTaps) + tol), 1.0),

@@ -34,13 +34,23 @@ bool isSoftwareRasterizer(const std::string& renderer) {
 
 bool prefersCpu(const Context& context) { return isSoftwareRasterizer(context.renderer()); }
 
-Device Device::choose(Backend requested, CpuPath cpuPath, const std::string& work) {
+Device Device::choose(Backend requested, CpuPath cpuPath, const std::string& work, const SpeedProbe& probe) {
     if (requested == Backend::Cpu) {
         if (cpuPath == CpuPath::None)
             throw Error(ErrorCode::InvalidArgument, work + " needs GL (it has no CPU path): use --backend auto, egl or osmesa");
         return cpu();
     }
     if (requested == Backend::Auto && cpuPath == CpuPath::Faster) return cpu();
+    if (requested == Backend::Auto && cpuPath == CpuPath::Measured) {
+        if (!probe.glFaster || (!probe.measureAnywhere && !mayHaveHardwareGpu())) return cpu();
+        try {
+            std::shared_ptr<Context> context = Context::create(Backend::Auto);
+            if (probe.glFaster(*context)) return on(std::move(context));
+        } catch (const Error&) {
+            // No GL at all, or the measurement failed on it: the CPU reference serves.
+        }
+        return cpu();
+    }
     if (requested != Backend::Auto || cpuPath == CpuPath::None)
         return on(Context::create(requested));  // asked for by name, or GL is the only way: its failure is an error
     if (!mayHaveHardwareGpu()) return cpu();

@@ -1,5 +1,6 @@
-// GPU image encode (paper section 3.2) on a Context: the plan's mesh rasterized at the CoNUS
-// resolution over the source's pyramid, whole or tile by tile; and the device dispatch of encodeImage.
+// GPU image encode (paper section 3.2) on a Context: the EWA encoder (the plan's mesh rasterized
+// at the CoNUS resolution over the source's pyramid, whole or tile by tile), the choice between it
+// and the mipmapped encoder (gpu_encode_mip.cpp), and the device dispatch of encodeImage.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -13,6 +14,7 @@
 #include "embedded_shaders.h"
 #include "gl_objects_pvt.h"
 #include "gpu_encode_plan_pvt.h"
+#include "gpu_encode_pvt.h"
 #include "gpu_pass_pvt.h"
 
 namespace conus::renderers {
@@ -78,7 +80,7 @@ public:
           m_vertexArray(makeVertexArray(m_gl)), m_vertexBuffer(makeBuffer(m_gl)), m_indexBuffer(makeBuffer(m_gl)),
           m_target(m_gl, out.width, out.height, kWhat) {
         m_program = cachedProgram(context, "encode", shaders::kShaderEncodeVert, shaders::kShaderEncodeFrag);
-        uploadMesh();
+        uploadMesh(m_gl, m_mesh, m_vertexArray.id(), m_vertexBuffer.id(), m_indexBuffer.id());
         const int limit = context.textureLimit();
         if (source.width > limit || source.height > limit || m_pyramid.atlasWidth > limit || m_pyramid.atlasHeight > limit)
             planTiling(limit);
@@ -95,6 +97,8 @@ public:
         t.readbackMs += millisecondsSince(start);
     }
 
+    bool tiled() const { return !m_tiles.empty(); }
+
     ~GpuEncoder() {
         m_gl.BindVertexArray(0);
         m_gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -107,24 +111,6 @@ private:
         return codec::uniformSpacing(m_source.width, m_source.height, m_out.width, m_out.height);
     }
     static constexpr float kFar = std::numeric_limits<float>::max();
-
-    void uploadMesh() {
-        m_gl.BindVertexArray(m_vertexArray.id());
-        m_gl.BindBuffer(GL_ARRAY_BUFFER, m_vertexBuffer.id());
-        m_gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(m_mesh.vertices.size() * sizeof(float)),
-                        m_mesh.vertices.data(), GL_STATIC_DRAW);
-        m_gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m_indexBuffer.id());
-        m_gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(m_mesh.indices.size() * sizeof(GLuint)),
-                        m_mesh.indices.data(), GL_STATIC_DRAW);
-        m_gl.EnableVertexAttribArray(0);
-        constexpr GLsizei kStride = kVertexFloats * sizeof(float);
-        m_gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, kStride, nullptr);
-        m_gl.EnableVertexAttribArray(1);
-        m_gl.VertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(2 * sizeof(float)));
-        m_gl.EnableVertexAttribArray(2);
-        m_gl.VertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(4 * sizeof(float)));
-        checkGl(m_gl, kWhat);
-    }
 
     // The plan, each tile's share of the mesh, and the pyramid's levels 1.. (built once on the
     // CPU with the reference's own area filter; the GPU then reads crops of them per tile).
@@ -242,16 +228,38 @@ private:
 
 }  // namespace
 
+void uploadMesh(const GladGLContext& gl, const Mesh& mesh, GLuint vertexArray, GLuint vertexBuffer, GLuint indexBuffer) {
+    uploadIndexedMesh(gl, vertexArray, vertexBuffer, indexBuffer, mesh.vertices, mesh.indices);
+    gl.EnableVertexAttribArray(0);
+    constexpr GLsizei kStride = kVertexFloats * sizeof(float);
+    gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, kStride, nullptr);
+    gl.EnableVertexAttribArray(1);
+    gl.VertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(2 * sizeof(float)));
+    gl.EnableVertexAttribArray(2);
+    gl.VertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(4 * sizeof(float)));
+    checkGl(gl, "encodeImageGpu");
+}
+
 Image encodeImageGpu(Context& context, const Image& source, const codec::SamplingMap& map,
-                             const codec::EncodeOptions& options, GpuTimings* timings) {
+                     const codec::EncodeOptions& options, GpuTimings* timings, const GpuEncodeOptions& gpu) {
     checkImage(source, "encodeImageGpu");
     Image out = makeImage(options.width, options.height, source.channels);
     checkTextureSize(context, out.width, out.height, "encodeImageGpu", "output");
     GpuTimings t;
     Clock::time_point start = Clock::now();
-    GpuEncoder encoder(context, source, map, out);
-    for (int first = 0; first < source.channelCount(); first += kChannelsPerPass)
-        encoder.pass(first, std::min(kChannelsPerPass, source.channelCount() - first), t, start);
+    const int limit = context.textureLimit();
+    const bool fits = source.width <= limit && source.height <= limit;
+    const bool mipmapped = gpu.kernel == GpuEncodeKernel::Mipmapped ||
+                           (gpu.kernel == GpuEncodeKernel::Auto && options.filter == codec::EncodeFilter::Anisotropic &&
+                            !codec::isUniformMap(map));
+    if (mipmapped && fits) {
+        encodeMipmapped(context, source, map, options, gpu, out, t, start);
+    } else {
+        GpuEncoder encoder(context, source, map, out);
+        for (int first = 0; first < source.channelCount(); first += kChannelsPerPass)
+            encoder.pass(first, std::min(kChannelsPerPass, source.channelCount() - first), t, start);
+        t.path = encoder.tiled() ? "ewa, tiled" : "ewa";
+    }
     if (timings) *timings = t;
     return out;
 }

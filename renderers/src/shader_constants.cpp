@@ -21,6 +21,8 @@ std::string constantsBlock() {
     s += "const float kEncodeAnisotropicSigma = " + glslFloat(codec::kEncodeAnisotropicSigma) + ";\n";
     s += "const float kEncodeGaussianReach = " + glslFloat(codec::kEncodeGaussianReach) + ";\n";
     s += "const float kEncodeBoxAnisotropy = " + glslFloat(codec::kEncodeBoxAnisotropy) + ";\n";
+    s += "const float kEncodeAnisotropicMinorTexels = " + glslFloat(codec::kEncodeAnisotropicMinorTexels) + ";\n";
+    s += "const int kEncodeAnisotropicMaxTaps = " + std::to_string(codec::kEncodeAnisotropicMaxTaps) + ";\n";
     s += "const int kTransferTableSize = " + std::to_string(codec::kTransferTableSize) + ";\n";
     s += "const float kTerminationOpacity = " + glslFloat(codec::kTerminationOpacity) + ";\n";
     s += "const vec3 kBackground = vec3(" + glslFloat(kViewBackground) + ");\n";

@@ -721,6 +721,8 @@ bool encodeAvx2Available() { return cpuHasAvx2(); }
 void forceBaselineEncode(bool baseline) { g_forceBaselineEncode.store(baseline, std::memory_order_relaxed); }
 }  // namespace detail
 
+bool isUniformMap(const SamplingMap& map) { return isUniform(map); }
+
 FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b, double uniform) {
     double minor = 0;
     const glm::dvec2 extent = filterExtent(footprintFilter(a, b, uniform, minor));

@@ -90,6 +90,9 @@ private:
 // whatever is asked: there it is the exact area average at integer ratios, and the uniform image
 // (`conus uniform`, the baseline every gain is measured against) stays that average.
 enum class EncodeFilter { Anisotropic, Ewa };
+// Whether every node of the map sits where the identity puts it (to float rounding): where the
+// encoders take the EWA filter whatever is asked.
+bool isUniformMap(const SamplingMap& map);
 constexpr auto enumNameTable(EncodeFilter) {
     return makeEnumNameTable<EncodeFilter>("encode filter",
                                            {{EncodeFilter::Anisotropic, "anisotropic"}, {EncodeFilter::Ewa, "ewa"}}, true);
