@@ -13,7 +13,7 @@
 #include "embedded_shaders.h"
 #include "gpu_encode_pvt.h"
 #include "gpu_pass_pvt.h"
-#include "gpu_upload.h"
+#include "gpu_upload_pvt.h"
 
 namespace conus::renderers {
 namespace {

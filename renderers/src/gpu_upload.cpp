@@ -1,5 +1,5 @@
 // The mipmapped GL encoder's transfers (gpu_upload.h).
-#include "gpu_upload.h"
+#include "gpu_upload_pvt.h"
 
 #include <algorithm>
 #include <array>
