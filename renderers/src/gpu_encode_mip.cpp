@@ -9,7 +9,7 @@
 #include <string>
 
 #include "context_pvt.h"
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "embedded_shaders.h"
 #include "gpu_encode_pvt.h"
 #include "gpu_pass_pvt.h"

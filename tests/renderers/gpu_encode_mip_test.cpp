@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/renderers/backend.h"

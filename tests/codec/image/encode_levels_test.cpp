@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "conus/codec/build/foci.h"
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/image/encode.h"
 #include "test_images.h"
 
