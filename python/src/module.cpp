@@ -312,13 +312,19 @@ PYBIND11_MODULE(_conus, m) {
             {
                 py::gil_scoped_release release;
                 Image encoded;
-                if (enumArgument<renderers::Backend>(backend, "backend") == renderers::Backend::Cpu) {
-                    encoded = codec::encodeImage(source, map->map, options);
+                const bool cpu = enumArgument<renderers::Backend>(backend, "backend") == renderers::Backend::Cpu;
+                if (cpu && budget && budget->encode) {
+                    // The budget's confirming encode of this map, encoded and fitted as asked: not made again.
+                    encoded = budget->encode->image;
                 } else {
-                    std::lock_guard<std::mutex> lock(g_deviceMutex);
-                    encoded = renderers::encodeImage(deviceFor(backend), source, map->map, options);
+                    if (cpu) {
+                        encoded = codec::encodeImage(source, map->map, options);
+                    } else {
+                        std::lock_guard<std::mutex> lock(g_deviceMutex);
+                        encoded = renderers::encodeImage(deviceFor(backend), source, map->map, options);
+                    }
+                    fitTo(source, map->map, encoded, fit, fitHold);
                 }
-                fitTo(source, map->map, encoded, fit, fitHold);
                 file->file = codec::makeImageFile(std::move(encoded), map->map, source.width, source.height, SourceEncoding{},
                                                   map->analytic);
             }

@@ -318,3 +318,16 @@ def test_encode_holds_the_frame_loss_budget(tmp_path, conus_bin):
         tight = conus.encode(detail, foci=foci, size=(60, 40), fit=0, frame_loss=0.1)
     assert tight.budget["k_given"][0] < b["k_given"][0]
     assert conus.encode(detail, size=(60, 40), fit=0).budget is None
+
+
+def test_encode_writes_the_budgets_confirming_encode(asymmetric):
+    """The budget's confirming encode of the map it keeps is the File's pixels (not encoded again):
+    the same as a fresh encode and fit through that File's own map, and a fit that did something."""
+    foci = [(0.62, 0.4, 0.13, 3.0)]
+    for exact in (True, False):
+        with pytest.warns(UserWarning):
+            f = conus.encode(asymmetric, foci=foci, size=(60, 40), exact_k=exact)
+        again = conus.encode(asymmetric, map=f.map, size=(60, 40))
+        np.testing.assert_allclose(f.pixels, again.pixels, atol=1e-5)
+        unfitted = conus.encode(asymmetric, map=f.map, size=(60, 40), fit=0)
+        assert np.abs(f.pixels - unfitted.pixels).max() > 1e-3

@@ -117,11 +117,22 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         FociReport report;
         FramePrediction predicted;
         std::shared_ptr<const ModelEncode> encode{};  // this map's own encode, where one was made
+        const DensityField* context = nullptr;         // the context it was built on
     };
+    // The maps built, by t and context: a map depends on them alone, not on the model that judges
+    // it, and every search (on the model, on a confirmed model) starts at t = 1 and t = 0.
+    std::vector<Try> built;
     const auto attempt = [&](const FrameErrorModel& m, double t, const FociOptions& o) {
-        Try x{t, powered(foci, t), SamplingMap::identity(2, 2), {}, {}, {}};
+        for (const Try& b : built)
+            if (b.t == t && b.context == o.context) {
+                Try x = b;
+                x.predicted = m.predict(x.map);
+                return x;
+            }
+        Try x{t, powered(foci, t), SamplingMap::identity(2, 2), {}, {}, {}, o.context};
         x.map = buildFociMap(x.given, o, &x.report);
         x.predicted = m.predict(x.map);
+        built.push_back(x);
         return x;
     };
     // How far a try is over the budget (dB, <= 0: within): continuous in t, as the model is.
