@@ -13,6 +13,7 @@
 #include "conus/codec/build/foci.h"
 #include "conus/codec/build/foci_budget.h"
 #include "conus/codec/build/frame_budget.h"
+#include "conus/codec/build/importance.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
 #include "conus/core/limits.h"
@@ -42,6 +43,14 @@ struct EncodeOptions {
     StorageOptions storage;
 };
 
+// The picture: linear floats, or (`--fast`, a plain 8-bit sRGB file) its 8-bit codes, `image` then
+// holding only their size and channels.
+struct Picture {
+    Picture(const Image& picture, const codec::EightBitImage* eightBit = nullptr) : image(picture), codes(eightBit) {}
+    const Image& image;
+    const codec::EightBitImage* codes;
+};
+
 struct BuiltMap {
     std::unique_ptr<codec::SamplingMap> map;
     std::optional<format::AnalyticMap> analytic;
@@ -68,9 +77,23 @@ BuiltMap mapFromFile(const std::string& path, const Image& source) {
 // context foci and importance maps sit on.
 codec::AutoMapOptions ownDetailOptions(const EncodeOptions& o) { return autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method); }
 
+// The detail importance of a picture kept as 8-bit codes: each code's display value the one
+// imageio::displayEncoded gives its linear value, so that it is the linear picture's detail exactly.
+Image detailOfCodes(const codec::EightBitImage& codes) {
+    Image linear = makeImage(256, 1, {"R", "G", "B"});
+    for (int v = 0; v < 256; ++v)
+        for (int c = 0; c < 3; ++c) linear.at(v, 0, c) = codec::srgbCodeToLinear()[v];
+    const Image shown = imageio::displayEncoded(linear);
+    float table[256];
+    for (int v = 0; v < 256; ++v) table[v] = shown.at(v, 0, 0);
+    return codec::detailImportance(codes, table);
+}
+
 // The density the picture's own detail asks for (codec::ownDetailContext), the budget's model choosing its floor.
-codec::DensityField ownDetailContext(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
-    return codec::ownDetailContext(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), modelOptions);
+codec::DensityField ownDetailContext(const EncodeOptions& o, const Picture& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
+    if (source.codes)
+        return codec::ownDetailContext(*source.codes, detailOfCodes(*source.codes), size.width, size.height, ownDetailOptions(o), modelOptions);
+    return codec::ownDetailContext(source.image, importanceFrom("detail", source.image), size.width, size.height, ownDetailOptions(o), modelOptions);
 }
 
 BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
@@ -99,11 +122,11 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
 
 // The foci's map under the frame-loss budget (foci_budget.h): says, before the work, what the foci
 // take and the k each got; `given` receives that k for the line that says what was written.
-BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
+BuiltMap mapFromFoci(const EncodeOptions& o, const Picture& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
     const std::vector<codec::Focus> foci = parseFoci(o.foci);
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
-    fo.aspect = double(source.width) / source.height;
+    fo.aspect = double(source.image.width) / source.image.height;
     fo.maxAnisotropy = o.maxAnisotropy;
     fo.composition = parseEnum<format::FociComposition>(o.compose);
     fo.falloff = codec::parseFalloff(o.falloff);
@@ -112,12 +135,13 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     const codec::DensityField context = ownDetailContext(o, source, size, modelOptions);
     fo.context = &context;
     const int side = 256;
-    const codec::FrameErrorModel model(source, size.width, size.height,
-                                       codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))), modelOptions);
+    const Image fociImportance = codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect)));
+    const codec::FrameErrorModel model = source.codes ? codec::FrameErrorModel(*source.codes, size.width, size.height, fociImportance, modelOptions)
+                                                      : codec::FrameErrorModel(source.image, size.width, size.height, fociImportance, modelOptions);
     codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, o.frameLoss, o.exactK);
     progress.done();
     const std::string said =
-        describeFociBudget(budget, BudgetFrame{size.width, size.height, source.width, source.height, o.frameLoss}, o.exactK, o.grid,
+        describeFociBudget(budget, BudgetFrame{size.width, size.height, source.image.width, source.image.height, o.frameLoss}, o.exactK, o.grid,
                            o.maxAnisotropy);
     if (!quiet()) std::printf("%s\n", said.c_str());
     *given = "k " + fociKText(budget.given);
@@ -128,10 +152,11 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
 
 // No focus, map or importance: the samples follow the picture's own detail, with the context floor
 // the model predicts gains most over the whole frame (frame_budget.h), said once per batch.
-BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
+BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Picture& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
     Progress progress("build sampling map from the picture's detail");
     codec::BudgetResult r =
-        codec::buildOwnDetailMap(source, importanceFrom("detail", source), size.width, size.height, ownDetailOptions(o), modelOptions);
+        source.codes ? codec::buildOwnDetailMap(*source.codes, detailOfCodes(*source.codes), size.width, size.height, ownDetailOptions(o), modelOptions)
+                     : codec::buildOwnDetailMap(source.image, importanceFrom("detail", source.image), size.width, size.height, ownDetailOptions(o), modelOptions);
     progress.done();
     static std::once_flag once;  // once per batch, not per file
     std::call_once(once, [] {
@@ -148,7 +173,12 @@ BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Siz
 // One input to one output; returns the line that says what was written.
 std::string encodeOne(const EncodeOptions& o, const std::string& input, const std::string& output) {
     checkConusOutput(output, input);
-    const imageio::ImageFile source = readSource(input, o.source);
+    // `--fast` without an importance file reads a plain 8-bit sRGB picture as its codes: the budget's
+    // model, the detail and the CPU encoder read them, and no float copy of the picture is made.
+    imageio::ImageFile source = readSource(input, o.source, o.fast && o.importance.empty());
+    codec::EightBitImage codes;
+    if (!source.codes.empty()) codes = {source.image.width, source.image.height, source.image.channels, std::move(source.codes)};
+    const Picture picture(source.image, codes.codes.empty() ? nullptr : &codes);
     const Size size = conusSize(o.storage, source.image);
     codec::checkEncodeMemory(source.image, size.width, size.height);  // before a map is built for it
     if (!o.importance.empty() || !o.foci.empty()) checkGridForImage(o.grid, size.width, size.height);
@@ -163,12 +193,13 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     modelOptions.fitMethod = parseEnum<codec::FitMethod>(o.fit.method);
     if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image);
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, modelOptions);
-    else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, modelOptions, &given);
-    else built = mapFromOwnDetail(o, source.image, size, modelOptions, &given);
+    else if (!o.foci.empty()) built = mapFromFoci(o, picture, size, modelOptions, &given);
+    else built = mapFromOwnDetail(o, picture, size, modelOptions, &given);
     const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Faster, "encoding");
     std::string fitNote;
     format::ConusFile file =
-        encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
+        picture.codes ? encodeToConus(device, codes, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote)
+                      : encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
     applyStorage(o.storage, file);
     Progress writing("write " + output);
     format::writeConusFile(output, file);

@@ -59,6 +59,11 @@ void addFitOption(CLI::App& command, FitSetting& fit, bool byDefault = false);
 format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
                                 const FitSetting& fit = {}, std::string* fitNote = nullptr, const std::string& what = {});
+// The same of a picture kept as 8-bit codes: the CPU encoder reads them (codec::encodeImage of
+// an EightBitImage); the GL encoder and the fit take the linear picture they stand for.
+format::ConusFile encodeToConus(const renderers::Device& device, const codec::EightBitImage& source, const SourceEncoding& encoding,
+                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
+                                const FitSetting& fit = {}, std::string* fitNote = nullptr, const std::string& what = {});
 
 // Applies the storage options to a file model. Without --half or --float, colour is stored as
 // float when the source had more precision than half keeps (16-bit integers, float), else half.

@@ -100,6 +100,14 @@ float shown(float v, bool display, const std::vector<float>& table) {
     return table[i] + f * (table[i + 1] - table[i]);
 }
 
+// Value i of the picture as the model weighs it: shown() of its linear value (of 8-bit codes, the
+// value their table gives: the same floats as the linear picture's, so the same model).
+float shownAt(const Image& source, const EightBitImage* codes, std::size_t i, bool display, const std::vector<float>& table) {
+    if (!codes) return shown(source.pixels[i], display, table);
+    const bool colour = isColourChannelName(source.channels[i % source.channels.size()]);
+    return shown((colour ? srgbCodeToLinear() : codeToUnit())[codes->codes[i]], display, table);
+}
+
 // Singular values of a 2x2 matrix (largest first).
 std::pair<double, double> singularValues(double a, double b, double c, double d) {
     const double s1 = a * a + b * b + c * c + d * d, det = std::abs(a * d - b * c);
@@ -110,13 +118,24 @@ std::pair<double, double> singularValues(double a, double b, double c, double d)
 }  // namespace
 
 FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, const Image& importance, const FrameModelOptions& options)
+    : FrameErrorModel(source, nullptr, width, height, importance, options) {}
+
+FrameErrorModel::FrameErrorModel(const EightBitImage& source, int width, int height, const Image& importance,
+                                 const FrameModelOptions& options)
+    : FrameErrorModel(Image{source.width, source.height, source.channels, {}}, &source, width, height, importance, options) {}
+
+// `codes`: the picture is those codes, `source` only their size and channels.
+FrameErrorModel::FrameErrorModel(const Image& source, const EightBitImage* codes, int width, int height, const Image& importance,
+                                 const FrameModelOptions& options)
     : m_options(options) {
     if (source.empty()) invalid("the frame-loss model needs the source picture");
     if (width < 1 || height < 1 || width > source.width || height > source.height)
         invalid("the frame-loss model: CoNUS size " + std::to_string(width) + "x" + std::to_string(height) +
                 " is outside 1x1 .. the source's " + std::to_string(source.width) + "x" + std::to_string(source.height));
     const int sw = source.width, sh = source.height;
-    m_source = &source;
+    m_source = codes ? nullptr : &source;
+    if (codes && codes->codes.size() != std::size_t(source.width) * source.height * source.channels.size())
+        invalid("the frame-loss model: the 8-bit picture's codes do not fill it");
     m_sourceWidth = sw;
     m_sourceHeight = sh;
     m_conusWidth = width;
@@ -144,7 +163,7 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
     std::vector<float> level, next;
     int w = sw, h = sh;
     const auto at = [&](int j, int x, int y, std::size_t c) {
-        return j == 0 ? shown(source.pixels[(std::size_t(y) * sw + x) * channels + c], display[c], table)
+        return j == 0 ? shownAt(source, codes, (std::size_t(y) * sw + x) * channels + c, display[c], table)
                       : level[(std::size_t(y) * w + x) * channels + c];
     };
     for (int j = 0; j < m_levels; ++j) {
@@ -274,6 +293,7 @@ std::vector<double> FrameErrorModel::tileErrors(const SamplingMap& map) const {
 FramePrediction FrameErrorModel::predict(const SamplingMap& map) const { return measure(tileErrors(map)); }
 
 FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
+    if (!m_source) invalid("the frame-loss model of 8-bit codes cannot be confirmed: build it from the linear picture");
     const Image& source = *m_source;
     // The real encode (fitted as the encode will be) and decode at the source's size, and the
     // uniform image's, each tile's mean squared error on the values shown; the model then keeps
@@ -477,6 +497,19 @@ BudgetResult buildOwnDetailMap(const Image& source, const Image& detail, int wid
 
 DensityField ownDetailContext(const Image& source, const Image& detail, int width, int height, const AutoMapOptions& options,
                               const FrameModelOptions& model) {
+    AutoMapOptions at = options;
+    at.minDensity = buildOwnDetailMap(source, detail, width, height, options, model).minDensity;
+    return importanceToDensity(detail, at);
+}
+
+BudgetResult buildOwnDetailMap(const EightBitImage& source, const Image& detail, int width, int height,
+                               const AutoMapOptions& options, const FrameModelOptions& model) {
+    const FrameErrorModel trials(source, width, height, detail, model);
+    return buildAutoMapForBestFrame(detail, trials, kOwnDetailTileLoss, options);
+}
+
+DensityField ownDetailContext(const EightBitImage& source, const Image& detail, int width, int height,
+                              const AutoMapOptions& options, const FrameModelOptions& model) {
     AutoMapOptions at = options;
     at.minDensity = buildOwnDetailMap(source, detail, width, height, options, model).minDensity;
     return importanceToDensity(detail, at);

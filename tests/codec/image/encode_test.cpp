@@ -9,6 +9,9 @@
 #include <gtest/gtest.h>
 
 #include "conus/codec/build/foci.h"
+#include "conus/codec/build/foci_budget.h"
+#include "conus/codec/build/frame_budget.h"
+#include "conus/codec/build/importance.h"
 #include "conus/codec/image/metrics.h"
 #include "conus/core/error.h"
 #include "conus/core/map_rules.h"
@@ -624,6 +627,38 @@ TEST(EncodeEightBit, EqualsTheEncodeOfTheLinearPicture) {
                 EXPECT_LT(lo, 0.1f);
                 EXPECT_GT(hi, 0.5f);
             }
+    }
+}
+
+// The budget reads the codes as the linear picture: the same model (bit for bit), so the same k;
+// the detail of code / 255 is the detail of that display picture.
+TEST(EncodeEightBit, BudgetModelAndDetailAreTheLinearPictures) {
+    for (const std::vector<std::string>& channels : {std::vector<std::string>{"R", "G", "B"}, std::vector<std::string>{"R", "G", "B", "A"}}) {
+        const EightBitImage codes = eightBitPicture(256, 192, channels, 11u);
+        const Image linear = linearImage(codes);
+        Image display = makeImage(codes.width, codes.height, codes.channels);
+        for (std::size_t i = 0; i < codes.codes.size(); ++i) display.pixels[i] = codeToUnit()[codes.codes[i]];
+        const Image detail = detailImportance(codes);
+        const Image detailOfDisplay = detailImportance(display);
+        ASSERT_EQ(detail.pixels.size(), detailOfDisplay.pixels.size());
+        EXPECT_EQ(maxAbsDifference(detail, detailOfDisplay), 0.0f);
+        const std::vector<Focus> foci = {{0.3, 0.4, 0.15, 8}};
+        FociOptions fo;
+        fo.aspect = 256.0 / 192.0;
+        FrameModelOptions options;
+        options.fitIterations = 0;
+        options.confirm = false;
+        const Image importance = fociImportance(foci, fo.aspect, 64, 48);
+        const FrameErrorModel fromCodes(codes, 64, 48, importance, options), fromLinear(linear, 64, 48, importance, options);
+        const SamplingMap map = buildFociMap(foci, fo);
+        EXPECT_EQ(fromCodes.tileErrors(map), fromLinear.tileErrors(map));
+        EXPECT_EQ(fromCodes.uniformErrors(), fromLinear.uniformErrors());
+        EXPECT_EQ(fromCodes.predict(map).frameLoss, fromLinear.predict(map).frameLoss);
+        const FociBudget a = fociForFrameLoss(foci, fo, fromCodes, 0.05, false), b = fociForFrameLoss(foci, fo, fromLinear, 0.05, false);
+        ASSERT_EQ(a.given.size(), 1u);
+        EXPECT_EQ(a.given[0].k, b.given[0].k);
+        EXPECT_LT(a.given[0].k, 7.9);  // the budget binds: k is chosen, not the asked one
+        EXPECT_THROW(fromCodes.confirmed(map), Error);
     }
 }
 

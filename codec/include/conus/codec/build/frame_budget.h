@@ -82,6 +82,9 @@ public:
     // any size (its region R is where it reaches half its peak; empty: R is the whole frame). Throws
     // conus::Error(InvalidArgument) on an empty source or a size outside 1..source size.
     FrameErrorModel(const Image& source, int width, int height, const Image& importance, const FrameModelOptions& options = {});
+    // The same model of a picture kept as 8-bit codes (the same as of linearImage(source)),
+    // which cannot be confirmed (confirmed() throws: build the model of linearImage(source) for that).
+    FrameErrorModel(const EightBitImage& source, int width, int height, const Image& importance, const FrameModelOptions& options = {});
 
     // The losses and gain of encoding through `map`, predicted by the model (microseconds).
     FramePrediction predict(const SamplingMap& map) const;
@@ -105,6 +108,8 @@ public:
     struct BandFit;
 
 private:
+    FrameErrorModel(const Image& source, const EightBitImage* codes, int width, int height, const Image& importance,
+                    const FrameModelOptions& options);
     // S of the footprint of axes sigma1 >= sigma2 (source pixels) on `tile`, with `fit`'s constants.
     double tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const;
     std::vector<double> shownTileErrors(const Image& source, const Image& view) const;  // measured, per tile
@@ -181,6 +186,11 @@ BudgetResult buildOwnDetailMap(const Image& source, const Image& detail, int wid
 // floor buildOwnDetailMap chooses): the context that `encode`'s foci multiply (FociOptions::context),
 // so that the frame outside them is sampled as the no-focus default would sample it.
 DensityField ownDetailContext(const Image& source, const Image& detail, int width, int height,
+                              const AutoMapOptions& options = {}, const FrameModelOptions& model = {});
+// The same two of a picture kept as 8-bit codes (FrameErrorModel's own, unconfirmed: `model.confirm` off).
+BudgetResult buildOwnDetailMap(const EightBitImage& source, const Image& detail, int width, int height,
+                               const AutoMapOptions& options = {}, const FrameModelOptions& model = {});
+DensityField ownDetailContext(const EightBitImage& source, const Image& detail, int width, int height,
                               const AutoMapOptions& options = {}, const FrameModelOptions& model = {});
 
 }  // namespace conus::codec
