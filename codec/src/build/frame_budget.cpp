@@ -2,6 +2,7 @@
 #include "conus/codec/build/frame_budget.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -100,14 +101,6 @@ float shown(float v, bool display, const std::vector<float>& table) {
     return table[i] + f * (table[i + 1] - table[i]);
 }
 
-// Value i of the picture as the model weighs it: shown() of its linear value (of 8-bit codes, the
-// value their table gives: the same floats as the linear picture's, so the same model).
-float shownAt(const Image& source, const EightBitImage* codes, std::size_t i, bool display, const std::vector<float>& table) {
-    if (!codes) return shown(source.pixels[i], display, table);
-    const bool colour = isColourChannelName(source.channels[i % source.channels.size()]);
-    return shown((colour ? srgbCodeToLinear() : codeToUnit())[codes->codes[i]], display, table);
-}
-
 // Singular values of a 2x2 matrix (largest first).
 std::pair<double, double> singularValues(double a, double b, double c, double d) {
     const double s1 = a * a + b * b + c * c + d * d, det = std::abs(a * d - b * c);
@@ -162,8 +155,15 @@ FrameErrorModel::FrameErrorModel(const Image& source, const EightBitImage* codes
     const std::vector<float>& table = displayTable();
     std::vector<float> level, next;
     int w = sw, h = sh;
+    // 8-bit codes: each channel's shown() of each code's linear value (the same floats as the
+    // linear picture's, so the same model).
+    std::vector<std::array<float, 256>> codeShown(codes ? channels : 0);
+    for (std::size_t c = 0; c < codeShown.size(); ++c)
+        for (int v = 0; v < 256; ++v)
+            codeShown[c][v] = shown((isColourChannel(source.channels[c]) ? srgbCodeToLinear() : codeToUnit())[v], display[c], table);
     const auto at = [&](int j, int x, int y, std::size_t c) {
-        return j == 0 ? shownAt(source, codes, (std::size_t(y) * sw + x) * channels + c, display[c], table)
+        const std::size_t i = (std::size_t(y) * sw + x) * channels + c;
+        return j == 0 ? (codes ? codeShown[c][codes->codes[i]] : shown(source.pixels[i], display[c], table))
                       : level[(std::size_t(y) * w + x) * channels + c];
     };
     for (int j = 0; j < m_levels; ++j) {
