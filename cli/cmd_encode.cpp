@@ -13,6 +13,7 @@
 #include "conus/codec/builders/foci.h"
 #include "conus/codec/builders/foci_budget.h"
 #include "conus/codec/builders/frame_budget.h"
+#include "conus/codec/builders/importance.h"
 #include "conus/codec/conus_file.h"
 #include "conus/codec/image/encode.h"
 #include "conus/core/limits.h"
@@ -43,6 +44,14 @@ struct EncodeOptions {
     StorageOptions storage;
 };
 
+// The picture: linear floats, or (`--fast`, a plain 8-bit sRGB file) its 8-bit codes, `image` then
+// holding only their size and channels.
+struct Picture {
+    Picture(const Image& picture, const codec::EightBitImage* eightBit = nullptr) : image(picture), codes(eightBit) {}
+    const Image& image;
+    const codec::EightBitImage* codes;
+};
+
 struct BuiltMap {
     std::unique_ptr<codec::SamplingMap> map;
     std::optional<format::AnalyticMap> analytic;
@@ -69,6 +78,29 @@ BuiltMap mapFromFile(const std::string& path, const Image& source) {
 // The options of the map of the picture's own detail: what `encode` makes with no focus, and the
 // context foci and importance maps sit on.
 codec::AutoMapOptions ownDetailOptions(const EncodeOptions& o) { return autoMapOptions(o.grid, 0.25, o.maxDensity, o.maxAnisotropy, o.method); }
+
+// The detail importance of a picture kept as 8-bit codes: each code's display value the one
+// imageio::displayEncoded gives its linear value, so that it is the linear picture's detail exactly.
+Image detailOfCodes(const codec::EightBitImage& codes) {
+    Image linear = makeImage(256, 1, {"R", "G", "B"});
+    for (int v = 0; v < 256; ++v)
+        for (int c = 0; c < 3; ++c) linear.at(v, 0, c) = codec::srgbCodeToLinear()[v];
+    const Image shown = imageio::displayEncoded(linear);
+    float table[256];
+    for (int v = 0; v < 256; ++v) table[v] = shown.at(v, 0, 0);
+    return codec::detailImportance(codes, table);
+}
+
+// The picture's own detail (the importance `detail`), from its codes where it is kept as codes.
+Image detailOf(const Picture& source) {
+    return source.codes ? detailOfCodes(*source.codes) : importanceFrom(enumName(codec::ImportanceRule::Detail), source.image);
+}
+
+// One model of the picture (its pyramid taken once), its region `region`.
+codec::FrameErrorModel modelOf(const Picture& source, const Size& size, const Image& region, const codec::FrameModelOptions& modelOptions) {
+    return source.codes ? codec::FrameErrorModel(*source.codes, size.width, size.height, region, modelOptions)
+                        : codec::FrameErrorModel(source.image, size.width, size.height, region, modelOptions);
+}
 
 BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
     Progress progress("build sampling map from " + o.importance + " importance");
@@ -100,19 +132,19 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
 
 // The foci's map under the frame-loss budget (foci_budget.h): says, before the work, what the foci
 // take and the k each got; `given` receives that k for the line that says what was written.
-BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
+BuiltMap mapFromFoci(const EncodeOptions& o, const Picture& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
     const std::vector<codec::Focus> foci = parseFoci(o.foci);
     codec::FociOptions fo;
     fo.columns = fo.rows = o.grid;
-    fo.aspect = double(source.width) / source.height;
+    fo.aspect = double(source.image.width) / source.image.height;
     fo.maxAnisotropy = o.maxAnisotropy;
     fo.composition = parseEnum<format::FociComposition>(o.compose);
     fo.falloff = codec::parseFalloff(o.falloff);
     Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
     // Away from the foci the samples follow the picture's own detail, as with no focus at all.
     // One model of the picture (its pyramid taken once), its region the detail's for the context.
-    const Image detail = importanceFrom(enumName(codec::ImportanceRule::Detail), source);
-    const codec::FrameErrorModel picture(source, size.width, size.height, detail, modelOptions);
+    const Image detail = detailOf(source);
+    const codec::FrameErrorModel picture = modelOf(source, size, detail, modelOptions);
     const codec::DensityField context = codec::ownDetailContext(picture, detail, ownDetailOptions(o));
     fo.context = &context;
     const int side = 256;
@@ -121,7 +153,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
     codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, o.frameLoss, o.exactK);
     progress.done();
     const std::string said =
-        describeFociBudget(budget, BudgetFrame{size.width, size.height, source.width, source.height, o.frameLoss}, o.exactK, o.grid,
+        describeFociBudget(budget, BudgetFrame{size.width, size.height, source.image.width, source.image.height, o.frameLoss}, o.exactK, o.grid,
                            o.maxAnisotropy);
     if (!quiet()) std::printf("%s\n", said.c_str());
     *given = "k " + fociKText(budget.given);
@@ -132,10 +164,11 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Image& source, const Size& si
 
 // No focus, map or importance: the samples follow the picture's own detail, with the context floor
 // the model predicts gains most over the whole frame (frame_budget.h), said once per batch.
-BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
+BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Picture& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
     Progress progress("build sampling map from the picture's detail");
     codec::BudgetResult r =
-        codec::buildOwnDetailMap(source, importanceFrom(enumName(codec::ImportanceRule::Detail), source), size.width, size.height, ownDetailOptions(o), modelOptions);
+        source.codes ? codec::buildOwnDetailMap(*source.codes, detailOfCodes(*source.codes), size.width, size.height, ownDetailOptions(o), modelOptions)
+                     : codec::buildOwnDetailMap(source.image, detailOf(source), size.width, size.height, ownDetailOptions(o), modelOptions);
     progress.done();
     static std::once_flag once;  // once per batch, not per file
     std::call_once(once, [] {
@@ -152,7 +185,12 @@ BuiltMap mapFromOwnDetail(const EncodeOptions& o, const Image& source, const Siz
 // One input to one output; returns the line that says what was written.
 std::string encodeOne(const EncodeOptions& o, const std::string& input, const std::string& output) {
     checkConusOutput(output, input);
-    const imageio::ImageFile source = readSource(input, o.source);
+    // `--fast` without an importance file reads a plain 8-bit sRGB picture as its codes: the budget's
+    // model, the detail and the CPU encoder read them, and no float copy of the picture is made.
+    imageio::ImageFile source = readSource(input, o.source, o.fast && o.importance.empty());
+    codec::EightBitImage codes;
+    if (!source.codes.empty()) codes = {source.image.width, source.image.height, source.image.channels, std::move(source.codes)};
+    const Picture picture(source.image, codes.codes.empty() ? nullptr : &codes);
     const Size size = conusSize(o.storage, source.image);
     codec::checkEncodeMemory(source.image, size.width, size.height);  // before a map is built for it
     if (!o.importance.empty() || !o.foci.empty()) checkGridForImage(o.grid, size.width, size.height);
@@ -167,8 +205,8 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
     modelOptions.fitMethod = parseEnum<codec::FitMethod>(o.fit.method);
     if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image);
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, modelOptions);
-    else if (!o.foci.empty()) built = mapFromFoci(o, source.image, size, modelOptions, &given);
-    else built = mapFromOwnDetail(o, source.image, size, modelOptions, &given);
+    else if (!o.foci.empty()) built = mapFromFoci(o, picture, size, modelOptions, &given);
+    else built = mapFromOwnDetail(o, picture, size, modelOptions, &given);
     const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Measured, "encoding", renderers::encodeSpeedProbe());
     std::string fitNote;
     // The budget's confirming encode is this encode on the CPU (same kernel, same fit): kept.
@@ -176,7 +214,8 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
         built.encoded && !device.onGpu()
             ? keptEncodeToConus(*built.encoded, source.info.encoding, *built.map, source.image.width, source.image.height,
                                 built.analytic, &fitNote)
-            : encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
+        : picture.codes ? encodeToConus(device, codes, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote)
+                        : encodeToConus(device, source.image, source.info.encoding, *built.map, size, built.analytic, o.fit, &fitNote);
     applyStorage(o.storage, file);
     Progress writing("write " + output);
     format::writeConusFile(output, file);

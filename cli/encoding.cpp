@@ -110,15 +110,18 @@ std::string fitText(const codec::FitResult& r) {
     return text;
 }
 
+std::string encodeStage(int width, int height, Size size, const std::string& what) {
+    return "encode " + std::to_string(width) + "x" + std::to_string(height) + " -> " + std::to_string(size.width) + "x" +
+           std::to_string(size.height) + (what.empty() ? "" : ": " + what);
+}
+
 }  // namespace
 
 format::ConusFile encodeToConus(const renderers::Device& device, const Image& source, const SourceEncoding& encoding,
                                 const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
                                 const FitSetting& fit, std::string* fitNote, const std::string& what,
                                 codec::EncodeLevels* keptLevels) {
-    Progress progress("encode " + std::to_string(source.width) + "x" + std::to_string(source.height) + " -> " +
-                      std::to_string(size.width) + "x" + std::to_string(size.height) + (what.empty() ? "" : ": " + what) +
-                      (device.onGpu() ? " (" + device.describe() + ")" : ""));
+    Progress progress(encodeStage(source.width, source.height, size, what) + (device.onGpu() ? " (" + device.describe() + ")" : ""));
     Image image =
         renderers::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback(),
                                                    parseEnum<codec::EncodeFilter>(fit.filter), keptLevels});
@@ -144,6 +147,17 @@ format::ConusFile keptEncodeToConus(const codec::ModelEncode& kept, const Source
                                     std::string* fitNote) {
     if (fitNote) *fitNote = fitText(kept.fit);
     return codec::makeImageFile(kept.image, map, sourceWidth, sourceHeight, encoding, std::move(analytic));
+}
+
+format::ConusFile encodeToConus(const renderers::Device& device, const codec::EightBitImage& source, const SourceEncoding& encoding,
+                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
+                                const FitSetting& fit, std::string* fitNote, const std::string& what) {
+    if (device.onGpu() || fit.count() > 0)
+        return encodeToConus(device, codec::linearImage(source), encoding, map, size, std::move(analytic), fit, fitNote, what);
+    Progress progress(encodeStage(source.width, source.height, size, what));
+    Image image = codec::encodeImage(source, map, {size.width, size.height, 0, progress.callback(), parseEnum<codec::EncodeFilter>(fit.filter)});
+    progress.done();
+    return codec::makeImageFile(std::move(image), map, source.width, source.height, encoding, std::move(analytic));
 }
 
 }  // namespace conus::cli

@@ -72,6 +72,11 @@ format::ConusFile encodeToConus(const renderers::Device& device, const Image& so
 format::ConusFile keptEncodeToConus(const codec::ModelEncode& kept, const SourceEncoding& encoding, const codec::SamplingMap& map,
                                     int sourceWidth, int sourceHeight, std::optional<format::AnalyticMap> analytic,
                                     std::string* fitNote = nullptr);
+// The same of a picture kept as 8-bit codes: the CPU encoder reads them (codec::encodeImage of
+// an EightBitImage); the GL encoder and the fit take the linear picture they stand for.
+format::ConusFile encodeToConus(const renderers::Device& device, const codec::EightBitImage& source, const SourceEncoding& encoding,
+                                const codec::SamplingMap& map, Size size, std::optional<format::AnalyticMap> analytic,
+                                const FitSetting& fit = {}, std::string* fitNote = nullptr, const std::string& what = {});
 
 // Applies the storage options to a file model. Without --half or --float, colour is stored as
 // float when the source had more precision than half keeps (16-bit integers, float), else half.

@@ -27,8 +27,9 @@ void addSourceOptions(CLI::App& command, SourceOptions& options) {
     command.add_option("--part", options.part, "the part of a multi-part input to read, by name or index (default: the first)");
 }
 
-imageio::ImageFile readSource(const std::string& path, const SourceOptions& options) {
+imageio::ImageFile readSource(const std::string& path, const SourceOptions& options, bool keepCodes) {
     imageio::ReadOptions read;
+    read.keepCodes = keepCodes;
     if (options.colorspace != kFromTheFile) read.colorspace = parseEnum<Transfer>(options.colorspace);
     read.autoOrient = !options.noAutoOrient;
     read.part = options.part;

@@ -29,7 +29,7 @@ void addSourceOptions(CLI::App& command, SourceOptions& options);
 
 // Reads a picture (a progress stage), says which part of a multi-part file it took, and warns
 // about NaN/Inf values it kept.
-imageio::ImageFile readSource(const std::string& path, const SourceOptions& options);
+imageio::ImageFile readSource(const std::string& path, const SourceOptions& options, bool keepCodes = false);  // ReadOptions::keepCodes
 
 // Reads a data image (importance map, DEM): raw values, never converted, upright.
 Image readData(const std::string& path);

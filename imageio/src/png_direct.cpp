@@ -87,6 +87,15 @@ bool readRows(Png& p, std::uint32_t width, std::uint32_t height, int channels, i
     return true;
 }
 
+// Decodes 8-bit rows into `out` as they are stored; false when libpng found the data damaged.
+bool readCodes(Png& p, std::uint32_t width, std::uint32_t height, int channels, unsigned char* out) {
+    if (setjmp(p.jump)) return false;
+    png_read_update_info(p.png, p.info);
+    for (std::uint32_t y = 0; y < height; ++y) png_read_row(p.png, out + std::size_t{y} * width * channels, nullptr);
+    png_read_end(p.png, nullptr);
+    return true;
+}
+
 // Metadata by name, in the order the attributes were first set, a later value replacing an
 // earlier one in place (as OpenImageIO's ImageSpec::attribute does).
 void setText(std::vector<MetadataItem>& items, const std::string& name, const std::string& value) {
@@ -207,6 +216,14 @@ std::optional<ImageFile> readPngDirect(const std::string& path, const ReadOption
         for (float& t : table) t = srgbToLinear(t);
 
     Image& image = result.image;
+    if (options.keepCodes && depth == 8 && encoding.transfer == Transfer::Srgb) {
+        image.width = static_cast<int>(width);
+        image.height = static_cast<int>(height);
+        image.channels = channels == 1 ? std::vector<std::string>{"Y"} : std::vector<std::string>{"R", "G", "B"};
+        result.codes.resize(std::size_t{width} * height * channels);
+        if (!readCodes(p, width, height, channels, result.codes.data())) return std::nullopt;
+        return result;
+    }
     image = makeImage(static_cast<int>(width), static_cast<int>(height),
                       channels == 1 ? std::vector<std::string>{"Y"} : std::vector<std::string>{"R", "G", "B"});
     std::vector<unsigned char> row(std::size_t{width} * channels * (depth / 8));

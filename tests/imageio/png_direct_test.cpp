@@ -126,6 +126,30 @@ TEST_F(PngDirectTest, TakesPlainPngsAndReadsWhatOpenImageIoReads) {
     EXPECT_EQ(imageio::readImageFile(path("linear16.png")).info.encoding.transfer, Transfer::Linear);
 }
 
+// keepCodes: a plain 8-bit sRGB PNG read as its codes, whose values through the sRGB curve (computed
+// as the float read computes it) are that read's pixels exactly; any other file reads as floats.
+TEST_F(PngDirectTest, KeepsTheCodesOfAn8BitSrgbPng) {
+    ASSERT_NO_FATAL_FAILURE(writePng(path("codes8.png"), 37, 23, 3, OIIO::TypeDesc::UINT8, {}));
+    ASSERT_NO_FATAL_FAILURE(writePng(path("codes16.png"), 19, 11, 3, OIIO::TypeDesc::UINT16, {}));
+    imageio::ReadOptions options;
+    const imageio::ImageFile floats = imageio::readImageFile(path("codes8.png"), options);
+    options.keepCodes = true;
+    const imageio::ImageFile codes = imageio::readImageFile(path("codes8.png"), options);
+    EXPECT_TRUE(codes.image.pixels.empty());
+    EXPECT_EQ(codes.image.width, 37);
+    EXPECT_EQ(codes.image.height, 23);
+    EXPECT_EQ(codes.image.channels, floats.image.channels);
+    EXPECT_EQ(codes.info.encoding, floats.info.encoding);
+    ASSERT_EQ(codes.codes.size(), floats.image.pixels.size());
+    for (std::size_t i = 0; i < codes.codes.size(); ++i)
+        ASSERT_EQ(imageio::srgbToLinear(static_cast<float>(codes.codes[i]) * (1.0f / 255.0f)), floats.image.pixels[i]) << i;
+    const imageio::ImageFile wide = imageio::readImageFile(path("codes16.png"), options);
+    EXPECT_TRUE(wide.codes.empty());
+    EXPECT_EQ(wide.image.pixels.size(), std::size_t{19} * 11 * 3);
+    options.colorspace = Transfer::Linear;  // not sRGB: floats
+    EXPECT_TRUE(imageio::readImageFile(path("codes8.png"), options).codes.empty());
+}
+
 // A real photograph as a camera pipeline leaves it: an ICC profile (iCCP), gAMA, cHRM, pHYs and
 // text chunks (scikit-image's astronaut, from the Debian package the benchmarks use).
 TEST_F(PngDirectTest, ReadsAPhotographWithItsProfileAsOpenImageIoDoes) {

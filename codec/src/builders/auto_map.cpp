@@ -240,11 +240,44 @@ SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options)
 }
 
 // importance.h's detail rule, here beside importanceToDensity for the luminance they share.
+namespace {
+Image detailOfLuminance(const Image& single);
+}
+
 Image detailImportance(const Image& image) {
     if (image.empty()) invalid("the image is empty");
-    const double scale = std::min(1.0, 1024.0 / std::max(image.width, image.height));
     Image single = makeImage(image.width, image.height, {"Y"});
     single.pixels = luminance(image);
+    return detailOfLuminance(single);
+}
+
+Image detailImportance(const EightBitImage& codes, const float* shownCode) {
+    if (codes.width < 1 || codes.height < 1 || codes.channels.empty() ||
+        codes.codes.size() != std::size_t(codes.width) * codes.height * codes.channels.size())
+        invalid("the image is empty");
+    // luminance() of the codes' display values, without a float copy of the picture.
+    const std::vector<std::string>& names = codes.channels;
+    const auto index = [&](const char* name) {
+        const auto it = std::find(names.begin(), names.end(), name);
+        return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+    };
+    const int r = index("R"), g = index("G"), b = index("B"), y = std::max(0, index("Y"));
+    const std::size_t ch = names.size();
+    Image single = makeImage(codes.width, codes.height, {"Y"});
+    const float* unit = shownCode ? shownCode : codeToUnit();
+    for (std::size_t p = 0; p < single.pixels.size(); ++p) {
+        const std::uint8_t* px = &codes.codes[p * ch];
+        single.pixels[p] = (r >= 0 && g >= 0 && b >= 0) ? (unit[px[r]] + unit[px[g]] + unit[px[b]]) / 3.0f : unit[px[y]];
+    }
+    return detailOfLuminance(single);
+}
+
+namespace {
+// The detail rule on the picture's luminance: area-downsampled to at most 1024 px a side, its
+// Sobel gradient magnitude.
+Image detailOfLuminance(const Image& single) {
+    const Image& image = single;
+    const double scale = std::min(1.0, 1024.0 / std::max(image.width, image.height));
     const int w = std::max(1, static_cast<int>(std::lround(image.width * scale)));
     const int h = std::max(1, static_cast<int>(std::lround(image.height * scale)));
     const Image small = scale < 1 ? areaDownsample(single, w, h) : single;
@@ -261,6 +294,7 @@ Image detailImportance(const Image& image) {
         }
     return detail;
 }
+}  // namespace
 
 double densityCorrelation(const SamplingMap& map, const DensityField& target) {
     const std::size_t n = target.values.size();

@@ -2,6 +2,7 @@
 #include "conus/codec/builders/frame_budget.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -119,13 +120,24 @@ std::pair<double, double> singularValues(double a, double b, double c, double d)
 }  // namespace
 
 FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, const Image& importance, const FrameModelOptions& options)
+    : FrameErrorModel(source, nullptr, width, height, importance, options) {}
+
+FrameErrorModel::FrameErrorModel(const EightBitImage& source, int width, int height, const Image& importance,
+                                 const FrameModelOptions& options)
+    : FrameErrorModel(Image{source.width, source.height, source.channels, {}}, &source, width, height, importance, options) {}
+
+// `codes`: the picture is those codes, `source` only their size and channels.
+FrameErrorModel::FrameErrorModel(const Image& source, const EightBitImage* codes, int width, int height, const Image& importance,
+                                 const FrameModelOptions& options)
     : m_options(options) {
     if (source.empty()) invalid("the frame-loss model needs the source picture");
     if (width < 1 || height < 1 || width > source.width || height > source.height)
         invalid("the frame-loss model: CoNUS size " + std::to_string(width) + "x" + std::to_string(height) +
                 " is outside 1x1 .. the source's " + std::to_string(source.width) + "x" + std::to_string(source.height));
     const int sw = source.width, sh = source.height;
-    m_source = &source;
+    m_source = codes ? nullptr : &source;
+    if (codes && codes->codes.size() != std::size_t(source.width) * source.height * source.channels.size())
+        invalid("the frame-loss model: the 8-bit picture's codes do not fill it");
     m_measuredUniform = std::make_shared<MeasuredUniform>();
     m_sourceWidth = sw;
     m_sourceHeight = sh;
@@ -153,8 +165,15 @@ FrameErrorModel::FrameErrorModel(const Image& source, int width, int height, con
     const std::vector<float>& table = displayTable();
     std::vector<float> level, next;
     int w = sw, h = sh;
+    // 8-bit codes: each channel's shown() of each code's linear value (the same floats as the
+    // linear picture's, so the same model).
+    std::vector<std::array<float, 256>> codeShown(codes ? channels : 0);
+    for (std::size_t c = 0; c < codeShown.size(); ++c)
+        for (int v = 0; v < 256; ++v)
+            codeShown[c][v] = shown((isColourChannel(source.channels[c]) ? srgbCodeToLinear() : codeToUnit())[v], display[c], table);
     const auto at = [&](int j, int x, int y, std::size_t c) {
-        return j == 0 ? shown(source.pixels[(std::size_t(y) * sw + x) * channels + c], display[c], table)
+        const std::size_t i = (std::size_t(y) * sw + x) * channels + c;
+        return j == 0 ? (codes ? codeShown[c][codes->codes[i]] : shown(source.pixels[i], display[c], table))
                       : level[(std::size_t(y) * w + x) * channels + c];
     };
     std::vector<double> energies;
@@ -306,6 +325,7 @@ std::vector<double> FrameErrorModel::tileErrors(const SamplingMap& map) const {
 FramePrediction FrameErrorModel::predict(const SamplingMap& map) const { return measure(tileErrors(map)); }
 
 FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
+    if (!m_source) invalid("the frame-loss model of 8-bit codes cannot be confirmed: build it from the linear picture");
     const Image& source = *m_source;
     // The real encode (fitted as the encode will be) and decode at the source's size, and the
     // uniform image's, each tile's mean squared error on the values shown; the model then keeps
@@ -541,6 +561,19 @@ DensityField ownDetailContext(const Image& source, const Image& detail, int widt
 DensityField ownDetailContext(const FrameErrorModel& model, const Image& detail, const AutoMapOptions& options) {
     AutoMapOptions at = options;
     at.minDensity = buildAutoMapForBestFrame(detail, model, kOwnDetailTileLoss, options).minDensity;
+    return importanceToDensity(detail, at);
+}
+
+BudgetResult buildOwnDetailMap(const EightBitImage& source, const Image& detail, int width, int height,
+                               const AutoMapOptions& options, const FrameModelOptions& model) {
+    const FrameErrorModel trials(source, width, height, detail, model);
+    return buildAutoMapForBestFrame(detail, trials, kOwnDetailTileLoss, options);
+}
+
+DensityField ownDetailContext(const EightBitImage& source, const Image& detail, int width, int height,
+                              const AutoMapOptions& options, const FrameModelOptions& model) {
+    AutoMapOptions at = options;
+    at.minDensity = buildOwnDetailMap(source, detail, width, height, options, model).minDensity;
     return importanceToDensity(detail, at);
 }
 

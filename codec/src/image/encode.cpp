@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <iterator>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -101,21 +102,21 @@ public:
 
 namespace {
 
-// Box-filtered mip levels of the source, each built the first time a footprint needs it (or taken
-// from `kept`, where the same source's levels were left by an earlier encode).
+// Box-filtered mip levels of the source, each built the first time a footprint needs it (or, for
+// a float source, taken from `kept`, where the same source's levels were left by an earlier encode). A source
+// of 8-bit codes (EightBitImage) is never made linear as a whole: level 1 is built from its codes
+// through the tables (at an exact halving; otherwise from level 0 made linear whole), and level 0,
+// an array whose pages are touched only where written, is made linear a band of rows at a time,
+// the bands footprints on it read (ensureRows) the first time one does.
 class Pyramid {
 public:
     static constexpr int kMaxLevels = 40;
+    static constexpr int kBandRows = 16;
     using Access = EncodeLevelsAccess;
 
-    Pyramid(const Image& source, EncodeLevels* kept) : m_source(source), m_channels(source.channelCount()), m_kept(kept) {
-        int w = source.width, h = source.height;
-        m_sizes.push_back({w, h});
-        while ((w > 1 || h > 1) && static_cast<int>(m_sizes.size()) < kMaxLevels) {
-            w = std::max(1, (w + 1) / 2);
-            h = std::max(1, (h + 1) / 2);
-            m_sizes.push_back({w, h});
-        }
+    Pyramid(const Image& source, EncodeLevels* kept)
+        : m_source(&source), m_names(&source.channels), m_channels(source.channelCount()), m_kept(kept) {
+        addSizes(source.width, source.height);
         if (!m_kept) return;
         if (Access::source(*m_kept) != source.pixels.data() || Access::width(*m_kept) != source.width ||
             Access::height(*m_kept) != source.height || Access::channels(*m_kept) != m_channels) {
@@ -132,6 +133,16 @@ public:
                 std::call_once(m_once[l], [] {});
             }
     }
+    explicit Pyramid(const EightBitImage& codes)
+        : m_codes(&codes), m_names(&codes.channels), m_channels(codes.channelCount()) {
+        addSizes(codes.width, codes.height);
+        m_bands = (codes.height + kBandRows - 1) / kBandRows;
+        m_bandOnce = std::make_unique<std::once_flag[]>(static_cast<std::size_t>(m_bands));
+        // new float[]: no value written, so no page touched until a band is made linear.
+        m_linear.reset(new float[static_cast<std::size_t>(codes.width) * codes.height * m_channels]);
+        for (int c = 0; c < m_channels; ++c)
+            m_tables.push_back(isColourChannelName(codes.channels[c]) ? srgbCodeToLinear() : codeToUnit());
+    }
     // The levels built or taken go back to `kept` when there is one, else their memory to
     // LevelMemory for the next encode.
     ~Pyramid() {
@@ -142,8 +153,7 @@ public:
         std::vector<Image>& held = Access::levels(*m_kept);
         held.resize(levels());
         for (int l = 1; l < levels(); ++l)
-            if (!m_levels[l].empty())
-                held[l] = Image{width(l), height(l), m_source.channels, std::move(m_levels[l])};
+            if (!m_levels[l].empty()) held[l] = Image{width(l), height(l), *m_names, std::move(m_levels[l])};
     }
     Pyramid(const Pyramid&) = delete;
     Pyramid& operator=(const Pyramid&) = delete;
@@ -151,25 +161,84 @@ public:
     int width(int level) const { return m_sizes[level][0]; }
     int height(int level) const { return m_sizes[level][1]; }
     // The first worker to need a level builds it with all threads while the others wait for it.
+    // Level 0 of 8-bit codes holds only the bands made linear so far: see ensureRows.
     Plane level(int level, int threads) {
-        if (level == 0) return {m_source.pixels.data(), m_source.width, m_source.height};
+        if (level == 0) return {m_codes ? m_linear.get() : m_source->pixels.data(), width(0), height(0)};
         std::call_once(m_once[level], [&] {
-            const Plane below = this->level(level - 1, threads);
             const std::size_t values = static_cast<std::size_t>(width(level)) * height(level) * m_channels;
-            std::vector<float> built = LevelMemory::take(values, width(level), height(level), m_source.channels);
-            areaDownsamplePlane(below, built.data(), width(level), height(level), m_channels, threads);
+            std::vector<float> built = LevelMemory::take(values, width(level), height(level), *m_names);
+            if (level == 1 && m_codes && width(1) * 2 == width(0) && height(1) * 2 == height(0)) {
+                halveCodes(built.data(), threads);
+            } else {
+                if (level == 1) ensureRows(0, 0.0, height(0));
+                const Plane below = this->level(level - 1, threads);
+                areaDownsamplePlane(below, built.data(), width(level), height(level), m_channels, threads);
+            }
             m_levels[level] = std::move(built);  // only a whole level is ever kept
         });
         return {m_levels[level].data(), width(level), height(level)};
     }
+    // Before level `level` is read between rows y0 and y1 (texel coordinates): the bands of level
+    // 0 of 8-bit codes that hold them, and the rows a bilinear tap and a four-float read reach
+    // beyond, made linear. Nothing to do on a float source or another level.
+    void ensureRows(int level, double y0, double y1) {
+        if (level != 0 || !m_codes) return;
+        const int last = height(0) - 1;
+        const int first = std::clamp(static_cast<int>(std::floor(y0)) - 1, 0, last);
+        const int end = std::clamp(static_cast<int>(std::ceil(y1)) + 2, 0, last);
+        for (int b = first / kBandRows; b <= end / kBandRows; ++b) std::call_once(m_bandOnce[b], [&] { linearBand(b); });
+    }
 
 private:
-    const Image& m_source;
+    void addSizes(int w, int h) {
+        m_sizes.push_back({w, h});
+        while ((w > 1 || h > 1) && static_cast<int>(m_sizes.size()) < kMaxLevels) {
+            w = std::max(1, (w + 1) / 2);
+            h = std::max(1, (h + 1) / 2);
+            m_sizes.push_back({w, h});
+        }
+    }
+    void linearBand(int band) {
+        const std::size_t begin = static_cast<std::size_t>(band) * kBandRows * width(0) * m_channels;
+        const std::size_t end = std::min<std::size_t>(begin + std::size_t(kBandRows) * width(0) * m_channels,
+                                                      std::size_t(width(0)) * height(0) * m_channels);
+        const std::uint8_t* codes = m_codes->codes.data();
+        float* out = m_linear.get();
+        for (std::size_t i = begin; i < end; i += m_channels)
+            for (int c = 0; c < m_channels; ++c) out[i + c] = m_tables[c][codes[i + c]];
+    }
+    // Level 1 at an exact halving: each texel the mean of its 2x2 source pixels, made linear.
+    void halveCodes(float* out, int threads) {
+        const int w = width(1), sw = width(0), ch = m_channels;
+        const std::uint8_t* codes = m_codes->codes.data();
+        parallelRows(height(1), threads, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::uint8_t* r0 = codes + std::size_t(2 * y) * sw * ch;
+                const std::uint8_t* r1 = r0 + std::size_t(sw) * ch;
+                float* o = out + std::size_t(y) * w * ch;
+                for (int x = 0; x < w; ++x)
+                    for (int c = 0; c < ch; ++c) {
+                        const float* t = m_tables[c];
+                        const std::size_t i = std::size_t(2 * x) * ch + c;
+                        o[std::size_t(x) * ch + c] = 0.25f * ((t[r0[i]] + t[r0[i + ch]]) + (t[r1[i]] + t[r1[i + ch]]));
+                    }
+            }
+        });
+    }
+
+    const Image* m_source = nullptr;
+    const EightBitImage* m_codes = nullptr;
+    const std::vector<std::string>* m_names = nullptr;
     int m_channels;
-    EncodeLevels* m_kept;
+    EncodeLevels* m_kept = nullptr;  // a float source's levels kept across encodes (EncodeOptions::keptLevels)
     std::vector<std::array<int, 2>> m_sizes;
     std::array<std::vector<float>, kMaxLevels> m_levels;
     std::array<std::once_flag, kMaxLevels> m_once;
+    // 8-bit codes: level 0's array, its bands' flags, and each channel's table.
+    std::unique_ptr<float[]> m_linear;
+    std::unique_ptr<std::once_flag[]> m_bandOnce;
+    int m_bands = 0;
+    std::vector<const float*> m_tables;
 };
 
 // The footprint filter of encode.h: the unit box in CoNUS pixel units (s,t), convolved with a
@@ -485,6 +554,7 @@ void filterOnLevel(Pyramid& pyramid, int level, int threads, int channels, const
     const double ex = 0.5 * (std::abs(g.aL.x) * extent.x + std::abs(g.bL.x) * extent.y);
     const double ey = 0.5 * (std::abs(g.aL.y) * extent.x + std::abs(g.bL.y) * extent.y);
     const bool inner = g.cx - ex >= 0 && g.cx + ex < img.width - 1 && g.cy - ey >= 0 && g.cy + ey < img.height - 1;
+    pyramid.ensureRows(level, g.cy - ey, g.cy + ey);
     const std::size_t stride = static_cast<std::size_t>(img.width) * channels;
     RowTaps r;
     Slabs columns, rows;
@@ -595,6 +665,7 @@ void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, 
     const double ex = 0.5 * (std::abs(major.x) * extent + std::abs(minor.x));
     const double ey = 0.5 * (std::abs(major.y) * extent + std::abs(minor.y));
     const bool inner = cx - ex >= 0 && cx + ex < img.width - 1 && cy - ey >= 0 && cy + ey < img.height - 1;
+    pyramid.ensureRows(level, cy - ey, cy + ey);
     const std::size_t stride = static_cast<std::size_t>(img.width) * channels;
     RowTaps r;
     double total = 0;
@@ -782,22 +853,77 @@ void checkEncodeMemory(const Image& source, int width, int height, std::int64_t 
                                                   std::to_string(maxBytes) + "; give a smaller size");
 }
 
-Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options) {
-    checkImage(source, "encodeImage");
+namespace {
+
+// The encode of a source of `shape`'s size and channels from its pyramid.
+Image encodeFrom(const Image& shape, Pyramid& pyramid, const SamplingMap& map, const EncodeOptions& options) {
     detail::checkOutputSize(options.width, options.height, "encodeImage");
-    checkEncodeMemory(source, options.width, options.height);
-    Image out = detail::makeOutput(source, options.width, options.height);
-    Pyramid pyramid(source, options.keptLevels);
+    checkEncodeMemory(shape, options.width, options.height);
+    Image out = detail::makeOutput(shape, options.width, options.height);
     const FootprintField field(map);
     const bool anisotropic = options.filter == EncodeFilter::Anisotropic && !isUniform(map);  // encode.h says why
     detail::RowProgress progress(options.progress, out.height);
     parallelRows(out.height, options.threads, [&](int y0, int y1) {
-        detail::dispatchChannels(source.channelCount(), [&]<int kC>() {
-            encodeRows<kC>(source, map, field, pyramid, out, options.threads, anisotropic, y0, y1);
+        detail::dispatchChannels(shape.channelCount(), [&]<int kC>() {
+            encodeRows<kC>(shape, map, field, pyramid, out, options.threads, anisotropic, y0, y1);
         });
         progress.add(y1 - y0);
     });
     return out;
+}
+
+std::array<float, 256> codeTable(bool srgb) {
+    std::array<float, 256> t{};
+    const float scale = 1.0f / 255.0f;
+    for (int v = 0; v < 256; ++v) {
+        const float unit = static_cast<float>(v) * scale;  // as imageio's 8-bit reads take it
+        const double e = unit;
+        t[v] = !srgb ? unit : static_cast<float>(e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4));
+    }
+    return t;
+}
+
+void checkCodes(const EightBitImage& codes, const char* what) {
+    if (codes.width < 1 || codes.height < 1 || codes.channels.empty() ||
+        codes.codes.size() != std::size_t(codes.width) * codes.height * codes.channels.size())
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": the 8-bit picture is empty or its codes do not fill it");
+}
+
+}  // namespace
+
+Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options) {
+    checkImage(source, "encodeImage");
+    Pyramid pyramid(source, options.keptLevels);
+    return encodeFrom(source, pyramid, map, options);
+}
+
+const float* srgbCodeToLinear() {
+    static const std::array<float, 256> table = codeTable(true);
+    return table.data();
+}
+
+const float* codeToUnit() {
+    static const std::array<float, 256> table = codeTable(false);
+    return table.data();
+}
+
+bool isColourChannelName(const std::string& name) { return name == "R" || name == "G" || name == "B" || name == "Y"; }
+
+Image linearImage(const EightBitImage& codes) {
+    checkCodes(codes, "linearImage");
+    Image image = makeImage(codes.width, codes.height, codes.channels);
+    const int ch = codes.channelCount();
+    std::vector<const float*> tables;
+    for (int c = 0; c < ch; ++c) tables.push_back(isColourChannelName(codes.channels[c]) ? srgbCodeToLinear() : codeToUnit());
+    for (std::size_t i = 0; i < codes.codes.size(); ++i) image.pixels[i] = tables[i % ch][codes.codes[i]];
+    return image;
+}
+
+Image encodeImage(const EightBitImage& source, const SamplingMap& map, const EncodeOptions& options) {
+    checkCodes(source, "encodeImage");
+    const Image shape{source.width, source.height, source.channels, {}};  // sizes and channels only
+    Pyramid pyramid(source);
+    return encodeFrom(shape, pyramid, map, options);
 }
 
 }  // namespace conus::codec

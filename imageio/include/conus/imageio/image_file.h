@@ -46,6 +46,9 @@ struct ReadOptions {
     std::string part;                    // a part (subimage) by name or index; empty: the first
     NonFiniteRepair repair = NonFiniteRepair::Keep;
     Limits limits;  // maxPixels, maxChannels, maxAttributeBytes, maxHeaderBytes, maxDecodeBytes apply
+    // A plain 8-bit sRGB PNG (one read without OpenImageIO) kept as its codes: ImageFile::codes
+    // holds them and `image` only its size and channels (no pixels). Any other file reads as ever.
+    bool keepCodes = false;
 };
 
 struct ImageFileInfo {
@@ -62,6 +65,9 @@ struct ImageFileInfo {
 struct ImageFile {
     Image image;
     ImageFileInfo info;
+    // ReadOptions::keepCodes, where it applied: the 8-bit sRGB codes, interleaved as image's
+    // channels; image.pixels is then empty.
+    std::vector<std::uint8_t> codes;
 };
 
 // Reads `path` ("-": standard input). Refuses files that are not regular files.

@@ -93,6 +93,9 @@ public:
     // any size (its region R is where it reaches half its peak; empty: R is the whole frame). Throws
     // conus::Error(InvalidArgument) on an empty source or a size outside 1..source size.
     FrameErrorModel(const Image& source, int width, int height, const Image& importance, const FrameModelOptions& options = {});
+    // The same model of a picture kept as 8-bit codes (the same as of linearImage(source)),
+    // which cannot be confirmed (confirmed() throws: build the model of linearImage(source) for that).
+    FrameErrorModel(const EightBitImage& source, int width, int height, const Image& importance, const FrameModelOptions& options = {});
 
     // The same model (the same picture's bands, unconfirmed or confirmed alike) with the region of
     // `importance` instead: the picture's pyramid is not taken again.
@@ -122,6 +125,8 @@ public:
     struct BandFit;
 
 private:
+    FrameErrorModel(const Image& source, const EightBitImage* codes, int width, int height, const Image& importance,
+                    const FrameModelOptions& options);
     // S of the footprint of axes sigma1 >= sigma2 (source pixels) on `tile`, with `fit`'s constants.
     double tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const;
     std::vector<double> shownTileErrors(const Image& source, const Image& view) const;  // measured, per tile
@@ -211,5 +216,10 @@ DensityField ownDetailContext(const Image& source, const Image& detail, int widt
 // The same on a model of the picture already built with `detail` as its region (a model whose
 // pyramid the caller then reuses through withRegion).
 DensityField ownDetailContext(const FrameErrorModel& model, const Image& detail, const AutoMapOptions& options = {});
+// The same two of a picture kept as 8-bit codes (FrameErrorModel's own, unconfirmed: `model.confirm` off).
+BudgetResult buildOwnDetailMap(const EightBitImage& source, const Image& detail, int width, int height,
+                               const AutoMapOptions& options = {}, const FrameModelOptions& model = {});
+DensityField ownDetailContext(const EightBitImage& source, const Image& detail, int width, int height,
+                              const AutoMapOptions& options = {}, const FrameModelOptions& model = {});
 
 }  // namespace conus::codec

@@ -24,6 +24,11 @@ Image ruleImportance(ImportanceRule rule, const Image& shown);
 // Local detail of an image: gradient magnitude of its luminance (one channel "Y"), computed at
 // most 1024 px a side.
 Image detailImportance(const Image& image);
+struct EightBitImage;  // image/encode.h
+// The same of a picture kept as 8-bit codes, as a display shows it: each code's value
+// `shownCode[code]` (nullptr: code / 255). With imageio::displayEncoded's value of each code's
+// linear value, exactly detailImportance(imageio::displayEncoded(linearImage(codes))).
+Image detailImportance(const EightBitImage& codes, const float* shownCode = nullptr);
 
 // High on each face found in `shown` (a soft disc over every detection), zero elsewhere, at most
 // 1024 px a side; throws conus::Error(Unsupported: it depends on the picture, exit 1) when no face

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -133,6 +134,27 @@ struct EncodeOptions {
 void checkEncodeMemory(const Image& source, int width, int height, std::int64_t maxBytes = kMaxEncodeBytes);
 
 Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options);
+
+// A picture read from 8-bit codes, kept as them: interleaved like Image's pixels. The colour
+// channels (R, G, B, Y) are sRGB-encoded, the others (alpha) code / 255, straight (not
+// premultiplied). It stands for the float picture linearImage() makes, a quarter of its memory.
+struct EightBitImage {
+    int width = 0, height = 0;
+    std::vector<std::string> channels;
+    std::vector<std::uint8_t> codes;
+    int channelCount() const { return static_cast<int>(channels.size()); }
+};
+// The linear value of each code of a colour channel (sRGB curve, computed in double and rounded
+// once, as imageio decodes 8-bit sRGB), and of any other channel's (code / 255).
+const float* srgbCodeToLinear();
+const float* codeToUnit();
+bool isColourChannelName(const std::string& name);  // R, G, B, Y: the channels a display encodes
+// The float picture `codes` stands for (throws conus::Error InvalidArgument on an inconsistent one).
+Image linearImage(const EightBitImage& codes);
+// The same CoNUS image as encodeImage(linearImage(source), ...) to float rounding, without that
+// float picture: the pyramid's first level is built from the codes through the tables above, and
+// the source's own pixels are made linear only in the row bands that footprints on it read.
+Image encodeImage(const EightBitImage& source, const SamplingMap& map, const EncodeOptions& options);
 
 // The plain baseline: box-filter area downsample to width x height (exact area weights). It only
 // shrinks: a width or height above the source's throws conus::Error(InvalidArgument).
