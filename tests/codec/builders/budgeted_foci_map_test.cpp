@@ -89,17 +89,20 @@ TEST(BudgetedFociMap, WithoutTheDetailTheContextIsUniform) {
 // budget's own choice holds it and says nothing.
 TEST(BudgetedFociMap, AnExactKPastTheBudgetIsAFinding) {
     const Image source = picture();
-    const std::vector<Focus> foci{{0.35, 0.5, 0.2, 12.0}};
+    const std::vector<Focus> foci{{0.83, 0.5, 0.15, 5.0}};  // on the flat part, 2.6x the samples there are
     FociMapRequest request;
     request.model = kModel;
+    request.frameLoss = 0.1;  // a tight budget: the focus as asked costs the frame more
     request.exactK = true;
     const FociMap exact = budgetedFociMap(source, foci, kWidth / 4, kHeight / 4, request);
-    EXPECT_EQ(exact.budget.given[0].k, 12.0);
+    EXPECT_EQ(exact.budget.given[0].k, 5.0);
+    EXPECT_TRUE(exact.budget.predicted.frameLoss > 0.1 || exact.budget.predicted.tileLoss > kDefaultTileLoss)
+        << exact.budget.predicted.frameLoss << " " << exact.budget.predicted.tileLoss;
     EXPECT_TRUE(exact.budget.overBudget);
-    EXPECT_TRUE(exact.budget.predicted.frameLoss > kDefaultFrameLoss || exact.budget.predicted.tileLoss > kDefaultTileLoss);
     request.exactK = false;
     const FociMap held = budgetedFociMap(source, foci, kWidth / 4, kHeight / 4, request);
-    EXPECT_LT(held.budget.given[0].k, 12.0);
+    EXPECT_LT(held.budget.given[0].k, 5.0);
+    EXPECT_LE(held.budget.predicted.frameLoss, 0.1 + 0.01);
     EXPECT_FALSE(held.budget.overBudget);
 }
 
