@@ -133,23 +133,22 @@ int runBakeRelief(const BakeOptions& o) {
         Progress building("build the sampling map");
         if (!o.foci.empty()) {
             const std::vector<codec::Focus> foci = parseFoci(o.foci);
-            codec::FociOptions fo;
-            fo.columns = fo.rows = o.grid;
-            fo.aspect = double(source.heights.width) / source.heights.height;
-            // The budget of `encode --focus`, on the asset's colour: the rest of the field keeps its samples.
-            const int side = 256;
-            const codec::FrameErrorModel model(source.colour, size.width, size.height,
-                                               codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))),
-                                               codec::FrameModelOptions{codec::ErrorSpace::Display, 0, codec::kFitHoldLowPass, true, kReliefConfirmRounds});
-            // And the field outside the focus within 1 dB of the uniform asset: a relief is read all over.
-            codec::FociBudget budget =
-                codec::fociForFrameLoss(foci, fo, model, codec::kDefaultFrameLoss, o.exactK, codec::kDefaultTileLoss, kReliefRestLoss);
+            // The budget of `encode --focus`, on the asset's colour (on a uniform context: the rest of
+            // the field keeps its samples), and the field outside the focus within kReliefRestLoss of
+            // the uniform asset: a relief is read all over.
+            codec::FociMapRequest request;
+            request.options.columns = request.options.rows = o.grid;
+            request.model = codec::FrameModelOptions{codec::ErrorSpace::Display, 0, codec::kFitHoldLowPass, true, kReliefConfirmRounds};
+            request.exactK = o.exactK;
+            request.restLoss = kReliefRestLoss;
+            codec::FociMap built = codec::budgetedFociMap(source.colour, foci, size.width, size.height, request);
+            const codec::FociBudget& budget = built.budget;
             const std::string said = describeFociBudget(
                 budget, BudgetFrame{size.width, size.height, source.heights.width, source.heights.height, codec::kDefaultFrameLoss, kReliefRestLoss},
                 o.exactK, o.grid);
             if (!quiet()) std::printf("%s\n", said.c_str());
-            map = std::move(budget.map);
-            analytic = codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff));
+            map = std::move(built.budget.map);
+            analytic = std::move(built.analytic);
             how = plural(foci.size(), "focus", "foci") + " map (k " + fociKText(budget.given) + ")";
         } else {
             codec::AutoMapOptions ao;

@@ -91,22 +91,16 @@ DemoMap demoMap(const DemoOptions& o, DemoSource& source, const Size& size) {
         m.map = codec::buildAutoMapForFrameLoss(importance, model, codec::kDefaultFrameLoss, {}, codec::kDefaultTileLoss).map;
         if (o.foci.empty()) source.foci = {codec::hottestRegion(importance, w, h)};
     } else {
-        codec::FociOptions fociOptions;
-        fociOptions.aspect = double(w) / h;
         // As `encode`: away from the foci the samples follow the picture's own detail.
-        const codec::DensityField context =
-            codec::ownDetailContext(source.image, importanceFrom(enumName(codec::ImportanceRule::Detail), source.image), size.width, size.height, {}, kDemoTrials);
-        fociOptions.context = &context;
-        const int side = 256;
-        const codec::FrameErrorModel model(
-            source.image, size.width, size.height,
-            codec::fociImportance(source.foci, fociOptions.aspect, side, std::max(1, static_cast<int>(side / fociOptions.aspect))),
-            kDemoTrials);
-        codec::FociBudget budget = codec::fociForFrameLoss(source.foci, fociOptions, model);
-        said = describeFociBudget(budget, BudgetFrame{size.width, size.height, w, h}, false, fociOptions.columns);
-        source.foci = budget.given;
-        m.map = std::move(budget.map);
-        m.analytic = codec::toAnalytic(source.foci, fociOptions.composition, codec::recordedFalloff(budget, fociOptions.falloff));
+        codec::FociMapRequest request;
+        request.model = kDemoTrials;
+        const Image detail = importanceFrom(enumName(codec::ImportanceRule::Detail), source.image);
+        request.detail = &detail;
+        codec::FociMap built = codec::budgetedFociMap(source.image, source.foci, size.width, size.height, request);
+        said = describeFociBudget(built.budget, BudgetFrame{size.width, size.height, w, h}, false, request.options.columns);
+        source.foci = built.budget.given;
+        m.map = std::move(built.budget.map);
+        m.analytic = std::move(built.analytic);
     }
     building.done();
     if (!said.empty() && !quiet()) std::printf("%s\n", said.c_str());

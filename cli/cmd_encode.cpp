@@ -38,6 +38,7 @@ struct EncodeOptions {
     bool exactK = false;      // --exact-k: foci keep k as asked
     bool fast = false;        // --fast: the filtered encode alone, no fit to the decoder
     std::vector<std::string> foci;
+    std::vector<codec::Focus> parsedFoci;  // --focus, parsed once (runEncode)
     int grid = map_rules::kDefaultSide;
     FitSetting fit = defaultFit();  // fitted by default; --fast leaves it out
     SourceOptions source;
@@ -96,12 +97,6 @@ Image detailOf(const Picture& source) {
     return source.codes ? detailOfCodes(*source.codes) : importanceFrom(enumName(codec::ImportanceRule::Detail), source.image);
 }
 
-// One model of the picture (its pyramid taken once), its region `region`.
-codec::FrameErrorModel modelOf(const Picture& source, const Size& size, const Image& region, const codec::FrameModelOptions& modelOptions) {
-    return source.codes ? codec::FrameErrorModel(*source.codes, size.width, size.height, region, modelOptions)
-                        : codec::FrameErrorModel(source.image, size.width, size.height, region, modelOptions);
-}
-
 BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
     Progress progress("build sampling map from " + o.importance + " importance");
     codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
@@ -133,33 +128,25 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
 // The foci's map under the frame-loss budget (foci_budget.h): says, before the work, what the foci
 // take and the k each got; `given` receives that k for the line that says what was written.
 BuiltMap mapFromFoci(const EncodeOptions& o, const Picture& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
-    const std::vector<codec::Focus> foci = parseFoci(o.foci);
-    codec::FociOptions fo;
-    fo.columns = fo.rows = o.grid;
-    fo.aspect = double(source.image.width) / source.image.height;
-    fo.maxAnisotropy = o.maxAnisotropy;
-    fo.composition = parseEnum<format::FociComposition>(o.compose);
-    fo.falloff = codec::parseFalloff(o.falloff);
-    Progress progress("build sampling map (" + plural(foci.size(), "focus", "foci") + ")");
+    codec::FociMapRequest request;
+    request.options = fociMapOptions(o.grid, o.compose, o.falloff, o.maxAnisotropy);
+    request.model = modelOptions;
+    request.frameLoss = o.frameLoss;
+    request.exactK = o.exactK;
     // Away from the foci the samples follow the picture's own detail, as with no focus at all.
-    // One model of the picture (its pyramid taken once), its region the detail's for the context.
     const Image detail = detailOf(source);
-    const codec::FrameErrorModel picture = modelOf(source, size, detail, modelOptions);
-    const codec::DensityField context = codec::ownDetailContext(picture, detail, ownDetailOptions(o));
-    fo.context = &context;
-    const int side = 256;
-    const codec::FrameErrorModel model =
-        picture.withRegion(codec::fociImportance(foci, fo.aspect, side, std::max(1, static_cast<int>(side / fo.aspect))));
-    codec::FociBudget budget = codec::fociForFrameLoss(foci, fo, model, o.frameLoss, o.exactK);
+    request.detail = &detail;
+    request.contextOptions = ownDetailOptions(o);
+    Progress progress("build sampling map (" + plural(o.parsedFoci.size(), "focus", "foci") + ")");
+    codec::FociMap built = source.codes ? codec::budgetedFociMap(*source.codes, o.parsedFoci, size.width, size.height, request)
+                                        : codec::budgetedFociMap(source.image, o.parsedFoci, size.width, size.height, request);
     progress.done();
     const std::string said =
-        describeFociBudget(budget, BudgetFrame{size.width, size.height, source.image.width, source.image.height, o.frameLoss}, o.exactK, o.grid,
+        describeFociBudget(built.budget, BudgetFrame{size.width, size.height, source.image.width, source.image.height, o.frameLoss}, o.exactK, o.grid,
                            o.maxAnisotropy);
     if (!quiet()) std::printf("%s\n", said.c_str());
-    *given = "k " + fociKText(budget.given);
-    // The file records the falloff the map holds (a transition widened for the anisotropy bound).
-    return {std::make_unique<codec::SamplingMap>(std::move(budget.map)),
-            codec::toAnalytic(budget.given, fo.composition, codec::recordedFalloff(budget, fo.falloff)), std::move(budget.encode)};
+    *given = "k " + fociKText(built.budget.given);
+    return {std::make_unique<codec::SamplingMap>(std::move(built.budget.map)), std::move(built.analytic), std::move(built.budget.encode)};
 }
 
 // No focus, map or importance: the samples follow the picture's own detail, with the context floor
@@ -231,7 +218,7 @@ int runEncode(const EncodeOptions& given) {
     // Usage first, before any input is read.
     if (o.frameLossGiven && o.foci.empty() && o.importance.empty())
         throw Error(ErrorCode::InvalidArgument, "--frame-loss is the budget of --focus and --importance: give one of them");
-    parseFoci(o.foci);
+    o.parsedFoci = parseFoci(o.foci);  // the --focus text, parsed once
     if (!o.storage.sizeText.empty()) parseSize(o.storage.sizeText);
     if (o.fast) o.fit.enabled = false;
     return runConversions(o.batch, [&o](const Job& job) { return encodeOne(o, job.input, job.output); });

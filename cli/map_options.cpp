@@ -32,6 +32,15 @@ std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts) {
     return foci;
 }
 
+codec::FociOptions fociMapOptions(int grid, const std::string& compose, const std::string& falloff, double maxAnisotropy) {
+    codec::FociOptions options;
+    options.columns = options.rows = grid;
+    options.composition = parseEnum<format::FociComposition>(compose);
+    options.falloff = codec::parseFalloff(falloff);
+    options.maxAnisotropy = maxAnisotropy;
+    return options;
+}
+
 codec::FociOptions frameFociOptions(int grid, const std::string& compose, double aspect) {
     codec::FociOptions options;
     options.columns = options.rows = grid;
@@ -136,7 +145,7 @@ std::string describeFociBudget(const codec::FociBudget& b, const std::optional<B
                 std::to_string(frame->height) + " pixels; the context is sampled like a " +
                 oneIn(codec::contextDownscale(b.share, frame->width, frame->height, frame->sourceWidth, frame->sourceHeight)) +
                 " downscale (the uniform image: " + oneIn(uniform) + ")";
-        if (exactK && (b.predicted.frameLoss > frame->frameLoss || b.predicted.tileLoss > codec::kDefaultTileLoss))
+        if (b.overBudget)
             warn("--exact-k: predicted against the uniform image, the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 1) +
                  ", the tiles outside the foci " + lossText(b.predicted.tileLoss, "lose", "gain", 1) + " (the budget: " +
                  numberText(frame->frameLoss) + " and " + numberText(codec::kDefaultTileLoss) + " dB)");

@@ -71,6 +71,10 @@ void checkGridForImage(int grid, int width, int height, int defaultGrid = map_ru
 // The foci of repeated --focus u,v,r,k options, in order.
 std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);
 
+// The foci builder's options from --grid, --compose (a FociComposition's name), --falloff and
+// --max-anisotropy (0: the builder's default), for a picture's foci (encode, bake relief).
+codec::FociOptions fociMapOptions(int grid, const std::string& compose, const std::string& falloff, double maxAnisotropy = 0);
+
 // The foci builder's options for a rendered frame of `aspect` from --grid and --compose (a FociComposition's name),
 // with the r..2r ring (codec::kFormatFalloff).
 codec::FociOptions frameFociOptions(int grid, const std::string& compose, double aspect);

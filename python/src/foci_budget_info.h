@@ -16,8 +16,8 @@
 namespace conus::python {
 
 // The dict of File.budget; warns (UserWarning) when k was lowered, when exact_k left the frame
-// losing more than the budget, and when the grid held a focus only to a lower k.
-inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, int w, int h, int sourceW, int sourceH, bool exactK) {
+// losing more than the budget (FociBudget::overBudget), and when the grid held a focus only to a lower k.
+inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, int w, int h, int sourceW, int sourceH) {
     std::vector<double> asked, given;
     for (const codec::Focus& f : b.asked) asked.push_back(f.k);
     for (const codec::Focus& f : b.given) given.push_back(f.k);
@@ -51,7 +51,7 @@ inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, i
                   list(given) + " (exact_k=True keeps k: predicted, the whole frame then loses " +
                   numberText(std::round(b.askedPredicted.frameLoss * 100) / 100) + " dB, the tiles " +
                   numberText(std::round(b.askedPredicted.tileLoss * 10) / 10) + " dB)";
-    else if (exactK && (b.predicted.frameLoss > frameLoss || b.predicted.tileLoss > codec::kDefaultTileLoss))
+    else if (b.overBudget)
         warning = "conus.encode: exact_k: predicted against the uniform image, the whole frame loses " +
                   numberText(std::round(b.predicted.frameLoss * 10) / 10) + " dB, the tiles outside the foci " +
                   numberText(std::round(b.predicted.tileLoss * 10) / 10) + " dB (the budget: " + numberText(frameLoss) + " and " +

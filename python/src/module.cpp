@@ -277,24 +277,21 @@ PYBIND11_MODULE(_conus, m) {
                                                   fit, fitHold, fit > 0};
             if (!map) {
                 if (!foci.empty()) {
-                    const std::vector<codec::Focus>& f = foci;
-                    codec::FociOptions options;
-                    options.aspect = aspect;
+                    // The budget of `conus encode --focus` (foci_budget.h): k lowered to hold frame_loss,
+                    // the foci on the context the picture's own detail asks for.
+                    codec::FociMapRequest request;
+                    request.model = trials;
+                    request.frameLoss = frameLoss;
+                    request.exactK = exactK;
+                    std::optional<codec::FociMap> built;
                     {
-                        // The budget of `conus encode --focus` (foci_budget.h): k lowered to hold frame_loss,
-                        // the foci on the context the picture's own detail asks for.
                         py::gil_scoped_release release;
-                        const codec::DensityField context = codec::ownDetailContext(
-                            source, pictureImportance(codec::ImportanceRule::Detail, source), w, h, {}, trials);
-                        options.context = &context;
-                        const int side = 256;
-                        const codec::FrameErrorModel model(source, w, h, codec::fociImportance(f, aspect, side, std::max(1, int(side / aspect))),
-                                                           trials);
-                        budget = codec::fociForFrameLoss(f, options, model, frameLoss, exactK);
-                        options.context = nullptr;  // the field ends with this block
+                        const Image detail = pictureImportance(codec::ImportanceRule::Detail, source);
+                        request.detail = &detail;
+                        built = codec::budgetedFociMap(source, foci, w, h, request);
                     }
-                    map = std::make_shared<Map>(
-                        Map{budget->map, codec::toAnalytic(budget->given, options.composition, codec::recordedFalloff(*budget, options.falloff)), aspect});
+                    budget = std::move(built->budget);
+                    map = std::make_shared<Map>(Map{budget->map, std::move(built->analytic), aspect});
                 } else {
                     // As `conus encode` with no focus, map or importance: the picture's own detail.
                     warn("conus.encode: no foci or map: the samples follow the picture's own detail (conus.importance(pixels, "
@@ -312,12 +309,11 @@ PYBIND11_MODULE(_conus, m) {
             {
                 py::gil_scoped_release release;
                 Image encoded;
-                const bool cpu = enumArgument<renderers::Backend>(backend, "backend") == renderers::Backend::Cpu;
-                if (cpu && budget && budget->encode) {
-                    // The budget's confirming encode of this map, encoded and fitted as asked: not made again.
-                    encoded = budget->encode->image;
+                const bool onCpu = enumArgument<renderers::Backend>(backend, "backend") == renderers::Backend::Cpu;
+                if (onCpu && budget && budget->encode) {
+                    encoded = budget->encode->image;  // the budget's confirming encode of this map, fitted as asked: kept
                 } else {
-                    if (cpu) {
+                    if (onCpu) {
                         encoded = codec::encodeImage(source, map->map, options);
                     } else {
                         std::lock_guard<std::mutex> lock(g_deviceMutex);
@@ -329,7 +325,7 @@ PYBIND11_MODULE(_conus, m) {
                                                   map->analytic);
             }
             file->map = map;
-            if (budget) file->budget = budgetInfo(*budget, frameLoss, w, h, source.width, source.height, exactK);
+            if (budget) file->budget = budgetInfo(*budget, frameLoss, w, h, source.width, source.height);
             return file;
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),

@@ -372,7 +372,7 @@ TEST_F(ReaderHostile, AMaterialLibraryIsCheckedBeforeItIsOpened) {
     for (const auto& c : cases) {
         SCOPED_TRACE(c.file);
         Outcome r = run({"render", "mesh", path(c.file), "-o", path("x.exr"), "--size", "32x32"});
-        expectRefusedQuietly(r, "mesh", c.reason, c.secret);
+        expectRefusedQuietly(r, "render", c.reason, c.secret);
         expectMemory(r, 300);
         r = run({"bake", "reflection", path(c.file), "--size", "8", "-o", path("a.exr")});
         expectRefusedQuietly(r, "bake", c.reason, c.secret);
@@ -384,7 +384,7 @@ TEST_F(ReaderHostile, AMaterialLibraryIsCheckedBeforeItIsOpened) {
     const std::string shared = round4("mesh/model/mtllib_passwd.obj");
     CONUS_REQUIRE(shared);
     const Outcome r = run({"render", "mesh", shared, "-o", path("x.exr")});
-    expectRefusedQuietly(r, "mesh", "outside its folder", "root:");
+    expectRefusedQuietly(r, "render", "outside its folder", "root:");
 }
 
 // An NRRD header's fields are found as teem finds them: in any case, at any line end (LF, CR LF,
@@ -418,7 +418,7 @@ TEST_F(ReaderHostile, NrrdDataFilesAreVettedInAnyCaseAndLineEnding) {
         const std::string name = "data/h" + std::to_string(n++) + ".nhdr";
         write(name, c.text);
         const Outcome r = run({"render", "volume", path(name), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
-        expectRefusedQuietly(r, "volume", c.reason, "root:");
+        expectRefusedQuietly(r, "render", c.reason, "root:");
         expectMemory(r, 300);
         EXPECT_FALSE(fs::exists(path("v.exr")));
     }
@@ -435,7 +435,7 @@ TEST_F(ReaderHostile, NrrdDataFilesAreVettedInAnyCaseAndLineEnding) {
     const std::string shared = round4("volume/model/nhdr_upper_passwd.nhdr");
     CONUS_REQUIRE(shared);
     const Outcome r = run({"render", "volume", shared, "-o", path("v.exr"), "--size", "32x32"});
-    expectRefusedQuietly(r, "volume", "an absolute path", "root:");
+    expectRefusedQuietly(r, "render", "an absolute path", "root:");
 }
 
 // ---- elevation models ----------------------------------------------------------------------------

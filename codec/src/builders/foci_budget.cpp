@@ -243,7 +243,44 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
     out.gridLimited = recordReached(out.map, out.given);
     out.share = fociShare(out.given, options.aspect, options.falloff);
     out.askedShare = out.lowered || out.gridLimited ? fociShare(out.asked, options.aspect, options.falloff) : out.share;
+    out.overBudget = exactK && (out.predicted.frameLoss > frameLossDb || out.predicted.tileLoss > tileLossDb);
     return out;
+}
+
+namespace {
+
+// budgetedFociMap of a picture as floats or as 8-bit codes (FrameErrorModel takes either).
+template <class Picture>
+FociMap budgeted(const Picture& picture, std::span<const Focus> foci, int width, int height, const FociMapRequest& request) {
+    FociOptions options = request.options;
+    options.aspect = double(picture.width) / picture.height;
+    const Image region = fociImportance(foci, options.aspect, kFociImportanceSide,
+                                        std::max(1, static_cast<int>(kFociImportanceSide / options.aspect)));
+    DensityField context;
+    std::optional<FrameErrorModel> model;
+    if (request.detail) {
+        // One model of the picture (its pyramid taken once): its region the detail's for the
+        // context, then the foci's for their budget.
+        const FrameErrorModel own(picture, width, height, *request.detail, request.model);
+        context = ownDetailContext(own, *request.detail, request.contextOptions);
+        options.context = &context;
+        model.emplace(own.withRegion(region));
+    } else {
+        model.emplace(picture, width, height, region, request.model);
+    }
+    FociMap out{fociForFrameLoss(foci, options, *model, request.frameLoss, request.exactK, request.tileLoss, request.restLoss), {}};
+    out.analytic = toAnalytic(out.budget.given, options.composition, recordedFalloff(out.budget, options.falloff));
+    return out;
+}
+
+}  // namespace
+
+FociMap budgetedFociMap(const Image& picture, std::span<const Focus> foci, int width, int height, const FociMapRequest& request) {
+    return budgeted(picture, foci, width, height, request);
+}
+
+FociMap budgetedFociMap(const EightBitImage& picture, std::span<const Focus> foci, int width, int height, const FociMapRequest& request) {
+    return budgeted(picture, foci, width, height, request);
 }
 
 FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options, double floor, bool exactK) {

@@ -61,6 +61,9 @@ struct FociBudget {
     // The encode of `map` where the budget's confirming encode was of the map kept (FrameErrorModel::
     // confirmed; `predicted` is then what it measured); null otherwise.
     std::shared_ptr<const ModelEncode> encode{};
+    // With a picture and an explicit k (exactK): the map's predicted whole-frame or tile loss is
+    // past the budget, which callers warn of.
+    bool overBudget = false;
 };
 
 // The falloff the file records for a budget's map: `asked`, its width the widest transition the
@@ -84,6 +87,41 @@ Image fociImportance(std::span<const Focus> foci, double aspect, int width, int 
 FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& options, const FrameErrorModel& model,
                             double frameLossDb = kDefaultFrameLoss, bool exactK = false, double tileLossDb = kDefaultTileLoss,
                             double restLossDb = std::numeric_limits<double>::infinity());
+// The side, along the picture's width, of the fociImportance image a picture's foci budget measures
+// its region on (its height: this over the aspect, at least 1).
+inline constexpr int kFociImportanceSide = 256;
+
+// What an encode of foci asks (`encode --focus`, `bake relief --focus`, `demo`, conus.encode(foci=)).
+struct FociMapRequest {
+    FociOptions options;                   // grid, composition, falloff, anisotropy bound (aspect and context: set by the call)
+    FrameModelOptions model;               // the encode the budget predicts, and confirms (keeping that encode)
+    double frameLoss = kDefaultFrameLoss;  // the budget, as fociForFrameLoss takes it
+    double tileLoss = kDefaultTileLoss;
+    double restLoss = std::numeric_limits<double>::infinity();
+    bool exactK = false;
+    // The picture's own detail (its ImportanceRule::Detail as a display shows it, any size): away
+    // from the foci the samples follow it (ownDetailContext with `contextOptions`), as an encode
+    // with no focus samples the frame. Null: the foci sit on a uniform context.
+    const Image* detail = nullptr;
+    AutoMapOptions contextOptions{};
+};
+
+// The map a budget gives, its analytic form as the file records it (the foci given, the
+// composition, the falloff the map holds) and the budget's findings (budget: the k given, shares,
+// predictions, the builder's notes, the kept encode, overBudget).
+struct FociMap {
+    FociBudget budget;
+    format::AnalyticMap analytic;
+};
+
+// The one call from a picture and its foci to the map of a width x height CoNUS image of it: the
+// foci on the picture's own detail (or a uniform context), the budget's model of that picture
+// (one pyramid for the context and the foci's region, kFociImportanceSide), fociForFrameLoss.
+// Throws what fociForFrameLoss and FrameErrorModel throw.
+FociMap budgetedFociMap(const Image& picture, std::span<const Focus> foci, int width, int height, const FociMapRequest& request);
+// The same of a picture kept as 8-bit codes (its model unconfirmed: `request.model.confirm` off).
+FociMap budgetedFociMap(const EightBitImage& picture, std::span<const Focus> foci, int width, int height, const FociMapRequest& request);
+
 // The same without a picture: k lowered until the context's target density is at least `floor`.
 FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options,
                                double floor = kDefaultContextFloor, bool exactK = false);
