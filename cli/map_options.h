@@ -70,6 +70,10 @@ std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, 
 // the larger of the command's default and map_rules::maxSideForImage (4 nodes a pixel along the
 // image's longer side plus one, 129 always), the bound readers hold files to.
 void checkGridForImage(int grid, int width, int height, int defaultGrid = map_rules::kDefaultSide);
+// The same bound for a map taken from a file (`option` names it, e.g. "--map m.exr"): a map of
+// columns x rows nodes is refused (InvalidArgument) past map_rules::maxSideForImage, which the
+// writer would hold the file to after all the work.
+void checkMapForImage(const std::string& option, int columns, int rows, int width, int height);
 
 // The foci of repeated --focus u,v,r,k options, in order.
 std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);
