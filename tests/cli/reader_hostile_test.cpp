@@ -525,18 +525,18 @@ TEST_F(ReaderHostile, OverlappingCopiesOfATriangleAreRefusedBeforeTheRender) {
     writeNearCopies(m_dir / "near17.gltf", 1 << 17);
     writeNearCopies(m_dir / "near6.gltf", 64);
     const std::string reason = "deep along the average ray of this view";
-    Outcome r = run({"mesh", "render", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--backend", "cpu"});
+    Outcome r = run({"mesh", "render", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--backend", "cpu", "--uniform"});
     expectRefused(r, "mesh", reason);
     EXPECT_TRUE(contains(r.err, "limit meshOverlap")) << r.err;
     EXPECT_LT(r.seconds, 5.0 * conus::testing::kTimeScale);
     expectMemory(r, 500);
-    r = run({"mesh", "render", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--backend", "cpu", "--reference"});
+    r = run({"mesh", "render", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--reference", "--uniform"});
     expectRefused(r, "mesh", reason);
     r = run({"bake", "reflection", path("near17.gltf"), "--size", "64", "-o", path("a.exr")});
     expectRefused(r, "bake", reason);
     expectMemory(r, 500);
     EXPECT_FALSE(fs::exists(path("x.exr")) || fs::exists(path("a.exr")));
-    r = run({"mesh", "render", path("near6.gltf"), "-o", path("ok.exr"), "--size", "64x64", "--backend", "cpu"});
+    r = run({"mesh", "render", path("near6.gltf"), "-o", path("ok.exr"), "--size", "64x64", "--backend", "cpu", "--uniform"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     // Someone else's reader: the triangle covers part of the CoNUS image, not all of it.
     auto in = OIIO::ImageInput::open(path("ok.exr"));
