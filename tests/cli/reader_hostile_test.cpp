@@ -122,6 +122,33 @@ TEST_F(ReaderHostile, VolumeAndCubeTexturesAreRefusedAsPictures) {
     EXPECT_TRUE(contains(r.out, "of a 8x4 source")) << r.out;
 }
 
+// An uncompressed DDS whose pixel format gives a channel no bits (a zero mask): OpenImageIO's
+// reader never finished it (found by the image harness: a 177-byte file held `conus uniform`
+// past any limit); the header refuses it, for each channel, and a full set of masks still reads.
+TEST_F(ReaderHostile, ADdsChannelWithoutBitsIsRefusedFromItsHeader) {
+    write("found.dds", slurp(seed("image", "found-dds-zero-channel-mask-oiio-hang")).substr(1));
+    const struct {
+        std::size_t at;
+        const char* channel;
+    } masks[] = {{92, "red"}, {96, "green"}, {100, "blue"}, {104, "alpha"}};
+    for (const auto& m : masks) {
+        std::string bytes = dds(8, 4, 1, false);
+        put32(bytes, m.at, 0);
+        write(std::string("no_") + m.channel + ".dds", bytes);
+    }
+    for (const std::string file : {"found.dds", "no_red.dds", "no_green.dds", "no_blue.dds", "no_alpha.dds"}) {
+        SCOPED_TRACE(file);
+        const std::string channel = file == "found.dds" ? "green" : file.substr(3, file.size() - 7);
+        Outcome r = run({"uniform", path(file), "-o", path("x.exr")});
+        expectRefused(r, "uniform", "a DDS whose pixel format gives its " + channel + " channel no bits");
+        EXPECT_LT(r.seconds, 5.0 * conus::testing::kTimeScale);
+        expectMemory(r, 300);
+        r = runTool("conus", {"uniform", "-", "-o", path("x.exr")}, path(file));  // standard input
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_FALSE(fs::exists(path("x.exr")));
+    }
+}
+
 // A model whose material names the volume texture: the mesh read refuses it, through render,
 // bake and the viewer.
 TEST_F(ReaderHostile, AVolumeTextureNamedByAMeshIsRefused) {
