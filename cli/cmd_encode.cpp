@@ -59,8 +59,9 @@ struct BuiltMap {
     std::shared_ptr<const codec::ModelEncode> encoded{};  // the budget's confirming encode of `map`, kept
 };
 
-BuiltMap mapFromFile(const std::string& path, const Image& source) {
+BuiltMap mapFromFile(const std::string& path, const Image& source, const Size& size) {
     const format::ConusFile mapSource = format::readConusFile(path);
+    checkMapForImage("--map " + path, mapSource.map.columns, mapSource.map.rows, size.width, size.height);
     // Foci built for another aspect are ellipses on this picture.
     if (const std::optional<double> aspect = codec::madeForAspect(mapSource)) {
         const double here = double(source.width) / source.height;
@@ -190,7 +191,7 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
         !o.fast};
     modelOptions.filter = parseEnum<codec::EncodeFilter>(o.fit.filter);
     modelOptions.fitMethod = parseEnum<codec::FitMethod>(o.fit.method);
-    if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image);
+    if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image, size);
     else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, modelOptions);
     else if (!o.foci.empty()) built = mapFromFoci(o, picture, size, modelOptions, &given);
     else built = mapFromOwnDetail(o, picture, size, modelOptions, &given);
@@ -219,7 +220,14 @@ int runEncode(const EncodeOptions& given) {
     if (o.frameLossGiven && o.foci.empty() && o.importance.empty())
         throw Error(ErrorCode::InvalidArgument, "--frame-loss is the budget of --focus and --importance: give one of them");
     o.parsedFoci = parseFoci(o.foci);  // the --focus text, parsed once
-    if (!o.storage.sizeText.empty()) parseSize(o.storage.sizeText);
+    if (!o.storage.sizeText.empty()) {
+        const Size size = parseSize(o.storage.sizeText);
+        // A map file too fine for --size: refused before any picture is read (its header says).
+        if (!o.mapFile.empty()) {
+            const format::ConusFile map = format::readConusHeader(o.mapFile);
+            checkMapForImage("--map " + o.mapFile, map.map.columns, map.map.rows, size.width, size.height);
+        }
+    }
     if (o.fast) o.fit.enabled = false;
     return runConversions(o.batch, [&o](const Job& job) { return encodeOne(o, job.input, job.output); });
 }

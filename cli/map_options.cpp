@@ -204,4 +204,13 @@ void addDensityBoundOptions(CLI::App& command, double& minDensity, double& maxDe
 
 void checkGridForImage(int grid, int width, int height, int defaultGrid) { codec::checkGridForImage(grid, width, height, "--grid", defaultGrid); }
 
+void checkMapForImage(const std::string& option, int columns, int rows, int width, int height) {
+    const std::int64_t most = map_rules::maxSideForImage(width, height);
+    if (std::max(columns, rows) > most)
+        throw Error(ErrorCode::InvalidArgument, option + ": its " + std::to_string(columns) + "x" + std::to_string(rows) +
+                                                    " sampling map is finer than a " + std::to_string(width) + "x" +
+                                                    std::to_string(height) + " image can show; at most " +
+                                                    std::to_string(most) + " nodes a side");
+}
+
 }  // namespace conus::cli

@@ -67,6 +67,10 @@ std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, 
 
 // --grid against the image it shapes (codec::checkGridForImage).
 void checkGridForImage(int grid, int width, int height, int defaultGrid = map_rules::kDefaultSide);
+// The same bound for a map taken from a file (`option` names it, e.g. "--map m.exr"): a map of
+// columns x rows nodes is refused (InvalidArgument) past map_rules::maxSideForImage, which the
+// writer would hold the file to after all the work.
+void checkMapForImage(const std::string& option, int columns, int rows, int width, int height);
 
 // The foci of repeated --focus u,v,r,k options, in order.
 std::vector<codec::Focus> parseFoci(const std::vector<std::string>& texts);

@@ -11,6 +11,8 @@
 # under a second on an idle core; a lower limit reports false timeouts when the machine is busy (a
 # build beside a niced fuzzer starved it past 10 s while the same inputs replay in 0.8 s).
 # CONUS_FUZZ_RUNS=N stops each harness after N executions instead (SECONDS still bounds it).
+# CONUS_FUZZ_MAX_LEN=N caps the inputs at N bytes instead of 16384 (4096 suits the image harness,
+# whose pictures past 4096 pixels are refused before decoding).
 # CONUS_FUZZ_SANITIZERS=undefined builds into build-fuzz-undefined/ without AddressSanitizer: the
 # harnesses then run several times faster where a reader allocates large buffers (Assimp's OBJ
 # importer fills 16 MB per file, and ASan maps and faults those pages in afresh every time). The
@@ -62,7 +64,7 @@ for name in "${harnesses[@]}"; do
   log="build-fuzz/$name$suffix.log"
   echo "fuzz: $name for ${seconds} s, -fsanitize=$sanitizers (log: $log)"
   set +e
-  "$build/bin/fuzz_$name" -max_total_time="$seconds" -dict=tests/fuzz/conus.dict -timeout="${CONUS_FUZZ_TIMEOUT:-30}" -rss_limit_mb=2048 -max_len=16384 \
+  "$build/bin/fuzz_$name" -max_total_time="$seconds" -dict=tests/fuzz/conus.dict -timeout="${CONUS_FUZZ_TIMEOUT:-30}" -rss_limit_mb=2048 -max_len="${CONUS_FUZZ_MAX_LEN:-16384}" \
     -print_final_stats=1 -runs="${CONUS_FUZZ_RUNS:--1}" "${fork[@]}" -artifact_prefix="build-fuzz/artifacts/$name-" "${corpora[@]}" >"$log" 2>&1
   rc=$?
   set -e

@@ -176,6 +176,23 @@ void checkDdsHeader(const unsigned char* bytes, std::size_t size, const std::str
     if ((caps2 & kCube) || (misc & kCubeMisc)) throw Error(ErrorCode::Unsupported, shown + ": a cube map, not a picture");
     if (layers > 1)
         throw Error(ErrorCode::Unsupported, shown + ": an array of " + std::to_string(layers) + " textures, not a picture");
+    // Uncompressed samples (no FourCC) are unpacked by each channel's bit mask; OpenImageIO's reader
+    // never finishes a file whose pixel format gives a channel it names no bits (a zero mask).
+    constexpr std::uint32_t kAlphaPixels = 0x1, kAlphaOnly = 0x2, kFourCc = 0x4, kRgb = 0x40, kLuminance = 0x20000;
+    const std::uint32_t format = u32(80);
+    if (!(format & kFourCc)) {
+        const struct {
+            bool used;
+            std::uint32_t mask;
+            const char* channel;
+        } masks[] = {{(format & (kRgb | kLuminance)) != 0, u32(92), (format & kRgb) ? "red" : "luminance"},
+                     {(format & kRgb) != 0, u32(96), "green"},
+                     {(format & kRgb) != 0, u32(100), "blue"},
+                     {(format & (kAlphaPixels | kAlphaOnly)) != 0, u32(104), "alpha"}};
+        for (const auto& m : masks)
+            if (m.used && m.mask == 0)
+                throw Error(ErrorCode::Corrupt, shown + ": a DDS whose pixel format gives its " + m.channel + " channel no bits");
+    }
 }
 
 bool isJpeg(const unsigned char* bytes, std::size_t size) {

@@ -122,6 +122,33 @@ TEST_F(ReaderHostile, VolumeAndCubeTexturesAreRefusedAsPictures) {
     EXPECT_TRUE(contains(r.out, "of a 8x4 source")) << r.out;
 }
 
+// An uncompressed DDS whose pixel format gives a channel no bits (a zero mask): OpenImageIO's
+// reader never finished it (found by the image harness: a 177-byte file held `conus uniform`
+// past any limit); the header refuses it, for each channel, and a full set of masks still reads.
+TEST_F(ReaderHostile, ADdsChannelWithoutBitsIsRefusedFromItsHeader) {
+    write("found.dds", slurp(seed("image", "found-dds-zero-channel-mask-oiio-hang")).substr(1));
+    const struct {
+        std::size_t at;
+        const char* channel;
+    } masks[] = {{92, "red"}, {96, "green"}, {100, "blue"}, {104, "alpha"}};
+    for (const auto& m : masks) {
+        std::string bytes = dds(8, 4, 1, false);
+        put32(bytes, m.at, 0);
+        write(std::string("no_") + m.channel + ".dds", bytes);
+    }
+    for (const std::string file : {"found.dds", "no_red.dds", "no_green.dds", "no_blue.dds", "no_alpha.dds"}) {
+        SCOPED_TRACE(file);
+        const std::string channel = file == "found.dds" ? "green" : file.substr(3, file.size() - 7);
+        Outcome r = run({"uniform", path(file), "-o", path("x.exr")});
+        expectRefused(r, "uniform", "a DDS whose pixel format gives its " + channel + " channel no bits");
+        EXPECT_LT(r.seconds, 5.0 * conus::testing::kTimeScale);
+        expectMemory(r, 300);
+        r = runTool("conus", {"uniform", "-", "-o", path("x.exr")}, path(file));  // standard input
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_FALSE(fs::exists(path("x.exr")));
+    }
+}
+
 // A model whose material names the volume texture: the mesh read refuses it, through render,
 // bake and the viewer.
 TEST_F(ReaderHostile, AVolumeTextureNamedByAMeshIsRefused) {
@@ -493,6 +520,63 @@ TEST_F(ReaderHostile, AnNpzMemberNobodyUsesIsNeverInflated) {
     const Outcome r = run({"heightfield", "encode", file, "-o", path("t.exr"), "--size", "64x64"});
     EXPECT_EQ(r.exitCode, 0) << r.err;
     expectMemory(r, 200);  // the 537 MB member stays compressed
+}
+
+// ---- work ----------------------------------------------------------------------------------------
+
+// `copies` near-copies of one triangle in one glTF mesh (its buffer a file beside it), copy i
+// shifted by i millionths along (1, 0.5, 0.25): no two are the same (none is dropped as a
+// duplicate), and every ray through the triangle crosses them all.
+void writeNearCopies(const fs::path& gltf, int copies) {
+    std::string bin;
+    bin.reserve(std::size_t(copies) * 36);
+    for (int i = 0; i < copies; ++i) {
+        const float e = float(i) * 1e-6f;
+        const float xyz[9] = {e, 0.5f * e, 0.25f * e, 1 + e, 0.5f * e, 0.25f * e, e, 1 + 0.5f * e, 0.25f * e};
+        bin.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+    }
+    const float spread = float(copies) * 1e-6f;
+    std::ofstream(fs::path(gltf).replace_extension(".bin"), std::ios::binary) << bin;
+    std::ofstream(gltf) << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+ "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+ "buffers": [{"uri": ")" << fs::path(gltf).replace_extension(".bin").filename().string() << R"(", "byteLength": )" << bin.size() << R"(}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": )" << bin.size() << R"(}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": )" << 3 * copies << R"(, "type": "VEC3", "min": [0, 0, 0], "max": [)"
+                        << 1 + spread << ", " << 1 + spread << ", " << spread << "]}]}";
+}
+
+// 2^17 overlapping near-copies of a triangle: each ray of a CPU render would test every copy (over
+// a minute at 512x512); refused from a probe of the view before the render, by the render and the
+// reflection bake alike. 64 copies render.
+TEST_F(ReaderHostile, OverlappingCopiesOfATriangleAreRefusedBeforeTheRender) {
+    writeNearCopies(m_dir / "near17.gltf", 1 << 17);
+    writeNearCopies(m_dir / "near6.gltf", 64);
+    const std::string reason = "deep along the average ray of this view";
+    Outcome r = run({"mesh", "render", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--backend", "cpu", "--uniform"});
+    expectRefused(r, "mesh", reason);
+    EXPECT_TRUE(contains(r.err, "limit meshOverlap")) << r.err;
+    EXPECT_LT(r.seconds, 5.0 * conus::testing::kTimeScale);
+    expectMemory(r, 500);
+    r = run({"mesh", "render", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--reference", "--uniform"});
+    expectRefused(r, "mesh", reason);
+    r = run({"bake", "reflection", path("near17.gltf"), "--size", "64", "-o", path("a.exr")});
+    expectRefused(r, "bake", reason);
+    expectMemory(r, 500);
+    EXPECT_FALSE(fs::exists(path("x.exr")) || fs::exists(path("a.exr")));
+    r = run({"mesh", "render", path("near6.gltf"), "-o", path("ok.exr"), "--size", "64x64", "--backend", "cpu", "--uniform"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    // Someone else's reader: the triangle covers part of the CoNUS image, not all of it.
+    auto in = OIIO::ImageInput::open(path("ok.exr"));
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec spec = in->spec();
+    const int alpha = spec.channelindex("A");
+    ASSERT_GE(alpha, 0);
+    std::vector<float> pixels(std::size_t(spec.image_pixels()) * spec.nchannels);
+    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()));
+    int covered = 0;
+    for (std::size_t p = 0; p < std::size_t(spec.image_pixels()); ++p) covered += pixels[p * spec.nchannels + alpha] > 0.5f;
+    EXPECT_GT(covered, 0);
+    EXPECT_LT(covered, spec.image_pixels());
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 
 #include "../image/resample_pvt.h"
 #include "conus/codec/mesh/shading.h"
+#include "conus/core/limits.h"
 #include "conus/core/parallel.h"
 
 namespace conus::codec {
@@ -35,6 +36,22 @@ void checkDevice(RTCDevice device, const char* what) {
     if (error != RTC_ERROR_NONE)
         throw Error(error == RTC_ERROR_OUT_OF_MEMORY ? ErrorCode::LimitExceeded : ErrorCode::Unsupported,
                     std::string("mesh reference: Embree failed to ") + what + ": " + embreeErrorText(error));
+}
+
+// An occlusion query's context that counts the surfaces its ray crosses: the filter rejects each
+// hit (so the traversal goes on) until `stopAt`, then accepts one (which ends it).
+struct CountingContext {
+    RTCIntersectContext base;  // first: Embree hands the filter a pointer to it
+    std::int64_t count = 0;
+    std::int64_t stopAt = 0;
+};
+
+void countCrossing(const RTCFilterFunctionNArguments* args) {
+    auto* context = reinterpret_cast<CountingContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        if (++context->count < context->stopAt) args->valid[i] = 0;
+    }
 }
 
 }  // namespace
@@ -73,6 +90,8 @@ MeshScene::MeshScene(Mesh mesh) : m_impl(std::make_unique<Impl>()) {
     }
     std::memcpy(vertices, m.positions.data(), m.positions.size() * sizeof(glm::vec3));
     std::memcpy(indices, m.indices.data(), m.indices.size() * sizeof(std::uint32_t));
+    // Only occlusion queries (surfacesAlong) count; first-hit queries run without a filter.
+    rtcSetGeometryOccludedFilterFunction(geometry, countCrossing);
     rtcCommitGeometry(geometry);
     rtcAttachGeometry(impl.scene, geometry);
     rtcReleaseGeometry(geometry);
@@ -137,6 +156,27 @@ std::optional<MeshScene::Hit> MeshScene::intersect(const Ray& ray, double tNear,
     return hit;
 }
 
+std::int64_t MeshScene::surfacesAlong(const Ray& ray, double tNear, double tFar, std::int64_t most) const {
+    if (!(tFar >= tNear) || most < 1) return 0;
+    const double shift = std::min(tNear, 0.0);
+    const glm::dvec3 origin = ray.origin + ray.direction * shift;
+    RTCRay r{};
+    r.org_x = float(origin.x);
+    r.org_y = float(origin.y);
+    r.org_z = float(origin.z);
+    r.dir_x = float(ray.direction.x);
+    r.dir_y = float(ray.direction.y);
+    r.dir_z = float(ray.direction.z);
+    r.tnear = float(tNear - shift);
+    r.tfar = std::isfinite(tFar) ? float(tFar - shift) : std::numeric_limits<float>::infinity();
+    r.mask = 0xFFFFFFFFu;
+    CountingContext context;
+    rtcInitIntersectContext(&context.base);
+    context.stopAt = most;
+    rtcOccluded1(m_impl->scene, &context.base, &r);
+    return std::min(context.count, most);
+}
+
 namespace {
 
 // The shaded R, G, B, A, Z of the first surface along `ray` at distance in [from, to] (the far
@@ -151,16 +191,47 @@ std::array<float, 5> shadeFirst(const MeshScene& scene, const Camera& camera, co
     return {colour.r, colour.g, colour.b, 1.0f, float(camera.project(hit->position).z)};
 }
 
+// The ray of the undistorted image position uv between the camera's near and far depths, as
+// distances along it (a point at distance t has depth t * dot(direction, forward), plus the
+// origin's, which is 0 for both projections); nullopt when it looks away from the view.
+struct DepthRange {
+    Ray ray;
+    double from = 0, to = 0;
+};
+std::optional<DepthRange> viewRay(const Camera& camera, glm::dvec2 uv) {
+    const Ray ray = camera.ray(uv);
+    const double cosine = glm::dot(ray.direction, camera.forward());
+    if (!(cosine > 0)) return std::nullopt;
+    return DepthRange{ray, camera.near() / cosine, camera.far() / cosine};
+}
+
 }  // namespace
 
+void checkSurfaceOverlap(const MeshScene& scene, const Fpc& fpc, int width, int height) {
+    const int columns = std::clamp(width, 1, 64), rows = std::clamp(height, 1, 64);
+    const std::int64_t probes = std::int64_t{columns} * rows;
+    const std::int64_t budget = std::int64_t{kMaxMeshOverlap} * probes;
+    const Distortion* distortion = fpc.distortion();
+    std::int64_t total = 0;
+    for (int j = 0; j < rows && total <= budget; ++j)
+        for (int i = 0; i < columns && total <= budget; ++i) {
+            const glm::dvec2 pd((i + 0.5) / columns, (j + 0.5) / rows);
+            if (const auto v = viewRay(fpc.camera(), distortion ? distortion->undistort(pd) : pd))
+                total += scene.surfacesAlong(v->ray, v->from, v->to, budget - total + 1);
+        }
+    if (total > budget)
+        throw Error(ErrorCode::LimitExceeded,
+                    "mesh reference: the surfaces lie more than " + std::to_string(kMaxMeshOverlap) +
+                        " deep along the average ray of this view (" + std::to_string(probes) +
+                        " rays probed), and each ray tests every surface in front of its first hit: overlapping "
+                        "copies of its triangles? (limit meshOverlap)");
+}
+
 std::array<float, 5> shadeRay(const MeshScene& scene, const Camera& camera, glm::dvec2 uv) {
-    const Ray ray = camera.ray(uv);
-    // A point at distance t has depth t * dot(direction, forward) (+ the origin's depth, which is
-    // 0 for both projections): the near..far depth range as a range of t.
-    const double cosine = glm::dot(ray.direction, camera.forward());
-    if (!(cosine > 0)) return {0, 0, 0, 0, float(camera.far())};
+    const auto v = viewRay(camera, uv);
+    if (!v) return {0, 0, 0, 0, float(camera.far())};
     double at = 0;
-    return shadeFirst(scene, camera, ray, camera.near() / cosine, camera.far() / cosine, at);
+    return shadeFirst(scene, camera, v->ray, v->from, v->to, at);
 }
 
 std::vector<std::array<float, 5>> shadeRayLayers(const MeshScene& scene, const Camera& camera, glm::dvec2 uv, int layers) {
@@ -184,6 +255,7 @@ Image renderMeshReference(const MeshScene& scene, const Fpc& fpc, int width, int
         throw Error(ErrorCode::InvalidArgument, "mesh reference: samples per pixel must be a square from 1 to 256, got " +
                                                     std::to_string(options.samplesPerPixel));
     Image out = makeImage(width, height, meshChannelNames());
+    checkSurfaceOverlap(scene, fpc, width, height);
     const Camera& camera = fpc.camera();
     const Distortion* distortion = fpc.distortion();
     const float far = float(camera.far());
@@ -220,6 +292,7 @@ Image renderMeshReference(const MeshScene& scene, const Fpc& fpc, int width, int
 
 std::vector<Image> renderMeshLayers(const MeshScene& scene, const Fpc& fpc, int width, int height, int layers, int threads) {
     if (layers < 1) throw Error(ErrorCode::InvalidArgument, "mesh layers: at least one layer, got " + std::to_string(layers));
+    checkSurfaceOverlap(scene, fpc, width, height);
     std::vector<Image> out(static_cast<std::size_t>(layers), makeImage(width, height, meshChannelNames()));
     const Distortion* distortion = fpc.distortion();
     parallelRows(height, threads, [&](int y0, int y1) {

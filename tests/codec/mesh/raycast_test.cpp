@@ -11,6 +11,7 @@
 #include "conus/codec/image/metrics.h"
 #include "conus/codec/mesh/shading.h"
 #include "conus/core/error.h"
+#include "conus/core/limits.h"
 #include "conus/sceneio/mesh_file.h"
 
 namespace conus::codec {
@@ -226,6 +227,59 @@ TEST(MeshReference, BadRequests) {
     broken.indices[5] = 99;
     EXPECT_THROW(MeshScene{std::move(broken)}, Error);
     EXPECT_THROW(MeshScene{Mesh{}}, Error);
+}
+
+// `copies` squares (two triangles each) facing +z, at z = -0.01 i, each shifted sideways by
+// `shift` i: a stack the camera on the +z axis sees through.
+Mesh stackedSquares(int copies, float shift) {
+    Mesh m;
+    for (int i = 0; i < copies; ++i) {
+        const float z = -0.01f * float(i), d = shift * float(i);
+        const auto first = static_cast<std::uint32_t>(m.positions.size());
+        for (const glm::vec3 p : {glm::vec3(-1 + d, -1, z), glm::vec3(1 + d, -1, z), glm::vec3(1 + d, 1, z), glm::vec3(-1 + d, 1, z)})
+            m.positions.push_back(p);
+        for (const std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(first + k);
+    }
+    return m;
+}
+
+TEST(MeshReference, SurfacesAlongARayAreCountedUpToTheAskedMost) {
+    const MeshScene stack(stackedSquares(40, 0.0f));
+    // Through the squares' insides (not their shared diagonal), inside and outside a range.
+    const Ray ray{{0.3, -0.2, 5}, {0, 0, -1}};
+    EXPECT_EQ(stack.surfacesAlong(ray, 0, 100, 1000), 40);
+    EXPECT_EQ(stack.surfacesAlong(ray, 0, 5.0 + 0.095, 1000), 10);  // z = 0 .. -0.09
+    EXPECT_EQ(stack.surfacesAlong(ray, 0, 100, 7), 7);
+    EXPECT_EQ(stack.surfacesAlong(Ray{{3, 3, 5}, {0, 0, -1}}, 0, 100, 1000), 0);
+    // A box: a ray through it crosses two faces; the first-hit query is unchanged by the count.
+    const MeshScene box(sharedBox({-1, -1, -1}, {1, 1, 1}));
+    const Ray through{{0.3, -0.2, 5}, {0, 0, -1}};
+    EXPECT_EQ(box.surfacesAlong(through, 0, 100, 1000), 2);
+    const auto hit = box.intersect(through);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->distance, 4.0, 1e-9);
+}
+
+// Overlapping copies of a surface cost every ray one test each: past kMaxMeshOverlap surfaces on
+// the average probed ray the render is refused before it starts (both renders); a stack within
+// it renders, its front square in front.
+TEST(MeshReference, AViewThroughTooManyOverlappingSurfacesIsRefused) {
+    // Close enough that the squares fill the view: every probed ray crosses the whole stack.
+    const Camera camera = testCamera({0, 0, 1.5}, {0, 0, 0});
+    const Fpc fpc(camera, focusMap(0.4, 0.58, 0.15, 3, double(kW) / kH));
+    const MeshScene deep(stackedSquares(2 * kMaxMeshOverlap, 1e-4f));
+    try {
+        renderMeshReference(deep, fpc, kW, kH);
+        ADD_FAILURE() << "rendered";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::LimitExceeded);
+        EXPECT_NE(std::string(e.what()).find("limit meshOverlap"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(renderMeshLayers(deep, fpc, kW, kH, 2), Error);
+    const MeshScene within(stackedSquares(kMaxMeshOverlap / 2, 1e-4f));
+    const Image out = renderMeshReference(within, fpc, kW, kH);
+    EXPECT_EQ(out.at(kW / 2, kH / 2, kMeshChannelA), 1.0f);
+    EXPECT_NEAR(out.at(kW / 2, kH / 2, kMeshChannelZ), float(camera.project({0, 0, 0}).z), 1e-5);
 }
 
 TEST(MeshReference, ProgressReachesOne) {

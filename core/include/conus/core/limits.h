@@ -66,6 +66,11 @@ inline constexpr int kMaxMarkupDepth = 512;
 // Scans of a progressive JPEG: each is a pass over the whole image (libjpeg's progressive
 // pictures have 10 or fewer).
 inline constexpr int kMaxJpegScans = 100;
+// Surfaces along the average ray of a CPU mesh render (the CoNUS ray cast and its layers), probed
+// before the render: a ray must test every surface stacked in front of its first hit, so a mesh of
+// many overlapping copies of one triangle costs each ray as many tests as copies, whatever the
+// acceleration structure (2^17 copies: over a minute at 512x512). Closed models show a handful.
+inline constexpr int kMaxMeshOverlap = 256;
 
 // The caps a reader applies; a caller may lower any of them (never raise them past the constants:
 // the constants are also what the format's own rules allow).
@@ -86,7 +91,7 @@ struct LimitEntry {
     const char* meaning;  // one line
 };
 
-inline constexpr std::array<LimitEntry, 29> limitTable() {
+inline constexpr std::array<LimitEntry, 30> limitTable() {
     return {{
         {"imageSide", kMaxImageSide, "pixels", "width or height of any image (CoNUS image, source, decoded frame)"},
         {"imagePixels", kMaxImagePixels, "pixels", "width x height of any image"},
@@ -117,6 +122,7 @@ inline constexpr std::array<LimitEntry, 29> limitTable() {
         {"sceneNodes", kMaxSceneNodes, "nodes", "nodes of a scene once shared nodes are expanded (instancing)"},
         {"markupDepth", kMaxMarkupDepth, "levels", "nesting of a glTF's JSON or a COLLADA or X3D file's XML"},
         {"jpegScans", kMaxJpegScans, "scans", "scans of a progressive JPEG (each a pass over the image)"},
+        {"meshOverlap", kMaxMeshOverlap, "surfaces", "surfaces along the average ray of a CPU mesh render, probed before it"},
     }};
 }
 

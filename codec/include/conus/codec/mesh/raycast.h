@@ -47,6 +47,10 @@ public:
     // The first hit along `ray` at distance in [tNear, tFar], if any.
     std::optional<Hit> intersect(const Ray& ray, double tNear = 0.0,
                                  double tFar = std::numeric_limits<double>::infinity()) const;
+    // The surfaces `ray` crosses at distance in [tNear, tFar], counted up to `most` (the count
+    // stops there): what a first-hit query may have to test. A triangle split across several
+    // nodes of the acceleration structure may count more than once.
+    std::int64_t surfacesAlong(const Ray& ray, double tNear, double tFar, std::int64_t most) const;
 
 private:
     struct Impl;
@@ -63,9 +67,17 @@ struct ReferenceOptions {
     ProgressFn progress;
 };
 
+// Refuses (LimitExceeded) a view whose rays cross more than kMaxMeshOverlap (limits.h) surfaces on
+// average between the camera's near and far planes, probed on a grid of up to 64x64 rays through
+// `fpc` before a width x height render (renderMeshReference and renderMeshLayers call it): each
+// ray of the render tests every surface in front of its first hit, so many overlapping copies of a
+// triangle would cost every ray that many tests. The probe stops once the limit is passed.
+void checkSurfaceOverlap(const MeshScene& scene, const Fpc& fpc, int width, int height);
+
 // A width x height CoNUS render of `scene` through `fpc`, channels R, G, B, A, Z (shading.h).
 // Hits count between the camera's near and far depths. Throws conus::Error(InvalidArgument) for a
-// bad size or a samplesPerPixel that is not a square in [1, 256].
+// bad size or a samplesPerPixel that is not a square in [1, 256], and LimitExceeded as
+// checkSurfaceOverlap does.
 Image renderMeshReference(const MeshScene& scene, const Fpc& fpc, int width, int height,
                           const ReferenceOptions& options = {});
 
