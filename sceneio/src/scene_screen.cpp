@@ -363,7 +363,9 @@ void checkGltfTree(const std::string& json, const SceneCaps& caps, const std::st
         return !(depth == 1 && event == nlohmann::json::parse_event_t::key && !kKept.count(parsed.get<std::string>()));
     };
     const nlohmann::json doc = nlohmann::json::parse(json, keep, /*allow_exceptions=*/false);
-    if (!doc.is_object()) return;  // not JSON: Assimp says what is wrong with it
+    // Refused rather than left to Assimp: its JSON reader takes text this one does not (invalid
+    // UTF-8 in a key), and a node graph not screened here may instance past every cap.
+    if (!doc.is_object()) throw Error(ErrorCode::Corrupt, what + ": its JSON does not parse as a glTF's (UTF-8 JSON, an object)");
     checkGltfGraph(doc, caps, what);
 }
 

@@ -246,6 +246,13 @@ TEST_F(ReaderHostile, DeepAndInstancedGltfNodeTreesAreRefusedBeforeAssimp) {
     write("chain_20000.gltf", chainGltf(20000));
     write("dag_22.gltf", dagGltf(22));
     write("dag_12.gltf", dagGltf(12));
+    // The DAG with a byte that is not UTF-8 in a key (found by the mesh harness): Assimp's JSON
+    // reader took it and expanded 2^22 instances (9.7 GB) while the screen, unable to parse it, let it by.
+    write("dag_22_not_utf8.gltf", [] {
+        std::string g = dagGltf(22);
+        g.insert(g.find("\"children\"") + 5, "\xff");
+        return g;
+    }());
     write("cycle.gltf", [] {
         std::string g = chainGltf(2);
         g.replace(g.find("{\"mesh\": 0}"), 11, "{\"mesh\": 0, \"children\": [0]}");
@@ -269,6 +276,7 @@ TEST_F(ReaderHostile, DeepAndInstancedGltfNodeTreesAreRefusedBeforeAssimp) {
         {"chain_20000.gltf", "its node tree is more than"},
         {"dag_22.gltf", "its node tree expands to more than " + std::to_string(conus::kMaxSceneNodes) + " nodes"},
         {"cycle.gltf", "node 0 is its own ancestor"},
+        {"dag_22_not_utf8.gltf", "its JSON does not parse as a glTF's"},
         {"json_deep.gltf", "its JSON nests more than " + std::to_string(conus::kMaxMarkupDepth) + " levels deep"},
     };
     for (const auto& c : cases) {
