@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <vector>
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
@@ -110,6 +111,43 @@ bool isOpenExr(const unsigned char* bytes, std::size_t size) {
     return size >= 4 && std::memcmp(bytes, "\x76\x2f\x31\x01", 4) == 0;
 }
 
+// A JPEG's APP13 segment ("Photoshop 3.0": image resources, the IPTC records among them) is
+// walked before OpenImageIO opens the file: OpenImageIO 2.4's IPTC decoder trusts a record's
+// length and reads past the segment's end where it says more than the segment holds. A resource
+// or an IPTC record that runs past what holds it is refused.
+void checkPhotoshopSegment(const std::vector<unsigned char>& segment, const std::string& shown) {
+    static constexpr char kSignature[] = "Photoshop 3.0";  // and its terminating zero
+    if (segment.size() < sizeof kSignature || std::memcmp(segment.data(), kSignature, sizeof kSignature) != 0) return;
+    const auto refuse = [&](const char* what) {
+        throw Error(ErrorCode::Io, shown + ": a JPEG whose Photoshop (APP13) segment is damaged: " + what);
+    };
+    const std::size_t end = segment.size();
+    std::size_t at = sizeof kSignature;
+    while (at + 4 <= end && std::memcmp(&segment[at], "8BIM", 4) == 0) {
+        if (at + 7 > end) refuse("a resource runs past the segment");
+        const int id = segment[at + 4] << 8 | segment[at + 5];
+        const std::size_t nameBytes = (std::size_t{segment[at + 6]} + 2) & ~std::size_t{1};  // length byte + name, padded to even
+        std::size_t p = at + 6 + nameBytes;
+        if (p + 4 > end) refuse("a resource runs past the segment");
+        const std::size_t size = std::size_t{segment[p]} << 24 | std::size_t{segment[p + 1]} << 16 | std::size_t{segment[p + 2]} << 8 | segment[p + 3];
+        p += 4;
+        if (size > end - p) refuse("a resource says more bytes than the segment holds");
+        if (id == 0x0404) {  // IPTC-IIM: records of 0x1C, record, dataset, 2-byte length, data
+            std::size_t r = p;
+            const std::size_t rEnd = p + size;
+            while (r < rEnd && segment[r] == 0x1C) {
+                if (r + 5 > rEnd) refuse("an IPTC record runs past its resource");
+                const std::size_t length = std::size_t{segment[r + 3]} << 8 | segment[r + 4];
+                if (length & 0x8000) refuse("an IPTC record of extended length");
+                r += 5;
+                if (length > rEnd - r) refuse("an IPTC record says more bytes than its resource holds");
+                r += length;
+            }
+        }
+        at = p + size + (size & 1);
+    }
+}
+
 // A progressive JPEG's decoder passes over every block of the image once per scan, and a scan
 // may code nothing but an end-of-band run: 2,000 such scans in 592 KB cost libjpeg over a minute
 // at 8192x8192. OpenImageIO sets no scan limit, so the scans are counted here, walking the
@@ -136,7 +174,17 @@ void checkJpegScans(Next next, const std::string& shown) {
                                                       " scans, the limit (each scan is a pass over the whole image)");
         const int high = next(), low = next();
         if (high < 0 || low < 0) return;
-        for (int left = (high << 8 | low) - 2; left > 0 && c >= 0; --left) c = next();  // the segment
+        if (c == 0xED) {  // APP13: kept whole and screened (checkPhotoshopSegment)
+            std::vector<unsigned char> segment;
+            for (int left = (high << 8 | low) - 2; left > 0; --left) {
+                const int b = next();
+                if (b < 0) break;
+                segment.push_back(static_cast<unsigned char>(b));
+            }
+            checkPhotoshopSegment(segment, shown);
+        } else {
+            for (int left = (high << 8 | low) - 2; left > 0 && c >= 0; --left) c = next();  // the segment
+        }
         c = next();
     }
 }

@@ -215,6 +215,60 @@ TEST_F(ReaderHostile, AJpegOfEndlessScansIsRefusedBeforeDecoding) {
     expectMemory(r, 300);
 }
 
+// A JPEG with a Photoshop (APP13) segment after its SOI: one IPTC caption record whose length field
+// says `recordLength` and whose resource says `resourceSize` (the record holds 9 bytes, the resource 14).
+std::string withIptc(const std::string& jpeg, int recordLength, std::uint32_t resourceSize) {
+    const std::string caption = "A caption";
+    std::string records = "\x1C\x02\x78";
+    records += static_cast<char>(recordLength >> 8);
+    records += static_cast<char>(recordLength & 0xFF);
+    records += caption;
+    std::string body = std::string("Photoshop 3.0", 14) + "8BIM" + std::string("\x04\x04\x00\x00", 4);
+    for (int shift = 24; shift >= 0; shift -= 8) body += static_cast<char>((resourceSize >> shift) & 0xFF);
+    body += records;
+    const std::size_t length = body.size() + 2;
+    std::string segment = "\xFF\xED";
+    segment += static_cast<char>(length >> 8);
+    segment += static_cast<char>(length & 0xFF);
+    return jpeg.substr(0, 2) + segment + body + jpeg.substr(2);
+}
+
+TEST_F(ReaderHostile, AJpegWhoseIptcRecordsRunPastTheirSegmentIsRefused) {
+    {
+        OIIO::ImageSpec spec(40, 24, 3, OIIO::TypeDesc::UINT8);
+        std::vector<unsigned char> pixels(40 * 24 * 3);
+        for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<unsigned char>((i * 53) % 241);
+        auto out = OIIO::ImageOutput::create(path("base.jpg"));
+        ASSERT_TRUE(out && out->open(path("base.jpg"), spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+        out->close();
+    }
+    const std::string jpeg = slurp(path("base.jpg"));
+    write("fine.jpg", withIptc(jpeg, 9, 14));
+    Outcome r = run({"uniform", path("fine.jpg"), "-o", path("fine.exr")});
+    EXPECT_EQ(r.exitCode, 0) << r.err;  // a well-formed record reads
+    EXPECT_TRUE(fs::exists(path("fine.exr")));
+    const struct {
+        const char* name;
+        int recordLength;
+        std::uint32_t resourceSize;
+        const char* said;
+    } cases[] = {
+        {"record.jpg", 0x40, 14, "an IPTC record says more bytes than its resource holds"},
+        {"resource.jpg", 9, 0x47, "a resource says more bytes than the segment holds"},
+        {"extended.jpg", 0x8004, 14, "an IPTC record of extended length"},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.name);
+        write(c.name, withIptc(jpeg, c.recordLength, c.resourceSize));
+        r = run({"uniform", path(c.name), "-o", path("x.exr")});
+        expectRefused(r, "uniform", c.said);
+        r = runTool("conus", {"uniform", "-", "-o", path("x.exr")}, path(c.name));
+        expectRefused(r, "uniform", "standard input: a JPEG whose Photoshop (APP13) segment is damaged");
+    }
+    EXPECT_FALSE(fs::exists(path("x.exr")));
+}
+
 // ---- scene files ---------------------------------------------------------------------------------
 
 // A glTF of one triangle under a chain of `depth` nodes (each the only child of the one before).
@@ -560,18 +614,18 @@ TEST_F(ReaderHostile, OverlappingCopiesOfATriangleAreRefusedBeforeTheRender) {
     writeNearCopies(m_dir / "near17.gltf", 1 << 17);
     writeNearCopies(m_dir / "near6.gltf", 64);
     const std::string reason = "deep along the average ray of this view";
-    Outcome r = run({"mesh", "render", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--backend", "cpu", "--uniform"});
-    expectRefused(r, "mesh", reason);
+    Outcome r = run({"render", "mesh", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--backend", "cpu", "--uniform"});
+    expectRefused(r, "render", reason);
     EXPECT_TRUE(contains(r.err, "limit meshOverlap")) << r.err;
     EXPECT_LT(r.seconds, 5.0 * conus::testing::kTimeScale);
     expectMemory(r, 500);
-    r = run({"mesh", "render", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--reference", "--uniform"});
-    expectRefused(r, "mesh", reason);
+    r = run({"render", "mesh", path("near17.gltf"), "-o", path("x.exr"), "--size", "512x512", "--reference", "--uniform"});
+    expectRefused(r, "render", reason);
     r = run({"bake", "reflection", path("near17.gltf"), "--size", "64", "-o", path("a.exr")});
     expectRefused(r, "bake", reason);
     expectMemory(r, 500);
     EXPECT_FALSE(fs::exists(path("x.exr")) || fs::exists(path("a.exr")));
-    r = run({"mesh", "render", path("near6.gltf"), "-o", path("ok.exr"), "--size", "64x64", "--backend", "cpu", "--uniform"});
+    r = run({"render", "mesh", path("near6.gltf"), "-o", path("ok.exr"), "--size", "64x64", "--backend", "cpu", "--uniform"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     // Someone else's reader: the triangle covers part of the CoNUS image, not all of it.
     auto in = OIIO::ImageInput::open(path("ok.exr"));
