@@ -27,6 +27,8 @@
 #include "cpu_features_pvt.h"
 #include "conus/core/parallel.h"
 #include "encode_pvt.h"
+#include "encode_pyramid_pvt.h"
+#include "encode_taps_pvt.h"
 #include "resample_pvt.h"
 
 namespace conus::codec {
@@ -37,209 +39,11 @@ constexpr double kTapTolerance = kEncodeTapTolerance;
 
 using detail::areaDownsamplePlane;
 using detail::Plane;
-
-// The memory of the last encodes' pyramid levels, kept for the next encode of a source of the
-// same size (the budget's confirming encodes and the final one, a batch of photos from one
-// camera): a fresh 50 MB level is first touched page by page, and the kernel's clearing of those
-// pages cost more than building the level (perf: clear_page ~20 % of a repeated 4096^2 encode).
-// Every value of a level is written when it is built, so a kept array is handed out as it is.
-// At most kMaxKeptBytes are kept; the oldest arrays go first.
-class LevelMemory {
-public:
-    static constexpr std::size_t kMaxKeptBytes = std::size_t{160} << 20;
-
-    // An array of exactly `values` floats: a kept one if there is one, else a new one (makeImage:
-    // huge pages, faulted in on every core).
-    static std::vector<float> take(std::size_t values, int width, int height, const std::vector<std::string>& channels) {
-        {
-            std::lock_guard lock(mutex());
-            std::vector<std::vector<float>>& kept = store();
-            for (auto it = kept.rbegin(); it != kept.rend(); ++it)
-                if (it->size() == values) {
-                    std::vector<float> found = std::move(*it);
-                    kept.erase(std::next(it).base());
-                    return found;
-                }
-        }
-        return std::move(makeImage(width, height, channels).pixels);
-    }
-    static void give(std::vector<float>&& array) {
-        const std::size_t bytes = array.size() * sizeof(float);
-        if (bytes == 0 || bytes > kMaxKeptBytes) return;
-        std::lock_guard lock(mutex());
-        std::vector<std::vector<float>>& kept = store();
-        kept.push_back(std::move(array));
-        std::size_t total = 0;
-        for (const auto& a : kept) total += a.size() * sizeof(float);
-        while (total > kMaxKeptBytes) {
-            total -= kept.front().size() * sizeof(float);
-            kept.erase(kept.begin());
-        }
-    }
-
-private:
-    static std::mutex& mutex() {
-        static std::mutex m;
-        return m;
-    }
-    static std::vector<std::vector<float>>& store() {
-        static std::vector<std::vector<float>> s;
-        return s;
-    }
-};
-
-}  // namespace
-
-// EncodeLevels's fields, for the Pyramid below.
-class EncodeLevelsAccess {
-public:
-    static const float*& source(EncodeLevels& k) { return k.m_source; }
-    static int& width(EncodeLevels& k) { return k.m_width; }
-    static int& height(EncodeLevels& k) { return k.m_height; }
-    static int& channels(EncodeLevels& k) { return k.m_channels; }
-    static std::vector<Image>& levels(EncodeLevels& k) { return k.m_levels; }
-};
-
-namespace {
-
-// Box-filtered mip levels of the source, each built the first time a footprint needs it (or, for
-// a float source, taken from `kept`, where the same source's levels were left by an earlier encode). A source
-// of 8-bit codes (EightBitImage) is never made linear as a whole: level 1 is built from its codes
-// through the tables (at an exact halving; otherwise from level 0 made linear whole), and level 0,
-// an array whose pages are touched only where written, is made linear a band of rows at a time,
-// the bands footprints on it read (ensureRows) the first time one does.
-class Pyramid {
-public:
-    static constexpr int kMaxLevels = 40;
-    static constexpr int kBandRows = 16;
-    using Access = EncodeLevelsAccess;
-
-    Pyramid(const Image& source, EncodeLevels* kept)
-        : m_source(&source), m_names(&source.channels), m_channels(source.channelCount()), m_kept(kept) {
-        addSizes(source.width, source.height);
-        if (!m_kept) return;
-        if (Access::source(*m_kept) != source.pixels.data() || Access::width(*m_kept) != source.width ||
-            Access::height(*m_kept) != source.height || Access::channels(*m_kept) != m_channels) {
-            m_kept->clear();
-            Access::source(*m_kept) = source.pixels.data();
-            Access::width(*m_kept) = source.width;
-            Access::height(*m_kept) = source.height;
-            Access::channels(*m_kept) = m_channels;
-        }
-        std::vector<Image>& held = Access::levels(*m_kept);
-        for (int l = 1; l < std::min<int>(levels(), static_cast<int>(held.size())); ++l)
-            if (!held[l].pixels.empty()) {
-                m_levels[l] = std::move(held[l].pixels);
-                std::call_once(m_once[l], [] {});
-            }
-    }
-    explicit Pyramid(const EightBitImage& codes)
-        : m_codes(&codes), m_names(&codes.channels), m_channels(codes.channelCount()) {
-        addSizes(codes.width, codes.height);
-        m_bands = (codes.height + kBandRows - 1) / kBandRows;
-        m_bandOnce = std::make_unique<std::once_flag[]>(static_cast<std::size_t>(m_bands));
-        // new float[]: no value written, so no page touched until a band is made linear.
-        m_linear.reset(new float[static_cast<std::size_t>(codes.width) * codes.height * m_channels]);
-        for (int c = 0; c < m_channels; ++c)
-            m_tables.push_back(isColourChannelName(codes.channels[c]) ? srgbCodeToLinear() : codeToUnit());
-    }
-    // The levels built or taken go back to `kept` when there is one, else their memory to
-    // LevelMemory for the next encode.
-    ~Pyramid() {
-        if (!m_kept) {
-            for (std::vector<float>& level : m_levels) LevelMemory::give(std::move(level));
-            return;
-        }
-        std::vector<Image>& held = Access::levels(*m_kept);
-        held.resize(levels());
-        for (int l = 1; l < levels(); ++l)
-            if (!m_levels[l].empty()) held[l] = Image{width(l), height(l), *m_names, std::move(m_levels[l])};
-    }
-    Pyramid(const Pyramid&) = delete;
-    Pyramid& operator=(const Pyramid&) = delete;
-    int levels() const { return static_cast<int>(m_sizes.size()); }
-    int width(int level) const { return m_sizes[level][0]; }
-    int height(int level) const { return m_sizes[level][1]; }
-    // The first worker to need a level builds it with all threads while the others wait for it.
-    // Level 0 of 8-bit codes holds only the bands made linear so far: see ensureRows.
-    Plane level(int level, int threads) {
-        if (level == 0) return {m_codes ? m_linear.get() : m_source->pixels.data(), width(0), height(0)};
-        std::call_once(m_once[level], [&] {
-            const std::size_t values = static_cast<std::size_t>(width(level)) * height(level) * m_channels;
-            std::vector<float> built = LevelMemory::take(values, width(level), height(level), *m_names);
-            if (level == 1 && m_codes && width(1) * 2 == width(0) && height(1) * 2 == height(0)) {
-                halveCodes(built.data(), threads);
-            } else {
-                if (level == 1) ensureRows(0, 0.0, height(0));
-                const Plane below = this->level(level - 1, threads);
-                areaDownsamplePlane(below, built.data(), width(level), height(level), m_channels, threads);
-            }
-            m_levels[level] = std::move(built);  // only a whole level is ever kept
-        });
-        return {m_levels[level].data(), width(level), height(level)};
-    }
-    // Before level `level` is read between rows y0 and y1 (texel coordinates): the bands of level
-    // 0 of 8-bit codes that hold them, and the rows a bilinear tap and a four-float read reach
-    // beyond, made linear. Nothing to do on a float source or another level.
-    void ensureRows(int level, double y0, double y1) {
-        if (level != 0 || !m_codes) return;
-        const int last = height(0) - 1;
-        const int first = std::clamp(static_cast<int>(std::floor(y0)) - 1, 0, last);
-        const int end = std::clamp(static_cast<int>(std::ceil(y1)) + 2, 0, last);
-        for (int b = first / kBandRows; b <= end / kBandRows; ++b) std::call_once(m_bandOnce[b], [&] { linearBand(b); });
-    }
-
-private:
-    void addSizes(int w, int h) {
-        m_sizes.push_back({w, h});
-        while ((w > 1 || h > 1) && static_cast<int>(m_sizes.size()) < kMaxLevels) {
-            w = std::max(1, (w + 1) / 2);
-            h = std::max(1, (h + 1) / 2);
-            m_sizes.push_back({w, h});
-        }
-    }
-    void linearBand(int band) {
-        const std::size_t begin = static_cast<std::size_t>(band) * kBandRows * width(0) * m_channels;
-        const std::size_t end = std::min<std::size_t>(begin + std::size_t(kBandRows) * width(0) * m_channels,
-                                                      std::size_t(width(0)) * height(0) * m_channels);
-        const std::uint8_t* codes = m_codes->codes.data();
-        float* out = m_linear.get();
-        for (std::size_t i = begin; i < end; i += m_channels)
-            for (int c = 0; c < m_channels; ++c) out[i + c] = m_tables[c][codes[i + c]];
-    }
-    // Level 1 at an exact halving: each texel the mean of its 2x2 source pixels, made linear.
-    void halveCodes(float* out, int threads) {
-        const int w = width(1), sw = width(0), ch = m_channels;
-        const std::uint8_t* codes = m_codes->codes.data();
-        parallelRows(height(1), threads, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y) {
-                const std::uint8_t* r0 = codes + std::size_t(2 * y) * sw * ch;
-                const std::uint8_t* r1 = r0 + std::size_t(sw) * ch;
-                float* o = out + std::size_t(y) * w * ch;
-                for (int x = 0; x < w; ++x)
-                    for (int c = 0; c < ch; ++c) {
-                        const float* t = m_tables[c];
-                        const std::size_t i = std::size_t(2 * x) * ch + c;
-                        o[std::size_t(x) * ch + c] = 0.25f * ((t[r0[i]] + t[r0[i + ch]]) + (t[r1[i]] + t[r1[i + ch]]));
-                    }
-            }
-        });
-    }
-
-    const Image* m_source = nullptr;
-    const EightBitImage* m_codes = nullptr;
-    const std::vector<std::string>* m_names = nullptr;
-    int m_channels;
-    EncodeLevels* m_kept = nullptr;  // a float source's levels kept across encodes (EncodeOptions::keptLevels)
-    std::vector<std::array<int, 2>> m_sizes;
-    std::array<std::vector<float>, kMaxLevels> m_levels;
-    std::array<std::once_flag, kMaxLevels> m_once;
-    // 8-bit codes: level 0's array, its bands' flags, and each channel's table.
-    std::unique_ptr<float[]> m_linear;
-    std::unique_ptr<std::once_flag[]> m_bandOnce;
-    int m_bands = 0;
-    std::vector<const float*> m_tables;
-};
+using detail::Float4;
+using detail::load4;
+using detail::Pyramid;
+using detail::RowTaps;
+using detail::TapRow;
 
 // The footprint filter of encode.h: the unit box in CoNUS pixel units (s,t), convolved with a
 // Gaussian of standard deviation `sigma` along the unit direction `major` (sigma 0: the plain box).
@@ -303,16 +107,6 @@ struct TapGrid {
     double cx = 0, cy = 0;  // its centre, texel coordinates
     int ns = 1, nt = 1;
     double ds = 1, dt = 1, s0 = 0, t0 = 0;
-};
-
-// One grid row's taps, all worked out before any texel is read: each tap's arithmetic is then
-// independent of the others' and the loops vectorize (the loop this replaced took a tap at a time,
-// each waiting on two divisions, two erf table reads and a branch).
-struct RowTaps {
-    static constexpr int kMax = 2 * kEncodeMaxAxisTaps;
-    int count = 0;
-    double x[kMax], y[kMax];
-    double weight[kMax];  // <= 0: the tap is left out
 };
 
 // Grid row j of the box filter (sigma 0): the extent is the unit box itself and every tap weighs
@@ -402,16 +196,6 @@ CONUS_VECTOR_CLONES void gaussianRow(const TapGrid& g, const FootprintFilter& fi
     }
 }
 
-// Four floats: one texel's channels (kC <= 4) in one register, so a bilinear tap is a handful of
-// vector operations instead of a loop over channels.
-using Float4 = float __attribute__((vector_size(16)));
-
-inline Float4 load4(const float* p) {
-    Float4 v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-}
-
 // The row's taps, bilinear, weighted, added to acc, their weights to total: detail::
 // addBilinearInterior's arithmetic, the same operations in the same order, on all channels at once.
 // Each of the 2x2 texels is read as four floats from its first channel: the caller keeps the taps
@@ -438,94 +222,16 @@ void accumulateRow(const float* pixels, std::size_t stride, const RowTaps& r, Fl
     }
 }
 
-// One row of the anisotropic kernel's taps, all inside the level a row clear of its last: tap i
-// at texel coordinates (x + i sx, y + i sy), weight weight[i] (every one > 0), bilinear on all
-// channels at once, added to acc. The taps' texel offsets and fractions are worked out first,
-// without a branch, so that loop vectorizes.
-struct TapRow {
-    double x = 0, y = 0, sx = 0, sy = 0;
-    int count = 0;
-    const float* weight = nullptr;
-};
-
-// The row's taps' first texels (offsets in floats) and their fractions, without a branch so the
-// loop vectorizes (inlined into each copy of the tap loop, with that copy's instructions).
-template <int kC>
-inline void tapPlaces(std::size_t stride, const TapRow& row, std::size_t* offset, float* fx, float* fy) {
-    for (int n = 0; n < row.count; ++n) {
-        const double x = row.x + n * row.sx, y = row.y + n * row.sy;
-        const int xi = static_cast<int>(x), yi = static_cast<int>(y);
-        fx[n] = static_cast<float>(x - xi);
-        fy[n] = static_cast<float>(y - yi);
-        offset[n] = yi * stride + static_cast<std::size_t>(xi) * kC;
-    }
-}
-
-template <int kC>
-inline void tapRowBaseline(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
-    std::size_t offset[RowTaps::kMax];
-    float fx[RowTaps::kMax], fy[RowTaps::kMax];
-    tapPlaces<kC>(stride, row, offset, fx, fy);
-    for (int n = 0; n < row.count; ++n) {
-        const float* p0 = pixels + offset[n];
-        const float* p1 = p0 + stride;
-        const Float4 a = load4(p0), b = load4(p1);
-        const Float4 top = a + fx[n] * (load4(p0 + kC) - a);
-        const Float4 bottom = b + fx[n] * (load4(p1 + kC) - b);
-        acc += row.weight[n] * (top + fy[n] * (bottom - top));
-    }
-}
-
+// detail::forceBaselineEncode: the baseline tap loop even where AVX2 is there (tests compare them).
 std::atomic<bool> g_forceBaselineEncode{false};
-
-#if CONUS_HAVE_AVX2_COPY
-// tapRowBaseline on a processor with AVX2: the offsets four taps at a time, then two taps a step,
-// one in each 128-bit half of a register, each lerp a fused multiply-add (so the sums differ from
-// the baseline's in their last bits); the same four-float texel reads.
-template <int kC>
-CONUS_TARGET_AVX2 void tapRowAvx2(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
-    std::size_t offset[RowTaps::kMax];
-    float fx[RowTaps::kMax], fy[RowTaps::kMax];
-    tapPlaces<kC>(stride, row, offset, fx, fy);
-    __m256 sum = _mm256_setzero_ps();
-    int n = 0;
-    for (; n + 1 < row.count; n += 2) {
-        const float* p = pixels + offset[n];
-        const float* q = pixels + offset[n + 1];
-        const __m256 a = _mm256_set_m128(_mm_loadu_ps(q), _mm_loadu_ps(p));
-        const __m256 a1 = _mm256_set_m128(_mm_loadu_ps(q + kC), _mm_loadu_ps(p + kC));
-        const __m256 b = _mm256_set_m128(_mm_loadu_ps(q + stride), _mm_loadu_ps(p + stride));
-        const __m256 b1 = _mm256_set_m128(_mm_loadu_ps(q + stride + kC), _mm_loadu_ps(p + stride + kC));
-        const __m256 fxv = _mm256_set_m128(_mm_set1_ps(fx[n + 1]), _mm_set1_ps(fx[n]));
-        const __m256 fyv = _mm256_set_m128(_mm_set1_ps(fy[n + 1]), _mm_set1_ps(fy[n]));
-        const __m256 wv = _mm256_set_m128(_mm_set1_ps(row.weight[n + 1]), _mm_set1_ps(row.weight[n]));
-        const __m256 top = _mm256_fmadd_ps(fxv, _mm256_sub_ps(a1, a), a);
-        const __m256 bottom = _mm256_fmadd_ps(fxv, _mm256_sub_ps(b1, b), b);
-        sum = _mm256_fmadd_ps(wv, _mm256_fmadd_ps(fyv, _mm256_sub_ps(bottom, top), top), sum);
-    }
-    __m128 s = _mm_add_ps(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1));
-    if (n < row.count) {
-        const float* p = pixels + offset[n];
-        const __m128 a = _mm_loadu_ps(p), a1 = _mm_loadu_ps(p + kC);
-        const __m128 b = _mm_loadu_ps(p + stride), b1 = _mm_loadu_ps(p + stride + kC);
-        const __m128 fxv = _mm_set1_ps(fx[n]);
-        const __m128 top = _mm_fmadd_ps(fxv, _mm_sub_ps(a1, a), a);
-        const __m128 bottom = _mm_fmadd_ps(fxv, _mm_sub_ps(b1, b), b);
-        s = _mm_fmadd_ps(_mm_set1_ps(row.weight[n]), _mm_fmadd_ps(_mm_set1_ps(fy[n]), _mm_sub_ps(bottom, top), top), s);
-    }
-    Float4 v;
-    std::memcpy(&v, &s, sizeof v);
-    acc += v;
-}
-#endif
 
 template <int kC>
 void tapRow(const float* pixels, std::size_t stride, const TapRow& row, Float4& acc) {
 #if CONUS_HAVE_AVX2_COPY
     static const bool avx2 = detail::cpuHasAvx2();
-    if (avx2 && !g_forceBaselineEncode.load(std::memory_order_relaxed)) return tapRowAvx2<kC>(pixels, stride, row, acc);
+    if (avx2 && !g_forceBaselineEncode.load(std::memory_order_relaxed)) return detail::tapRowAvx2<kC>(pixels, stride, row, acc);
 #endif
-    tapRowBaseline<kC>(pixels, stride, row, acc);
+    detail::tapRowBaseline<kC>(pixels, stride, row, acc);
 }
 
 // The filtered value on one level, normalized, written to out. The taps are encode.h's grid
@@ -829,30 +535,6 @@ glm::dmat2 FootprintField::inverseJacobian(glm::dvec2 p) const {
     return (at(0, 0) * (1 - s) + at(1, 0) * s) * (1 - t) + (at(0, 1) * (1 - s) + at(1, 1) * s) * t;
 }
 
-std::int64_t EncodeLevels::bytes() const {
-    std::int64_t total = 0;
-    for (const Image& level : m_levels) total += static_cast<std::int64_t>(level.pixels.size()) * std::int64_t(sizeof(float));
-    return total;
-}
-
-void EncodeLevels::clear() {
-    m_levels.clear();
-    m_source = nullptr;
-    m_width = m_height = m_channels = 0;
-}
-
-void checkEncodeMemory(const Image& source, int width, int height, std::int64_t maxBytes) {
-    const std::int64_t channels = source.channelCount();
-    const std::int64_t bytes =
-        (std::int64_t{source.width} * source.height + std::int64_t{width} * height) * channels * std::int64_t(sizeof(float));
-    if (bytes > maxBytes)
-        throw Error(ErrorCode::LimitExceeded, "encoding a " + std::to_string(source.width) + "x" + std::to_string(source.height) +
-                                                  " picture to " + std::to_string(width) + "x" + std::to_string(height) +
-                                                  " pixels of " + std::to_string(channels) + " channels takes " +
-                                                  std::to_string(bytes) + " bytes, beyond the encode memory limit of " +
-                                                  std::to_string(maxBytes) + "; give a smaller size");
-}
-
 namespace {
 
 // The encode of a source of `shape`'s size and channels from its pyramid.
@@ -872,23 +554,6 @@ Image encodeFrom(const Image& shape, Pyramid& pyramid, const SamplingMap& map, c
     return out;
 }
 
-std::array<float, 256> codeTable(bool srgb) {
-    std::array<float, 256> t{};
-    const float scale = 1.0f / 255.0f;
-    for (int v = 0; v < 256; ++v) {
-        const float unit = static_cast<float>(v) * scale;  // as imageio's 8-bit reads take it
-        const double e = unit;
-        t[v] = !srgb ? unit : static_cast<float>(e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4));
-    }
-    return t;
-}
-
-void checkCodes(const EightBitImage& codes, const char* what) {
-    if (codes.width < 1 || codes.height < 1 || codes.channels.empty() ||
-        codes.codes.size() != std::size_t(codes.width) * codes.height * codes.channels.size())
-        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": the 8-bit picture is empty or its codes do not fill it");
-}
-
 }  // namespace
 
 Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options) {
@@ -897,30 +562,8 @@ Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptio
     return encodeFrom(source, pyramid, map, options);
 }
 
-const float* srgbCodeToLinear() {
-    static const std::array<float, 256> table = codeTable(true);
-    return table.data();
-}
-
-const float* codeToUnit() {
-    static const std::array<float, 256> table = codeTable(false);
-    return table.data();
-}
-
-bool isColourChannelName(const std::string& name) { return name == "R" || name == "G" || name == "B" || name == "Y"; }
-
-Image linearImage(const EightBitImage& codes) {
-    checkCodes(codes, "linearImage");
-    Image image = makeImage(codes.width, codes.height, codes.channels);
-    const int ch = codes.channelCount();
-    std::vector<const float*> tables;
-    for (int c = 0; c < ch; ++c) tables.push_back(isColourChannelName(codes.channels[c]) ? srgbCodeToLinear() : codeToUnit());
-    for (std::size_t i = 0; i < codes.codes.size(); ++i) image.pixels[i] = tables[i % ch][codes.codes[i]];
-    return image;
-}
-
 Image encodeImage(const EightBitImage& source, const SamplingMap& map, const EncodeOptions& options) {
-    checkCodes(source, "encodeImage");
+    detail::checkCodes(source, "encodeImage");
     const Image shape{source.width, source.height, source.channels, {}};  // sizes and channels only
     Pyramid pyramid(source);
     return encodeFrom(shape, pyramid, map, options);
