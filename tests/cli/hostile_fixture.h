@@ -104,6 +104,11 @@ protected:
     }
 
     std::string path(const std::string& name) const { return (m_dir / name).string(); }
+    // `bytes` as the file `name` in the test's folder (its folders made).
+    void write(const std::string& name, const std::string& bytes) const {
+        fs::create_directories((m_dir / name).parent_path());
+        std::ofstream(m_dir / name, std::ios::binary) << bytes;
+    }
 
     // A committed copy of a small reproducer, or the shared one.
     static std::string reproducer(const std::string& name) {

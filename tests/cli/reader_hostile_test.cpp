@@ -1,10 +1,10 @@
 // The readers against ../shared/data/hostile/round4 and variants of each class the tests make
-// themselves: images that are not flat pictures (volume and cube DDS textures, DDS arrays), JPEGs
-// of endless scans, scene files nested past what a parser's recursion survives, instancing bombs,
-// files named outside a model's folder (an OBJ's material library, an NRRD data file in any
-// case and line ending), .npy headers that sent std::regex into deep recursion, and .npz archives
-// with a large member nobody reads. Each goes through the real tools (`conus` commands, the
-// viewer) and is refused in one line with exit 1, or read correctly, within a bounded peak memory.
+// themselves: images that are not flat pictures (volume and cube DDS textures, DDS arrays), scene
+// files nested past what a parser's recursion survives, instancing bombs, files named outside a
+// model's folder (an OBJ's material library, an NRRD data file in any case and line ending), .npy
+// headers that sent std::regex into deep recursion, and .npz archives with a large member nobody
+// reads (JPEGs: reader_hostile_jpeg_test.cpp). Each goes through the real tools (`conus` commands,
+// the viewer) and is refused in one line with exit 1, or read correctly, within a bounded peak memory.
 #include <sys/stat.h>
 
 #include <cstring>
@@ -24,10 +24,6 @@ protected:
     }
     static std::string seed(const std::string& folder, const std::string& name) {
         return (fs::path(CONUS_FUZZ_CORPUS) / folder / name).string();
-    }
-    void write(const std::string& name, const std::string& bytes) const {
-        fs::create_directories((m_dir / name).parent_path());
-        std::ofstream(m_dir / name, std::ios::binary) << bytes;
     }
     // One refusal line holding `reason` and none of `secret` (a file's content).
     void expectRefusedQuietly(const Outcome& r, const std::string& command, const std::string& reason,
@@ -169,106 +165,6 @@ TEST_F(ReaderHostile, AVolumeTextureNamedByAMeshIsRefused) {
 
 // A progressive JPEG made by libjpeg (through OpenImageIO), then the same with its last scan
 // repeated: each scan is a pass over the whole image, so scans are counted before decoding.
-TEST_F(ReaderHostile, AJpegOfEndlessScansIsRefusedBeforeDecoding) {
-    {
-        OIIO::ImageSpec spec(64, 48, 3, OIIO::TypeDesc::UINT8);
-        spec.attribute("jpeg:progressive", 1);
-        std::vector<unsigned char> pixels(64 * 48 * 3);
-        for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<unsigned char>((i * 37) % 251);
-        auto out = OIIO::ImageOutput::create(path("plain.jpg"));
-        ASSERT_TRUE(out && out->open(path("plain.jpg"), spec));
-        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
-        out->close();
-    }
-    const std::string jpeg = slurp(path("plain.jpg"));
-    int scans = 0;
-    for (std::size_t at = 0; (at = jpeg.find("\xFF\xDA", at)) != std::string::npos; ++at) ++scans;
-    ASSERT_GT(scans, 1) << "libjpeg's progression has several scans";
-    ASSERT_LE(scans, conus::kMaxJpegScans);
-    Outcome r = run({"uniform", path("plain.jpg"), "-o", path("plain.exr")});
-    EXPECT_EQ(r.exitCode, 0) << r.err;
-    // The last scan (a refinement) repeated: libjpeg decodes every repeat again.
-    const std::size_t sos = jpeg.rfind("\xFF\xDA"), eoi = jpeg.rfind("\xFF\xD9");
-    ASSERT_LT(sos, eoi);
-    const std::string scan = jpeg.substr(sos, eoi - sos);
-    const auto repeated = [&](int times) {
-        std::string file = jpeg.substr(0, eoi);
-        for (int i = 0; i < times; ++i) file += scan;
-        return file + "\xFF\xD9";
-    };
-    write("few.jpg", repeated(3));
-    r = run({"uniform", path("few.jpg"), "-o", path("few.exr")});
-    EXPECT_EQ(r.exitCode, 0) << r.err;  // within the limit it reads
-    write("many.jpg", repeated(conus::kMaxJpegScans));
-    r = run({"uniform", path("many.jpg"), "-o", path("x.exr")});
-    expectRefused(r, "uniform", "a JPEG of more than " + std::to_string(conus::kMaxJpegScans) + " scans");
-    expectMemory(r, 300);
-    r = runTool("conus", {"uniform", "-", "-o", path("x.exr")}, path("many.jpg"));
-    expectRefused(r, "uniform", "standard input: a JPEG of more than");
-    r = run({"heightfield", "encode", path("many.jpg"), "-o", path("t.exr"), "--size", "16x16"});
-    expectRefused(r, "heightfield", "a JPEG of more than");
-    EXPECT_FALSE(fs::exists(path("x.exr")) || fs::exists(path("t.exr")));
-    const std::string shared = round4("images/scans_2000.jpg");
-    CONUS_REQUIRE(shared);
-    r = run({"uniform", shared, "-o", path("x.exr")});
-    expectRefused(r, "uniform", "a JPEG of more than");
-    expectMemory(r, 300);
-}
-
-// A JPEG with a Photoshop (APP13) segment after its SOI: one IPTC caption record whose length field
-// says `recordLength` and whose resource says `resourceSize` (the record holds 9 bytes, the resource 14).
-std::string withIptc(const std::string& jpeg, int recordLength, std::uint32_t resourceSize) {
-    const std::string caption = "A caption";
-    std::string records = "\x1C\x02\x78";
-    records += static_cast<char>(recordLength >> 8);
-    records += static_cast<char>(recordLength & 0xFF);
-    records += caption;
-    std::string body = std::string("Photoshop 3.0", 14) + "8BIM" + std::string("\x04\x04\x00\x00", 4);
-    for (int shift = 24; shift >= 0; shift -= 8) body += static_cast<char>((resourceSize >> shift) & 0xFF);
-    body += records;
-    const std::size_t length = body.size() + 2;
-    std::string segment = "\xFF\xED";
-    segment += static_cast<char>(length >> 8);
-    segment += static_cast<char>(length & 0xFF);
-    return jpeg.substr(0, 2) + segment + body + jpeg.substr(2);
-}
-
-TEST_F(ReaderHostile, AJpegWhoseIptcRecordsRunPastTheirSegmentIsRefused) {
-    {
-        OIIO::ImageSpec spec(40, 24, 3, OIIO::TypeDesc::UINT8);
-        std::vector<unsigned char> pixels(40 * 24 * 3);
-        for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<unsigned char>((i * 53) % 241);
-        auto out = OIIO::ImageOutput::create(path("base.jpg"));
-        ASSERT_TRUE(out && out->open(path("base.jpg"), spec));
-        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
-        out->close();
-    }
-    const std::string jpeg = slurp(path("base.jpg"));
-    write("fine.jpg", withIptc(jpeg, 9, 14));
-    Outcome r = run({"uniform", path("fine.jpg"), "-o", path("fine.exr")});
-    EXPECT_EQ(r.exitCode, 0) << r.err;  // a well-formed record reads
-    EXPECT_TRUE(fs::exists(path("fine.exr")));
-    const struct {
-        const char* name;
-        int recordLength;
-        std::uint32_t resourceSize;
-        const char* said;
-    } cases[] = {
-        {"record.jpg", 0x40, 14, "an IPTC record says more bytes than its resource holds"},
-        {"resource.jpg", 9, 0x47, "a resource says more bytes than the segment holds"},
-        {"extended.jpg", 0x8004, 14, "an IPTC record of extended length"},
-    };
-    for (const auto& c : cases) {
-        SCOPED_TRACE(c.name);
-        write(c.name, withIptc(jpeg, c.recordLength, c.resourceSize));
-        r = run({"uniform", path(c.name), "-o", path("x.exr")});
-        expectRefused(r, "uniform", c.said);
-        r = runTool("conus", {"uniform", "-", "-o", path("x.exr")}, path(c.name));
-        expectRefused(r, "uniform", "standard input: a JPEG whose Photoshop (APP13) segment is damaged");
-    }
-    EXPECT_FALSE(fs::exists(path("x.exr")));
-}
-
 // ---- scene files ---------------------------------------------------------------------------------
 
 // A glTF of one triangle under a chain of `depth` nodes (each the only child of the one before).
