@@ -111,40 +111,36 @@ bool isOpenExr(const unsigned char* bytes, std::size_t size) {
     return size >= 4 && std::memcmp(bytes, "\x76\x2f\x31\x01", 4) == 0;
 }
 
-// A JPEG's APP13 segment ("Photoshop 3.0": image resources, the IPTC records among them) is
-// walked before OpenImageIO opens the file: OpenImageIO 2.4's IPTC decoder trusts a record's
-// length and reads past the segment's end where it says more than the segment holds. A resource
-// or an IPTC record that runs past what holds it is refused.
+// A JPEG's APP13 segment ("Photoshop 3.0": image resources, IPTC records among them) is screened
+// as OpenImageIO 2.4 reads it before OpenImageIO opens the file: it looks only at the first
+// resource, at fixed offsets ("8BIM", the id 0x0404, four bytes it skips, a 16-bit size), and walks
+// the IPTC records from there trusting each record's 16-bit length, past the segment's end where
+// a record says more than the segment holds (a heap over-read). Reading the resource the way the
+// Photoshop format defines it (a name of any length) would screen other bytes than the ones
+// OpenImageIO reads, so the screen reads it the same way and refuses what would take OpenImageIO
+// past the segment.
 void checkPhotoshopSegment(const std::vector<unsigned char>& segment, const std::string& shown) {
     static constexpr char kSignature[] = "Photoshop 3.0";  // and its terminating zero
-    if (segment.size() < sizeof kSignature || std::memcmp(segment.data(), kSignature, sizeof kSignature) != 0) return;
+    const std::size_t end = segment.size(), at = sizeof kSignature;
+    if (end < at || std::memcmp(segment.data(), kSignature, sizeof kSignature) != 0) return;
     const auto refuse = [&](const char* what) {
         throw Error(ErrorCode::Io, shown + ": a JPEG whose Photoshop (APP13) segment is damaged: " + what);
     };
-    const std::size_t end = segment.size();
-    std::size_t at = sizeof kSignature;
-    while (at + 4 <= end && std::memcmp(&segment[at], "8BIM", 4) == 0) {
-        if (at + 7 > end) refuse("a resource runs past the segment");
-        const int id = segment[at + 4] << 8 | segment[at + 5];
-        const std::size_t nameBytes = (std::size_t{segment[at + 6]} + 2) & ~std::size_t{1};  // length byte + name, padded to even
-        std::size_t p = at + 6 + nameBytes;
-        if (p + 4 > end) refuse("a resource runs past the segment");
-        const std::size_t size = std::size_t{segment[p]} << 24 | std::size_t{segment[p + 1]} << 16 | std::size_t{segment[p + 2]} << 8 | segment[p + 3];
-        p += 4;
-        if (size > end - p) refuse("a resource says more bytes than the segment holds");
-        if (id == 0x0404) {  // IPTC-IIM: records of 0x1C, record, dataset, 2-byte length, data
-            std::size_t r = p;
-            const std::size_t rEnd = p + size;
-            while (r < rEnd && segment[r] == 0x1C) {
-                if (r + 5 > rEnd) refuse("an IPTC record runs past its resource");
-                const std::size_t length = std::size_t{segment[r + 3]} << 8 | segment[r + 4];
-                if (length & 0x8000) refuse("an IPTC record of extended length");
-                r += 5;
-                if (length > rEnd - r) refuse("an IPTC record says more bytes than its resource holds");
-                r += length;
-            }
-        }
-        at = p + size + (size & 1);
+    if (end < at + 6 || std::memcmp(&segment[at], "8BIM", 4) != 0 || (segment[at + 4] << 8 | segment[at + 5]) != 0x0404) return;
+    if (end < at + 12) refuse("its IPTC block is cut short");
+    const std::size_t size = std::size_t{segment[at + 10]} << 8 | segment[at + 11];
+    std::size_t r = at + 12;
+    if (size > end - r) refuse("its IPTC block says more bytes than the segment holds");
+    std::size_t left = size;
+    while (left > 0 && r < end && segment[r] == 0x1C) {
+        if (end - r < 5) refuse("an IPTC record runs past the segment");
+        if (segment[r + 1] != 0x01 && segment[r + 1] != 0x02) return;  // where OpenImageIO stops
+        const std::size_t length = std::size_t{segment[r + 3]} << 8 | segment[r + 4];
+        if (length > end - (r + 5)) refuse("an IPTC record runs past the segment");
+        const std::size_t step = 5 + length;
+        if (step >= left) return;
+        left -= step;
+        r += step;
     }
 }
 

@@ -97,9 +97,9 @@ TEST_F(JpegHostile, AJpegWhoseIptcRecordsRunPastTheirSegmentIsRefused) {
         std::uint32_t resourceSize;
         const char* said;
     } cases[] = {
-        {"record.jpg", 0x40, 14, "an IPTC record says more bytes than its resource holds"},
-        {"resource.jpg", 9, 0x47, "a resource says more bytes than the segment holds"},
-        {"extended.jpg", 0x8004, 14, "an IPTC record of extended length"},
+        {"record.jpg", 0x40, 14, "an IPTC record runs past the segment"},
+        {"resource.jpg", 9, 0x47, "its IPTC block says more bytes than the segment holds"},
+        {"extended.jpg", 0x8004, 14, "an IPTC record runs past the segment"},
     };
     for (const auto& c : cases) {
         SCOPED_TRACE(c.name);
@@ -109,6 +109,25 @@ TEST_F(JpegHostile, AJpegWhoseIptcRecordsRunPastTheirSegmentIsRefused) {
         r = runTool("conus", {"uniform", "-", "-o", path("x.exr")}, path(c.name));
         expectRefused(r, "uniform", "standard input: a JPEG whose Photoshop (APP13) segment is damaged");
     }
+    // A named first resource: OpenImageIO takes its IPTC size from fixed offsets, here two bytes of
+    // the name (0xFFFF), whatever the resource's own size says: screened as OpenImageIO reads it.
+    std::string named = std::string("Photoshop 3.0", 14) + "8BIM" + std::string("\x04\x04\x06" "AAA\xFF\xFF" "A\x00", 10) +
+                        std::string("\x00\x00\x00\x09\x1C\x02\x78\x00\x04" "abcd", 13);
+    std::string segment = "\xFF\xED";
+    segment += static_cast<char>((named.size() + 2) >> 8);
+    segment += static_cast<char>((named.size() + 2) & 0xFF);
+    write("named.jpg", jpeg.substr(0, 2) + segment + named + jpeg.substr(2));
+    r = run({"uniform", path("named.jpg"), "-o", path("x.exr")});
+    expectRefused(r, "uniform", "its IPTC block says more bytes than the segment holds");
+    // Resources OpenImageIO does not read (the first not IPTC) are not screened: a thumbnail
+    // resource (0x0409) whose size runs on into a next segment, as large resources do, reads.
+    std::string thumb = std::string("Photoshop 3.0", 14) + "8BIM" + std::string("\x04\x09\x00\x00\x00\x01\x00\x00", 8) + "data";
+    segment = "\xFF\xED";
+    segment += static_cast<char>((thumb.size() + 2) >> 8);
+    segment += static_cast<char>((thumb.size() + 2) & 0xFF);
+    write("thumb.jpg", jpeg.substr(0, 2) + segment + thumb + jpeg.substr(2));
+    r = run({"uniform", path("thumb.jpg"), "-o", path("thumb.exr")});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
     EXPECT_FALSE(fs::exists(path("x.exr")));
 }
 
