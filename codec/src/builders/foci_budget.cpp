@@ -280,7 +280,9 @@ FociMap budgetedFociMap(const Image& picture, std::span<const Focus> foci, int w
 }
 
 FociMap budgetedFociMap(const EightBitImage& picture, std::span<const Focus> foci, int width, int height, const FociMapRequest& request) {
-    return budgeted(picture, foci, width, height, request);
+    FociMapRequest unconfirmed = request;
+    unconfirmed.model.confirm = false;  // a model of codes cannot be confirmed by an encode (frame_budget.h)
+    return budgeted(picture, foci, width, height, unconfirmed);
 }
 
 FociBudget fociForContextFloor(std::span<const Focus> foci, const FociOptions& options, double floor, bool exactK) {

@@ -119,7 +119,8 @@ struct FociMap {
 // (one pyramid for the context and the foci's region, kFociImportanceSide), fociForFrameLoss.
 // Throws what fociForFrameLoss and FrameErrorModel throw.
 FociMap budgetedFociMap(const Image& picture, std::span<const Focus> foci, int width, int height, const FociMapRequest& request);
-// The same of a picture kept as 8-bit codes (its model unconfirmed: `request.model.confirm` off).
+// The same of a picture kept as 8-bit codes: its model is never confirmed (`request.model.confirm`
+// is taken as off).
 FociMap budgetedFociMap(const EightBitImage& picture, std::span<const Focus> foci, int width, int height, const FociMapRequest& request);
 
 // The same without a picture: k lowered until the context's target density is at least `floor`.
