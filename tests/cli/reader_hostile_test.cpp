@@ -25,6 +25,14 @@ protected:
     static std::string seed(const std::string& folder, const std::string& name) {
         return (fs::path(CONUS_FUZZ_CORPUS) / folder / name).string();
     }
+    // `render mesh` (within 300 MB) and `bake reflection` of `scene` both refused for `reason`.
+    void expectRenderAndBakeRefuse(const std::string& scene, const std::string& reason) {
+        Outcome r = run({"render", "mesh", scene, "-o", path("x.exr"), "--size", "32x32"});
+        expectRefused(r, "render", reason);
+        expectMemory(r, 300);
+        r = run({"bake", "reflection", scene, "--size", "8", "-o", path("a.exr")});
+        expectRefused(r, "bake", reason);
+    }
     // One refusal line holding `reason` and none of `secret` (a file's content).
     void expectRefusedQuietly(const Outcome& r, const std::string& command, const std::string& reason,
                               const std::string& secret = "") {
@@ -231,11 +239,7 @@ TEST_F(ReaderHostile, DeepAndInstancedGltfNodeTreesAreRefusedBeforeAssimp) {
     };
     for (const auto& c : cases) {
         SCOPED_TRACE(c.file);
-        r = run({"render", "mesh", path(c.file), "-o", path("x.exr"), "--size", "32x32"});
-        expectRefused(r, "render", c.reason);
-        expectMemory(r, 300);
-        r = run({"bake", "reflection", path(c.file), "--size", "8", "-o", path("a.exr")});
-        expectRefused(r, "bake", c.reason);
+        expectRenderAndBakeRefuse(path(c.file), c.reason);
         r = runTool("conus-view", {"--mesh", path(c.file), "--screenshot", path("s.png"), "--size", "32x32"});
         EXPECT_EQ(r.exitCode, 1) << r.err;
         EXPECT_TRUE(errorLines(r.err).size() == 1u && contains(r.err, c.reason)) << r.err;
@@ -327,11 +331,7 @@ TEST_F(ReaderHostile, DeepColladaAndX3dAreRefused) {
     };
     for (const auto& c : cases) {
         SCOPED_TRACE(c.file);
-        r = run({"render", "mesh", path(c.file), "-o", path("x.exr"), "--size", "32x32"});
-        expectRefused(r, "render", c.reason);
-        expectMemory(r, 300);
-        r = run({"bake", "reflection", path(c.file), "--size", "8", "-o", path("a.exr")});
-        expectRefused(r, "bake", c.reason);
+        expectRenderAndBakeRefuse(path(c.file), c.reason);
     }
 }
 
