@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -113,6 +114,7 @@ public:
             if (!held[l].pixels.empty()) {
                 m_levels[l] = std::move(held[l].pixels);
                 std::call_once(m_once[l], [] {});
+                m_built[l].store(true, std::memory_order_release);
             }
     }
     explicit Pyramid(const EightBitImage& codes)
@@ -120,6 +122,7 @@ public:
         addSizes(codes.width, codes.height);
         m_bands = (codes.height + kBandRows - 1) / kBandRows;
         m_bandOnce = std::make_unique<std::once_flag[]>(static_cast<std::size_t>(m_bands));
+        m_bandDone = std::make_unique<std::atomic<bool>[]>(static_cast<std::size_t>(m_bands));
         // new float[]: no value written, so no page touched until a band is made linear.
         m_linear.reset(new float[static_cast<std::size_t>(codes.width) * codes.height * m_channels]);
         for (int c = 0; c < m_channels; ++c)
@@ -143,9 +146,12 @@ public:
     int width(int level) const { return m_sizes[level][0]; }
     int height(int level) const { return m_sizes[level][1]; }
     // The first worker to need a level builds it with all threads while the others wait for it.
-    // Level 0 of 8-bit codes holds only the bands made linear so far: see ensureRows.
+    // Level 0 of 8-bit codes holds only the bands made linear so far: see ensureRows. Every pixel
+    // asks for its levels, so a built one is found by one atomic load: std::call_once sets
+    // thread-local state and calls pthread_once on every call.
     Plane level(int level, int threads) {
         if (level == 0) return {m_codes ? m_linear.get() : m_source->pixels.data(), width(0), height(0)};
+        if (m_built[level].load(std::memory_order_acquire)) return {m_levels[level].data(), width(level), height(level)};
         std::call_once(m_once[level], [&] {
             const std::size_t values = static_cast<std::size_t>(width(level)) * height(level) * m_channels;
             std::vector<float> built = LevelMemory::take(values, width(level), height(level), *m_names);
@@ -157,6 +163,7 @@ public:
                 areaDownsamplePlane(below, built.data(), width(level), height(level), m_channels, threads);
             }
             m_levels[level] = std::move(built);  // only a whole level is ever kept
+            m_built[level].store(true, std::memory_order_release);
         });
         return {m_levels[level].data(), width(level), height(level)};
     }
@@ -168,7 +175,12 @@ public:
         const int last = height(0) - 1;
         const int first = std::clamp(static_cast<int>(std::floor(y0)) - 1, 0, last);
         const int end = std::clamp(static_cast<int>(std::ceil(y1)) + 2, 0, last);
-        for (int b = first / kBandRows; b <= end / kBandRows; ++b) std::call_once(m_bandOnce[b], [&] { linearBand(b); });
+        for (int b = first / kBandRows; b <= end / kBandRows; ++b)
+            if (!m_bandDone[b].load(std::memory_order_acquire))
+                std::call_once(m_bandOnce[b], [&] {
+                    linearBand(b);
+                    m_bandDone[b].store(true, std::memory_order_release);
+                });
     }
 
 private:
@@ -216,9 +228,11 @@ private:
     std::vector<std::array<int, 2>> m_sizes;
     std::array<std::vector<float>, kMaxLevels> m_levels;
     std::array<std::once_flag, kMaxLevels> m_once;
+    std::array<std::atomic<bool>, kMaxLevels> m_built{};  // set once a level's m_once has run
     // 8-bit codes: level 0's array, its bands' flags, and each channel's table.
     std::unique_ptr<float[]> m_linear;
     std::unique_ptr<std::once_flag[]> m_bandOnce;
+    std::unique_ptr<std::atomic<bool>[]> m_bandDone;
     int m_bands = 0;
     std::vector<const float*> m_tables;
 };
