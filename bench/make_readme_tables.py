@@ -435,7 +435,10 @@ def run_web(build):
 def web_table(result):
     c, d, dwaa = result["conus"], result["dzi"], result["conus_dwaa"]
     roi = result["roi_pixels"]
-    lines = [stamp_line(result["stamp"], "`bench/web_bench.py`, one run; headless Chromium"), "",
+    # A result web_bench.py wrote by itself has no stamp: its own date and load, the commit unknown.
+    stamp = result.get("stamp") or {"date": result["date"], "commit": "unknown",
+                                     "machine": f"{result['cores']} cores, load {result['load']:.1f}"}
+    lines = [stamp_line(stamp, "`bench/web_bench.py`, one run; headless Chromium"), "",
              "| measure | CoNUS | baseline (same run) | ratio | target |", "|---|---|---|---|---|",
              f"| whole frame 1024² + {roi}² region at full detail | 1 request, {c['bytes'] / 1024:.0f} KiB "
              f"({c['whole_db']:.1f} / {c['roi_db']:.1f} dB) | DZI Q {d['quality']}: {d['requests']} requests, "
