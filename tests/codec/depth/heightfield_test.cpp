@@ -68,11 +68,10 @@ TEST(HeightFieldTerrain, ColoursInRange) {
     }
 }
 
-// The viewer a user gives, completed from the field's size in metres: far to its far edge, the
-// field of view to its width there; the defaults where the size is unknown; what was given kept.
 // With no texture the ramp is made linear by the sRGB curve (display 0.5 is 0.2140 of the light,
 // the linear toe below 0.04045 is v / 12.92); a texture is kept at the DEM's size, averaged down
-// from a larger one (a 2x2 block's mean) and refused when smaller, naming it.
+// from a larger one (each sample the mean of the block of texels it covers) and refused when
+// smaller, naming it.
 TEST(HeightFieldTerrain, DemColourIsLinearRampOrTheTextureAtTheDemsSize) {
     const Image dem = generateTerrain(smallTerrain(16));
     const glm::dvec2 extent{900, 700};
@@ -111,6 +110,8 @@ TEST(HeightFieldTerrain, DemColourIsLinearRampOrTheTextureAtTheDemsSize) {
     EXPECT_EQ(demColour(generateTerrain(wide), extent, texture, "ortho.png").pixels, texture.pixels) << "the DEM's size: as it is";
 }
 
+// The viewer a user gives, completed from the field's size in metres: far to its far edge, the
+// field of view to its width there; the defaults where the size is unknown; what was given kept.
 TEST(HeightFieldGround, TheViewerIsCompletedFromTheFieldsSize) {
     const TerrainViewer viewer{120.0, 300.0, 0.0, 0.0};
     const GroundParams fitted = groundForField(viewer, {5000.0, 3500.0});
