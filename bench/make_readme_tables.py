@@ -2,8 +2,9 @@
 """Regenerates the tables of bench/README.md from a run of the suites.
 
     bench/make_readme_tables.py [--build DIR] [--repetitions N] [--instructions] [--from-results] SUITE...
-    SUITE: codec, oiio, renderers, subdivision, reflections, terrain, end-to-end, viewer, quality-defaults, quality,
-           or all
+    bench/make_readme_tables.py --plan [SUITE...]
+    SUITE: codec, oiio, renderers, subdivision, reflections, terrain, end-to-end, viewer, web, quality-defaults,
+           quality, or all
 
 Each suite's table sits between `<!-- table:SUITE -->` and `<!-- /table -->` in bench/README.md;
 this script rewrites that block only, stamped with the date, the commit, the machine and the
@@ -17,7 +18,15 @@ bench/end_to_end.sh and keeps its table; `viewer` times conus-view under Xvfb on
 image of a photograph, both decode paths; `quality` runs bench/quality.py, keeps the headline of
 its report and copies the report and its plots to bench/quality-plots/.
 
-`subdivision`, `reflections`, `terrain` and `quality-defaults` write a result file first
+`web` runs bench/web_bench.py (build/bench-results/web.json): one CoNUS frame against a DZI pyramid
+and the browser page's figures.
+
+`all` is one run at one commit: it refuses a tree with changes (commit first, or --allow-modified),
+so that every table names the same commit. Each suite's wall time is kept in
+build/bench-results/durations.json; `--plan` lists what the suites would run and how long each
+took when it last ran here, without running anything.
+
+`subdivision`, `reflections`, `terrain`, `web` and `quality-defaults` write a result file first
 (build/bench-results/subdivision.json and reflections.json: renderers_bench's JSON with the run's stamp;
 build/bench-results/terrain.json from bench/terrain_gain.py; build/quality/targets.json from
 `bench/quality.py --defaults-only`) and make the table from it; `--from-results` makes their tables
@@ -31,6 +40,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import terrain_gain
@@ -412,6 +422,81 @@ def quality_defaults_table(result):
     return "\n".join(lines)
 
 
+def run_web(build):
+    """Runs bench/web_bench.py, which writes build/bench-results/web.json."""
+    saved = Path(build) / RESULTS / "web.json"
+    run([sys.executable, str(BENCH / "web_bench.py"), "--bin", str(Path(build) / "bin"), "--out", str(saved)])
+    result = json.loads(saved.read_text())
+    result["stamp"] = run_stamp()
+    saved.write_text(json.dumps(result, indent=1))
+    return result
+
+
+def web_table(result):
+    c, d, dwaa = result["conus"], result["dzi"], result["conus_dwaa"]
+    roi = result["roi_pixels"]
+    # A result web_bench.py wrote by itself has no stamp: its own date and load, the commit unknown.
+    stamp = result.get("stamp") or {"date": result["date"], "commit": "unknown",
+                                     "machine": f"{result['cores']} cores, load {result['load']:.1f}"}
+    lines = [stamp_line(stamp, "`bench/web_bench.py`, one run; headless Chromium"), "",
+             "| measure | CoNUS | baseline (same run) | ratio | target |", "|---|---|---|---|---|",
+             f"| whole frame 1024² + {roi}² region at full detail | 1 request, {c['bytes'] / 1024:.0f} KiB "
+             f"({c['whole_db']:.1f} / {c['roi_db']:.1f} dB) | DZI Q {d['quality']}: {d['requests']} requests, "
+             f"{d['bytes'] / 1024:.0f} KiB ({d['whole_db']:.1f} / {d['roi_db']:.1f} dB) | "
+             f"{c['bytes'] / d['bytes']:.2f}x the bytes, 1/{d['requests']} the requests | |",
+             f"| the same, CoNUS stored dwaa (not read by the page) | 1 request, {dwaa['bytes'] / 1024:.0f} KiB "
+             f"({dwaa['whole_db']:.1f} / {dwaa['roi_db']:.1f} dB) | DZI Q {d['quality']} as above | "
+             f"{dwaa['bytes'] / d['bytes']:.2f}x the bytes | |"]
+    for gl, b in result["browser"].items():
+        lines += [f"| first frame, 2048² CoNUS file at 1280x720, {gl} | {b['first_frame_ms']:.0f} ms | | | ≤ 1000 ms "
+                  f"({'met' if b['first_frame_ms'] <= 1000 else '**not met**'}) |",
+                  f"| first frame from `conus serve`, {gl} | {b['remote_first_frame_ms']:.0f} ms | | | |",
+                  f"| pan/zoom at 1280x720, {gl} | {b['pan_zoom_fps']:.1f} frames/s | | | ≥ 30 frames/s "
+                  f"({'met' if b['pan_zoom_fps'] >= 30 else '**not met**'}) |",
+                  f"| `conus serve`: 1024² frame of the 4096² picture, new focus ({gl} run) | {b['serve_frame_s']:.2f} s | | | "
+                  f"≤ 0.5 s ({'met' if b['serve_frame_s'] <= 0.5 else '**not met**'}) |"]
+    return "\n".join(lines)
+
+
+# What each suite runs, for --plan.
+PLAN = {"codec": "build/bin/codec_bench (wall medians; --instructions: callgrind)",
+        "oiio": "build/bin/oiio_baseline_bench", "renderers": "build/bin/renderers_bench",
+        "subdivision": "build/bin/renderers_bench: BM_SubdivisionQuality, BM_GpuBendOverAsBuiltPaired",
+        "reflections": "build/bin/renderers_bench: BM_ReflectionSilhouette, its costs, BM_ReliefPaired",
+        "terrain": "bench/terrain_gain.py",
+        "end-to-end": "bench/end_to_end.sh", "viewer": "conus encode + conus-view --benchmark-frames under Xvfb",
+        "web": "bench/web_bench.py (vips, Chromium)", "quality-defaults": "bench/quality.py --defaults-only",
+        "quality": "bench/quality.py"}
+
+
+def durations_path(build):
+    return Path(build) / RESULTS / "durations.json"
+
+
+def print_plan(build, suites):
+    path = durations_path(build)
+    known = json.loads(path.read_text()) if path.exists() else {}
+    total, untimed = 0.0, []
+    for suite in suites:
+        last = known.get(suite)
+        when = (f"{last['seconds'] / 60:.1f} min when it last ran ({last['stamp']['date']}, {last['stamp']['machine']})"
+                if last else "not timed here yet")
+        print(f"{suite:17} {PLAN[suite]}: {when}")
+        if last:
+            total += last["seconds"]
+        else:
+            untimed.append(suite)
+    print(f"total: {total / 60:.0f} min" + (f" plus {', '.join(untimed)} (not timed)" if untimed else ""))
+
+
+def record_duration(build, suite, seconds):
+    path = durations_path(build)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    known = json.loads(path.read_text()) if path.exists() else {}
+    known[suite] = {"seconds": seconds, "stamp": run_stamp()}
+    path.write_text(json.dumps(known, indent=1))
+
+
 def replace_block(text, suite, body):
     pattern = re.compile(rf"(<!-- table:{re.escape(suite)} -->\n).*?(<!-- /table -->)", re.S)
     if not pattern.search(text):
@@ -421,23 +506,34 @@ def replace_block(text, suite, body):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    names = [*SUITES, "subdivision", "reflections", "terrain", "end-to-end", "viewer", "quality-defaults", "quality"]
-    parser.add_argument("suites", nargs="+", choices=[*names, "all"])
+    names = [*SUITES, "subdivision", "reflections", "terrain", "end-to-end", "viewer", "web", "quality-defaults", "quality"]
+    parser.add_argument("suites", nargs="*", metavar="SUITE", help=", ".join([*names, "all"]))
+    parser.add_argument("--plan", action="store_true", help="say what the suites run and how long each last took; run nothing")
+    parser.add_argument("--allow-modified", action="store_true", help="all: run on a tree with uncommitted changes")
     parser.add_argument("--build", default=str(ROOT / "build"))
     parser.add_argument("--repetitions", type=int, default=7)
     parser.add_argument("--instructions", action="store_true", help="callgrind instruction counts (codec only)")
     parser.add_argument("--from-results", action="store_true",
-                        help="subdivision, reflections, terrain, quality-defaults: the tables from the result files of an "
+                        help="subdivision, reflections, terrain, web, quality-defaults: the tables from the result files of an "
                         "earlier run")
     args = parser.parse_args()
-    suites = names if "all" in args.suites else args.suites
+    suites = names if "all" in args.suites or (args.plan and not args.suites) else args.suites
+    if not suites or set(suites) - {*names, "all"}:
+        parser.error(f"name suites among {', '.join(names)}, or all")
+    if args.plan:
+        print_plan(args.build, suites)
+        return
+    if "all" in args.suites and not args.allow_modified and "(modified)" in run_stamp()["commit"]:
+        sys.exit("make_readme_tables.py: all: the tree has uncommitted changes; commit them first, so that every table "
+                 "names one commit (or --allow-modified)")
     if args.instructions and set(suites) - {"codec"}:
         sys.exit("make_readme_tables.py: --instructions counts codec_bench only (valgrind stops at llvmpipe and libhwy)")
-    if args.from_results and set(suites) - {"subdivision", "reflections", "terrain", "quality-defaults"}:
-        sys.exit("make_readme_tables.py: --from-results remakes the subdivision, reflections, terrain and quality-defaults "
-                 "tables only")
+    if args.from_results and set(suites) - {"subdivision", "reflections", "terrain", "web", "quality-defaults"}:
+        sys.exit("make_readme_tables.py: --from-results remakes the subdivision, reflections, terrain, web and "
+                 "quality-defaults tables only")
     text = README.read_text()
     for suite in suites:
+        started = time.monotonic()
         if suite in SUITES:
             body = benchmark_table(args.build, suite, args.repetitions, args.instructions)
         elif suite == "subdivision":
@@ -459,6 +555,9 @@ def main():
             body = end_to_end_table(args.build, min(args.repetitions, 5))
         elif suite == "viewer":
             body = viewer_table(args.build)
+        elif suite == "web":
+            saved = Path(args.build) / RESULTS / "web.json"
+            body = web_table(json.loads(saved.read_text()) if args.from_results else run_web(args.build))
         elif suite == "quality-defaults":
             saved = Path(args.build) / "quality" / "targets.json"
             body = quality_defaults_table(json.loads(saved.read_text()) if args.from_results
@@ -467,6 +566,8 @@ def main():
             body = quality_table(args.build)
         text = replace_block(text, suite, body)
         README.write_text(text)  # after each suite, so a later failure keeps the tables already made
+        if not args.from_results:
+            record_duration(args.build, suite, time.monotonic() - started)
     print(f"bench/README.md: {', '.join(suites)} rewritten")
 
 

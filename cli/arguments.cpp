@@ -102,21 +102,12 @@ sceneio::Dem demFrom(const std::string& source, double heightScale) {
 
 Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding) {
     if (texture.empty()) {
-        Image ramp = codec::terrainColours(dem.heights, extent);
-        imageio::linearize(ramp);
         if (encoding) *encoding = {Transfer::Srgb, SampleType::Uint8, kRec709Chromaticities, {}, {}};
-        return ramp;
+        return codec::demColour(dem.heights, extent);
     }
     imageio::ImageFile file = readSource(texture, {});
     if (encoding) *encoding = file.info.encoding;
-    Image image = std::move(file.image);
-    if (image.width == dem.heights.width && image.height == dem.heights.height) return image;
-    if (image.width < dem.heights.width || image.height < dem.heights.height)
-        throw Error(ErrorCode::InvalidArgument, "colour texture " + texture + " (" + std::to_string(image.width) + "x" +
-                                                    std::to_string(image.height) + ") is smaller than the DEM (" +
-                                                    std::to_string(dem.heights.width) + "x" +
-                                                    std::to_string(dem.heights.height) + ")");
-    return codec::areaDownsample(image, dem.heights.width, dem.heights.height);
+    return codec::demColour(dem.heights, extent, std::move(file.image), texture);
 }
 
 Mesh readSceneMesh(const std::string& path, const std::vector<std::string>& allowDirs) {

@@ -40,9 +40,8 @@ glm::dvec3 parseVector3(const std::string& text, const std::string& what);  // "
 // The elevation model a DEM argument names: procedural[:SIZE[:SEED]] (codec's terrain, SIZE x SIZE
 // samples) or a file (sceneio::readDem), its heights times `heightScale`.
 sceneio::Dem demFrom(const std::string& source, double heightScale);
-// The DEM's colour in linear light: `texture` (an image file, resized down to the DEM when larger;
-// smaller is refused), else codec's height/slope ramp (drawn as display colours). `encoding`
-// receives what the colour came from.
+// The DEM's colour (codec::demColour) of the image file `texture`, or of codec's height/slope ramp
+// when it is empty; `encoding` receives what the colour came from.
 Image demColour(const sceneio::Dem& dem, const std::string& texture, glm::dvec2 extent, SourceEncoding* encoding = nullptr);
 
 // The mesh a scene argument names (sceneio::readMesh: files it names may also lie in `allowDirs`;

@@ -47,7 +47,7 @@ bool Controller::load() {
         return true;
     }
     for (const std::string& path : m_options.files) {
-        m_docs.push_back(loadDocument(path));
+        m_docs.push_back(loadDocument(path, m_options.foci));
         if (!m_docs.back().ok()) {
             std::fprintf(stderr, "conus-view: %s\n", m_docs.back().error.c_str());
             m_exitCode = 1;
@@ -345,7 +345,7 @@ void Controller::doAction(Action action) {
     case Action::Reload:
         if (Document* doc = currentDocument()) {
             const int w = doc->sourceWidth(), h = doc->sourceHeight();
-            *doc = loadDocument(doc->path);
+            *doc = loadDocument(doc->path, m_options.foci);
             if (!doc->ok()) std::fprintf(stderr, "conus-view: %s: %s\n", doc->path.c_str(), doc->error.c_str());
             else std::printf("reloaded %s\n", doc->path.c_str());
             showDocument(m_current, doc->sourceWidth() != w || doc->sourceHeight() != h);

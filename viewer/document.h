@@ -4,8 +4,10 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
 
+#include "conus/codec/builders/foci.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/image.h"
 #include "conus/format/container.h"
@@ -23,7 +25,15 @@ struct Document {
     int sourceHeight() const;
 };
 
-Document loadDocument(const std::string& path);
+// The CoNUS file at `path`; with `foci`, the picture at `path` (PNG, JPEG, EXR, ...) as `conus
+// encode --focus` writes it (encodedPicture).
+Document loadDocument(const std::string& path, std::span<const codec::Focus> foci = {});
+
+// The picture at `path` encoded through the map `conus encode --focus` gives `foci` on it, at the
+// default size (codec::defaultConusSize): codec::budgetedFociMap with the encode's defaults (the
+// foci on the picture's own detail, k held to the default frame-loss budget, the encode fitted),
+// its confirming encode kept where it was of the map kept. Throws conus::Error.
+format::ConusFile encodedPicture(const std::string& path, std::span<const codec::Focus> foci);
 
 // `message` about the file at `path`, naming it once: as it is when it names the file already
 // (the readers' messages do), else after "path: ".

@@ -65,7 +65,7 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
     std::string mesh, volume, relief, reflection;
     std::vector<std::string> foci;
     CLI::App app(kDescription, "conus-view");
-    app.add_option("files", o.files, "CoNUS files (.exr); Tab / PageDown switch between them");
+    app.add_option("files", o.files, "CoNUS files (.exr), or pictures with --focus; Tab / PageDown switch between them");
     app.add_option("--edit", o.edit, "paint a sampling map over IMAGE (PNG, JPEG, EXR, ...)");
     app.add_option("-o,--output", o.output, "--edit: base path for S (<base>.map.exr) and Ctrl-S (<base>.conus.exr)");
     app.add_option("--screenshot", o.screenshot,
@@ -92,7 +92,9 @@ std::optional<Options> parseOptions(int argc, char** argv, int* exitCode) {
         ->capture_default_str()
         ->check(cli::finiteRange(0.0, 1e6, true, true));
     app.add_option("--tf", o.transferFunction, "--volume: transfer function preset or file (T cycles the presets)");
-    app.add_option("--focus", foci, "3-D modes: a focus u,v,r,k (repeat for more; N adds one at the cursor)");
+    app.add_option("--focus", foci,
+                   "a focus u,v,r,k (repeat for more). 3-D modes: the first foci (N adds one at the cursor); with files: "
+                   "each file is a picture (PNG, JPEG, EXR, ...) shown as `conus encode --focus` writes it");
     app.add_option("--view", view, "undistorted rectangle u0,v0,u1,v1 to show");
     app.add_option("--size", size, "WxH of --screenshot, or of the CoNUS image --edit encodes");
     app.add_option("--window", window, "window size WxH")->capture_default_str();

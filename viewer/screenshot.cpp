@@ -55,7 +55,7 @@ int sceneScreenshot(const Options& options) {
 
 int runScreenshot(const Options& options) {
     if (options.sceneKind != SceneKind::None) return sceneScreenshot(options);
-    const Document doc = loadDocument(options.files.front());
+    const Document doc = loadDocument(options.files.front(), options.foci);
     if (!doc.ok()) {
         std::fprintf(stderr, "conus-view: %s\n", doc.error.c_str());
         return 1;

@@ -86,22 +86,25 @@ struct ExrAttribute<std::vector<float>> {
     static std::vector<float> from(const std::vector<float>& v) { return v; }
     static Type to(const std::vector<float>& v) { return Type(v); }
 };
-template <>
-struct ExrAttribute<std::array<float, 16>> {  // row-major, as Imath stores a matrix
-    using Type = Imf::M44fAttribute;
-    static std::array<float, 16> from(const Imath::M44f& m) {
-        std::array<float, 16> a{};
-        for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c) a[r * 4 + c] = m[r][c];
+// A square matrix of side N, row-major as Imath stores one.
+template <int N, class Matrix, class Attribute>
+struct ExrMatrixAttribute {
+    using Type = Attribute;
+    static std::array<float, N * N> from(const Matrix& m) {
+        std::array<float, N * N> a{};
+        for (int r = 0; r < N; ++r)
+            for (int c = 0; c < N; ++c) a[r * N + c] = m[r][c];
         return a;
     }
-    static Type to(const std::array<float, 16>& a) {
-        Imath::M44f m;
-        for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c) m[r][c] = a[r * 4 + c];
+    static Type to(const std::array<float, N * N>& a) {
+        Matrix m;
+        for (int r = 0; r < N; ++r)
+            for (int c = 0; c < N; ++c) m[r][c] = a[r * N + c];
         return Type(m);
     }
 };
+template <>
+struct ExrAttribute<std::array<float, 16>> : ExrMatrixAttribute<4, Imath::M44f, Imf::M44fAttribute> {};
 template <>
 struct ExrAttribute<std::array<float, 8>> {  // red, green, blue, white: x, y each
     using Type = Imf::ChromaticitiesAttribute;
@@ -121,21 +124,7 @@ struct ExrAttribute<std::array<float, 3>> {
     static Type to(const std::array<float, 3>& v) { return Type(Imath::V3f(v[0], v[1], v[2])); }
 };
 template <>
-struct ExrAttribute<std::array<float, 9>> {  // row-major, as Imath stores a matrix
-    using Type = Imf::M33fAttribute;
-    static std::array<float, 9> from(const Imath::M33f& m) {
-        std::array<float, 9> a{};
-        for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) a[r * 3 + c] = m[r][c];
-        return a;
-    }
-    static Type to(const std::array<float, 9>& a) {
-        Imath::M33f m;
-        for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) m[r][c] = a[r * 3 + c];
-        return Type(m);
-    }
-};
+struct ExrAttribute<std::array<float, 9>> : ExrMatrixAttribute<3, Imath::M33f, Imf::M33fAttribute> {};
 
 template <class T>
 Attr<T> readAttr(const Imf::Attribute& attribute) {

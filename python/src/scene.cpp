@@ -25,19 +25,28 @@ py::array rows(const std::vector<V>& values, py::ssize_t width) {
     return out;
 }
 
+// A reader's options with the folders its scene file's named files may also lie in.
+template <class Options>
+Options allowing(const std::vector<std::string>& allowDirs) {
+    Options options;
+    options.allowedDirs = allowDirs;
+    return options;
+}
+
+// What `read` returns, run with the GIL released.
+template <class Read>
+auto released(Read read) {
+    py::gil_scoped_release release;
+    return read();
+}
+
 }  // namespace
 
 void addSceneReaders(py::module_& m) {
     m.def(
         "read_mesh",
         [](const std::string& path, const std::vector<std::string>& allowDirs) {
-            sceneio::MeshReadOptions options;
-            options.allowedDirs = allowDirs;
-            Mesh mesh;
-            {
-                py::gil_scoped_release release;
-                mesh = sceneio::readMesh(path, options);
-            }
+            const Mesh mesh = released([&] { return sceneio::readMesh(path, allowing<sceneio::MeshReadOptions>(allowDirs)); });
             py::dict out;
             out["positions"] = rows<float>(mesh.positions, 3);
             out["normals"] = rows<float>(mesh.normals, 3);
@@ -55,13 +64,7 @@ void addSceneReaders(py::module_& m) {
     m.def(
         "read_volume",
         [](const std::string& spec, const std::vector<std::string>& allowDirs) {
-            sceneio::VolumeReadOptions options;
-            options.allowedDirs = allowDirs;
-            Volume volume;
-            {
-                py::gil_scoped_release release;
-                volume = sceneio::readVolume(spec, options);
-            }
+            const Volume volume = released([&] { return sceneio::readVolume(spec, allowing<sceneio::VolumeReadOptions>(allowDirs)); });
             py::array_t<float> values({py::ssize_t(volume.depth), py::ssize_t(volume.height), py::ssize_t(volume.width)});
             std::memcpy(values.mutable_data(), volume.values.data(), volume.values.size() * sizeof(float));
             return py::make_tuple(values, py::make_tuple(volume.spacing.x, volume.spacing.y, volume.spacing.z));

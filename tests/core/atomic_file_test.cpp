@@ -41,6 +41,34 @@ std::string slurp(const std::string& path) {
     return s.str();
 }
 
+// Forks a child that installs the signal handlers and runs `work`, which ends by calling the
+// function it is given: that tells this process the child is ready and waits to be killed there.
+// Returns the child's pid once it is ready (-1 if it never was).
+template <class Work>
+pid_t readyChild(Work work) {
+    int ready[2];
+    if (::pipe(ready) != 0) return -1;
+    const pid_t child = ::fork();
+    if (child == 0) {
+        conus::removeTemporariesOnSignals();
+        work([&] {
+            (void)!::write(ready[1], "r", 1);
+            ::pause();
+        });
+        std::_Exit(0);
+    }
+    char c;
+    return ::read(ready[0], &c, 1) == 1 ? child : -1;
+}
+
+// Sends SIGTERM to `child` and returns its wait status.
+int terminated(pid_t child) {
+    ::kill(child, SIGTERM);
+    int status = 0;
+    EXPECT_EQ(::waitpid(child, &status, 0), child);
+    return status;
+}
+
 }  // namespace
 
 TEST_F(AtomicFileTest, WritesAppendsAndPatchesThenRenames) {
@@ -156,26 +184,17 @@ TEST_F(AtomicFileTest, AWritePastTheFileSizeLimitIsAFailureNamingTheDestination)
 }
 
 TEST_F(AtomicFileTest, SigtermRemovesTheTemporaryFile) {
-    int ready[2];
-    ASSERT_EQ(::pipe(ready), 0);
-    const pid_t child = ::fork();
-    if (child == 0) {
-        conus::removeTemporariesOnSignals();
+    const pid_t child = readyChild([&](auto waitToBeKilled) {
         conus::AtomicFile file(path("slow.bin"));
         file.write("partial", 7);
         file.writeAt(0, "P", 1);  // on disk now
-        (void)!::write(ready[1], "r", 1);
-        ::pause();  // killed here, mid-write
-        std::_Exit(0);
-    }
-    char c;
-    ASSERT_EQ(::read(ready[0], &c, 1), 1);
+        waitToBeKilled();         // killed here, mid-write
+    });
+    ASSERT_GT(child, 0);
     bool sawTemporary = false;
     for (const std::string& name : entries()) sawTemporary |= name.find(".tmp-") != std::string::npos;
     EXPECT_TRUE(sawTemporary);
-    ::kill(child, SIGTERM);
-    int status = 0;
-    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    const int status = terminated(child);
     EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << "ends as SIGTERM would";
     EXPECT_TRUE(entries().empty()) << "the temporary was removed";
 }
@@ -217,23 +236,14 @@ TEST_F(AtomicFileTest, ACommittedSetRenamesEveryOutputAndNestedSetsJoinTheOuterO
 }
 
 TEST_F(AtomicFileTest, SigtermRemovesTheOutputsWaitingInASet) {
-    int ready[2];
-    ASSERT_EQ(::pipe(ready), 0);
-    const pid_t child = ::fork();
-    if (child == 0) {
-        conus::removeTemporariesOnSignals();
+    const pid_t child = readyChild([&](auto waitToBeKilled) {
         conus::AtomicOutputs outputs;
         conus::writeFileAtomically(path("first.bin"), std::vector<unsigned char>{'1'});
-        (void)!::write(ready[1], "r", 1);
-        ::pause();  // killed while the command's second output is being made
-        std::_Exit(0);
-    }
-    char c;
-    ASSERT_EQ(::read(ready[0], &c, 1), 1);
+        waitToBeKilled();  // killed while the command's second output is being made
+    });
+    ASSERT_GT(child, 0);
     EXPECT_EQ(entries().size(), 1u) << "the finished first output waits as a temporary";
-    ::kill(child, SIGTERM);
-    int status = 0;
-    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    terminated(child);
     EXPECT_TRUE(entries().empty()) << "the signal removed it";
 }
 

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <string>
 
+#include "conus/core/error.h"
 #include "fuzz.h"
 
 class SceneFixture {
@@ -53,3 +54,18 @@ inline bool startsWith(const std::uint8_t* data, std::size_t size, const char* p
 }
 
 inline bool isOneLine(const std::string& s) { return s.find('\n') == std::string::npos && s.find('\r') == std::string::npos; }
+
+// Runs `read` (a reader on one input and the checks of what it read): the reader may refuse the
+// input with a one-line conus::Error and throws nothing else.
+template <class Read>
+int readOrRefuse(Read read) {
+    try {
+        read();
+    } catch (const conus::Error& e) {
+        CONUS_FUZZ_CHECK(isOneLine(e.what()), "an error is one line");
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "non-CoNUS exception: %s\n", e.what());
+        CONUS_FUZZ_CHECK(false, "the reader throws only conus::Error");
+    }
+    return 0;
+}

@@ -43,6 +43,21 @@ std::string gltfNaming(const std::string& uri, int byteLength = 36) {
  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [2, 3, 0]}]})";
 }
 
+// A name a scene file may not give a file it reads, with the reason its refusal says.
+struct BadName {
+    std::string name, reason;
+};
+// Each escape: absolute, "..", a symbolic link out of the folder, a FIFO (a reader would block on
+// it forever); the folder beside the scene's is added by each test, with its own file.
+std::vector<BadName> namesOutOfFolder(const std::string& besideFile) {
+    return {{"/etc/passwd", "an absolute path"},
+            {"/dev/zero", "an absolute path"},
+            {"../../../../../../../../etc/passwd", "outside its folder"},
+            {"../outside/" + besideFile, "outside its folder"},
+            {"link.bin", "outside its folder"},
+            {"fifo.bin", "not a regular file"}};
+}
+
 struct Refusal {
     ErrorCode code = ErrorCode::InvalidArgument;
     std::string message;
@@ -97,19 +112,9 @@ TEST_F(NamedFilesTest, AGltfBufferInTheModelsFolderReads) {
 }
 
 TEST_F(NamedFilesTest, AGltfBufferOutsideTheFolderIsRefused) {
-    const struct {
-        std::string uri, reason;
-    } cases[] = {
-        {"/etc/passwd", "an absolute path"},
-        {"../../../../../../../../etc/passwd", "outside its folder"},
-        {"../outside/tri.bin", "outside its folder"},
-        {"link.bin", "outside its folder"},  // a symbolic link out
-        {"fifo.bin", "not a regular file"},  // would block forever
-        {"/dev/zero", "an absolute path"},
-    };
-    for (const auto& c : cases) {
-        SCOPED_TRACE(c.uri);
-        const std::string path = scene("escape.gltf", gltfNaming(c.uri));
+    for (const BadName& c : namesOutOfFolder("tri.bin")) {
+        SCOPED_TRACE(c.name);
+        const std::string path = scene("escape.gltf", gltfNaming(c.name));
         expectRefused(refusal([&] { readMesh(path); }), path, c.reason);
     }
 }
@@ -241,17 +246,7 @@ TEST_F(NamedFilesTest, AnNrrdDataFileInTheFolderReads) {
 
 TEST_F(NamedFilesTest, AnNrrdDataFileOutsideTheFolderOrNotRegularIsRefused) {
     writeBytes(outside() / "cube.raw", std::string(64, '\x07'));
-    const struct {
-        std::string name, reason;
-    } cases[] = {
-        {"/etc/passwd", "an absolute path"},
-        {"/dev/zero", "an absolute path"},
-        {"../../../../../../../../etc/passwd", "outside its folder"},
-        {"../outside/cube.raw", "outside its folder"},
-        {"link.bin", "outside its folder"},
-        {"fifo.bin", "not a regular file"},  // teem would block on it forever
-    };
-    for (const auto& c : cases) {
+    for (const BadName& c : namesOutOfFolder("cube.raw")) {
         SCOPED_TRACE(c.name);
         const std::string path = scene("escape.nhdr", nrrdHeader("uchar", "4 4 4", "raw") + "data file: " + c.name + "\n");
         expectRefused(refusal([&] { readVolume(path); }), path, c.reason);

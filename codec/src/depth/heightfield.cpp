@@ -10,6 +10,7 @@
 #include <string>
 
 #include "conus/codec/image/encode.h"
+#include "conus/core/display.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
 #include "conus/core/parallel.h"
@@ -240,6 +241,20 @@ Image terrainColours(const Image& heights, glm::dvec2 extent) {
             }
     });
     return out;
+}
+
+Image demColour(const Image& heights, glm::dvec2 extent, std::optional<Image> texture, const std::string& textureName) {
+    if (!texture) {
+        Image ramp = terrainColours(heights, extent);
+        for (float& v : ramp.pixels) v = srgbDisplayToLinear(v);
+        return ramp;
+    }
+    if (texture->width == heights.width && texture->height == heights.height) return std::move(*texture);
+    if (texture->width < heights.width || texture->height < heights.height)
+        throw Error(ErrorCode::InvalidArgument, "colour texture " + textureName + " (" + std::to_string(texture->width) + "x" +
+                                                    std::to_string(texture->height) + ") is smaller than the DEM (" +
+                                                    std::to_string(heights.width) + "x" + std::to_string(heights.height) + ")");
+    return areaDownsample(*texture, heights.width, heights.height);
 }
 
 glm::dvec2 fieldExtent(const GroundParams& params) {

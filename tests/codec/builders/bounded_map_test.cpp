@@ -19,6 +19,7 @@
 #include "conus/codec/image/encode.h"
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
+#include "../round_trip.h"
 
 namespace conus::codec {
 namespace {
@@ -259,14 +260,7 @@ double tongueExcess(DensityBuilder builder) {
     options.aspect = double(W) / H;
     options.builder = builder;
     const SamplingMap map = buildFociMap(std::vector<Focus>{focus}, options);
-    EncodeOptions encode;
-    encode.width = w;
-    encode.height = h;
-    DecodeOptions decode;
-    decode.width = W;
-    decode.height = H;
-    const Image decoded = decodeImage(encodeImage(source, map, encode), map, decode);
-    const Image uniform = resizeBilinear(areaDownsample(source, w, h), View{}, W, H);
+    const auto [decoded, uniform] = test::roundTrip(source, map, w, h);
     const int tile = std::max(W, H) / 32;
     const double e = (2.0 / 255) * (2.0 / 255), cx = focus.u * W, cy = focus.v * H, radius = focus.r * W;
     std::vector<double> losses;

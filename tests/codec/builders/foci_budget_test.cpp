@@ -19,6 +19,7 @@
 #include "conus/core/display.h"
 #include "conus/core/error.h"
 #include "../../test_images.h"
+#include "../round_trip.h"
 
 namespace conus::codec {
 namespace {
@@ -112,14 +113,7 @@ TEST(FociBudget, LowersEveryKAlikeToHoldTheBudget) {
 
     // Measured, not only predicted: the budget's map loses less over the frame than the exact one.
     const auto measuredLoss = [&](const SamplingMap& map) {
-        EncodeOptions e;
-        e.width = kWidth / 4;
-        e.height = kHeight / 4;
-        DecodeOptions d;
-        d.width = kWidth;
-        d.height = kHeight;
-        const Image view = decodeImage(encodeImage(source, map, e), map, d);
-        const Image uniform = resizeBilinear(areaDownsample(source, e.width, e.height), {}, kWidth, kHeight);
+        const auto [view, uniform] = test::roundTrip(source, map, kWidth / 4, kHeight / 4);
         double a = 0, b = 0;
         for (std::size_t i = 0; i < source.pixels.size(); ++i) {
             a += std::pow(view.pixels[i] - source.pixels[i], 2);

@@ -19,6 +19,7 @@
 #include "conus/core/display.h"
 #include "conus/core/error.h"
 #include "../../test_images.h"
+#include "../round_trip.h"
 
 namespace conus::codec {
 namespace {
@@ -80,15 +81,7 @@ struct Measured {
 // Encode to 1/16 of the pixels through `map`, decode at the source size; against the uniform image
 // of the same pixel count (area downsample, bilinear up).
 Measured measure(const Image& source, const SamplingMap& map, const Image& importance) {
-    const int w = kWidth / 4, h = kHeight / 4;
-    EncodeOptions e;
-    e.width = w;
-    e.height = h;
-    DecodeOptions d;
-    d.width = kWidth;
-    d.height = kHeight;
-    const Image view = decodeImage(encodeImage(source, map, e), map, d);
-    const Image uniform = resizeBilinear(areaDownsample(source, w, h), {}, kWidth, kHeight);
+    const auto [view, uniform] = test::roundTrip(source, map, kWidth / 4, kHeight / 4);
     return {10 * std::log10(mse(view, source, importance, false) / mse(uniform, source, importance, false)),
             10 * std::log10(mse(uniform, source, importance, true) / mse(view, source, importance, true))};
 }
@@ -109,11 +102,7 @@ double measuredFrameLoss(const Image& source, const SamplingMap& map, int fitIte
         f.method = method;
         fitToDecoder(source, map, conus, f);
     }
-    DecodeOptions d;
-    d.width = kWidth;
-    d.height = kHeight;
-    const Image view = decodeImage(conus, map, d);
-    const Image uniform = resizeBilinear(areaDownsample(source, e.width, e.height), {}, kWidth, kHeight);
+    const auto [view, uniform] = test::decodedBeside(source, map, conus);
     const auto displayMse = [&](const Image& im) {
         double sum = 0;
         for (std::size_t i = 0; i < im.pixels.size(); ++i) {

@@ -8,6 +8,7 @@
 
 #include "conus/codec/builders/ground_map.h"
 #include "conus/format/container.h"
+#include "conus/core/display.h"
 #include "conus/core/error.h"
 
 namespace conus::codec {
@@ -65,6 +66,48 @@ TEST(HeightFieldTerrain, ColoursInRange) {
         EXPECT_GE(c, 0.0f);
         EXPECT_LE(c, 1.0f);
     }
+}
+
+// With no texture the ramp is made linear by the sRGB curve (display 0.5 is 0.2140 of the light,
+// the linear toe below 0.04045 is v / 12.92); a texture is kept at the DEM's size, averaged down
+// from a larger one (each sample the mean of the block of texels it covers) and refused when
+// smaller, naming it.
+TEST(HeightFieldTerrain, DemColourIsLinearRampOrTheTextureAtTheDemsSize) {
+    const Image dem = generateTerrain(smallTerrain(16));
+    const glm::dvec2 extent{900, 700};
+    const Image ramp = terrainColours(dem, extent), linear = demColour(dem, extent);
+    ASSERT_EQ(linear.channels, ramp.channels);
+    ASSERT_EQ(linear.pixels.size(), ramp.pixels.size());
+    for (std::size_t i = 0; i < ramp.pixels.size(); ++i) {
+        const double v = ramp.pixels[i];
+        const double want = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+        ASSERT_NEAR(linear.pixels[i], want, 1e-7) << i;
+        ASSERT_LT(linear.pixels[i], v + 1e-7) << "light is never above its display value";
+    }
+    EXPECT_NEAR(srgbDisplayToLinear(0.5f), 0.214041, 1e-6);
+    EXPECT_FLOAT_EQ(srgbDisplayToLinear(0.03f), 0.03f / 12.92f);
+
+    Image texture = makeImage(32, 16, {"R", "G", "B"});
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 32; ++x)
+            for (int c = 0; c < 3; ++c) texture.at(x, y, c) = float(x + 100 * y + 1000 * c);
+    const Image small = generateTerrain(smallTerrain(8));  // 8x8: the texture is 4x wider, 2x taller
+    const Image down = demColour(small, extent, texture, "ortho.png");
+    ASSERT_EQ(down.width, 8);
+    ASSERT_EQ(down.height, 8);
+    // Each DEM sample covers 4 x 2 texels: x 4i..4i+3 (mean 4i + 1.5), y 2j..2j+1 (mean 2j + 0.5).
+    EXPECT_NEAR(down.at(3, 5, 1), 1000 + (4 * 3 + 1.5) + 100 * (2 * 5 + 0.5), 1e-3);
+    try {
+        demColour(generateTerrain(smallTerrain(32)), extent, texture, "ortho.png");  // 32x16 under 32x32
+        ADD_FAILURE() << "a texture smaller than the DEM was taken";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+        EXPECT_NE(std::string(e.what()).find("ortho.png (32x16) is smaller than the DEM (32x32)"), std::string::npos) << e.what();
+    }
+    TerrainOptions wide = smallTerrain();
+    wide.width = 32;
+    wide.height = 16;
+    EXPECT_EQ(demColour(generateTerrain(wide), extent, texture, "ortho.png").pixels, texture.pixels) << "the DEM's size: as it is";
 }
 
 // The viewer a user gives, completed from the field's size in metres: far to its far edge, the

@@ -62,4 +62,11 @@ inline float linearToSrgbDisplay(float linear) {
     return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
 }
 
+// The sRGB curve's inverse, from display [0,1] to linear light (IEC 61966-2-1), computed in double
+// and rounded once: colours drawn as a display shows them (a procedural ramp) made linear.
+inline float srgbDisplayToLinear(float display) {
+    const double x = display;
+    return static_cast<float>(x <= 0.04045 ? x / 12.92 : std::pow((x + 0.055) / 1.055, 2.4));
+}
+
 }  // namespace conus

@@ -58,6 +58,12 @@ std::optional<TerrainOptions> proceduralTerrain(const std::string& source);
 // depth), which turns height differences into slopes; the ramp spans the DEM's own min..max.
 Image terrainColours(const Image& heights, glm::dvec2 extent);
 
+// A DEM's colour in linear light, what `heightfield encode` and `bake relief` give the field:
+// `texture` (linear light, however read; `textureName` names it in errors) at the DEM's size,
+// area-downsampled when larger and refused when smaller (InvalidArgument); with no texture, the
+// ramp of terrainColours taken as display colours (sRGB) and made linear.
+Image demColour(const Image& heights, glm::dvec2 extent, std::optional<Image> texture = std::nullopt, const std::string& textureName = "");
+
 // ---- Encode (server) -----------------------------------------------------------------------
 
 // Width and depth in metres of the field a ground map covers: (2 * half width at the far edge,
