@@ -209,6 +209,105 @@ void BM_LayeredReflectionEyeSweep(benchmark::State& state) {
     state.counters["disoccluded_pct"] = 100.0 * codec::disocclusionFraction(s.scene, eye, codec::reflectedRays(r, s.camera.eye(), codec::kViewRays), 1);
 }
 
+// The eye placed as placeReflectionEye places it for the camera (a plane's reflected viewpoint;
+// 3/4 of the way to a sphere's virtual image), one layer, faces of range(2) texels, the focus's
+// magnification range(1): the mirror, the model's reflection and the rest, CoNUS and uniform, and
+// the CoNUS asset's bytes against the centred single-layer CoNUS asset of 128-texel faces. With
+// CONUS_BENCH_SUPERSAMPLE set, "ss_" scores the frames (reference and assets alike) rendered with
+// 3x3 rays a pixel, box-filtered, and "truth1spp_" the one-ray reference against that one.
+void BM_PlacedMirrorFocus(benchmark::State& state) {
+    const int index = static_cast<int>(state.range(0));
+    if (!std::filesystem::exists(kModels[index / 2])) {
+        state.SkipWithError("the model is not installed (assimp-testmodels)");
+        return;
+    }
+    static std::unique_ptr<codec::MeshScene> scenes[2];
+    if (!scenes[index / 2]) scenes[index / 2] = std::make_unique<codec::MeshScene>(sceneio::readMesh(kModels[index / 2]));
+    const codec::MeshScene& scene = *scenes[index / 2];
+    codec::ReflectionFrameOptions options;
+    codec::Reflector& r = options.reflector;
+    const bool plane = index % 2 == 0;
+    r.kind = plane ? codec::Reflector::Kind::Plane : codec::Reflector::Kind::Sphere;
+    r.centre = plane ? glm::dvec3(0.0, 1.5, -6.0) : glm::dvec3(0.0, 1.5, -7.0);
+    r.radius = 4.0;
+    r.normal = glm::normalize(glm::dvec3(0.15, 0.0, 1.0));
+    const Camera camera = Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, plane ? 38.0 : 45.0, 1.0, 1e-3, 1e3);
+    const glm::dvec3 image = codec::reflectedViewpoint(r, camera.eye());
+    const glm::dvec3 eye = plane ? image : r.centre + 0.75 * (image - r.centre);
+    codec::ReflectionBakeOptions bake;
+    bake.centre = eye;
+    bake.size = static_cast<int>(state.range(2));
+    bake.roi = boundsOf(scene.mesh());
+    bake.magnification = static_cast<double>(state.range(1));
+    Image frames[2], truth;
+    const auto bytesOf = [](const std::vector<codec::ReflectionFace>& faces) {
+        const std::string path = (std::filesystem::temp_directory_path() / "conus-placed-focus.exr").string();
+        format::writeReflectionAsset(path, codec::reflectionAssetFile(faces));
+        const auto bytes = static_cast<double>(std::filesystem::file_size(path));
+        std::filesystem::remove(path);
+        return bytes;
+    };
+    double bytes = 0;
+    for (auto _ : state) {
+        for (int u = 0; u < 2; ++u) {
+            bake.uniform = u == 0;
+            const auto faces = codec::bakeReflection(scene, bake);
+            frames[u] = codec::renderReflectionFrame(scene, &faces, eye, camera, kFrame, kFrame, options);
+            if (u == 1) bytes = bytesOf(faces);
+        }
+        truth = codec::renderReflectionFrame(scene, nullptr, eye, camera, kFrame, kFrame, options);
+    }
+    codec::ReflectionBakeOptions centred;  // the centred single-layer CoNUS asset of 128-texel faces
+    centred.centre = r.centre;
+    centred.size = kFace;
+    centred.roi = bake.roi;
+    state.counters["bytes_ratio"] = bytes / bytesOf(codec::bakeReflection(scene, centred));
+    const auto triangles = static_cast<std::uint32_t>(scene.mesh().indices.size() / 3);
+    const bench::MirrorScore score = bench::scoreMirror(frames, truth, scene, r, camera, kFrame, triangles);
+    if (std::getenv("CONUS_BENCH_SUPERSAMPLE")) {  // 3x3 rays a frame pixel, box-filtered, for all three
+        constexpr int kS = 3;
+        const auto down = [&](const Image& big) {
+            Image out = big;
+            out.width = out.height = kFrame;
+            out.pixels.assign(std::size_t(kFrame) * kFrame * big.channels.size(), 0.0f);
+            for (int y = 0; y < kFrame; ++y)
+                for (int x = 0; x < kFrame; ++x)
+                    for (std::size_t c = 0; c < big.channels.size(); ++c) {
+                        float sum = 0;
+                        for (int j = 0; j < kS; ++j)
+                            for (int i = 0; i < kS; ++i) sum += big.at(kS * x + i, kS * y + j, int(c));
+                        out.at(x, y, int(c)) = c == 3 ? big.at(kS * x + 1, kS * y + 1, 3) : sum / (kS * kS);
+                    }
+            return out;
+        };
+        const Image ssTruth = down(codec::renderReflectionFrame(scene, nullptr, eye, camera, kS * kFrame, kS * kFrame, options));
+        Image ss[2];
+        for (int u = 0; u < 2; ++u) {
+            bake.uniform = u == 0;
+            const auto faces = codec::bakeReflection(scene, bake);
+            ss[u] = down(codec::renderReflectionFrame(scene, &faces, eye, camera, kS * kFrame, kS * kFrame, options));
+        }
+        const bench::MirrorScore s2 = bench::scoreMirror(ss, ssTruth, scene, r, camera, kFrame, triangles);
+        const Image alias[2] = {truth, truth};
+        const bench::MirrorScore s3 = bench::scoreMirror(alias, ssTruth, scene, r, camera, kFrame, triangles);
+        state.counters["ss_mirror_conus_dB"] = s2.psnr(1, {0, 1});
+        state.counters["ss_mirror_uniform_dB"] = s2.psnr(0, {0, 1});
+        state.counters["ss_model_conus_dB"] = s2.psnr(1, {0});
+        state.counters["ss_model_uniform_dB"] = s2.psnr(0, {0});
+        state.counters["truth1spp_mirror_dB"] = s3.psnr(1, {0, 1});
+        state.counters["truth1spp_model_dB"] = s3.psnr(1, {0});
+    }
+    state.counters["mirror_conus_dB"] = score.psnr(1, {0, 1});
+    state.counters["mirror_uniform_dB"] = score.psnr(0, {0, 1});
+    state.counters["model_conus_dB"] = score.psnr(1, {0});
+    state.counters["model_uniform_dB"] = score.psnr(0, {0});
+    state.counters["rest_conus_dB"] = score.psnr(1, {1});
+    state.counters["rest_uniform_dB"] = score.psnr(0, {1});
+    if (const char* prefix = std::getenv("CONUS_BENCH_PICTURES"))
+        bench::writeMirrorStrip(std::string(prefix) + "-focus-" + std::to_string(index) + "-" +
+                                    std::to_string(state.range(1)) + "-" + std::to_string(state.range(2)) + ".png", frames, truth, score, kFrame, 3);
+}
+
 // Single-layer (A) against layered (B) CoNUS frames: /x/0 the CPU reference, /x/1 GLSL; /x/x/1 the
 // layered asset from the placed eye as B.
 void BM_LayeredReflectionPaired(benchmark::State& state) {
@@ -250,6 +349,7 @@ void BM_LayeredReflectionPaired(benchmark::State& state) {
 BENCHMARK(BM_LayeredReflectionQuality)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LayeredReflectionEyeSweep)->ArgsProduct({{0, 2}, {0, 1, 2, 3, 4}, {kFace}})->Args({0, 4, 160})->Args({2, 4, 160})
     ->Args({0, 4, 192})->Args({2, 4, 192})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlacedMirrorFocus)->ArgsProduct({{0, 1, 2, 3}, {4, 8, 16}, {kFace, 160, 192, 256, 512}})->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LayeredReflectionPaired)->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})->Iterations(21)
     ->Unit(benchmark::kMillisecond);
 
