@@ -262,6 +262,8 @@ void BM_PlacedMirrorFocus(benchmark::State& state) {
     centred.size = kFace;
     centred.roi = bake.roi;
     state.counters["bytes_ratio"] = bytes / bytesOf(codec::bakeReflection(scene, centred));
+    state.counters["eye_x"] = eye.x;
+    state.counters["eye_z"] = eye.z;
     const auto triangles = static_cast<std::uint32_t>(scene.mesh().indices.size() / 3);
     const bench::MirrorScore score = bench::scoreMirror(frames, truth, scene, r, camera, kFrame, triangles);
     if (std::getenv("CONUS_BENCH_SUPERSAMPLE")) {  // 3x3 rays a frame pixel, box-filtered, for all three
