@@ -209,8 +209,7 @@ void BM_LayeredReflectionEyeSweep(benchmark::State& state) {
     state.counters["disoccluded_pct"] = 100.0 * codec::disocclusionFraction(s.scene, eye, codec::reflectedRays(r, s.camera.eye(), codec::kViewRays), 1);
 }
 
-// The eye placed as placeReflectionEye places it for the camera (a plane's reflected viewpoint;
-// 3/4 of the way to a sphere's virtual image), one layer, faces of range(2) texels, the focus's
+// The eye placed as placeReflectionEye places it for the camera (one layer), one layer, faces of range(2) texels, the focus's
 // magnification range(1): the mirror, the model's reflection and the rest, CoNUS and uniform, and
 // the CoNUS asset's bytes against the centred single-layer CoNUS asset of 128-texel faces. With
 // CONUS_BENCH_SUPERSAMPLE set, "ss_" scores the frames (reference and assets alike) rendered with
@@ -232,8 +231,7 @@ void BM_PlacedMirrorFocus(benchmark::State& state) {
     r.radius = 4.0;
     r.normal = glm::normalize(glm::dvec3(0.15, 0.0, 1.0));
     const Camera camera = Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, plane ? 38.0 : 45.0, 1.0, 1e-3, 1e3);
-    const glm::dvec3 image = codec::reflectedViewpoint(r, camera.eye());
-    const glm::dvec3 eye = plane ? image : r.centre + 0.75 * (image - r.centre);
+    const glm::dvec3 eye = codec::placeReflectionEye(scene, r, camera.eye(), 1).eye;
     codec::ReflectionBakeOptions bake;
     bake.centre = eye;
     bake.size = static_cast<int>(state.range(2));
@@ -296,6 +294,8 @@ void BM_PlacedMirrorFocus(benchmark::State& state) {
         state.counters["ss_mirror_uniform_dB"] = s2.psnr(0, {0, 1});
         state.counters["ss_model_conus_dB"] = s2.psnr(1, {0});
         state.counters["ss_model_uniform_dB"] = s2.psnr(0, {0});
+        state.counters["ss_rest_conus_dB"] = s2.psnr(1, {1});
+        state.counters["ss_rest_uniform_dB"] = s2.psnr(0, {1});
         state.counters["truth1spp_mirror_dB"] = s3.psnr(1, {0, 1});
         state.counters["truth1spp_model_dB"] = s3.psnr(1, {0});
     }
