@@ -214,7 +214,8 @@ void BM_LayeredReflectionEyeSweep(benchmark::State& state) {
 // magnification range(1): the mirror, the model's reflection and the rest, CoNUS and uniform, and
 // the CoNUS asset's bytes against the centred single-layer CoNUS asset of 128-texel faces. With
 // CONUS_BENCH_SUPERSAMPLE set, "ss_" scores the frames (reference and assets alike) rendered with
-// 3x3 rays a pixel, box-filtered, and "truth1spp_" the one-ray reference against that one.
+// 3x3 rays a pixel, box-filtered (ReflectionFrameOptions::samples), "aaref_" the one-ray asset frames
+// against that reference, and "truth1spp_" the one-ray reference against it.
 void BM_PlacedMirrorFocus(benchmark::State& state) {
     const int index = static_cast<int>(state.range(0));
     if (!std::filesystem::exists(kModels[index / 2])) {
@@ -265,32 +266,27 @@ void BM_PlacedMirrorFocus(benchmark::State& state) {
     state.counters["eye_z"] = eye.z;
     const auto triangles = static_cast<std::uint32_t>(scene.mesh().indices.size() / 3);
     const bench::MirrorScore score = bench::scoreMirror(frames, truth, scene, r, camera, kFrame, triangles);
-    if (std::getenv("CONUS_BENCH_SUPERSAMPLE")) {  // 3x3 rays a frame pixel, box-filtered, for all three
-        constexpr int kS = 3;
-        const auto down = [&](const Image& big) {
-            Image out = big;
-            out.width = out.height = kFrame;
-            out.pixels.assign(std::size_t(kFrame) * kFrame * big.channels.size(), 0.0f);
-            for (int y = 0; y < kFrame; ++y)
-                for (int x = 0; x < kFrame; ++x)
-                    for (std::size_t c = 0; c < big.channels.size(); ++c) {
-                        float sum = 0;
-                        for (int j = 0; j < kS; ++j)
-                            for (int i = 0; i < kS; ++i) sum += big.at(kS * x + i, kS * y + j, int(c));
-                        out.at(x, y, int(c)) = c == 3 ? big.at(kS * x + 1, kS * y + 1, 3) : sum / (kS * kS);
-                    }
-            return out;
-        };
-        const Image ssTruth = down(codec::renderReflectionFrame(scene, nullptr, eye, camera, kS * kFrame, kS * kFrame, options));
+    if (std::getenv("CONUS_BENCH_SUPERSAMPLE")) {  // 3x3 rays a frame pixel, box-filtered
+        codec::ReflectionFrameOptions ssOptions = options;
+        ssOptions.samples = 3;
+        const Image ssTruth = codec::renderReflectionFrame(scene, nullptr, eye, camera, kFrame, kFrame, ssOptions);
         Image ss[2];
         for (int u = 0; u < 2; ++u) {
             bake.uniform = u == 0;
             const auto faces = codec::bakeReflection(scene, bake);
-            ss[u] = down(codec::renderReflectionFrame(scene, &faces, eye, camera, kS * kFrame, kS * kFrame, options));
+            ss[u] = codec::renderReflectionFrame(scene, &faces, eye, camera, kFrame, kFrame, ssOptions);
         }
         const bench::MirrorScore s2 = bench::scoreMirror(ss, ssTruth, scene, r, camera, kFrame, triangles);
         const Image alias[2] = {truth, truth};
         const bench::MirrorScore s3 = bench::scoreMirror(alias, ssTruth, scene, r, camera, kFrame, triangles);
+        // The one-ray asset frames (what the GLSL renderer draws) against the antialiased reference.
+        const bench::MirrorScore s4 = bench::scoreMirror(frames, ssTruth, scene, r, camera, kFrame, triangles);
+        state.counters["aaref_mirror_conus_dB"] = s4.psnr(1, {0, 1});
+        state.counters["aaref_mirror_uniform_dB"] = s4.psnr(0, {0, 1});
+        state.counters["aaref_model_conus_dB"] = s4.psnr(1, {0});
+        state.counters["aaref_model_uniform_dB"] = s4.psnr(0, {0});
+        state.counters["aaref_rest_conus_dB"] = s4.psnr(1, {1});
+        state.counters["aaref_rest_uniform_dB"] = s4.psnr(0, {1});
         state.counters["ss_mirror_conus_dB"] = s2.psnr(1, {0, 1});
         state.counters["ss_mirror_uniform_dB"] = s2.psnr(0, {0, 1});
         state.counters["ss_model_conus_dB"] = s2.psnr(1, {0});

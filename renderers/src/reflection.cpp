@@ -173,7 +173,11 @@ std::unique_ptr<DepthFrameRenderer::Scene> reflectionScene(Context& context, con
 ReflectionRenderer::ReflectionRenderer(Context& context, const Mesh& scene,
                                        const std::vector<codec::ReflectionFace>& faces,
                                        const codec::ReflectionFrameOptions& options)
-    : DepthFrameRenderer(reflectionScene(context, scene, faces, options)) {}
+    : DepthFrameRenderer(reflectionScene(context, scene, faces, options)) {
+    if (options.samples != 1)
+        throw Error(ErrorCode::Unsupported, "the GLSL reflection renderer casts one ray a pixel (samples 1), not " +
+                                                std::to_string(options.samples) + " a side");
+}
 
 Image renderReflection(const Device& device, const codec::MeshScene& scene,
                        const std::vector<codec::ReflectionFace>& faces, const Camera& camera, int width, int height,

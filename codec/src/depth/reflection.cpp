@@ -533,30 +533,43 @@ Image renderReflectionFrame(const MeshScene& scene, const std::vector<Reflection
                             const Camera& camera, int width, int height, const ReflectionFrameOptions& o) {
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         throw Error(ErrorCode::InvalidArgument, "reflection frames are 1 to 16384 pixels a side");
+    if (o.samples < 1 || o.samples > kMaxFrameSamples)
+        throw Error(ErrorCode::InvalidArgument, "reflection frames take 1 to " + std::to_string(kMaxFrameSamples) +
+                                                    " rays a pixel a side, not " + std::to_string(o.samples));
     checkIntersectOptions(o.intersect);
+    // One ray: its colour and the mask M.
+    const auto shade = [&](glm::dvec2 uv, glm::vec3& colour) {
+        const Ray ray = camera.ray(uv);
+        const std::array<float, 5> behind = shadeRay(scene, camera, uv);
+        colour = glm::vec3(behind[0], behind[1], behind[2]);
+        const auto mirror = hitReflector(o.reflector, ray);
+        if (!mirror) return 0.0f;
+        const double depth = camera.project(ray.origin + ray.direction * mirror->t).z;
+        if (behind[kMeshChannelA] > 0 && depth >= behind[kMeshChannelZ]) return 0.0f;
+        std::optional<glm::vec3> seen;
+        if (faces) {
+            if (const auto hit = traceReflection(*faces, mirror->reflected, o.intersect)) seen = hit->colour;
+        } else {
+            seen = traceReflectionReference(scene, mirror->reflected, centre);
+        }
+        colour = seen ? *seen : glm::vec3(kReflectionSky[0], kReflectionSky[1], kReflectionSky[2]);
+        return seen ? 2.0f : 1.0f;
+    };
+    const int n = o.samples;
     Image frame{width, height, {"R", "G", "B", "M"}, std::vector<float>(static_cast<std::size_t>(width) * height * 4)};
     parallelRows(height, o.threads, [&](int y0, int y1) {
       for (int y = y0; y < y1; ++y)
         for (int x = 0; x < width; ++x) {
-            const glm::dvec2 uv((x + 0.5) / width, (y + 0.5) / height);
-            const Ray ray = camera.ray(uv);
-            const std::array<float, 5> behind = shadeRay(scene, camera, uv);
-            glm::vec3 colour(behind[0], behind[1], behind[2]);
+            glm::vec3 sum(0.0f);
             float mask = 0;
-            if (const auto mirror = hitReflector(o.reflector, ray)) {
-                const double depth = camera.project(ray.origin + ray.direction * mirror->t).z;
-                if (behind[kMeshChannelA] <= 0 || depth < behind[kMeshChannelZ]) {
-                    std::optional<glm::vec3> seen;
-                    if (faces) {
-                        if (const auto hit = traceReflection(*faces, mirror->reflected, o.intersect)) seen = hit->colour;
-                    } else {
-                        seen = traceReflectionReference(scene, mirror->reflected, centre);
-                    }
-                    colour = seen ? *seen : glm::vec3(kReflectionSky[0], kReflectionSky[1], kReflectionSky[2]);
-                    mask = seen ? 2.0f : 1.0f;
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) {
+                    glm::vec3 colour;
+                    const float m = shade({(x + (i + 0.5) / n) / width, (y + (j + 0.5) / n) / height}, colour);
+                    sum += colour;
+                    if (i == n / 2 && j == n / 2) mask = m;
                 }
-            }
-            for (int c = 0; c < 3; ++c) frame.at(x, y, c) = colour[c];
+            for (int c = 0; c < 3; ++c) frame.at(x, y, c) = sum[c] / float(n * n);
             frame.at(x, y, 3) = mask;
         }
     });
