@@ -111,11 +111,12 @@ int runRenderReflection(const ReflectionRenderText& o) {
     const codec::MeshScene scene(readSceneMesh(o.scene, o.allowDirs));
     const double aspect = double(size.width) / size.height;
     const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);
-    // The ground truth traces the mesh itself: the CPU only.
+    // The ground truth traces the mesh itself, and only the CPU casts more than one ray a pixel.
+    const bool cpuOnly = o.reference || (options.samples > 1 && o.backend == enumName(renderers::Backend::Auto));
     const renderers::Device device =
-        o.reference ? renderers::Device::cpu() : deviceFor(o.backend, renderers::CpuPath::Available, "reflection rendering");
+        cpuOnly ? renderers::Device::cpu() : deviceFor(o.backend, renderers::CpuPath::Available, "reflection rendering");
     if (options.samples > 1 && device.backend() != renderers::Backend::Cpu)
-        throw Error(ErrorCode::InvalidArgument, "--samples above 1 needs --reference or --backend cpu (the GLSL renderer casts one ray a pixel)");
+        throw Error(ErrorCode::InvalidArgument, "--samples above 1 needs the CPU (--reference, --backend cpu or auto): the GLSL renderer casts one ray a pixel");
     Progress rendering("render " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                        (o.reference ? " (reflections traced against the mesh)" : " (reflections from the faces)"));
     Image frame = o.reference
@@ -155,7 +156,7 @@ CLI::App* addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
     reflection->add_flag("--reference", o.reference,
                          "trace reflected rays against the mesh (Embree, CPU): the ground truth");
     reflection->add_option("--samples", o.samples,
-                           "N: N x N rays a pixel, one in each cell of an N x N grid over it, averaged (CPU only; default " +
+                           "N: N x N rays a pixel, one in each cell of an N x N grid over it, averaged (the CPU only, which auto then picks; default " +
                                std::to_string(kReferenceSamples) + " with --reference, else 1)")
         ->check(CLI::Range(1, codec::kMaxFrameSamples));
     addBackendOption(*reflection, o.backend);
