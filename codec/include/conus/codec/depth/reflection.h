@@ -97,8 +97,8 @@ std::optional<Focus> reflectionFocus(const Camera& face, const AxisBox& roi, dou
 
 // The six faces of `scene` from options.centre, each rendered by the Embree reference (one exact
 // ray per CoNUS pixel for depth and coverage: depths of one surface, never a mean across a
-// silhouette; the first layer's colour the mean of 3x3 rays over the texel that meet the same
-// surface, so that a texture finer than the texels is not aliased); a face with a
+// silhouette; the first layer's colour the mean of those of 3x3 rays over the texel that meet a
+// surface within 5% of the centre ray's depth, so that a texture finer than the texels is not aliased); a face with a
 // focus is rendered uniform first, for its context. Throws
 // conus::Error(InvalidArgument) for a size outside [8, 4096], a magnification outside [1, 16],
 // layers outside [0, kMaxReflectionLayers], a non-finite centre, or a centre inside no free space
