@@ -12,7 +12,8 @@
 // reference shaded from its own eye); "moved_" the layered CoNUS assets seen from kMovedEye, a
 // viewpoint the eye was not placed for. BM_LayeredReflectionPaired times single-layer and
 // layered CoNUS frames in interleaved pairs, on the CPU (/0) and through GLSL (/1, the context
-// CONUS_BACKEND names, default auto).
+// CONUS_BACKEND names, default auto). BM_PlacedMirrorFocus scores the asset baked from the placed
+// eye by face size and magnification, also on antialiased frames (CONUS_BENCH_SUPERSAMPLE).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -209,6 +210,103 @@ void BM_LayeredReflectionEyeSweep(benchmark::State& state) {
     state.counters["disoccluded_pct"] = 100.0 * codec::disocclusionFraction(s.scene, eye, codec::reflectedRays(r, s.camera.eye(), codec::kViewRays), 1);
 }
 
+// The eye placed as placeReflectionEye places it for the camera (one layer), one layer, faces of range(2) texels, the focus's
+// magnification range(1): the mirror, the model's reflection and the rest, CoNUS and uniform, and
+// the CoNUS asset's bytes against the centred single-layer CoNUS asset of 128-texel faces. With
+// CONUS_BENCH_SUPERSAMPLE set, "ss_" scores the frames (reference and assets alike) rendered with
+// 3x3 rays a pixel, box-filtered (ReflectionFrameOptions::samples), "aaref_" the one-ray asset frames
+// against that reference, and "truth1spp_" the one-ray reference against it.
+void BM_PlacedMirrorFocus(benchmark::State& state) {
+    const int index = static_cast<int>(state.range(0));
+    if (!std::filesystem::exists(kModels[index / 2])) {
+        state.SkipWithError("the model is not installed (assimp-testmodels)");
+        return;
+    }
+    static std::unique_ptr<codec::MeshScene> scenes[2];
+    if (!scenes[index / 2]) scenes[index / 2] = std::make_unique<codec::MeshScene>(sceneio::readMesh(kModels[index / 2]));
+    const codec::MeshScene& scene = *scenes[index / 2];
+    codec::ReflectionFrameOptions options;
+    codec::Reflector& r = options.reflector;
+    const bool plane = index % 2 == 0;
+    r.kind = plane ? codec::Reflector::Kind::Plane : codec::Reflector::Kind::Sphere;
+    r.centre = plane ? glm::dvec3(0.0, 1.5, -6.0) : glm::dvec3(0.0, 1.5, -7.0);
+    r.radius = 4.0;
+    r.normal = glm::normalize(glm::dvec3(0.15, 0.0, 1.0));
+    const Camera camera = Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, plane ? 38.0 : 45.0, 1.0, 1e-3, 1e3);
+    const glm::dvec3 eye = codec::placeReflectionEye(scene, r, camera.eye(), 1).eye;
+    codec::ReflectionBakeOptions bake;
+    bake.centre = eye;
+    bake.size = static_cast<int>(state.range(2));
+    bake.roi = boundsOf(scene.mesh());
+    bake.magnification = static_cast<double>(state.range(1));
+    Image frames[2], truth;
+    const auto bytesOf = [](const std::vector<codec::ReflectionFace>& faces) {
+        const std::string path = (std::filesystem::temp_directory_path() / "conus-placed-focus.exr").string();
+        format::writeReflectionAsset(path, codec::reflectionAssetFile(faces));
+        const auto bytes = static_cast<double>(std::filesystem::file_size(path));
+        std::filesystem::remove(path);
+        return bytes;
+    };
+    double bytes = 0;
+    for (auto _ : state) {
+        for (int u = 0; u < 2; ++u) {
+            bake.uniform = u == 0;
+            const auto faces = codec::bakeReflection(scene, bake);
+            frames[u] = codec::renderReflectionFrame(scene, &faces, eye, camera, kFrame, kFrame, options);
+            if (u == 1) bytes = bytesOf(faces);
+        }
+        truth = codec::renderReflectionFrame(scene, nullptr, eye, camera, kFrame, kFrame, options);
+    }
+    codec::ReflectionBakeOptions centred;  // the centred single-layer CoNUS asset of 128-texel faces
+    centred.centre = r.centre;
+    centred.size = kFace;
+    centred.roi = bake.roi;
+    state.counters["bytes_ratio"] = bytes / bytesOf(codec::bakeReflection(scene, centred));
+    state.counters["eye_x"] = eye.x;
+    state.counters["eye_z"] = eye.z;
+    const auto triangles = static_cast<std::uint32_t>(scene.mesh().indices.size() / 3);
+    const bench::MirrorScore score = bench::scoreMirror(frames, truth, scene, r, camera, kFrame, triangles);
+    if (std::getenv("CONUS_BENCH_SUPERSAMPLE")) {  // 3x3 rays a frame pixel, box-filtered
+        codec::ReflectionFrameOptions ssOptions = options;
+        ssOptions.samples = 3;
+        const Image ssTruth = codec::renderReflectionFrame(scene, nullptr, eye, camera, kFrame, kFrame, ssOptions);
+        Image ss[2];
+        for (int u = 0; u < 2; ++u) {
+            bake.uniform = u == 0;
+            const auto faces = codec::bakeReflection(scene, bake);
+            ss[u] = codec::renderReflectionFrame(scene, &faces, eye, camera, kFrame, kFrame, ssOptions);
+        }
+        const bench::MirrorScore s2 = bench::scoreMirror(ss, ssTruth, scene, r, camera, kFrame, triangles);
+        const Image alias[2] = {truth, truth};
+        const bench::MirrorScore s3 = bench::scoreMirror(alias, ssTruth, scene, r, camera, kFrame, triangles);
+        // The one-ray asset frames (what the GLSL renderer draws) against the antialiased reference.
+        const bench::MirrorScore s4 = bench::scoreMirror(frames, ssTruth, scene, r, camera, kFrame, triangles);
+        state.counters["aaref_mirror_conus_dB"] = s4.psnr(1, {0, 1});
+        state.counters["aaref_mirror_uniform_dB"] = s4.psnr(0, {0, 1});
+        state.counters["aaref_model_conus_dB"] = s4.psnr(1, {0});
+        state.counters["aaref_model_uniform_dB"] = s4.psnr(0, {0});
+        state.counters["aaref_rest_conus_dB"] = s4.psnr(1, {1});
+        state.counters["aaref_rest_uniform_dB"] = s4.psnr(0, {1});
+        state.counters["ss_mirror_conus_dB"] = s2.psnr(1, {0, 1});
+        state.counters["ss_mirror_uniform_dB"] = s2.psnr(0, {0, 1});
+        state.counters["ss_model_conus_dB"] = s2.psnr(1, {0});
+        state.counters["ss_model_uniform_dB"] = s2.psnr(0, {0});
+        state.counters["ss_rest_conus_dB"] = s2.psnr(1, {1});
+        state.counters["ss_rest_uniform_dB"] = s2.psnr(0, {1});
+        state.counters["truth1spp_mirror_dB"] = s3.psnr(1, {0, 1});
+        state.counters["truth1spp_model_dB"] = s3.psnr(1, {0});
+    }
+    state.counters["mirror_conus_dB"] = score.psnr(1, {0, 1});
+    state.counters["mirror_uniform_dB"] = score.psnr(0, {0, 1});
+    state.counters["model_conus_dB"] = score.psnr(1, {0});
+    state.counters["model_uniform_dB"] = score.psnr(0, {0});
+    state.counters["rest_conus_dB"] = score.psnr(1, {1});
+    state.counters["rest_uniform_dB"] = score.psnr(0, {1});
+    if (const char* prefix = std::getenv("CONUS_BENCH_PICTURES"))
+        bench::writeMirrorStrip(std::string(prefix) + "-focus-" + std::to_string(index) + "-" +
+                                    std::to_string(state.range(1)) + "-" + std::to_string(state.range(2)) + ".png", frames, truth, score, kFrame, 3);
+}
+
 // Single-layer (A) against layered (B) CoNUS frames: /x/0 the CPU reference, /x/1 GLSL; /x/x/1 the
 // layered asset from the placed eye as B.
 void BM_LayeredReflectionPaired(benchmark::State& state) {
@@ -250,6 +348,8 @@ void BM_LayeredReflectionPaired(benchmark::State& state) {
 BENCHMARK(BM_LayeredReflectionQuality)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LayeredReflectionEyeSweep)->ArgsProduct({{0, 2}, {0, 1, 2, 3, 4}, {kFace}})->Args({0, 4, 160})->Args({2, 4, 160})
     ->Args({0, 4, 192})->Args({2, 4, 192})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlacedMirrorFocus)->ArgsProduct({{0, 1, 2, 3}, {4}, {kFace, 160}})->Args({2, 8, kFace})->Args({2, 16, kFace})
+    ->Args({2, 4, 256})->Args({2, 4, 512})->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LayeredReflectionPaired)->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})->Iterations(21)
     ->Unit(benchmark::kMillisecond);
 

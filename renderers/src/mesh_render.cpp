@@ -214,6 +214,24 @@ MeshRenderer::~MeshRenderer() {
 
 Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, int width, int height,
                            const MeshRenderOptions& options, GpuTimings* timings, std::int64_t* trianglesDrawn) {
+    return frame(camera, map, width, height, options, timings, trianglesDrawn, nullptr);
+}
+
+std::vector<Image> MeshRenderer::renderLayers(const Camera& camera, const codec::SamplingMap& map, int width,
+                                              int height, int layers, const MeshRenderOptions& options) {
+    if (layers < 1) throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": layers must be at least 1");
+    MeshRenderOptions one = options;
+    one.samples = 1;  // a previous layer's depth is one per pixel
+    std::vector<Image> out;
+    out.reserve(static_cast<std::size_t>(layers));
+    for (int k = 0; k < layers; ++k)
+        out.push_back(frame(camera, map, width, height, one, nullptr, nullptr, k == 0 ? nullptr : &out.back()));
+    return out;
+}
+
+Image MeshRenderer::frame(const Camera& camera, const codec::SamplingMap& map, int width, int height,
+                          const MeshRenderOptions& options, GpuTimings* timings, std::int64_t* trianglesDrawn,
+                          const Image* behind) {
     Context& context = m_impl->context;
     checkFrame(context, width, height, kWhat);
     checkOptions(options);
@@ -277,6 +295,24 @@ Image MeshRenderer::render(const Camera& camera, const codec::SamplingMap& map, 
         gl.ActiveTexture(GL_TEXTURE1);
         gl.BindTexture(GL_TEXTURE_2D, impl.texture.id());
         gl.ActiveTexture(GL_TEXTURE0);
+    }
+    // Peeling: the previous layer's camera depth a pixel, in the rows the readback gave them.
+    std::optional<GlHandle> behindDepth;
+    gl.Uniform1i(gl.GetUniformLocation(program, "uPeel"), behind != nullptr);
+    gl.Uniform1i(gl.GetUniformLocation(program, "uBehind"), 4);
+    if (behind) {
+        std::vector<float> z(static_cast<std::size_t>(width) * height);
+        for (std::size_t p = 0; p < z.size(); ++p) z[p] = behind->pixels[p * 5 + 4];
+        behindDepth = makeTexture(gl);
+        gl.ActiveTexture(GL_TEXTURE4);
+        gl.BindTexture(GL_TEXTURE_2D, behindDepth->id());
+        gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_R32F, width, height);
+        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RED, GL_FLOAT, z.data());
+        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        gl.ActiveTexture(GL_TEXTURE0);
+        gl.Uniform1f(gl.GetUniformLocation(program, "uPeelGap"), static_cast<float>(codec::kPeelGap));
     }
     gl.BindVertexArray(impl.vertexArray.id());
     if (trianglesDrawn) gl.BeginQuery(GL_PRIMITIVES_GENERATED, impl.primitivesQuery.id());

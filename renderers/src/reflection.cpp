@@ -137,6 +137,9 @@ std::unique_ptr<DepthFrameRenderer::Scene> reflectionScene(Context& context, con
                                                            const std::vector<codec::ReflectionFace>& faces,
                                                            const codec::ReflectionFrameOptions& options) {
     codec::checkIntersectOptions(options.intersect);
+    if (options.samples != 1)
+        throw Error(ErrorCode::Unsupported, "the GLSL " + std::string(kWhat) + " renderer casts one ray a pixel (samples 1), not " +
+                                                std::to_string(options.samples) + " a side");
     if (faces.size() != static_cast<std::size_t>(codec::kCubeFaces))
         throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": " + std::to_string(faces.size()) +
                                                     " faces; the GPU renderer draws a cube of " +

@@ -94,7 +94,9 @@ TEST_F(ReflectionCli, OneFileBakesValidatesDescribesAndRenders) {
     const std::string common = " --scene " + scene + " --camera -0.8,0.5,3,0,0,0,22 --size 96x96 --radius 0.5 -q";
     ASSERT_EQ(run("render reflection " + conus + common + " --backend cpu -o " + path("conus.png")).exitCode, 0);
     ASSERT_EQ(run("render reflection " + uniform + common + " --backend cpu -o " + path("uniform.png")).exitCode, 0);
-    ASSERT_EQ(run("render reflection " + conus + common + " --reference -o " + path("truth.png")).exitCode, 0);
+    // The reference along the same rays as the faces' frames (one a pixel): the faces' error alone,
+    // without the one-ray frames' aliasing against an antialiased reference.
+    ASSERT_EQ(run("render reflection " + conus + common + " --reference --samples 1 -o " + path("truth.png")).exitCode, 0);
     // The faces approximate the traced reflection: 38.4 dB on this scene at these sizes.
     const double conusPsnr = psnr(path("conus.png"), path("truth.png"));
     EXPECT_GT(conusPsnr, 38.0);
@@ -241,7 +243,8 @@ TEST_F(ReflectionCli, AViewPlacesTheEyeAndItsFrameBeatsTheCentredAsset) {
     for (const std::string* asset : {&centred, &placed}) {
         const std::string stem = asset == &centred ? "centred" : "placed";
         ASSERT_EQ(run("render reflection " + *asset + common + " --backend cpu -o " + path(stem + ".png")).exitCode, 0);
-        ASSERT_EQ(run("render reflection " + *asset + common + " --reference -o " + path(stem + "-truth.png")).exitCode, 0);
+        // The reference along the frames' rays, one a pixel, as above.
+        ASSERT_EQ(run("render reflection " + *asset + common + " --reference --samples 1 -o " + path(stem + "-truth.png")).exitCode, 0);
         r = run("render reflection " + *asset + common + " --backend egl -o " + path(stem + "-gl.png"));
         ASSERT_EQ(r.exitCode, 0) << r.err;
     }
@@ -382,6 +385,40 @@ TEST_F(ReflectionCli, AWriteCutShortLeavesTheEarlierAssetWhole) {
     EXPECT_EQ(run("validate -q " + asset).exitCode, 0);
     for (const auto& e : fs::directory_iterator(fs::path(asset).parent_path()))
         EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+}
+
+// --reference antialiases by default (3x3 rays a pixel): across the box's outlines and the mirror's
+// it is much nearer a 8x8-ray render than the one-ray reference (--samples 1); a count of rays
+// outside 1..16, or above 1 on the GLSL renderer, is refused in one line with nothing written.
+TEST_F(ReflectionCli, TheReferenceAntialiasesByDefault) {
+    const std::string scene = path("scene.obj"), asset = path("asset.exr");
+    writeScene(scene);
+    ASSERT_EQ(run("bake reflection " + scene + " --center 0,0,0 --size 16 --uniform -q -o " + asset).exitCode, 0);
+    const std::string common = "render reflection " + asset + " --scene " + scene +
+                               " --camera -0.8,0.5,3,0,0,0,22 --size 48x40 --radius 0.5 --reference -o ";
+    Result r = run(common + path("default.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("3x3 rays a pixel"), std::string::npos) << r.out;
+    ASSERT_EQ(run(common + path("one.exr") + " --samples 1").exitCode, 0);
+    ASSERT_EQ(run(common + path("fine.exr") + " --samples 8").exitCode, 0);
+    const double oneDb = psnr(path("one.exr"), path("fine.exr")), defaultDb = psnr(path("default.exr"), path("fine.exr"));
+    std::printf("[ info ] against 8x8 rays a pixel: one ray %.1f dB, the default %.1f dB\n", oneDb, defaultDb);
+    EXPECT_GT(defaultDb, oneDb + 4.0) << oneDb;
+    EXPECT_GT(meanError(path("one.exr"), path("default.exr")), 0.0);
+    for (const std::string bad : {" --samples 0", " --samples 17", " --samples 2 --backend egl"}) {
+        const std::string out = path("bad.png");
+        r = run("render reflection " + asset + " --scene " + scene + " --camera -0.8,0.5,3,0,0,0,22 --size 8x8 -q -o " + out + bad);
+        EXPECT_NE(r.exitCode, 0) << bad;
+        EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+        EXPECT_FALSE(fs::exists(out)) << bad;
+    }
+    // The GLSL renderer is not antialiased: where only --samples is wrong, the error says what works;
+    // the backend left to choose takes the CPU for an antialiased frame of the faces.
+    EXPECT_NE(r.err.find("needs the CPU"), std::string::npos) << r.err;
+    r = run("render reflection " + asset + " --scene " + scene + " --camera -0.8,0.5,3,0,0,0,22 --size 8x8 --samples 2 -o " + path("aa.png"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("2x2 rays a pixel"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("(cpu)"), std::string::npos) << r.out;
 }
 
 TEST_F(ReflectionCli, BadInputIsOneLineAndNonZero) {

@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "conus/codec/builders/foci.h"
+#include "conus/codec/mesh/raycast.h"
 #include "conus/core/error.h"
 #include "gl_test_util.h"
 #include "mesh_test_util.h"
@@ -151,6 +153,58 @@ TEST_P(MeshRender, NormalsAreComputedWhenAbsent) {
     const Image computed = renderMeshGpu(context, mesh, camera, identity, kWidth, kHeight, options);
     // Area-weighted normals of a fine sphere are nearly the exact ones (not flat, not zero).
     EXPECT_GE(test::colourPsnr(withNormals, computed), 40.0);
+}
+
+// Depth peeling on the GPU against codec's ray-cast layers (the bake's CPU reference): three
+// layers of the two spheres (the small one's front, its back or the big one's front, then what
+// lies behind that), through the focus and without. Pixels whose coverage differs are those a
+// silhouette crosses (the rasterizer's and the ray's edges part there); elsewhere the depths and
+// colours agree.
+TEST_P(MeshRender, PeeledLayersMatchTheRayCastLayers) {
+    Context& context = contextFor(GetParam());
+    const Mesh mesh = sphereMesh(twoSpheres());
+    const Camera camera = testCamera();
+    MeshRenderer renderer(context, mesh);
+    const codec::MeshScene scene(mesh);
+    for (const bool focused : {false, true}) {
+        SCOPED_TRACE(focused ? "focus map" : "identity map");
+        const codec::SamplingMap map = focused ? focusMap() : codec::SamplingMap::identity(2, 2);
+        const std::vector<Image> gpu = renderer.renderLayers(camera, map, kWidth, kHeight, 3);
+        const std::vector<Image> cpu =
+            codec::renderMeshLayers(scene, Fpc(camera, std::make_shared<codec::SamplingMap>(map)), kWidth, kHeight, 3);
+        ASSERT_EQ(gpu.size(), 3u);
+        for (int k = 0; k < 3; ++k) {
+            SCOPED_TRACE("layer " + std::to_string(k));
+            int both = 0, differ = 0, depthOff = 0, colourOff = 0;
+            for (int y = 0; y < kHeight; ++y)
+                for (int x = 0; x < kWidth; ++x) {
+                    const bool g = gpu[k].at(x, y, 3) > 0.5f, c = cpu[k].at(x, y, 3) > 0.5f;
+                    if (g != c) {
+                        ++differ;
+                        continue;
+                    }
+                    if (!g) {
+                        EXPECT_FLOAT_EQ(gpu[k].at(x, y, 4), static_cast<float>(camera.far()));
+                        continue;
+                    }
+                    ++both;
+                    const float z = cpu[k].at(x, y, 4);
+                    depthOff += std::abs(gpu[k].at(x, y, 4) - z) > 0.01f * z;
+                    for (int ch = 0; ch < 3; ++ch) colourOff += std::abs(gpu[k].at(x, y, ch) - cpu[k].at(x, y, ch)) > 0.05f;
+                }
+            EXPECT_GT(both, 50);  // every layer holds surfaces (layer 2: where the small sphere covers the big one)
+            EXPECT_LT(differ, both / 20);
+            EXPECT_LT(depthOff, both / 50);
+            EXPECT_LT(colourOff, both / 20);
+        }
+        // Past the last surface: nothing.
+        const std::vector<Image> deep = renderer.renderLayers(camera, map, kWidth, kHeight, 5);
+        double covered = 0;
+        for (int y = 0; y < kHeight; ++y)
+            for (int x = 0; x < kWidth; ++x) covered += deep[4].at(x, y, 3);
+        EXPECT_EQ(covered, 0.0);
+    }
+    EXPECT_THROW(renderer.renderLayers(camera, codec::SamplingMap::identity(2, 2), kWidth, kHeight, 0), Error);
 }
 
 INSTANTIATE_TEST_SUITE_P(MeshGl, MeshRender, ::testing::Values(Backend::Egl, Backend::OsMesa), test::paramName);

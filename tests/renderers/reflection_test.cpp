@@ -155,6 +155,9 @@ TEST_P(ReflectionGl, BadInputIsRefused) {
     options.intersect.stepTexels = 0;
     EXPECT_THROW(ReflectionRenderer(context(), scene().mesh(), set, options), Error);
     options = {};
+    options.samples = 2;  // one ray a pixel only (the CPU reference antialiases)
+    EXPECT_THROW(ReflectionRenderer(context(), scene().mesh(), set, options), Error);
+    options = {};
     ReflectionRenderer renderer(context(), scene().mesh(), set, options);
     const Camera camera = Camera::perspective({0, 0, 3}, {0, 0, 0}, {0, 1, 0}, 40.0, 1.0, 0.1, 20.0);
     EXPECT_THROW(renderer.render(camera, 0, 10), Error);

@@ -96,6 +96,40 @@ std::optional<DensityField> outlineContext(const Image& uniform) {
     return field;
 }
 
+// A baked texel's colour is the mean over kTexelRays^2 rays spread evenly over its footprint (the
+// texel's square in the map's distorted image, each position undistorted), counting those that meet
+// the surface its centre ray meets (covered, Z within kSameSurface of the centre's); its A and Z
+// stay the centre ray's: one exact surface, never a mean across a silhouette. One ray a texel
+// point-samples a texture many times finer than the texels (the milk truck's 2048^2 texture seen
+// from 17 units away) and stores aliased values where the surface's mean belongs. kTexelRays is
+// odd, so the middle ray is the centre ray.
+constexpr int kTexelRays = 3;
+constexpr double kSameSurface = 0.05;
+
+void filterTexelColours(const MeshScene& scene, const Fpc& fpc, Image& rgbaz) {
+    const int w = rgbaz.width, h = rgbaz.height;
+    const Distortion* distortion = fpc.distortion();
+    parallelRows(h, 0, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x) {
+                if (rgbaz.at(x, y, kMeshChannelA) <= 0.0f) continue;
+                const float z = rgbaz.at(x, y, kMeshChannelZ);
+                glm::vec3 sum(0.0f);
+                int n = 0;
+                for (int j = 0; j < kTexelRays; ++j)
+                    for (int i = 0; i < kTexelRays; ++i) {
+                        const glm::dvec2 pd((x + (i + 0.5) / kTexelRays) / w, (y + (j + 0.5) / kTexelRays) / h);
+                        const auto ray = shadeRay(scene, fpc.camera(), distortion ? distortion->undistort(pd) : pd);
+                        if (!(ray[kMeshChannelA] > 0.0f) || std::abs(ray[kMeshChannelZ] - z) > kSameSurface * z) continue;
+                        sum += glm::vec3(ray[0], ray[1], ray[2]);
+                        ++n;
+                    }
+                if (n == 0) continue;  // the centre ray itself always counts; kept for safety
+                for (int c = 0; c < 3; ++c) rgbaz.at(x, y, kMeshChannelR + c) = sum[c] / float(n);
+            }
+    }, 4);
+}
+
 // A plane mirror's in-plane axes for unit normal n: any orthonormal pair; the mirror is square
 // about its centre, so a disc test would not do, but the pair's choice only turns the square in
 // its plane.
@@ -180,10 +214,12 @@ std::vector<ReflectionFace> bakeReflection(const MeshScene& scene, const Reflect
         }
         if (peel == 1) {
             Image rgbaz = renderMeshReference(scene, Fpc(camera, map), o.size, o.size);
+            filterTexelColours(scene, Fpc(camera, map), rgbaz);
             faces.push_back({DepthImage(camera, map, o.size, o.size, depthsOf(rgbaz), false), std::move(rgbaz), {}});
             continue;
         }
         std::vector<Image> layers = renderMeshLayers(scene, Fpc(camera, map), o.size, o.size, peel);
+        filterTexelColours(scene, Fpc(camera, map), layers[0]);
         ReflectionFace face{DepthImage(camera, map, o.size, o.size, depthsOf(layers[0]), false), std::move(layers[0]), {}};
         for (std::size_t k = 1; k < layers.size(); ++k)
             face.behind.push_back({DepthImage(camera, map, o.size, o.size, depthsOf(layers[k]), false), std::move(layers[k])});
@@ -497,30 +533,43 @@ Image renderReflectionFrame(const MeshScene& scene, const std::vector<Reflection
                             const Camera& camera, int width, int height, const ReflectionFrameOptions& o) {
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         throw Error(ErrorCode::InvalidArgument, "reflection frames are 1 to 16384 pixels a side");
+    if (o.samples < 1 || o.samples > kMaxFrameSamples)
+        throw Error(ErrorCode::InvalidArgument, "reflection frames take 1 to " + std::to_string(kMaxFrameSamples) +
+                                                    " rays a pixel a side, not " + std::to_string(o.samples));
     checkIntersectOptions(o.intersect);
+    // One ray: its colour and the mask M.
+    const auto shade = [&](glm::dvec2 uv, glm::vec3& colour) {
+        const Ray ray = camera.ray(uv);
+        const std::array<float, 5> behind = shadeRay(scene, camera, uv);
+        colour = glm::vec3(behind[0], behind[1], behind[2]);
+        const auto mirror = hitReflector(o.reflector, ray);
+        if (!mirror) return 0.0f;
+        const double depth = camera.project(ray.origin + ray.direction * mirror->t).z;
+        if (behind[kMeshChannelA] > 0 && depth >= behind[kMeshChannelZ]) return 0.0f;
+        std::optional<glm::vec3> seen;
+        if (faces) {
+            if (const auto hit = traceReflection(*faces, mirror->reflected, o.intersect)) seen = hit->colour;
+        } else {
+            seen = traceReflectionReference(scene, mirror->reflected, centre);
+        }
+        colour = seen ? *seen : glm::vec3(kReflectionSky[0], kReflectionSky[1], kReflectionSky[2]);
+        return seen ? 2.0f : 1.0f;
+    };
+    const int n = o.samples;
     Image frame{width, height, {"R", "G", "B", "M"}, std::vector<float>(static_cast<std::size_t>(width) * height * 4)};
     parallelRows(height, o.threads, [&](int y0, int y1) {
       for (int y = y0; y < y1; ++y)
         for (int x = 0; x < width; ++x) {
-            const glm::dvec2 uv((x + 0.5) / width, (y + 0.5) / height);
-            const Ray ray = camera.ray(uv);
-            const std::array<float, 5> behind = shadeRay(scene, camera, uv);
-            glm::vec3 colour(behind[0], behind[1], behind[2]);
+            glm::vec3 sum(0.0f);
             float mask = 0;
-            if (const auto mirror = hitReflector(o.reflector, ray)) {
-                const double depth = camera.project(ray.origin + ray.direction * mirror->t).z;
-                if (behind[kMeshChannelA] <= 0 || depth < behind[kMeshChannelZ]) {
-                    std::optional<glm::vec3> seen;
-                    if (faces) {
-                        if (const auto hit = traceReflection(*faces, mirror->reflected, o.intersect)) seen = hit->colour;
-                    } else {
-                        seen = traceReflectionReference(scene, mirror->reflected, centre);
-                    }
-                    colour = seen ? *seen : glm::vec3(kReflectionSky[0], kReflectionSky[1], kReflectionSky[2]);
-                    mask = seen ? 2.0f : 1.0f;
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) {
+                    glm::vec3 colour;
+                    const float m = shade({(x + (i + 0.5) / n) / width, (y + (j + 0.5) / n) / height}, colour);
+                    sum += colour;
+                    if (i == n / 2 && j == n / 2) mask = m;
                 }
-            }
-            for (int c = 0; c < 3; ++c) frame.at(x, y, c) = colour[c];
+            for (int c = 0; c < 3; ++c) frame.at(x, y, c) = sum[c] / float(n * n);
             frame.at(x, y, 3) = mask;
         }
     });

@@ -2,11 +2,15 @@
 // it, a sphere's virtual image of it, and a placed eye that sees what the mirror shows.
 #include "conus/codec/depth/reflection.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "codec/mesh/mesh_test_scenes.h"
+#include "conus/codec/mesh/shading.h"
 #include "conus/core/error.h"
 
 namespace conus::codec {
@@ -118,6 +122,66 @@ TEST(ReflectionEye, ThePlacedEyeSeesWhatTheMirrorShowsAndItsFrameBeatsTheCentres
     ASSERT_GT(count, 1000);
     const double centreDb = 10 * std::log10(3 * count / squared[0]), placedDb = 10 * std::log10(3 * count / squared[1]);
     EXPECT_GT(placedDb, centreDb + 3.0) << centreDb << " dB from the centre";
+}
+
+// A baked texel holds the mean colour of the surface over its footprint, not one point of it: a
+// floor under the -y face whose texture alternates black and white columns, three to a texel of a
+// 16-texel face (the floor at distance 1 fills the face, parallel to it), bakes to a third or two
+// thirds of the white floor's colour in every texel; its centre ray alone would give 0 or 1.
+TEST(ReflectionBake, ATexelsColourIsItsFootprintsMeanOverOneSurface) {
+    Image stripes{48, 4, {"R", "G", "B"}, std::vector<float>(48 * 4 * 3)};
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 48; ++x)
+            for (int c = 0; c < 3; ++c) stripes.at(x, y, c) = float(x % 2);
+    Image white = stripes;
+    std::fill(white.pixels.begin(), white.pixels.end(), 1.0f);
+    ReflectionBakeOptions o;
+    o.size = 16;
+    o.uniform = true;
+    const auto bake = [&](Mesh mesh) { return bakeReflection(MeshScene(std::move(mesh)), o)[3]; };  // ny
+    const ReflectionFace striped = bake(test::plane(-1.0f, 1.0f, 1.0f, stripes));
+    const ReflectionFace plain = bake(test::plane(-1.0f, 1.0f, 1.0f, white));
+    int thirds = 0, twoThirds = 0;
+    for (int y = 1; y < 15; ++y)
+        for (int x = 1; x < 15; ++x) {
+            ASSERT_GT(plain.image.at(x, y, kMeshChannelA), 0.0f);
+            EXPECT_EQ(striped.image.at(x, y, kMeshChannelZ), plain.image.at(x, y, kMeshChannelZ));  // the centre ray's
+            const float ratio = striped.image.at(x, y, 1) / plain.image.at(x, y, 1);
+            EXPECT_GT(ratio, 0.2f) << x << "," << y;
+            EXPECT_LT(ratio, 0.8f) << x << "," << y;
+            thirds += std::abs(ratio - 1.0f / 3) < 0.05f;
+            twoThirds += std::abs(ratio - 2.0f / 3) < 0.05f;
+        }
+    EXPECT_GT(thirds, 14 * 14 / 3);
+    EXPECT_GT(twoThirds, 14 * 14 / 3);
+
+    // Across a silhouette the mean takes only the centre ray's surface: a white square (y = -1,
+    // half side 0.4) over a black floor (y = -2): the floor's texels stay black beside it, and the
+    // square's keep the colour they have without the floor (up to the shading's scale, which
+    // follows the scene's size: one ratio over the whole square, its outline included).
+    Mesh both = test::plane(-1.0f, 0.4f);
+    Mesh floor = test::plane(-2.0f, 4.0f);
+    const auto base = static_cast<std::uint32_t>(both.positions.size());
+    both.positions.insert(both.positions.end(), floor.positions.begin(), floor.positions.end());
+    both.normals.insert(both.normals.end(), floor.normals.begin(), floor.normals.end());
+    for (std::uint32_t i : floor.indices) both.indices.push_back(base + i);
+    both.colours.assign(4, glm::vec3(1.0f));
+    both.colours.resize(8, glm::vec3(0.0f));
+    const ReflectionFace withFloor = bake(both);
+    const ReflectionFace square = bake(test::plane(-1.0f, 0.4f));
+    const float scale = withFloor.image.at(8, 8, 0) / square.image.at(8, 8, 0);
+    int edges = 0;
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) {
+            const float z = withFloor.image.at(x, y, kMeshChannelZ);
+            if (z > 1.5f) {
+                EXPECT_EQ(withFloor.image.at(x, y, 0), 0.0f) << x << "," << y;
+            } else {
+                EXPECT_NEAR(withFloor.image.at(x, y, 0) / square.image.at(x, y, 0), scale, 1e-4) << x << "," << y;
+                edges += x < 15 && withFloor.image.at(x + 1, y, kMeshChannelZ) > 1.5f;
+            }
+        }
+    EXPECT_GT(edges, 0);  // the square's outline crosses the face
 }
 
 }  // namespace

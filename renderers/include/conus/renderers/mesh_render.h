@@ -26,6 +26,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "conus/codec/map/sampling_map.h"
 #include "conus/core/camera.h"
@@ -62,7 +63,18 @@ public:
                  const MeshRenderOptions& options = {}, GpuTimings* timings = nullptr,
                  std::int64_t* trianglesDrawn = nullptr);
 
+    // Depth peeling: `layers` frames, frame k the k-th surface along each pixel (the first more
+    // than codec::kPeelGap of its depth behind frame k - 1's; A = 0 and the far depth where there
+    // is none), one sample a pixel (options.samples is ignored), as codec::renderMeshLayers casts
+    // its rays. Throws InvalidArgument for layers < 1.
+    std::vector<Image> renderLayers(const Camera& camera, const codec::SamplingMap& map, int width, int height,
+                                    int layers, const MeshRenderOptions& options = {});
+
 private:
+    Image frame(const Camera& camera, const codec::SamplingMap& map, int width, int height,
+                const MeshRenderOptions& options, GpuTimings* timings, std::int64_t* trianglesDrawn,
+                const Image* behind);
+
     struct Impl;
     std::unique_ptr<Impl> m_impl;
 };

@@ -96,7 +96,9 @@ struct ReflectionBakeOptions {
 std::optional<Focus> reflectionFocus(const Camera& face, const AxisBox& roi, double magnification);
 
 // The six faces of `scene` from options.centre, each rendered by the Embree reference (one exact
-// ray per CoNUS pixel: depths of one surface, never a mean across a silhouette); a face with a
+// ray per CoNUS pixel for depth and coverage: depths of one surface, never a mean across a
+// silhouette; the first layer's colour the mean of those of 3x3 rays over the texel that meet a
+// surface within 5% of the centre ray's depth, so that a texture finer than the texels is not aliased); a face with a
 // focus is rendered uniform first, for its context. Throws
 // conus::Error(InvalidArgument) for a size outside [8, 4096], a magnification outside [1, 16],
 // layers outside [0, kMaxReflectionLayers], a non-finite centre, or a centre inside no free space
@@ -196,17 +198,25 @@ EyePlacement placeReflectionEye(const MeshScene& scene, const Reflector& reflect
 // What the reflector shows where a reflected ray meets nothing: a constant sky.
 inline constexpr float kReflectionSky[3] = {0.55f, 0.65f, 0.8f};
 
+// The most rays a frame pixel a side (samples x samples rays a pixel).
+inline constexpr int kMaxFrameSamples = 16;
+
 struct ReflectionFrameOptions {
     Reflector reflector;
     IntersectOptions intersect;
     int threads = 0;  // 0: all cores
+    // samples x samples rays a pixel, one at the centre of each cell of a regular samples x samples
+    // grid over the pixel, their colours box-filtered (averaged); 1: one ray through the pixel's
+    // centre. 1 to kMaxFrameSamples.
+    int samples = 1;
 };
 
-// The CPU reference of `render reflection`, width x height: each pixel's ray from `camera`; where
-// it meets the reflector before the scene, the reflected ray's colour from `faces` (null: traced
+// The CPU reference of `render reflection`, width x height: each pixel's rays from `camera`; where
+// one meets the reflector before the scene, the reflected ray's colour from `faces` (null: traced
 // against the mesh, traceReflectionReference, the ground truth); elsewhere the scene as the mesh
-// reference shades it (identity map). Channels R, G, B and M: 0 scene or nothing, 1 the reflector
-// showing the sky, 2 the reflector showing the scene.
+// reference shades it (identity map). R, G, B are the mean over the pixel's rays. M, of the pixel's
+// ray nearest its centre (the centre itself for an odd `samples`): 0 scene or nothing, 1 the
+// reflector showing the sky, 2 the reflector showing the scene.
 Image renderReflectionFrame(const MeshScene& scene, const std::vector<ReflectionFace>* faces, glm::dvec3 centre,
                             const Camera& camera, int width, int height, const ReflectionFrameOptions& options);
 

@@ -1,8 +1,9 @@
 // Procedural test volumes with known content: Marschner-Lobb (the standard test signal of volume
 // reconstruction filters, S. Marschner and R. Lobb, "An evaluation of reconstruction filters for
 // volume rendering", 1994) and a 3-D Shepp-Logan head phantom (the ten ellipsoids of the modified
-// 3-D phantom, values added where they overlap). Both are sampled over [-1,1]^3 on an n^3 grid
-// with spacing 2 / (n - 1); values lie in [0,1].
+// 3-D phantom, values added where they overlap, seen through a Gaussian point spread of one voxel
+// so that its one-voxel skull does not alias against the grid). Both are sampled over [-1,1]^3 on
+// an n^3 grid with spacing 2 / (n - 1); values lie in [0,1].
 #pragma once
 
 #include <string>
