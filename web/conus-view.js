@@ -371,9 +371,9 @@ void main() {
       // The kept frame moved by (dx, dy) into the other target; the strips it leaves, drawn.
       const [dx, dy] = shift;
       const x0 = Math.max(0, dx), x1 = Math.min(w, w + dx), y0 = Math.max(0, dy), y1 = Math.min(h, h + dy);
-      gl.enable(gl.SCISSOR_TEST);
       gl.bindFramebuffer(gl.READ_FRAMEBUFFER, from.fb);
       gl.blitFramebuffer(x0 - dx, y0 - dy, x1 - dx, y1 - dy, x0, y0, x1, y1, gl.COLOR_BUFFER_BIT, gl.NEAREST);
+      gl.enable(gl.SCISSOR_TEST);  // after the blit, which the scissor would clip too
       const strips = [];
       if (dx > 0) strips.push([0, 0, dx, h]); else if (dx < 0) strips.push([w + dx, 0, -dx, h]);
       if (dy > 0) strips.push([0, 0, w, dy]); else if (dy < 0) strips.push([0, h + dy, w, -dy]);
