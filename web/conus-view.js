@@ -323,25 +323,28 @@ void main() {
     requestAnimationFrame(() => { pending = false; draw(); });
   }
 
-  // The frame last drawn, kept in one of two offscreen targets of the canvas's size. A pan by whole
-  // pixels at the same scale copies it, moved, into the other target (blitFramebuffer, an exact
-  // copy) and draws Equation 1 only where the move uncovers new pixels: each pixel keeps the value
-  // the shader gives it at its (u,v), so the canvas is the one a full draw makes. Anything else (a
-  // zoom, another overlay, another frame, a resize) draws every pixel.
-  const kept = { targets: [], current: 0, view: null, key: "" };
-  function target(k) {
-    const t = kept.targets[k];
+  // A pan by whole pixels at the same scale moves the frame on the canvas (kept there by
+  // preserveDrawingBuffer): copied into an offscreen target of its size, blitted back moved (an
+  // exact copy), and Equation 1 drawn only on the strips the move uncovers. Each pixel keeps the
+  // value the shader gives it at its (u,v), so the canvas is the one a full draw makes. Anything
+  // else (a zoom, another overlay, another frame, a resize) draws every pixel onto the canvas.
+  // RGB8: the canvas has no alpha, and a copy may not add a channel.
+  const kept = { target: null, view: null, key: "" };
+  function target() {
+    const t = kept.target;
     if (t && t.width === canvas.width && t.height === canvas.height) return t;
     if (t) { gl.deleteFramebuffer(t.fb); gl.deleteTexture(t.texture); }
     const texture = gl.createTexture();
+    gl.activeTexture(gl.TEXTURE2);
     gl.bindTexture(gl.TEXTURE_2D, texture);
-    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, canvas.width, canvas.height);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGB8, canvas.width, canvas.height);
     const fb = gl.createFramebuffer();
     gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, texture, 0);
-    kept.view = null;
-    return (kept.targets[k] = { fb, texture, width: canvas.width, height: canvas.height });
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    return (kept.target = { fb, texture, width: canvas.width, height: canvas.height });
   }
+
   // The whole-pixel move (x right, y up, GL's window coordinates) from the kept frame to `view`,
   // or null where the kept frame cannot be moved there (another scale, a fraction of a pixel off,
   // nothing kept).
@@ -363,16 +366,19 @@ void main() {
     const key = `${overlays.density ? 4 : 0}/${overlays.outlines}/${frame.id}`;
     const { p, u } = program(overlays.density ? 4 : 0, overlays.outlines);
     const w = canvas.width, h = canvas.height;
-    const from = target(kept.current), to = target(1 - kept.current);
-    const shift = pixelShift(key);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, to.fb);
+    const shift = canvas.width === kept.width && canvas.height === kept.height ? pixelShift(key) : null;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, w, h);
     if (shift) {
-      // The kept frame moved by (dx, dy) into the other target; the strips it leaves, drawn.
-      const [dx, dy] = shift;
+      // The canvas into the target, back onto the canvas moved by (dx, dy); the strips it leaves, drawn.
+      const [dx, dy] = shift, t = target();
+      gl.activeTexture(gl.TEXTURE2);
+      gl.bindTexture(gl.TEXTURE_2D, t.texture);
+      gl.copyTexSubImage2D(gl.TEXTURE_2D, 0, 0, 0, 0, 0, w, h);
       const x0 = Math.max(0, dx), x1 = Math.min(w, w + dx), y0 = Math.max(0, dy), y1 = Math.min(h, h + dy);
-      gl.bindFramebuffer(gl.READ_FRAMEBUFFER, from.fb);
+      gl.bindFramebuffer(gl.READ_FRAMEBUFFER, t.fb);
       gl.blitFramebuffer(x0 - dx, y0 - dy, x1 - dx, y1 - dy, x0, y0, x1, y1, gl.COLOR_BUFFER_BIT, gl.NEAREST);
+      gl.bindFramebuffer(gl.READ_FRAMEBUFFER, null);
       gl.enable(gl.SCISSOR_TEST);  // after the blit, which the scissor would clip too
       const strips = [];
       if (dx > 0) strips.push([0, 0, dx, h]); else if (dx < 0) strips.push([w + dx, 0, -dx, h]);
@@ -385,13 +391,9 @@ void main() {
     } else {
       drawEquation1(p, u);
     }
-    // The target onto the canvas, as it is.
-    gl.bindFramebuffer(gl.READ_FRAMEBUFFER, to.fb);
-    gl.bindFramebuffer(gl.DRAW_FRAMEBUFFER, null);
-    gl.blitFramebuffer(0, 0, w, h, 0, 0, w, h, gl.COLOR_BUFFER_BIT, gl.NEAREST);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    kept.current = 1 - kept.current;
     kept.view = view.slice();
+    kept.width = w;
+    kept.height = h;
     kept.key = key;
     window.conusMoved = (window.conusMoved || 0) + (shift ? 1 : 0);  // frames drawn by moving the kept one
     ++frames;
