@@ -182,7 +182,15 @@ public:
             return;
         }
         std::lock_guard lock(m_warmMutex);
-        if (!m_warming.insert(path).second) return;
+        // At most kMaxWarming pictures waiting to be read: page requests for many names do not
+        // queue unbounded work. Threads that have finished (none is warming) are joined here.
+        constexpr std::size_t kMaxWarming = 4;
+        if (m_warming.size() >= kMaxWarming || m_warming.count(path)) return;
+        if (m_warming.empty()) {
+            for (std::thread& t : m_warmers) t.join();
+            m_warmers.clear();
+        }
+        m_warming.insert(path);
         m_warmers.emplace_back([this, path] {
             try {
                 const auto start = std::chrono::steady_clock::now();
