@@ -324,8 +324,8 @@ void main() {
   }
 
   // A pan by whole pixels at the same scale moves the frame on the canvas (kept there by
-  // preserveDrawingBuffer): copied into an offscreen target of its size, blitted back moved (an
-  // exact copy), and Equation 1 drawn only on the strips the move uncovers. Each pixel keeps the
+  // preserveDrawingBuffer): blitted into an offscreen target of its size and back, moved (exact
+  // copies), and Equation 1 drawn only on the strips the move uncovers. Each pixel keeps the
   // value the shader gives it at its (u,v), so the canvas is the one a full draw makes. Anything
   // else (a zoom, another overlay, another frame, a resize) draws every pixel onto the canvas.
   // RGB8: the canvas has no alpha, and a copy may not add a channel.
@@ -372,9 +372,9 @@ void main() {
     if (shift) {
       // The canvas into the target, back onto the canvas moved by (dx, dy); the strips it leaves, drawn.
       const [dx, dy] = shift, t = target();
-      gl.activeTexture(gl.TEXTURE2);
-      gl.bindTexture(gl.TEXTURE_2D, t.texture);
-      gl.copyTexSubImage2D(gl.TEXTURE_2D, 0, 0, 0, 0, 0, w, h);
+      gl.bindFramebuffer(gl.DRAW_FRAMEBUFFER, t.fb);
+      gl.blitFramebuffer(0, 0, w, h, 0, 0, w, h, gl.COLOR_BUFFER_BIT, gl.NEAREST);  // copyTexSubImage2D: 2.8x slower on SwiftShader
+      gl.bindFramebuffer(gl.DRAW_FRAMEBUFFER, null);
       const x0 = Math.max(0, dx), x1 = Math.min(w, w + dx), y0 = Math.max(0, dy), y1 = Math.min(h, h + dy);
       gl.bindFramebuffer(gl.READ_FRAMEBUFFER, t.fb);
       gl.blitFramebuffer(x0 - dx, y0 - dy, x1 - dx, y1 - dy, x0, y0, x1, y1, gl.COLOR_BUFFER_BIT, gl.NEAREST);
