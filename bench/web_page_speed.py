@@ -5,8 +5,10 @@ Each FOLDER holds a page as `conus web` writes it (index.html, the scripts, the 
 folders are served by Python's own HTTP server (the same for every page, so the fetch is compared
 fairly) and loaded in turn, round after round, so that the shared machine's load falls on all
 alike. For each page and software GL: the time from navigation to the first complete frame (title
-`ready`, window.conusReadyAt) and its parts (window.conusTimings), and the pan/zoom rate at
-1280x720 (window.conusPanZoomRate: frames drawn and each waited for); medians over the rounds.
+`ready`, window.conusReadyAt) and its parts (window.conusTimings), and at 1280x720 the rates of a
+drag, a zoom and both at once (window.conusPanZoomRate: frames drawn and each waited for; a page
+older than the drag's whole-pixel moves draws every kind as "both") and of a drag and a zoom one
+frame an animation frame (window.conusShownRate, where the page has it); medians over the rounds.
 
     bench/web_page_speed.py FILE.exr FOLDER [FOLDER...] [--rounds 5] [--gl swiftshader,llvmpipe]
 """
@@ -81,7 +83,12 @@ def main():
                     assert wait_title(driver, 120) == "ready", driver.title
                     figures = json.loads(driver.execute_script(
                         "return JSON.stringify(Object.assign({ready: window.conusReadyAt}, window.conusTimings))"))
-                    figures["fps"] = driver.execute_script(f"return window.conusPanZoomRate({a.frames})")
+                    for kind in ("pan", "zoom", "both"):  # a drag (whole pixels), a zoom, both at once
+                        figures[kind] = driver.execute_script(f"return window.conusPanZoomRate({a.frames}, '{kind}')")
+                    if driver.execute_script("return !!window.conusShownRate"):  # one frame an animation frame
+                        for kind in ("pan", "zoom"):
+                            figures["shown-" + kind] = driver.execute_async_script(
+                                f"window.conusShownRate({a.frames}, '{kind}').then(arguments[0])")
                     runs[folder].append(figures)
             result[gl] = runs
             for folder in a.folders:

@@ -3,8 +3,11 @@
 // GET /frame?file=NAME&focus=u,v,r,k&size=WxH: a CoNUS file of the picture NAME encoded on request
 // around that focus (the filtered encode, not fitted: encode --fast), kept for the next identical
 // request. The pictures themselves are kept decoded, with the box-filtered levels the encoder
-// builds from them, within --memory: a new focus on a picture already asked for is an encode only. Names stay inside the folder (their canonical path is checked); a bad parameter is a
-// 400 with one line, a name that is not there a 404.
+// builds from them, within --memory: a new focus on a picture already asked for is an encode only.
+// The page asked for with ?picture=NAME starts reading NAME and building its levels on a thread of
+// their own while the browser loads the page, so that the page's first frame is mostly an encode.
+// Names stay inside the folder (their canonical path is checked); a bad parameter is a 400 with
+// one line, a name that is not there a 404.
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -18,8 +21,10 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -27,6 +32,7 @@
 #include "backend.h"
 #include "commands.h"
 #include "conus/codec/builders/foci.h"
+#include "conus/codec/image/encode.h"
 #include "conus/core/error.h"
 #include "conus/core/limits.h"
 #include "conus/renderers/gpu_image.h"
@@ -95,6 +101,11 @@ std::vector<double> numbers(const std::string& text, std::size_t count, const st
 class FrameServer {
 public:
     explicit FrameServer(const ServeOptions& o) : m_options(o), m_root(fs::canonical(o.folder)) {}
+    ~FrameServer() {
+        for (std::thread& t : m_warmers) t.join();
+    }
+    FrameServer(const FrameServer&) = delete;
+    FrameServer& operator=(const FrameServer&) = delete;
 
     const fs::path& root() const { return m_root; }
 
@@ -126,7 +137,8 @@ public:
         std::lock_guard encoding(m_encodeMutex);  // one encode at a time: it uses every core
         if (auto kept = cached(key)) return *kept;
         const auto start = std::chrono::steady_clock::now();
-        Picture& kept = sourcePicture(picture);
+        bool readNow = false;
+        Picture& kept = sourcePicture(picture, &readNow);
         const imageio::ImageFile& source = kept.file;
         if (size.width > source.image.width || size.height > source.image.height)
             throw Refusal{400, "size: " + std::to_string(size.width) + "x" + std::to_string(size.height) + " is larger than the picture (" +
@@ -135,7 +147,8 @@ public:
         fo.aspect = double(source.image.width) / source.image.height;
         const std::vector<codec::Focus> foci{focus};
         const auto seconds = [](auto from) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - from).count(); };
-        const double read = seconds(start);
+        char read[32] = "kept";
+        if (readNow) std::snprintf(read, sizeof read, "%.2f s", seconds(start));
         const auto mapStart = std::chrono::steady_clock::now();
         const codec::SamplingMap map = codec::buildFociMap(foci, fo);
         const double mapTime = seconds(mapStart);
@@ -150,11 +163,50 @@ public:
         applyStorage(StorageOptions{}, file);
         std::vector<unsigned char> bytes = conusFileBytes(file);
         if (!quiet())
-            std::fprintf(stderr, "frame %s focus %s size %dx%d: %zu bytes in %.2f s (picture %.2f, map %.2f, encode %.2f, write %.2f)\n",
+            std::fprintf(stderr, "frame %s focus %s size %dx%d: %zu bytes in %.2f s (picture %s, map %.2f, encode %.2f, write %.2f)\n",
                          picture.filename().c_str(), param("focus").c_str(), size.width, size.height, bytes.size(),
                          seconds(start), read, mapTime, encodeTime, seconds(writeStart));
         keep(key, bytes);
         return bytes;
+    }
+
+    // The picture `name` read and its encoder levels built now, on a thread of its own (the page
+    // that will ask for its frames is loading). Nothing where the name is refused, the picture is
+    // kept with its levels already, or it is being prepared; a picture that cannot be read is left
+    // for /frame to refuse.
+    void warm(const std::string& name) {
+        fs::path path;
+        try {
+            path = confined(m_root, name);
+        } catch (const Refusal&) {
+            return;
+        }
+        std::lock_guard lock(m_warmMutex);
+        // At most kMaxWarming pictures waiting to be read: page requests for many names do not
+        // queue unbounded work. Threads that have finished (none is warming) are joined here.
+        constexpr std::size_t kMaxWarming = 4;
+        if (m_warming.size() >= kMaxWarming || m_warming.count(path)) return;
+        if (m_warming.empty()) {
+            for (std::thread& t : m_warmers) t.join();
+            m_warmers.clear();
+        }
+        m_warming.insert(path);
+        m_warmers.emplace_back([this, path] {
+            try {
+                const auto start = std::chrono::steady_clock::now();
+                std::lock_guard encoding(m_encodeMutex);
+                Picture& kept = sourcePicture(path);
+                const double read = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                if (kept.levels.bytes() == 0) codec::buildEncodeLevels(kept.file.image, kept.levels);
+                keepWithinMemory();
+                if (!quiet())
+                    std::fprintf(stderr, "warm %s: picture and levels ready in %.2f s (picture %.2f)\n", path.filename().c_str(),
+                                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), read);
+            } catch (...) {  // /frame says what is wrong with it
+            }
+            std::lock_guard done(m_warmMutex);
+            m_warming.erase(path);
+        });
     }
 
 private:
@@ -193,7 +245,8 @@ private:
 
     // The picture, read once while it is unchanged (a 4096^2 photo takes longer to read than to
     // encode), the most recently asked for first. Called under m_encodeMutex.
-    Picture& sourcePicture(const fs::path& path) {
+    // `readNow`, where given, says whether it was read (not kept).
+    Picture& sourcePicture(const fs::path& path, bool* readNow = nullptr) {
         std::error_code error;
         const auto written = fs::last_write_time(path, error);
         for (auto it = m_pictures.begin(); it != m_pictures.end(); ++it)
@@ -206,6 +259,7 @@ private:
                 break;
             }
         Picture picture{path, written, {}, {}};
+        if (readNow) *readNow = true;
         try {
             picture.file = readSource(path.string(), SourceOptions{});
         } catch (const Error& e) {
@@ -234,6 +288,9 @@ private:
     std::mutex m_encodeMutex, m_cacheMutex;
     std::list<std::pair<std::string, std::vector<unsigned char>>> m_frames;
     std::list<Picture> m_pictures;
+    std::mutex m_warmMutex;
+    std::set<fs::path> m_warming;        // pictures being prepared by warm()
+    std::vector<std::thread> m_warmers;  // joined when the server goes
 };
 
 std::string contentTypeOf(const fs::path& path) {
@@ -253,6 +310,7 @@ int runServe(const ServeOptions& o) {
     const HttpHandler handler = [&](const HttpRequest& request) -> HttpReply {
         try {
             const std::string name = request.path == "/" ? "index.html" : request.path.substr(1);
+            if (name == "index.html" && request.params.count("picture")) frames.warm(request.params.at("picture"));
             for (const WebFile& f : page)
                 if (f.name == name) return {200, f.contentType, f.text};
             if (name == "frame") {

@@ -20,9 +20,11 @@ int serve(const std::string& host, int port, const conus::cli::HttpHandler& hand
     server.set_keep_alive_timeout(2);
     // SO_REUSEADDR (a restart binds while old connections linger) but not the library's default
     // SO_REUSEPORT, which lets a second server, or anyone's, bind the same port and take half the requests.
-    server.set_socket_options([](socket_t sock) {
+    socket_t listening_socket = INVALID_SOCKET;
+    server.set_socket_options([&listening_socket](socket_t sock) {
         int yes = 1;
         setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+        listening_socket = sock;
     });
     server.Get(R"(/.*)", [&handler](const httplib::Request& request, httplib::Response& response) {
         conus::cli::HttpRequest r;
@@ -44,6 +46,10 @@ int serve(const std::string& host, int port, const conus::cli::HttpHandler& hand
     });
     const int bound = port == 0 ? server.bind_to_any_port(host) : (server.bind_to_port(host, port) ? port : -1);
     if (bound <= 0) return -1;
+    // Debian's library listens with a backlog of 5: past 5 connections not yet accepted, the kernel
+    // drops new ones and their clients retry after 1, 3, 7... s (100 requests at once timed out
+    // after 60 s). Listening again on the bound socket sets the backlog to the system's largest.
+    if (listening_socket != INVALID_SOCKET) ::listen(listening_socket, SOMAXCONN);
     listening(bound);
     return server.listen_after_bind() ? 0 : -1;
 }

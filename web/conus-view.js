@@ -284,7 +284,7 @@ void main() {
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
     if (frame) { gl.deleteTexture(frame.conus); gl.deleteTexture(frame.map); }
-    frame = { conus, map, sourceSize: file.sourceSize, foci: file.foci, logDensity: densityRange(file.map) };
+    frame = { id: (frame ? frame.id : 0) + 1, conus, map, sourceSize: file.sourceSize, foci: file.foci, logDensity: densityRange(file.map) };
   }
 
   // ---- view state ----------------------------------------------------------------------------
@@ -323,12 +323,85 @@ void main() {
     requestAnimationFrame(() => { pending = false; draw(); });
   }
 
+  // A pan by whole pixels at the same scale moves the frame on the canvas (kept there by
+  // preserveDrawingBuffer): blitted into an offscreen target of its size and back, moved (exact
+  // copies), and Equation 1 drawn only on the strips the move uncovers. Each pixel keeps the
+  // value the shader gives it at its (u,v), so the canvas is the one a full draw makes. Anything
+  // else (a zoom, another overlay, another frame, a resize) draws every pixel onto the canvas.
+  // RGB8: the canvas has no alpha, and a copy may not add a channel.
+  const kept = { target: null, view: null, key: "" };
+  function target() {
+    const t = kept.target;
+    if (t && t.width === canvas.width && t.height === canvas.height) return t;
+    if (t) { gl.deleteFramebuffer(t.fb); gl.deleteTexture(t.texture); }
+    const texture = gl.createTexture();
+    gl.activeTexture(gl.TEXTURE2);
+    gl.bindTexture(gl.TEXTURE_2D, texture);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGB8, canvas.width, canvas.height);
+    const fb = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, texture, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    return (kept.target = { fb, texture, width: canvas.width, height: canvas.height });
+  }
+
+  // The whole-pixel move (x right, y up, GL's window coordinates) from the kept frame to `view`,
+  // or null where the kept frame cannot be moved there (another scale, a fraction of a pixel off,
+  // nothing kept).
+  function pixelShift(key) {
+    const k = kept.view;
+    if (!k || kept.key !== key) return null;
+    const w = canvas.width, h = canvas.height, sx = (k[2] - k[0]) / w, sy = (k[3] - k[1]) / h;
+    if (Math.abs((view[2] - view[0]) / w - sx) > 1e-9 * Math.abs(sx) || Math.abs((view[3] - view[1]) / h - sy) > 1e-9 * Math.abs(sy)) return null;
+    const n = (view[0] - k[0]) / sx, m = (view[1] - k[1]) / sy;
+    if (Math.abs(n - Math.round(n)) > 1e-3 || Math.abs(m - Math.round(m)) > 1e-3) return null;
+    const dx = -Math.round(n), dy = Math.round(m);  // the kept picture moves by (dx, dy); rows grow downward in v
+    return Math.abs(dx) < w && Math.abs(dy) < h ? [dx, dy] : null;
+  }
+
   let frames = 0;
   function draw() {
     if (!frame) return;
     resize();
+    const key = `${overlays.density ? 4 : 0}/${overlays.outlines}/${frame.id}`;
     const { p, u } = program(overlays.density ? 4 : 0, overlays.outlines);
-    gl.viewport(0, 0, canvas.width, canvas.height);
+    const w = canvas.width, h = canvas.height;
+    const shift = canvas.width === kept.width && canvas.height === kept.height ? pixelShift(key) : null;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.viewport(0, 0, w, h);
+    if (shift) {
+      // The canvas into the target, back onto the canvas moved by (dx, dy); the strips it leaves, drawn.
+      const [dx, dy] = shift, t = target();
+      gl.bindFramebuffer(gl.DRAW_FRAMEBUFFER, t.fb);
+      gl.blitFramebuffer(0, 0, w, h, 0, 0, w, h, gl.COLOR_BUFFER_BIT, gl.NEAREST);  // copyTexSubImage2D: 2.8x slower on SwiftShader
+      gl.bindFramebuffer(gl.DRAW_FRAMEBUFFER, null);
+      const x0 = Math.max(0, dx), x1 = Math.min(w, w + dx), y0 = Math.max(0, dy), y1 = Math.min(h, h + dy);
+      gl.bindFramebuffer(gl.READ_FRAMEBUFFER, t.fb);
+      gl.blitFramebuffer(x0 - dx, y0 - dy, x1 - dx, y1 - dy, x0, y0, x1, y1, gl.COLOR_BUFFER_BIT, gl.NEAREST);
+      gl.bindFramebuffer(gl.READ_FRAMEBUFFER, null);
+      gl.enable(gl.SCISSOR_TEST);  // after the blit, which the scissor would clip too
+      const strips = [];
+      if (dx > 0) strips.push([0, 0, dx, h]); else if (dx < 0) strips.push([w + dx, 0, -dx, h]);
+      if (dy > 0) strips.push([0, 0, w, dy]); else if (dy < 0) strips.push([0, h + dy, w, -dy]);
+      for (const [x, y, sw, sh] of strips) {
+        gl.scissor(x, y, sw, sh);
+        drawEquation1(p, u);
+      }
+      gl.disable(gl.SCISSOR_TEST);
+    } else {
+      drawEquation1(p, u);
+    }
+    kept.view = view.slice();
+    kept.width = w;
+    kept.height = h;
+    kept.key = key;
+    window.conusMoved = (window.conusMoved || 0) + (shift ? 1 : 0);  // frames drawn by moving the kept one
+    ++frames;
+    window.conusFrames = frames;
+  }
+
+  // Equation 1 over the bound target's viewport (and scissor): the frame of `view`.
+  function drawEquation1(p, u) {
     gl.useProgram(p);
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D, frame.conus);
@@ -348,22 +421,32 @@ void main() {
     gl.uniform1f(u("uWipeX"), 0);
     gl.uniform2f(u("uLogDensity"), frame.logDensity[0], frame.logDensity[1]);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
-    ++frames;
-    window.conusFrames = frames;
   }
 
   // For tests: the view drawn now, and how many frames the page has asked `conus serve` for.
   window.conusView = () => view && view.slice();
 
-  // For bench/web_bench.py: `count` frames of a pan and zoom about the current view, each drawn
-  // and waited for (a one-pixel read), in frames a second; the view is put back.
-  window.conusPanZoomRate = (count) => {
+  // For the benches: the view of frame k of a move about `start`. "pan": a drag, whole pixels a
+  // frame at the same scale; "zoom": the scale alone, about the centre; "both": a zoom and pan at
+  // once, every frame at another scale.
+  function movedView(kind, start, k) {
+    const w = canvas.width, h = canvas.height, su = (start[2] - start[0]) / w, sv = (start[3] - start[1]) / h;
+    if (kind === "pan") {
+      const x = Math.round(60 * Math.sin(k / 9)), y = Math.round(40 * Math.cos(k / 7) - 40);  // pixels from the start
+      return [start[0] + x * su, start[1] + y * sv, start[2] + x * su, start[3] + y * sv];
+    }
+    const s = Math.exp(-0.5 * Math.sin(k / 9));
+    const du = kind === "both" ? 0.1 * Math.sin(k / 13) : 0, dv = kind === "both" ? 0.1 * Math.cos(k / 11) : 0;
+    const cu = (start[0] + start[2]) / 2 + du, cv = (start[1] + start[3]) / 2 + dv;
+    const hw = (start[2] - start[0]) / 2 * s, hh = (start[3] - start[1]) / 2 * s;
+    return [cu - hw, cv - hh, cu + hw, cv + hh];
+  }
+  // `count` frames of a move ("pan", "zoom" or "both", above), each drawn and waited for (a one-pixel
+  // read), in frames a second; the view is put back.
+  window.conusPanZoomRate = (count, kind = "both") => {
     const start = view.slice(), pixel = new Uint8Array(4), t0 = performance.now();
-    for (let k = 0; k < count; ++k) {
-      const s = Math.exp(-0.5 * Math.sin(k / 9)), du = 0.1 * Math.sin(k / 13), dv = 0.1 * Math.cos(k / 11);
-      const cu = (start[0] + start[2]) / 2 + du, cv = (start[1] + start[3]) / 2 + dv;
-      const hw = (start[2] - start[0]) / 2 * s, hh = (start[3] - start[1]) / 2 * s;
-      view = [cu - hw, cv - hh, cu + hw, cv + hh];
+    for (let k = 1; k <= count; ++k) {
+      view = movedView(kind, start, k);
       draw();
       gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
     }
@@ -372,6 +455,26 @@ void main() {
     draw();
     return count / seconds;
   };
+  // The same move, one frame an animation frame, so that the browser shows each (its compositing
+  // counted): a promise of the frames a second shown.
+  window.conusShownRate = (count, kind = "both") => new Promise((resolve) => {
+    const start = view.slice();
+    let k = 0, t0 = 0;
+    const step = () => {
+      if (k === 0) t0 = performance.now();
+      if (k === count) {
+        const rate = count / ((performance.now() - t0) / 1000);
+        view = start;
+        draw();
+        resolve(rate);
+        return;
+      }
+      view = movedView(kind, start, ++k);
+      draw();
+      requestAnimationFrame(step);
+    };
+    requestAnimationFrame(step);
+  });
 
   function finishFirstFrame() {
     const t0 = performance.now();
@@ -406,9 +509,17 @@ void main() {
     view = [u - x * w, v - y * h, u - x * w + w, v - y * h + h];
     changed();
   }
+  // A drag of (dx, dy) CSS pixels moves the view by whole canvas pixels (the rest is carried to
+  // the next move), so that the frame kept on the GPU is moved and not drawn again (draw()).
+  const panRest = [0, 0];
   function panBy(dx, dy) {
     const r = canvas.getBoundingClientRect();
-    const du = dx / r.width * (view[2] - view[0]), dv = dy / r.height * (view[3] - view[1]);
+    panRest[0] += dx / r.width * canvas.width;
+    panRest[1] += dy / r.height * canvas.height;
+    const px = Math.round(panRest[0]), py = Math.round(panRest[1]);
+    panRest[0] -= px;
+    panRest[1] -= py;
+    const du = px * (view[2] - view[0]) / canvas.width, dv = py * (view[3] - view[1]) / canvas.height;
     view = [view[0] - du, view[1] - dv, view[2] - du, view[3] - dv];
     changed();
   }

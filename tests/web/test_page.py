@@ -187,3 +187,25 @@ def test_a_map_finer_than_its_image_is_refused(browser, server, served):
         assert title.startswith("error: "), title
         refused = "finer than its 192x128 image can show (at most 769 nodes a side, V7)" in title
         assert refused == finer, title
+
+
+@pytest.mark.parametrize("name", ["foci.exr", "ground.exr"])
+def test_a_drag_moves_the_kept_frame_and_gives_the_decoded_view(browser, server, served, tmp_path, name):
+    """A drag moves the frame kept on the GPU by whole pixels and draws only the strips it uncovers:
+    after drags right-up and left-down the canvas is `conus decode` of the view the page shows then,
+    and the frames were moved, not drawn whole."""
+    from selenium.webdriver.common.action_chains import ActionChains
+    assert open_page(browser, server, f"file={name}&view=0.2,0.25,0.5,0.45&size=300x200") == "ready"
+    canvas = browser.find_element("id", "view")
+    for dx, dy in [(37, -23), (-11, 29)]:
+        ActionChains(browser).move_to_element(canvas).click_and_hold().move_by_offset(dx, dy).release().perform()
+    moved = browser.execute_script("return window.conusMoved || 0")
+    assert moved >= 2, moved
+    view = browser.execute_script("return window.conusView()")
+    # Whole pixels: the view moved by (26, -6) of its 300x200 pixels, each 0.3/300 by 0.2/200 wide.
+    assert abs(view[0] - (0.2 - 26 * 0.001)) < 1e-9 and abs(view[1] - (0.25 - 6 * 0.001)) < 1e-9, view
+    reference = tmp_path / "reference.png"
+    text = ",".join(repr(v) for v in view)
+    subprocess.run([CONUS, "decode", served / name, "-o", reference, "--view", text, "--size", "300x200", "-q"], check=True)
+    quality = psnr8(canvas_rgb(browser), png_rgb(reference))
+    assert quality >= 40.0, f"{name} dragged to {text}: canvas {quality:.1f} dB from conus decode"

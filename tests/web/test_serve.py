@@ -6,6 +6,7 @@ import json
 import os
 import subprocess
 import threading
+import time
 import urllib.parse
 
 import pytest
@@ -106,11 +107,15 @@ def test_bad_requests_get_one_line(server, link_out, path, expected):
 
 
 def test_hundred_concurrent_bad_requests(server, link_out, served):
+    """100 bad requests from 100 threads released at once (a barrier), each on its own connection to
+    the real server: each answered with its own status, the server alive and serving after."""
     results = []
     lock = threading.Lock()
+    together = threading.Barrier(100)
 
     def ask(k):
         path, expected = BAD[k % len(BAD)]
+        together.wait(60)
         try:
             status, _ = get(server, path)
         except OSError as e:
@@ -175,3 +180,36 @@ def test_kept_pictures_give_the_frames_of_fresh_ones(server, served, tmp_path):
     finally:
         process.terminate()
         process.wait(timeout=10)
+
+
+def test_the_page_of_a_picture_prepares_it(served):
+    """GET /?picture=NAME starts reading NAME and building its encoder levels on a thread of its own
+    (the log says so, once, however often the page is asked for); the frame asked for next is the
+    one a server that keeps nothing (--memory 0) sends; a name outside the folder prepares nothing."""
+    process = subprocess.Popen([CONUS, "serve", str(served), "--port", "0"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    fresh = subprocess.Popen([CONUS, "serve", str(served), "--port", "0", "-q", "--memory", "0"], stdout=subprocess.PIPE, text=True)
+    log = []
+    reader = threading.Thread(target=lambda: log.extend(iter(process.stderr.readline, "")), daemon=True)
+    try:
+        url = lambda p: {"url": p.stdout.readline().split(" at ")[1].split(" ")[0]}
+        warmed, plain = url(process), url(fresh)
+        reader.start()
+        assert get(warmed, "/?picture=../../etc/passwd")[0] == 200
+        for _ in range(3):
+            status, body = get(warmed, "/?picture=photo.png&view=0.1,0.1,0.6,0.6")
+            assert status == 200 and b"conus-view.js" in body
+        for _ in range(600):
+            if any(line.startswith("warm photo.png: picture and levels ready") for line in log):
+                break
+            time.sleep(0.1)
+        path = "/frame?file=photo.png&focus=0.45,0.55,0.07,4&size=224x160"
+        assert get(warmed, path) == get(plain, path)
+        warm_lines = [line for line in log if line.startswith("warm ")]
+        assert len(warm_lines) == 1 and "photo.png" in warm_lines[0], log
+        frame_lines = [line for line in log if line.startswith("frame photo.png")]
+        assert len(frame_lines) == 1 and "(picture kept," in frame_lines[0], log
+    finally:
+        for p in (process, fresh):
+            p.terminate()
+            p.wait(timeout=10)

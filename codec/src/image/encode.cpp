@@ -562,6 +562,12 @@ Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptio
     return encodeFrom(source, pyramid, map, options);
 }
 
+void buildEncodeLevels(const Image& source, EncodeLevels& kept, int threads) {
+    checkImage(source, "buildEncodeLevels");
+    Pyramid pyramid(source, &kept);  // hands its levels back to `kept` when it goes
+    for (int level = 1; level < pyramid.levels(); ++level) pyramid.level(level, threads);
+}
+
 Image encodeImage(const EightBitImage& source, const SamplingMap& map, const EncodeOptions& options) {
     detail::checkCodes(source, "encodeImage");
     const Image shape{source.width, source.height, source.channels, {}};  // sizes and channels only

@@ -1,6 +1,9 @@
 // codec::EncodeLevels: the encoder's levels of a source kept from one encode to the next give the
 // same CoNUS image, bit for bit, as an encode that builds them afresh, for another map, another
-// filter and another source (which empties them first).
+// filter and another source (which empties them first); levels built ahead of any encode
+// (buildEncodeLevels) are every level, and give the same image too.
+#include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -65,6 +68,28 @@ TEST(EncodeLevels, KeptLevelsGiveTheSameImageAsFreshOnes) {
 
     kept.clear();
     EXPECT_EQ(kept.bytes(), 0);
+}
+
+TEST(EncodeLevels, LevelsBuiltAheadAreEveryLevelAndGiveTheSameImage) {
+    const Image source = photoLike(613, 419);
+    EncodeLevels kept;
+    buildEncodeLevels(source, kept);
+    // Levels 1.. down to 1x1, each side halved rounding up: 307x210, 154x105, ... 1x1.
+    std::int64_t expected = 0;
+    for (int w = 613, h = 419; w > 1 || h > 1;) {
+        w = std::max(1, (w + 1) / 2);
+        h = std::max(1, (h + 1) / 2);
+        expected += std::int64_t(w) * h * source.channelCount() * std::int64_t(sizeof(float));
+    }
+    EXPECT_EQ(kept.bytes(), expected);
+
+    const SamplingMap map = focusAt(0.66, 0.35, 613.0 / 419.0);
+    for (const EncodeFilter filter : {EncodeFilter::Anisotropic, EncodeFilter::Ewa}) {
+        const Image fresh = encodeImage(source, map, sized(170, 121, filter, nullptr));
+        const Image fromBuilt = encodeImage(source, map, sized(170, 121, filter, &kept));
+        EXPECT_EQ(fromBuilt.pixels, fresh.pixels);
+    }
+    EXPECT_EQ(kept.bytes(), expected);  // nothing more to build
 }
 
 }  // namespace

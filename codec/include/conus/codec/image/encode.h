@@ -135,6 +135,10 @@ void checkEncodeMemory(const Image& source, int width, int height, std::int64_t 
 
 Image encodeImage(const Image& source, const SamplingMap& map, const EncodeOptions& options);
 
+// Every level of `source`'s pyramid built into `kept` now, as encodes with keptLevels = &kept build
+// them on first use: a later encode of `source` (unmoved in memory) starts at its taps.
+void buildEncodeLevels(const Image& source, EncodeLevels& kept, int threads = 0);
+
 // A picture read from 8-bit codes, kept as them: interleaved like Image's pixels. The colour
 // channels (R, G, B, Y) are sRGB-encoded, the others (alpha) code / 255, straight (not
 // premultiplied). It stands for the float picture linearImage() makes, a quarter of its memory.
