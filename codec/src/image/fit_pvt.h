@@ -137,10 +137,35 @@ private:
     ViewColumns m_cols;
 };
 
+// The decoded whole-image view at width x height of `conus` (D c: decodeImage's view, without a
+// pyramid), a row at a time, for a measure that keeps no view (FrameErrorModel::confirmed; the
+// uniform image's bilinear view through the identity map alike). `conus` and `map` must outlive it.
+class DecodedRows {
+public:
+    DecodedRows(const Image& conus, const SamplingMap& map, int width, int height)
+        : m_conus(conus), m_taps(map, conus.width, conus.height, width, height) {}
+    // Output row y into out (width * channels values).
+    void row(int y, DecoderTaps::Scratch& scratch, float* out) const;
+
+private:
+    const Image& m_conus;
+    DecoderTaps m_taps;
+};
+
 // D and D^T for a whole-image view at width x height: the decoded view of `conus` (every channel,
 // as decodeImage computes it), and the splat of `view` into a conusWidth x conusHeight image
 // through the same taps. <fitForward(c), y> == <c, fitAdjoint(y)>.
 Image fitForward(const Image& conus, const SamplingMap& map, int width, int height, int threads = 0);
 Image fitAdjoint(const Image& view, const SamplingMap& map, int conusWidth, int conusHeight, int threads = 0);
+
+// fitToDecoder solves its normal equations assembled on the CoNUS grid (one walk of the taps) unless
+// the view minifies much of the image; forced, it walks the taps every iteration instead (the
+// tests compare the two).
+// A x of the assembled normal equations (A = D^T D for a whole-image view at width x height),
+// and how many wide rows of D they keep; throws where the fit would walk the taps instead.
+Image fitNormalProduct(const Image& x, const SamplingMap& map, int width, int height, std::size_t* wideRows = nullptr,
+                       int threads = 0);
+void forceFitPasses(bool passes);
+bool fitPassesForced();
 
 }  // namespace conus::codec::detail
