@@ -14,6 +14,7 @@
 #include "conus/core/error.h"
 #include "conus/core/parallel.h"
 #include "../image/fit_pvt.h"
+#include "../image/resize_rows_pvt.h"
 #include "budget_search_pvt.h"
 
 namespace conus::codec {
@@ -385,12 +386,11 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
     if (m_options.space == ErrorSpace::Display)
         for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
     const std::vector<float>& table = displayTable();
-    // The views at the source's size: the CoNUS image's through `map`, the uniform image's
-    // bilinear resize (the identity map's view).
-    const SamplingMap identity = SamplingMap::identity(2, 2);
+    // The views at the source's size, a row at a time: the CoNUS image's through `map`, the
+    // uniform image's bilinear resize.
     const detail::DecodedRows conusRows(conus, map, source.width, source.height);
-    std::optional<detail::DecodedRows> uniformRows;
-    if (uniform) uniformRows.emplace(*uniform, identity, source.width, source.height);
+    std::optional<detail::ResizedRows> uniformRows;
+    if (uniform) uniformRows.emplace(*uniform, source.width, source.height);
     // A row of tiles at a time, the rows of tiles spread over the threads (each tile's sum is
     // taken in the same order whatever the thread count).
     std::vector<double> out(m_pixels.size(), 0.0), flat(uniform ? m_pixels.size() : 0, 0.0);
@@ -402,7 +402,7 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
             std::vector<float> view(values), resized(uniform ? values : 0), shownSource(channels);
             for (int y = r0 * m_tile; y < std::min(source.height, r1 * m_tile); ++y) {
                 conusRows.row(y, scratch, view.data());
-                if (uniform) uniformRows->row(y, scratch, resized.data());
+                if (uniform) uniformRows->row(y, resized.data());
                 const float* from = source.pixels.data() + std::size_t(y) * values;
                 double* row = &out[std::size_t(y / m_tile) * m_columns];
                 double* flatRow = uniform ? &flat[std::size_t(y / m_tile) * m_columns] : nullptr;

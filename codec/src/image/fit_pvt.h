@@ -138,8 +138,8 @@ private:
 };
 
 // The decoded whole-image view at width x height of `conus` (D c: decodeImage's view, without a
-// pyramid), a row at a time, for a measure that keeps no view (FrameErrorModel::confirmed; the
-// uniform image's bilinear view through the identity map alike). `conus` and `map` must outlive it.
+// pyramid), a row at a time, for a measure that keeps no view (FrameErrorModel::confirmed).
+// `conus` and `map` must outlive it.
 class DecodedRows {
 public:
     DecodedRows(const Image& conus, const SamplingMap& map, int width, int height)
