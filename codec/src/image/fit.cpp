@@ -805,15 +805,17 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         for (float d : diag) largest = std::max(largest, d);
         for (std::size_t i = 0; i < pixels; ++i)
             precondition[i] = diag[i] > 1e-6f * largest ? 1.0f / ((1.0f + hold[i]) * diag[i]) : 0.0f;
-        std::vector<float> ax(values), q(values), zp(values);
-        // z = b - A x - lambda diag (x - x0), and the step recorded.
+        // zp holds A p as well, until the preconditioner needs it (every vector here is a fresh
+        // CoNUS image's worth of pages).
+        std::vector<float> zp(values);
+        // z = b - A x - lambda diag (x - x0) (A x made in z), and the step recorded.
         const auto residualOfX = [&] {
-            normal.apply(x.data(), ax.data(), channels, options.threads);
+            normal.apply(x.data(), z.data(), channels, options.threads);
             double xb = 0, xax = 0;
             for (std::size_t i = 0; i < values; ++i) {
                 xb += double(x[i]) * b[i];
-                xax += double(x[i]) * ax[i];
-                z[i] = b[i] - ax[i] - (damped ? hold[i / channels] * diag[i / channels] * (x[i] - x0[i]) : 0.0f);
+                xax += double(x[i]) * z[i];
+                z[i] = b[i] - z[i] - (damped ? hold[i / channels] * diag[i / channels] * (x[i] - x0[i]) : 0.0f);
             }
             record(std::max(0.0, squares - 2.0 * xb + xax), penaltyOf());
         };
@@ -821,8 +823,8 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         applyPreconditioner(p);
         double gamma = detail::dot(z, p);
         for (int it = 1; it <= options.iterations && gamma > 0; ++it) {
-            normal.apply(p.data(), q.data(), channels, options.threads);
-            double delta = detail::dot(p, q);  // |D p|^2
+            normal.apply(p.data(), zp.data(), channels, options.threads);
+            double delta = detail::dot(p, zp);  // |D p|^2
             if (damped)
                 for (std::size_t i = 0; i < values; ++i)
                     delta += double(hold[i / channels]) * diag[i / channels] * p[i] * p[i];
