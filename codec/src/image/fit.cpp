@@ -165,24 +165,27 @@ inline void gather(const float* image, int width, int height, int c, const Decod
     }
 }
 
+// Adds one tap's corner weights times value into a band's buffer (rows from `lo`).
+template <int kC>
+inline void splatCorners(float* buffer, int lo, int width, int c, const TapCorners& q, const float* value) {
+    const int channels = kC > 0 ? kC : c;
+    float* p00 = buffer + (static_cast<std::size_t>(q.y0 - lo) * width + q.x0) * channels;
+    float* p01 = buffer + (static_cast<std::size_t>(q.y0 - lo) * width + q.x1) * channels;
+    float* p10 = buffer + (static_cast<std::size_t>(q.y1 - lo) * width + q.x0) * channels;
+    float* p11 = buffer + (static_cast<std::size_t>(q.y1 - lo) * width + q.x1) * channels;
+    for (int k = 0; k < channels; ++k) {
+        p00[k] += q.w00 * value[k];
+        p01[k] += q.w01 * value[k];
+        p10[k] += q.w10 * value[k];
+        p11[k] += q.w11 * value[k];
+    }
+}
+
 // Adds the taps' weights times value into a band's buffer (rows from `lo`).
 template <int kC>
 inline void splat(float* buffer, int lo, int width, int height, int c, const DecoderTap* taps, int count,
                   const float* value) {
-    const int channels = kC > 0 ? kC : c;
-    for (int t = 0; t < count; ++t) {
-        const TapCorners q = tapCorners(taps[t], width, height);
-        float* p00 = buffer + (static_cast<std::size_t>(q.y0 - lo) * width + q.x0) * channels;
-        float* p01 = buffer + (static_cast<std::size_t>(q.y0 - lo) * width + q.x1) * channels;
-        float* p10 = buffer + (static_cast<std::size_t>(q.y1 - lo) * width + q.x0) * channels;
-        float* p11 = buffer + (static_cast<std::size_t>(q.y1 - lo) * width + q.x1) * channels;
-        for (int k = 0; k < channels; ++k) {
-            p00[k] += q.w00 * value[k];
-            p01[k] += q.w01 * value[k];
-            p10[k] += q.w10 * value[k];
-            p11[k] += q.w11 * value[k];
-        }
-    }
+    for (int t = 0; t < count; ++t) splatCorners<kC>(buffer, lo, width, c, tapCorners(taps[t], width, height), value);
 }
 
 // Adds the taps' squared corner weights into a band's `squares` (rows from `lo`): diag(D^T D)
@@ -393,6 +396,14 @@ bool assemblePass(DecoderOperator& op, const float* source, int c) {
             taps.row(y, scratch, [&](int x, const DecoderTap* t, int count) {
                 const float* value = row + static_cast<std::size_t>(x) * channels;
                 for (int k = 0; k < channels; ++k) sum += double(value[k]) * value[k];
+                if (count == 1) {  // most pixels: the corners found once for both
+                    const TapCorners q = tapCorners(t[0], wc, hc);
+                    splatCorners<kC>(band.buffer.data(), band.lo, wc, channels, q, value);
+                    float w[4];
+                    blockWeights(q, w);
+                    addBlock(band.stencil.data(), band.lo, band.hi, wc, q.x0, q.y0, w[0], w[1], w[2], w[3]);
+                    return;
+                }
                 splat<kC>(band.buffer.data(), band.lo, wc, hc, channels, t, count, value);
                 if (!addOuter(band, wc, hc, t, count, entries, wideLeft)) abandoned.store(true, std::memory_order_relaxed);
             });
@@ -770,9 +781,12 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
     const auto penaltyOf = [&] {
         double penalty = 0;
         if (damped)
-            for (std::size_t i = 0; i < values; ++i) {
-                const float d = x[i] - x0[i], w = hold[i / channels] * diag[i / channels];
-                penalty += double(w) * d * d;
+            for (std::size_t px = 0, i = 0; px < pixels; ++px) {
+                const float w = hold[px] * diag[px];
+                for (int k = 0; k < channels; ++k, ++i) {
+                    const float d = x[i] - x0[i];
+                    penalty += double(w) * d * d;
+                }
             }
         return penalty;
     };
@@ -790,7 +804,8 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         record(data, penaltyOf());
     };
     const auto applyPreconditioner = [&](std::vector<float>& out) {
-        for (std::size_t i = 0; i < values; ++i) out[i] = precondition[i / channels] * z[i];
+        for (std::size_t px = 0, i = 0; px < pixels; ++px)
+            for (int k = 0; k < channels; ++k, ++i) out[i] = precondition[px] * z[i];
     };
 
     // The normal equations assembled on the CoNUS grid in one walk of the taps (A = D^T D, b =
@@ -812,10 +827,13 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         const auto residualOfX = [&] {
             normal.apply(x.data(), z.data(), channels, options.threads);
             double xb = 0, xax = 0;
-            for (std::size_t i = 0; i < values; ++i) {
-                xb += double(x[i]) * b[i];
-                xax += double(x[i]) * z[i];
-                z[i] = b[i] - z[i] - (damped ? hold[i / channels] * diag[i / channels] * (x[i] - x0[i]) : 0.0f);
+            for (std::size_t px = 0, i = 0; px < pixels; ++px) {
+                const float w = damped ? hold[px] * diag[px] : 0.0f;
+                for (int k = 0; k < channels; ++k, ++i) {
+                    xb += double(x[i]) * b[i];
+                    xax += double(x[i]) * z[i];
+                    z[i] = b[i] - z[i] - (damped ? w * (x[i] - x0[i]) : 0.0f);
+                }
             }
             record(std::max(0.0, squares - 2.0 * xb + xax), penaltyOf());
         };
@@ -826,8 +844,10 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
             normal.apply(p.data(), zp.data(), channels, options.threads);
             double delta = detail::dot(p, zp);  // |D p|^2
             if (damped)
-                for (std::size_t i = 0; i < values; ++i)
-                    delta += double(hold[i / channels]) * diag[i / channels] * p[i] * p[i];
+                for (std::size_t px = 0, i = 0; px < pixels; ++px) {
+                    const double w = double(hold[px]) * diag[px];
+                    for (int k = 0; k < channels; ++k, ++i) delta += w * p[i] * p[i];
+                }
             if (!(delta > 0)) break;
             const float alpha = static_cast<float>(gamma / delta);
             for (std::size_t i = 0; i < values; ++i) x[i] += alpha * p[i];
