@@ -13,7 +13,6 @@
 #include "conus/core/display.h"
 #include "conus/core/error.h"
 #include "conus/core/parallel.h"
-#include "../image/fit_pvt.h"
 #include "../image/resize_rows_pvt.h"
 #include "budget_search_pvt.h"
 
@@ -386,9 +385,8 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
     if (m_options.space == ErrorSpace::Display)
         for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
     const std::vector<float>& table = displayTable();
-    // The views at the source's size, a row at a time: the CoNUS image's through `map`, the
-    // uniform image's bilinear resize.
-    const detail::DecodedRows conusRows(conus, map, source.width, source.height);
+    // The views at the source's size, never whole: the CoNUS image's decoded a row of tiles at a
+    // time (the decoder's view of those rows), the uniform image's bilinear resize a row at a time.
     std::optional<detail::ResizedRows> uniformRows;
     if (uniform) uniformRows.emplace(*uniform, source.width, source.height);
     // A row of tiles at a time, the rows of tiles spread over the threads (each tile's sum is
@@ -397,11 +395,20 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
     parallelRows(
         m_rows, 0,
         [&](int r0, int r1) {
-            detail::DecoderTaps::Scratch scratch;
             const std::size_t values = std::size_t(source.width) * channels;
-            std::vector<float> view(values), resized(uniform ? values : 0), shownSource(channels);
+            std::vector<float> resized(uniform ? values : 0);
+            Image decoded;
             for (int y = r0 * m_tile; y < std::min(source.height, r1 * m_tile); ++y) {
-                conusRows.row(y, scratch, view.data());
+                if (y % m_tile == 0) {
+                    DecodeOptions rows;
+                    const int y1 = std::min(source.height, y + m_tile);
+                    rows.view = {0.0, double(y) / source.height, 1.0, double(y1) / source.height};
+                    rows.width = source.width;
+                    rows.height = y1 - y;
+                    rows.threads = 1;
+                    decoded = decodeImage(conus, map, rows);
+                }
+                const float* view = decoded.pixels.data() + std::size_t(y % m_tile) * values;
                 if (uniform) uniformRows->row(y, resized.data());
                 const float* from = source.pixels.data() + std::size_t(y) * values;
                 double* row = &out[std::size_t(y / m_tile) * m_columns];

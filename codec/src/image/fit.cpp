@@ -657,17 +657,6 @@ Image fitAdjoint(const Image& view, const SamplingMap& map, int conusWidth, int 
     return out;
 }
 
-void DecodedRows::row(int y, DecoderTaps::Scratch& scratch, float* out) const {
-    const int channels = m_conus.channelCount();
-    std::fill(out, out + static_cast<std::size_t>(m_taps.width()) * channels, 0.0f);
-    dispatchChannels(channels, [&]<int kC>() {
-        m_taps.row(y, scratch, [&](int x, const DecoderTap* t, int count) {
-            gather<kC>(m_conus.pixels.data(), m_conus.width, m_conus.height, channels, t, count,
-                       out + static_cast<std::size_t>(x) * channels);
-        });
-    });
-}
-
 Image fitNormalProduct(const Image& x, const SamplingMap& map, int width, int height, std::size_t* wideRows, int threads) {
     checkImage(x, "fitNormalProduct");
     checkOutputSize(width, height, "fitNormalProduct");

@@ -137,21 +137,6 @@ private:
     ViewColumns m_cols;
 };
 
-// The decoded whole-image view at width x height of `conus` (D c: decodeImage's view, without a
-// pyramid), a row at a time, for a measure that keeps no view (FrameErrorModel::confirmed).
-// `conus` and `map` must outlive it.
-class DecodedRows {
-public:
-    DecodedRows(const Image& conus, const SamplingMap& map, int width, int height)
-        : m_conus(conus), m_taps(map, conus.width, conus.height, width, height) {}
-    // Output row y into out (width * channels values).
-    void row(int y, DecoderTaps::Scratch& scratch, float* out) const;
-
-private:
-    const Image& m_conus;
-    DecoderTaps m_taps;
-};
-
 // D and D^T for a whole-image view at width x height: the decoded view of `conus` (every channel,
 // as decodeImage computes it), and the splat of `view` into a conusWidth x conusHeight image
 // through the same taps. <fitForward(c), y> == <c, fitAdjoint(y)>.
