@@ -1,5 +1,8 @@
 #include "image_files.h"
 
+#include <algorithm>
+#include <cstddef>
+
 #include <CLI/CLI.hpp>
 
 #include "arguments.h"
@@ -56,10 +59,41 @@ Image readData(const std::string& path) {
     return imageio::readImageFile(path, read).image;
 }
 
+namespace {
+
+// The luminance of the picture as a display shows it (detailImportance's: the mean of R, G and B,
+// else the grey channel Y, else the first), a band of rows display-encoded at a time: the same
+// values as of displayEncoded(picture), without that copy of the picture (its size again, in
+// fresh pages).
+Image shownLuminance(const Image& picture) {
+    constexpr int kBandRows = 128;
+    const int r = picture.channelIndex("R"), g = picture.channelIndex("G"), b = picture.channelIndex("B");
+    const int single = std::max(0, picture.channelIndex("Y"));
+    const bool colour = r >= 0 && g >= 0 && b >= 0;
+    const std::size_t channels = picture.channels.size(), row = std::size_t(picture.width) * channels;
+    Image out = makeImage(picture.width, picture.height, {"Y"});
+    Image band{picture.width, 0, picture.channels, {}};
+    for (int y0 = 0; y0 < picture.height; y0 += kBandRows) {
+        const int rows = std::min(kBandRows, picture.height - y0);
+        band.height = rows;
+        band.pixels.assign(picture.pixels.begin() + std::ptrdiff_t(y0 * row), picture.pixels.begin() + std::ptrdiff_t((y0 + rows) * row));
+        const Image shown = imageio::displayEncoded(band);
+        float* to = out.pixels.data() + std::size_t(y0) * picture.width;
+        for (std::size_t p = 0; p < std::size_t(rows) * picture.width; ++p) {
+            const float* px = &shown.pixels[p * channels];
+            to[p] = colour ? (px[r] + px[g] + px[b]) / 3.0f : px[single];
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
 Image importanceFrom(const std::string& source, const Image& picture) {
     const std::optional<codec::ImportanceRule> rule = tryParseEnum<codec::ImportanceRule>(source);
     if (!rule) return readData(source);
     if (picture.empty()) throw Error(ErrorCode::InvalidArgument, "'" + source + "' importance needs an input image");
+    if (*rule == codec::ImportanceRule::Detail) return codec::detailImportanceOfLuminance(shownLuminance(picture));
     return codec::ruleImportance(*rule, imageio::displayEncoded(picture));
 }
 

@@ -117,8 +117,8 @@ void BM_BuildPyramid(benchmark::State& state) {
 BENCHMARK(BM_EncodeConus)->UseRealTime()->MeasureProcessCPUTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EncodeConusEwa)->UseRealTime()->MeasureProcessCPUTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EncodeBaselineAreaDownsample)->UseRealTime()->MeasureProcessCPUTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FitLocal)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FitLeastSquares)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FitLocal)->UseRealTime()->MeasureProcessCPUTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FitLeastSquares)->UseRealTime()->MeasureProcessCPUTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeConusView)->ArgName("zoom")->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeBaselineBilinear)->ArgName("zoom")->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeConusPyramid)->ArgName("zoom")->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);

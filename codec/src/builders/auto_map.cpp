@@ -246,9 +246,12 @@ Image detailOfLuminance(const Image& single);
 
 Image detailImportance(const Image& image) {
     if (image.empty()) invalid("the image is empty");
-    Image single = makeImage(image.width, image.height, {"Y"});
-    single.pixels = luminance(image);
-    return detailOfLuminance(single);
+    return detailOfLuminance(Image{image.width, image.height, {"Y"}, luminance(image)});
+}
+
+Image detailImportanceOfLuminance(const Image& luminance) {
+    if (luminance.empty() || luminance.channelCount() != 1) invalid("the luminance must be one channel");
+    return detailOfLuminance(luminance);
 }
 
 Image detailImportance(const EightBitImage& codes, const float* shownCode) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "conus/codec/image/decode.h"
@@ -12,6 +13,7 @@
 #include "conus/core/display.h"
 #include "conus/core/error.h"
 #include "conus/core/parallel.h"
+#include "../image/resize_rows_pvt.h"
 #include "budget_search_pvt.h"
 
 namespace conus::codec {
@@ -346,14 +348,16 @@ FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
         fit.method = m_options.fitMethod;
         kept->fit = fitToDecoder(source, map, kept->image, fit);
     }
-    DecodeOptions decode;
-    decode.width = source.width;
-    decode.height = source.height;
-    const std::vector<double> measured = shownTileErrors(source, decodeImage(kept->image, map, decode));
+    // The decoded views are measured a row at a time as they are made, none kept (each would be
+    // the source's size again); the uniform image's with the first confirmation's.
+    std::vector<double> measured;
     std::call_once(m_measuredUniform->once, [&] {
-        m_measuredUniform->errors =
-            shownTileErrors(source, resizeBilinear(areaDownsample(source, m_conusWidth, m_conusHeight), {}, source.width, source.height));
+        const Image uniform = areaDownsample(source, m_conusWidth, m_conusHeight);
+        auto [conus, flat] = shownTileErrors(source, kept->image, map, &uniform);
+        measured = std::move(conus);
+        m_measuredUniform->errors = std::move(flat);
     });
+    if (measured.empty()) measured = shownTileErrors(source, kept->image, map, nullptr).first;
     out.m_uniformError = m_measuredUniform->errors;
     // Each tile's footprints scaled by 2^shift so that the model gives what was measured: the
     // error grows with the footprint, so the shift is found by bisection (to 1e-4 octaves, within
@@ -373,34 +377,63 @@ FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
     return out;
 }
 
-std::vector<double> FrameErrorModel::shownTileErrors(const Image& source, const Image& view) const {
+std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileErrors(const Image& source, const Image& conus,
+                                                                                    const SamplingMap& map,
+                                                                                    const Image* uniform) const {
     const std::size_t channels = source.channels.size();
     std::vector<bool> display(channels, false);
     if (m_options.space == ErrorSpace::Display)
         for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
     const std::vector<float>& table = displayTable();
+    // The views at the source's size, never whole: the CoNUS image's decoded a row of tiles at a
+    // time (the decoder's view of those rows), the uniform image's bilinear resize a row at a time.
+    std::optional<detail::ResizedRows> uniformRows;
+    if (uniform) uniformRows.emplace(*uniform, source.width, source.height);
     // A row of tiles at a time, the rows of tiles spread over the threads (each tile's sum is
     // taken in the same order whatever the thread count).
-    std::vector<double> out(m_pixels.size(), 0.0);
+    std::vector<double> out(m_pixels.size(), 0.0), flat(uniform ? m_pixels.size() : 0, 0.0);
     parallelRows(
         m_rows, 0,
         [&](int r0, int r1) {
+            const std::size_t values = std::size_t(source.width) * channels;
+            std::vector<float> resized(uniform ? values : 0);
+            Image decoded;
             for (int y = r0 * m_tile; y < std::min(source.height, r1 * m_tile); ++y) {
+                if (y % m_tile == 0) {
+                    DecodeOptions rows;
+                    const int y1 = std::min(source.height, y + m_tile);
+                    rows.view = {0.0, double(y) / source.height, 1.0, double(y1) / source.height};
+                    rows.width = source.width;
+                    rows.height = y1 - y;
+                    rows.threads = 1;
+                    decoded = decodeImage(conus, map, rows);
+                }
+                const float* view = decoded.pixels.data() + std::size_t(y % m_tile) * values;
+                if (uniform) uniformRows->row(y, resized.data());
+                const float* from = source.pixels.data() + std::size_t(y) * values;
                 double* row = &out[std::size_t(y / m_tile) * m_columns];
+                double* flatRow = uniform ? &flat[std::size_t(y / m_tile) * m_columns] : nullptr;
                 for (int x = 0; x < source.width; ++x) {
-                    double e = 0;
+                    double e = 0, u = 0;
                     for (std::size_t c = 0; c < channels; ++c) {
-                        const std::size_t i = (std::size_t(y) * source.width + x) * channels + c;
-                        const double d = double(shown(view.pixels[i], display[c], table)) - shown(source.pixels[i], display[c], table);
+                        const std::size_t i = std::size_t(x) * channels + c;
+                        const double s = shown(from[i], display[c], table);
+                        const double d = double(shown(view[i], display[c], table)) - s;
                         e += d * d;
+                        if (uniform) {
+                            const double f = double(shown(resized[i], display[c], table)) - s;
+                            u += f * f;
+                        }
                     }
                     row[x / m_tile] += e / double(channels);
+                    if (uniform) flatRow[x / m_tile] += u / double(channels);
                 }
             }
         },
         1);
     for (std::size_t t = 0; t < out.size(); ++t) out[t] /= m_pixels[t];
-    return out;
+    for (std::size_t t = 0; t < flat.size(); ++t) flat[t] /= m_pixels[t];
+    return {std::move(out), std::move(flat)};
 }
 
 FramePrediction FrameErrorModel::measure(const std::vector<double>& mapped) const {

@@ -1,4 +1,13 @@
-// The encoder fitted to its decoder (fit.h): Jacobi-preconditioned CGLS through the decoder's taps.
+// The encoder fitted to its decoder (fit.h): Jacobi-preconditioned conjugate gradients on the
+// normal equations D^T D c = D^T s.
+//
+// Usually they are assembled on the CoNUS grid in one walk of the decoder's taps over the source
+// (assemblePass): D^T s, |s|^2, and A = D^T D as a 3x3 stencil per CoNUS pixel (an output pixel's
+// taps reach one 2x2 block of CoNUS pixels wherever the view magnifies), with the few output
+// pixels whose taps reach wider (where it minifies) kept as rows of D. Every iteration is then a
+// few stencil products on the CoNUS image, a sixteenth of the source's pixels at the default
+// encode's 1/16, instead of two walks over the source. Where the view minifies much of the image
+// (more wide rows than kWideEntriesPerPixel allows) the fit walks the taps every iteration (CGLS):
 //
 // Each pass walks the output rows in bands, one thread per band at a time. A gather (D) reads the
 // CoNUS image; a splat (D^T) writes into the band's own buffer, which spans only the CoNUS rows
@@ -6,11 +15,15 @@
 // locks, no per-source-pixel storage, and the same sums whatever the thread count. The residual
 // s - D x is recomputed from x in every pass instead of being stored (a 4096^2 source would need
 // 192 MiB per vector), which also keeps it from drifting; after the last step only its norm is
-// wanted (the PSNR reported), and that follows from the step's own sums without a pass.
+// wanted (the PSNR reported), and that follows from the step's own sums without a pass. The
+// assembly walks the same bands into buffers of the same rows.
 #include <algorithm>
+#include <atomic>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "conus/codec/image/encode.h"
@@ -36,6 +49,9 @@ struct Band {
     int lo = 0, hi = -1;  // CoNUS rows its taps reach
     std::vector<float> buffer;
     std::vector<float> squares;  // the taps' squared corner weights (diag(D^T D)), one value a CoNUS pixel
+    std::vector<float> stencil;  // the normal equations' assembly: kStencil values a CoNUS pixel
+    std::vector<std::int32_t> wideStart, wideIndex;  // the wide rows of D (WideRows), in walk order
+    std::vector<float> wideWeight;
     double sum = 0;       // the pass's sum over the band (sums of squares)
 };
 
@@ -149,24 +165,27 @@ inline void gather(const float* image, int width, int height, int c, const Decod
     }
 }
 
+// Adds one tap's corner weights times value into a band's buffer (rows from `lo`).
+template <int kC>
+inline void splatCorners(float* buffer, int lo, int width, int c, const TapCorners& q, const float* value) {
+    const int channels = kC > 0 ? kC : c;
+    float* p00 = buffer + (static_cast<std::size_t>(q.y0 - lo) * width + q.x0) * channels;
+    float* p01 = buffer + (static_cast<std::size_t>(q.y0 - lo) * width + q.x1) * channels;
+    float* p10 = buffer + (static_cast<std::size_t>(q.y1 - lo) * width + q.x0) * channels;
+    float* p11 = buffer + (static_cast<std::size_t>(q.y1 - lo) * width + q.x1) * channels;
+    for (int k = 0; k < channels; ++k) {
+        p00[k] += q.w00 * value[k];
+        p01[k] += q.w01 * value[k];
+        p10[k] += q.w10 * value[k];
+        p11[k] += q.w11 * value[k];
+    }
+}
+
 // Adds the taps' weights times value into a band's buffer (rows from `lo`).
 template <int kC>
 inline void splat(float* buffer, int lo, int width, int height, int c, const DecoderTap* taps, int count,
                   const float* value) {
-    const int channels = kC > 0 ? kC : c;
-    for (int t = 0; t < count; ++t) {
-        const TapCorners q = tapCorners(taps[t], width, height);
-        float* p00 = buffer + (static_cast<std::size_t>(q.y0 - lo) * width + q.x0) * channels;
-        float* p01 = buffer + (static_cast<std::size_t>(q.y0 - lo) * width + q.x1) * channels;
-        float* p10 = buffer + (static_cast<std::size_t>(q.y1 - lo) * width + q.x0) * channels;
-        float* p11 = buffer + (static_cast<std::size_t>(q.y1 - lo) * width + q.x1) * channels;
-        for (int k = 0; k < channels; ++k) {
-            p00[k] += q.w00 * value[k];
-            p01[k] += q.w01 * value[k];
-            p10[k] += q.w10 * value[k];
-            p11[k] += q.w11 * value[k];
-        }
-    }
+    for (int t = 0; t < count; ++t) splatCorners<kC>(buffer, lo, width, c, tapCorners(taps[t], width, height), value);
 }
 
 // Adds the taps' squared corner weights into a band's `squares` (rows from `lo`): diag(D^T D)
@@ -242,6 +261,246 @@ void residualPass(DecoderOperator& op, const float* image, const float* source, 
         }
         band.sum = sum;
     });
+}
+
+// The normal equations' matrix A = D^T D, assembled on the CoNUS grid in one walk of the taps.
+// An output pixel's row d of D (its taps' corner weights, merged where two fall on one CoNUS
+// pixel) adds d d^T to A. Where d lies within one 2x2 block of CoNUS pixels (every magnified output
+// pixel, and minified ones whose taps stay that close) that is a 3x3 stencil, kept per CoNUS
+// pixel as its upper half: the pixel's own coefficient and those with its right, lower,
+// lower-right and lower-left neighbours (kStencil values). A wider d is kept as it is (a wide
+// row), and A applied through it as d (d . x).
+constexpr int kStencil = 5;
+enum StencilEntry { kOwn, kRight, kBelow, kBelowRight, kBelowLeft };
+// The wide rows' entries the assembly may keep, per CoNUS pixel. Where the view minifies by f
+// along both axes an output pixel's row of D has about (f + 1)^2 entries for f^2 CoNUS pixels
+// (its taps' corners, merged): at most 2.25 a CoNUS pixel there (f = 2). Beyond this many (a map
+// that minifies almost everywhere, taps far apart) the fit walks the taps every iteration instead.
+constexpr std::int64_t kWideEntriesPerPixel = 4;
+
+// Adds d d^T of a d within the 2x2 block at (bx, by): a at (bx, by), b to its right, c below, e
+// below right (b and e are 0 where bx is the last column, c and e where by is the band's last row).
+inline void addBlock(float* stencil, int lo, int hi, int wc, int bx, int by, float a, float b, float c, float e) {
+    float* p00 = stencil + ((static_cast<std::size_t>(by - lo) * wc) + bx) * kStencil;
+    p00[kOwn] += a * a;
+    p00[kRight] += a * b;
+    p00[kBelow] += a * c;
+    p00[kBelowRight] += a * e;
+    const bool right = bx + 1 < wc, below = by + 1 <= hi;
+    if (right) {
+        float* p01 = p00 + kStencil;
+        p01[kOwn] += b * b;
+        p01[kBelow] += b * e;
+        p01[kBelowLeft] += b * c;
+    }
+    if (below) {
+        float* p10 = p00 + static_cast<std::size_t>(wc) * kStencil;
+        p10[kOwn] += c * c;
+        p10[kRight] += c * e;
+        if (right) p10[kStencil + kOwn] += e * e;
+    }
+}
+
+// A tap's corner weights on the 2x2 block at its top-left corner (x0, y0), a clamped corner's
+// weight merged into the one it fell on.
+inline void blockWeights(const TapCorners& q, float w[4]) {
+    w[0] = q.w00;
+    w[1] = q.w01;
+    w[2] = q.w10;
+    w[3] = q.w11;
+    if (q.x1 == q.x0) {
+        w[0] += w[1];
+        w[2] += w[3];
+        w[1] = w[3] = 0.0f;
+    }
+    if (q.y1 == q.y0) {
+        w[0] += w[2];
+        w[1] += w[3];
+        w[2] = w[3] = 0.0f;
+    }
+}
+
+// Adds one output pixel's d d^T: into the stencil, or as a wide row of the band (false when the
+// wide rows' allowance `wideLeft` is spent: the assembly is then abandoned).
+inline bool addOuter(Band& band, int wc, int hc, const DecoderTap* taps, int count,
+                     std::vector<std::pair<std::int32_t, float>>& entries, std::atomic<std::int64_t>& wideLeft) {
+    if (count == 1) {
+        const TapCorners q = tapCorners(taps[0], wc, hc);
+        float w[4];
+        blockWeights(q, w);
+        addBlock(band.stencil.data(), band.lo, band.hi, wc, q.x0, q.y0, w[0], w[1], w[2], w[3]);
+        return true;
+    }
+    int x0 = wc, y0 = hc, x1 = -1, y1 = -1;
+    TapCorners corners[DecoderTaps::kMaxTaps];
+    for (int t = 0; t < count; ++t) {
+        const TapCorners& q = corners[t] = tapCorners(taps[t], wc, hc);
+        x0 = std::min(x0, q.x0);
+        y0 = std::min(y0, q.y0);
+        x1 = std::max(x1, q.x1);
+        y1 = std::max(y1, q.y1);
+    }
+    if (x1 - x0 <= 1 && y1 - y0 <= 1) {
+        float block[4] = {0, 0, 0, 0};
+        for (int t = 0; t < count; ++t) {
+            const TapCorners& q = corners[t];
+            block[(q.y0 - y0) * 2 + (q.x0 - x0)] += q.w00;
+            block[(q.y0 - y0) * 2 + (q.x1 - x0)] += q.w01;
+            block[(q.y1 - y0) * 2 + (q.x0 - x0)] += q.w10;
+            block[(q.y1 - y0) * 2 + (q.x1 - x0)] += q.w11;
+        }
+        addBlock(band.stencil.data(), band.lo, band.hi, wc, x0, y0, block[0], block[1], block[2], block[3]);
+        return true;
+    }
+    entries.clear();
+    for (int t = 0; t < count; ++t) {
+        const TapCorners& q = corners[t];
+        entries.push_back({q.y0 * wc + q.x0, q.w00});
+        entries.push_back({q.y0 * wc + q.x1, q.w01});
+        entries.push_back({q.y1 * wc + q.x0, q.w10});
+        entries.push_back({q.y1 * wc + q.x1, q.w11});
+    }
+    std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+        if (kept > 0 && entries[kept - 1].first == entries[k].first) entries[kept - 1].second += entries[k].second;
+        else entries[kept++] = entries[k];
+    }
+    if (wideLeft.fetch_sub(static_cast<std::int64_t>(kept), std::memory_order_relaxed) < static_cast<std::int64_t>(kept))
+        return false;
+    band.wideStart.push_back(static_cast<std::int32_t>(band.wideIndex.size()));
+    for (std::size_t k = 0; k < kept; ++k) {
+        band.wideIndex.push_back(entries[k].first);
+        band.wideWeight.push_back(entries[k].second);
+    }
+    return true;
+}
+
+// One walk of the taps for the normal equations: each band's sum of |source|^2, D^T source
+// splatted into its buffer and A into its stencil and wide rows. False where the wide rows
+// outgrew their allowance.
+template <int kC>
+bool assemblePass(DecoderOperator& op, const float* source, int c) {
+    const DecoderTaps& taps = op.taps();
+    const int channels = kC > 0 ? kC : c, wc = taps.conusWidth(), hc = taps.conusHeight();
+    std::atomic<std::int64_t> wideLeft{kWideEntriesPerPixel * wc * hc};
+    std::atomic<bool> abandoned{false};
+    op.forEachBand([&](Band& band, DecoderTaps::Scratch& scratch) {
+        std::vector<std::pair<std::int32_t, float>> entries;
+        band.wideStart.clear();
+        band.wideIndex.clear();
+        band.wideWeight.clear();
+        double sum = 0;
+        for (int y = band.y0; y < band.y1 && !abandoned.load(std::memory_order_relaxed); ++y) {
+            const float* row = source + static_cast<std::size_t>(y) * taps.width() * channels;
+            taps.row(y, scratch, [&](int x, const DecoderTap* t, int count) {
+                const float* value = row + static_cast<std::size_t>(x) * channels;
+                for (int k = 0; k < channels; ++k) sum += double(value[k]) * value[k];
+                if (count == 1) {  // most pixels: the corners found once for both
+                    const TapCorners q = tapCorners(t[0], wc, hc);
+                    splatCorners<kC>(band.buffer.data(), band.lo, wc, channels, q, value);
+                    float w[4];
+                    blockWeights(q, w);
+                    addBlock(band.stencil.data(), band.lo, band.hi, wc, q.x0, q.y0, w[0], w[1], w[2], w[3]);
+                    return;
+                }
+                splat<kC>(band.buffer.data(), band.lo, wc, hc, channels, t, count, value);
+                if (!addOuter(band, wc, hc, t, count, entries, wideLeft)) abandoned.store(true, std::memory_order_relaxed);
+            });
+        }
+        band.sum = sum;
+    });
+    return !abandoned.load();
+}
+
+// A = D^T D as assembled (assemblePass), summed over the bands: the stencil of every CoNUS pixel
+// and the wide rows in walk order (CSR: row r's entries are start[r] .. start[r + 1]).
+struct NormalMatrix {
+    int width = 0, height = 0;
+    std::vector<float> stencil;
+    std::vector<std::int32_t> start{0}, index;
+    std::vector<float> weight;
+
+    // A's diagonal.
+    std::vector<float> diagonal() const {
+        std::vector<float> d(static_cast<std::size_t>(width) * height);
+        for (std::size_t i = 0; i < d.size(); ++i) d[i] = stencil[i * kStencil + kOwn];
+        for (std::size_t k = 0; k < index.size(); ++k) d[index[k]] += weight[k] * weight[k];
+        return d;
+    }
+
+    // out = A x (`channels` values a pixel).
+    void apply(const float* x, float* out, int channels, int threads) const {
+        const int wc = width, hc = height;
+        parallelRows(hc, threads, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                for (int xi = 0; xi < wc; ++xi) {
+                    const std::size_t i = static_cast<std::size_t>(y) * wc + xi;
+                    const float* s = stencil.data() + i * kStencil;
+                    const std::size_t row = static_cast<std::size_t>(wc) * kStencil;
+                    float* o = out + i * channels;
+                    const float* xc = x + i * channels;
+                    const std::size_t step = static_cast<std::size_t>(wc) * channels;
+                    const bool left = xi > 0, right = xi + 1 < wc, up = y > 0, down = y + 1 < hc;
+                    for (int k = 0; k < channels; ++k) {
+                        float v = s[kOwn] * xc[k];
+                        if (right) v += s[kRight] * xc[channels + k];
+                        if (left) v += s[kRight - kStencil] * xc[k - channels];
+                        if (down) {
+                            v += s[kBelow] * xc[step + k];
+                            if (right) v += s[kBelowRight] * xc[step + channels + k];
+                            if (left) v += s[kBelowLeft] * xc[step - channels + k];
+                        }
+                        if (up) {
+                            v += (s - row)[kBelow] * xc[k - step];
+                            if (left) (v += (s - row - kStencil)[kBelowRight] * xc[k - step - channels]);
+                            if (right) v += (s - row + kStencil)[kBelowLeft] * xc[k - step + channels];
+                        }
+                        o[k] = v;
+                    }
+                }
+        });
+        // The wide rows, in order (a few, where the view minifies): d (d . x).
+        std::vector<double> along(channels);
+        for (std::size_t r = 0; r + 1 < start.size(); ++r) {
+            std::fill(along.begin(), along.end(), 0.0);
+            for (std::int32_t k = start[r]; k < start[r + 1]; ++k)
+                for (int c = 0; c < channels; ++c) along[c] += double(weight[k]) * x[std::size_t(index[k]) * channels + c];
+            for (std::int32_t k = start[r]; k < start[r + 1]; ++k)
+                for (int c = 0; c < channels; ++c) out[std::size_t(index[k]) * channels + c] += float(weight[k] * along[c]);
+        }
+    }
+};
+
+// The normal equations of `op` for `source` (`channels` values a pixel): A, D^T source into b and
+// |source|^2 into squares; false (nothing assembled) where the view minifies too much of the image.
+bool assembleNormal(DecoderOperator& op, const float* source, int channels, NormalMatrix& a, std::vector<float>& b,
+                    double& squares) {
+    const int wc = op.taps().conusWidth(), hc = op.taps().conusHeight();
+    if (std::int64_t{wc} * hc * kStencil >= (std::int64_t{1} << 31)) return false;
+    op.clearBuffers(channels);
+    op.clearBuffers(kStencil, &Band::stencil);
+    bool assembled = false;
+    dispatchChannels(channels, [&]<int kC>() { assembled = assemblePass<kC>(op, source, channels); });
+    if (!assembled) return false;
+    squares = op.bandSum();
+    a.width = wc;
+    a.height = hc;
+    a.stencil.resize(static_cast<std::size_t>(wc) * hc * kStencil);
+    op.sumBuffers(a.stencil.data(), kStencil, &Band::stencil);
+    b.resize(static_cast<std::size_t>(wc) * hc * channels);
+    op.sumBuffers(b.data(), channels);
+    a.start.clear();
+    for (Band& band : op.bands()) {
+        const std::int32_t base = static_cast<std::int32_t>(a.index.size());
+        for (const std::int32_t s : band.wideStart) a.start.push_back(base + s);
+        a.index.insert(a.index.end(), band.wideIndex.begin(), band.wideIndex.end());
+        a.weight.insert(a.weight.end(), band.wideWeight.begin(), band.wideWeight.end());
+        std::vector<float>().swap(band.stencil);
+        std::vector<float>().swap(band.buffer);
+    }
+    a.start.push_back(static_cast<std::int32_t>(a.index.size()));
+    return true;
 }
 
 double dot(const std::vector<float>& a, const std::vector<float>& b) {
@@ -367,7 +626,12 @@ void localFit(std::vector<float>& x, int width, int height, int channels, const 
     });
 }
 
+std::atomic<bool> g_forcePasses{false};
+
 }  // namespace
+
+void forceFitPasses(bool passes) { g_forcePasses.store(passes, std::memory_order_relaxed); }
+bool fitPassesForced() { return g_forcePasses.load(std::memory_order_relaxed); }
 
 Image fitForward(const Image& conus, const SamplingMap& map, int width, int height, int threads) {
     checkImage(conus, "fitForward");
@@ -390,6 +654,22 @@ Image fitAdjoint(const Image& view, const SamplingMap& map, int conusWidth, int 
         residualPass<kC>(op, nullptr, view.pixels.data(), view.channelCount(), true);
     });
     op.sumBuffers(out.pixels.data(), view.channelCount());
+    return out;
+}
+
+Image fitNormalProduct(const Image& x, const SamplingMap& map, int width, int height, std::size_t* wideRows, int threads) {
+    checkImage(x, "fitNormalProduct");
+    checkOutputSize(width, height, "fitNormalProduct");
+    DecoderOperator op(map, x.width, x.height, width, height, threads);
+    const std::vector<float> zeros(static_cast<std::size_t>(width) * height * x.channelCount(), 0.0f);
+    NormalMatrix a;
+    std::vector<float> b;
+    double squares = 0;
+    if (!assembleNormal(op, zeros.data(), x.channelCount(), a, b, squares))
+        throw Error(ErrorCode::InvalidArgument, "fitNormalProduct: the view minifies too much of the image to assemble");
+    if (wideRows) *wideRows = a.start.size() - 1;
+    Image out = makeOutput(x, x.width, x.height);
+    a.apply(x.pixels.data(), out.pixels.data(), x.channelCount(), threads);
     return out;
 }
 
@@ -490,9 +770,12 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
     const auto penaltyOf = [&] {
         double penalty = 0;
         if (damped)
-            for (std::size_t i = 0; i < values; ++i) {
-                const float d = x[i] - x0[i], w = hold[i / channels] * diag[i / channels];
-                penalty += double(w) * d * d;
+            for (std::size_t px = 0, i = 0; px < pixels; ++px) {
+                const float w = hold[px] * diag[px];
+                for (int k = 0; k < channels; ++k, ++i) {
+                    const float d = x[i] - x0[i];
+                    penalty += double(w) * d * d;
+                }
             }
         return penalty;
     };
@@ -510,8 +793,63 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         record(data, penaltyOf());
     };
     const auto applyPreconditioner = [&](std::vector<float>& out) {
-        for (std::size_t i = 0; i < values; ++i) out[i] = precondition[i / channels] * z[i];
+        for (std::size_t px = 0, i = 0; px < pixels; ++px)
+            for (int k = 0; k < channels; ++k, ++i) out[i] = precondition[px] * z[i];
     };
+
+    // The normal equations assembled on the CoNUS grid in one walk of the taps (A = D^T D, b =
+    // D^T s): the same iterations then cost a few stencil products on the CoNUS image instead of
+    // two walks over the source each. |s - D x|^2 = |s|^2 - 2 <x, b> + <x, A x>, in double.
+    detail::NormalMatrix normal;
+    std::vector<float> b;
+    double squares = 0;
+    if (options.iterations > 0 && !detail::fitPassesForced() && detail::assembleNormal(op, s, channels, normal, b, squares)) {
+        diag = normal.diagonal();
+        float largest = 0;
+        for (float d : diag) largest = std::max(largest, d);
+        for (std::size_t i = 0; i < pixels; ++i)
+            precondition[i] = diag[i] > 1e-6f * largest ? 1.0f / ((1.0f + hold[i]) * diag[i]) : 0.0f;
+        // zp holds A p as well, until the preconditioner needs it (every vector here is a fresh
+        // CoNUS image's worth of pages).
+        std::vector<float> zp(values);
+        // z = b - A x - lambda diag (x - x0) (A x made in z), and the step recorded.
+        const auto residualOfX = [&] {
+            normal.apply(x.data(), z.data(), channels, options.threads);
+            double xb = 0, xax = 0;
+            for (std::size_t px = 0, i = 0; px < pixels; ++px) {
+                const float w = damped ? hold[px] * diag[px] : 0.0f;
+                for (int k = 0; k < channels; ++k, ++i) {
+                    xb += double(x[i]) * b[i];
+                    xax += double(x[i]) * z[i];
+                    z[i] = b[i] - z[i] - (damped ? w * (x[i] - x0[i]) : 0.0f);
+                }
+            }
+            record(std::max(0.0, squares - 2.0 * xb + xax), penaltyOf());
+        };
+        residualOfX();
+        applyPreconditioner(p);
+        double gamma = detail::dot(z, p);
+        for (int it = 1; it <= options.iterations && gamma > 0; ++it) {
+            normal.apply(p.data(), zp.data(), channels, options.threads);
+            double delta = detail::dot(p, zp);  // |D p|^2
+            if (damped)
+                for (std::size_t px = 0, i = 0; px < pixels; ++px) {
+                    const double w = double(hold[px]) * diag[px];
+                    for (int k = 0; k < channels; ++k, ++i) delta += w * p[i] * p[i];
+                }
+            if (!(delta > 0)) break;
+            const float alpha = static_cast<float>(gamma / delta);
+            for (std::size_t i = 0; i < values; ++i) x[i] += alpha * p[i];
+            residualOfX();
+            if (it == options.iterations) break;
+            applyPreconditioner(zp);
+            const double next = detail::dot(z, zp);
+            const float beta = static_cast<float>(next / gamma);
+            for (std::size_t i = 0; i < values; ++i) p[i] = zp[i] + beta * p[i];
+            gamma = next;
+        }
+        return finish();
+    }
 
     residual(options.iterations > 0, options.iterations > 0);
     applyPreconditioner(p);

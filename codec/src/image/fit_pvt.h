@@ -143,4 +143,14 @@ private:
 Image fitForward(const Image& conus, const SamplingMap& map, int width, int height, int threads = 0);
 Image fitAdjoint(const Image& view, const SamplingMap& map, int conusWidth, int conusHeight, int threads = 0);
 
+// fitToDecoder solves its normal equations assembled on the CoNUS grid (one walk of the taps) unless
+// the view minifies much of the image; forced, it walks the taps every iteration instead (the
+// tests compare the two).
+// A x of the assembled normal equations (A = D^T D for a whole-image view at width x height),
+// and how many wide rows of D they keep; throws where the fit would walk the taps instead.
+Image fitNormalProduct(const Image& x, const SamplingMap& map, int width, int height, std::size_t* wideRows = nullptr,
+                       int threads = 0);
+void forceFitPasses(bool passes);
+bool fitPassesForced();
+
 }  // namespace conus::codec::detail

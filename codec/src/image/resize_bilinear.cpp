@@ -11,18 +11,13 @@
 #include "conus/core/parallel.h"
 #include "decode_pvt.h"
 #include "resample_pvt.h"
+#include "resize_rows_pvt.h"
 
 namespace conus::codec {
 namespace {
 
-// Per-axis bilinear taps of the baseline, precomputed like the decoder's view columns.
-struct AxisTaps {
-    std::vector<int> i0, i1;
-    std::vector<float> f;
-};
-
-AxisTaps axisTaps(int size, double a0, double a1, int count) {
-    AxisTaps t;
+detail::AxisTaps axisTaps(int size, double a0, double a1, int count) {
+    detail::AxisTaps t;
     t.i0.resize(count);
     t.i1.resize(count);
     t.f.resize(count);
@@ -37,39 +32,36 @@ AxisTaps axisTaps(int size, double a0, double a1, int count) {
     return t;
 }
 
+// Output row y (width pixels) into out.
 template <int kC>
-void bilinearRows(const Image& src, Image& dst, const AxisTaps& tx, const AxisTaps& ty, int y0,
-                  int y1) {
+void bilinearRow(const Image& src, float* out, int width, const detail::AxisTaps& tx, const detail::AxisTaps& ty, int y) {
     const int channels = kC > 0 ? kC : src.channelCount();
     const std::size_t stride = static_cast<std::size_t>(src.width) * channels;
-    for (int y = y0; y < y1; ++y) {
-        const float* r0 = src.pixels.data() + ty.i0[y] * stride;
-        const float* r1 = src.pixels.data() + ty.i1[y] * stride;
-        const float fy = ty.f[y];
-        float* out = dst.pixels.data() + static_cast<std::size_t>(y) * dst.width * channels;
-        if constexpr (detail::kLanes<kC>) {
-            // As the decoder's magnified spans: every pixel but the row's last stores four lanes (the
-            // next pixel overwrites the fourth).
-            const float* last = src.pixels.data() + src.pixels.size() - kC;
-            const int wide = kC == 4 ? dst.width : dst.width - 1;
-            for (int x = 0; x < wide; ++x, out += kC) {
-                const detail::PixelLanes v = detail::bilinearLanes<kC>(r0, r1, std::size_t(tx.i0[x]) * kC,
-                                                                       std::size_t(tx.i1[x]) * kC, tx.f[x], fy, last);
-                std::memcpy(out, &v, sizeof v);
-            }
-            for (int x = wide; x < dst.width; ++x, out += kC)
-                detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(r0, r1, std::size_t(tx.i0[x]) * kC,
-                                                                      std::size_t(tx.i1[x]) * kC, tx.f[x], fy, last));
-            continue;
+    const float* r0 = src.pixels.data() + ty.i0[y] * stride;
+    const float* r1 = src.pixels.data() + ty.i1[y] * stride;
+    const float fy = ty.f[y];
+    if constexpr (detail::kLanes<kC>) {
+        // As the decoder's magnified spans: every pixel but the row's last stores four lanes (the
+        // next pixel overwrites the fourth).
+        const float* last = src.pixels.data() + src.pixels.size() - kC;
+        const int wide = kC == 4 ? width : width - 1;
+        for (int x = 0; x < wide; ++x, out += kC) {
+            const detail::PixelLanes v = detail::bilinearLanes<kC>(r0, r1, std::size_t(tx.i0[x]) * kC,
+                                                                   std::size_t(tx.i1[x]) * kC, tx.f[x], fy, last);
+            std::memcpy(out, &v, sizeof v);
         }
-        for (int x = 0; x < dst.width; ++x, out += channels) {
-            const int o0 = tx.i0[x] * channels, o1 = tx.i1[x] * channels;
-            const float fx = tx.f[x];
-            for (int k = 0; k < channels; ++k) {
-                const float top = r0[o0 + k] + fx * (r0[o1 + k] - r0[o0 + k]);
-                const float bottom = r1[o0 + k] + fx * (r1[o1 + k] - r1[o0 + k]);
-                out[k] = top + fy * (bottom - top);
-            }
+        for (int x = wide; x < width; ++x, out += kC)
+            detail::storeLanes<kC>(out, detail::bilinearLanes<kC>(r0, r1, std::size_t(tx.i0[x]) * kC,
+                                                                  std::size_t(tx.i1[x]) * kC, tx.f[x], fy, last));
+        return;
+    }
+    for (int x = 0; x < width; ++x, out += channels) {
+        const int o0 = tx.i0[x] * channels, o1 = tx.i1[x] * channels;
+        const float fx = tx.f[x];
+        for (int k = 0; k < channels; ++k) {
+            const float top = r0[o0 + k] + fx * (r0[o1 + k] - r0[o0 + k]);
+            const float bottom = r1[o0 + k] + fx * (r1[o1 + k] - r1[o0 + k]);
+            out[k] = top + fy * (bottom - top);
         }
     }
 }
@@ -82,17 +74,31 @@ Image resizeBilinear(const Image& image, const View& view, int width, int height
     checkDecodeMemory(image, width, height);
     detail::checkView(view, "resizeBilinear");
     Image out = detail::makeOutput(image, width, height);
-    const AxisTaps tx = axisTaps(image.width, view.u0, view.u1, width);
-    const AxisTaps ty = axisTaps(image.height, view.v0, view.v1, height);
+    const detail::AxisTaps tx = axisTaps(image.width, view.u0, view.u1, width);
+    const detail::AxisTaps ty = axisTaps(image.height, view.v0, view.v1, height);
     parallelRows(
         height, threads,
         [&](int y0, int y1) {
-            detail::dispatchChannels(image.channelCount(),
-                                     [&]<int kC>() { bilinearRows<kC>(image, out, tx, ty, y0, y1); });
+            detail::dispatchChannels(image.channelCount(), [&]<int kC>() {
+                for (int y = y0; y < y1; ++y)
+                    bilinearRow<kC>(image, out.pixels.data() + static_cast<std::size_t>(y) * width * image.channelCount(), width,
+                                    tx, ty, y);
+            });
         },
         16);
     detail::clearOutside(out, view);
     return out;
 }
+
+namespace detail {
+
+ResizedRows::ResizedRows(const Image& image, int width, int height)
+    : m_image(image), m_width(width), m_tx(axisTaps(image.width, 0.0, 1.0, width)), m_ty(axisTaps(image.height, 0.0, 1.0, height)) {}
+
+void ResizedRows::row(int y, float* out) const {
+    dispatchChannels(m_image.channelCount(), [&]<int kC>() { bilinearRow<kC>(m_image, out, m_width, m_tx, m_ty, y); });
+}
+
+}  // namespace detail
 
 }  // namespace conus::codec

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "../../../codec/src/image/fit_pvt.h"
+#include "../../../codec/src/image/resize_rows_pvt.h"
 #include "conus/codec/builders/foci.h"
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
@@ -82,6 +83,93 @@ TEST(Fit, AdjointIdentityThroughAFocusMap) {
         EXPECT_GT(std::abs(lhs), 1.0);
         // The same sums whatever the thread count (bands are fixed, their sums added in order).
         EXPECT_EQ(test::maxAbsDifference(dty, detail::fitAdjoint(y, map, c.conusWidth, c.conusHeight, 1)), 0.0f);
+    }
+}
+
+// What the budget's confirmation measures without keeping a view at the source's size: the
+// decoder's view of a band of rows (a view of those rows alone) is those rows of the whole view,
+// and the uniform image's bilinear resize a row at a time is resizeBilinear's.
+TEST(Fit, BandsOfTheViewAreTheWholeViewsRows) {
+    const SamplingMap map = twoFoci(1.5);
+    for (const Case& c : kCases) {
+        const Image x = caseNoise(c, c.conusWidth, c.conusHeight, 9);
+        DecodeOptions d;
+        d.width = 300;
+        d.height = 200;
+        const Image decoded = decodeImage(x, map, d), resized = resizeBilinear(x, View{}, 300, 200);
+        Image bands = decoded, flat = resized;
+        std::fill(bands.pixels.begin(), bands.pixels.end(), -1.0f);
+        const detail::ResizedRows bilinear(x, 300, 200);
+        const std::size_t row = std::size_t(300) * c.channels;
+        for (int y0 = 0; y0 < 200; y0 += 37) {  // bands of 37 rows, the last one shorter
+            DecodeOptions band = d;
+            band.height = std::min(37, 200 - y0);
+            band.view = {0.0, y0 / 200.0, 1.0, (y0 + band.height) / 200.0};
+            const Image part = decodeImage(x, map, band);
+            std::copy(part.pixels.begin(), part.pixels.end(), bands.pixels.begin() + std::ptrdiff_t(y0 * row));
+        }
+        for (int y = 0; y < 200; ++y) bilinear.row(y, flat.pixels.data() + std::size_t(y) * row);
+        EXPECT_LT(test::maxAbsDifference(decoded, bands), 1e-5f) << c.conusWidth << "x" << c.conusHeight;
+        EXPECT_EQ(test::maxAbsDifference(resized, flat), 0.0f) << c.conusWidth << "x" << c.conusHeight;
+        EXPECT_GT(test::maxAbsDifference(decoded, resized), 0.05f);  // the two views differ: not one image twice
+    }
+}
+
+// The normal equations' matrix, assembled as a stencil (and wide rows where the foci minify),
+// is D^T D: A x against the adjoint of the forward view, on the magnified and the minified cases.
+TEST(Fit, AssembledNormalEquationsAreDtD) {
+    const SamplingMap map = twoFoci(1.5);
+    std::size_t mostWide = 0;
+    for (const Case& c : kCases) {
+        const Image x = caseNoise(c, c.conusWidth, c.conusHeight, 7);
+        std::size_t wide = 0;
+        const Image ax = detail::fitNormalProduct(x, map, 300, 200, &wide, 2);
+        const Image dtdx = detail::fitAdjoint(detail::fitForward(x, map, 300, 200, 2), map, c.conusWidth, c.conusHeight, 2);
+        float largest = 0;
+        for (const float v : dtdx.pixels) largest = std::max(largest, std::abs(v));
+        EXPECT_GT(largest, 1.0f);
+        EXPECT_LT(test::maxAbsDifference(ax, dtdx), 2e-5f * largest) << c.conusWidth << "x" << c.conusHeight;
+        // The same whatever the thread count (the bands' sums in order).
+        EXPECT_EQ(test::maxAbsDifference(ax, detail::fitNormalProduct(x, map, 300, 200, nullptr, 1)), 0.0f);
+        mostWide = std::max(mostWide, wide);
+    }
+    // The 240x170 case minifies in the foci: some output pixels' taps reach past a 2x2 block.
+    EXPECT_GT(mostWide, 0u);
+}
+
+// The assembled fit and the one that walks the taps every iteration take the same steps where the
+// view magnifies, and the assembled ones are no worse where it minifies.
+TEST(Fit, AssembledFitMatchesThePasses) {
+    const Image source = test::photoLike(300, 200, {"R", "G", "B"});
+    const SamplingMap map = twoFoci(1.5);
+    for (const Case& c : {Case{75, 50, 3}, Case{240, 170, 3}}) {
+        EncodeOptions e;
+        e.width = c.conusWidth;
+        e.height = c.conusHeight;
+        const Image encoded = encodeImage(source, map, e);
+        std::size_t wide = 0;
+        detail::fitNormalProduct(encoded, map, 300, 200, &wide);  // throws where the fit would not assemble
+        Image assembled = encoded, walked = encoded;
+        FitOptions f;
+        f.iterations = 3;
+        const FitResult a = fitToDecoder(source, map, assembled, f);
+        detail::forceFitPasses(true);
+        const FitResult w = fitToDecoder(source, map, walked, f);
+        detail::forceFitPasses(false);
+        ASSERT_EQ(a.steps.size(), w.steps.size());
+        EXPECT_NEAR(a.steps[0].psnr, w.steps[0].psnr, 1e-3);
+        // Magnified, the two are the same iterations. Minified (wide rows), the walk's Jacobi
+        // diagonal sums each corner's square apart where the assembly merges the corners that fall on
+        // one CoNUS pixel first (the true diag(D^T D)): the assembly's steps are better there.
+        for (std::size_t i = 1; i < a.steps.size(); ++i) {
+            if (wide == 0) EXPECT_NEAR(a.steps[i].psnr, w.steps[i].psnr, 0.02) << i;
+            else EXPECT_GT(a.steps[i].psnr, w.steps[i].psnr - 0.02) << i;
+        }
+        EXPECT_GT(a.steps.back().psnr, a.steps[0].psnr + 0.3);
+        const double decoded = psnr(decodeImage(assembled, map, sourceView(source)), source);
+        EXPECT_NEAR(decoded, a.steps.back().psnr, 0.01) << c.conusWidth << "x" << c.conusHeight;
+        std::printf("[ info ] %dx%d (%zu wide rows): assembled %.3f dB, walked %.3f dB\n", c.conusWidth, c.conusHeight, wide,
+                    a.steps.back().psnr, w.steps.back().psnr);
     }
 }
 

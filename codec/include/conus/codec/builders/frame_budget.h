@@ -129,7 +129,10 @@ private:
                     const FrameModelOptions& options);
     // S of the footprint of axes sigma1 >= sigma2 (source pixels) on `tile`, with `fit`'s constants.
     double tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const;
-    std::vector<double> shownTileErrors(const Image& source, const Image& view) const;  // measured, per tile
+    // Measured, per tile: the view of `conus` through `map` at the source's size and (where given)
+    // the uniform image's bilinear view, each against the source; neither view is kept.
+    std::pair<std::vector<double>, std::vector<double>> shownTileErrors(const Image& source, const Image& conus,
+                                                                        const SamplingMap& map, const Image* uniform) const;
     // The footprint's axes (source pixels, largest first) at a few points of each tile, tile by tile.
     std::vector<std::pair<double, double>> footprints(const SamplingMap& map) const;
     // A tile's error from its points' axes, each scaled by 2^shift.

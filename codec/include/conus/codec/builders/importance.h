@@ -24,6 +24,10 @@ Image ruleImportance(ImportanceRule rule, const Image& shown);
 // Local detail of an image: gradient magnitude of its luminance (one channel "Y"), computed at
 // most 1024 px a side.
 Image detailImportance(const Image& image);
+// The same of the shown picture's luminance alone (one channel: the mean of R, G and B, or the
+// grey channel, as detailImportance takes it), which a caller may make a band of rows at a time
+// without a display-encoded copy of the whole picture.
+Image detailImportanceOfLuminance(const Image& luminance);
 struct EightBitImage;  // image/encode.h
 // The same of a picture kept as 8-bit codes, as a display shows it: each code's value
 // `shownCode[code]` (nullptr: code / 255). With imageio::displayEncoded's value of each code's

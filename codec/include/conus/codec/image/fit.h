@@ -15,8 +15,12 @@
 //
 // Colour and alpha channels are fitted; a channel named "Z" (depth) is left as it was. Values are
 // not clamped: a fit overshoots at hard edges like any L2 projection (FitResult counts the values
-// below 0). CoNUS pixels no tap reaches keep their value. Memory: the CoNUS image a few times over
-// (no per-source-pixel storage: each pass walks Eq. 1 along the rows again). The same fit serves
+// below 0). CoNUS pixels no tap reaches keep their value. Cost: the normal equations D^T D c = D^T s
+// are assembled on the CoNUS grid in one walk of Eq. 1 over the source's rows (D^T D is a 3x3
+// stencil per CoNUS pixel where the view magnifies, plus the rows of D where it minifies), and the
+// iterations run on them; where the view minifies most of the image, each iteration walks the
+// source's rows twice instead. Memory: the CoNUS image some ten times over (no per-source-pixel
+// storage). The same fit serves
 // the uniform baseline (the identity map: D is then resizeBilinear to the source's size).
 #pragma once
 
@@ -45,8 +49,8 @@ inline constexpr double kFitDamping = 0.0;
 inline constexpr double kFitHoldLowPass = 3.0;
 
 // How the fit is found.
-//  - LeastSquares: CGLS through the decoder's taps at the source's size, as above: each iteration
-//    walks every source pixel twice.
+//  - LeastSquares: conjugate gradients on the normal equations through the decoder's taps at the
+//    source's size, as above: one walk of every source pixel, then the iterations on the CoNUS grid.
 //  - Local: one pass over the CoNUS image. Where the decoder magnifies (a CoNUS pixel covers a
 //    source pixel or more), re-encoding the decoded view is a fixed convolution in CoNUS pixel units,
 //    whatever the map: the encoder's unit box over the decoder's bilinear tent, [q, 1 - 2q, q] along
