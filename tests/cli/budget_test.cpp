@@ -71,7 +71,7 @@ TEST_F(BudgetCli, TwoLargeFociAreLoweredAndSaySo) {
     EXPECT_GT(k[0].first, 1.0);
     EXPECT_LT(k[0].first, 4.0);
     EXPECT_NEAR(std::log(k[0].first), std::log(k[1].first), 0.02);  // every k lowered alike
-    const double frame = printedLoss(r.out, "predicted: the whole frame");
+    const double frame = printedLoss(r.out, ": the whole frame");
     EXPECT_LE(frame, 1.5 + 0.005) << r.out;
     EXPECT_LE(printedLoss(r.out, "tiles outside the foci"), 4.0 + 0.05) << r.out;
     EXPECT_NE(r.out.find("k as asked: --exact-k (predicted: the whole frame "), std::string::npos) << r.out;
@@ -93,15 +93,15 @@ TEST_F(BudgetCli, TwoLargeFociAreLoweredAndSaySo) {
     EXPECT_EQ(recordedK(path("exact.exr")), (std::vector<double>{4.0, 4.0}));
     EXPECT_EQ(exact.out.find("k as asked"), std::string::npos) << exact.out;
     // (Each run confirms its model by an encode of the map it chose: the --exact-k run on this very map.)
-    EXPECT_NEAR(printedLoss(exact.out, "predicted: the whole frame"), asked, 0.3) << exact.out;
-    EXPECT_NE(exact.err.find("warning: --exact-k: predicted against the uniform image, the whole frame "), std::string::npos) << exact.err;
+    EXPECT_NEAR(printedLoss(exact.out, ": the whole frame"), asked, 0.3) << exact.out;
+    EXPECT_NE(exact.err.find("warning: --exact-k: against the uniform image, the whole frame "), std::string::npos) << exact.err;
 
     // A tighter whole-frame budget holds, as predicted, by lowering k.
     ASSERT_EQ(run("encode " + picture + foci + " --fast -o " + path("fast.exr")).exitCode, 0);
     const Result tight = run("encode " + picture + foci + " --fast --frame-loss 0.1 -o " + path("tight.exr"));
     ASSERT_EQ(tight.exitCode, 0) << tight.err;
     EXPECT_NE(tight.out.find("budget: the whole frame within 0.1 dB"), std::string::npos) << tight.out;
-    EXPECT_LE(printedLoss(tight.out, "predicted: the whole frame"), 0.1 + 0.005) << tight.out;
+    EXPECT_LE(printedLoss(tight.out, ": the whole frame"), 0.1 + 0.005) << tight.out;
     EXPECT_LT(recordedK(path("tight.exr"))[0], 4.0 - 0.05);
 }
 
@@ -135,7 +135,7 @@ TEST_F(BudgetCli, FrameLossSetsTheDetailMap) {
     const auto [floorLoose, capLoose] = floorAndCap(loose.out);
     ASSERT_TRUE(std::isfinite(floorTight) && std::isfinite(capTight)) << tight.out;
     ASSERT_TRUE(std::isfinite(floorLoose) && std::isfinite(capLoose)) << loose.out;
-    const double tightLoss = printedLoss(tight.out, "predicted: the whole frame"), looseLoss = printedLoss(loose.out, "predicted: the whole frame");
+    const double tightLoss = printedLoss(tight.out, ": the whole frame"), looseLoss = printedLoss(loose.out, ": the whole frame");
     EXPECT_LE(tightLoss, 0.2 + 0.005) << tight.out;
     EXPECT_LE(looseLoss, 3 + 0.005) << loose.out;
     // Where the budget binds, the looser one spends more on the detail; where even the lowest floor
