@@ -6,6 +6,8 @@
 #include <regex>
 #include <utility>
 
+#include <OpenImageIO/imagebuf.h>
+
 #include "cli/cli_fixture.h"
 #include "conus/codec/map/sampling_map.h"
 #include "conus/format/container.h"
@@ -103,6 +105,38 @@ TEST_F(BudgetCli, TwoLargeFociAreLoweredAndSaySo) {
     EXPECT_NE(tight.out.find("budget: the whole frame within 0.1 dB"), std::string::npos) << tight.out;
     EXPECT_LE(printedLoss(tight.out, ": the whole frame"), 0.1 + 0.005) << tight.out;
     EXPECT_LT(recordedK(path("tight.exr"))[0], 4.0 - 0.05);
+}
+
+// The 8-bit codes of a PNG, read by OpenImageIO.
+std::vector<unsigned char> codesOf(const std::string& file, int width, int height) {
+    const OIIO::ImageBuf image(file);
+    std::vector<unsigned char> codes(std::size_t(width) * height * 3);
+    EXPECT_TRUE(image.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, 3), OIIO::TypeDesc::UINT8, codes.data()));
+    return codes;
+}
+
+// What the block says the frame loses is the file's own loss, measured by someone else's reader:
+// the encode and `conus uniform` of the same pixel count, each decoded to an 8-bit PNG at the
+// source's size and read by OpenImageIO, their PSNR against the source's codes differ by what was
+// printed (a focus the budget lowered: the file is the budget's measured encode).
+TEST_F(BudgetCli, ThePrintedFrameLossIsTheFilesOwn) {
+    const std::string picture = makePicture(360, 240);
+    const Result r = run("encode " + picture + " --focus 0.3,0.4,0.16,4 --focus 0.7,0.55,0.15,4 --size 90x60 -o " + path("c.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    ASSERT_NE(r.out.find("measured by the encode kept: the whole frame "), std::string::npos) << r.out;
+    ASSERT_EQ(run("uniform " + picture + " --size 90x60 -q -o " + path("u.exr")).exitCode, 0);
+    for (const char* name : {"c", "u"})
+        ASSERT_EQ(run(std::string("decode ") + path(std::string(name) + ".exr") + " --size 360x240 -q -o " + path(std::string(name) + ".png")).exitCode, 0);
+    const std::vector<unsigned char> s = codesOf(picture, 360, 240), c = codesOf(path("c.png"), 360, 240), u = codesOf(path("u.png"), 360, 240);
+    double ec = 0, eu = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        ec += (double(c[i]) - s[i]) * (double(c[i]) - s[i]);
+        eu += (double(u[i]) - s[i]) * (double(u[i]) - s[i]);
+    }
+    const double measured = 10 * std::log10(ec / eu), printed = printedLoss(r.out, ": the whole frame");
+    std::printf("frame loss printed %.2f dB, the files' PNGs %.3f dB\n", printed, measured);
+    EXPECT_GT(std::abs(measured), 0.05);  // the map does change the frame's error
+    EXPECT_NEAR(printed, measured, 0.05) << r.out;
 }
 
 TEST_F(BudgetCli, ASmallFocusKeepsItsK) {
