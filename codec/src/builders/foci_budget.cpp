@@ -174,12 +174,14 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         // measured, it is kept with its encode, which the caller then need not make again; what the
         // block prints is then what that encode measured.
         const auto confirm = [&](Search s, const FociOptions& o) {
-            // A try at t with its own encode: its losses what that encode measured.
+            // A try at t with its own encode: its losses what that encode measured (`last`: the
+            // model that encode confirmed).
+            std::optional<FrameErrorModel> last;
             const auto measured = [&](double t) {
                 Try x = attempt(model, t, o);
-                const FrameErrorModel c = model.confirmed(x.map);
-                x.predicted = c.predict(x.map);
-                x.encode = c.encode();
+                last.emplace(model.confirmed(x.map));
+                x.predicted = last->predict(x.map);
+                x.encode = last->encode();
                 return x;
             };
             Try encoded = s.chosen;
@@ -194,7 +196,7 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
             // The choice moved: the map it moved to is encoded (the encode the file then keeps, as
             // it would be encoded anyway) and measured, so that what is kept is a map whose own
             // encode measured its losses: of the two, the one that holds the budget (the larger k
-            // where both do; where neither does, the one nearer it). The confirmed model's
+            // where both do; where neither does, a third choice on the second's model). The confirmed model's
             // prediction of a map it was not measured on is off by up to a dB on photographs
             // (bench/notes/2026-12-07-budget-check.md); a measure is not.
             const int rounds = model.options().confirmRounds - 1;
@@ -205,7 +207,9 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
             } else if (nextHolds != encodedHolds && (rounds <= 0 || (nextHolds ? next.t > encoded.t : encoded.t > next.t))) {
                 s.chosen = std::move(nextHolds ? next : encoded);  // the one that holds
             } else if (rounds <= 0) {
-                s.chosen = std::move(over(next) <= over(encoded) ? next : encoded);  // neither: the nearer the budget
+                // Neither holds: the choice made once more on the model the second encode confirmed,
+                // its map not encoded here (what is said of it is predicted).
+                s.chosen = search(*last, o).chosen;
             } else {
                 // Further rounds: the same regula falsi on t, each try's losses measured by its own
                 // encode, between a try that misses the budget and, at a smaller t, one that holds it

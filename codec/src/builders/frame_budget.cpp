@@ -533,7 +533,9 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         const bool againHolds = over(again) <= 0, chosenHolds = over(chosen) <= 0;
         if (againHolds != chosenHolds) return againHolds ? again : chosen;
         if (againHolds) return again.predicted.roiGain >= chosen.predicted.roiGain ? again : chosen;
-        return over(again) <= over(chosen) ? again : chosen;
+        // Neither holds: the choice made once more on the model the second encode confirms (the
+        // nearer of the two maps measured), its map not encoded here: what is said of it is predicted.
+        return buildAutoMapForFrameLoss(importance, moved, frameLossDb, options, tileLossDb);
     }
     return chosen;
 }

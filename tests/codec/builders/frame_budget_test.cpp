@@ -425,11 +425,13 @@ TEST(FrameBudget, TighterBudgetGivesSmallerLoss) {
     std::vector<Measured> measured, confirmed;
     for (double budget : {0.5, 1.5, 3.0}) {
         const BudgetResult c = buildAutoMapForFrameLoss(importance, confirming, budget, options);
-        ASSERT_NE(c.encode, nullptr);
         confirmed.push_back(measure(source, c.map, importance));
-        EXPECT_NEAR(c.predicted.frameLoss, confirmed.back().frameLoss, 0.05);
-        std::printf("budget %.1f dB, confirmed: floor %.3f, cap %.1f, measured by its encode %.2f, here %.2f\n", budget, c.minDensity,
-                    c.maxDensity, c.predicted.frameLoss, confirmed.back().frameLoss);
+        // Measured by its own encode (the map kept is one of the two encoded), or where neither held,
+        // predicted by the model the second encode confirmed: within the budget, and within 0.3 dB.
+        EXPECT_NEAR(c.predicted.frameLoss, confirmed.back().frameLoss, c.encode ? 0.05 : 0.3);
+        if (c.encode) EXPECT_LE(c.predicted.frameLoss, budget + 1e-9);
+        std::printf("budget %.1f dB, confirmed: floor %.3f, cap %.1f, %s %.2f, here %.2f\n", budget, c.minDensity, c.maxDensity,
+                    c.encode ? "measured by its encode" : "predicted", c.predicted.frameLoss, confirmed.back().frameLoss);
         SCOPED_TRACE(budget);
         const BudgetResult r = buildAutoMapForFrameLoss(importance, model, budget, options);
         EXPECT_TRUE(r.budgetBinds);

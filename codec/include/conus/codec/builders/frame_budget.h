@@ -66,8 +66,9 @@ struct FrameModelOptions {
     // One: the map chosen on the model alone is encoded and the choice made again on the model that
     // encode confirms; where that choice moved (its exponent of k by more than kConfirmedT), the map
     // it moved to is encoded too (the encode the file keeps, which it would take anyway) and of the
-    // two the one whose own encode holds the budget is kept (the larger k where both do, the nearer
-    // the budget where neither): what the budget says of the map kept is what its encode measured.
+    // two the one whose own encode holds the budget is kept (the larger k where both do): what the
+    // budget says of the map kept is what its encode measured. Where neither holds, the choice is
+    // made once more on the model the second encode confirmed, and that map's losses are predicted.
     // More: where neither holds or the one that holds has the smaller k, the search goes on on
     // measured losses alone, each try encoded (regula falsi between the maps encoded, up to this
     // many encodes besides those two), and keeps a map whose own encode holds the budget:
