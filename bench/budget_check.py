@@ -4,12 +4,13 @@
 
 For each photograph (reduced to at most 1280 px wide, written as an 8-bit sRGB PNG, as
 bench/quality_targets.py does) `conus encode` runs with its defaults and one `--focus u,v,r,4` per
-region; what it printed (the predicted whole-frame loss and the 95th percentile of the tiles
-outside the foci) is set beside what the decoded file loses against `conus uniform` of the same
-pixel count on 8-bit sRGB (quality_targets.scores). Targets: predicted within 0.5 dB of measured for
-the frame and 1 dB for the p95 tile; measured frame loss within the budget and p95 tile loss
-<= 4 dB. The photographs: bench/quality_targets.PHOTOS (the model's constants were fitted on
-these), its UNSEEN ones and HELD_OUT below, on which nothing was fitted.
+region; what it printed (the whole-frame loss and the 95th percentile of the tiles outside the
+foci, 'measured by the encode kept' or 'predicted', the column 'printed as') is set beside what the
+decoded file loses against `conus uniform` of the same pixel count on 8-bit sRGB
+(quality_targets.scores). Targets: printed within 0.5 dB of measured for the frame and 1 dB for the
+p95 tile; measured frame loss within the budget and p95 tile loss <= 4 dB. The photographs:
+bench/quality_targets.PHOTOS (the model's constants were fitted on these: the 'fitted' set), its
+UNSEEN ones and HELD_OUT below, on which nothing was fitted; the summary gives the two apart.
 
 `--fast`: the same with `encode --fast`, whose budget is the model alone (no confirming encode).
 
