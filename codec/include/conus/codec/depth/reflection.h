@@ -206,7 +206,9 @@ struct ReflectionFrameOptions {
 // it meets the reflector before the scene, the reflected ray's colour from `faces` (null: traced
 // against the mesh, traceReflectionReference, the ground truth); elsewhere the scene as the mesh
 // reference shades it (identity map). Channels R, G, B and M: 0 scene or nothing, 1 the reflector
-// showing the sky, 2 the reflector showing the scene.
+// showing the sky, 2 the reflector showing the scene. Throws LimitExceeded, as
+// checkSurfaceOverlap (raycast.h) does, when a probe of the rays it would trace against the mesh
+// (eye rays, and reflected rays without faces) crosses too many surfaces on average.
 Image renderReflectionFrame(const MeshScene& scene, const std::vector<ReflectionFace>* faces, glm::dvec3 centre,
                             const Camera& camera, int width, int height, const ReflectionFrameOptions& options);
 
