@@ -121,9 +121,8 @@ TEST_F(Cli, AnOutputThatIsAnInputIsRefusedByAnyPathAndTheInputIsUnchanged) {
         "decode " + path("in/b.exr") + " --out-dir " + path("in") + " --name {name}",
         // A folder of outputs with fixed names, one of which is the input.
         "demo --input " + path("in/conus.png") + " --out " + path("in"),
-        "web " + path("in/b.exr") + " -o " + path("in"),
         // The raw volume's path lies inside its specification; its frames are written beside it.
-        "volume animate raw:8x8x8:uint8:" + path("in/frame_0000.png") + " --out-dir " + path("in") + " --frames 1 --size 16x16",
+        "volume animate raw:8x8x8:uint8:" + path("in/frame_0000.png") + " --out-dir " + path("in") + " --frames 1 --size 16x16 -q",
     };
     const auto before = snapshot(m_dir);
     for (const std::string& command : commands) {

@@ -66,13 +66,13 @@ TEST_F(NamedHostile, AFileAModelNamesIsAnInputNoOutputReplaces) {
     std::string voxels(512, '\0');
     for (std::size_t i = 0; i < voxels.size(); ++i) voxels[i] = char(i * 7);
     write("v.exr", voxels);
-    Outcome r = run({"render", "volume", "raw:8x8x8:uint8:" + path("v.exr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu"});
+    Outcome r = run({"render", "volume", "raw:8x8x8:uint8:" + path("v.exr"), "-o", path("v.exr"), "--size", "16x16", "--backend", "cpu", "--uniform"});
     expectInputKept(r, "v.exr", voxels);
     EXPECT_EQ(r.exitCode, 2) << "a usage error, found from the command line";
     // An NRRD header's data file.
     write("n/d.exr", voxels);
     write("n/h.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 8 8 8\nencoding: raw\ndata file: d.exr\n");
-    expectInputKept(run({"render", "volume", path("n/h.nhdr"), "-o", path("n/d.exr"), "--size", "16x16", "--backend", "cpu"}),
+    expectInputKept(run({"render", "volume", path("n/h.nhdr"), "-o", path("n/d.exr"), "--size", "16x16", "--backend", "cpu", "--uniform"}),
                     "n/d.exr", voxels);
     write("v.png", voxels);
     r = runTool("conus-view", {"--volume", "raw:8x8x8:uint8:" + path("v.png"), "--screenshot", path("v.png"), "--size", "16x16"});

@@ -3,6 +3,8 @@
 // at once, not after reading gigabytes; a list of inputs read from standard input alike.
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
+
 #include "hostile_fixture.h"
 
 namespace {
@@ -68,7 +70,10 @@ TEST_F(StdinHostile, APicturePipedInIsReadAsFromItsFile) {
     };
     const std::vector<float> piped = pixels(path("piped.exr")), named = pixels(path("named.exr"));
     ASSERT_FALSE(piped.empty());
-    EXPECT_EQ(piped, named);
+    ASSERT_EQ(piped.size(), named.size());
+    // A file goes to CoNUS's own PNG reader, standard input to OpenImageIO's: their sRGB curves
+    // agree within 1e-5, which the half-float samples may round one step apart (2^-11 relative).
+    for (std::size_t i = 0; i < piped.size(); ++i) EXPECT_NEAR(piped[i], named[i], 1e-3 * std::max(1.0f, named[i])) << i;
     EXPECT_NE(*std::min_element(piped.begin(), piped.end()), *std::max_element(piped.begin(), piped.end()));
 }
 
