@@ -363,7 +363,7 @@ TEST(ConusView, ScriptScreenshotsAndEditorSavesNeverReplaceAnInput) {
         return std::string{std::istreambuf_iterator<char>(in), {}};
     };
     const std::string photo = bytes(dir / "photo.png");
-    const fs::path script = dir / "s.txt";
+    const fs::path script = dir / "script.png";  // text, named so that a screenshot could be written there
     test::writeText(script, "screenshot " + (dir / "photo.png").string() + "\nscreenshot " + script.string() + "\nkey S\nscreenshot " +
                                 (dir / "fine.png").string() + "\n");
     const std::string scriptText = bytes(script);
