@@ -125,7 +125,7 @@ inline constexpr std::array<LimitEntry, 30> limitTable() {
         {"sceneNodes", kMaxSceneNodes, "nodes", "nodes of a scene once shared nodes are expanded (instancing)"},
         {"markupDepth", kMaxMarkupDepth, "levels", "nesting of a glTF's JSON or a COLLADA or X3D file's XML"},
         {"jpegScans", kMaxJpegScans, "scans", "scans of a progressive JPEG (each a pass over the image)"},
-        {"meshOverlap", kMaxMeshOverlap, "surfaces", "surfaces along the average ray of a CPU mesh render, probed before it"},
+        {"meshOverlap", kMaxMeshOverlap, "surfaces", "surfaces along the average ray of a CPU mesh render (probed), or over any region of a GL-rendered mesh"},
     }};
 }
 
