@@ -37,21 +37,33 @@ std::vector<std::string> readList(const std::string& listFile) {
     std::ifstream file;
     if (listFile != "-") {
         checkInputPath(listFile);
-        file.open(listFile);
+        file.open(listFile, std::ios::binary);
         if (!file) throw Error(ErrorCode::Io, "cannot read the list " + listFile);
     }
     std::istream& in = listFile == "-" ? std::cin : file;
+    const auto tooLong = [&] {
+        return Error(ErrorCode::LimitExceeded, "the list " + listFile + " is longer than " + std::to_string(kMaxListBytes) +
+                                                   " bytes or has a line of over 4096");
+    };
+    // Read in blocks, never a line at a time: a stream without a newline (/dev/zero) would make
+    // one line of any length.
+    std::string text;
+    char block[1 << 16];
+    while (in.read(block, sizeof block) || in.gcount() > 0) {
+        text.append(block, std::size_t(in.gcount()));
+        if (text.size() > kMaxListBytes) throw tooLong();
+    }
     std::vector<std::string> inputs;
-    std::size_t bytes = 0;
-    for (std::string line; std::getline(in, line);) {
-        bytes += line.size() + 1;
-        if (bytes > kMaxListBytes || line.size() > 4096)
-            throw Error(ErrorCode::LimitExceeded, "the list " + listFile + " is longer than " +
-                                                      std::to_string(kMaxListBytes) + " bytes or has a line of over 4096");
+    std::size_t start = 0;
+    while (start < text.size()) {
+        const std::size_t end = std::min(text.find('\n', start), text.size());
+        std::string line = text.substr(start, end - start);
+        start = end + 1;
+        if (line.size() > 4096) throw tooLong();
         while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
-        const std::size_t start = line.find_first_not_of(" \t");
-        if (start == std::string::npos || line[start] == '#') continue;  // blank lines and comments
-        inputs.push_back(line.substr(start));
+        const std::size_t first = line.find_first_not_of(" \t");
+        if (first == std::string::npos || line[first] == '#') continue;  // blank lines and comments
+        inputs.push_back(line.substr(first));
     }
     return inputs;
 }

@@ -11,6 +11,7 @@
 
 #include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
+#include "conus/sceneio/volume_file.h"
 
 namespace conus::cli {
 namespace {
@@ -39,8 +40,14 @@ void collect(const CLI::App& app, Given& given) {
                 given.outputs.push_back({value, option->get_name()});
                 continue;
             }
+            // A raw volume's path is inside its specification ("raw:WxHxD:type[:spacing]:path").
+            std::string path = value;
+            if (value.rfind("raw:", 0) == 0) try {
+                    path = sceneio::parseRawSpec(value).path;
+                } catch (const Error&) {  // not a raw spec after all: the reader says so
+                }
             struct stat st {};
-            if (value != "-" && ::stat(value.c_str(), &st) == 0 && S_ISREG(st.st_mode)) given.inputs.push_back(value);
+            if (path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) given.inputs.push_back(path);
         }
     }
     for (const CLI::App* sub : app.get_subcommands()) collect(*sub, given);

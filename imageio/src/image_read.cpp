@@ -80,29 +80,42 @@ struct StdinImage {
     std::string name;
 };
 
+// The extension OpenImageIO knows the format by, from the first bytes; empty for none CoNUS reads.
+const char* stdinExtension(const std::vector<unsigned char>& bytes) {
+    const auto starts = [&](const char* magic, std::size_t size) {
+        return bytes.size() >= size && std::memcmp(bytes.data(), magic, size) == 0;
+    };
+    return starts("\x89PNG", 4)                          ? "png"
+           : starts("\xFF\xD8\xFF", 3)                   ? "jpg"
+           : starts("II*\0", 4) || starts("MM\0*", 4)     ? "tif"
+           : starts("\x76\x2f\x31\x01", 4)               ? "exr"
+           : starts("BM", 2)                               ? "bmp"
+           : starts("#?", 2)                               ? "hdr"
+           : bytes.size() >= 2 && bytes[0] == 'P' && bytes[1] != 0 && std::strchr("1234567Ff", bytes[1]) ? "ppm"
+                                                           : "";
+}
+
 StdinImage readStdin() {
     constexpr std::size_t kMaxStdinBytes = std::size_t{4} << 30;
+    const char* notAnImage = "standard input is not an image format CoNUS recognizes (PNG, JPEG, TIFF, EXR, BMP, HDR, PPM)";
     StdinImage in;
     unsigned char chunk[1 << 16];
     std::size_t n;
+    bool known = false;
     while ((n = std::fread(chunk, 1, sizeof chunk, stdin)) > 0) {
         in.bytes.insert(in.bytes.end(), chunk, chunk + n);
+        // The format by its first bytes before reading on: an endless stream that is no picture
+        // (/dev/zero, a log) is refused at once, not after 4 GiB.
+        if (!known && in.bytes.size() >= 4) {
+            if (!*stdinExtension(in.bytes)) throw Error(ErrorCode::Io, notAnImage);
+            known = true;
+        }
         if (in.bytes.size() > kMaxStdinBytes)
             throw Error(ErrorCode::LimitExceeded, "standard input holds more than 4 GiB; give a file instead");
     }
     if (in.bytes.empty()) throw Error(ErrorCode::Io, "standard input is empty");
-    const auto starts = [&](const char* magic, std::size_t size) {
-        return in.bytes.size() >= size && std::memcmp(in.bytes.data(), magic, size) == 0;
-    };
-    const char* ext = starts("\x89PNG", 4)               ? "png"
-                      : starts("\xFF\xD8\xFF", 3)          ? "jpg"
-                      : starts("II*\0", 4) || starts("MM\0*", 4) ? "tif"
-                      : starts("\x76\x2f\x31\x01", 4)      ? "exr"
-                      : starts("BM", 2)                    ? "bmp"
-                      : starts("#?", 2)                    ? "hdr"
-                      : starts("P", 1)                     ? "ppm"
-                                                           : "";
-    if (!*ext) throw Error(ErrorCode::Io, "standard input is not an image format CoNUS recognizes (PNG, JPEG, TIFF, EXR, BMP, HDR, PPM)");
+    const char* ext = stdinExtension(in.bytes);
+    if (!*ext) throw Error(ErrorCode::Io, notAnImage);
     in.name = std::string("stdin.") + ext;
     return in;
 }

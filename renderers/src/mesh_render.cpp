@@ -15,6 +15,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "conus/codec/mesh/overdraw.h"
 #include "conus/codec/mesh/raycast.h"
 #include "context_pvt.h"
 #include "embedded_shaders.h"
@@ -147,6 +148,7 @@ struct MeshRenderer::Impl {
 
 MeshRenderer::MeshRenderer(Context& context, const Mesh& given) {
     checkMesh(given, kWhat);
+    codec::checkMeshOverdraw(given, kWhat);
     if (given.indices.size() > static_cast<std::size_t>(std::numeric_limits<GLsizei>::max()))
         throw Error(ErrorCode::LimitExceeded, std::string(kWhat) + ": too many indices for one draw");
     std::optional<Mesh> withNormals;

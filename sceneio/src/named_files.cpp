@@ -5,6 +5,7 @@
 #include <system_error>
 #include <utility>
 
+#include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 
 namespace conus::sceneio {
@@ -54,6 +55,8 @@ std::string NamedFiles::check(const std::string& path) const {
                                        " (a scene file may name files in its own folder; --allow-dir allows another)");
     const fs::file_status status = fs::status(canonical, ec);
     if (ec || !fs::is_regular_file(status)) throw Error(ErrorCode::Io, what + ", not a regular file");
+    // An input of this run like the files its command line names: no output may replace it.
+    protectInput(canonical.string());
     return canonical.string();
 }
 

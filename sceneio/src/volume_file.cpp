@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "conus/core/atomic_file.h"
 #include "conus/core/error.h"
 #include "extension_pvt.h"
 
@@ -126,6 +127,7 @@ RawSpec parseRawSpec(const std::string& spec) {
 Volume readVolume(const std::string& spec, const VolumeReadOptions& options) {
     if (spec.rfind("raw:", 0) == 0) {
         const RawSpec raw = parseRawSpec(spec);
+        protectInput(raw.path);  // named inside the spec: an input all the same
         return readRawVolume(raw.path, raw.layout, options);
     }
     const std::string ext = lowerExtension(spec);

@@ -139,6 +139,27 @@ protected:
     fs::path m_dir;
 };
 
+// `copies` near-copies of one triangle in one glTF mesh (its buffer a file beside it), copy i
+// shifted by i millionths along (1, 0.5, 0.25): no two are the same (none is dropped as a
+// duplicate), and every ray through the triangle crosses them all.
+inline void writeNearCopies(const fs::path& gltf, int copies) {
+    std::string bin;
+    bin.reserve(std::size_t(copies) * 36);
+    for (int i = 0; i < copies; ++i) {
+        const float e = float(i) * 1e-6f;
+        const float xyz[9] = {e, 0.5f * e, 0.25f * e, 1 + e, 0.5f * e, 0.25f * e, e, 1 + 0.5f * e, 0.25f * e};
+        bin.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+    }
+    const float spread = float(copies) * 1e-6f;
+    std::ofstream(fs::path(gltf).replace_extension(".bin"), std::ios::binary) << bin;
+    std::ofstream(gltf) << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+ "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+ "buffers": [{"uri": ")" << fs::path(gltf).replace_extension(".bin").filename().string() << R"(", "byteLength": )" << bin.size() << R"(}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": )" << bin.size() << R"(}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": )" << 3 * copies << R"(, "type": "VEC3", "min": [0, 0, 0], "max": [)"
+                        << 1 + spread << ", " << 1 + spread << ", " << spread << "]}]}";
+}
+
 #define CONUS_REQUIRE(file)                                                                   \
     do {                                                                                      \
         if (!fs::exists(file)) GTEST_SKIP() << "shared data not found: " << (file);           \

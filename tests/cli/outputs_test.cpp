@@ -95,6 +95,7 @@ TEST_F(Cli, AnOutputThatIsAnInputIsRefusedByAnyPathAndTheInputIsUnchanged) {
     fs::create_directories(m_dir / "in");
     fs::copy_file(path("a.exr"), path("in/b.exr"));
     fs::copy_file(picture, path("in/conus.png"));
+    { std::ofstream(path("in/frame_0000.png"), std::ios::binary) << std::string(512, '\x40'); }  // 8x8x8 voxels
     fs::create_directories(m_dir / "sub");
     fs::create_symlink("../a.exr", path("sub/up.exr"));  // a relative link
     const std::string a = path("a.exr");
@@ -120,6 +121,8 @@ TEST_F(Cli, AnOutputThatIsAnInputIsRefusedByAnyPathAndTheInputIsUnchanged) {
         "decode " + path("in/b.exr") + " --out-dir " + path("in") + " --name {name}",
         // A folder of outputs with fixed names, one of which is the input.
         "demo --input " + path("in/conus.png") + " --out " + path("in"),
+        // The raw volume's path lies inside its specification; its frames are written beside it.
+        "volume animate raw:8x8x8:uint8:" + path("in/frame_0000.png") + " --out-dir " + path("in") + " --frames 1 --size 16x16 -q",
     };
     const auto before = snapshot(m_dir);
     for (const std::string& command : commands) {

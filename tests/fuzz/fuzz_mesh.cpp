@@ -5,9 +5,11 @@
 // duplicate triangle; anything else must be a one-line conus::Error.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <set>
 #include <string>
 
+#include "conus/codec/mesh/overdraw.h"
 #include "conus/core/error.h"
 #include "conus/sceneio/mesh_file.h"
 #include "fuzz.h"
@@ -52,5 +54,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             for (int c = 0; c < 9; ++c) key[c] = corners[c / 3][c % 3];
             CONUS_FUZZ_CHECK(seen.insert(key).second, "no exact duplicate triangle survives");
         }
+        // What the GL renders check first: a finite count, one surface at most for one triangle.
+        const double overdraw = conus::codec::meshOverdraw(mesh);
+        CONUS_FUZZ_CHECK(std::isfinite(overdraw) && overdraw >= 0, "meshOverdraw is a finite count");
+        CONUS_FUZZ_CHECK(mesh.indices.size() != 3 || overdraw <= 1.0 + 1e-6, "one triangle is one surface");
     });
 }

@@ -348,6 +348,38 @@ TEST(ConusView, EditorPaintsSavesAndEncodes) {
     EXPECT_EQ(readPng(dir / "edit.png").width, 320);
 }
 
+// What a script's screenshot or the editor's save (S) writes never replaces a file the viewer
+// reads, by any path (the picture being edited, the script itself, a link to either): each is
+// refused in one line, the file unchanged, and the run fails; other names are written.
+TEST(ConusView, ScriptScreenshotsAndEditorSavesNeverReplaceAnInput) {
+    ASSERT_TRUE(test::haveXvfb());
+    const fs::path dir = test::tempDir() / "inputs";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    writePng(dir / "photo.png", test::sourceImage());
+    fs::create_symlink(dir / "photo.png", dir / "alias.map.exr");
+    const auto bytes = [](const fs::path& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string{std::istreambuf_iterator<char>(in), {}};
+    };
+    const std::string photo = bytes(dir / "photo.png");
+    const fs::path script = dir / "script.png";  // text, named so that a screenshot could be written there
+    test::writeText(script, "screenshot " + (dir / "photo.png").string() + "\nscreenshot " + script.string() + "\nkey S\nscreenshot " +
+                                (dir / "fine.png").string() + "\n");
+    const std::string scriptText = bytes(script);
+    std::string log;
+    const int status = test::run(xvfb("--edit " + (dir / "photo.png").string() + " -o " + (dir / "alias").string() +
+                                      " --size 160x120 --window 320x240 --script " + script.string()), &log);
+    EXPECT_NE(status, 0) << log;
+    EXPECT_NE(log.find("refusing to write " + (dir / "photo.png").string() + ": it is the input"), std::string::npos) << log;
+    EXPECT_NE(log.find("refusing to write " + script.string() + ": it is the input"), std::string::npos) << log;
+    EXPECT_NE(log.find("refusing to write " + (dir / "alias.map.exr").string() + ": it is the input"), std::string::npos) << log;
+    EXPECT_EQ(bytes(dir / "photo.png"), photo);
+    EXPECT_EQ(bytes(script), scriptText);
+    EXPECT_TRUE(fs::is_symlink(dir / "alias.map.exr"));
+    EXPECT_EQ(readPng(dir / "fine.png").width, 320) << "another name is written";
+}
+
 // The window's fitted view shades only the image's box (rows counted from the bottom there) after
 // a clear to the background: the same picture as the headless frame, which counts rows from the
 // top, and the CPU decode's, bands included; and panned off centre, as the CPU decode shows it.

@@ -537,6 +537,21 @@ Image renderReflectionFrame(const MeshScene& scene, const std::vector<Reflection
         throw Error(ErrorCode::InvalidArgument, "reflection frames take 1 to " + std::to_string(kMaxFrameSamples) +
                                                     " rays a pixel a side, not " + std::to_string(o.samples));
     checkIntersectOptions(o.intersect);
+    // Each pixel traces its eye ray against the mesh and, without faces, the ray the mirror
+    // reflects there: probed first as the mesh render probes its rays (checkSurfaceOverlap).
+    {
+        const int columns = std::clamp(width, 1, 64), rows = std::clamp(height, 1, 64);
+        std::vector<RaySpan> spans;
+        spans.reserve(std::size_t(columns) * std::size_t(rows) * (faces ? 1 : 2));
+        for (int j = 0; j < rows; ++j)
+            for (int i = 0; i < columns; ++i) {
+                const Ray ray = camera.ray({(i + 0.5) / columns, (j + 0.5) / rows});
+                const double cosine = glm::dot(ray.direction, camera.forward());
+                if (cosine > 0) spans.push_back({ray, camera.near() / cosine, camera.far() / cosine});
+                if (const auto mirror = hitReflector(o.reflector, ray); mirror && !faces) spans.push_back({mirror->reflected, 1e-6});
+            }
+        checkSurfaceOverlap(scene, spans, "reflection frame");
+    }
     // One ray: its colour and the mask M.
     const auto shade = [&](glm::dvec2 uv, glm::vec3& colour) {
         const Ray ray = camera.ray(uv);

@@ -207,24 +207,33 @@ std::optional<DepthRange> viewRay(const Camera& camera, glm::dvec2 uv) {
 
 }  // namespace
 
-void checkSurfaceOverlap(const MeshScene& scene, const Fpc& fpc, int width, int height) {
-    const int columns = std::clamp(width, 1, 64), rows = std::clamp(height, 1, 64);
-    const std::int64_t probes = std::int64_t{columns} * rows;
-    const std::int64_t budget = std::int64_t{kMaxMeshOverlap} * probes;
-    const Distortion* distortion = fpc.distortion();
+void checkSurfaceOverlap(const MeshScene& scene, const std::vector<RaySpan>& spans, const std::string& what) {
+    const std::int64_t budget = std::int64_t{kMaxMeshOverlap} * std::int64_t(spans.size());
     std::int64_t total = 0;
-    for (int j = 0; j < rows && total <= budget; ++j)
-        for (int i = 0; i < columns && total <= budget; ++i) {
-            const glm::dvec2 pd((i + 0.5) / columns, (j + 0.5) / rows);
-            if (const auto v = viewRay(fpc.camera(), distortion ? distortion->undistort(pd) : pd))
-                total += scene.surfacesAlong(v->ray, v->from, v->to, budget - total + 1);
-        }
+    for (std::size_t k = 0; k < spans.size() && total <= budget; ++k)
+        total += scene.surfacesAlong(spans[k].ray, spans[k].from, spans[k].to, budget - total + 1);
     if (total > budget)
         throw Error(ErrorCode::LimitExceeded,
-                    "mesh reference: the surfaces lie more than " + std::to_string(kMaxMeshOverlap) +
-                        " deep along the average ray of this view (" + std::to_string(probes) +
+                    what + ": the surfaces lie more than " + std::to_string(kMaxMeshOverlap) +
+                        " deep along the average ray of this view (" + std::to_string(spans.size()) +
                         " rays probed), and each ray tests every surface in front of its first hit: overlapping "
                         "copies of its triangles? (limit meshOverlap)");
+}
+
+void checkSurfaceOverlap(const MeshScene& scene, const Fpc& fpc, int width, int height) {
+    const int columns = std::clamp(width, 1, 64), rows = std::clamp(height, 1, 64);
+    const Distortion* distortion = fpc.distortion();
+    std::vector<RaySpan> spans;
+    spans.reserve(std::size_t(columns) * std::size_t(rows));
+    for (int j = 0; j < rows; ++j)
+        for (int i = 0; i < columns; ++i) {
+            const glm::dvec2 pd((i + 0.5) / columns, (j + 0.5) / rows);
+            if (const auto v = viewRay(fpc.camera(), distortion ? distortion->undistort(pd) : pd))
+                spans.push_back({v->ray, v->from, v->to});
+            else
+                spans.push_back({Ray{}, 0, -1});  // looks away: crosses nothing, counts in the average
+        }
+    checkSurfaceOverlap(scene, spans, "mesh reference");
 }
 
 std::array<float, 5> shadeRay(const MeshScene& scene, const Camera& camera, glm::dvec2 uv) {

@@ -66,10 +66,13 @@ inline constexpr int kMaxMarkupDepth = 512;
 // Scans of a progressive JPEG: each is a pass over the whole image (libjpeg's progressive
 // pictures have 10 or fewer).
 inline constexpr int kMaxJpegScans = 100;
-// Surfaces along the average ray of a CPU mesh render (the CoNUS ray cast and its layers), probed
-// before the render: a ray must test every surface stacked in front of its first hit, so a mesh of
-// many overlapping copies of one triangle costs each ray as many tests as copies, whatever the
-// acceleration structure (2^17 copies: over a minute at 512x512). Closed models show a handful.
+// Surfaces along the average ray of a CPU mesh render (the CoNUS ray cast and its layers, the
+// reflection frame's eye and reflected rays), probed before the render: a ray must test every
+// surface stacked in front of its first hit, so a mesh of many overlapping copies of one triangle
+// costs each ray as many tests as copies, whatever the acceleration structure (2^17 copies: over a
+// minute at 512x512). A GL render shades every copy at each pixel it covers: there the bound is
+// on the surfaces the mesh stacks over any region, whatever the view (codec/mesh/overdraw.h).
+// Closed models show a handful.
 inline constexpr int kMaxMeshOverlap = 256;
 
 // The caps a reader applies; a caller may lower any of them (never raise them past the constants:
@@ -122,7 +125,7 @@ inline constexpr std::array<LimitEntry, 30> limitTable() {
         {"sceneNodes", kMaxSceneNodes, "nodes", "nodes of a scene once shared nodes are expanded (instancing)"},
         {"markupDepth", kMaxMarkupDepth, "levels", "nesting of a glTF's JSON or a COLLADA or X3D file's XML"},
         {"jpegScans", kMaxJpegScans, "scans", "scans of a progressive JPEG (each a pass over the image)"},
-        {"meshOverlap", kMaxMeshOverlap, "surfaces", "surfaces along the average ray of a CPU mesh render, probed before it"},
+        {"meshOverlap", kMaxMeshOverlap, "surfaces", "surfaces along the average ray of a CPU mesh render (probed), or over any region of a GL-rendered mesh"},
     }};
 }
 

@@ -47,7 +47,8 @@ struct MeshRenderOptions {
 };
 
 // Keeps a mesh uploaded, so that frames of one mesh (another camera, another map) cost only the draw
-// and the readback.
+// and the readback. Refuses (LimitExceeded) a mesh whose triangles overlap too deeply for any
+// view (codec::checkMeshOverdraw) before uploading it.
 class MeshRenderer {
 public:
     MeshRenderer(Context& context, const Mesh& mesh);

@@ -6,7 +6,8 @@
 // - it is a regular file (no FIFO, device, socket or directory, which could block or never end),
 //   and it exists.
 // A converter fed uploaded models thus never reads its own files back as picture data. A refusal
-// is conus::Error(Io), one line naming the scene file and the name it gave.
+// is conus::Error(Io), one line naming the scene file and the name it gave. A file let through is
+// an input of the run (core protectInput): no output of the process may replace it.
 #pragma once
 
 #include <string>

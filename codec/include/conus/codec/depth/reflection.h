@@ -217,6 +217,9 @@ struct ReflectionFrameOptions {
 // reference shades it (identity map). R, G, B are the mean over the pixel's rays. M, of the pixel's
 // ray nearest its centre (the centre itself for an odd `samples`): 0 scene or nothing, 1 the
 // reflector showing the sky, 2 the reflector showing the scene.
+// Throws LimitExceeded, as checkSurfaceOverlap (raycast.h) does, when a probe of the rays it
+// would trace against the mesh (eye rays, and reflected rays without faces) crosses too many
+// surfaces on average.
 Image renderReflectionFrame(const MeshScene& scene, const std::vector<ReflectionFace>* faces, glm::dvec3 centre,
                             const Camera& camera, int width, int height, const ReflectionFrameOptions& options);
 

@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -73,6 +74,16 @@ struct ReferenceOptions {
 // ray of the render tests every surface in front of its first hit, so many overlapping copies of a
 // triangle would cost every ray that many tests. The probe stops once the limit is passed.
 void checkSurfaceOverlap(const MeshScene& scene, const Fpc& fpc, int width, int height);
+
+// A ray between two distances along it (from <= to; to may be infinite).
+struct RaySpan {
+    Ray ray;
+    double from = 0, to = std::numeric_limits<double>::infinity();
+};
+// The same refusal for any rays a render will trace (the reflection frame's eye rays and the
+// rays its mirror reflects): `spans` cross more than kMaxMeshOverlap surfaces on average. `what`
+// names the render in the message.
+void checkSurfaceOverlap(const MeshScene& scene, const std::vector<RaySpan>& spans, const std::string& what);
 
 // A width x height CoNUS render of `scene` through `fpc`, channels R, G, B, A, Z (shading.h).
 // Hits count between the camera's near and far depths. Throws conus::Error(InvalidArgument) for a

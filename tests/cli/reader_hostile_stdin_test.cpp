@@ -1,0 +1,80 @@
+// Standard input as the tools read it, through the real binary: a picture piped in, and streams
+// that never end or are no picture (/dev/zero, text, nothing), which must be refused in one line
+// at once, not after reading gigabytes; a list of inputs read from standard input alike.
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+
+#include "hostile_fixture.h"
+
+namespace {
+
+using namespace conus::hostile;
+
+using StdinHostile = Hostile;
+
+TEST_F(StdinHostile, EndlessOrForeignStreamsAreRefusedAtOnce) {
+    std::string text;
+    while (text.size() < (4u << 20)) text += "hello, this is a log file and no picture at all\n";
+    write("log.txt", text);
+    const struct {
+        std::string stdinFile;
+        const char* reason;
+    } cases[] = {
+        {"/dev/zero", "standard input is not an image format"},
+        {path("log.txt"), "standard input is not an image format"},
+        {"/dev/null", "standard input is empty"},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.stdinFile);
+        for (const char* command : {"encode", "uniform"}) {
+            const Outcome r = runTool("conus", {command, "-", "-o", path("x.exr"), "--size", "16x12"}, c.stdinFile);
+            expectRefused(r, command, c.reason);
+            expectBounded(r, 300);
+            EXPECT_FALSE(fs::exists(path("x.exr")));
+        }
+    }
+    // A list of inputs on standard input: /dev/zero has no line end, and is refused by its length.
+    const Outcome r = runTool("conus", {"encode", "--list", "-", "--out-dir", path("out"), "--size", "16x12"}, "/dev/zero");
+    expectRefused(r, "encode", "is longer than");
+    expectMemory(r, 300);
+    EXPECT_LT(r.seconds, 20.0 * conus::testing::kTimeScale);
+    EXPECT_FALSE(fs::exists(path("out")) && !fs::is_empty(path("out")));
+}
+
+TEST_F(StdinHostile, APicturePipedInIsReadAsFromItsFile) {
+    // A 24x16 PNG of a horizontal ramp, written by OpenImageIO.
+    const int w = 24, h = 16;
+    std::vector<unsigned char> ramp(std::size_t(w) * h * 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) ramp[(std::size_t(y) * w + x) * 3 + c] = static_cast<unsigned char>(x * 10 + c * 20 + y);
+    {
+        auto out = OIIO::ImageOutput::create(path("ramp.png"));
+        ASSERT_TRUE(out);
+        ASSERT_TRUE(out->open(path("ramp.png"), OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::UINT8)));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, ramp.data()));
+        out->close();
+    }
+    Outcome r = runTool("conus", {"uniform", "-", "-o", path("piped.exr"), "--size", "12x8"}, path("ramp.png"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    r = run({"uniform", path("ramp.png"), "-o", path("named.exr"), "--size", "12x8"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto pixels = [](const std::string& file) {
+        auto in = OIIO::ImageInput::open(file);
+        std::vector<float> values;
+        if (!in) return values;
+        values.resize(std::size_t(in->spec().image_pixels()) * in->spec().nchannels);
+        if (!in->read_image(0, 0, 0, in->spec().nchannels, OIIO::TypeDesc::FLOAT, values.data())) values.clear();
+        return values;
+    };
+    const std::vector<float> piped = pixels(path("piped.exr")), named = pixels(path("named.exr"));
+    ASSERT_FALSE(piped.empty());
+    ASSERT_EQ(piped.size(), named.size());
+    // A file goes to CoNUS's own PNG reader, standard input to OpenImageIO's: their sRGB curves
+    // agree within 1e-5, which the half-float samples may round one step apart (2^-11 relative).
+    for (std::size_t i = 0; i < piped.size(); ++i) EXPECT_NEAR(piped[i], named[i], 1e-3 * std::max(1.0f, named[i])) << i;
+    EXPECT_NE(*std::min_element(piped.begin(), piped.end()), *std::max_element(piped.begin(), piped.end()));
+}
+
+}  // namespace
