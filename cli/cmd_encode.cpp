@@ -98,7 +98,8 @@ Image detailOf(const Picture& source) {
     return source.codes ? detailOfCodes(*source.codes) : importanceFrom(enumName(codec::ImportanceRule::Detail), source.image);
 }
 
-BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions) {
+BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Size& size, const codec::FrameModelOptions& modelOptions,
+                           bool encodeKept) {
     Progress progress("build sampling map from " + o.importance + " importance");
     codec::AutoMapOptions autoOptions = autoMapOptions(o.grid, o.minDensity, o.maxDensity, o.maxAnisotropy, o.method);
     const Image importance = importanceFrom(o.importance, source);
@@ -122,13 +123,14 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions, codec::kDefaultTileLoss);
     progress.done();
     if (!quiet())
-        std::printf("%s\n", describeFloorBudget(r, o.frameLoss, o.importance + " importance").c_str());
+        std::printf("%s\n", describeFloorBudget(r, o.frameLoss, o.importance + " importance", encodeKept).c_str());
     return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt, std::move(r.encode)};
 }
 
 // The foci's map under the frame-loss budget (foci_budget.h): says, before the work, what the foci
 // take and the k each got; `given` receives that k for the line that says what was written.
-BuiltMap mapFromFoci(const EncodeOptions& o, const Picture& source, const Size& size, const codec::FrameModelOptions& modelOptions, std::string* given) {
+BuiltMap mapFromFoci(const EncodeOptions& o, const Picture& source, const Size& size, const codec::FrameModelOptions& modelOptions, bool encodeKept,
+                     std::string* given) {
     codec::FociMapRequest request;
     request.options = fociMapOptions(o.grid, o.compose, o.falloff, o.maxAnisotropy);
     request.model = modelOptions;
@@ -144,7 +146,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Picture& source, const Size& 
     progress.done();
     const std::string said =
         describeFociBudget(built.budget, BudgetFrame{size.width, size.height, source.image.width, source.image.height, o.frameLoss}, o.exactK, o.grid,
-                           o.maxAnisotropy);
+                           o.maxAnisotropy, encodeKept);
     if (!quiet()) std::printf("%s\n", said.c_str());
     *given = "k " + fociKText(built.budget.given);
     return {std::make_unique<codec::SamplingMap>(std::move(built.budget.map)), std::move(built.analytic), std::move(built.budget.encode)};
@@ -191,11 +193,12 @@ std::string encodeOne(const EncodeOptions& o, const std::string& input, const st
         !o.fast};
     modelOptions.filter = parseEnum<codec::EncodeFilter>(o.fit.filter);
     modelOptions.fitMethod = parseEnum<codec::FitMethod>(o.fit.method);
-    if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image, size);
-    else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, modelOptions);
-    else if (!o.foci.empty()) built = mapFromFoci(o, picture, size, modelOptions, &given);
-    else built = mapFromOwnDetail(o, picture, size, modelOptions, &given);
+    // Chosen first, so that the budget can say whether the file is the encode it measured.
     const renderers::Device device = deviceFor(o.storage.backend, renderers::CpuPath::Measured, "encoding", renderers::encodeSpeedProbe());
+    if (!o.mapFile.empty()) built = mapFromFile(o.mapFile, source.image, size);
+    else if (!o.importance.empty()) built = mapFromImportance(o, source.image, size, modelOptions, !device.onGpu());
+    else if (!o.foci.empty()) built = mapFromFoci(o, picture, size, modelOptions, !device.onGpu(), &given);
+    else built = mapFromOwnDetail(o, picture, size, modelOptions, &given);
     std::string fitNote;
     // The budget's confirming encode is this encode on the CPU (same kernel, same fit): kept.
     format::ConusFile file =

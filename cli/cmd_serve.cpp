@@ -10,6 +10,7 @@
 // one line, a name that is not there a 404.
 #include <CLI/CLI.hpp>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -19,6 +20,7 @@
 #include <iterator>
 #include <list>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -102,7 +104,7 @@ class FrameServer {
 public:
     explicit FrameServer(const ServeOptions& o) : m_options(o), m_root(fs::canonical(o.folder)) {}
     ~FrameServer() {
-        for (std::thread& t : m_warmers) t.join();
+        for (Warmer& w : m_warmers) w.thread.join();
     }
     FrameServer(const FrameServer&) = delete;
     FrameServer& operator=(const FrameServer&) = delete;
@@ -183,15 +185,17 @@ public:
         }
         std::lock_guard lock(m_warmMutex);
         // At most kMaxWarming pictures waiting to be read: page requests for many names do not
-        // queue unbounded work. Threads that have finished (none is warming) are joined here.
+        // queue unbounded work. Threads that have finished are joined here.
         constexpr std::size_t kMaxWarming = 4;
+        std::erase_if(m_warmers, [](Warmer& w) {
+            if (!w.done->load()) return false;
+            w.thread.join();
+            return true;
+        });
         if (m_warming.size() >= kMaxWarming || m_warming.count(path)) return;
-        if (m_warming.empty()) {
-            for (std::thread& t : m_warmers) t.join();
-            m_warmers.clear();
-        }
-        m_warming.insert(path);
-        m_warmers.emplace_back([this, path] {
+        auto done = std::make_shared<std::atomic<bool>>(false);
+        // The thread's last step takes m_warmMutex, held here until `path` is in m_warming.
+        m_warmers.push_back({std::thread([this, path, done] {
             try {
                 const auto start = std::chrono::steady_clock::now();
                 std::lock_guard encoding(m_encodeMutex);
@@ -204,9 +208,11 @@ public:
                                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), read);
             } catch (...) {  // /frame says what is wrong with it
             }
-            std::lock_guard done(m_warmMutex);
+            std::lock_guard finished(m_warmMutex);
             m_warming.erase(path);
-        });
+            done->store(true);
+        }), done});
+        m_warming.insert(path);
     }
 
 private:
@@ -290,7 +296,11 @@ private:
     std::list<Picture> m_pictures;
     std::mutex m_warmMutex;
     std::set<fs::path> m_warming;        // pictures being prepared by warm()
-    std::vector<std::thread> m_warmers;  // joined when the server goes
+    struct Warmer {
+        std::thread thread;
+        std::shared_ptr<std::atomic<bool>> done;  // set as its last step: join() returns at once
+    };
+    std::vector<Warmer> m_warmers;  // joined as they finish, and when the server goes
 };
 
 std::string contentTypeOf(const fs::path& path) {

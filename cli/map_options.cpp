@@ -100,7 +100,11 @@ std::string oneIn(double downscale) { return "1/" + numberText(std::round(downsc
 
 // What a budget's losses are: the measure of the encode the file keeps (the budget's confirming
 // encode of the map kept), or the model's prediction (`--fast`, a picture kept as 8-bit codes).
-std::string saidOf(bool measured) { return measured ? "measured by the encode kept" : "predicted"; }
+// Whether the losses printed are measured, and whether the file written is the encode measured
+// (on the GL backend, and in demo and bake, the file is another encode of the same map).
+std::string saidOf(bool measured, bool kept) {
+    return !measured ? "predicted" : kept ? "measured by the encode kept" : "measured by an encode of this map";
+}
 
 }  // namespace
 
@@ -110,20 +114,20 @@ std::string lossText(double db, const char* lose, const char* gain, int decimals
     return text;
 }
 
-std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what) {
+std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what, bool encodeKept) {
     char floor[32];
     std::snprintf(floor, sizeof floor, "%.3g", r.minDensity);
     return "budget: the whole frame within " + numberText(frameLoss) + " dB and tiles outside the region within " +
            numberText(codec::kDefaultTileLoss) + " dB (95th percentile), against `conus uniform` of the same pixel count on 8-bit sRGB "
            "(--frame-loss sets it)\n  " + what + ": context floor " + floor + ", density cap " + numberText(std::round(r.maxDensity * 10) / 10) +
            (r.budgetBinds ? "" : " (the budget does not bind: the lowest floor and the highest cap hold it)") +
-           "\n  " + saidOf(r.encode != nullptr) + ": the whole frame " + lossText(r.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the region " +
+           "\n  " + saidOf(r.encode != nullptr, encodeKept) + ": the whole frame " + lossText(r.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the region " +
            lossText(r.predicted.tileLoss, "lose", "gain", 1) + " at the 95th percentile, the region gains " +
            numberText(std::round(r.predicted.roiGain * 10) / 10) + " dB";
 }
 
 std::string describeFociBudget(const codec::FociBudget& b, const std::optional<BudgetFrame>& frame, bool exactK, int grid,
-                               double maxAnisotropy) {
+                               double maxAnisotropy, bool encodeKept) {
     std::string text;
     const auto kOf = [](double k) { return numberText(std::round(k * 100) / 100); };
     if (frame) {
@@ -138,7 +142,7 @@ std::string describeFociBudget(const codec::FociBudget& b, const std::optional<B
                           b.given[i].r, kOf(b.given[i].k).c_str(), kOf(b.asked[i].k).c_str());
             text += line;
         }
-        text += "\n  " + saidOf(b.encode != nullptr) + ": the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the foci " +
+        text += "\n  " + saidOf(b.encode != nullptr, encodeKept) + ": the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the foci " +
                 lossText(b.predicted.tileLoss, "lose", "gain", 1) + " at the 95th percentile, the foci gain " +
                 numberText(std::round(b.predicted.roiGain * 10) / 10) + " dB";
         if (b.lowered)
@@ -151,7 +155,7 @@ std::string describeFociBudget(const codec::FociBudget& b, const std::optional<B
                 " downscale (the uniform image: " + oneIn(uniform) + ")";
         if (b.overBudget)
             warn("--exact-k: against the uniform image, the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 1) +
-                 ", the tiles outside the foci " + lossText(b.predicted.tileLoss, "lose", "gain", 1) + " (" + saidOf(b.encode != nullptr) +
+                 ", the tiles outside the foci " + lossText(b.predicted.tileLoss, "lose", "gain", 1) + " (" + saidOf(b.encode != nullptr, encodeKept) +
                  "; the budget: " + numberText(frame->frameLoss) + " and " + numberText(codec::kDefaultTileLoss) + " dB)");
     } else {
         if (b.askedShare.ask > 1.0)

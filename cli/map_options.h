@@ -54,16 +54,17 @@ struct BudgetFrame {
 // What a foci budget did, in a line: the share of the pixels the foci take, what the context is
 // sampled like, the k each focus got and, when the budget lowered k, why. Warns (even when quiet)
 // where --exact-k left the context sparser than the budget, and where a grid held a focus only to
-// a lower k (recorded so).
+// a lower k (recorded so). `encodeKept`: the file written is the budget's confirming encode (else
+// a measured loss is said to be of an encode of this map).
 std::string describeFociBudget(const codec::FociBudget& budget, const std::optional<BudgetFrame>& frame, bool exactK, int grid,
-                               double maxAnisotropy = 0);
+                               double maxAnisotropy = 0, bool encodeKept = false);
 
 // "loses 1.50 dB" or, for a negative loss, "gains 0.44 dB" (`lose` and `gain` the verbs as they
 // agree with the subject), to `decimals` places.
 std::string lossText(double db, const char* lose, const char* gain, int decimals);
 // What the budget of an importance map did, in a short block: the budget, the context floor it
 // chose, the predicted losses and the region's gain (`what`: the importance's name).
-std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what);
+std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what, bool encodeKept);
 
 // --grid against the image it shapes (codec::checkGridForImage).
 void checkGridForImage(int grid, int width, int height, int defaultGrid = map_rules::kDefaultSide);

@@ -153,6 +153,9 @@ void protectInput(const std::string& path) {
     struct stat st {};
     if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
     std::lock_guard lock(g_inputsMutex);
+    // Once per file: a long-running process (a server, a fuzzer) reads the same files again.
+    for (const auto& entry : g_inputs)
+        if (entry.second.first == st.st_dev && entry.second.second == st.st_ino) return;
     g_inputs.push_back({path, {st.st_dev, st.st_ino}});
 }
 

@@ -440,7 +440,7 @@ struct NormalMatrix {
                     const std::size_t row = static_cast<std::size_t>(wc) * kStencil;
                     float* o = out + i * channels;
                     const float* xc = x + i * channels;
-                    const std::size_t step = static_cast<std::size_t>(wc) * channels;
+                    const std::ptrdiff_t step = std::ptrdiff_t(wc) * channels;  // signed: rows above are at -step
                     const bool left = xi > 0, right = xi + 1 < wc, up = y > 0, down = y + 1 < hc;
                     for (int k = 0; k < channels; ++k) {
                         float v = s[kOwn] * xc[k];
