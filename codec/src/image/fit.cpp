@@ -5,10 +5,10 @@
 // (assemblePass, fit_normal.cpp): D^T s, |s|^2, and A = D^T D as a 3x3 stencil per CoNUS pixel
 // (an output pixel's taps reach one 2x2 block of CoNUS pixels wherever the view magnifies), with
 // the few output pixels whose taps reach wider (where it minifies) kept as rows of D. Every
-// iteration is then a
-// few stencil products on the CoNUS image, a sixteenth of the source's pixels at the default
-// encode's 1/16, instead of two walks over the source. Where the view minifies much of the image
-// (more wide rows than kWideEntriesPerPixel allows) the fit walks the taps every iteration (CGLS):
+// iteration is then a few stencil products on the CoNUS image, a sixteenth of the source's pixels
+// at the default encode's 1/16, instead of two walks over the source. Where the view minifies much
+// of the image (more wide rows than kWideEntriesPerPixel allows) the fit walks the taps every
+// iteration (CGLS):
 //
 // Each pass walks the output rows in bands, one thread per band at a time. A gather (D) reads the
 // CoNUS image; a splat (D^T) writes into the band's own buffer, which spans only the CoNUS rows
