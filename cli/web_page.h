@@ -19,7 +19,7 @@ struct WebFile {
 };
 
 // index.html (opening `defaultFile` when its URL names none; empty: none), conus-exr.js,
-// conus-view.js and conus-shaders.js (renderers::viewFrameShaderEs as a script).
+// conus-gl.js, conus-view.js and conus-shaders.js (renderers::viewFrameShaderEs as a script).
 std::vector<WebFile> viewerFiles(const std::string& defaultFile);
 
 // A script that hands `bytes` to the page as CONUS_FILES[name] (base64): how a page opened from

@@ -76,8 +76,8 @@ def test_conus_web_folder(browser, served, tmp_path):
     site = tmp_path / "site"
     done = subprocess.run([CONUS, "web", served / "piz.exr", "-o", site], check=True, capture_output=True, text=True)
     assert "index.html" in done.stdout
-    assert sorted(p.name for p in site.iterdir()) == ["conus-exr.js", "conus-shaders.js", "conus-view.js", "index.html",
-                                                       "piz.exr", "piz.exr.js"]
+    assert sorted(p.name for p in site.iterdir()) == ["conus-exr.js", "conus-gl.js", "conus-shaders.js", "conus-view.js",
+                                                       "index.html", "piz.exr", "piz.exr.js"]
     header = subprocess.run(["exrheader", str(site / "piz.exr")], check=True, capture_output=True, text=True).stdout
     compression = [line for line in header.splitlines() if line.startswith("compression")]
     assert len(compression) == 2 and all("): zip," in line for line in compression), compression
