@@ -10,6 +10,7 @@
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/core/error.h"
+#include "density_cells_pvt.h"
 
 namespace conus::codec {
 namespace {
@@ -65,6 +66,53 @@ constexpr int kBoundRounds = 4;
 }
 
 }  // namespace
+
+double leastScaleForMeanOne(const std::vector<double>& field, const std::vector<double>& context, double floor, double cap,
+                            double sMax) {
+    // The mean as the bisection always took it: in index order, divided once.
+    const auto meanFor = [&](double s) {
+        double sum = 0;
+        for (std::size_t i = 0; i < field.size(); ++i) sum += context[i] * std::clamp(s * field[i], floor, cap);
+        return sum / double(field.size());
+    };
+    // 1. Near the root in a few passes: the sum is linear in s between each cell's clamp knots, so
+    // each pass follows the line of the piece s is on to its root, bisection guarding the bracket.
+    const double wanted = double(field.size());
+    double lo = 0.0, hi = sMax, guess = sMax;
+    for (int pass = 0; pass < 100; ++pass) {
+        double constant = 0.0, slope = 0.0;
+        for (std::size_t i = 0; i < field.size(); ++i) {
+            const double v = guess * field[i];
+            if (v <= floor) constant += context[i] * floor;
+            else if (v >= cap) constant += context[i] * cap;
+            else slope += context[i] * field[i];
+        }
+        const double sum = constant + slope * guess;
+        if (std::abs(sum - wanted) <= 1e-14 * wanted) break;
+        (sum < wanted ? lo : hi) = guess;
+        if (!(hi - lo > 1e-14 * hi)) break;
+        const double root = slope > 0.0 ? (wanted - constant) / slope : -1.0;
+        guess = (root > lo && root < hi) ? root : 0.5 * (lo + hi);
+    }
+    // 2. The exact double: meanFor is monotone in s as computed (every term is, and a rounded sum
+    // of non-decreasing terms is), so the least s with meanFor(s) >= 1 is what bisecting [0, sMax]
+    // to adjacent doubles finds; here the bisection starts from a bracket around the guess.
+    lo = 0.0;
+    hi = sMax;
+    for (double width = 1e-12; width < 1.0; width *= 64.0) {
+        const double a = guess * (1.0 - width), b = std::min(sMax, guess * (1.0 + width));
+        if (meanFor(a) < 1.0 && meanFor(b) >= 1.0) {
+            lo = a;
+            hi = b;
+            break;
+        }
+    }
+    for (;;) {
+        const double mid = 0.5 * (lo + hi);
+        if (!(mid > lo && mid < hi)) return hi;
+        (meanFor(mid) < 1.0 ? lo : hi) = mid;
+    }
+}
 
 DensityField importanceToDensity(const Image& importance, const AutoMapOptions& options) {
     if (importance.empty()) invalid("the importance image is empty");
@@ -131,12 +179,7 @@ DensityField importanceToDensity(const Image& importance, const AutoMapOptions& 
         }
         floor = hi;
     } else {
-        double lo = 0, hi = sMax;
-        for (int i = 0; i < 200; ++i) {
-            const double mid = 0.5 * (lo + hi);
-            (meanFor(mid, floor) < 1.0 ? lo : hi) = mid;
-        }
-        s = hi;
+        s = leastScaleForMeanOne(field, context, floor, options.maxDensity, sMax);
     }
     for (std::size_t i = 0; i < field.size(); ++i)
         out.values[i] = static_cast<float>(context[i] * std::clamp(s * field[i], floor, options.maxDensity));

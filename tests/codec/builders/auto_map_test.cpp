@@ -1,9 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
+#include <vector>
 
+#include "../../../codec/src/builders/density_cells_pvt.h"
 #include "conus/codec/builders/auto_map.h"
 #include "conus/codec/builders/map_measures.h"
 #include "conus/core/map_rules.h"
@@ -29,6 +33,19 @@ Image blobs(int w, int h, std::initializer_list<std::array<double, 3>> centres, 
     return img;
 }
 
+
+// Importance with a bump near the top right, a noisy ramp along x and, at zeroShare, cells of none.
+Image importance(int w, int h, std::mt19937& rng, double zeroShare) {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    Image img = makeImage(w, h, {"Y"});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const double dx = (x + 0.5) / w - 0.7, dy = (y + 0.5) / h - 0.25;
+            const double v = std::exp(-(dx * dx + dy * dy) / 0.003) + 0.3 * std::pow(unit(rng), 4.0) * x / w;
+            img.at(x, y) = unit(rng) < zeroShare ? 0.0f : float(v);
+        }
+    return img;
+}
 }  // namespace
 
 TEST(AutoMap, TargetHasMeanOneAndRespectsFloorAndCap) {
@@ -136,3 +153,90 @@ TEST(AutoMap, DetailIsHighAtEdgesAndZeroInFlatRegions) {
     EXPECT_EQ(detail.at(10, 40), 0.0f);
     EXPECT_EQ(detail.at(90, 40), 0.0f);
 }
+
+// The scale of the importance puts the density's mean at 1 with the floor and cap exact: with and
+// without a context, with cells at the cap, with a cap no cell reaches.
+TEST(AutoMap, TargetMeanFloorAndCapHoldWithContextsAndCaps) {
+    std::mt19937 rng(11);
+    DensityField context;
+    context.width = 40;
+    context.height = 23;
+    for (int y = 0; y < context.height; ++y)
+        for (int x = 0; x < context.width; ++x) context.values.push_back(float(0.4 + 1.3 * x / 40.0 + 0.2 * (y % 3)));
+    struct Case {
+        int w, h;
+        double minDensity, maxDensity, zeroShare;
+        bool withContext;
+    };
+    const Case cases[] = {{300, 200, 0.25, 16, 0.0, false}, {180, 420, 0.1, 4, 0.0, false}, {256, 256, 0.5, 64, 0.0, true},
+                          {1024, 640, 0.3, 9, 0.0, true},   {200, 130, 0.2, 1.5, 0.0, false}, {120, 90, 0.4, 2000, 0.0, false}};
+    for (const Case& c : cases) {
+        AutoMapOptions options;
+        options.minDensity = c.minDensity;
+        options.maxDensity = c.maxDensity;
+        options.context = c.withContext ? &context : nullptr;
+        const DensityField field = importanceToDensity(importance(c.w, c.h, rng, c.zeroShare), options);
+        double sum = 0.0, lowestFactor = HUGE_VAL, highestFactor = 0.0;
+        // The factor over the context: the context's own mean over the field's cells is 1.
+        std::vector<double> ctx(field.values.size(), 1.0);
+        if (c.withContext) {
+            double ctxSum = 0.0;
+            for (int y = 0; y < field.height; ++y)
+                for (int x = 0; x < field.width; ++x)
+                    ctxSum += ctx[std::size_t(y) * field.width + x] = densityAt(context, (x + 0.5) / field.width, (y + 0.5) / field.height);
+            for (double& v : ctx) v *= double(ctx.size()) / ctxSum;
+        }
+        for (std::size_t k = 0; k < field.values.size(); ++k) {
+            sum += field.values[k];
+            lowestFactor = std::min(lowestFactor, field.values[k] / ctx[k]);
+            highestFactor = std::max(highestFactor, field.values[k] / ctx[k]);
+        }
+        const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " max " + std::to_string(c.maxDensity);
+        EXPECT_NEAR(sum / double(field.values.size()), 1.0, 1e-6) << what;
+        EXPECT_NEAR(lowestFactor, c.minDensity, 1e-5 * c.minDensity) << what;
+        EXPECT_LE(highestFactor, c.maxDensity * (1 + 1e-6)) << what;
+        // The cap binds where the importance is concentrated enough.
+        if (c.maxDensity <= 9) {
+            EXPECT_NEAR(highestFactor, c.maxDensity, 1e-5 * c.maxDensity) << what;
+        }
+    }
+}
+
+// The scale is the very double that bisecting [0, sMax] 200 times finds (the answer the maps were
+// built from before), on fields with and without contexts, floors and caps that bind or not.
+TEST(AutoMap, ScaleIsTheBisectionsDouble) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    int compared = 0;
+    for (int trial = 0; trial < 60; ++trial) {
+        const std::size_t n = 500 + std::size_t(unit(rng) * 4000);
+        std::vector<double> field(n), context(n, 1.0);
+        const double spread = 1.0 + 8.0 * unit(rng);
+        for (double& v : field) v = unit(rng) < 0.2 ? 0.0 : std::pow(unit(rng), spread);
+        if (trial % 2) {
+            double sum = 0;
+            for (double& c : context) sum += c = 0.3 + 2.0 * unit(rng);
+            for (double& c : context) c *= double(n) / sum;
+        }
+        const double floor = 0.05 + 0.6 * unit(rng), cap = 1.2 + 40.0 * unit(rng) * unit(rng);
+        double smallest = HUGE_VAL;
+        for (double v : field)
+            if (v > 0) smallest = std::min(smallest, v);
+        const double sMax = cap / smallest;
+        const auto meanFor = [&](double s) {
+            double sum = 0;
+            for (std::size_t i = 0; i < n; ++i) sum += context[i] * std::clamp(s * field[i], floor, cap);
+            return sum / double(n);
+        };
+        if (meanFor(sMax) < 1.0) continue;  // importanceToDensity raises the floor instead
+        double lo = 0, hi = sMax;
+        for (int i = 0; i < 200; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            (meanFor(mid) < 1.0 ? lo : hi) = mid;
+        }
+        EXPECT_EQ(leastScaleForMeanOne(field, context, floor, cap, sMax), hi) << "trial " << trial;
+        ++compared;
+    }
+    EXPECT_GT(compared, 40);
+}
+
