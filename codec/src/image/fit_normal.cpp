@@ -144,6 +144,14 @@ bool assemblePass(DecoderOperator& op, const float* source, int c) {
     return !abandoned.load();
 }
 
+// A band's part of the assembly (its stencil, kStencil values a CoNUS pixel, and its wide rows),
+// freed once summed into A or abandoned.
+void releaseAssembly(Band& band) {
+    std::vector<float>().swap(band.stencil);
+    std::vector<std::int32_t>().swap(band.wideStart);
+    std::vector<std::int32_t>().swap(band.wideIndex);
+    std::vector<float>().swap(band.wideWeight);
+}
 
 }  // namespace
 
@@ -157,7 +165,11 @@ bool assembleNormal(DecoderOperator& op, const float* source, int channels, Norm
     op.clearBuffers(kStencil, &Band::stencil);
     bool assembled = false;
     dispatchChannels(channels, [&]<int kC>() { assembled = assemblePass<kC>(op, source, channels); });
-    if (!assembled) return false;
+    if (!assembled) {
+        // The walk that follows needs only the bands' buffers.
+        for (Band& band : op.bands()) releaseAssembly(band);
+        return false;
+    }
     squares = op.bandSum();
     a.width = wc;
     a.height = hc;
@@ -171,7 +183,7 @@ bool assembleNormal(DecoderOperator& op, const float* source, int channels, Norm
         for (const std::int32_t s : band.wideStart) a.start.push_back(base + s);
         a.index.insert(a.index.end(), band.wideIndex.begin(), band.wideIndex.end());
         a.weight.insert(a.weight.end(), band.wideWeight.begin(), band.wideWeight.end());
-        std::vector<float>().swap(band.stencil);
+        releaseAssembly(band);
         std::vector<float>().swap(band.buffer);
     }
     a.start.push_back(static_cast<std::int32_t>(a.index.size()));

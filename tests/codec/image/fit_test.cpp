@@ -137,6 +137,32 @@ TEST(Fit, AssembledNormalEquationsAreDtD) {
     EXPECT_GT(mostWide, 0u);
 }
 
+// A CoNUS image squeezed across (the view minifies it about 1.9x along x and magnifies it 2.2x
+// along y): most output pixels' taps reach past a 2x2 block, several output rows a CoNUS row, more
+// wide rows than the assembly keeps. The assembly is abandoned part way and the fit walks the taps
+// instead, taking exactly the steps the forced walk takes.
+TEST(Fit, AnAbandonedAssemblyWalksTheTaps) {
+    const Image source = test::photoLike(300, 200, {"R", "G", "B"});
+    const SamplingMap map = twoFoci(1.5);
+    EncodeOptions e;
+    e.width = 560;
+    e.height = 90;
+    const Image encoded = encodeImage(source, map, e);
+    EXPECT_THROW(detail::fitNormalProduct(encoded, map, 300, 200), Error);
+    Image fallen = encoded, walked = encoded;
+    FitOptions f;
+    f.iterations = 2;
+    const FitResult a = fitToDecoder(source, map, fallen, f);
+    detail::forceFitPasses(true);
+    const FitResult w = fitToDecoder(source, map, walked, f);
+    detail::forceFitPasses(false);
+    ASSERT_EQ(a.steps.size(), w.steps.size());
+    for (std::size_t i = 0; i < a.steps.size(); ++i) EXPECT_EQ(a.steps[i].psnr, w.steps[i].psnr) << i;
+    EXPECT_EQ(test::maxAbsDifference(fallen, walked), 0.0f);
+    EXPECT_GT(test::maxAbsDifference(fallen, encoded), 1e-3f);  // the fit moved the pixels
+    EXPECT_GT(a.steps.back().psnr, a.steps[0].psnr);
+}
+
 // The assembled fit and the one that walks the taps every iteration take the same steps where the
 // view magnifies, and the assembled ones are no worse where it minifies.
 TEST(Fit, AssembledFitMatchesThePasses) {
