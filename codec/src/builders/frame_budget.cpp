@@ -100,10 +100,22 @@ float shown(float v, bool display, const std::vector<float>& table) {
     return table[i] + f * (table[i + 1] - table[i]);
 }
 
-// A shown colour value as an 8-bit display shows it (its nearest code): the measured errors are
-// those of the 8-bit sRGB pictures bench/quality.py compares. Other values as they are.
-double onDisplay(float shownValue, bool display) {
-    return display ? std::round(double(shownValue) * 255.0) / 255.0 : double(shownValue);
+// code / 255.0 for each 8-bit code, without a division.
+constexpr std::array<double, 256> kCodeValues = [] {
+    std::array<double, 256> values{};
+    for (int code = 0; code < 256; ++code) values[code] = code / 255.0;
+    return values;
+}();
+
+// The 8-bit code a display shows for a colour value: shown(), then its nearest code, the value of
+// the 8-bit sRGB pictures bench/quality.py compares. x is exact and within [0, 255] (the table's
+// values lie in [0, 1]), where the only half is 127.5 (0.5f * 255): there rounding to even, as
+// adding and taking away 1.5 * 2^52 does, gives round()'s 128 too. (The clamp holds the index
+// whatever the table.)
+int displayCode(float v, const std::vector<float>& table) {
+    const double x = double(shown(v, true, table)) * 255.0;
+    constexpr double kRoundingShift = 6755399441055744.0;
+    return std::clamp(static_cast<int>((x + kRoundingShift) - kRoundingShift), 0, 255);
 }
 
 // Singular values of a 2x2 matrix (largest first).
@@ -386,7 +398,7 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
                                                                                     const SamplingMap& map,
                                                                                     const Image* uniform) const {
     const std::size_t channels = source.channels.size();
-    std::vector<bool> display(channels, false);
+    std::vector<char> display(channels, 0);
     if (m_options.space == ErrorSpace::Display)
         for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
     const std::vector<float>& table = displayTable();
@@ -402,6 +414,14 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
         [&](int r0, int r1) {
             const std::size_t values = std::size_t(source.width) * channels;
             std::vector<float> resized(uniform ? values : 0);
+            // Each row's values as the display shows them, one array a picture: colour channels
+            // as their 8-bit code's value, others as they are.
+            std::vector<double> fromShown(values), viewShown(values), resizedShown(uniform ? values : 0);
+            const auto onDisplay = [&](const float* in, std::vector<double>& out) {
+                for (std::size_t i = 0; i < values; i += channels)
+                    for (std::size_t c = 0; c < channels; ++c)
+                        out[i + c] = display[c] ? kCodeValues[displayCode(in[i + c], table)] : double(shown(in[i + c], false, table));
+            };
             Image decoded;
             for (int y = r0 * m_tile; y < std::min(source.height, r1 * m_tile); ++y) {
                 if (y % m_tile == 0) {
@@ -413,20 +433,23 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
                     rows.threads = 1;
                     decoded = decodeImage(conus, map, rows);
                 }
-                const float* view = decoded.pixels.data() + std::size_t(y % m_tile) * values;
-                if (uniform) uniformRows->row(y, resized.data());
-                const float* from = source.pixels.data() + std::size_t(y) * values;
+                onDisplay(decoded.pixels.data() + std::size_t(y % m_tile) * values, viewShown);
+                onDisplay(source.pixels.data() + std::size_t(y) * values, fromShown);
+                if (uniform) {
+                    uniformRows->row(y, resized.data());
+                    onDisplay(resized.data(), resizedShown);
+                }
                 double* row = &out[std::size_t(y / m_tile) * m_columns];
                 double* flatRow = uniform ? &flat[std::size_t(y / m_tile) * m_columns] : nullptr;
                 for (int x = 0; x < source.width; ++x) {
                     double e = 0, u = 0;
                     for (std::size_t c = 0; c < channels; ++c) {
                         const std::size_t i = std::size_t(x) * channels + c;
-                        const double s = onDisplay(shown(from[i], display[c], table), display[c]);
-                        const double d = onDisplay(shown(view[i], display[c], table), display[c]) - s;
+                        const double s = fromShown[i];
+                        const double d = viewShown[i] - s;
                         e += d * d;
                         if (uniform) {
-                            const double f = onDisplay(shown(resized[i], display[c], table), display[c]) - s;
+                            const double f = resizedShown[i] - s;
                             u += f * f;
                         }
                     }
