@@ -20,6 +20,8 @@
 #include "conus/codec/depth/reflection.h"
 #include "conus/imageio/image_file.h"
 #include "conus/renderers/reflection.h"
+#include "bench_context.h"
+#include "box_mesh.h"
 #include "reflection_scoring.h"
 
 namespace conus {
@@ -32,25 +34,10 @@ constexpr std::uint32_t kBoxTriangles = 12;
 Mesh boxAndFloor() {
     Mesh m;
     const glm::vec3 lo(0.4f, -0.3f, 1.5f), hi(1.0f, 0.5f, 2.2f);
-    // Each face its own four corners, so the flat faces shade flat; a colour ramp across the box
-    // so that a misplaced hit shows.
-    const int faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
-    for (const auto& f : faces) {
-        const auto base = static_cast<std::uint32_t>(m.positions.size());
-        for (int c : f) {
-            const glm::vec3 p(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
-            m.positions.push_back(p);
-            m.colours.emplace_back((p.x - lo.x) / (hi.x - lo.x), 0.25f + 0.5f * (p.y - lo.y) / (hi.y - lo.y),
-                                   (p.z - lo.z) / (hi.z - lo.z));
-        }
-        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    }
-    const auto base = static_cast<std::uint32_t>(m.positions.size());
-    for (const glm::vec3 p : {glm::vec3(-4, -1, -4), glm::vec3(-4, -1, 4), glm::vec3(4, -1, 4), glm::vec3(4, -1, -4)}) {
-        m.positions.push_back(p);
-        m.colours.emplace_back(0.6f, 0.6f, 0.55f);
-    }
-    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    bench::addBox(m, lo, hi, bench::rampAcross(lo, hi));
+    const glm::vec3 floor(0.6f, 0.6f, 0.55f);
+    bench::addQuad(m, {glm::vec3(-4, -1, -4), glm::vec3(-4, -1, 4), glm::vec3(4, -1, 4), glm::vec3(4, -1, -4)},
+                   {floor, floor, floor, floor});
     return m;
 }
 
@@ -89,10 +76,7 @@ void BM_ReflectionFrame(benchmark::State& state) {
 
 void BM_ReflectionFrameGl(benchmark::State& state) {
     Setup& s = setup(static_cast<int>(codec::ReflectionBakeOptions{}.magnification));
-    static std::unique_ptr<renderers::Context> context = [] {
-        const char* backend = std::getenv("CONUS_BACKEND");
-        return renderers::Context::create(backend ? parseEnum<renderers::Backend>(backend) : renderers::Backend::Auto);
-    }();
+    static std::unique_ptr<renderers::Context> context = bench::createBenchContext();
     renderers::ReflectionRenderer renderer(*context, s.scene.mesh(), s.faces[state.range(0)], s.options);
     renderer.draw(s.camera, kFrame, kFrame);  // compiles the program
     const auto start = std::chrono::steady_clock::now();

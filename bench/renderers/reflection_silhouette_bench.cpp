@@ -18,6 +18,7 @@
 
 #include "conus/codec/depth/reflection.h"
 #include "conus/imageio/image_file.h"
+#include "box_mesh.h"
 #include "reflection_scoring.h"
 
 namespace conus {
@@ -26,31 +27,6 @@ namespace {
 constexpr int kFrame = 256;
 constexpr std::uint32_t kBoxTriangles = 12;
 const codec::AxisBox kBox{{0.4, -0.3, 1.5}, {1.0, 0.5, 2.2}};
-
-// An axis box of its own four-corner faces, coloured by `colour` at each corner.
-template <class Colour>
-void addBox(Mesh& m, glm::vec3 lo, glm::vec3 hi, Colour colour) {
-    const int faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
-    for (const auto& f : faces) {
-        const auto base = static_cast<std::uint32_t>(m.positions.size());
-        for (int c : f) {
-            const glm::vec3 p(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
-            m.positions.push_back(p);
-            m.colours.push_back(colour(p));
-        }
-        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    }
-}
-
-// A quad of four corners, each its own colour.
-void addQuad(Mesh& m, const std::array<glm::vec3, 4>& corners, const std::array<glm::vec3, 4>& colours) {
-    const auto base = static_cast<std::uint32_t>(m.positions.size());
-    for (int k = 0; k < 4; ++k) {
-        m.positions.push_back(corners[k]);
-        m.colours.push_back(colours[k]);
-    }
-    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-}
 
 // The room's wall (its top at y = `top`, its face at z = `wallZ`, its foot on the floor) and floor
 // (y = `floorY`, out to z = 4) move in BM_ReflectionSilhouetteVariants; the defaults: the bench's scene.
@@ -61,15 +37,13 @@ struct Room {
 Mesh room(const Room& r = {}) {
     Mesh m;
     const glm::vec3 lo(kBox.lo), hi(kBox.hi);
-    addBox(m, lo, hi, [&](glm::vec3 p) {
-        return glm::vec3((p.x - lo.x) / (hi.x - lo.x), 0.25f + 0.5f * (p.y - lo.y) / (hi.y - lo.y), (p.z - lo.z) / (hi.z - lo.z));
-    });
+    bench::addBox(m, lo, hi, bench::rampAcross(lo, hi));
     // A pole beside the mirror, 0.08 wide: thin against the wall and the floor behind it.
-    addBox(m, {0.9f, -1.0f, 0.5f}, {0.98f, 0.9f, 0.58f}, [](glm::vec3 p) { return glm::vec3(0.85f, 0.3f + 0.3f * p.y, 0.2f); });
+    bench::addBox(m, {0.9f, -1.0f, 0.5f}, {0.98f, 0.9f, 0.58f}, [](glm::vec3 p) { return glm::vec3(0.85f, 0.3f + 0.3f * p.y, 0.2f); });
     const float f = r.floorY, z = r.wallZ;
-    addQuad(m, {glm::vec3(-4, f, -4), glm::vec3(-4, f, 4), glm::vec3(4, f, 4), glm::vec3(4, f, -4)},
+    bench::addQuad(m, {glm::vec3(-4, f, -4), glm::vec3(-4, f, 4), glm::vec3(4, f, 4), glm::vec3(4, f, -4)},
             {glm::vec3(0.3f, 0.5f, 0.3f), glm::vec3(0.6f, 0.6f, 0.4f), glm::vec3(0.7f, 0.5f, 0.5f), glm::vec3(0.4f, 0.4f, 0.6f)});
-    addQuad(m, {glm::vec3(-4, f, z), glm::vec3(-4, r.top, z), glm::vec3(4, r.top, z), glm::vec3(4, f, z)},
+    bench::addQuad(m, {glm::vec3(-4, f, z), glm::vec3(-4, r.top, z), glm::vec3(4, r.top, z), glm::vec3(4, f, z)},
             {glm::vec3(0.2f, 0.3f, 0.7f), glm::vec3(0.8f, 0.8f, 0.9f), glm::vec3(0.9f, 0.7f, 0.3f), glm::vec3(0.3f, 0.6f, 0.3f)});
     return m;
 }
@@ -120,12 +94,7 @@ void BM_ReflectionSilhouettes(benchmark::State& state) {
     Image frames[2], truth;
     bench::MirrorScore score;
     for (auto _ : state) score = scoreScene(s, static_cast<int>(state.range(0)), frames, truth);
-    state.counters["mirror_conus_dB"] = score.psnr(1, {0, 1});
-    state.counters["mirror_uniform_dB"] = score.psnr(0, {0, 1});
-    state.counters["roi_conus_dB"] = score.psnr(1, {0});
-    state.counters["roi_uniform_dB"] = score.psnr(0, {0});
-    state.counters["rest_conus_dB"] = score.psnr(1, {1});
-    state.counters["rest_uniform_dB"] = score.psnr(0, {1});
+    bench::addMirrorCounters(state, score, "", "roi");
     state.counters["roi_pixels"] = score.count[0];
     state.counters["mirror_pixels"] = score.count[0] + score.count[1];
     state.counters["wrong_conus"] = score.wrong[1][0] + score.wrong[1][1];
