@@ -26,6 +26,7 @@
 #include "conus/format/reflection_asset.h"
 #include "conus/renderers/reflection.h"
 #include "conus/sceneio/mesh_file.h"
+#include "bench_context.h"
 #include "paired.h"
 #include "reflection_scoring.h"
 
@@ -56,23 +57,44 @@ const glm::dvec3 kMovedEye(2.5, 2.0, 6.5);
 const std::string kModels[2] = {std::string(CONUS_SHARED_DATA) + "/meshes/teapot.obj",
                                 "/usr/share/assimp/models/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf"};
 
+// The mirror of a setup (even index: the plane mirror, odd: the sphere), and the camera's field of
+// view on it; the camera stands at (6, 3.5, 4) looking at the mirror's centre.
+codec::Reflector mirrorOf(int index) {
+    codec::Reflector r;
+    const bool plane = index % 2 == 0;
+    r.kind = plane ? codec::Reflector::Kind::Plane : codec::Reflector::Kind::Sphere;
+    r.centre = plane ? glm::dvec3(0.0, 1.5, -6.0) : glm::dvec3(0.0, 1.5, -7.0);
+    r.radius = 4.0;
+    r.normal = glm::normalize(glm::dvec3(0.15, 0.0, 1.0));
+    return r;
+}
+double fovOf(int index) { return index % 2 == 0 ? 38.0 : 45.0; }
+Camera cameraOn(const codec::Reflector& r, double fov) {
+    return Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, fov, 1.0, 1e-3, 1e3);
+}
+
+// The bytes of the reflection asset file of `faces`.
+double assetBytes(const std::vector<codec::ReflectionFace>& faces) {
+    const std::string path = (std::filesystem::temp_directory_path() / "conus-layered-bench.exr").string();
+    format::writeReflectionAsset(path, codec::reflectionAssetFile(faces));
+    const auto bytes = static_cast<double>(std::filesystem::file_size(path));
+    std::filesystem::remove(path);
+    return bytes;
+}
+
 // Setup 0: the plane mirror, 1: the sphere, beside the teapot; 2 and 3 the same beside the truck.
 // Null when the model is not installed.
 Setup* setup(int index) {
     static std::unique_ptr<Setup> setups[4];
-    const int mirror = index % 2;
     auto& s = setups[index];
     if (s) return s.get();
     if (!std::filesystem::exists(kModels[index / 2])) return nullptr;
     s = std::make_unique<Setup>(Setup{codec::MeshScene(sceneio::readMesh(kModels[index / 2])), {},
                                       Camera::perspective({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 40, 1, 0.1, 10), 40.0, {}});
     codec::Reflector& r = s->options.reflector;
-    r.kind = mirror == 0 ? codec::Reflector::Kind::Plane : codec::Reflector::Kind::Sphere;
-    r.centre = mirror == 0 ? glm::dvec3(0.0, 1.5, -6.0) : glm::dvec3(0.0, 1.5, -7.0);
-    r.radius = 4.0;
-    r.normal = glm::normalize(glm::dvec3(0.15, 0.0, 1.0));
-    s->fov = mirror == 0 ? 38.0 : 45.0;
-    s->camera = Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, s->fov, 1.0, 1e-3, 1e3);
+    r = mirrorOf(index);
+    s->fov = fovOf(index);
+    s->camera = cameraOn(r, s->fov);
     const AxisBox bounds = boundsOf(s->scene.mesh());
     for (int uniform = 0; uniform < 2; ++uniform)
         for (int layered = 0; layered < 3; ++layered) {
@@ -86,10 +108,7 @@ Setup* setup(int index) {
             bake.layers = layered == 2 ? s->placed.layers : layered ? 0 : 1;
             auto& faces = s->faces[uniform][layered];
             faces = codec::bakeReflection(s->scene, bake);
-            const std::string path = (std::filesystem::temp_directory_path() / "conus-layered-bench.exr").string();
-            format::writeReflectionAsset(path, codec::reflectionAssetFile(faces));
-            s->bytes[uniform][layered] = static_cast<double>(std::filesystem::file_size(path));
-            std::filesystem::remove(path);
+            s->bytes[uniform][layered] = assetBytes(faces);
         }
     const int layers = s->faces[1][1].front().layers();
     s->disoccluded[0] = codec::disocclusionFraction(s->scene, r.centre, r.radius, 1);
@@ -97,12 +116,16 @@ Setup* setup(int index) {
     return s.get();
 }
 
-void BM_LayeredReflectionQuality(benchmark::State& state) {
+// The setup of the row's range(0), or null when its model is not installed (the row then skips).
+Setup* setupOrSkip(benchmark::State& state) {
     Setup* found = setup(static_cast<int>(state.range(0)));
-    if (!found) {
-        state.SkipWithError("the model is not installed (assimp-testmodels)");
-        return;
-    }
+    if (!found) state.SkipWithError("the model is not installed (assimp-testmodels)");
+    return found;
+}
+
+void BM_LayeredReflectionQuality(benchmark::State& state) {
+    Setup* found = setupOrSkip(state);
+    if (!found) return;
     Setup& s = *found;
     // The reference shades with the headlight at the faces' eye, as the asset does: the placed
     // asset has its own (traced rays land on the same surfaces; only the shading moves).
@@ -129,12 +152,7 @@ void BM_LayeredReflectionQuality(benchmark::State& state) {
             bench::scoreMirror(pair, truth[l == 2 ? 1 : 0], s.scene, s.options.reflector, s.camera, kFrame, triangles);
         const char* tags[3] = {"single_", "layered_", "placed_"};
         const std::string tag = tags[l];
-        state.counters[tag + "mirror_conus_dB"] = score.psnr(1, {0, 1});
-        state.counters[tag + "mirror_uniform_dB"] = score.psnr(0, {0, 1});
-        state.counters[tag + "teapot_conus_dB"] = score.psnr(1, {0});
-        state.counters[tag + "teapot_uniform_dB"] = score.psnr(0, {0});
-        state.counters[tag + "rest_conus_dB"] = score.psnr(1, {1});
-        state.counters[tag + "rest_uniform_dB"] = score.psnr(0, {1});
+        bench::addMirrorCounters(state, score, tag, "teapot");
         state.counters[tag + "wrong_conus"] = score.wrong[1][0] + score.wrong[1][1];
     }
     state.counters["layers"] = s.faces[1][1].front().layers();
@@ -172,11 +190,8 @@ void BM_LayeredReflectionQuality(benchmark::State& state) {
 // reflected viewpoint; range(1)), one layer, faces of range(2) texels: the rays toward the camera that land in a
 // disocclusion there and the mirror's dB against the reference shaded from that eye.
 void BM_LayeredReflectionEyeSweep(benchmark::State& state) {
-    Setup* found = setup(static_cast<int>(state.range(0)));
-    if (!found) {
-        state.SkipWithError("the model is not installed (assimp-testmodels)");
-        return;
-    }
+    Setup* found = setupOrSkip(state);
+    if (!found) return;
     Setup& s = *found;
     const codec::Reflector& r = s.options.reflector;
     const glm::dvec3 image = codec::reflectedViewpoint(r, s.camera.eye());
@@ -192,12 +207,7 @@ void BM_LayeredReflectionEyeSweep(benchmark::State& state) {
             bake.uniform = u == 0;
             const auto faces = codec::bakeReflection(s.scene, bake);
             frames[u] = codec::renderReflectionFrame(s.scene, &faces, eye, s.camera, kFrame, kFrame, s.options);
-            if (u == 1) {
-                const std::string path = (std::filesystem::temp_directory_path() / "conus-eye-sweep.exr").string();
-                format::writeReflectionAsset(path, codec::reflectionAssetFile(faces));
-                bytes = static_cast<double>(std::filesystem::file_size(path));
-                std::filesystem::remove(path);
-            }
+            if (u == 1) bytes = assetBytes(faces);
         }
         truth = codec::renderReflectionFrame(s.scene, nullptr, eye, s.camera, kFrame, kFrame, s.options);
     }
@@ -227,12 +237,8 @@ void BM_PlacedMirrorFocus(benchmark::State& state) {
     const codec::MeshScene& scene = *scenes[index / 2];
     codec::ReflectionFrameOptions options;
     codec::Reflector& r = options.reflector;
-    const bool plane = index % 2 == 0;
-    r.kind = plane ? codec::Reflector::Kind::Plane : codec::Reflector::Kind::Sphere;
-    r.centre = plane ? glm::dvec3(0.0, 1.5, -6.0) : glm::dvec3(0.0, 1.5, -7.0);
-    r.radius = 4.0;
-    r.normal = glm::normalize(glm::dvec3(0.15, 0.0, 1.0));
-    const Camera camera = Camera::perspective({6.0, 3.5, 4.0}, r.centre, {0, 1, 0}, plane ? 38.0 : 45.0, 1.0, 1e-3, 1e3);
+    r = mirrorOf(index);
+    const Camera camera = cameraOn(r, fovOf(index));
     const glm::dvec3 eye = codec::placeReflectionEye(scene, r, camera.eye(), 1).eye;
     codec::ReflectionBakeOptions bake;
     bake.centre = eye;
@@ -240,20 +246,13 @@ void BM_PlacedMirrorFocus(benchmark::State& state) {
     bake.roi = boundsOf(scene.mesh());
     bake.magnification = static_cast<double>(state.range(1));
     Image frames[2], truth;
-    const auto bytesOf = [](const std::vector<codec::ReflectionFace>& faces) {
-        const std::string path = (std::filesystem::temp_directory_path() / "conus-placed-focus.exr").string();
-        format::writeReflectionAsset(path, codec::reflectionAssetFile(faces));
-        const auto bytes = static_cast<double>(std::filesystem::file_size(path));
-        std::filesystem::remove(path);
-        return bytes;
-    };
     double bytes = 0;
     for (auto _ : state) {
         for (int u = 0; u < 2; ++u) {
             bake.uniform = u == 0;
             const auto faces = codec::bakeReflection(scene, bake);
             frames[u] = codec::renderReflectionFrame(scene, &faces, eye, camera, kFrame, kFrame, options);
-            if (u == 1) bytes = bytesOf(faces);
+            if (u == 1) bytes = assetBytes(faces);
         }
         truth = codec::renderReflectionFrame(scene, nullptr, eye, camera, kFrame, kFrame, options);
     }
@@ -261,7 +260,7 @@ void BM_PlacedMirrorFocus(benchmark::State& state) {
     centred.centre = r.centre;
     centred.size = kFace;
     centred.roi = bake.roi;
-    state.counters["bytes_ratio"] = bytes / bytesOf(codec::bakeReflection(scene, centred));
+    state.counters["bytes_ratio"] = bytes / assetBytes(codec::bakeReflection(scene, centred));
     state.counters["eye_x"] = eye.x;
     state.counters["eye_z"] = eye.z;
     const auto triangles = static_cast<std::uint32_t>(scene.mesh().indices.size() / 3);
@@ -281,27 +280,12 @@ void BM_PlacedMirrorFocus(benchmark::State& state) {
         const bench::MirrorScore s3 = bench::scoreMirror(alias, ssTruth, scene, r, camera, kFrame, triangles);
         // The one-ray asset frames (what the GLSL renderer draws) against the antialiased reference.
         const bench::MirrorScore s4 = bench::scoreMirror(frames, ssTruth, scene, r, camera, kFrame, triangles);
-        state.counters["aaref_mirror_conus_dB"] = s4.psnr(1, {0, 1});
-        state.counters["aaref_mirror_uniform_dB"] = s4.psnr(0, {0, 1});
-        state.counters["aaref_model_conus_dB"] = s4.psnr(1, {0});
-        state.counters["aaref_model_uniform_dB"] = s4.psnr(0, {0});
-        state.counters["aaref_rest_conus_dB"] = s4.psnr(1, {1});
-        state.counters["aaref_rest_uniform_dB"] = s4.psnr(0, {1});
-        state.counters["ss_mirror_conus_dB"] = s2.psnr(1, {0, 1});
-        state.counters["ss_mirror_uniform_dB"] = s2.psnr(0, {0, 1});
-        state.counters["ss_model_conus_dB"] = s2.psnr(1, {0});
-        state.counters["ss_model_uniform_dB"] = s2.psnr(0, {0});
-        state.counters["ss_rest_conus_dB"] = s2.psnr(1, {1});
-        state.counters["ss_rest_uniform_dB"] = s2.psnr(0, {1});
+        bench::addMirrorCounters(state, s4, "aaref_", "model");
+        bench::addMirrorCounters(state, s2, "ss_", "model");
         state.counters["truth1spp_mirror_dB"] = s3.psnr(1, {0, 1});
         state.counters["truth1spp_model_dB"] = s3.psnr(1, {0});
     }
-    state.counters["mirror_conus_dB"] = score.psnr(1, {0, 1});
-    state.counters["mirror_uniform_dB"] = score.psnr(0, {0, 1});
-    state.counters["model_conus_dB"] = score.psnr(1, {0});
-    state.counters["model_uniform_dB"] = score.psnr(0, {0});
-    state.counters["rest_conus_dB"] = score.psnr(1, {1});
-    state.counters["rest_uniform_dB"] = score.psnr(0, {1});
+    bench::addMirrorCounters(state, score, "", "model");
     if (const char* prefix = std::getenv("CONUS_BENCH_PICTURES"))
         bench::writeMirrorStrip(std::string(prefix) + "-focus-" + std::to_string(index) + "-" +
                                     std::to_string(state.range(1)) + "-" + std::to_string(state.range(2)) + ".png", frames, truth, score, kFrame, 3);
@@ -310,11 +294,8 @@ void BM_PlacedMirrorFocus(benchmark::State& state) {
 // Single-layer (A) against layered (B) CoNUS frames: /x/0 the CPU reference, /x/1 GLSL; /x/x/1 the
 // layered asset from the placed eye as B.
 void BM_LayeredReflectionPaired(benchmark::State& state) {
-    Setup* found = setup(static_cast<int>(state.range(0)));
-    if (!found) {
-        state.SkipWithError("the model is not installed (assimp-testmodels)");
-        return;
-    }
+    Setup* found = setupOrSkip(state);
+    if (!found) return;
     Setup& s = *found;
     const int b = state.range(2) ? 2 : 1;
     const auto ms = [](auto&& render) {
@@ -332,10 +313,7 @@ void BM_LayeredReflectionPaired(benchmark::State& state) {
         bench::pairedRatio(state, [&] { return frame(0); }, [&] { return frame(b); });
         return;
     }
-    static std::unique_ptr<renderers::Context> context = [] {
-        const char* backend = std::getenv("CONUS_BACKEND");
-        return renderers::Context::create(backend ? parseEnum<renderers::Backend>(backend) : renderers::Backend::Auto);
-    }();
+    static std::unique_ptr<renderers::Context> context = bench::createBenchContext();
     renderers::ReflectionRenderer single(*context, s.scene.mesh(), s.faces[1][0], s.options);
     renderers::ReflectionRenderer layered(*context, s.scene.mesh(), s.faces[1][b], s.options);
     single.draw(s.camera, kFrame, kFrame);  // compiles the program

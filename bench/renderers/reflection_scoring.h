@@ -5,6 +5,8 @@
 // below.
 #pragma once
 
+#include <benchmark/benchmark.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -63,6 +65,17 @@ inline MirrorScore scoreMirror(const Image (&frames)[2], const Image& truth, con
             s.count[region] += 1;
         }
     return s;
+}
+
+// The PSNR counters of a scored mirror, each name led by `prefix`: mirror_ (the whole mirror),
+// `roi`_ (the region of interest) and rest_, each of them _conus_dB and _uniform_dB.
+inline void addMirrorCounters(benchmark::State& state, const MirrorScore& s, const std::string& prefix, const std::string& roi) {
+    const char* frames[2] = {"_uniform_dB", "_conus_dB"};
+    for (int k = 0; k < 2; ++k) {
+        state.counters[prefix + "mirror" + frames[k]] = s.psnr(k, {0, 1});
+        state.counters[prefix + roi + frames[k]] = s.psnr(k, {0});
+        state.counters[prefix + "rest" + frames[k]] = s.psnr(k, {1});
+    }
 }
 
 // CoNUS | uniform | reference above; below, each `zoom` times enlarged (nearest) around the ROI's centre.
