@@ -121,6 +121,14 @@ void checkRay(const Ray& ray) {
 
 namespace {
 
+// Where a walk stands: at s along its segment (pd: where that lies in the CoNUS image), the step
+// before it at `before`, after `steps` steps.
+struct Cursor {
+    glm::dvec2 pd{0.0};
+    double before = 0.0, s = 0.0;
+    int steps = 0;
+};
+
 // What both walks (the first surface's and a deeper layer's) share: the clipped segment, the
 // stored surface along it, the step and the hit record.
 struct Walk {
@@ -149,21 +157,22 @@ struct Walk {
     bool flagged(glm::dvec2 p) const { return !image.solid() && image.cellFlags()[image.cellIndex(p)] != 0; }
     // The smallest jump that is a discontinuity at depth d.
     double jump(double d) const { return image.jumpRelative() * d + image.jumpAbsolute(); }
-    // One step of the linear search from s (updated, with before and pd): stepTexels CoNUS pixels
+    // One step of the linear search from c.s (c updated, its steps counted): stepTexels CoNUS pixels
     // along the curve, as measured by the map's Jacobian where the step starts, kSilhouetteStep
-    // as long from or into a flagged cell. Returns the stored depth at the new s.
-    double step(double& before, double& s, glm::dvec2& pd, double stepTexels) const {
+    // as long from or into a flagged cell. Returns the stored depth at the new c.s.
+    double step(Cursor& c, double stepTexels) const {
         // CoNUS pixels the curve covers per unit s here: |J (p1 - p0)| in pixels.
-        const double speed = glm::length(image.map().jacobian(segment.point(s)) * along * size);
-        const auto advance = [&](double texels) { return std::min(segment.end, before + (speed > 0.0 ? texels / speed : 1.0)); };
-        const bool fine = flagged(pd);
-        before = s;
-        s = advance(stepTexels * (fine ? kSilhouetteStep : 1.0));
-        double stored = surface(s, pd);
-        if (!fine && flagged(pd)) {  // a full step into a flagged cell: taken again, finely
-            s = advance(stepTexels * kSilhouetteStep);
-            stored = surface(s, pd);
+        const double speed = glm::length(image.map().jacobian(segment.point(c.s)) * along * size);
+        const auto advance = [&](double texels) { return std::min(segment.end, c.before + (speed > 0.0 ? texels / speed : 1.0)); };
+        const bool fine = flagged(c.pd);
+        c.before = c.s;
+        c.s = advance(stepTexels * (fine ? kSilhouetteStep : 1.0));
+        double stored = surface(c.s, c.pd);
+        if (!fine && flagged(c.pd)) {  // a full step into a flagged cell: taken again, finely
+            c.s = advance(stepTexels * kSilhouetteStep);
+            stored = surface(c.s, c.pd);
         }
+        ++c.steps;
         return stored;
     }
     DepthHit hitAt(double s, glm::dvec2 pd, int steps, bool hidden) const {
@@ -202,60 +211,56 @@ std::optional<DepthHit> intersect(const DepthImage& image, const Ray& ray, const
     if (!started) return std::nullopt;
     const Walk& walk = *started;
     const Segment& segment = walk.segment;
-
-    glm::dvec2 pd;
-    double before = 0.0, s = 0.0;
-    int steps = 0;
+    Cursor c;
     // Hidden: behind the surface of a scene, since the ray was at depth `hiddenDepth` (file comment).
     bool hidden = false;
     double hiddenDepth = 0.0;
     glm::dvec2 hiddenFrom(0.0);  // the last point in front of the surface: the background's side
-    if (const double entry = walk.surface(0.0, pd); entry - segment.depth(0.0) <= 0.0) {
-        if (image.solid() || walk.acrossSide(entry)) return walk.hitAt(0.0, pd, 0, false);
+    if (const double entry = walk.surface(0.0, c.pd); entry - segment.depth(0.0) <= 0.0) {
+        if (image.solid() || walk.acrossSide(entry)) return walk.hitAt(0.0, c.pd, 0, false);
         if (segment.end <= 0.0) return std::nullopt;  // entered beyond the data's depth range
         hidden = true;
         firstHidden = segment.t(0.0);
         hiddenDepth = segment.depth(0.0);
-        hiddenFrom = pd;
+        hiddenFrom = c.pd;
     }
     for (;;) {
-        if (s >= segment.end || steps >= options.maxSteps) {
+        if (c.s >= segment.end || c.steps >= options.maxSteps) {
             // Hidden up to the farthest stored depth: behind the background, which takes the
             // colour of where the ray went hidden.
-            if (hidden && s >= segment.end && segment.endsAtRange) return walk.hitAt(segment.end, hiddenFrom, steps, true);
+            if (hidden && c.s >= segment.end && segment.endsAtRange) return walk.hitAt(segment.end, hiddenFrom, c.steps, true);
             return std::nullopt;
         }
-        const double stored = walk.step(before, s, pd, options.stepTexels);
-        ++steps;
-        const double gap = stored - segment.depth(s);
+        const double stored = walk.step(c, options.stepTexels);
+        const double gap = stored - segment.depth(c.s);
         if (hidden) {
             if (gap > 0.0) {
                 hidden = false;  // in front of the surface again
             } else if (stored >= hiddenDepth) {
                 // Behind the background: where the stored surface first reaches hiddenDepth.
-                double a = before, b = s;
+                double a = c.before, b = c.s;
                 for (int k = 0; k < options.refinements; ++k) {
                     const double m = 0.5 * (a + b);
-                    (walk.surface(m, pd) >= hiddenDepth ? b : a) = m;
+                    (walk.surface(m, c.pd) >= hiddenDepth ? b : a) = m;
                 }
-                walk.surface(b, pd);
-                return walk.hitAt(b, pd, steps, true);
+                walk.surface(b, c.pd);
+                return walk.hitAt(b, c.pd, c.steps, true);
             }
             continue;
         }
         if (gap > 0.0) continue;
         // A crossing between `before` (in front) and s (behind): bisect it.
-        double a = before, b = s;
+        double a = c.before, b = c.s;
         for (int k = 0; k < options.refinements; ++k) {
             const double m = 0.5 * (a + b);
-            (walk.surface(m, pd) - segment.depth(m) > 0.0 ? a : b) = m;
+            (walk.surface(m, c.pd) - segment.depth(m) > 0.0 ? a : b) = m;
         }
         glm::dvec2 pa, pb;
         const double jump = walk.surface(a, pa) - walk.surface(b, pb);
         if (image.solid() || jump <= 0.5 * walk.jump(walk.surface(b, pb))) {
             const double mid = 0.5 * (a + b);
-            walk.surface(mid, pd);
-            return walk.hitAt(mid, pd, steps, false);
+            walk.surface(mid, c.pd);
+            return walk.hitAt(mid, c.pd, c.steps, false);
         }
         // A wall: the ray passes behind an occluder's silhouette.
         hidden = true;
@@ -270,31 +275,27 @@ std::optional<DepthHit> intersectBehind(const DepthImage& layer, const Ray& ray,
     if (!started) return std::nullopt;
     const Walk& walk = *started;
     const Segment& segment = walk.segment;
-
-    glm::dvec2 pd;
-    double before = 0.0, s = 0.0;
-    int steps = 0;
-    const double entry = walk.surface(0.0, pd);
-    if (entry - segment.depth(0.0) <= 0.0 && walk.acrossSide(entry)) return walk.hitAt(0.0, pd, 0, false);
+    Cursor c;
+    const double entry = walk.surface(0.0, c.pd);
+    if (entry - segment.depth(0.0) <= 0.0 && walk.acrossSide(entry)) return walk.hitAt(0.0, c.pd, 0, false);
     // Which side of the stored surface the ray is on; a crossing either way is a hit where the
     // surface is continuous (the mirror meets a surface that faces the centre from its front, one
     // that faces away from its back), a wall where it is not.
     bool front = entry - segment.depth(0.0) > 0.0;
-    while (s < segment.end && steps < options.maxSteps) {
-        const double stored = walk.step(before, s, pd, options.stepTexels);
-        ++steps;
-        if ((stored - segment.depth(s) > 0.0) == front) continue;
-        double a = before, b = s;
+    while (c.s < segment.end && c.steps < options.maxSteps) {
+        const double stored = walk.step(c, options.stepTexels);
+        if ((stored - segment.depth(c.s) > 0.0) == front) continue;
+        double a = c.before, b = c.s;
         for (int k = 0; k < options.refinements; ++k) {
             const double m = 0.5 * (a + b);
-            ((walk.surface(m, pd) - segment.depth(m) > 0.0) == front ? a : b) = m;
+            ((walk.surface(m, c.pd) - segment.depth(m) > 0.0) == front ? a : b) = m;
         }
         glm::dvec2 pa, pb;
         const double sa = walk.surface(a, pa), sb = walk.surface(b, pb);
         if ((front ? sa - sb : sb - sa) <= 0.5 * walk.jump(std::min(sa, sb))) {
             const double mid = 0.5 * (a + b);
-            walk.surface(mid, pd);
-            return walk.hitAt(mid, pd, steps, false);
+            walk.surface(mid, c.pd);
+            return walk.hitAt(mid, c.pd, c.steps, false);
         }
         front = !front;  // a wall: the ray is now on the other side, with nothing met
     }
