@@ -35,6 +35,15 @@ constexpr double kTilePenalty = 4.0;  // dB of frame loss per dB of tile loss ov
 
 [[noreturn]] void invalid(const std::string& what) { throw Error(ErrorCode::InvalidArgument, what); }
 
+// The map of `importance` at the context floor `floor` (options.minDensity set to it, its cap
+// options.maxDensity), with the model's prediction for it.
+BudgetResult buildAtFloor(const Image& importance, const FrameErrorModel& model, AutoMapOptions& options, double floor) {
+    options.minDensity = floor;
+    BudgetResult r{buildAutoMap(importance, options), floor, {}, true, options.maxDensity};
+    r.predicted = model.predict(r.map);
+    return r;
+}
+
 }  // namespace
 
 BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorModel& model, double frameLossDb,
@@ -45,12 +54,7 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
     // floor within the budget, by regula falsi (Illinois) in log floor on how far each built map is
     // predicted to be over it: a continuous function of the picture.
     options.refuseBounds = false;
-    const auto build = [&](double floor) {
-        options.minDensity = floor;
-        BudgetResult r{buildAutoMap(importance, options), floor, {}, true, options.maxDensity};
-        r.predicted = model.predict(r.map);
-        return r;
-    };
+    const auto build = [&](double floor) { return buildAtFloor(importance, model, options, floor); };
     const auto over = [&](const BudgetResult& r) { return std::max(r.predicted.frameLoss - frameLossDb, r.predicted.tileLoss - tileLossDb); };
     const double cap = options.maxDensity;
     const auto search = [&]() {
@@ -130,12 +134,7 @@ BudgetResult buildAutoMapForBestFrame(const Image& importance, const FrameErrorM
     // for the least of the frame's loss plus kTilePenalty per dB the tiles lose over their budget
     // (a continuous objective: a tiny change of the picture moves the floor a little).
     options.refuseBounds = false;
-    const auto build = [&](double floor) {
-        options.minDensity = floor;
-        BudgetResult r{buildAutoMap(importance, options), floor, {}, true, options.maxDensity};
-        r.predicted = model.predict(r.map);
-        return r;
-    };
+    const auto build = [&](double floor) { return buildAtFloor(importance, model, options, floor); };
     const auto cost = [&](const BudgetResult& r) {
         return r.predicted.frameLoss + kTilePenalty * std::max(0.0, r.predicted.tileLoss - tileLossDb);
     };

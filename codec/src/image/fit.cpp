@@ -331,6 +331,15 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
         for (std::size_t px = 0, i = 0; px < pixels; ++px)
             for (int k = 0; k < channels; ++k, ++i) out[i] = precondition[px] * z[i];
     };
+    // The next conjugate direction: zp = M z, p = zp + beta p with beta = <z, zp> / gamma; gamma
+    // becomes <z, zp>.
+    const auto nextDirection = [&](std::vector<float>& zp, double& gamma) {
+        applyPreconditioner(zp);
+        const double next = detail::dot(z, zp);
+        const float beta = static_cast<float>(next / gamma);
+        for (std::size_t i = 0; i < values; ++i) p[i] = zp[i] + beta * p[i];
+        gamma = next;
+    };
 
     // The normal equations assembled on the CoNUS grid in one walk of the taps (A = D^T D, b =
     // D^T s): the same iterations then cost a few stencil products on the CoNUS image instead of
@@ -377,11 +386,7 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
             for (std::size_t i = 0; i < values; ++i) x[i] += alpha * p[i];
             residualOfX();
             if (it == options.iterations) break;
-            applyPreconditioner(zp);
-            const double next = detail::dot(z, zp);
-            const float beta = static_cast<float>(next / gamma);
-            for (std::size_t i = 0; i < values; ++i) p[i] = zp[i] + beta * p[i];
-            gamma = next;
+            nextDirection(zp, gamma);
         }
         return finish();
     }
@@ -414,11 +419,7 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
             break;
         }
         residual(true, false);
-        applyPreconditioner(zp);
-        const double next = detail::dot(z, zp);
-        const float beta = static_cast<float>(next / gamma);
-        for (std::size_t i = 0; i < values; ++i) p[i] = zp[i] + beta * p[i];
-        gamma = next;
+        nextDirection(zp, gamma);
     }
 
     return finish();
