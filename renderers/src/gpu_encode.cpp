@@ -161,12 +161,7 @@ private:
         t.uploadMs += millisecondsSince(start);
 
         setDrawState(texture.id(), atlas.id(), m_pyramid.rects, {-kFar, -kFar, kFar, kFar});
-        gl.ClearColor(0, 0, 0, 0);
-        gl.Clear(GL_COLOR_BUFFER_BIT);
-        gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(m_mesh.indices.size()), GL_UNSIGNED_INT, nullptr);
-        checkGl(gl, kWhat);
-        gl.Finish();
-        t.drawMs += millisecondsSince(start);
+        drawMeshTimed(gl, m_mesh, t, start);
     }
 
     // Per tile: upload the crops of every level around its core, draw its triangles; the shader
@@ -238,6 +233,15 @@ void uploadMesh(const GladGLContext& gl, const Mesh& mesh, GLuint vertexArray, G
     gl.EnableVertexAttribArray(2);
     gl.VertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(4 * sizeof(float)));
     checkGl(gl, "encodeImageGpu");
+}
+
+void drawMeshTimed(const GladGLContext& gl, const Mesh& mesh, GpuTimings& t, Clock::time_point& start) {
+    gl.ClearColor(0, 0, 0, 0);
+    gl.Clear(GL_COLOR_BUFFER_BIT);
+    gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.indices.size()), GL_UNSIGNED_INT, nullptr);
+    checkGl(gl, "encodeImageGpu");
+    gl.Finish();
+    t.drawMs += millisecondsSince(start);
 }
 
 Image encodeImageGpu(Context& context, const Image& source, const codec::SamplingMap& map,

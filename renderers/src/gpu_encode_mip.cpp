@@ -91,12 +91,7 @@ void encodeMipmapped(Context& context, const Image& source, const codec::Samplin
                      static_cast<float>(codec::uniformSpacing(source.width, source.height, out.width, out.height)));
         gl.Uniform1i(gl.GetUniformLocation(program, "uSegment"), segment);
         gl.BindVertexArray(vertexArray.id());
-        gl.ClearColor(0, 0, 0, 0);
-        gl.Clear(GL_COLOR_BUFFER_BIT);
-        gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.indices.size()), GL_UNSIGNED_INT, nullptr);
-        checkGl(gl, kWhat);
-        gl.Finish();
-        t.drawMs += millisecondsSince(start);
+        drawMeshTimed(gl, mesh, t, start);
 
         readBackPass(gl, out, first, count, options.threads);
         checkGl(gl, kWhat);

@@ -14,6 +14,10 @@ namespace conus::renderers {
 // the vertex array's buffers, for encode.vert.glsl.
 void uploadMesh(const GladGLContext& gl, const Mesh& mesh, GLuint vertexArray, GLuint vertexBuffer, GLuint indexBuffer);
 
+// Clears the bound framebuffer and draws all of the mesh's triangles from the bound vertex array
+// and program, waits for the GPU, and adds the time since `start` to t.drawMs.
+void drawMeshTimed(const GladGLContext& gl, const Mesh& mesh, GpuTimings& t, Clock::time_point& start);
+
 // The mipmapped encoder (gpu_image.h) into `out` (the output's size and channels), timed into t
 // from `start`.
 void encodeMipmapped(Context& context, const Image& source, const codec::SamplingMap& map, const codec::EncodeOptions& options,
