@@ -23,6 +23,18 @@ inline Image noise(int w, int h, std::vector<std::string> channels, unsigned see
     return im;
 }
 
+// An RGB picture made from RGB noise: channel c at (x, y) is value(n, x, y, c), n the noise
+// (noise above, of `seed`).
+template <class Value>
+Image fromNoise(int w, int h, unsigned seed, Value value) {
+    const Image n = noise(w, h, {"R", "G", "B"}, seed);
+    Image im = makeImage(w, h, {"R", "G", "B"});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) im.at(x, y, c) = value(n, x, y, c);
+    return im;
+}
+
 // Noise box-blurred over 3x3: a detailed texture with little energy at the very top frequencies.
 inline Image texture(int size, unsigned seed) {
     const Image n = noise(size, size, {"Y"}, seed);

@@ -110,11 +110,13 @@ protected:
         std::ofstream(m_dir / name, std::ios::binary) << bytes;
     }
 
+    // The file `relative` of the shared hostile files (shared/data/hostile).
+    static std::string hostileData(const fs::path& relative) { return (fs::path(CONUS_SHARED_DATA) / "hostile" / relative).string(); }
     // A committed copy of a small reproducer, or the shared one.
     static std::string reproducer(const std::string& name) {
         const fs::path seed = fs::path(CONUS_FUZZ_CORPUS) / "container" / ("hostile-" + name);
         if (fs::exists(seed)) return seed.string();
-        return (fs::path(CONUS_SHARED_DATA) / "hostile" / name).string();
+        return hostileData(name);
     }
 
     // Refused: exit 1, the last stderr line is the one error line of `command`, holding `reason`.

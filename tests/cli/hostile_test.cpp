@@ -98,9 +98,9 @@ TEST_F(Hostile, MapsFinerThanTheirImageAreRefusedFromTheHeaders) {
     const struct {
         std::string file;
         const char* size;
-    } cases[] = {{(fs::path(CONUS_SHARED_DATA) / "hostile" / "samplingmap-index-uint32-overflow-n900.exr").string(), "900x900 nodes is finer than its 24x16 image"},
-                 {(fs::path(CONUS_SHARED_DATA) / "hostile" / "samplingmap-index-blowup-n257-575MB.exr").string(), "257x257 nodes is finer than its 24x16 image"},
-                 {(fs::path(CONUS_SHARED_DATA) / "hostile" / "round4" / "conus" / "map4097_img16.exr").string(), "4097x4097 nodes is finer than its 16x16 image"}};
+    } cases[] = {{hostileData("samplingmap-index-uint32-overflow-n900.exr"), "900x900 nodes is finer than its 24x16 image"},
+                 {hostileData("samplingmap-index-blowup-n257-575MB.exr"), "257x257 nodes is finer than its 24x16 image"},
+                 {hostileData("round4/conus/map4097_img16.exr"), "4097x4097 nodes is finer than its 16x16 image"}};
     for (const auto& c : cases) {
         SCOPED_TRACE(c.file);
         CONUS_REQUIRE(c.file);
@@ -152,7 +152,7 @@ TEST_F(Hostile, AMapIsNeverWrittenFinerThanItsImage) {
 }
 
 TEST_F(Hostile, LyingNpzIsRefusedBeforeAllocating) {
-    const std::string file = (fs::path(CONUS_SHARED_DATA) / "hostile" / "npz-lying-size-4GB.npz").string();
+    const std::string file = hostileData("npz-lying-size-4GB.npz");
     CONUS_REQUIRE(file);
     const Outcome r = run({"heightfield", "encode", file, "-o", path("t.exr"), "--size", "32x32"});
     expectRefused(r, "heightfield", "claims 4294967280 bytes from 73 compressed bytes");

@@ -10,19 +10,23 @@ namespace {
 
 using namespace conus::hostile;
 
-class JpegHostile : public Hostile {};
-
-TEST_F(JpegHostile, AJpegOfEndlessScansIsRefusedBeforeDecoding) {
-    {
-        OIIO::ImageSpec spec(64, 48, 3, OIIO::TypeDesc::UINT8);
-        spec.attribute("jpeg:progressive", 1);
-        std::vector<unsigned char> pixels(64 * 48 * 3);
-        for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<unsigned char>((i * 37) % 251);
-        auto out = OIIO::ImageOutput::create(path("plain.jpg"));
-        ASSERT_TRUE(out && out->open(path("plain.jpg"), spec));
+class JpegHostile : public Hostile {
+protected:
+    // Writes `name`, a w x h RGB JPEG (progressive when asked) whose bytes ramp as (i * step) % modulus.
+    void writeJpeg(const std::string& name, int w, int h, std::size_t step, std::size_t modulus, bool progressive) {
+        OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
+        if (progressive) spec.attribute("jpeg:progressive", 1);
+        std::vector<unsigned char> pixels(std::size_t(w) * h * 3);
+        for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<unsigned char>((i * step) % modulus);
+        auto out = OIIO::ImageOutput::create(path(name));
+        ASSERT_TRUE(out && out->open(path(name), spec));
         ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
         out->close();
     }
+};
+
+TEST_F(JpegHostile, AJpegOfEndlessScansIsRefusedBeforeDecoding) {
+    ASSERT_NO_FATAL_FAILURE(writeJpeg("plain.jpg", 64, 48, 37, 251, true));
     const std::string jpeg = slurp(path("plain.jpg"));
     int scans = 0;
     for (std::size_t at = 0; (at = jpeg.find("\xFF\xDA", at)) != std::string::npos; ++at) ++scans;
@@ -51,7 +55,7 @@ TEST_F(JpegHostile, AJpegOfEndlessScansIsRefusedBeforeDecoding) {
     r = run({"heightfield", "encode", path("many.jpg"), "-o", path("t.exr"), "--size", "16x16"});
     expectRefused(r, "heightfield", "a JPEG of more than");
     EXPECT_FALSE(fs::exists(path("x.exr")) || fs::exists(path("t.exr")));
-    const std::string shared = (fs::path(CONUS_SHARED_DATA) / "hostile" / "round4" / "images" / "scans_2000.jpg").string();
+    const std::string shared = hostileData("round4/images/scans_2000.jpg");
     CONUS_REQUIRE(shared);
     r = run({"uniform", shared, "-o", path("x.exr")});
     expectRefused(r, "uniform", "a JPEG of more than");
@@ -77,15 +81,7 @@ std::string withIptc(const std::string& jpeg, int recordLength, std::uint32_t re
 }
 
 TEST_F(JpegHostile, AJpegWhoseIptcRecordsRunPastTheirSegmentIsRefused) {
-    {
-        OIIO::ImageSpec spec(40, 24, 3, OIIO::TypeDesc::UINT8);
-        std::vector<unsigned char> pixels(40 * 24 * 3);
-        for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<unsigned char>((i * 53) % 241);
-        auto out = OIIO::ImageOutput::create(path("base.jpg"));
-        ASSERT_TRUE(out && out->open(path("base.jpg"), spec));
-        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
-        out->close();
-    }
+    ASSERT_NO_FATAL_FAILURE(writeJpeg("base.jpg", 40, 24, 53, 241, false));
     const std::string jpeg = slurp(path("base.jpg"));
     write("fine.jpg", withIptc(jpeg, 9, 14));
     Outcome r = run({"uniform", path("fine.jpg"), "-o", path("fine.exr")});

@@ -19,9 +19,7 @@ using namespace conus::hostile;
 
 class ReaderHostile : public Hostile {
 protected:
-    static std::string round4(const std::string& name) {
-        return (fs::path(CONUS_SHARED_DATA) / "hostile" / "round4" / name).string();
-    }
+    static std::string round4(const std::string& name) { return hostileData(fs::path("round4") / name); }
     static std::string seed(const std::string& folder, const std::string& name) {
         return (fs::path(CONUS_FUZZ_CORPUS) / folder / name).string();
     }

@@ -14,9 +14,7 @@ using namespace conus::hostile;
 
 class SceneHostile : public Hostile {
 protected:
-    static std::string scene(const std::string& name) {
-        return (fs::path(CONUS_SHARED_DATA) / "hostile" / "scene" / name).string();
-    }
+    static std::string scene(const std::string& name) { return hostileData(fs::path("scene") / name); }
     // A glTF whose one buffer is `uri`: a triangle when the buffer holds three float32 corners.
     void writeGltf(const std::string& name, const std::string& uri) const {
         write(name, R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "scene": 0, "nodes": [{"mesh": 0}],

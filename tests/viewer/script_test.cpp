@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <initializer_list>
+#include <string>
+#include <utility>
+
 #include "conus/core/error.h"
 
 namespace conus::viewer {
@@ -27,44 +31,31 @@ TEST(Actions, ChordsParse) {
     EXPECT_FALSE(parseChord("Gee"));
 }
 
+// Each chord of `expected` does its action in `table` (Action::None: nothing).
+void expectActions(KeyTable table, std::initializer_list<std::pair<const char*, Action>> expected) {
+    for (const auto& [chord, action] : expected) EXPECT_EQ(actionFor(*parseChord(chord), table), action) << chord;
+}
+
 TEST(Actions, TheKeysTheIssueAsksFor) {
-    const auto act = [](const char* chord, bool editing = false) {
-        return actionFor(*parseChord(chord), editing ? KeyTable::Edit : KeyTable::View);
-    };
-    EXPECT_EQ(act("1"), Action::SourceResolution);  // 1 is 1:1, not a file number
-    EXPECT_EQ(act("F"), Action::Fit);
-    EXPECT_EQ(act("R"), Action::ModeRaw);
-    EXPECT_EQ(act("ctrl+R"), Action::Reload);
-    EXPECT_EQ(act("F5"), Action::Reload);
-    EXPECT_EQ(act("E"), Action::ExposureUp);
-    EXPECT_EQ(act("shift+E"), Action::ExposureDown);
-    EXPECT_EQ(act("E", true), Action::EncodeImage);
-    EXPECT_EQ(act("ctrl+S", true), Action::EncodeImage);
-    EXPECT_EQ(act("S", true), Action::SaveMap);
-    EXPECT_EQ(act("S"), Action::None);
-    EXPECT_EQ(act("Tab"), Action::NextFile);
-    EXPECT_EQ(act("shift+Tab"), Action::PreviousFile);
-    for (const char* key : {"C", "U", "W", "D", "G", "O", "H", "I", "+", "-", "Left"}) EXPECT_NE(act(key), Action::None) << key;
+    // 1 is 1:1, not a file number.
+    expectActions(KeyTable::View, {{"1", Action::SourceResolution}, {"F", Action::Fit}, {"R", Action::ModeRaw},
+                                   {"ctrl+R", Action::Reload}, {"F5", Action::Reload}, {"E", Action::ExposureUp},
+                                   {"shift+E", Action::ExposureDown}, {"S", Action::None}, {"Tab", Action::NextFile},
+                                   {"shift+Tab", Action::PreviousFile}, {"Z", Action::ToggleDepth}});
+    expectActions(KeyTable::Edit, {{"E", Action::EncodeImage}, {"ctrl+S", Action::EncodeImage}, {"S", Action::SaveMap}});
+    for (const char* key : {"C", "U", "W", "D", "G", "O", "H", "I", "+", "-", "Left"})
+        EXPECT_NE(actionFor(*parseChord(key), KeyTable::View), Action::None) << key;
     EXPECT_NE(helpText(KeyTable::View).find("G "), std::string::npos);
     EXPECT_NE(helpText(KeyTable::Edit).find("Ctrl-S"), std::string::npos);
-    EXPECT_EQ(act("Z"), Action::ToggleDepth);
 }
 
 // The 3-D modes orbit with the arrows and toggle CoNUS with U; the display keys of the frame stay,
 // the file and pan keys do not, and the help lists exactly what works.
 TEST(Actions, SceneKeys) {
-    const auto act = [](const char* chord) { return actionFor(*parseChord(chord), KeyTable::Scene); };
-    EXPECT_EQ(act("Left"), Action::OrbitLeft);
-    EXPECT_EQ(act("+"), Action::DollyIn);
-    EXPECT_EQ(act("U"), Action::ToggleConus);
-    EXPECT_EQ(act("N"), Action::AddFocus);
-    EXPECT_EQ(act("T"), Action::NextLook);
-    EXPECT_EQ(act("F"), Action::HomeCamera);
-    EXPECT_EQ(act("Z"), Action::ToggleDepth);
-    EXPECT_EQ(act("R"), Action::ModeRaw);
-    EXPECT_EQ(act("E"), Action::ExposureUp);
-    EXPECT_EQ(act("Tab"), Action::None);
-    EXPECT_EQ(act("W"), Action::None);
+    expectActions(KeyTable::Scene, {{"Left", Action::OrbitLeft}, {"+", Action::DollyIn}, {"U", Action::ToggleConus},
+                                    {"N", Action::AddFocus}, {"T", Action::NextLook}, {"F", Action::HomeCamera},
+                                    {"Z", Action::ToggleDepth}, {"R", Action::ModeRaw}, {"E", Action::ExposureUp},
+                                    {"Tab", Action::None}, {"W", Action::None}});
     const std::string help = helpText(KeyTable::Scene);
     EXPECT_NE(help.find("orbit"), std::string::npos);
     EXPECT_EQ(help.find("Tab"), std::string::npos);

@@ -28,16 +28,10 @@ constexpr int kWidth = 384, kHeight = 256;
 
 // Fine detail everywhere (noise and slanted waves), so that every sample the context loses costs.
 Image picture() {
-    const Image n = test::noise(kWidth, kHeight, {"R", "G", "B"}, 11);
-    Image im = makeImage(kWidth, kHeight, {"R", "G", "B"});
-    for (int y = 0; y < kHeight; ++y)
-        for (int x = 0; x < kWidth; ++x)
-            for (int c = 0; c < 3; ++c) {
-                const double wave = 0.5 + 0.5 * std::sin(0.23 * x + 0.11 * y + c);
-                im.pixels[(std::size_t(y) * kWidth + x) * 3 + c] =
-                    static_cast<float>(0.5 * n.pixels[(std::size_t(y) * kWidth + x) * 3 + c] + 0.5 * wave);
-            }
-    return im;
+    return test::fromNoise(kWidth, kHeight, 11, [](const Image& n, int x, int y, int c) {
+        const double wave = 0.5 + 0.5 * std::sin(0.23 * x + 0.11 * y + c);
+        return static_cast<float>(0.5 * n.at(x, y, c) + 0.5 * wave);
+    });
 }
 
 FociOptions optionsFor(double aspect) {

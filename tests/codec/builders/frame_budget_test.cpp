@@ -28,22 +28,15 @@ constexpr int kWidth = 384, kHeight = 256;
 // Detail everywhere, finer on the right than on the left, and a few slanted waves: a frame whose
 // context loses something at every floor, asymmetric so that a transposed map cannot pass.
 Image picture() {
-    const Image n = test::noise(kWidth, kHeight, {"R", "G", "B"}, 7);
-    Image im = makeImage(kWidth, kHeight, {"R", "G", "B"});
-    for (int y = 0; y < kHeight; ++y)
-        for (int x = 0; x < kWidth; ++x) {
-            const int radius = x < kWidth / 3 ? 2 : 1;
-            for (int c = 0; c < 3; ++c) {
-                double sum = 0;
-                int count = 0;
-                for (int j = -radius; j <= radius; ++j)
-                    for (int i = -radius; i <= radius; ++i, ++count)
-                        sum += n.pixels[(std::size_t(std::clamp(y + j, 0, kHeight - 1)) * kWidth + std::clamp(x + i, 0, kWidth - 1)) * 3 + c];
-                const double wave = 0.5 + 0.5 * std::sin(0.21 * x + 0.13 * y + c);
-                im.pixels[(std::size_t(y) * kWidth + x) * 3 + c] = static_cast<float>(0.6 * sum / count + 0.4 * wave);
-            }
-        }
-    return im;
+    return test::fromNoise(kWidth, kHeight, 7, [](const Image& n, int x, int y, int c) {
+        const int radius = x < kWidth / 3 ? 2 : 1;
+        double sum = 0;
+        int count = 0;
+        for (int j = -radius; j <= radius; ++j)
+            for (int i = -radius; i <= radius; ++i, ++count) sum += n.at(std::clamp(x + i, 0, kWidth - 1), std::clamp(y + j, 0, kHeight - 1), c);
+        const double wave = 0.5 + 0.5 * std::sin(0.21 * x + 0.13 * y + c);
+        return static_cast<float>(0.6 * sum / count + 0.4 * wave);
+    });
 }
 
 // 1 on two boxes (the regions of interest), 0 elsewhere.

@@ -18,14 +18,7 @@ namespace {
 
 // The eye placed for a viewpoint: a plane mirror z = 0 facing +z before the occluder and the wall
 // (test::boxBeforeWall), seen from beside and above.
-Reflector mirrorBeforeOccluder() {
-    Reflector r;
-    r.kind = Reflector::Kind::Plane;
-    r.centre = {0.0, 0.0, 0.0};
-    r.normal = {0.0, 0.0, 1.0};
-    r.radius = 1.0;
-    return r;
-}
+Reflector mirrorBeforeOccluder() { return test::planeMirrorZ(1.0); }
 const glm::dvec3 kViewpoint(0.6, 0.35, 1.1);
 
 double distanceToLine(glm::dvec3 p, const Ray& ray) {

@@ -27,10 +27,7 @@ Mesh stripedFloor(float repeat) {
 }
 ReflectionFrameOptions mirrorOptions(int samples) {
     ReflectionFrameOptions o;
-    o.reflector.kind = Reflector::Kind::Plane;
-    o.reflector.centre = {0.0, 0.0, 0.0};
-    o.reflector.normal = {0.0, 0.0, 1.0};
-    o.reflector.radius = 1.0;
+    o.reflector = test::planeMirrorZ(1.0);
     o.samples = samples;
     o.threads = 1;
     return o;

@@ -24,14 +24,7 @@ const glm::dvec3 kEye(-1.2, 0.1, 3.0);
 
 glm::dvec3 mirrorZ(glm::dvec3 p) { return {p.x, p.y, -p.z}; }
 
-Reflector planeMirror() {
-    Reflector r;
-    r.kind = Reflector::Kind::Plane;
-    r.centre = {0.0, 0.0, 0.0};
-    r.normal = {0.0, 0.0, 1.0};
-    r.radius = 3.0;
-    return r;
-}
+Reflector planeMirror() { return test::planeMirrorZ(3.0); }
 
 std::vector<ReflectionFace> bakeBox(int size, bool uniform) {
     static const MeshScene scene(flatBox(glm::vec3(kBoxLo), glm::vec3(kBoxHi)));

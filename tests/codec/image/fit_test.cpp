@@ -34,12 +34,14 @@ double dot(const Image& a, const Image& b) {
     return sum;
 }
 
-DecodeOptions sourceView(const Image& source) {
+// The decode of the whole frame at width x height; sourceView: at the source's size.
+DecodeOptions viewOf(int width, int height) {
     DecodeOptions d;
-    d.width = source.width;
-    d.height = source.height;
+    d.width = width;
+    d.height = height;
     return d;
 }
+DecodeOptions sourceView(const Image& source) { return viewOf(source.width, source.height); }
 
 // Magnified (the view finer than the CoNUS image everywhere) and minified in the foci (several
 // taps per output pixel there): the CoNUS size against a 300x200 view.
@@ -59,9 +61,7 @@ TEST(Fit, ForwardIsTheDecoder) {
     const SamplingMap map = twoFoci(1.5);
     for (const Case& c : kCases) {
         const Image sized = caseNoise(c, c.conusWidth, c.conusHeight, 3);
-        DecodeOptions d;
-        d.width = 300;
-        d.height = 200;
+        const DecodeOptions d = viewOf(300, 200);
         const Image decoded = decodeImage(sized, map, d);
         const Image forward = detail::fitForward(sized, map, 300, 200, 2);
         EXPECT_LT(test::maxAbsDifference(decoded, forward), 2e-5f) << c.conusWidth << "x" << c.conusHeight;
@@ -93,9 +93,7 @@ TEST(Fit, BandsOfTheViewAreTheWholeViewsRows) {
     const SamplingMap map = twoFoci(1.5);
     for (const Case& c : kCases) {
         const Image x = caseNoise(c, c.conusWidth, c.conusHeight, 9);
-        DecodeOptions d;
-        d.width = 300;
-        d.height = 200;
+        const DecodeOptions d = viewOf(300, 200);
         const Image decoded = decodeImage(x, map, d), resized = resizeBilinear(x, View{}, 300, 200);
         Image bands = decoded, flat = resized;
         std::fill(bands.pixels.begin(), bands.pixels.end(), -1.0f);

@@ -1,5 +1,5 @@
 // Scenes for the mesh reference's tests: cameras, an FPC with an off-centre focus, a box with flat
-// faces, a textured plane, and the analytic intersections they are checked against.
+// faces, a textured plane, a plane mirror, and the analytic intersections they are checked against.
 #pragma once
 
 #include <cmath>
@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "conus/codec/builders/foci.h"
+#include "conus/codec/depth/reflection.h"
 #include "conus/core/fpc.h"
 #include "conus/core/mesh.h"
 #include "sceneio/test_meshes.h"
@@ -132,6 +133,16 @@ inline std::optional<BoxHit> hitBox(const Ray& ray, glm::dvec3 lo, glm::dvec3 hi
     }
     if (tEnter > tExit || tEnter < 0) return std::nullopt;
     return BoxHit{tEnter, axis};
+}
+
+// A square plane mirror z = 0 facing +z, centred on the origin, of half side `halfSide`.
+inline Reflector planeMirrorZ(double halfSide) {
+    Reflector r;
+    r.kind = Reflector::Kind::Plane;
+    r.centre = {0.0, 0.0, 0.0};
+    r.normal = {0.0, 0.0, 1.0};
+    r.radius = halfSide;
+    return r;
 }
 
 }  // namespace conus::codec::test
