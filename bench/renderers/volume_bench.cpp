@@ -175,23 +175,20 @@ void BM_VolumeGpuConusOverConventionalPaired(benchmark::State& state) {
     state.SetLabel(filled ? "filled" : "framed");
 }
 
-void BM_VolumeGpuConventional(benchmark::State& state) { runGpu(state, false); }
-void BM_VolumeGpuConus(benchmark::State& state) { runGpu(state, true); }
-void BM_VolumeCpuConventional(benchmark::State& state) { runCpu(state, false); }
-void BM_VolumeCpuConus(benchmark::State& state) { runCpu(state, true); }
-void BM_VolumeGpuConventionalFilled(benchmark::State& state) { runGpu(state, false, true); }
-void BM_VolumeGpuConusFilled(benchmark::State& state) { runGpu(state, true, true); }
-void BM_VolumeCpuConventionalFilled(benchmark::State& state) { runCpu(state, false, true); }
-void BM_VolumeCpuConusFilled(benchmark::State& state) { runCpu(state, true, true); }
-
 }  // namespace
 
 BENCHMARK(BM_VolumeGpuConusOverConventionalPaired)->Arg(0)->Arg(1)->Iterations(21)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_VolumeGpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_VolumeGpuConus)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_VolumeCpuConventional)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_VolumeCpuConus)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_VolumeGpuConventionalFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_VolumeGpuConusFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_VolumeCpuConventionalFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_VolumeCpuConusFilled)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The frames, each way: BM_Volume{Gpu,Cpu}{Conventional,Conus}, then the same with Filled; in
+// milliseconds of wall clock.
+static const bool kFrameBenches = [] {
+    for (const bool filled : {false, true})
+        for (const bool gpu : {true, false})
+            for (const bool conus : {false, true}) {
+                const std::string name =
+                    std::string("BM_Volume") + (gpu ? "Gpu" : "Cpu") + (conus ? "Conus" : "Conventional") + (filled ? "Filled" : "");
+                benchmark::RegisterBenchmark(name.c_str(), gpu ? runGpu : runCpu, conus, filled)
+                    ->Unit(benchmark::kMillisecond)
+                    ->UseRealTime();
+            }
+    return true;
+}();
