@@ -135,6 +135,21 @@ TEST(Fit, AssembledNormalEquationsAreDtD) {
     EXPECT_GT(mostWide, 0u);
 }
 
+// The fit of `encoded` as fitToDecoder chooses to make it, and as the forced walk of the taps.
+struct FitBothWays {
+    Image usualImage, walkedImage;
+    FitResult usual, walked;
+    FitBothWays(const Image& source, const SamplingMap& map, const Image& encoded, int iterations)
+        : usualImage(encoded), walkedImage(encoded) {
+        FitOptions f;
+        f.iterations = iterations;
+        usual = fitToDecoder(source, map, usualImage, f);
+        detail::forceFitPasses(true);
+        walked = fitToDecoder(source, map, walkedImage, f);
+        detail::forceFitPasses(false);
+    }
+};
+
 // A CoNUS image squeezed across (the view minifies it about 1.9x along x and magnifies it 2.2x
 // along y): most output pixels' taps reach past a 2x2 block, several output rows a CoNUS row, more
 // wide rows than the assembly keeps. The assembly is abandoned part way and the fit walks the taps
@@ -147,17 +162,12 @@ TEST(Fit, AnAbandonedAssemblyWalksTheTaps) {
     e.height = 90;
     const Image encoded = encodeImage(source, map, e);
     EXPECT_THROW(detail::fitNormalProduct(encoded, map, 300, 200), Error);
-    Image fallen = encoded, walked = encoded;
-    FitOptions f;
-    f.iterations = 2;
-    const FitResult a = fitToDecoder(source, map, fallen, f);
-    detail::forceFitPasses(true);
-    const FitResult w = fitToDecoder(source, map, walked, f);
-    detail::forceFitPasses(false);
+    const FitBothWays fits(source, map, encoded, 2);
+    const FitResult &a = fits.usual, &w = fits.walked;
     ASSERT_EQ(a.steps.size(), w.steps.size());
     for (std::size_t i = 0; i < a.steps.size(); ++i) EXPECT_EQ(a.steps[i].psnr, w.steps[i].psnr) << i;
-    EXPECT_EQ(test::maxAbsDifference(fallen, walked), 0.0f);
-    EXPECT_GT(test::maxAbsDifference(fallen, encoded), 1e-3f);  // the fit moved the pixels
+    EXPECT_EQ(test::maxAbsDifference(fits.usualImage, fits.walkedImage), 0.0f);
+    EXPECT_GT(test::maxAbsDifference(fits.usualImage, encoded), 1e-3f);  // the fit moved the pixels
     EXPECT_GT(a.steps.back().psnr, a.steps[0].psnr);
 }
 
@@ -173,13 +183,8 @@ TEST(Fit, AssembledFitMatchesThePasses) {
         const Image encoded = encodeImage(source, map, e);
         std::size_t wide = 0;
         detail::fitNormalProduct(encoded, map, 300, 200, &wide);  // throws where the fit would not assemble
-        Image assembled = encoded, walked = encoded;
-        FitOptions f;
-        f.iterations = 3;
-        const FitResult a = fitToDecoder(source, map, assembled, f);
-        detail::forceFitPasses(true);
-        const FitResult w = fitToDecoder(source, map, walked, f);
-        detail::forceFitPasses(false);
+        const FitBothWays fits(source, map, encoded, 3);
+        const FitResult &a = fits.usual, &w = fits.walked;
         ASSERT_EQ(a.steps.size(), w.steps.size());
         EXPECT_NEAR(a.steps[0].psnr, w.steps[0].psnr, 1e-3);
         // Magnified, the two are the same iterations. Minified (wide rows), the walk's Jacobi
@@ -190,7 +195,7 @@ TEST(Fit, AssembledFitMatchesThePasses) {
             else EXPECT_GT(a.steps[i].psnr, w.steps[i].psnr - 0.02) << i;
         }
         EXPECT_GT(a.steps.back().psnr, a.steps[0].psnr + 0.3);
-        const double decoded = psnr(decodeImage(assembled, map, sourceView(source)), source);
+        const double decoded = psnr(decodeImage(fits.usualImage, map, sourceView(source)), source);
         EXPECT_NEAR(decoded, a.steps.back().psnr, 0.01) << c.conusWidth << "x" << c.conusHeight;
         std::printf("[ info ] %dx%d (%zu wide rows): assembled %.3f dB, walked %.3f dB\n", c.conusWidth, c.conusHeight, wide,
                     a.steps.back().psnr, w.steps.back().psnr);
