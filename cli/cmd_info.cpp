@@ -354,17 +354,17 @@ int runInfo(const InfoOptions& o) {
     if (!o.densityPng.empty()) checkPictureOutput(o.densityPng, {}, {o.input});  // before the file is read
     if (o.verbose) explainIfInvalid(o.input);
     if (format::isReflectionAsset(o.input)) return printReflectionAsset(o);
-    // Not OpenEXR: a mesh file when Assimp reads it; otherwise the CoNUS reader says what is wrong.
+    // Not OpenEXR: a mesh file when Assimp reads it; otherwise both readers' reasons.
     if (std::filesystem::is_regular_file(o.input) && !isExr(o.input)) {
-        std::optional<Mesh> mesh;
+        Mesh mesh;
         try {
             mesh = sceneio::readMesh(o.input);
-        } catch (const Error&) {
+        } catch (const Error& e) {
+            throw Error(e.code(), o.input + " is not an OpenEXR file (what CoNUS files and assets are), nor a mesh file this tool reads: " +
+                                      e.what());
         }
-        if (mesh) {
-            if (!o.densityPng.empty()) throw Error(ErrorCode::InvalidArgument, "--density draws a CoNUS file's map; " + o.input + " is a mesh");
-            return printMesh(o, *mesh);
-        }
+        if (!o.densityPng.empty()) throw Error(ErrorCode::InvalidArgument, "--density draws a CoNUS file's map; " + o.input + " is a mesh");
+        return printMesh(o, mesh);
     }
     const FileFacts facts = readFacts(o.input);
     nlohmann::ordered_json j = toJson(o.input, facts);

@@ -2,9 +2,11 @@
 // element counts up front, and Assimp allocates by them.
 #include <algorithm>
 #include <cctype>
+#include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "conus/core/limits.h"
 #include "extension_pvt.h"
@@ -25,6 +27,29 @@ void checkPlyLine(const std::string& path, const std::string& keyword, std::istr
                         ? (a == "ascii" || a == "binary_little_endian" || a == "binary_big_endian") && b == "1.0" && c.empty()
                         : a == "list" ? kTypes.count(b) && kTypes.count(c) && !d.empty() : kTypes.count(a) && !b.empty() && c.empty();
     if (!ok) fail(ErrorCode::Corrupt, path, "its PLY header has a " + keyword + " line the format does not define");
+}
+
+// Assimp's OFF reader copies each line into a buffer of kAssimpLineBuffer characters and ends it
+// one past the end; the rest of a longer line is read as the next lines (a 13 KB vertex line made
+// it read faces out of the vertex text and crash). Its line ends are CR, LF, form feed and NUL.
+constexpr std::size_t kAssimpLineBuffer = 4096;
+void checkOffLineLengths(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<char> block(1 << 16);
+    std::size_t run = 0, line = 1;
+    while (in) {
+        in.read(block.data(), static_cast<std::streamsize>(block.size()));
+        for (std::streamsize i = 0; i < in.gcount(); ++i) {
+            const char c = block[std::size_t(i)];
+            if (c == '\n' || c == '\r' || c == '\f' || c == '\0') {
+                if (c == '\n') ++line;
+                run = 0;
+            } else if (++run >= kAssimpLineBuffer) {
+                fail(ErrorCode::Corrupt, path, "its line " + std::to_string(line) + " is longer than the " +
+                                                   std::to_string(kAssimpLineBuffer - 1) + " characters an OFF line may have");
+            }
+        }
+    }
 }
 
 }  // namespace
@@ -81,7 +106,11 @@ void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
     }
     const std::string ext = lowerExtension(path);
     const bool keyword = !tokens.empty() && tokens[0].size() >= 3 && tokens[0].compare(tokens[0].size() - 3, 3, "OFF") == 0;
-    if (!keyword && ext != ".off") return;
+    // Assimp's OFF reader also takes any file that starts with the letters, in either case.
+    std::string magic = tokens.empty() ? std::string() : tokens[0].substr(0, 3);
+    for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (!keyword && ext != ".off" && magic != "off") return;
+    checkOffLineLengths(path);
     const std::size_t first = keyword ? 1 : 0;
     if (tokens.size() < first + 2) return;  // Assimp refuses what has no counts
     long double counts[2] = {0, 0};

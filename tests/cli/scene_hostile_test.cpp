@@ -176,6 +176,29 @@ TEST_F(SceneHostile, AnOffFaceCountPastTheFileIsRefusedAtOnce) {
     expectRefused(r, "render", "faces in a file of");
 }
 
+// Assimp's OFF reader copies a line into 4096 characters and reads the rest of a longer line as
+// the next ones: the fuzzer's 13 KB file (a vertex line that runs on) crashed `conus info` and
+// every command that reads a mesh. Lines of 4096 characters or more are refused first; 4095 read.
+TEST_F(SceneHostile, AnOffLineLongerThanAssimpsBufferIsRefused) {
+    const std::string found = (fs::path(CONUS_FUZZ_CORPUS) / "mesh" / "found-off-long-line.off").string();
+    write("runs-on.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0" + std::string(13000, 'x') + "\n3 0 1 2\n");
+    write("at-4096.off", "OFF\n3 1 0\n0 0 0" + std::string(4096 - 5, ' ') + "\n1 0 0\n0 1 0\n3 0 1 2\n");
+    for (const std::string& file : {found, path("runs-on.off"), path("at-4096.off")}) {
+        SCOPED_TRACE(file);
+        Outcome r = run({"info", file});
+        expectRefused(r, "info", "characters an OFF line may have");
+        EXPECT_TRUE(contains(r.err, "is not an OpenEXR file")) << r.err;
+        r = run({"render", "mesh", file, "-o", path("x.exr"), "--size", "32x32"});
+        expectRefused(r, "render", "characters an OFF line may have");
+        expectBounded(r, 400);
+        EXPECT_FALSE(fs::exists(path("x.exr")));
+    }
+    write("at-4095.off", "OFF\n3 1 0\n0 0 0" + std::string(4095 - 5, ' ') + "\n1 0 0\n0 1 0\n3 0 1 2\n");
+    const Outcome r = run({"info", path("at-4095.off")});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(contains(r.out, "mesh, 1 triangles, 3 vertices")) << r.out;
+}
+
 TEST_F(SceneHostile, AnNpzBombIsRefusedBeforeInflating) {
     const std::string file = scene("npz_bomb_1GiB.npz");
     CONUS_REQUIRE(file);
