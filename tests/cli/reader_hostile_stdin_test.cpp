@@ -4,6 +4,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <fstream>
 
 #include "hostile_fixture.h"
 
@@ -40,6 +41,38 @@ TEST_F(StdinHostile, EndlessOrForeignStreamsAreRefusedAtOnce) {
     expectMemory(r, 300);
     EXPECT_LT(r.seconds, 20.0 * conus::testing::kTimeScale);
     EXPECT_FALSE(fs::exists(path("out")) && !fs::is_empty(path("out")));
+}
+
+// A stream that starts like a picture and never ends (a header, then gigabytes of zeros: a sparse
+// file here) is refused once it runs past what its header's picture can take, without keeping
+// more; a picture of each kind piped in whole still reads.
+TEST_F(StdinHostile, APictureHeaderFollowedByEndlessBytesIsRefusedByWhatItDeclares) {
+    std::vector<unsigned char> ramp(std::size_t(40) * 30 * 3);
+    for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = static_cast<unsigned char>(i * 7 % 251);
+    for (const char* ext : {"png", "jpg", "bmp", "ppm"}) {
+        SCOPED_TRACE(ext);
+        const std::string picture = path(std::string("ramp.") + ext);
+        {
+            auto out = OIIO::ImageOutput::create(picture);
+            ASSERT_TRUE(out);
+            ASSERT_TRUE(out->open(picture, OIIO::ImageSpec(40, 30, 3, OIIO::TypeDesc::UINT8)));
+            ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, ramp.data()));
+            out->close();
+        }
+        Outcome r = runTool("conus", {"uniform", "-", "-o", path("piped.exr"), "--size", "20x15"}, picture);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        // The same file's first 200 bytes (its header), then zeros up to 6 GiB, read by no disk.
+        std::string head(200, '\0');
+        std::ifstream(picture, std::ios::binary).read(head.data(), std::streamsize(head.size()));
+        const std::string endless = path(std::string("endless.") + ext);
+        std::ofstream(endless, std::ios::binary).write(head.data(), std::streamsize(head.size()));
+        fs::resize_file(endless, std::uintmax_t{6} << 30);
+        r = runTool("conus", {"encode", "-", "-o", path("x.exr"), "--size", "16x12"}, endless);
+        expectRefused(r, "encode", "a 40x30");
+        EXPECT_TRUE(contains(r.err, "can take")) << r.err;
+        expectMemory(r, 400);
+        EXPECT_FALSE(fs::exists(path("x.exr")));
+    }
 }
 
 TEST_F(StdinHostile, APicturePipedInIsReadAsFromItsFile) {
