@@ -52,6 +52,77 @@ void checkOffLineLengths(const std::string& path) {
     }
 }
 
+// Assimp's OFF reader drops a face whose corner count is 0 or past 9 by lowering the mesh's face
+// count and moving on: where it drops them all, the mesh has no faces and Assimp reads past its
+// arrays (a fuzzer's 80-byte file crashed every command). The face lines are found as it finds
+// them (the header's tokens, comment lines skipped; then one line a vertex and one a face, blank
+// lines skipped) and each must start with a count of 1 to 9.
+void checkOffFaceCorners(const std::string& path, std::uintmax_t bytes) {
+    std::string text(static_cast<std::size_t>(bytes), '\0');
+    std::ifstream(path, std::ios::binary).read(text.data(), static_cast<std::streamsize>(text.size()));
+    const char* at = text.c_str();
+    const char* end = at + text.size();
+    const auto isLineEnd = [](char c) { return c == '\r' || c == '\n' || c == '\0' || c == '\f'; };
+    const auto skipLine = [&] {
+        while (at < end && *at != '\r' && *at != '\n' && *at != '\0') ++at;
+        while (at < end && (*at == '\r' || *at == '\n')) ++at;
+    };
+    const auto nextToken = [&] {
+        while (at < end && (*at == ' ' || *at == '\t' || *at == '\r' || *at == '\n')) ++at;
+        while (at < end && (*at == '#' || *at == '\n' || *at == '\r')) {
+            skipLine();
+            while (at < end && (*at == ' ' || *at == '\t' || *at == '\r' || *at == '\n')) ++at;
+        }
+    };
+    const auto number = [&] {
+        std::uintmax_t v = 0;
+        while (at < end && *at >= '0' && *at <= '9') v = std::min<std::uintmax_t>(v * 10 + std::uintmax_t(*at++ - '0'), 1u << 31);
+        return v;
+    };
+    nextToken();
+    if (end - at > 2 && at[0] == 'S' && at[1] == 'T') at += 2;
+    for (const char letter : {'C', 'N', '4'})
+        if (end - at > 1 && *at == letter) ++at;
+    const bool dimension = end - at > 1 && *at == 'n';
+    if (dimension) ++at;
+    if (end - at > 3 && std::equal(at, at + 3, "OFF")) at += 3;
+    nextToken();
+    if (dimension) {
+        number();
+        nextToken();
+    }
+    nextToken();
+    const std::uintmax_t vertices = number();
+    nextToken();
+    const std::uintmax_t faces = number();
+    nextToken();
+    number();
+    nextToken();
+    if (vertices == 0 || faces == 0) return;  // Assimp refuses the file itself
+    // GetNextLine: the text to the next line end, then every line end after it.
+    const auto nextLine = [&] {
+        if (at >= end || *at == '\0') return false;
+        const char* start = at;
+        while (at < end && !isLineEnd(*at)) ++at;
+        const char* lineEnd = at;
+        while (at < end && isLineEnd(*at) && *at != '\0') ++at;
+        return lineEnd >= start;
+    };
+    for (std::uintmax_t v = 0; v < vertices; ++v)
+        if (!nextLine()) return;  // too few lines: Assimp says so
+    for (std::uintmax_t f = 0; f < faces; ++f) {
+        const char* line = at;
+        if (!nextLine()) return;
+        const char* sz = line;
+        while (*sz == ' ' || *sz == '\t') ++sz;
+        std::uintmax_t corners = 0;
+        while (*sz >= '0' && *sz <= '9' && corners < 10) corners = corners * 10 + std::uintmax_t(*sz++ - '0');
+        if (corners == 0 || corners > 9)
+            fail(ErrorCode::Corrupt, path, "its OFF face " + std::to_string(f + 1) +
+                                               " does not start with a corner count of 1 to 9");
+    }
+}
+
 }  // namespace
 
 // PLY headers declare their element counts up front and Assimp reserves memory for them before
@@ -111,6 +182,7 @@ void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
     for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (!keyword && ext != ".off" && magic != "off") return;
     checkOffLineLengths(path);
+    checkOffFaceCorners(path, bytes);
     const std::size_t first = keyword ? 1 : 0;
     if (tokens.size() < first + 2) return;  // Assimp refuses what has no counts
     long double counts[2] = {0, 0};
