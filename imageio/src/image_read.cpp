@@ -349,6 +349,16 @@ void checkDdsHeader(const unsigned char* bytes, std::size_t size, const std::str
         for (const auto& m : masks)
             if (m.used && m.mask == 0)
                 throw Error(ErrorCode::Corrupt, shown + ": a DDS whose pixel format gives its " + m.channel + " channel no bits");
+        // Nor one whose pixels take no bits (a 151-byte file with an alpha mask and 0 bits a pixel),
+        // or a mask past the pixel's bits: whole bytes, 8 to 32 bits a pixel, are what the format has.
+        const std::uint32_t bits = u32(88);
+        if (bits == 0 || bits > 32 || bits % 8 != 0)
+            throw Error(ErrorCode::Corrupt, shown + ": a DDS whose pixel format says " + std::to_string(bits) +
+                                                " bits a pixel (8, 16, 24 or 32 are what it may hold)");
+        for (const auto& m : masks)
+            if (m.used && bits < 32 && (m.mask >> bits) != 0)
+                throw Error(ErrorCode::Corrupt, shown + ": a DDS whose " + m.channel + " mask reaches past its " +
+                                                    std::to_string(bits) + " bits a pixel");
     }
 }
 

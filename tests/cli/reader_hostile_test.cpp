@@ -151,6 +151,51 @@ TEST_F(ReaderHostile, ADdsChannelWithoutBitsIsRefusedFromItsHeader) {
     }
 }
 
+// An uncompressed DDS whose pixels take no bits, or bits that are no whole bytes, or a mask past
+// them: OpenImageIO's reader never finished the first (found by the image harness: a 151-byte file
+// with an alpha mask and 0 bits a pixel held `conus uniform` and oiiotool alike). The header
+// refuses them; 16-bit 5:6:5 pixels still read.
+TEST_F(ReaderHostile, ADdsPixelWithoutWholeBytesIsRefusedFromItsHeader) {
+    write("found.dds", slurp(seed("image", "found-dds-zero-bits-oiio-hang")).substr(1));
+    const struct {
+        const char* file;
+        std::uint32_t bits, alphaMask;
+        const char* reason;
+    } cases[] = {{"found.dds", 0, 0, "says 0 bits a pixel"},
+                 {"bits0.dds", 0, 0xff000000, "says 0 bits a pixel"},
+                 {"bits12.dds", 12, 0x00000f00, "says 12 bits a pixel"},
+                 {"wide_alpha.dds", 16, 0xff000000, "alpha mask reaches past its 16 bits a pixel"}};
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.file);
+        if (std::string(c.file) != "found.dds") {
+            std::string bytes = dds(8, 4, 1, false);
+            put32(bytes, 88, c.bits);
+            put32(bytes, 92, 0xf800);
+            put32(bytes, 96, 0x07e0);
+            put32(bytes, 100, 0x001f);
+            put32(bytes, 104, c.alphaMask);
+            write(c.file, bytes);
+        }
+        Outcome r = run({"uniform", path(c.file), "-o", path("x.exr")});
+        expectRefused(r, "uniform", c.reason);
+        expectMemory(r, 300);
+        r = runTool("conus", {"uniform", "-", "-o", path("x.exr")}, path(c.file));  // standard input
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_FALSE(fs::exists(path("x.exr")));
+    }
+    std::string rgb565 = dds(8, 4, 1, false);
+    put32(rgb565, 80, 0x40);  // RGB, no alpha
+    put32(rgb565, 88, 16);
+    put32(rgb565, 92, 0xf800);
+    put32(rgb565, 96, 0x07e0);
+    put32(rgb565, 100, 0x001f);
+    put32(rgb565, 104, 0);
+    write("rgb565.dds", rgb565);
+    const Outcome r = run({"uniform", path("rgb565.dds"), "-o", path("flat.exr")});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(contains(r.out, "of a 8x4 source")) << r.out;
+}
+
 // A model whose material names the volume texture: the mesh read refuses it, through render,
 // bake and the viewer.
 TEST_F(ReaderHostile, AVolumeTextureNamedByAMeshIsRefused) {
