@@ -52,12 +52,13 @@ void checkOffLineLengths(const std::string& path) {
     }
 }
 
-// Assimp's OFF reader drops a face whose corner count is 0 or past 9 by lowering the mesh's face
-// count and moving on: where it drops them all, the mesh has no faces and Assimp reads past its
-// arrays (a fuzzer's 80-byte file crashed every command). The face lines are found as it finds
-// them (the header's tokens, comment lines skipped; then one line a vertex and one a face, blank
-// lines skipped) and each must start with a count of 1 to 9.
-void checkOffFaceCorners(const std::string& path, std::uintmax_t bytes) {
+// An OFF file read as Assimp reads it: the header's tokens (comment lines skipped; letters before
+// "OFF", and counts glued to it, as it takes them; each count an unsigned 32-bit number that wraps),
+// then one line a vertex and one a face (blank lines skipped). Its counts must fit the file and the
+// caps, and each face line must start with a corner count of 1 to 9: Assimp drops other faces by
+// lowering the mesh's face count, and where it drops them all it reads past its arrays (a fuzzer's
+// 80-byte file crashed every command).
+void checkOffBody(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
     std::string text(static_cast<std::size_t>(bytes), '\0');
     std::ifstream(path, std::ios::binary).read(text.data(), static_cast<std::streamsize>(text.size()));
     const char* at = text.c_str();
@@ -74,9 +75,9 @@ void checkOffFaceCorners(const std::string& path, std::uintmax_t bytes) {
             while (at < end && (*at == ' ' || *at == '\t' || *at == '\r' || *at == '\n')) ++at;
         }
     };
-    const auto number = [&] {
-        std::uintmax_t v = 0;
-        while (at < end && *at >= '0' && *at <= '9') v = std::min<std::uintmax_t>(v * 10 + std::uintmax_t(*at++ - '0'), 1u << 31);
+    const auto number = [&] {  // strtoul10: an unsigned 32-bit value, wrapping as it goes
+        std::uint32_t v = 0;
+        while (at < end && *at >= '0' && *at <= '9') v = v * 10u + std::uint32_t(*at++ - '0');
         return v;
     };
     nextToken();
@@ -92,13 +93,27 @@ void checkOffFaceCorners(const std::string& path, std::uintmax_t bytes) {
         nextToken();
     }
     nextToken();
-    const std::uintmax_t vertices = number();
+    const std::uint32_t vertices = number();
     nextToken();
-    const std::uintmax_t faces = number();
+    const std::uint32_t faces = number();
     nextToken();
     number();
     nextToken();
     if (vertices == 0 || faces == 0) return;  // Assimp refuses the file itself
+    // Assimp allocates by the counts before reading a vertex (a 139-byte file asked for 61 GB): a
+    // count no file of this size can hold (a vertex takes at least 6 bytes, a face 8) or one past
+    // the caps is refused first.
+    const char* names[2] = {"vertices", "faces"};
+    const std::uintmax_t counts[2] = {vertices, faces}, leastBytes[2] = {6, 8};
+    const std::int64_t caps[2] = {options.maxVertices, options.maxTriangles};
+    for (int i = 0; i < 2; ++i) {
+        if (counts[i] * leastBytes[i] > bytes)
+            fail(ErrorCode::Corrupt, path, "its OFF header declares " + std::to_string(counts[i]) + " " + names[i] +
+                                               " in a file of " + std::to_string(bytes) + " bytes");
+        if (counts[i] > std::uintmax_t(caps[i]))
+            fail(ErrorCode::LimitExceeded, path, "its OFF header declares " + std::to_string(counts[i]) + " " + names[i] +
+                                                     ", more than the limit of " + std::to_string(caps[i]));
+    }
     // GetNextLine: the text to the next line end, then every line end after it.
     const auto nextLine = [&] {
         if (at >= end || *at == '\0') return false;
@@ -163,44 +178,21 @@ void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
     fail(ErrorCode::Corrupt, path, "its PLY header has no end_header line");
 }
 
-// OFF files declare their vertex and face counts in the first line after the keyword, and Assimp
-// allocates the faces by the count before reading one (a 139-byte file asked for 61 GB): a count no
-// file of this size can hold (a vertex takes at least 6 bytes, a face 8) or one past the caps is
-// refused here.
+// OFF files: Assimp's reader takes any file whose name ends in .off or whose first token ends in
+// OFF (or starts with the letters, in either case); those are checked as it reads them.
 void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
     std::ifstream in(path, std::ios::binary);
-    std::string token;
-    std::vector<std::string> tokens;
-    for (std::string line; tokens.size() < 4 && std::getline(in, line) && in.tellg() < 65536;) {
+    std::string first;
+    for (std::string line; first.empty() && std::getline(in, line) && in.tellg() < 65536;) {
         std::istringstream words(line.substr(0, line.find('#')));
-        while (tokens.size() < 4 && words >> token) tokens.push_back(token);
+        words >> first;
     }
-    const std::string ext = lowerExtension(path);
-    const bool keyword = !tokens.empty() && tokens[0].size() >= 3 && tokens[0].compare(tokens[0].size() - 3, 3, "OFF") == 0;
-    // Assimp's OFF reader also takes any file that starts with the letters, in either case.
-    std::string magic = tokens.empty() ? std::string() : tokens[0].substr(0, 3);
+    std::string magic = first.substr(0, 3);
     for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (!keyword && ext != ".off" && magic != "off") return;
+    const bool keyword = first.size() >= 3 && first.compare(first.size() - 3, 3, "OFF") == 0;
+    if (!keyword && lowerExtension(path) != ".off" && magic != "off") return;
     checkOffLineLengths(path);
-    checkOffFaceCorners(path, bytes);
-    const std::size_t first = keyword ? 1 : 0;
-    if (tokens.size() < first + 2) return;  // Assimp refuses what has no counts
-    long double counts[2] = {0, 0};
-    for (int i = 0; i < 2; ++i) {
-        std::istringstream number(tokens[first + std::size_t(i)]);
-        if (!(number >> counts[i])) return;  // not a count: Assimp refuses it itself
-    }
-    const char* names[2] = {"vertices", "faces"};
-    const long double leastBytes[2] = {6, 8};
-    const std::int64_t caps[2] = {options.maxVertices, options.maxTriangles};
-    for (int i = 0; i < 2; ++i) {
-        if (counts[i] * leastBytes[i] > static_cast<long double>(bytes))
-            fail(ErrorCode::Corrupt, path, "its OFF header declares " + numberText(double(counts[i])) + " " + names[i] +
-                                               " in a file of " + std::to_string(bytes) + " bytes");
-        if (counts[i] > static_cast<long double>(caps[i]))
-            fail(ErrorCode::LimitExceeded, path, "its OFF header declares " + numberText(double(counts[i])) + " " +
-                                                     names[i] + ", more than the limit of " + std::to_string(caps[i]));
-    }
+    checkOffBody(path, bytes, options);
 }
 
 }  // namespace conus::sceneio

@@ -44,7 +44,8 @@ private:
 // PLY headers: their format and property lines as the spec has them, and element counts that a
 // file of `bytes` can hold within the caps; a no-op for other files.
 void checkPlyCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options);
-// OFF files: their vertex and face counts, likewise; a no-op for other files.
+// OFF files, as Assimp reads them: lines within its buffer, counts the file can hold within the
+// caps, and faces it keeps; a no-op for other files.
 void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options);
 
 }  // namespace conus::sceneio
