@@ -359,6 +359,13 @@ void checkDdsHeader(const unsigned char* bytes, std::size_t size, const std::str
             if (m.used && bits < 32 && (m.mask >> bits) != 0)
                 throw Error(ErrorCode::Corrupt, shown + ": a DDS whose " + m.channel + " mask reaches past its " +
                                                     std::to_string(bits) + " bits a pixel");
+        // Alpha beside colour that is not there (the alpha-pixels flag without RGB or luminance),
+        // or no channel at all: OpenImageIO's reader never finished such a file (the image
+        // harness's 161-byte DDS).
+        if ((format & kAlphaPixels) && !(format & (kRgb | kLuminance)))
+            throw Error(ErrorCode::Corrupt, shown + ": a DDS whose pixel format has alpha beside no colour (neither RGB nor luminance)");
+        if (!(format & (kRgb | kLuminance | kAlphaOnly)))
+            throw Error(ErrorCode::Corrupt, shown + ": a DDS whose pixel format names no channels (neither RGB, luminance nor alpha)");
     }
 }
 

@@ -196,6 +196,44 @@ TEST_F(ReaderHostile, ADdsPixelWithoutWholeBytesIsRefusedFromItsHeader) {
     EXPECT_TRUE(contains(r.out, "of a 8x4 source")) << r.out;
 }
 
+// An uncompressed DDS whose pixel format names alpha beside no colour (the alpha-pixels flag
+// without RGB or luminance), or no channel at all: OpenImageIO's reader never finished either
+// (found by the image harness: a 161-byte file). The header refuses them; luminance with alpha,
+// luminance alone and alpha alone still read.
+TEST_F(ReaderHostile, ADdsAlphaBesideNoColourIsRefusedFromItsHeader) {
+    write("found.dds", slurp(seed("image", "found-dds-alpha-beside-no-colour-oiio-hang")).substr(1));
+    const auto format = [&](const char* file, std::uint32_t flags, std::uint32_t bits, std::uint32_t first, std::uint32_t alpha) {
+        std::string bytes = dds(8, 4, 1, false);
+        put32(bytes, 80, flags);
+        put32(bytes, 88, bits);
+        put32(bytes, 92, first);
+        put32(bytes, 96, 0);
+        put32(bytes, 100, 0);
+        put32(bytes, 104, alpha);
+        write(file, bytes);
+    };
+    format("alpha_beside.dds", 0x1, 32, 0, 0xff000000);
+    format("alpha_both.dds", 0x3, 32, 0, 0xff000000);
+    format("nothing.dds", 0x0, 32, 0, 0);
+    for (const std::string file : {"found.dds", "alpha_beside.dds", "alpha_both.dds", "nothing.dds"}) {
+        SCOPED_TRACE(file);
+        Outcome r = run({"uniform", path(file), "-o", path("x.exr")});
+        expectRefused(r, "uniform", file == "nothing.dds" ? "names no channels" : "has alpha beside no colour");
+        expectMemory(r, 300);
+        r = runTool("conus", {"uniform", "-", "-o", path("x.exr")}, path(file));  // standard input
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_FALSE(fs::exists(path("x.exr")));
+    }
+    format("luminance_alpha.dds", 0x20001, 16, 0x00ff, 0xff00);
+    format("luminance.dds", 0x20000, 8, 0xff, 0);
+    format("alpha.dds", 0x2, 8, 0, 0xff);
+    for (const std::string file : {"luminance_alpha.dds", "luminance.dds", "alpha.dds"}) {
+        const Outcome r = run({"uniform", path(file), "-o", path("flat.exr")});
+        EXPECT_EQ(r.exitCode, 0) << file << ": " << r.err;
+        EXPECT_TRUE(contains(r.out, "of a 8x4 source")) << r.out;
+    }
+}
+
 // A model whose material names the volume texture: the mesh read refuses it, through render,
 // bake and the viewer.
 TEST_F(ReaderHostile, AVolumeTextureNamedByAMeshIsRefused) {
