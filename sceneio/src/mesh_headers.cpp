@@ -117,11 +117,9 @@ void checkOffBody(const std::string& path, std::uintmax_t bytes, const MeshReadO
     // GetNextLine: the text to the next line end, then every line end after it.
     const auto nextLine = [&] {
         if (at >= end || *at == '\0') return false;
-        const char* start = at;
         while (at < end && !isLineEnd(*at)) ++at;
-        const char* lineEnd = at;
         while (at < end && isLineEnd(*at) && *at != '\0') ++at;
-        return lineEnd >= start;
+        return true;
     };
     for (std::uintmax_t v = 0; v < vertices; ++v)
         if (!nextLine()) return;  // too few lines: Assimp says so
