@@ -33,21 +33,15 @@ void checkPlyLine(const std::string& path, const std::string& keyword, std::istr
 // one past the end; the rest of a longer line is read as the next lines (a 13 KB vertex line made
 // it read faces out of the vertex text and crash). Its line ends are CR, LF, form feed and NUL.
 constexpr std::size_t kAssimpLineBuffer = 4096;
-void checkOffLineLengths(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::vector<char> block(1 << 16);
+void checkOffLineLengths(const std::string& path, const std::string& text) {
     std::size_t run = 0, line = 1;
-    while (in) {
-        in.read(block.data(), static_cast<std::streamsize>(block.size()));
-        for (std::streamsize i = 0; i < in.gcount(); ++i) {
-            const char c = block[std::size_t(i)];
-            if (c == '\n' || c == '\r' || c == '\f' || c == '\0') {
-                if (c == '\n') ++line;
-                run = 0;
-            } else if (++run >= kAssimpLineBuffer) {
-                fail(ErrorCode::Corrupt, path, "its line " + std::to_string(line) + " is longer than the " +
-                                                   std::to_string(kAssimpLineBuffer - 1) + " characters an OFF line may have");
-            }
+    for (const char c : text) {
+        if (c == '\n' || c == '\r' || c == '\f' || c == '\0') {
+            if (c == '\n') ++line;
+            run = 0;
+        } else if (++run >= kAssimpLineBuffer) {
+            fail(ErrorCode::Corrupt, path, "its line " + std::to_string(line) + " is longer than the " +
+                                               std::to_string(kAssimpLineBuffer - 1) + " characters an OFF line may have");
         }
     }
 }
@@ -58,9 +52,8 @@ void checkOffLineLengths(const std::string& path) {
 // caps, and each face line must start with a corner count of 1 to 9: Assimp drops other faces by
 // lowering the mesh's face count, and where it drops them all it reads past its arrays (a fuzzer's
 // 80-byte file crashed every command).
-void checkOffBody(const std::string& path, std::uintmax_t bytes, const MeshReadOptions& options) {
-    std::string text(static_cast<std::size_t>(bytes), '\0');
-    std::ifstream(path, std::ios::binary).read(text.data(), static_cast<std::streamsize>(text.size()));
+void checkOffBody(const std::string& path, const std::string& text, const MeshReadOptions& options) {
+    const std::uintmax_t bytes = text.size();
     const char* at = text.c_str();
     const char* end = at + text.size();
     const auto isLineEnd = [](char c) { return c == '\r' || c == '\n' || c == '\0' || c == '\f'; };
@@ -189,8 +182,11 @@ void checkOffCounts(const std::string& path, std::uintmax_t bytes, const MeshRea
     for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     const bool keyword = first.size() >= 3 && first.compare(first.size() - 3, 3, "OFF") == 0;
     if (!keyword && lowerExtension(path) != ".off" && magic != "off") return;
-    checkOffLineLengths(path);
-    checkOffBody(path, bytes, options);
+    // The whole file, once (Assimp reads it whole too), for both checks.
+    std::string text(static_cast<std::size_t>(bytes), '\0');
+    std::ifstream(path, std::ios::binary).read(text.data(), static_cast<std::streamsize>(text.size()));
+    checkOffLineLengths(path, text);
+    checkOffBody(path, text, options);
 }
 
 }  // namespace conus::sceneio
