@@ -1,10 +1,7 @@
 #version 450 core
 // A mesh vertex handed to the tessellation stages as it is (mesh.tesc.glsl chooses how finely to
 // split its triangle, mesh.tese.glsl projects the vertices it makes).
-layout(location = 0) in vec3 aPosition;
-layout(location = 1) in vec3 aNormal;
-layout(location = 2) in vec3 aColour;
-layout(location = 3) in vec2 aUv;
+#include "mesh_attributes.inc.glsl"
 out vec3 pWorld;
 out vec3 pNormal;
 out vec3 pColour;
