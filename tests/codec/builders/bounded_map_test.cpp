@@ -20,14 +20,12 @@
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "../round_trip.h"
+#include "codec/builders/valid_map.h"
 
 namespace conus::codec {
 namespace {
 
-void expectValid(const SamplingMap& map) {
-    const format::ValidationReport report = format::validateGrid(map.toGrid());
-    EXPECT_TRUE(report.ok()) << report.str();
-}
+using test::expectValid;
 
 std::string text(const std::vector<Focus>& foci, double aspect) {
     std::string s = "aspect " + std::to_string(aspect) + ":";

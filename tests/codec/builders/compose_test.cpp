@@ -13,14 +13,12 @@
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
+#include "codec/builders/valid_map.h"
 
 namespace conus::codec {
 namespace {
 
-void expectValid(const SamplingMap& map) {
-    const format::ValidationReport report = format::validateGrid(map.toGrid());
-    EXPECT_TRUE(report.ok()) << report.str();
-}
+using test::expectValid;
 
 SamplingMap focusMap(double u, double v, double r, double k, int side = map_rules::kDefaultSide) {
     const std::vector<Focus> foci{{u, v, r, k}};

@@ -12,6 +12,7 @@
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
+#include "codec/builders/valid_map.h"
 
 namespace conus::codec {
 namespace {
@@ -50,9 +51,9 @@ double correlation(const SamplingMap& map, const std::function<double(double, do
     return (sab - sa * sb / n) / std::sqrt((saa - sa * sa / n) * (sbb - sb * sb / n));
 }
 
+// Valid, and its corners on the frame's corners.
 void expectValid(const SamplingMap& map) {
-    const format::ValidationReport report = format::validateGrid(map.toGrid());
-    EXPECT_TRUE(report.ok()) << report.str();
+    test::expectValid(map);
     const int n = map.columns(), m = map.rows();
     EXPECT_EQ(map.node(0, 0), glm::vec2(0, 0));
     EXPECT_EQ(map.node(n - 1, 0), glm::vec2(1, 0));

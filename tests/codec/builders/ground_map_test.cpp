@@ -9,6 +9,7 @@
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
+#include "codec/builders/valid_map.h"
 
 namespace conus::codec {
 namespace {
@@ -74,8 +75,7 @@ TEST(Ground, BuiltGridIsValidAndMatches) {
     for (const GroundParams& g : kCases) {
         for (int side : {2, 3, 17, map_rules::kDefaultSide, 257}) {
             const SamplingMap map = buildGroundMap(g, side, side);
-            const format::ValidationReport report = format::validateGrid(map.toGrid());
-            EXPECT_TRUE(report.ok()) << report.str();
+            test::expectValid(map);
             if (side == 257) {
                 const glm::dvec2 p(0.3, 0.8);
                 EXPECT_NEAR(glm::length(map.distort(p) - groundDistort(g, p)), 0.0, 1e-4);

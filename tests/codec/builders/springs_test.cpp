@@ -14,14 +14,12 @@
 #include "conus/core/map_rules.h"
 #include "conus/format/container.h"
 #include "conus/core/error.h"
+#include "codec/builders/valid_map.h"
 
 namespace conus::codec {
 namespace {
 
-void expectValid(const SamplingMap& map) {
-    const format::ValidationReport report = format::validateGrid(map.toGrid());
-    EXPECT_TRUE(report.ok()) << report.str();
-}
+using test::expectValid;
 
 void expectValidPositions(const SpringSystem& system) {
     const std::vector<glm::vec2> p = system.positions();
