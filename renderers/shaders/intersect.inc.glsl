@@ -159,8 +159,12 @@ struct DepthSegment {
     int entered;
 };
 
-// The ray's camera depth at s (perspective-correct).
+// The ray's camera depth and its t at s (perspective-correct).
 float segmentDepth(DepthSegment g, float s) { return mix(g.dw0, g.dw1, s) / mix(g.iw0, g.iw1, s); }
+float segmentT(DepthSegment g, float s) { return mix(g.tw0, g.tw1, s) / mix(g.iw0, g.iw1, s); }
+
+// The smallest jump that is a discontinuity at depth d (Walk::jump in intersect.cpp).
+float depthJump(DepthView view, float d) { return view.jumpRelative * d + view.jumpAbsolute; }
 
 // 1. Clip: u, v in [0,1] and depth in [lo, hi], each a + b t >= 0; 2. project the ends. False when
 // the ray misses the volume.
@@ -221,7 +225,7 @@ bool clipDepthRay(DepthView view, vec3 origin, vec3 direction, float tMax, out D
 // (where a scene saw nothing): met where it enters.
 bool acrossSide(DepthView view, DepthSegment g, float entry) {
     return !view.solid && g.entered >= 0 && g.entered < 4 && entry < view.far * (1.0 - kSideRuleFarMargin) &&
-           segmentDepth(g, 0.0) - entry <= view.jumpRelative * entry + view.jumpAbsolute;
+           segmentDepth(g, 0.0) - entry <= depthJump(view, entry);
 }
 
 // One step of the linear search (Walk::step in intersect.cpp): stepTexels CoNUS pixels along the
@@ -244,11 +248,10 @@ float stepAlong(sampler2D depths, sampler2D map, DepthView view, DepthSegment g,
 // The hit at s (where the CoNUS image holds pd).
 void finishHit(inout DepthHit result, DepthSegment g, vec3 origin, vec3 direction, float s, vec2 pd, vec2 size,
                int steps) {
-    const float iw = mix(g.iw0, g.iw1, s);
     result.hit = true;
-    result.t = mix(g.tw0, g.tw1, s) / iw;
+    result.t = segmentT(g, s);
     result.position = origin + direction * result.t;
-    result.depth = mix(g.dw0, g.dw1, s) / iw;
+    result.depth = segmentDepth(g, s);
     result.point = g.p0 + g.along * s;
     result.distorted = pd;
     result.texel = clamp(ivec2(floor(pd * size)), ivec2(0), ivec2(size) - 1);
@@ -288,7 +291,7 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
     if (behind && !view.solid && !across) {
         if (g.end <= 0.0) return result;  // entered beyond the data's depth range
         hidden = true;
-        result.firstHidden = mix(g.tw0, g.tw1, 0.0) / mix(g.iw0, g.iw1, 0.0);
+        result.firstHidden = segmentT(g, 0.0);
         hiddenDepth = segmentDepth(g, 0.0);
         hiddenFrom = m;
     }
@@ -350,13 +353,13 @@ DepthHit intersectDepthImage(sampler2D depths, sampler2D map, DepthView view, ve
             }
             const float sb = surfaceAlong(depths, view, map, g.p0, g.along, b, q);
             MapPoint qa;
-            if (surfaceAlong(depths, view, map, g.p0, g.along, a, qa) - sb <= 0.5 * (view.jumpRelative * sb + view.jumpAbsolute)) {
+            if (surfaceAlong(depths, view, map, g.p0, g.along, a, qa) - sb <= 0.5 * depthJump(view, sb)) {
                 s = 0.5 * (a + b);
                 m = evalMap(map, g.p0 + g.along * s);
                 break;
             }
             hidden = true;  // a wall: the ray passes behind an occluder's silhouette
-            result.firstHidden = min(result.firstHidden, mix(g.tw0, g.tw1, a) / mix(g.iw0, g.iw1, a));
+            result.firstHidden = min(result.firstHidden, segmentT(g, a));
             hiddenDepth = segmentDepth(g, b);
             hiddenFrom = qa;
         }
@@ -398,7 +401,7 @@ DepthHit intersectBehindLayer(sampler2D depths, sampler2D map, DepthView view, v
         MapPoint qa, qb;
         const float sa = surfaceAlong(depths, view, map, g.p0, g.along, a, qa);
         const float sb = surfaceAlong(depths, view, map, g.p0, g.along, b, qb);
-        if ((front ? sa - sb : sb - sa) <= 0.5 * (view.jumpRelative * min(sa, sb) + view.jumpAbsolute)) {
+        if ((front ? sa - sb : sb - sa) <= 0.5 * depthJump(view, min(sa, sb))) {
             const float mid = 0.5 * (a + b);
             m = evalMap(map, g.p0 + g.along * mid);
             finishHit(result, g, origin, direction, mid, m.pd, size, steps);
