@@ -108,6 +108,21 @@ codec::VolumeRenderOptions renderOptions(const VolumeOptions& o) {
     return options;
 }
 
+// The frame's size and the render options, every value of them checked before any work: --camera
+// and --up, --size, --grid against that size, --range.
+struct Frame {
+    Size size;
+    double aspect;
+    codec::VolumeRenderOptions options;
+};
+
+Frame checkedFrame(const VolumeOptions& o) {
+    checkCameraOptions(o);
+    const Size size = parseSize(o.sizeText);
+    checkGridForImage(o.grid, size.width, size.height);
+    return {size, double(size.width) / size.height, renderOptions(o)};
+}
+
 // What render and animate read before rendering: the transfer function, the volume, the camera.
 struct Scene {
     codec::TransferFunction tf;
@@ -127,11 +142,7 @@ Scene loadScene(const VolumeOptions& o, double aspect) {
 int runRender(const VolumeOptions& o) {
     checkConusOutput(o.output, o.volume);
     if (!o.picture.empty()) checkPictureOutput(o.picture, {}, {o.volume, o.output});
-    checkCameraOptions(o);
-    const Size size = parseSize(o.sizeText);
-    checkGridForImage(o.grid, size.width, size.height);
-    const double aspect = double(size.width) / size.height;
-    codec::VolumeRenderOptions options = renderOptions(o);
+    auto [size, aspect, options] = checkedFrame(o);
     const Scene scene = loadScene(o, aspect);
     const Volume& volume = scene.volume;
     const Camera& camera = scene.camera;
@@ -186,11 +197,7 @@ glm::dvec2 parsePoint(const std::string& text, const std::string& what) {
 int runAnimate(const AnimateOptions& a) {
     const VolumeOptions& o = a.volume;
     const glm::dvec2 from = parsePoint(a.from, "--from"), to = parsePoint(a.to, "--to");
-    checkCameraOptions(o);
-    const Size size = parseSize(o.sizeText);
-    checkGridForImage(o.grid, size.width, size.height);
-    const double aspect = double(size.width) / size.height;
-    codec::VolumeRenderOptions options = renderOptions(o);
+    auto [size, aspect, options] = checkedFrame(o);
     AtomicOutputs outputs;  // every frame or none
     outputs.makeFolder(a.outDir);
     const Scene scene = loadScene(o, aspect);
