@@ -44,12 +44,12 @@ Size parseSize(const std::string& text) {
     return {static_cast<int>(values[0]), static_cast<int>(values[1])};
 }
 
-CLI::Validator sizeCheck() {
+CLI::Validator sizeCheck(std::function<std::string(const std::string&, Size)> rule) {
     return CLI::Validator(
-        [](std::string& text) -> std::string {
+        [rule = std::move(rule)](std::string& text) -> std::string {
             try {
-                parseSize(text);
-                return {};
+                const Size size = parseSize(text);
+                return rule ? rule(text, size) : std::string();
             } catch (const Error& e) {
                 return e.what();
             }

@@ -2,6 +2,7 @@
 // Each parser throws conus::Error(InvalidArgument) with a reason that names the bad text.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,9 @@ struct Size {
 };
 
 Size parseSize(const std::string& text);        // "1024x768"; each side in [1, 65536]
-CLI::Validator sizeCheck();                      // parseSize as a CLI11 check: a usage error before any work
+// parseSize as a CLI11 check, a usage error before any work; `rule` (the text, the size parsed from
+// it) adds a command's own bounds: what it returns, when not empty, is the error.
+CLI::Validator sizeCheck(std::function<std::string(const std::string&, Size)> rule = {});
 codec::View parseView(const std::string& text);  // "u0,v0,u1,v1" with u0 < u1, v0 < v1, all finite
 
 // "x,y,z,lx,ly,lz,fovDeg": eye, look-at point, vertical field of view in degrees (what

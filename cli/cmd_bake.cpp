@@ -61,22 +61,15 @@ constexpr int kTabletMaxSide = 8192;
 constexpr std::int64_t kTabletMaxPixels = std::int64_t{4096} * 4096;
 
 CLI::Validator tabletSizeCheck() {
-    return CLI::Validator(
-        [](std::string& text) -> std::string {
-            try {
-                const Size size = parseSize(text);
-                if (size.width < kTabletMinSide || size.height < kTabletMinSide || size.width > kTabletMaxSide ||
-                    size.height > kTabletMaxSide)
-                    return "tablet size '" + text + "': each side must lie in [" + std::to_string(kTabletMinSide) + ", " +
-                           std::to_string(kTabletMaxSide) + "]";
-                if (std::int64_t{size.width} * size.height > kTabletMaxPixels)
-                    return "tablet size '" + text + "' holds more than 4096x4096 pixels";
-                return {};
-            } catch (const Error& e) {
-                return e.what();
-            }
-        },
-        "WxH");
+    return sizeCheck([](const std::string& text, Size size) -> std::string {
+        if (size.width < kTabletMinSide || size.height < kTabletMinSide || size.width > kTabletMaxSide ||
+            size.height > kTabletMaxSide)
+            return "tablet size '" + text + "': each side must lie in [" + std::to_string(kTabletMinSide) + ", " +
+                   std::to_string(kTabletMaxSide) + "]";
+        if (std::int64_t{size.width} * size.height > kTabletMaxPixels)
+            return "tablet size '" + text + "' holds more than 4096x4096 pixels";
+        return {};
+    });
 }
 
 struct BakeOptions {
