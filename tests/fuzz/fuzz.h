@@ -10,6 +10,10 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
+#include <string>
+
+#include "conus/core/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 
@@ -21,3 +25,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             std::abort();                                                                   \
         }                                                                                   \
     } while (0)
+
+inline bool isOneLine(const std::string& s) { return s.find('\n') == std::string::npos && s.find('\r') == std::string::npos; }
+
+// Runs `read` (a reader on one input and the checks of what it read): the reader may refuse the
+// input with a one-line conus::Error and throws nothing else.
+template <class Read>
+int readOrRefuse(Read read) {
+    try {
+        read();
+    } catch (const conus::Error& e) {
+        CONUS_FUZZ_CHECK(isOneLine(e.what()), "an error is one line");
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "non-CoNUS exception: %s\n", e.what());
+        CONUS_FUZZ_CHECK(false, "the reader throws only conus::Error");
+    }
+    return 0;
+}

@@ -52,20 +52,3 @@ inline bool startsWith(const std::uint8_t* data, std::size_t size, const char* p
     const std::string p(prefix);
     return size >= p.size() && std::string(reinterpret_cast<const char*>(data), p.size()) == p;
 }
-
-inline bool isOneLine(const std::string& s) { return s.find('\n') == std::string::npos && s.find('\r') == std::string::npos; }
-
-// Runs `read` (a reader on one input and the checks of what it read): the reader may refuse the
-// input with a one-line conus::Error and throws nothing else.
-template <class Read>
-int readOrRefuse(Read read) {
-    try {
-        read();
-    } catch (const conus::Error& e) {
-        CONUS_FUZZ_CHECK(isOneLine(e.what()), "an error is one line");
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "non-CoNUS exception: %s\n", e.what());
-        CONUS_FUZZ_CHECK(false, "the reader throws only conus::Error");
-    }
-    return 0;
-}
