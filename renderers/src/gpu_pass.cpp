@@ -1,5 +1,7 @@
-// What the GPU image encoder and decoder share (gpu_pass_pvt.h).
+// What the GPU passes share (gpu_pass_pvt.h).
 #include "gpu_pass_pvt.h"
+
+#include <algorithm>
 
 #include "context_pvt.h"
 #include "conus/core/error.h"
@@ -46,6 +48,23 @@ void readBack(const GladGLContext& gl, Image& out, int first, int count) {
     gl.ReadPixels(0, 0, out.width, out.height, pixelFormat(count), GL_FLOAT, buffer.data());
     for (std::size_t i = 0; i < pixels; ++i)
         for (int c = 0; c < count; ++c) out.pixels[i * channels + first + c] = buffer[i * count + c];
+}
+
+Image readColourAndDepth(const GladGLContext& gl, int width, int height) {
+    const std::size_t pixels = static_cast<std::size_t>(width) * height;
+    std::vector<float> rgba(pixels * 4), z(pixels);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+    gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());
+    gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
+    gl.ReadPixels(0, 0, width, height, GL_RED, GL_FLOAT, z.data());
+    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+    Image frame = makeImage(width, height, {"R", "G", "B", "A", "Z"});
+    for (std::size_t p = 0; p < pixels; ++p) {
+        std::copy_n(&rgba[p * 4], 4, &frame.pixels[p * 5]);
+        frame.pixels[p * 5 + 4] = z[p];
+    }
+    return frame;
 }
 
 }  // namespace conus::renderers

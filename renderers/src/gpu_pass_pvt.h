@@ -1,5 +1,6 @@
 // Private: what the GPU image encoder and decoder share: passes of up to four channels, their
-// float texture formats, the texture-size check and the read-back (gpu_pass.cpp).
+// float texture formats, the texture-size check and the read-back (gpu_pass.cpp); and the
+// colour + depth read-back of the mesh and volume passes.
 //
 // Images travel to and from GL in memory order, top row first, so texture row 0 and window row 0
 // are the image's top row: GL's y axis is the spec's v (downward) and no flip is needed anywhere;
@@ -52,5 +53,10 @@ private:
 
 // Reads the bound framebuffer's first `count` channels into channels [first, first + count).
 void readBack(const GladGLContext& gl, Image& out, int first, int count);
+
+// The bound framebuffer's colour (attachment 0, RGBA) and camera depth (attachment 1, one channel)
+// as one width x height image of R, G, B, A, Z: what the mesh and volume passes draw. Leaves
+// attachment 0 the read buffer.
+Image readColourAndDepth(const GladGLContext& gl, int width, int height);
 
 }  // namespace conus::renderers

@@ -21,6 +21,7 @@
 #include "embedded_shaders.h"
 #include "frame_pvt.h"
 #include "gl_objects_pvt.h"
+#include "gpu_pass_pvt.h"
 #include "shader_constants_pvt.h"
 
 namespace conus::renderers {
@@ -367,22 +368,10 @@ Image MeshRenderer::frame(const Camera& camera, const codec::SamplingMap& map, i
         phase = std::chrono::steady_clock::now();
     }
 
-    const std::size_t pixels = static_cast<std::size_t>(width) * height;
-    std::vector<float> rgba(pixels * 4), z(pixels);
     gl.BindFramebuffer(GL_FRAMEBUFFER, readFramebuffer);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-    gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());
-    gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
-    gl.ReadPixels(0, 0, width, height, GL_RED, GL_FLOAT, z.data());
-    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+    Image frame = readColourAndDepth(gl, width, height);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     checkGl(gl, kWhat);
-    Image frame = makeImage(width, height, {"R", "G", "B", "A", "Z"});
-    for (std::size_t p = 0; p < pixels; ++p) {
-        std::copy_n(&rgba[p * 4], 4, &frame.pixels[p * 5]);
-        frame.pixels[p * 5 + 4] = z[p];
-    }
     if (timings) timings->readbackMs = elapsedMilliseconds(phase);
     return frame;
 }

@@ -14,6 +14,7 @@
 #include "context_pvt.h"
 #include "embedded_shaders.h"
 #include "gl_objects_pvt.h"
+#include "gpu_pass_pvt.h"
 
 namespace conus::renderers {
 namespace {
@@ -171,20 +172,9 @@ Image VolumeRendererGpu::render(const Fpc& fpc, int width, int height, const cod
     t.drawMs += millisecondsSince(start);
 
     // GL's row 0 is the image's top row (the pass writes pixel (x, y) at window (x, y)).
-    const std::size_t pixels = static_cast<std::size_t>(width) * height;
-    std::vector<float> rgba(pixels * 4), z(pixels);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-    gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());
-    gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
-    gl.ReadPixels(0, 0, width, height, GL_RED, GL_FLOAT, z.data());
+    Image out = readColourAndDepth(gl, width, height);  // codec::kVolumeChannels
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     checkGl(gl, kWhat);
-    Image out = makeImage(width, height, {codec::kVolumeChannels.begin(), codec::kVolumeChannels.end()});
-    for (std::size_t i = 0; i < pixels; ++i) {
-        std::copy_n(&rgba[i * 4], 4, &out.pixels[i * 5]);
-        out.pixels[i * 5 + 4] = z[i];
-    }
     t.readbackMs += millisecondsSince(start);
     if (timings) *timings = t;
     if (options.progress) options.progress(1.0);
