@@ -17,7 +17,7 @@ struct StdinImage {
 const char* stdinExtension(const std::vector<unsigned char>& bytes);
 
 // Standard input read to its end: refused (conus::Error) when it is no picture CoNUS reads, empty,
-// or longer than its header's picture can take (1 GiB where the first bytes do not say).
+// or longer than its header's picture can take (448 MiB where the header does not say).
 StdinImage readStdin();
 
 }  // namespace conus::imageio::oiio

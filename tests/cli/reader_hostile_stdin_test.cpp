@@ -45,13 +45,15 @@ TEST_F(StdinHostile, EndlessOrForeignStreamsAreRefusedAtOnce) {
 
 // A stream that starts like a picture and never ends (a header, then gigabytes of zeros: a sparse
 // file here) is refused once it runs past what its header's picture can take, without keeping
-// more; a picture of each kind piped in whole still reads.
+// more; a picture of each kind piped in whole still reads. PNG, JPEG, BMP and PNM give their size
+// in their first 200 bytes; a TIFF in its directory (after the pixels, as OpenImageIO writes it),
+// OpenEXR and Radiance HDR in their headers: of those the whole picture comes before the zeros.
 TEST_F(StdinHostile, APictureHeaderFollowedByEndlessBytesIsRefusedByWhatItDeclares) {
     std::vector<unsigned char> ramp(std::size_t(40) * 30 * 3);
     for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = static_cast<unsigned char>(i * 7 % 251);
-    for (const char* ext : {"png", "jpg", "bmp", "ppm"}) {
+    for (const std::string ext : {"png", "jpg", "bmp", "ppm", "tif", "exr", "hdr"}) {
         SCOPED_TRACE(ext);
-        const std::string picture = path(std::string("ramp.") + ext);
+        const std::string picture = path("ramp." + ext);
         {
             auto out = OIIO::ImageOutput::create(picture);
             ASSERT_TRUE(out);
@@ -61,16 +63,66 @@ TEST_F(StdinHostile, APictureHeaderFollowedByEndlessBytesIsRefusedByWhatItDeclar
         }
         Outcome r = runTool("conus", {"uniform", "-", "-o", path("piped.exr"), "--size", "20x15"}, picture);
         EXPECT_EQ(r.exitCode, 0) << r.err;
-        // The same file's first 200 bytes (its header), then zeros up to 6 GiB, read by no disk.
-        std::string head(200, '\0');
+        // The same file's header, then zeros up to 6 GiB, read by no disk.
+        const bool headerFirst = ext == "png" || ext == "jpg" || ext == "bmp" || ext == "ppm";
+        std::string head(headerFirst ? 200 : fs::file_size(picture), '\0');
         std::ifstream(picture, std::ios::binary).read(head.data(), std::streamsize(head.size()));
-        const std::string endless = path(std::string("endless.") + ext);
+        const std::string endless = path("endless." + ext);
         std::ofstream(endless, std::ios::binary).write(head.data(), std::streamsize(head.size()));
         fs::resize_file(endless, std::uintmax_t{6} << 30);
         r = runTool("conus", {"encode", "-", "-o", path("x.exr"), "--size", "16x12"}, endless);
         expectRefused(r, "encode", "a 40x30");
         EXPECT_TRUE(contains(r.err, "can take")) << r.err;
         expectMemory(r, 400);
+        EXPECT_FALSE(fs::exists(path("x.exr")));
+    }
+}
+
+// Where the first bytes do not give the size (a BigTIFF, whose directory CoNUS does not walk) a
+// stream is held to 256 MiB; a TIFF whose directory lies past that is refused at its first bytes,
+// and one whose directory holds no picture is refused there. A BigTIFF piped in whole still reads.
+TEST_F(StdinHostile, AStreamWhoseHeaderGivesNoSizeIsHeldToAFewHundredMegabytes) {
+    std::vector<unsigned char> ramp(std::size_t(40) * 30 * 3);
+    for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = static_cast<unsigned char>(i * 5 % 253);
+    const std::string big = path("big.tif");
+    {
+        auto out = OIIO::ImageOutput::create(big);
+        ASSERT_TRUE(out);
+        OIIO::ImageSpec spec(40, 30, 3, OIIO::TypeDesc::UINT8);
+        spec.attribute("tiff:bigtiff", 1);
+        ASSERT_TRUE(out->open(big, spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, ramp.data()));
+        out->close();
+    }
+    ASSERT_EQ(slurp(big).substr(0, 4), std::string("II+\0", 4));
+    Outcome r = runTool("conus", {"uniform", "-", "-o", path("piped.exr"), "--size", "20x15"}, big);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+
+    const auto endless = [&](const std::string& name, const std::string& head) {
+        std::ofstream(path(name), std::ios::binary).write(head.data(), std::streamsize(head.size()));
+        fs::resize_file(path(name), std::uintmax_t{6} << 30);
+        return path(name);
+    };
+    // A TIFF's first directory is at the 32-bit offset after its byte order and 42.
+    const auto tiffTo = [](std::uint32_t at) {
+        std::string head("II*\0", 4);
+        for (int i = 0; i < 4; ++i) head += static_cast<char>(at >> (8 * i) & 0xff);
+        return head;
+    };
+    const struct {
+        std::string stdinFile;
+        const char* reason;
+        long maxMb;
+    } cases[] = {
+        {endless("endless-big.tif", slurp(big).substr(0, 16)), "holds more than 256 MiB; give a file instead", 500},
+        {endless("far.tif", tiffTo(0x7fff0000u)), "first directory is at byte 2147418112", 300},
+        {endless("empty-directory.tif", tiffTo(64u << 20)), "gives no width or length", 400},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.stdinFile);
+        r = runTool("conus", {"encode", "-", "-o", path("x.exr"), "--size", "16x12"}, c.stdinFile);
+        expectRefused(r, "encode", c.reason);
+        expectMemory(r, c.maxMb);
         EXPECT_FALSE(fs::exists(path("x.exr")));
     }
 }

@@ -3,7 +3,8 @@
 // picture (TIFF pages, DDS volumes, cube maps and arrays), its size checks, channel placement,
 // colour conversion, orientation and metadata on top of OpenImageIO. The first byte picks the
 // format (the reader goes by the name's extension), the rest is the file, written to /dev/shm
-// (memory). A file that reads must keep the reader's promises: within the limits, one line per
+// (memory); with its top bit set the file is read as standard input instead (the format by its
+// first bytes, the stream bounded by what its header declares). A file that reads must keep the reader's promises: within the limits, one line per
 // error, values placed by name.
 // Each run is kept cheap, since a million are asked for: when fuzzing, only the named format's
 // reader is tried (OpenImageIO's try_all_readers off; by default a file its extension's reader refuses goes to
@@ -39,7 +40,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         CONUS_FUZZ_CHECK(std::fwrite(data + 1, 1, size - 1, f) == size - 1, "fwrite");
         std::fclose(f);
     }
+    const bool throughStdin = data[0] & 0x80;
     for (const bool raw : {false, true}) {
+        if (throughStdin) CONUS_FUZZ_CHECK(std::freopen(path.c_str(), "rb", stdin) != nullptr, "freopen");
         conus::imageio::ReadOptions options;
         if (raw) options.colorspace = conus::Transfer::Raw;
         // A lowered cap, as any caller may set: a 16 KB input may declare up to 64 MB of samples
@@ -47,7 +50,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         // ~10 executions a second.
         options.limits.maxPixels = std::int64_t{1} << 12;
         readOrRefuse([&] {
-            const conus::imageio::ImageFile file = conus::imageio::readImageFile(path, options);
+            const conus::imageio::ImageFile file = conus::imageio::readImageFile(throughStdin ? "-" : path, options);
             const conus::Image& image = file.image;
             CONUS_FUZZ_CHECK(image.width >= 1 && image.height >= 1 && image.width <= conus::kMaxImageSide &&
                                  image.height <= conus::kMaxImageSide &&
