@@ -238,7 +238,7 @@ bool isJpeg(const unsigned char* bytes, std::size_t size) {
 // file's size in bytes.
 std::uintmax_t screenInput(const std::string& path, const StdinImage& stdinImage, const Limits& limits) {
     if (path == "-") {
-        const std::vector<unsigned char>& bytes = stdinImage.bytes;
+        const std::span<const unsigned char> bytes = stdinImage.bytes.view();
         if (isOpenExr(bytes.data(), bytes.size())) {
             const int fd = ::memfd_create("conus-stdin", MFD_CLOEXEC);
             if (fd < 0) throw Error(ErrorCode::Io, "cannot screen standard input: " + std::string(std::strerror(errno)) + "; give a file instead");

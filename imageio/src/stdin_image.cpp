@@ -2,12 +2,16 @@
 // bounded by what its header declares, so that a stream that never ends is refused early.
 #include "stdin_image_pvt.h"
 
+#include <sys/mman.h>
+
+#include <cerrno>
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "conus/core/error.h"
@@ -35,7 +39,7 @@ constexpr std::size_t kMaxTextHeader = 64 << 10;
 
 // Reads of the first bytes, each within `bytes` (callers check the length first).
 struct Bytes {
-    const std::vector<unsigned char>& b;
+    std::span<const unsigned char> b;
     std::uintmax_t be(std::size_t at, int count) const {
         std::uintmax_t v = 0;
         for (int i = 0; i < count; ++i) v = v << 8 | b[at + std::size_t(i)];
@@ -58,7 +62,7 @@ StdinBound bound(std::uintmax_t w, std::uintmax_t h, std::uintmax_t sampleBits, 
 // The first directory's width, length, bits and samples a pixel. Most writers put the directory
 // after the pixels, so the stream up to it is what it is; past it the slack allows for the
 // directory's values and further pages.
-std::optional<StdinBound> tiffBound(const std::vector<unsigned char>& b) {
+std::optional<StdinBound> tiffBound(std::span<const unsigned char> b) {
     const std::size_t n = b.size();
     if (n < 8) return std::nullopt;
     const bool big = b[0] == 'M';
@@ -94,7 +98,7 @@ std::optional<StdinBound> tiffBound(const std::vector<unsigned char>& b) {
 
 // Every part's data window and channels, from the attributes of its header (a multi-part file has
 // one header a part, the list ended by an empty one). Deep parts hold any number of samples a pixel.
-std::optional<StdinBound> exrBound(const std::vector<unsigned char>& b) {
+std::optional<StdinBound> exrBound(std::span<const unsigned char> b) {
     const std::size_t n = b.size();
     if (n < 8) return std::nullopt;
     const Bytes r{b};
@@ -169,7 +173,7 @@ std::optional<StdinBound> exrBound(const std::vector<unsigned char>& b) {
 }
 
 // The resolution line after the header's empty line: "-Y 480 +X 640" (either axis first).
-std::optional<StdinBound> hdrBound(const std::vector<unsigned char>& b) {
+std::optional<StdinBound> hdrBound(std::span<const unsigned char> b) {
     const std::string head(b.begin(), b.begin() + std::ptrdiff_t(std::min(b.size(), kMaxTextHeader)));
     const std::size_t blank = head.find("\n\n");
     const std::size_t lineEnd = blank == std::string::npos ? blank : head.find('\n', blank + 2);
@@ -185,7 +189,7 @@ std::optional<StdinBound> hdrBound(const std::vector<unsigned char>& b) {
 }
 
 // PNM: P1-P6 (width, height and the largest value) and PFM (PF, Pf: width, height, scale).
-std::optional<StdinBound> pnmBound(const std::vector<unsigned char>& b) {
+std::optional<StdinBound> pnmBound(std::span<const unsigned char> b) {
     const std::size_t n = b.size();
     if (n < 2) return std::nullopt;
     const char kind = static_cast<char>(b[1]);
@@ -216,7 +220,7 @@ std::optional<StdinBound> pnmBound(const std::vector<unsigned char>& b) {
     return bound(fields[0], fields[1], bits * channels, 2, "PNM");
 }
 
-std::optional<StdinBound> stdinBound(const std::vector<unsigned char>& b, const std::string& ext) {
+std::optional<StdinBound> stdinBound(std::span<const unsigned char> b, const std::string& ext) {
     const std::size_t n = b.size();
     const Bytes r{b};
     if (ext == "png") {  // IHDR first: width, height, bit depth, colour type
@@ -257,7 +261,7 @@ std::optional<StdinBound> stdinBound(const std::vector<unsigned char>& b, const 
 
 }  // namespace
 
-const char* stdinExtension(const std::vector<unsigned char>& bytes) {
+const char* stdinExtension(std::span<const unsigned char> bytes) {
     const auto starts = [&](const char* magic, std::size_t size) {
         return bytes.size() >= size && std::memcmp(bytes.data(), magic, size) == 0;
     };
@@ -271,15 +275,47 @@ const char* stdinExtension(const std::vector<unsigned char>& bytes) {
                                                            : "";
 }
 
+StdinBytes::StdinBytes(std::size_t capacity) : m_capacity(capacity) {
+    void* base = ::mmap(nullptr, capacity, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+    if (base == MAP_FAILED)
+        throw Error(ErrorCode::Io, "cannot hold standard input: " + std::string(std::strerror(errno)) + "; give a file instead");
+    m_base = static_cast<unsigned char*>(base);
+}
+
+StdinBytes::StdinBytes(StdinBytes&& other) noexcept
+    : m_base(std::exchange(other.m_base, nullptr)),
+      m_capacity(std::exchange(other.m_capacity, 0)),
+      m_size(std::exchange(other.m_size, 0)) {}
+
+StdinBytes& StdinBytes::operator=(StdinBytes&& other) noexcept {
+    if (this != &other) {
+        StdinBytes old(std::move(*this));
+        m_base = std::exchange(other.m_base, nullptr);
+        m_capacity = std::exchange(other.m_capacity, 0);
+        m_size = std::exchange(other.m_size, 0);
+    }
+    return *this;
+}
+
+StdinBytes::~StdinBytes() {
+    if (m_base) ::munmap(m_base, m_capacity);
+}
+
+void StdinBytes::append(const unsigned char* bytes, std::size_t count) {
+    if (count > m_capacity - m_size) throw Error(ErrorCode::LimitExceeded, "standard input runs past the bytes kept for it");
+    std::memcpy(m_base + m_size, bytes, count);
+    m_size += count;
+}
+
 StdinImage readStdin() {
     const char* notAnImage = "standard input is not an image format CoNUS recognizes (PNG, JPEG, TIFF, EXR, BMP, HDR, PPM)";
-    StdinImage in;
+    StdinImage in{StdinBytes(kMaxStdinBytes), ""};
     unsigned char chunk[1 << 16];
     std::size_t n;
     std::string ext;
     std::optional<StdinBound> limit;
     while ((n = std::fread(chunk, 1, sizeof chunk, stdin)) > 0) {
-        // Refused before the bytes past the cap are kept (the buffer never grows past it).
+        // Refused before the bytes past the cap are kept.
         const std::uintmax_t cap = limit ? std::min(limit->bytes, kMaxStdinBytes) : kUnboundedStdinBytes;
         if (in.bytes.size() + n > cap) {
             if (limit && !limit->what.empty() && limit->bytes < kMaxStdinBytes)
@@ -288,23 +324,17 @@ StdinImage readStdin() {
             throw Error(ErrorCode::LimitExceeded, "standard input holds more than " + std::to_string(cap >> 20) +
                                                       " MiB; give a file instead");
         }
-        in.bytes.insert(in.bytes.end(), chunk, chunk + n);
+        in.bytes.append(chunk, n);
         // The format by its first bytes before reading on: an endless stream that is no picture
         // (/dev/zero, a log) is refused at once; one that is, past what its header declares.
         if (ext.empty() && in.bytes.size() >= 4) {
-            ext = stdinExtension(in.bytes);
+            ext = stdinExtension(in.bytes.view());
             if (ext.empty()) throw Error(ErrorCode::Io, notAnImage);
-            // Room for all a stream may hold before its header is read (untouched pages cost
-            // nothing), so that it is not copied as it grows; once read, for all it may declare.
-            in.bytes.reserve(kUnboundedStdinBytes);
         }
-        if (!ext.empty() && !limit) {
-            limit = stdinBound(in.bytes, ext);
-            if (limit) in.bytes.reserve(std::min(limit->bytes, kMaxStdinBytes));
-        }
+        if (!ext.empty() && !limit) limit = stdinBound(in.bytes.view(), ext);
     }
-    if (in.bytes.empty()) throw Error(ErrorCode::Io, "standard input is empty");
-    const char* name = stdinExtension(in.bytes);
+    if (in.bytes.size() == 0) throw Error(ErrorCode::Io, "standard input is empty");
+    const char* name = stdinExtension(in.bytes.view());
     if (!*name) throw Error(ErrorCode::Io, notAnImage);
     in.name = std::string("stdin.") + name;
     return in;
