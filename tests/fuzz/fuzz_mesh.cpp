@@ -1,6 +1,7 @@
 // Fuzz harness: the mesh reader (sceneio::readMesh, Assimp behind it) on arbitrary bytes, written
-// as a file whose extension follows its content (glTF, GLB, PLY, STL, OFF, OBJ; else the first
-// byte picks one) in a folder with files it may name and traps it must not open (scene_fixture.h).
+// as a file whose extension follows its content (glTF, GLB, PLY, STL, OFF, OBJ, COLLADA, X3D, FBX,
+// 3DS; else the first byte picks one) in a folder with files it may name and traps it must not
+// open (scene_fixture.h).
 // A mesh that reads must satisfy checkMesh, stay within the caps given, and hold no exact
 // duplicate triangle; anything else must be a one-line conus::Error.
 #include <algorithm>
@@ -24,8 +25,14 @@ std::string extensionOf(const std::uint8_t* data, std::size_t size) {
     if (startsWith(data, size, "solid")) return "stl";
     if (startsWith(data, size, "OFF")) return "off";
     if (startsWith(data, size, "v ") || startsWith(data, size, "#") || startsWith(data, size, "mtllib")) return "obj";
-    static const char* kAny[] = {"obj", "ply", "stl", "gltf", "glb", "off"};
-    return size == 0 ? "obj" : kAny[data[0] % 6];
+    if (startsWith(data, size, "<?xml") || startsWith(data, size, "<")) {  // X3D or COLLADA by the root element
+        const std::string head(reinterpret_cast<const char*>(data), std::min<std::size_t>(size, 512));
+        return head.find("<X3D") != std::string::npos ? "x3d" : "dae";
+    }
+    if (startsWith(data, size, "Kaydara FBX Binary") || startsWith(data, size, "; FBX")) return "fbx";
+    if (startsWith(data, size, "MM")) return "3ds";
+    static const char* kAny[] = {"obj", "ply", "stl", "gltf", "glb", "off", "dae", "x3d", "fbx", "3ds"};
+    return size == 0 ? "obj" : kAny[data[0] % (sizeof kAny / sizeof *kAny)];
 }
 
 }  // namespace
