@@ -77,19 +77,20 @@ int runRenderRelief(const RenderOptions& o) {
 
 // --- reflection -------------------------------------------------------------------------------
 
+// Rays a pixel a side when --samples is not given, for the reference and the asset's frame alike
+// (scored against each other, they alias alike): one ray a pixel aliases a texture finer than the
+// frame's pixels (the milk truck's 2048^2 on a truck a hundred pixels long), and 3x3 rays cost 9x
+// the one-ray frame's rays and come within 47 dB of 8x8 (bench/notes/2026-12-07-mirrors-2.md).
+constexpr int kFrameSamples = 3;
+
 struct ReflectionRenderText {
     std::string asset, scene, output, cameraText, sizeText = "640x480", at, normal = "0,0,1", backend = enumName(renderers::Backend::Auto);
     std::string reflector = enumName(codec::Reflector::Kind::Sphere);
     std::vector<std::string> allowDirs;
     double radius = 0.5, step = 1.0;
     bool reference = false;
-    int samples = 0;  // 0: kReferenceSamples with --reference, else 1
+    int samples = kFrameSamples;
 };
-
-// --reference's rays a pixel a side when --samples is not given: one ray a pixel aliases a texture
-// finer than the frame's pixels (the milk truck's 2048^2 on a truck a hundred pixels long), and
-// 3x3 rays cost 9x the one-ray frame's rays and come within 47 dB of 8x8 (bench/notes/2026-12-07-mirrors-2.md).
-constexpr int kReferenceSamples = 3;
 
 int runRenderReflection(const ReflectionRenderText& o) {
     const Size size = parseSize(o.sizeText);
@@ -104,19 +105,16 @@ int runRenderReflection(const ReflectionRenderText& o) {
     if (!(glm::length(options.reflector.normal) > 0)) throw Error(ErrorCode::InvalidArgument, "--normal is the zero vector");
     options.reflector.normal = glm::normalize(options.reflector.normal);
     options.intersect.stepTexels = o.step;
-    options.samples = o.samples > 0 ? o.samples : o.reference ? kReferenceSamples : 1;
+    options.samples = o.samples;
     const std::vector<codec::ReflectionFace> faces = codec::readReflectionFaces(o.asset);
     const glm::dvec3 centre = faces.front().depth.camera().eye();
     options.reflector.centre = o.at.empty() ? centre : parseVector3(o.at, "--at");
     const codec::MeshScene scene(readSceneMesh(o.scene, o.allowDirs));
     const double aspect = double(size.width) / size.height;
     const Camera camera = Camera::perspective(given.eye, given.target, {0, 1, 0}, given.fovYDegrees, aspect, 1e-3, 1e6);
-    // The ground truth traces the mesh itself, and only the CPU casts more than one ray a pixel.
-    const bool cpuOnly = o.reference || (options.samples > 1 && o.backend == enumName(renderers::Backend::Auto));
+    // The ground truth traces the mesh itself, on the CPU.
     const renderers::Device device =
-        cpuOnly ? renderers::Device::cpu() : deviceFor(o.backend, renderers::CpuPath::Available, "reflection rendering");
-    if (options.samples > 1 && device.backend() != renderers::Backend::Cpu)
-        throw Error(ErrorCode::InvalidArgument, "--samples above 1 needs the CPU (--reference, --backend cpu or auto): the GLSL renderer casts one ray a pixel");
+        o.reference ? renderers::Device::cpu() : deviceFor(o.backend, renderers::CpuPath::Available, "reflection rendering");
     Progress rendering("render " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                        (o.reference ? " (reflections traced against the mesh)" : " (reflections from the faces)"));
     Image frame = o.reference
@@ -156,8 +154,8 @@ CLI::App* addRenderReflection(CLI::App& command, ReflectionRenderText& o) {
     reflection->add_flag("--reference", o.reference,
                          "trace reflected rays against the mesh (Embree, CPU): the ground truth");
     reflection->add_option("--samples", o.samples,
-                           "N: N x N rays a pixel, one in each cell of an N x N grid over it, averaged (the CPU only, which auto then picks; default " +
-                               std::to_string(kReferenceSamples) + " with --reference, else 1)")
+                           "N: N x N rays a pixel, one in each cell of an N x N grid over it, averaged (1: one ray through the pixel's centre)")
+        ->capture_default_str()
         ->check(CLI::Range(1, codec::kMaxFrameSamples));
     addBackendOption(*reflection, o.backend);
     return reflection;

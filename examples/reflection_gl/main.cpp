@@ -162,11 +162,14 @@ void run(int argc, char** argv) {
         glUniform1i(at("uColours" + i), 3 * k + 2);
         glUniform1f(at("uFar" + i), d.far);
     }
-    // Nothing drawn behind the mirror here: the pass's scene texture says "nothing" everywhere.
-    std::vector<float> nothing(std::size_t(width) * height * 4, 0.0f);  // black, at no depth
+    // Rays a pixel a side, averaged (conus render reflection's default): the pass's scene texture
+    // holds a texel a ray. Nothing is drawn behind the mirror here: it says "nothing" everywhere.
+    const int samples = 3;
+    std::vector<float> nothing(std::size_t(width) * samples * height * samples * 4, 0.0f);  // black, at no depth
     for (std::size_t p = 3; p < nothing.size(); p += 4) nothing[p] = FLT_MAX;
-    texture(18, width, height, 4, nothing.data());
+    texture(18, width * samples, height * samples, 4, nothing.data());
     glUniform1i(at("uBehind"), 18);
+    glUniform1i(at("uSamples"), samples);
     glUniform1i(at("uLayers"), layers);
     const conus::codec::IntersectOptions options;  // the defaults `conus render reflection` uses
     glUniform1f(at("uStepTexels"), float(options.stepTexels));

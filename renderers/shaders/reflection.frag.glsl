@@ -6,7 +6,10 @@
 // algorithm), the nearest hit that is not the far plane wins and takes the face's colour there
 // (codec::reflectionColour); a ray that meets nothing shows the sky. A layered asset's faces hold
 // their layers side by side in their depth and colour textures (intersect.inc.glsl), the deeper
-// ones walked as codec::traceReflection walks them. Out: R, G, B and the mask M
+// ones walked as codec::traceReflection walks them. Each pixel casts uSamples x uSamples rays, one
+// at the centre of each cell of a regular grid over it, and averages their colours, as the CPU's
+// ReflectionFrameOptions::samples does; the scene behind is drawn with one sample a ray (uSamples
+// times the frame's size). Out: R, G, B and the mask M of the ray nearest the pixel's centre
 // (0 the scene or nothing, 1 the reflector showing the sky, 2 the reflector showing the scene).
 // Installed (<datadir>/conus/glsl); examples/reflection_gl sets its uniforms outside CoNUS.
 #include "equation1.inc.glsl"
@@ -20,7 +23,8 @@ uniform sampler2D uColours[kFaces];  // R, G, B, coverage per CoNUS pixel
 uniform int uLayers;                 // each face's layers (side by side in its textures)
 uniform DepthView uViews[kFaces];
 uniform float uFar[kFaces];          // each face's far clip (where nothing was seen)
-uniform sampler2D uBehind;           // the scene: R, G, B and camera depth (huge where nothing)
+uniform sampler2D uBehind;           // the scene: R, G, B and camera depth (huge where nothing), a texel a ray
+uniform int uSamples;                // rays a pixel a side (below 1: one)
 // The frame camera's rays, affine in the image point uv (computed in double precision on the
 // CPU: a matrix through the near and far planes loses them in float when far / near is large):
 // origin o0 + u oU + v oV, direction (unnormalized) d0 + u dU + v dV.
@@ -85,25 +89,23 @@ bool onSky(int f, DepthHit h) {
            (!h.hidden && h.depth >= uFar[f] * (1.0 - 1e-4));
 }
 
-void main() {
-    // GL's window row 0 is the frame's top row (the readback is top row first).
-    const vec2 uv = gl_FragCoord.xy / uFrameSize;
+// One ray through the image point uv, the scene behind it `behind`: its colour, and its mask M.
+float shadeRay(vec2 uv, vec4 behind, out vec3 colour) {
     const vec3 origin = uRayO0 + uRayOU * uv.x + uRayOV * uv.y;
     const vec3 direction = normalize(uRayD0 + uRayDU * uv.x + uRayDV * uv.y);
-    const vec4 behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0);
-    outColour = vec4(behind.rgb, 0.0);
+    colour = behind.rgb;
     vec3 normal;
     const float tMirror = hitReflector(origin, direction, normal);
-    if (tMirror < 0.0) return;
+    if (tMirror < 0.0) return 0.0;
     const vec3 at = origin + direction * tMirror;
-    if (!(dot(at - uFrameEye, uFrameForward) < behind.a)) return;
+    if (!(dot(at - uFrameEye, uFrameForward) < behind.a)) return 0.0;
     const vec3 reflected = normalize(direction - 2.0 * dot(direction, normal) * normal);
 
     // codec::traceReflection: the nearest hit among the faces that is not the far plane; a face's
     // deeper layers only where its first went hidden, short of a real first-layer hit.
     bool found = false;
     float best = uTMax;
-    vec3 colour = uSky;
+    colour = uSky;
     gDepthLayers = uLayers;
     for (int f = 0; f < kFaces; ++f) {
         gDepthLayer = 0;
@@ -120,11 +122,11 @@ void main() {
         }
         // From where the ray first went behind layer 0 (codec::traceReflection).
         if (h.firstHidden < best && uLayers > 1) {
-            const vec3 behind = at + reflected * h.firstHidden;
+            const vec3 behindLayer = at + reflected * h.firstHidden;
             for (int k = 1; k < uLayers; ++k) {
                 if (!(mineT - h.firstHidden > 0.0)) break;
                 gDepthLayer = k;
-                const DepthHit d = intersectBehindLayer(uDepths[f], uMaps[f], uViews[f], behind, reflected, uStepTexels,
+                const DepthHit d = intersectBehindLayer(uDepths[f], uMaps[f], uViews[f], behindLayer, reflected, uStepTexels,
                                                         uRefinements, uMaxSteps, mineT - h.firstHidden);
                 if (!d.hit || onSky(f, d)) continue;
                 mine = true;
@@ -138,5 +140,22 @@ void main() {
             colour = mineColour;
         }
     }
-    outColour = vec4(colour, found ? 2.0 : 1.0);
+    return found ? 2.0 : 1.0;
+}
+
+void main() {
+    // GL's window row 0 is the frame's top row (the readback is top row first).
+    const int n = max(uSamples, 1);
+    const ivec2 pixel = ivec2(gl_FragCoord.xy);
+    vec3 sum = vec3(0.0);
+    float mask = 0.0;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const vec2 uv = (vec2(pixel) + (vec2(i, j) + 0.5) / float(n)) / uFrameSize;
+            vec3 colour;
+            const float m = shadeRay(uv, texelFetch(uBehind, pixel * n + ivec2(i, j), 0), colour);
+            sum += colour;
+            if (i == n / 2 && j == n / 2) mask = m;
+        }
+    outColour = vec4(sum / float(n * n), mask);
 }

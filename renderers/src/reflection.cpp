@@ -1,5 +1,5 @@
-// Reflection frames on a Context (reflection.h): the scene behind from the mesh renderer, then one
-// full-screen pass (reflection.frag.glsl) through intersect.inc.glsl. Window row 0 is the frame's
+// Reflection frames on a Context (reflection.h): the scene behind from the mesh renderer (a pixel
+// a ray), then one full-screen pass (reflection.frag.glsl) through intersect.inc.glsl. Window row 0 is the frame's
 // top row, as in the other renderers, so readbacks need no flip.
 #include "conus/renderers/reflection.h"
 
@@ -69,11 +69,18 @@ struct ReflectionScene : DepthFrameRenderer::Scene {
 
     void drawFrame(const Camera& camera, int w, int h) override {
         checkFrame(context, w, h, kWhat);
-        // The scene behind: R, G, B and camera depth (kNothingBehind where nothing was hit).
+        // The scene behind: R, G, B and camera depth (kNothingBehind where nothing was hit), one
+        // pixel a ray: the frame's size times the rays a pixel a side, as the CPU shades each ray.
+        const int n = options.samples;
+        if (w > kMaxFrameSide / n || h > kMaxFrameSide / n)
+            throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": " + std::to_string(n) + "x" + std::to_string(n) +
+                                                        " rays a pixel over a " + std::to_string(w) + "x" + std::to_string(h) +
+                                                        " frame need a scene frame of over " + std::to_string(kMaxFrameSide) + " a side");
+        checkFrame(context, w * n, h * n, kWhat);
         MeshRenderOptions one;
         one.samples = 1;
-        const Image mesh = scene.render(camera, codec::SamplingMap::identity(2, 2), w, h, one);
-        std::vector<float> rgbz(static_cast<std::size_t>(w) * h * 4);
+        const Image mesh = scene.render(camera, codec::SamplingMap::identity(2, 2), w * n, h * n, one);
+        std::vector<float> rgbz(static_cast<std::size_t>(w * n) * std::size_t(h * n) * 4);
         for (std::size_t p = 0; p < rgbz.size() / 4; ++p) {
             const float* m = &mesh.pixels[p * mesh.channels.size()];
             rgbz[p * 4] = m[codec::kMeshChannelR];
@@ -82,7 +89,7 @@ struct ReflectionScene : DepthFrameRenderer::Scene {
             rgbz[p * 4 + 3] = m[codec::kMeshChannelA] > 0.0f ? m[codec::kMeshChannelZ] : kNothingBehind;
         }
         const GladGLContext& gl = makeCurrentGl(context);
-        behind = floatTexture(gl, GL_TEXTURE0 + kBehindUnit, w, h, 4, rgbz.data());
+        behind = floatTexture(gl, GL_TEXTURE0 + kBehindUnit, w * n, h * n, 4, rgbz.data());
 
         const GLuint program =
             cachedProgram(context, "reflection", shaders::kShaderFullscreenVert, shaders::kShaderReflectionFrag);
@@ -103,6 +110,7 @@ struct ReflectionScene : DepthFrameRenderer::Scene {
         gl.BindTexture(GL_TEXTURE_2D, behind.id());
         gl.Uniform1i(at("uBehind"), kBehindUnit);
         gl.Uniform1i(at("uLayers"), layers);
+        gl.Uniform1i(at("uSamples"), n);
         setIntersectOptions(gl, program, options.intersect);
         gl.Uniform1f(at("uTMax"), static_cast<float>(std::min(options.intersect.tMax, 1e30)));
         // Camera::ray as affine functions of uv (reflection.frag.glsl).
@@ -137,9 +145,9 @@ std::unique_ptr<DepthFrameRenderer::Scene> reflectionScene(Context& context, con
                                                            const std::vector<codec::ReflectionFace>& faces,
                                                            const codec::ReflectionFrameOptions& options) {
     codec::checkIntersectOptions(options.intersect);
-    if (options.samples != 1)
-        throw Error(ErrorCode::Unsupported, "the GLSL " + std::string(kWhat) + " renderer casts one ray a pixel (samples 1), not " +
-                                                std::to_string(options.samples) + " a side");
+    if (options.samples < 1 || options.samples > codec::kMaxFrameSamples)
+        throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": 1 to " + std::to_string(codec::kMaxFrameSamples) +
+                                                    " rays a pixel a side, not " + std::to_string(options.samples));
     if (faces.size() != static_cast<std::size_t>(codec::kCubeFaces))
         throw Error(ErrorCode::InvalidArgument, std::string(kWhat) + ": " + std::to_string(faces.size()) +
                                                     " faces; the GPU renderer draws a cube of " +

@@ -91,12 +91,12 @@ TEST_F(ReflectionCli, OneFileBakesValidatesDescribesAndRenders) {
     EXPECT_EQ(names, (std::vector<std::string>{"conus.px", "samplingmap.px", "conus.nx", "samplingmap.nx", "conus.py", "samplingmap.py",
                                                "conus.ny", "samplingmap.ny", "conus.pz", "samplingmap.pz", "conus.nz", "samplingmap.nz"}));
 
-    const std::string common = " --scene " + scene + " --camera -0.8,0.5,3,0,0,0,22 --size 96x96 --radius 0.5 -q";
+    // One ray a pixel, the faces' frames and the reference alike: the faces' error alone, without
+    // the aliasing of one ray a pixel against many.
+    const std::string common = " --scene " + scene + " --camera -0.8,0.5,3,0,0,0,22 --size 96x96 --radius 0.5 --samples 1 -q";
     ASSERT_EQ(run("render reflection " + conus + common + " --backend cpu -o " + path("conus.png")).exitCode, 0);
     ASSERT_EQ(run("render reflection " + uniform + common + " --backend cpu -o " + path("uniform.png")).exitCode, 0);
-    // The reference along the same rays as the faces' frames (one a pixel): the faces' error alone,
-    // without the one-ray frames' aliasing against an antialiased reference.
-    ASSERT_EQ(run("render reflection " + conus + common + " --reference --samples 1 -o " + path("truth.png")).exitCode, 0);
+    ASSERT_EQ(run("render reflection " + conus + common + " --reference -o " + path("truth.png")).exitCode, 0);
     // The faces approximate the traced reflection: 38.4 dB on this scene at these sizes.
     const double conusPsnr = psnr(path("conus.png"), path("truth.png"));
     EXPECT_GT(conusPsnr, 38.0);
@@ -239,12 +239,11 @@ TEST_F(ReflectionCli, AViewPlacesTheEyeAndItsFrameBeatsTheCentredAsset) {
     EXPECT_LT(one, before) << r.out;
 
     const std::string common = " --scene " + scene + " --camera 0.6,0.35,1.1,0,0,0,60 --size 96x96 --reflector plane --normal 0,0,1 "
-                               "--radius 1 --at 0,0,0 -q";
+                               "--radius 1 --at 0,0,0 --samples 1 -q";  // one ray a pixel, as above
     for (const std::string* asset : {&centred, &placed}) {
         const std::string stem = asset == &centred ? "centred" : "placed";
         ASSERT_EQ(run("render reflection " + *asset + common + " --backend cpu -o " + path(stem + ".png")).exitCode, 0);
-        // The reference along the frames' rays, one a pixel, as above.
-        ASSERT_EQ(run("render reflection " + *asset + common + " --reference --samples 1 -o " + path(stem + "-truth.png")).exitCode, 0);
+        ASSERT_EQ(run("render reflection " + *asset + common + " --reference -o " + path(stem + "-truth.png")).exitCode, 0);
         r = run("render reflection " + *asset + common + " --backend egl -o " + path(stem + "-gl.png"));
         ASSERT_EQ(r.exitCode, 0) << r.err;
     }
@@ -277,7 +276,7 @@ TEST_F(ReflectionCli, TheRoomsGlFrameDiffersFromTheCpuOnlyInOneColumnAtTheMirror
     ASSERT_EQ(run(bake + path("conus.exr")).exitCode, 0);
     ASSERT_EQ(run(bake + path("uniform.exr") + " --uniform").exitCode, 0);
     const std::string common = " --scene " + scene + " --reflector plane --normal 0,0,1 --radius 0.5 "
-                               "--camera -0.8,0.5,3,0,0,0,30 --size 320x240 -q -o ";
+                               "--camera -0.8,0.5,3,0,0,0,30 --size 320x240 --samples 1 -q -o ";
     for (const char* asset : {"conus", "uniform"})
         for (const char* backend : {"cpu", "egl"}) {
             const std::string frame = path(std::string(asset) + "-" + backend + ".exr");
@@ -387,15 +386,17 @@ TEST_F(ReflectionCli, AWriteCutShortLeavesTheEarlierAssetWhole) {
         EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
 }
 
-// --reference antialiases by default (3x3 rays a pixel): across the box's outlines and the mirror's
-// it is much nearer a 8x8-ray render than the one-ray reference (--samples 1); a count of rays
-// outside 1..16, or above 1 on the GLSL renderer, is refused in one line with nothing written.
-TEST_F(ReflectionCli, TheReferenceAntialiasesByDefault) {
+// Frames antialias by default (3x3 rays a pixel), the traced reference and the faces' frames on
+// every backend: across the box's outlines and the mirror's the reference is much nearer a 8x8-ray
+// render than one ray a pixel (--samples 1) is; the faces' GLSL frame is the CPU's, and their
+// default frame is nearer the default reference than their one-ray frame. A count of rays outside
+// 1..16 is refused in one line with nothing written.
+TEST_F(ReflectionCli, FramesAntialiasByDefaultOnEveryBackend) {
     const std::string scene = path("scene.obj"), asset = path("asset.exr");
     writeScene(scene);
     ASSERT_EQ(run("bake reflection " + scene + " --center 0,0,0 --size 16 --uniform -q -o " + asset).exitCode, 0);
-    const std::string common = "render reflection " + asset + " --scene " + scene +
-                               " --camera -0.8,0.5,3,0,0,0,22 --size 48x40 --radius 0.5 --reference -o ";
+    const std::string frame = "render reflection " + asset + " --scene " + scene + " --camera -0.8,0.5,3,0,0,0,22 --size 48x40 --radius 0.5 -o ";
+    const std::string common = frame.substr(0, frame.size() - 4) + " --reference -o ";
     Result r = run(common + path("default.exr"));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("3x3 rays a pixel"), std::string::npos) << r.out;
@@ -405,20 +406,28 @@ TEST_F(ReflectionCli, TheReferenceAntialiasesByDefault) {
     std::printf("[ info ] against 8x8 rays a pixel: one ray %.1f dB, the default %.1f dB\n", oneDb, defaultDb);
     EXPECT_GT(defaultDb, oneDb + 4.0) << oneDb;
     EXPECT_GT(meanError(path("one.exr"), path("default.exr")), 0.0);
-    for (const std::string bad : {" --samples 0", " --samples 17", " --samples 2 --backend egl"}) {
+
+    for (const char* backend : {"cpu", "egl"}) {
+        r = run(frame + path(std::string("faces-") + backend + ".exr") + " --backend " + backend);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_NE(r.out.find("3x3 rays a pixel"), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find(backend), std::string::npos) << r.out;
+    }
+    ASSERT_EQ(run(frame + path("faces-one.exr") + " --backend cpu --samples 1").exitCode, 0);
+    const double glDb = psnr(path("faces-egl.exr"), path("faces-cpu.exr"));
+    const double facesDb = psnr(path("faces-cpu.exr"), path("default.exr")), facesOneDb = psnr(path("faces-one.exr"), path("default.exr"));
+    std::printf("[ info ] the faces' frames against the default reference: 3x3 %.1f dB, one ray %.1f dB; GL against CPU %.1f dB\n",
+                facesDb, facesOneDb, glDb);
+    EXPECT_GT(glDb, 35.0);
+    EXPECT_GT(facesDb, facesOneDb + 1.0);
+
+    for (const std::string bad : {" --samples 0", " --samples 17"}) {
         const std::string out = path("bad.png");
         r = run("render reflection " + asset + " --scene " + scene + " --camera -0.8,0.5,3,0,0,0,22 --size 8x8 -q -o " + out + bad);
         EXPECT_NE(r.exitCode, 0) << bad;
         EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
         EXPECT_FALSE(fs::exists(out)) << bad;
     }
-    // The GLSL renderer is not antialiased: where only --samples is wrong, the error says what works;
-    // the backend left to choose takes the CPU for an antialiased frame of the faces.
-    EXPECT_NE(r.err.find("needs the CPU"), std::string::npos) << r.err;
-    r = run("render reflection " + asset + " --scene " + scene + " --camera -0.8,0.5,3,0,0,0,22 --size 8x8 --samples 2 -o " + path("aa.png"));
-    ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_NE(r.out.find("2x2 rays a pixel"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("(cpu)"), std::string::npos) << r.out;
 }
 
 TEST_F(ReflectionCli, BadInputIsOneLineAndNonZero) {

@@ -146,6 +146,25 @@ TEST_P(ReflectionGl, PlaneMirrorMatchesCpu) {
     expectAgreement(context(), camera, options, false);
 }
 
+// 3x3 rays a pixel: the GLSL pass casts the CPU's rays (the scene behind drawn a pixel a ray) and
+// averages them as it does; the mask is the centre ray's. The antialiased frame is not the one-ray
+// frame (the box's and the mirror's outlines are mixed).
+TEST_P(ReflectionGl, AntialiasedFramesMatchCpu) {
+    codec::ReflectionFrameOptions options;
+    options.reflector.radius = 0.5;
+    options.samples = 3;
+    const Camera camera = Camera::perspective({-0.8, 0.5, 3.0}, {0.0, 0.0, 0.0}, {0, 1, 0}, 22.0, 1.0, 0.1, 20.0);
+    for (const bool uniform : {false, true}) expectAgreement(context(), camera, options, uniform);
+    const auto set = faces(false);
+    options.samples = 1;
+    const Image one = ReflectionRenderer(context(), scene().mesh(), set, options).render(camera, kFrame, kFrame);
+    options.samples = 3;
+    const Image three = ReflectionRenderer(context(), scene().mesh(), set, options).render(camera, kFrame, kFrame);
+    int mixed = 0;
+    for (std::size_t i = 0; i < one.pixels.size(); ++i) mixed += i % 4 != 3 && std::abs(one.pixels[i] - three.pixels[i]) > 0.05f;
+    EXPECT_GT(mixed, 50);
+}
+
 TEST_P(ReflectionGl, BadInputIsRefused) {
     auto set = faces(false);
     codec::ReflectionFrameOptions options;
@@ -155,8 +174,10 @@ TEST_P(ReflectionGl, BadInputIsRefused) {
     options.intersect.stepTexels = 0;
     EXPECT_THROW(ReflectionRenderer(context(), scene().mesh(), set, options), Error);
     options = {};
-    options.samples = 2;  // one ray a pixel only (the CPU reference antialiases)
-    EXPECT_THROW(ReflectionRenderer(context(), scene().mesh(), set, options), Error);
+    for (const int samples : {0, codec::kMaxFrameSamples + 1}) {
+        options.samples = samples;
+        EXPECT_THROW(ReflectionRenderer(context(), scene().mesh(), set, options), Error) << samples;
+    }
     options = {};
     ReflectionRenderer renderer(context(), scene().mesh(), set, options);
     const Camera camera = Camera::perspective({0, 0, 3}, {0, 0, 0}, {0, 1, 0}, 40.0, 1.0, 0.1, 20.0);

@@ -1,9 +1,10 @@
 // Reflections on the GPU (paper section 5, Figure 6): the GLSL twin of
 // codec::renderReflectionFrame. A reflection asset's six cube faces (codec/depth/reflection.h) are
 // uploaded as float textures (camera depths, the maps' nodes, colour + coverage); a frame draws
-// the scene behind with the mesh renderer (one sample a pixel, identity map) and then, in one
-// fragment pass, meets each pixel's eye ray with the reflector and intersects the reflected ray
-// with the faces through intersect.inc.glsl, the one intersection algorithm.
+// the scene behind with the mesh renderer (one sample a ray, identity map) and then, in one
+// fragment pass, meets each of a pixel's options.samples x options.samples eye rays (the CPU's
+// rays, averaged as it averages them) with the reflector and intersects the reflected ray with the
+// faces through intersect.inc.glsl, the one intersection algorithm.
 //
 // Shared rules as depth_frames.h; a driver with fewer than 19 fragment texture units is Unsupported.
 #pragma once
