@@ -303,7 +303,9 @@ TEST_F(ReflectionCli, TheRoomsGlFrameDiffersFromTheCpuOnlyInOneColumnAtTheMirror
                 hi = std::max(hi, x);
             }
         }
-    if (conus > 0) EXPECT_LE(hi - lo, 6) << lo << ".." << hi;
+    if (conus > 0) {
+        EXPECT_LE(hi - lo, 6) << lo << ".." << hi;
+    }
 }
 
 // A damaged asset: validate lists the broken rule and exits 1; render says it in one line and

@@ -196,7 +196,9 @@ TEST(Foci, BothCompositionsValidForHardCases) {
                 }
                 // Magnifies at the first focus; adding three large overlapping foci's maps (case 4)
                 // can cancel one of them, which is what the density composition is for.
-                if (composition == FociComposition::Density || c != 4) EXPECT_GT(map.density({foci[0].u, foci[0].v}), 1.0);
+                if (composition == FociComposition::Density || c != 4) {
+                    EXPECT_GT(map.density({foci[0].u, foci[0].v}), 1.0);
+                }
             }
         }
     }
