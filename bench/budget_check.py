@@ -4,8 +4,8 @@
 
 For each photograph (reduced to at most 1280 px wide, written as an 8-bit sRGB PNG, as
 bench/quality_targets.py does) `conus encode` runs with its defaults and one `--focus u,v,r,4` per
-region; what it printed (the whole-frame loss and the 95th percentile of the tiles outside the
-foci, 'measured by the encode kept' or 'predicted', the column 'printed as') is set beside what the
+region; what it printed (the whole-frame loss, the 95th percentile of the tiles outside the foci
+and the foci's gain, 'measured by the encode kept' or 'predicted', the column 'printed as') is set beside what the
 decoded file loses against `conus uniform` of the same pixel count on 8-bit sRGB
 (quality_targets.scores). Targets: printed within 0.5 dB of measured for the frame and 1 dB for the
 p95 tile; measured frame loss within the budget and p95 tile loss <= 4 dB. The photographs:
@@ -85,9 +85,18 @@ def predicted(text):
         v = float(m.group(2))
         return -v if m.group(1) in ("gains", "gain") else v
     said = re.search(r"\n  (predicted|measured by the encode kept): the whole frame", text)
+    roi = re.search(r"the foci gain ([-0-9.]+) dB", text)
     return (value(r"whole frame (loses|gains) ([-0-9.]+) dB"),
             value(r"tiles outside the foci (lose|gain) ([-0-9.]+) dB"),
-            "measured" if said and said.group(1).startswith("measured") else "predicted")
+            "measured" if said and said.group(1).startswith("measured") else "predicted",
+            float(roi.group(1)) if roi else float("nan"))
+
+
+def roi_text(r):
+    """The ROI gain printed against measured (the encode prints none where it cannot predict it)."""
+    if np.isnan(r["predicted_roi"]):
+        return f"not printed / {r['roi_gain']:+.2f}"
+    return f"{r['predicted_roi']:+.2f} / {r['roi_gain']:+.2f} ({r['predicted_roi'] - r['roi_gain']:+.2f})"
 
 
 def check(photos, out, extra=()):
@@ -104,21 +113,22 @@ def check(photos, out, extra=()):
             text, wall = run(BINARY, ["encode", src, "-o", work / "c.exr"] + foci + list(extra))
             c8, _ = decoded8(work / "c.exr", w, h)
             m = scores(c8, u8, s8, regions)
-            pf, pt, said = predicted(text)
+            pf, pt, said, pr = predicted(text)
             ks = ", ".join(re.findall(r": k ([0-9.]+) \(asked", text))
             rows.append(dict(group=group, name=name, size=f"{w}x{h}", k=ks, predicted_frame=pf,
                              measured_frame=m["frame_loss"], predicted_tile=pt, measured_tile=m["tile95"],
-                             roi_gain=m["roi_gain"], wall=wall, said=said))
+                             roi_gain=m["roi_gain"], predicted_roi=pr, wall=wall, said=said))
         r = rows[-1]
         print(f"{group:8} {name:12} k {r['k']:12} frame {r['predicted_frame']:+.2f} / {r['measured_frame']:+.2f} dB  "
-              f"tile p95 {r['predicted_tile']:+.2f} / {r['measured_tile']:+.2f} dB  ROI {r['roi_gain']:+.2f} dB  {wall:.1f} s", flush=True)
+              f"tile p95 {r['predicted_tile']:+.2f} / {r['measured_tile']:+.2f} dB  ROI {roi_text(r)} dB  "
+              f"{wall:.1f} s", flush=True)
     lines = ["| set | photo | size | k given | printed as | frame loss printed / measured (diff) | p95 tile loss printed / measured (diff) "
-             "| ROI gain | encode s |", "|---|---|---|---|---|---|---|---|---|"]
+             "| ROI gain printed / measured (diff) | encode s |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         df, dt = r["predicted_frame"] - r["measured_frame"], r["predicted_tile"] - r["measured_tile"]
         lines.append(f"| {r['group']} | {r['name']} | {r['size']} | {r['k']} | {r['said']} | {r['predicted_frame']:+.2f} / "
                      f"{r['measured_frame']:+.2f} ({df:+.2f}) | {r['predicted_tile']:+.2f} / {r['measured_tile']:+.2f} ({dt:+.2f}) | "
-                     f"{r['roi_gain']:+.2f} | {r['wall']:.1f} |")
+                     f"{roi_text(r)} | {r['wall']:.1f} |")
     lines.append("")
     # The set the constants were fitted on, and the others (unseen and held-out: nothing fitted on them), apart.
     for label, subset in (("fitted", [r for r in rows if r["group"] == "fitted"]),
@@ -127,12 +137,15 @@ def check(photos, out, extra=()):
             continue
         df = np.array([r["predicted_frame"] - r["measured_frame"] for r in subset])
         dt = np.array([r["predicted_tile"] - r["measured_tile"] for r in subset])
+        dr = np.array([r["predicted_roi"] - r["roi_gain"] for r in subset if not np.isnan(r["predicted_roi"])])
         lines += [f"- {label}: frame printed within 0.5 dB of measured on {sum(abs(d) <= 0.5 for d in df)} of {len(subset)} "
                   f"(mean |diff| {np.abs(df).mean():.2f} dB, worst {df[np.abs(df).argmax()]:+.2f} dB); p95 tile within 1 dB on "
                   f"{sum(abs(d) <= 1.0 for d in dt)} of {len(subset)} (mean |diff| {np.abs(dt).mean():.2f} dB, worst "
                   f"{dt[np.abs(dt).argmax()]:+.2f} dB); measured frame loss over the {BUDGET_FRAME_DEFAULT} dB budget on "
                   f"{sum(r['measured_frame'] > BUDGET_FRAME_DEFAULT for r in subset)}, p95 tile loss over {BUDGET_TILE} dB on "
-                  f"{sum(r['measured_tile'] > BUDGET_TILE for r in subset)}"]
+                  f"{sum(r['measured_tile'] > BUDGET_TILE for r in subset)}; "
+                  + (f"ROI gain printed within 1 dB of measured on {sum(abs(d) <= 1.0 for d in dr)} of {len(dr)} (mean |diff| "
+                     f"{np.abs(dr).mean():.2f} dB, worst {dr[np.abs(dr).argmax()]:+.2f} dB)" if len(dr) else "no ROI gain printed")]
     lines += [f"- measured: worst frame loss {max(r['measured_frame'] for r in rows):.2f} dB, worst p95 tile loss "
               f"{max(r['measured_tile'] for r in rows):.2f} dB; mean ROI gain {np.mean([r['roi_gain'] for r in rows]):+.2f} dB; "
               f"printed as measured on {sum(r['said'] == 'measured' for r in rows)} of {len(rows)}"]

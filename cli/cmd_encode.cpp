@@ -123,7 +123,7 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     codec::BudgetResult r = codec::buildAutoMapForFrameLoss(importance, model, o.frameLoss, autoOptions, codec::kDefaultTileLoss);
     progress.done();
     if (!quiet())
-        std::printf("%s\n", describeFloorBudget(r, o.frameLoss, o.importance + " importance", encodeKept).c_str());
+        std::printf("%s\n", describeFloorBudget(r, o.frameLoss, o.importance + " importance", encodeKept, !o.fast).c_str());
     return {std::make_unique<codec::SamplingMap>(std::move(r.map)), std::nullopt, std::move(r.encode)};
 }
 
@@ -145,7 +145,10 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Picture& source, const Size& 
                                         : codec::budgetedFociMap(source.image, o.parsedFoci, size.width, size.height, request);
     progress.done();
     const std::string said =
-        describeFociBudget(built.budget, BudgetFrame{size.width, size.height, source.image.width, source.image.height, o.frameLoss}, o.exactK, o.grid,
+        describeFociBudget(built.budget,
+                           BudgetFrame{size.width, size.height, source.image.width, source.image.height, o.frameLoss,
+                                       std::numeric_limits<double>::infinity(), !o.fast},
+                           o.exactK, o.grid,
                            o.maxAnisotropy, encodeKept);
     if (!quiet()) std::printf("%s\n", said.c_str());
     *given = "k " + fociKText(built.budget.given);

@@ -50,6 +50,9 @@ struct BudgetFrame {
     int width = 0, height = 0, sourceWidth = 0, sourceHeight = 0;
     double frameLoss = codec::kDefaultFrameLoss;
     double restLoss = std::numeric_limits<double>::infinity();  // outside the foci (finite: said)
+    // false: the budget's model was never confirmed by an encode (`--fast`): its frame and tile
+    // losses are printed as predicted, its foci's gain not at all (the model alone overstates it).
+    bool confirmed = true;
 };
 // What a foci budget did, in a line: the share of the pixels the foci take, what the context is
 // sampled like, the k each focus got and, when the budget lowered k, why. Warns (even when quiet)
@@ -64,7 +67,8 @@ std::string describeFociBudget(const codec::FociBudget& budget, const std::optio
 std::string lossText(double db, const char* lose, const char* gain, int decimals);
 // What the budget of an importance map did, in a short block: the budget, the context floor it
 // chose, the predicted losses and the region's gain (`what`: the importance's name).
-std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what, bool encodeKept);
+std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what, bool encodeKept,
+                                bool confirmed = true);
 
 // --grid against the image it shapes (codec::checkGridForImage).
 void checkGridForImage(int grid, int width, int height, int defaultGrid = map_rules::kDefaultSide);

@@ -105,6 +105,12 @@ TEST_F(BudgetCli, TwoLargeFociAreLoweredAndSaySo) {
     EXPECT_NE(tight.out.find("budget: the whole frame within 0.1 dB"), std::string::npos) << tight.out;
     EXPECT_LE(printedLoss(tight.out, ": the whole frame"), 0.1 + 0.005) << tight.out;
     EXPECT_LT(recordedK(path("tight.exr"))[0], 4.0 - 0.05);
+    // The model alone (no encode confirms it under --fast) predicts the losses and says so; the
+    // foci's gain, which it overstates, is not printed. With an encode to confirm it, it is.
+    EXPECT_NE(tight.out.find("\n  predicted: the whole frame"), std::string::npos) << tight.out;
+    EXPECT_NE(tight.out.find("the foci's gain is not predicted under --fast"), std::string::npos) << tight.out;
+    EXPECT_EQ(tight.out.find("the foci gain "), std::string::npos) << tight.out;
+    EXPECT_NE(r.out.find(" at the 95th percentile, the foci gain "), std::string::npos) << r.out;
 }
 
 // The 8-bit codes of a PNG, read by OpenImageIO.
