@@ -142,8 +142,8 @@ std::optional<StdinBound> exrBound(std::span<const unsigned char> b) {
             const std::int64_t size = signed32(at);
             at += 4;
             if (size < 0 || size > kMaxAttributeBytes)
-                throw Error(ErrorCode::Corrupt, "standard input's OpenEXR attribute '" + name->substr(0, 64) + "' declares " +
-                                                    std::to_string(size) + " bytes");
+                throw Error(ErrorCode::Corrupt, "standard input's OpenEXR header has an attribute of " + std::to_string(size) +
+                                                    " bytes (at most " + std::to_string(kMaxAttributeBytes) + ")");
             if (at + std::size_t(size) > n) return more();
             const std::size_t end = at + std::size_t(size);
             if (*name == "dataWindow" && *type == "box2i" && size == 16) {

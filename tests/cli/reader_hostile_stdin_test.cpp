@@ -80,7 +80,8 @@ TEST_F(StdinHostile, APictureHeaderFollowedByEndlessBytesIsRefusedByWhatItDeclar
 
 // Where the first bytes do not give the size (a BigTIFF, whose directory CoNUS does not walk) a
 // stream is held to 256 MiB; a TIFF whose directory lies past that is refused at its first bytes,
-// and one whose directory holds no picture is refused there. A BigTIFF piped in whole still reads.
+// one whose directory holds no picture is refused there, and an OpenEXR header whose attribute
+// declares more than a header may hold at once. A BigTIFF piped in whole still reads.
 TEST_F(StdinHostile, AStreamWhoseHeaderGivesNoSizeIsHeldToAFewHundredMegabytes) {
     std::vector<unsigned char> ramp(std::size_t(40) * 30 * 3);
     for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = static_cast<unsigned char>(i * 5 % 253);
@@ -117,6 +118,9 @@ TEST_F(StdinHostile, AStreamWhoseHeaderGivesNoSizeIsHeldToAFewHundredMegabytes) 
         {endless("endless-big.tif", slurp(big).substr(0, 16)), "holds more than 256 MiB; give a file instead", 500},
         {endless("far.tif", tiffTo(0x7fff0000u)), "first directory is at byte 2147418112", 300},
         {endless("empty-directory.tif", tiffTo(64u << 20)), "gives no width or length", 400},
+        // An OpenEXR header whose attribute declares 1 GiB (its name, type, then the size).
+        {endless("huge-attribute.exr", std::string("\x76\x2f\x31\x01\x02\0\0\0comments\0string\0\0\0\0\x40", 28)),
+         "has an attribute of 1073741824 bytes", 300},
     };
     for (const auto& c : cases) {
         SCOPED_TRACE(c.stdinFile);
