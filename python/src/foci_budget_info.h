@@ -17,7 +17,10 @@ namespace conus::python {
 
 // The dict of File.budget; warns (UserWarning) when k was lowered, when exact_k left the frame
 // losing more than the budget (FociBudget::overBudget), and when the grid held a focus only to a lower k.
-inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, int w, int h, int sourceW, int sourceH) {
+// `confirmed`: the budget's model was confirmed by an encode (fit > 0); the model alone (fit=0, as
+// `--fast`) overstates the foci's gain, whose predicted_roi_gain is then None, as the CLI does not
+// print it.
+inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, int w, int h, int sourceW, int sourceH, bool confirmed) {
     std::vector<double> asked, given;
     for (const codec::Focus& f : b.asked) asked.push_back(f.k);
     for (const codec::Focus& f : b.given) given.push_back(f.k);
@@ -29,7 +32,8 @@ inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, i
     d["builder_notes"] = b.builderNotes;  // what the anisotropy bound cost (a transition widened, a grid refined)
     d["frame_loss"] = frameLoss;
     d["predicted_frame_loss"] = b.predicted.frameLoss;
-    d["predicted_roi_gain"] = b.predicted.roiGain;
+    d["confirmed"] = confirmed || b.encode != nullptr;
+    d["predicted_roi_gain"] = confirmed || b.encode != nullptr ? pybind11::object(pybind11::float_(b.predicted.roiGain)) : pybind11::none();
     d["predicted_tile_loss"] = b.predicted.tileLoss;
     // What k as asked would hold (exact_k=True), predicted the same way.
     d["predicted_frame_loss_exact_k"] = b.askedPredicted.frameLoss;

@@ -221,7 +221,8 @@ PYBIND11_MODULE(_conus, m) {
             "budget", [](const File& self) -> py::object { return self.budget ? py::object(*self.budget) : py::none(); },
             "What encode(foci=...)'s budget did, or None: k_asked, k_given (each focus's), lowered, frame_loss (the\n"
             "budget), tile_loss (its tiles' budget), predicted_frame_loss, predicted_tile_loss, predicted_roi_gain (dB;\n"
-            "a negative loss is a gain), predicted_frame_loss_exact_k and predicted_tile_loss_exact_k (what the k\n"
+            "a negative loss is a gain; None where fit=0 leaves the model unconfirmed: the model alone overstates it),\n"
+            "confirmed (whether an encode confirmed the model), predicted_frame_loss_exact_k and predicted_tile_loss_exact_k (what the k\n"
             "asked would hold: the price of exact_k=True), foci_share (of the CoNUS pixels),\n"
             "context_downscale and uniform_downscale (the linear downscale the context and the uniform image are\n"
             "sampled like), ask (the discs' pixels at k over all the pixels), grid_limited")
@@ -325,7 +326,7 @@ PYBIND11_MODULE(_conus, m) {
                                                   map->analytic);
             }
             file->map = map;
-            if (budget) file->budget = budgetInfo(*budget, frameLoss, w, h, source.width, source.height);
+            if (budget) file->budget = budgetInfo(*budget, frameLoss, w, h, source.width, source.height, trials.confirm);
             return file;
         },
         py::arg("pixels"), py::arg("foci") = py::none(), py::arg("size") = py::none(), py::arg("map") = py::none(),

@@ -294,6 +294,12 @@ def test_encode_holds_the_frame_loss_budget(tmp_path, conus_bin):
     assert b["lowered"] and b["k_asked"] == [4.0, 4.0] and b["frame_loss"] == 1.5
     assert 1.0 < b["k_given"][0] < 4.0 and b["k_given"][0] == pytest.approx(b["k_given"][1])
     assert b["predicted_frame_loss"] <= 1.5 and b["predicted_tile_loss"] <= 4.0 and b["ask"] > 1.0
+    # fit=0: no encode confirms the model, which overstates the foci's gain: not given (as --fast
+    # does not print it); fitted, one encode confirms it and the gain is given.
+    assert not b["confirmed"] and b["predicted_roi_gain"] is None
+    with pytest.warns(UserWarning):
+        fitted = conus.encode(detail, foci=foci, size=(60, 40)).budget
+    assert fitted["confirmed"] and isinstance(fitted["predicted_roi_gain"], float)
     assert b["context_downscale"] > b["uniform_downscale"] == pytest.approx(4.0)
     assert [focus[3] for focus in f.attributes["analytic"]["foci"]] == pytest.approx(b["k_given"])
     # The binary gives the same k for the same picture.
