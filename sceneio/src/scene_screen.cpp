@@ -99,10 +99,11 @@ std::string attribute(const std::string& attributes, const char* key) {
     return {};
 }
 
-// XML: elements opened and not yet closed (comments, CDATA, declarations and processing
-// instructions skipped; quoted attribute values may hold '>'), each tag given to `onTag`.
-template <class OnTag>
-void scanXml(Bytes& in, int limit, const std::string& what, OnTag onTag) {
+// XML: elements opened and not yet closed (comments, declarations and processing instructions
+// skipped; quoted attribute values may hold '>'), each tag given to `onTag`, each character of
+// text between tags (CDATA sections' whole, "[CDATA[" included) to `onText`.
+template <class OnTag, class OnText>
+void scanXml(Bytes& in, int limit, const std::string& what, OnTag onTag, OnText onText) {
     int depth = 0;
     const auto skipPast = [&](const char* end) {  // to the end of `end`
         const std::size_t n = std::strlen(end);
@@ -113,6 +114,7 @@ void scanXml(Bytes& in, int limit, const std::string& what, OnTag onTag) {
     XmlTag tag;
     for (int c = in.next(); c >= 0;) {
         if (c != '<') {
+            onText(c);
             c = in.next();
             continue;
         }
@@ -121,9 +123,19 @@ void scanXml(Bytes& in, int limit, const std::string& what, OnTag onTag) {
             skipPast("?>");
         } else if (c == '!') {
             const int a = in.next(), b = in.next();
-            if (a == '-' && b == '-') skipPast("-->");
-            else if (a == '[') skipPast("]]>");
-            else skipPast(">");
+            if (a == '-' && b == '-') {
+                skipPast("-->");
+            } else if (a == '[') {  // CDATA: text as it stands
+                onText(a);
+                onText(b);
+                std::size_t matched = 0;
+                for (int t; matched < 3 && (t = in.next()) >= 0;) {
+                    onText(t);
+                    matched = t == "]]>"[matched] ? matched + 1 : (t == ']' ? 1 : 0);
+                }
+            } else {
+                skipPast(">");
+            }
         } else {
             // A tag: to its '>', quoted values skipped; "/>" closes it at once.
             tag = XmlTag{};
@@ -231,11 +243,15 @@ private:
 // are the nodes of the visual scenes.
 class ColladaGraph {
 public:
-    ColladaGraph(const SceneCaps& caps, const std::string& what) : m_graph(caps, what) {}
+    ColladaGraph(const SceneCaps& caps, const std::string& what) : m_graph(caps, what), m_what(what) {}
 
     void onTag(const XmlTag& tag) {
         const std::string& name = tag.name;
         if (name == "COLLADA") m_collada = true;
+        // A primitive's index list: Assimp's reader reads it number by number and, at a character
+        // that is neither a digit nor a space, neither moves on nor stops (a 9.7 KB file grew
+        // past 4.7 GB in 15 s), so every such character is refused before it reads.
+        if (name == "p" || name == "ph" || name == "h") m_indexList = m_collada && !tag.end && !tag.empty;
         if (name == "visual_scene") m_inScene = !tag.end && !tag.empty;
         if (name == "geometry") m_geometry = tag.end || tag.empty ? std::string() : attribute(tag.attributes, "id");
         if (tag.end) {
@@ -263,6 +279,12 @@ public:
         }
     }
 
+    void onText(int c) {
+        if (!m_indexList || (c >= '0' && c <= '9') || c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f') return;
+        throw Error(ErrorCode::Corrupt, m_what + ": a COLLADA index list (<p>) holds a character that is neither a digit nor a "
+                                                 "space, which the library's reader would loop on without end");
+    }
+
     void check() {
         if (!m_collada) return;
         const auto target = [](const std::string& url) { return url.empty() || url[0] != '#' ? url : url.substr(1); };
@@ -278,7 +300,8 @@ public:
 
 private:
     NodeGraph m_graph;
-    bool m_collada = false, m_inScene = false;
+    const std::string& m_what;
+    bool m_collada = false, m_inScene = false, m_indexList = false;
     std::string m_geometry;
     std::vector<std::int64_t> m_open;
     std::map<std::string, std::int64_t> m_ids;
@@ -408,7 +431,7 @@ void screenSceneText(const std::string& path, std::uintmax_t bytes, const SceneC
             checkJsonDepth(in, caps.maxMarkupDepth, what);
         } else {
             ColladaGraph collada(caps, what);
-            scanXml(in, caps.maxMarkupDepth, what, [&](const XmlTag& tag) { collada.onTag(tag); });
+            scanXml(in, caps.maxMarkupDepth, what, [&](const XmlTag& tag) { collada.onTag(tag); }, [&](int c) { collada.onText(c); });
             collada.check();
         }
     }
