@@ -1,6 +1,6 @@
 // Reflection frames on a Context (reflection.h): the scene behind from the mesh renderer (a pixel
-// a ray), then one full-screen pass (reflection.frag.glsl) through intersect.inc.glsl. Window row 0 is the frame's
-// top row, as in the other renderers, so readbacks need no flip.
+// a ray), then one full-screen pass (reflection.frag.glsl) through intersect.inc.glsl. Window row 0
+// is the frame's top row, as in the other renderers, so readbacks need no flip.
 #include "conus/renderers/reflection.h"
 
 #include <array>
