@@ -71,8 +71,8 @@ std::optional<StdinBound> tiffBound(std::span<const unsigned char> b) {
     if (read(2, 2) != 42) return StdinBound{kUnboundedStdinBytes, ""};  // BigTIFF: offsets of 8 bytes, not bounded here
     const std::uintmax_t dir = read(4, 4);
     if (dir >= kUnboundedStdinBytes)
-        throw Error(ErrorCode::LimitExceeded, "standard input is a TIFF whose first directory is at byte " + std::to_string(dir) +
-                                                  ", past the " + std::to_string(kUnboundedStdinBytes >> 20) + " MiB it may hold; give a file instead");
+        throw Error(ErrorCode::LimitExceeded, "standard input is a TIFF whose first directory is at byte " + std::to_string(dir) + ", past the " +
+                                                  std::to_string(kUnboundedStdinBytes >> 20) + " MiB it may hold; give a file instead");
     if (dir + 2 > n) return std::nullopt;
     const std::uintmax_t entries = read(std::size_t(dir), 2);
     if (dir + 2 + 12 * entries + 4 > n) return std::nullopt;
@@ -150,8 +150,8 @@ std::optional<StdinBound> exrBound(std::span<const unsigned char> b) {
                 w = std::clamp<std::int64_t>(signed32(at + 8) - signed32(at) + 1, 0, kMaxImageSide);
                 h = std::clamp<std::int64_t>(signed32(at + 12) - signed32(at + 4) + 1, 0, kMaxImageSide);
             }
-            if (*name == "type" && *type == "string" && std::string(b.begin() + std::ptrdiff_t(at), b.begin() + std::ptrdiff_t(end)).rfind("deep", 0) == 0)
-                return StdinBound{kUnboundedStdinBytes, ""};
+            const auto value = [&] { return std::string(b.begin() + std::ptrdiff_t(at), b.begin() + std::ptrdiff_t(end)); };
+            if (*name == "type" && *type == "string" && value().rfind("deep", 0) == 0) return StdinBound{kUnboundedStdinBytes, ""};
             if (*name == "channels" && *type == "chlist") {  // a name, then pixel type, 4 bytes, x and y sampling
                 for (std::size_t c = at; c < end && b[c] != 0;) {
                     while (c < end && b[c] != 0) ++c;
