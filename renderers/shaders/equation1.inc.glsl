@@ -13,8 +13,14 @@ struct MapPoint {
     vec2 dv;  // d pd / dv
 };
 
+// The map's nodes a side where the caller sets them, else (0, 0): the texture's size. A shader
+// that picks the map from a sampler array by a variable index sets them from sizes taken with
+// constant indices (reflection.frag.glsl): llvmpipe (Mesa 22.3) answers such a size query with
+// another element's size in invocations beside ones that have returned.
+ivec2 gMapNodes = ivec2(0);
+
 MapPoint evalMap(sampler2D map, vec2 uv) {
-    const ivec2 nodes = textureSize(map, 0);
+    const ivec2 nodes = gMapNodes.x > 0 ? gMapNodes : textureSize(map, 0);
     const vec2 cells = vec2(nodes - 1);
     const vec2 g = clamp(uv, 0.0, 1.0) * cells;
     const ivec2 c = clamp(ivec2(g), ivec2(0), nodes - 2);

@@ -43,6 +43,11 @@ uniform float uTMax;
 
 out vec4 outColour;
 
+// Each face's map nodes a side, taken in main() with constant indices (equation1.inc.glsl's
+// gMapNodes). The faces' depth and colour textures are all of one size (spec), so the size queries
+// the includes make of uDepths[f] need no such care.
+ivec2 gFaceNodes[kFaces];
+
 // codec::hitReflector: the t along the eye ray and the unit normal facing it; t < 0 on a miss.
 float hitReflector(vec3 origin, vec3 d, out vec3 normal) {
     normal = uReflectorNormal;
@@ -109,6 +114,7 @@ float shadeRay(vec2 uv, vec4 behind, out vec3 colour) {
     gDepthLayers = uLayers;
     for (int f = 0; f < kFaces; ++f) {
         gDepthLayer = 0;
+        gMapNodes = gFaceNodes[f];
         const DepthHit h = intersectDepthImage(uDepths[f], uMaps[f], uViews[f], at, reflected, uStepTexels,
                                                uRefinements, uMaxSteps, best);
         bool mine = false;
@@ -144,6 +150,8 @@ float shadeRay(vec2 uv, vec4 behind, out vec3 colour) {
 }
 
 void main() {
+    gFaceNodes = ivec2[kFaces](textureSize(uMaps[0], 0), textureSize(uMaps[1], 0), textureSize(uMaps[2], 0),
+                               textureSize(uMaps[3], 0), textureSize(uMaps[4], 0), textureSize(uMaps[5], 0));
     // GL's window row 0 is the frame's top row (the readback is top row first).
     const int n = max(uSamples, 1);
     const ivec2 pixel = ivec2(gl_FragCoord.xy);
