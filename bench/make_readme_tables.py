@@ -212,7 +212,13 @@ def quality_table(build):
     for png in ("gain-loss.png", "rate-distortion.png"):
         if (out_dir / png).exists():
             shutil.copy(out_dir / png, plots / png)
-    headline = [l for l in report.splitlines() if l.startswith("- 1/")]
+    # The report's headlines: each rate, plain and then fitted to the decoder (the section that
+    # follows the line starting "Fitted to the decoder").
+    headline, fitted = [], False
+    for line in report.splitlines():
+        fitted = fitted or line.startswith("Fitted to the decoder")
+        if line.startswith("- 1/"):
+            headline.append(line.replace("- ", "- fitted to the decoder (`--fit 4` against `uniform --fit`), " if fitted else "- ", 1))
     return "\n".join([stamp("quality metrics (deterministic; load does not change them)"), ""] + headline +
                      ["", "The whole report: [quality-plots/quality.md](quality-plots/quality.md)."])
 

@@ -29,7 +29,8 @@ def machine():
 def run_stamp():
     """date (UTC), commit (short; ' (modified)' for a tree with changes outside the files the
     benches write) and machine (processor, cores, load average) of a run starting now."""
-    dirty = _git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!bench/README.md", ":!bench/quality-plots")
+    dirty = _git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!bench/README.md", ":!bench/quality-plots",
+                 ":!bench/img/terrain-compare.png")
     return {"date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
             "commit": _git("rev-parse", "--short", "HEAD") + (" (modified)" if dirty else ""),
             "machine": machine()}
