@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "codec/mesh/mesh_test_scenes.h"
-#include "conus/core/mesh.h"
 #include "conus/core/error.h"
+#include "conus/core/mesh.h"
 #include "conus/sceneio/mesh_file.h"
 #include "renderers/gl_test_util.h"
 
@@ -171,7 +171,7 @@ TEST_P(ReflectionGl, AntialiasedFramesMatchCpu) {
 // mirror of radius 4 that the truck itself partly hides: the one focused face (a 65-node map, the
 // others 2x2) is walked by rays beside rays that end on the truck in front. On llvmpipe the map's
 // size, queried from the sampler array by the faces' loop index, came back as another face's
-// there: 40 of these pixels showed the sky through the reflected truck, in lines along its
+// there: 30 reflecting pixels showed the sky where the CPU shows the truck, in lines along its
 // outline (bench/notes/2026-12-07-held-out-mirrors-and-gl-map-sizes.md).
 TEST_P(ReflectionGl, FocusedFaceBesideTheSceneInFrontMatchesCpu) {
     static const codec::MeshScene truck(
