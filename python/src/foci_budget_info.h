@@ -32,8 +32,9 @@ inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, i
     d["builder_notes"] = b.builderNotes;  // what the anisotropy bound cost (a transition widened, a grid refined)
     d["frame_loss"] = frameLoss;
     d["predicted_frame_loss"] = b.predicted.frameLoss;
-    d["confirmed"] = confirmed || b.encode != nullptr;
-    d["predicted_roi_gain"] = confirmed || b.encode != nullptr ? pybind11::object(pybind11::float_(b.predicted.roiGain)) : pybind11::none();
+    const bool measured = confirmed || b.encode != nullptr;
+    d["confirmed"] = measured;
+    d["predicted_roi_gain"] = measured ? pybind11::object(pybind11::float_(b.predicted.roiGain)) : pybind11::none();
     d["predicted_tile_loss"] = b.predicted.tileLoss;
     // What k as asked would hold (exact_k=True), predicted the same way.
     d["predicted_frame_loss_exact_k"] = b.askedPredicted.frameLoss;
