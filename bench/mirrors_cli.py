@@ -14,6 +14,7 @@ coverage in `conus render mesh` from the same camera), and the whole frame's mea
 Markdown table; the frames stay in --out.
 """
 import argparse
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -33,13 +34,15 @@ EYE = np.array([6.0, 3.5, 4.0])
 NORMAL = np.array([0.15, 0.0, 1.0]) / np.linalg.norm([0.15, 0.0, 1.0])
 
 
-def placement(name):
+def placement(conus, name, model):
     """(scale, base): the bench's world point p is the model's own (p / scale + base). The
     spider is 193 units long about (-17, -2, -10); the bench makes its longer ground side 5 units,
-    centred over the origin, on the ground (layered_reflection_bench.cpp's readModel)."""
+    centred over the origin, on the ground (layered_reflection_bench.cpp's readModel), from its
+    bounds as `conus info` gives them."""
     if name != "spider":
         return 1.0, np.zeros(3)
-    lo, hi = np.array([-92.6552, -42.2338, -106.691]), np.array([57.9362, 37.504, 86.6912])
+    info = json.loads(subprocess.run([conus, "info", str(model), "--json"], check=True, capture_output=True, text=True).stdout)
+    lo, hi = np.array(info["bounds"]["min"]), np.array(info["bounds"]["max"])
     size = hi - lo
     return 5.0 / max(size[0], size[2]), np.array([(lo[0] + hi[0]) / 2, lo[1], (lo[2] + hi[2]) / 2])
 
@@ -91,7 +94,7 @@ def main():
     for name, model in MODELS.items():
         if not model.exists():
             sys.exit(f"mirrors_cli.py: {model} is not installed (scripts/packages.txt)")
-        scale, base = placement(name)
+        scale, base = placement(conus, name, model)
         for kind in ("plane", "sphere"):
             centre = np.array([0.0, 1.5, -6.0 if kind == "plane" else -7.0]) / scale + base
             eye, radius, fov = EYE / scale + base, 4.0 / scale, 38.0 if kind == "plane" else 45.0
