@@ -24,6 +24,8 @@ constexpr int kBisectionSteps = 10;
 // budget, or after kSearchSteps maps built.
 constexpr double kTolerance = 1.0 / 1024, kToleranceDb = 0.01;
 constexpr int kSearchSteps = 12;
+// A choice within this of the t measured before it is that map again.
+constexpr double kSameT = 1e-6;
 // The rounds of confirming encodes (FrameModelOptions::confirmRounds) stop within this of the budget.
 constexpr double kMeasuredToleranceDb = 0.05;
 
@@ -135,10 +137,13 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
         built.push_back(x);
         return x;
     };
-    // How far a try is over the budget (dB, <= 0: within): continuous in t, as the model is.
+    // How far a try is over the budget (dB, <= 0: within): continuous in t, as the model is. `margin`
+    // lowers every budget alike (a last search after a confirmed model's choice missed).
+    double margin = 0.0;
     const auto over = [&](const Try& x) {
         const FramePrediction& p = x.predicted;
-        return std::max({p.frameLoss - frameLossDb, p.tileLoss - tileLossDb, std::isfinite(restLossDb) ? p.restLoss - restLossDb : -1e9});
+        return margin + std::max({p.frameLoss - frameLossDb, p.tileLoss - tileLossDb,
+                                  std::isfinite(restLossDb) ? p.restLoss - restLossDb : -1e9});
     };
     // A lower k leaves the context more samples: the loss falls with t. The largest t within the
     // budget: regula falsi (Illinois) on over(t) between t = 0 (k = 1) and 1, to kTolerance in t,
@@ -189,11 +194,13 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
             encoded.predicted = confirmed.predict(encoded.map);
             encoded.encode = confirmed.encode();
             s = search(confirmed, o);
-            if (exactK || std::abs(s.chosen.t - encoded.t) <= kConfirmedT) {
-                if (over(encoded) <= 0 || over(s.chosen) > 0) s.chosen = std::move(encoded);
+            const bool near = std::abs(s.chosen.t - encoded.t) <= kConfirmedT;
+            if (exactK || (near && (over(encoded) <= 0 || over(s.chosen) > 0))) {
+                s.chosen = std::move(encoded);
                 return std::pair{std::move(s), std::move(confirmed)};
             }
-            // The choice moved: the map it moved to is encoded (the encode the file then keeps, as
+            // The choice moved (or stayed next to a map encoded that misses, and is predicted to
+            // hold): the map it moved to is encoded (the encode the file then keeps, as
             // it would be encoded anyway) and measured, so that what is kept is a map whose own
             // encode measured its losses: of the two, the one that holds the budget (the larger k
             // where both do; where neither does, a third choice on the second's model). The confirmed model's
@@ -208,8 +215,36 @@ FociBudget fociForFrameLoss(std::span<const Focus> foci, const FociOptions& opti
                 s.chosen = std::move(nextHolds ? next : encoded);  // the one that holds
             } else if (rounds <= 0) {
                 // Neither holds: the choice made once more on the model the second encode confirmed,
-                // its map not encoded here (what is said of it is predicted).
-                s.chosen = search(*last, o).chosen;
+                // and that map encoded and measured too (the encode the file keeps, made anyway).
+                // Where its encode still misses, one last choice on the model the third encode
+                // confirms, under budgets lowered by what the third missed by
+                // (detail::loweredBudget), encoded and measured. The first of the two that holds
+                // the budget is kept, else the nearest the budget of the maps measured: what is
+                // said of it is what its own encode measured (as frame_budget_search.cpp does).
+                const Try guess = search(*last, o).chosen;
+                if (std::abs(guess.t - next.t) <= kSameT) {
+                    s.chosen = std::move(over(next) <= over(encoded) ? next : encoded);  // nothing nearer to be had
+                } else {
+                    const double promised = over(next) - over(guess);  // the fall in loss the model said
+                    Try third = measured(guess.t);
+                    const double missed = over(third);
+                    Try* kept = &third;
+                    std::optional<Try> fourth;
+                    if (missed > 0) {
+                        margin = detail::loweredBudget(missed, (over(next) - missed) / std::max(promised, 1e-9));
+                        const double t = search(*last, o).chosen.t;
+                        margin = 0.0;
+                        if (std::abs(t - third.t) > kSameT) fourth = measured(t);
+                        if (fourth && over(*fourth) <= 0) {
+                            kept = &*fourth;
+                        } else {
+                            for (Try* x : {&encoded, &next})
+                                if (over(*x) < over(*kept)) kept = x;
+                            if (fourth && over(*fourth) < over(*kept)) kept = &*fourth;
+                        }
+                    }
+                    s.chosen = std::move(*kept);
+                }
             } else {
                 // Further rounds: the same regula falsi on t, each try's losses measured by its own
                 // encode, between a try that misses the budget and, at a smaller t, one that holds it

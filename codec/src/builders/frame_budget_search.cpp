@@ -31,6 +31,8 @@ constexpr int kGoldenSteps = 8;
 // How near (in log floor and log cap) the map chosen on a confirmed model must be to the map whose
 // encode confirmed it for that map and its encode to be kept instead of a second encode.
 constexpr double kNearEncoded = 0.02;
+// A choice within this (log floor and log cap) of the map measured before it is that map again.
+constexpr double kSameMap = 1e-6;
 constexpr double kTilePenalty = 4.0;  // dB of frame loss per dB of tile loss over its budget
 
 [[noreturn]] void invalid(const std::string& what) { throw Error(ErrorCode::InvalidArgument, what); }
@@ -120,9 +122,41 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         const bool againHolds = over(again) <= 0, chosenHolds = over(chosen) <= 0;
         if (againHolds != chosenHolds) return againHolds ? again : chosen;
         if (againHolds) return again.predicted.roiGain >= chosen.predicted.roiGain ? again : chosen;
-        // Neither holds: the choice made once more on the model the second encode confirms (the
-        // nearer of the two maps measured), its map not encoded here: what is said of it is predicted.
-        return buildAutoMapForFrameLoss(importance, moved, frameLossDb, options, tileLossDb);
+        // Neither holds: the choice made once more on the model the second encode confirms, and that
+        // map encoded and measured too (the encode the file keeps, made anyway). Where its encode
+        // still misses (the model's carry from the map it measured to a map near it is off by tenths
+        // of a dB), one last choice on the model the third encode confirms, under budgets lowered
+        // by what the third missed by (detail::loweredBudget), encoded and measured. The first of
+        // the two whose encode holds the budget is kept, else the nearest the budget of the maps
+        // measured: what is said of the map kept is what its own encode measured. Where a choice
+        // stays at the map measured before it (the highest floor, which still misses), nothing
+        // nearer is to be had.
+        const auto encoded = [&](BudgetResult r, const FrameErrorModel& confirmedOnIt) {
+            r.predicted = confirmedOnIt.predict(r.map);
+            r.encode = confirmedOnIt.encode();
+            return r;
+        };
+        const auto same = [](const BudgetResult& a, const BudgetResult& b) {
+            return std::abs(std::log(a.minDensity / b.minDensity)) <= kSameMap && std::abs(std::log(a.maxDensity / b.maxDensity)) <= kSameMap;
+        };
+        BudgetResult third = buildAutoMapForFrameLoss(importance, moved, frameLossDb, options, tileLossDb);
+        if (same(third, again)) return again;
+        const double promised = over(again) - over(third);  // the fall in loss the model said
+        const FrameErrorModel thirdModel = model.confirmed(third.map);
+        third = encoded(std::move(third), thirdModel);
+        const double missed = over(third);
+        if (missed <= 0) return third;
+        const double margin = detail::loweredBudget(missed, (over(again) - missed) / std::max(promised, 1e-9));
+        BudgetResult fourth = buildAutoMapForFrameLoss(importance, thirdModel, std::max(0.0, frameLossDb - margin), options,
+                                                       std::max(0.0, tileLossDb - margin));
+        if (!same(fourth, third)) {
+            fourth = encoded(std::move(fourth), model.confirmed(fourth.map));
+            if (over(fourth) <= 0) return fourth;
+        }
+        BudgetResult* nearest = &third;
+        for (BudgetResult* r : {&chosen, &again, &fourth})
+            if (r->encode && over(*r) < over(*nearest)) nearest = r;
+        return std::move(*nearest);
     }
     return chosen;
 }

@@ -68,7 +68,11 @@ struct FrameModelOptions {
     // it moved to is encoded too (the encode the file keeps, which it would take anyway) and of the
     // two the one whose own encode holds the budget is kept (the larger k where both do): what the
     // budget says of the map kept is what its encode measured. Where neither holds, the choice is
-    // made once more on the model the second encode confirmed, and that map's losses are predicted.
+    // made once more on the model the second encode confirmed and that map encoded and measured;
+    // where it misses too, once more under budgets lowered by what it missed by, on the model its
+    // encode confirmed, and that map encoded and measured (the first that holds is kept, else the
+    // nearest the budget): every map kept has its losses measured. The importance maps' budget
+    // (buildAutoMapForFrameLoss) does the same.
     // More: where neither holds or the one that holds has the smaller k, the search goes on on
     // measured losses alone, each try encoded (regula falsi between the maps encoded, up to this
     // many encodes besides those two), and keeps a map whose own encode holds the budget:
