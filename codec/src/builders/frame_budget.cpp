@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -116,6 +119,44 @@ int displayCode(float v, const std::vector<float>& table) {
     const double x = double(shown(v, true, table)) * 255.0;
     constexpr double kRoundingShift = 6755399441055744.0;
     return std::clamp(static_cast<int>((x + kRoundingShift) - kRoundingShift), 0, 255);
+}
+
+// displayCode through the thresholds between codes: the code at the start of v's step of the table,
+// then one more where v reaches the next threshold (a step of the table spans at most 0.8 of a code,
+// where sRGB is steepest). The same code for every float (checked over all 2^32 of them), without
+// the interpolation, the rounding or a branch on the value: the confirming measure takes three a
+// value, over the source's size.
+struct CodeThresholds {
+    std::array<float, 257> lowest{};                                 // [c]: the least v whose code is c or more
+    std::array<std::uint8_t, kDisplayTableSteps + 1> start{};        // displayCode(i / kDisplayTableSteps)
+};
+
+const CodeThresholds& codeThresholds() {
+    static const CodeThresholds thresholds = [] {
+        CodeThresholds t;
+        const std::vector<float>& table = displayTable();
+        for (int c = 1; c <= 255; ++c) {
+            // Bisection on the bits of the floats in [0, 1], which order as the integers do.
+            std::uint32_t lo = 0, hi = std::bit_cast<std::uint32_t>(1.0f);
+            while (hi - lo > 1) {
+                const std::uint32_t mid = lo + (hi - lo) / 2;
+                (displayCode(std::bit_cast<float>(mid), table) >= c ? hi : lo) = mid;
+            }
+            t.lowest[c] = std::bit_cast<float>(hi);
+        }
+        t.lowest[256] = std::numeric_limits<float>::infinity();
+        for (int i = 0; i <= kDisplayTableSteps; ++i) t.start[i] = std::uint8_t(displayCode(float(i) / kDisplayTableSteps, table));
+        return t;
+    }();
+    return thresholds;
+}
+
+// displayCode(v): NaN, infinities and values up to 0 show as 0 (shown()), 1 and above as 255.
+int fastDisplayCode(float v, const CodeThresholds& t) {
+    if (!(v > 0.0f) || v == std::numeric_limits<float>::infinity()) return 0;
+    if (v >= 1.0f) return 255;
+    const int c = t.start[static_cast<int>(v * kDisplayTableSteps)];
+    return c + (v >= t.lowest[c + 1]);
 }
 
 // Singular values of a 2x2 matrix (largest first).
@@ -402,6 +443,7 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
     if (m_options.space == ErrorSpace::Display)
         for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
     const std::vector<float>& table = displayTable();
+    const CodeThresholds& codes = codeThresholds();
     // The views at the source's size, never whole: the CoNUS image's decoded a row of tiles at a
     // time (the decoder's view of those rows), the uniform image's bilinear resize a row at a time.
     std::optional<detail::ResizedRows> uniformRows;
@@ -420,7 +462,7 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
             const auto onDisplay = [&](const float* in, std::vector<double>& out) {
                 for (std::size_t i = 0; i < values; i += channels)
                     for (std::size_t c = 0; c < channels; ++c)
-                        out[i + c] = display[c] ? kCodeValues[displayCode(in[i + c], table)] : double(shown(in[i + c], false, table));
+                        out[i + c] = display[c] ? kCodeValues[fastDisplayCode(in[i + c], codes)] : double(shown(in[i + c], false, table));
             };
             Image decoded;
             for (int y = r0 * m_tile; y < std::min(source.height, r1 * m_tile); ++y) {
@@ -439,28 +481,32 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
                     uniformRows->row(y, resized.data());
                     onDisplay(resized.data(), resizedShown);
                 }
+                // Each tile's sum over its values (divided by the channels with the pixels, below).
                 double* row = &out[std::size_t(y / m_tile) * m_columns];
                 double* flatRow = uniform ? &flat[std::size_t(y / m_tile) * m_columns] : nullptr;
-                for (int x = 0; x < source.width; ++x) {
-                    double e = 0, u = 0;
-                    for (std::size_t c = 0; c < channels; ++c) {
-                        const std::size_t i = std::size_t(x) * channels + c;
-                        const double s = fromShown[i];
-                        const double d = viewShown[i] - s;
+                for (int tx = 0; tx < m_columns; ++tx) {
+                    const std::size_t i0 = std::size_t(tx) * m_tile * channels;
+                    const std::size_t i1 = std::min(values, i0 + std::size_t(m_tile) * channels);
+                    double e = 0;
+                    for (std::size_t i = i0; i < i1; ++i) {
+                        const double d = viewShown[i] - fromShown[i];
                         e += d * d;
-                        if (uniform) {
-                            const double f = resizedShown[i] - s;
+                    }
+                    row[tx] += e;
+                    if (uniform) {
+                        double u = 0;
+                        for (std::size_t i = i0; i < i1; ++i) {
+                            const double f = resizedShown[i] - fromShown[i];
                             u += f * f;
                         }
+                        flatRow[tx] += u;
                     }
-                    row[x / m_tile] += e / double(channels);
-                    if (uniform) flatRow[x / m_tile] += u / double(channels);
                 }
             }
         },
         1);
-    for (std::size_t t = 0; t < out.size(); ++t) out[t] /= m_pixels[t];
-    for (std::size_t t = 0; t < flat.size(); ++t) flat[t] /= m_pixels[t];
+    for (std::size_t t = 0; t < out.size(); ++t) out[t] /= m_pixels[t] * double(channels);
+    for (std::size_t t = 0; t < flat.size(); ++t) flat[t] /= m_pixels[t] * double(channels);
     return {std::move(out), std::move(flat)};
 }
 

@@ -289,6 +289,44 @@ Image varied(int which) {
     return im;
 }
 
+// The confirming encode measures each tile as the bench does: the CoNUS image decoded to the
+// source's size and the uniform image (`conus uniform`: the identity map through the encoder)
+// resized to it, both as 8-bit sRGB codes against the source's, each tile's mean squared error.
+// The model's codes go through its table of the display curve, this test's through pow: a code
+// apart where a value sits on a rounding edge, so each tile within 2%. On a picture whose width is
+// not a whole number of tiles, with partial tiles on the right and at the bottom.
+TEST(FrameBudget, ConfirmingMeasureIsTheBenchsTileErrors) {
+    const Image whole = varied(1);
+    Image source = makeImage(500, 379, whole.channels);  // tiles of 15: 34 columns, the last of 5 pixels; 26 rows
+    for (int y = 0; y < source.height; ++y)
+        for (int x = 0; x < source.width; ++x)
+            for (int c = 0; c < 3; ++c) source.at(x, y, c) = whole.at(x, y, c);
+    const int w = source.width / 4, h = source.height / 4;
+    FociOptions fo;
+    fo.aspect = double(source.width) / source.height;
+    const SamplingMap map = buildFociMap(std::vector<Focus>{{0.3, 0.6, 0.12, 3.0}}, fo);
+    const FrameErrorModel model(source, w, h, Image{}, {ErrorSpace::Display, 1});
+    const FrameErrorModel confirmed = model.confirmed(map);
+    DecodeOptions d;
+    d.width = source.width;
+    d.height = source.height;
+    const Image view = decodeImage(confirmed.encode()->image, map, d);
+    EncodeOptions e;
+    e.width = w;
+    e.height = h;
+    const Image uniform = resizeBilinear(encodeImage(source, SamplingMap::identity(2, 2), e), {}, source.width, source.height);
+    const std::vector<double> conusTiles = displayTileErrors(view, source, model.tileSide());
+    const std::vector<double> uniformTiles = displayTileErrors(uniform, source, model.tileSide());
+    const std::vector<double> measured = confirmed.tileErrors(map);
+    ASSERT_EQ(measured.size(), conusTiles.size());
+    ASSERT_EQ(confirmed.uniformErrors().size(), uniformTiles.size());
+    for (std::size_t t = 0; t < measured.size(); ++t) {
+        SCOPED_TRACE(t);
+        EXPECT_NEAR(measured[t], conusTiles[t], 0.02 * conusTiles[t] + 1e-9);
+        EXPECT_NEAR(confirmed.uniformErrors()[t], uniformTiles[t], 0.02 * uniformTiles[t] + 1e-9);
+    }
+}
+
 // The model confirmed on one map predicts a map near it (the foci's k lowered by a third, an
 // automatic map's floor raised), against real encodes (fitted to the decoder, as the default) and
 // the uniform image, decoded to the source's size, on 8-bit sRGB: whole frame within 0.75 dB, p95
