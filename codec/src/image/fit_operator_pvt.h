@@ -95,15 +95,21 @@ private:
         std::vector<int> lo(blocks, hc), hi(blocks, -1);
         parallelRows(blocks, m_threads, [&](int b0, int b1) {
             DecoderTaps::Scratch scratch;
-            for (int b = b0; b < b1; ++b)
+            for (int b = b0; b < b1; ++b) {
+                // The block's reach kept in locals, stored once: neighbouring blocks' bounds share a
+                // cache line, and the threads take neighbouring blocks.
+                int blockLo = hc, blockHi = -1;
                 for (int y = b * kBlockRows; y < std::min(rows, (b + 1) * kBlockRows); ++y)
                     m_taps.row(y, scratch, [&](int, const DecoderTap* taps, int count) {
                         for (int k = 0; k < count; ++k) {
                             const TapCorners c = tapCorners(taps[k], m_taps.conusWidth(), hc);
-                            lo[b] = std::min(lo[b], c.y0);
-                            hi[b] = std::max(hi[b], c.y1);
+                            blockLo = std::min(blockLo, c.y0);
+                            blockHi = std::max(blockHi, c.y1);
                         }
                     });
+                lo[b] = blockLo;
+                hi[b] = blockHi;
+            }
         });
         // kBands bands, halved while their buffers hold too much.
         for (int count = std::min(blocks, kBands);; count = std::max(1, count / 2)) {
