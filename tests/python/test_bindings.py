@@ -188,11 +188,14 @@ def test_frame_loss_budget_sets_the_floor(asymmetric):
     importance = np.zeros((h, w), np.float32)
     importance[h // 4:h // 2, w // 2:3 * w // 4] = 1.0
     size = (w // 4, h // 4)
-    tight = conus.Map.auto_for_frame_loss(importance, asymmetric[..., :3], size, 0.3, grid=33)
+    # On this picture every map of the family its encodes measure loses 0.75 dB or more over the
+    # frame (the ramp, which the uniform image keeps best), so the tight budget is 1 dB: the loss
+    # said is what the kept map's own encode measured, and it holds.
+    tight = conus.Map.auto_for_frame_loss(importance, asymmetric[..., :3], size, 1.0, grid=33)
     loose = conus.Map.auto_for_frame_loss(importance, asymmetric[..., :3], size, 2.0, grid=33)
-    # (map, floor, predicted loss, predicted ROI gain): a looser budget buys a lower floor and more gain.
+    # (map, floor, loss, ROI gain): a looser budget buys a lower floor and more gain.
     assert loose[1] < tight[1]
-    assert tight[2] <= 0.3 + 1e-9 and loose[2] <= 2.0 + 1e-9
+    assert tight[2] <= 1.0 + 1e-9 and loose[2] <= 2.0 + 1e-9
     assert loose[3] > tight[3]
     with pytest.raises(conus.Error):
         conus.Map.auto_for_frame_loss(importance, asymmetric[..., :3], size, -1.0)
