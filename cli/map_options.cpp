@@ -108,10 +108,10 @@ std::string saidOf(bool measured, bool kept) {
 
 // The region's gain, as measured or predicted by a confirmed model; a model no encode confirmed
 // (`--fast`) overstates it (bench/budget_check.py --fast: by 1.7 to 14 dB on 20 of 21
-// photographs), so it is not printed then.
-std::string gainText(const char* region, const char* gains, double db, bool confirmed) {
+// photographs), so it is not printed then. A negative gain is printed as a loss.
+std::string gainText(const char* region, const char* gains, const char* loses, double db, bool confirmed) {
     if (!confirmed) return std::string(", ") + region + "'s gain is not predicted under --fast (the model alone overstates it)";
-    return std::string(", ") + region + " " + gains + " " + numberText(std::round(db * 10) / 10) + " dB";
+    return std::string(", ") + region + " " + lossText(-db, loses, gains, 1);
 }
 
 }  // namespace
@@ -125,13 +125,17 @@ std::string lossText(double db, const char* lose, const char* gain, int decimals
 std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what, bool encodeKept, bool confirmed) {
     char floor[32];
     std::snprintf(floor, sizeof floor, "%.3g", r.minDensity);
+    // Only a measure can say so: the model's choice is within the budget by construction.
+    const bool over = r.encode != nullptr && (r.predicted.frameLoss > frameLoss ||
+                                              r.predicted.tileLoss > codec::kDefaultTileLoss);
     return "budget: the whole frame within " + numberText(frameLoss) + " dB and tiles outside the region within " +
            numberText(codec::kDefaultTileLoss) + " dB (95th percentile), against `conus uniform` of the same pixel count on 8-bit sRGB "
            "(--frame-loss sets it)\n  " + what + ": context floor " + floor + ", density cap " + numberText(std::round(r.maxDensity * 10) / 10) +
            (r.budgetBinds ? "" : " (the budget does not bind: the lowest floor and the highest cap hold it)") +
            "\n  " + saidOf(r.encode != nullptr, encodeKept) + ": the whole frame " + lossText(r.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the region " +
            lossText(r.predicted.tileLoss, "lose", "gain", 1) + " at the 95th percentile" +
-           gainText("the region", "gains", r.predicted.roiGain, confirmed || r.encode != nullptr);
+           gainText("the region", "gains", "loses", r.predicted.roiGain, confirmed || r.encode != nullptr) +
+           (over ? "\n  over the budget: no map its encodes measured held it; this one is the nearest" : "");
 }
 
 std::string describeFociBudget(const codec::FociBudget& b, const std::optional<BudgetFrame>& frame, bool exactK, int grid,
@@ -152,7 +156,7 @@ std::string describeFociBudget(const codec::FociBudget& b, const std::optional<B
         }
         text += "\n  " + saidOf(b.encode != nullptr, encodeKept) + ": the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 2) + ", tiles outside the foci " +
                 lossText(b.predicted.tileLoss, "lose", "gain", 1) + " at the 95th percentile" +
-                gainText("the foci", "gain", b.predicted.roiGain, frame->confirmed || b.encode != nullptr);
+                gainText("the foci", "gain", "lose", b.predicted.roiGain, frame->confirmed || b.encode != nullptr);
         if (b.lowered)
             text += "\n  k as asked: --exact-k (predicted: the whole frame " + lossText(b.askedPredicted.frameLoss, "loses", "gains", 2) +
                     ", the tiles " + lossText(b.askedPredicted.tileLoss, "lose", "gain", 1) + ")";

@@ -191,6 +191,35 @@ TEST_F(BudgetCli, FrameLossSetsTheDetailMap) {
     }
 }
 
+// A region the map does worse on than the uniform image (a flat stretch of a smooth ramp, which the
+// uniform image keeps as well as any, while the region's own map spends the fit elsewhere) is said
+// to lose, never to "gain -3.9 dB".
+TEST_F(BudgetCli, ARegionThatLosesIsSaidToLose) {
+    const int w = 240, h = 160;
+    const auto write = [&](const std::string& name, int channels, const std::vector<unsigned char>& pixels) {
+        auto output = OIIO::ImageOutput::create(path(name));
+        EXPECT_TRUE(output->open(path(name), OIIO::ImageSpec(w, h, channels, OIIO::TypeDesc::UINT8)));
+        EXPECT_TRUE(output->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+        output->close();
+        return path(name);
+    };
+    std::vector<unsigned char> ramp(std::size_t(w) * h * 3), roi(std::size_t(w) * h, 0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const bool red = x < 36 && y < 24;  // a red patch in the top-left corner
+            const double rgb[3] = {red ? 1.0 : 0.1, red ? 0.0 : double(x) / (w - 1), red ? 0.0 : 0.2 + 0.1 * std::sin(y / 7.0)};
+            for (int c = 0; c < 3; ++c) ramp[(std::size_t(y) * w + x) * 3 + c] = static_cast<unsigned char>(255 * std::pow(rgb[c], 1 / 2.2));
+            roi[std::size_t(y) * w + x] = (y >= h / 4 && y < h / 2 && x >= w / 2 && x < 3 * w / 4) ? 255 : 0;
+        }
+    const Result r = run("encode " + write("ramp.png", 3, ramp) + " --importance " + write("roi.png", 1, roi) +
+                         " --frame-loss 0.1 -o " + path("ramp.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("measured by the encode kept"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("the region loses "), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("gains -"), std::string::npos) << r.out;
+    EXPECT_GT(printedLoss(r.out, "the region"), 0.5) << r.out;
+}
+
 TEST_F(BudgetCli, MapFociKeepsTheContextFloor) {
     // No picture: the context keeps at least a quarter of the uniform density.
     const std::string foci = " --focus 0.25,0.3,0.2,5 --focus 0.7,0.7,0.18,3";
