@@ -133,8 +133,8 @@ void addMaps(py::module_& m) {
             py::arg("importance"), py::arg("source"), py::arg("size"), py::arg("frame_loss"),
             py::arg("grid") = map_rules::kDefaultSide, py::arg("max_density") = 16.0, py::arg("max_anisotropy") = 0.0,
             "The automatic map (max_anisotropy: 0 none, else as --max-anisotropy) with the lowest context floor whose whole-frame loss against the uniform "
-            "image of `size` (width, height), predicted by the picture's band model and confirmed by an encode fitted as encode's default, stays within `frame_loss` dB: (map, floor, "
-            "predicted loss, predicted ROI gain)")
+            "image of `size` (width, height), chosen on the picture's band model and confirmed by encodes fitted as encode's default, stays within `frame_loss` dB as the "
+            "map's own encode measures it (where no map measured holds it, the nearest): (map, floor, loss, ROI gain), both that encode's measure")
         .def_static(
             "from_nodes",
             [](const py::array& nodes) {
