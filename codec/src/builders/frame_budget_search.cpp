@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -150,7 +151,8 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         BudgetResult fourth = buildAutoMapForFrameLoss(importance, thirdModel, std::max(0.0, frameLossDb - margin), options,
                                                        std::max(0.0, tileLossDb - margin));
         if (!same(fourth, third)) {
-            fourth = encoded(std::move(fourth), model.confirmed(fourth.map));
+            const FrameErrorModel confirmedOnIt = model.confirmed(fourth.map);
+            fourth = encoded(std::move(fourth), confirmedOnIt);
             if (over(fourth) <= 0) return fourth;
         }
         // Still none: the model led astray (the p95 tile loss is not monotone in the floor where
@@ -160,11 +162,15 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         double highest = 0;
         for (const BudgetResult* r : {&chosen, &again, &third, &fourth})
             if (r->encode) highest = std::max(highest, r->minDensity);
-        BudgetResult fifth = buildAtFloor(importance, model, options, std::sqrt(highest * kHighestFloor));
-        fifth = encoded(std::move(fifth), model.confirmed(fifth.map));
-        if (over(fifth) <= 0) return fifth;
-        BudgetResult* nearest = &fifth;
-        for (BudgetResult* r : {&chosen, &again, &third, &fourth})
+        std::optional<BudgetResult> fifth;
+        if (highest < kHighestFloor) {
+            BudgetResult r = buildAtFloor(importance, model, options, std::sqrt(highest * kHighestFloor));
+            const FrameErrorModel confirmedOnIt = model.confirmed(r.map);
+            fifth = encoded(std::move(r), confirmedOnIt);
+            if (over(*fifth) <= 0) return std::move(*fifth);
+        }
+        BudgetResult* nearest = &third;
+        for (BudgetResult* r : {&chosen, &again, &fourth, fifth ? &*fifth : &third})
             if (r->encode && over(*r) < over(*nearest)) nearest = r;
         return std::move(*nearest);
     }
