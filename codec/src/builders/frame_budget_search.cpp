@@ -102,24 +102,29 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
     }
     if (model.options().confirm && !model.isConfirmed()) {
         // One real encode of the map chosen, and the choice made again on the model it confirms
-        // (the context kept as chosen).
+        // (the context kept as chosen). A map measured takes its encode and what that encode
+        // measured (`confirmedOnIt`: the model its encode confirms).
+        const auto measuredBy = [](BudgetResult& r, const FrameErrorModel& confirmedOnIt) {
+            r.predicted = confirmedOnIt.predict(r.map);
+            r.encode = confirmedOnIt.encode();
+        };
+        // Whether two maps lie within `tolerance` of each other in log floor and log cap.
+        const auto near = [](const BudgetResult& a, const BudgetResult& b, double tolerance) {
+            return std::abs(std::log(a.minDensity / b.minDensity)) <= tolerance && std::abs(std::log(a.maxDensity / b.maxDensity)) <= tolerance;
+        };
         const FrameErrorModel confirmed = model.confirmed(chosen.map);
         BudgetResult again = buildAutoMapForFrameLoss(importance, confirmed, frameLossDb, options, tileLossDb);
         // Where that choice is next to the map encoded (kNearEncoded in log floor and log cap) and
         // the encoded map holds the budget as measured (or neither does), the map encoded is kept,
         // with its encode and what it measured: the encode is then not made again.
-        chosen.predicted = confirmed.predict(chosen.map);
-        const bool near = std::abs(std::log(again.minDensity / chosen.minDensity)) <= kNearEncoded &&
-                          std::abs(std::log(again.maxDensity / chosen.maxDensity)) <= kNearEncoded;
-        chosen.encode = confirmed.encode();
-        if (near && (over(chosen) <= 0 || over(again) > 0)) return chosen;
+        measuredBy(chosen, confirmed);
+        if (near(again, chosen, kNearEncoded) && (over(chosen) <= 0 || over(again) > 0)) return chosen;
         // The choice moved: the map it moved to is encoded (the encode the file then keeps) and
         // measured, and of the two the one whose own encode holds the budget is kept (the more ROI
         // gain where both do, the nearer the budget where neither): what is said of the map kept
         // is what its encode measured.
         const FrameErrorModel moved = model.confirmed(again.map);
-        again.predicted = moved.predict(again.map);
-        again.encode = moved.encode();
+        measuredBy(again, moved);
         const bool againHolds = over(again) <= 0, chosenHolds = over(chosen) <= 0;
         if (againHolds != chosenHolds) return againHolds ? again : chosen;
         if (againHolds) return again.predicted.roiGain >= chosen.predicted.roiGain ? again : chosen;
@@ -132,27 +137,18 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
         // budget is kept, else the nearest the budget of the maps measured: what is said of the
         // map kept is what its own encode measured. Where a choice stays at the map measured
         // before it (the highest floor, which still misses), nothing nearer is to be had.
-        const auto encoded = [&](BudgetResult r, const FrameErrorModel& confirmedOnIt) {
-            r.predicted = confirmedOnIt.predict(r.map);
-            r.encode = confirmedOnIt.encode();
-            return r;
-        };
-        const auto same = [](const BudgetResult& a, const BudgetResult& b) {
-            return std::abs(std::log(a.minDensity / b.minDensity)) <= kSameMap && std::abs(std::log(a.maxDensity / b.maxDensity)) <= kSameMap;
-        };
         BudgetResult third = buildAutoMapForFrameLoss(importance, moved, frameLossDb, options, tileLossDb);
-        if (same(third, again)) return again;
+        if (near(third, again, kSameMap)) return again;
         const double promised = over(again) - over(third);  // the fall in loss the model said
         const FrameErrorModel thirdModel = model.confirmed(third.map);
-        third = encoded(std::move(third), thirdModel);
+        measuredBy(third, thirdModel);
         const double missed = over(third);
         if (missed <= 0) return third;
         const double margin = detail::loweredBudget(missed, (over(again) - missed) / std::max(promised, 1e-9));
         BudgetResult fourth = buildAutoMapForFrameLoss(importance, thirdModel, std::max(0.0, frameLossDb - margin), options,
                                                        std::max(0.0, tileLossDb - margin));
-        if (!same(fourth, third)) {
-            const FrameErrorModel confirmedOnIt = model.confirmed(fourth.map);
-            fourth = encoded(std::move(fourth), confirmedOnIt);
+        if (!near(fourth, third, kSameMap)) {
+            measuredBy(fourth, model.confirmed(fourth.map));
             if (over(fourth) <= 0) return fourth;
         }
         // Still none: the model led astray (the p95 tile loss is not monotone in the floor where
@@ -164,9 +160,8 @@ BudgetResult buildAutoMapForFrameLoss(const Image& importance, const FrameErrorM
             if (r->encode) highest = std::max(highest, r->minDensity);
         std::optional<BudgetResult> fifth;
         if (highest < kHighestFloor) {
-            BudgetResult r = buildAtFloor(importance, model, options, std::sqrt(highest * kHighestFloor));
-            const FrameErrorModel confirmedOnIt = model.confirmed(r.map);
-            fifth = encoded(std::move(r), confirmedOnIt);
+            fifth = buildAtFloor(importance, model, options, std::sqrt(highest * kHighestFloor));
+            measuredBy(*fifth, model.confirmed(fifth->map));
             if (over(*fifth) <= 0) return std::move(*fifth);
         }
         BudgetResult* nearest = &third;
