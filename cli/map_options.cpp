@@ -116,12 +116,6 @@ std::string gainText(const char* region, const char* gains, const char* loses, d
 
 }  // namespace
 
-std::string lossText(double db, const char* lose, const char* gain, int decimals) {
-    char text[64];
-    std::snprintf(text, sizeof text, "%s %.*f dB", db < 0 ? gain : lose, decimals, std::abs(db));
-    return text;
-}
-
 std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what, bool encodeKept, bool confirmed) {
     char floor[32];
     std::snprintf(floor, sizeof floor, "%.3g", r.minDensity);

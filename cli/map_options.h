@@ -62,9 +62,6 @@ struct BudgetFrame {
 std::string describeFociBudget(const codec::FociBudget& budget, const std::optional<BudgetFrame>& frame, bool exactK, int grid,
                                double maxAnisotropy = 0, bool encodeKept = false);
 
-// "loses 1.50 dB" or, for a negative loss, "gains 0.44 dB" (`lose` and `gain` the verbs as they
-// agree with the subject), to `decimals` places.
-std::string lossText(double db, const char* lose, const char* gain, int decimals);
 // What the budget of an importance map did, in a short block: the budget, the context floor it
 // chose, the predicted losses and the region's gain (`what`: the importance's name).
 std::string describeFloorBudget(const codec::BudgetResult& r, double frameLoss, const std::string& what, bool encodeKept,

@@ -1,5 +1,6 @@
 #include "conus/core/error.h"
 
+#include <cmath>
 #include <cstdio>
 
 namespace conus {
@@ -20,6 +21,12 @@ std::string numberText(double value, int significantDigits) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.*g", significantDigits, value);
     return buf;
+}
+
+std::string lossText(double db, const char* lose, const char* gain, int decimals) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%s %.*f dB", db < 0 ? gain : lose, decimals, std::abs(db));
+    return text;
 }
 
 }  // namespace conus

@@ -53,14 +53,14 @@ inline pybind11::dict budgetInfo(const codec::FociBudget& b, double frameLoss, i
     if (b.lowered)
         warning = "conus.encode: the loss budget (whole frame " + numberText(frameLoss) + " dB, tiles " + numberText(codec::kDefaultTileLoss) +
                   " dB) lowered k from " + list(asked) + " to " +
-                  list(given) + " (exact_k=True keeps k: predicted, the whole frame then loses " +
-                  numberText(std::round(b.askedPredicted.frameLoss * 100) / 100) + " dB, the tiles " +
-                  numberText(std::round(b.askedPredicted.tileLoss * 10) / 10) + " dB)";
+                  list(given) + " (exact_k=True keeps k: predicted, the whole frame then " +
+                  lossText(b.askedPredicted.frameLoss, "loses", "gains", 2) + ", the tiles " +
+                  lossText(b.askedPredicted.tileLoss, "lose", "gain", 1) + ")";
     else if (b.overBudget)
-        warning = "conus.encode: exact_k: predicted against the uniform image, the whole frame loses " +
-                  numberText(std::round(b.predicted.frameLoss * 10) / 10) + " dB, the tiles outside the foci " +
-                  numberText(std::round(b.predicted.tileLoss * 10) / 10) + " dB (the budget: " + numberText(frameLoss) + " and " +
-                  numberText(codec::kDefaultTileLoss) + " dB)";
+        warning = std::string("conus.encode: exact_k: ") + (measured ? "measured by an encode" : "predicted") +
+                  " against the uniform image, the whole frame " + lossText(b.predicted.frameLoss, "loses", "gains", 1) +
+                  ", the tiles outside the foci " + lossText(b.predicted.tileLoss, "lose", "gain", 1) + " (the budget: " +
+                  numberText(frameLoss) + " and " + numberText(codec::kDefaultTileLoss) + " dB)";
     if (b.gridLimited) warning += (warning.empty() ? "conus.encode: " : "; ") + std::string("the grid holds the foci only to k ") + list(given);
     if (!warning.empty()) warn(warning);
     return d;

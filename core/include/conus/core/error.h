@@ -25,6 +25,10 @@ std::string oneLine(std::string text);
 
 // A number as messages show it: `significantDigits` digits, %g style ("0.1", "1e+06", "nan").
 std::string numberText(double value, int significantDigits = 6);
+// A loss in dB as messages say it: "loses 1.50 dB", or for a negative loss "gains 0.44 dB" (`lose`
+// and `gain` the verbs as they agree with the subject), to `decimals` places. The CLI and the
+// Python module say a budget's findings with it, so that neither prints "loses -0.9 dB".
+std::string lossText(double db, const char* lose, const char* gain, int decimals);
 
 class Error : public std::runtime_error {
 public:
