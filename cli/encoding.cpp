@@ -122,12 +122,14 @@ format::ConusFile encodeToConus(const renderers::Device& device, const Image& so
                                 const FitSetting& fit, std::string* fitNote, const std::string& what,
                                 codec::EncodeLevels* keptLevels) {
     Progress progress(encodeStage(source.width, source.height, size, what) + (device.onGpu() ? " (" + device.describe() + ")" : ""));
+    std::vector<float> share;
     Image image =
         renderers::encodeImage(device, source, map, {size.width, size.height, 0, progress.callback(),
-                                                   parseEnum<codec::EncodeFilter>(fit.filter), keptLevels});
+                                                   parseEnum<codec::EncodeFilter>(fit.filter), keptLevels, &share});
     progress.done();
     if (fit.count() > 0) {
         codec::FitOptions options;
+        options.lowPassShare = &share;
         options.method = parseEnum<codec::FitMethod>(fit.method);
         const bool local = options.method == codec::FitMethod::Local;
         Progress fitting(local ? std::string("fit to the decoder (local)")

@@ -55,8 +55,10 @@ format::ConusFile encodedPicture(const std::string& path, std::span<const codec:
     if (built.budget.encode) {
         encoded = built.budget.encode->image;  // the confirming encode of this map, fitted as `encode` fits
     } else {
-        encoded = codec::encodeImage(source, map, {width, height, 0, {}, request.model.filter});
+        std::vector<float> share;
+        encoded = codec::encodeImage(source, map, {width, height, 0, {}, request.model.filter, nullptr, &share});
         codec::FitOptions fit;
+        fit.lowPassShare = &share;
         fit.iterations = request.model.fitIterations;
         fit.holdLowPass = request.model.fitHold;
         fit.method = request.model.fitMethod;

@@ -147,12 +147,14 @@ void toDisplayOrder(Image& image) {
 }
 
 // fit > 0: the encoded image fitted to its decoder with that many iterations (fit.h).
+// `share`: the encode's low-pass share (EncodeOptions::lowPassShare), where it kept one.
 void fitTo(const Image& source, const codec::SamplingMap& map, Image& encoded, int fit,
-           double hold = codec::kFitHoldLowPass) {
+           double hold = codec::kFitHoldLowPass, const std::vector<float>* share = nullptr) {
     if (fit == 0) return;
     codec::FitOptions options;
     options.iterations = fit;
     options.holdLowPass = hold;
+    options.lowPassShare = share;
     codec::fitToDecoder(source, map, encoded, options);
 }
 
@@ -306,6 +308,8 @@ PYBIND11_MODULE(_conus, m) {
             codec::EncodeOptions options;
             options.width = w;
             options.height = h;
+            std::vector<float> share;
+            options.lowPassShare = &share;
             auto file = std::make_shared<File>();
             {
                 py::gil_scoped_release release;
@@ -320,7 +324,7 @@ PYBIND11_MODULE(_conus, m) {
                         std::lock_guard<std::mutex> lock(g_deviceMutex);
                         encoded = renderers::encodeImage(deviceFor(backend), source, map->map, options);
                     }
-                    fitTo(source, map->map, encoded, fit, fitHold);
+                    fitTo(source, map->map, encoded, fit, fitHold, &share);
                 }
                 file->file = codec::makeImageFile(std::move(encoded), map->map, source.width, source.height, SourceEncoding{},
                                                   map->analytic);

@@ -247,6 +247,7 @@ void drawMeshTimed(const GladGLContext& gl, const Mesh& mesh, GpuTimings& t, Clo
 Image encodeImageGpu(Context& context, const Image& source, const codec::SamplingMap& map,
                      const codec::EncodeOptions& options, GpuTimings* timings, const GpuEncodeOptions& gpu) {
     checkImage(source, "encodeImageGpu");
+    if (options.lowPassShare) options.lowPassShare->clear();  // the CPU encoder's (encode.h): the fit finds its own
     Image out = makeImage(options.width, options.height, source.channels);
     checkTextureSize(context, out.width, out.height, "encodeImageGpu", "output");
     GpuTimings t;

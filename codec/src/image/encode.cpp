@@ -434,7 +434,7 @@ void anisotropicOnLevel(Pyramid& pyramid, int level, int threads, int channels, 
 
 template <int kC>
 void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& field, Pyramid& pyramid, Image& dst,
-                int threads, bool anisotropic, int y0, int y1) {
+                int threads, bool anisotropic, float* share, int y0, int y1) {
     const int channels = kC > 0 ? kC : src.channelCount();
     const int W = dst.width, H = dst.height;
     const double uniform = uniformSpacing(src.width, src.height, W, H);
@@ -451,6 +451,7 @@ void encodeRows(const Image& src, const SamplingMap& map, const FootprintField& 
         double minor = 0;
         const FootprintFilter filter = footprintFilter(a, b, uniform, minor);
         const glm::dvec2 extent = filterExtent(filter);
+        if (share) share[static_cast<std::size_t>(y) * W + x] = FootprintPlan{0.0, extent}.lowPassShare();
         const PrincipalAxes axes = principalAxes(a, b, filter);
         const double lambda = anisotropic ? anisotropicLevel(axes, filter) : footprintLevel(a, b, minor, extent);
         const int top = pyramid.levels() - 1;
@@ -544,10 +545,15 @@ Image encodeFrom(const Image& shape, Pyramid& pyramid, const SamplingMap& map, c
     Image out = detail::makeOutput(shape, options.width, options.height);
     const FootprintField field(map);
     const bool anisotropic = options.filter == EncodeFilter::Anisotropic && !isUniform(map);  // encode.h says why
+    float* share = nullptr;
+    if (options.lowPassShare) {
+        options.lowPassShare->assign(static_cast<std::size_t>(out.width) * out.height, 0.0f);
+        share = options.lowPassShare->data();
+    }
     detail::RowProgress progress(options.progress, out.height);
     parallelRows(out.height, options.threads, [&](int y0, int y1) {
         detail::dispatchChannels(shape.channelCount(), [&]<int kC>() {
-            encodeRows<kC>(shape, map, field, pyramid, out, options.threads, anisotropic, y0, y1);
+            encodeRows<kC>(shape, map, field, pyramid, out, options.threads, anisotropic, share, y0, y1);
         });
         progress.add(y1 - y0);
     });

@@ -72,8 +72,7 @@ std::vector<float> lowPassShare(const SamplingMap& map, int sourceWidth, int sou
                 const glm::dmat2 inverse = field.inverseJacobian(map.undistort({(x + 0.5) / width, (y + 0.5) / height}));
                 const FootprintPlan plan =
                     planFootprint(inverse[0] / double(width) * scale, inverse[1] / double(height) * scale, uniform);
-                share[static_cast<std::size_t>(y) * width + x] =
-                    static_cast<float>(std::clamp(std::max(plan.extent.x, plan.extent.y) - 1.0, 0.0, 1.0));
+                share[static_cast<std::size_t>(y) * width + x] = plan.lowPassShare();
             }
     });
     return share;
@@ -93,7 +92,7 @@ std::vector<float> localWeights(const SamplingMap& map, int sourceWidth, int sou
                 const glm::dmat2 inverse = field.inverseJacobian(map.undistort({(x + 0.5) / width, (y + 0.5) / height}));
                 const glm::dvec2 a = inverse[0] / double(width) * scale, b = inverse[1] / double(height) * scale;
                 const FootprintPlan plan = planFootprint(a, b, uniform);
-                const double share = std::clamp(std::max(plan.extent.x, plan.extent.y) - 1.0, 0.0, 1.0);
+                const double share = plan.lowPassShare();
                 // The short axis: |det| / long axis, from the singular values of [a b].
                 const double p = glm::dot(a, a), q = glm::dot(a, b), r = glm::dot(b, b);
                 const double mean = 0.5 * (p + r), half = std::sqrt(0.25 * (p - r) * (p - r) + q * q);
@@ -269,8 +268,11 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
     // Per CoNUS pixel: the damping, plus holdLowPass where the encoder low-passed a long axis.
     std::vector<float> hold(pixels, static_cast<float>(options.damping));
     if (options.holdLowPass > 0) {
-        const std::vector<float> share =
-            detail::lowPassShare(map, source.width, source.height, conus.width, conus.height, options.threads);
+        const bool given = options.lowPassShare && options.lowPassShare->size() == pixels;
+        const std::vector<float> found =
+            given ? std::vector<float>{}
+                  : detail::lowPassShare(map, source.width, source.height, conus.width, conus.height, options.threads);
+        const std::vector<float>& share = given ? *options.lowPassShare : found;
         for (std::size_t i = 0; i < pixels; ++i) hold[i] += static_cast<float>(options.holdLowPass) * share[i];
     }
     const bool damped = std::any_of(hold.begin(), hold.end(), [](float h) { return h > 0; });

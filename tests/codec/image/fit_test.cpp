@@ -1,6 +1,7 @@
 // The encoder fitted to its decoder (fit.h): the operator it inverts is the decoder, its transpose
 // is the true adjoint, and the fit lowers the decoded view's error step by step below the EWA
 // encode's, on pictures with hard edges, texture and smooth shading through asymmetric foci.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -199,6 +200,45 @@ TEST(Fit, AssembledFitMatchesThePasses) {
         EXPECT_NEAR(decoded, a.steps.back().psnr, 0.01) << c.conusWidth << "x" << c.conusHeight;
         std::printf("[ info ] %dx%d (%zu wide rows): assembled %.3f dB, walked %.3f dB\n", c.conusWidth, c.conusHeight, wide,
                     a.steps.back().psnr, w.steps.back().psnr);
+    }
+}
+
+// The encode hands the fit each CoNUS pixel's low-pass share (EncodeOptions::lowPassShare): the
+// values the fit finds from the map, so a fit given them is the same fit, bit for bit. On a focus
+// map the share is neither all 0 nor all 1 (the rims low-pass, the context keeps the box).
+TEST(Fit, TheEncodesLowPassShareIsTheFitsOwn) {
+    const Image source = test::photoLike(300, 200, {"R", "G", "B"});
+    const SamplingMap map = twoFoci(1.5);
+    for (const EncodeFilter filter : {EncodeFilter::Anisotropic, EncodeFilter::Ewa}) {
+        std::vector<float> share = {7.0f};  // stale contents are replaced
+        EncodeOptions e;
+        e.width = 75;
+        e.height = 50;
+        e.filter = filter;
+        e.lowPassShare = &share;
+        const Image encoded = encodeImage(source, map, e);
+        ASSERT_EQ(share.size(), 75u * 50u);
+        EXPECT_GT(*std::max_element(share.begin(), share.end()), 0.1f);
+        EXPECT_EQ(*std::min_element(share.begin(), share.end()), 0.0f);
+
+        Image own = encoded, given = encoded;
+        FitOptions f;
+        f.iterations = 3;
+        const FitResult a = fitToDecoder(source, map, own, f);
+        f.lowPassShare = &share;
+        const FitResult b = fitToDecoder(source, map, given, f);
+        EXPECT_EQ(own.pixels, given.pixels);
+        EXPECT_EQ(a.steps.back().psnr, b.steps.back().psnr);
+        // The share is taken: another one of the right size gives another fit. One of another size
+        // (another encode's) is not: the fit finds its own.
+        const std::vector<float> ones(share.size(), 1.0f), wrong(10, 1.0f);
+        Image held = encoded, other = encoded;
+        f.lowPassShare = &ones;
+        fitToDecoder(source, map, held, f);
+        EXPECT_NE(own.pixels, held.pixels);
+        f.lowPassShare = &wrong;
+        fitToDecoder(source, map, other, f);
+        EXPECT_EQ(own.pixels, other.pixels);
     }
 }
 

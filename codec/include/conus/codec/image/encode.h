@@ -7,6 +7,7 @@
 // threads = 0 uses every core; sizes are checked (conus::Error InvalidArgument / LimitExceeded).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -54,6 +55,9 @@ inline constexpr double kEncodeBoxAnisotropy = 1.5;
 struct FootprintPlan {
     double level = 0;
     glm::dvec2 extent{1.0, 1.0};
+    // How far the filter low-passes the long axis: its extent beyond the unit box, in CoNUS
+    // pixels, at most 1; 0 where the box was kept (the fit holds such pixels, fit.h).
+    float lowPassShare() const { return static_cast<float>(std::clamp(std::max(extent.x, extent.y) - 1.0, 0.0, 1.0)); }
 };
 FootprintPlan planFootprint(glm::dvec2 a, glm::dvec2 b, double uniform);
 // sqrt(sourceWidth * sourceHeight / (width * height)): the uniform image's pixel, in source pixels.
@@ -126,6 +130,10 @@ struct EncodeOptions {
     ProgressFn progress;
     EncodeFilter filter = EncodeFilter::Anisotropic;
     EncodeLevels* keptLevels = nullptr;  // the CPU encoder's; GPU encoders build their own
+    // Where given, the CPU encoder fills it with each CoNUS pixel's low-pass share (row-major, one
+    // value a pixel: how far it low-passed that pixel's long axis, fit.h), which the fit of this
+    // encode then need not find again (FitOptions::lowPassShare); GPU encoders empty it.
+    std::vector<float>* lowPassShare = nullptr;
 };
 
 // Throws conus::Error(LimitExceeded) when encoding `source` (its size and channels) to a width x

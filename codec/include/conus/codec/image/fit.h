@@ -82,6 +82,10 @@ struct FitOptions {
     ProgressFn progress;
     FitMethod method = FitMethod::LeastSquares;
     double localSide = kFitLocalSide;  // Local: q, in (0, 0.25)
+    // The encode's low-pass share of each CoNUS pixel (EncodeOptions::lowPassShare), the same
+    // values the least squares would find from the map; found from the map where this is null or
+    // not one value a pixel of the CoNUS image.
+    const std::vector<float>* lowPassShare = nullptr;
 };
 
 // The decoded view's error against the source over the fitted channels after `iteration`
