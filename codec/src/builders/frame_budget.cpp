@@ -35,9 +35,13 @@ namespace {
 // bench/notes/2026-12-06-budget-model.md.
 }  // namespace
 
-struct FrameErrorModel::MeasuredUniform {
+struct FrameErrorModel::Confirming {
     std::once_flag once;
-    std::vector<double> errors;
+    std::vector<double> errors;  // the uniform image's, per tile
+    // The source's pyramid levels (encode.h), kept between the confirming encodes (the uniform
+    // image's too) so that each level is built once; one encode at a time uses them.
+    std::mutex levelsInUse;
+    EncodeLevels levels;
 };
 
 struct FrameErrorModel::BandFit {
@@ -187,7 +191,7 @@ FrameErrorModel::FrameErrorModel(const Image& source, const EightBitImage* codes
     m_source = codes ? nullptr : &source;
     if (codes && codes->codes.size() != std::size_t(source.width) * source.height * source.channels.size())
         invalid("the frame-loss model: the 8-bit picture's codes do not fill it");
-    m_measuredUniform = std::make_shared<MeasuredUniform>();
+    m_confirming = std::make_shared<Confirming>();
     m_sourceWidth = sw;
     m_sourceHeight = sh;
     m_conusWidth = width;
@@ -392,10 +396,18 @@ FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
     encode.width = m_conusWidth;
     encode.height = m_conusHeight;
     encode.filter = m_options.filter;
+    // The levels kept by an earlier confirmation; where another thread's confirmation of a copy
+    // holds them, this one builds its own.
+    std::unique_lock<std::mutex> levels(m_confirming->levelsInUse, std::try_to_lock);
+    if (levels.owns_lock()) encode.keptLevels = &m_confirming->levels;
     auto kept = std::make_shared<ModelEncode>();
+    std::vector<float> share;
+    encode.lowPassShare = &share;
     kept->image = encodeImage(source, map, encode);
+    encode.lowPassShare = nullptr;
     if (m_options.fitIterations > 0) {
         FitOptions fit;
+        fit.lowPassShare = &share;
         fit.iterations = m_options.fitIterations;
         fit.holdLowPass = m_options.fitHold;
         fit.method = m_options.fitMethod;
@@ -406,14 +418,15 @@ FrameErrorModel FrameErrorModel::confirmed(const SamplingMap& map) const {
     // image as `conus uniform` makes it (the identity map through the same encoder), shown at the
     // source's size as the bench shows it (bilinear).
     std::vector<double> measured;
-    std::call_once(m_measuredUniform->once, [&] {
+    std::call_once(m_confirming->once, [&] {
         const Image uniform = encodeImage(source, SamplingMap::identity(2, 2), encode);
         auto [conus, flat] = shownTileErrors(source, kept->image, map, &uniform);
         measured = std::move(conus);
-        m_measuredUniform->errors = std::move(flat);
+        m_confirming->errors = std::move(flat);
     });
     if (measured.empty()) measured = shownTileErrors(source, kept->image, map, nullptr).first;
-    out.m_uniformError = m_measuredUniform->errors;
+    if (levels.owns_lock()) levels.unlock();
+    out.m_uniformError = m_confirming->errors;
     // Each tile's footprints scaled by 2^shift so that the model gives what was measured: the
     // error grows with the footprint, so the shift is found by bisection (to 1e-4 octaves, within
     // +-kMostShift: a tile with no detail to lose keeps what it can).

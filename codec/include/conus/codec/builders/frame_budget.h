@@ -167,10 +167,10 @@ private:
     std::vector<double> m_residual;     // per tile: what confirmed() measured that no shift gives (added)
     bool m_confirmed = false;
     std::shared_ptr<const ModelEncode> m_encode;  // confirmed(): the encode measured
-    // The uniform image's errors as measured, taken by the first confirmed() of this model or of
-    // any copy (the same picture and size): shared, measured once.
-    struct MeasuredUniform;
-    std::shared_ptr<MeasuredUniform> m_measuredUniform;
+    // What every confirmed() of this model or of any copy (the same picture and size) shares: the
+    // uniform image's errors, measured by the first, and the picture's encode pyramid, built once.
+    struct Confirming;
+    std::shared_ptr<Confirming> m_confirming;
 };
 
 struct BudgetResult {
