@@ -107,13 +107,6 @@ float shown(float v, bool display, const std::vector<float>& table) {
     return table[i] + f * (table[i + 1] - table[i]);
 }
 
-// code / 255.0 for each 8-bit code, without a division.
-constexpr std::array<double, 256> kCodeValues = [] {
-    std::array<double, 256> values{};
-    for (int code = 0; code < 256; ++code) values[code] = code / 255.0;
-    return values;
-}();
-
 // The 8-bit code a display shows for a colour value: shown(), then its nearest code, the value of
 // the 8-bit sRGB pictures bench/quality.py compares. x is exact and within [0, 255] (the table's
 // values lie in [0, 1]), where the only half is 127.5 (0.5f * 255): there rounding to even, as
@@ -455,27 +448,63 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
     std::vector<char> display(channels, 0);
     if (m_options.space == ErrorSpace::Display)
         for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
+    // The colour channels are compared as the 8-bit codes shown, in integers (exact, and a row of
+    // codes stays in the core's first cache); the others (alpha as stored, every channel of
+    // ErrorSpace::Linear) as the values shown, in double, only where there are such channels.
+    const bool others = std::any_of(display.begin(), display.end(), [](char d) { return !d; });
     const std::vector<float>& table = displayTable();
     const CodeThresholds& codes = codeThresholds();
     // The views at the source's size, never whole: the CoNUS image's decoded a row of tiles at a
     // time (the decoder's view of those rows), the uniform image's bilinear resize a row at a time.
     std::optional<detail::ResizedRows> uniformRows;
     if (uniform) uniformRows.emplace(*uniform, source.width, source.height);
-    // A row of tiles at a time, the rows of tiles spread over the threads (each tile's sum is
-    // taken in the same order whatever the thread count).
-    std::vector<double> out(m_pixels.size(), 0.0), flat(uniform ? m_pixels.size() : 0, 0.0);
+    // Per tile, the sum of squared code differences and of the other channels' squared
+    // differences. A row of tiles at a time, the rows of tiles spread over the threads (each
+    // tile's sums are taken in the same order whatever the thread count).
+    const std::size_t tiles = m_pixels.size();
+    std::vector<std::int64_t> codeSum(tiles, 0), flatCodeSum(uniform ? tiles : 0, 0);
+    std::vector<double> otherSum(others ? tiles : 0, 0.0), flatOtherSum(others && uniform ? tiles : 0, 0.0);
     parallelRows(
         m_rows, 0,
         [&](int r0, int r1) {
             const std::size_t values = std::size_t(source.width) * channels;
             std::vector<float> resized(uniform ? values : 0);
-            // Each row's values as the display shows them, one array a picture: colour channels
-            // as their 8-bit code's value, others as they are.
-            std::vector<double> fromShown(values), viewShown(values), resizedShown(uniform ? values : 0);
-            const auto onDisplay = [&](const float* in, std::vector<double>& out) {
+            // Each row as shown, one array a picture: the colour channels' codes (0 elsewhere), the
+            // other channels' values (0 at the colour channels; only where there are others).
+            struct Shown {
+                std::vector<std::uint8_t> codes;
+                std::vector<double> others;
+            };
+            const auto shownRow = [&](bool wanted) {
+                return Shown{std::vector<std::uint8_t>(wanted ? values : 0), std::vector<double>(wanted && others ? values : 0)};
+            };
+            Shown from = shownRow(true), view = shownRow(true), flat = shownRow(uniform != nullptr);
+            const auto onDisplay = [&](const float* in, Shown& out) {
                 for (std::size_t i = 0; i < values; i += channels)
                     for (std::size_t c = 0; c < channels; ++c)
-                        out[i + c] = display[c] ? kCodeValues[fastDisplayCode(in[i + c], codes)] : double(shown(in[i + c], false, table));
+                        out.codes[i + c] = display[c] ? std::uint8_t(fastDisplayCode(in[i + c], codes)) : 0;
+                if (others)
+                    for (std::size_t i = 0; i < values; i += channels)
+                        for (std::size_t c = 0; c < channels; ++c)
+                            out.others[i + c] = display[c] ? 0.0 : double(shown(in[i + c], false, table));
+            };
+            // Over values i0..i1 of a row: the squared code differences (at most 255^2 a value:
+            // a tile's row is far from overflowing), and the other channels'.
+            const auto codeSquares = [](const std::uint8_t* a, const std::uint8_t* b, std::size_t i0, std::size_t i1) {
+                std::int64_t e = 0;
+                for (std::size_t i = i0; i < i1; ++i) {
+                    const int d = int(a[i]) - int(b[i]);
+                    e += d * d;
+                }
+                return e;
+            };
+            const auto otherSquares = [](const std::vector<double>& a, const std::vector<double>& b, std::size_t i0, std::size_t i1) {
+                double e = 0;
+                for (std::size_t i = i0; i < i1; ++i) {
+                    const double d = a[i] - b[i];
+                    e += d * d;
+                }
+                return e;
             };
             Image decoded;
             for (int y = r0 * m_tile; y < std::min(source.height, r1 * m_tile); ++y) {
@@ -488,39 +517,34 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
                     rows.threads = 1;
                     decoded = decodeImage(conus, map, rows);
                 }
-                onDisplay(decoded.pixels.data() + std::size_t(y % m_tile) * values, viewShown);
-                onDisplay(source.pixels.data() + std::size_t(y) * values, fromShown);
+                onDisplay(decoded.pixels.data() + std::size_t(y % m_tile) * values, view);
+                onDisplay(source.pixels.data() + std::size_t(y) * values, from);
                 if (uniform) {
                     uniformRows->row(y, resized.data());
-                    onDisplay(resized.data(), resizedShown);
+                    onDisplay(resized.data(), flat);
                 }
-                // Each tile's sum over its values (divided by the channels with the pixels, below).
-                double* row = &out[std::size_t(y / m_tile) * m_columns];
-                double* flatRow = uniform ? &flat[std::size_t(y / m_tile) * m_columns] : nullptr;
+                const std::size_t first = std::size_t(y / m_tile) * m_columns;
                 for (int tx = 0; tx < m_columns; ++tx) {
                     const std::size_t i0 = std::size_t(tx) * m_tile * channels;
                     const std::size_t i1 = std::min(values, i0 + std::size_t(m_tile) * channels);
-                    double e = 0;
-                    for (std::size_t i = i0; i < i1; ++i) {
-                        const double d = viewShown[i] - fromShown[i];
-                        e += d * d;
-                    }
-                    row[tx] += e;
+                    codeSum[first + tx] += codeSquares(view.codes.data(), from.codes.data(), i0, i1);
+                    if (others) otherSum[first + tx] += otherSquares(view.others, from.others, i0, i1);
                     if (uniform) {
-                        double u = 0;
-                        for (std::size_t i = i0; i < i1; ++i) {
-                            const double f = resizedShown[i] - fromShown[i];
-                            u += f * f;
-                        }
-                        flatRow[tx] += u;
+                        flatCodeSum[first + tx] += codeSquares(flat.codes.data(), from.codes.data(), i0, i1);
+                        if (others) flatOtherSum[first + tx] += otherSquares(flat.others, from.others, i0, i1);
                     }
                 }
             }
         },
         1);
-    for (std::size_t t = 0; t < out.size(); ++t) out[t] /= m_pixels[t] * double(channels);
-    for (std::size_t t = 0; t < flat.size(); ++t) flat[t] /= m_pixels[t] * double(channels);
-    return {std::move(out), std::move(flat)};
+    // Each tile's mean over its values: codes as values code / 255.
+    const auto means = [&](const std::vector<std::int64_t>& code, const std::vector<double>& other) {
+        std::vector<double> out(code.size());
+        for (std::size_t t = 0; t < out.size(); ++t)
+            out[t] = (double(code[t]) / (255.0 * 255.0) + (others ? other[t] : 0.0)) / (m_pixels[t] * double(channels));
+        return out;
+    };
+    return {means(codeSum, otherSum), uniform ? means(flatCodeSum, flatOtherSum) : std::vector<double>{}};
 }
 
 FramePrediction FrameErrorModel::measure(const std::vector<double>& mapped) const {

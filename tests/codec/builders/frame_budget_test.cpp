@@ -225,17 +225,21 @@ TEST(FrameBudget, ConfirmedModelKeepsItsEncode) {
     }
 }
 
-// The 8-bit sRGB error of each tile of max(W, H) / 32 (the model's tiles), as bench/quality.py takes it.
-std::vector<double> displayTileErrors(const Image& view, const Image& source, int tile) {
+// The error of each tile of max(W, H) / 32 (the model's tiles) as bench/quality.py takes it: the
+// colour channels as 8-bit sRGB codes (in ErrorSpace::Display), the others (alpha; every channel of
+// ErrorSpace::Linear) as stored.
+std::vector<double> displayTileErrors(const Image& view, const Image& source, int tile, ErrorSpace space = ErrorSpace::Display) {
     const int cols = (source.width + tile - 1) / tile, rows = (source.height + tile - 1) / tile;
+    const int channels = source.channelCount();
     std::vector<double> sum(std::size_t(cols) * rows, 0.0), count(sum.size(), 0.0);
     const auto code = [](float v) { return std::round(255.0 * linearToSrgbDisplay(v)) / 255.0; };
     for (int y = 0; y < source.height; ++y)
         for (int x = 0; x < source.width; ++x) {
             double e = 0;
-            for (int c = 0; c < 3; ++c) {
-                const double d = code(view.at(x, y, c)) - code(source.at(x, y, c));
-                e += d * d / 3;
+            for (int c = 0; c < channels; ++c) {
+                const bool colour = space == ErrorSpace::Display && source.channels[c] != "A";
+                const double d = colour ? code(view.at(x, y, c)) - code(source.at(x, y, c)) : double(view.at(x, y, c)) - source.at(x, y, c);
+                e += d * d / channels;
             }
             const std::size_t t = std::size_t(y / tile) * cols + x / tile;
             sum[t] += e;
@@ -291,39 +295,52 @@ Image varied(int which) {
 
 // The confirming encode measures each tile as the bench does: the CoNUS image decoded to the
 // source's size and the uniform image (`conus uniform`: the identity map through the encoder)
-// resized to it, both as 8-bit sRGB codes against the source's, each tile's mean squared error.
+// resized to it, both as 8-bit sRGB codes against the source's, each tile's mean squared error;
+// alpha (partial, in a corner) as stored, and every channel as stored in ErrorSpace::Linear.
 // The model's codes go through its table of the display curve, this test's through pow: a code
 // apart where a value sits on a rounding edge, so each tile within 2%. On a picture whose width is
 // not a whole number of tiles, with partial tiles on the right and at the bottom.
 TEST(FrameBudget, ConfirmingMeasureIsTheBenchsTileErrors) {
     const Image whole = varied(1);
-    Image source = makeImage(500, 379, whole.channels);  // tiles of 15: 34 columns, the last of 5 pixels; 26 rows
-    for (int y = 0; y < source.height; ++y)
-        for (int x = 0; x < source.width; ++x)
-            for (int c = 0; c < 3; ++c) source.at(x, y, c) = whole.at(x, y, c);
-    const int w = source.width / 4, h = source.height / 4;
-    FociOptions fo;
-    fo.aspect = double(source.width) / source.height;
-    const SamplingMap map = buildFociMap(std::vector<Focus>{{0.3, 0.6, 0.12, 3.0}}, fo);
-    const FrameErrorModel model(source, w, h, Image{}, {ErrorSpace::Display, 1});
-    const FrameErrorModel confirmed = model.confirmed(map);
-    DecodeOptions d;
-    d.width = source.width;
-    d.height = source.height;
-    const Image view = decodeImage(confirmed.encode()->image, map, d);
-    EncodeOptions e;
-    e.width = w;
-    e.height = h;
-    const Image uniform = resizeBilinear(encodeImage(source, SamplingMap::identity(2, 2), e), {}, source.width, source.height);
-    const std::vector<double> conusTiles = displayTileErrors(view, source, model.tileSide());
-    const std::vector<double> uniformTiles = displayTileErrors(uniform, source, model.tileSide());
-    const std::vector<double> measured = confirmed.tileErrors(map);
-    ASSERT_EQ(measured.size(), conusTiles.size());
-    ASSERT_EQ(confirmed.uniformErrors().size(), uniformTiles.size());
-    for (std::size_t t = 0; t < measured.size(); ++t) {
-        SCOPED_TRACE(t);
-        EXPECT_NEAR(measured[t], conusTiles[t], 0.02 * conusTiles[t] + 1e-9);
-        EXPECT_NEAR(confirmed.uniformErrors()[t], uniformTiles[t], 0.02 * uniformTiles[t] + 1e-9);
+    struct Case {
+        std::vector<std::string> channels;
+        ErrorSpace space;
+    };
+    for (const Case& c : {Case{{"R", "G", "B"}, ErrorSpace::Display}, Case{{"R", "G", "B", "A"}, ErrorSpace::Display},
+                          Case{{"R", "G", "B"}, ErrorSpace::Linear}}) {
+        SCOPED_TRACE(c.channels.size());
+        SCOPED_TRACE(static_cast<int>(c.space));
+        Image source = makeImage(500, 379, c.channels);  // tiles of 15: 34 columns, the last of 5 pixels; 26 rows
+        for (int y = 0; y < source.height; ++y)
+            for (int x = 0; x < source.width; ++x) {
+                for (int k = 0; k < 3; ++k) source.at(x, y, k) = whole.at(x, y, k);
+                if (c.channels.size() == 4)  // opaque but for a ramp of partial alpha in the top-right corner
+                    source.at(x, y, 3) = x > 350 && y < 120 ? static_cast<float>(0.2 + 0.6 * whole.at(x, y, 1)) : 1.0f;
+            }
+        const int w = source.width / 4, h = source.height / 4;
+        FociOptions fo;
+        fo.aspect = double(source.width) / source.height;
+        const SamplingMap map = buildFociMap(std::vector<Focus>{{0.3, 0.6, 0.12, 3.0}}, fo);
+        const FrameErrorModel model(source, w, h, Image{}, {c.space, 1});
+        const FrameErrorModel confirmed = model.confirmed(map);
+        DecodeOptions d;
+        d.width = source.width;
+        d.height = source.height;
+        const Image view = decodeImage(confirmed.encode()->image, map, d);
+        EncodeOptions e;
+        e.width = w;
+        e.height = h;
+        const Image uniform = resizeBilinear(encodeImage(source, SamplingMap::identity(2, 2), e), {}, source.width, source.height);
+        const std::vector<double> conusTiles = displayTileErrors(view, source, model.tileSide(), c.space);
+        const std::vector<double> uniformTiles = displayTileErrors(uniform, source, model.tileSide(), c.space);
+        const std::vector<double> measured = confirmed.tileErrors(map);
+        ASSERT_EQ(measured.size(), conusTiles.size());
+        ASSERT_EQ(confirmed.uniformErrors().size(), uniformTiles.size());
+        for (std::size_t t = 0; t < measured.size(); ++t) {
+            SCOPED_TRACE(t);
+            EXPECT_NEAR(measured[t], conusTiles[t], 0.02 * conusTiles[t] + 1e-9);
+            EXPECT_NEAR(confirmed.uniformErrors()[t], uniformTiles[t], 0.02 * uniformTiles[t] + 1e-9);
+        }
     }
 }
 
