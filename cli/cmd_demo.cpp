@@ -76,7 +76,7 @@ struct DemoMap {
 };
 
 // The demo encodes without the fit, and so do its budget's trials.
-constexpr codec::FrameModelOptions kDemoTrials{codec::ErrorSpace::Display, 0};
+const codec::FrameModelOptions kDemoTrials{codec::ErrorSpace::Display, 0};
 
 // From importance (its hottest region becomes the view when no focus names one), else the foci;
 // under encode's default frame-loss budget, so the demo shows what `conus encode` gives.

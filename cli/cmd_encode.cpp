@@ -114,7 +114,9 @@ BuiltMap mapFromImportance(const EncodeOptions& o, const Image& source, const Si
     const bool notDetail = o.importance != enumName(codec::ImportanceRule::Detail);
     const Image detail = notDetail ? importanceFrom(enumName(codec::ImportanceRule::Detail), source) : Image{};
     // One model of the picture (its pyramid taken once), its region the detail's for the context.
-    const codec::FrameErrorModel picture(source, size.width, size.height, notDetail ? detail : importance, modelOptions);
+    codec::FrameModelOptions confirming = modelOptions;
+    confirming.confirmProgress = progress.steps("confirming encode");
+    const codec::FrameErrorModel picture(source, size.width, size.height, notDetail ? detail : importance, confirming);
     if (notDetail) {
         context = codec::ownDetailContext(picture, detail, ownDetailOptions(o));
         autoOptions.context = &context;
@@ -141,6 +143,7 @@ BuiltMap mapFromFoci(const EncodeOptions& o, const Picture& source, const Size& 
     request.detail = &detail;
     request.contextOptions = ownDetailOptions(o);
     Progress progress("build sampling map (" + plural(o.parsedFoci.size(), "focus", "foci") + ")");
+    request.model.confirmProgress = progress.steps("confirming encode");
     codec::FociMap built = source.codes ? codec::budgetedFociMap(*source.codes, o.parsedFoci, size.width, size.height, request)
                                         : codec::budgetedFociMap(source.image, o.parsedFoci, size.width, size.height, request);
     progress.done();

@@ -92,6 +92,23 @@ ProgressFn Progress::callback() {
     };
 }
 
+ProgressFn Progress::steps(std::string step) {
+    if (quiet() || !m_tty) return {};
+    return [this, step = std::move(step)](double fraction) {
+        const int percent = static_cast<int>(fraction * 100.0);
+        std::lock_guard lock(g_printMutex);
+        if (fraction == 0.0) {
+            ++m_step;
+            m_lastPercent = -1;
+        }
+        if (percent <= m_lastPercent) return;
+        m_lastPercent = percent;
+        std::fprintf(stderr, "\r\033[Kconus %s: %s: %s %d %3d%%", g_command.c_str(), m_label.c_str(), step.c_str(), m_step,
+                     percent);
+        std::fflush(stderr);
+    };
+}
+
 void Progress::done() {
     if (m_finished) return;
     m_finished = true;
@@ -100,7 +117,7 @@ void Progress::done() {
     std::lock_guard lock(g_printMutex);
     g_stageSeconds += seconds;
     if (quiet()) return;
-    std::fprintf(stderr, "%sconus %s: %s done (%.2f s)\n", m_tty ? "\r" : "", g_command.c_str(), m_label.c_str(), seconds);
+    std::fprintf(stderr, "%sconus %s: %s done (%.2f s)\n", m_tty ? "\r\033[K" : "", g_command.c_str(), m_label.c_str(), seconds);
 }
 
 void beginCommand(const std::string& name) {

@@ -19,6 +19,9 @@ public:
     explicit Progress(std::string label);
     ~Progress();  // finishes the line if done() was not called
     ProgressFn callback();
+    // A stage made of steps whose count is not known ahead (a budget's confirming encodes): each
+    // call with 0 starts the next, shown as "<label>: <step> N" and its own percentage.
+    ProgressFn steps(std::string step);
     void done();
 
 private:
@@ -26,6 +29,7 @@ private:
     bool m_tty;
     bool m_finished = false;
     int m_lastPercent = -1;
+    int m_step = 0;  // steps(): the step shown
     std::chrono::steady_clock::time_point m_start;
 };
 

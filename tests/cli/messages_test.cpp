@@ -67,6 +67,26 @@ TEST_F(Cli, ProgressIsOneLinePerStageWithATotalAndQuietSilencesIt) {
     EXPECT_EQ(countLines(r.err, "conus decode: "), 1) << "errors still print: " << r.err;
 }
 
+// On a terminal (util-linux `script` gives the run one), the budget's map build shows each
+// confirming encode's percentage on the stage's live line, up to 100%, then the stage's line; the
+// same run to a file or a pipe prints the stage's line alone.
+TEST_F(Cli, TheMapBuildShowsItsConfirmingEncodesOnATerminal) {
+    const std::string in = makePicture(192, 128);
+    const fs::path typed = fs::path(path("typescript.txt"));
+    const std::string command = std::string(CONUS_BIN_DIR) + "/conus encode " + in + " -o " + path("t.exr") +
+                                " --size 64x48 --focus 0.3,0.4,0.15,3";
+    ASSERT_EQ(std::system(("script -qec '" + command + "' " + typed.string() + " >/dev/null 2>&1 </dev/null").c_str()), 0);
+    const std::string shown = slurp(typed);
+    EXPECT_NE(shown.find("build sampling map (1 focus): confirming encode 1   0%"), std::string::npos) << shown;
+    EXPECT_NE(shown.find("build sampling map (1 focus): confirming encode 1 100%"), std::string::npos) << shown;
+    EXPECT_NE(shown.find("build sampling map (1 focus) done"), std::string::npos) << shown;
+    EXPECT_EQ(shown.find("confirming encode 0"), std::string::npos) << shown;
+    const Result r = run("encode " + in + " -o " + path("u.exr") + " --size 64x48 --focus 0.3,0.4,0.15,3");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err.find("confirming encode"), std::string::npos) << r.err;
+    EXPECT_EQ(countLines(r.err, "build sampling map (1 focus) done"), 1) << r.err;
+}
+
 TEST_F(Cli, InfoOnAnInvalidFileIsOneLineAndVerboseListsEveryProblem) {
     ASSERT_EQ(run("uniform " + makePicture(64, 48) + " -o " + path("u.exr")).exitCode, 0);
     // Two broken rules, made by an ordinary EXR tool.

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <initializer_list>
 #include <limits>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -193,6 +194,46 @@ TEST(FrameBudget, AnotherRegionOnTheSamePyramidIsAFreshModel) {
 
 // The confirming encode is kept for the caller: exactly the CoNUS image (and fit report) that
 // encodeImage and fitToDecoder make of the map with the model's options, fitted and not.
+// Each confirmation reports its progress from 0 (first, so a caller counts confirmations by it) to
+// 1, within [0, 1] and along the way (the encode's rows, the fit's passes, the measure's rows of
+// tiles), the first and second alike (the second measures no uniform image); the reports change
+// nothing of what is measured.
+TEST(FrameBudget, ConfirmationsReportTheirProgress) {
+    const Image source = picture();
+    FociOptions fo;
+    fo.aspect = double(kWidth) / kHeight;
+    const SamplingMap a = buildFociMap(std::vector<Focus>{{0.62, 0.4, 0.13, 3.0}}, fo);
+    const SamplingMap b = buildFociMap(std::vector<Focus>{{0.3, 0.6, 0.1, 2.0}}, fo);
+    std::mutex mutex;
+    std::vector<double> seen;
+    FrameModelOptions options{ErrorSpace::Display, 2};
+    const FrameErrorModel silent(source, kWidth / 4, kHeight / 4, boxes(), options);
+    options.confirmProgress = [&](double f) {
+        std::lock_guard lock(mutex);
+        seen.push_back(f);
+    };
+    const FrameErrorModel model(source, kWidth / 4, kHeight / 4, boxes(), options);
+    const FrameErrorModel first = model.confirmed(a);
+    const std::size_t split = seen.size();
+    const FrameErrorModel second = first.confirmed(b);
+    ASSERT_GT(split, 4u);
+    ASSERT_GT(seen.size(), split + 4);
+    for (const auto& [from, to] : {std::pair{std::size_t{0}, split}, std::pair{split, seen.size()}}) {
+        EXPECT_EQ(seen[from], 0.0);
+        EXPECT_EQ(seen[to - 1], 1.0);
+        EXPECT_EQ(std::count(seen.begin() + std::ptrdiff_t(from), seen.begin() + std::ptrdiff_t(to), 0.0), 1);
+        for (std::size_t i = from; i < to; ++i) {
+            EXPECT_GE(seen[i], 0.0);
+            EXPECT_LE(seen[i], 1.0);
+        }
+        EXPECT_GT(std::count_if(seen.begin() + std::ptrdiff_t(from), seen.begin() + std::ptrdiff_t(to),
+                                [](double f) { return f > 0.3 && f < 0.75; }), 0) << "the fit's passes";
+    }
+    const FrameErrorModel quiet = silent.confirmed(a).confirmed(b);
+    EXPECT_EQ(quiet.tileErrors(b), second.tileErrors(b));
+    EXPECT_EQ(quiet.encode()->image.pixels, second.encode()->image.pixels);
+}
+
 TEST(FrameBudget, ConfirmedModelKeepsItsEncode) {
     const Image source = picture();
     FociOptions fo;

@@ -83,6 +83,10 @@ struct FrameModelOptions {
     // The encode's kernel and fit method, which the confirming encodes use as the encode will.
     EncodeFilter filter = EncodeFilter::Anisotropic;
     FitMethod fitMethod = FitMethod::LeastSquares;
+    // Where set, each confirmed() reports through it from 0 (called as it starts, on its caller's
+    // thread) to 1 over its encode, fit and measure (from worker threads too): a caller's progress
+    // bar over a budget counts the confirming encodes by their 0.
+    ProgressFn confirmProgress;
 };
 
 // How near (in the exponent t of k^t) the map chosen on a confirmed model must be to the map that
@@ -143,9 +147,11 @@ private:
     // S of the footprint of axes sigma1 >= sigma2 (source pixels) on `tile`, with `fit`'s constants.
     double tileError(std::size_t tile, double sigma1, double sigma2, const BandFit& fit) const;
     // Measured, per tile: the view of `conus` through `map` at the source's size and (where given)
-    // the uniform image's bilinear view, each against the source; neither view is kept.
+    // the uniform image's bilinear view, each against the source; neither view is kept. `progress`
+    // (where set) from 0 to 1 over the rows of tiles.
     std::pair<std::vector<double>, std::vector<double>> shownTileErrors(const Image& source, const Image& conus,
-                                                                        const SamplingMap& map, const Image* uniform) const;
+                                                                        const SamplingMap& map, const Image* uniform,
+                                                                        const ProgressFn& progress = {}) const;
     // The footprint's axes (source pixels, largest first) at a few points of each tile, tile by tile.
     std::vector<std::pair<double, double>> footprints(const SamplingMap& map) const;
     // A tile's error from its points' axes, each scaled by 2^shift.
