@@ -3,8 +3,8 @@
 #include "conus/codec/builders/frame_budget.h"
 
 #include <algorithm>
-#include <atomic>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -158,8 +158,7 @@ const CodeThresholds& codeThresholds() {
 }
 
 // displayCode(v): NaN, infinities and values up to 0 show as 0 (shown()), 1 and above as 255 (the
-// last step's code, below lowest[256]); without a branch on the value (the same code for every
-// float as the branching form that did those two apart, checked over all 2^32).
+// last step's code, below lowest[256]); without a branch on the value.
 int fastDisplayCode(float v, const CodeThresholds& t) {
     const float x = v > 0.0f && v != std::numeric_limits<float>::infinity() ? std::min(v, 1.0f) : 0.0f;
     const int c = t.start[static_cast<int>(x * kDisplayTableSteps)];
