@@ -52,9 +52,12 @@ void BM_EncodeConusEwa(benchmark::State& state) {
 void fitEncoded(benchmark::State& state, FitMethod method) {
     const Image& src = source4096();
     const SamplingMap& map = fociMap();
-    static const Image encoded = encodeImage(src, map, {1024, 1024, 0, {}});
+    // The encode's low-pass share goes to the fit, as `conus encode` hands it on.
+    static std::vector<float> share;
+    static const Image encoded = encodeImage(src, map, {1024, 1024, 0, {}, EncodeFilter::Anisotropic, nullptr, &share});
     FitOptions options;
     options.method = method;
+    options.lowPassShare = &share;
     options.iterations = kDefaultEncodeFitIterations;
     for (auto _ : state) {
         state.PauseTiming();
