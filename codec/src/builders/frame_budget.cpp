@@ -5,26 +5,18 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <bit>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <optional>
 #include <string>
 
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/codec/image/fit.h"
-#include "conus/core/display.h"
 #include "conus/core/error.h"
 #include "conus/core/parallel.h"
-#include "../image/cpu_features_pvt.h"
 #include "../image/resize_rows_pvt.h"
 #include "display_codes_pvt.h"
-
-#if CONUS_HAVE_AVX2_COPY
-#include <immintrin.h>
-#endif
 
 namespace conus::codec {
 namespace {
@@ -85,123 +77,10 @@ constexpr int kJacobianPoints = 3;
 constexpr int kRegionPoints = 16, kMostRegionPoints = 64;
 // The most a confirming encode moves a tile's footprints (octaves either way).
 constexpr double kMostShift = 3.0;
-// D through a table, linear between its entries (continuous, and some 20x faster than pow).
-constexpr int kDisplayTableSteps = 4096;
-
 [[noreturn]] void invalid(const std::string& what) { throw Error(ErrorCode::InvalidArgument, what); }
 
 // The channels a display shows through its transfer curve: colour and grey, not alpha or data.
 bool isColourChannel(const std::string& name) { return name == "R" || name == "G" || name == "B" || name == "Y"; }
-
-const std::vector<float>& displayTable() {
-    static const std::vector<float> table = [] {
-        std::vector<float> t(kDisplayTableSteps + 2);
-        for (int i = 0; i <= kDisplayTableSteps; ++i) t[i] = linearToSrgbDisplay(float(i) / kDisplayTableSteps);
-        t[kDisplayTableSteps + 1] = t[kDisplayTableSteps];
-        return t;
-    }();
-    return table;
-}
-
-// A value as the model weighs it; a NaN or infinite one (a picture kept as read, which filtering
-// spreads) as 0, so that it neither indexes the table nor turns a tile's error into NaN.
-float shown(float v, bool display, const std::vector<float>& table) {
-    if (!std::isfinite(v)) return 0.0f;
-    if (!display) return v;
-    const float x = std::clamp(v, 0.0f, 1.0f) * kDisplayTableSteps;
-    const int i = static_cast<int>(x);
-    const float f = x - float(i);
-    return table[i] + f * (table[i + 1] - table[i]);
-}
-
-// The 8-bit code a display shows for a colour value: shown(), then its nearest code, the value of
-// the 8-bit sRGB pictures bench/quality.py compares. x is exact and within [0, 255] (the table's
-// values lie in [0, 1]), where the only half is 127.5 (0.5f * 255): there rounding to even, as
-// adding and taking away 1.5 * 2^52 does, gives round()'s 128 too. (The clamp holds the index
-// whatever the table.)
-int displayCode(float v, const std::vector<float>& table) {
-    const double x = double(shown(v, true, table)) * 255.0;
-    constexpr double kRoundingShift = 6755399441055744.0;
-    return std::clamp(static_cast<int>((x + kRoundingShift) - kRoundingShift), 0, 255);
-}
-
-// displayCode through the thresholds between codes: the code at the start of v's step of the table,
-// then one more where v reaches the next threshold (a step of the table spans at most 0.8 of a code,
-// where sRGB is steepest). The same code for every float (checked over all 2^32 of them), without
-// the interpolation, the rounding or a branch on the value: the confirming measure takes three a
-// value, over the source's size.
-struct CodeThresholds {
-    std::array<float, 257> lowest{};                                 // [c]: the least v whose code is c or more
-    // [i]: displayCode(i / kDisplayTableSteps), i <= kDisplayTableSteps; three bytes after, so that
-    // a gather of four bytes at the last stays inside.
-    std::array<std::uint8_t, kDisplayTableSteps + 4> start{};
-};
-
-const CodeThresholds& codeThresholds() {
-    static const CodeThresholds thresholds = [] {
-        CodeThresholds t;
-        const std::vector<float>& table = displayTable();
-        for (int c = 1; c <= 255; ++c) {
-            // Bisection on the bits of the floats in [0, 1], which order as the integers do.
-            std::uint32_t lo = 0, hi = std::bit_cast<std::uint32_t>(1.0f);
-            while (hi - lo > 1) {
-                const std::uint32_t mid = lo + (hi - lo) / 2;
-                (displayCode(std::bit_cast<float>(mid), table) >= c ? hi : lo) = mid;
-            }
-            t.lowest[c] = std::bit_cast<float>(hi);
-        }
-        t.lowest[256] = std::numeric_limits<float>::infinity();
-        for (int i = 0; i <= kDisplayTableSteps; ++i) t.start[i] = std::uint8_t(displayCode(float(i) / kDisplayTableSteps, table));
-        return t;
-    }();
-    return thresholds;
-}
-
-// displayCode(v): NaN, infinities and values up to 0 show as 0 (shown()), 1 and above as 255 (the
-// last step's code, below lowest[256]); without a branch on the value.
-int fastDisplayCode(float v, const CodeThresholds& t) {
-    const float x = v > 0.0f && v != std::numeric_limits<float>::infinity() ? std::min(v, 1.0f) : 0.0f;
-    const int c = t.start[static_cast<int>(x * kDisplayTableSteps)];
-    return c + (x >= t.lowest[c + 1]);
-}
-
-#if CONUS_HAVE_AVX2_COPY
-// fastDisplayCode of eight values at a time: the two tables read by gathers.
-CONUS_TARGET_AVX2 void displayCodesAvx2(const float* in, std::uint8_t* out, std::size_t n, const CodeThresholds& t) {
-    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
-    const __m256 infinity = _mm256_set1_ps(std::numeric_limits<float>::infinity());
-    const __m256 steps = _mm256_set1_ps(float(kDisplayTableSteps));
-    const __m256i byte = _mm256_set1_epi32(0xff), next = _mm256_set1_epi32(1);
-    const int* start = reinterpret_cast<const int*>(t.start.data());
-    std::size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
-        const __m256 v = _mm256_loadu_ps(in + i);
-        // v where 0 < v < infinity (NaN fails both), at most 1 (minps gives 1 for a NaN: masked off).
-        const __m256 shown = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, infinity, _CMP_NEQ_OQ));
-        const __m256 x = _mm256_and_ps(_mm256_min_ps(v, one), shown);
-        const __m256i step = _mm256_cvttps_epi32(_mm256_mul_ps(x, steps));
-        __m256i code = _mm256_and_si256(_mm256_i32gather_epi32(start, step, 1), byte);
-        const __m256 threshold = _mm256_i32gather_ps(t.lowest.data(), _mm256_add_epi32(code, next), 4);
-        code = _mm256_sub_epi32(code, _mm256_castps_si256(_mm256_cmp_ps(x, threshold, _CMP_GE_OQ)));  // +1 where reached
-        const __m128i words = _mm_packus_epi32(_mm256_castsi256_si128(code), _mm256_extracti128_si256(code, 1));
-        _mm_storel_epi64(reinterpret_cast<__m128i*>(out + i), _mm_packus_epi16(words, words));
-    }
-    for (; i < n; ++i) out[i] = std::uint8_t(fastDisplayCode(in[i], t));
-}
-#endif
-
-}  // namespace
-
-void detail::displayCodes(const float* in, std::uint8_t* out, std::size_t n, bool vectors) {
-    const CodeThresholds& t = codeThresholds();
-#if CONUS_HAVE_AVX2_COPY
-    static const bool avx2 = detail::cpuHasAvx2();
-    if (vectors && avx2) return displayCodesAvx2(in, out, n, t);
-#endif
-    for (std::size_t i = 0; i < n; ++i) out[i] = std::uint8_t(fastDisplayCode(in[i], t));
-}
-
-namespace {
 
 // Singular values of a 2x2 matrix (largest first).
 std::pair<double, double> singularValues(double a, double b, double c, double d) {
@@ -256,7 +135,7 @@ FrameErrorModel::FrameErrorModel(const Image& source, const EightBitImage* codes
     std::vector<bool> display(channels, false);
     if (options.space == ErrorSpace::Display)
         for (std::size_t c = 0; c < channels; ++c) display[c] = isColourChannel(source.channels[c]);
-    const std::vector<float>& table = displayTable();
+    const std::vector<float>& table = detail::displayTable();
     std::vector<float> level, next;
     int w = sw, h = sh;
     // 8-bit codes: each channel's shown() of each code's linear value (the same floats as the
@@ -264,10 +143,10 @@ FrameErrorModel::FrameErrorModel(const Image& source, const EightBitImage* codes
     std::vector<std::array<float, 256>> codeShown(codes ? channels : 0);
     for (std::size_t c = 0; c < codeShown.size(); ++c)
         for (int v = 0; v < 256; ++v)
-            codeShown[c][v] = shown((isColourChannel(source.channels[c]) ? srgbCodeToLinear() : codeToUnit())[v], display[c], table);
+            codeShown[c][v] = detail::shown((isColourChannel(source.channels[c]) ? srgbCodeToLinear() : codeToUnit())[v], display[c], table);
     const auto at = [&](int j, int x, int y, std::size_t c) {
         const std::size_t i = (std::size_t(y) * sw + x) * channels + c;
-        return j == 0 ? (codes ? codeShown[c][codes->codes[i]] : shown(source.pixels[i], display[c], table))
+        return j == 0 ? (codes ? codeShown[c][codes->codes[i]] : detail::shown(source.pixels[i], display[c], table))
                       : level[(std::size_t(y) * w + x) * channels + c];
     };
     std::vector<double> energies;
@@ -513,8 +392,7 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
     // codes stays in the core's first cache); the others (alpha as stored, every channel of
     // ErrorSpace::Linear) as the values shown, in double, only where there are such channels.
     const bool others = std::any_of(display.begin(), display.end(), [](char d) { return !d; });
-    const std::vector<float>& table = displayTable();
-    const CodeThresholds& codes = codeThresholds();
+    const std::vector<float>& table = detail::displayTable();
     // The views at the source's size, never whole: the CoNUS image's decoded a row of tiles at a
     // time (the decoder's view of those rows), the uniform image's bilinear resize a row at a time.
     std::optional<detail::ResizedRows> uniformRows;
@@ -542,17 +420,12 @@ std::pair<std::vector<double>, std::vector<double>> FrameErrorModel::shownTileEr
             };
             Shown from = shownRow(true), view = shownRow(true), flat = shownRow(uniform != nullptr);
             const auto onDisplay = [&](const float* in, Shown& out) {
-                std::uint8_t* const to = out.codes.data();
-                if (!others)
-                    detail::displayCodes(in, to, values);
-                else
-                    for (std::size_t i = 0; i < values; i += channels)
-                        for (std::size_t c = 0; c < channels; ++c)
-                            to[i + c] = display[c] ? std::uint8_t(fastDisplayCode(in[i + c], codes)) : 0;
-                if (others)
-                    for (std::size_t i = 0; i < values; i += channels)
-                        for (std::size_t c = 0; c < channels; ++c)
-                            out.others[i + c] = display[c] ? 0.0 : double(shown(in[i + c], false, table));
+                if (!others) return detail::displayCodes(in, out.codes.data(), values);
+                for (std::size_t i = 0; i < values; i += channels)
+                    for (std::size_t c = 0; c < channels; ++c) {
+                        out.codes[i + c] = display[c] ? detail::displayCode(in[i + c]) : 0;
+                        out.others[i + c] = display[c] ? 0.0 : double(detail::shown(in[i + c], false, table));
+                    }
             };
             // Over values i0..i1 of a row: the squared code differences (at most 255^2 a value:
             // a tile's row is far from overflowing), and the other channels'.
