@@ -80,32 +80,31 @@ Progress::~Progress() {
     done();
 }
 
+void Progress::show(const std::string& shown, double fraction) {
+    const int percent = static_cast<int>(fraction * 100.0);
+    if (percent <= m_lastPercent) return;
+    m_lastPercent = percent;
+    std::fprintf(stderr, "\r\033[Kconus %s: %s %3d%%", g_command.c_str(), shown.c_str(), percent);
+    std::fflush(stderr);
+}
+
 ProgressFn Progress::callback() {
     if (quiet() || !m_tty) return {};
     return [this](double fraction) {
-        const int percent = static_cast<int>(fraction * 100.0);
         std::lock_guard lock(g_printMutex);
-        if (percent <= m_lastPercent) return;
-        m_lastPercent = percent;
-        std::fprintf(stderr, "\rconus %s: %s %3d%%", g_command.c_str(), m_label.c_str(), percent);
-        std::fflush(stderr);
+        show(m_label, fraction);
     };
 }
 
 ProgressFn Progress::steps(std::string step) {
     if (quiet() || !m_tty) return {};
     return [this, step = std::move(step)](double fraction) {
-        const int percent = static_cast<int>(fraction * 100.0);
         std::lock_guard lock(g_printMutex);
         if (fraction == 0.0) {
             ++m_step;
             m_lastPercent = -1;
         }
-        if (percent <= m_lastPercent) return;
-        m_lastPercent = percent;
-        std::fprintf(stderr, "\r\033[Kconus %s: %s: %s %d %3d%%", g_command.c_str(), m_label.c_str(), step.c_str(), m_step,
-                     percent);
-        std::fflush(stderr);
+        show(m_label + ": " + step + " " + std::to_string(m_step), fraction);
     };
 }
 

@@ -25,6 +25,10 @@ public:
     void done();
 
 private:
+    // The live line: `shown` and the percentage of `fraction`, where it moved on (the caller holds
+    // the print lock).
+    void show(const std::string& shown, double fraction);
+
     std::string m_label;
     bool m_tty;
     bool m_finished = false;
