@@ -149,42 +149,45 @@ FrameErrorModel::FrameErrorModel(const Image& source, const EightBitImage* codes
         return j == 0 ? (codes ? codeShown[c][codes->codes[i]] : detail::shown(source.pixels[i], display[c], table))
                       : level[(std::size_t(y) * w + x) * channels + c];
     };
-    std::vector<double> energies;
     for (int j = 0; j < m_levels; ++j) {
         const int nw = w / 2, nh = h / 2, cell = 1 << (j + 1);
         next.assign(std::size_t(nw) * nh * channels, 0.0f);
-        // Each cell's energy and mean, rows of cells spread over the threads; then the energies
-        // spread over the tiles in the same order whatever the thread count.
-        energies.assign(std::size_t(nw) * nh, 0.0);
-        parallelRows(nh, 0, [&](int r0, int r1) {
-            for (int y = r0; y < r1; ++y)
-                for (int x = 0; x < nw; ++x) {
-                    double energy = 0;
-                    for (std::size_t c = 0; c < channels; ++c) {
-                        const double v00 = at(j, 2 * x, 2 * y, c), v10 = at(j, 2 * x + 1, 2 * y, c);
-                        const double v01 = at(j, 2 * x, 2 * y + 1, c), v11 = at(j, 2 * x + 1, 2 * y + 1, c);
-                        const double mean = 0.25 * (v00 + v10 + v01 + v11);
-                        energy += 0.25 * ((v00 - mean) * (v00 - mean) + (v10 - mean) * (v10 - mean) + (v01 - mean) * (v01 - mean) +
-                                          (v11 - mean) * (v11 - mean));
-                        next[(std::size_t(y) * nw + x) * channels + c] = static_cast<float>(mean);
+        // Each cell's energy and mean. The rows of tiles are spread over the threads: each walks
+        // the rows of cells its tiles cover, in order, and adds each cell's energy to its own
+        // tiles, so that every tile's sum is made in the same order whatever the thread count. A
+        // row of cells across two threads' tiles is found by both; the one that holds its first
+        // source row stores its means.
+        parallelRows(
+            m_rows, 0,
+            [&](int t0, int t1) {
+                const int first = t0 * m_tile / cell, last = std::min(nh - 1, (t1 * m_tile - 1) / cell);
+                for (int y = first; y <= last; ++y) {
+                    const int y0 = y * cell, y1 = std::min(sh, y0 + cell);
+                    const int ty0 = std::max(t0, y0 / m_tile), ty1 = std::min(t1 - 1, (y1 - 1) / m_tile);
+                    const bool store = y0 / m_tile >= t0;
+                    for (int x = 0; x < nw; ++x) {
+                        double energy = 0;
+                        for (std::size_t c = 0; c < channels; ++c) {
+                            const double v00 = at(j, 2 * x, 2 * y, c), v10 = at(j, 2 * x + 1, 2 * y, c);
+                            const double v01 = at(j, 2 * x, 2 * y + 1, c), v11 = at(j, 2 * x + 1, 2 * y + 1, c);
+                            const double mean = 0.25 * (v00 + v10 + v01 + v11);
+                            energy += 0.25 * ((v00 - mean) * (v00 - mean) + (v10 - mean) * (v10 - mean) + (v01 - mean) * (v01 - mean) +
+                                              (v11 - mean) * (v11 - mean));
+                            if (store) next[(std::size_t(y) * nw + x) * channels + c] = static_cast<float>(mean);
+                        }
+                        energy /= double(channels);
+                        const int x0 = x * cell, x1 = std::min(sw, x0 + cell);
+                        for (int ty = ty0; ty <= ty1; ++ty) {
+                            const int oy = std::min(y1, (ty + 1) * m_tile) - std::max(y0, ty * m_tile);
+                            for (int tx = x0 / m_tile; tx <= (x1 - 1) / m_tile; ++tx) {
+                                const int ox = std::min(x1, (tx + 1) * m_tile) - std::max(x0, tx * m_tile);
+                                m_bands[(std::size_t(ty) * m_columns + tx) * m_levels + j] += energy * double(ox) * double(oy);
+                            }
+                        }
                     }
-                    energies[std::size_t(y) * nw + x] = energy / double(channels);
                 }
-        });
-        for (int y = 0; y < nh; ++y) {
-            const int y0 = y * cell, y1 = std::min(sh, y0 + cell);
-            for (int x = 0; x < nw; ++x) {
-                const double energy = energies[std::size_t(y) * nw + x];
-                const int x0 = x * cell, x1 = std::min(sw, x0 + cell);
-                for (int ty = y0 / m_tile; ty <= (y1 - 1) / m_tile; ++ty) {
-                    const int oy = std::min(y1, (ty + 1) * m_tile) - std::max(y0, ty * m_tile);
-                    for (int tx = x0 / m_tile; tx <= (x1 - 1) / m_tile; ++tx) {
-                        const int ox = std::min(x1, (tx + 1) * m_tile) - std::max(x0, tx * m_tile);
-                        m_bands[(std::size_t(ty) * m_columns + tx) * m_levels + j] += energy * double(ox) * double(oy);
-                    }
-                }
-            }
-        }
+            },
+            1);
         level.swap(next);
         w = nw;
         h = nh;
