@@ -293,7 +293,10 @@ FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus
             precondition[i] = diag[i] > 1e-6f * largest ? 1.0f / ((1.0f + hold[i]) * diag[i]) : 0.0f;
     };
 
-    const std::vector<float> x0 = damped ? x : std::vector<float>{};
+    // The image the damping holds x near, x as it starts: the encode's own, which `conus` keeps
+    // until finish() (a copy of the packed channels where only some are fitted).
+    const std::vector<float> packedX0 = damped && !all ? x : std::vector<float>{};
+    const float* x0 = all ? conus.pixels.data() : packedX0.data();
     std::vector<float> z(values), p(values);
     // r = s - D x with sum |r|^2, and z = D^T r - lambda diag (x - x0) when asked; returns the objective.
     double lastData = 0;  // |s - D x|^2 for the x of the last step recorded
