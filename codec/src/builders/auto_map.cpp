@@ -10,6 +10,7 @@
 #include "conus/codec/image/decode.h"
 #include "conus/codec/image/encode.h"
 #include "conus/core/error.h"
+#include "../image/area_downsample_pvt.h"
 #include "density_cells_pvt.h"
 
 namespace conus::codec {
@@ -284,7 +285,10 @@ SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options)
 
 // importance.h's detail rule, here beside importanceToDensity for the luminance they share.
 namespace {
+// The detail rule reads the luminance area-downsampled to at most this many pixels a side.
+constexpr int kDetailSide = 1024;
 Image detailOfLuminance(const Image& single);
+Image sobelMagnitude(const Image& small);
 }
 
 Image detailImportance(const Image& image) {
@@ -309,24 +313,39 @@ Image detailImportance(const EightBitImage& codes, const float* shownCode) {
     };
     const int r = index("R"), g = index("G"), b = index("B"), y = std::max(0, index("Y"));
     const std::size_t ch = names.size();
-    Image single = makeImage(codes.width, codes.height, {"Y"});
     const float* unit = shownCode ? shownCode : codeToUnit();
-    for (std::size_t p = 0; p < single.pixels.size(); ++p) {
-        const std::uint8_t* px = &codes.codes[p * ch];
-        single.pixels[p] = (r >= 0 && g >= 0 && b >= 0) ? (unit[px[r]] + unit[px[g]] + unit[px[b]]) / 3.0f : unit[px[y]];
+    const auto luminanceRow = [&](int row, float* out) {
+        const std::uint8_t* px = &codes.codes[std::size_t(row) * codes.width * ch];
+        for (int x = 0; x < codes.width; ++x, px += ch)
+            out[x] = (r >= 0 && g >= 0 && b >= 0) ? (unit[px[r]] + unit[px[g]] + unit[px[b]]) / 3.0f : unit[px[y]];
+    };
+    const double scale = std::min(1.0, double(kDetailSide) / std::max(codes.width, codes.height));
+    if (scale < 1) {
+        // Rows of luminance made as the downsample reads them: no picture-sized copy.
+        const int w = std::max(1, static_cast<int>(std::lround(codes.width * scale)));
+        const int h = std::max(1, static_cast<int>(std::lround(codes.height * scale)));
+        Image small = makeImage(w, h, {"Y"});
+        detail::areaDownsampleRows(codes.width, codes.height, 1, luminanceRow, small.pixels.data(), w, h, 0);
+        return sobelMagnitude(small);
     }
-    return detailOfLuminance(single);
+    Image single = makeImage(codes.width, codes.height, {"Y"});
+    for (int row = 0; row < codes.height; ++row) luminanceRow(row, single.pixels.data() + std::size_t(row) * codes.width);
+    return sobelMagnitude(single);
 }
 
 namespace {
-// The detail rule on the picture's luminance: area-downsampled to at most 1024 px a side, its
-// Sobel gradient magnitude.
+// The detail rule on the picture's luminance: area-downsampled to at most kDetailSide px a side,
+// its Sobel gradient magnitude.
 Image detailOfLuminance(const Image& single) {
-    const Image& image = single;
-    const double scale = std::min(1.0, 1024.0 / std::max(image.width, image.height));
-    const int w = std::max(1, static_cast<int>(std::lround(image.width * scale)));
-    const int h = std::max(1, static_cast<int>(std::lround(image.height * scale)));
-    const Image small = scale < 1 ? areaDownsample(single, w, h) : single;
+    const double scale = std::min(1.0, double(kDetailSide) / std::max(single.width, single.height));
+    const int w = std::max(1, static_cast<int>(std::lround(single.width * scale)));
+    const int h = std::max(1, static_cast<int>(std::lround(single.height * scale)));
+    return sobelMagnitude(scale < 1 ? areaDownsample(single, w, h) : single);
+}
+
+// The Sobel gradient magnitude of a one-channel picture (its border clamped).
+Image sobelMagnitude(const Image& small) {
+    const int w = small.width, h = small.height;
     Image detail = makeImage(w, h, {"Y"});
     auto at = [&](int x, int y) { return small.at(std::clamp(x, 0, w - 1), std::clamp(y, 0, h - 1)); };
     for (int y = 0; y < h; ++y)

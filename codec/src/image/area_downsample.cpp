@@ -1,6 +1,7 @@
 // The area-downsample baseline: each output pixel the exact area average of the source pixels it
 // covers (the uniform image's encode, and the encoder's pyramid levels).
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -43,19 +44,19 @@ AxisWeights areaWeights(int source, int target) {
 }
 
 // Vertical pass into a row of source width, then the horizontal pass: each source value is read
-// once per output row it touches and the row buffer stays in cache.
-template <int kC>
-void areaRows(Plane src, float* dst, int dstWidth, int c, const AxisWeights& wx, const AxisWeights& wy, int y0,
-              int y1) {
+// once per output row it touches and the row buffer stays in cache. sourceRow(k): source row k.
+template <int kC, class SourceRow>
+void areaRows(const SourceRow& sourceRow, int srcWidth, float* dst, int dstWidth, int c, const AxisWeights& wx,
+              const AxisWeights& wy, int y0, int y1) {
     const int channels = kC > 0 ? kC : c;
-    const std::size_t rowValues = static_cast<std::size_t>(src.width) * channels;
+    const std::size_t rowValues = static_cast<std::size_t>(srcWidth) * channels;
     std::vector<float> row(rowValues);
     std::vector<float> dynamicAcc(kC > 0 ? 0 : channels);
     for (int y = y0; y < y1; ++y) {
         std::fill(row.begin(), row.end(), 0.0f);
         for (int k = 0; k < wy.count[y]; ++k) {
             const float w = wy.weight[wy.offset[y] + k];
-            const float* s = src.data + (wy.first[y] + k) * rowValues;
+            const float* s = sourceRow(wy.first[y] + k);
             for (std::size_t i = 0; i < rowValues; ++i) row[i] += w * s[i];
         }
         float* out = dst + static_cast<std::size_t>(y) * dstWidth * channels;
@@ -77,8 +78,25 @@ void areaRows(Plane src, float* dst, int dstWidth, int c, const AxisWeights& wx,
 void areaDownsamplePlane(Plane src, float* dst, int width, int height, int channels, int threads) {
     const AxisWeights wx = areaWeights(src.width, width);
     const AxisWeights wy = areaWeights(src.height, height);
+    const std::size_t rowValues = static_cast<std::size_t>(src.width) * channels;
+    const auto sourceRow = [&](int k) { return src.data + k * rowValues; };
     parallelRows(height, threads, [&](int y0, int y1) {
-        detail::dispatchChannels(channels, [&]<int kC>() { areaRows<kC>(src, dst, width, channels, wx, wy, y0, y1); });
+        detail::dispatchChannels(channels, [&]<int kC>() { areaRows<kC>(sourceRow, src.width, dst, width, channels, wx, wy, y0, y1); });
+    });
+}
+
+void areaDownsampleRows(int srcWidth, int srcHeight, int channels, const std::function<void(int, float*)>& fill, float* dst,
+                        int width, int height, int threads) {
+    const AxisWeights wx = areaWeights(srcWidth, width);
+    const AxisWeights wy = areaWeights(srcHeight, height);
+    const std::size_t rowValues = static_cast<std::size_t>(srcWidth) * channels;
+    parallelRows(height, threads, [&](int y0, int y1) {
+        // The source rows these output rows cover (the intervals rise with the row), made once.
+        const int s0 = wy.first[y0], s1 = wy.first[y1 - 1] + wy.count[y1 - 1];
+        std::vector<float> band(static_cast<std::size_t>(std::max(0, s1 - s0)) * rowValues);
+        for (int k = s0; k < s1; ++k) fill(k, band.data() + (k - s0) * rowValues);
+        const auto sourceRow = [&](int k) { return band.data() + (k - s0) * rowValues; };
+        detail::dispatchChannels(channels, [&]<int kC>() { areaRows<kC>(sourceRow, srcWidth, dst, width, channels, wx, wy, y0, y1); });
     });
 }
 

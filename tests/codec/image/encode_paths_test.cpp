@@ -2,6 +2,7 @@
 // a picture kept as 8-bit codes against the linear picture it stands for (image, budget, detail).
 #include "conus/codec/image/encode.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
@@ -108,6 +109,23 @@ TEST(EncodeEightBit, EqualsTheEncodeOfTheLinearPicture) {
                 EXPECT_LT(lo, 0.1f);
                 EXPECT_GT(hi, 0.5f);
             }
+    }
+}
+
+// A picture wider than the detail rule reads (1024 px) is area-downsampled first; from codes its
+// rows of luminance are made as the downsample reads them, and the detail is still that of the
+// display picture bit for bit (a scale that is not a whole number, so rows are shared).
+TEST(EncodeEightBit, DetailOfAPictureLargerThanItsDownsampleIsTheDisplayPictures) {
+    for (const std::vector<std::string>& channels : {std::vector<std::string>{"R", "G", "B"}, std::vector<std::string>{"Y"}}) {
+        const EightBitImage codes = eightBitPicture(1500, 701, channels, 5u);
+        Image display = makeImage(codes.width, codes.height, codes.channels);
+        for (std::size_t i = 0; i < codes.codes.size(); ++i) display.pixels[i] = codeToUnit()[codes.codes[i]];
+        const Image detail = detailImportance(codes);
+        const Image detailOfDisplay = detailImportance(display);
+        EXPECT_EQ(detail.width, 1024);
+        ASSERT_EQ(detail.pixels.size(), detailOfDisplay.pixels.size());
+        EXPECT_EQ(maxAbsDifference(detail, detailOfDisplay), 0.0f);
+        EXPECT_GT(*std::max_element(detail.pixels.begin(), detail.pixels.end()), 0.1f);  // not a flat picture
     }
 }
 
