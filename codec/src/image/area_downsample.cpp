@@ -91,12 +91,18 @@ void areaDownsampleRows(int srcWidth, int srcHeight, int channels, const std::fu
     const AxisWeights wy = areaWeights(srcHeight, height);
     const std::size_t rowValues = static_cast<std::size_t>(srcWidth) * channels;
     parallelRows(height, threads, [&](int y0, int y1) {
-        // The source rows these output rows cover (the intervals rise with the row), made once.
-        const int s0 = wy.first[y0], s1 = wy.first[y1 - 1] + wy.count[y1 - 1];
-        std::vector<float> band(static_cast<std::size_t>(std::max(0, s1 - s0)) * rowValues);
-        for (int k = s0; k < s1; ++k) fill(k, band.data() + (k - s0) * rowValues);
-        const auto sourceRow = [&](int k) { return band.data() + (k - s0) * rowValues; };
-        detail::dispatchChannels(channels, [&]<int kC>() { areaRows<kC>(sourceRow, srcWidth, dst, width, channels, wx, wy, y0, y1); });
+        // A few output rows at a time (one thread may be handed all of them), and the source rows
+        // they cover (the intervals rise with the row) made once for them.
+        constexpr int kOutputRows = 8;
+        std::vector<float> band;
+        for (int a = y0; a < y1; a += kOutputRows) {
+            const int b = std::min(y1, a + kOutputRows);
+            const int s0 = wy.first[a], s1 = wy.first[b - 1] + wy.count[b - 1];
+            band.resize(static_cast<std::size_t>(std::max(0, s1 - s0)) * rowValues);
+            for (int k = s0; k < s1; ++k) fill(k, band.data() + (k - s0) * rowValues);
+            const auto sourceRow = [&](int k) { return band.data() + (k - s0) * rowValues; };
+            detail::dispatchChannels(channels, [&]<int kC>() { areaRows<kC>(sourceRow, srcWidth, dst, width, channels, wx, wy, a, b); });
+        }
     });
 }
 

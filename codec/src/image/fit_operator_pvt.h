@@ -19,13 +19,13 @@ inline namespace fit_operator {
 
 // Output rows per block when the reach of the bands is measured; bands are runs of blocks.
 constexpr int kBlockRows = 8;
-// Bands: as many whatever the thread count, so that the sums come out the same (enough for 16
+// Bands: as many whatever the thread count, so that the sums come out the same (32: enough for 16
 // threads to balance uneven rows), halved while their buffers would exceed this many CoNUS images
 // in all. A band's buffers span every CoNUS row its source rows reach, and where the map bends
 // (a focus) the bands' reaches overlap: on codec_bench's two-focus map 32 bands buffered 3.6
-// images (120 MiB for the normal equations of a 1024x1024 RGB image), and zeroing, faulting in
-// and summing those cost about a quarter of the fit (bench/notes/2026-12-08-fit-buffers.md);
-// 8 bands buffer 1.7.
+// images (about 115 MiB for the normal equations of a 1024x1024 RGB image), zeroed, faulted in
+// and summed on every fit; 8 bands there buffer 1.7 and take a quarter off the fit's CPU, at the
+// price of using at most 8 threads on such a map (bench/notes/2026-12-08-fit-buffers.md).
 constexpr int kBands = 32;
 constexpr int kMaxBufferImages = 2;
 

@@ -104,8 +104,9 @@ struct FitResult {
 };
 
 // Fits `conus` (in place; the encode of `source` through `map`, same channels in the same order)
-// to the decoder's view at source.width x source.height. Throws conus::Error(InvalidArgument)
-// when the channels differ or options are out of range.
+// to the decoder's view at source.width x source.height. `conus` is read as the fit's starting
+// point until the call returns (options.progress must not change it). Throws
+// conus::Error(InvalidArgument) when the channels differ or options are out of range.
 FitResult fitToDecoder(const Image& source, const SamplingMap& map, Image& conus, const FitOptions& options = {});
 
 }  // namespace conus::codec
