@@ -287,6 +287,17 @@ SamplingMap buildAutoMap(const Image& importance, const AutoMapOptions& options)
 namespace {
 // The detail rule reads the luminance area-downsampled to at most this many pixels a side.
 constexpr int kDetailSide = 1024;
+// The size the detail rule reads a width x height picture's luminance at; `shrinks` where that
+// is an area downsample of it.
+struct DetailSize {
+    int width, height;
+    bool shrinks;
+};
+DetailSize detailSize(int width, int height) {
+    const double scale = std::min(1.0, double(kDetailSide) / std::max(width, height));
+    return {std::max(1, static_cast<int>(std::lround(width * scale))), std::max(1, static_cast<int>(std::lround(height * scale))),
+            scale < 1};
+}
 Image detailOfLuminance(const Image& single);
 Image sobelMagnitude(const Image& small);
 }
@@ -319,13 +330,11 @@ Image detailImportance(const EightBitImage& codes, const float* shownCode) {
         for (int x = 0; x < codes.width; ++x, px += ch)
             out[x] = (r >= 0 && g >= 0 && b >= 0) ? (unit[px[r]] + unit[px[g]] + unit[px[b]]) / 3.0f : unit[px[y]];
     };
-    const double scale = std::min(1.0, double(kDetailSide) / std::max(codes.width, codes.height));
-    if (scale < 1) {
+    const DetailSize size = detailSize(codes.width, codes.height);
+    if (size.shrinks) {
         // Rows of luminance made as the downsample reads them: no picture-sized copy.
-        const int w = std::max(1, static_cast<int>(std::lround(codes.width * scale)));
-        const int h = std::max(1, static_cast<int>(std::lround(codes.height * scale)));
-        Image small = makeImage(w, h, {"Y"});
-        detail::areaDownsampleRows(codes.width, codes.height, 1, luminanceRow, small.pixels.data(), w, h, 0);
+        Image small = makeImage(size.width, size.height, {"Y"});
+        detail::areaDownsampleRows(codes.width, codes.height, 1, luminanceRow, small.pixels.data(), size.width, size.height, 0);
         return sobelMagnitude(small);
     }
     Image single = makeImage(codes.width, codes.height, {"Y"});
@@ -337,10 +346,8 @@ namespace {
 // The detail rule on the picture's luminance: area-downsampled to at most kDetailSide px a side,
 // its Sobel gradient magnitude.
 Image detailOfLuminance(const Image& single) {
-    const double scale = std::min(1.0, double(kDetailSide) / std::max(single.width, single.height));
-    const int w = std::max(1, static_cast<int>(std::lround(single.width * scale)));
-    const int h = std::max(1, static_cast<int>(std::lround(single.height * scale)));
-    return sobelMagnitude(scale < 1 ? areaDownsample(single, w, h) : single);
+    const DetailSize size = detailSize(single.width, single.height);
+    return sobelMagnitude(size.shrinks ? areaDownsample(single, size.width, size.height) : single);
 }
 
 // The Sobel gradient magnitude of a one-channel picture (its border clamped).
