@@ -86,7 +86,7 @@ struct FrameModelOptions {
     // Where set, each confirmed() reports through it from 0 (called as it starts, on its caller's
     // thread) to 1 over its encode, fit and measure (from worker threads too): a caller's progress
     // bar over a budget counts the confirming encodes by their 0.
-    ProgressFn confirmProgress;
+    ProgressFn confirmProgress{};
 };
 
 // How near (in the exponent t of k^t) the map chosen on a confirmed model must be to the map that
